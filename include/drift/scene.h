@@ -1,0 +1,298 @@
+// drift scene: the scene as plain data (camera, meshes, materials, lights, textures,
+// environment), plus the shading math every renderer shares: camera rays, BSDF
+// evaluation and sampling, light sampling and surface reconstruction from a hit.
+//
+// Data refers to data by index (DRIFT_INVALID_INDEX for none). The scene owns every array
+// in it; add_* functions copy what they are given. Positions are in world space (loaders
+// apply transforms) and padded by one float so Embree can share them without copies.
+//
+// STEP BY STEP
+//   drift_scene *scene = NULL;
+//   drift_scene_create(ctx, &scene);
+//   uint32_t white;  drift_scene_add_material(scene, &(drift_material){ .diffuse = {.8f,.8f,.8f} }, &white);
+//   drift_scene_add_mesh(scene, &(drift_mesh_desc){ .positions = p, .vertex_count = 4,
+//                        .indices = idx, .triangle_count = 2, .material = white }, NULL);
+//   drift_scene_add_light(scene, &(drift_light){ .type = DRIFT_LIGHT_SPHERE, ... }, NULL);
+//   scene->camera = drift_camera_look_at(eye, target, up, fov_y, width, height);
+//   if (drift_scene_commit(scene) != DRIFT_OK) { ... }   // validates, builds light tables
+//   ... render ...
+//   drift_scene_destroy(scene);
+//
+// Units: scene units are whatever the file uses (the Cornell box is in millimetres);
+// angles are radians. Threads: a committed scene is immutable and every const function
+// here is thread-safe on it; add_* and commit are not.
+//
+// Material model (docs/materials.md): Lambertian diffuse plus a normalized modified-Phong
+// glossy lobe (Lafortune & Willems 1994), f = kd/pi + ks (n+2)/(2 pi) cos^n(alpha), alpha
+// the angle between wi and the mirror direction of wo. With kd + ks <= 1 per channel it
+// conserves energy (commit rescales materials that exceed it and warns). A mirror material
+// reflects ks along the mirror direction exactly.
+#ifndef DRIFT_SCENE_H
+#define DRIFT_SCENE_H
+
+#include "drift/core.h"
+#include "drift/image.h"
+#include "drift/math.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define DRIFT_INVALID_INDEX UINT32_MAX
+// Limits the loaders and commit enforce ("absurd sizes").
+#define DRIFT_SCENE_MAX_TRIANGLES (1u << 28)
+#define DRIFT_SCENE_MAX_VERTICES (1u << 28)
+#define DRIFT_SCENE_MAX_LIGHTS (1u << 24)
+#define DRIFT_NAME_MAX 64
+
+// --- CAMERA ---
+
+// Thin-lens camera; aperture_radius 0 is a pinhole. Looks from position toward target.
+typedef struct drift_camera {
+    drift_vec3 position;
+    drift_vec3 target;
+    drift_vec3 up;
+    float fov_y;           // full vertical field of view, radians
+    float aperture_radius; // lens radius in scene units; 0 = pinhole
+    float focus_distance;  // distance to the plane in focus; 0 = |target - position|
+    int32_t width, height; // default image size in pixels
+} drift_camera;
+
+drift_camera drift_camera_look_at(drift_vec3 position, drift_vec3 target, drift_vec3 up,
+                                  float fov_y, int32_t width, int32_t height);
+
+// The ray through film point (film_x, film_y) in pixels (top-left origin; pixel centres at
+// +0.5) for an image of width x height, with lens sample `lens` in [0,1)^2 (ignored for a
+// pinhole). The direction is unit length.
+drift_ray drift_camera_ray(const drift_camera *camera, int32_t width, int32_t height, float film_x,
+                           float film_y, drift_vec2 lens);
+
+// --- MATERIALS ---
+
+typedef enum drift_material_type {
+    DRIFT_MATERIAL_DEFAULT = 0, // diffuse + glossy (either may be zero)
+    DRIFT_MATERIAL_MIRROR,      // perfect specular reflection with reflectance `specular`
+    DRIFT_MATERIAL_COUNT
+} drift_material_type;
+
+typedef struct drift_material {
+    char name[DRIFT_NAME_MAX];
+    drift_material_type type;
+    drift_vec3 diffuse;       // Lambertian albedo kd
+    drift_vec3 specular;      // glossy or mirror reflectance ks
+    float exponent;           // Phong exponent n of the glossy lobe (> 0 when specular > 0)
+    drift_vec3 emission;      // emitted radiance from the front face (0 = not emissive)
+    uint32_t diffuse_texture; // texture index modulating `diffuse`, or DRIFT_INVALID_INDEX
+} drift_material;
+
+// A material with no texture: the value to start from when filling one in.
+drift_material drift_material_make(drift_vec3 diffuse);
+
+// --- LIGHTS ---
+
+typedef enum drift_light_type {
+    DRIFT_LIGHT_POINT = 0,   // position, color = intensity (W/sr in scene units)
+    DRIFT_LIGHT_SPOT,        // position, direction, inner/outer half angles
+    DRIFT_LIGHT_DIRECTIONAL, // direction (the way light travels), color = irradiance
+    DRIFT_LIGHT_QUAD,        // position = corner, edge_u, edge_v; emits along cross(u, v)
+    DRIFT_LIGHT_DISK,        // position = centre, direction = normal it emits along, radius
+    DRIFT_LIGHT_SPHERE,      // position = centre, radius; emits outward
+    DRIFT_LIGHT_TRIANGLE,    // an emissive mesh triangle (made by commit from materials)
+    DRIFT_LIGHT_COUNT
+} drift_light_type;
+
+typedef struct drift_light {
+    drift_light_type type;
+    drift_vec3 color; // intensity, irradiance or radiance by type (see above)
+    drift_vec3 position;
+    drift_vec3 direction;
+    drift_vec3 edge_u, edge_v;
+    float radius;
+    float spot_inner, spot_outer; // half angles, radians
+    uint32_t mesh, triangle;      // DRIFT_LIGHT_TRIANGLE only
+} drift_light;
+
+// True for lights with area (they are geometry: rays can hit them).
+bool drift_light_is_area(drift_light_type type);
+
+// --- MESHES ---
+
+typedef struct drift_mesh {
+    char name[DRIFT_NAME_MAX];
+    float *positions;   // 3 floats a vertex, plus 1 padding float at the end
+    float *normals;     // 3 floats a vertex (unit), or NULL for flat shading
+    float *uvs;         // 2 floats a vertex, or NULL
+    uint32_t *indices;  // 3 a triangle
+    uint32_t vertex_count;
+    uint32_t triangle_count;
+    uint32_t material;
+    uint32_t first_light; // light index of triangle 0 when emissive (set by commit), else invalid
+} drift_mesh;
+
+// Input for drift_scene_add_mesh; arrays are copied. normals and uvs are optional.
+typedef struct drift_mesh_desc {
+    const char *name;
+    const float *positions;
+    const float *normals;
+    const float *uvs;
+    const uint32_t *indices;
+    uint32_t vertex_count;
+    uint32_t triangle_count;
+    uint32_t material;
+} drift_mesh_desc;
+
+// --- ENVIRONMENT ---
+
+// Radiance arriving from infinitely far away: `color`, times the lat-long texture if set.
+// Lat-long layout: u = phi / (2 pi) with phi measured from +x toward -z... see
+// docs/conventions.md; v = theta / pi from +y (up).
+typedef struct drift_environment {
+    drift_vec3 color;
+    uint32_t texture; // DRIFT_INVALID_INDEX for a constant environment
+} drift_environment;
+
+// --- SCENE ---
+
+typedef struct drift_light_table drift_light_table; // private: light sampling distributions
+
+typedef struct drift_scene {
+    drift_context *ctx;
+    drift_camera camera;
+    drift_environment environment;
+    drift_mesh *meshes;
+    uint32_t mesh_count;
+    drift_material *materials;
+    uint32_t material_count;
+    drift_light *lights;
+    uint32_t light_count;
+    drift_image *textures; // linear RGB(A); owned
+    uint32_t texture_count;
+    drift_bounds3 bounds;  // of all geometry, set by commit
+    drift_light_table *light_table; // set by commit
+    bool committed;
+} drift_scene;
+
+drift_result drift_scene_create(drift_context *ctx, drift_scene **out_scene);
+void drift_scene_destroy(drift_scene *scene); // NULL-safe
+
+// Copies the mesh in. Errors: DRIFT_ERR_INVALID_ARGUMENT (index out of range, non-finite
+// vertex, sizes over the limits), DRIFT_ERR_OUT_OF_MEMORY. Degenerate (zero-area) triangles
+// are dropped with a warning; a mesh left empty is an error.
+drift_result drift_scene_add_mesh(drift_scene *scene, const drift_mesh_desc *desc,
+                                  uint32_t *out_index);
+drift_result drift_scene_add_material(drift_scene *scene, const drift_material *material,
+                                      uint32_t *out_index);
+// Errors: DRIFT_ERR_INVALID_ARGUMENT for zero-area area lights, non-finite or negative
+// values, zero directions.
+drift_result drift_scene_add_light(drift_scene *scene, const drift_light *light,
+                                   uint32_t *out_index);
+// Takes ownership of `image` (its pixels are freed with the scene).
+drift_result drift_scene_add_texture(drift_scene *scene, drift_image image, uint32_t *out_index);
+
+// Validates every reference, computes bounds, adds one DRIFT_LIGHT_TRIANGLE light per
+// emissive mesh triangle and builds the power-proportional light distribution.
+// Idempotent: a second call rebuilds. Errors: DRIFT_ERR_INVALID_ARGUMENT with a logged reason.
+drift_result drift_scene_commit(drift_scene *scene);
+
+// Triangle, material, light and texture counts.
+uint64_t drift_scene_triangle_count(const drift_scene *scene);
+
+// --- SURFACES ---
+
+// What the accel reports about a hit: which geometry, which primitive, where.
+typedef struct drift_hit {
+    float t;
+    float u, v;       // barycentrics of vertices 1 and 2 (triangles); unused otherwise
+    uint32_t mesh;    // mesh index, or DRIFT_INVALID_INDEX when an area light's shape was hit
+    uint32_t prim;    // triangle index within the mesh
+    uint32_t light;   // area light index (shape hit, or emissive mesh triangle), else invalid
+    drift_vec3 ng;    // geometric normal, unnormalized, as the accel computed it
+} drift_hit;
+
+// Everything shading needs at a hit point.
+typedef struct drift_surface {
+    drift_vec3 position;
+    drift_vec3 ng;       // unit geometric normal, flipped to face the incoming ray
+    drift_vec3 ns;       // unit shading normal, on the same side as ng
+    drift_vec2 uv;
+    uint32_t material;   // DRIFT_INVALID_INDEX for light shapes (pure emitters)
+    uint32_t light;      // area light at this point, or DRIFT_INVALID_INDEX
+    drift_vec3 emission; // radiance emitted toward the incoming ray's origin
+    bool front_face;     // the ray hit the side the geometric normal points to
+} drift_surface;
+
+drift_surface drift_scene_surface(const drift_scene *scene, const drift_ray *ray,
+                                  const drift_hit *hit);
+
+// Ray origin offset along the geometric normal toward `dir`, scaled to the position's
+// magnitude, so secondary rays do not re-hit their own surface.
+drift_vec3 drift_offset_origin(drift_vec3 position, drift_vec3 ng, drift_vec3 dir);
+
+// --- BSDF ---
+
+// Resolved material at one point (textures applied). All directions in world space.
+typedef struct drift_bsdf {
+    drift_material_type type;
+    drift_vec3 diffuse, specular;
+    float exponent;
+    drift_frame frame; // z = shading normal
+} drift_bsdf;
+
+drift_bsdf drift_bsdf_make(const drift_scene *scene, const drift_surface *surface);
+// f(wo, wi) (without the cosine). Zero for mirrors (a delta lobe).
+drift_vec3 drift_bsdf_eval(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec3 wi);
+// Solid-angle pdf of sampling wi given wo. Zero for mirrors.
+float drift_bsdf_pdf(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec3 wi);
+
+typedef struct drift_bsdf_sample {
+    drift_vec3 wi;
+    drift_vec3 weight; // f * cos / pdf (for mirrors: ks)
+    float pdf;         // solid-angle pdf; 0 on failure
+    bool is_delta;     // sampled from a delta lobe (mirror): skip MIS and NEE there
+} drift_bsdf_sample;
+
+// Samples wi. u_lobe picks the lobe, u the direction. pdf == 0 means no sample.
+drift_bsdf_sample drift_bsdf_sample_wi(const drift_bsdf *bsdf, drift_vec3 wo, float u_lobe,
+                                       drift_vec2 u);
+bool drift_bsdf_is_delta(const drift_bsdf *bsdf);
+
+// --- LIGHT SAMPLING ---
+
+typedef struct drift_light_sample {
+    drift_vec3 wi;        // unit direction from the reference point toward the light
+    float distance;       // to the sampled point; INFINITY for directional/environment
+    drift_vec3 radiance;  // L arriving along -wi (intensity / d^2 for point lights)
+    float pdf;            // solid-angle pdf of this light's sampling (times nothing else);
+                          // for delta lights the pdf is 1 and is_delta is set
+    bool is_delta;
+    drift_vec3 point;     // the sampled point on the light (for shadow rays)
+    drift_vec3 light_normal;
+} drift_light_sample;
+
+// Picks a light in proportion to its power. Returns DRIFT_INVALID_INDEX when the scene has
+// no lights; out_pmf gets the probability of the pick.
+uint32_t drift_scene_pick_light(const drift_scene *scene, float u, float *out_pmf);
+// Probability with which pick_light returns `light`.
+float drift_scene_light_pmf(const drift_scene *scene, uint32_t light);
+// Samples a point on light `light` as seen from `ref` (with normal `ref_n`, or zero vector
+// for a point in a medium). pdf == 0 means no contribution.
+drift_light_sample drift_light_sample_li(const drift_scene *scene, uint32_t light, drift_vec3 ref,
+                                         drift_vec2 u);
+// Solid-angle pdf with which drift_light_sample_li would pick direction wi toward the point
+// `point` with normal `light_normal` on area light `light`, from `ref`.
+float drift_light_pdf_li(const drift_scene *scene, uint32_t light, drift_vec3 ref, drift_vec3 wi,
+                         float distance, drift_vec3 light_normal);
+
+// Environment: radiance along direction dir (dir points away from the scene), and its
+// sampling (importance-sampled by luminance when textured, uniform sphere otherwise).
+bool drift_scene_has_environment(const drift_scene *scene);
+drift_vec3 drift_environment_eval(const drift_scene *scene, drift_vec3 dir);
+drift_light_sample drift_environment_sample(const drift_scene *scene, drift_vec2 u);
+float drift_environment_pdf(const drift_scene *scene, drift_vec3 dir);
+// Probability of choosing the environment rather than a scene light for NEE.
+float drift_scene_environment_pmf(const drift_scene *scene);
+
+#ifdef __cplusplus
+}
+#endif
+#endif // DRIFT_SCENE_H

@@ -1,0 +1,90 @@
+#include "drift/image.h"
+
+#include <math.h>
+#include <string.h>
+
+drift_result drift_image_create(drift_context *ctx, int32_t width, int32_t height,
+                                int32_t channels, drift_image *out_image)
+{
+    if (!out_image) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    *out_image = (drift_image){ 0 };
+    if (width <= 0 || height <= 0 || width > DRIFT_IMAGE_MAX_DIMENSION ||
+        height > DRIFT_IMAGE_MAX_DIMENSION || channels < 1 || channels > 4) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    size_t count, bytes;
+    if (!drift_size_mul((size_t)width * (size_t)height, (size_t)channels, &count) ||
+        !drift_size_mul(count, sizeof(float), &bytes)) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    float *pixels = drift_alloc(ctx, bytes);
+    if (!pixels) {
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    *out_image = (drift_image){ .pixels = pixels,
+                                .width = width,
+                                .height = height,
+                                .channels = channels,
+                                .stride = (ptrdiff_t)width * channels };
+    return DRIFT_OK;
+}
+
+void drift_image_destroy(drift_context *ctx, drift_image *image)
+{
+    if (!image) {
+        return;
+    }
+    drift_free(ctx, image->pixels);
+    *image = (drift_image){ 0 };
+}
+
+drift_image drift_image_view(const drift_image *image, int32_t x, int32_t y, int32_t width,
+                             int32_t height)
+{
+    DRIFT_ASSERT(x >= 0 && y >= 0 && x + width <= image->width && y + height <= image->height);
+    return (drift_image){ .pixels = drift_image_pixel(image, x, y),
+                          .width = width,
+                          .height = height,
+                          .channels = image->channels,
+                          .stride = image->stride };
+}
+
+float drift_srgb_to_linear(float v)
+{
+    return v <= 0.04045f ? v / 12.92f : powf((v + 0.055f) / 1.055f, 2.4f);
+}
+
+float drift_linear_to_srgb(float v)
+{
+    return v <= 0.0031308f ? 12.92f * v : 1.055f * powf(v, 1.0f / 2.4f) - 0.055f;
+}
+
+float drift_tonemap_value(float linear, const drift_tonemap_params *params)
+{
+    drift_tonemap_params p = params ? *params : (drift_tonemap_params){ 0 };
+    float x = linear * exp2f(p.exposure_stops);
+    if (!(x > 0.0f)) { // also maps NaN to black
+        return 0.0f;
+    }
+    if (p.op == DRIFT_TONEMAP_REINHARD) {
+        x = x / (1.0f + x);
+    }
+    return drift_linear_to_srgb(fminf(x, 1.0f));
+}
+
+void drift_image_tonemap(const drift_image *image, const drift_tonemap_params *params,
+                         uint8_t *out_rgb8)
+{
+    for (int32_t y = 0; y < image->height; ++y) {
+        for (int32_t x = 0; x < image->width; ++x) {
+            const float *p = drift_image_pixel(image, x, y);
+            uint8_t *o = out_rgb8 + ((size_t)y * (size_t)image->width + (size_t)x) * 3;
+            for (int c = 0; c < 3; ++c) {
+                float v = image->channels >= 3 ? p[c] : p[0];
+                o[c] = (uint8_t)lrintf(drift_tonemap_value(v, params) * 255.0f);
+            }
+        }
+    }
+}

@@ -1,0 +1,40 @@
+// Test support: cmocka includes in the right order, a capture logger, paths, and helpers
+// shared by the unit tests.
+#ifndef DRIFT_TEST_H
+#define DRIFT_TEST_H
+
+// cmocka needs these before its header.
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include "drift/core.h"
+
+// Remembers the codes and levels of messages so tests can assert on codes, not text.
+typedef struct test_log_capture {
+    int count;
+    int warnings;
+    int errors;
+    drift_result last_code;
+    char last_message[512];
+} test_log_capture;
+
+drift_logger test_capture_logger(test_log_capture *capture);
+
+// A context with `threads` threads and the capture logger (capture may be NULL: silent).
+drift_context *test_context(int threads, test_log_capture *capture);
+
+// Path of a file under the repository root / under ../shared (NULL-free; static buffer per call
+// site is not used: writes into out, which must hold 1024 bytes).
+const char *test_repo_path(char *out, const char *relative);
+const char *test_shared_path(char *out, const char *relative);
+// Directory for test outputs (created on demand): build/test-out.
+const char *test_out_path(char *out, const char *name);
+
+// DRIFT_TEST_INTENSITY (default 1) scales sample counts in statistical tests.
+double test_intensity(void);
+
+#endif

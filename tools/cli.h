@@ -1,0 +1,34 @@
+// Shared pieces of the drift command-line tool: subcommand entry points, option parsing
+// helpers that reject malformed numbers, and a logger that prints to stderr.
+#ifndef DRIFT_TOOLS_CLI_H
+#define DRIFT_TOOLS_CLI_H
+
+#include "drift/core.h"
+
+#include <stdbool.h>
+#include <stdint.h>
+
+// Subcommands. Each takes the arguments after its own name (argv[0] is the subcommand) and
+// returns the process exit status: 0 success, 1 failure, 2 usage error.
+int drift_cmd_render(int argc, char **argv);
+int drift_cmd_diff(int argc, char **argv);
+int drift_cmd_info(int argc, char **argv);
+int drift_cmd_bench(int argc, char **argv);
+
+// Option values: print "drift <cmd>: <flag> expects ..." and return false when malformed or
+// out of [lo, hi].
+bool cli_parse_int(const char *cmd, const char *flag, const char *text, long lo, long hi,
+                   long *out);
+bool cli_parse_float(const char *cmd, const char *flag, const char *text, double lo, double hi,
+                     double *out);
+// Returns argv[*i + 1] and advances *i, or prints a usage error and returns NULL.
+const char *cli_next_value(const char *cmd, int argc, char **argv, int *i);
+
+// A logger that prints warnings and errors (and info with verbose) as
+// "drift: FILE:LINE: level: message" on stderr.
+drift_logger cli_stderr_logger(bool verbose);
+
+// Directory of the built-in default scene (the repository's scenes/ folder).
+const char *cli_default_scene_path(void);
+
+#endif

@@ -1,0 +1,79 @@
+#include "cli.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+bool cli_parse_int(const char *cmd, const char *flag, const char *text, long lo, long hi,
+                   long *out)
+{
+    char *end = NULL;
+    errno = 0;
+    long v = strtol(text, &end, 10);
+    if (errno != 0 || end == text || *end != '\0' || v < lo || v > hi) {
+        fprintf(stderr, "drift %s: %s expects an integer in [%ld, %ld], got '%s'\n", cmd, flag, lo,
+                hi, text);
+        return false;
+    }
+    *out = v;
+    return true;
+}
+
+bool cli_parse_float(const char *cmd, const char *flag, const char *text, double lo, double hi,
+                     double *out)
+{
+    char *end = NULL;
+    errno = 0;
+    double v = strtod(text, &end);
+    if (errno != 0 || end == text || *end != '\0' || !isfinite(v) || v < lo || v > hi) {
+        fprintf(stderr, "drift %s: %s expects a number in [%g, %g], got '%s'\n", cmd, flag, lo, hi,
+                text);
+        return false;
+    }
+    *out = v;
+    return true;
+}
+
+const char *cli_next_value(const char *cmd, int argc, char **argv, int *i)
+{
+    if (*i + 1 >= argc) {
+        fprintf(stderr, "drift %s: %s needs a value (see drift %s --help)\n", cmd, argv[*i], cmd);
+        return NULL;
+    }
+    *i += 1;
+    return argv[*i];
+}
+
+static void stderr_log(drift_log_level level, drift_result code, const char *file, int line,
+                       const char *message, void *user)
+{
+    bool verbose = user != NULL;
+    if (level < DRIFT_LOG_WARNING && !verbose) {
+        return;
+    }
+    static const char *const names[] = { "info", "debug", "info", "warning", "error" };
+    const char *name = level < DRIFT_LOG_COUNT ? names[level] : "log";
+    (void)code;
+    if (file && line > 0) {
+        fprintf(stderr, "drift: %s:%d: %s: %s\n", file, line, name, message);
+    } else if (file) {
+        fprintf(stderr, "drift: %s: %s: %s\n", file, name, message);
+    } else {
+        fprintf(stderr, "drift: %s: %s\n", name, message);
+    }
+}
+
+drift_logger cli_stderr_logger(bool verbose)
+{
+    // The user pointer only carries the verbose flag; any non-NULL value means verbose.
+    static int verbose_marker;
+    return (drift_logger){ .func = stderr_log, .user = verbose ? &verbose_marker : NULL };
+}
+
+const char *cli_default_scene_path(void)
+{
+    const char *env = getenv("DRIFT_DEFAULT_SCENE");
+    return env && *env ? env : DRIFT_SOURCE_DIR "/scenes/cornell-box/cornell_box.json";
+}
