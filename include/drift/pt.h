@@ -1,0 +1,101 @@
+// drift pt: the reference path tracer, the ground truth every technique is measured against.
+//
+// Unidirectional path tracing with next-event estimation and multiple importance sampling
+// (power heuristic) for every light type and the environment (Veach 1997, ch. 9), thin-lens
+// depth of field, glossy and mirror reflection, Russian roulette. Every random number comes
+// from drift_sampler keyed on (seed, pixel, sample), and each pixel accumulates its samples
+// in order, so the image is bit-identical for any thread count.
+//
+// Rendering is progressive: each call to drift_pt_render_samples adds samples to every
+// pixel; the image can be read between calls (checkpoints, progress, viewers).
+//
+// STEP BY STEP
+//   drift_pt *pt = NULL;
+//   drift_pt_create(ctx, scene, accel, &(drift_pt_params){ .seed = 7 }, &pt);
+//   while (drift_pt_sample_count(pt) < 256) {
+//       drift_pt_render_samples(pt, 16, &cancel_flag);     // DRIFT_ERR_CANCELLED on Ctrl-C
+//   }
+//   drift_image beauty;  drift_pt_resolve(pt, DRIFT_PT_AOV_BEAUTY, &beauty);  // owned by pt
+//   drift_pt_destroy(pt);
+//
+// Ownership: scene and accel are borrowed and must outlive the pt. Images returned by
+// drift_pt_resolve belong to the pt and stay valid until the next render call or destroy.
+// Threads: one pt is driven from one thread; it uses the context's pool internally.
+#ifndef DRIFT_PT_H
+#define DRIFT_PT_H
+
+#include "drift/accel.h"
+#include "drift/core.h"
+#include "drift/image.h"
+#include "drift/scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+// How to render. The default configuration is:
+//   width, height = 0 -> the scene camera's size
+//   seed          = 0 (a valid seed)
+//   max_depth     = 0 -> 8. Depth counts scattering vertices as in pbrt: 1 = direct light only
+//                   (camera -> surface -> light). Emitters seen directly are always included.
+//   rr_depth      = 0 -> 3: Russian roulette starts after this many bounces
+//   disable_mis   = false: with true, NEE handles all non-delta light (BSDF hits on emitters
+//                   are ignored except after delta bounces); for tests and comparisons
+//   disable_nee   = false: with true, only BSDF sampling finds lights (pure path tracing)
+//   disable_rr    = false
+typedef struct drift_pt_params {
+    int32_t width, height;
+    uint32_t seed;
+    int32_t max_depth;
+    int32_t rr_depth;
+    bool disable_mis;
+    bool disable_nee;
+    bool disable_rr;
+} drift_pt_params;
+
+drift_pt_params drift_pt_params_resolve(const drift_pt_params *params, const drift_scene *scene);
+
+typedef enum drift_pt_aov {
+    DRIFT_PT_AOV_BEAUTY = 0, // radiance, RGB
+    DRIFT_PT_AOV_ALBEDO,     // diffuse + specular reflectance (or emission) at the first hit, RGB
+    DRIFT_PT_AOV_NORMAL,     // shading normal at the first hit, RGB in [-1, 1]
+    DRIFT_PT_AOV_DEPTH,      // distance along the camera ray to the first hit, 1 channel (0 = miss)
+    DRIFT_PT_AOV_COUNT
+} drift_pt_aov;
+
+typedef struct drift_pt_stats {
+    uint64_t camera_rays;
+    uint64_t shadow_rays;
+    uint64_t bounce_rays;
+    uint64_t nan_samples;  // samples with a non-finite value, discarded (should stay 0)
+    double render_seconds; // wall time inside drift_pt_render_samples
+} drift_pt_stats;
+
+typedef struct drift_pt drift_pt;
+
+// Errors: DRIFT_ERR_INVALID_ARGUMENT (uncommitted scene, bad size), DRIFT_ERR_OUT_OF_MEMORY.
+drift_result drift_pt_create(drift_context *ctx, const drift_scene *scene, const drift_accel *accel,
+                             const drift_pt_params *params, drift_pt **out_pt);
+void drift_pt_destroy(drift_pt *pt); // NULL-safe
+
+// Adds `count` samples to every pixel. `cancel` (may be NULL) is polled between tiles; when
+// it becomes true the call returns DRIFT_ERR_CANCELLED and pixels keep what they had, each
+// divided by its own sample count at resolve.
+drift_result drift_pt_render_samples(drift_pt *pt, uint32_t count, const atomic_bool *cancel);
+
+// Completed samples per pixel (the minimum over pixels).
+uint32_t drift_pt_sample_count(const drift_pt *pt);
+drift_pt_stats drift_pt_get_stats(const drift_pt *pt);
+drift_pt_params drift_pt_get_params(const drift_pt *pt);
+
+// The mean of the samples so far for one AOV (see the ownership note above).
+drift_result drift_pt_resolve(drift_pt *pt, drift_pt_aov aov, drift_image *out_image);
+
+// Radiance of one camera-ray sample (pixel x, y; sample index) exactly as the renderer
+// computes it: for tests and for replaying a single sample (`drift render --debug-sample`).
+drift_vec3 drift_pt_trace_sample(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample);
+
+#ifdef __cplusplus
+}
+#endif
+#endif // DRIFT_PT_H

@@ -1,0 +1,385 @@
+// Reference path tracer: unidirectional, next-event estimation, MIS with the power heuristic.
+#include "drift/pt.h"
+
+#include <math.h>
+#include <string.h>
+
+#define TILE_SIZE 16
+// Channels accumulated per pixel: beauty RGB, albedo RGB, normal XYZ, depth.
+#define SUM_CHANNELS 10
+
+// Per-thread counters, padded to a cache line so threads do not share one.
+typedef struct thread_stats {
+    uint64_t camera_rays, shadow_rays, bounce_rays, nan_samples;
+    uint8_t padding[64 - 4 * sizeof(uint64_t)];
+} thread_stats;
+
+struct drift_pt {
+    drift_context *ctx;
+    const drift_scene *scene;
+    const drift_accel *accel;
+    drift_pt_params params;
+    double *sums;     // SUM_CHANNELS a pixel
+    uint32_t *counts; // samples a pixel
+    thread_stats *thread_stats;
+    int thread_count;
+    drift_image resolved[DRIFT_PT_AOV_COUNT];
+    double render_seconds;
+};
+
+typedef struct path_result {
+    drift_vec3 radiance;
+    drift_vec3 albedo;
+    drift_vec3 normal;
+    float depth;
+} path_result;
+
+drift_pt_params drift_pt_params_resolve(const drift_pt_params *params, const drift_scene *scene)
+{
+    drift_pt_params p = params ? *params : (drift_pt_params){ 0 };
+    if (p.width == 0) {
+        p.width = scene ? scene->camera.width : 512;
+    }
+    if (p.height == 0) {
+        p.height = scene ? scene->camera.height : 512;
+    }
+    if (p.max_depth == 0) {
+        p.max_depth = 8;
+    }
+    if (p.rr_depth == 0) {
+        p.rr_depth = 3;
+    }
+    return p;
+}
+
+drift_result drift_pt_create(drift_context *ctx, const drift_scene *scene, const drift_accel *accel,
+                             const drift_pt_params *params, drift_pt **out_pt)
+{
+    if (!out_pt) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    *out_pt = NULL;
+    if (!scene || !accel || !scene->committed) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    drift_pt_params p = drift_pt_params_resolve(params, scene);
+    if (p.width <= 0 || p.height <= 0 || p.width > DRIFT_IMAGE_MAX_DIMENSION ||
+        p.height > DRIFT_IMAGE_MAX_DIMENSION || p.max_depth < 0 || p.rr_depth < 0) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, NULL, 0,
+                  "path tracer: image %dx%d or depth %d out of range", p.width, p.height,
+                  p.max_depth);
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    drift_pt *pt = drift_alloc(ctx, sizeof(drift_pt));
+    if (!pt) {
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    pt->ctx = ctx;
+    pt->scene = scene;
+    pt->accel = accel;
+    pt->params = p;
+    pt->thread_count = drift_context_thread_count(ctx);
+    size_t pixels = (size_t)p.width * (size_t)p.height;
+    pt->sums = drift_alloc(ctx, pixels * SUM_CHANNELS * sizeof(double));
+    pt->counts = drift_alloc(ctx, pixels * sizeof(uint32_t));
+    pt->thread_stats = drift_alloc(ctx, (size_t)pt->thread_count * sizeof(thread_stats));
+    if (!pt->sums || !pt->counts || !pt->thread_stats) {
+        drift_pt_destroy(pt);
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    *out_pt = pt;
+    return DRIFT_OK;
+}
+
+void drift_pt_destroy(drift_pt *pt)
+{
+    if (!pt) {
+        return;
+    }
+    drift_context *ctx = pt->ctx;
+    for (int i = 0; i < DRIFT_PT_AOV_COUNT; ++i) {
+        drift_image_destroy(ctx, &pt->resolved[i]);
+    }
+    drift_free(ctx, pt->sums);
+    drift_free(ctx, pt->counts);
+    drift_free(ctx, pt->thread_stats);
+    drift_free(ctx, pt);
+}
+
+// --- PATH ---
+
+// Light arriving by next-event estimation at a surface point, MIS-weighted against BSDF
+// sampling (Veach 1997, §9.2), with visibility.
+static drift_vec3 sample_direct(const drift_pt *pt, const drift_surface *surf,
+                                const drift_bsdf *bsdf, drift_vec3 wo, drift_sampler *sampler,
+                                float u_pick, thread_stats *stats)
+{
+    const drift_scene *scene = pt->scene;
+    drift_vec2 u_light = drift_sampler_next2(sampler);
+    float pmf;
+    uint32_t light = drift_scene_pick_light(scene, u_pick, &pmf);
+    if (light == DRIFT_INVALID_INDEX || !(pmf > 0.0f)) {
+        return drift_vec3_splat(0.0f);
+    }
+    drift_light_sample ls = drift_light_sample_li(scene, light, surf->position, u_light);
+    if (!(ls.pdf > 0.0f) || drift_vec3_is_zero(ls.radiance)) {
+        return drift_vec3_splat(0.0f);
+    }
+    drift_vec3 f = drift_bsdf_eval(bsdf, wo, ls.wi);
+    float cos_i = fabsf(drift_vec3_dot(ls.wi, surf->ns));
+    if (drift_vec3_is_zero(f) || cos_i <= 0.0f) {
+        return drift_vec3_splat(0.0f);
+    }
+    // Shadow ray: stop just short of the light so its own surface does not block it.
+    drift_ray shadow = { .origin = drift_offset_origin(surf->position, surf->ng, ls.wi),
+                         .dir = ls.wi,
+                         .tmin = 0.0f,
+                         .tmax = isfinite(ls.distance) ? ls.distance * (1.0f - 1e-4f) : INFINITY };
+    stats->shadow_rays++;
+    if (drift_accel_occluded(pt->accel, &shadow)) {
+        return drift_vec3_splat(0.0f);
+    }
+    float light_pdf = pmf * ls.pdf;
+    float weight = 1.0f;
+    if (!ls.is_delta && !pt->params.disable_mis) {
+        weight = drift_power_heuristic(light_pdf, drift_bsdf_pdf(bsdf, wo, ls.wi));
+    }
+    return drift_vec3_scale(drift_vec3_mul(f, ls.radiance), cos_i * weight / light_pdf);
+}
+
+// MIS weight for emission found by BSDF sampling from `prev` with solid-angle pdf bsdf_pdf.
+static float emission_weight(const drift_pt *pt, bool prev_specular, float bsdf_pdf,
+                             float light_pdf)
+{
+    if (pt->params.disable_nee || prev_specular) {
+        return 1.0f;
+    }
+    if (pt->params.disable_mis) {
+        return 0.0f; // NEE already counted this light
+    }
+    return drift_power_heuristic(bsdf_pdf, light_pdf);
+}
+
+static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample,
+                       path_result *out, thread_stats *stats)
+{
+    const drift_scene *scene = pt->scene;
+    const drift_pt_params *p = &pt->params;
+    uint32_t pixel = (uint32_t)y * (uint32_t)p->width + (uint32_t)x;
+    drift_sampler sampler = drift_sampler_make(p->seed, pixel, sample);
+    drift_vec2 film = drift_sampler_next2(&sampler);
+    drift_vec2 lens = drift_sampler_next2(&sampler);
+    drift_ray ray = drift_camera_ray(&scene->camera, p->width, p->height, (float)x + film.x,
+                                     (float)y + film.y, lens);
+    *out = (path_result){ 0 };
+    drift_vec3 radiance = drift_vec3_splat(0.0f);
+    drift_vec3 beta = drift_vec3_splat(1.0f);
+    bool prev_specular = true; // the camera ray counts as specular: see emitters directly
+    float prev_bsdf_pdf = 0.0f;
+    drift_vec3 prev_position = ray.origin;
+    stats->camera_rays++;
+
+    for (int32_t depth = 0;; ++depth) {
+        drift_hit hit;
+        if (!drift_accel_intersect(pt->accel, &ray, &hit)) {
+            if (drift_scene_has_environment(scene)) {
+                drift_vec3 le = drift_environment_eval(scene, ray.dir);
+                float light_pdf = drift_scene_environment_pmf(scene) *
+                                  drift_environment_pdf(scene, ray.dir);
+                float w = emission_weight(pt, prev_specular, prev_bsdf_pdf, light_pdf);
+                radiance = drift_vec3_add(radiance, drift_vec3_scale(drift_vec3_mul(beta, le), w));
+                if (depth == 0) {
+                    out->albedo = le;
+                }
+            }
+            break;
+        }
+        drift_surface surf = drift_scene_surface(scene, &ray, &hit);
+        drift_vec3 wo = drift_vec3_neg(ray.dir);
+        if (depth == 0) {
+            out->depth = hit.t;
+            out->normal = surf.ns;
+            if (surf.material != DRIFT_INVALID_INDEX) {
+                const drift_material *m = &scene->materials[surf.material];
+                out->albedo = drift_vec3_add(m->diffuse, m->specular);
+            } else {
+                out->albedo = surf.emission;
+            }
+        }
+        if (!drift_vec3_is_zero(surf.emission)) {
+            float w = 1.0f;
+            if (!prev_specular && surf.light != DRIFT_INVALID_INDEX) {
+                float light_pdf =
+                    drift_scene_light_pmf(scene, surf.light) *
+                    drift_light_pdf_li(scene, surf.light, prev_position, ray.dir, hit.t, surf.ng);
+                w = emission_weight(pt, prev_specular, prev_bsdf_pdf, light_pdf);
+            }
+            radiance = drift_vec3_add(radiance, drift_vec3_scale(drift_vec3_mul(beta, surf.emission), w));
+        }
+        if (surf.material == DRIFT_INVALID_INDEX || depth >= p->max_depth) {
+            break;
+        }
+        drift_bsdf bsdf = drift_bsdf_make(scene, &surf);
+        drift_vec2 u_choice = drift_sampler_next2(&sampler); // x: light pick, y: lobe pick
+        if (!p->disable_nee && !drift_bsdf_is_delta(&bsdf)) {
+            drift_vec3 ld = sample_direct(pt, &surf, &bsdf, wo, &sampler, u_choice.x, stats);
+            radiance = drift_vec3_add(radiance, drift_vec3_mul(beta, ld));
+        } else {
+            (void)drift_sampler_next2(&sampler); // keep the dimension layout fixed
+        }
+        drift_bsdf_sample bs = drift_bsdf_sample_wi(&bsdf, wo, u_choice.y, drift_sampler_next2(&sampler));
+        float u_rr = drift_sampler_next1(&sampler);
+        if (!(bs.pdf > 0.0f) || drift_vec3_is_zero(bs.weight)) {
+            break;
+        }
+        beta = drift_vec3_mul(beta, bs.weight);
+        prev_specular = bs.is_delta;
+        prev_bsdf_pdf = bs.pdf;
+        prev_position = surf.position;
+        // Russian roulette (pbrt-v4 §14.1.4): survive with probability max(beta), at most 1.
+        float max_beta = drift_vec3_max_component(beta);
+        if (!p->disable_rr && depth + 1 >= p->rr_depth && max_beta < 1.0f) {
+            float q = fmaxf(0.0f, 1.0f - max_beta);
+            if (u_rr < q) {
+                break;
+            }
+            beta = drift_vec3_scale(beta, 1.0f / (1.0f - q));
+        }
+        ray = (drift_ray){ .origin = drift_offset_origin(surf.position, surf.ng, bs.wi),
+                           .dir = bs.wi,
+                           .tmin = 0.0f,
+                           .tmax = INFINITY };
+        stats->bounce_rays++;
+    }
+    out->radiance = radiance;
+}
+
+drift_vec3 drift_pt_trace_sample(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample)
+{
+    thread_stats scratch = { 0 };
+    path_result r;
+    trace_path(pt, x, y, sample, &r, &scratch);
+    return r.radiance;
+}
+
+// --- RENDER LOOP ---
+
+typedef struct render_job {
+    drift_pt *pt;
+    uint32_t sample_count;
+    int32_t tiles_x;
+    const atomic_bool *cancel;
+} render_job;
+
+static void render_tiles(size_t begin, size_t end, int thread_index, void *user)
+{
+    render_job *job = user;
+    drift_pt *pt = job->pt;
+    thread_stats *stats = &pt->thread_stats[thread_index];
+    int32_t width = pt->params.width, height = pt->params.height;
+    for (size_t tile = begin; tile < end; ++tile) {
+        if (job->cancel && atomic_load(job->cancel)) {
+            return;
+        }
+        int32_t x0 = (int32_t)(tile % (size_t)job->tiles_x) * TILE_SIZE;
+        int32_t y0 = (int32_t)(tile / (size_t)job->tiles_x) * TILE_SIZE;
+        int32_t x1 = x0 + TILE_SIZE < width ? x0 + TILE_SIZE : width;
+        int32_t y1 = y0 + TILE_SIZE < height ? y0 + TILE_SIZE : height;
+        for (int32_t y = y0; y < y1; ++y) {
+            for (int32_t x = x0; x < x1; ++x) {
+                size_t pixel = (size_t)y * (size_t)width + (size_t)x;
+                double *sum = pt->sums + pixel * SUM_CHANNELS;
+                uint32_t first = pt->counts[pixel];
+                for (uint32_t s = first; s < first + job->sample_count; ++s) {
+                    path_result r;
+                    trace_path(pt, x, y, s, &r, stats);
+                    if (!drift_vec3_is_finite(r.radiance)) {
+                        stats->nan_samples++;
+                        r.radiance = drift_vec3_splat(0.0f);
+                    }
+                    const float v[SUM_CHANNELS] = { r.radiance.x, r.radiance.y, r.radiance.z,
+                                                    r.albedo.x,   r.albedo.y,   r.albedo.z,
+                                                    r.normal.x,   r.normal.y,   r.normal.z,
+                                                    r.depth };
+                    for (int c = 0; c < SUM_CHANNELS; ++c) {
+                        sum[c] += (double)v[c];
+                    }
+                }
+                pt->counts[pixel] = first + job->sample_count;
+            }
+        }
+    }
+}
+
+drift_result drift_pt_render_samples(drift_pt *pt, uint32_t count, const atomic_bool *cancel)
+{
+    if (!pt) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    double start = drift_time_now();
+    render_job job = { .pt = pt,
+                       .sample_count = count,
+                       .tiles_x = (pt->params.width + TILE_SIZE - 1) / TILE_SIZE,
+                       .cancel = cancel };
+    int32_t tiles_y = (pt->params.height + TILE_SIZE - 1) / TILE_SIZE;
+    drift_parallel_for(pt->ctx, (size_t)job.tiles_x * (size_t)tiles_y, 1, render_tiles, &job);
+    pt->render_seconds += drift_time_now() - start;
+    return cancel && atomic_load(cancel) ? DRIFT_ERR_CANCELLED : DRIFT_OK;
+}
+
+uint32_t drift_pt_sample_count(const drift_pt *pt)
+{
+    size_t pixels = (size_t)pt->params.width * (size_t)pt->params.height;
+    uint32_t lowest = UINT32_MAX;
+    for (size_t i = 0; i < pixels; ++i) {
+        lowest = pt->counts[i] < lowest ? pt->counts[i] : lowest;
+    }
+    return pixels ? lowest : 0;
+}
+
+drift_pt_stats drift_pt_get_stats(const drift_pt *pt)
+{
+    drift_pt_stats s = { .render_seconds = pt->render_seconds };
+    for (int i = 0; i < pt->thread_count; ++i) {
+        s.camera_rays += pt->thread_stats[i].camera_rays;
+        s.shadow_rays += pt->thread_stats[i].shadow_rays;
+        s.bounce_rays += pt->thread_stats[i].bounce_rays;
+        s.nan_samples += pt->thread_stats[i].nan_samples;
+    }
+    return s;
+}
+
+drift_pt_params drift_pt_get_params(const drift_pt *pt)
+{
+    return pt->params;
+}
+
+drift_result drift_pt_resolve(drift_pt *pt, drift_pt_aov aov, drift_image *out_image)
+{
+    if (!pt || !out_image || (unsigned)aov >= DRIFT_PT_AOV_COUNT) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    static const int first_channel[DRIFT_PT_AOV_COUNT] = { 0, 3, 6, 9 };
+    static const int channel_count[DRIFT_PT_AOV_COUNT] = { 3, 3, 3, 1 };
+    drift_image *img = &pt->resolved[aov];
+    if (!img->pixels) {
+        drift_result r = drift_image_create(pt->ctx, pt->params.width, pt->params.height,
+                                            channel_count[aov], img);
+        if (r != DRIFT_OK) {
+            return r;
+        }
+    }
+    for (int32_t y = 0; y < img->height; ++y) {
+        for (int32_t x = 0; x < img->width; ++x) {
+            size_t pixel = (size_t)y * (size_t)img->width + (size_t)x;
+            uint32_t n = pt->counts[pixel];
+            const double *sum = pt->sums + pixel * SUM_CHANNELS + first_channel[aov];
+            float *dst = drift_image_pixel(img, x, y);
+            for (int c = 0; c < channel_count[aov]; ++c) {
+                dst[c] = n ? (float)(sum[c] / (double)n) : 0.0f;
+            }
+        }
+    }
+    *out_image = *img;
+    return DRIFT_OK;
+}

@@ -1,0 +1,112 @@
+// Lambertian diffuse plus a normalized modified-Phong glossy lobe (Lafortune & Willems 1994,
+// "Using the Modified Phong Reflectance Model for Physically Based Rendering"), and a perfect
+// mirror. Directions are world space; the lobe frame's z is the shading normal.
+#include <math.h>
+
+#include "scene_internal.h"
+
+drift_bsdf drift_bsdf_make(const drift_scene *scene, const drift_surface *surface)
+{
+    const drift_material *m = &scene->materials[surface->material];
+    drift_bsdf b = { .type = m->type,
+                     .diffuse = m->diffuse,
+                     .specular = m->specular,
+                     .exponent = m->exponent,
+                     .frame = drift_frame_from_normal(surface->ns) };
+    if (m->diffuse_texture != DRIFT_INVALID_INDEX) {
+        b.diffuse = drift_vec3_mul(
+            b.diffuse, drift__texture_bilinear(&scene->textures[m->diffuse_texture], surface->uv));
+    }
+    return b;
+}
+
+bool drift_bsdf_is_delta(const drift_bsdf *bsdf)
+{
+    return bsdf->type == DRIFT_MATERIAL_MIRROR;
+}
+
+// Probability of sampling the glossy lobe rather than the diffuse one.
+static float glossy_probability(const drift_bsdf *b)
+{
+    float ld = drift_luminance(b->diffuse), ls = drift_luminance(b->specular);
+    return ld + ls > 0.0f ? ls / (ld + ls) : 0.0f;
+}
+
+// cos^n(alpha) and cos(alpha), alpha between wi and the mirror direction of wo.
+static float phong_cos_alpha(const drift_bsdf *b, drift_vec3 wo, drift_vec3 wi)
+{
+    drift_vec3 r = drift_vec3_reflect(wo, b->frame.z);
+    return fmaxf(0.0f, drift_vec3_dot(r, wi));
+}
+
+drift_vec3 drift_bsdf_eval(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec3 wi)
+{
+    float cos_o = drift_vec3_dot(wo, bsdf->frame.z), cos_i = drift_vec3_dot(wi, bsdf->frame.z);
+    if (bsdf->type == DRIFT_MATERIAL_MIRROR || cos_o <= 0.0f || cos_i <= 0.0f) {
+        return drift_vec3_splat(0.0f);
+    }
+    drift_vec3 f = drift_vec3_scale(bsdf->diffuse, DRIFT_INV_PI);
+    if (!drift_vec3_is_zero(bsdf->specular)) {
+        float n = bsdf->exponent;
+        float lobe = (n + 2.0f) * DRIFT_INV_2PI * powf(phong_cos_alpha(bsdf, wo, wi), n);
+        f = drift_vec3_fma(f, bsdf->specular, lobe);
+    }
+    return f;
+}
+
+float drift_bsdf_pdf(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec3 wi)
+{
+    float cos_o = drift_vec3_dot(wo, bsdf->frame.z), cos_i = drift_vec3_dot(wi, bsdf->frame.z);
+    if (bsdf->type == DRIFT_MATERIAL_MIRROR || cos_o <= 0.0f || cos_i <= 0.0f) {
+        return 0.0f;
+    }
+    float ps = glossy_probability(bsdf);
+    float pdf = (1.0f - ps) * cos_i * DRIFT_INV_PI;
+    if (ps > 0.0f) {
+        float n = bsdf->exponent;
+        pdf += ps * (n + 1.0f) * DRIFT_INV_2PI * powf(phong_cos_alpha(bsdf, wo, wi), n);
+    }
+    return pdf;
+}
+
+drift_bsdf_sample drift_bsdf_sample_wi(const drift_bsdf *bsdf, drift_vec3 wo, float u_lobe,
+                                       drift_vec2 u)
+{
+    drift_bsdf_sample s = { 0 };
+    float cos_o = drift_vec3_dot(wo, bsdf->frame.z);
+    if (cos_o <= 0.0f) {
+        return s;
+    }
+    if (bsdf->type == DRIFT_MATERIAL_MIRROR) {
+        s.wi = drift_vec3_reflect(wo, bsdf->frame.z);
+        s.weight = bsdf->specular;
+        s.pdf = 1.0f;
+        s.is_delta = true;
+        return s;
+    }
+    float ps = glossy_probability(bsdf);
+    if (drift_vec3_is_zero(bsdf->diffuse) && ps <= 0.0f) {
+        return s;
+    }
+    if (u_lobe < ps) {
+        // Sample cos(alpha) = u^(1/(n+1)) around the mirror direction.
+        drift_vec3 r = drift_vec3_reflect(wo, bsdf->frame.z);
+        drift_frame f = drift_frame_from_normal(r);
+        float cos_a = powf(u.x, 1.0f / (bsdf->exponent + 1.0f));
+        float sin_a = sqrtf(fmaxf(0.0f, 1.0f - cos_a * cos_a));
+        float phi = 2.0f * DRIFT_PI * u.y;
+        s.wi = drift_frame_to_world(&f, drift_vec3_make(sin_a * cosf(phi), sin_a * sinf(phi), cos_a));
+    } else {
+        s.wi = drift_frame_to_world(&bsdf->frame, drift_sample_cosine_hemisphere(u));
+    }
+    float cos_i = drift_vec3_dot(s.wi, bsdf->frame.z);
+    if (cos_i <= 0.0f) {
+        return (drift_bsdf_sample){ 0 };
+    }
+    s.pdf = drift_bsdf_pdf(bsdf, wo, s.wi);
+    if (!(s.pdf > 0.0f)) {
+        return (drift_bsdf_sample){ 0 };
+    }
+    s.weight = drift_vec3_scale(drift_bsdf_eval(bsdf, wo, s.wi), cos_i / s.pdf);
+    return s;
+}
