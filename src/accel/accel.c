@@ -1,0 +1,462 @@
+// The accel: an Embree device and scene over a committed drift_scene. Meshes are shared
+// with Embree (no copies); area-light shapes get small buffers of their own.
+#include "drift/accel.h"
+
+#include <math.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <string.h>
+
+#include <embree3/rtcore.h>
+
+// Geometry IDs: mesh i is geometry i, so a hit maps to its mesh without a table. The light
+// shapes follow, one geometry per shape kind (all quads, all disks, all spheres).
+enum shape_kind { SHAPE_QUAD, SHAPE_DISK, SHAPE_SPHERE, SHAPE_COUNT };
+
+// Rays per Embree stream call in the coherent queries: converted on the stack in chunks.
+#define COHERENT_CHUNK 64
+
+struct drift_accel {
+    drift_context *ctx;
+    const drift_scene *scene;
+    RTCDevice device;
+    RTCScene rtc_scene;
+    uint32_t mesh_count;
+    // Copy of meshes[i].first_light: saves a 100-byte-stride load through the scene per hit.
+    uint32_t *mesh_first_light;
+    // Per shape kind: light index of each Embree primitive (quads have two per light).
+    uint32_t *shape_prim_light[SHAPE_COUNT];
+    uint32_t shape_geom[SHAPE_COUNT]; // geometry ID of each kind, or RTC_INVALID_GEOMETRY_ID
+    // Memory monitor (only installed with a limit).
+    size_t memory_limit;
+    atomic_llong memory_used;
+    // First Embree error code seen by the error callback (RTC_ERROR_NONE if none).
+    atomic_int first_error;
+};
+
+drift_accel_desc drift_accel_desc_resolve(const drift_accel_desc *desc)
+{
+    drift_accel_desc d = desc ? *desc : (drift_accel_desc){ 0 };
+    return d;
+}
+
+static const char *rtc_error_name(enum RTCError code)
+{
+    switch (code) {
+    case RTC_ERROR_NONE:
+        return "none";
+    case RTC_ERROR_UNKNOWN:
+        return "unknown";
+    case RTC_ERROR_INVALID_ARGUMENT:
+        return "invalid argument";
+    case RTC_ERROR_INVALID_OPERATION:
+        return "invalid operation";
+    case RTC_ERROR_OUT_OF_MEMORY:
+        return "out of memory";
+    case RTC_ERROR_UNSUPPORTED_CPU:
+        return "unsupported cpu";
+    case RTC_ERROR_CANCELLED:
+        return "cancelled";
+    }
+    return "unrecognised error";
+}
+
+static drift_result result_of(enum RTCError code)
+{
+    if (code == RTC_ERROR_NONE) {
+        return DRIFT_OK;
+    }
+    return code == RTC_ERROR_OUT_OF_MEMORY ? DRIFT_ERR_OUT_OF_MEMORY : DRIFT_ERR_EMBREE;
+}
+
+// Embree calls this from whichever thread hit the error; drift_log is thread-safe.
+static void on_embree_error(void *user, enum RTCError code, const char *message)
+{
+    drift_accel *accel = user;
+    int none = RTC_ERROR_NONE;
+    atomic_compare_exchange_strong(&accel->first_error, &none, (int)code);
+    drift_log(accel->ctx, DRIFT_LOG_ERROR, result_of(code), __FILE__, __LINE__,
+              "embree: %s (%s)", message ? message : "no message", rtc_error_name(code));
+}
+
+// Embree reports every allocation (bytes > 0) and release (bytes < 0); returning false
+// fails the allocation, and Embree then aborts the build with RTC_ERROR_OUT_OF_MEMORY.
+static bool on_embree_memory(void *user, ssize_t bytes, bool post)
+{
+    drift_accel *accel = user;
+    (void)post;
+    long long used = atomic_fetch_add(&accel->memory_used, (long long)bytes) + (long long)bytes;
+    if (bytes > 0 && used > (long long)accel->memory_limit) {
+        // Embree does not report the release of a refused allocation: undo it here.
+        atomic_fetch_sub(&accel->memory_used, (long long)bytes);
+        return false;
+    }
+    return true;
+}
+
+// Reads (and clears) the device's pending error; logs it when the callback did not.
+static drift_result check_device(drift_accel *accel, const char *what)
+{
+    enum RTCError code = rtcGetDeviceError(accel->device);
+    int seen = atomic_load(&accel->first_error);
+    if (code == RTC_ERROR_NONE && seen != RTC_ERROR_NONE) {
+        code = (enum RTCError)seen;
+    }
+    // The callback has logged Embree's own message already; only a silent error is logged here.
+    if (code != RTC_ERROR_NONE && seen == RTC_ERROR_NONE) {
+        drift_log(accel->ctx, DRIFT_LOG_ERROR, result_of(code), __FILE__, __LINE__,
+                  "embree failed during %s (%s)", what, rtc_error_name(code));
+    }
+    return result_of(code);
+}
+
+static drift_result add_mesh(drift_accel *accel, const drift_mesh *mesh, uint32_t id)
+{
+    RTCGeometry geom = rtcNewGeometry(accel->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    if (!geom) {
+        return check_device(accel, "rtcNewGeometry");
+    }
+    // The scene pads positions by one float, which covers Embree's 16-byte load of the
+    // last vertex (buffer_padding.md); so the buffer can be shared as it is.
+    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, mesh->positions,
+                               0, 3 * sizeof(float), mesh->vertex_count);
+    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, mesh->indices, 0,
+                               3 * sizeof(uint32_t), mesh->triangle_count);
+    rtcCommitGeometry(geom);
+    rtcAttachGeometryByID(accel->rtc_scene, geom, id);
+    rtcReleaseGeometry(geom);
+    return check_device(accel, "mesh setup");
+}
+
+static void put3(float *dst, drift_vec3 v)
+{
+    dst[0] = v.x;
+    dst[1] = v.y;
+    dst[2] = v.z;
+}
+
+// One geometry for all lights of one shape kind; prims[i] gets the light of primitive i.
+static drift_result add_shapes(drift_accel *accel, enum shape_kind kind, uint32_t id)
+{
+    const drift_scene *scene = accel->scene;
+    static const drift_light_type light_type[SHAPE_COUNT] = { DRIFT_LIGHT_QUAD, DRIFT_LIGHT_DISK,
+                                                              DRIFT_LIGHT_SPHERE };
+    uint32_t count = 0;
+    for (uint32_t i = 0; i < scene->light_count; ++i) {
+        count += scene->lights[i].type == light_type[kind];
+    }
+    accel->shape_geom[kind] = RTC_INVALID_GEOMETRY_ID;
+    if (count == 0) {
+        return DRIFT_OK;
+    }
+    uint32_t prims_per_light = kind == SHAPE_QUAD ? 2 : 1;
+    uint32_t *prim_light = drift_alloc(accel->ctx, (size_t)count * prims_per_light *
+                                                       sizeof(uint32_t));
+    if (!prim_light) {
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    accel->shape_prim_light[kind] = prim_light;
+
+    enum RTCGeometryType type = kind == SHAPE_QUAD   ? RTC_GEOMETRY_TYPE_TRIANGLE
+                                : kind == SHAPE_DISK ? RTC_GEOMETRY_TYPE_ORIENTED_DISC_POINT
+                                                     : RTC_GEOMETRY_TYPE_SPHERE_POINT;
+    RTCGeometry geom = rtcNewGeometry(accel->device, type);
+    if (!geom) {
+        return check_device(accel, "rtcNewGeometry");
+    }
+    // Embree-allocated buffers (rtcSetNewGeometryBuffer) come padded and are freed with it.
+    float *vertices = NULL, *normals = NULL;
+    uint32_t *indices = NULL;
+    if (kind == SHAPE_QUAD) {
+        vertices = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                           3 * sizeof(float), (size_t)count * 4);
+        indices = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                          3 * sizeof(uint32_t), (size_t)count * 2);
+    } else {
+        vertices = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
+                                           4 * sizeof(float), count);
+        if (kind == SHAPE_DISK) {
+            normals = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_NORMAL, 0, RTC_FORMAT_FLOAT3,
+                                              3 * sizeof(float), count);
+        }
+    }
+    if (!vertices || (kind == SHAPE_QUAD && !indices) || (kind == SHAPE_DISK && !normals)) {
+        rtcReleaseGeometry(geom);
+        drift_result r = check_device(accel, "light shape buffers");
+        return r != DRIFT_OK ? r : DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    uint32_t k = 0;
+    for (uint32_t i = 0; i < scene->light_count; ++i) {
+        const drift_light *l = &scene->lights[i];
+        if (l->type != light_type[kind]) {
+            continue;
+        }
+        if (kind == SHAPE_QUAD) {
+            // Corners c, c+u, c+u+v, c+v; both triangles wind so that ng = u x v.
+            drift_vec3 c = l->position;
+            put3(vertices + 12 * (size_t)k, c);
+            put3(vertices + 12 * (size_t)k + 3, drift_vec3_add(c, l->edge_u));
+            put3(vertices + 12 * (size_t)k + 6,
+                 drift_vec3_add(drift_vec3_add(c, l->edge_u), l->edge_v));
+            put3(vertices + 12 * (size_t)k + 9, drift_vec3_add(c, l->edge_v));
+            uint32_t *tri = indices + 6 * (size_t)k;
+            uint32_t base = 4 * k;
+            tri[0] = base, tri[1] = base + 1, tri[2] = base + 2;
+            tri[3] = base, tri[4] = base + 2, tri[5] = base + 3;
+            prim_light[2 * k] = prim_light[2 * k + 1] = i;
+        } else {
+            put3(vertices + 4 * (size_t)k, l->position);
+            vertices[4 * (size_t)k + 3] = l->radius;
+            if (kind == SHAPE_DISK) {
+                put3(normals + 3 * (size_t)k, l->direction); // unit: add_light normalizes it
+            }
+            prim_light[k] = i;
+        }
+        k++;
+    }
+    rtcCommitGeometry(geom);
+    rtcAttachGeometryByID(accel->rtc_scene, geom, id);
+    rtcReleaseGeometry(geom);
+    accel->shape_geom[kind] = id;
+    return check_device(accel, "light shape setup");
+}
+
+static drift_result build(drift_accel *accel, const drift_accel_desc *desc)
+{
+    drift_context *ctx = accel->ctx;
+    const drift_scene *scene = accel->scene;
+    char config[64];
+    snprintf(config, sizeof(config), "threads=%d", drift_context_thread_count(ctx));
+    accel->device = rtcNewDevice(config);
+    if (!accel->device) {
+        enum RTCError code = rtcGetDeviceError(NULL);
+        drift_log(ctx, DRIFT_LOG_ERROR, result_of(code), __FILE__, __LINE__,
+                  "embree could not create a device with \"%s\" (%s)", config,
+                  rtc_error_name(code));
+        return code == RTC_ERROR_NONE ? DRIFT_ERR_EMBREE : result_of(code);
+    }
+    rtcSetDeviceErrorFunction(accel->device, on_embree_error, accel);
+    if (desc->memory_limit_bytes > 0) {
+        rtcSetDeviceMemoryMonitorFunction(accel->device, on_embree_memory, accel);
+    }
+
+    accel->rtc_scene = rtcNewScene(accel->device);
+    if (!accel->rtc_scene) {
+        return check_device(accel, "rtcNewScene");
+    }
+    rtcSetSceneBuildQuality(accel->rtc_scene, desc->quality == DRIFT_ACCEL_QUALITY_FAST_BUILD
+                                                  ? RTC_BUILD_QUALITY_MEDIUM
+                                                  : RTC_BUILD_QUALITY_HIGH);
+
+    accel->mesh_count = scene->mesh_count;
+    accel->mesh_first_light = drift_alloc(ctx, ((size_t)scene->mesh_count + 1) * sizeof(uint32_t));
+    if (!accel->mesh_first_light) {
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    for (uint32_t m = 0; m < scene->mesh_count; ++m) {
+        accel->mesh_first_light[m] = scene->meshes[m].first_light;
+        drift_result r = add_mesh(accel, &scene->meshes[m], m);
+        if (r != DRIFT_OK) {
+            return r;
+        }
+    }
+    for (int kind = 0; kind < SHAPE_COUNT; ++kind) {
+        drift_result r = add_shapes(accel, (enum shape_kind)kind, scene->mesh_count + (uint32_t)kind);
+        if (r != DRIFT_OK) {
+            return r;
+        }
+    }
+    rtcCommitScene(accel->rtc_scene);
+    return check_device(accel, "rtcCommitScene");
+}
+
+drift_result drift_accel_create(drift_context *ctx, const drift_scene *scene,
+                                const drift_accel_desc *desc, drift_accel **out_accel)
+{
+    if (!out_accel) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    *out_accel = NULL;
+    drift_accel_desc d = drift_accel_desc_resolve(desc);
+    if (!ctx || !scene || (unsigned)d.quality >= DRIFT_ACCEL_QUALITY_COUNT) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, __FILE__, __LINE__,
+                  "drift_accel_create needs a context, a scene and a valid quality");
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    if (!scene->committed) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, __FILE__, __LINE__,
+                  "the scene must be committed (drift_scene_commit) before building an accel");
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    // Geometry IDs are mesh indices followed by the shape kinds; Embree IDs are unsigned.
+    if (scene->mesh_count > UINT32_MAX - SHAPE_COUNT - 1) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    drift_accel *accel = drift_alloc(ctx, sizeof(drift_accel));
+    if (!accel) {
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    accel->ctx = ctx;
+    accel->scene = scene;
+    accel->memory_limit = d.memory_limit_bytes;
+    atomic_init(&accel->memory_used, 0);
+    atomic_init(&accel->first_error, RTC_ERROR_NONE);
+    for (int k = 0; k < SHAPE_COUNT; ++k) {
+        accel->shape_geom[k] = RTC_INVALID_GEOMETRY_ID;
+    }
+    drift_result r = build(accel, &d);
+    if (r != DRIFT_OK) {
+        drift_accel_destroy(accel);
+        return r;
+    }
+    *out_accel = accel;
+    return DRIFT_OK;
+}
+
+void drift_accel_destroy(drift_accel *accel)
+{
+    if (!accel) {
+        return;
+    }
+    drift_context *ctx = accel->ctx;
+    if (accel->rtc_scene) {
+        rtcReleaseScene(accel->rtc_scene);
+    }
+    if (accel->device) {
+        rtcReleaseDevice(accel->device);
+    }
+    for (int k = 0; k < SHAPE_COUNT; ++k) {
+        drift_free(ctx, accel->shape_prim_light[k]);
+    }
+    drift_free(ctx, accel->mesh_first_light);
+    drift_free(ctx, accel);
+}
+
+// --- QUERIES ---
+//
+// These are on every hot path: no validation beyond what Embree does, no branches that
+// a well-formed query does not need.
+
+static inline void ray_to_rtc(const drift_ray *ray, struct RTCRay *out)
+{
+    out->org_x = ray->origin.x;
+    out->org_y = ray->origin.y;
+    out->org_z = ray->origin.z;
+    out->tnear = ray->tmin;
+    out->dir_x = ray->dir.x;
+    out->dir_y = ray->dir.y;
+    out->dir_z = ray->dir.z;
+    out->time = 0.0f;
+    out->tfar = ray->tmax;
+    out->mask = UINT32_MAX;
+    out->id = 0;
+    out->flags = 0;
+}
+
+static inline void rayhit_init(const drift_ray *ray, struct RTCRayHit *rh)
+{
+    ray_to_rtc(ray, &rh->ray);
+    rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+}
+
+// Light shapes are rare in a scene's hits, so their lookup stays out of the inlined path.
+static void fill_shape_hit(const drift_accel *accel, uint32_t geom, uint32_t prim, drift_hit *hit)
+{
+    uint32_t kind = geom - accel->mesh_count;
+    hit->mesh = DRIFT_INVALID_INDEX;
+    hit->light = accel->shape_prim_light[kind][prim];
+    hit->prim = kind == SHAPE_QUAD ? (prim & 1u) : 0u;
+}
+
+static inline void fill_hit(const drift_accel *accel, const struct RTCRayHit *rh, drift_hit *hit)
+{
+    uint32_t geom = rh->hit.geomID, prim = rh->hit.primID;
+    hit->t = rh->ray.tfar;
+    hit->u = rh->hit.u;
+    hit->v = rh->hit.v;
+    hit->ng = (drift_vec3){ rh->hit.Ng_x, rh->hit.Ng_y, rh->hit.Ng_z };
+    if (geom < accel->mesh_count) {
+        uint32_t first = accel->mesh_first_light[geom];
+        hit->mesh = geom;
+        hit->prim = prim;
+        hit->light = first == DRIFT_INVALID_INDEX ? DRIFT_INVALID_INDEX : first + prim;
+    } else {
+        fill_shape_hit(accel, geom, prim, hit);
+    }
+}
+
+static inline void fill_miss(drift_hit *hit)
+{
+    hit->t = INFINITY;
+    hit->u = hit->v = 0.0f;
+    hit->mesh = hit->prim = hit->light = DRIFT_INVALID_INDEX;
+    hit->ng = (drift_vec3){ 0.0f, 0.0f, 0.0f };
+}
+
+bool drift_accel_intersect(const drift_accel *accel, const drift_ray *ray, drift_hit *out_hit)
+{
+    struct RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    struct RTCRayHit rh;
+    rayhit_init(ray, &rh);
+    rtcIntersect1(accel->rtc_scene, &context, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+        return false;
+    }
+    fill_hit(accel, &rh, out_hit);
+    return true;
+}
+
+bool drift_accel_occluded(const drift_accel *accel, const drift_ray *ray)
+{
+    struct RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    struct RTCRay r;
+    ray_to_rtc(ray, &r);
+    rtcOccluded1(accel->rtc_scene, &context, &r);
+    // Embree marks an occluded ray by setting tfar to -inf.
+    return r.tfar < 0.0f;
+}
+
+void drift_accel_intersect_coherent(const drift_accel *accel, const drift_ray *rays,
+                                    drift_hit *hits, uint32_t count)
+{
+    struct RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    struct RTCRayHit chunk[COHERENT_CHUNK];
+    for (uint32_t begin = 0; begin < count; begin += COHERENT_CHUNK) {
+        uint32_t n = count - begin < COHERENT_CHUNK ? count - begin : COHERENT_CHUNK;
+        for (uint32_t i = 0; i < n; ++i) {
+            rayhit_init(&rays[begin + i], &chunk[i]);
+        }
+        rtcIntersect1M(accel->rtc_scene, &context, chunk, n, sizeof(struct RTCRayHit));
+        for (uint32_t i = 0; i < n; ++i) {
+            if (chunk[i].hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+                fill_miss(&hits[begin + i]);
+            } else {
+                fill_hit(accel, &chunk[i], &hits[begin + i]);
+            }
+        }
+    }
+}
+
+void drift_accel_occluded_coherent(const drift_accel *accel, const drift_ray *rays,
+                                   uint8_t *out_occluded, uint32_t count)
+{
+    struct RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    struct RTCRay chunk[COHERENT_CHUNK];
+    for (uint32_t begin = 0; begin < count; begin += COHERENT_CHUNK) {
+        uint32_t n = count - begin < COHERENT_CHUNK ? count - begin : COHERENT_CHUNK;
+        for (uint32_t i = 0; i < n; ++i) {
+            ray_to_rtc(&rays[begin + i], &chunk[i]);
+        }
+        rtcOccluded1M(accel->rtc_scene, &context, chunk, n, sizeof(struct RTCRay));
+        for (uint32_t i = 0; i < n; ++i) {
+            out_occluded[begin + i] = chunk[i].tfar < 0.0f;
+        }
+    }
+}
