@@ -1,0 +1,515 @@
+// Sampling correctness: the sampler's stratification, every BSDF sampling routine against its
+// pdf (chi-square), pdf normalization, light sampling against closed-form irradiance, and the
+// environment map's importance sampling.
+#include "drift_test.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "drift/math.h"
+#include "drift/scene.h"
+
+#define M_PI 3.14159265358979323846
+
+// --- SAMPLER ---
+
+static void test_sampling_sampler_is_deterministic_and_in_range(void **state)
+{
+    (void)state;
+    for (uint32_t s = 0; s < 256; ++s) {
+        drift_sampler a = drift_sampler_make(7, 1234, s), b = drift_sampler_make(7, 1234, s);
+        for (int d = 0; d < 8; ++d) {
+            drift_vec2 u = drift_sampler_next2(&a), v = drift_sampler_next2(&b);
+            assert_true(u.x >= 0.0f && u.x < 1.0f && u.y >= 0.0f && u.y < 1.0f);
+            assert_true(u.x == v.x && u.y == v.y);
+        }
+    }
+    drift_sampler a = drift_sampler_make(7, 1234, 3), b = drift_sampler_make(8, 1234, 3);
+    drift_vec2 u = drift_sampler_next2(&a), v = drift_sampler_next2(&b);
+    assert_true(u.x != v.x || u.y != v.y);
+}
+
+// A (0,2)-sequence puts exactly one of the first 2^k points in every elementary interval
+// of area 2^-k; Owen scrambling keeps that. Check all shapes for 2^k = 64.
+static void test_sampling_sampler_is_stratified(void **state)
+{
+    (void)state;
+    const int n = 64;
+    for (uint32_t pixel = 0; pixel < 20; ++pixel) {
+        for (int dim = 0; dim < 4; ++dim) {
+            drift_vec2 pts[64];
+            for (int s = 0; s < n; ++s) {
+                drift_sampler smp = drift_sampler_make(3, pixel, (uint32_t)s);
+                for (int d = 0; d <= dim; ++d) {
+                    pts[s] = drift_sampler_next2(&smp);
+                }
+            }
+            for (int bx = 1; bx <= n; bx *= 2) {
+                int by = n / bx;
+                int counts[64] = { 0 };
+                for (int s = 0; s < n; ++s) {
+                    int ix = (int)(pts[s].x * (float)bx), iy = (int)(pts[s].y * (float)by);
+                    counts[iy * bx + ix]++;
+                }
+                for (int c = 0; c < n; ++c) {
+                    assert_int_equal(counts[c], 1);
+                }
+            }
+        }
+    }
+}
+
+// --- CHI-SQUARE (pbrt-v3's and Mitsuba's approach) ---
+
+#define THETA_BINS 16
+#define PHI_BINS 32
+
+// Upper quantile of the chi-square distribution (Wilson-Hilferty approximation), for
+// significance 1e-3 per test: z = 3.09.
+static double chi2_critical(int dof)
+{
+    double k = (double)dof, z = 3.09;
+    double t = 1.0 - 2.0 / (9.0 * k) + z * sqrt(2.0 / (9.0 * k));
+    return k * t * t * t;
+}
+
+static drift_vec3 sphere_dir(double cos_theta, double phi)
+{
+    double s = sqrt(fmax(0.0, 1.0 - cos_theta * cos_theta));
+    return drift_vec3_make((float)(s * cos(phi)), (float)(s * sin(phi)), (float)cos_theta);
+}
+
+// Binning uses +y as its pole: every tested lobe lies in the xz plane, so it sits on the
+// binning equator where equal-area bins are well shaped (near a pole they are slivers and
+// the per-bin quadrature of a sharp lobe fails).
+static drift_vec3 bin_dir(double cos_theta, double phi)
+{
+    drift_vec3 d = sphere_dir(cos_theta, phi);
+    return drift_vec3_make(d.y, d.z, d.x);
+}
+
+typedef float (*pdf_fn)(void *user, drift_vec3 wi);
+typedef bool (*sample_fn)(void *user, drift_vec2 u, float u_lobe, drift_vec3 *out_wi);
+
+// Bins sampled directions over (cos theta, phi) of the whole sphere and compares with the
+// pdf integrated over each bin. Bins expecting fewer than 5 samples are pooled. Returns
+// false, with the reason in `why`, when the sampler and pdf disagree.
+static bool chi_square_passes(const char *what, pdf_fn pdf, sample_fn sample, void *user,
+                              int sample_count, char *why, size_t why_size)
+{
+    static double observed[THETA_BINS * PHI_BINS], expected[THETA_BINS * PHI_BINS];
+    memset(observed, 0, sizeof(observed));
+    memset(expected, 0, sizeof(expected));
+    int failed = 0;
+    for (int i = 0; i < sample_count; ++i) {
+        drift_sampler s = drift_sampler_make(11, 0, (uint32_t)i);
+        drift_vec2 u = drift_sampler_next2(&s);
+        float u_lobe = drift_sampler_next1(&s);
+        drift_vec3 wi;
+        if (!sample(user, u, u_lobe, &wi)) {
+            failed++;
+            continue;
+        }
+        double ct = fmax(-1.0, fmin(1.0, (double)wi.y));
+        double phi = atan2((double)wi.x, (double)wi.z);
+        if (phi < 0.0) {
+            phi += 2.0 * M_PI;
+        }
+        int ti = (int)((ct + 1.0) * 0.5 * THETA_BINS), pi = (int)(phi / (2.0 * M_PI) * PHI_BINS);
+        ti = ti >= THETA_BINS ? THETA_BINS - 1 : ti;
+        pi = pi >= PHI_BINS ? PHI_BINS - 1 : pi;
+        observed[ti * PHI_BINS + pi] += 1.0;
+    }
+    // Integrate the pdf over each bin with a midpoint rule (bins are equal-area); fine enough
+    // that the quadrature error stays far below the 1% tolerance for lobes up to n = 300.
+    double integral = 0.0;
+    const int sub = 32;
+    double bin_area = (2.0 / THETA_BINS) * (2.0 * M_PI / PHI_BINS);
+    for (int ti = 0; ti < THETA_BINS; ++ti) {
+        for (int pi = 0; pi < PHI_BINS; ++pi) {
+            double acc = 0.0;
+            for (int a = 0; a < sub; ++a) {
+                for (int b = 0; b < sub; ++b) {
+                    double ct = -1.0 + (ti + (a + 0.5) / sub) * (2.0 / THETA_BINS);
+                    double phi = (pi + (b + 0.5) / sub) * (2.0 * M_PI / PHI_BINS);
+                    acc += (double)pdf(user, bin_dir(ct, phi));
+                }
+            }
+            double p = acc / (sub * sub) * bin_area;
+            expected[ti * PHI_BINS + pi] = p * sample_count;
+            integral += p;
+        }
+    }
+    // The pdf integrates to the probability that sampling succeeds.
+    double success = 1.0 - (double)failed / sample_count;
+    if (fabs(integral - success) > 0.01) {
+        snprintf(why, why_size, "%s: pdf integrates to %.4f but sampling succeeds %.4f of the time",
+                 what, integral, success);
+        return false;
+    }
+    double chi2 = 0.0, pooled_obs = 0.0, pooled_exp = 0.0;
+    int dof = -1;
+    for (int i = 0; i < THETA_BINS * PHI_BINS; ++i) {
+        if (expected[i] < 5.0) {
+            pooled_obs += observed[i];
+            pooled_exp += expected[i];
+            continue;
+        }
+        double d = observed[i] - expected[i];
+        chi2 += d * d / expected[i];
+        dof++;
+    }
+    if (pooled_exp >= 5.0) {
+        double d = pooled_obs - pooled_exp;
+        chi2 += d * d / pooled_exp;
+        dof++;
+    } else if (pooled_obs > 5.0 + 5.0 * pooled_exp) {
+        snprintf(why, why_size, "%s: %.0f samples landed where the pdf expects %.2f", what,
+                 pooled_obs, pooled_exp);
+        return false;
+    }
+    if (dof < 1) {
+        snprintf(why, why_size, "%s: too few populated bins", what);
+        return false;
+    }
+    double critical = chi2_critical(dof);
+    if (chi2 > critical) {
+        snprintf(why, why_size, "%s: chi-square %.1f exceeds %.1f (dof %d)", what, chi2, critical,
+                 dof);
+        return false;
+    }
+    return true;
+}
+
+static void chi_square_check(const char *what, pdf_fn pdf, sample_fn sample, void *user,
+                             int sample_count)
+{
+    char why[256] = "";
+    if (!chi_square_passes(what, pdf, sample, user, sample_count, why, sizeof(why))) {
+        fail_msg("%s", why);
+    }
+}
+
+typedef struct bsdf_case {
+    drift_bsdf bsdf;
+    drift_vec3 wo;
+} bsdf_case;
+
+static float bsdf_pdf_cb(void *user, drift_vec3 wi)
+{
+    bsdf_case *c = user;
+    return drift_bsdf_pdf(&c->bsdf, c->wo, wi);
+}
+
+static bool bsdf_sample_cb(void *user, drift_vec2 u, float u_lobe, drift_vec3 *out_wi)
+{
+    bsdf_case *c = user;
+    drift_bsdf_sample s = drift_bsdf_sample_wi(&c->bsdf, c->wo, u_lobe, u);
+    *out_wi = s.wi;
+    return s.pdf > 0.0f;
+}
+
+static bsdf_case make_case(drift_vec3 kd, drift_vec3 ks, float n, float theta_o)
+{
+    bsdf_case c = { .bsdf = { .type = DRIFT_MATERIAL_DEFAULT,
+                              .diffuse = kd,
+                              .specular = ks,
+                              .exponent = n,
+                              .frame = drift_frame_from_normal(drift_vec3_make(0, 0, 1)) },
+                    .wo = drift_vec3_make(sinf(theta_o), 0.0f, cosf(theta_o)) };
+    return c;
+}
+
+static void test_sampling_bsdf_chi_square(void **state)
+{
+    (void)state;
+    int n = (int)(200000 * test_intensity());
+    const float angles[] = { 1.3f, 0.8f, 0.1f };
+    for (int a = 0; a < 3; ++a) {
+        bsdf_case diffuse = make_case(drift_vec3_splat(0.8f), drift_vec3_splat(0), 0, angles[a]);
+        chi_square_check("lambert", bsdf_pdf_cb, bsdf_sample_cb, &diffuse, n);
+        bsdf_case glossy = make_case(drift_vec3_splat(0), drift_vec3_splat(0.9f), 20.0f, angles[a]);
+        chi_square_check("phong n=20", bsdf_pdf_cb, bsdf_sample_cb, &glossy, n);
+        bsdf_case sharp = make_case(drift_vec3_splat(0), drift_vec3_splat(0.9f), 300.0f, angles[a]);
+        char label[64];
+        snprintf(label, sizeof(label), "phong n=300 theta_o=%.1f", (double)angles[a]);
+        chi_square_check(label, bsdf_pdf_cb, bsdf_sample_cb, &sharp, n);
+        bsdf_case mixed = make_case(drift_vec3_make(0.5f, 0.3f, 0.2f), drift_vec3_splat(0.4f), 8.0f,
+                                    angles[a]);
+        chi_square_check("lambert+phong", bsdf_pdf_cb, bsdf_sample_cb, &mixed, n);
+    }
+}
+
+// A sampler that is wrong (cosine samples reported against a uniform pdf) must fail: the
+// test can fail.
+static float uniform_hemisphere_pdf(void *user, drift_vec3 wi)
+{
+    (void)user;
+    return wi.z > 0.0f ? DRIFT_INV_2PI : 0.0f;
+}
+
+static bool cosine_sample_cb(void *user, drift_vec2 u, float u_lobe, drift_vec3 *out_wi)
+{
+    (void)user;
+    (void)u_lobe;
+    *out_wi = drift_sample_cosine_hemisphere(u);
+    return true;
+}
+
+static void test_sampling_chi_square_detects_a_wrong_pdf(void **state)
+{
+    (void)state;
+    char why[256] = "";
+    assert_false(chi_square_passes("wrong pdf", uniform_hemisphere_pdf, cosine_sample_cb, NULL,
+                                   100000, why, sizeof(why)));
+}
+
+static void test_sampling_warps_match_their_pdfs(void **state)
+{
+    (void)state;
+    int n = (int)(200000 * test_intensity());
+    chi_square_check("cosine hemisphere", bsdf_pdf_cb, bsdf_sample_cb,
+                     &(bsdf_case){ .bsdf = { .diffuse = drift_vec3_splat(1),
+                                             .frame = drift_frame_from_normal(drift_vec3_make(0, 0, 1)) },
+                                   .wo = drift_vec3_make(0, 0, 1) },
+                     n);
+}
+
+// --- ENERGY ---
+
+static void test_sampling_bsdf_albedo_is_at_most_one(void **state)
+{
+    (void)state;
+    const float exponents[] = { 1.0f, 10.0f, 100.0f, 1000.0f };
+    for (int e = 0; e < 4; ++e) {
+        for (float theta = 0.0f; theta < 1.55f; theta += 0.3f) {
+            bsdf_case c = make_case(drift_vec3_splat(0.5f), drift_vec3_splat(0.5f), exponents[e], theta);
+            double albedo = 0.0;
+            const int n = 20000;
+            for (int i = 0; i < n; ++i) {
+                drift_sampler s = drift_sampler_make(5, 9, (uint32_t)i);
+                drift_vec2 u = drift_sampler_next2(&s);
+                drift_bsdf_sample bs = drift_bsdf_sample_wi(&c.bsdf, c.wo, drift_sampler_next1(&s), u);
+                if (bs.pdf > 0.0f) {
+                    albedo += (double)bs.weight.x;
+                }
+            }
+            albedo /= n;
+            assert_true(albedo <= 1.0 + 0.01);
+            if (theta == 0.0f) {
+                // At normal incidence the normalized lobe reflects exactly ks.
+                if (fabs(albedo - 1.0) > 0.01) {
+                    fail_msg("albedo at normal incidence %.4f, expected 1 (n=%g)", albedo,
+                             (double)exponents[e]);
+                }
+            }
+        }
+    }
+}
+
+// --- LIGHTS ---
+
+static drift_scene *light_scene(drift_context *ctx, const drift_light *light)
+{
+    drift_scene *scene = NULL;
+    assert_int_equal(drift_scene_create(ctx, &scene), DRIFT_OK);
+    assert_int_equal(drift_scene_add_light(scene, light, NULL), DRIFT_OK);
+    assert_int_equal(drift_scene_commit(scene), DRIFT_OK);
+    return scene;
+}
+
+// Irradiance at `ref` (normal +y) by light sampling alone.
+static double estimate_irradiance(const drift_scene *scene, drift_vec3 ref, int n)
+{
+    double e = 0.0;
+    for (int i = 0; i < n; ++i) {
+        drift_sampler s = drift_sampler_make(1, 2, (uint32_t)i);
+        drift_light_sample ls = drift_light_sample_li(scene, 0, ref, drift_sampler_next2(&s));
+        if (ls.pdf > 0.0f && ls.wi.y > 0.0f) {
+            e += (double)(ls.radiance.x * ls.wi.y / ls.pdf);
+        }
+    }
+    return e / n;
+}
+
+static void test_sampling_sphere_light_irradiance_closed_form(void **state)
+{
+    (void)state;
+    drift_context *ctx = test_context(1, NULL);
+    const double radius = 0.5, height = 3.0, radiance = 2.0;
+    drift_scene *scene = light_scene(ctx, &(drift_light){ .type = DRIFT_LIGHT_SPHERE,
+                                                          .position = { 0, (float)height, 0 },
+                                                          .radius = (float)radius,
+                                                          .color = drift_vec3_splat((float)radiance) });
+    // A sphere wholly above the horizon, centred on the normal: E = pi L (r / d)^2.
+    double expected = M_PI * radiance * (radius / height) * (radius / height);
+    double e = estimate_irradiance(scene, drift_vec3_make(0, 0, 0), 4096);
+    assert_true(fabs(e - expected) < 0.002 * expected);
+    drift_scene_destroy(scene);
+    drift_context_destroy(ctx);
+}
+
+static void test_sampling_disk_light_irradiance_closed_form(void **state)
+{
+    (void)state;
+    drift_context *ctx = test_context(1, NULL);
+    const double radius = 1.5, height = 2.0, radiance = 3.0;
+    drift_scene *scene = light_scene(ctx, &(drift_light){ .type = DRIFT_LIGHT_DISK,
+                                                          .position = { 0, (float)height, 0 },
+                                                          .direction = { 0, -1, 0 },
+                                                          .radius = (float)radius,
+                                                          .color = drift_vec3_splat((float)radiance) });
+    // Coaxial, parallel disk: E = pi L R^2 / (h^2 + R^2).
+    double expected = M_PI * radiance * radius * radius / (height * height + radius * radius);
+    double e = estimate_irradiance(scene, drift_vec3_make(0, 0, 0), 4096);
+    if (fabs(e - expected) > 0.005 * expected) {
+        fail_msg("disk irradiance %.5f, closed form %.5f", e, expected);
+    }
+    drift_scene_destroy(scene);
+    drift_context_destroy(ctx);
+}
+
+static void test_sampling_quad_light_irradiance_closed_form(void **state)
+{
+    (void)state;
+    drift_context *ctx = test_context(1, NULL);
+    // Square of side 2a centred above the point at height h, facing down. The form factor of
+    // a rectangle to a parallel point on its corner normal, summed over 4 quadrants.
+    const double a = 1.0, h = 1.5, radiance = 1.0;
+    drift_scene *scene = light_scene(ctx, &(drift_light){ .type = DRIFT_LIGHT_QUAD,
+                                                          .position = { (float)-a, (float)h, (float)-a },
+                                                          .edge_u = { (float)(2 * a), 0, 0 },
+                                                          .edge_v = { 0, 0, (float)(2 * a) },
+                                                          .color = drift_vec3_splat((float)radiance) });
+    double x = a / h, y = a / h;
+    double f = 1.0 / (2.0 * M_PI) *
+               (x / sqrt(1 + x * x) * atan(y / sqrt(1 + x * x)) +
+                y / sqrt(1 + y * y) * atan(x / sqrt(1 + y * y)));
+    double expected = 4.0 * f * M_PI * radiance;
+    double e = estimate_irradiance(scene, drift_vec3_make(0, 0, 0), 8192);
+    if (fabs(e - expected) > 0.005 * expected) {
+        fail_msg("quad irradiance %.5f, closed form %.5f", e, expected);
+    }
+    drift_scene_destroy(scene);
+    drift_context_destroy(ctx);
+}
+
+// The pdf a light's sampler reports equals drift_light_pdf_li for that direction (MIS needs
+// the two to agree).
+static void test_sampling_light_pdf_matches_sample(void **state)
+{
+    (void)state;
+    drift_context *ctx = test_context(1, NULL);
+    const drift_light lights[] = {
+        { .type = DRIFT_LIGHT_SPHERE, .position = { 0.3f, 2, 0 }, .radius = 0.7f, .color = { 1, 1, 1 } },
+        { .type = DRIFT_LIGHT_DISK, .position = { 0, 2, 0.5f }, .direction = { 0.2f, -1, 0 }, .radius = 0.5f, .color = { 1, 1, 1 } },
+        { .type = DRIFT_LIGHT_QUAD, .position = { -1, 2, -1 }, .edge_u = { 2, 0.3f, 0 }, .edge_v = { 0, 0, 2 }, .color = { 1, 1, 1 } },
+    };
+    for (int i = 0; i < 3; ++i) {
+        drift_scene *scene = light_scene(ctx, &lights[i]);
+        for (uint32_t k = 0; k < 200; ++k) {
+            drift_sampler s = drift_sampler_make(4, (uint32_t)i, k);
+            drift_light_sample ls = drift_light_sample_li(scene, 0, drift_vec3_make(0, 0, 0),
+                                                          drift_sampler_next2(&s));
+            if (!(ls.pdf > 0.0f)) {
+                continue;
+            }
+            float pdf = drift_light_pdf_li(scene, 0, drift_vec3_make(0, 0, 0), ls.wi, ls.distance,
+                                           ls.light_normal);
+            assert_true(fabsf(pdf - ls.pdf) <= 1e-3f * ls.pdf);
+        }
+        drift_scene_destroy(scene);
+    }
+    drift_context_destroy(ctx);
+}
+
+static void test_sampling_light_pick_follows_power(void **state)
+{
+    (void)state;
+    drift_context *ctx = test_context(1, NULL);
+    drift_scene *scene = NULL;
+    assert_int_equal(drift_scene_create(ctx, &scene), DRIFT_OK);
+    drift_light a = { .type = DRIFT_LIGHT_POINT, .color = { 1, 1, 1 } };
+    drift_light b = { .type = DRIFT_LIGHT_POINT, .position = { 1, 0, 0 }, .color = { 3, 3, 3 } };
+    assert_int_equal(drift_scene_add_light(scene, &a, NULL), DRIFT_OK);
+    assert_int_equal(drift_scene_add_light(scene, &b, NULL), DRIFT_OK);
+    assert_int_equal(drift_scene_commit(scene), DRIFT_OK);
+    assert_float_equal(drift_scene_light_pmf(scene, 0), 0.25f, 1e-5f);
+    assert_float_equal(drift_scene_light_pmf(scene, 1), 0.75f, 1e-5f);
+    float pmf;
+    assert_int_equal(drift_scene_pick_light(scene, 0.1f, &pmf), 0);
+    assert_int_equal(drift_scene_pick_light(scene, 0.3f, &pmf), 1);
+    assert_float_equal(pmf, 0.75f, 1e-5f);
+    drift_scene_destroy(scene);
+    drift_context_destroy(ctx);
+}
+
+// --- ENVIRONMENT ---
+
+static void test_sampling_environment_pdf_integrates_to_one(void **state)
+{
+    (void)state;
+    drift_context *ctx = test_context(1, NULL);
+    drift_scene *scene = NULL;
+    assert_int_equal(drift_scene_create(ctx, &scene), DRIFT_OK);
+    drift_image map;
+    assert_int_equal(drift_image_create(ctx, 32, 16, 3, &map), DRIFT_OK);
+    for (int y = 0; y < 16; ++y) {
+        for (int x = 0; x < 32; ++x) {
+            float v = (x == 5 && y == 4) ? 50.0f : 0.1f + 0.05f * (float)((x * 7 + y * 3) % 5);
+            float *p = drift_image_pixel(&map, x, y);
+            p[0] = p[1] = p[2] = v;
+        }
+    }
+    uint32_t tex;
+    assert_int_equal(drift_scene_add_texture(scene, map, &tex), DRIFT_OK);
+    scene->environment = (drift_environment){ .color = { 1, 1, 1 }, .texture = tex };
+    assert_int_equal(drift_scene_commit(scene), DRIFT_OK);
+    // Integral of the pdf over the sphere by a fine midpoint rule in (cos theta, phi).
+    double integral = 0.0;
+    const int nt = 400, np = 800;
+    for (int i = 0; i < nt; ++i) {
+        for (int j = 0; j < np; ++j) {
+            double ct = -1.0 + (i + 0.5) * 2.0 / nt, phi = (j + 0.5) * 2.0 * M_PI / np;
+            integral += (double)drift_environment_pdf(scene, sphere_dir(ct, phi)) *
+                        (2.0 / nt) * (2.0 * M_PI / np);
+        }
+    }
+    if (fabs(integral - 1.0) > 0.01) {
+        fail_msg("environment pdf integrates to %.4f", integral);
+    }
+    // Sampled directions report the pdf the evaluator gives, and the bright texel is favoured.
+    int bright = 0;
+    for (uint32_t k = 0; k < 2000; ++k) {
+        drift_sampler s = drift_sampler_make(2, 0, k);
+        drift_light_sample ls = drift_environment_sample(scene, drift_sampler_next2(&s));
+        assert_true(ls.pdf > 0.0f);
+        float pdf = drift_environment_pdf(scene, ls.wi);
+        assert_true(fabsf(pdf - ls.pdf) <= 1e-3f * ls.pdf + 1e-6f);
+        bright += ls.radiance.x > 10.0f;
+    }
+    assert_true(bright > 200);
+    drift_scene_destroy(scene);
+    drift_context_destroy(ctx);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_sampling_sampler_is_deterministic_and_in_range),
+        cmocka_unit_test(test_sampling_sampler_is_stratified),
+        cmocka_unit_test(test_sampling_warps_match_their_pdfs),
+        cmocka_unit_test(test_sampling_chi_square_detects_a_wrong_pdf),
+        cmocka_unit_test(test_sampling_bsdf_chi_square),
+        cmocka_unit_test(test_sampling_bsdf_albedo_is_at_most_one),
+        cmocka_unit_test(test_sampling_sphere_light_irradiance_closed_form),
+        cmocka_unit_test(test_sampling_disk_light_irradiance_closed_form),
+        cmocka_unit_test(test_sampling_quad_light_irradiance_closed_form),
+        cmocka_unit_test(test_sampling_light_pdf_matches_sample),
+        cmocka_unit_test(test_sampling_light_pick_follows_power),
+        cmocka_unit_test(test_sampling_environment_pdf_integrates_to_one),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
