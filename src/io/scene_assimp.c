@@ -1,0 +1,529 @@
+// Mesh files through assimp (.obj, .gltf, .glb, .ply, and those gzipped): meshes with the
+// node graph's transforms applied, materials, punctual lights and the first camera.
+//
+// Normals: the file's normals are kept; none are generated, so a file without them is
+// shaded flat (right for boxes like the Cornell box). UVs are kept as the file has them.
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include <assimp/cimport.h>
+#include <assimp/material.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include "scene_io_internal.h"
+
+// Row-major 4x4 affine transforms (the layout of aiMatrix4x4 and of the JSON "matrix").
+typedef struct mat4 {
+    float m[16];
+} mat4;
+
+static mat4 mat4_identity(void)
+{
+    return (mat4){ { 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1 } };
+}
+
+static mat4 mat4_mul(const mat4 *a, const mat4 *b)
+{
+    mat4 r;
+    for (int i = 0; i < 4; ++i) {
+        for (int j = 0; j < 4; ++j) {
+            float s = 0.0f;
+            for (int k = 0; k < 4; ++k) {
+                s += a->m[4 * i + k] * b->m[4 * k + j];
+            }
+            r.m[4 * i + j] = s;
+        }
+    }
+    return r;
+}
+
+static mat4 mat4_from_ai(const struct aiMatrix4x4 *a)
+{
+    return (mat4){ { a->a1, a->a2, a->a3, a->a4, a->b1, a->b2, a->b3, a->b4, a->c1, a->c2, a->c3,
+                     a->c4, a->d1, a->d2, a->d3, a->d4 } };
+}
+
+static drift_vec3 transform_point(const mat4 *t, drift_vec3 p)
+{
+    const float *m = t->m;
+    return drift_vec3_make(m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3],
+                           m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7],
+                           m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]);
+}
+
+static drift_vec3 transform_vector(const mat4 *t, drift_vec3 v)
+{
+    const float *m = t->m;
+    return drift_vec3_make(m[0] * v.x + m[1] * v.y + m[2] * v.z,
+                           m[4] * v.x + m[5] * v.y + m[6] * v.z,
+                           m[8] * v.x + m[9] * v.y + m[10] * v.z);
+}
+
+static float mat3_determinant(const mat4 *t)
+{
+    const float *m = t->m;
+    return m[0] * (m[5] * m[10] - m[6] * m[9]) - m[1] * (m[4] * m[10] - m[6] * m[8]) +
+           m[2] * (m[4] * m[9] - m[5] * m[8]);
+}
+
+// Cofactor matrix of the upper 3x3 (= det * inverse transpose): maps normals up to scale.
+static void mat3_cofactor(const mat4 *t, float c[9])
+{
+    const float *m = t->m;
+    c[0] = m[5] * m[10] - m[6] * m[9];
+    c[1] = m[6] * m[8] - m[4] * m[10];
+    c[2] = m[4] * m[9] - m[5] * m[8];
+    c[3] = m[2] * m[9] - m[1] * m[10];
+    c[4] = m[0] * m[10] - m[2] * m[8];
+    c[5] = m[1] * m[8] - m[0] * m[9];
+    c[6] = m[1] * m[6] - m[2] * m[5];
+    c[7] = m[2] * m[4] - m[0] * m[6];
+    c[8] = m[0] * m[5] - m[1] * m[4];
+}
+
+typedef struct import_state {
+    drift_scene *scene;
+    drift_context *ctx;
+    const struct aiScene *ai;
+    const drift__import_params *params;
+    const char *where;
+    int line;
+    char dir[DRIFT__PATH_MAX]; // folder of the mesh file, for texture paths
+    const char *base_name;     // file name without folder, for unnamed meshes and materials
+    uint32_t *material_map;    // assimp material -> drift material
+    bool *light_placed;        // assimp light already added through its node
+    drift__import_info *info;
+} import_state;
+
+static void ai_name(const struct aiString *s, char *out, size_t out_size)
+{
+    size_t n = s->length < out_size - 1 ? s->length : out_size - 1;
+    memcpy(out, s->data, n);
+    out[n] = '\0';
+}
+
+static drift_vec3 ai_color3(const struct aiMaterial *mat, const char *key, unsigned type,
+                            unsigned index, bool *found)
+{
+    struct aiColor4D c;
+    if (aiGetMaterialColor(mat, key, type, index, &c) == AI_SUCCESS) {
+        *found = true;
+        return drift_vec3_make(c.r, c.g, c.b);
+    }
+    *found = false;
+    return drift_vec3_splat(0.0f);
+}
+
+// Loads the diffuse texture of `mat`, if any. A texture that cannot be loaded is a
+// warning: the material keeps its colour, as viewers do.
+static void material_texture(import_state *s, const struct aiMaterial *mat, drift_material *m)
+{
+    struct aiString tex;
+    enum aiTextureType types[2] = { aiTextureType_DIFFUSE, aiTextureType_BASE_COLOR };
+    for (int t = 0; t < 2; ++t) {
+        if (aiGetMaterialTexture(mat, types[t], 0, &tex, NULL, NULL, NULL, NULL, NULL, NULL) !=
+            AI_SUCCESS) {
+            continue;
+        }
+        char rel[DRIFT__PATH_MAX];
+        ai_name(&tex, rel, sizeof(rel));
+        if (rel[0] == '*' || rel[0] == '\0') {
+            drift_log(s->ctx, DRIFT_LOG_WARNING, DRIFT_ERR_UNSUPPORTED, s->where, s->line,
+                      "material '%s': embedded textures are not supported; ignored", m->name);
+            return;
+        }
+        // Files written on Windows use backslashes.
+        for (char *c = rel; *c; ++c) {
+            if (*c == '\\') {
+                *c = '/';
+            }
+        }
+        char full[DRIFT__PATH_MAX];
+        uint32_t index;
+        if (!drift__path_join(s->dir, rel, full, sizeof(full)) ||
+            drift__texture_cache_get(s->scene, s->params->textures, full, s->where, s->line,
+                                     &index) != DRIFT_OK) {
+            drift_log(s->ctx, DRIFT_LOG_WARNING, DRIFT_ERR_IO, s->where, s->line,
+                      "material '%s': texture '%s' not loaded; using its colour", m->name, rel);
+            return;
+        }
+        m->diffuse_texture = index;
+        // A texture multiplies the diffuse colour; a black Kd would hide it.
+        if (drift_vec3_is_zero(m->diffuse)) {
+            m->diffuse = drift_vec3_splat(1.0f);
+        }
+        return;
+    }
+}
+
+static drift_result convert_materials(import_state *s)
+{
+    const struct aiScene *ai = s->ai;
+    for (unsigned i = 0; i < ai->mNumMaterials; ++i) {
+        const struct aiMaterial *mat = ai->mMaterials[i];
+        drift_material m = drift_material_make(drift_vec3_splat(0.5f));
+        struct aiString name;
+        if (aiGetMaterialString(mat, AI_MATKEY_NAME, &name) == AI_SUCCESS) {
+            ai_name(&name, m.name, sizeof(m.name));
+        }
+        if (!m.name[0]) {
+            snprintf(m.name, sizeof(m.name), "%s#material%u", s->base_name, i);
+        }
+        bool found;
+        drift_vec3 kd = ai_color3(mat, AI_MATKEY_COLOR_DIFFUSE, &found);
+        if (!found) {
+            kd = ai_color3(mat, AI_MATKEY_BASE_COLOR, &found);
+        }
+        if (found) {
+            m.diffuse = kd;
+        }
+        m.specular = ai_color3(mat, AI_MATKEY_COLOR_SPECULAR, &found);
+        float shininess = 0.0f;
+        if (aiGetMaterialFloatArray(mat, AI_MATKEY_SHININESS, &shininess, NULL) == AI_SUCCESS) {
+            // MTL Ns is the Phong exponent; drift's glossy lobe is normalized Phong.
+            m.exponent = shininess;
+        }
+        if (!drift_vec3_is_zero(m.specular) && !(m.exponent > 0.0f)) {
+            // Common (PLY default materials, MTL without Ns), so not worth a warning.
+            drift_log(s->ctx, DRIFT_LOG_INFO, DRIFT_ERR_INVALID_ARGUMENT, s->where, s->line,
+                      "material '%s' has a specular colour but no exponent; specular dropped",
+                      m.name);
+            m.specular = drift_vec3_splat(0.0f);
+            m.exponent = 0.0f;
+        }
+        m.emission = ai_color3(mat, AI_MATKEY_COLOR_EMISSIVE, &found);
+        float strength = 1.0f;
+        if (aiGetMaterialFloatArray(mat, AI_MATKEY_EMISSIVE_INTENSITY, &strength, NULL) ==
+            AI_SUCCESS) {
+            m.emission = drift_vec3_scale(m.emission, strength);
+        }
+        material_texture(s, mat, &m);
+        uint32_t index;
+        drift_result r = drift_scene_add_material(s->scene, &m, &index);
+        if (r != DRIFT_OK) {
+            drift_log(s->ctx, DRIFT_LOG_ERROR, r, s->where, s->line,
+                      "material '%s' of '%s' is not valid", m.name, s->params->path);
+            return r;
+        }
+        s->material_map[i] = index;
+        if (!drift_vec3_is_zero(m.emission) && s->params->material_override == DRIFT_INVALID_INDEX) {
+            s->info->emissive_material_count++;
+        }
+    }
+    return DRIFT_OK;
+}
+
+static drift_result add_mesh(import_state *s, const struct aiMesh *mesh, const mat4 *world,
+                             const char *node_name)
+{
+    drift_context *ctx = s->ctx;
+    if (!(mesh->mPrimitiveTypes & aiPrimitiveType_TRIANGLE) || mesh->mNumVertices == 0) {
+        return DRIFT_OK; // points and lines have no surface to render
+    }
+    uint32_t tri_count = 0;
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+        tri_count += mesh->mFaces[f].mNumIndices == 3;
+    }
+    if (tri_count == 0) {
+        return DRIFT_OK;
+    }
+    size_t nv = mesh->mNumVertices;
+    float *positions = drift_alloc(ctx, nv * 3 * sizeof(float));
+    float *normals = mesh->mNormals ? drift_alloc(ctx, nv * 3 * sizeof(float)) : NULL;
+    float *uvs = mesh->mTextureCoords[0] ? drift_alloc(ctx, nv * 2 * sizeof(float)) : NULL;
+    uint32_t *indices = drift_alloc(ctx, (size_t)tri_count * 3 * sizeof(uint32_t));
+    drift_result r = DRIFT_OK;
+    if (!positions || !indices || (mesh->mNormals && !normals) ||
+        (mesh->mTextureCoords[0] && !uvs)) {
+        r = DRIFT_ERR_OUT_OF_MEMORY;
+        goto done;
+    }
+    float det = mat3_determinant(world);
+    float cof[9];
+    mat3_cofactor(world, cof);
+    float normal_sign = det < 0.0f ? -1.0f : 1.0f;
+    for (size_t v = 0; v < nv; ++v) {
+        const struct aiVector3D *p = &mesh->mVertices[v];
+        drift_vec3 q = transform_point(world, drift_vec3_make(p->x, p->y, p->z));
+        positions[3 * v] = q.x;
+        positions[3 * v + 1] = q.y;
+        positions[3 * v + 2] = q.z;
+        if (normals) {
+            const struct aiVector3D *n = &mesh->mNormals[v];
+            for (int k = 0; k < 3; ++k) {
+                normals[3 * v + (size_t)k] =
+                    normal_sign * (cof[3 * k] * n->x + cof[3 * k + 1] * n->y + cof[3 * k + 2] * n->z);
+            }
+        }
+        if (uvs) {
+            uvs[2 * v] = mesh->mTextureCoords[0][v].x;
+            uvs[2 * v + 1] = mesh->mTextureCoords[0][v].y;
+        }
+    }
+    // A mirroring transform reverses the winding; swap two corners to keep faces facing out.
+    bool flip = det < 0.0f;
+    size_t t = 0;
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+        const struct aiFace *face = &mesh->mFaces[f];
+        if (face->mNumIndices != 3) {
+            continue;
+        }
+        indices[3 * t] = face->mIndices[0];
+        indices[3 * t + 1] = face->mIndices[flip ? 2 : 1];
+        indices[3 * t + 2] = face->mIndices[flip ? 1 : 2];
+        t++;
+    }
+    uint32_t material = s->params->material_override;
+    if (material == DRIFT_INVALID_INDEX) {
+        if (mesh->mMaterialIndex >= s->ai->mNumMaterials) {
+            drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, s->where, s->line,
+                      "'%s': mesh refers to material %u of %u", s->params->path,
+                      mesh->mMaterialIndex, s->ai->mNumMaterials);
+            r = DRIFT_ERR_PARSE;
+            goto done;
+        }
+        material = s->material_map[mesh->mMaterialIndex];
+    }
+    char name[DRIFT_NAME_MAX];
+    ai_name(&mesh->mName, name, sizeof(name));
+    if (!name[0]) {
+        snprintf(name, sizeof(name), "%s", node_name[0] ? node_name : s->base_name);
+    }
+    drift_mesh_desc desc = { .name = name,
+                             .positions = positions,
+                             .normals = normals,
+                             .uvs = uvs,
+                             .indices = indices,
+                             .vertex_count = (uint32_t)nv,
+                             .triangle_count = tri_count,
+                             .material = material };
+    r = drift_scene_add_mesh(s->scene, &desc, NULL);
+    if (r != DRIFT_OK) {
+        drift_log(ctx, DRIFT_LOG_ERROR, r, s->where, s->line, "mesh '%s' of '%s' is not valid",
+                  name, s->params->path);
+        goto done;
+    }
+    s->info->mesh_count++;
+done:
+    drift_free(ctx, positions);
+    drift_free(ctx, normals);
+    drift_free(ctx, uvs);
+    drift_free(ctx, indices);
+    return r;
+}
+
+static drift_result add_light(import_state *s, const struct aiLight *l, const mat4 *world)
+{
+    drift_light light = { 0 };
+    drift_vec3 position = transform_point(world, drift_vec3_make(l->mPosition.x, l->mPosition.y,
+                                                                 l->mPosition.z));
+    drift_vec3 direction = drift_vec3_normalize(transform_vector(
+        world, drift_vec3_make(l->mDirection.x, l->mDirection.y, l->mDirection.z)));
+    light.color = drift_vec3_make(l->mColorDiffuse.r, l->mColorDiffuse.g, l->mColorDiffuse.b);
+    char name[DRIFT_NAME_MAX];
+    ai_name(&l->mName, name, sizeof(name));
+    switch (l->mType) {
+    case aiLightSource_POINT:
+        light.type = DRIFT_LIGHT_POINT;
+        light.position = position;
+        break;
+    case aiLightSource_SPOT:
+        light.type = DRIFT_LIGHT_SPOT;
+        light.position = position;
+        light.direction = direction;
+        // glTF (KHR_lights_punctual) cone angles arrive as half angles, measured from the axis.
+        light.spot_outer = l->mAngleOuterCone > 0.0f && l->mAngleOuterCone <= DRIFT_PI
+                               ? l->mAngleOuterCone
+                               : DRIFT_PI / 4.0f;
+        light.spot_inner = drift_clampf(l->mAngleInnerCone, 0.0f, light.spot_outer);
+        break;
+    case aiLightSource_DIRECTIONAL:
+        light.type = DRIFT_LIGHT_DIRECTIONAL;
+        light.direction = direction;
+        break;
+    case aiLightSource_AMBIENT:
+        s->scene->environment.color = drift_vec3_add(s->scene->environment.color, light.color);
+        s->info->light_count++;
+        return DRIFT_OK;
+    default:
+        drift_log(s->ctx, DRIFT_LOG_WARNING, DRIFT_ERR_UNSUPPORTED, s->where, s->line,
+                  "'%s': light '%s' has an unsupported type; ignored", s->params->path, name);
+        return DRIFT_OK;
+    }
+    drift_result r = drift_scene_add_light(s->scene, &light, NULL);
+    if (r != DRIFT_OK) {
+        drift_log(s->ctx, DRIFT_LOG_ERROR, r, s->where, s->line, "light '%s' of '%s' is not valid",
+                  name, s->params->path);
+        return r;
+    }
+    s->info->light_count++;
+    return DRIFT_OK;
+}
+
+static void set_camera(import_state *s, const struct aiCamera *cam, const mat4 *world)
+{
+    drift_vec3 eye = transform_point(world, drift_vec3_make(cam->mPosition.x, cam->mPosition.y,
+                                                            cam->mPosition.z));
+    drift_vec3 look = drift_vec3_normalize(
+        transform_vector(world, drift_vec3_make(cam->mLookAt.x, cam->mLookAt.y, cam->mLookAt.z)));
+    drift_vec3 up = drift_vec3_normalize(
+        transform_vector(world, drift_vec3_make(cam->mUp.x, cam->mUp.y, cam->mUp.z)));
+    float aspect = cam->mAspect > 0.0f && isfinite(cam->mAspect) ? cam->mAspect : 1.0f;
+    // assimp stores the full horizontal field of view (its glTF importer computes
+    // 2 atan(aspect tan(yfov / 2))); drift wants the vertical one.
+    float fov_x = cam->mHorizontalFOV;
+    float fov_y = 2.0f * atanf(tanf(0.5f * fov_x) / aspect);
+    if (!(fov_y > 0.0f && fov_y < DRIFT_PI)) {
+        fov_y = 45.0f * DRIFT_PI / 180.0f;
+    }
+    int32_t height = 512;
+    int32_t width = (int32_t)lroundf(drift_clampf(512.0f * aspect, 1.0f, 8192.0f));
+    s->info->camera = drift_camera_look_at(eye, drift_vec3_add(eye, look), up, fov_y, width, height);
+    s->info->has_camera = true;
+}
+
+static drift_result walk_nodes(import_state *s, const struct aiNode *node, const mat4 *parent,
+                               int depth)
+{
+    if (depth > DRIFT__SCENE_MAX_NODE_DEPTH) {
+        drift_log(s->ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, s->where, s->line,
+                  "'%s': node graph is deeper than %d", s->params->path,
+                  DRIFT__SCENE_MAX_NODE_DEPTH);
+        return DRIFT_ERR_PARSE;
+    }
+    mat4 local = mat4_from_ai(&node->mTransformation);
+    mat4 world = mat4_mul(parent, &local);
+    char node_name[DRIFT_NAME_MAX];
+    ai_name(&node->mName, node_name, sizeof(node_name));
+    for (unsigned i = 0; i < node->mNumMeshes; ++i) {
+        unsigned mi = node->mMeshes[i];
+        if (mi >= s->ai->mNumMeshes) {
+            continue; // aiProcess_ValidateDataStructure rejects this; stay safe anyway
+        }
+        drift_result r = add_mesh(s, s->ai->mMeshes[mi], &world, node_name);
+        if (r != DRIFT_OK) {
+            return r;
+        }
+    }
+    // Cameras and lights are tied to the node of the same name.
+    if (!s->info->has_camera && s->ai->mNumCameras > 0 &&
+        strcmp(s->ai->mCameras[0]->mName.data, node->mName.data) == 0) {
+        set_camera(s, s->ai->mCameras[0], &world);
+    }
+    for (unsigned i = 0; i < s->ai->mNumLights; ++i) {
+        const struct aiLight *l = s->ai->mLights[i];
+        if (!s->light_placed[i] && strcmp(l->mName.data, node->mName.data) == 0) {
+            s->light_placed[i] = true;
+            drift_result r = add_light(s, l, &world);
+            if (r != DRIFT_OK) {
+                return r;
+            }
+        }
+    }
+    for (unsigned c = 0; c < node->mNumChildren; ++c) {
+        drift_result r = walk_nodes(s, node->mChildren[c], &world, depth + 1);
+        if (r != DRIFT_OK) {
+            return r;
+        }
+    }
+    return DRIFT_OK;
+}
+
+static drift_result import_scene(import_state *s)
+{
+    const struct aiScene *ai = s->ai;
+    drift_context *ctx = s->ctx;
+    mat4 root = mat4_identity();
+    if (s->params->transform) {
+        memcpy(root.m, s->params->transform, sizeof(root.m));
+    }
+    drift_result r = DRIFT_OK;
+    s->material_map = drift_alloc(ctx, ((size_t)ai->mNumMaterials + 1) * sizeof(uint32_t));
+    s->light_placed = drift_alloc(ctx, ((size_t)ai->mNumLights + 1) * sizeof(bool));
+    if (!s->material_map || !s->light_placed) {
+        r = DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    if (r == DRIFT_OK) {
+        r = convert_materials(s);
+    }
+    if (r == DRIFT_OK && ai->mRootNode) {
+        r = walk_nodes(s, ai->mRootNode, &root, 0);
+    }
+    // Lights no node names are in world space already.
+    for (unsigned i = 0; r == DRIFT_OK && i < ai->mNumLights; ++i) {
+        if (!s->light_placed[i]) {
+            r = add_light(s, ai->mLights[i], &root);
+        }
+    }
+    if (r == DRIFT_OK && s->info->mesh_count == 0) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, s->where, s->line,
+                  "'%s' has no triangles", s->params->path);
+        r = DRIFT_ERR_PARSE;
+    }
+    drift_free(ctx, s->material_map);
+    drift_free(ctx, s->light_placed);
+    return r;
+}
+
+drift_result drift__scene_import_mesh_file(drift_scene *scene, const drift__import_params *params,
+                                           drift__import_info *out_info)
+{
+    drift_context *ctx = scene->ctx;
+    *out_info = (drift__import_info){ 0 };
+    import_state s = { .scene = scene,
+                       .ctx = ctx,
+                       .params = params,
+                       .where = params->where ? params->where : params->path,
+                       .line = params->line,
+                       .info = out_info };
+    const char *slash = strrchr(params->path, '/');
+    s.base_name = slash ? slash + 1 : params->path;
+    if (slash) {
+        snprintf(s.dir, sizeof(s.dir), "%.*s", (int)(slash - params->path), params->path);
+    }
+    if (slash == params->path) {
+        snprintf(s.dir, sizeof(s.dir), "/");
+    }
+    char ext[16];
+    bool gz = false;
+    drift__path_extension(params->path, ext, sizeof(ext), &gz);
+
+    // Triangulate quads and polygons, share vertices, split point/line primitives away from
+    // triangles, and let assimp reject out-of-range indices. No normal generation: see top.
+    const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                           aiProcess_SortByPType | aiProcess_ValidateDataStructure;
+    char *data = NULL;
+    size_t size = 0;
+    // Plain files go to assimp by name so that it finds their side files.
+    drift_result r = gz ? drift__read_file(ctx, params->path, true, s.where, s.line, &data, &size)
+                        : drift__check_file(ctx, params->path, s.where, s.line, &size);
+    if (r != DRIFT_OK) {
+        return r;
+    }
+    if (size == 0) {
+        drift_free(ctx, data);
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, s.where, s.line, "'%s' is empty",
+                  params->path);
+        return DRIFT_ERR_PARSE;
+    }
+    const struct aiScene *ai = NULL;
+    if (gz) {
+        // From memory, assimp cannot open side files (an OBJ's .mtl, a glTF's .bin).
+        ai = aiImportFileFromMemory(data, (unsigned)size, flags, ext);
+    } else {
+        ai = aiImportFile(params->path, flags);
+    }
+    drift_free(ctx, data);
+    if (!ai || !ai->mRootNode) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, s.where, s.line,
+                  "cannot read '%s': %s", params->path, ai ? "no scene" : aiGetErrorString());
+        aiReleaseImport(ai);
+        return DRIFT_ERR_PARSE;
+    }
+    s.ai = ai;
+    r = import_scene(&s);
+    aiReleaseImport(ai);
+    return r;
+}

@@ -1,0 +1,75 @@
+// Private to the scene loaders in src/io: what scene_load.c (dispatch, gzip, defaults),
+// scene_json.c and scene_assimp.c share.
+#ifndef DRIFT_SCENE_IO_INTERNAL_H
+#define DRIFT_SCENE_IO_INTERNAL_H
+
+#include "drift/scene.h"
+#include "drift/scene_io.h"
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+// Deepest assimp node graph walked (a guard against cycles and absurd files).
+#define DRIFT__SCENE_MAX_NODE_DEPTH 256
+#define DRIFT__PATH_MAX 4096
+
+// Textures loaded once per path while one scene loads.
+typedef struct drift__texture_cache {
+    char **paths;
+    uint32_t *indices;
+    uint32_t count;
+    uint32_t capacity;
+} drift__texture_cache;
+
+// Returns the scene texture index for the image at `path`, loading it on first use.
+// Errors are logged against (where, line).
+drift_result drift__texture_cache_get(drift_scene *scene, drift__texture_cache *cache,
+                                      const char *path, const char *where, int line,
+                                      uint32_t *out_index);
+void drift__texture_cache_clear(drift_context *ctx, drift__texture_cache *cache);
+
+// How to bring one mesh file into a scene.
+typedef struct drift__import_params {
+    const char *path;           // the mesh file
+    const char *where;          // file named in messages about this import (NULL: path)
+    int line;                   // line of `where` that asked for the import (0: none)
+    const float *transform;     // 4x4 row-major, applied after the file's own; NULL: identity
+    uint32_t material_override; // DRIFT_INVALID_INDEX: the file's materials
+    drift__texture_cache *textures;
+} drift__import_params;
+
+// What the import found besides geometry.
+typedef struct drift__import_info {
+    bool has_camera;
+    drift_camera camera; // the file's first camera (when has_camera)
+    uint32_t mesh_count, light_count, emissive_material_count;
+} drift__import_info;
+
+// Imports meshes, materials, lights and the first camera of a mesh file through assimp.
+drift_result drift__scene_import_mesh_file(drift_scene *scene, const drift__import_params *params,
+                                           drift__import_info *out_info);
+
+// Fails with DRIFT_ERR_IO unless path names a readable regular file (not a directory or a
+// device); *out_size gets its size in bytes.
+drift_result drift__check_file(drift_context *ctx, const char *path, const char *where, int line,
+                               size_t *out_size);
+
+// Reads a whole file into memory (gunzipped when gzip is true), NUL-terminated; size
+// excludes the terminator. Errors are logged against `where`/`line`.
+drift_result drift__read_file(drift_context *ctx, const char *path, bool gzip, const char *where,
+                              int line, char **out_data, size_t *out_size);
+
+// Lower-case extension of path without the dot ("" when none); with strip_gz, the extension
+// before a trailing ".gz". *out_gz tells whether the name ended in .gz.
+void drift__path_extension(const char *path, char *out, size_t out_size, bool *out_gz);
+
+// base_dir + "/" + relative (relative unchanged when absolute or base_dir is NULL/empty).
+bool drift__path_join(const char *base_dir, const char *relative, char *out, size_t out_size);
+
+// Bounds of all mesh vertices added so far.
+drift_bounds3 drift__scene_mesh_bounds(const drift_scene *scene);
+// The framing camera of a bare mesh file (see scene_io.h).
+drift_camera drift__framing_camera(drift_bounds3 bounds);
+
+#endif
