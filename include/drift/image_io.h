@@ -1,0 +1,78 @@
+// drift image_io: loading and saving images (OpenEXR, PNG, JPEG, Radiance HDR).
+//
+// Loading always produces linear float RGB: an image of 3 channels that the caller frees with
+// drift_image_destroy. Display-encoded 8- and 16-bit files (PNG, JPEG) are decoded with the
+// sRGB transfer curve; EXR and HDR files are taken as linear. Alpha is dropped (not
+// premultiplied in, not kept). Saving writes OpenEXR (float32, ZIP, any number of layers) or
+// a tone-mapped 8-bit sRGB PNG.
+//
+// Writers never leave a partial file behind: they write to a temporary file next to the
+// target ("<path>.tmp-XXXXXXXX") and rename() it over the target only when everything was
+// written; on failure the temporary file is removed and the target is untouched.
+//
+// STEP BY STEP
+//   drift_image img;
+//   if (drift_image_load(ctx, "render.exr", &img) != DRIFT_OK) { ... }   // detail in the log
+//   drift_image_layer layers[] = { { NULL, &img }, { "albedo", &albedo } };
+//   drift_image_save_exr(ctx, "out.exr", layers, 2);   // R,G,B + albedo.R, albedo.G, albedo.B
+//   drift_image_save_png(ctx, "out.png", &img, &(drift_tonemap_params){ .exposure_stops = 1 });
+//   drift_image_destroy(ctx, &img);
+//
+// Errors (every message names the path): DRIFT_ERR_IO (cannot open/read/write/rename),
+// DRIFT_ERR_PARSE (corrupt or truncated content), DRIFT_ERR_UNSUPPORTED (extension or
+// EXR feature such as deep data, subsampled channels, no colour channels),
+// DRIFT_ERR_INVALID_ARGUMENT (bad arguments, image over DRIFT_IMAGE_MAX_DIMENSION),
+// DRIFT_ERR_OUT_OF_MEMORY.
+//
+// Threads: all functions are thread-safe on distinct paths and images.
+#ifndef DRIFT_IMAGE_IO_H
+#define DRIFT_IMAGE_IO_H
+
+#include "drift/core.h"
+#include "drift/image.h"
+
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+// Loads an image by file extension (case-insensitive):
+//   .exr          OpenEXR (scanline or tiled, half/float/uint; level 0 of mip/rip maps). The
+//                 channels used are, in order of preference: the default layer's R,G,B; its Y
+//                 (grey, copied to R,G,B); the first named layer with .R,.G,.B (alphabetic).
+//                 Of a multi-part file the first part with such channels is read. The image
+//                 is the data window (its origin is dropped).
+//   .png          8- or 16-bit, grey or colour, sRGB-decoded to linear.
+//   .jpg, .jpeg   8-bit baseline/progressive, sRGB-decoded to linear.
+//   .hdr          Radiance RGBE, linear.
+// *out_image receives a 3-channel image owned by the caller (drift_image_destroy); it is
+// zeroed on failure. Sizes are checked against DRIFT_IMAGE_MAX_DIMENSION before allocating.
+drift_result drift_image_load(drift_context *ctx, const char *path, drift_image *out_image);
+
+// One layer of a multi-layer EXR. name NULL or "" is the default layer (plain channel names);
+// any other name prefixes the channels ("name.R"). Borrowed for the duration of the call.
+typedef struct drift_image_layer {
+    const char *name;
+    const drift_image *image;
+} drift_image_layer;
+
+// Writes a single-part scanline OpenEXR file with ZIP compression and float32 channels (so a
+// round trip is bit-exact). Channel names per image channel count: 1 -> Y, 2 -> Y,A,
+// 3 -> R,G,B, 4 -> R,G,B,A, prefixed by "name." for named layers. All layers must have the
+// same width and height; names must be unique and at most 200 bytes long, and at most one
+// layer may be the default one. Errors: DRIFT_ERR_INVALID_ARGUMENT, DRIFT_ERR_IO,
+// DRIFT_ERR_OUT_OF_MEMORY.
+drift_result drift_image_save_exr(drift_context *ctx, const char *path,
+                                  const drift_image_layer *layers, uint32_t layer_count);
+
+// Writes an 8-bit RGB PNG of the image tone-mapped by drift_image_tonemap (tonemap may be NULL:
+// defaults). 1-channel images are written grey in RGB; alpha is dropped. Errors:
+// DRIFT_ERR_INVALID_ARGUMENT, DRIFT_ERR_IO, DRIFT_ERR_OUT_OF_MEMORY.
+drift_result drift_image_save_png(drift_context *ctx, const char *path, const drift_image *image,
+                                  const drift_tonemap_params *tonemap);
+
+#ifdef __cplusplus
+}
+#endif
+#endif // DRIFT_IMAGE_IO_H

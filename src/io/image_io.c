@@ -1,0 +1,369 @@
+// Image file I/O front end: extension dispatch, whole-file reads, the stb back end (PNG, JPEG,
+// Radiance HDR) and the temp-file-then-rename protocol every writer follows.
+//
+// The stb implementation is not compiled here: Debian's libstb (pkg-config stb, -lstb) already
+// contains stb_image and stb_image_write, so only the declarations are included.
+#include "image_io_internal.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <stdio.h>
+#include <string.h>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <stb/stb_image.h>
+#include <stb/stb_image_write.h>
+
+#include "drift/math.h"
+
+typedef enum image_format {
+    FORMAT_UNKNOWN = 0,
+    FORMAT_EXR,
+    FORMAT_PNG,
+    FORMAT_JPEG,
+    FORMAT_HDR,
+} image_format;
+
+static int lower_ascii(int c)
+{
+    return c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c;
+}
+
+static bool extension_is(const char *ext, const char *want)
+{
+    for (; *ext && *want; ++ext, ++want) {
+        if (lower_ascii((unsigned char)*ext) != *want) {
+            return false;
+        }
+    }
+    return *ext == '\0' && *want == '\0';
+}
+
+static image_format format_from_path(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    const char *dot = strrchr(slash ? slash + 1 : path, '.');
+    if (!dot) {
+        return FORMAT_UNKNOWN;
+    }
+    const char *ext = dot + 1;
+    if (extension_is(ext, "exr")) {
+        return FORMAT_EXR;
+    }
+    if (extension_is(ext, "png")) {
+        return FORMAT_PNG;
+    }
+    if (extension_is(ext, "jpg") || extension_is(ext, "jpeg")) {
+        return FORMAT_JPEG;
+    }
+    if (extension_is(ext, "hdr")) {
+        return FORMAT_HDR;
+    }
+    return FORMAT_UNKNOWN;
+}
+
+static const char *errno_text(int err, char *buf, size_t cap)
+{
+    // XSI strerror_r (we build with _POSIX_C_SOURCE=200809L) fills buf and returns int;
+    // plain strerror is not thread-safe.
+    if (strerror_r(err, buf, cap) != 0) {
+        snprintf(buf, cap, "error %d", err);
+    }
+    return buf;
+}
+
+// --- WHOLE-FILE READS ---
+
+drift_result drift__image_read_file(drift_context *ctx, const char *path, uint8_t **out_data,
+                                    size_t *out_size)
+{
+    *out_data = NULL;
+    *out_size = 0;
+    char why[128];
+    int fd = open(path, O_RDONLY);
+    if (fd < 0) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, path, 0, "cannot open image: %s",
+                  errno_text(errno, why, sizeof(why)));
+        return DRIFT_ERR_IO;
+    }
+    struct stat st;
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, path, 0, "not a regular file");
+        close(fd);
+        return DRIFT_ERR_IO;
+    }
+    size_t size = (size_t)st.st_size;
+    // One extra byte so an empty file still gets a non-NULL buffer.
+    uint8_t *data = drift_alloc(ctx, size + 1);
+    if (!data) {
+        close(fd);
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    size_t done = 0;
+    while (done < size) {
+        ssize_t n = read(fd, data + done, size - done);
+        if (n < 0 && errno == EINTR) {
+            continue;
+        }
+        if (n <= 0) {
+            drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, path, 0, "read failed: %s",
+                      n < 0 ? errno_text(errno, why, sizeof(why)) : "file shrank while reading");
+            drift_free(ctx, data);
+            close(fd);
+            return DRIFT_ERR_IO;
+        }
+        done += (size_t)n;
+    }
+    close(fd);
+    *out_data = data;
+    *out_size = size;
+    return DRIFT_OK;
+}
+
+// --- TEMP FILE, THEN RENAME ---
+
+drift_result drift__image_temp_open(drift_context *ctx, const char *path, drift__image_temp *out)
+{
+    *out = (drift__image_temp){ .fd = -1, .path = path };
+    char why[128];
+    // The name only has to be unlikely to collide; O_EXCL makes a collision a retry, not a
+    // clobber. Keyed on time, pid and the address of *out so concurrent writers differ.
+    uint32_t key = drift_hash_combine((uint32_t)getpid(), (uint32_t)(uintptr_t)out);
+    key = drift_hash_combine(key, (uint32_t)(drift_time_now() * 1e9));
+    for (int attempt = 0; attempt < 64; ++attempt) {
+        uint32_t tag = drift_hash_combine(key, (uint32_t)attempt);
+        int n = snprintf(out->temp_path, sizeof(out->temp_path), "%s.tmp-%08x", path, tag);
+        if (n < 0 || (size_t)n >= sizeof(out->temp_path)) {
+            drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, path, 0, "path too long");
+            return DRIFT_ERR_IO;
+        }
+        int fd = open(out->temp_path, O_WRONLY | O_CREAT | O_EXCL, 0666);
+        if (fd >= 0) {
+            out->fd = fd;
+            return DRIFT_OK;
+        }
+        if (errno != EEXIST) {
+            break;
+        }
+    }
+    drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, path, 0, "cannot create file: %s",
+              errno_text(errno, why, sizeof(why)));
+    out->temp_path[0] = '\0';
+    return DRIFT_ERR_IO;
+}
+
+bool drift__image_temp_write(drift__image_temp *t, const void *data, size_t size, uint64_t offset)
+{
+    const uint8_t *p = data;
+    while (size > 0) {
+        ssize_t n = pwrite(t->fd, p, size, (off_t)offset);
+        if (n < 0 && errno == EINTR) {
+            continue;
+        }
+        if (n <= 0) {
+            if (n == 0) {
+                errno = EIO;
+            }
+            return false;
+        }
+        p += n;
+        size -= (size_t)n;
+        offset += (uint64_t)n;
+    }
+    return true;
+}
+
+drift_result drift__image_temp_close(drift_context *ctx, drift__image_temp *t, drift_result result)
+{
+    char why[128];
+    if (t->fd >= 0) {
+        // close() can report a delayed write error (NFS, full disk); it counts as a failure.
+        if (close(t->fd) != 0 && result == DRIFT_OK) {
+            drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, t->path, 0, "write failed: %s",
+                      errno_text(errno, why, sizeof(why)));
+            result = DRIFT_ERR_IO;
+        }
+        t->fd = -1;
+    }
+    if (result == DRIFT_OK && rename(t->temp_path, t->path) != 0) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, t->path, 0, "cannot rename %s: %s",
+                  t->temp_path, errno_text(errno, why, sizeof(why)));
+        result = DRIFT_ERR_IO;
+    }
+    if (result != DRIFT_OK && t->temp_path[0]) {
+        unlink(t->temp_path);
+    }
+    t->temp_path[0] = '\0';
+    return result;
+}
+
+// --- STB BACK END (PNG, JPEG, HDR) ---
+
+static drift_result stb_load(drift_context *ctx, const char *path, image_format format,
+                             const uint8_t *data, size_t size, drift_image *out_image)
+{
+    if (size > (size_t)INT_MAX) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_UNSUPPORTED, path, 0, "file over 2 GiB");
+        return DRIFT_ERR_UNSUPPORTED;
+    }
+    int len = (int)size;
+    int width = 0, height = 0, file_channels = 0;
+    // Header first, so the size is checked before stb allocates the pixels.
+    if (!stbi_info_from_memory(data, len, &width, &height, &file_channels)) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, path, 0, "not a readable image: %s",
+                  stbi_failure_reason() ? stbi_failure_reason() : "unknown format");
+        return DRIFT_ERR_PARSE;
+    }
+    if (width <= 0 || height <= 0 || width > DRIFT_IMAGE_MAX_DIMENSION ||
+        height > DRIFT_IMAGE_MAX_DIMENSION) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, path, 0,
+                  "image is %dx%d; the limit is %d per side", width, height,
+                  DRIFT_IMAGE_MAX_DIMENSION);
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    bool is_hdr = stbi_is_hdr_from_memory(data, len) != 0;
+    if ((format == FORMAT_HDR) != is_hdr) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, path, 0,
+                  "content does not match the extension (%s data)",
+                  is_hdr ? "Radiance HDR" : "8/16-bit");
+        return DRIFT_ERR_PARSE;
+    }
+    drift_image img;
+    drift_result r = drift_image_create(ctx, width, height, 3, &img);
+    if (r != DRIFT_OK) {
+        return r;
+    }
+    size_t count = (size_t)width * (size_t)height * 3;
+    int w = 0, h = 0, n = 0;
+    void *pixels = NULL;
+    if (is_hdr) {
+        float *f = stbi_loadf_from_memory(data, len, &w, &h, &n, 3);
+        if (f) {
+            memcpy(img.pixels, f, count * sizeof(float));
+        }
+        pixels = f;
+    } else if (format == FORMAT_PNG && stbi_is_16_bit_from_memory(data, len)) {
+        uint16_t *s = stbi_load_16_from_memory(data, len, &w, &h, &n, 3);
+        if (s) {
+            for (size_t i = 0; i < count; ++i) {
+                img.pixels[i] = drift_srgb_to_linear((float)s[i] * (1.0f / 65535.0f));
+            }
+        }
+        pixels = s;
+    } else {
+        uint8_t *b = stbi_load_from_memory(data, len, &w, &h, &n, 3);
+        if (b) {
+            float lut[256];
+            for (int i = 0; i < 256; ++i) {
+                lut[i] = drift_srgb_to_linear((float)i * (1.0f / 255.0f));
+            }
+            for (size_t i = 0; i < count; ++i) {
+                img.pixels[i] = lut[b[i]];
+            }
+        }
+        pixels = b;
+    }
+    if (!pixels || w != width || h != height) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, path, 0, "corrupt image: %s",
+                  stbi_failure_reason() ? stbi_failure_reason() : "decoder failed");
+        stbi_image_free(pixels);
+        drift_image_destroy(ctx, &img);
+        return DRIFT_ERR_PARSE;
+    }
+    stbi_image_free(pixels);
+    *out_image = img;
+    return DRIFT_OK;
+}
+
+// --- PUBLIC ---
+
+drift_result drift_image_load(drift_context *ctx, const char *path, drift_image *out_image)
+{
+    if (!out_image) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    *out_image = (drift_image){ 0 };
+    if (!path) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    image_format format = format_from_path(path);
+    if (format == FORMAT_UNKNOWN) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_UNSUPPORTED, path, 0,
+                  "unsupported image extension (use .exr, .png, .jpg, .jpeg or .hdr)");
+        return DRIFT_ERR_UNSUPPORTED;
+    }
+    uint8_t *data = NULL;
+    size_t size = 0;
+    drift_result r = drift__image_read_file(ctx, path, &data, &size);
+    if (r != DRIFT_OK) {
+        return r;
+    }
+    if (format == FORMAT_EXR) {
+        r = drift__image_exr_load(ctx, path, data, size, out_image);
+    } else {
+        r = stb_load(ctx, path, format, data, size, out_image);
+    }
+    drift_free(ctx, data);
+    return r;
+}
+
+typedef struct png_sink {
+    drift__image_temp *temp;
+    uint64_t offset;
+    bool failed;
+    int error;
+} png_sink;
+
+static void png_write(void *context, void *data, int size)
+{
+    png_sink *sink = context;
+    if (sink->failed || size <= 0) {
+        return;
+    }
+    if (!drift__image_temp_write(sink->temp, data, (size_t)size, sink->offset)) {
+        sink->failed = true;
+        sink->error = errno;
+        return;
+    }
+    sink->offset += (uint64_t)size;
+}
+
+drift_result drift_image_save_png(drift_context *ctx, const char *path, const drift_image *image,
+                                  const drift_tonemap_params *tonemap)
+{
+    if (!path || !drift_image_is_valid(image)) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, path, 0,
+                  "drift_image_save_png: invalid image");
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    size_t bytes;
+    if (!drift_size_mul((size_t)image->width * (size_t)image->height, 3, &bytes) ||
+        (size_t)image->width * 3 > (size_t)INT_MAX) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    uint8_t *rgb = drift_alloc(ctx, bytes);
+    if (!rgb) {
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    drift_image_tonemap(image, tonemap, rgb);
+
+    drift__image_temp temp;
+    drift_result r = drift__image_temp_open(ctx, path, &temp);
+    if (r == DRIFT_OK) {
+        png_sink sink = { .temp = &temp };
+        int ok = stbi_write_png_to_func(png_write, &sink, image->width, image->height, 3, rgb,
+                                        image->width * 3);
+        if (!ok || sink.failed) {
+            char why[128];
+            drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, path, 0, "PNG write failed: %s",
+                      sink.failed ? errno_text(sink.error, why, sizeof(why)) : "encoder failed");
+            r = DRIFT_ERR_IO;
+        }
+        r = drift__image_temp_close(ctx, &temp, r);
+    }
+    drift_free(ctx, rgb);
+    return r;
+}
