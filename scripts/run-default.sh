@@ -1,0 +1,10 @@
+#!/usr/bin/env bash
+# Installs dependencies, builds drift (Release) and renders the built-in Cornell box with the
+# reference path tracer. Extra arguments go to `drift render` (e.g. --spp 256).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/install-deps.sh
+cmake -S . -B build/release -DCMAKE_BUILD_TYPE=Release -DDRIFT_BUILD_TESTS=OFF >/dev/null
+cmake --build build/release -j"$(nproc)" >/dev/null
+mkdir -p out
+./build/release/bin/drift render --spp 64 --out out/cornell-box.exr "$@"
