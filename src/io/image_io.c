@@ -202,6 +202,25 @@ drift_result drift__image_temp_close(drift_context *ctx, drift__image_temp *t, d
 
 // --- STB BACK END (PNG, JPEG, HDR) ---
 
+// stb stops at the last IDAT it needs and never looks at the end of the file, so a PNG cut
+// inside its final chunk would load. A complete file ends its chunk list with IEND (length 0,
+// type, CRC); trailing bytes after it are tolerated.
+static bool png_has_end(const uint8_t *data, size_t size)
+{
+    if (size < 8 + 12) {
+        return false;
+    }
+    for (size_t i = size - 12;; --i) {
+        if (data[i] == 0 && data[i + 1] == 0 && data[i + 2] == 0 && data[i + 3] == 0 &&
+            memcmp(data + i + 4, "IEND", 4) == 0) {
+            return true;
+        }
+        if (i == 8) {
+            return false;
+        }
+    }
+}
+
 static drift_result stb_load(drift_context *ctx, const char *path, image_format format,
                              const uint8_t *data, size_t size, drift_image *out_image)
 {
@@ -223,6 +242,11 @@ static drift_result stb_load(drift_context *ctx, const char *path, image_format 
                   "image is %dx%d; the limit is %d per side", width, height,
                   DRIFT_IMAGE_MAX_DIMENSION);
         return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    if (format == FORMAT_PNG && !png_has_end(data, size)) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, path, 0,
+                  "truncated PNG: no complete IEND chunk");
+        return DRIFT_ERR_PARSE;
     }
     bool is_hdr = stbi_is_hdr_from_memory(data, len) != 0;
     if ((format == FORMAT_HDR) != is_hdr) {

@@ -1,0 +1,436 @@
+#include "drift_test.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <dirent.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <OpenEXR/openexr.h>
+#include <stb/stb_image_write.h>
+
+#include "drift/image.h"
+#include "drift/image_io.h"
+#include "drift/math.h"
+
+// cmocka's assert_float_equal works in float; these checks need double.
+static void assert_close(double a, double b, double eps, int line)
+{
+    if (!(fabs(a - b) <= eps)) {
+        fail_msg("line %d: %.17g vs %.17g (eps %g)", line, a, b, eps);
+    }
+}
+#define assert_near(a, b, eps) assert_close((double)(a), (double)(b), (eps), __LINE__)
+
+static float hash_unit(uint32_t i)
+{
+    return drift_u32_to_unit(drift_hash_u32(i));
+}
+
+static drift_image make_random(drift_context *ctx, int32_t w, int32_t h, int32_t channels,
+                               uint32_t seed, float lo, float hi)
+{
+    drift_image img;
+    assert_int_equal(drift_image_create(ctx, w, h, channels, &img), DRIFT_OK);
+    for (int32_t i = 0; i < w * h * channels; ++i) {
+        img.pixels[i] = lo + (hi - lo) * hash_unit(seed * 7919u + (uint32_t)i);
+    }
+    return img;
+}
+
+static void write_bytes(const char *path, const void *data, size_t size)
+{
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    assert_int_equal(fwrite(data, 1, size, f), size);
+    fclose(f);
+}
+
+static uint8_t *read_bytes(const char *path, size_t *out_size)
+{
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    uint8_t *data = malloc((size_t)n + 1);
+    assert_non_null(data);
+    assert_int_equal(fread(data, 1, (size_t)n, f), (size_t)n);
+    fclose(f);
+    *out_size = (size_t)n;
+    return data;
+}
+
+static bool file_exists(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0;
+}
+
+// Number of entries in a directory other than . and ..
+static int dir_entry_count(const char *path)
+{
+    DIR *d = opendir(path);
+    assert_non_null(d);
+    int n = 0;
+    for (struct dirent *e = readdir(d); e; e = readdir(d)) {
+        if (strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0) {
+            ++n;
+        }
+    }
+    closedir(d);
+    return n;
+}
+
+static void assert_rgb_equal_exact(const drift_image *a, const drift_image *b)
+{
+    assert_int_equal(a->width, b->width);
+    assert_int_equal(a->height, b->height);
+    for (int32_t y = 0; y < a->height; ++y) {
+        for (int32_t x = 0; x < a->width; ++x) {
+            for (int c = 0; c < 3; ++c) {
+                float va = drift_image_pixel(a, x, y)[a->channels >= 3 ? c : 0];
+                float vb = drift_image_pixel(b, x, y)[b->channels >= 3 ? c : 0];
+                assert_memory_equal(&va, &vb, sizeof(float));
+            }
+        }
+    }
+}
+
+// Channel names of part 0 of an EXR file, comma-separated, via OpenEXRCore directly.
+static void exr_channel_names(const char *path, char *out, size_t cap)
+{
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    exr_context_t f = NULL;
+    assert_int_equal(exr_start_read(&f, path, &init), EXR_ERR_SUCCESS);
+    const exr_attr_chlist_t *list = NULL;
+    assert_int_equal(exr_get_channels(f, 0, &list), EXR_ERR_SUCCESS);
+    out[0] = '\0';
+    for (int i = 0; i < list->num_channels; ++i) {
+        size_t len = strlen(out);
+        snprintf(out + len, cap - len, "%s%s", i ? "," : "", list->entries[i].name.str);
+    }
+    exr_compression_t comp;
+    assert_int_equal(exr_get_compression(f, 0, &comp), EXR_ERR_SUCCESS);
+    assert_int_equal(comp, EXR_COMPRESSION_ZIP);
+    exr_finish(&f);
+}
+
+static void test_image_io_exr_multilayer_round_trip_is_exact(void **state)
+{
+    (void)state;
+    drift_context *ctx = test_context(2, NULL);
+    // Odd sizes (more than one 16-line ZIP chunk), HDR, negative and tiny values.
+    drift_image beauty = make_random(ctx, 37, 41, 3, 1, -2.0f, 1000.0f);
+    beauty.pixels[5] = 1e-30f;
+    beauty.pixels[6] = -0.0f;
+    drift_image albedo = make_random(ctx, 37, 41, 3, 2, 0.0f, 1.0f);
+    drift_image depth = make_random(ctx, 37, 41, 1, 3, 0.0f, 1e6f);
+    drift_image rgba = make_random(ctx, 37, 41, 4, 4, 0.0f, 1.0f);
+    drift_image_layer layers[] = {
+        { "albedo", &albedo }, { NULL, &beauty }, { "depth", &depth }, { "rgba", &rgba }
+    };
+    char path[1024];
+    test_out_path(path, "io_multilayer.exr");
+    assert_int_equal(drift_image_save_exr(ctx, path, layers, 4), DRIFT_OK);
+
+    char names[512];
+    exr_channel_names(path, names, sizeof(names));
+    assert_string_equal(names, "B,G,R,albedo.B,albedo.G,albedo.R,depth.Y,rgba.A,rgba.B,rgba.G,"
+                               "rgba.R");
+
+    drift_image loaded;
+    assert_int_equal(drift_image_load(ctx, path, &loaded), DRIFT_OK);
+    assert_int_equal(loaded.channels, 3);
+    assert_rgb_equal_exact(&beauty, &loaded);
+    drift_image_destroy(ctx, &loaded);
+
+    // Without a default layer the first named RGB layer (alphabetic) is loaded.
+    drift_image_layer named[] = { { "zeta", &beauty }, { "albedo", &albedo } };
+    assert_int_equal(drift_image_save_exr(ctx, path, named, 2), DRIFT_OK);
+    assert_int_equal(drift_image_load(ctx, path, &loaded), DRIFT_OK);
+    assert_rgb_equal_exact(&albedo, &loaded);
+    drift_image_destroy(ctx, &loaded);
+
+    // A single Y channel loads as grey RGB; a strided view saves what the view shows.
+    drift_image_layer grey[] = { { "", &depth } };
+    assert_int_equal(drift_image_save_exr(ctx, path, grey, 1), DRIFT_OK);
+    assert_int_equal(drift_image_load(ctx, path, &loaded), DRIFT_OK);
+    assert_rgb_equal_exact(&depth, &loaded);
+    drift_image_destroy(ctx, &loaded);
+    drift_image view = drift_image_view(&beauty, 3, 5, 20, 17);
+    drift_image_layer views[] = { { NULL, &view } };
+    assert_int_equal(drift_image_save_exr(ctx, path, views, 1), DRIFT_OK);
+    assert_int_equal(drift_image_load(ctx, path, &loaded), DRIFT_OK);
+    assert_rgb_equal_exact(&view, &loaded);
+    drift_image_destroy(ctx, &loaded);
+
+    drift_image_destroy(ctx, &beauty);
+    drift_image_destroy(ctx, &albedo);
+    drift_image_destroy(ctx, &depth);
+    drift_image_destroy(ctx, &rgba);
+    drift_context_destroy(ctx);
+}
+
+static void test_image_io_png_round_trip_within_quantization(void **state)
+{
+    (void)state;
+    drift_context *ctx = test_context(1, NULL);
+    drift_image img = make_random(ctx, 23, 19, 3, 9, 0.0f, 1.0f);
+    char path[1024];
+    test_out_path(path, "io_round_trip.PNG"); // extension match is case-insensitive
+    assert_int_equal(drift_image_save_png(ctx, path, &img, NULL), DRIFT_OK);
+    drift_image loaded;
+    assert_int_equal(drift_image_load(ctx, path, &loaded), DRIFT_OK);
+    assert_int_equal(loaded.width, 23);
+    assert_int_equal(loaded.height, 19);
+    assert_int_equal(loaded.channels, 3);
+    // 8-bit quantisation happens in sRGB space: half a code value there.
+    for (int32_t i = 0; i < 23 * 19 * 3; ++i) {
+        float a = drift_linear_to_srgb(img.pixels[i]);
+        float b = drift_linear_to_srgb(loaded.pixels[i]);
+        assert_near(a, b, 0.5 / 255.0 + 1e-4);
+    }
+    drift_image_destroy(ctx, &loaded);
+    drift_image_destroy(ctx, &img);
+    drift_context_destroy(ctx);
+}
+
+static void test_image_io_png16_jpeg_and_hdr_load(void **state)
+{
+    (void)state;
+    drift_context *ctx = test_context(1, NULL);
+    char path[1024];
+    drift_image loaded;
+
+    // Radiance HDR: linear floats with RGBE precision (8-bit mantissa per pixel).
+    float hdr[4 * 3 * 3];
+    for (int i = 0; i < 36; ++i) {
+        hdr[i] = 0.1f + 10.0f * hash_unit((uint32_t)i);
+    }
+    test_out_path(path, "io_load.hdr");
+    assert_true(stbi_write_hdr(path, 4, 3, 3, hdr) != 0);
+    assert_int_equal(drift_image_load(ctx, path, &loaded), DRIFT_OK);
+    for (int i = 0; i < 36; ++i) {
+        assert_near(loaded.pixels[i], hdr[i], 0.01 * 11.0);
+    }
+    drift_image_destroy(ctx, &loaded);
+
+    // JPEG: 8-bit sRGB, lossy; a flat grey survives closely.
+    uint8_t grey[8 * 8 * 3];
+    memset(grey, 128, sizeof(grey));
+    test_out_path(path, "io_load.jpeg");
+    assert_true(stbi_write_jpg(path, 8, 8, 3, grey, 100) != 0);
+    assert_int_equal(drift_image_load(ctx, path, &loaded), DRIFT_OK);
+    assert_near(loaded.pixels[0], drift_srgb_to_linear(128.0f / 255.0f), 0.01);
+    drift_image_destroy(ctx, &loaded);
+
+    // 16-bit grey PNG, written by hand: signature, IHDR, one stored-deflate IDAT, IEND.
+    // (stb cannot write 16-bit; a stored zlib block needs no compressor.) stb does not check
+    // chunk CRCs or the Adler-32, so those are left zero.
+    static const uint8_t png16[] = {
+        0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n',
+        0, 0, 0, 13, 'I', 'H', 'D', 'R', 0, 0, 0, 2, 0, 0, 0, 1, 16, 0, 0, 0, 0, 0, 0, 0, 0,
+        0, 0, 0, 16, 'I', 'D', 'A', 'T', 0x78, 0x01, 0x01, 5, 0, 0xfa, 0xff,
+        0, 0xff, 0xff, 0x80, 0x00, 0, 0, 0, 0, 0, 0, 0, 0,
+        0, 0, 0, 0, 'I', 'E', 'N', 'D', 0, 0, 0, 0,
+    };
+    test_out_path(path, "io_load16.png");
+    write_bytes(path, png16, sizeof(png16));
+    drift_result r = drift_image_load(ctx, path, &loaded);
+    assert_int_equal(r, DRIFT_OK);
+    assert_int_equal(loaded.width, 2);
+    assert_near(loaded.pixels[0], 1.0, 1e-6);
+    assert_near(loaded.pixels[3], drift_srgb_to_linear(32768.0f / 65535.0f), 1e-6);
+    drift_image_destroy(ctx, &loaded);
+    drift_context_destroy(ctx);
+}
+
+static void test_image_io_errors_have_codes(void **state)
+{
+    (void)state;
+    test_log_capture cap = { 0 };
+    drift_context *ctx = test_context(1, &cap);
+    drift_image img = { .width = 5 };
+    char path[1024];
+
+    assert_int_equal(drift_image_load(ctx, "/nonexistent/dir/file.exr", &img), DRIFT_ERR_IO);
+    assert_int_equal(cap.last_code, DRIFT_ERR_IO);
+    assert_non_null(strstr(cap.last_message, "cannot open"));
+    assert_null(img.pixels);
+    assert_int_equal(img.width, 0);
+
+    assert_int_equal(drift_image_load(ctx, "picture.tiff", &img), DRIFT_ERR_UNSUPPORTED);
+    assert_int_equal(drift_image_load(ctx, "no_extension", &img), DRIFT_ERR_UNSUPPORTED);
+    assert_int_equal(cap.last_code, DRIFT_ERR_UNSUPPORTED);
+
+    // A PNG header claiming 40000 x 1 pixels is refused before any pixel allocation.
+    static const uint8_t huge[] = {
+        0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R',
+        0, 0, 0x9c, 0x40, 0, 0, 0, 1, 8, 2, 0, 0, 0, 0, 0, 0, 0,
+    };
+    test_out_path(path, "io_huge.png");
+    write_bytes(path, huge, sizeof(huge));
+    assert_int_equal(drift_image_load(ctx, path, &img), DRIFT_ERR_INVALID_ARGUMENT);
+
+    // PNG content behind an .hdr name does not silently decode with a guessed gamma.
+    drift_image small = make_random(ctx, 4, 4, 3, 1, 0.0f, 1.0f);
+    test_out_path(path, "io_mismatch.png");
+    assert_int_equal(drift_image_save_png(ctx, path, &small, NULL), DRIFT_OK);
+    char renamed[1024];
+    test_out_path(renamed, "io_mismatch.hdr");
+    assert_int_equal(rename(path, renamed), 0);
+    assert_int_equal(drift_image_load(ctx, renamed, &img), DRIFT_ERR_PARSE);
+    drift_image_destroy(ctx, &small);
+    drift_context_destroy(ctx);
+}
+
+// Every prefix of a valid file, and a few byte flips, must fail cleanly (or, for flips that
+// hit pixel data, load) — never crash. ASan/UBSan watch the decoders.
+static void check_damaged_copies(drift_context *ctx, test_log_capture *cap, const char *good,
+                                 const char *bad)
+{
+    size_t size = 0;
+    uint8_t *data = read_bytes(good, &size);
+    size_t step = size / 97 + 1;
+    for (size_t len = 0; len < size; len += step) {
+        write_bytes(bad, data, len);
+        drift_image img;
+        cap->last_code = DRIFT_OK;
+        drift_result r = drift_image_load(ctx, bad, &img);
+        assert_int_equal(r, DRIFT_ERR_PARSE);
+        assert_int_equal(cap->last_code, DRIFT_ERR_PARSE);
+        assert_null(img.pixels);
+    }
+    // Dropping only the last byte is a truncated file too.
+    write_bytes(bad, data, size - 1);
+    drift_image img;
+    assert_int_equal(drift_image_load(ctx, bad, &img), DRIFT_ERR_PARSE);
+    for (uint32_t i = 0; i < 64; ++i) {
+        size_t at = drift_hash_u32(i) % size;
+        data[at] ^= (uint8_t)(1u + drift_hash_u32(i + 100) % 255u);
+        write_bytes(bad, data, size);
+        drift_result r = drift_image_load(ctx, bad, &img);
+        assert_true(r == DRIFT_OK || r == DRIFT_ERR_PARSE || r == DRIFT_ERR_UNSUPPORTED ||
+                    r == DRIFT_ERR_INVALID_ARGUMENT);
+        drift_image_destroy(ctx, &img);
+        data[at] ^= (uint8_t)(1u + drift_hash_u32(i + 100) % 255u);
+    }
+    free(data);
+}
+
+static void test_image_io_truncated_and_corrupt_files_fail_cleanly(void **state)
+{
+    (void)state;
+    test_log_capture cap = { 0 };
+    drift_context *ctx = test_context(1, &cap);
+    drift_image img = make_random(ctx, 40, 35, 3, 5, 0.0f, 4.0f);
+    char good[1024], bad[1024];
+
+    test_out_path(good, "io_good.exr");
+    drift_image_layer layers[] = { { NULL, &img }, { "extra", &img } };
+    assert_int_equal(drift_image_save_exr(ctx, good, layers, 2), DRIFT_OK);
+    test_out_path(bad, "io_bad.exr");
+    check_damaged_copies(ctx, &cap, good, bad);
+
+    test_out_path(good, "io_good.png");
+    assert_int_equal(drift_image_save_png(ctx, good, &img, NULL), DRIFT_OK);
+    test_out_path(bad, "io_bad.png");
+    check_damaged_copies(ctx, &cap, good, bad);
+
+    // Garbage with the right extension.
+    const char garbage[] = "this is not an image at all, just some text";
+    write_bytes(bad, garbage, sizeof(garbage));
+    drift_image out;
+    assert_int_equal(drift_image_load(ctx, bad, &out), DRIFT_ERR_PARSE);
+    test_out_path(bad, "io_bad.exr");
+    write_bytes(bad, garbage, sizeof(garbage));
+    assert_int_equal(drift_image_load(ctx, bad, &out), DRIFT_ERR_PARSE);
+    drift_image_destroy(ctx, &img);
+    drift_context_destroy(ctx);
+}
+
+static void test_image_io_writers_leave_no_file_on_failure(void **state)
+{
+    (void)state;
+    test_log_capture cap = { 0 };
+    drift_context *ctx = test_context(1, &cap);
+    drift_image img = make_random(ctx, 8, 8, 3, 1, 0.0f, 1.0f);
+    drift_image other = make_random(ctx, 9, 8, 3, 1, 0.0f, 1.0f);
+    char dir[1024], path[2048];
+    test_out_path(dir, "io_writer_dir");
+    mkdir(dir, 0755);
+    // Start from an empty directory.
+    DIR *d = opendir(dir);
+    for (struct dirent *e = readdir(d); e; e = readdir(d)) {
+        if (e->d_name[0] != '.') {
+            snprintf(path, sizeof(path), "%s/%s", dir, e->d_name);
+            rmdir(path);
+            unlink(path);
+        }
+    }
+    closedir(d);
+    drift_image_layer layers[] = { { NULL, &img } };
+
+    // A missing directory.
+    snprintf(path, sizeof(path), "%s/missing/out.exr", dir);
+    assert_int_equal(drift_image_save_exr(ctx, path, layers, 1), DRIFT_ERR_IO);
+    assert_int_equal(cap.last_code, DRIFT_ERR_IO);
+    snprintf(path, sizeof(path), "%s/missing/out.png", dir);
+    assert_int_equal(drift_image_save_png(ctx, path, &img, NULL), DRIFT_ERR_IO);
+    assert_int_equal(dir_entry_count(dir), 0);
+
+    // The target is a directory: everything is written, the final rename fails, and the
+    // temporary file must be gone.
+    snprintf(path, sizeof(path), "%s/target", dir);
+    assert_int_equal(mkdir(path, 0755), 0);
+    assert_int_equal(drift_image_save_exr(ctx, path, layers, 1), DRIFT_ERR_IO);
+    assert_int_equal(drift_image_save_png(ctx, path, &img, NULL), DRIFT_ERR_IO);
+    assert_int_equal(dir_entry_count(dir), 1);
+    assert_int_equal(dir_entry_count(path), 0);
+    rmdir(path);
+
+    // Invalid layers fail before any file is created.
+    drift_image_layer mismatch[] = { { NULL, &img }, { "b", &other } };
+    drift_image_layer duplicate[] = { { "a", &img }, { "a", &img } };
+    snprintf(path, sizeof(path), "%s/layers.exr", dir);
+    assert_int_equal(drift_image_save_exr(ctx, path, mismatch, 2), DRIFT_ERR_INVALID_ARGUMENT);
+    assert_int_equal(drift_image_save_exr(ctx, path, duplicate, 2), DRIFT_ERR_INVALID_ARGUMENT);
+    assert_int_equal(drift_image_save_exr(ctx, path, layers, 0), DRIFT_ERR_INVALID_ARGUMENT);
+    assert_false(file_exists(path));
+
+    // An unwritable directory (not meaningful as root, who may write anyway).
+    if (geteuid() != 0) {
+        chmod(dir, 0555);
+        snprintf(path, sizeof(path), "%s/ro.exr", dir);
+        assert_int_equal(drift_image_save_exr(ctx, path, layers, 1), DRIFT_ERR_IO);
+        chmod(dir, 0755);
+    }
+    assert_int_equal(dir_entry_count(dir), 0);
+
+    // And success replaces an existing file atomically, leaving only the target.
+    snprintf(path, sizeof(path), "%s/ok.png", dir);
+    assert_int_equal(drift_image_save_png(ctx, path, &img, NULL), DRIFT_OK);
+    assert_int_equal(drift_image_save_png(ctx, path, &img, NULL), DRIFT_OK);
+    assert_int_equal(dir_entry_count(dir), 1);
+    unlink(path);
+    drift_image_destroy(ctx, &img);
+    drift_image_destroy(ctx, &other);
+    drift_context_destroy(ctx);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_image_io_exr_multilayer_round_trip_is_exact),
+        cmocka_unit_test(test_image_io_png_round_trip_within_quantization),
+        cmocka_unit_test(test_image_io_png16_jpeg_and_hdr_load),
+        cmocka_unit_test(test_image_io_errors_have_codes),
+        cmocka_unit_test(test_image_io_truncated_and_corrupt_files_fail_cleanly),
+        cmocka_unit_test(test_image_io_writers_leave_no_file_on_failure),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
