@@ -1,0 +1,105 @@
+#!/usr/bin/env bash
+# CLI tests for `drift diff`: exit codes, plain and --json output, --difftol, --heatmap, and
+# clear failures for missing, corrupt and mismatched inputs. $1 is the drift binary.
+set -u
+drift="$1"
+tmp="$(mktemp -d)"
+trap 'rm -rf "$tmp"' EXIT
+failures=0
+
+fail() {
+    echo "FAIL: $*" >&2
+    failures=$((failures + 1))
+}
+
+# expect STATUS CMD...: runs CMD, stdout to $tmp/out, stderr to $tmp/err.
+expect() {
+    local want="$1"
+    shift
+    "$@" >"$tmp/out" 2>"$tmp/err"
+    local got=$?
+    if [ "$got" -ne "$want" ]; then
+        fail "expected exit $want, got $got: $*"
+        sed 's/^/  stderr: /' "$tmp/err" >&2
+    fi
+}
+
+# Inputs are small PNGs written with python3's zlib and struct (no image tools needed).
+python3 - "$tmp" <<'PY'
+import struct, sys, zlib
+def png(path, w, h, pixel):
+    raw = b"".join(b"\x00" + b"".join(bytes(pixel(x, y)) for x in range(w)) for y in range(h))
+    def chunk(t, d):
+        c = struct.pack(">I", len(d)) + t + d
+        return c + struct.pack(">I", zlib.crc32(t + d) & 0xffffffff)
+    data = b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
+    data += chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b"")
+    open(path, "wb").write(data)
+d = sys.argv[1]
+png(d + "/ref.png", 32, 24, lambda x, y: (x * 8, y * 10, 128))
+png(d + "/test.png", 32, 24, lambda x, y: (x * 8, y * 10, 128 if (x + y) % 7 else 160))
+png(d + "/small.png", 16, 24, lambda x, y: (0, 0, 0))
+open(d + "/corrupt.png", "wb").write(open(d + "/ref.png", "rb").read()[:60])
+open(d + "/garbage.exr", "wb").write(b"not an exr file" * 10)
+PY
+
+# Help and usage.
+expect 0 "$drift" diff --help
+grep -q "usage: drift diff" "$tmp/out" || fail "--help prints usage on stdout"
+expect 2 "$drift" diff
+expect 2 "$drift" diff "$tmp/ref.png"
+expect 2 "$drift" diff "$tmp/ref.png" "$tmp/test.png" --bogus
+expect 2 "$drift" diff "$tmp/ref.png" "$tmp/test.png" --ppd nope
+expect 2 "$drift" diff "$tmp/ref.png" "$tmp/test.png" --difftol
+
+# Identical images: zero error; psnr is null in JSON and "inf" in plain output.
+expect 0 "$drift" diff "$tmp/ref.png" "$tmp/ref.png"
+for key in mse rmse relmse psnr ssim flip; do
+    grep -q "^$key " "$tmp/out" || fail "plain output has a '$key' line"
+done
+grep -q "^psnr *inf$" "$tmp/out" || fail "plain psnr of identical images is inf"
+expect 0 "$drift" diff "$tmp/ref.png" "$tmp/ref.png" --json
+python3 - "$tmp/out" <<'PY' || fail "--json of identical images"
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert sorted(d) == sorted(["mse", "rmse", "relmse", "psnr", "ssim", "flip"]), d
+assert d["mse"] == 0 and d["flip"] == 0 and d["ssim"] == 1 and d["psnr"] is None, d
+PY
+
+# Different images: all numbers, FLIP in (0, 1), and --difftol decides the exit status.
+expect 0 "$drift" diff "$tmp/ref.png" "$tmp/test.png" --json --ppd 40
+python3 - "$tmp/out" <<'PY' || fail "--json of different images"
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert sorted(d) == sorted(["mse", "rmse", "relmse", "psnr", "ssim", "flip"]), d
+assert all(isinstance(v, float) for v in d.values()), d
+assert d["mse"] > 0 and 0 < d["flip"] < 1 and d["ssim"] < 1 and d["psnr"] > 0, d
+assert abs(d["rmse"] ** 2 - d["mse"]) < 1e-12, d
+PY
+expect 1 "$drift" diff "$tmp/ref.png" "$tmp/test.png" --difftol 0
+grep -q "exceeds" "$tmp/err" || fail "--difftol failure is explained"
+expect 0 "$drift" diff "$tmp/ref.png" "$tmp/test.png" --difftol 1
+
+# Heat map: a PNG of the same size appears.
+expect 0 "$drift" diff "$tmp/ref.png" "$tmp/test.png" --heatmap "$tmp/heat.png"
+[ -s "$tmp/heat.png" ] || fail "--heatmap writes the file"
+expect 0 "$drift" diff "$tmp/heat.png" "$tmp/heat.png"
+expect 1 "$drift" diff "$tmp/ref.png" "$tmp/test.png" --heatmap "$tmp/no/such/dir/heat.png"
+ls "$tmp/no" >/dev/null 2>&1 && fail "failed heat map leaves nothing behind"
+
+# Errors: missing, corrupt, unsupported, size mismatch — exit 1 and the file is named.
+expect 1 "$drift" diff "$tmp/missing.png" "$tmp/ref.png"
+grep -q "missing.png" "$tmp/err" || fail "missing file is named"
+expect 1 "$drift" diff "$tmp/ref.png" "$tmp/corrupt.png"
+grep -q "corrupt.png" "$tmp/err" || fail "corrupt file is named"
+expect 1 "$drift" diff "$tmp/garbage.exr" "$tmp/ref.png"
+grep -q "garbage.exr" "$tmp/err" || fail "corrupt EXR is named"
+expect 1 "$drift" diff "$tmp/ref.png" "$tmp/ref.bmp"
+expect 1 "$drift" diff "$tmp/ref.png" "$tmp/small.png"
+grep -q "sizes differ" "$tmp/err" || fail "size mismatch is explained"
+
+if [ "$failures" -ne 0 ]; then
+    echo "$failures failure(s)" >&2
+    exit 1
+fi
+echo "cli.diff: all checks passed"
