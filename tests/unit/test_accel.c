@@ -1,10 +1,9 @@
+#include "drift/accel.h"
+#include "drift/scene.h"
 #include "drift_test.h"
 
 #include <math.h>
 #include <string.h>
-
-#include "drift/accel.h"
-#include "drift/scene.h"
 
 // --- HELPERS ---
 
@@ -64,15 +63,15 @@ static void add_random_meshes(drift_scene *scene, rng *r, uint32_t material, uin
                 idx[3 * t + k] = 3 * t + (uint32_t)k;
             }
         }
-        assert_int_equal(drift_scene_add_mesh(scene,
-                                              &(drift_mesh_desc){ .positions = p,
-                                                                  .vertex_count = vertex_count,
-                                                                  .indices = idx,
-                                                                  .triangle_count =
-                                                                      triangles_per_mesh,
-                                                                  .material = material },
-                                              NULL),
-                         DRIFT_OK);
+        assert_int_equal(
+            drift_scene_add_mesh(scene,
+                                 &(drift_mesh_desc){ .positions = p,
+                                                     .vertex_count = vertex_count,
+                                                     .indices = idx,
+                                                     .triangle_count = triangles_per_mesh,
+                                                     .material = material },
+                                 NULL),
+            DRIFT_OK);
         test_free(p);
         test_free(idx);
     }
@@ -97,7 +96,7 @@ typedef struct bf_hit {
     bool hit;
     double t, second_t; // closest and second-closest t in range
     uint32_t mesh, prim;
-    double margin;      // min over candidate triangles of |barycentric - boundary|
+    double margin; // min over candidate triangles of |barycentric - boundary|
     drift_vec3 ng;
 } bf_hit;
 
@@ -198,7 +197,8 @@ static void test_accel_matches_brute_force(void **state)
                 assert_int_equal(hit.prim, ref.prim);
                 assert_int_equal(hit.light, DRIFT_INVALID_INDEX);
                 // Same geometric normal direction (Embree's Ng = e1 x e2, unnormalized).
-                float c = drift_vec3_dot(drift_vec3_normalize(hit.ng), drift_vec3_normalize(ref.ng));
+                float c =
+                    drift_vec3_dot(drift_vec3_normalize(hit.ng), drift_vec3_normalize(ref.ng));
                 assert_true(c > 0.999f);
             }
         }
@@ -228,8 +228,12 @@ static void test_accel_coherent_equals_single(void **state)
                               NULL),
         DRIFT_OK);
     drift_accel *accel = new_accel(ctx, scene);
+
     // Not a multiple of any chunk or packet size, so the tails are exercised.
-    enum { N = 1000 + 37 };
+    enum {
+        N = 1000 + 37
+    };
+
     drift_ray *rays = test_malloc(sizeof(drift_ray) * N);
     drift_hit *hits = test_malloc(sizeof(drift_hit) * N);
     uint8_t *occluded = test_malloc(N);
@@ -240,8 +244,8 @@ static void test_accel_coherent_equals_single(void **state)
         if (i % 3 == 0) {
             rays[i] = random_ray(&r, i % 2 == 0);
         } else {
-            rays[i] = drift_camera_ray(&cam, 33, 32, (float)(i % 33) + 0.5f,
-                                       (float)(i / 33) + 0.5f, drift_vec2_make(0.5f, 0.5f));
+            rays[i] = drift_camera_ray(&cam, 33, 32, (float)(i % 33) + 0.5f, (float)(i / 33) + 0.5f,
+                                       drift_vec2_make(0.5f, 0.5f));
             rays[i].tmax = i % 4 == 0 ? 4.0f : INFINITY;
         }
     }
@@ -517,8 +521,8 @@ static void test_accel_embree_error_reaches_logger(void **state)
     // A 4 KiB cap cannot hold a BVH over 2000 triangles: Embree's allocation fails inside
     // the build and Embree reports RTC_ERROR_OUT_OF_MEMORY through its error callback.
     drift_accel *accel = (drift_accel *)1;
-    drift_result res = drift_accel_create(
-        ctx, scene, &(drift_accel_desc){ .memory_limit_bytes = 4096 }, &accel);
+    drift_result res =
+        drift_accel_create(ctx, scene, &(drift_accel_desc){ .memory_limit_bytes = 4096 }, &accel);
     assert_int_equal(res, DRIFT_ERR_OUT_OF_MEMORY);
     assert_null(accel);
     assert_true(cap.errors > errors_before);
@@ -556,11 +560,10 @@ static void test_accel_uncommitted_scene_rejected(void **state)
                                         &(drift_accel_desc){ .quality = DRIFT_ACCEL_QUALITY_COUNT },
                                         &accel),
                      DRIFT_ERR_INVALID_ARGUMENT);
-    assert_int_equal(drift_accel_create(ctx, scene,
-                                        &(drift_accel_desc){ .quality =
-                                                                 DRIFT_ACCEL_QUALITY_FAST_BUILD },
-                                        &accel),
-                     DRIFT_OK);
+    assert_int_equal(
+        drift_accel_create(
+            ctx, scene, &(drift_accel_desc){ .quality = DRIFT_ACCEL_QUALITY_FAST_BUILD }, &accel),
+        DRIFT_OK);
     drift_accel_destroy(accel);
     drift_accel_destroy(NULL);
     drift_scene_destroy(scene);
