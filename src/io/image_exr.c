@@ -312,6 +312,18 @@ drift_result drift__image_exr_load(drift_context *ctx, const char *path, const u
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
 
+    // The float image is allocated (and zeroed) before any chunk is read, so a forged header
+    // could make a tiny file cost gigabytes. OpenEXR's codecs are bounded in expansion (deflate
+    // 1032:1; flat-image PIZ/DWA can go further), so allow 4096:1 on top of a 256 MiB floor
+    // and call anything beyond corrupt.
+    uint64_t decoded = (uint64_t)width * (uint64_t)height * 3u * sizeof(float);
+    if (decoded > ((uint64_t)256 << 20) + (uint64_t)size * 4096u) {
+        exr_finish(&f);
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, path, 0,
+                  "corrupt OpenEXR file: a %lldx%lld image cannot fit in %zu bytes",
+                  (long long)width, (long long)height, size);
+        return DRIFT_ERR_PARSE;
+    }
     drift_image img;
     drift_result r = drift_image_create(ctx, (int32_t)width, (int32_t)height, 3, &img);
     if (r != DRIFT_OK) {

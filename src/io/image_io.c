@@ -255,47 +255,58 @@ static drift_result stb_load(drift_context *ctx, const char *path, image_format 
                   is_hdr ? "Radiance HDR" : "8/16-bit");
         return DRIFT_ERR_PARSE;
     }
-    drift_image img;
-    drift_result r = drift_image_create(ctx, width, height, 3, &img);
-    if (r != DRIFT_OK) {
-        return r;
+    if (format == FORMAT_PNG) {
+        // Deflate expands at most 1032:1, and every row holds a filter byte plus at least one
+        // bit per pixel. A header promising more than the file can hold is corrupt; refusing
+        // it here keeps a 60-byte file from costing gigabytes.
+        uint64_t raw_min = (uint64_t)height * (1u + ((uint64_t)width + 7u) / 8u);
+        if (raw_min > (uint64_t)size * 1032u) {
+            drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, path, 0,
+                      "corrupt PNG: a %dx%d image cannot fit in %zu bytes", width, height, size);
+            return DRIFT_ERR_PARSE;
+        }
     }
+    // Decode first, then allocate the float image, so corrupt files cost no float buffer.
     size_t count = (size_t)width * (size_t)height * 3;
     int w = 0, h = 0, n = 0;
     void *pixels = NULL;
+    bool wide = false;
     if (is_hdr) {
-        float *f = stbi_loadf_from_memory(data, len, &w, &h, &n, 3);
-        if (f) {
-            memcpy(img.pixels, f, count * sizeof(float));
-        }
-        pixels = f;
+        pixels = stbi_loadf_from_memory(data, len, &w, &h, &n, 3);
     } else if (format == FORMAT_PNG && stbi_is_16_bit_from_memory(data, len)) {
-        uint16_t *s = stbi_load_16_from_memory(data, len, &w, &h, &n, 3);
-        if (s) {
-            for (size_t i = 0; i < count; ++i) {
-                img.pixels[i] = drift_srgb_to_linear((float)s[i] * (1.0f / 65535.0f));
-            }
-        }
-        pixels = s;
+        pixels = stbi_load_16_from_memory(data, len, &w, &h, &n, 3);
+        wide = true;
     } else {
-        uint8_t *b = stbi_load_from_memory(data, len, &w, &h, &n, 3);
-        if (b) {
-            float lut[256];
-            for (int i = 0; i < 256; ++i) {
-                lut[i] = drift_srgb_to_linear((float)i * (1.0f / 255.0f));
-            }
-            for (size_t i = 0; i < count; ++i) {
-                img.pixels[i] = lut[b[i]];
-            }
-        }
-        pixels = b;
+        pixels = stbi_load_from_memory(data, len, &w, &h, &n, 3);
     }
     if (!pixels || w != width || h != height) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, path, 0, "corrupt image: %s",
                   stbi_failure_reason() ? stbi_failure_reason() : "decoder failed");
         stbi_image_free(pixels);
-        drift_image_destroy(ctx, &img);
         return DRIFT_ERR_PARSE;
+    }
+    drift_image img;
+    drift_result r = drift_image_create(ctx, width, height, 3, &img);
+    if (r != DRIFT_OK) {
+        stbi_image_free(pixels);
+        return r;
+    }
+    if (is_hdr) {
+        memcpy(img.pixels, pixels, count * sizeof(float));
+    } else if (wide) {
+        const uint16_t *p16 = pixels;
+        for (size_t i = 0; i < count; ++i) {
+            img.pixels[i] = drift_srgb_to_linear((float)p16[i] * (1.0f / 65535.0f));
+        }
+    } else {
+        const uint8_t *p8 = pixels;
+        float lut[256];
+        for (int i = 0; i < 256; ++i) {
+            lut[i] = drift_srgb_to_linear((float)i * (1.0f / 255.0f));
+        }
+        for (size_t i = 0; i < count; ++i) {
+            img.pixels[i] = lut[p8[i]];
+        }
     }
     stbi_image_free(pixels);
     *out_image = img;

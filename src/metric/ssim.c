@@ -63,7 +63,7 @@ static void horizontal_row(int32_t y, void *user)
                 continue;
             }
             double w = j->weight[k + SSIM_RADIUS];
-            double va = a[xx], vb = b[xx];
+            double va = (double)a[xx], vb = (double)b[xx];
             wsum += w;
             sa += w * va;
             sb += w * vb;
