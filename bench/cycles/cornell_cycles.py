@@ -44,9 +44,13 @@
 #     away).
 #   * World black (strength 0). Flat shading (face normals), triangles (v0 v1 v2)(v0 v2 v3).
 #   * max bounces = D (+ --bounces-offset): Cycles counts bounces AFTER the first hit:
-#     max_bounces 0 = direct lighting only. diffuse/glossy/transmission bounces = same, volume 0.
+#     max_bounces 0 = direct lighting only (the BSDF ray from the last vertex is still traced and
+#     its emission, MIS-weighted, added). So Cycles D <=> up to D+1 scattering vertices <=> drift /
+#     pbrt --max-depth D+1. diffuse/glossy/transmission bounces = same, volume 0.
 #   * Russian roulette off by default (min_light_bounces = max_bounces) = a plain path tracer of
-#     fixed depth; --russian-roulette restores Cycles' default (RR from the first bounce).
+#     fixed depth; --russian-roulette restores Cycles' default (RR from the first bounce),
+#     --rr-min-bounces N starts it after N bounces (N=2 ~ drift's rr_depth 3; Cycles survives
+#     with sqrt(max throughput), drift/pbrt-v4 with max throughput).
 #   * No clamping (direct/indirect 0), filter glossy 0, light threshold 0, no adaptive sampling,
 #     no denoising, box pixel filter of width 1 px, exposure 0, gamma 1, view transform Standard.
 #     Cycles still does next-event estimation + MIS (material "multiple importance" on).
@@ -85,7 +89,10 @@ def parse_args():
                    help="OpenEXR compression: NONE (default, simplest to read), ZIP, PIZ, ...")
     p.add_argument("--rgba", action="store_true", help="write RGBA instead of RGB channels")
     p.add_argument("--russian-roulette", action="store_true",
-                   help="keep Cycles' default Russian roulette (off by default)")
+                   help="Cycles' default Russian roulette from the first bounce (off by default)")
+    p.add_argument("--rr-min-bounces", type=int, default=None, metavar="N",
+                   help="Russian roulette after N bounces (Cycles min_light_bounces; implies RR). "
+                        "N=2 starts RR at the 4th path vertex, like drift's rr_depth 3")
     p.add_argument("--one-sided-light", action="store_true",
                    help="make the back face of the light black (Cycles emission is two-sided)")
     p.add_argument("--light-diffuse", action="store_true",
@@ -264,6 +271,12 @@ def build_scene(args):
     return ntris
 
 
+def rr_min_bounces(args, depth):
+    if args.rr_min_bounces is not None:
+        return max(0, args.rr_min_bounces)
+    return 0 if args.russian_roulette else max(depth, 0)
+
+
 def configure(args):
     scene = bpy.context.scene
     r = scene.render
@@ -299,8 +312,10 @@ def configure(args):
     c.transmission_bounces = depth
     c.transparent_max_bounces = depth
     c.volume_bounces = 0
-    c.min_light_bounces = 0 if args.russian_roulette else depth
-    c.min_transparent_bounces = 0 if args.russian_roulette else depth
+    # Cycles: no roulette while bounce <= min_light_bounces; then survive with
+    # min(1, sqrt(max throughput)) (checked at the start of shading a vertex, before its NEE).
+    c.min_light_bounces = rr_min_bounces(args, depth)
+    c.min_transparent_bounces = c.min_light_bounces
     c.sample_clamp_direct = 0.0
     c.sample_clamp_indirect = 0.0
     c.blur_glossy = 0.0
@@ -462,10 +477,11 @@ def main():
     bpy.app.handlers.render_post.append(timer.post)
     bpy.app.handlers.render_stats.append(timer.stats)
 
+    rr_min = rr_min_bounces(args, depth)
     print("CYCLES_CONFIG blender=%s tris=%d spp=%d max_bounces=%d rr=%s threads=%d filter=BOX/1px "
           "seed=%d codec=%s" % (bpy.app.version_string, ntris, args.spp, depth,
-                                "on" if args.russian_roulette else "off", args.threads, args.seed,
-                                args.exr_codec), flush=True)
+                                "off" if rr_min >= depth else "after_%d_bounces" % rr_min,
+                                args.threads, args.seed, args.exr_codec), flush=True)
     t0 = time.perf_counter()
     render_captured(timer)
     t1 = time.perf_counter()

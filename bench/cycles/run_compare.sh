@@ -20,10 +20,14 @@
 #   SEED                  Cycles seed                     (default 0)
 #   DRIFT_SCENE           if set, passed to drift render as --scene "$DRIFT_SCENE"
 #   DRIFT_ARGS            extra args for drift render (word-split)
-#   CYCLES_BOUNCES_OFFSET Cycles max_bounces = DEPTH + offset (default 0; see README: Cycles
-#                         max_bounces 0 = direct lighting, pbrt-style maxdepth 1 = direct lighting
-#                         -> use -1 if drift counts like pbrt)
-#   CYCLES_ARGS           extra args for cornell_cycles.py (e.g. --russian-roulette)
+#   CYCLES_BOUNCES_OFFSET Cycles max_bounces = DEPTH + offset. Default -1: drift's --max-depth
+#                         counts scattering vertices like pbrt (1 = direct light only), Cycles'
+#                         max_bounces counts bounces after the first hit (0 = direct light only).
+#   CYCLES_ARGS           extra args for cornell_cycles.py. Default
+#                         "--rr-min-bounces 2 --one-sided-light --light-diffuse", i.e. as drift's
+#                         reference: Russian roulette from the 4th vertex on (rr_depth 3), one-sided
+#                         emitter, and the light quad also reflects with its .mtl Kd 0.78.
+#                         CYCLES_ARGS=" " = plain Cycles: no roulette, two-sided pure emitter.
 #   BLENDER               blender binary                  (default blender)
 set -euo pipefail
 
@@ -36,7 +40,8 @@ HERE=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 OUT_DIR=${OUT_DIR:-/tmp/drift-vs-cycles}
 WIDTH=${WIDTH:-512} HEIGHT=${HEIGHT:-512} THREADS=${THREADS:-1} REPEATS=${REPEATS:-1}
 SEED=${SEED:-0} BLENDER=${BLENDER:-blender}
-CYCLES_BOUNCES_OFFSET=${CYCLES_BOUNCES_OFFSET:-0}
+CYCLES_BOUNCES_OFFSET=${CYCLES_BOUNCES_OFFSET:--1}
+CYCLES_ARGS=${CYCLES_ARGS:---rr-min-bounces 2 --one-sided-light --light-diffuse}
 mkdir -p "$OUT_DIR"
 
 if ! "$BLENDER" --version >/dev/null 2>&1; then
@@ -53,6 +58,7 @@ DR_EXR=$OUT_DIR/drift.exr
 DR_JSON=$OUT_DIR/drift.json
 
 echo "== drift vs Cycles: ${WIDTH}x${HEIGHT}, spp=$SPP, depth=$DEPTH, threads=$THREADS, repeats=$REPEATS"
+echo "   drift --max-depth $DEPTH; Cycles max_bounces $((DEPTH + CYCLES_BOUNCES_OFFSET)), cornell_cycles.py args: ${CYCLES_ARGS}"
 echo "   host: $(nproc) cpus, load $(cut -d' ' -f1-3 /proc/loadavg), $("$BLENDER" --version 2>/dev/null | head -n1)"
 
 best_cy="" best_cy_sync="" best_dr="" dr_rays="" dr_spp="" cy_mean=""
@@ -62,13 +68,14 @@ for rep in $(seq 1 "$REPEATS"); do
     "$BLENDER" -b --factory-startup -noaudio --python "$HERE/cornell_cycles.py" -- \
         --spp "$SPP" --max-depth "$DEPTH" --bounces-offset "$CYCLES_BOUNCES_OFFSET" \
         --threads "$THREADS" --width "$WIDTH" --height "$HEIGHT" --seed "$SEED" \
-        --out "$CY_EXR" ${CYCLES_ARGS:-} >"$OUT_DIR/cycles.log" 2>&1 || {
+        --out "$CY_EXR" ${CYCLES_ARGS} >"$OUT_DIR/cycles.log" 2>&1 || {
         echo "run_compare: Cycles render failed, see $OUT_DIR/cycles.log" >&2; tail -n 20 "$OUT_DIR/cycles.log" >&2; exit 1; }
     line=$(grep '^CYCLES_TIME ' "$OUT_DIR/cycles.log" | tail -n1)
     cy_mean=$(grep '^CYCLES_MEAN ' "$OUT_DIR/cycles.log" | tail -n1 | cut -d' ' -f2-)
     cy_s=$(sed -n 's/.*render_seconds=\([^ ]*\).*/\1/p' <<<"$line")
     cy_sync=$(sed -n 's/.*sync_seconds=\([^ ]*\).*/\1/p' <<<"$line")
     echo "   [$rep] $line"
+    grep '^CYCLES_CONFIG ' "$OUT_DIR/cycles.log" | tail -n1 | sed "s/^/   [$rep] /"
     if [ -z "$best_cy" ] || awk "BEGIN{exit !($cy_s < $best_cy)}"; then best_cy=$cy_s best_cy_sync=$cy_sync; fi
 
     # --- drift ----------------------------------------------------------------------------
@@ -94,7 +101,10 @@ ms = s.get("milliseconds", {})
 render = ms.get("render") if isinstance(ms, dict) else None
 if render is None:
     sys.exit("drift stats: no milliseconds.render in " + sys.argv[1])
-print(float(render), s.get("spp", "nan"), s.get("rays", "nan"))
+rays = s.get("rays", "nan")
+if isinstance(rays, dict):  # drift: {"camera":..,"shadow":..,"bounce":..,"total":..}
+    rays = rays.get("total", sum(v for v in rays.values() if isinstance(v, (int, float))))
+print(float(render), s.get("spp", "nan"), rays)
 EOF
 )
     dr_s=$(awk "BEGIN{printf \"%.6f\", $dr_ms/1000.0}")
