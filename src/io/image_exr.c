@@ -287,10 +287,11 @@ drift_result drift__image_exr_load(drift_context *ctx, const char *path, const u
     for (int k = 0; k < 3; ++k) {
         const exr_attr_chlist_entry_t *e = pick.index[k] >= 0 ? &list->entries[pick.index[k]] : NULL;
         if (e && (e->x_sampling != 1 || e->y_sampling != 1)) {
-            exr_finish(&f);
+            // Log before exr_finish: the channel list belongs to the context.
             drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_UNSUPPORTED, path, 0,
                       "channel %s is subsampled (%dx%d); not supported", e->name.str,
                       e->x_sampling, e->y_sampling);
+            exr_finish(&f);
             return DRIFT_ERR_UNSUPPORTED;
         }
     }
