@@ -65,17 +65,22 @@ best_cy="" best_cy_sync="" best_dr="" dr_rays="" dr_spp="" cy_mean=""
 for rep in $(seq 1 "$REPEATS"); do
     # --- Cycles ---------------------------------------------------------------------------
     # shellcheck disable=SC2086
-    "$BLENDER" -b --factory-startup -noaudio --python "$HERE/cornell_cycles.py" -- \
+    TIMEFORMAT='%R %U %S'
+    { time "$BLENDER" -b --factory-startup -noaudio --python "$HERE/cornell_cycles.py" -- \
         --spp "$SPP" --max-depth "$DEPTH" --bounces-offset "$CYCLES_BOUNCES_OFFSET" \
         --threads "$THREADS" --width "$WIDTH" --height "$HEIGHT" --seed "$SEED" \
         --out "$CY_EXR" ${CYCLES_ARGS} >"$OUT_DIR/cycles.log" 2>&1 || {
         echo "run_compare: Cycles render failed, see $OUT_DIR/cycles.log" >&2; tail -n 20 "$OUT_DIR/cycles.log" >&2; exit 1; }
+    } 2>"$OUT_DIR/cycles.time"
     line=$(grep '^CYCLES_TIME ' "$OUT_DIR/cycles.log" | tail -n1)
     cy_mean=$(grep '^CYCLES_MEAN ' "$OUT_DIR/cycles.log" | tail -n1 | cut -d' ' -f2-)
     cy_s=$(sed -n 's/.*render_seconds=\([^ ]*\).*/\1/p' <<<"$line")
     cy_sync=$(sed -n 's/.*sync_seconds=\([^ ]*\).*/\1/p' <<<"$line")
     echo "   [$rep] $line"
     grep '^CYCLES_CONFIG ' "$OUT_DIR/cycles.log" | tail -n1 | sed "s/^/   [$rep] /"
+    cpu_line=$(grep '^CYCLES_TIME_DETAIL ' "$OUT_DIR/cycles.log" | tail -n1 | sed -n 's/.*\(render_cpu_seconds=[^ ]*\).*/\1/p')
+    read -r w u s <"$OUT_DIR/cycles.time"
+    echo "   [$rep] cycles process: wall ${w}s cpu $(awk "BEGIN{print $u+$s}")s; path tracing $cpu_line (cpu/wall far below threads = CPU contention)"
     if [ -z "$best_cy" ] || awk "BEGIN{exit !($cy_s < $best_cy)}"; then best_cy=$cy_s best_cy_sync=$cy_sync; fi
 
     # --- drift ----------------------------------------------------------------------------
@@ -86,11 +91,13 @@ for rep in $(seq 1 "$REPEATS"); do
     [ -n "${DRIFT_SCENE:-}" ] && drift_cmd+=(--scene "$DRIFT_SCENE")
     # shellcheck disable=SC2206
     [ -n "${DRIFT_ARGS:-}" ] && drift_cmd+=(${DRIFT_ARGS})
-    if ! "${drift_cmd[@]}" >"$OUT_DIR/drift.log" 2>&1; then
+    if ! { time "${drift_cmd[@]}" >"$OUT_DIR/drift.log" 2>&1; } 2>"$OUT_DIR/drift.time"; then
         echo "run_compare: drift render failed (${drift_cmd[*]}), see $OUT_DIR/drift.log:" >&2
         tail -n 20 "$OUT_DIR/drift.log" >&2
         exit 1
     fi
+    read -r w u s <"$OUT_DIR/drift.time"
+    echo "   [$rep] drift process: wall ${w}s cpu $(awk "BEGIN{print $u+$s}")s (includes load/accel/write)"
     if [ ! -s "$DR_JSON" ]; then
         echo "run_compare: drift wrote no stats JSON ($DR_JSON)" >&2; exit 1
     fi
