@@ -91,6 +91,7 @@ typedef struct import_state {
     const char *where;
     int line;
     char dir[DRIFT__PATH_MAX]; // folder of the mesh file, for texture paths
+    bool is_gltf;              // .gltf or .glb: glTF camera conventions
     const char *base_name;     // file name without folder, for unnamed meshes and materials
     uint32_t *material_map;    // assimp material -> drift material
     bool *light_placed;        // assimp light already added through its node
@@ -364,20 +365,29 @@ static drift_result add_light(import_state *s, const struct aiLight *l, const ma
 
 static void set_camera(import_state *s, const struct aiCamera *cam, const mat4 *world)
 {
-    drift_vec3 eye = transform_point(world, drift_vec3_make(cam->mPosition.x, cam->mPosition.y,
-                                                            cam->mPosition.z));
-    drift_vec3 look = drift_vec3_normalize(
-        transform_vector(world, drift_vec3_make(cam->mLookAt.x, cam->mLookAt.y, cam->mLookAt.z)));
-    drift_vec3 up = drift_vec3_normalize(
-        transform_vector(world, drift_vec3_make(cam->mUp.x, cam->mUp.y, cam->mUp.z)));
+    drift_vec3 local_eye = drift_vec3_make(cam->mPosition.x, cam->mPosition.y, cam->mPosition.z);
+    drift_vec3 local_look = drift_vec3_make(cam->mLookAt.x, cam->mLookAt.y, cam->mLookAt.z);
+    drift_vec3 local_up = drift_vec3_make(cam->mUp.x, cam->mUp.y, cam->mUp.z);
     float aspect = cam->mAspect > 0.0f && isfinite(cam->mAspect) ? cam->mAspect : 1.0f;
-    // assimp stores the full horizontal field of view (its glTF importer computes
-    // 2 atan(aspect tan(yfov / 2))); drift wants the vertical one.
-    float fov_x = cam->mHorizontalFOV;
-    float fov_y = 2.0f * atanf(tanf(0.5f * fov_x) / aspect);
+    float fov_y;
+    if (s->is_gltf) {
+        // glTF cameras sit at their node's origin looking down -z with +y up. assimp 5.2
+        // also copies the node's translation into mPosition (applying it twice), and stores
+        // yfov * aspect as mHorizontalFOV.
+        local_eye = drift_vec3_make(0.0f, 0.0f, 0.0f);
+        local_look = drift_vec3_make(0.0f, 0.0f, -1.0f);
+        local_up = drift_vec3_make(0.0f, 1.0f, 0.0f);
+        fov_y = cam->mHorizontalFOV / aspect;
+    } else {
+        // Elsewhere mHorizontalFOV is the full horizontal angle.
+        fov_y = 2.0f * atanf(tanf(0.5f * cam->mHorizontalFOV) / aspect);
+    }
     if (!(fov_y > 0.0f && fov_y < DRIFT_PI)) {
         fov_y = 45.0f * DRIFT_PI / 180.0f;
     }
+    drift_vec3 eye = transform_point(world, local_eye);
+    drift_vec3 look = drift_vec3_normalize(transform_vector(world, local_look));
+    drift_vec3 up = drift_vec3_normalize(transform_vector(world, local_up));
     int32_t height = 512;
     int32_t width = (int32_t)lroundf(drift_clampf(512.0f * aspect, 1.0f, 8192.0f));
     s->info->camera = drift_camera_look_at(eye, drift_vec3_add(eye, look), up, fov_y, width, height);
@@ -467,6 +477,58 @@ static drift_result import_scene(import_state *s)
     return r;
 }
 
+// assimp's PLY reader reserves what the header declares before reading any data, so a
+// header claiming 10^9 vertices takes gigabytes. Every element takes at least one byte
+// (ASCII or binary), which bounds the counts a file of this size can hold.
+static drift_result check_ply_header(const import_state *s, const char *head, size_t head_size,
+                                     size_t file_size)
+{
+    size_t pos = 0;
+    unsigned long long declared = 0;
+    while (pos < head_size) {
+        const char *line = head + pos;
+        const char *end = memchr(line, '\n', head_size - pos);
+        size_t len = end ? (size_t)(end - line) : head_size - pos;
+        pos += len + 1;
+        if (len >= 10 && memcmp(line, "end_header", 10) == 0) {
+            size_t data = file_size > pos ? file_size - pos : 0;
+            if (declared > data) {
+                drift_log(s->ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, s->where, s->line,
+                          "'%s': the PLY header declares %llu elements but only %zu bytes of "
+                          "data follow",
+                          s->params->path, declared, data);
+                return DRIFT_ERR_PARSE;
+            }
+            return DRIFT_OK;
+        }
+        if (len > 8 && memcmp(line, "element ", 8) == 0) {
+            char buf[128];
+            size_t n = len < sizeof(buf) - 1 ? len : sizeof(buf) - 1;
+            memcpy(buf, line, n);
+            buf[n] = '\0';
+            char name[64];
+            unsigned long long count = 0;
+            if (sscanf(buf, "element %63s %llu", name, &count) == 2) {
+                declared += count > DRIFT_SCENE_MAX_FILE_BYTES ? DRIFT_SCENE_MAX_FILE_BYTES : count;
+            }
+        }
+    }
+    return DRIFT_OK; // no end_header in the first bytes: assimp reports the file as broken
+}
+
+// Reads the start of a file for check_ply_header.
+static drift_result check_ply_file(const import_state *s, size_t file_size)
+{
+    char head[8192];
+    FILE *f = fopen(s->params->path, "rb");
+    if (!f) {
+        return DRIFT_OK; // drift__check_file just saw it; let assimp report what changed
+    }
+    size_t n = fread(head, 1, sizeof(head), f);
+    fclose(f);
+    return check_ply_header(s, head, n, file_size);
+}
+
 drift_result drift__scene_import_mesh_file(drift_scene *scene, const drift__import_params *params,
                                            drift__import_info *out_info)
 {
@@ -489,6 +551,7 @@ drift_result drift__scene_import_mesh_file(drift_scene *scene, const drift__impo
     char ext[16];
     bool gz = false;
     drift__path_extension(params->path, ext, sizeof(ext), &gz);
+    s.is_gltf = strcmp(ext, "gltf") == 0 || strcmp(ext, "glb") == 0;
 
     // Triangulate quads and polygons, share vertices, split point/line primitives away from
     // triangles, and let assimp reject out-of-range indices. No normal generation: see top.
@@ -507,6 +570,14 @@ drift_result drift__scene_import_mesh_file(drift_scene *scene, const drift__impo
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, s.where, s.line, "'%s' is empty",
                   params->path);
         return DRIFT_ERR_PARSE;
+    }
+    if (strcmp(ext, "ply") == 0) {
+        r = gz ? check_ply_header(&s, data, size < 8192 ? size : 8192, size)
+               : check_ply_file(&s, size);
+        if (r != DRIFT_OK) {
+            drift_free(ctx, data);
+            return r;
+        }
     }
     const struct aiScene *ai = NULL;
     if (gz) {
