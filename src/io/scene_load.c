@@ -314,6 +314,10 @@ drift_bounds3 drift__scene_mesh_bounds(const drift_scene *scene)
 drift_camera drift__framing_camera(drift_bounds3 bounds)
 {
     const float fov_y = 45.0f * DRIFT_PI / 180.0f;
+    if (drift_bounds3_is_empty(bounds)) {
+        // Nothing to frame (a scene of lights only): look at the origin from +z.
+        bounds = (drift_bounds3){ drift_vec3_splat(-1.0f), drift_vec3_splat(1.0f) };
+    }
     drift_vec3 centre = drift_vec3_scale(drift_vec3_add(bounds.min, bounds.max), 0.5f);
     float radius = 0.5f * drift_vec3_length(drift_vec3_sub(bounds.max, bounds.min));
     if (!(radius > 0.0f) || !isfinite(radius)) {
