@@ -1,0 +1,119 @@
+#!/usr/bin/env bash
+# drift info on bad scene files: each must exit non-zero (1 = could not load, 2 = usage),
+# name the file in its message, and not crash (exit status < 128, no sanitizer report).
+# Usage: test_bad_input.sh path/to/drift
+set -u
+drift=${1:?usage: test_bad_input.sh path/to/drift}
+dir=$(mktemp -d)
+trap 'rm -rf "$dir"' EXIT
+failures=0
+
+fail() {
+    echo "FAIL: $*" >&2
+    failures=$((failures + 1))
+}
+
+# expect_failure NAME: runs drift info on $dir/NAME and checks status and message.
+expect_failure() {
+    local name=$1 file="$dir/$1" status
+    "$drift" info "$file" >"$dir/out" 2>"$dir/err"
+    status=$?
+    if [ "$status" -eq 0 ]; then
+        fail "$name: exit status 0"
+    elif [ "$status" -ge 128 ]; then
+        fail "$name: crashed (exit status $status)"
+    fi
+    if ! grep -qF "$name" "$dir/err"; then
+        fail "$name: the message does not name the file:"
+        sed 's/^/    /' "$dir/err" >&2
+    fi
+    if grep -qE "AddressSanitizer|LeakSanitizer|runtime error" "$dir/err"; then
+        fail "$name: sanitizer report:"
+        sed 's/^/    /' "$dir/err" >&2
+    fi
+}
+
+# expect_line NAME LINE: the message points at line LINE of the file.
+expect_line() {
+    if ! grep -qF "$1:$2" "$dir/err"; then
+        fail "$1: no message at line $2:"
+        sed 's/^/    /' "$dir/err" >&2
+    fi
+}
+
+printf '{\n  "camera": {\n    "position": [1, 2,\n  }\n}\n' >"$dir/malformed.json"
+expect_failure malformed.json
+expect_line malformed.json 4
+
+printf '' >"$dir/empty.json"
+expect_failure empty.json
+
+printf '{\n "camera": { "position": [0,0,1], "target": [0,0,0],\n   "fov_y": "wide" }\n}\n' \
+    >"$dir/wrong_type.json"
+expect_failure wrong_type.json
+expect_line wrong_type.json 3
+
+printf '{\n "camera": { "position": [0,0,1], "target": [0,0,0],\n   "width": 1000000000 }\n}\n' \
+    >"$dir/absurd_width.json"
+expect_failure absurd_width.json
+expect_line absurd_width.json 3
+
+printf '{\n "lights": [\n  { "type": "point", "position": [0, 1e999, 0], "intensity": 1 }\n ]\n}\n' \
+    >"$dir/infinite.json"
+expect_failure infinite.json
+expect_line infinite.json 3
+
+printf '{\n "lights": [\n  { "type": "quad", "corner": [0,0,0], "edge_u": [1,0,0],\n    "edge_v": [0,0,0], "radiance": 1 }\n ]\n}\n' \
+    >"$dir/zero_area.json"
+expect_failure zero_area.json
+expect_line zero_area.json 3
+
+printf '{\n "lights": [ { "type": "sphere", "center": [0,0,0],\n   "radius": -2, "radiance": 1 } ]\n}\n' \
+    >"$dir/negative_radius.json"
+expect_failure negative_radius.json
+
+printf '{\n "meshes": [\n  { "path": "missing_mesh.obj" }\n ]\n}\n' >"$dir/missing_mesh.json"
+expect_failure missing_mesh.json
+expect_line missing_mesh.json 3
+
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99\n' >"$dir/bad_index.obj"
+expect_failure bad_index.obj
+
+printf 'ply\nformat ascii 1.0\nelement vertex 1000000000\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n' \
+    >"$dir/huge.ply"
+expect_failure huge.ply
+
+printf 'not gzip at all' >"$dir/fake.obj.gz"
+expect_failure fake.obj.gz
+
+printf 'solid x\nendsolid x\n' >"$dir/model.stl"
+expect_failure model.stl
+
+expect_failure does_not_exist.json
+
+mkdir "$dir/folder.obj"
+expect_failure folder.obj
+
+# Usage errors exit 2; --help exits 0.
+"$drift" info --no-such-flag >/dev/null 2>&1
+[ $? -eq 2 ] || fail "unknown option: expected exit status 2"
+"$drift" info --help >/dev/null 2>&1 || fail "--help: expected exit status 0"
+
+# The default scene loads; --json is valid JSON with the expected counts.
+if ! "$drift" info --json >"$dir/info.json" 2>"$dir/err"; then
+    fail "default scene: drift info failed"
+    sed 's/^/    /' "$dir/err" >&2
+elif command -v python3 >/dev/null; then
+    python3 - "$dir/info.json" <<'EOF' || fail "default scene: unexpected --json output"
+import json, sys
+info = json.load(open(sys.argv[1]))
+assert info["triangles"] == 32, info
+assert info["lights"]["triangle"] == 2, info
+EOF
+fi
+
+if [ "$failures" -ne 0 ]; then
+    echo "$failures failure(s)" >&2
+    exit 1
+fi
+echo "all bad inputs rejected cleanly"
