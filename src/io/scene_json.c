@@ -1017,9 +1017,10 @@ static drift_result report_syntax_error(const json_reader *r, const char *text, 
     }
     near[n] = '\0';
     int column = (int)(offset - line_start) + 1;
+    // The logger gets file and line; the column goes in the text ("file:line: ... column").
     drift_log(r->ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, r->file, line,
-              "%s:%d:%d: malformed JSON %s%s%s", r->file, line, column,
-              offset >= length ? "(unexpected end of file)" : "near '", n ? near : "",
+              "malformed JSON at column %d%s%s%s", column,
+              offset >= length ? " (unexpected end of file)" : ", near '", n ? near : "",
               offset >= length ? "" : "'");
     return DRIFT_ERR_PARSE;
 }
