@@ -342,7 +342,7 @@ static drift_result read_number(const json_reader *r, const cJSON *obj, const ch
 static drift_result read_float(const json_reader *r, const cJSON *obj, const char *path,
                                const char *key, bool required, double lo, double hi, float *out)
 {
-    double v = *out;
+    double v = (double)*out;
     drift_result res = read_number(r, obj, path, key, required, lo, hi, &v);
     *out = (float)v;
     return res;
