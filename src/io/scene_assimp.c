@@ -2,7 +2,8 @@
 // node graph's transforms applied, materials, punctual lights and the first camera.
 //
 // Normals: the file's normals are kept; none are generated, so a file without them is
-// shaded flat (right for boxes like the Cornell box). UVs are kept as the file has them.
+// shaded flat (right for boxes like the Cornell box). UVs are kept as assimp gives them
+// (origin bottom-left, as docs/conventions.md wants).
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
