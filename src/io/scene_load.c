@@ -189,6 +189,11 @@ drift_result drift__read_file(drift_context *ctx, const char *path, bool gzip, c
     if (gzip) {
         return read_gzip(ctx, path, where, line, out_data, out_size);
     }
+    if (file_size > DRIFT_SCENE_MAX_FILE_BYTES) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, where, line,
+                  "'%s' is larger than %zu bytes", path, DRIFT_SCENE_MAX_FILE_BYTES);
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
     FILE *f = fopen(path, "rb");
     if (!f) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, where, line, "cannot open '%s': %s", path,

@@ -701,6 +701,20 @@ static void test_scene_io_textures_are_shared(void **state)
     assert_float_equal(scene->environment.color.x, 2.0f, 1e-6f);
     assert_int_equal(scene->textures[0].width, 4);
     drift_scene_destroy(scene);
+
+    // An OBJ's map_Kd is found next to the OBJ, and its UVs come along.
+    char obj[1024], mtl[1024];
+    write_file(test_out_path(mtl, "scene_io_textured.mtl"),
+               "newmtl tex\nKd 1 1 1\nmap_Kd scene_io_texture.png\n");
+    write_file(test_out_path(obj, "scene_io_textured.obj"),
+               "mtllib scene_io_textured.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"
+               "vt 0 0\nvt 1 0\nvt 0 1\nusemtl tex\nf 1/1 2/2 3/3\n");
+    scene = NULL;
+    assert_int_equal(drift_scene_load(ctx, obj, &scene), DRIFT_OK);
+    assert_int_equal(scene->texture_count, 1);
+    assert_int_equal(scene->materials[scene->meshes[0].material].diffuse_texture, 0);
+    assert_non_null(scene->meshes[0].uvs);
+    drift_scene_destroy(scene);
     drift_context_destroy(ctx);
 }
 
