@@ -1,13 +1,12 @@
 // drift info [SCENE]: loads a scene (the built-in Cornell box when none is given) and prints
 // its triangle, mesh, material, light and texture counts, bounds and camera, as text or JSON.
 #include "cli.h"
+#include "drift/scene.h"
+#include "drift/scene_io.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
-
-#include "drift/scene.h"
-#include "drift/scene_io.h"
 
 static void print_help(FILE *out)
 {
@@ -113,9 +112,9 @@ static void print_text(const char *path, const drift_scene *scene, const uint32_
            (double)scene->bounds.min.y, (double)scene->bounds.min.z, (double)scene->bounds.max.x,
            (double)scene->bounds.max.y, (double)scene->bounds.max.z);
     printf("camera     position (%g %g %g) target (%g %g %g) up (%g %g %g)\n",
-           (double)c->position.x, (double)c->position.y, (double)c->position.z,
-           (double)c->target.x, (double)c->target.y, (double)c->target.z, (double)c->up.x,
-           (double)c->up.y, (double)c->up.z);
+           (double)c->position.x, (double)c->position.y, (double)c->position.z, (double)c->target.x,
+           (double)c->target.y, (double)c->target.z, (double)c->up.x, (double)c->up.y,
+           (double)c->up.z);
     printf("           fov_y %.4g deg, %dx%d", (double)(c->fov_y * 180.0f / DRIFT_PI), c->width,
            c->height);
     if (c->aperture_radius > 0.0f) {

@@ -4,16 +4,15 @@
 // Normals: the file's normals are kept; none are generated, so a file without them is
 // shaded flat (right for boxes like the Cornell box). UVs are kept as assimp gives them
 // (origin bottom-left, as docs/conventions.md wants).
-#include <math.h>
-#include <stdio.h>
-#include <string.h>
+#include "scene_io_internal.h"
 
 #include <assimp/cimport.h>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
-
-#include "scene_io_internal.h"
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
 
 // Row-major 4x4 affine transforms (the layout of aiMatrix4x4 and of the JSON "matrix").
 typedef struct mat4 {
@@ -123,7 +122,9 @@ static drift_vec3 ai_color3(const struct aiMaterial *mat, const char *key, unsig
 static void material_texture(import_state *s, const struct aiMaterial *mat, drift_material *m)
 {
     struct aiString tex;
+
     enum aiTextureType types[2] = { aiTextureType_DIFFUSE, aiTextureType_BASE_COLOR };
+
     for (int t = 0; t < 2; ++t) {
         if (aiGetMaterialTexture(mat, types[t], 0, &tex, NULL, NULL, NULL, NULL, NULL, NULL) !=
             AI_SUCCESS) {
@@ -210,7 +211,8 @@ static drift_result convert_materials(import_state *s)
             return r;
         }
         s->material_map[i] = index;
-        if (!drift_vec3_is_zero(m.emission) && s->params->material_override == DRIFT_INVALID_INDEX) {
+        if (!drift_vec3_is_zero(m.emission) &&
+            s->params->material_override == DRIFT_INVALID_INDEX) {
             s->info->emissive_material_count++;
         }
     }
@@ -256,7 +258,8 @@ static drift_result add_mesh(import_state *s, const struct aiMesh *mesh, const m
             const struct aiVector3D *n = &mesh->mNormals[v];
             for (int k = 0; k < 3; ++k) {
                 normals[3 * v + (size_t)k] =
-                    normal_sign * (cof[3 * k] * n->x + cof[3 * k + 1] * n->y + cof[3 * k + 2] * n->z);
+                    normal_sign *
+                    (cof[3 * k] * n->x + cof[3 * k + 1] * n->y + cof[3 * k + 2] * n->z);
             }
         }
         if (uvs) {
@@ -319,8 +322,8 @@ done:
 static drift_result add_light(import_state *s, const struct aiLight *l, const mat4 *world)
 {
     drift_light light = { 0 };
-    drift_vec3 position = transform_point(world, drift_vec3_make(l->mPosition.x, l->mPosition.y,
-                                                                 l->mPosition.z));
+    drift_vec3 position =
+        transform_point(world, drift_vec3_make(l->mPosition.x, l->mPosition.y, l->mPosition.z));
     drift_vec3 direction = drift_vec3_normalize(transform_vector(
         world, drift_vec3_make(l->mDirection.x, l->mDirection.y, l->mDirection.z)));
     light.color = drift_vec3_make(l->mColorDiffuse.r, l->mColorDiffuse.g, l->mColorDiffuse.b);
@@ -391,7 +394,8 @@ static void set_camera(import_state *s, const struct aiCamera *cam, const mat4 *
     drift_vec3 up = drift_vec3_normalize(transform_vector(world, local_up));
     int32_t height = 512;
     int32_t width = (int32_t)lroundf(drift_clampf(512.0f * aspect, 1.0f, 8192.0f));
-    s->info->camera = drift_camera_look_at(eye, drift_vec3_add(eye, look), up, fov_y, width, height);
+    s->info->camera =
+        drift_camera_look_at(eye, drift_vec3_add(eye, look), up, fov_y, width, height);
     s->info->has_camera = true;
 }
 
@@ -469,8 +473,8 @@ static drift_result import_scene(import_state *s)
         }
     }
     if (r == DRIFT_OK && s->info->mesh_count == 0) {
-        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, s->where, s->line,
-                  "'%s' has no triangles", s->params->path);
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, s->where, s->line, "'%s' has no triangles",
+                  s->params->path);
         r = DRIFT_ERR_PARSE;
     }
     drift_free(ctx, s->material_map);
@@ -589,8 +593,8 @@ drift_result drift__scene_import_mesh_file(drift_scene *scene, const drift__impo
     }
     drift_free(ctx, data);
     if (!ai || !ai->mRootNode) {
-        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, s.where, s.line,
-                  "cannot read '%s': %s", params->path, ai ? "no scene" : aiGetErrorString());
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, s.where, s.line, "cannot read '%s': %s",
+                  params->path, ai ? "no scene" : aiGetErrorString());
         aiReleaseImport(ai);
         return DRIFT_ERR_PARSE;
     }

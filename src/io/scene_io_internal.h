@@ -12,7 +12,7 @@
 
 // Deepest assimp node graph walked (a guard against cycles and absurd files).
 #define DRIFT__SCENE_MAX_NODE_DEPTH 256
-#define DRIFT__PATH_MAX 4096
+#define DRIFT__PATH_MAX             4096
 
 // Textures loaded once per path while one scene loads.
 typedef struct drift__texture_cache {

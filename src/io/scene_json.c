@@ -4,6 +4,9 @@
 // where every JSON value starts. Values appear in the text in the same order as a pre-order
 // walk of cJSON's tree, which pairs each cJSON node with its line. Messages can then name
 // "file:line" for any key the reader complains about.
+#include "scene_io_internal.h"
+
+#include <cjson/cJSON.h>
 #include <float.h>
 #include <math.h>
 #include <stdarg.h>
@@ -11,14 +14,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <cjson/cJSON.h>
-
-#include "scene_io_internal.h"
-
 // Largest counts a scene file may list (far above real scenes; keeps a hostile file small).
-#define MAX_JSON_MESHES 65536
+#define MAX_JSON_MESHES    65536
 #define MAX_JSON_MATERIALS 65536
-#define KEY_PATH_MAX 256
+#define KEY_PATH_MAX       256
 
 typedef struct node_line {
     const cJSON *node;
@@ -171,8 +170,9 @@ static int line_of(const json_reader *r, const cJSON *node)
 #if defined(__GNUC__)
 __attribute__((format(printf, 5, 6)))
 #endif
-static drift_result report(const json_reader *r, drift_log_level level, const cJSON *node,
-                           drift_result code, const char *fmt, ...)
+static drift_result
+report(const json_reader *r, drift_log_level level, const cJSON *node, drift_result code,
+       const char *fmt, ...)
 {
     char message[768];
     va_list args;
@@ -261,8 +261,8 @@ static drift_result check_duplicates(const json_reader *r, const cJSON *obj, con
     for (i = 1; i < n; ++i) {
         if (strcmp(keys[i - 1]->string, keys[i]->string) == 0) {
             // Report the later of the two in the file.
-            const cJSON *later = line_of(r, keys[i]) >= line_of(r, keys[i - 1]) ? keys[i]
-                                                                                : keys[i - 1];
+            const cJSON *later =
+                line_of(r, keys[i]) >= line_of(r, keys[i - 1]) ? keys[i] : keys[i - 1];
             char full[KEY_PATH_MAX];
             key_path(full, path, later->string);
             res = FAIL(r, later, DRIFT_ERR_PARSE, "duplicate key '%s'", full);
@@ -296,8 +296,8 @@ static drift_result check_keys(const json_reader *r, const cJSON *obj, const cha
     return DRIFT_OK;
 }
 
-#define CHECK_KEYS(r, obj, path, ...)                                                              \
-    check_keys((r), (obj), (path), (const char *const[]){ __VA_ARGS__ },                          \
+#define CHECK_KEYS(r, obj, path, ...)                                    \
+    check_keys((r), (obj), (path), (const char *const[]){ __VA_ARGS__ }, \
                sizeof((const char *const[]){ __VA_ARGS__ }) / sizeof(const char *))
 
 static drift_result missing(const json_reader *r, const cJSON *obj, const char *path,
@@ -312,16 +312,15 @@ static drift_result number_value(const json_reader *r, const cJSON *item, const 
                                  double lo, double hi, double *out)
 {
     if (!cJSON_IsNumber(item)) {
-        return FAIL(r, item, DRIFT_ERR_PARSE, "%s must be a number, not %s", path,
-                    type_name(item));
+        return FAIL(r, item, DRIFT_ERR_PARSE, "%s must be a number, not %s", path, type_name(item));
     }
     double v = item->valuedouble;
     if (!isfinite(v)) {
         return FAIL(r, item, DRIFT_ERR_INVALID_ARGUMENT, "%s is not a finite number", path);
     }
     if (v < lo || v > hi) {
-        return FAIL(r, item, DRIFT_ERR_INVALID_ARGUMENT, "%s = %g is outside [%g, %g]", path, v,
-                    lo, hi);
+        return FAIL(r, item, DRIFT_ERR_INVALID_ARGUMENT, "%s = %g is outside [%g, %g]", path, v, lo,
+                    hi);
     }
     *out = v;
     return DRIFT_OK;
@@ -422,8 +421,7 @@ static drift_result read_string(const json_reader *r, const cJSON *obj, const ch
     char full[KEY_PATH_MAX];
     key_path(full, path, key);
     if (!cJSON_IsString(item) || !item->valuestring) {
-        return FAIL(r, item, DRIFT_ERR_PARSE, "%s must be a string, not %s", full,
-                    type_name(item));
+        return FAIL(r, item, DRIFT_ERR_PARSE, "%s must be a string, not %s", full, type_name(item));
     }
     if (!item->valuestring[0]) {
         return FAIL(r, item, DRIFT_ERR_INVALID_ARGUMENT, "%s must not be empty", full);
@@ -747,8 +745,8 @@ static drift_result read_mesh(json_reader *r, const cJSON *item, const char *pat
     drift__path_extension(rel, ext, sizeof(ext), &gz);
     if (!is_mesh_extension(ext)) {
         return FAIL(r, path_item, DRIFT_ERR_UNSUPPORTED,
-                    "%s.path '%s': meshes must be .obj, .gltf, .glb or .ply (optionally .gz)",
-                    path, rel);
+                    "%s.path '%s': meshes must be .obj, .gltf, .glb or .ply (optionally .gz)", path,
+                    rel);
     }
     char full[DRIFT__PATH_MAX];
     if ((res = resolve_path(r, path_item, rel, full)) != DRIFT_OK) {
@@ -861,25 +859,24 @@ static drift_result read_light(json_reader *r, const cJSON *item, const char *pa
             (res = read_vec3(r, item, path, "center", true, VEC3_ANY, &l.position)) != DRIFT_OK ||
             (res = read_vec3(r, item, path, "normal", true, VEC3_DIRECTION, &l.direction)) !=
                 DRIFT_OK ||
-            (res = read_float(r, item, path, "radius", true, -(double)FLT_MAX, (double)FLT_MAX, &l.radius)) !=
-                DRIFT_OK ||
+            (res = read_float(r, item, path, "radius", true, -(double)FLT_MAX, (double)FLT_MAX,
+                              &l.radius)) != DRIFT_OK ||
             (res = read_vec3(r, item, path, "radiance", true, VEC3_COLOR, &l.color)) != DRIFT_OK) {
             return res;
         }
     } else if (strcmp(type, "sphere") == 0) {
         l.type = DRIFT_LIGHT_SPHERE;
-        if ((res = CHECK_KEYS(r, item, path, "type", "center", "radius", "radiance")) !=
-                DRIFT_OK ||
+        if ((res = CHECK_KEYS(r, item, path, "type", "center", "radius", "radiance")) != DRIFT_OK ||
             (res = read_vec3(r, item, path, "center", true, VEC3_ANY, &l.position)) != DRIFT_OK ||
-            (res = read_float(r, item, path, "radius", true, -(double)FLT_MAX, (double)FLT_MAX, &l.radius)) !=
-                DRIFT_OK ||
+            (res = read_float(r, item, path, "radius", true, -(double)FLT_MAX, (double)FLT_MAX,
+                              &l.radius)) != DRIFT_OK ||
             (res = read_vec3(r, item, path, "radiance", true, VEC3_COLOR, &l.color)) != DRIFT_OK) {
             return res;
         }
     } else {
         return FAIL(r, cJSON_GetObjectItemCaseSensitive(item, "type"), DRIFT_ERR_INVALID_ARGUMENT,
-                    "%s.type '%s' is not one of point, spot, directional, quad, disk, sphere",
-                    path, type);
+                    "%s.type '%s' is not one of point, spot, directional, quad, disk, sphere", path,
+                    type);
     }
     // drift_scene_add_light checks the values (zero area, cone angles) and logs the reason;
     // this adds where in the file the light is.
@@ -922,8 +919,8 @@ static drift_result read_environment(json_reader *r, const cJSON *root)
     }
     const char *path = "environment";
     drift_result res = expect_object(r, env, path);
-    if (res != DRIFT_OK || (res = CHECK_KEYS(r, env, path, "color", "map", "multiplier")) !=
-                               DRIFT_OK) {
+    if (res != DRIFT_OK ||
+        (res = CHECK_KEYS(r, env, path, "color", "map", "multiplier")) != DRIFT_OK) {
         return res;
     }
     bool has_map = cJSON_HasObjectItem(env, "map");
@@ -972,16 +969,16 @@ static drift_result read_camera(json_reader *r, const cJSON *root, bool *out_fou
                           &c.focus_distance)) != DRIFT_OK ||
         (res = read_int(r, cam, path, "width", false, 1, DRIFT_IMAGE_MAX_DIMENSION, &c.width)) !=
             DRIFT_OK ||
-        (res = read_int(r, cam, path, "height", false, 1, DRIFT_IMAGE_MAX_DIMENSION,
-                        &c.height)) != DRIFT_OK) {
+        (res = read_int(r, cam, path, "height", false, 1, DRIFT_IMAGE_MAX_DIMENSION, &c.height)) !=
+            DRIFT_OK) {
         return res;
     }
     c.fov_y = fov_deg * DRIFT_PI / 180.0f;
     // Commit rejects these too, but without saying where in the file they are.
     drift_vec3 forward = drift_vec3_sub(c.target, c.position);
     if (!(drift_vec3_length(forward) > 0.0f) || !isfinite(drift_vec3_length(forward))) {
-        return FAIL(r, cJSON_GetObjectItemCaseSensitive(cam, "target"),
-                    DRIFT_ERR_INVALID_ARGUMENT, "camera.target must differ from camera.position");
+        return FAIL(r, cJSON_GetObjectItemCaseSensitive(cam, "target"), DRIFT_ERR_INVALID_ARGUMENT,
+                    "camera.target must differ from camera.position");
     }
     if (!(drift_vec3_length(drift_vec3_cross(drift_vec3_normalize(forward),
                                              drift_vec3_normalize(c.up))) > 1e-6f)) {
@@ -1028,9 +1025,8 @@ static drift_result report_syntax_error(const json_reader *r, const char *text, 
 static drift_result read_scene(json_reader *r, const cJSON *root)
 {
     drift_result res = expect_object(r, root, "the scene file");
-    if (res != DRIFT_OK ||
-        (res = CHECK_KEYS(r, root, "", "version", "camera", "materials", "meshes", "lights",
-                          "environment")) != DRIFT_OK) {
+    if (res != DRIFT_OK || (res = CHECK_KEYS(r, root, "", "version", "camera", "materials",
+                                             "meshes", "lights", "environment")) != DRIFT_OK) {
         return res;
     }
     const cJSON *version = cJSON_GetObjectItemCaseSensitive(root, "version");

@@ -1,18 +1,16 @@
 // Scene loading entry point: dispatch by extension, whole-file reads (gunzipped with zlib),
 // the texture cache, and the camera and light a bare mesh file is given.
+#include "drift/image_io.h"
 #include "drift/scene_io.h"
+#include "scene_io_internal.h"
 
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
-
 #include <sys/stat.h>
 #include <zlib.h>
-
-#include "drift/image_io.h"
-#include "scene_io_internal.h"
 
 void drift__path_extension(const char *path, char *out, size_t out_size, bool *out_gz)
 {
@@ -128,7 +126,11 @@ static drift_result read_gzip(drift_context *ctx, const char *path, const char *
     char *data = NULL;
     size_t size = 0, cap = 0;
     drift_result r = DRIFT_OK;
-    enum { CHUNK = 1 << 16 };
+
+    enum {
+        CHUNK = 1 << 16
+    };
+
     char *chunk = drift_alloc(ctx, CHUNK);
     if (!chunk) {
         r = DRIFT_ERR_OUT_OF_MEMORY;
@@ -339,14 +341,14 @@ drift_camera drift__framing_camera(drift_bounds3 bounds)
 // facing the sun as bright as its albedo.
 static drift_result add_default_lights(drift_scene *scene, const char *path)
 {
-    drift_vec3 view = drift_vec3_normalize(
-        drift_vec3_sub(scene->camera.target, scene->camera.position));
+    drift_vec3 view =
+        drift_vec3_normalize(drift_vec3_sub(scene->camera.target, scene->camera.position));
     drift_vec3 right = drift_vec3_normalize(drift_vec3_cross(view, scene->camera.up));
     drift_vec3 up = drift_vec3_cross(right, view);
     // From behind the camera, up and to the right: the light travels forward, down, left.
-    drift_vec3 toward_light = drift_vec3_add(drift_vec3_add(drift_vec3_scale(view, -1.0f),
-                                                            drift_vec3_scale(up, 1.0f)),
-                                             drift_vec3_scale(right, 0.5f));
+    drift_vec3 toward_light =
+        drift_vec3_add(drift_vec3_add(drift_vec3_scale(view, -1.0f), drift_vec3_scale(up, 1.0f)),
+                       drift_vec3_scale(right, 0.5f));
     drift_light sun = { .type = DRIFT_LIGHT_DIRECTIONAL,
                         .color = drift_vec3_splat(DRIFT_PI),
                         .direction = drift_vec3_neg(drift_vec3_normalize(toward_light)) };
@@ -377,15 +379,14 @@ static drift_result load_mesh_scene(drift_context *ctx, const char *path, drift_
     }
     drift__texture_cache textures = { 0 };
     drift__import_info info = { 0 };
-    drift__import_params params = { .path = path,
-                                    .where = path,
-                                    .material_override = DRIFT_INVALID_INDEX,
-                                    .textures = &textures };
+    drift__import_params params = {
+        .path = path, .where = path, .material_override = DRIFT_INVALID_INDEX, .textures = &textures
+    };
     r = drift__scene_import_mesh_file(scene, &params, &info);
     drift__texture_cache_clear(ctx, &textures);
     if (r == DRIFT_OK) {
-        scene->camera = info.has_camera ? info.camera
-                                        : drift__framing_camera(drift__scene_mesh_bounds(scene));
+        scene->camera =
+            info.has_camera ? info.camera : drift__framing_camera(drift__scene_mesh_bounds(scene));
         if (info.light_count == 0 && info.emissive_material_count == 0) {
             r = add_default_lights(scene, path);
         }
@@ -423,8 +424,7 @@ drift_result drift_scene_load(drift_context *ctx, const char *path, drift_scene 
     }
     *out_scene = NULL;
     if (!path || !path[0]) {
-        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, NULL, 0,
-                  "no scene path given");
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, NULL, 0, "no scene path given");
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
     if (strlen(path) >= DRIFT__PATH_MAX) {

@@ -2,12 +2,12 @@
 // resolved against a folder that does not exist, so mesh and texture loads fail (that error
 // path is part of what is fuzzed). Any result code is fine; crashes, sanitizer reports and
 // leaks are not.
+#include "drift/scene.h"
+#include "drift/scene_io.h"
+
 #include <stddef.h>
 #include <stdint.h>
 #include <string.h>
-
-#include "drift/scene.h"
-#include "drift/scene_io.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -26,7 +26,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     size_t total = 0;
     drift_context *ctx = NULL;
-    drift_context_desc desc = { .thread_count = 1, .logger = { .func = check_log, .user = &total } };
+    drift_context_desc desc = { .thread_count = 1,
+                                .logger = { .func = check_log, .user = &total } };
     if (drift_context_create(&desc, &ctx) != DRIFT_OK) {
         return 0;
     }

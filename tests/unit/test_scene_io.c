@@ -1,18 +1,16 @@
 // Scene loading: the default Cornell box, the real scenes in ../shared/scenes, JSON errors
 // with their lines, unknown keys, gzip, transforms, glTF cameras and lights, textures.
+#include "drift/image_io.h"
+#include "drift/scene.h"
+#include "drift/scene_io.h"
 #include "drift_test.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
 #include <sys/stat.h>
 #include <zlib.h>
-
-#include "drift/image_io.h"
-#include "drift/scene.h"
-#include "drift/scene_io.h"
 
 // Remembers the first error's code, file and line (drift_test's capture keeps no location).
 typedef struct located_log {
@@ -83,9 +81,9 @@ static void test_scene_io_default_cornell_box(void **state)
     drift_context *ctx = located_context(&log);
     char path[1024];
     drift_scene *scene = NULL;
-    assert_int_equal(drift_scene_load(ctx, test_repo_path(path, "scenes/cornell-box/cornell_box.json"),
-                                      &scene),
-                     DRIFT_OK);
+    assert_int_equal(
+        drift_scene_load(ctx, test_repo_path(path, "scenes/cornell-box/cornell_box.json"), &scene),
+        DRIFT_OK);
     assert_true(scene->committed);
     assert_int_equal(drift_scene_triangle_count(scene), 32);
     // The light is the emissive quad of the OBJ: two triangle lights and nothing else.
@@ -229,72 +227,91 @@ static void test_scene_io_bad_json_reports_code_and_line(void **state)
 {
     (void)state;
     static const bad_json cases[] = {
-        { "malformed", "{\n  \"camera\": {\n    \"position\": [1, 2,\n  }\n}\n", DRIFT_ERR_PARSE, 4 },
+        { "malformed", "{\n  \"camera\": {\n    \"position\": [1, 2,\n  }\n}\n", DRIFT_ERR_PARSE,
+          4 },
         { "truncated", "{\n  \"meshes\": [\n", DRIFT_ERR_PARSE, 3 },
         { "trailing garbage", "{}\n\nxyz\n", DRIFT_ERR_PARSE, 3 },
         { "empty", "", DRIFT_ERR_PARSE, 1 },
         { "not an object", "[1, 2]\n", DRIFT_ERR_PARSE, 1 },
-        { "wrong type", "{\n  \"camera\": {\n    \"position\": [0,0,1], \"target\": [0,0,0],\n"
-                        "    \"fov_y\": \"wide\"\n  }\n}\n",
+        { "wrong type",
+          "{\n  \"camera\": {\n    \"position\": [0,0,1], \"target\": [0,0,0],\n"
+          "    \"fov_y\": \"wide\"\n  }\n}\n",
           DRIFT_ERR_PARSE, 4 },
         { "vector of 2", "{\n \"camera\": {\n  \"position\": [0, 1],\n  \"target\": [0,0,0] }\n}",
           DRIFT_ERR_PARSE, 3 },
-        { "infinite", "{\n \"lights\": [\n  { \"type\": \"point\",\n    \"position\": [0, 1e999, 0],\n"
-                      "    \"intensity\": 1 }\n ]\n}\n",
+        { "infinite",
+          "{\n \"lights\": [\n  { \"type\": \"point\",\n    \"position\": [0, 1e999, 0],\n"
+          "    \"intensity\": 1 }\n ]\n}\n",
           DRIFT_ERR_INVALID_ARGUMENT, 4 },
-        { "float overflow", "{\n \"lights\": [ { \"type\": \"point\", \"position\": [0,0,0],\n"
-                            "   \"intensity\": 1e300 } ]\n}\n",
+        { "float overflow",
+          "{\n \"lights\": [ { \"type\": \"point\", \"position\": [0,0,0],\n"
+          "   \"intensity\": 1e300 } ]\n}\n",
           DRIFT_ERR_INVALID_ARGUMENT, 3 },
-        { "negative radius", "{\n \"lights\": [\n  {\n   \"type\": \"sphere\", \"center\": [0,0,0],\n"
-                             "   \"radius\": -1, \"radiance\": 1\n  }\n ]\n}\n",
+        { "negative radius",
+          "{\n \"lights\": [\n  {\n   \"type\": \"sphere\", \"center\": [0,0,0],\n"
+          "   \"radius\": -1, \"radiance\": 1\n  }\n ]\n}\n",
           DRIFT_ERR_INVALID_ARGUMENT, 3 },
-        { "zero-area quad", "{\n \"lights\": [\n  { \"type\": \"quad\", \"corner\": [0,0,0],\n"
-                            "    \"edge_u\": [1,0,0], \"edge_v\": [2,0,0], \"radiance\": 1 }\n ]\n}\n",
+        { "zero-area quad",
+          "{\n \"lights\": [\n  { \"type\": \"quad\", \"corner\": [0,0,0],\n"
+          "    \"edge_u\": [1,0,0], \"edge_v\": [2,0,0], \"radiance\": 1 }\n ]\n}\n",
           DRIFT_ERR_INVALID_ARGUMENT, 3 },
-        { "zero disk", "{\"lights\": [\n{\"type\": \"disk\", \"center\": [0,0,0], \"normal\": [0,1,0],"
-                       " \"radius\": 0, \"radiance\": 1}]}",
+        { "zero disk",
+          "{\"lights\": [\n{\"type\": \"disk\", \"center\": [0,0,0], \"normal\": [0,1,0],"
+          " \"radius\": 0, \"radiance\": 1}]}",
           DRIFT_ERR_INVALID_ARGUMENT, 2 },
-        { "negative colour", "{\n \"materials\": {\n  \"m\": { \"diffuse\": [0.5, -0.1, 0.5] }\n }\n}\n",
+        { "negative colour",
+          "{\n \"materials\": {\n  \"m\": { \"diffuse\": [0.5, -0.1, 0.5] }\n }\n}\n",
           DRIFT_ERR_INVALID_ARGUMENT, 3 },
-        { "absurd width", "{\n \"camera\": { \"position\": [0,0,1], \"target\": [0,0,0],\n"
-                          "   \"width\": 1000000000 }\n}\n",
+        { "absurd width",
+          "{\n \"camera\": { \"position\": [0,0,1], \"target\": [0,0,0],\n"
+          "   \"width\": 1000000000 }\n}\n",
           DRIFT_ERR_INVALID_ARGUMENT, 3 },
-        { "fractional height", "{\n \"camera\": { \"position\": [0,0,1], \"target\": [0,0,0],\n\n"
-                               "   \"height\": 1.5 }\n}\n",
+        { "fractional height",
+          "{\n \"camera\": { \"position\": [0,0,1], \"target\": [0,0,0],\n\n"
+          "   \"height\": 1.5 }\n}\n",
           DRIFT_ERR_INVALID_ARGUMENT, 4 },
-        { "fov out of range", "{\"camera\": {\"position\": [0,0,1], \"target\": [0,0,0],\n"
-                              "\"fov_y\": 180}}",
+        { "fov out of range",
+          "{\"camera\": {\"position\": [0,0,1], \"target\": [0,0,0],\n"
+          "\"fov_y\": 180}}",
           DRIFT_ERR_INVALID_ARGUMENT, 2 },
-        { "up parallel", "{\"camera\": {\"position\": [0,0,1], \"target\": [0,0,0],\n"
-                         "\"up\": [0,0,2]}}",
+        { "up parallel",
+          "{\"camera\": {\"position\": [0,0,1], \"target\": [0,0,0],\n"
+          "\"up\": [0,0,2]}}",
           DRIFT_ERR_INVALID_ARGUMENT, 2 },
         { "missing mesh file", "{\n \"meshes\": [\n  { \"path\": \"no_such_file.obj\" }\n ]\n}\n",
           DRIFT_ERR_IO, 3 },
         { "mesh extension", "{\n \"meshes\": [ { \"path\": \"mesh.fbx\" } ]\n}\n",
           DRIFT_ERR_UNSUPPORTED, 2 },
-        { "unknown material", "{\n \"meshes\": [\n  { \"path\": \"cornell_box.obj\",\n"
-                              "    \"material\": \"nope\" }\n ]\n}\n",
+        { "unknown material",
+          "{\n \"meshes\": [\n  { \"path\": \"cornell_box.obj\",\n"
+          "    \"material\": \"nope\" }\n ]\n}\n",
           DRIFT_ERR_INVALID_ARGUMENT, 4 },
         { "missing key", "{\n \"lights\": [\n  { \"type\": \"point\", \"intensity\": 1 }\n ]\n}\n",
           DRIFT_ERR_PARSE, 3 },
         { "unknown light type", "{\n \"lights\": [\n  { \"type\": \"laser\" }\n ]\n}\n",
           DRIFT_ERR_INVALID_ARGUMENT, 3 },
-        { "duplicate key", "{\n \"camera\": { \"position\": [0,0,1], \"target\": [0,0,0],\n"
-                           "   \"position\": [0,0,2] }\n}\n",
+        { "duplicate key",
+          "{\n \"camera\": { \"position\": [0,0,1], \"target\": [0,0,0],\n"
+          "   \"position\": [0,0,2] }\n}\n",
           DRIFT_ERR_PARSE, 3 },
-        { "spot cone", "{\"lights\": [\n{\"type\": \"spot\", \"position\": [0,0,0], \"direction\": [0,-1,0],"
-                       " \"intensity\": 1, \"inner_angle\": 40, \"outer_angle\": 30}]}",
+        { "spot cone",
+          "{\"lights\": [\n{\"type\": \"spot\", \"position\": [0,0,0], \"direction\": [0,-1,0],"
+          " \"intensity\": 1, \"inner_angle\": 40, \"outer_angle\": 30}]}",
           DRIFT_ERR_INVALID_ARGUMENT, 2 },
-        { "zero scale", "{\"meshes\": [{\"path\": \"cornell_box.obj\",\n\"transform\": {\"scale\": 0}}]}",
+        { "zero scale",
+          "{\"meshes\": [{\"path\": \"cornell_box.obj\",\n\"transform\": {\"scale\": 0}}]}",
           DRIFT_ERR_INVALID_ARGUMENT, 2 },
-        { "non-affine matrix", "{\"meshes\": [{\"path\": \"cornell_box.obj\", \"transform\":\n"
-                               "{\"matrix\": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,1,1]}}]}",
+        { "non-affine matrix",
+          "{\"meshes\": [{\"path\": \"cornell_box.obj\", \"transform\":\n"
+          "{\"matrix\": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,1,1]}}]}",
           DRIFT_ERR_INVALID_ARGUMENT, 2 },
-        { "matrix and translate", "{\"meshes\": [{\"path\": \"cornell_box.obj\", \"transform\":\n"
-                                  "{\"translate\": [1,0,0],\n\"matrix\": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]}}]}",
+        { "matrix and translate",
+          "{\"meshes\": [{\"path\": \"cornell_box.obj\", \"transform\":\n"
+          "{\"translate\": [1,0,0],\n\"matrix\": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]}}]}",
           DRIFT_ERR_INVALID_ARGUMENT, 3 },
-        { "glossy without exponent", "{\"materials\": {\n\"g\": {\"type\": \"glossy\", \"specular\": 0.5}}}",
-          DRIFT_ERR_PARSE, 2 },
+        { "glossy without exponent",
+          "{\"materials\": {\n\"g\": {\"type\": \"glossy\", \"specular\": 0.5}}}", DRIFT_ERR_PARSE,
+          2 },
         { "specular on diffuse", "{\"materials\": {\"d\": {\n\"specular\": 0.5}}}",
           DRIFT_ERR_INVALID_ARGUMENT, 2 },
         { "version", "{\n\"version\": 2}", DRIFT_ERR_UNSUPPORTED, 2 },
@@ -334,8 +351,9 @@ static void test_scene_io_embedded_nul_is_a_parse_error(void **state)
     drift_context *ctx = located_context(&log);
     static const char text[] = "{}\n\0{\"x\": 1}";
     drift_scene *scene = NULL;
-    assert_int_equal(drift_scene_load_json_text(ctx, text, sizeof(text) - 1, NULL, "nul.json", &scene),
-                     DRIFT_ERR_PARSE);
+    assert_int_equal(
+        drift_scene_load_json_text(ctx, text, sizeof(text) - 1, NULL, "nul.json", &scene),
+        DRIFT_ERR_PARSE);
     assert_null(scene);
     assert_int_equal(log.first_error_line, 2);
     drift_context_destroy(ctx);
@@ -361,7 +379,8 @@ static void test_scene_io_bad_mesh_files(void **state)
           "property float y\nproperty float z\nelement face 1\n"
           "property list uchar int vertex_indices\nend_header\n0 0 0\n",
           DRIFT_ERR_PARSE },
-        { "scene_io_nan.obj", "v 0 0 0\nv 1 0 0\nv 0 nan 0\nf 1 2 3\n", DRIFT_ERR_INVALID_ARGUMENT },
+        { "scene_io_nan.obj", "v 0 0 0\nv 1 0 0\nv 0 nan 0\nf 1 2 3\n",
+          DRIFT_ERR_INVALID_ARGUMENT },
         { "scene_io_degenerate.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n",
           DRIFT_ERR_INVALID_ARGUMENT },
         { "scene_io_not_gzip.obj.gz", "v 0 0 0\n", DRIFT_ERR_PARSE },
@@ -474,9 +493,10 @@ static void test_scene_io_gzip(void **state)
     // A gzipped scene file.
     char json_src[1024];
     test_out_path(json_src, "scene_io_plain.json");
-    write_file(json_src, "{ \"environment\": { \"color\": 0.5 },\n"
-                         "  \"lights\": [ { \"type\": \"sphere\", \"center\": [0,0,0], \"radius\": 1,"
-                         " \"radiance\": 2 } ] }\n");
+    write_file(json_src,
+               "{ \"environment\": { \"color\": 0.5 },\n"
+               "  \"lights\": [ { \"type\": \"sphere\", \"center\": [0,0,0], \"radius\": 1,"
+               " \"radiance\": 2 } ] }\n");
     test_out_path(dst, "scene_io_scene.json.gz");
     gzip_file(json_src, dst);
     assert_int_equal(drift_scene_load(ctx, dst, &scene), DRIFT_OK);
@@ -504,9 +524,9 @@ static void test_scene_io_transforms_and_overrides(void **state)
     located_log log;
     drift_context *ctx = located_context(&log);
     // Scale 2 then translate: x in [1000, 1000 + 2 * 556].
-    drift_scene *scene = load_text(
-        ctx, "{\"meshes\": [{\"path\": \"cornell_box.obj\", \"transform\": "
-             "{\"translate\": [1000, 0, 0], \"scale\": 2}}]}");
+    drift_scene *scene =
+        load_text(ctx, "{\"meshes\": [{\"path\": \"cornell_box.obj\", \"transform\": "
+                       "{\"translate\": [1000, 0, 0], \"scale\": 2}}]}");
     assert_float_equal(scene->bounds.min.x, 1000.0f, 1e-2f);
     assert_float_equal(scene->bounds.max.x, 1000.0f + 2.0f * 556.0f, 1e-2f);
     assert_float_equal(scene->bounds.max.y, 2.0f * 548.8f, 1e-2f);
@@ -543,11 +563,12 @@ static void test_scene_io_transforms_and_overrides(void **state)
     drift_scene_destroy(scene);
 
     // A material override replaces every material of the file, emission included.
-    scene = load_text(ctx, "{\"materials\": {\"grey\": {\"diffuse\": 0.5},\n"
-                           "               \"chrome\": {\"type\": \"mirror\", \"specular\": 0.9}},\n"
-                           " \"meshes\": [{\"path\": \"cornell_box.obj\", \"material\": \"chrome\"}],\n"
-                           " \"lights\": [{\"type\": \"directional\", \"direction\": [0,-1,0],"
-                           " \"irradiance\": 3}]}");
+    scene =
+        load_text(ctx, "{\"materials\": {\"grey\": {\"diffuse\": 0.5},\n"
+                       "               \"chrome\": {\"type\": \"mirror\", \"specular\": 0.9}},\n"
+                       " \"meshes\": [{\"path\": \"cornell_box.obj\", \"material\": \"chrome\"}],\n"
+                       " \"lights\": [{\"type\": \"directional\", \"direction\": [0,-1,0],"
+                       " \"irradiance\": 3}]}");
     uint32_t chrome = DRIFT_INVALID_INDEX;
     for (uint32_t i = 0; i < scene->material_count; ++i) {
         if (strcmp(scene->materials[i].name, "chrome") == 0) {
@@ -627,7 +648,8 @@ static const char gltf_text[] =
     "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIAAAA=\"}],"
     " \"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 36},"
     "  {\"buffer\": 0, \"byteOffset\": 36, \"byteLength\": 6}],"
-    " \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\","
+    " \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 3, \"type\": "
+    "\"VEC3\","
     "  \"min\": [0, 0, 0], \"max\": [1, 1, 0]},"
     "  {\"bufferView\": 1, \"componentType\": 5123, \"count\": 3, \"type\": \"SCALAR\"}]}";
 
