@@ -3,26 +3,7 @@
 # clear failures for missing, corrupt and mismatched inputs. $1 is the drift binary.
 set -u
 drift="$1"
-tmp="$(mktemp -d)"
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-
-fail() {
-    echo "FAIL: $*" >&2
-    failures=$((failures + 1))
-}
-
-# expect STATUS CMD...: runs CMD, stdout to $tmp/out, stderr to $tmp/err.
-expect() {
-    local want="$1"
-    shift
-    "$@" >"$tmp/out" 2>"$tmp/err"
-    local got=$?
-    if [ "$got" -ne "$want" ]; then
-        fail "expected exit $want, got $got: $*"
-        sed 's/^/  stderr: /' "$tmp/err" >&2
-    fi
-}
+source "$(dirname "$0")/common.sh"
 
 # Inputs are small PNGs written with python3's zlib and struct (no image tools needed).
 python3 - "$tmp" <<'PY'

@@ -4,25 +4,7 @@
 # $1 is the drift binary.
 set -u
 drift="$1"
-tmp="$(mktemp -d)"
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-
-fail() {
-    echo "FAIL: $*" >&2
-    failures=$((failures + 1))
-}
-
-expect() {
-    local want="$1"
-    shift
-    "$@" >"$tmp/out" 2>"$tmp/err"
-    local got=$?
-    if [ "$got" -ne "$want" ]; then
-        fail "expected exit $want, got $got: $*"
-        sed 's/^/  stderr: /' "$tmp/err" >&2
-    fi
-}
+source "$(dirname "$0")/common.sh"
 
 # A tiny render of the built-in Cornell box writes EXR (with AOV layers), PNG and stats.
 expect 0 "$drift" render --spp 2 --width 24 --height 24 --threads 2 --aov --checkpoint 0 \

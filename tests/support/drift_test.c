@@ -1,5 +1,8 @@
 #include "drift_test.h"
 
+#include "drift/math.h"
+
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -67,4 +70,16 @@ double test_intensity(void)
     const char *s = getenv("DRIFT_TEST_INTENSITY");
     double v = s ? strtod(s, NULL) : 1.0;
     return v > 0.0 ? v : 1.0;
+}
+
+void test_assert_close(double a, double b, double eps, int line)
+{
+    if (!(fabs(a - b) <= eps)) {
+        fail_msg("line %d: %.17g vs %.17g (eps %g)", line, a, b, eps);
+    }
+}
+
+float test_hash_unit(uint32_t i)
+{
+    return drift_u32_to_unit(drift_hash_u32(i));
 }

@@ -34,6 +34,13 @@ const char *test_shared_path(char *out, const char *relative);
 // Directory for test outputs (created on demand): build/test-out.
 const char *test_out_path(char *out, const char *name);
 
+// Fails with both values and the line when |a - b| > eps (cmocka's float asserts are float-only).
+void test_assert_close(double a, double b, double eps, int line);
+#define assert_near(a, b, eps) test_assert_close((double)(a), (double)(b), (eps), __LINE__)
+
+// A deterministic value in [0, 1) for test data.
+float test_hash_unit(uint32_t i);
+
 // DRIFT_TEST_INTENSITY (default 1) scales sample counts in statistical tests.
 double test_intensity(void);
 

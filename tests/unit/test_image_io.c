@@ -16,19 +16,6 @@
 #include "drift/image_io.h"
 #include "drift/math.h"
 
-// cmocka's assert_float_equal works in float; these checks need double.
-static void assert_close(double a, double b, double eps, int line)
-{
-    if (!(fabs(a - b) <= eps)) {
-        fail_msg("line %d: %.17g vs %.17g (eps %g)", line, a, b, eps);
-    }
-}
-#define assert_near(a, b, eps) assert_close((double)(a), (double)(b), (eps), __LINE__)
-
-static float hash_unit(uint32_t i)
-{
-    return drift_u32_to_unit(drift_hash_u32(i));
-}
 
 static drift_image make_random(drift_context *ctx, int32_t w, int32_t h, int32_t channels,
                                uint32_t seed, float lo, float hi)
@@ -36,7 +23,7 @@ static drift_image make_random(drift_context *ctx, int32_t w, int32_t h, int32_t
     drift_image img;
     assert_int_equal(drift_image_create(ctx, w, h, channels, &img), DRIFT_OK);
     for (int32_t i = 0; i < w * h * channels; ++i) {
-        img.pixels[i] = lo + (hi - lo) * hash_unit(seed * 7919u + (uint32_t)i);
+        img.pixels[i] = lo + (hi - lo) * test_hash_unit(seed * 7919u + (uint32_t)i);
     }
     return img;
 }
@@ -280,7 +267,7 @@ static void test_image_io_png16_jpeg_and_hdr_load(void **state)
     // Radiance HDR: linear floats with RGBE precision (8-bit mantissa per pixel).
     float hdr[4 * 3 * 3];
     for (int i = 0; i < 36; ++i) {
-        hdr[i] = 0.1f + 10.0f * hash_unit((uint32_t)i);
+        hdr[i] = 0.1f + 10.0f * test_hash_unit((uint32_t)i);
     }
     test_out_path(path, "io_load.hdr");
     assert_true(stbi_write_hdr(path, 4, 3, 3, hdr) != 0);

@@ -7,19 +7,6 @@
 #include "drift/math.h"
 #include "drift/metric.h"
 
-// cmocka's assert_float_equal works in float; these checks need double.
-static void assert_close(double a, double b, double eps, int line)
-{
-    if (!(fabs(a - b) <= eps)) {
-        fail_msg("line %d: %.17g vs %.17g (eps %g)", line, a, b, eps);
-    }
-}
-#define assert_near(a, b, eps) assert_close((double)(a), (double)(b), (eps), __LINE__)
-
-static float hash_unit(uint32_t i)
-{
-    return drift_u32_to_unit(drift_hash_u32(i));
-}
 
 // Smooth-ish random texture in [0.05, 0.95]: a product of hashed values on a coarse grid and
 // per-pixel jitter, so SSIM and FLIP see structure rather than a flat field.
@@ -31,8 +18,8 @@ static drift_image make_texture(drift_context *ctx, int32_t w, int32_t h, uint32
         for (int32_t x = 0; x < w; ++x) {
             for (int c = 0; c < 3; ++c) {
                 uint32_t coarse = drift_hash_combine(seed, (uint32_t)((y / 4) * 1000 + x / 4));
-                float v = 0.7f * hash_unit(coarse + (uint32_t)c) +
-                          0.3f * hash_unit(seed ^ (uint32_t)((y * w + x) * 3 + c));
+                float v = 0.7f * test_hash_unit(coarse + (uint32_t)c) +
+                          0.3f * test_hash_unit(seed ^ (uint32_t)((y * w + x) * 3 + c));
                 drift_image_pixel(&img, x, y)[c] = 0.05f + 0.9f * v;
             }
         }
