@@ -9,18 +9,18 @@ bash scripts/install-deps.sh
 jobs=$(nproc)
 
 echo "== build (Debug, ASan+UBSan, -Werror)"
-cmake -S . -B build/dev -DCMAKE_BUILD_TYPE=Debug -DDRIFT_SANITIZE=address,undefined >/dev/null
+cmake -S . -B build/dev -DCMAKE_BUILD_TYPE=Debug -DDRIFT_SANITIZE=address,undefined -DDRIFT_WERROR=ON >/dev/null
 cmake --build build/dev -j"$jobs"
 
 echo "== build (Release, -Werror)"
-cmake -S . -B build/release -DCMAKE_BUILD_TYPE=Release -DDRIFT_BUILD_TESTS=OFF >/dev/null
+cmake -S . -B build/release -DCMAKE_BUILD_TYPE=Release -DDRIFT_BUILD_TESTS=OFF -DDRIFT_WERROR=ON >/dev/null
 cmake --build build/release -j"$jobs"
 
 echo "== fuzz smoke (libFuzzer, ${DRIFT_FUZZ_SECONDS:-20} s per target)"
 # fuzzer-no-link instruments the library too, so libFuzzer sees coverage inside drift.
 CC=clang cmake -S . -B build/fuzz -DCMAKE_BUILD_TYPE=Debug -DDRIFT_BUILD_FUZZERS=ON \
   -DCMAKE_C_FLAGS=-fsanitize=fuzzer-no-link \
-  -DDRIFT_BUILD_TESTS=OFF -DDRIFT_SANITIZE=address,undefined >/dev/null
+  -DDRIFT_BUILD_TESTS=OFF -DDRIFT_SANITIZE=address,undefined -DDRIFT_WERROR=ON >/dev/null
 cmake --build build/fuzz -j"$jobs"
 for fuzzer in build/fuzz/fuzz_*; do
   name=$(basename "$fuzzer")

@@ -185,18 +185,26 @@ report(const json_reader *r, drift_log_level level, const cJSON *node, drift_res
 
 #define FAIL(r, node, code, ...) report((r), DRIFT_LOG_ERROR, (node), (code), __VA_ARGS__)
 
+// Key paths only label messages: a path too long for the buffer ends in "..." instead.
+static void mark_truncation(char *out, int written)
+{
+    if (written < 0 || written >= KEY_PATH_MAX) {
+        memcpy(out + KEY_PATH_MAX - 4, "...", 4);
+    }
+}
+
 static void key_path(char *out, const char *parent, const char *key)
 {
     if (parent && parent[0]) {
-        snprintf(out, KEY_PATH_MAX, "%s.%s", parent, key);
+        mark_truncation(out, snprintf(out, KEY_PATH_MAX, "%s.%s", parent, key));
     } else {
-        snprintf(out, KEY_PATH_MAX, "%s", key);
+        mark_truncation(out, snprintf(out, KEY_PATH_MAX, "%s", key));
     }
 }
 
 static void index_path(char *out, const char *parent, size_t index)
 {
-    snprintf(out, KEY_PATH_MAX, "%s[%zu]", parent, index);
+    mark_truncation(out, snprintf(out, KEY_PATH_MAX, "%s[%zu]", parent, index));
 }
 
 static const char *type_name(const cJSON *item)
