@@ -144,8 +144,8 @@ typedef struct drift_mesh_desc {
 // --- ENVIRONMENT ---
 
 // Radiance arriving from infinitely far away: `color`, times the lat-long texture if set.
-// Lat-long layout: u = phi / (2 pi) with phi measured from +x toward -z... see
-// docs/conventions.md; v = theta / pi from +y (up).
+// Lat-long layout (docs/conventions.md): u = phi / (2 pi), phi = atan2(-dir.z, dir.x) in
+// [0, 2 pi); v = theta / pi with theta measured from +y (v = 0 is the top row).
 typedef struct drift_environment {
     drift_vec3 color;
     uint32_t texture; // DRIFT_INVALID_INDEX for a constant environment
@@ -274,8 +274,8 @@ typedef struct drift_light_sample {
 uint32_t drift_scene_pick_light(const drift_scene *scene, float u, float *out_pmf);
 // Probability with which pick_light returns `light`.
 float drift_scene_light_pmf(const drift_scene *scene, uint32_t light);
-// Samples a point on light `light` as seen from `ref` (with normal `ref_n`, or zero vector
-// for a point in a medium). pdf == 0 means no contribution.
+// Samples a point (or direction) on light `light` as seen from the point `ref`; the index
+// light_count means the environment. u picks the point. pdf == 0 means no contribution.
 drift_light_sample drift_light_sample_li(const drift_scene *scene, uint32_t light, drift_vec3 ref,
                                          drift_vec2 u);
 // Solid-angle pdf with which drift_light_sample_li would pick direction wi toward the point
