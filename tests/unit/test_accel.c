@@ -102,16 +102,16 @@ typedef struct bf_hit {
 
 static bf_hit brute_force(const drift_scene *scene, const drift_ray *ray)
 {
-    bf_hit best = { .t = INFINITY, .second_t = INFINITY, .margin = INFINITY };
-    double o[3] = { ray->origin.x, ray->origin.y, ray->origin.z };
-    double d[3] = { ray->dir.x, ray->dir.y, ray->dir.z };
+    bf_hit best = { .t = (double)INFINITY, .second_t = (double)INFINITY, .margin = (double)INFINITY };
+    double o[3] = { (double)ray->origin.x, (double)ray->origin.y, (double)ray->origin.z };
+    double d[3] = { (double)ray->dir.x, (double)ray->dir.y, (double)ray->dir.z };
     for (uint32_t m = 0; m < scene->mesh_count; ++m) {
         const drift_mesh *mesh = &scene->meshes[m];
         for (uint32_t t = 0; t < mesh->triangle_count; ++t) {
             double v[3][3];
             for (int k = 0; k < 3; ++k) {
                 const float *p = mesh->positions + 3 * (size_t)mesh->indices[3 * t + k];
-                v[k][0] = p[0], v[k][1] = p[1], v[k][2] = p[2];
+                v[k][0] = (double)p[0], v[k][1] = (double)p[1], v[k][2] = (double)p[2];
             }
             double e1[3], e2[3], s[3];
             for (int k = 0; k < 3; ++k) {
