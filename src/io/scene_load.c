@@ -100,32 +100,39 @@ static drift_result buffer_append(drift_context *ctx, char **data, size_t *size,
     return DRIFT_OK;
 }
 
-static drift_result read_gzip(drift_context *ctx, const char *path, const char *where, int line,
-                              char **out_data, size_t *out_size)
+drift_result drift__read_file(drift_context *ctx, const char *path, bool gzip, const char *where,
+                              int line, char **out_data, size_t *out_size)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f) {
+    *out_data = NULL;
+    *out_size = 0;
+    size_t file_size = 0;
+    drift_result r = drift__check_file(ctx, path, where, line, &file_size);
+    if (r != DRIFT_OK) {
+        return r;
+    }
+    const char *too_big = gzip ? "unpacks to more than" : "is larger than";
+    if (!gzip && file_size > DRIFT_SCENE_MAX_FILE_BYTES) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, where, line, "'%s' %s %zu bytes",
+                  path, too_big, DRIFT_SCENE_MAX_FILE_BYTES);
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    // gzread inflates gzip data and passes anything else through unchanged, so one loop reads
+    // both kinds; gzdirect says which kind the file is, and it must match its name.
+    gzFile gz = gzopen(path, "rb");
+    if (!gz) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, where, line, "cannot open '%s': %s", path,
                   strerror(errno));
         return DRIFT_ERR_IO;
     }
-    // gzread passes non-gzip data through unchanged; a .gz that is not gzip is an error.
-    unsigned char magic[2] = { 0, 0 };
-    size_t got = fread(magic, 1, 2, f);
-    fclose(f);
-    if (got != 2 || magic[0] != 0x1f || magic[1] != 0x8b) {
-        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, where, line, "'%s' is not a gzip file",
+    if (gzdirect(gz) == (int)gzip) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, where, line,
+                  gzip ? "'%s' is not a gzip file" : "'%s' is gzip-compressed but not named .gz",
                   path);
+        gzclose(gz);
         return DRIFT_ERR_PARSE;
-    }
-    gzFile gz = gzopen(path, "rb");
-    if (!gz) {
-        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, where, line, "cannot open '%s'", path);
-        return DRIFT_ERR_IO;
     }
     char *data = NULL;
     size_t size = 0, cap = 0;
-    drift_result r = DRIFT_OK;
 
     enum {
         CHUNK = 1 << 16
@@ -140,13 +147,14 @@ static drift_result read_gzip(drift_context *ctx, const char *path, const char *
         if (n < 0) {
             int errnum = 0;
             const char *msg = gzerror(gz, &errnum);
-            drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, where, line,
-                      "'%s': gzip data is corrupt (%s)", path, msg ? msg : "unknown zlib error");
-            r = DRIFT_ERR_PARSE;
+            drift_log(ctx, DRIFT_LOG_ERROR, gzip ? DRIFT_ERR_PARSE : DRIFT_ERR_IO, where, line,
+                      gzip ? "'%s': gzip data is corrupt (%s)" : "cannot read '%s' (%s)", path,
+                      msg ? msg : "unknown zlib error");
+            r = gzip ? DRIFT_ERR_PARSE : DRIFT_ERR_IO;
             break;
         }
         if (n == 0) {
-            // A truncated stream ends in Z_BUF_ERROR rather than a clean end of file.
+            // A truncated gzip stream ends in Z_BUF_ERROR rather than a clean end of file.
             int errnum = 0;
             gzerror(gz, &errnum);
             if (errnum != Z_OK) {
@@ -158,7 +166,7 @@ static drift_result read_gzip(drift_context *ctx, const char *path, const char *
         }
         if (size + (size_t)n > DRIFT_SCENE_MAX_FILE_BYTES) {
             drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, where, line,
-                      "'%s' unpacks to more than %zu bytes", path, DRIFT_SCENE_MAX_FILE_BYTES);
+                      "'%s' %s %zu bytes", path, too_big, DRIFT_SCENE_MAX_FILE_BYTES);
             r = DRIFT_ERR_INVALID_ARGUMENT;
             break;
         }
@@ -166,66 +174,6 @@ static drift_result read_gzip(drift_context *ctx, const char *path, const char *
     }
     gzclose(gz);
     drift_free(ctx, chunk);
-    if (r == DRIFT_OK && !data) {
-        r = buffer_append(ctx, &data, &size, &cap, "", 0);
-    }
-    if (r != DRIFT_OK) {
-        drift_free(ctx, data);
-        return r;
-    }
-    *out_data = data;
-    *out_size = size;
-    return DRIFT_OK;
-}
-
-drift_result drift__read_file(drift_context *ctx, const char *path, bool gzip, const char *where,
-                              int line, char **out_data, size_t *out_size)
-{
-    *out_data = NULL;
-    *out_size = 0;
-    size_t file_size = 0;
-    drift_result r = drift__check_file(ctx, path, where, line, &file_size);
-    if (r != DRIFT_OK) {
-        return r;
-    }
-    if (gzip) {
-        return read_gzip(ctx, path, where, line, out_data, out_size);
-    }
-    if (file_size > DRIFT_SCENE_MAX_FILE_BYTES) {
-        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, where, line,
-                  "'%s' is larger than %zu bytes", path, DRIFT_SCENE_MAX_FILE_BYTES);
-        return DRIFT_ERR_INVALID_ARGUMENT;
-    }
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, where, line, "cannot open '%s': %s", path,
-                  strerror(errno));
-        return DRIFT_ERR_IO;
-    }
-    char *data = NULL;
-    size_t size = 0, cap = 0;
-    char chunk[65536];
-    for (;;) {
-        size_t n = fread(chunk, 1, sizeof(chunk), f);
-        if (n == 0) {
-            break;
-        }
-        if (size + n > DRIFT_SCENE_MAX_FILE_BYTES) {
-            drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, where, line,
-                      "'%s' is larger than %zu bytes", path, DRIFT_SCENE_MAX_FILE_BYTES);
-            r = DRIFT_ERR_INVALID_ARGUMENT;
-            break;
-        }
-        r = buffer_append(ctx, &data, &size, &cap, chunk, n);
-        if (r != DRIFT_OK) {
-            break;
-        }
-    }
-    if (r == DRIFT_OK && ferror(f)) {
-        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, where, line, "cannot read '%s'", path);
-        r = DRIFT_ERR_IO;
-    }
-    fclose(f);
     if (r == DRIFT_OK && !data) {
         r = buffer_append(ctx, &data, &size, &cap, "", 0);
     }
