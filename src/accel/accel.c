@@ -371,13 +371,11 @@ static void fill_shape_hit(const drift_accel *accel, uint32_t geom, uint32_t pri
     hit->prim = kind == SHAPE_QUAD ? (prim & 1u) : 0u;
 }
 
-static inline void fill_hit(const drift_accel *accel, const struct RTCRayHit *rh, drift_hit *hit)
+// Maps Embree's (geometry, primitive) to drift's mesh, triangle and light: the one place that
+// knows mesh i is geometry i and that light shapes follow the meshes.
+static inline void fill_hit_ids(const drift_accel *accel, uint32_t geom, uint32_t prim,
+                                drift_hit *hit)
 {
-    uint32_t geom = rh->hit.geomID, prim = rh->hit.primID;
-    hit->t = rh->ray.tfar;
-    hit->u = rh->hit.u;
-    hit->v = rh->hit.v;
-    hit->ng = (drift_vec3){ rh->hit.Ng_x, rh->hit.Ng_y, rh->hit.Ng_z };
     if (geom < accel->mesh_count) {
         uint32_t first = accel->mesh_first_light[geom];
         hit->mesh = geom;
@@ -386,6 +384,15 @@ static inline void fill_hit(const drift_accel *accel, const struct RTCRayHit *rh
     } else {
         fill_shape_hit(accel, geom, prim, hit);
     }
+}
+
+static inline void fill_hit(const drift_accel *accel, const struct RTCRayHit *rh, drift_hit *hit)
+{
+    hit->t = rh->ray.tfar;
+    hit->u = rh->hit.u;
+    hit->v = rh->hit.v;
+    hit->ng = (drift_vec3){ rh->hit.Ng_x, rh->hit.Ng_y, rh->hit.Ng_z };
+    fill_hit_ids(accel, rh->hit.geomID, rh->hit.primID, hit);
 }
 
 static inline void fill_miss(drift_hit *hit)
@@ -464,8 +471,7 @@ void drift_accel_intersect_coherent(const drift_accel *accel, const drift_ray *r
         rtcIntersect16(valid, accel->rtc_scene, &context, &p);
         for (uint32_t i = 0; i < n; ++i) {
             drift_hit *hit = &hits[begin + i];
-            uint32_t geom = p.hit.geomID[i], prim = p.hit.primID[i];
-            if (geom == RTC_INVALID_GEOMETRY_ID) {
+            if (p.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) {
                 fill_miss(hit);
                 continue;
             }
@@ -473,14 +479,7 @@ void drift_accel_intersect_coherent(const drift_accel *accel, const drift_ray *r
             hit->u = p.hit.u[i];
             hit->v = p.hit.v[i];
             hit->ng = (drift_vec3){ p.hit.Ng_x[i], p.hit.Ng_y[i], p.hit.Ng_z[i] };
-            if (geom < accel->mesh_count) {
-                uint32_t first = accel->mesh_first_light[geom];
-                hit->mesh = geom;
-                hit->prim = prim;
-                hit->light = first == DRIFT_INVALID_INDEX ? DRIFT_INVALID_INDEX : first + prim;
-            } else {
-                fill_shape_hit(accel, geom, prim, hit);
-            }
+            fill_hit_ids(accel, p.hit.geomID[i], p.hit.primID[i], hit);
         }
     }
 }
