@@ -1,6 +1,7 @@
 #include "drift_test.h"
 
 #include "drift/math.h"
+#include "drift/scene.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -82,4 +83,21 @@ void test_assert_close(double a, double b, double eps, int line)
 float test_hash_unit(uint32_t i)
 {
     return drift_u32_to_unit(drift_hash_u32(i));
+}
+
+uint32_t test_add_mesh(struct drift_scene *scene, const float *positions, uint32_t vertex_count,
+                       const uint32_t *indices, uint32_t triangle_count, uint32_t material)
+{
+    uint32_t index = DRIFT_INVALID_INDEX;
+    drift_result r = drift_scene_add_mesh(scene,
+                                          &(drift_mesh_desc){ .positions = positions,
+                                                              .vertex_count = vertex_count,
+                                                              .indices = indices,
+                                                              .triangle_count = triangle_count,
+                                                              .material = material },
+                                          &index);
+    if (r != DRIFT_OK) {
+        fail_msg("drift_scene_add_mesh: %s", drift_result_string(r));
+    }
+    return index;
 }

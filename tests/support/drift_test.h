@@ -41,6 +41,11 @@ void test_assert_close(double a, double b, double eps, int line);
 // A deterministic value in [0, 1) for test data.
 float test_hash_unit(uint32_t i);
 
+// Adds a mesh to a test scene and returns its index; fails the test if the scene rejects it.
+struct drift_scene;
+uint32_t test_add_mesh(struct drift_scene *scene, const float *positions, uint32_t vertex_count,
+                   const uint32_t *indices, uint32_t triangle_count, uint32_t material);
+
 // DRIFT_TEST_INTENSITY (default 1) scales sample counts in statistical tests.
 double test_intensity(void);
 

@@ -63,15 +63,7 @@ static void add_random_meshes(drift_scene *scene, rng *r, uint32_t material, uin
                 idx[3 * t + k] = 3 * t + (uint32_t)k;
             }
         }
-        assert_int_equal(
-            drift_scene_add_mesh(scene,
-                                 &(drift_mesh_desc){ .positions = p,
-                                                     .vertex_count = vertex_count,
-                                                     .indices = idx,
-                                                     .triangle_count = triangles_per_mesh,
-                                                     .material = material },
-                                 NULL),
-            DRIFT_OK);
+        test_add_mesh(scene, p, vertex_count, idx, triangles_per_mesh, material);
         test_free(p);
         test_free(idx);
     }
@@ -304,14 +296,7 @@ static void test_accel_light_shapes_hit_at_known_t(void **state)
     // A small mesh far away, so meshes and shapes coexist in one Embree scene.
     static const float floor_p[] = { -1, -50, -1, 1, -50, -1, 0, -50, 1 };
     static const uint32_t floor_i[] = { 0, 1, 2 };
-    assert_int_equal(drift_scene_add_mesh(scene,
-                                          &(drift_mesh_desc){ .positions = floor_p,
-                                                              .vertex_count = 3,
-                                                              .indices = floor_i,
-                                                              .triangle_count = 1,
-                                                              .material = material },
-                                          NULL),
-                     DRIFT_OK);
+    test_add_mesh(scene, floor_p, 3, floor_i, 1, material);
     uint32_t point, quad, disk, sphere, quad2;
     // A point light first, so that shape light indices are not their shape ordinals.
     assert_int_equal(drift_scene_add_light(scene,
@@ -410,22 +395,8 @@ static void test_accel_emissive_mesh_reports_its_light(void **state)
     float plain_p[] = { 5, 5, 0, 6, 5, 0, 6, 6, 0, 5, 6, 0 };
     float glow_p[] = { 0, 0, -1, 1, 0, -1, 1, 1, -1, 0, 1, -1 };
     uint32_t plain_mesh, glow_mesh;
-    assert_int_equal(drift_scene_add_mesh(scene,
-                                          &(drift_mesh_desc){ .positions = plain_p,
-                                                              .vertex_count = 4,
-                                                              .indices = idx,
-                                                              .triangle_count = 2,
-                                                              .material = white },
-                                          &plain_mesh),
-                     DRIFT_OK);
-    assert_int_equal(drift_scene_add_mesh(scene,
-                                          &(drift_mesh_desc){ .positions = glow_p,
-                                                              .vertex_count = 4,
-                                                              .indices = idx,
-                                                              .triangle_count = 2,
-                                                              .material = emissive },
-                                          &glow_mesh),
-                     DRIFT_OK);
+    plain_mesh = test_add_mesh(scene, plain_p, 4, idx, 2, white);
+    glow_mesh = test_add_mesh(scene, glow_p, 4, idx, 2, emissive);
     drift_accel *accel = new_accel(ctx, scene);
     uint32_t first = scene->meshes[glow_mesh].first_light;
     assert_int_not_equal(first, DRIFT_INVALID_INDEX);
@@ -466,14 +437,7 @@ static void test_accel_occluded_respects_range(void **state)
     // A large square at z = -5.
     static const float p[] = { -10, -10, -5, 10, -10, -5, 10, 10, -5, -10, 10, -5 };
     static const uint32_t idx[] = { 0, 1, 2, 0, 2, 3 };
-    assert_int_equal(drift_scene_add_mesh(scene,
-                                          &(drift_mesh_desc){ .positions = p,
-                                                              .vertex_count = 4,
-                                                              .indices = idx,
-                                                              .triangle_count = 2,
-                                                              .material = material },
-                                          NULL),
-                     DRIFT_OK);
+    test_add_mesh(scene, p, 4, idx, 2, material);
     drift_accel *accel = new_accel(ctx, scene);
     drift_ray ray = { .origin = drift_vec3_make(0.3f, 0.1f, 0), .dir = drift_vec3_make(0, 0, -1) };
     drift_hit hit;

@@ -51,30 +51,14 @@ static void add_inward_box(drift_scene *scene, float h, uint32_t material)
     // Each face wound so that its normal points into the box.
     const uint32_t idx[] = { 0, 1, 2, 0, 2, 3, 4, 7, 6, 4, 6, 5, 0, 4, 5, 0, 5, 1,
                              3, 2, 6, 3, 6, 7, 0, 3, 7, 0, 7, 4, 1, 5, 6, 1, 6, 2 };
-    assert_int_equal(drift_scene_add_mesh(scene,
-                                          &(drift_mesh_desc){ .name = "box",
-                                                              .positions = p,
-                                                              .vertex_count = 8,
-                                                              .indices = idx,
-                                                              .triangle_count = 12,
-                                                              .material = material },
-                                          NULL),
-                     DRIFT_OK);
+    test_add_mesh(scene, p, 8, idx, 12, material);
 }
 
 static void add_floor(drift_scene *scene, float half, uint32_t material)
 {
     const float p[] = { -half, 0, -half, half, 0, -half, half, 0, half, -half, 0, half };
     const uint32_t idx[] = { 0, 2, 1, 0, 3, 2 }; // normal +y
-    assert_int_equal(drift_scene_add_mesh(scene,
-                                          &(drift_mesh_desc){ .name = "floor",
-                                                              .positions = p,
-                                                              .vertex_count = 4,
-                                                              .indices = idx,
-                                                              .triangle_count = 2,
-                                                              .material = material },
-                                          NULL),
-                     DRIFT_OK);
+    test_add_mesh(scene, p, 4, idx, 2, material);
 }
 
 static double image_mean(const drift_image *img, int channel)
@@ -252,19 +236,9 @@ static drift_scene *small_box_scene(rig *r, float aperture)
     add_inward_box(r->scene, 1.0f, w);
     const float p[] = { -0.4f, -0.99f, -0.4f, 0.4f, -0.99f, -0.4f, 0.0f, -0.2f, 0.0f };
     const uint32_t idx[] = { 0, 1, 2 };
-    assert_int_equal(drift_scene_add_mesh(r->scene,
-                                          &(drift_mesh_desc){ .positions = p, .vertex_count = 3,
-                                                              .indices = idx, .triangle_count = 1,
-                                                              .material = g },
-                                          NULL),
-                     DRIFT_OK);
+    test_add_mesh(r->scene, p, 3, idx, 1, g);
     const float q[] = { -0.99f, -1, -1, -0.99f, -1, 1, -0.99f, 1, 1 };
-    assert_int_equal(drift_scene_add_mesh(r->scene,
-                                          &(drift_mesh_desc){ .positions = q, .vertex_count = 3,
-                                                              .indices = idx, .triangle_count = 1,
-                                                              .material = rd },
-                                          NULL),
-                     DRIFT_OK);
+    test_add_mesh(r->scene, q, 3, idx, 1, rd);
     assert_int_equal(drift_scene_add_light(r->scene,
                                            &(drift_light){ .type = DRIFT_LIGHT_QUAD,
                                                            .position = { -0.3f, 0.98f, -0.3f },
