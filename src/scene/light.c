@@ -12,6 +12,10 @@ struct drift_light_table {
     bool has_environment;
     float environment_radius; // radius of the scene's bounding sphere (for env power)
     drift__env_distribution *environment; // NULL for a constant environment
+    // Per light, fixed after commit, so sampling does not recompute them: 1 / area (0 for
+    // delta lights) and the emitting normal (unused for spheres, whose normal varies).
+    float *inv_area;
+    drift_vec3 *normal;
 };
 
 const drift__env_distribution *drift__light_table_environment(const drift_scene *scene)
@@ -79,28 +83,28 @@ static float light_power(const drift_scene *scene, const drift_light *l, float s
     return 0.0f;
 }
 
-// Normal an area light emits along at point p (unit).
-static drift_vec3 area_light_normal(const drift_scene *scene, const drift_light *l, drift_vec3 p)
+// Unit normal a flat area light emits along; zero for spheres (their normal varies per point)
+// and for delta lights.
+static drift_vec3 flat_light_normal(const drift_scene *scene, const drift_light *l)
 {
     switch (l->type) {
     case DRIFT_LIGHT_QUAD:
         return drift_vec3_normalize(drift_vec3_cross(l->edge_u, l->edge_v));
     case DRIFT_LIGHT_DISK:
         return l->direction;
-    case DRIFT_LIGHT_SPHERE:
-        return drift_vec3_normalize(drift_vec3_sub(p, l->position));
     case DRIFT_LIGHT_TRIANGLE: {
         drift_vec3 a, b, c;
         triangle_vertices(scene, l, &a, &b, &c);
         return drift_vec3_normalize(drift_vec3_cross(drift_vec3_sub(b, a), drift_vec3_sub(c, a)));
     }
+    case DRIFT_LIGHT_SPHERE:
     case DRIFT_LIGHT_POINT:
     case DRIFT_LIGHT_SPOT:
     case DRIFT_LIGHT_DIRECTIONAL:
     case DRIFT_LIGHT_COUNT:
         break;
     }
-    return drift_vec3_make(0, 1, 0);
+    return drift_vec3_splat(0.0f);
 }
 
 // --- TABLE ---
@@ -123,6 +127,18 @@ drift_result drift__light_table_build(drift_scene *scene)
     table->environment_radius =
         drift_bounds3_is_empty(b) ? 1.0f : 0.5f * drift_vec3_length(drift_vec3_sub(b.max, b.min));
     table->entry_count = scene->light_count + (table->has_environment ? 1u : 0u);
+    size_t lights = scene->light_count ? scene->light_count : 1;
+    table->inv_area = drift_alloc(ctx, sizeof(float) * lights);
+    table->normal = drift_alloc(ctx, sizeof(drift_vec3) * lights);
+    if (!table->inv_area || !table->normal) {
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    for (uint32_t i = 0; i < scene->light_count; ++i) {
+        const drift_light *l = &scene->lights[i];
+        float area = light_area(scene, l);
+        table->inv_area[i] = area > 0.0f ? 1.0f / area : 0.0f;
+        table->normal[i] = flat_light_normal(scene, l);
+    }
     table->cdf = drift_alloc(ctx, sizeof(float) * ((size_t)table->entry_count + 1));
     if (!table->cdf) {
         return DRIFT_ERR_OUT_OF_MEMORY;
@@ -158,6 +174,8 @@ void drift__light_table_destroy(drift_scene *scene)
 {
     if (scene->light_table) {
         drift__environment_destroy(scene, scene->light_table->environment);
+        drift_free(scene->ctx, scene->light_table->inv_area);
+        drift_free(scene->ctx, scene->light_table->normal);
         drift_free(scene->ctx, scene->light_table->cdf);
         drift_free(scene->ctx, scene->light_table);
         scene->light_table = NULL;
@@ -229,9 +247,12 @@ static float sphere_cone_one_minus_cos(float r, float d)
     return sin2 / (1.0f + sqrtf(fmaxf(0.0f, 1.0f - sin2)));
 }
 
-static drift_light_sample sample_area_point(const drift_scene *scene, const drift_light *l,
-                                            drift_vec3 ref, drift_vec3 p, float pdf_area)
+// A uniformly sampled point p on area light `light` (density 1 / area), seen from ref.
+static drift_light_sample sample_area_point(const drift_scene *scene, uint32_t light,
+                                            drift_vec3 ref, drift_vec3 p)
 {
+    const drift_light *l = &scene->lights[light];
+    const drift_light_table *t = scene->light_table;
     drift_light_sample s = { 0 };
     drift_vec3 d = drift_vec3_sub(p, ref);
     float dist = drift_vec3_length(d);
@@ -241,8 +262,10 @@ static drift_light_sample sample_area_point(const drift_scene *scene, const drif
     s.wi = drift_vec3_scale(d, 1.0f / dist);
     s.distance = dist;
     s.point = p;
-    s.light_normal = area_light_normal(scene, l, p);
-    s.pdf = area_to_solid_angle(pdf_area, dist, s.wi, s.light_normal);
+    s.light_normal = l->type == DRIFT_LIGHT_SPHERE
+                         ? drift_vec3_normalize(drift_vec3_sub(p, l->position))
+                         : t->normal[light];
+    s.pdf = area_to_solid_angle(t->inv_area[light], dist, s.wi, s.light_normal);
     // One-sided emitters: light leaves along the normal only.
     bool facing = drift_vec3_dot(s.light_normal, s.wi) < 0.0f;
     s.radiance = facing ? l->color : drift_vec3_splat(0.0f);
@@ -293,14 +316,14 @@ drift_light_sample drift_light_sample_li(const drift_scene *scene, uint32_t ligh
     case DRIFT_LIGHT_QUAD: {
         drift_vec3 p = drift_vec3_add(l->position, drift_vec3_add(drift_vec3_scale(l->edge_u, u.x),
                                                                   drift_vec3_scale(l->edge_v, u.y)));
-        return sample_area_point(scene, l, ref, p, 1.0f / light_area(scene, l));
+        return sample_area_point(scene, light, ref, p);
     }
     case DRIFT_LIGHT_DISK: {
         drift_frame f = drift_frame_from_normal(l->direction);
         drift_vec2 d = drift_sample_disk_concentric(u);
         drift_vec3 p = drift_vec3_add(
             l->position, drift_frame_to_world(&f, drift_vec3_make(d.x * l->radius, d.y * l->radius, 0)));
-        return sample_area_point(scene, l, ref, p, 1.0f / light_area(scene, l));
+        return sample_area_point(scene, light, ref, p);
     }
     case DRIFT_LIGHT_SPHERE: {
         drift_vec3 to_center = drift_vec3_sub(l->position, ref);
@@ -308,7 +331,7 @@ drift_light_sample drift_light_sample_li(const drift_scene *scene, uint32_t ligh
         if (dc <= l->radius * 1.0001f) {
             // Inside (or on) the sphere: uniform area sampling.
             drift_vec3 p = drift_vec3_fma(l->position, drift_sample_uniform_sphere(u), l->radius);
-            return sample_area_point(scene, l, ref, p, 1.0f / light_area(scene, l));
+            return sample_area_point(scene, light, ref, p);
         }
         // Outside: uniform over the cone of directions the sphere subtends (pbrt-v4 §6.2.4).
         float one_minus_cos = sphere_cone_one_minus_cos(l->radius, dc);
@@ -335,7 +358,7 @@ drift_light_sample drift_light_sample_li(const drift_scene *scene, uint32_t ligh
         drift_vec3 p = drift_vec3_add(drift_vec3_scale(a, 1.0f - bary.x - bary.y),
                                       drift_vec3_add(drift_vec3_scale(b, bary.x),
                                                      drift_vec3_scale(c, bary.y)));
-        return sample_area_point(scene, l, ref, p, 1.0f / light_area(scene, l));
+        return sample_area_point(scene, light, ref, p);
     }
     case DRIFT_LIGHT_COUNT:
         break;
@@ -356,12 +379,12 @@ float drift_light_pdf_li(const drift_scene *scene, uint32_t light, drift_vec3 re
         if (dc > l->radius * 1.0001f) {
             return 1.0f / (2.0f * DRIFT_PI * sphere_cone_one_minus_cos(l->radius, dc));
         }
-        return area_to_solid_angle(1.0f / light_area(scene, l), distance, wi, light_normal);
+        return area_to_solid_angle(scene->light_table->inv_area[light], distance, wi, light_normal);
     }
     case DRIFT_LIGHT_QUAD:
     case DRIFT_LIGHT_DISK:
     case DRIFT_LIGHT_TRIANGLE:
-        return area_to_solid_angle(1.0f / light_area(scene, l), distance, wi, light_normal);
+        return area_to_solid_angle(scene->light_table->inv_area[light], distance, wi, light_normal);
     case DRIFT_LIGHT_POINT:
     case DRIFT_LIGHT_SPOT:
     case DRIFT_LIGHT_DIRECTIONAL:
