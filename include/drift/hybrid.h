@@ -1,0 +1,209 @@
+// drift hybrid: the hybrid frame. One sharp sample per pixel stored as image-space buffers,
+// the rasterization-style approximations a real-time renderer uses, and a composition that
+// picks a technique per effect. Every later technique (ISG, AAF, SIR) is one more pass here.
+//
+// The frame, pass by pass (docs/hybrid.md has the equations):
+//   1. primary visibility: one pinhole ray through each pixel centre -> the G-buffer planes
+//   2. sharp inputs: one shadow ray per pixel per light toward the light's centre (hard-shadow
+//      buffer), one mirror ray per glossy or mirror pixel (sharp reflection buffer), and the
+//      in-focus colour, depth and circle of confusion
+//   3. approximations: shadow maps (hard lookup, PCF, PCSS), a cube environment map captured
+//      at a probe point, post-process depth of field
+//   4. composition: L = E + sum_l U_l * S_l + R + I, then depth of field.
+//      E emission, U_l the unshadowed direct light from light l, S_l its shadow term,
+//      R reflections (paths whose first bounce is glossy or mirror), I indirect light
+//      (first bounce diffuse). Each of S, R, I and the depth of field comes from the chosen
+//      technique; `reference` computes that term alone with the reference path tracer
+//      (drift_pt with DRIFT_PT_COMPONENT_*), so its error is the technique's and no other.
+//
+// STEP BY STEP
+//   drift_hybrid *frame = NULL;
+//   drift_hybrid_params params = { .shadows = DRIFT_SHADOWS_PCSS, .dof = DRIFT_DOF_POST };
+//   drift_hybrid_create(ctx, scene, accel, &params, &frame);
+//   drift_hybrid_render(frame, &scene->camera, &cancel);      // once per frame
+//   const drift_image *rgb = drift_hybrid_image(frame);        // linear radiance
+//   drift_hybrid_stats stats = drift_hybrid_get_stats(frame); // ms and rays per pass
+//   drift_hybrid_destroy(frame);
+//
+// Ownership: scene and accel are borrowed and must outlive the frame. Images returned here
+// belong to the frame and stay valid until the next render or destroy.
+// Threads: one frame is driven from one thread; it uses the context's pool internally.
+#ifndef DRIFT_HYBRID_H
+#define DRIFT_HYBRID_H
+
+#include "drift/accel.h"
+#include "drift/core.h"
+#include "drift/image.h"
+#include "drift/scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+// --- EFFECTS AND TECHNIQUES ---
+
+typedef enum drift_effect {
+    DRIFT_EFFECT_SHADOWS = 0,
+    DRIFT_EFFECT_REFLECTIONS,
+    DRIFT_EFFECT_DOF,
+    DRIFT_EFFECT_INDIRECT,
+    DRIFT_EFFECT_COUNT
+} drift_effect;
+
+// Technique values per effect. The names (drift_technique_name) are stable: the command
+// line, stats files and the viewer use them, and later issues append to these lists.
+typedef enum drift_shadow_technique {
+    DRIFT_SHADOWS_HARD = 0,   // ray-traced visibility of the light's centre
+    DRIFT_SHADOWS_PCF,        // shadow map, percentage-closer filtering
+    DRIFT_SHADOWS_PCSS,       // shadow map, percentage-closer soft shadows (Fernando 2005)
+    DRIFT_SHADOWS_REFERENCE,  // path-traced direct light at --spp
+    DRIFT_SHADOWS_COUNT
+} drift_shadow_technique;
+
+typedef enum drift_reflection_technique {
+    DRIFT_REFLECTIONS_NONE = 0,
+    DRIFT_REFLECTIONS_ENVMAP,    // cube map captured at a probe point
+    DRIFT_REFLECTIONS_SHARP,     // one mirror ray per pixel
+    DRIFT_REFLECTIONS_REFERENCE, // path-traced first-bounce glossy/mirror light at --spp
+    DRIFT_REFLECTIONS_COUNT
+} drift_reflection_technique;
+
+typedef enum drift_dof_technique {
+    DRIFT_DOF_NONE = 0,      // pinhole
+    DRIFT_DOF_POST,          // gather over the circle of confusion in image space
+    DRIFT_DOF_REFERENCE,     // the whole frame path-traced through the thin lens
+    DRIFT_DOF_COUNT
+} drift_dof_technique;
+
+typedef enum drift_indirect_technique {
+    DRIFT_INDIRECT_NONE = 0,
+    DRIFT_INDIRECT_AMBIENT,   // diffuse albedo x a constant radiance
+    DRIFT_INDIRECT_REFERENCE, // path-traced first-bounce diffuse light at --spp
+    DRIFT_INDIRECT_COUNT
+} drift_indirect_technique;
+
+const char *drift_effect_name(drift_effect effect); // "shadows", "reflections", "dof", "indirect"
+int drift_technique_count(drift_effect effect);
+// NULL when technique is out of range.
+const char *drift_technique_name(drift_effect effect, int technique);
+// The technique called `name`, or -1.
+int drift_technique_parse(drift_effect effect, const char *name);
+
+// --- PARAMETERS ---
+
+// How to build a frame. The default configuration is:
+//   width, height    = 0 -> the scene camera's size
+//   techniques       = hard shadows, no reflections, no depth of field, no indirect light
+//   seed             = 0
+//   spp              = 0 -> 64 samples a pixel for `reference` effects
+//   max_depth        = 0 -> 2 for reference reflections and indirect light (pt convention:
+//                      2 = one bounce, what the sharp buffers can capture)
+//   light_samples    = 0 -> 8 samples per area light for the unshadowed light U_l
+//   shadow_map_size  = 0 -> 512 texels a cube face
+//   shadow_bias      = 0 -> 1.5 texels (the depth bias, scaled by the texel footprint)
+//   pcf_kernel       = 0 -> 3 (texels across; 1 = a single tap)
+//   envmap_size      = 0 -> 128 texels a cube face
+//   probe_per_object = false: one probe at the scene centre (or `probe` when has_probe)
+//   ambient          = used when has_ambient; otherwise the mean direct radiance of the frame
+typedef struct drift_hybrid_params {
+    int32_t width, height;
+    drift_shadow_technique shadows;
+    drift_reflection_technique reflections;
+    drift_dof_technique dof;
+    drift_indirect_technique indirect;
+    uint32_t seed;
+    uint32_t spp;
+    int32_t max_depth;
+    uint32_t light_samples;
+    int32_t shadow_map_size;
+    float shadow_bias;
+    int32_t pcf_kernel;
+    int32_t envmap_size;
+    bool has_probe;
+    drift_vec3 probe;
+    bool probe_per_object;
+    bool has_ambient;
+    drift_vec3 ambient;
+} drift_hybrid_params;
+
+drift_hybrid_params drift_hybrid_params_resolve(const drift_hybrid_params *params,
+                                                const drift_scene *scene);
+
+// --- G-BUFFER ---
+
+// One pinhole sample at each pixel centre. A pixel whose ray misses has depth 0 and
+// material_id -1; its emission plane holds the environment radiance.
+typedef struct drift_gbuffer {
+    int32_t width, height;
+    drift_image depth;            // 1: view depth (along the camera's forward axis)
+    drift_image position;         // 3: world position
+    drift_image normal;           // 3: unit shading normal, facing the camera
+    drift_image geometric_normal; // 3: unit geometric normal, facing the camera
+    drift_image albedo;           // 3: diffuse reflectance kd (textures applied)
+    drift_image specular;         // 3: glossy or mirror reflectance ks
+    drift_image gloss;            // 3: theta_max (radians; 0 mirror), Phong exponent, roughness
+    drift_image material_id;      // 1: material index, -1 for a miss or a light's shape
+    drift_image emission;         // 3: emitted radiance toward the camera (environment on a miss)
+    drift_image motion;           // 2: pixels from here to this point in the previous frame
+    drift_surface *surfaces;      // width*height, what shading needs (material invalid = none)
+} drift_gbuffer;
+
+// --- FRAME ---
+
+typedef enum drift_hybrid_pass {
+    DRIFT_PASS_PRIMARY = 0,    // G-buffer
+    DRIFT_PASS_UNSHADOWED,     // U_l for every pixel and light
+    DRIFT_PASS_HARD_SHADOWS,   // hard-shadow buffer
+    DRIFT_PASS_SHADOW_MAPS,    // building the shadow maps (cached while the scene stands)
+    DRIFT_PASS_SHADOW_FILTER,  // PCF or PCSS lookups
+    DRIFT_PASS_REFLECTIONS,    // sharp reflection buffer
+    DRIFT_PASS_ENVMAP,         // capturing the cube map (cached) and looking it up
+    DRIFT_PASS_REFERENCE,      // every `reference` effect
+    DRIFT_PASS_COMPOSE,
+    DRIFT_PASS_DOF,            // post-process depth of field
+    DRIFT_PASS_COUNT
+} drift_hybrid_pass;
+
+const char *drift_hybrid_pass_name(drift_hybrid_pass pass);
+
+typedef struct drift_hybrid_stats {
+    double ms[DRIFT_PASS_COUNT];    // wall milliseconds of the last frame, per pass
+    uint64_t rays[DRIFT_PASS_COUNT];
+    double frame_ms;                // the whole drift_hybrid_render call
+} drift_hybrid_stats;
+
+typedef struct drift_hybrid drift_hybrid;
+
+// Errors: DRIFT_ERR_INVALID_ARGUMENT (uncommitted scene, bad parameters, logged),
+// DRIFT_ERR_OUT_OF_MEMORY.
+drift_result drift_hybrid_create(drift_context *ctx, const drift_scene *scene,
+                                 const drift_accel *accel, const drift_hybrid_params *params,
+                                 drift_hybrid **out_frame);
+void drift_hybrid_destroy(drift_hybrid *frame); // NULL-safe
+
+// Changes techniques or settings for the next frame. Caches that still hold (shadow maps,
+// the environment map) are kept. The size may not change.
+drift_result drift_hybrid_set_params(drift_hybrid *frame, const drift_hybrid_params *params);
+drift_hybrid_params drift_hybrid_get_params(const drift_hybrid *frame);
+
+// Renders one frame seen by `camera` (its width/height are ignored: the frame's size is
+// used). Motion vectors are relative to the camera of the previous call (zero the first
+// time). `cancel` may be NULL; reference passes poll it (DRIFT_ERR_CANCELLED).
+drift_result drift_hybrid_render(drift_hybrid *frame, const drift_camera *camera,
+                                 const atomic_bool *cancel);
+
+// The composed frame: linear radiance, RGB.
+const drift_image *drift_hybrid_image(const drift_hybrid *frame);
+const drift_gbuffer *drift_hybrid_gbuffer(const drift_hybrid *frame);
+drift_hybrid_stats drift_hybrid_get_stats(const drift_hybrid *frame);
+
+// Every plane and buffer of the last frame, by name ("depth", "hard_shadow.visible",
+// "reflection.sharp", ...): for --aov and the viewer. Returns false past the last index.
+// Planes a technique did not need this frame are absent.
+bool drift_hybrid_plane(const drift_hybrid *frame, uint32_t index, const char **out_name,
+                        const drift_image **out_image);
+
+#ifdef __cplusplus
+}
+#endif
+#endif // DRIFT_HYBRID_H

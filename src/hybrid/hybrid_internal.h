@@ -1,0 +1,143 @@
+// Private interfaces between the passes of the hybrid frame (src/hybrid). Each pass is one
+// file with one job; frame.c drives them. Tests include this header to test passes alone.
+#ifndef DRIFT_HYBRID_INTERNAL_H
+#define DRIFT_HYBRID_INTERNAL_H
+
+#include "drift/hybrid.h"
+
+// --- LIGHTS AS THE HYBRID FRAME SEES THEM (lights.c) ---
+
+// One light of the frame: a scene light, or every triangle light of one emissive mesh
+// gathered into one (the Cornell box's ceiling quad is two triangle lights, one light here).
+// Shadow maps, hard shadows and the gathers of later issues work per hybrid light.
+typedef struct drift_hybrid_light {
+    drift_light_type type;  // DRIFT_LIGHT_TRIANGLE stands for an emissive mesh
+    drift_vec3 centre;      // where hard-shadow rays aim and shadow maps look from
+                            // (area-weighted centroid for meshes); unused for directional
+    drift_vec3 direction;   // directional: the way light travels; spot: its axis; quad, disk
+                            // and mesh: the (mean) normal light leaves along; else zero
+    float radius;           // light size L: 0 for point, spot and directional lights; for
+                            // area lights the radius of a bounding sphere about `centre`
+    bool one_sided;         // emits only into the hemisphere around `direction`
+    uint32_t first_light;   // the scene lights it stands for: first_light ..
+    uint32_t light_count;   //   first_light + light_count - 1 (1 unless a mesh)
+    uint32_t mesh;          // the emissive mesh, or DRIFT_INVALID_INDEX
+    float *light_cdf;       // light_count entries: area CDF over the triangles (meshes), or NULL
+} drift_hybrid_light;
+
+// Builds the hybrid lights of a committed scene (not the environment). *out_lights is NULL
+// when there are none. Free with drift_hybrid_lights_destroy.
+drift_result drift_hybrid_lights_build(drift_context *ctx, const drift_scene *scene,
+                                       drift_hybrid_light **out_lights, uint32_t *out_count);
+void drift_hybrid_lights_destroy(drift_context *ctx, drift_hybrid_light *lights, uint32_t count);
+
+// Samples a point on the light (u in [0,1)^2, u_pick picks a triangle of a mesh) as seen from
+// ref, with the solid-angle pdf of that choice folded into the sample's pdf.
+drift_light_sample drift_hybrid_light_sample(const drift_scene *scene,
+                                             const drift_hybrid_light *light, drift_vec3 ref,
+                                             float u_pick, drift_vec2 u);
+
+// --- SHADING SHARED BY EVERY PASS (shading.c) ---
+
+// Unshadowed direct light U_l: outgoing radiance toward wo at the surface from light
+// `light` through the non-delta lobes, without visibility; `sample_count` stratified light
+// samples from `sampler` for area lights (delta lights are exact). Zero for mirrors.
+drift_vec3 drift_hybrid_unshadowed(const drift_scene *scene, const drift_hybrid_light *light,
+                                   const drift_surface *surface, const drift_bsdf *bsdf,
+                                   drift_vec3 wo, uint32_t sample_count, drift_sampler *sampler);
+
+// A shadow ray from the surface toward the light's centre (or against a directional
+// light's direction). Returns whether the centre is visible; distances to the nearest
+// occluder (INFINITY when visible) and to the light's centre go to the out pointers.
+bool drift_hybrid_hard_shadow(const drift_accel *accel, const drift_hybrid_light *light,
+                              const drift_surface *surface, float *out_occluder_distance,
+                              float *out_light_distance);
+
+// Radiance leaving a hit point back along ray->dir, split in two: what it emits, and direct
+// light from every light with a hard shadow (one shadow ray each, counted in *rays). This is
+// how the sharp reflection buffer and the environment map shade what they see.
+typedef struct drift_hybrid_radiance {
+    drift_vec3 emitted;
+    drift_vec3 reflected;
+} drift_hybrid_radiance;
+
+typedef struct drift_hybrid_shading {
+    const drift_scene *scene;
+    const drift_accel *accel;
+    const drift_hybrid_light *lights;
+    uint32_t light_count;
+    uint32_t light_samples;
+} drift_hybrid_shading;
+
+// Traces `ray`; a miss returns the environment as emitted radiance. skip_mesh (or
+// DRIFT_INVALID_INDEX) is a mesh the ray passes through (a probe inside its own object).
+drift_hybrid_radiance drift_hybrid_trace_radiance(const drift_hybrid_shading *shading,
+                                                  drift_ray ray, uint32_t skip_mesh,
+                                                  drift_sampler *sampler, uint64_t *rays,
+                                                  float *out_distance);
+
+// Glossiness of a material for the gloss plane and gathers: the half angle theta_max of the
+// cone that holds 90% of the Phong lobe, cos(theta_max) = 0.1^(1/(n+1)); 0 for mirrors,
+// pi/2 for materials with no specular lobe.
+float drift_gloss_theta_max(const drift_material *material);
+
+// --- SHADOW MAPS (shadow_map.c) ---
+
+// A depth map seen from a light: a cube map of radial distances from the centre for local
+// lights (faces behind a one-sided light are skipped), an orthographic map over the scene
+// bounds for directional lights. Texels hold the distance to the nearest surface through
+// the texel centre (ray-cast: the value a rasterizer writes at that centre).
+typedef struct drift_shadow_map drift_shadow_map;
+
+typedef struct drift_shadow_map_params {
+    int32_t size;      // texels across a face
+    float bias_texels; // depth bias in texel footprints at the receiver's distance
+} drift_shadow_map_params;
+
+drift_result drift_shadow_map_build(drift_context *ctx, const drift_scene *scene,
+                                    const drift_accel *accel, const drift_hybrid_light *light,
+                                    const drift_shadow_map_params *params,
+                                    drift_shadow_map **out_map, uint64_t *out_rays);
+void drift_shadow_map_destroy(drift_context *ctx, drift_shadow_map *map); // NULL-safe
+
+// Visibility in [0,1] of the light from point p with geometric normal n:
+// hard = one tap, pcf = a kernel x kernel box of taps, pcss = blocker search, penumbra
+// estimate w = L (d_receiver - d_blocker) / d_blocker, then PCF over w (taps rotated by
+// `rotation_hash` per pixel to trade banding for noise).
+float drift_shadow_map_hard(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n);
+float drift_shadow_map_pcf(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n,
+                           int32_t kernel);
+float drift_shadow_map_pcss(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n,
+                            uint32_t rotation_hash);
+
+// --- ENVIRONMENT MAP (envmap.c) ---
+
+// A cube map of the radiance seen from a probe point, emitted and reflected parts apart,
+// with a mip chain so glossy lookups can blur by cone angle.
+typedef struct drift_envmap drift_envmap;
+
+drift_result drift_envmap_capture(drift_context *ctx, const drift_hybrid_shading *shading,
+                                  drift_vec3 probe, uint32_t skip_mesh, int32_t face_size,
+                                  uint32_t seed, drift_envmap **out_map, uint64_t *out_rays);
+void drift_envmap_destroy(drift_context *ctx, drift_envmap *map); // NULL-safe
+
+// Radiance seen along dir, blurred over a cone of half angle cone_angle (0 = sharpest level,
+// bilinear).
+drift_hybrid_radiance drift_envmap_lookup(const drift_envmap *map, drift_vec3 dir,
+                                          float cone_angle);
+drift_vec3 drift_envmap_probe(const drift_envmap *map);
+
+// --- DEPTH OF FIELD (post_dof.c) ---
+
+// Circle-of-confusion radius in pixels of a point at view depth z for the thin-lens camera
+// (aperture radius A, focus distance F, image height H): A |z - F| / z scaled by the
+// pixels per scene unit on the focus plane, H / (2 F tan(fov_y / 2)). 0 for a pinhole.
+float drift_coc_radius_pixels(const drift_camera *camera, int32_t image_height, float z);
+
+// The usual post-process DOF: each pixel averages `taps` concentric-disk samples over its
+// own circle of confusion (colour leaks across depth edges, as in the usual real-time
+// gather). coc holds radii in pixels. in and out must differ; taps 0 -> 64.
+drift_result drift_post_dof(drift_context *ctx, const drift_image *in, const drift_image *coc,
+                            uint32_t taps, drift_image *out);
+
+#endif // DRIFT_HYBRID_INTERNAL_H
