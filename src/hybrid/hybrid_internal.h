@@ -160,6 +160,10 @@ float drift_coc_radius_pixels(const drift_camera *camera, int32_t image_height, 
 // The usual post-process DOF: each pixel averages `taps` concentric-disk samples over its
 // own circle of confusion (colour leaks across depth edges, as in the usual real-time
 // gather). coc holds radii in pixels. in and out must differ; taps 0 -> 64.
+// A pixel whose CoC is under half a pixel is copied exactly. out is preallocated with the
+// size and channels of in. Errors: DRIFT_ERR_INVALID_ARGUMENT (sizes differ, out is in or coc,
+// taps over DRIFT_POST_DOF_MAX_TAPS; logged), DRIFT_ERR_OUT_OF_MEMORY.
+#define DRIFT_POST_DOF_MAX_TAPS 4096
 drift_result drift_post_dof(drift_context *ctx, const drift_image *in, const drift_image *coc,
                             uint32_t taps, drift_image *out);
 
