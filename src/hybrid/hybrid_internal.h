@@ -40,11 +40,21 @@ drift_light_sample drift_hybrid_light_sample(const drift_scene *scene,
 // --- SHADING SHARED BY EVERY PASS (shading.c) ---
 
 // Unshadowed direct light U_l: outgoing radiance toward wo at the surface from light
-// `light` through the non-delta lobes, without visibility; `sample_count` stratified light
-// samples from `sampler` for area lights (delta lights are exact). Zero for mirrors.
+// `light` through the non-delta lobes, without visibility. Area lights take `sample_count`
+// points of a Hammersley set, shifted by one random offset drawn from `sampler`
+// (Cranley-Patterson rotation: stratified within a pixel, decorrelated between pixels);
+// delta lights are exact. Zero for mirrors.
 drift_vec3 drift_hybrid_unshadowed(const drift_scene *scene, const drift_hybrid_light *light,
                                    const drift_surface *surface, const drift_bsdf *bsdf,
                                    drift_vec3 wo, uint32_t sample_count, drift_sampler *sampler);
+
+// Direct light from the environment with ray-traced visibility (`sample_count` shadow rays,
+// counted in *rays). The environment has no centre, so the shadow techniques do not apply
+// to it: every technique shades it this way (docs/hybrid.md).
+drift_vec3 drift_hybrid_environment_direct(const drift_scene *scene, const drift_accel *accel,
+                                           const drift_surface *surface, const drift_bsdf *bsdf,
+                                           drift_vec3 wo, uint32_t sample_count,
+                                           drift_sampler *sampler, uint64_t *rays);
 
 // A shadow ray from the surface toward the light's centre (or against a directional
 // light's direction). Returns whether the centre is visible; distances to the nearest
