@@ -393,6 +393,69 @@ static void test_faces_behind_one_sided_light_are_skipped(void **state)
     rig_destroy(&r);
 }
 
+// An emissive ceiling quad (two triangles facing down) as drift_hybrid_lights_build makes
+// it: one one-sided light over both triangles, so 5 faces, and its own triangles are no
+// occluders. One PCF tap agrees with the frame's hard-shadow ray away from edges.
+static void test_mesh_light_matches_hybrid_hard_shadow(void **state)
+{
+    (void)state;
+    rig r = rig_begin();
+    add_ground(&r);
+    add_square(&r, 0.3f, -0.2f, 0.6f, 1.0f);
+    drift_material emitter = drift_material_make(drift_vec3_splat(0.0f));
+    emitter.emission = drift_vec3_splat(10.0f);
+    uint32_t emissive;
+    assert_int_equal(drift_scene_add_material(r.scene, &emitter, &emissive), DRIFT_OK);
+    const float h = 0.3f, y = 3.0f;
+    const float p[] = { -h, y, -h, h, y, -h, h, y, h, -h, y, h };
+    const uint32_t idx[] = { 0, 1, 2, 0, 2, 3 }; // normal -y
+    test_add_mesh(r.scene, p, 4, idx, 2, emissive);
+    assert_int_equal(drift_scene_commit(r.scene), DRIFT_OK);
+    drift_hybrid_light *lights = NULL;
+    uint32_t light_count = 0;
+    assert_int_equal(drift_hybrid_lights_build(r.ctx, r.scene, &lights, &light_count), DRIFT_OK);
+    assert_int_equal(light_count, 1);
+    assert_int_equal(lights[0].type, DRIFT_LIGHT_TRIANGLE);
+    assert_int_equal(lights[0].light_count, 2);
+    assert_true(lights[0].one_sided);
+    r.light = lights[0];
+    const int32_t size = 128;
+    rig_build(&r, size);
+    // 5 faces; a texel ray re-traced past the light's own triangles would cost one more.
+    assert_true(r.rays >= 5 * (uint64_t)(size * size) && r.rays < 6 * (uint64_t)(size * size));
+
+    bool *visible = test_malloc(sizeof(bool) * GRID * GRID);
+    for (int k = 0; k < GRID * GRID; ++k) {
+        drift_surface surface = {
+            .position = ground_point(grid_coord(k % GRID), grid_coord(k / GRID)), .ng = up, .ns = up
+        };
+        float occluder, distance;
+        visible[k] = drift_hybrid_hard_shadow(r.accel, &r.light, &surface, &occluder, &distance);
+    }
+    int compared = 0, mismatches = 0, shadowed = 0;
+    for (int j = 2; j < GRID - 2; ++j) {
+        for (int i = 2; i < GRID - 2; ++i) {
+            bool v = visible[j * GRID + i], stable = true;
+            for (int d = -2; d <= 2; ++d) {
+                stable =
+                    stable && visible[(j + d) * GRID + i] == v && visible[j * GRID + i + d] == v;
+            }
+            if (stable) {
+                float pcf =
+                    drift_shadow_map_pcf(r.map, ground_point(grid_coord(i), grid_coord(j)), up, 1);
+                compared++;
+                mismatches += (pcf == 1.0f) != v;
+                shadowed += !v;
+            }
+        }
+    }
+    test_free(visible);
+    assert_int_equal(mismatches, 0);
+    assert_true(compared > GRID * GRID / 2 && shadowed > 10);
+    drift_hybrid_lights_destroy(r.ctx, lights, light_count);
+    rig_destroy(&r);
+}
+
 static void test_build_rejects_bad_arguments(void **state)
 {
     (void)state;
@@ -430,6 +493,7 @@ int main(void)
         cmocka_unit_test(test_open_sky_lit_and_deep_umbra_dark),
         cmocka_unit_test(test_directional_map),
         cmocka_unit_test(test_faces_behind_one_sided_light_are_skipped),
+        cmocka_unit_test(test_mesh_light_matches_hybrid_hard_shadow),
         cmocka_unit_test(test_build_rejects_bad_arguments),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
