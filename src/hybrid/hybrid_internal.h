@@ -104,6 +104,8 @@ typedef struct drift_shadow_map_params {
     float bias_texels; // depth bias in texel footprints at the receiver's distance
 } drift_shadow_map_params;
 
+// Adds the rays it casts to *out_rays (may be NULL). Errors: DRIFT_ERR_INVALID_ARGUMENT
+// (uncommitted scene, size outside [1, 16384], negative bias; logged), DRIFT_ERR_OUT_OF_MEMORY.
 drift_result drift_shadow_map_build(drift_context *ctx, const drift_scene *scene,
                                     const drift_accel *accel, const drift_hybrid_light *light,
                                     const drift_shadow_map_params *params,
