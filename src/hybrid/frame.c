@@ -334,9 +334,9 @@ drift_sampler drift_hybrid_sampler(const drift_hybrid *frame, uint32_t stream, i
 
 drift_vec3 drift_hybrid_wo(const drift_hybrid *frame, int32_t x, int32_t y)
 {
-    drift_ray ray = drift_gbuffer_ray(&frame->camera, frame->params.width, frame->params.height,
-                                      x, y);
-    return drift_vec3_neg(ray.dir);
+    // The primary ray is a pinhole ray from the camera's position: toward the eye from the hit.
+    const drift_surface *s = &frame->gbuffer.surfaces[(size_t)y * (size_t)frame->params.width + (size_t)x];
+    return drift_vec3_normalize(drift_vec3_sub(frame->camera.position, s->position));
 }
 
 void drift_hybrid_copy_rgb(const drift_image *from, drift_image *to)

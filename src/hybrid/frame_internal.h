@@ -97,7 +97,7 @@ void drift_hybrid_copy_rgb(const drift_image *from, drift_image *to);
 drift_sampler drift_hybrid_sampler(const drift_hybrid *frame, uint32_t stream, int32_t x,
                                    int32_t y);
 
-// Outgoing direction at the pixel's surface (toward the camera).
+// Outgoing direction at the pixel's surface (toward the camera); pixels with a hit only.
 drift_vec3 drift_hybrid_wo(const drift_hybrid *frame, int32_t x, int32_t y);
 
 #endif

@@ -61,10 +61,12 @@ drift_light_sample drift_hybrid_light_sample(const drift_scene *scene,
 // --- SHADING SHARED BY EVERY PASS (shading.c) ---
 
 // Unshadowed direct light U_l: outgoing radiance toward wo at the surface from light
-// `light` through the non-delta lobes, without visibility. Area lights take `sample_count`
-// points of a Hammersley set, shifted by one random offset drawn from `sampler`
-// (Cranley-Patterson rotation: stratified within a pixel, decorrelated between pixels);
-// delta lights are exact. Zero for mirrors.
+// `light` through the non-delta lobes, without visibility. Delta lights are exact. Quad
+// lights and emissive meshes of up to 8 triangles get their diffuse lobe in closed form
+// (Lambert's polygon formula, clipped to the hemisphere). What remains (the glossy lobe;
+// both lobes for disk, sphere and larger mesh lights) takes `sample_count` points of a
+// Hammersley set shifted by one random offset drawn from `sampler` (Cranley-Patterson
+// rotation: stratified within a pixel, decorrelated between pixels). Zero for mirrors.
 drift_vec3 drift_hybrid_unshadowed(const drift_scene *scene, const drift_hybrid_light *light,
                                    const drift_surface *surface, const drift_bsdf *bsdf,
                                    drift_vec3 wo, uint32_t sample_count, drift_sampler *sampler);
@@ -190,9 +192,10 @@ drift_vec3 drift_cube_texel_direction(int32_t face_size, int face, int32_t i, in
 // pixels per scene unit on the focus plane, H / (2 F tan(fov_y / 2)). 0 for a pinhole.
 float drift_coc_radius_pixels(const drift_camera *camera, int32_t image_height, float z);
 
-// The usual post-process DOF: each pixel averages `taps` concentric-disk samples over its
-// own circle of confusion (colour leaks across depth edges, as in the usual real-time
-// gather). coc holds radii in pixels. in and out must differ; taps 0 -> 64.
+// The usual post-process DOF: each pixel averages concentric-disk samples over its own
+// circle of confusion (colour leaks across depth edges, as in the usual real-time gather):
+// the centre plus about one tap per four pixels of the disk's area (a power of two), at most
+// `taps` in all. coc holds radii in pixels. in and out must differ; taps 0 -> 64.
 // A pixel whose CoC is under half a pixel is copied exactly. out is preallocated with the
 // size and channels of in. Errors: DRIFT_ERR_INVALID_ARGUMENT (sizes differ, out is in or coc,
 // taps over DRIFT_POST_DOF_MAX_TAPS; logged), DRIFT_ERR_OUT_OF_MEMORY.

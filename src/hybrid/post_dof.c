@@ -67,7 +67,8 @@ static float lerp(float a, float b, float t)
 }
 
 // Bilinear fetch at (x, y) in pixel-centre units (pixel p's centre at p), clamped to the image.
-static void fetch_bilinear(const drift_image *image, float x, float y, float *out)
+static inline void fetch_bilinear(const drift_image *image, float x, float y, float *out,
+                                  const int32_t channels)
 {
     float x0f = floorf(x), y0f = floorf(y);
     float fx = x - x0f, fy = y - y0f;
@@ -77,28 +78,52 @@ static void fetch_bilinear(const drift_image *image, float x, float y, float *ou
     int32_t yb = clamp_index((int32_t)y0f + 1, image->height);
     const float *p00 = drift_image_pixel(image, xa, ya), *p10 = drift_image_pixel(image, xb, ya);
     const float *p01 = drift_image_pixel(image, xa, yb), *p11 = drift_image_pixel(image, xb, yb);
-    for (int32_t c = 0; c < image->channels; ++c) {
+    for (int32_t c = 0; c < channels; ++c) {
         out[c] = lerp(lerp(p00[c], p10[c], fx), lerp(p01[c], p11[c], fx), fy);
     }
 }
 
-// Equal weights. Summing differences from the centre pixel keeps a flat region exactly flat
-// (a float sum of 64 equal values would not return the value).
-static void gather_pixel(const dof_job *job, int32_t x, int32_t y, float radius, float *out)
+// Taps for a disk of `radius` pixels: the centre plus a power of two of the stratified set
+// (a prefix of 2^k points stays stratified), one per four pixels of the disk's area, at most
+// the table: each bilinear tap reads a 2x2 footprint, so together they read about every pixel.
+static uint32_t taps_for_radius(float radius, uint32_t table_size)
 {
-    int32_t channels = job->in->channels;
+    float quarter_area = 0.25f * 3.14159265f * radius * radius;
+    uint32_t n = 4;
+    while ((float)n < quarter_area && n < table_size - 1) {
+        n *= 2;
+    }
+    return n + 1 < table_size ? n + 1 : table_size;
+}
+
+// Equal weights. Summing differences from the centre pixel keeps a flat region exactly flat
+// (a float sum of 64 equal values would not return the value). Inlined with a constant
+// channel count for RGB, so the channel loops unroll.
+static inline void gather(const dof_job *job, int32_t x, int32_t y, float radius, float *out,
+                          const int32_t channels)
+{
     const float *centre = drift_image_pixel(job->in, x, y);
     float sum[4] = { 0.0f, 0.0f, 0.0f, 0.0f }, tap[4];
-    for (uint32_t k = 0; k < job->tap_count; ++k) {
+    uint32_t tap_count = taps_for_radius(radius, job->tap_count);
+    for (uint32_t k = 0; k < tap_count; ++k) {
         float tx = (float)x + job->taps[k].x * radius, ty = (float)y + job->taps[k].y * radius;
-        fetch_bilinear(job->in, tx, ty, tap);
+        fetch_bilinear(job->in, tx, ty, tap, channels);
         for (int32_t c = 0; c < channels; ++c) {
             sum[c] += tap[c] - centre[c];
         }
     }
-    float inv = 1.0f / (float)job->tap_count;
+    float inv = 1.0f / (float)tap_count;
     for (int32_t c = 0; c < channels; ++c) {
         out[c] = centre[c] + sum[c] * inv;
+    }
+}
+
+static void gather_pixel(const dof_job *job, int32_t x, int32_t y, float radius, float *out)
+{
+    if (job->in->channels == 3) {
+        gather(job, x, y, radius, out, 3);
+    } else {
+        gather(job, x, y, radius, out, job->in->channels);
     }
 }
 

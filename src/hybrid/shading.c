@@ -20,16 +20,124 @@ static drift_vec2 shifted_hammersley(uint32_t k, uint32_t n, drift_vec2 shift)
     return drift_vec2_make(x - floorf(x), y - floorf(y));
 }
 
-// f * L * cos / pdf of one light sample, without visibility (the pt's NEE, minus the ray).
+// f * L * cos / pdf of one light sample, without visibility (the pt's NEE, minus the ray);
+// with glossy_only, f is the glossy lobe alone.
 static drift_vec3 light_sample_contribution(const drift_surface *surface, const drift_bsdf *bsdf,
-                                            drift_vec3 wo, const drift_light_sample *ls)
+                                            drift_vec3 wo, const drift_light_sample *ls,
+                                            bool glossy_only)
 {
     if (!(ls->pdf > 0.0f) || drift_vec3_is_zero(ls->radiance)) {
         return drift_vec3_splat(0.0f);
     }
-    drift_vec3 f = drift_bsdf_eval(bsdf, wo, ls->wi);
+    drift_vec3 diffuse, glossy;
+    drift_bsdf_eval_lobes(bsdf, wo, ls->wi, &diffuse, &glossy);
+    drift_vec3 f = glossy_only ? glossy : drift_vec3_add(diffuse, glossy);
     float cos_i = fabsf(drift_vec3_dot(ls->wi, surface->ns));
     return drift_vec3_scale(drift_vec3_mul(f, ls->radiance), cos_i / ls->pdf);
+}
+
+// --- POLYGON LIGHTS IN CLOSED FORM ---
+
+// Meshes with more triangles than this are sampled rather than summed triangle by triangle.
+#define MAX_CLOSED_FORM_TRIANGLES 8
+
+// Clips the convex polygon `in` to the half space above the plane through p with normal n
+// (Sutherland-Hodgman); returns the vertex count of `out` (room for count + 1).
+static int clip_to_hemisphere(drift_vec3 p, drift_vec3 n, const drift_vec3 *in, int count,
+                              drift_vec3 *out)
+{
+    int m = 0;
+    for (int i = 0; i < count; ++i) {
+        drift_vec3 a = in[i], b = in[(i + 1) % count];
+        float da = drift_vec3_dot(drift_vec3_sub(a, p), n);
+        float db = drift_vec3_dot(drift_vec3_sub(b, p), n);
+        if (da >= 0.0f) {
+            out[m++] = a;
+        }
+        if ((da >= 0.0f) != (db >= 0.0f)) {
+            out[m++] = drift_vec3_add(a, drift_vec3_scale(drift_vec3_sub(b, a), da / (da - db)));
+        }
+    }
+    return m;
+}
+
+// Irradiance at p (normal n) from a polygon of unit radiance: Lambert's formula,
+// E = 1/2 sum_i theta_i (n . gamma_i) over the edges (Arvo 1994), after clipping the polygon
+// to the hemisphere above p.
+static float polygon_irradiance(drift_vec3 p, drift_vec3 n, const drift_vec3 *polygon, int count)
+{
+    drift_vec3 clipped[8];
+    int m = clip_to_hemisphere(p, n, polygon, count, clipped);
+    if (m < 3) {
+        return 0.0f;
+    }
+    drift_vec3 dirs[8];
+    for (int i = 0; i < m; ++i) {
+        dirs[i] = drift_vec3_normalize(drift_vec3_sub(clipped[i], p));
+    }
+    float sum = 0.0f;
+    for (int i = 0; i < m; ++i) {
+        drift_vec3 a = dirs[i], b = dirs[(i + 1) % m];
+        drift_vec3 c = drift_vec3_cross(a, b);
+        float length = drift_vec3_length(c);
+        if (length > 1e-12f) {
+            float theta = acosf(drift_clampf(drift_vec3_dot(a, b), -1.0f, 1.0f));
+            sum += theta * drift_vec3_dot(c, n) / length;
+        }
+    }
+    return 0.5f * fabsf(sum);
+}
+
+// The corners of a quad or triangle light, and its emitting normal.
+static int light_polygon(const drift_scene *scene, const drift_light *l, drift_vec3 *out,
+                         drift_vec3 *out_normal)
+{
+    if (l->type == DRIFT_LIGHT_QUAD) {
+        out[0] = l->position;
+        out[1] = drift_vec3_add(l->position, l->edge_u);
+        out[2] = drift_vec3_add(out[1], l->edge_v);
+        out[3] = drift_vec3_add(l->position, l->edge_v);
+        *out_normal = drift_vec3_cross(l->edge_u, l->edge_v);
+        return 4;
+    }
+    const drift_mesh *mesh = &scene->meshes[l->mesh];
+    const uint32_t *idx = mesh->indices + 3u * l->triangle;
+    for (int k = 0; k < 3; ++k) {
+        const float *v = mesh->positions + 3u * idx[k];
+        out[k] = drift_vec3_make(v[0], v[1], v[2]);
+    }
+    *out_normal = drift_vec3_cross(drift_vec3_sub(out[1], out[0]), drift_vec3_sub(out[2], out[0]));
+    return 3;
+}
+
+static bool has_closed_form(const drift_hybrid_light *light)
+{
+    return light->type == DRIFT_LIGHT_QUAD ||
+           (light->type == DRIFT_LIGHT_TRIANGLE && light->light_count <= MAX_CLOSED_FORM_TRIANGLES);
+}
+
+// The diffuse lobe's share of U_l in closed form: kd / pi * sum over polygons of L_e * E.
+// Each polygon emits from its front face only.
+static drift_vec3 polygon_diffuse(const drift_scene *scene, const drift_hybrid_light *light,
+                                  const drift_surface *surface, const drift_bsdf *bsdf,
+                                  drift_vec3 wo)
+{
+    drift_vec3 n = bsdf->frame.z;
+    drift_vec3 sum = drift_vec3_splat(0.0f);
+    if (drift_vec3_dot(wo, n) <= 0.0f) {
+        return sum; // the diffuse lobe is zero for a viewer below the shading normal
+    }
+    for (uint32_t i = 0; i < light->light_count; ++i) {
+        const drift_light *l = &scene->lights[light->first_light + i];
+        drift_vec3 polygon[4], normal;
+        int count = light_polygon(scene, l, polygon, &normal);
+        if (drift_vec3_dot(drift_vec3_sub(surface->position, polygon[0]), normal) <= 0.0f) {
+            continue; // behind the emitting side
+        }
+        float e = polygon_irradiance(surface->position, n, polygon, count);
+        sum = drift_vec3_fma(sum, l->color, e);
+    }
+    return drift_vec3_scale(drift_vec3_mul(sum, bsdf->diffuse), DRIFT_INV_PI);
 }
 
 drift_vec3 drift_hybrid_unshadowed(const drift_scene *scene, const drift_hybrid_light *light,
@@ -43,8 +151,17 @@ drift_vec3 drift_hybrid_unshadowed(const drift_scene *scene, const drift_hybrid_
     if (!drift_light_is_area(light->type)) {
         drift_light_sample ls = drift_hybrid_light_sample(scene, light, surface->position, 0.0f,
                                                           drift_vec2_make(0.5f, 0.5f));
-        return light_sample_contribution(surface, bsdf, wo, &ls);
+        return light_sample_contribution(surface, bsdf, wo, &ls, false);
     }
+    // Polygons: the diffuse lobe in closed form (no noise), samples for the glossy lobe only.
+    bool closed_form = has_closed_form(light);
+    if (closed_form) {
+        sum = polygon_diffuse(scene, light, surface, bsdf, wo);
+        if (drift_vec3_is_zero(bsdf->specular)) {
+            return sum;
+        }
+    }
+    drift_vec3 sampled = drift_vec3_splat(0.0f);
     uint32_t n = sample_count > 0 ? sample_count : 1;
     drift_vec2 shift = drift_sampler_next2(sampler);
     float pick_shift = drift_sampler_next1(sampler);
@@ -54,9 +171,9 @@ drift_vec3 drift_hybrid_unshadowed(const drift_scene *scene, const drift_hybrid_
         float pick = (float)k * 0.618034f + pick_shift;
         drift_light_sample ls =
             drift_hybrid_light_sample(scene, light, surface->position, pick - floorf(pick), u);
-        sum = drift_vec3_add(sum, light_sample_contribution(surface, bsdf, wo, &ls));
+        sampled = drift_vec3_add(sampled, light_sample_contribution(surface, bsdf, wo, &ls, closed_form));
     }
-    return drift_vec3_scale(sum, 1.0f / (float)n);
+    return drift_vec3_fma(sum, sampled, 1.0f / (float)n);
 }
 
 drift_vec3 drift_hybrid_environment_direct(const drift_scene *scene, const drift_accel *accel,
@@ -72,7 +189,7 @@ drift_vec3 drift_hybrid_environment_direct(const drift_scene *scene, const drift
     drift_vec2 shift = drift_sampler_next2(sampler);
     for (uint32_t k = 0; k < n; ++k) {
         drift_light_sample ls = drift_environment_sample(scene, shifted_hammersley(k, n, shift));
-        drift_vec3 c = light_sample_contribution(surface, bsdf, wo, &ls);
+        drift_vec3 c = light_sample_contribution(surface, bsdf, wo, &ls, false);
         if (drift_vec3_is_zero(c)) {
             continue;
         }

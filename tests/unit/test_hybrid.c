@@ -12,6 +12,7 @@
 #include "drift/hybrid.h"
 #include "drift/pt.h"
 #include "drift/scene.h"
+#include "hybrid/hybrid_internal.h"
 
 #define PI_F 3.14159265f
 #define M_PI 3.14159265358979323846
@@ -563,6 +564,64 @@ static void test_deterministic_across_threads(void **state)
     }
 }
 
+// --- UNSHADOWED LIGHT ---
+
+// The closed-form diffuse term of a quad light equals a brute-force Monte Carlo integral of
+// the same BSDF and light code, including points that see the light partly below their
+// horizon (clipping) and points behind it (zero).
+static void test_unshadowed_quad_matches_monte_carlo(void **state)
+{
+    (void)state;
+    rig r = rig_begin(1);
+    uint32_t white = add_material(r.scene, drift_material_make(drift_vec3_make(0.8f, 0.5f, 0.2f)));
+    add_floor(r.scene, 10.0f, -5.0f, white);
+    assert_int_equal(drift_scene_add_light(r.scene,
+                                           &(drift_light){ .type = DRIFT_LIGHT_QUAD,
+                                                           .position = { -0.5f, 1.0f, -0.5f },
+                                                           .edge_u = { 1, 0, 0 },
+                                                           .edge_v = { 0, 0, 1 },
+                                                           .color = { 3, 3, 3 } },
+                                           NULL),
+                     DRIFT_OK);
+    rig_commit(&r);
+    drift_hybrid_light *lights = NULL;
+    uint32_t count = 0;
+    assert_int_equal(drift_hybrid_lights_build(r.ctx, r.scene, &lights, &count), DRIFT_OK);
+    assert_int_equal(count, 1);
+    const struct { drift_vec3 p, n; } cases[] = {
+        { { 0, 0, 0 }, { 0, 1, 0 } },            // straight below
+        { { 2, 0.5f, 0.3f }, { -0.6f, 0.8f, 0 } }, // off to the side, tilted
+        { { 0.2f, 0.9f, 0 }, { 1, 0, 0 } },      // a wall just below: the quad crosses its horizon
+        { { 0, 2, 0 }, { 0, -1, 0 } },           // above the light: behind its emitting side
+    };
+    for (size_t c = 0; c < sizeof cases / sizeof *cases; ++c) {
+        drift_surface s = { .position = cases[c].p, .material = white, .light = DRIFT_INVALID_INDEX };
+        s.ns = s.ng = drift_vec3_normalize(cases[c].n);
+        drift_bsdf bsdf = drift_bsdf_make(r.scene, &s);
+        drift_vec3 wo = s.ns;
+        drift_sampler sampler = drift_sampler_make(1, 0, 0);
+        drift_vec3 closed = drift_hybrid_unshadowed(r.scene, &lights[0], &s, &bsdf, wo, 8, &sampler);
+        double mc = 0.0;
+        const int n = 200000;
+        for (int k = 0; k < n; ++k) {
+            drift_sampler ks = drift_sampler_make(7, 0, (uint32_t)k);
+            drift_light_sample ls = drift_light_sample_li(r.scene, 0, s.position, drift_sampler_next2(&ks));
+            if (ls.pdf > 0.0f) {
+                drift_vec3 f = drift_bsdf_eval(&bsdf, wo, ls.wi);
+                mc += (double)(f.x * ls.radiance.x * fabsf(drift_vec3_dot(ls.wi, s.ns)) / ls.pdf);
+            }
+        }
+        mc /= n;
+        print_message("case %zu: closed form %g, Monte Carlo %g\n", c, (double)closed.x, mc);
+        assert_near(closed.x, mc, 0.01 * mc + 1e-6);
+        if (c == 3) {
+            assert_near(closed.x, 0.0, 0.0);
+        }
+    }
+    drift_hybrid_lights_destroy(r.ctx, lights, count);
+    rig_destroy(&r);
+}
+
 // --- NAMES AND ARGUMENTS ---
 
 static void test_technique_names_round_trip(void **state)
@@ -617,6 +676,7 @@ int main(void)
         cmocka_unit_test(test_envmap_mirror_sphere_matches_ray_traced),
         cmocka_unit_test(test_post_dof_pinhole_is_identity),
         cmocka_unit_test(test_deterministic_across_threads),
+        cmocka_unit_test(test_unshadowed_quad_matches_monte_carlo),
         cmocka_unit_test(test_technique_names_round_trip),
         cmocka_unit_test(test_rejects_bad_params),
     };
