@@ -36,6 +36,7 @@ struct drift_view {
     drift_hybrid *hybrid;
     drift_hybrid_params params;
     bool params_changed;
+    bool hybrid_rendered;            // a frame was rendered: drift_hybrid_plane has planes
 
     drift_pt *reference;             // NULL until a frame with the split on, and after a move
     drift_camera reference_camera;   // the camera the reference was created with
@@ -48,6 +49,7 @@ struct drift_view {
     float move_step;
 
     char buffer_name[BUFFER_NAME_MAX]; // "frame" or a plane name; looked up at each frame
+    int32_t pending_buffer_steps;      // buffer keys pressed before the first frame
     float exposure_stops;
     bool split;
     float split_position;
@@ -100,7 +102,7 @@ static int32_t split_column(const drift_view *view)
 // The index (1-based; 0 = the composed frame) of the plane called `name` in the last frame.
 static uint32_t buffer_index(const drift_view *view, const char *name)
 {
-    if (view->frame_count == 0 || strcmp(name, "frame") == 0) {
+    if (!view->hybrid_rendered || strcmp(name, "frame") == 0) {
         return 0;
     }
     const char *plane_name = NULL;
@@ -115,7 +117,7 @@ static uint32_t buffer_index(const drift_view *view, const char *name)
 
 static uint32_t plane_count(const drift_view *view)
 {
-    if (view->frame_count == 0) {
+    if (!view->hybrid_rendered) {
         return 0;
     }
     const char *name = NULL;
@@ -135,6 +137,19 @@ static void select_buffer(drift_view *view, uint32_t index)
         name = "frame";
     }
     snprintf(view->buffer_name, sizeof(view->buffer_name), "%s", name);
+}
+
+// Moves the shown buffer by `steps` through the frame and every plane of the last frame,
+// wrapping around. Before the first frame there are no planes yet: the steps wait for it.
+static void step_buffer(drift_view *view, int32_t steps)
+{
+    if (!view->hybrid_rendered) {
+        view->pending_buffer_steps += steps;
+        return;
+    }
+    int64_t count = (int64_t)plane_count(view) + 1; // the frame, then every plane
+    int64_t index = ((int64_t)buffer_index(view, view->buffer_name) + steps) % count;
+    select_buffer(view, (uint32_t)(index < 0 ? index + count : index));
 }
 
 // --- THE REFERENCE ---
@@ -389,14 +404,9 @@ static bool handle_key(drift_view *view, drift_view_key key)
         cycle_technique(view, DRIFT_EFFECT_INDIRECT);
         return true;
     case DRIFT_VIEW_KEY_NEXT_BUFFER:
-    case DRIFT_VIEW_KEY_PREV_BUFFER: {
-        uint32_t count = plane_count(view) + 1; // the frame, then every plane
-        uint32_t index = buffer_index(view, view->buffer_name);
-        index = key == DRIFT_VIEW_KEY_NEXT_BUFFER ? (index + 1) % count
-                                                  : (index + count - 1) % count;
-        select_buffer(view, index);
+    case DRIFT_VIEW_KEY_PREV_BUFFER:
+        step_buffer(view, key == DRIFT_VIEW_KEY_NEXT_BUFFER ? 1 : -1);
         return true;
-    }
     case DRIFT_VIEW_KEY_SPLIT:
         view->split = !view->split;
         return true;
@@ -489,7 +499,7 @@ typedef enum buffer_look {
     LOOK_UNIT,         // 1 channel in [0,1]: grey as is (visibility, masks)
     LOOK_RANGE,        // 1 channel: (v - min) / (max - min), grey (ids, distances)
     LOOK_DEPTH,        // v / max, grey; misses (0) stay black
-    LOOK_NORMAL,       // 0.5 + 0.5 n
+    LOOK_NORMAL,       // 0.5 + 0.5 n; black where there is no normal (a miss)
     LOOK_POSITION,     // normalized to the scene's bounds
     LOOK_MOTION,       // 2 channels: 0.5 + 0.5 m / max|m| as red and green
 } buffer_look;
@@ -566,7 +576,8 @@ static void show_row(drift_view *view, const drift_image *image, buffer_look loo
             v[0] = v[1] = v[2] = range.hi > 0.0f ? p[0] / range.hi : 0.0f;
             break;
         case LOOK_NORMAL:
-            for (int c = 0; c < 3; ++c) {
+            // A miss has no normal (zero): black rather than the grey of 0.5 + 0.5 * 0.
+            for (int c = 0; c < 3 && (p[0] != 0.0f || p[1] != 0.0f || p[2] != 0.0f); ++c) {
                 v[c] = 0.5f + 0.5f * p[c];
             }
             break;
@@ -611,34 +622,107 @@ static void blend_rect(drift_view *view, int32_t x0, int32_t y0, int32_t x1, int
     }
 }
 
-// stb_easy_font indexes a table by (char - 32): keep only printable ASCII and newlines.
+// stb_easy_font indexes a table by (char - 32): keep printable ASCII, tabs and newlines.
 static void sanitize(char *text)
 {
     for (char *c = text; *c; ++c) {
-        if (*c != '\n' && (*c < 32 || *c > 126)) {
+        if (*c != '\n' && *c != '\t' && (*c < 32 || *c > 126)) {
             *c = '?';
         }
     }
 }
 
-// Draws `text` (lines separated by '\n') at (x, y) on a dark box, `scale` pixels a font unit.
+#define TEXT_MAX_COLUMNS 8
+#define TEXT_COLUMN_GAP 8 // font units between table columns
+#define TEXT_LINE_HEIGHT 12
+
+// Calls draw(cell, column x, line y) for every tab-separated cell of `text` in font units;
+// columns line up (each as wide as its widest cell). Returns the table's size.
+typedef void (*cell_func)(drift_view *view, char *cell, int32_t x, int32_t y, void *user);
+
+static void layout_table(drift_view *view, char *text, cell_func draw, void *user,
+                         int32_t *out_width, int32_t *out_height)
+{
+    int32_t widths[TEXT_MAX_COLUMNS] = { 0 };
+    int32_t lines = 0;
+    for (int pass = 0; pass < 2; ++pass) {
+        char *line = text;
+        lines = 0;
+        while (*line) {
+            char *line_end = strchr(line, '\n');
+            char *next = line_end ? line_end + 1 : line + strlen(line);
+            char saved_line = line_end ? *line_end : '\0';
+            if (line_end) {
+                *line_end = '\0';
+            }
+            int32_t x = 0;
+            char *cell = line;
+            for (int column = 0; cell; ++column) {
+                char *tab = column < TEXT_MAX_COLUMNS - 1 ? strchr(cell, '\t') : NULL;
+                if (tab) {
+                    *tab = '\0';
+                }
+                if (pass == 0) {
+                    int32_t w = stb_easy_font_width(cell);
+                    widths[column] = w > widths[column] ? w : widths[column];
+                } else if (draw) {
+                    draw(view, cell, x, lines * TEXT_LINE_HEIGHT, user);
+                }
+                x += widths[column] + TEXT_COLUMN_GAP;
+                if (tab) {
+                    *tab = '\t';
+                }
+                cell = tab ? tab + 1 : NULL;
+            }
+            if (line_end) {
+                *line_end = saved_line;
+            }
+            lines += 1;
+            line = next;
+        }
+    }
+    int32_t width = 0;
+    for (int c = 0; c < TEXT_MAX_COLUMNS; ++c) {
+        width += widths[c] > 0 ? widths[c] + (c ? TEXT_COLUMN_GAP : 0) : 0;
+    }
+    *out_width = width;
+    *out_height = lines * TEXT_LINE_HEIGHT - 2; // the last line has no gap below it
+}
+
+typedef struct text_origin {
+    int32_t x, y, scale;
+} text_origin;
+
+// Rasterizes stb_easy_font's quads for one cell into the framebuffer.
+static void draw_cell(drift_view *view, char *cell, int32_t x, int32_t y, void *user)
+{
+    const text_origin *o = user;
+    const uint8_t ink[3] = { 235, 235, 235 };
+    int quads = stb_easy_font_print((float)x, (float)y, cell, NULL, view->text_vertices,
+                                    TEXT_VERTEX_BYTES);
+    const float *v = view->text_vertices; // 4 floats a vertex: x, y, z, colour bytes
+    const float s = (float)o->scale;
+    for (int q = 0; q < quads; ++q, v += 16) {
+        // Vertices 0 and 2 are opposite corners of the quad.
+        float qx0 = fminf(v[0], v[8]), qx1 = fmaxf(v[0], v[8]);
+        float qy0 = fminf(v[1], v[9]), qy1 = fmaxf(v[1], v[9]);
+        blend_rect(view, o->x + (int32_t)lrintf(qx0 * s), o->y + (int32_t)lrintf(qy0 * s),
+                   o->x + (int32_t)lrintf(qx1 * s), o->y + (int32_t)lrintf(qy1 * s), ink, 1.0f);
+    }
+}
+
+// Draws `text` (lines separated by '\n', table cells by '\t') at (x, y) on a dark box,
+// `scale` pixels a font unit.
 static void draw_text(drift_view *view, char *text, int32_t x, int32_t y, int32_t scale)
 {
     sanitize(text);
-    const int32_t pad = 3 * scale;
-    int32_t w = stb_easy_font_width(text) * scale, h = stb_easy_font_height(text) * scale;
-    const uint8_t dark[3] = { 0, 0, 0 }, ink[3] = { 235, 235, 235 };
-    blend_rect(view, x - pad, y - pad, x + w + pad, y + h + pad, dark, 0.7f);
-    int quads = stb_easy_font_print(0.0f, 0.0f, text, NULL, view->text_vertices,
-                                    TEXT_VERTEX_BYTES);
-    const float *v = view->text_vertices; // 4 floats a vertex: x, y, z, colour bytes
-    for (int q = 0; q < quads; ++q, v += 16) {
-        float qx0 = fminf(v[0], v[8]), qx1 = fmaxf(v[0], v[8]);
-        float qy0 = fminf(v[1], v[9]), qy1 = fmaxf(v[1], v[9]);
-        blend_rect(view, x + (int32_t)lrintf(qx0 * (float)scale),
-                   y + (int32_t)lrintf(qy0 * (float)scale), x + (int32_t)lrintf(qx1 * (float)scale),
-                   y + (int32_t)lrintf(qy1 * (float)scale), ink, 1.0f);
-    }
+    int32_t w = 0, h = 0;
+    layout_table(view, text, NULL, NULL, &w, &h);
+    const int32_t pad = 4 * scale;
+    const uint8_t dark[3] = { 0, 0, 0 };
+    blend_rect(view, x - pad, y - pad, x + w * scale + pad, y + h * scale + pad, dark, 0.7f);
+    text_origin origin = { x, y, scale };
+    layout_table(view, text, draw_cell, &origin, &w, &h);
 }
 
 // Appends printf-style text to buf (capacity OVERLAY_TEXT_MAX), truncating quietly.
@@ -678,34 +762,31 @@ static void draw_overlay(drift_view *view)
         append(text, &len, "%s", view->help_text);
     } else {
         for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
-            append(text, &len, "%-12s %s\n", drift_effect_name((drift_effect)e),
+            append(text, &len, "%s\t%s\n", drift_effect_name((drift_effect)e),
                    technique_of(&view->params, (drift_effect)e));
         }
-        append(text, &len, "%-12s %s\n", "buffer", view->buffer_name);
-        append(text, &len, "%-12s %+.1f stops\n", "exposure", (double)view->exposure_stops);
+        append(text, &len, "buffer\t%s\n", view->buffer_name);
+        append(text, &len, "exposure\t%+.1f stops\n", (double)view->exposure_stops);
         if (view->split) {
-            append(text, &len, "%-12s %u spp (right of the split)\n", "reference",
+            append(text, &len, "reference\t%u spp\n",
                    view->reference ? drift_pt_sample_count(view->reference) : 0u);
         } else {
-            append(text, &len, "%-12s off\n", "reference");
+            append(text, &len, "reference\toff\n");
         }
         drift_hybrid_stats stats = drift_hybrid_get_stats(view->hybrid);
-        append(text, &len, "%-12s %.2f ms\n", "frame", stats.frame_ms);
+        append(text, &len, "frame\t%.2f ms\n", stats.frame_ms);
         int column = 0;
         for (int p = 0; p < DRIFT_PASS_COUNT; ++p) {
             if (!(stats.ms[p] > 0.0)) {
                 continue; // the pass did not run (or was cached) this frame
             }
             const char *name = drift_hybrid_pass_name((drift_hybrid_pass)p);
-            append(text, &len, "%s%-12s %7.2f ms", column ? "   " : "", name ? name : "?",
+            append(text, &len, "%s%s\t%.2f ms", column ? "\t" : "", name ? name : "?",
                    stats.ms[p]);
             column = !column;
             if (!column) {
                 append(text, &len, "\n");
             }
-        }
-        if (view->help_text) {
-            append(text, &len, "%s(help: H)", column ? "\n" : "");
         }
     }
     while (len > 0 && text[len - 1] == '\n') {
@@ -735,6 +816,11 @@ drift_result drift_view_frame(drift_view *view, const atomic_bool *cancel)
     r = drift_hybrid_render(view->hybrid, &view->camera, cancel);
     if (r != DRIFT_OK) {
         return r;
+    }
+    view->hybrid_rendered = true; // its planes exist from now on
+    if (view->pending_buffer_steps != 0) {
+        step_buffer(view, view->pending_buffer_steps);
+        view->pending_buffer_steps = 0;
     }
     if (view->camera_moved) {
         drift_pt_destroy(view->reference);
