@@ -32,26 +32,44 @@ static void on_sigint(int sig)
 typedef struct view_options {
     const char *scene_path;
     const char *screenshot_path;
+    const char *press; // --press: view keys applied before the first frame
     long width, height, threads, spp_per_frame, spp, seed, frames;
     double exposure;
     int techniques[DRIFT_EFFECT_COUNT]; // -1: not given
     bool split, no_overlay, verbose;
 } view_options;
 
-// The key bindings, shown by the help key in the overlay (ASCII only: the overlay font).
+// The key bindings, shown by the help key in the overlay (a tab separates the columns; ASCII
+// only: the overlay's font has nothing else).
 static const char help_text[] =
-    "1 2 3 4       next shadows / reflections / dof / indirect technique\n"
-    "Tab, S-Tab    next / previous buffer (frame, then every plane)\n"
-    "Space         split view: hybrid left, reference right\n"
-    "[ ]           move the split (middle click: put it there)\n"
-    "W A S D       fly forward / left / back / right\n"
-    "Q E           down / up\n"
-    "left drag     orbit the target;  right drag: look around\n"
-    "wheel         dolly toward / away from the target\n"
-    "+ -           exposure +/- 0.5 stops\n"
-    "R             reset the camera\n"
-    "O             overlay on/off;  H: this help\n"
-    "Esc           quit";
+    "1 2 3 4\tnext shadows / reflections / dof / indirect technique\n"
+    "Tab, Shift-Tab\tnext / previous buffer: the frame, then every plane\n"
+    "Space\tsplit view: hybrid left, reference right\n"
+    "[ ]\tmove the split (middle click: put it there)\n"
+    "W A S D, arrows\tfly forward / left / back / right\n"
+    "E Q\tup / down\n"
+    "left drag\torbit about the target\n"
+    "right drag\tlook around\n"
+    "wheel\tdolly toward / away from the target\n"
+    "+ -\texposure +/- 0.5 stops\n"
+    "R, Home\treset the camera\n"
+    "O\toverlay on/off\n"
+    "H, F1\tthis help on/off\n"
+    "Esc\tquit";
+
+// The key table for a terminal: the first column padded instead of tabbed.
+static void print_keys(void)
+{
+    const char *line = help_text;
+    while (*line) {
+        const char *end = strchr(line, '\n');
+        int len = end ? (int)(end - line) : (int)strlen(line);
+        const char *tab = memchr(line, '\t', (size_t)len);
+        int key_len = tab ? (int)(tab - line) : len;
+        printf("  %-18.*s%.*s\n", key_len, line, tab ? len - key_len - 1 : 0, tab ? tab + 1 : "");
+        line = end ? end + 1 : line + len;
+    }
+}
 
 static void print_help(void)
 {
@@ -75,6 +93,8 @@ static void print_help(void)
            "  --split                  start in split view\n"
            "  --exposure STOPS         display exposure (default 0)\n"
            "  --no-overlay             start without the text overlay\n"
+           "  --press KEY,KEY,...      apply view keys before the first frame, by their names\n"
+           "                           (shadows, next-buffer, split, help, ...: docs/viewer.md)\n"
            "  --frames N               render N frames, then exit (default: until closed)\n"
            "  --screenshot FILE.png    after the last frame (--frames, default 1) save the\n"
            "                           window's contents and print on stdout one line:\n"
@@ -83,12 +103,12 @@ static void print_help(void)
            "  --verbose                more log output\n"
            "  -h, --help               this text\n"
            "\n"
-           "keys:\n%s\n"
-           "\n"
+           "keys:\n");
+    print_keys();
+    printf("\n"
            "A window needs a display: without one, run it under a virtual X server\n"
            "(xvfb-run -a drift view ...). Exit status: 0 success, 1 failure (no display, scene,\n"
-           "render), 2 usage error, 130 interrupted.\n",
-           help_text);
+           "render), 2 usage error, 130 interrupted.\n");
 }
 
 static bool parse_technique(drift_effect effect, const char *flag, const char *value, int *out)
@@ -104,6 +124,37 @@ static bool parse_technique(drift_effect effect, const char *flag, const char *v
     }
     fprintf(stderr, ", got '%s'\n", value);
     return false;
+}
+
+// Checks (view == NULL) or applies a comma-separated list of view key names.
+static bool parse_keys(const char *list, drift_view *view)
+{
+    const char *p = list;
+    while (*p) {
+        size_t len = strcspn(p, ",");
+        drift_view_key key = DRIFT_VIEW_KEY_NONE;
+        for (int k = 1; k < DRIFT_VIEW_KEY_COUNT; ++k) {
+            const char *name = drift_view_key_name((drift_view_key)k);
+            if (strlen(name) == len && strncmp(name, p, len) == 0) {
+                key = (drift_view_key)k;
+            }
+        }
+        if (key == DRIFT_VIEW_KEY_NONE) {
+            fprintf(stderr, "drift view: --press: unknown key '%.*s' (keys:", (int)len, p);
+            for (int k = 1; k < DRIFT_VIEW_KEY_COUNT; ++k) {
+                fprintf(stderr, " %s", drift_view_key_name((drift_view_key)k));
+            }
+            fprintf(stderr, ")\n");
+            return false;
+        }
+        if (view) {
+            drift_view_handle_event(view, &(drift_view_event){ .type = DRIFT_VIEW_EVENT_KEY,
+                                                               .key = key });
+        }
+        p += len;
+        p += *p == ',';
+    }
+    return true;
 }
 
 // Returns 0 on success, 2 on a usage error (message printed), -1 after --help.
@@ -144,6 +195,9 @@ static int parse_options(int argc, char **argv, view_options *o)
         } else if (strcmp(a, "--screenshot") == 0) {
             ok = VALUE() != NULL;
             o->screenshot_path = v;
+        } else if (strcmp(a, "--press") == 0) {
+            ok = VALUE() && parse_keys(v, NULL);
+            o->press = v;
         } else if (strcmp(a, "--split") == 0) {
             o->split = true;
         } else if (strcmp(a, "--no-overlay") == 0) {
@@ -490,12 +544,20 @@ int drift_cmd_view(int argc, char **argv)
     }
     // The window first: without a display there is no point in loading the scene.
     SDL_SetHint(SDL_HINT_NO_SIGNAL_HANDLERS, "1");
-    if (SDL_Init(SDL_INIT_VIDEO) != 0) {
+    bool video = SDL_Init(SDL_INIT_VIDEO) == 0;
+    // Without a display SDL may fall back to its windowless "offscreen" driver: that is no
+    // window either, unless asked for by name (SDL_VIDEODRIVER=offscreen).
+    const char *driver = video ? SDL_GetCurrentVideoDriver() : NULL;
+    const char *requested = SDL_getenv("SDL_VIDEODRIVER");
+    bool windowless = driver && (strcmp(driver, "offscreen") == 0 || strcmp(driver, "dummy") == 0);
+    if (!video || (windowless && !(requested && *requested))) {
         fprintf(stderr,
                 "drift view: cannot open a window: %s\n"
                 "drift view: is there a display (DISPLAY or WAYLAND_DISPLAY)? Without one, run\n"
                 "            it under a virtual X server: xvfb-run -a drift view ...\n",
-                SDL_GetError());
+                video ? "no display (only SDL's windowless video driver is available)"
+                      : SDL_GetError());
+        SDL_Quit();
         return 1;
     }
     signal(SIGINT, on_sigint);
@@ -554,6 +616,9 @@ int drift_cmd_view(int argc, char **argv)
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift view: %s\n", drift_result_string(r));
         goto done;
+    }
+    if (o.press) {
+        parse_keys(o.press, view);
     }
     drift_view_state s = drift_view_get_state(view);
     char title[512];
