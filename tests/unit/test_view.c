@@ -391,6 +391,7 @@ static void test_view_split_shows_the_reference_right_of_the_line(void **state)
     assert_true(drift_view_handle_event(
         r.view, &(drift_view_event){ .type = DRIFT_VIEW_EVENT_SPLIT_AT, .x = 16.0f }));
     assert_int_equal(drift_view_get_state(r.view).split_x, 16);
+    frame(&r);
     double mean0 = mean_byte(drift_view_pixels(r.view), W * H * 3);
     assert_true(key(&r, DRIFT_VIEW_KEY_EXPOSURE_UP));
     assert_near(drift_view_get_state(r.view).exposure_stops, 0.5, 1e-6);
