@@ -18,8 +18,9 @@
 //   drift_image beauty;  drift_pt_resolve(pt, DRIFT_PT_AOV_BEAUTY, &beauty);  // owned by pt
 //   drift_pt_destroy(pt);
 //
-// Ownership: scene and accel are borrowed and must outlive the pt. Images returned by
-// drift_pt_resolve belong to the pt and stay valid until the next render call or destroy.
+// Ownership: scene, accel and params.camera are borrowed and must outlive the pt. Images
+// returned by drift_pt_resolve belong to the pt and stay valid until the next render call or
+// destroy.
 // Threads: one pt is driven from one thread; it uses the context's pool internally.
 #ifndef DRIFT_PT_H
 #define DRIFT_PT_H
@@ -33,8 +34,28 @@
 extern "C" {
 #endif
 
+// Which parts of the light to accumulate (bit set of drift_pt_component); 0 = all. The parts
+// split every path by its first scattering event, so their sum is the full image:
+//   EMISSION  emitted radiance at the first hit (the environment on a miss)
+//   DIRECT    light reaching the first hit straight from an emitter through its non-delta
+//             lobes: NEE at the first vertex plus the MIS-weighted emitter hit of the
+//             first BSDF-sampled ray (when that sample was not a delta/mirror sample)
+//   SPECULAR  everything else whose first bounce is the glossy or mirror lobe (for a mirror
+//             first bounce this includes the emission it sees)
+//   DIFFUSE   everything else whose first bounce is the diffuse lobe
+// Diffuse and glossy lobes share the sampled direction of the first bounce, so the light
+// that continues the path is shared between SPECULAR and DIFFUSE per channel in the ratio
+// of the two lobes at the first vertex, f_glossy : f_diffuse (docs/reference-renderer.md).
+typedef enum drift_pt_component {
+    DRIFT_PT_COMPONENT_EMISSION = 1,
+    DRIFT_PT_COMPONENT_DIRECT = 2,
+    DRIFT_PT_COMPONENT_SPECULAR = 4,
+    DRIFT_PT_COMPONENT_DIFFUSE = 8,
+    DRIFT_PT_COMPONENT_ALL = 15
+} drift_pt_component;
+
 // How to render. The default configuration is:
-//   width, height = 0 -> the scene camera's size
+//   width, height = 0 -> the scene camera's size (also with `camera` set: its size is ignored)
 //   seed          = 0 (a valid seed)
 //   max_depth     = 0 -> 8. Depth counts scattering vertices as in pbrt: 1 = direct light only
 //                   (camera -> surface -> light). Emitters seen directly are always included.
@@ -43,6 +64,14 @@ extern "C" {
 //                   are ignored except after delta bounces); for tests and comparisons
 //   disable_nee   = false: with true, only BSDF sampling finds lights (pure path tracing)
 //   disable_rr    = false
+//   components    = 0 -> DRIFT_PT_COMPONENT_ALL: the whole image. Any other set renders only
+//                   those parts into the beauty AOV (the other AOVs do not change); paths
+//                   and their random numbers stay the same, so the parts of one seed sum to
+//                   the full image of that seed
+//   pixel_centre  = false: with true, every sample goes through its pixel's centre (no pixel
+//                   jitter), the footprint of a one-sample-per-pixel G-buffer
+//   pinhole       = false: with true, the camera's aperture is ignored (no depth of field)
+//   camera        = NULL -> scene->camera
 typedef struct drift_pt_params {
     int32_t width, height;
     uint32_t seed;
@@ -51,6 +80,12 @@ typedef struct drift_pt_params {
     bool disable_mis;
     bool disable_nee;
     bool disable_rr;
+    uint32_t components; // bit set of drift_pt_component
+    bool pixel_centre;   // every sample through the pixel centre (no pixel jitter): the same
+                         // footprint as a one-sample-per-pixel G-buffer
+    bool pinhole;        // ignore the camera's aperture
+    const drift_camera *camera; // NULL = scene->camera; else this camera (borrowed; must
+                                // outlive the pt). width/height still come from params.
 } drift_pt_params;
 
 drift_pt_params drift_pt_params_resolve(const drift_pt_params *params, const drift_scene *scene);
@@ -73,7 +108,8 @@ typedef struct drift_pt_stats {
 
 typedef struct drift_pt drift_pt;
 
-// Errors: DRIFT_ERR_INVALID_ARGUMENT (uncommitted scene, bad size), DRIFT_ERR_OUT_OF_MEMORY.
+// Errors: DRIFT_ERR_INVALID_ARGUMENT (uncommitted scene, bad size, components outside
+// DRIFT_PT_COMPONENT_ALL), DRIFT_ERR_OUT_OF_MEMORY.
 drift_result drift_pt_create(drift_context *ctx, const drift_scene *scene, const drift_accel *accel,
                              const drift_pt_params *params, drift_pt **out_pt);
 void drift_pt_destroy(drift_pt *pt); // NULL-safe
@@ -92,7 +128,8 @@ drift_pt_params drift_pt_get_params(const drift_pt *pt);
 drift_result drift_pt_resolve(drift_pt *pt, drift_pt_aov aov, drift_image *out_image);
 
 // Radiance of one camera-ray sample (pixel x, y; sample index) exactly as the renderer
-// computes it: for tests and for replaying a single sample (`drift render --debug-sample`).
+// computes it, of the selected components only: for tests and for replaying a single sample
+// (`drift render --debug-sample`).
 drift_vec3 drift_pt_trace_sample(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample);
 
 #ifdef __cplusplus

@@ -239,8 +239,14 @@ typedef struct drift_bsdf {
 } drift_bsdf;
 
 drift_bsdf drift_bsdf_make(const drift_scene *scene, const drift_surface *surface);
-// f(wo, wi) (without the cosine). Zero for mirrors (a delta lobe).
+// f(wo, wi) (without the cosine). Zero for mirrors (a delta lobe). The sum of the two lobes
+// of drift_bsdf_eval_lobes.
 drift_vec3 drift_bsdf_eval(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec3 wi);
+// The diffuse lobe kd/pi and the glossy lobe ks (n+2)/(2 pi) cos^n(alpha) of f(wo, wi) apart
+// (both zero for mirrors and below the surface): for splitting light by the lobe that
+// scattered it.
+void drift_bsdf_eval_lobes(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec3 wi,
+                           drift_vec3 *out_diffuse, drift_vec3 *out_glossy);
 // Solid-angle pdf of sampling wi given wo. Zero for mirrors.
 float drift_bsdf_pdf(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec3 wi);
 

@@ -40,11 +40,21 @@ drift_light_sample drift_hybrid_light_sample(const drift_scene *scene,
 // --- SHADING SHARED BY EVERY PASS (shading.c) ---
 
 // Unshadowed direct light U_l: outgoing radiance toward wo at the surface from light
-// `light` through the non-delta lobes, without visibility; `sample_count` stratified light
-// samples from `sampler` for area lights (delta lights are exact). Zero for mirrors.
+// `light` through the non-delta lobes, without visibility. Area lights take `sample_count`
+// points of a Hammersley set, shifted by one random offset drawn from `sampler`
+// (Cranley-Patterson rotation: stratified within a pixel, decorrelated between pixels);
+// delta lights are exact. Zero for mirrors.
 drift_vec3 drift_hybrid_unshadowed(const drift_scene *scene, const drift_hybrid_light *light,
                                    const drift_surface *surface, const drift_bsdf *bsdf,
                                    drift_vec3 wo, uint32_t sample_count, drift_sampler *sampler);
+
+// Direct light from the environment with ray-traced visibility (`sample_count` shadow rays,
+// counted in *rays). The environment has no centre, so the shadow techniques do not apply
+// to it: every technique shades it this way (docs/hybrid.md).
+drift_vec3 drift_hybrid_environment_direct(const drift_scene *scene, const drift_accel *accel,
+                                           const drift_surface *surface, const drift_bsdf *bsdf,
+                                           drift_vec3 wo, uint32_t sample_count,
+                                           drift_sampler *sampler, uint64_t *rays);
 
 // A shadow ray from the surface toward the light's centre (or against a directional
 // light's direction). Returns whether the centre is visible; distances to the nearest
@@ -94,6 +104,8 @@ typedef struct drift_shadow_map_params {
     float bias_texels; // depth bias in texel footprints at the receiver's distance
 } drift_shadow_map_params;
 
+// Adds the rays it casts to *out_rays (may be NULL). Errors: DRIFT_ERR_INVALID_ARGUMENT
+// (uncommitted scene, size outside [1, 16384], negative bias; logged), DRIFT_ERR_OUT_OF_MEMORY.
 drift_result drift_shadow_map_build(drift_context *ctx, const drift_scene *scene,
                                     const drift_accel *accel, const drift_hybrid_light *light,
                                     const drift_shadow_map_params *params,
@@ -127,6 +139,29 @@ drift_hybrid_radiance drift_envmap_lookup(const drift_envmap *map, drift_vec3 di
                                           float cone_angle);
 drift_vec3 drift_envmap_probe(const drift_envmap *map);
 
+// The capture with the radiance per texel from `radiance` instead of the scene (what
+// drift_envmap_capture wraps; tests pass a synthetic function of direction). `radiance` is
+// called from the pool's threads at once, once per texel with a ray from the probe through
+// the texel centre, and adds the rays it traced to *rays. out_rays may be NULL.
+// Errors: DRIFT_ERR_INVALID_ARGUMENT (face_size outside 1..DRIFT_ENVMAP_MAX_FACE_SIZE,
+// non-finite probe, NULL pointers; logged), DRIFT_ERR_OUT_OF_MEMORY.
+#define DRIFT_ENVMAP_MAX_FACE_SIZE 4096
+typedef drift_hybrid_radiance (*drift_envmap_radiance_fn)(void *user, drift_ray ray,
+                                                          drift_sampler *sampler, uint64_t *rays);
+drift_result drift_envmap_capture_fn(drift_context *ctx, drift_envmap_radiance_fn radiance,
+                                     void *user, drift_vec3 probe, int32_t face_size,
+                                     uint32_t seed, drift_envmap **out_map, uint64_t *out_rays);
+int32_t drift_envmap_face_size(const drift_envmap *map);   // texels across a face at level 0
+int32_t drift_envmap_level_count(const drift_envmap *map); // mip levels, down to 1x1
+
+// Cube-face addressing (OpenGL's faces and orientation; envmap.c spells them out).
+// The face a direction falls on (its major axis: 0..5 = +x -x +y -y +z -z) and its face
+// coordinates (s, t) in [0,1]^2; dir need not be unit length. -1 for a zero or non-finite dir.
+int drift_cube_face_coords(drift_vec3 dir, drift_vec2 *out_st);
+// Unit direction through the centre of texel (i, j) (column i along s, row j along t) of
+// `face` when a face has face_size x face_size texels.
+drift_vec3 drift_cube_texel_direction(int32_t face_size, int face, int32_t i, int32_t j);
+
 // --- DEPTH OF FIELD (post_dof.c) ---
 
 // Circle-of-confusion radius in pixels of a point at view depth z for the thin-lens camera
@@ -137,6 +172,10 @@ float drift_coc_radius_pixels(const drift_camera *camera, int32_t image_height, 
 // The usual post-process DOF: each pixel averages `taps` concentric-disk samples over its
 // own circle of confusion (colour leaks across depth edges, as in the usual real-time
 // gather). coc holds radii in pixels. in and out must differ; taps 0 -> 64.
+// A pixel whose CoC is under half a pixel is copied exactly. out is preallocated with the
+// size and channels of in. Errors: DRIFT_ERR_INVALID_ARGUMENT (sizes differ, out is in or coc,
+// taps over DRIFT_POST_DOF_MAX_TAPS; logged), DRIFT_ERR_OUT_OF_MEMORY.
+#define DRIFT_POST_DOF_MAX_TAPS 4096
 drift_result drift_post_dof(drift_context *ctx, const drift_image *in, const drift_image *coc,
                             uint32_t taps, drift_image *out);
 

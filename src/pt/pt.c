@@ -19,6 +19,7 @@ struct drift_pt {
     const drift_scene *scene;
     const drift_accel *accel;
     drift_pt_params params;
+    const drift_camera *camera; // params.camera or the scene's
     double *sums;     // SUM_CHANNELS a pixel
     uint32_t *counts; // samples a pixel
     thread_stats *thread_stats;
@@ -49,6 +50,9 @@ drift_pt_params drift_pt_params_resolve(const drift_pt_params *params, const dri
     if (p.rr_depth == 0) {
         p.rr_depth = 3;
     }
+    if (p.components == 0) {
+        p.components = DRIFT_PT_COMPONENT_ALL;
+    }
     return p;
 }
 
@@ -70,6 +74,11 @@ drift_result drift_pt_create(drift_context *ctx, const drift_scene *scene, const
                   p.max_depth);
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
+    if (p.components & ~(uint32_t)DRIFT_PT_COMPONENT_ALL) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, NULL, 0,
+                  "path tracer: components 0x%x outside DRIFT_PT_COMPONENT_ALL", p.components);
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
     drift_pt *pt = drift_alloc(ctx, sizeof(drift_pt));
     if (!pt) {
         return DRIFT_ERR_OUT_OF_MEMORY;
@@ -78,6 +87,7 @@ drift_result drift_pt_create(drift_context *ctx, const drift_scene *scene, const
     pt->scene = scene;
     pt->accel = accel;
     pt->params = p;
+    pt->camera = p.camera ? p.camera : &scene->camera;
     pt->thread_count = drift_context_thread_count(ctx);
     size_t pixels = (size_t)p.width * (size_t)p.height;
     pt->sums = drift_alloc(ctx, pixels * SUM_CHANNELS * sizeof(double));
@@ -104,6 +114,75 @@ void drift_pt_destroy(drift_pt *pt)
     drift_free(ctx, pt->counts);
     drift_free(ctx, pt->thread_stats);
     drift_free(ctx, pt);
+}
+
+// --- COMPONENTS ---
+
+// Where a path's contributions go when the image is split into components (pt.h): every
+// contribution is added to the path's radiance as usual and, when splitting, also to one of
+// these by the vertex it comes from. The first scattering event decides.
+typedef struct path_split {
+    bool active;                    // components select a strict subset: split
+    drift_vec3 emission;            // emitted at the first hit (the environment on a miss)
+    drift_vec3 direct;              // NEE at the first vertex + the first bounce's emitter hit
+    drift_vec3 rest;                // everything after the first bounce
+    bool first_delta;               // the first bounce was a mirror sample: rest is specular
+    drift_vec3 f_diffuse, f_glossy; // the first vertex's lobes for the first bounce (wo, wi)
+} path_split;
+
+// A contribution found at vertex `depth` (0 = the camera ray's hit), either emission seen
+// there (or the environment where the ray from vertex depth - 1 escaped) or NEE from it.
+static void split_add(path_split *s, int32_t depth, bool is_emission, drift_vec3 c)
+{
+    if (!s->active) {
+        return;
+    }
+    drift_vec3 *part = &s->rest;
+    if (depth == 0) {
+        part = is_emission ? &s->emission : &s->direct;
+    } else if (depth == 1 && is_emission && !s->first_delta) {
+        part = &s->direct;
+    }
+    *part = drift_vec3_add(*part, c);
+}
+
+// Share of a continuing path's light that goes with one lobe: f_lobe / (f_diffuse + f_glossy).
+static float lobe_share(float f_lobe, float f_sum, float if_none)
+{
+    return f_sum > 0.0f ? f_lobe / f_sum : if_none;
+}
+
+static drift_vec3 split_select(const path_split *s, uint32_t components)
+{
+    drift_vec3 out = drift_vec3_splat(0.0f);
+    if (components & DRIFT_PT_COMPONENT_EMISSION) {
+        out = drift_vec3_add(out, s->emission);
+    }
+    if (components & DRIFT_PT_COMPONENT_DIRECT) {
+        out = drift_vec3_add(out, s->direct);
+    }
+    if (s->first_delta) {
+        if (components & DRIFT_PT_COMPONENT_SPECULAR) {
+            out = drift_vec3_add(out, s->rest);
+        }
+        return out;
+    }
+    // The diffuse and glossy lobes sampled the same direction: share per channel by their
+    // values there (a channel where both are zero carries no light; it goes to diffuse).
+    drift_vec3 sum = drift_vec3_add(s->f_diffuse, s->f_glossy);
+    if (components & DRIFT_PT_COMPONENT_SPECULAR) {
+        drift_vec3 share = { lobe_share(s->f_glossy.x, sum.x, 0.0f),
+                             lobe_share(s->f_glossy.y, sum.y, 0.0f),
+                             lobe_share(s->f_glossy.z, sum.z, 0.0f) };
+        out = drift_vec3_add(out, drift_vec3_mul(s->rest, share));
+    }
+    if (components & DRIFT_PT_COMPONENT_DIFFUSE) {
+        drift_vec3 share = { lobe_share(s->f_diffuse.x, sum.x, 1.0f),
+                             lobe_share(s->f_diffuse.y, sum.y, 1.0f),
+                             lobe_share(s->f_diffuse.z, sum.z, 1.0f) };
+        out = drift_vec3_add(out, drift_vec3_mul(s->rest, share));
+    }
+    return out;
 }
 
 // --- PATH ---
@@ -169,7 +248,14 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
     drift_sampler sampler = drift_sampler_make(p->seed, pixel, sample);
     drift_vec2 film = drift_sampler_next2(&sampler);
     drift_vec2 lens = drift_sampler_next2(&sampler);
-    drift_ray ray = drift_camera_ray(&scene->camera, p->width, p->height, (float)x + film.x,
+    if (p->pixel_centre) {
+        film = drift_vec2_make(0.5f, 0.5f); // the dimensions are still drawn: same layout
+    }
+    drift_camera camera = *pt->camera;
+    if (p->pinhole) {
+        camera.aperture_radius = 0.0f;
+    }
+    drift_ray ray = drift_camera_ray(&camera, p->width, p->height, (float)x + film.x,
                                      (float)y + film.y, lens);
     *out = (path_result){ 0 };
     drift_vec3 radiance = drift_vec3_splat(0.0f);
@@ -177,6 +263,7 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
     bool prev_specular = true; // the camera ray counts as specular: see emitters directly
     float prev_bsdf_pdf = 0.0f;
     drift_vec3 prev_position = ray.origin;
+    path_split split = { .active = p->components != DRIFT_PT_COMPONENT_ALL };
     stats->camera_rays++;
 
     for (int32_t depth = 0;; ++depth) {
@@ -187,7 +274,9 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
                 float light_pdf = drift_scene_environment_pmf(scene) *
                                   drift_environment_pdf(scene, ray.dir);
                 float w = emission_weight(pt, prev_specular, prev_bsdf_pdf, light_pdf);
-                radiance = drift_vec3_add(radiance, drift_vec3_scale(drift_vec3_mul(beta, le), w));
+                drift_vec3 c = drift_vec3_scale(drift_vec3_mul(beta, le), w);
+                radiance = drift_vec3_add(radiance, c);
+                split_add(&split, depth, true, c);
                 if (depth == 0) {
                     out->albedo = le;
                 }
@@ -214,7 +303,9 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
                     drift_light_pdf_li(scene, surf.light, prev_position, ray.dir, hit.t, surf.ng);
                 w = emission_weight(pt, prev_specular, prev_bsdf_pdf, light_pdf);
             }
-            radiance = drift_vec3_add(radiance, drift_vec3_scale(drift_vec3_mul(beta, surf.emission), w));
+            drift_vec3 c = drift_vec3_scale(drift_vec3_mul(beta, surf.emission), w);
+            radiance = drift_vec3_add(radiance, c);
+            split_add(&split, depth, true, c);
         }
         if (surf.material == DRIFT_INVALID_INDEX || depth >= p->max_depth) {
             break;
@@ -223,7 +314,9 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
         drift_vec2 u_choice = drift_sampler_next2(&sampler); // x: light pick, y: lobe pick
         if (!p->disable_nee && !drift_bsdf_is_delta(&bsdf)) {
             drift_vec3 ld = sample_direct(pt, &surf, &bsdf, wo, &sampler, u_choice.x, stats);
-            radiance = drift_vec3_add(radiance, drift_vec3_mul(beta, ld));
+            drift_vec3 c = drift_vec3_mul(beta, ld);
+            radiance = drift_vec3_add(radiance, c);
+            split_add(&split, depth, false, c);
         } else {
             (void)drift_sampler_next2(&sampler); // keep the dimension layout fixed
         }
@@ -231,6 +324,12 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
         float u_rr = drift_sampler_next1(&sampler);
         if (!(bs.pdf > 0.0f) || drift_vec3_is_zero(bs.weight)) {
             break;
+        }
+        if (depth == 0 && split.active) {
+            split.first_delta = bs.is_delta;
+            if (!bs.is_delta) {
+                drift_bsdf_eval_lobes(&bsdf, wo, bs.wi, &split.f_diffuse, &split.f_glossy);
+            }
         }
         beta = drift_vec3_mul(beta, bs.weight);
         prev_specular = bs.is_delta;
@@ -251,7 +350,7 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
                            .tmax = INFINITY };
         stats->bounce_rays++;
     }
-    out->radiance = radiance;
+    out->radiance = split.active ? split_select(&split, p->components) : radiance;
 }
 
 drift_vec3 drift_pt_trace_sample(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample)

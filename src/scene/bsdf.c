@@ -39,19 +39,28 @@ static float phong_cos_alpha(const drift_bsdf *b, drift_vec3 wo, drift_vec3 wi)
     return fmaxf(0.0f, drift_vec3_dot(r, wi));
 }
 
-drift_vec3 drift_bsdf_eval(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec3 wi)
+void drift_bsdf_eval_lobes(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec3 wi,
+                           drift_vec3 *out_diffuse, drift_vec3 *out_glossy)
 {
+    *out_diffuse = drift_vec3_splat(0.0f);
+    *out_glossy = drift_vec3_splat(0.0f);
     float cos_o = drift_vec3_dot(wo, bsdf->frame.z), cos_i = drift_vec3_dot(wi, bsdf->frame.z);
     if (bsdf->type == DRIFT_MATERIAL_MIRROR || cos_o <= 0.0f || cos_i <= 0.0f) {
-        return drift_vec3_splat(0.0f);
+        return;
     }
-    drift_vec3 f = drift_vec3_scale(bsdf->diffuse, DRIFT_INV_PI);
+    *out_diffuse = drift_vec3_scale(bsdf->diffuse, DRIFT_INV_PI);
     if (!drift_vec3_is_zero(bsdf->specular)) {
         float n = bsdf->exponent;
         float lobe = (n + 2.0f) * DRIFT_INV_2PI * powf(phong_cos_alpha(bsdf, wo, wi), n);
-        f = drift_vec3_fma(f, bsdf->specular, lobe);
+        *out_glossy = drift_vec3_scale(bsdf->specular, lobe);
     }
-    return f;
+}
+
+drift_vec3 drift_bsdf_eval(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec3 wi)
+{
+    drift_vec3 diffuse, glossy;
+    drift_bsdf_eval_lobes(bsdf, wo, wi, &diffuse, &glossy);
+    return drift_vec3_add(diffuse, glossy);
 }
 
 float drift_bsdf_pdf(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec3 wi)

@@ -1,6 +1,7 @@
 // Reference path tracer against closed forms and invariants: white furnace, a plane under
 // a constant sky, irradiance from sphere and disk lights, thin lens vs pinhole, bit-identical
-// images for any thread count, and 1/sqrt(spp) convergence.
+// images for any thread count, 1/sqrt(spp) convergence, and the image split into components
+// (emission, direct, specular, diffuse) with pixel-centre, pinhole and camera overrides.
 #include "drift_test.h"
 
 #include <math.h>
@@ -20,11 +21,17 @@ typedef struct rig {
     drift_pt *pt;
 } rig;
 
-static void rig_finish(rig *r, const drift_pt_params *params)
+// Commits the scene and builds the accel; rig_finish also makes the rig's pt.
+static void rig_build(rig *r)
 {
     assert_int_equal(drift_scene_commit(r->scene), DRIFT_OK);
     assert_int_equal(drift_accel_create(r->ctx, r->scene, &(drift_accel_desc){ 0 }, &r->accel),
                      DRIFT_OK);
+}
+
+static void rig_finish(rig *r, const drift_pt_params *params)
+{
+    rig_build(r);
     assert_int_equal(drift_pt_create(r->ctx, r->scene, r->accel, params, &r->pt), DRIFT_OK);
 }
 
@@ -366,6 +373,339 @@ static void test_pt_cancel_flag_stops_and_reports(void **state)
     rig_destroy(&r);
 }
 
+// --- COMPONENTS ---
+
+// An image copied out of its pt: channels floats a pixel, rows packed.
+typedef struct plain_image {
+    int32_t width, height, channels;
+    float *v;
+} plain_image;
+
+static plain_image plain_copy(const drift_image *img)
+{
+    plain_image out = { img->width, img->height, img->channels, NULL };
+    size_t row = (size_t)img->width * (size_t)img->channels;
+    out.v = test_malloc(row * (size_t)img->height * sizeof(float));
+    for (int32_t y = 0; y < img->height; ++y) {
+        memcpy(out.v + (size_t)y * row, drift_image_pixel(img, 0, y), row * sizeof(float));
+    }
+    return out;
+}
+
+static size_t plain_size(const plain_image *img)
+{
+    return (size_t)img->width * (size_t)img->height * (size_t)img->channels;
+}
+
+static double plain_mean(const plain_image *img)
+{
+    double sum = 0.0;
+    for (size_t i = 0; i < plain_size(img); ++i) {
+        sum += (double)img->v[i];
+    }
+    return sum / (double)plain_size(img);
+}
+
+static bool plain_identical(const plain_image *a, const plain_image *b)
+{
+    return plain_size(a) == plain_size(b) && memcmp(a->v, b->v, plain_size(a) * sizeof(float)) == 0;
+}
+
+// Renders `spp` samples of a built rig's scene with `params` (a pt of its own) and copies out
+// one AOV.
+static plain_image render_aov(rig *r, const drift_pt_params *params, uint32_t spp, drift_pt_aov aov)
+{
+    drift_pt *pt = NULL;
+    assert_int_equal(drift_pt_create(r->ctx, r->scene, r->accel, params, &pt), DRIFT_OK);
+    assert_int_equal(drift_pt_render_samples(pt, spp, NULL), DRIFT_OK);
+    assert_int_equal(drift_pt_get_stats(pt).nan_samples, 0);
+    drift_image img;
+    assert_int_equal(drift_pt_resolve(pt, aov, &img), DRIFT_OK);
+    plain_image out = plain_copy(&img);
+    drift_pt_destroy(pt);
+    return out;
+}
+
+// small_box_scene (a diffuse + glossy triangle, a quad light on the ceiling) plus an emissive
+// triangle the camera sees on the back wall and, with `mirror`, a mirror on the right wall.
+static void component_scene(rig *r, bool mirror)
+{
+    small_box_scene(r, 0.0f);
+    drift_material lamp = drift_material_make(drift_vec3_splat(0.0f));
+    lamp.emission = drift_vec3_make(3.0f, 2.5f, 2.0f);
+    uint32_t l;
+    assert_int_equal(drift_scene_add_material(r->scene, &lamp, &l), DRIFT_OK);
+    const uint32_t idx[] = { 0, 1, 2 };
+    const float lp[] = { -0.7f, 0.3f, -0.98f, -0.2f, 0.3f, -0.98f, -0.45f, 0.7f, -0.98f }; // +z
+    test_add_mesh(r->scene, lp, 3, idx, 1, l);
+    if (mirror) {
+        drift_material m = drift_material_make(drift_vec3_splat(0.0f));
+        m.type = DRIFT_MATERIAL_MIRROR;
+        m.specular = drift_vec3_splat(0.9f);
+        uint32_t mi;
+        assert_int_equal(drift_scene_add_material(r->scene, &m, &mi), DRIFT_OK);
+        const float mp[] = { 0.99f, -0.6f, -0.9f, 0.99f, -0.6f, 0.2f, 0.99f, 0.6f, -0.35f }; // -x
+        test_add_mesh(r->scene, mp, 3, idx, 1, mi);
+    }
+}
+
+static const uint32_t single_components[4] = { DRIFT_PT_COMPONENT_EMISSION,
+                                               DRIFT_PT_COMPONENT_DIRECT,
+                                               DRIFT_PT_COMPONENT_SPECULAR,
+                                               DRIFT_PT_COMPONENT_DIFFUSE };
+
+// Each path's light goes to exactly one component (the continuing light shared between
+// specular and diffuse by the lobes), so the four single-component images sum to the full
+// image of the same seed. Counting a contribution twice or dropping one breaks the sum.
+static void test_pt_components_sum_to_the_full_image(void **state)
+{
+    (void)state;
+    rig r = rig_begin(2);
+    component_scene(&r, true);
+    rig_build(&r);
+    const uint32_t spp = 8;
+    for (int centre = 0; centre < 2; ++centre) {
+        drift_pt_params params = {
+            .width = 24, .height = 24, .seed = 5, .pixel_centre = centre == 1
+        };
+        plain_image full = render_aov(&r, &params, spp, DRIFT_PT_AOV_BEAUTY);
+        params.components = DRIFT_PT_COMPONENT_ALL;
+        plain_image all = render_aov(&r, &params, spp, DRIFT_PT_AOV_BEAUTY);
+        assert_true(plain_identical(&full, &all)); // 0 and ALL are the same: no split
+        plain_image parts[4];
+        for (int c = 0; c < 4; ++c) {
+            params.components = single_components[c];
+            parts[c] = render_aov(&r, &params, spp, DRIFT_PT_AOV_BEAUTY);
+            // Every component carries light in this scene: the split is not degenerate.
+            if (!(plain_mean(&parts[c]) > 1e-3 * plain_mean(&full))) {
+                fail_msg("component %u: mean %g of a full mean %g", single_components[c],
+                         plain_mean(&parts[c]), plain_mean(&full));
+            }
+        }
+        if (centre == 1) {
+            // Where every sample's first hit is the mirror (albedo exactly its 0.9), all light
+            // is specular; where it is a white diffuse wall (0.7), none is.
+            plain_image albedo = render_aov(&r, &params, 1, DRIFT_PT_AOV_ALBEDO);
+            int mirror_pixels = 0, lit_mirror_pixels = 0, wall_pixels = 0;
+            for (size_t i = 0; i < plain_size(&full); ++i) {
+                if (albedo.v[i] == 0.9f) {
+                    mirror_pixels++;
+                    lit_mirror_pixels += parts[2].v[i] > 0.0f;
+                    assert_true(parts[0].v[i] == 0.0f && parts[1].v[i] == 0.0f &&
+                                parts[3].v[i] == 0.0f);
+                } else if (albedo.v[i] == 0.7f) {
+                    wall_pixels++;
+                    assert_true(parts[2].v[i] == 0.0f);
+                }
+            }
+            assert_true(mirror_pixels > 10 && lit_mirror_pixels > 10 && wall_pixels > 10);
+            test_free(albedo.v);
+        }
+        for (size_t i = 0; i < plain_size(&full); ++i) {
+            double sum = 0.0;
+            for (int c = 0; c < 4; ++c) {
+                sum += (double)parts[c].v[i];
+            }
+            double expected = (double)full.v[i];
+            if (fabs(sum - expected) > 1e-4 * fabs(expected) + 1e-6) {
+                fail_msg("pixel centre %d, value %zu: components sum to %.7g, full image %.7g",
+                         centre, i, sum, expected);
+            }
+        }
+        for (int c = 0; c < 4; ++c) {
+            test_free(parts[c].v);
+        }
+        test_free(all.v);
+        test_free(full.v);
+    }
+    rig_destroy(&r);
+}
+
+// With max_depth 1 a path is the emission it sees plus its first vertex's direct light, so
+// DIRECT = full - EMISSION, and nothing is left for SPECULAR or DIFFUSE (no mirror here).
+// drift_pt_trace_sample returns what the components select.
+static void test_pt_direct_is_the_first_bounce_without_emission(void **state)
+{
+    (void)state;
+    rig r = rig_begin(2);
+    component_scene(&r, false);
+    rig_build(&r);
+    drift_pt_params params = { .width = 24, .height = 24, .seed = 8, .max_depth = 1 };
+    const uint32_t spp = 8;
+    plain_image full = render_aov(&r, &params, spp, DRIFT_PT_AOV_BEAUTY);
+    params.components = DRIFT_PT_COMPONENT_EMISSION;
+    plain_image emission = render_aov(&r, &params, spp, DRIFT_PT_AOV_BEAUTY);
+    params.components = DRIFT_PT_COMPONENT_DIRECT;
+    plain_image direct = render_aov(&r, &params, spp, DRIFT_PT_AOV_BEAUTY);
+    params.components = DRIFT_PT_COMPONENT_SPECULAR | DRIFT_PT_COMPONENT_DIFFUSE;
+    plain_image rest = render_aov(&r, &params, spp, DRIFT_PT_AOV_BEAUTY);
+    assert_true(plain_mean(&direct) > 0.1 * plain_mean(&full));
+    assert_true(plain_mean(&emission) > 0.0);
+    for (size_t i = 0; i < plain_size(&full); ++i) {
+        double expected = (double)full.v[i] - (double)emission.v[i];
+        if (fabs((double)direct.v[i] - expected) > 1e-4 * (double)full.v[i] + 1e-6) {
+            fail_msg("value %zu: direct %.7g, full - emission %.7g", i, (double)direct.v[i],
+                     expected);
+        }
+        assert_true(rest.v[i] == 0.0f);
+    }
+    // One sample replayed equals the one-sample image, component by component.
+    params.components = DRIFT_PT_COMPONENT_DIRECT;
+    drift_pt *pt = NULL;
+    assert_int_equal(drift_pt_create(r.ctx, r.scene, r.accel, &params, &pt), DRIFT_OK);
+    assert_int_equal(drift_pt_render_samples(pt, 1, NULL), DRIFT_OK);
+    drift_image img;
+    assert_int_equal(drift_pt_resolve(pt, DRIFT_PT_AOV_BEAUTY, &img), DRIFT_OK);
+    for (int32_t y = 0; y < 24; y += 5) {
+        for (int32_t x = 0; x < 24; x += 3) {
+            drift_vec3 v = drift_pt_trace_sample(pt, x, y, 0);
+            const float *px = drift_image_pixel(&img, x, y);
+            assert_true(v.x == px[0] && v.y == px[1] && v.z == px[2]);
+        }
+    }
+    drift_pt_destroy(pt);
+    test_free(rest.v);
+    test_free(direct.v);
+    test_free(emission.v);
+    test_free(full.v);
+    rig_destroy(&r);
+}
+
+static void test_pt_rejects_unknown_components(void **state)
+{
+    (void)state;
+    rig r = rig_begin(1);
+    component_scene(&r, false);
+    rig_build(&r);
+    drift_pt *pt = NULL;
+    assert_int_equal(
+        drift_pt_create(r.ctx, r.scene, r.accel, &(drift_pt_params){ .components = 16 }, &pt),
+        DRIFT_ERR_INVALID_ARGUMENT);
+    assert_null(pt);
+    rig_destroy(&r);
+}
+
+// Every camera ray through the pixel centre: the first-hit distance to a tilted plane is the
+// centre ray's at every pixel, for one sample and for four (no jitter averages in).
+static void test_pt_pixel_centre_samples_go_through_the_pixel_centre(void **state)
+{
+    (void)state;
+    rig r = rig_begin(2);
+    uint32_t mat;
+    assert_int_equal(
+        drift_scene_add_material(r.scene,
+                                 &(drift_material){ .diffuse = drift_vec3_splat(0.5f),
+                                                    .diffuse_texture = DRIFT_INVALID_INDEX },
+                                 &mat),
+        DRIFT_OK);
+    add_floor(r.scene, 100.0f, mat);
+    const int32_t w = 16, h = 12;
+    r.scene->camera = drift_camera_look_at(drift_vec3_make(0.3f, 3, 3), drift_vec3_make(0, 0, 0),
+                                           drift_vec3_make(0, 1, 0), 0.8f, w, h);
+    rig_build(&r);
+    const uint32_t spps[2] = { 1, 4 };
+    for (int i = 0; i < 2; ++i) {
+        plain_image depth = render_aov(
+            &r, &(drift_pt_params){ .width = w, .height = h, .max_depth = 1, .pixel_centre = true },
+            spps[i], DRIFT_PT_AOV_DEPTH);
+        for (int32_t y = 0; y < h; ++y) {
+            for (int32_t x = 0; x < w; ++x) {
+                drift_ray c = drift_camera_ray(&r.scene->camera, w, h, (float)x + 0.5f,
+                                               (float)y + 0.5f, drift_vec2_make(0.5f, 0.5f));
+                double t = -(double)c.origin.y / (double)c.dir.y; // the plane y = 0
+                double got = (double)depth.v[(size_t)y * (size_t)w + (size_t)x];
+                if (fabs(got - t) > 1e-4 * t) {
+                    fail_msg("%u spp, pixel %d,%d: depth %.6f, through the centre %.6f", spps[i], x,
+                             y, got, t);
+                }
+            }
+        }
+        test_free(depth.v);
+    }
+    // Negative control: with pixel jitter the one-sample depths leave the centre's.
+    plain_image jittered = render_aov(
+        &r, &(drift_pt_params){ .width = w, .height = h, .max_depth = 1 }, 1, DRIFT_PT_AOV_DEPTH);
+    double worst = 0.0;
+    for (int32_t y = 0; y < h; ++y) {
+        for (int32_t x = 0; x < w; ++x) {
+            drift_ray c = drift_camera_ray(&r.scene->camera, w, h, (float)x + 0.5f, (float)y + 0.5f,
+                                           drift_vec2_make(0.5f, 0.5f));
+            double t = -(double)c.origin.y / (double)c.dir.y;
+            double got = (double)jittered.v[(size_t)y * (size_t)w + (size_t)x];
+            worst = fmax(worst, fabs(got - t) / t);
+        }
+    }
+    assert_true(worst > 1e-3);
+    test_free(jittered.v);
+    rig_destroy(&r);
+}
+
+// pinhole = true on a camera with an aperture renders exactly what the zero-aperture camera
+// renders (the lens sample is still drawn, and ignored).
+static void test_pt_pinhole_flag_ignores_the_aperture(void **state)
+{
+    (void)state;
+    rig lens = rig_begin(2), pin = rig_begin(2);
+    small_box_scene(&lens, 0.05f);
+    lens.scene->camera.focus_distance = 0.6f;
+    small_box_scene(&pin, 0.0f);
+    pin.scene->camera.focus_distance = 0.6f;
+    rig_build(&lens);
+    rig_build(&pin);
+    const drift_pt_params params = { .seed = 4 };
+    plain_image expected = render_aov(&pin, &params, 4, DRIFT_PT_AOV_BEAUTY);
+    plain_image got =
+        render_aov(&lens, &(drift_pt_params){ .seed = 4, .pinhole = true }, 4, DRIFT_PT_AOV_BEAUTY);
+    plain_image blurred = render_aov(&lens, &params, 4, DRIFT_PT_AOV_BEAUTY);
+    assert_true(plain_identical(&expected, &got));
+    assert_false(plain_identical(&expected, &blurred)); // the aperture matters without the flag
+    test_free(blurred.v);
+    test_free(got.v);
+    test_free(expected.v);
+    rig_destroy(&pin);
+    rig_destroy(&lens);
+}
+
+// params.camera replaces the scene camera (its width and height are not used): the same image
+// as a scene whose camera it is.
+static void test_pt_camera_override_equals_the_scene_camera(void **state)
+{
+    (void)state;
+    drift_camera other =
+        drift_camera_look_at(drift_vec3_make(0.4f, 0.3f, 0.9f), drift_vec3_make(-0.2f, -0.5f, 0.0f),
+                             drift_vec3_make(0, 1, 0), 1.1f, 7, 5);
+    other.aperture_radius = 0.03f;
+    other.focus_distance = 1.2f;
+    rig a = rig_begin(2), b = rig_begin(2);
+    small_box_scene(&a, 0.0f);
+    small_box_scene(&b, 0.0f);
+    drift_camera own = a.scene->camera;
+    b.scene->camera = other;
+    b.scene->camera.width = 24; // the size comes from the params either way
+    b.scene->camera.height = 20;
+    rig_build(&a);
+    rig_build(&b);
+    plain_image overridden =
+        render_aov(&a, &(drift_pt_params){ .width = 24, .height = 20, .seed = 9, .camera = &other },
+                   4, DRIFT_PT_AOV_BEAUTY);
+    plain_image expected = render_aov(
+        &b, &(drift_pt_params){ .width = 24, .height = 20, .seed = 9 }, 4, DRIFT_PT_AOV_BEAUTY);
+    plain_image scene_camera =
+        render_aov(&a, &(drift_pt_params){ .width = 24, .height = 20, .seed = 9, .camera = &own },
+                   4, DRIFT_PT_AOV_BEAUTY);
+    plain_image defaulted = render_aov(
+        &a, &(drift_pt_params){ .width = 24, .height = 20, .seed = 9 }, 4, DRIFT_PT_AOV_BEAUTY);
+    assert_true(plain_identical(&overridden, &expected));
+    assert_true(plain_identical(&scene_camera, &defaulted)); // NULL is the scene camera
+    assert_false(plain_identical(&overridden, &defaulted));  // the override is used
+    test_free(defaulted.v);
+    test_free(scene_camera.v);
+    test_free(expected.v);
+    test_free(overridden.v);
+    rig_destroy(&b);
+    rig_destroy(&a);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -378,6 +718,12 @@ int main(void)
         cmocka_unit_test(test_pt_bit_identical_for_any_thread_count),
         cmocka_unit_test(test_pt_converges_as_inverse_sqrt_spp),
         cmocka_unit_test(test_pt_cancel_flag_stops_and_reports),
+        cmocka_unit_test(test_pt_components_sum_to_the_full_image),
+        cmocka_unit_test(test_pt_direct_is_the_first_bounce_without_emission),
+        cmocka_unit_test(test_pt_rejects_unknown_components),
+        cmocka_unit_test(test_pt_pixel_centre_samples_go_through_the_pixel_centre),
+        cmocka_unit_test(test_pt_pinhole_flag_ignores_the_aperture),
+        cmocka_unit_test(test_pt_camera_override_equals_the_scene_camera),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

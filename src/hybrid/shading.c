@@ -1,0 +1,197 @@
+// Shading shared by every pass of the hybrid frame: the unshadowed light U_l, the hard
+// shadow toward a light's centre, and the radiance a secondary ray sees (what the sharp
+// reflection buffer and the environment map store). It calls the same BSDF and light code
+// as the reference path tracer, so a technique's error is its own.
+#include "hybrid/hybrid_internal.h"
+
+#include <math.h>
+
+// Point k of a Hammersley set of n points in [0,1)^2 shifted by `shift` modulo 1.
+static drift_vec2 shifted_hammersley(uint32_t k, uint32_t n, drift_vec2 shift)
+{
+    uint32_t bits = k;
+    bits = (bits << 16) | (bits >> 16);
+    bits = ((bits & 0x55555555u) << 1) | ((bits & 0xAAAAAAAAu) >> 1);
+    bits = ((bits & 0x33333333u) << 2) | ((bits & 0xCCCCCCCCu) >> 2);
+    bits = ((bits & 0x0F0F0F0Fu) << 4) | ((bits & 0xF0F0F0F0u) >> 4);
+    bits = ((bits & 0x00FF00FFu) << 8) | ((bits & 0xFF00FF00u) >> 8);
+    float x = ((float)k + 0.5f) / (float)n + shift.x;
+    float y = (float)bits * 0x1p-32f + shift.y;
+    return drift_vec2_make(x - floorf(x), y - floorf(y));
+}
+
+// f * L * cos / pdf of one light sample, without visibility (the pt's NEE, minus the ray).
+static drift_vec3 light_sample_contribution(const drift_surface *surface, const drift_bsdf *bsdf,
+                                            drift_vec3 wo, const drift_light_sample *ls)
+{
+    if (!(ls->pdf > 0.0f) || drift_vec3_is_zero(ls->radiance)) {
+        return drift_vec3_splat(0.0f);
+    }
+    drift_vec3 f = drift_bsdf_eval(bsdf, wo, ls->wi);
+    float cos_i = fabsf(drift_vec3_dot(ls->wi, surface->ns));
+    return drift_vec3_scale(drift_vec3_mul(f, ls->radiance), cos_i / ls->pdf);
+}
+
+drift_vec3 drift_hybrid_unshadowed(const drift_scene *scene, const drift_hybrid_light *light,
+                                   const drift_surface *surface, const drift_bsdf *bsdf,
+                                   drift_vec3 wo, uint32_t sample_count, drift_sampler *sampler)
+{
+    drift_vec3 sum = drift_vec3_splat(0.0f);
+    if (drift_bsdf_is_delta(bsdf)) {
+        return sum;
+    }
+    if (!drift_light_is_area(light->type)) {
+        drift_light_sample ls = drift_hybrid_light_sample(scene, light, surface->position, 0.0f,
+                                                          drift_vec2_make(0.5f, 0.5f));
+        return light_sample_contribution(surface, bsdf, wo, &ls);
+    }
+    uint32_t n = sample_count > 0 ? sample_count : 1;
+    drift_vec2 shift = drift_sampler_next2(sampler);
+    float pick_shift = drift_sampler_next1(sampler);
+    for (uint32_t k = 0; k < n; ++k) {
+        drift_vec2 u = shifted_hammersley(k, n, shift);
+        // Golden-ratio sequence for the triangle pick of mesh lights.
+        float pick = (float)k * 0.618034f + pick_shift;
+        drift_light_sample ls =
+            drift_hybrid_light_sample(scene, light, surface->position, pick - floorf(pick), u);
+        sum = drift_vec3_add(sum, light_sample_contribution(surface, bsdf, wo, &ls));
+    }
+    return drift_vec3_scale(sum, 1.0f / (float)n);
+}
+
+drift_vec3 drift_hybrid_environment_direct(const drift_scene *scene, const drift_accel *accel,
+                                           const drift_surface *surface, const drift_bsdf *bsdf,
+                                           drift_vec3 wo, uint32_t sample_count,
+                                           drift_sampler *sampler, uint64_t *rays)
+{
+    drift_vec3 sum = drift_vec3_splat(0.0f);
+    if (!drift_scene_has_environment(scene) || drift_bsdf_is_delta(bsdf)) {
+        return sum;
+    }
+    uint32_t n = sample_count > 0 ? sample_count : 1;
+    drift_vec2 shift = drift_sampler_next2(sampler);
+    for (uint32_t k = 0; k < n; ++k) {
+        drift_light_sample ls = drift_environment_sample(scene, shifted_hammersley(k, n, shift));
+        drift_vec3 c = light_sample_contribution(surface, bsdf, wo, &ls);
+        if (drift_vec3_is_zero(c)) {
+            continue;
+        }
+        drift_ray shadow = { .origin = drift_offset_origin(surface->position, surface->ng, ls.wi),
+                             .dir = ls.wi,
+                             .tmin = 0.0f,
+                             .tmax = INFINITY };
+        ++*rays;
+        if (!drift_accel_occluded(accel, &shadow)) {
+            sum = drift_vec3_add(sum, c);
+        }
+    }
+    return drift_vec3_scale(sum, 1.0f / (float)n);
+}
+
+static bool hit_is_light(const drift_hybrid_light *light, const drift_hit *hit)
+{
+    return hit->light != DRIFT_INVALID_INDEX && hit->light >= light->first_light &&
+           hit->light - light->first_light < light->light_count;
+}
+
+bool drift_hybrid_hard_shadow(const drift_accel *accel, const drift_hybrid_light *light,
+                              const drift_surface *surface, float *out_occluder_distance,
+                              float *out_light_distance)
+{
+    drift_vec3 dir;
+    float distance;
+    if (light->type == DRIFT_LIGHT_DIRECTIONAL) {
+        dir = drift_vec3_neg(light->direction);
+        distance = INFINITY;
+    } else {
+        drift_vec3 d = drift_vec3_sub(light->centre, surface->position);
+        distance = drift_vec3_length(d);
+        dir = distance > 0.0f ? drift_vec3_scale(d, 1.0f / distance) : surface->ns;
+    }
+    *out_light_distance = distance;
+    *out_occluder_distance = INFINITY;
+    // Closest hit rather than any hit: the buffer needs the occluder's distance, and a ray
+    // toward the centre of a sphere light meets the light's own surface, which is no occluder.
+    drift_ray ray = { .origin = drift_offset_origin(surface->position, surface->ng, dir),
+                      .dir = dir,
+                      .tmin = 0.0f,
+                      .tmax = isfinite(distance) ? distance * (1.0f - 1e-4f) : INFINITY };
+    drift_hit hit;
+    if (!drift_accel_intersect(accel, &ray, &hit) || hit_is_light(light, &hit)) {
+        return true;
+    }
+    *out_occluder_distance = hit.t;
+    return false;
+}
+
+// Direct light at a secondary hit from every light, each with its hard shadow.
+static drift_vec3 direct_with_hard_shadows(const drift_hybrid_shading *shading,
+                                           const drift_surface *surface, const drift_bsdf *bsdf,
+                                           drift_vec3 wo, drift_sampler *sampler, uint64_t *rays)
+{
+    drift_vec3 sum = drift_vec3_splat(0.0f);
+    for (uint32_t l = 0; l < shading->light_count; ++l) {
+        const drift_hybrid_light *light = &shading->lights[l];
+        drift_vec3 u = drift_hybrid_unshadowed(shading->scene, light, surface, bsdf, wo,
+                                               shading->light_samples, sampler);
+        if (drift_vec3_is_zero(u)) {
+            continue;
+        }
+        float occluder, distance;
+        ++*rays;
+        if (drift_hybrid_hard_shadow(shading->accel, light, surface, &occluder, &distance)) {
+            sum = drift_vec3_add(sum, u);
+        }
+    }
+    drift_vec3 env = drift_hybrid_environment_direct(shading->scene, shading->accel, surface, bsdf,
+                                                     wo, shading->light_samples, sampler, rays);
+    return drift_vec3_add(sum, env);
+}
+
+drift_hybrid_radiance drift_hybrid_trace_radiance(const drift_hybrid_shading *shading,
+                                                  drift_ray ray, uint32_t skip_mesh,
+                                                  drift_sampler *sampler, uint64_t *rays,
+                                                  float *out_distance)
+{
+    const drift_scene *scene = shading->scene;
+    drift_hybrid_radiance out = { drift_vec3_splat(0.0f), drift_vec3_splat(0.0f) };
+    *out_distance = INFINITY;
+    drift_hit hit;
+    // Pass through the skipped mesh (a probe inside its own object); a few layers at most.
+    for (int layer = 0;; ++layer) {
+        ++*rays;
+        if (!drift_accel_intersect(shading->accel, &ray, &hit)) {
+            if (drift_scene_has_environment(scene)) {
+                out.emitted = drift_environment_eval(scene, ray.dir);
+            }
+            return out;
+        }
+        if (hit.mesh != skip_mesh || skip_mesh == DRIFT_INVALID_INDEX || layer == 8) {
+            break;
+        }
+        ray.tmin = hit.t * (1.0f + 1e-5f) + 1e-6f;
+    }
+    *out_distance = hit.t;
+    drift_surface surface = drift_scene_surface(scene, &ray, &hit);
+    out.emitted = surface.emission;
+    if (surface.material == DRIFT_INVALID_INDEX) {
+        return out;
+    }
+    drift_bsdf bsdf = drift_bsdf_make(scene, &surface);
+    out.reflected = direct_with_hard_shadows(shading, &surface, &bsdf, drift_vec3_neg(ray.dir),
+                                             sampler, rays);
+    return out;
+}
+
+float drift_gloss_theta_max(const drift_material *material)
+{
+    if (material->type == DRIFT_MATERIAL_MIRROR) {
+        return 0.0f;
+    }
+    if (drift_vec3_is_zero(material->specular) || !(material->exponent > 0.0f)) {
+        return 0.5f * DRIFT_PI;
+    }
+    // The Phong lobe's pdf is proportional to cos^n: the cone of half angle theta holds
+    // 1 - cos^(n+1)(theta) of it; 90% gives cos(theta) = 0.1^(1/(n+1)).
+    return acosf(powf(0.1f, 1.0f / (material->exponent + 1.0f)));
+}
