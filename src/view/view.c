@@ -154,10 +154,9 @@ static void step_buffer(drift_view *view, int32_t steps)
 
 // --- THE REFERENCE ---
 
-// The reference's parameters: the view's size and the view's camera. `camera` in
-// drift_pt_params makes the path tracer look through a camera other than the scene's; this
-// is the only place the view depends on it. reference_camera stays put while the reference
-// lives, so it does not matter whether the path tracer copies the camera or keeps the pointer.
+// The reference's parameters: the view's size and the view's camera (`camera` in
+// drift_pt_params: the path tracer looks through it instead of the scene's). The path tracer
+// borrows the camera, so reference_camera stays put while the reference lives.
 static drift_pt_params reference_params(const drift_view *view)
 {
     return (drift_pt_params){ .width = view->width,
