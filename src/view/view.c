@@ -13,7 +13,7 @@
 #include "drift/image.h"
 #include "drift/math.h"
 
-#define BUFFER_NAME_MAX 64
+#define BUFFER_NAME_MAX 128
 #define HELP_TEXT_MAX 4096
 #define OVERLAY_TEXT_MAX 2048
 // stb_easy_font writes 64 bytes a quad; one line of the overlay stays far below this.
