@@ -3,6 +3,7 @@
 // Reads like the API walk-through: load the scene, build the accel, create the path tracer,
 // add samples in passes (progress, checkpoints, Ctrl-C), resolve and write the images.
 #include "cli.h"
+#include "render.h"
 
 #include <math.h>
 #include <signal.h>
@@ -26,20 +27,12 @@ static void on_sigint(int sig)
     atomic_store(&interrupted, true);
 }
 
-typedef struct render_options {
-    const char *scene_path;
-    const char *out_path;
-    const char *stats_path;
-    const char *mode;
-    long spp, seed, threads, max_depth, width, height;
-    double checkpoint_seconds;
-    double exposure;
-    drift_tonemap_operator tonemap;
-    bool aov;
-    bool quiet;
-    bool verbose;
-    long debug_x, debug_y, debug_sample; // -1: not replaying a sample
-} render_options;
+const atomic_bool *render_catch_sigint(void)
+{
+    signal(SIGINT, on_sigint);
+    return &interrupted;
+}
+
 
 static void print_help(void)
 {
@@ -49,7 +42,8 @@ static void print_help(void)
            "built-in Cornell box. Writes a linear EXR and a tone-mapped sRGB PNG beside it.\n"
            "\n"
            "options:\n"
-           "  --mode reference      renderer (only 'reference' for now)\n"
+           "  --mode MODE           reference (path tracer, default) or hybrid (the hybrid\n"
+           "                        frame: one sample a pixel plus a technique per effect)\n"
            "  --spp N               samples per pixel (default 64)\n"
            "  --seed S              random seed (default 0); same seed, same image, any threads\n"
            "  --threads T           worker threads (default: all cores)\n"
@@ -57,13 +51,31 @@ static void print_help(void)
            "                        light only (default 8)\n"
            "  --width W, --height H image size (default: the scene camera's)\n"
            "  --out FILE.exr        output (default out/render.exr); FILE.png is written too\n"
-           "  --aov                 add albedo, normal and depth layers to the EXR\n"
+           "  --aov [FILE.exr]      reference: add albedo, normal and depth layers to the EXR;\n"
+           "                        hybrid: write every plane and buffer as layers of FILE.exr\n"
            "  --stats FILE.json     spp, rays traced and milliseconds per phase\n"
            "  --checkpoint SECONDS  write the image so far every SECONDS (default 60; 0 = never)\n"
            "  --exposure STOPS      PNG exposure (default 0)\n"
            "  --tonemap OP          PNG operator: clamp (default) or reinhard\n"
            "  --debug-sample X,Y,S  trace one sample of one pixel and print its radiance\n"
            "  --quiet               no progress output;  --verbose  more log output\n"
+           "\n"
+           "\n"
+           "hybrid mode (docs/hybrid.md):\n"
+           "  --shadows T           hard (default), pcf, pcss or reference\n"
+           "  --reflections T       none (default), envmap, sharp or reference\n"
+           "  --dof T               none (default), post or reference\n"
+           "  --indirect T          none (default), ambient or reference\n"
+           "                        reference = that effect alone path-traced at --spp\n"
+           "  --max-depth D         depth of reference reflections and indirect (default 2)\n"
+           "  --light-samples N     samples per area light for unshadowed light (default 8)\n"
+           "  --shadow-map-size N   texels a cube face (default 512); --pcf-kernel K (3)\n"
+           "  --envmap-size N       texels a cube face (default 128)\n"
+           "  --probe X,Y,Z|object  environment-map probe: a point, or one per reflective mesh\n"
+           "                        (default: the scene's centre)\n"
+           "  --ambient R,G,B       ambient radiance (default: the frame's mean direct light)\n"
+           "  --aperture R          lens radius in scene units (default: the scene camera's)\n"
+           "  --focus-distance F    distance to the plane in focus (default: the camera's)\n"
            "\n"
            "Ctrl-C stops the render and writes what it has.\n");
 }
@@ -77,7 +89,9 @@ static int parse_options(int argc, char **argv, render_options *o)
                            .checkpoint_seconds = 60.0,
                            .debug_x = -1,
                            .debug_y = -1,
-                           .debug_sample = -1 };
+                           .debug_sample = -1,
+                           .aperture = -1.0,
+                           .focus_distance = -1.0 };
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i];
         const char *v = NULL;
@@ -129,6 +143,15 @@ static int parse_options(int argc, char **argv, render_options *o)
             }
         } else if (strcmp(a, "--aov") == 0) {
             o->aov = true;
+            // An optional value: a following argument that names an .exr file.
+            const char *next = i + 1 < argc ? argv[i + 1] : NULL;
+            size_t next_len = next ? strlen(next) : 0;
+            if (next && next[0] != '-' && next_len > 4 && strcmp(next + next_len - 4, ".exr") == 0) {
+                o->aov_path = next;
+                ++i;
+            }
+        } else if (render_parse_hybrid_option(argc, argv, &i, o, &ok)) {
+            // handled: a hybrid-mode option
         } else if (strcmp(a, "--quiet") == 0) {
             o->quiet = true;
         } else if (strcmp(a, "--verbose") == 0) {
@@ -148,8 +171,18 @@ static int parse_options(int argc, char **argv, render_options *o)
             return 2;
         }
     }
-    if (strcmp(o->mode, "reference") != 0) {
-        fprintf(stderr, "drift render: --mode '%s' is not available (modes: reference)\n", o->mode);
+    if (strcmp(o->mode, "reference") != 0 && strcmp(o->mode, "hybrid") != 0) {
+        fprintf(stderr, "drift render: unknown --mode '%s' (modes: reference, hybrid)\n", o->mode);
+        return 2;
+    }
+    bool hybrid = strcmp(o->mode, "hybrid") == 0;
+    if (!hybrid && o->hybrid_option) {
+        fprintf(stderr, "drift render: %s needs --mode hybrid\n", o->hybrid_option);
+        return 2;
+    }
+    if (!hybrid && o->aov_path) {
+        fprintf(stderr, "drift render: --aov FILE needs --mode hybrid (reference mode: --aov "
+                        "adds layers to --out)\n");
         return 2;
     }
     size_t len = strlen(o->out_path);
@@ -161,7 +194,7 @@ static int parse_options(int argc, char **argv, render_options *o)
 }
 
 // FILE.exr -> FILE.png
-static void png_path_for(const char *exr_path, char *out, size_t size)
+void render_png_path(const char *exr_path, char *out, size_t size)
 {
     snprintf(out, size, "%.*s.png", (int)(strlen(exr_path) - 4), exr_path);
 }
@@ -191,7 +224,7 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
         return r;
     }
     char png[4096];
-    png_path_for(o->out_path, png, sizeof(png));
+    render_png_path(o->out_path, png, sizeof(png));
     return drift_image_save_png(
         ctx, png, &beauty,
         &(drift_tonemap_params){ .exposure_stops = (float)o->exposure, .op = o->tonemap });
@@ -262,6 +295,9 @@ int drift_cmd_render(int argc, char **argv)
     if (status != 0) {
         return status < 0 ? 0 : status;
     }
+    if (strcmp(o.mode, "hybrid") == 0) {
+        return render_hybrid(&o);
+    }
     double t_start = drift_time_now();
     drift_context *ctx = NULL;
     drift_result r = drift_context_create(
@@ -319,7 +355,7 @@ int drift_cmd_render(int argc, char **argv)
 
     // Passes grow until one takes about a second: responsive progress, checkpoints and
     // Ctrl-C, without per-pass overhead dominating small images.
-    signal(SIGINT, on_sigint);
+    render_catch_sigint();
     bool tty = isatty(STDERR_FILENO) != 0;
     uint32_t total = (uint32_t)o.spp, done_spp = 0, pass = 1;
     double t_render = drift_time_now(), last_checkpoint = t_render, last_report = 0.0;
@@ -378,7 +414,7 @@ int drift_cmd_render(int argc, char **argv)
                 (unsigned long long)stats.nan_samples);
     }
     char png[4096];
-    png_path_for(o.out_path, png, sizeof(png));
+    render_png_path(o.out_path, png, sizeof(png));
     printf("wrote %s and %s (%u spp, %dx%d) in %.2f s (render %.2f s)\n", o.out_path, png,
            drift_pt_sample_count(pt), params.width, params.height, t_written - t_start,
            t_rendered - t_render);

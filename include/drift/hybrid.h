@@ -141,11 +141,13 @@ typedef struct drift_gbuffer {
     drift_image geometric_normal; // 3: unit geometric normal, facing the camera
     drift_image albedo;           // 3: diffuse reflectance kd (textures applied)
     drift_image specular;         // 3: glossy or mirror reflectance ks
-    drift_image gloss;            // 3: theta_max (radians; 0 mirror), Phong exponent, roughness
+    drift_image gloss;            // 3: theta_max (radians; 0 mirror), Phong exponent (INFINITY
+                                  //    for a mirror), Beckmann-equivalent roughness
     drift_image material_id;      // 1: material index, -1 for a miss or a light's shape
     drift_image emission;         // 3: emitted radiance toward the camera (environment on a miss)
     drift_image motion;           // 2: pixels from here to this point in the previous frame
     drift_surface *surfaces;      // width*height, what shading needs (material invalid = none)
+    uint32_t *mesh_index;         // width*height, the mesh hit, DRIFT_INVALID_INDEX for none
 } drift_gbuffer;
 
 // --- FRAME ---

@@ -16,6 +16,7 @@
 #define DRIFT_IMAGE_H
 
 #include "drift/core.h"
+#include "drift/math.h"
 
 #include <stddef.h>
 #include <stdint.h>
@@ -50,6 +51,19 @@ static inline float *drift_image_pixel(const drift_image *image, int32_t x, int3
     return image->pixels + (ptrdiff_t)y * image->stride + (ptrdiff_t)x * image->channels;
 }
 
+// The first three channels of a pixel as a vector (images with 3 or 4 channels).
+static inline drift_vec3 drift_image_get3(const drift_image *image, int32_t x, int32_t y)
+{
+    const float *p = drift_image_pixel(image, x, y);
+    return (drift_vec3){ p[0], p[1], p[2] };
+}
+static inline void drift_image_set3(const drift_image *image, int32_t x, int32_t y, drift_vec3 v)
+{
+    float *p = drift_image_pixel(image, x, y);
+    p[0] = v.x;
+    p[1] = v.y;
+    p[2] = v.z;
+}
 static inline bool drift_image_is_valid(const drift_image *image)
 {
     return image && image->pixels && image->width > 0 && image->height > 0 &&

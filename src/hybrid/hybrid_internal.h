@@ -5,6 +5,27 @@
 
 #include "drift/hybrid.h"
 
+// --- PRIMARY VISIBILITY (gbuffer.c) ---
+
+drift_result drift_gbuffer_create(drift_context *ctx, int32_t width, int32_t height,
+                                  drift_gbuffer *out);
+void drift_gbuffer_destroy(drift_context *ctx, drift_gbuffer *gbuffer);
+
+// Fills every plane from one pinhole ray through each pixel centre of `camera` (coherent
+// packets, one tile at a time). prev_camera (NULL: none) sets the motion plane.
+void drift_gbuffer_render(drift_context *ctx, const drift_scene *scene, const drift_accel *accel,
+                          const drift_camera *camera, const drift_camera *prev_camera,
+                          drift_gbuffer *gbuffer, uint64_t *rays);
+
+// The pinhole ray through the centre of pixel (x, y): what the G-buffer traced.
+drift_ray drift_gbuffer_ray(const drift_camera *camera, int32_t width, int32_t height, int32_t x,
+                            int32_t y);
+
+// Film position (pixels, top-left origin) of world point p seen by a pinhole camera; false
+// when p is behind the camera.
+bool drift_camera_project(const drift_camera *camera, int32_t width, int32_t height, drift_vec3 p,
+                          drift_vec2 *out_film);
+
 // --- LIGHTS AS THE HYBRID FRAME SEES THEM (lights.c) ---
 
 // One light of the frame: a scene light, or every triangle light of one emissive mesh

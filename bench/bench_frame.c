@@ -1,0 +1,224 @@
+// drift bench frame: what a hybrid frame costs against its primary-visibility pass, in one
+// run. The target: hard shadows + sharp reflections + post depth of field at 640x480
+// on the Cornell box with a glossy bunny cost at most 4x the primary pass.
+#include "bench.h"
+#include "cli.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "drift/accel.h"
+#include "drift/hybrid.h"
+#include "drift/scene_io.h"
+
+typedef struct frame_options {
+    const char *scene_path;
+    long width, height, frames, threads;
+    bool json;
+} frame_options;
+
+// The configurations measured; the first is the target frame.
+typedef struct frame_config {
+    const char *name;
+    drift_hybrid_params params;
+} frame_config;
+
+static void print_help(FILE *out)
+{
+    fprintf(out,
+            "usage: drift bench frame [SCENE] [--width W] [--height H] [--frames N] [--threads T]\n"
+            "                         [--json]\n\n"
+            "Renders hybrid frames and reports the median milliseconds of the primary pass and\n"
+            "of the whole frame for several technique sets; the first, hard shadows + sharp\n"
+            "reflections + post DOF, is the one the 4x target is about.\n\n"
+            "  SCENE       default scenes/cornell-bunny/cornell_bunny.json (needs ../shared)\n"
+            "  --width, --height  default 640x480\n"
+            "  --frames N  frames per configuration after one warm-up frame (default 5)\n"
+            "  --threads T worker threads (default 1: per-thread figures)\n"
+            "  --json      one JSON object on stdout\n");
+}
+
+static int parse(int argc, char **argv, frame_options *o)
+{
+    *o = (frame_options){ .width = 640, .height = 480, .frames = 5, .threads = 1 };
+    for (int i = 1; i < argc; ++i) {
+        const char *a = argv[i], *v = NULL;
+        bool ok = true;
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            print_help(stdout);
+            return -1;
+        } else if (strcmp(a, "--json") == 0) {
+            o->json = true;
+        } else if (strcmp(a, "--width") == 0) {
+            ok = (v = cli_next_value("bench frame", argc, argv, &i)) &&
+                 cli_parse_int("bench frame", a, v, 1, DRIFT_IMAGE_MAX_DIMENSION, &o->width);
+        } else if (strcmp(a, "--height") == 0) {
+            ok = (v = cli_next_value("bench frame", argc, argv, &i)) &&
+                 cli_parse_int("bench frame", a, v, 1, DRIFT_IMAGE_MAX_DIMENSION, &o->height);
+        } else if (strcmp(a, "--frames") == 0) {
+            ok = (v = cli_next_value("bench frame", argc, argv, &i)) &&
+                 cli_parse_int("bench frame", a, v, 1, 1000, &o->frames);
+        } else if (strcmp(a, "--threads") == 0) {
+            ok = (v = cli_next_value("bench frame", argc, argv, &i)) &&
+                 cli_parse_int("bench frame", a, v, 0, 256, &o->threads);
+        } else if (a[0] == '-') {
+            fprintf(stderr, "drift bench frame: unknown option '%s'\n", a);
+            ok = false;
+        } else if (!o->scene_path) {
+            o->scene_path = a;
+        } else {
+            fprintf(stderr, "drift bench frame: more than one scene given\n");
+            ok = false;
+        }
+        if (!ok) {
+            return 2;
+        }
+    }
+    return 0;
+}
+
+static int compare_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median(double *v, long n)
+{
+    qsort(v, (size_t)n, sizeof *v, compare_double);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+typedef struct frame_result {
+    double primary_ms, frame_ms;
+    double pass_ms[DRIFT_PASS_COUNT];
+} frame_result;
+
+static drift_result measure(drift_context *ctx, const drift_scene *scene, const drift_accel *accel,
+                            const frame_options *o, const frame_config *config,
+                            frame_result *out)
+{
+    drift_hybrid_params params = config->params;
+    params.width = (int32_t)o->width;
+    params.height = (int32_t)o->height;
+    drift_hybrid *frame = NULL;
+    drift_result r = drift_hybrid_create(ctx, scene, accel, &params, &frame);
+    double *primary = calloc((size_t)o->frames, sizeof(double));
+    double *total = calloc((size_t)o->frames, sizeof(double));
+    double *passes = calloc((size_t)o->frames * DRIFT_PASS_COUNT, sizeof(double));
+    if (r == DRIFT_OK && (!primary || !total || !passes)) {
+        r = DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    // Frame 0 warms caches and builds the cached maps; frames 1..N are measured.
+    for (long k = 0; r == DRIFT_OK && k <= o->frames; ++k) {
+        r = drift_hybrid_render(frame, &scene->camera, NULL);
+        if (r != DRIFT_OK || k == 0) {
+            continue;
+        }
+        drift_hybrid_stats s = drift_hybrid_get_stats(frame);
+        primary[k - 1] = s.ms[DRIFT_PASS_PRIMARY];
+        total[k - 1] = s.frame_ms;
+        for (int p = 0; p < DRIFT_PASS_COUNT; ++p) {
+            passes[(size_t)p * (size_t)o->frames + (size_t)(k - 1)] = s.ms[p];
+        }
+    }
+    if (r == DRIFT_OK) {
+        out->primary_ms = median(primary, o->frames);
+        out->frame_ms = median(total, o->frames);
+        for (int p = 0; p < DRIFT_PASS_COUNT; ++p) {
+            out->pass_ms[p] = median(passes + (size_t)p * (size_t)o->frames, o->frames);
+        }
+    }
+    free(primary);
+    free(total);
+    free(passes);
+    drift_hybrid_destroy(frame);
+    return r;
+}
+
+int drift_bench_frame(int argc, char **argv)
+{
+    frame_options o;
+    int status = parse(argc, argv, &o);
+    if (status != 0) {
+        return status < 0 ? 0 : status;
+    }
+    static const char default_scene[] = DRIFT_SOURCE_DIR "/scenes/cornell-bunny/cornell_bunny.json";
+    const char *scene_path = o.scene_path ? o.scene_path : default_scene;
+    const frame_config configs[] = {
+        { "hard+sharp+post",
+          { .shadows = DRIFT_SHADOWS_HARD, .reflections = DRIFT_REFLECTIONS_SHARP, .dof = DRIFT_DOF_POST } },
+        { "hard", { .shadows = DRIFT_SHADOWS_HARD } },
+        { "pcf", { .shadows = DRIFT_SHADOWS_PCF } },
+        { "pcss", { .shadows = DRIFT_SHADOWS_PCSS } },
+        { "hard+envmap", { .shadows = DRIFT_SHADOWS_HARD, .reflections = DRIFT_REFLECTIONS_ENVMAP } },
+    };
+    const int config_count = (int)(sizeof configs / sizeof *configs);
+    drift_context *ctx = NULL;
+    drift_scene *scene = NULL;
+    drift_accel *accel = NULL;
+    int exit_code = 1;
+    drift_result r = drift_context_create(
+        &(drift_context_desc){ .thread_count = (int)o.threads, .logger = cli_stderr_logger(false) },
+        &ctx);
+    if (r == DRIFT_OK) {
+        r = drift_scene_load(ctx, scene_path, &scene);
+    }
+    if (r == DRIFT_OK) {
+        r = drift_accel_create(ctx, scene, &(drift_accel_desc){ 0 }, &accel);
+    }
+    if (r != DRIFT_OK) {
+        fprintf(stderr, "drift bench frame: cannot set up %s: %s\n", scene_path,
+                drift_result_string(r));
+        goto done;
+    }
+    frame_result results[sizeof configs / sizeof *configs];
+    for (int c = 0; c < config_count; ++c) {
+        r = measure(ctx, scene, accel, &o, &configs[c], &results[c]);
+        if (r != DRIFT_OK) {
+            fprintf(stderr, "drift bench frame: %s failed: %s\n", configs[c].name,
+                    drift_result_string(r));
+            goto done;
+        }
+    }
+    if (o.json) {
+        printf("{\"scene\": \"%s\", \"width\": %ld, \"height\": %ld, \"threads\": %d, "
+               "\"frames\": %ld, \"configs\": [",
+               scene_path, o.width, o.height, drift_context_thread_count(ctx), o.frames);
+        for (int c = 0; c < config_count; ++c) {
+            printf("%s{\"name\": \"%s\", \"primary_ms\": %.3f, \"frame_ms\": %.3f, \"ratio\": %.3f, "
+                   "\"passes\": {",
+                   c ? ", " : "", configs[c].name, results[c].primary_ms, results[c].frame_ms,
+                   results[c].frame_ms / results[c].primary_ms);
+            for (int p = 0; p < DRIFT_PASS_COUNT; ++p) {
+                printf("%s\"%s\": %.3f", p ? ", " : "", drift_hybrid_pass_name((drift_hybrid_pass)p),
+                       results[c].pass_ms[p]);
+            }
+            printf("}}");
+        }
+        printf("]}\n");
+    } else {
+        printf("%s, %ldx%ld, %d thread(s), median of %ld frames\n", scene_path, o.width, o.height,
+               drift_context_thread_count(ctx), o.frames);
+        printf("%-18s %12s %12s %8s\n", "techniques", "primary ms", "frame ms", "ratio");
+        for (int c = 0; c < config_count; ++c) {
+            printf("%-18s %12.2f %12.2f %7.2fx\n", configs[c].name, results[c].primary_ms,
+                   results[c].frame_ms, results[c].frame_ms / results[c].primary_ms);
+        }
+        printf("\npasses of %s (ms):", configs[0].name);
+        for (int p = 0; p < DRIFT_PASS_COUNT; ++p) {
+            if (results[0].pass_ms[p] > 0.0) {
+                printf(" %s %.2f", drift_hybrid_pass_name((drift_hybrid_pass)p), results[0].pass_ms[p]);
+            }
+        }
+        printf("\ntarget: %s frame <= 4x primary: %s\n", configs[0].name,
+               results[0].frame_ms <= 4.0 * results[0].primary_ms ? "met" : "NOT met");
+    }
+    exit_code = 0;
+done:
+    drift_accel_destroy(accel);
+    drift_scene_destroy(scene);
+    drift_context_destroy(ctx);
+    return exit_code;
+}

@@ -1,0 +1,137 @@
+// Direct light of the hybrid frame: D = sum_l U_l * S_l + environment. U_l is the unshadowed
+// light (shading.c); S_l the shadow term of the chosen technique: the hard-shadow buffer, or
+// a shadow map filtered by PCF or PCSS. The reference technique leaves D to reference.c.
+#include "hybrid/frame_internal.h"
+
+#include <math.h>
+
+// Sampler streams, so that passes draw independent numbers for the same pixel.
+enum { STREAM_UNSHADOWED = 1, STREAM_PCSS = 2 };
+
+static size_t pixel_index(const drift_hybrid *f, int32_t x, int32_t y)
+{
+    return (size_t)y * (size_t)f->params.width + (size_t)x;
+}
+
+static void unshadowed_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays, void *user)
+{
+    (void)user;
+    const drift_surface *s = &f->gbuffer.surfaces[pixel_index(f, x, y)];
+    drift_vec3 zero = drift_vec3_splat(0.0f);
+    if (s->material == DRIFT_INVALID_INDEX) {
+        for (uint32_t l = 0; l < f->light_count; ++l) {
+            drift_image_set3(&f->light_buffers[l].unshadowed, x, y, zero);
+        }
+        drift_image_set3(&f->environment_direct, x, y, zero);
+        return;
+    }
+    drift_bsdf bsdf = drift_bsdf_make(f->scene, s);
+    drift_vec3 wo = drift_hybrid_wo(f, x, y);
+    drift_sampler sampler = drift_hybrid_sampler(f, STREAM_UNSHADOWED, x, y);
+    for (uint32_t l = 0; l < f->light_count; ++l) {
+        drift_vec3 u = drift_hybrid_unshadowed(f->scene, &f->lights[l], s, &bsdf, wo,
+                                               f->params.light_samples, &sampler);
+        drift_image_set3(&f->light_buffers[l].unshadowed, x, y, u);
+    }
+    drift_image_set3(&f->environment_direct, x, y,
+           drift_hybrid_environment_direct(f->scene, f->accel, s, &bsdf, wo,
+                                           f->params.light_samples, &sampler, rays));
+}
+
+static void hard_shadow_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays, void *user)
+{
+    (void)user;
+    const drift_surface *s = &f->gbuffer.surfaces[pixel_index(f, x, y)];
+    for (uint32_t l = 0; l < f->light_count; ++l) {
+        drift_hybrid_light_buffers *b = &f->light_buffers[l];
+        float *out = drift_image_pixel(&b->hard_shadow, x, y);
+        if (s->material == DRIFT_INVALID_INDEX) {
+            out[0] = 0.0f;
+            out[1] = out[2] = INFINITY;
+        } else {
+            ++*rays;
+            out[0] = drift_hybrid_hard_shadow(f->accel, &f->lights[l], s, &out[1], &out[2]) ? 1.0f
+                                                                                            : 0.0f;
+        }
+        drift_image_pixel(&b->shadow, x, y)[0] = out[0];
+    }
+}
+
+static void shadow_filter_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays, void *user)
+{
+    (void)rays;
+    (void)user;
+    const drift_surface *s = &f->gbuffer.surfaces[pixel_index(f, x, y)];
+    uint32_t hash = drift_hash_combine(f->params.seed ^ STREAM_PCSS, (uint32_t)pixel_index(f, x, y));
+    for (uint32_t l = 0; l < f->light_count; ++l) {
+        const drift_shadow_map *map = f->light_buffers[l].shadow_map;
+        float v = 0.0f;
+        if (s->material != DRIFT_INVALID_INDEX) {
+            v = f->params.shadows == DRIFT_SHADOWS_PCSS
+                    ? drift_shadow_map_pcss(map, s->position, s->ng, drift_hash_u32(hash + l))
+                    : drift_shadow_map_pcf(map, s->position, s->ng, f->params.pcf_kernel);
+        }
+        drift_image_pixel(&f->light_buffers[l].shadow, x, y)[0] = v;
+    }
+}
+
+static void sum_direct_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays, void *user)
+{
+    (void)rays;
+    (void)user;
+    drift_vec3 d = drift_image_get3(&f->environment_direct, x, y);
+    for (uint32_t l = 0; l < f->light_count; ++l) {
+        const drift_hybrid_light_buffers *b = &f->light_buffers[l];
+        d = drift_vec3_fma(d, drift_image_get3(&b->unshadowed, x, y), drift_image_pixel(&b->shadow, x, y)[0]);
+    }
+    drift_image_set3(&f->direct, x, y, d);
+}
+
+static drift_result build_shadow_maps(drift_hybrid *f)
+{
+    drift_shadow_map_params params = { .size = f->params.shadow_map_size,
+                                       .bias_texels = f->params.shadow_bias };
+    for (uint32_t l = 0; l < f->light_count; ++l) {
+        if (f->light_buffers[l].shadow_map) {
+            continue; // cached: the scene has not changed
+        }
+        drift_result r = drift_shadow_map_build(f->ctx, f->scene, f->accel, &f->lights[l], &params,
+                                                &f->light_buffers[l].shadow_map,
+                                                &f->stats.rays[DRIFT_PASS_SHADOW_MAPS]);
+        if (r != DRIFT_OK) {
+            return r;
+        }
+    }
+    return DRIFT_OK;
+}
+
+drift_result drift_hybrid_pass_direct(drift_hybrid *f)
+{
+    drift_hybrid_stats *st = &f->stats;
+    if (f->params.shadows == DRIFT_SHADOWS_REFERENCE) {
+        return DRIFT_OK; // reference.c fills `direct`
+    }
+    double t = drift_time_now();
+    st->rays[DRIFT_PASS_UNSHADOWED] += drift_hybrid_for_each_pixel(f, unshadowed_pixel, NULL);
+    st->ms[DRIFT_PASS_UNSHADOWED] = 1000.0 * (drift_time_now() - t);
+
+    t = drift_time_now();
+    if (f->params.shadows == DRIFT_SHADOWS_HARD) {
+        st->rays[DRIFT_PASS_HARD_SHADOWS] += drift_hybrid_for_each_pixel(f, hard_shadow_pixel, NULL);
+        st->ms[DRIFT_PASS_HARD_SHADOWS] = 1000.0 * (drift_time_now() - t);
+    } else {
+        drift_result r = build_shadow_maps(f);
+        st->ms[DRIFT_PASS_SHADOW_MAPS] = 1000.0 * (drift_time_now() - t);
+        if (r != DRIFT_OK) {
+            return r;
+        }
+        t = drift_time_now();
+        drift_hybrid_for_each_pixel(f, shadow_filter_pixel, NULL);
+        st->ms[DRIFT_PASS_SHADOW_FILTER] = 1000.0 * (drift_time_now() - t);
+    }
+    // Summing is part of composition.
+    t = drift_time_now();
+    drift_hybrid_for_each_pixel(f, sum_direct_pixel, NULL);
+    st->ms[DRIFT_PASS_COMPOSE] += 1000.0 * (drift_time_now() - t);
+    return DRIFT_OK;
+}

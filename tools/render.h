@@ -1,0 +1,45 @@
+// drift render: options shared by the reference and the hybrid mode.
+#ifndef DRIFT_TOOLS_RENDER_H
+#define DRIFT_TOOLS_RENDER_H
+
+#include <stdatomic.h>
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "drift/hybrid.h"
+#include "drift/image.h"
+
+typedef struct render_options {
+    const char *scene_path;
+    const char *out_path;
+    const char *stats_path;
+    const char *aov_path; // hybrid: every plane as layers of this EXR
+    const char *mode;
+    long spp, seed, threads, max_depth, width, height;
+    double checkpoint_seconds;
+    double exposure;
+    drift_tonemap_operator tonemap;
+    bool aov;
+    bool quiet;
+    bool verbose;
+    long debug_x, debug_y, debug_sample; // -1: not replaying a sample
+    // hybrid mode
+    const char *hybrid_option; // the first hybrid-only option seen (for the error message)
+    drift_hybrid_params hybrid;
+    double aperture, focus_distance; // < 0: the scene camera's
+} render_options;
+
+// Parses argv[*i] when it is a hybrid-mode option (advancing *i past its value); returns
+// false when it is not one. *ok becomes false on a malformed value (message printed).
+bool render_parse_hybrid_option(int argc, char **argv, int *i, render_options *o, bool *ok);
+
+// Renders in hybrid mode; returns the process exit code.
+int render_hybrid(const render_options *o);
+
+// FILE.exr -> FILE.png
+void render_png_path(const char *exr_path, char *out, size_t size);
+
+// Installs the Ctrl-C handler; the flag it returns becomes true on SIGINT.
+const atomic_bool *render_catch_sigint(void);
+
+#endif
