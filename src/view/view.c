@@ -497,7 +497,7 @@ typedef enum buffer_look {
     LOOK_RADIANCE = 0, // tone-mapped with the exposure (frame, radiance and colour planes)
     LOOK_UNIT,         // 1 channel in [0,1]: grey as is (visibility, masks)
     LOOK_RANGE,        // 1 channel: (v - min) / (max - min), grey (ids, distances)
-    LOOK_DEPTH,        // v / max, grey; misses (0) stay black
+    LOOK_DEPTH,        // grey from 0.1 at the nearest hit to 1 at the farthest; misses (0) black
     LOOK_NORMAL,       // 0.5 + 0.5 n; black where there is no normal (a miss)
     LOOK_POSITION,     // normalized to the scene's bounds
     LOOK_MOTION,       // 2 channels: 0.5 + 0.5 m / max|m| as red and green
@@ -507,14 +507,15 @@ typedef struct buffer_range {
     float lo, hi;
 } buffer_range;
 
-static buffer_range image_range(const drift_image *image, bool absolute)
+// The finite range of the values (absolute: of |v|; positive: of the values above 0 only).
+static buffer_range image_range(const drift_image *image, bool absolute, bool positive)
 {
     buffer_range range = { INFINITY, -INFINITY };
     for (int32_t y = 0; y < image->height; ++y) {
         const float *p = drift_image_pixel(image, 0, y);
         for (int32_t i = 0; i < image->width * image->channels; ++i) {
             float v = absolute ? fabsf(p[i]) : p[i];
-            if (isfinite(v)) {
+            if (isfinite(v) && (!positive || v > 0.0f)) {
                 range.lo = fminf(range.lo, v);
                 range.hi = fmaxf(range.hi, v);
             }
@@ -529,14 +530,15 @@ static buffer_range image_range(const drift_image *image, bool absolute)
 static buffer_look look_of(const char *name, const drift_image *image, buffer_range *range)
 {
     if (image->channels == 2) {
-        *range = image_range(image, true);
+        *range = image_range(image, true, false);
         return LOOK_MOTION;
     }
     if (image->channels == 1) {
-        *range = image_range(image, false);
         if (strstr(name, "depth")) {
+            *range = image_range(image, false, true);
             return LOOK_DEPTH;
         }
+        *range = image_range(image, false, false);
         return range->lo >= 0.0f && range->hi <= 1.0f ? LOOK_UNIT : LOOK_RANGE;
     }
     if (strstr(name, "normal")) {
@@ -572,7 +574,10 @@ static void show_row(drift_view *view, const drift_image *image, buffer_look loo
                                                      : 0.5f;
             break;
         case LOOK_DEPTH:
-            v[0] = v[1] = v[2] = range.hi > 0.0f ? p[0] / range.hi : 0.0f;
+            v[0] = v[1] = v[2] = !(p[0] > 0.0f)         ? 0.0f
+                                 : range.hi > range.lo ? 0.1f + 0.9f * (p[0] - range.lo) /
+                                                                    (range.hi - range.lo)
+                                                       : 1.0f;
             break;
         case LOOK_NORMAL:
             // A miss has no normal (zero): black rather than the grey of 0.5 + 0.5 * 0.
@@ -767,10 +772,10 @@ static void draw_overlay(drift_view *view)
         append(text, &len, "buffer\t%s\n", view->buffer_name);
         append(text, &len, "exposure\t%+.1f stops\n", (double)view->exposure_stops);
         if (view->split) {
-            append(text, &len, "reference\t%u spp\n",
+            append(text, &len, "pt reference\t%u spp\n",
                    view->reference ? drift_pt_sample_count(view->reference) : 0u);
         } else {
-            append(text, &len, "reference\toff\n");
+            append(text, &len, "pt reference\toff\n");
         }
         drift_hybrid_stats stats = drift_hybrid_get_stats(view->hybrid);
         append(text, &len, "frame\t%.2f ms\n", stats.frame_ms);
