@@ -11,14 +11,14 @@
 #include <string.h>
 
 #define SDL_MAIN_HANDLED
-#include <SDL.h>
-
 #include "drift/accel.h"
 #include "drift/hybrid.h"
 #include "drift/image.h"
 #include "drift/image_io.h"
 #include "drift/scene_io.h"
 #include "drift/view.h"
+
+#include <SDL.h>
 
 // Set from the SIGINT handler; frames poll it (reference passes stop early).
 static atomic_bool interrupted;
@@ -73,37 +73,38 @@ static void print_keys(void)
 
 static void print_help(void)
 {
-    printf("usage: drift view [SCENE] [options]\n"
-           "\n"
-           "Opens a window on SCENE (default: the built-in Cornell box) rendered by the hybrid\n"
-           "frame renderer, with a camera you move, a technique per effect you switch, every\n"
-           "buffer of the frame, a split view against the progressive reference path tracer\n"
-           "and the milliseconds of each pass on screen.\n"
-           "\n"
-           "options:\n"
-           "  --width W, --height H    window and image size (default: the scene camera's)\n"
-           "  --threads T              worker threads (default: all cores)\n"
-           "  --shadows NAME           hard, pcf, pcss, reference (default hard)\n"
-           "  --reflections NAME       none, envmap, sharp, reference (default none)\n"
-           "  --dof NAME               none, post, reference (default none)\n"
-           "  --indirect NAME          none, ambient, reference (default none)\n"
-           "  --spp N                  samples a pixel for `reference` techniques (default 4)\n"
-           "  --spp-per-frame N        reference samples added per frame in split view (default 1)\n"
-           "  --seed S                 the reference's seed (default 0)\n"
-           "  --split                  start in split view\n"
-           "  --exposure STOPS         display exposure (default 0)\n"
-           "  --no-overlay             start without the text overlay\n"
-           "  --press KEY,KEY,...      apply view keys before the first frame, by their names\n"
-           "                           (shadows, next-buffer, split, help, ...: docs/viewer.md)\n"
-           "  --frames N               render N frames, then exit (default: until closed)\n"
-           "  --screenshot FILE.png    after the last frame (--frames, default 1) save the\n"
-           "                           window's contents and print on stdout one line:\n"
-           "                           'wrote FILE (WxH, N frames, SOURCE): mean M, C colours'\n"
-           "                           (M the mean 8-bit value / 255, C the distinct RGB colours)\n"
-           "  --verbose                more log output\n"
-           "  -h, --help               this text\n"
-           "\n"
-           "keys:\n");
+    printf(
+        "usage: drift view [SCENE] [options]\n"
+        "\n"
+        "Opens a window on SCENE (default: the built-in Cornell box) rendered by the hybrid\n"
+        "frame renderer, with a camera you move, a technique per effect you switch, every\n"
+        "buffer of the frame, a split view against the progressive reference path tracer\n"
+        "and the milliseconds of each pass on screen.\n"
+        "\n"
+        "options:\n"
+        "  --width W, --height H    window and image size (default: the scene camera's)\n"
+        "  --threads T              worker threads (default: all cores)\n"
+        "  --shadows NAME           hard, pcf, pcss, reference (default hard)\n"
+        "  --reflections NAME       none, envmap, sharp, reference (default none)\n"
+        "  --dof NAME               none, post, reference (default none)\n"
+        "  --indirect NAME          none, ambient, reference (default none)\n"
+        "  --spp N                  samples a pixel for `reference` techniques (default 4)\n"
+        "  --spp-per-frame N        reference samples added per frame in split view (default 1)\n"
+        "  --seed S                 the reference's seed (default 0)\n"
+        "  --split                  start in split view\n"
+        "  --exposure STOPS         display exposure (default 0)\n"
+        "  --no-overlay             start without the text overlay\n"
+        "  --press KEY,KEY,...      apply view keys before the first frame, by their names\n"
+        "                           (shadows, next-buffer, split, help, ...: docs/viewer.md)\n"
+        "  --frames N               render N frames, then exit (default: until closed)\n"
+        "  --screenshot FILE.png    after the last frame (--frames, default 1) save the\n"
+        "                           window's contents and print on stdout one line:\n"
+        "                           'wrote FILE (WxH, N frames, SOURCE): mean M, C colours'\n"
+        "                           (M the mean 8-bit value / 255, C the distinct RGB colours)\n"
+        "  --verbose                more log output\n"
+        "  -h, --help               this text\n"
+        "\n"
+        "keys:\n");
     print_keys();
     printf("\n"
            "A window needs a display: without one, run it under a virtual X server\n"
@@ -148,8 +149,8 @@ static bool parse_keys(const char *list, drift_view *view)
             return false;
         }
         if (view) {
-            drift_view_handle_event(view, &(drift_view_event){ .type = DRIFT_VIEW_EVENT_KEY,
-                                                               .key = key });
+            drift_view_handle_event(
+                view, &(drift_view_event){ .type = DRIFT_VIEW_EVENT_KEY, .key = key });
         }
         p += len;
         p += *p == ',';
@@ -210,8 +211,8 @@ static int parse_options(int argc, char **argv, view_options *o)
         } else if (!o->scene_path) {
             o->scene_path = a;
         } else {
-            fprintf(stderr, "drift view: more than one scene given ('%s', '%s')\n",
-                    o->scene_path, a);
+            fprintf(stderr, "drift view: more than one scene given ('%s', '%s')\n", o->scene_path,
+                    a);
             ok = false;
         }
 #undef VALUE
@@ -341,10 +342,10 @@ static bool handle_sdl_event(drift_view *view, const SDL_Event *e, bool *quit)
         ev = (drift_view_event){ .type = DRIFT_VIEW_EVENT_SPLIT_AT, .x = (float)e->button.x };
         break;
     case SDL_MOUSEWHEEL:
-        ev = (drift_view_event){ .type = DRIFT_VIEW_EVENT_DOLLY,
-                                 .dy = (float)(e->wheel.direction == SDL_MOUSEWHEEL_FLIPPED
-                                                   ? -e->wheel.y
-                                                   : e->wheel.y) };
+        ev = (drift_view_event){
+            .type = DRIFT_VIEW_EVENT_DOLLY,
+            .dy = (float)(e->wheel.direction == SDL_MOUSEWHEEL_FLIPPED ? -e->wheel.y : e->wheel.y)
+        };
         break;
     case SDL_WINDOWEVENT:
         // Exposed or restored: present again, nothing to re-render.
@@ -381,7 +382,8 @@ static void window_destroy(window *w)
 static bool window_draw(window *w, const uint8_t *pixels, int width)
 {
     if (SDL_UpdateTexture(w->texture, NULL, pixels, width * 3) != 0 ||
-        SDL_RenderClear(w->renderer) != 0 || SDL_RenderCopy(w->renderer, w->texture, NULL, NULL) != 0) {
+        SDL_RenderClear(w->renderer) != 0 ||
+        SDL_RenderCopy(w->renderer, w->texture, NULL, NULL) != 0) {
         fprintf(stderr, "drift view: cannot draw the frame: %s\n", SDL_GetError());
         return false;
     }
@@ -444,10 +446,10 @@ static int take_screenshot(drift_context *ctx, window *w, const drift_view *view
     if (SDL_GetRendererOutputSize(w->renderer, &width, &height) == 0 && width > 0 && height > 0) {
         pixels = malloc((size_t)width * (size_t)height * 3u);
     }
-    if (pixels && SDL_RenderReadPixels(w->renderer, NULL, SDL_PIXELFORMAT_RGB24, pixels,
-                                       width * 3) == 0) {
-        int status = save_screenshot(ctx, o->screenshot_path, pixels, width, height, o->frames,
-                                     "window");
+    if (pixels &&
+        SDL_RenderReadPixels(w->renderer, NULL, SDL_PIXELFORMAT_RGB24, pixels, width * 3) == 0) {
+        int status =
+            save_screenshot(ctx, o->screenshot_path, pixels, width, height, o->frames, "window");
         free(pixels);
         return status;
     }
@@ -568,10 +570,10 @@ int drift_cmd_view(int argc, char **argv)
     drift_view *view = NULL;
     window w = { 0 };
     int exit_code = 1;
-    drift_result r = drift_context_create(
-        &(drift_context_desc){ .thread_count = (int)o.threads,
-                               .logger = cli_stderr_logger(o.verbose) },
-        &ctx);
+    drift_result r =
+        drift_context_create(&(drift_context_desc){ .thread_count = (int)o.threads,
+                                                    .logger = cli_stderr_logger(o.verbose) },
+                             &ctx);
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift view: %s\n", drift_result_string(r));
         goto done;

@@ -12,7 +12,8 @@
 //
 // STEP BY STEP
 //   drift_view *view = NULL;
-//   drift_view_create(ctx, scene, accel, &(drift_view_desc){ .hybrid.shadows = DRIFT_SHADOWS_PCSS },
+//   drift_view_create(ctx, scene, accel, &(drift_view_desc){ .hybrid.shadows = DRIFT_SHADOWS_PCSS
+//   },
 //                     &view);
 //   drift_view_handle_event(view, &(drift_view_event){ .type = DRIFT_VIEW_EVENT_KEY,
 //                                                      .key = DRIFT_VIEW_KEY_SPLIT });
@@ -39,20 +40,20 @@ extern "C" {
 // Keys the view understands (the window maps physical keys to these; docs/viewer.md).
 typedef enum drift_view_key {
     DRIFT_VIEW_KEY_NONE = 0,
-    DRIFT_VIEW_KEY_SHADOWS,       // next shadow technique (wraps around)
-    DRIFT_VIEW_KEY_REFLECTIONS,   // next reflection technique
-    DRIFT_VIEW_KEY_DOF,           // next depth-of-field technique
-    DRIFT_VIEW_KEY_INDIRECT,      // next indirect-light technique
-    DRIFT_VIEW_KEY_NEXT_BUFFER,   // show the next buffer: the frame, then every plane
+    DRIFT_VIEW_KEY_SHADOWS,     // next shadow technique (wraps around)
+    DRIFT_VIEW_KEY_REFLECTIONS, // next reflection technique
+    DRIFT_VIEW_KEY_DOF,         // next depth-of-field technique
+    DRIFT_VIEW_KEY_INDIRECT,    // next indirect-light technique
+    DRIFT_VIEW_KEY_NEXT_BUFFER, // show the next buffer: the frame, then every plane
     DRIFT_VIEW_KEY_PREV_BUFFER,
-    DRIFT_VIEW_KEY_SPLIT,         // split view on/off
-    DRIFT_VIEW_KEY_SPLIT_LEFT,    // move the split line by 1/16 of the width
+    DRIFT_VIEW_KEY_SPLIT,      // split view on/off
+    DRIFT_VIEW_KEY_SPLIT_LEFT, // move the split line by 1/16 of the width
     DRIFT_VIEW_KEY_SPLIT_RIGHT,
-    DRIFT_VIEW_KEY_FORWARD,       // fly: move camera and target together
+    DRIFT_VIEW_KEY_FORWARD, // fly: move camera and target together
     DRIFT_VIEW_KEY_BACK,
     DRIFT_VIEW_KEY_LEFT,
     DRIFT_VIEW_KEY_RIGHT,
-    DRIFT_VIEW_KEY_UP,            // along the camera's up vector
+    DRIFT_VIEW_KEY_UP, // along the camera's up vector
     DRIFT_VIEW_KEY_DOWN,
     DRIFT_VIEW_KEY_EXPOSURE_UP,   // +0.5 stops
     DRIFT_VIEW_KEY_EXPOSURE_DOWN, // -0.5 stops
@@ -63,10 +64,10 @@ typedef enum drift_view_key {
 } drift_view_key;
 
 typedef enum drift_view_event_type {
-    DRIFT_VIEW_EVENT_KEY = 0, // key pressed (or auto-repeated)
-    DRIFT_VIEW_EVENT_ORBIT,   // drag by (dx, dy) pixels: orbit the camera about its target
-    DRIFT_VIEW_EVENT_LOOK,    // drag by (dx, dy) pixels: turn the camera about its position
-    DRIFT_VIEW_EVENT_DOLLY,   // wheel by dy notches: toward the target (dy > 0) or away
+    DRIFT_VIEW_EVENT_KEY = 0,  // key pressed (or auto-repeated)
+    DRIFT_VIEW_EVENT_ORBIT,    // drag by (dx, dy) pixels: orbit the camera about its target
+    DRIFT_VIEW_EVENT_LOOK,     // drag by (dx, dy) pixels: turn the camera about its position
+    DRIFT_VIEW_EVENT_DOLLY,    // wheel by dy notches: toward the target (dy > 0) or away
     DRIFT_VIEW_EVENT_SPLIT_AT, // put the split line at column x (and turn the split on)
     DRIFT_VIEW_EVENT_COUNT
 } drift_view_event_type;
@@ -104,16 +105,16 @@ typedef struct drift_view_desc {
 // What the view shows now.
 typedef struct drift_view_state {
     int32_t width, height;
-    drift_camera camera;         // the camera both renderers use
-    drift_hybrid_params params;  // the hybrid frame's parameters (techniques)
-    uint32_t buffer;             // 0: the composed frame; i > 0: drift_hybrid_plane(i - 1)
-    const char *buffer_name;     // "frame" or the plane's name; valid until the next frame
+    drift_camera camera;        // the camera both renderers use
+    drift_hybrid_params params; // the hybrid frame's parameters (techniques)
+    uint32_t buffer;            // 0: the composed frame; i > 0: drift_hybrid_plane(i - 1)
+    const char *buffer_name;    // "frame" or the plane's name; valid until the next frame
     bool split;
-    int32_t split_x;             // first column of the reference when split (0..width)
+    int32_t split_x; // first column of the reference when split (0..width)
     float exposure_stops;
     bool overlay, help;
-    uint32_t reference_spp;      // samples a pixel in the reference so far
-    uint64_t frame_count;        // drift_view_frame calls that succeeded
+    uint32_t reference_spp; // samples a pixel in the reference so far
+    uint64_t frame_count;   // drift_view_frame calls that succeeded
 } drift_view_state;
 
 typedef struct drift_view drift_view;

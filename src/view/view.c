@@ -3,27 +3,26 @@
 // code here (tools/cmd_view.c is the window); see include/drift/view.h and docs/viewer.md.
 #include "drift/view.h"
 
+#include "drift/image.h"
+#include "drift/math.h"
+
 #include <math.h>
+#include <stb/stb_easy_font.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
 
-#include <stb/stb_easy_font.h>
-
-#include "drift/image.h"
-#include "drift/math.h"
-
-#define BUFFER_NAME_MAX 128
-#define HELP_TEXT_MAX 4096
+#define BUFFER_NAME_MAX  128
+#define HELP_TEXT_MAX    4096
 #define OVERLAY_TEXT_MAX 2048
 // stb_easy_font writes 64 bytes a quad; one line of the overlay stays far below this.
 #define TEXT_VERTEX_BYTES (64 * 4096)
 
 #define ORBIT_RADIANS_PER_PIXEL 0.005f
-#define MOVE_FRACTION 0.02f   // of the scene's bounding-box diagonal, per key press
-#define DOLLY_FACTOR 0.9f     // distance to the target times this per wheel notch
-#define EXPOSURE_STEP 0.5f
-#define SPLIT_STEP (1.0f / 16.0f)
+#define MOVE_FRACTION           0.02f // of the scene's bounding-box diagonal, per key press
+#define DOLLY_FACTOR            0.9f  // distance to the target times this per wheel notch
+#define EXPOSURE_STEP           0.5f
+#define SPLIT_STEP              (1.0f / 16.0f)
 // How close (|cos|) the view direction may come to the up vector before pitching stops.
 #define MAX_COS_TO_UP 0.995f
 
@@ -36,16 +35,16 @@ struct drift_view {
     drift_hybrid *hybrid;
     drift_hybrid_params params;
     bool params_changed;
-    bool hybrid_rendered;            // a frame was rendered: drift_hybrid_plane has planes
+    bool hybrid_rendered; // a frame was rendered: drift_hybrid_plane has planes
 
-    drift_pt *reference;             // NULL until a frame with the split on, and after a move
-    drift_camera reference_camera;   // the camera the reference was created with
+    drift_pt *reference;           // NULL until a frame with the split on, and after a move
+    drift_camera reference_camera; // the camera the reference was created with
     uint32_t spp_per_frame;
     uint32_t seed;
 
     drift_camera camera;
-    drift_camera home;               // the scene's camera (RESET_CAMERA)
-    bool camera_moved;               // since the last frame: the reference must restart
+    drift_camera home; // the scene's camera (RESET_CAMERA)
+    bool camera_moved; // since the last frame: the reference must restart
     float move_step;
 
     char buffer_name[BUFFER_NAME_MAX]; // "frame" or a plane name; looked up at each frame
@@ -64,11 +63,10 @@ struct drift_view {
 // --- SMALL HELPERS ---
 
 static const char *const key_names[DRIFT_VIEW_KEY_COUNT] = {
-    "none",        "shadows",      "reflections", "dof",          "indirect",
-    "next-buffer", "prev-buffer",  "split",       "split-left",   "split-right",
-    "forward",     "back",         "left",        "right",        "up",
-    "down",        "exposure-up",  "exposure-down", "reset-camera", "overlay",
-    "help",
+    "none",         "shadows", "reflections", "dof",         "indirect",    "next-buffer",
+    "prev-buffer",  "split",   "split-left",  "split-right", "forward",     "back",
+    "left",         "right",   "up",          "down",        "exposure-up", "exposure-down",
+    "reset-camera", "overlay", "help",
 };
 
 const char *drift_view_key_name(drift_view_key key)
@@ -570,14 +568,14 @@ static void show_row(drift_view *view, const drift_image *image, buffer_look loo
             v[0] = v[1] = v[2] = p[0];
             break;
         case LOOK_RANGE:
-            v[0] = v[1] = v[2] = range.hi > range.lo ? (p[0] - range.lo) / (range.hi - range.lo)
-                                                     : 0.5f;
+            v[0] = v[1] = v[2] =
+                range.hi > range.lo ? (p[0] - range.lo) / (range.hi - range.lo) : 0.5f;
             break;
         case LOOK_DEPTH:
-            v[0] = v[1] = v[2] = !(p[0] > 0.0f)         ? 0.0f
-                                 : range.hi > range.lo ? 0.1f + 0.9f * (p[0] - range.lo) /
-                                                                    (range.hi - range.lo)
-                                                       : 1.0f;
+            v[0] = v[1] = v[2] = !(p[0] > 0.0f) ? 0.0f
+                                 : range.hi > range.lo
+                                     ? 0.1f + 0.9f * (p[0] - range.lo) / (range.hi - range.lo)
+                                     : 1.0f;
             break;
         case LOOK_NORMAL:
             // A miss has no normal (zero): black rather than the grey of 0.5 + 0.5 * 0.
@@ -637,7 +635,7 @@ static void sanitize(char *text)
 }
 
 #define TEXT_MAX_COLUMNS 8
-#define TEXT_COLUMN_GAP 8 // font units between table columns
+#define TEXT_COLUMN_GAP  8 // font units between table columns
 #define TEXT_LINE_HEIGHT 12
 
 // Calls draw(cell, column x, line y) for every tab-separated cell of `text` in font units;
@@ -702,8 +700,8 @@ static void draw_cell(drift_view *view, char *cell, int32_t x, int32_t y, void *
 {
     const text_origin *o = user;
     const uint8_t ink[3] = { 235, 235, 235 };
-    int quads = stb_easy_font_print((float)x, (float)y, cell, NULL, view->text_vertices,
-                                    TEXT_VERTEX_BYTES);
+    int quads =
+        stb_easy_font_print((float)x, (float)y, cell, NULL, view->text_vertices, TEXT_VERTEX_BYTES);
     const float *v = view->text_vertices; // 4 floats a vertex: x, y, z, colour bytes
     const float s = (float)o->scale;
     for (int q = 0; q < quads; ++q, v += 16) {
@@ -733,7 +731,8 @@ static void draw_text(drift_view *view, char *text, int32_t x, int32_t y, int32_
 #if defined(__GNUC__)
 __attribute__((format(printf, 3, 4)))
 #endif
-static void append(char *buf, size_t *len, const char *fmt, ...)
+static void
+append(char *buf, size_t *len, const char *fmt, ...)
 {
     if (*len >= OVERLAY_TEXT_MAX - 1) {
         return;
@@ -785,8 +784,7 @@ static void draw_overlay(drift_view *view)
                 continue; // the pass did not run (or was cached) this frame
             }
             const char *name = drift_hybrid_pass_name((drift_hybrid_pass)p);
-            append(text, &len, "%s%s\t%.2f ms", column ? "\t" : "", name ? name : "?",
-                   stats.ms[p]);
+            append(text, &len, "%s%s\t%.2f ms", column ? "\t" : "", name ? name : "?", stats.ms[p]);
             column = !column;
             if (!column) {
                 append(text, &len, "\n");

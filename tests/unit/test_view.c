@@ -2,18 +2,17 @@
 // change the hybrid frame's parameters and wrap around, the buffer keys visit every plane,
 // the reference restarts when the camera moves and converges while it stands still, and
 // the split puts the reference right of the line.
-#include "drift_test.h"
-
-#include <math.h>
-#include <stdlib.h>
-#include <string.h>
-
 #include "drift/accel.h"
 #include "drift/hybrid.h"
 #include "drift/image.h"
 #include "drift/pt.h"
 #include "drift/scene.h"
 #include "drift/view.h"
+#include "drift_test.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
 
 #define W 64
 #define H 48
@@ -29,16 +28,20 @@ typedef struct rig {
 static void build_scene(drift_scene *scene)
 {
     uint32_t grey, red;
-    assert_int_equal(drift_scene_add_material(scene, &(drift_material){ .diffuse = { 0.7f, 0.7f, 0.7f },
-                                                                        .diffuse_texture = DRIFT_INVALID_INDEX },
-                                              &grey),
-                     DRIFT_OK);
-    assert_int_equal(drift_scene_add_material(scene, &(drift_material){ .diffuse = { 0.6f, 0.2f, 0.2f },
-                                                                        .specular = { 0.2f, 0.2f, 0.2f },
-                                                                        .exponent = 50.0f,
-                                                                        .diffuse_texture = DRIFT_INVALID_INDEX },
-                                              &red),
-                     DRIFT_OK);
+    assert_int_equal(
+        drift_scene_add_material(scene,
+                                 &(drift_material){ .diffuse = { 0.7f, 0.7f, 0.7f },
+                                                    .diffuse_texture = DRIFT_INVALID_INDEX },
+                                 &grey),
+        DRIFT_OK);
+    assert_int_equal(
+        drift_scene_add_material(scene,
+                                 &(drift_material){ .diffuse = { 0.6f, 0.2f, 0.2f },
+                                                    .specular = { 0.2f, 0.2f, 0.2f },
+                                                    .exponent = 50.0f,
+                                                    .diffuse_texture = DRIFT_INVALID_INDEX },
+                                 &red),
+        DRIFT_OK);
     const float floor_p[] = { -2, 0, -2, 2, 0, -2, 2, 0, 2, -2, 0, 2 };
     const uint32_t floor_i[] = { 0, 2, 1, 0, 3, 2 }; // normal +y
     test_add_mesh(scene, floor_p, 4, floor_i, 2, grey);
@@ -58,9 +61,9 @@ static void build_scene(drift_scene *scene)
                                                            .edge_v = { 0.0f, 0.0f, 0.5f } },
                                            NULL),
                      DRIFT_OK);
-    scene->camera = drift_camera_look_at(drift_vec3_make(0.0f, 1.2f, 2.5f),
-                                         drift_vec3_make(0.0f, 0.2f, 0.0f),
-                                         drift_vec3_make(0.0f, 1.0f, 0.0f), 0.9f, W, H);
+    scene->camera =
+        drift_camera_look_at(drift_vec3_make(0.0f, 1.2f, 2.5f), drift_vec3_make(0.0f, 0.2f, 0.0f),
+                             drift_vec3_make(0.0f, 1.0f, 0.0f), 0.9f, W, H);
 }
 
 static drift_hybrid_params cheap_params(void)
@@ -99,8 +102,8 @@ static void frame(rig *r)
 
 static bool key(rig *r, drift_view_key k)
 {
-    return drift_view_handle_event(r->view, &(drift_view_event){ .type = DRIFT_VIEW_EVENT_KEY,
-                                                                 .key = k });
+    return drift_view_handle_event(r->view,
+                                   &(drift_view_event){ .type = DRIFT_VIEW_EVENT_KEY, .key = k });
 }
 
 static double mean_byte(const uint8_t *p, size_t count)
@@ -183,8 +186,7 @@ static void test_view_technique_keys_cycle(void **state)
     frame(&r);
     const drift_view_key keys[DRIFT_EFFECT_COUNT] = { DRIFT_VIEW_KEY_SHADOWS,
                                                       DRIFT_VIEW_KEY_REFLECTIONS,
-                                                      DRIFT_VIEW_KEY_DOF,
-                                                      DRIFT_VIEW_KEY_INDIRECT };
+                                                      DRIFT_VIEW_KEY_DOF, DRIFT_VIEW_KEY_INDIRECT };
     for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
         int count = drift_technique_count((drift_effect)e);
         assert_true(count >= 2);
@@ -276,8 +278,8 @@ static void test_view_buffer_keys_visit_every_plane(void **state)
 static void test_view_reference_restarts_when_the_camera_moves(void **state)
 {
     (void)state;
-    rig r = rig_make(&(drift_view_desc){ .hybrid = cheap_params(), .spp_per_frame = 2,
-                                          .split = true, .hide_overlay = true });
+    rig r = rig_make(&(drift_view_desc){
+        .hybrid = cheap_params(), .spp_per_frame = 2, .split = true, .hide_overlay = true });
     assert_null(drift_view_reference(r.view));
     // Still camera: the reference grows frame by frame.
     for (uint32_t i = 1; i <= 3; ++i) {
