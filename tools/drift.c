@@ -15,6 +15,7 @@ static const subcommand subcommands[] = {
     { "diff", drift_cmd_diff, "compare two images: MSE, RMSE, relMSE, PSNR, SSIM, FLIP" },
     { "info", drift_cmd_info, "print a scene's triangle, material, light, texture counts" },
     { "bench", drift_cmd_bench, "benchmarks (drift bench --help)" },
+    { "view", drift_cmd_view, "interactive viewer: hybrid techniques against the reference" },
 };
 
 static void print_usage(FILE *out)
