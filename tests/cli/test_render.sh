@@ -44,7 +44,7 @@ expect 2 "$drift" render --spp zero --out "$tmp/c.exr"
 expect 2 "$drift" render --spp 0 --out "$tmp/c.exr"
 expect 2 "$drift" render --out "$tmp/c.png"
 expect 2 "$drift" render --bogus
-expect 2 "$drift" render --mode hybrid --out "$tmp/c.exr"
+expect 2 "$drift" render --mode bogus --out "$tmp/c.exr"
 [ -e "$tmp/c.exr" ] && fail "an output was written after a usage error"
 expect 0 "$drift" render --help
 grep -q -- "--max-depth" "$tmp/out" || fail "--help does not list --max-depth"
