@@ -13,8 +13,9 @@
 //     MAX_RECEIVER_SLOPE so that grazing planes cannot push it to infinity;
 //   bias = bias_texels * the texel footprint at the receiver (texel angle * distance for
 //     cube maps, texel size for orthographic maps), for curved receivers and rounding.
-// No normal offset: the receiver plane already removes acne on planes, and an offset would
-// move shadow edges away from the ray-traced ones.
+// Plus a normal offset of NORMAL_OFFSET_TEXELS footprints: the receiver plane alone left acne
+// on planes nearly edge-on to the light's centre (the Cornell box's tall block under PCSS);
+// the offset moves shadow edges by about a texel.
 #include "hybrid_internal.h"
 
 #include <math.h>
@@ -352,9 +353,30 @@ typedef struct tap_result {
     float receiver;
 } tap_result;
 
+// Normal offset (Holbert 2011): the lookup point moves this many texel footprints along the
+// normal toward the light, which removes the acne left where the receiver plane is nearly
+// edge-on to the light's centre (there the plane's depth is ill-conditioned and capped).
+#define NORMAL_OFFSET_TEXELS 1.0f
+
+static drift_vec3 offset_along_normal(drift_vec3 p, drift_vec3 n, drift_vec3 to_light, float footprint)
+{
+    if (drift_vec3_is_zero(n)) {
+        return p;
+    }
+    n = drift_vec3_normalize(n);
+    if (drift_vec3_dot(n, to_light) < 0.0f) {
+        n = drift_vec3_neg(n);
+    }
+    return drift_vec3_fma(p, n, NORMAL_OFFSET_TEXELS * footprint);
+}
+
 static receiver cube_receiver(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n)
 {
     receiver rec = { 0 };
+    drift_vec3 to_centre = drift_vec3_sub(map->centre, p);
+    // The footprint at the receiver: the face-centre texel angle times the distance.
+    float footprint = 2.0f / (float)map->size * drift_vec3_length(to_centre);
+    p = offset_along_normal(p, n, to_centre, footprint);
     drift_vec3 d = drift_vec3_sub(p, map->centre);
     rec.depth = drift_vec3_length(d);
     rec.dir = rec.depth > 0.0f ? drift_vec3_scale(d, 1.0f / rec.depth)
@@ -380,6 +402,7 @@ static receiver cube_receiver(const drift_shadow_map *map, drift_vec3 p, drift_v
 static receiver ortho_receiver(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n)
 {
     receiver rec = { 0 };
+    p = offset_along_normal(p, n, drift_vec3_neg(map->frame.z), map->texel_size);
     drift_vec3 local = drift_frame_to_local(&map->frame, drift_vec3_sub(p, map->origin));
     rec.x = local.x;
     rec.y = local.y;
