@@ -162,15 +162,11 @@ int drift_bench_frame(int argc, char **argv)
     drift_result r = drift_context_create(
         &(drift_context_desc){ .thread_count = (int)o.threads, .logger = cli_stderr_logger(false) },
         &ctx);
-    if (r == DRIFT_OK) {
-        r = drift_scene_load(ctx, scene_path, &scene);
-    }
-    if (r == DRIFT_OK) {
-        r = drift_accel_create(ctx, scene, &(drift_accel_desc){ 0 }, &accel);
-    }
     if (r != DRIFT_OK) {
-        fprintf(stderr, "drift bench frame: cannot set up %s: %s\n", scene_path,
-                drift_result_string(r));
+        fprintf(stderr, "drift bench frame: %s\n", drift_result_string(r));
+        goto done;
+    }
+    if (!cli_open_scene(ctx, "bench frame", scene_path, &scene, &accel, NULL)) {
         goto done;
     }
     frame_result results[sizeof configs / sizeof *configs];

@@ -32,4 +32,15 @@ drift_logger cli_stderr_logger(bool verbose);
 // Directory of the built-in default scene (the repository's scenes/ folder).
 const char *cli_default_scene_path(void);
 
+// Loads the scene at `path` (NULL: the default scene) and builds its ray-tracing structure,
+// printing "drift <cmd>: ..." on failure (the scene's problem is already logged). On success
+// *out_loaded_time is the drift_time_now() between the two steps (for phase timings; may be
+// NULL). Either out pointer holds NULL on failure; free with drift_accel_destroy and
+// drift_scene_destroy.
+struct drift_scene;
+struct drift_accel;
+bool cli_open_scene(drift_context *ctx, const char *cmd, const char *path,
+                    struct drift_scene **out_scene, struct drift_accel **out_accel,
+                    double *out_loaded_time);
+
 #endif

@@ -1,5 +1,8 @@
 #include "cli.h"
 
+#include "drift/accel.h"
+#include "drift/scene_io.h"
+
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -76,4 +79,27 @@ const char *cli_default_scene_path(void)
 {
     const char *env = getenv("DRIFT_DEFAULT_SCENE");
     return env && *env ? env : DRIFT_SOURCE_DIR "/scenes/cornell-box/cornell_box.json";
+}
+
+bool cli_open_scene(drift_context *ctx, const char *cmd, const char *path,
+                    drift_scene **out_scene, drift_accel **out_accel, double *out_loaded_time)
+{
+    *out_accel = NULL;
+    const char *scene_path = path ? path : cli_default_scene_path();
+    drift_result r = drift_scene_load(ctx, scene_path, out_scene);
+    if (r != DRIFT_OK) {
+        fprintf(stderr, "drift %s: cannot load scene %s: %s\n", cmd, scene_path,
+                drift_result_string(r));
+        return false;
+    }
+    if (out_loaded_time) {
+        *out_loaded_time = drift_time_now();
+    }
+    r = drift_accel_create(ctx, *out_scene, &(drift_accel_desc){ 0 }, out_accel);
+    if (r != DRIFT_OK) {
+        fprintf(stderr, "drift %s: cannot build the ray-tracing structure: %s\n", cmd,
+                drift_result_string(r));
+        return false;
+    }
+    return true;
 }

@@ -579,16 +579,7 @@ int drift_cmd_view(int argc, char **argv)
         goto done;
     }
     const char *scene_path = o.scene_path ? o.scene_path : cli_default_scene_path();
-    r = drift_scene_load(ctx, scene_path, &scene);
-    if (r != DRIFT_OK) {
-        fprintf(stderr, "drift view: cannot load scene %s: %s\n", scene_path,
-                drift_result_string(r));
-        goto done;
-    }
-    r = drift_accel_create(ctx, scene, &(drift_accel_desc){ 0 }, &accel);
-    if (r != DRIFT_OK) {
-        fprintf(stderr, "drift view: cannot build the ray-tracing structure: %s\n",
-                drift_result_string(r));
+    if (!cli_open_scene(ctx, "view", scene_path, &scene, &accel, NULL)) {
         goto done;
     }
     drift_hybrid_params params = { .spp = (uint32_t)o.spp };

@@ -228,17 +228,8 @@ int render_hybrid(const render_options *o)
     drift_accel *accel = NULL;
     drift_hybrid *frame = NULL;
     int exit_code = 1;
-    r = drift_scene_load(ctx, scene_path, &scene);
-    if (r != DRIFT_OK) {
-        fprintf(stderr, "drift render: cannot load scene %s: %s\n", scene_path,
-                drift_result_string(r));
-        goto done;
-    }
-    double t_loaded = drift_time_now();
-    r = drift_accel_create(ctx, scene, &(drift_accel_desc){ 0 }, &accel);
-    if (r != DRIFT_OK) {
-        fprintf(stderr, "drift render: cannot build the ray-tracing structure: %s\n",
-                drift_result_string(r));
+    double t_loaded = 0.0;
+    if (!cli_open_scene(ctx, "render", scene_path, &scene, &accel, &t_loaded)) {
         goto done;
     }
     double t_accel = drift_time_now();
