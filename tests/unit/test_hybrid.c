@@ -132,6 +132,12 @@ static uint32_t add_sphere(drift_scene *scene, drift_vec3 c, float radius, uint3
     return mesh;
 }
 
+static void add_point_light(drift_scene *scene, drift_vec3 position, drift_vec3 intensity)
+{
+    drift_light light = { .type = DRIFT_LIGHT_POINT, .position = position, .color = intensity };
+    assert_int_equal(drift_scene_add_light(scene, &light, NULL), DRIFT_OK);
+}
+
 static drift_vec3 pixel3(const drift_image *img, int x, int y)
 {
     return drift_image_get3(img, x, y);
@@ -149,12 +155,7 @@ static void test_gbuffer_plane(void **state)
     const float height = 3.0f;
     r.scene->camera = drift_camera_look_at(drift_vec3_make(0, height, 0), drift_vec3_make(0, 0, 0),
                                            drift_vec3_make(0, 0, 1), 0.8f, 48, 32);
-    assert_int_equal(drift_scene_add_light(r.scene,
-                                           &(drift_light){ .type = DRIFT_LIGHT_POINT,
-                                                           .position = { 0, 5, 0 },
-                                                           .color = { 1, 1, 1 } },
-                                           NULL),
-                     DRIFT_OK);
+    add_point_light(r.scene, drift_vec3_make(0, 5, 0), drift_vec3_splat(1));
     rig_commit(&r);
     rig_frame(&r, &(drift_hybrid_params){ 0 });
     const drift_gbuffer *g = drift_hybrid_gbuffer(r.frame);
@@ -193,12 +194,7 @@ static void test_gbuffer_sphere(void **state)
     add_sphere(r.scene, c, radius, glossy);
     r.scene->camera = drift_camera_look_at(drift_vec3_make(0, 0, 0), drift_vec3_make(0, 0, 1),
                                            drift_vec3_make(0, 1, 0), 0.5f, 64, 64);
-    assert_int_equal(drift_scene_add_light(r.scene,
-                                           &(drift_light){ .type = DRIFT_LIGHT_POINT,
-                                                           .position = { 0, 5, 0 },
-                                                           .color = { 1, 1, 1 } },
-                                           NULL),
-                     DRIFT_OK);
+    add_point_light(r.scene, drift_vec3_make(0, 5, 0), drift_vec3_splat(1));
     rig_commit(&r);
     rig_frame(&r, &(drift_hybrid_params){ 0 });
     const drift_gbuffer *g = drift_hybrid_gbuffer(r.frame);
@@ -372,12 +368,7 @@ static void test_hard_shadow_buffer_distances(void **state)
     const float occ[] = { -0.5f, h, -0.5f, 0.5f, h, -0.5f, 0.5f, h, 0.5f, -0.5f, h, 0.5f };
     const uint32_t occ_idx[] = { 0, 2, 1, 0, 3, 2 };
     test_add_mesh(r.scene, occ, 4, occ_idx, 2, white);
-    assert_int_equal(drift_scene_add_light(r.scene,
-                                           &(drift_light){ .type = DRIFT_LIGHT_POINT,
-                                                           .position = { light_x, light_height, 0 },
-                                                           .color = { 10, 10, 10 } },
-                                           NULL),
-                     DRIFT_OK);
+    add_point_light(r.scene, drift_vec3_make(light_x, light_height, 0), drift_vec3_splat(10));
     r.scene->camera = drift_camera_look_at(drift_vec3_make(0, 8, -0.01f), drift_vec3_make(0, 0, 0),
                                            drift_vec3_make(0, 1, 0), 0.6f, 32, 32);
     rig_commit(&r);
