@@ -4,6 +4,7 @@
 #define DRIFT_TOOLS_CLI_H
 
 #include "drift/core.h"
+#include "drift/hybrid.h"
 
 #include <stdbool.h>
 #include <stdint.h>
@@ -22,6 +23,10 @@ bool cli_parse_int(const char *cmd, const char *flag, const char *text, long lo,
                    long *out);
 bool cli_parse_float(const char *cmd, const char *flag, const char *text, double lo, double hi,
                      double *out);
+// A technique name for `effect` (drift_technique_parse) into *out; otherwise prints
+// "drift <cmd>: <flag> expects one of <the techniques>, got '<text>'" and returns false.
+bool cli_parse_technique(const char *cmd, drift_effect effect, const char *flag, const char *text,
+                         int *out);
 // Returns argv[*i + 1] and advances *i, or prints a usage error and returns NULL.
 const char *cli_next_value(const char *cmd, int argc, char **argv, int *i);
 

@@ -39,6 +39,22 @@ bool cli_parse_float(const char *cmd, const char *flag, const char *text, double
     return true;
 }
 
+bool cli_parse_technique(const char *cmd, drift_effect effect, const char *flag, const char *text,
+                         int *out)
+{
+    int t = drift_technique_parse(effect, text);
+    if (t >= 0) {
+        *out = t;
+        return true;
+    }
+    fprintf(stderr, "drift %s: %s expects one of", cmd, flag);
+    for (int i = 0; i < drift_technique_count(effect); ++i) {
+        fprintf(stderr, "%s %s", i ? "," : "", drift_technique_name(effect, i));
+    }
+    fprintf(stderr, ", got '%s'\n", text);
+    return false;
+}
+
 const char *cli_next_value(const char *cmd, int argc, char **argv, int *i)
 {
     if (*i + 1 >= argc) {

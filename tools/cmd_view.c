@@ -112,21 +112,6 @@ static void print_help(void)
            "render), 2 usage error, 130 interrupted.\n");
 }
 
-static bool parse_technique(drift_effect effect, const char *flag, const char *value, int *out)
-{
-    int t = drift_technique_parse(effect, value);
-    if (t >= 0) {
-        *out = t;
-        return true;
-    }
-    fprintf(stderr, "drift view: %s expects one of", flag);
-    for (int i = 0; i < drift_technique_count(effect); ++i) {
-        fprintf(stderr, "%s %s", i ? "," : "", drift_technique_name(effect, i));
-    }
-    fprintf(stderr, ", got '%s'\n", value);
-    return false;
-}
-
 // Checks (view == NULL) or applies a comma-separated list of view key names.
 static bool parse_keys(const char *list, drift_view *view)
 {
@@ -176,7 +161,8 @@ static int parse_options(int argc, char **argv, view_options *o)
             print_help();
             return -1;
         } else if (effect >= 0) {
-            ok = VALUE() && parse_technique((drift_effect)effect, a, v, &o->techniques[effect]);
+            ok = VALUE() &&
+                 cli_parse_technique("view", (drift_effect)effect, a, v, &o->techniques[effect]);
         } else if (strcmp(a, "--width") == 0) {
             ok = VALUE() && cli_parse_int("view", a, v, 1, 16384, &o->width);
         } else if (strcmp(a, "--height") == 0) {

@@ -12,21 +12,6 @@
 #include "drift/image_io.h"
 #include "drift/scene_io.h"
 
-static bool parse_technique(drift_effect effect, const char *flag, const char *v, int *out)
-{
-    int t = drift_technique_parse(effect, v);
-    if (t < 0) {
-        fprintf(stderr, "drift render: %s expects one of", flag);
-        for (int k = 0; k < drift_technique_count(effect); ++k) {
-            fprintf(stderr, "%s %s", k ? "," : "", drift_technique_name(effect, k));
-        }
-        fprintf(stderr, "; got '%s'\n", v);
-        return false;
-    }
-    *out = t;
-    return true;
-}
-
 static bool parse_vec3(const char *flag, const char *v, drift_vec3 *out)
 {
     float a, b, c;
@@ -74,19 +59,19 @@ bool render_parse_hybrid_option(int argc, char **argv, int *i, render_options *o
     int t = 0;
     switch (effect) {
     case DRIFT_EFFECT_SHADOWS:
-        *ok = parse_technique(DRIFT_EFFECT_SHADOWS, a, v, &t);
+        *ok = cli_parse_technique("render", DRIFT_EFFECT_SHADOWS, a, v, &t);
         h->shadows = (drift_shadow_technique)t;
         return true;
     case DRIFT_EFFECT_REFLECTIONS:
-        *ok = parse_technique(DRIFT_EFFECT_REFLECTIONS, a, v, &t);
+        *ok = cli_parse_technique("render", DRIFT_EFFECT_REFLECTIONS, a, v, &t);
         h->reflections = (drift_reflection_technique)t;
         return true;
     case DRIFT_EFFECT_DOF:
-        *ok = parse_technique(DRIFT_EFFECT_DOF, a, v, &t);
+        *ok = cli_parse_technique("render", DRIFT_EFFECT_DOF, a, v, &t);
         h->dof = (drift_dof_technique)t;
         return true;
     case DRIFT_EFFECT_INDIRECT:
-        *ok = parse_technique(DRIFT_EFFECT_INDIRECT, a, v, &t);
+        *ok = cli_parse_technique("render", DRIFT_EFFECT_INDIRECT, a, v, &t);
         h->indirect = (drift_indirect_technique)t;
         return true;
     default:

@@ -1,64 +1,17 @@
-// The viewer's core: camera controller, technique and buffer selection, split view against
-// the progressive reference, and the text overlay, all into an RGB8 framebuffer. No window
+// The viewer's core: the view's state, its events and keys, and each frame: the hybrid frame,
+// technique and buffer selection, the split view against the progressive reference, and the
+// overlay, into an RGB8 framebuffer. The camera controller is in view_camera.c, how buffers
+// are drawn in view_buffers.c, the text overlay in view_overlay.c (view_internal.h). No window
 // code here (tools/cmd_view.c is the window); see include/drift/view.h and docs/viewer.md.
-#include "drift/view.h"
-
-#include "drift/image.h"
-#include "drift/math.h"
+#include "view/view_internal.h"
 
 #include <math.h>
-#include <stb/stb_easy_font.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
 
-#define BUFFER_NAME_MAX  128
-#define HELP_TEXT_MAX    4096
-#define OVERLAY_TEXT_MAX 2048
-// stb_easy_font writes 64 bytes a quad; one line of the overlay stays far below this.
-#define TEXT_VERTEX_BYTES (64 * 4096)
-
-#define ORBIT_RADIANS_PER_PIXEL 0.005f
-#define MOVE_FRACTION           0.02f // of the scene's bounding-box diagonal, per key press
-#define DOLLY_FACTOR            0.9f  // distance to the target times this per wheel notch
-#define EXPOSURE_STEP           0.5f
-#define SPLIT_STEP              (1.0f / 16.0f)
-// How close (|cos|) the view direction may come to the up vector before pitching stops.
-#define MAX_COS_TO_UP 0.995f
-
-struct drift_view {
-    drift_context *ctx;
-    const drift_scene *scene;
-    const drift_accel *accel;
-    int32_t width, height;
-
-    drift_hybrid *hybrid;
-    drift_hybrid_params params;
-    bool params_changed;
-    bool hybrid_rendered; // a frame was rendered: drift_hybrid_plane has planes
-
-    drift_pt *reference;           // NULL until a frame with the split on, and after a move
-    drift_camera reference_camera; // the camera the reference was created with
-    uint32_t spp_per_frame;
-    uint32_t seed;
-
-    drift_camera camera;
-    drift_camera home; // the scene's camera (RESET_CAMERA)
-    bool camera_moved; // since the last frame: the reference must restart
-    float move_step;
-
-    char buffer_name[BUFFER_NAME_MAX]; // "frame" or a plane name; looked up at each frame
-    int32_t pending_buffer_steps;      // buffer keys pressed before the first frame
-    float exposure_stops;
-    bool split;
-    float split_position;
-    bool overlay, help;
-    char *help_text;
-
-    uint8_t *pixels;
-    void *text_vertices;
-    uint64_t frame_count;
-};
+#define HELP_TEXT_MAX 4096
+#define EXPOSURE_STEP 0.5f
+#define SPLIT_STEP    (1.0f / 16.0f)
 
 // --- SMALL HELPERS ---
 
@@ -72,23 +25,6 @@ static const char *const key_names[DRIFT_VIEW_KEY_COUNT] = {
 const char *drift_view_key_name(drift_view_key key)
 {
     return (unsigned)key < DRIFT_VIEW_KEY_COUNT ? key_names[key] : NULL;
-}
-
-static uint8_t to_byte(float display)
-{
-    if (!(display > 0.0f)) {
-        return 0;
-    }
-    return (uint8_t)lrintf(fminf(display, 1.0f) * 255.0f);
-}
-
-// Rotates v about the unit axis k by angle (Rodrigues).
-static drift_vec3 rotate(drift_vec3 v, drift_vec3 k, float angle)
-{
-    float c = cosf(angle), s = sinf(angle);
-    drift_vec3 r = drift_vec3_scale(v, c);
-    r = drift_vec3_fma(r, drift_vec3_cross(k, v), s);
-    return drift_vec3_fma(r, k, drift_vec3_dot(k, v) * (1.0f - c));
 }
 
 static int32_t split_column(const drift_view *view)
@@ -223,16 +159,11 @@ drift_result drift_view_create(drift_context *ctx, const drift_scene *scene,
                           .split = d.split,
                           .split_position = d.split_position > 0.0f ? d.split_position : 0.5f,
                           .overlay = !d.hide_overlay };
-    drift_vec3 extent = drift_vec3_sub(scene->bounds.max, scene->bounds.min);
-    float diagonal = drift_bounds3_is_empty(scene->bounds) ? 0.0f : drift_vec3_length(extent);
-    if (!(diagonal > 0.0f) || !isfinite(diagonal)) {
-        diagonal = drift_vec3_length(drift_vec3_sub(scene->camera.target, scene->camera.position));
-    }
-    view->move_step = diagonal > 0.0f && isfinite(diagonal) ? MOVE_FRACTION * diagonal : 0.1f;
+    view->move_step = drift_view_camera_step(scene);
 
     drift_result r = DRIFT_OK;
     view->pixels = drift_alloc(ctx, pixel_bytes);
-    view->text_vertices = drift_alloc(ctx, TEXT_VERTEX_BYTES);
+    view->text_vertices = drift_alloc(ctx, VIEW_TEXT_VERTEX_BYTES);
     if (d.help_text) {
         size_t len = strnlen(d.help_text, HELP_TEXT_MAX - 1);
         view->help_text = drift_alloc(ctx, len + 1);
@@ -302,91 +233,15 @@ static void cycle_technique(drift_view *view, drift_effect effect)
     view->params_changed = true;
 }
 
-// Moves camera and target together by `delta`.
-static void camera_translate(drift_view *view, drift_vec3 direction, float amount)
+// Passes on whether the camera controller moved the camera, noting a move for the reference.
+static bool note_camera_move(drift_view *view, bool moved)
 {
-    drift_vec3 delta = drift_vec3_scale(direction, amount);
-    view->camera.position = drift_vec3_add(view->camera.position, delta);
-    view->camera.target = drift_vec3_add(view->camera.target, delta);
-    view->camera_moved = true;
-}
-
-typedef struct camera_axes {
-    drift_vec3 forward, right, up;
-    float distance; // to the target
-} camera_axes;
-
-static bool camera_axes_of(const drift_camera *camera, camera_axes *out)
-{
-    drift_vec3 to_target = drift_vec3_sub(camera->target, camera->position);
-    out->distance = drift_vec3_length(to_target);
-    out->up = drift_vec3_normalize(camera->up);
-    if (!(out->distance > 0.0f) || drift_vec3_is_zero(out->up)) {
-        return false;
-    }
-    out->forward = drift_vec3_scale(to_target, 1.0f / out->distance);
-    drift_vec3 right = drift_vec3_cross(out->forward, out->up);
-    if (!(drift_vec3_length(right) > 1e-6f)) {
-        return false;
-    }
-    out->right = drift_vec3_normalize(right);
-    return true;
-}
-
-// Turns `v` (the view direction, or the offset from the target) by yaw about up and pitch
-// about right, refusing a pitch that would bring it within acos(MAX_COS_TO_UP) of up.
-static drift_vec3 turn(drift_vec3 v, const camera_axes *axes, float yaw, float pitch)
-{
-    v = rotate(v, axes->up, yaw);
-    drift_vec3 right = drift_vec3_normalize(drift_vec3_cross(v, axes->up));
-    drift_vec3 pitched = rotate(v, right, pitch);
-    float cos_up = drift_vec3_dot(drift_vec3_normalize(pitched), axes->up);
-    return fabsf(cos_up) < MAX_COS_TO_UP ? pitched : v;
-}
-
-static bool camera_drag(drift_view *view, drift_view_event_type type, float dx, float dy)
-{
-    camera_axes axes;
-    if (!isfinite(dx) || !isfinite(dy) || (dx == 0.0f && dy == 0.0f) ||
-        !camera_axes_of(&view->camera, &axes)) {
-        return false;
-    }
-    float yaw = -dx * ORBIT_RADIANS_PER_PIXEL, pitch = -dy * ORBIT_RADIANS_PER_PIXEL;
-    drift_camera *c = &view->camera;
-    if (type == DRIFT_VIEW_EVENT_ORBIT) {
-        // The camera circles the target; dragging right swings it to the left, so the scene
-        // appears to turn with the mouse. Pitch is negated for the same reason.
-        drift_vec3 offset = drift_vec3_sub(c->position, c->target);
-        c->position = drift_vec3_add(c->target, turn(offset, &axes, yaw, -pitch));
-    } else {
-        drift_vec3 direction = drift_vec3_sub(c->target, c->position);
-        c->target = drift_vec3_add(c->position, turn(direction, &axes, yaw, pitch));
-    }
-    view->camera_moved = true;
-    return true;
-}
-
-static bool camera_dolly(drift_view *view, float notches)
-{
-    camera_axes axes;
-    if (!isfinite(notches) || notches == 0.0f || !camera_axes_of(&view->camera, &axes)) {
-        return false;
-    }
-    float distance = axes.distance * powf(DOLLY_FACTOR, notches);
-    float min_distance = 1e-3f * view->move_step;
-    if (distance < min_distance) {
-        distance = min_distance;
-    }
-    view->camera.position = drift_vec3_fma(view->camera.target, axes.forward, -distance);
-    view->camera_moved = true;
-    return true;
+    view->camera_moved = view->camera_moved || moved;
+    return moved;
 }
 
 static bool handle_key(drift_view *view, drift_view_key key)
 {
-    camera_axes axes;
-    bool have_axes = camera_axes_of(&view->camera, &axes);
-    float step = view->move_step;
     switch (key) {
     case DRIFT_VIEW_KEY_SHADOWS:
         cycle_technique(view, DRIFT_EFFECT_SHADOWS);
@@ -415,25 +270,11 @@ static bool handle_key(drift_view *view, drift_view_key key)
         return view->split;
     case DRIFT_VIEW_KEY_FORWARD:
     case DRIFT_VIEW_KEY_BACK:
-        if (!have_axes) {
-            return false;
-        }
-        camera_translate(view, axes.forward, key == DRIFT_VIEW_KEY_FORWARD ? step : -step);
-        return true;
     case DRIFT_VIEW_KEY_LEFT:
     case DRIFT_VIEW_KEY_RIGHT:
-        if (!have_axes) {
-            return false;
-        }
-        camera_translate(view, axes.right, key == DRIFT_VIEW_KEY_RIGHT ? step : -step);
-        return true;
     case DRIFT_VIEW_KEY_UP:
     case DRIFT_VIEW_KEY_DOWN:
-        if (!have_axes) {
-            return false;
-        }
-        camera_translate(view, axes.up, key == DRIFT_VIEW_KEY_UP ? step : -step);
-        return true;
+        return note_camera_move(view, drift_view_camera_fly(&view->camera, key, view->move_step));
     case DRIFT_VIEW_KEY_EXPOSURE_UP:
         view->exposure_stops += EXPOSURE_STEP;
         return true;
@@ -466,9 +307,11 @@ bool drift_view_handle_event(drift_view *view, const drift_view_event *event)
         return handle_key(view, event->key);
     case DRIFT_VIEW_EVENT_ORBIT:
     case DRIFT_VIEW_EVENT_LOOK:
-        return camera_drag(view, event->type, event->dx, event->dy);
+        return note_camera_move(
+            view, drift_view_camera_drag(&view->camera, event->type, event->dx, event->dy));
     case DRIFT_VIEW_EVENT_DOLLY:
-        return camera_dolly(view, event->dy);
+        return note_camera_move(view,
+                                drift_view_camera_dolly(&view->camera, event->dy, view->move_step));
     case DRIFT_VIEW_EVENT_SPLIT_AT:
         if (!isfinite(event->x)) {
             return false;
@@ -487,315 +330,6 @@ void drift_view_set_camera(drift_view *view, const drift_camera *camera)
         view->camera = *camera;
         view->camera_moved = true;
     }
-}
-
-// --- SHOWING A BUFFER ---
-
-typedef enum buffer_look {
-    LOOK_RADIANCE = 0, // tone-mapped with the exposure (frame, radiance and colour planes)
-    LOOK_UNIT,         // 1 channel in [0,1]: grey as is (visibility, masks)
-    LOOK_RANGE,        // 1 channel: (v - min) / (max - min), grey (ids, distances)
-    LOOK_DEPTH,        // grey from 0.1 at the nearest hit to 1 at the farthest; misses (0) black
-    LOOK_NORMAL,       // 0.5 + 0.5 n; black where there is no normal (a miss)
-    LOOK_POSITION,     // normalized to the scene's bounds
-    LOOK_MOTION,       // 2 channels: 0.5 + 0.5 m / max|m| as red and green
-} buffer_look;
-
-typedef struct buffer_range {
-    float lo, hi;
-} buffer_range;
-
-// The finite range of the values (absolute: of |v|; positive: of the values above 0 only).
-static buffer_range image_range(const drift_image *image, bool absolute, bool positive)
-{
-    buffer_range range = { INFINITY, -INFINITY };
-    for (int32_t y = 0; y < image->height; ++y) {
-        const float *p = drift_image_pixel(image, 0, y);
-        for (int32_t i = 0; i < image->width * image->channels; ++i) {
-            float v = absolute ? fabsf(p[i]) : p[i];
-            if (isfinite(v) && (!positive || v > 0.0f)) {
-                range.lo = fminf(range.lo, v);
-                range.hi = fmaxf(range.hi, v);
-            }
-        }
-    }
-    if (range.lo > range.hi) {
-        range = (buffer_range){ 0.0f, 0.0f };
-    }
-    return range;
-}
-
-static buffer_look look_of(const char *name, const drift_image *image, buffer_range *range)
-{
-    if (image->channels == 2) {
-        *range = image_range(image, true, false);
-        return LOOK_MOTION;
-    }
-    if (image->channels == 1) {
-        if (strstr(name, "depth")) {
-            *range = image_range(image, false, true);
-            return LOOK_DEPTH;
-        }
-        *range = image_range(image, false, false);
-        return range->lo >= 0.0f && range->hi <= 1.0f ? LOOK_UNIT : LOOK_RANGE;
-    }
-    if (strstr(name, "normal")) {
-        return LOOK_NORMAL;
-    }
-    if (strstr(name, "position")) {
-        return LOOK_POSITION;
-    }
-    return LOOK_RADIANCE;
-}
-
-// Writes columns [x0, x1) of row y of `image` into the framebuffer.
-static void show_row(drift_view *view, const drift_image *image, buffer_look look,
-                     buffer_range range, int32_t y, int32_t x0, int32_t x1)
-{
-    const drift_tonemap_params tonemap = { .exposure_stops = view->exposure_stops };
-    const drift_bounds3 bounds = view->scene->bounds;
-    uint8_t *out = view->pixels + ((size_t)y * (size_t)view->width + (size_t)x0) * 3u;
-    for (int32_t x = x0; x < x1; ++x, out += 3) {
-        const float *p = drift_image_pixel(image, x, y);
-        float v[3] = { 0.0f, 0.0f, 0.0f };
-        switch (look) {
-        case LOOK_RADIANCE:
-            for (int c = 0; c < 3; ++c) {
-                v[c] = drift_tonemap_value(p[image->channels >= 3 ? c : 0], &tonemap);
-            }
-            break;
-        case LOOK_UNIT:
-            v[0] = v[1] = v[2] = p[0];
-            break;
-        case LOOK_RANGE:
-            v[0] = v[1] = v[2] =
-                range.hi > range.lo ? (p[0] - range.lo) / (range.hi - range.lo) : 0.5f;
-            break;
-        case LOOK_DEPTH:
-            v[0] = v[1] = v[2] = !(p[0] > 0.0f) ? 0.0f
-                                 : range.hi > range.lo
-                                     ? 0.1f + 0.9f * (p[0] - range.lo) / (range.hi - range.lo)
-                                     : 1.0f;
-            break;
-        case LOOK_NORMAL:
-            // A miss has no normal (zero): black rather than the grey of 0.5 + 0.5 * 0.
-            for (int c = 0; c < 3 && (p[0] != 0.0f || p[1] != 0.0f || p[2] != 0.0f); ++c) {
-                v[c] = 0.5f + 0.5f * p[c];
-            }
-            break;
-        case LOOK_POSITION: {
-            const float lo[3] = { bounds.min.x, bounds.min.y, bounds.min.z };
-            const float hi[3] = { bounds.max.x, bounds.max.y, bounds.max.z };
-            for (int c = 0; c < 3; ++c) {
-                v[c] = hi[c] > lo[c] ? (p[c] - lo[c]) / (hi[c] - lo[c]) : 0.5f;
-            }
-            break;
-        }
-        case LOOK_MOTION: {
-            float scale = range.hi > 1.0f ? range.hi : 1.0f;
-            v[0] = 0.5f + 0.5f * p[0] / scale;
-            v[1] = 0.5f + 0.5f * p[1] / scale;
-            break;
-        }
-        }
-        for (int c = 0; c < 3; ++c) {
-            out[c] = to_byte(v[c]);
-        }
-    }
-}
-
-// --- THE OVERLAY ---
-
-// Fills [x0, x1) x [y0, y1) with `color` blended at `alpha` over the framebuffer.
-static void blend_rect(drift_view *view, int32_t x0, int32_t y0, int32_t x1, int32_t y1,
-                       const uint8_t color[3], float alpha)
-{
-    x0 = x0 < 0 ? 0 : x0;
-    y0 = y0 < 0 ? 0 : y0;
-    x1 = x1 > view->width ? view->width : x1;
-    y1 = y1 > view->height ? view->height : y1;
-    for (int32_t y = y0; y < y1; ++y) {
-        uint8_t *p = view->pixels + ((size_t)y * (size_t)view->width + (size_t)x0) * 3u;
-        for (int32_t x = x0; x < x1; ++x, p += 3) {
-            for (int c = 0; c < 3; ++c) {
-                p[c] = (uint8_t)lrintf((float)p[c] * (1.0f - alpha) + (float)color[c] * alpha);
-            }
-        }
-    }
-}
-
-// stb_easy_font indexes a table by (char - 32): keep printable ASCII, tabs and newlines.
-static void sanitize(char *text)
-{
-    for (char *c = text; *c; ++c) {
-        if (*c != '\n' && *c != '\t' && (*c < 32 || *c > 126)) {
-            *c = '?';
-        }
-    }
-}
-
-#define TEXT_MAX_COLUMNS 8
-#define TEXT_COLUMN_GAP  8 // font units between table columns
-#define TEXT_LINE_HEIGHT 12
-
-// Calls draw(cell, column x, line y) for every tab-separated cell of `text` in font units;
-// columns line up (each as wide as its widest cell). Returns the table's size.
-typedef void (*cell_func)(drift_view *view, char *cell, int32_t x, int32_t y, void *user);
-
-static void layout_table(drift_view *view, char *text, cell_func draw, void *user,
-                         int32_t *out_width, int32_t *out_height)
-{
-    int32_t widths[TEXT_MAX_COLUMNS] = { 0 };
-    int32_t lines = 0;
-    for (int pass = 0; pass < 2; ++pass) {
-        char *line = text;
-        lines = 0;
-        while (*line) {
-            char *line_end = strchr(line, '\n');
-            char *next = line_end ? line_end + 1 : line + strlen(line);
-            char saved_line = line_end ? *line_end : '\0';
-            if (line_end) {
-                *line_end = '\0';
-            }
-            int32_t x = 0;
-            char *cell = line;
-            for (int column = 0; cell; ++column) {
-                char *tab = column < TEXT_MAX_COLUMNS - 1 ? strchr(cell, '\t') : NULL;
-                if (tab) {
-                    *tab = '\0';
-                }
-                if (pass == 0) {
-                    int32_t w = stb_easy_font_width(cell);
-                    widths[column] = w > widths[column] ? w : widths[column];
-                } else if (draw) {
-                    draw(view, cell, x, lines * TEXT_LINE_HEIGHT, user);
-                }
-                x += widths[column] + TEXT_COLUMN_GAP;
-                if (tab) {
-                    *tab = '\t';
-                }
-                cell = tab ? tab + 1 : NULL;
-            }
-            if (line_end) {
-                *line_end = saved_line;
-            }
-            lines += 1;
-            line = next;
-        }
-    }
-    int32_t width = 0;
-    for (int c = 0; c < TEXT_MAX_COLUMNS; ++c) {
-        width += widths[c] > 0 ? widths[c] + (c ? TEXT_COLUMN_GAP : 0) : 0;
-    }
-    *out_width = width;
-    *out_height = lines * TEXT_LINE_HEIGHT - 2; // the last line has no gap below it
-}
-
-typedef struct text_origin {
-    int32_t x, y, scale;
-} text_origin;
-
-// Rasterizes stb_easy_font's quads for one cell into the framebuffer.
-static void draw_cell(drift_view *view, char *cell, int32_t x, int32_t y, void *user)
-{
-    const text_origin *o = user;
-    const uint8_t ink[3] = { 235, 235, 235 };
-    int quads =
-        stb_easy_font_print((float)x, (float)y, cell, NULL, view->text_vertices, TEXT_VERTEX_BYTES);
-    const float *v = view->text_vertices; // 4 floats a vertex: x, y, z, colour bytes
-    const float s = (float)o->scale;
-    for (int q = 0; q < quads; ++q, v += 16) {
-        // Vertices 0 and 2 are opposite corners of the quad.
-        float qx0 = fminf(v[0], v[8]), qx1 = fmaxf(v[0], v[8]);
-        float qy0 = fminf(v[1], v[9]), qy1 = fmaxf(v[1], v[9]);
-        blend_rect(view, o->x + (int32_t)lrintf(qx0 * s), o->y + (int32_t)lrintf(qy0 * s),
-                   o->x + (int32_t)lrintf(qx1 * s), o->y + (int32_t)lrintf(qy1 * s), ink, 1.0f);
-    }
-}
-
-// Draws `text` (lines separated by '\n', table cells by '\t') at (x, y) on a dark box,
-// `scale` pixels a font unit.
-static void draw_text(drift_view *view, char *text, int32_t x, int32_t y, int32_t scale)
-{
-    sanitize(text);
-    int32_t w = 0, h = 0;
-    layout_table(view, text, NULL, NULL, &w, &h);
-    const int32_t pad = 4 * scale;
-    const uint8_t dark[3] = { 0, 0, 0 };
-    blend_rect(view, x - pad, y - pad, x + w * scale + pad, y + h * scale + pad, dark, 0.7f);
-    text_origin origin = { x, y, scale };
-    layout_table(view, text, draw_cell, &origin, &w, &h);
-}
-
-// Appends printf-style text to buf (capacity OVERLAY_TEXT_MAX), truncating quietly.
-#if defined(__GNUC__)
-__attribute__((format(printf, 3, 4)))
-#endif
-static void
-append(char *buf, size_t *len, const char *fmt, ...)
-{
-    if (*len >= OVERLAY_TEXT_MAX - 1) {
-        return;
-    }
-    va_list args;
-    va_start(args, fmt);
-    int n = vsnprintf(buf + *len, OVERLAY_TEXT_MAX - *len, fmt, args);
-    va_end(args);
-    if (n > 0) {
-        *len += (size_t)n < OVERLAY_TEXT_MAX - *len ? (size_t)n : OVERLAY_TEXT_MAX - 1 - *len;
-    }
-}
-
-static const char *technique_of(const drift_hybrid_params *p, drift_effect effect)
-{
-    int t = effect == DRIFT_EFFECT_SHADOWS       ? (int)p->shadows
-            : effect == DRIFT_EFFECT_REFLECTIONS ? (int)p->reflections
-            : effect == DRIFT_EFFECT_DOF         ? (int)p->dof
-                                                 : (int)p->indirect;
-    const char *name = drift_technique_name(effect, t);
-    return name ? name : "?";
-}
-
-static void draw_overlay(drift_view *view)
-{
-    char text[OVERLAY_TEXT_MAX];
-    size_t len = 0;
-    text[0] = '\0';
-    if (view->help && view->help_text) {
-        append(text, &len, "%s", view->help_text);
-    } else {
-        for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
-            append(text, &len, "%s\t%s\n", drift_effect_name((drift_effect)e),
-                   technique_of(&view->params, (drift_effect)e));
-        }
-        append(text, &len, "buffer\t%s\n", view->buffer_name);
-        append(text, &len, "exposure\t%+.1f stops\n", (double)view->exposure_stops);
-        if (view->split) {
-            append(text, &len, "pt reference\t%u spp\n",
-                   view->reference ? drift_pt_sample_count(view->reference) : 0u);
-        } else {
-            append(text, &len, "pt reference\toff\n");
-        }
-        drift_hybrid_stats stats = drift_hybrid_get_stats(view->hybrid);
-        append(text, &len, "frame\t%.2f ms\n", stats.frame_ms);
-        int column = 0;
-        for (int p = 0; p < DRIFT_PASS_COUNT; ++p) {
-            if (!(stats.ms[p] > 0.0)) {
-                continue; // the pass did not run (or was cached) this frame
-            }
-            const char *name = drift_hybrid_pass_name((drift_hybrid_pass)p);
-            append(text, &len, "%s%s\t%.2f ms", column ? "\t" : "", name ? name : "?", stats.ms[p]);
-            column = !column;
-            if (!column) {
-                append(text, &len, "\n");
-            }
-        }
-    }
-    while (len > 0 && text[len - 1] == '\n') {
-        text[--len] = '\0';
-    }
-    int32_t scale = view->width >= 1280 ? 2 : 1;
-    draw_text(view, text, 6 * scale, 6 * scale, scale);
 }
 
 // --- FRAME ---
@@ -850,8 +384,7 @@ drift_result drift_view_frame(drift_view *view, const atomic_bool *cancel)
     // The shown buffer: the composed frame, or a plane by name (it may have disappeared with
     // a technique change; then the frame again).
     const drift_image *shown = drift_hybrid_image(view->hybrid);
-    buffer_look look = LOOK_RADIANCE;
-    buffer_range range = { 0.0f, 0.0f };
+    const char *plane_name = NULL; // NULL: the composed frame
     uint32_t index = buffer_index(view, view->buffer_name);
     const char *name = NULL;
     const drift_image *plane = NULL;
@@ -859,25 +392,15 @@ drift_result drift_view_frame(drift_view *view, const atomic_bool *cancel)
         drift_image_is_valid(plane) && plane->width == view->width &&
         plane->height == view->height) {
         shown = plane;
-        look = look_of(name ? name : "", plane, &range);
+        plane_name = name ? name : "";
     } else {
         snprintf(view->buffer_name, sizeof(view->buffer_name), "frame");
     }
 
     int32_t split_x = view->split ? split_column(view) : view->width;
-    for (int32_t y = 0; y < view->height; ++y) {
-        show_row(view, shown, look, range, y, 0, split_x);
-        if (split_x < view->width) {
-            show_row(view, &reference, LOOK_RADIANCE, range, y, split_x, view->width);
-        }
-    }
-    if (view->split && split_x > 0 && split_x < view->width) {
-        // The split line, on the hybrid side's last column so reference pixels stay intact.
-        const uint8_t white[3] = { 255, 255, 255 };
-        blend_rect(view, split_x - 1, 0, split_x, view->height, white, 0.6f);
-    }
+    drift_view_show(view, shown, plane_name, &reference, split_x);
     if (view->overlay) {
-        draw_overlay(view);
+        drift_view_draw_overlay(view);
     }
     view->frame_count += 1;
     return DRIFT_OK;

@@ -1,0 +1,187 @@
+// The viewer's text overlay: a table of lines and tab-separated cells drawn with
+// stb_easy_font's quads on a dark box, top left of the framebuffer.
+#include "view/view_internal.h"
+
+#include <math.h>
+#include <stb/stb_easy_font.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#define OVERLAY_TEXT_MAX 2048
+
+// stb_easy_font indexes a table by (char - 32): keep printable ASCII, tabs and newlines.
+static void sanitize(char *text)
+{
+    for (char *c = text; *c; ++c) {
+        if (*c != '\n' && *c != '\t' && (*c < 32 || *c > 126)) {
+            *c = '?';
+        }
+    }
+}
+
+#define TEXT_MAX_COLUMNS 8
+#define TEXT_COLUMN_GAP  8 // font units between table columns
+#define TEXT_LINE_HEIGHT 12
+
+// Calls draw(cell, column x, line y) for every tab-separated cell of `text` in font units;
+// columns line up (each as wide as its widest cell). Returns the table's size.
+typedef void (*cell_func)(drift_view *view, char *cell, int32_t x, int32_t y, void *user);
+
+static void layout_table(drift_view *view, char *text, cell_func draw, void *user,
+                         int32_t *out_width, int32_t *out_height)
+{
+    int32_t widths[TEXT_MAX_COLUMNS] = { 0 };
+    int32_t lines = 0;
+    for (int pass = 0; pass < 2; ++pass) {
+        char *line = text;
+        lines = 0;
+        while (*line) {
+            char *line_end = strchr(line, '\n');
+            char *next = line_end ? line_end + 1 : line + strlen(line);
+            char saved_line = line_end ? *line_end : '\0';
+            if (line_end) {
+                *line_end = '\0';
+            }
+            int32_t x = 0;
+            char *cell = line;
+            for (int column = 0; cell; ++column) {
+                char *tab = column < TEXT_MAX_COLUMNS - 1 ? strchr(cell, '\t') : NULL;
+                if (tab) {
+                    *tab = '\0';
+                }
+                if (pass == 0) {
+                    int32_t w = stb_easy_font_width(cell);
+                    widths[column] = w > widths[column] ? w : widths[column];
+                } else if (draw) {
+                    draw(view, cell, x, lines * TEXT_LINE_HEIGHT, user);
+                }
+                x += widths[column] + TEXT_COLUMN_GAP;
+                if (tab) {
+                    *tab = '\t';
+                }
+                cell = tab ? tab + 1 : NULL;
+            }
+            if (line_end) {
+                *line_end = saved_line;
+            }
+            lines += 1;
+            line = next;
+        }
+    }
+    int32_t width = 0;
+    for (int c = 0; c < TEXT_MAX_COLUMNS; ++c) {
+        width += widths[c] > 0 ? widths[c] + (c ? TEXT_COLUMN_GAP : 0) : 0;
+    }
+    *out_width = width;
+    *out_height = lines * TEXT_LINE_HEIGHT - 2; // the last line has no gap below it
+}
+
+typedef struct text_origin {
+    int32_t x, y, scale;
+} text_origin;
+
+// Rasterizes stb_easy_font's quads for one cell into the framebuffer.
+static void draw_cell(drift_view *view, char *cell, int32_t x, int32_t y, void *user)
+{
+    const text_origin *o = user;
+    const uint8_t ink[3] = { 235, 235, 235 };
+    int quads = stb_easy_font_print((float)x, (float)y, cell, NULL, view->text_vertices,
+                                    VIEW_TEXT_VERTEX_BYTES);
+    const float *v = view->text_vertices; // 4 floats a vertex: x, y, z, colour bytes
+    const float s = (float)o->scale;
+    for (int q = 0; q < quads; ++q, v += 16) {
+        // Vertices 0 and 2 are opposite corners of the quad.
+        float qx0 = fminf(v[0], v[8]), qx1 = fmaxf(v[0], v[8]);
+        float qy0 = fminf(v[1], v[9]), qy1 = fmaxf(v[1], v[9]);
+        drift_view_blend_rect(view, o->x + (int32_t)lrintf(qx0 * s),
+                              o->y + (int32_t)lrintf(qy0 * s), o->x + (int32_t)lrintf(qx1 * s),
+                              o->y + (int32_t)lrintf(qy1 * s), ink, 1.0f);
+    }
+}
+
+// Draws `text` (lines separated by '\n', table cells by '\t') at (x, y) on a dark box,
+// `scale` pixels a font unit.
+static void draw_text(drift_view *view, char *text, int32_t x, int32_t y, int32_t scale)
+{
+    sanitize(text);
+    int32_t w = 0, h = 0;
+    layout_table(view, text, NULL, NULL, &w, &h);
+    const int32_t pad = 4 * scale;
+    const uint8_t dark[3] = { 0, 0, 0 };
+    drift_view_blend_rect(view, x - pad, y - pad, x + w * scale + pad, y + h * scale + pad, dark,
+                          0.7f);
+    text_origin origin = { x, y, scale };
+    layout_table(view, text, draw_cell, &origin, &w, &h);
+}
+
+// Appends printf-style text to buf (capacity OVERLAY_TEXT_MAX), truncating quietly.
+#if defined(__GNUC__)
+__attribute__((format(printf, 3, 4)))
+#endif
+static void
+append(char *buf, size_t *len, const char *fmt, ...)
+{
+    if (*len >= OVERLAY_TEXT_MAX - 1) {
+        return;
+    }
+    va_list args;
+    va_start(args, fmt);
+    int n = vsnprintf(buf + *len, OVERLAY_TEXT_MAX - *len, fmt, args);
+    va_end(args);
+    if (n > 0) {
+        *len += (size_t)n < OVERLAY_TEXT_MAX - *len ? (size_t)n : OVERLAY_TEXT_MAX - 1 - *len;
+    }
+}
+
+static const char *technique_of(const drift_hybrid_params *p, drift_effect effect)
+{
+    int t = effect == DRIFT_EFFECT_SHADOWS       ? (int)p->shadows
+            : effect == DRIFT_EFFECT_REFLECTIONS ? (int)p->reflections
+            : effect == DRIFT_EFFECT_DOF         ? (int)p->dof
+                                                 : (int)p->indirect;
+    const char *name = drift_technique_name(effect, t);
+    return name ? name : "?";
+}
+
+void drift_view_draw_overlay(drift_view *view)
+{
+    char text[OVERLAY_TEXT_MAX];
+    size_t len = 0;
+    text[0] = '\0';
+    if (view->help && view->help_text) {
+        append(text, &len, "%s", view->help_text);
+    } else {
+        for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
+            append(text, &len, "%s\t%s\n", drift_effect_name((drift_effect)e),
+                   technique_of(&view->params, (drift_effect)e));
+        }
+        append(text, &len, "buffer\t%s\n", view->buffer_name);
+        append(text, &len, "exposure\t%+.1f stops\n", (double)view->exposure_stops);
+        if (view->split) {
+            append(text, &len, "pt reference\t%u spp\n",
+                   view->reference ? drift_pt_sample_count(view->reference) : 0u);
+        } else {
+            append(text, &len, "pt reference\toff\n");
+        }
+        drift_hybrid_stats stats = drift_hybrid_get_stats(view->hybrid);
+        append(text, &len, "frame\t%.2f ms\n", stats.frame_ms);
+        int column = 0;
+        for (int p = 0; p < DRIFT_PASS_COUNT; ++p) {
+            if (!(stats.ms[p] > 0.0)) {
+                continue; // the pass did not run (or was cached) this frame
+            }
+            const char *name = drift_hybrid_pass_name((drift_hybrid_pass)p);
+            append(text, &len, "%s%s\t%.2f ms", column ? "\t" : "", name ? name : "?", stats.ms[p]);
+            column = !column;
+            if (!column) {
+                append(text, &len, "\n");
+            }
+        }
+    }
+    while (len > 0 && text[len - 1] == '\n') {
+        text[--len] = '\0';
+    }
+    int32_t scale = view->width >= 1280 ? 2 : 1;
+    draw_text(view, text, 6 * scale, 6 * scale, scale);
+}
