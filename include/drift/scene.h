@@ -197,6 +197,14 @@ drift_result drift_scene_commit(drift_scene *scene);
 // Triangle, material, light and texture counts.
 uint64_t drift_scene_triangle_count(const drift_scene *scene);
 
+// Bounds of one mesh's vertices.
+drift_bounds3 drift_mesh_bounds(const drift_mesh *mesh);
+
+// The corners of a DRIFT_LIGHT_TRIANGLE light, in the order of its mesh triangle (their
+// cross product points the way it emits).
+void drift_light_triangle_vertices(const drift_scene *scene, const drift_light *light,
+                                   drift_vec3 *a, drift_vec3 *b, drift_vec3 *c);
+
 // --- SURFACES ---
 
 // What the accel reports about a hit: which geometry, which primitive, where.

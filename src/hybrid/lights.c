@@ -5,16 +5,6 @@
 
 #include <math.h>
 
-static void triangle_corners(const drift_scene *scene, const drift_light *l, drift_vec3 out[3])
-{
-    const drift_mesh *mesh = &scene->meshes[l->mesh];
-    const uint32_t *idx = mesh->indices + 3u * l->triangle;
-    for (int k = 0; k < 3; ++k) {
-        const float *p = mesh->positions + 3u * idx[k];
-        out[k] = drift_vec3_make(p[0], p[1], p[2]);
-    }
-}
-
 static drift_hybrid_light single_light(const drift_scene *scene, uint32_t index)
 {
     const drift_light *l = &scene->lights[index];
@@ -46,7 +36,7 @@ static drift_hybrid_light single_light(const drift_scene *scene, uint32_t index)
         break;
     case DRIFT_LIGHT_TRIANGLE: {
         drift_vec3 c[3];
-        triangle_corners(scene, l, c);
+        drift_light_triangle_vertices(scene, l, &c[0], &c[1], &c[2]);
         h.centre = drift_vec3_scale(drift_vec3_add(c[0], drift_vec3_add(c[1], c[2])), 1.0f / 3.0f);
         h.direction = drift_vec3_normalize(
             drift_vec3_cross(drift_vec3_sub(c[1], c[0]), drift_vec3_sub(c[2], c[0])));
@@ -82,7 +72,7 @@ static drift_result mesh_light(drift_context *ctx, const drift_scene *scene, uin
     drift_vec3 centroid = drift_vec3_splat(0.0f), normal = drift_vec3_splat(0.0f);
     for (uint32_t t = 0; t < m->triangle_count; ++t) {
         drift_vec3 c[3];
-        triangle_corners(scene, &scene->lights[m->first_light + t], c);
+        drift_light_triangle_vertices(scene, &scene->lights[m->first_light + t], &c[0], &c[1], &c[2]);
         drift_vec3 cross = drift_vec3_cross(drift_vec3_sub(c[1], c[0]), drift_vec3_sub(c[2], c[0]));
         float area = 0.5f * drift_vec3_length(cross);
         total += (double)area;

@@ -115,12 +115,7 @@ static bool mesh_is_reflective(const drift_scene *scene, uint32_t mesh)
 
 static drift_vec3 mesh_centre(const drift_scene *scene, uint32_t mesh)
 {
-    const drift_mesh *m = &scene->meshes[mesh];
-    drift_bounds3 b = drift_bounds3_empty();
-    for (uint32_t v = 0; v < m->vertex_count; ++v) {
-        const float *p = m->positions + 3u * v;
-        b = drift_bounds3_extend(b, drift_vec3_make(p[0], p[1], p[2]));
-    }
+    drift_bounds3 b = drift_mesh_bounds(&scene->meshes[mesh]);
     return drift_vec3_scale(drift_vec3_add(b.min, b.max), 0.5f);
 }
 

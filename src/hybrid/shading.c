@@ -100,12 +100,7 @@ static int light_polygon(const drift_scene *scene, const drift_light *l, drift_v
         *out_normal = drift_vec3_cross(l->edge_u, l->edge_v);
         return 4;
     }
-    const drift_mesh *mesh = &scene->meshes[l->mesh];
-    const uint32_t *idx = mesh->indices + 3u * l->triangle;
-    for (int k = 0; k < 3; ++k) {
-        const float *v = mesh->positions + 3u * idx[k];
-        out[k] = drift_vec3_make(v[0], v[1], v[2]);
-    }
+    drift_light_triangle_vertices(scene, l, &out[0], &out[1], &out[2]);
     *out_normal = drift_vec3_cross(drift_vec3_sub(out[1], out[0]), drift_vec3_sub(out[2], out[0]));
     return 3;
 }

@@ -25,8 +25,8 @@ const drift__env_distribution *drift__light_table_environment(const drift_scene 
 
 // --- GEOMETRY HELPERS ---
 
-static void triangle_vertices(const drift_scene *scene, const drift_light *l, drift_vec3 *a,
-                              drift_vec3 *b, drift_vec3 *c)
+void drift_light_triangle_vertices(const drift_scene *scene, const drift_light *l, drift_vec3 *a,
+                                   drift_vec3 *b, drift_vec3 *c)
 {
     const drift_mesh *mesh = &scene->meshes[l->mesh];
     const uint32_t *tri = mesh->indices + 3 * (size_t)l->triangle;
@@ -48,7 +48,7 @@ static float light_area(const drift_scene *scene, const drift_light *l)
         return 4.0f * DRIFT_PI * l->radius * l->radius;
     case DRIFT_LIGHT_TRIANGLE: {
         drift_vec3 a, b, c;
-        triangle_vertices(scene, l, &a, &b, &c);
+        drift_light_triangle_vertices(scene, l, &a, &b, &c);
         return 0.5f * drift_vec3_length(drift_vec3_cross(drift_vec3_sub(b, a), drift_vec3_sub(c, a)));
     }
     case DRIFT_LIGHT_POINT:
@@ -94,7 +94,7 @@ static drift_vec3 flat_light_normal(const drift_scene *scene, const drift_light 
         return l->direction;
     case DRIFT_LIGHT_TRIANGLE: {
         drift_vec3 a, b, c;
-        triangle_vertices(scene, l, &a, &b, &c);
+        drift_light_triangle_vertices(scene, l, &a, &b, &c);
         return drift_vec3_normalize(drift_vec3_cross(drift_vec3_sub(b, a), drift_vec3_sub(c, a)));
     }
     case DRIFT_LIGHT_SPHERE:
@@ -353,7 +353,7 @@ drift_light_sample drift_light_sample_li(const drift_scene *scene, uint32_t ligh
     }
     case DRIFT_LIGHT_TRIANGLE: {
         drift_vec3 a, b, c;
-        triangle_vertices(scene, l, &a, &b, &c);
+        drift_light_triangle_vertices(scene, l, &a, &b, &c);
         drift_vec2 bary = drift_sample_triangle(u);
         drift_vec3 p = drift_vec3_add(drift_vec3_scale(a, 1.0f - bary.x - bary.y),
                                       drift_vec3_add(drift_vec3_scale(b, bary.x),

@@ -427,11 +427,7 @@ drift_result drift_scene_commit(drift_scene *scene)
     // Bounds over meshes and light shapes.
     drift_bounds3 bounds = drift_bounds3_empty();
     for (uint32_t m = 0; m < scene->mesh_count; ++m) {
-        const drift_mesh *mesh = &scene->meshes[m];
-        for (uint32_t v = 0; v < mesh->vertex_count; ++v) {
-            const float *p = mesh->positions + 3 * (size_t)v;
-            bounds = drift_bounds3_extend(bounds, drift_vec3_make(p[0], p[1], p[2]));
-        }
+        bounds = drift_bounds3_union(bounds, drift_mesh_bounds(&scene->meshes[m]));
     }
     for (uint32_t i = 0; i < scene->light_count; ++i) {
         const drift_light *l = &scene->lights[i];
@@ -483,6 +479,16 @@ drift_result drift_scene_commit(drift_scene *scene)
     }
     scene->committed = true;
     return DRIFT_OK;
+}
+
+drift_bounds3 drift_mesh_bounds(const drift_mesh *mesh)
+{
+    drift_bounds3 bounds = drift_bounds3_empty();
+    for (uint32_t v = 0; v < mesh->vertex_count; ++v) {
+        const float *p = mesh->positions + 3 * (size_t)v;
+        bounds = drift_bounds3_extend(bounds, drift_vec3_make(p[0], p[1], p[2]));
+    }
+    return bounds;
 }
 
 uint64_t drift_scene_triangle_count(const drift_scene *scene)
