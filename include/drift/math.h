@@ -232,6 +232,17 @@ static inline uint32_t drift_hash_combine(uint32_t seed, uint32_t v)
     return drift_hash_u32(seed ^ (v + 0x9e3779b9U + (seed << 6) + (seed >> 2)));
 }
 
+// The bits of x in reverse order: the base-2 radical inverse as 32-bit fixed point (van der
+// Corput), the basis of the Sobol sampler and of Hammersley point sets.
+static inline uint32_t drift_reverse_bits(uint32_t x)
+{
+    x = ((x >> 1) & 0x55555555U) | ((x & 0x55555555U) << 1);
+    x = ((x >> 2) & 0x33333333U) | ((x & 0x33333333U) << 2);
+    x = ((x >> 4) & 0x0f0f0f0fU) | ((x & 0x0f0f0f0fU) << 4);
+    x = ((x >> 8) & 0x00ff00ffU) | ((x & 0x00ff00ffU) << 8);
+    return (x >> 16) | (x << 16);
+}
+
 // 24 high bits to a float in [0, 1).
 static inline float drift_u32_to_unit(uint32_t x)
 {

@@ -46,6 +46,13 @@ typedef struct drift_hybrid_light {
     float *light_cdf;       // light_count entries: area CDF over the triangles (meshes), or NULL
 } drift_hybrid_light;
 
+// Whether scene light `scene_light` (e.g. drift_hit.light) is part of this light: a ray that
+// meets it has reached the light, not an occluder.
+static inline bool drift_hybrid_light_owns(const drift_hybrid_light *light, uint32_t scene_light)
+{
+    return scene_light != DRIFT_INVALID_INDEX && scene_light - light->first_light < light->light_count;
+}
+
 // Builds the hybrid lights of a committed scene (not the environment). *out_lights is NULL
 // when there are none. Free with drift_hybrid_lights_destroy.
 drift_result drift_hybrid_lights_build(drift_context *ctx, const drift_scene *scene,

@@ -9,14 +9,8 @@
 // Point k of a Hammersley set of n points in [0,1)^2 shifted by `shift` modulo 1.
 static drift_vec2 shifted_hammersley(uint32_t k, uint32_t n, drift_vec2 shift)
 {
-    uint32_t bits = k;
-    bits = (bits << 16) | (bits >> 16);
-    bits = ((bits & 0x55555555u) << 1) | ((bits & 0xAAAAAAAAu) >> 1);
-    bits = ((bits & 0x33333333u) << 2) | ((bits & 0xCCCCCCCCu) >> 2);
-    bits = ((bits & 0x0F0F0F0Fu) << 4) | ((bits & 0xF0F0F0F0u) >> 4);
-    bits = ((bits & 0x00FF00FFu) << 8) | ((bits & 0xFF00FF00u) >> 8);
     float x = ((float)k + 0.5f) / (float)n + shift.x;
-    float y = (float)bits * 0x1p-32f + shift.y;
+    float y = (float)drift_reverse_bits(k) * 0x1p-32f + shift.y;
     return drift_vec2_make(x - floorf(x), y - floorf(y));
 }
 
@@ -200,12 +194,6 @@ drift_vec3 drift_hybrid_environment_direct(const drift_scene *scene, const drift
     return drift_vec3_scale(sum, 1.0f / (float)n);
 }
 
-static bool hit_is_light(const drift_hybrid_light *light, const drift_hit *hit)
-{
-    return hit->light != DRIFT_INVALID_INDEX && hit->light >= light->first_light &&
-           hit->light - light->first_light < light->light_count;
-}
-
 bool drift_hybrid_hard_shadow(const drift_accel *accel, const drift_hybrid_light *light,
                               const drift_surface *surface, float *out_occluder_distance,
                               float *out_light_distance)
@@ -229,7 +217,7 @@ bool drift_hybrid_hard_shadow(const drift_accel *accel, const drift_hybrid_light
                       .tmin = 0.0f,
                       .tmax = isfinite(distance) ? distance * (1.0f - 1e-4f) : INFINITY };
     drift_hit hit;
-    if (!drift_accel_intersect(accel, &ray, &hit) || hit_is_light(light, &hit)) {
+    if (!drift_accel_intersect(accel, &ray, &hit) || drift_hybrid_light_owns(light, hit.light)) {
         return true;
     }
     *out_occluder_distance = hit.t;

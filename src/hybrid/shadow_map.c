@@ -127,16 +127,11 @@ static float cube_texel_angle(float u, float v, int32_t size)
 typedef struct build_job {
     drift_shadow_map *map;
     const drift_accel *accel;
-    uint32_t first_light, light_count;
+    const drift_hybrid_light *light;
     float tmin; // where rays start: past the centre, which lies on a planar light's shape
     int face_of_slot[CUBE_FACES];
     atomic_uint_fast64_t rays;
 } build_job;
-
-static bool is_own_light(const build_job *job, uint32_t light)
-{
-    return light != DRIFT_INVALID_INDEX && light - job->first_light < job->light_count;
-}
 
 // Distance along the unit direction to the nearest surface that is not the light's own
 // shape (rays from a sphere light's centre would hit its inside), INFINITY on a miss.
@@ -149,7 +144,7 @@ static float trace_depth(const build_job *job, drift_vec3 origin, drift_vec3 dir
         if (!drift_accel_intersect(job->accel, &ray, &hit)) {
             return INFINITY;
         }
-        if (!is_own_light(job, hit.light)) {
+        if (!drift_hybrid_light_owns(job->light, hit.light)) {
             return hit.t;
         }
         // Re-trace from just past the hit; t stays measured from the centre.
@@ -291,8 +286,7 @@ drift_result drift_shadow_map_build(drift_context *ctx, const drift_scene *scene
     map->centre = light->centre;
     build_job job = { .map = map,
                       .accel = accel,
-                      .first_light = light->first_light,
-                      .light_count = light->light_count };
+                      .light = light };
     if (map->directional) {
         setup_orthographic(map, scene, light->direction);
         map->slot_count = 1;

@@ -1,14 +1,5 @@
 #include "drift/math.h"
 
-static uint32_t reverse_bits(uint32_t x)
-{
-    x = ((x >> 1) & 0x55555555U) | ((x & 0x55555555U) << 1);
-    x = ((x >> 2) & 0x33333333U) | ((x & 0x33333333U) << 2);
-    x = ((x >> 4) & 0x0f0f0f0fU) | ((x & 0x0f0f0f0fU) << 4);
-    x = ((x >> 8) & 0x00ff00ffU) | ((x & 0x00ff00ffU) << 8);
-    return (x >> 16) | (x << 16);
-}
-
 // Burley 2020, §3: Laine-Karras style hash that only lets lower bits affect higher ones;
 // applied to bit-reversed values it is a nested uniform (Owen) scramble.
 static uint32_t laine_karras_permutation(uint32_t x, uint32_t seed)
@@ -23,14 +14,14 @@ static uint32_t laine_karras_permutation(uint32_t x, uint32_t seed)
 
 static uint32_t nested_uniform_scramble(uint32_t x, uint32_t seed)
 {
-    return reverse_bits(laine_karras_permutation(reverse_bits(x), seed));
+    return drift_reverse_bits(laine_karras_permutation(drift_reverse_bits(x), seed));
 }
 
 // First two Sobol dimensions as 32-bit fixed point. Dimension 0 is van der Corput; the
 // direction numbers of dimension 1 follow v_i = v_{i-1} ^ (v_{i-1} >> 1).
 static uint32_t sobol_dim0(uint32_t index)
 {
-    return reverse_bits(index);
+    return drift_reverse_bits(index);
 }
 
 static uint32_t sobol_dim1(uint32_t index)
