@@ -164,15 +164,22 @@ static drift_result write_stats(const render_options *o, const char *scene_path,
 
 static drift_result write_aov(drift_context *ctx, const char *path, const drift_hybrid *frame)
 {
-    drift_image_layer layers[128];
-    uint32_t count = 0;
     const char *name;
     const drift_image *image;
-    while (count < 128 && drift_hybrid_plane(frame, count, &name, &image)) {
-        layers[count] = (drift_image_layer){ name, image };
+    uint32_t count = 0;
+    while (drift_hybrid_plane(frame, count, &name, &image)) {
         ++count;
     }
-    return drift_image_save_exr(ctx, path, layers, count);
+    drift_image_layer *layers = calloc(count, sizeof *layers);
+    if (!layers) {
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    for (uint32_t i = 0; i < count; ++i) {
+        drift_hybrid_plane(frame, i, &layers[i].name, &layers[i].image);
+    }
+    drift_result r = drift_image_save_exr(ctx, path, layers, count);
+    free(layers);
+    return r;
 }
 
 static drift_result write_outputs(drift_context *ctx, const render_options *o,

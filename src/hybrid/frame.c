@@ -193,9 +193,12 @@ drift_result drift_hybrid_create(drift_context *ctx, const drift_scene *scene,
     drift_result r = drift_hybrid_lights_build(ctx, scene, &f->lights, &f->light_count);
     if (r == DRIFT_OK) {
         f->counters = drift_alloc(ctx, sizeof(drift_ray_counter) * (size_t)f->thread_count);
+        // + 1: a scene with no lights still gets an allocation.
         f->light_buffers =
             drift_alloc(ctx, sizeof(drift_hybrid_light_buffers) * (f->light_count + 1u));
-        r = f->counters && f->light_buffers ? DRIFT_OK : DRIFT_ERR_OUT_OF_MEMORY;
+        f->plane_capacity = DRIFT_HYBRID_FIXED_PLANES + DRIFT_HYBRID_PLANES_PER_LIGHT * f->light_count;
+        f->planes = drift_alloc(ctx, sizeof(drift_hybrid_plane_ref) * f->plane_capacity);
+        r = f->counters && f->light_buffers && f->planes ? DRIFT_OK : DRIFT_ERR_OUT_OF_MEMORY;
     }
     if (r == DRIFT_OK) {
         r = create_images(f);
@@ -256,6 +259,7 @@ void drift_hybrid_destroy(drift_hybrid *f)
     }
     drift_hybrid_lights_destroy(ctx, f->lights, f->light_count);
     drift_free(ctx, f->light_buffers);
+    drift_free(ctx, f->planes);
     drift_free(ctx, f->counters);
     drift_free(ctx, f);
 }
@@ -352,11 +356,10 @@ void drift_hybrid_copy_rgb(const drift_image *from, drift_image *to)
 
 static void add_plane(drift_hybrid *f, const char *name, const drift_image *image)
 {
-    if (f->plane_count < DRIFT_HYBRID_MAX_PLANES) {
-        drift_hybrid_plane_ref *p = &f->planes[f->plane_count++];
-        snprintf(p->name, sizeof p->name, "%s", name);
-        p->image = image;
-    }
+    DRIFT_CHECK(f->plane_count < f->plane_capacity); // sized for every plane at create
+    drift_hybrid_plane_ref *p = &f->planes[f->plane_count++];
+    snprintf(p->name, sizeof p->name, "%s", name);
+    p->image = image;
 }
 
 // The planes this frame filled, in a stable order: final image first.

@@ -8,7 +8,9 @@
 #include "hybrid/hybrid_internal.h"
 #include "drift/pt.h"
 
-#define DRIFT_HYBRID_MAX_PLANES 128
+// Planes the frame can list: the fixed ones, plus three a light.
+#define DRIFT_HYBRID_FIXED_PLANES 24
+#define DRIFT_HYBRID_PLANES_PER_LIGHT 3
 #define DRIFT_HYBRID_PLANE_NAME 48
 
 typedef struct drift_hybrid_plane_ref {
@@ -68,8 +70,8 @@ struct drift_hybrid {
     drift_ray_counter *counters; // one per thread
     int thread_count;
     drift_hybrid_stats stats;
-    drift_hybrid_plane_ref planes[DRIFT_HYBRID_MAX_PLANES];
-    uint32_t plane_count;
+    drift_hybrid_plane_ref *planes; // room for every plane (sized at create)
+    uint32_t plane_count, plane_capacity;
 };
 
 // Runs fn for every pixel, rows in parallel. `rays` is the calling thread's ray counter.
