@@ -18,7 +18,7 @@
 //   drift_image beauty;  drift_pt_resolve(pt, DRIFT_PT_AOV_BEAUTY, &beauty);  // owned by pt
 //   drift_pt_destroy(pt);
 //
-// Ownership: scene, accel and params.camera are borrowed and must outlive the pt. Images
+// Ownership: scene and accel are borrowed and must outlive the pt. Images
 // returned by drift_pt_resolve belong to the pt and stay valid until the next render call or
 // destroy.
 // Threads: one pt is driven from one thread; it uses the context's pool internally.
@@ -84,8 +84,9 @@ typedef struct drift_pt_params {
     bool pixel_centre;   // every sample through the pixel centre (no pixel jitter): the same
                          // footprint as a one-sample-per-pixel G-buffer
     bool pinhole;        // ignore the camera's aperture
-    const drift_camera *camera; // NULL = scene->camera; else this camera (borrowed; must
-                                // outlive the pt). width/height still come from params.
+    const drift_camera *camera; // NULL = scene->camera; else this camera, copied at create
+                                // (moving it later does not move the pt's camera).
+                                // width/height still come from params.
 } drift_pt_params;
 
 drift_pt_params drift_pt_params_resolve(const drift_pt_params *params, const drift_scene *scene);

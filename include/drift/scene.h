@@ -61,6 +61,28 @@ typedef struct drift_camera {
 drift_camera drift_camera_look_at(drift_vec3 position, drift_vec3 target, drift_vec3 up,
                                   float fov_y, int32_t width, int32_t height);
 
+// What every ray of one image shares: the camera's right-handed frame (w forward, u
+// image-right, v image-up), the film scale and the focus distance. Renderers derive it once
+// per image instead of once per ray.
+typedef struct drift_camera_frame {
+    drift_camera camera;
+    drift_vec3 u, v, w;
+    float tan_half;       // tan(fov_y / 2)
+    float aspect;         // width / height
+    float focus;          // focus_distance, or |target - position| when that is 0
+    int32_t width, height;
+} drift_camera_frame;
+
+drift_camera_frame drift_camera_frame_make(const drift_camera *camera, int32_t width,
+                                           int32_t height);
+// As drift_camera_ray, bit for bit.
+drift_ray drift_camera_frame_ray(const drift_camera_frame *frame, float film_x, float film_y,
+                                 drift_vec2 lens);
+// Film position (pixels, top-left origin) of world point p through the pinhole; false when
+// p is not in front of the camera. The inverse of drift_camera_frame_ray with a pinhole.
+bool drift_camera_frame_project(const drift_camera_frame *frame, drift_vec3 p,
+                                drift_vec2 *out_film);
+
 // The ray through film point (film_x, film_y) in pixels (top-left origin; pixel centres at
 // +0.5) for an image of width x height, with lens sample `lens` in [0,1)^2 (ignored for a
 // pinhole). The direction is unit length.

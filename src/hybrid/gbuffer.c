@@ -46,42 +46,13 @@ void drift_gbuffer_destroy(drift_context *ctx, drift_gbuffer *gbuffer)
     gbuffer->mesh_index = NULL;
 }
 
-drift_ray drift_gbuffer_ray(const drift_camera *camera, int32_t width, int32_t height, int32_t x,
-                            int32_t y)
-{
-    drift_camera pinhole = *camera;
-    pinhole.aperture_radius = 0.0f;
-    return drift_camera_ray(&pinhole, width, height, (float)x + 0.5f, (float)y + 0.5f,
-                            drift_vec2_make(0.5f, 0.5f));
-}
-
-bool drift_camera_project(const drift_camera *camera, int32_t width, int32_t height, drift_vec3 p,
-                          drift_vec2 *out_film)
-{
-    // The inverse of drift_camera_ray's pinhole: same frame, same scale.
-    drift_vec3 w = drift_vec3_normalize(drift_vec3_sub(camera->target, camera->position));
-    drift_vec3 u = drift_vec3_normalize(drift_vec3_cross(w, camera->up));
-    drift_vec3 v = drift_vec3_cross(u, w);
-    drift_vec3 d = drift_vec3_sub(p, camera->position);
-    float z = drift_vec3_dot(d, w);
-    if (!(z > 0.0f)) {
-        return false;
-    }
-    float tan_half = tanf(0.5f * camera->fov_y);
-    float aspect = (float)width / (float)height;
-    float sx = drift_vec3_dot(d, u) / (z * tan_half * aspect);
-    float sy = drift_vec3_dot(d, v) / (z * tan_half);
-    *out_film = drift_vec2_make(0.5f * (sx + 1.0f) * (float)width, 0.5f * (1.0f - sy) * (float)height);
-    return true;
-}
-
 typedef struct gbuffer_job {
     const drift_scene *scene;
     const drift_accel *accel;
-    const drift_camera *camera;
-    const drift_camera *prev_camera;
+    drift_camera_frame camera;      // pinhole: the G-buffer samples no lens
+    drift_camera_frame prev_camera;
+    bool has_prev_camera;
     drift_gbuffer *gbuffer;
-    drift_vec3 forward;
     int32_t tiles_x;
 } gbuffer_job;
 
@@ -114,7 +85,7 @@ static void write_pixel(const gbuffer_job *job, int32_t x, int32_t y, const drif
     }
     *surface = drift_scene_surface(scene, ray, hit);
     drift_image_pixel(&g->depth, x, y)[0] =
-        drift_vec3_dot(drift_vec3_sub(surface->position, ray->origin), job->forward);
+        drift_vec3_dot(drift_vec3_sub(surface->position, ray->origin), job->camera.w);
     drift_image_set3(&g->position, x, y, surface->position);
     drift_image_set3(&g->normal, x, y, surface->ns);
     drift_image_set3(&g->geometric_normal, x, y, surface->ng);
@@ -138,8 +109,8 @@ static void write_pixel(const gbuffer_job *job, int32_t x, int32_t y, const drif
     drift_image_pixel(&g->material_id, x, y)[0] = material_id;
     drift_vec2 prev;
     float *motion = drift_image_pixel(&g->motion, x, y);
-    if (job->prev_camera &&
-        drift_camera_project(job->prev_camera, g->width, g->height, surface->position, &prev)) {
+    if (job->has_prev_camera &&
+        drift_camera_frame_project(&job->prev_camera, surface->position, &prev)) {
         motion[0] = prev.x - ((float)x + 0.5f);
         motion[1] = prev.y - ((float)y + 0.5f);
     } else {
@@ -162,7 +133,8 @@ static void render_tiles(size_t begin, size_t end, int thread_index, void *user)
         uint32_t n = 0;
         for (int32_t y = y0; y < y1; ++y) {
             for (int32_t x = x0; x < x1; ++x) {
-                rays[n++] = drift_gbuffer_ray(job->camera, g->width, g->height, x, y);
+                rays[n++] = drift_camera_frame_ray(&job->camera, (float)x + 0.5f, (float)y + 0.5f,
+                                                   drift_vec2_make(0.5f, 0.5f));
             }
         }
         drift_accel_intersect_coherent(job->accel, rays, hits, n);
@@ -179,15 +151,19 @@ void drift_gbuffer_render(drift_context *ctx, const drift_scene *scene, const dr
                           const drift_camera *camera, const drift_camera *prev_camera,
                           drift_gbuffer *gbuffer, uint64_t *rays)
 {
+    drift_camera pinhole = *camera;
+    pinhole.aperture_radius = 0.0f;
     gbuffer_job job = {
         .scene = scene,
         .accel = accel,
-        .camera = camera,
-        .prev_camera = prev_camera,
+        .camera = drift_camera_frame_make(&pinhole, gbuffer->width, gbuffer->height),
+        .has_prev_camera = prev_camera != NULL,
         .gbuffer = gbuffer,
-        .forward = drift_vec3_normalize(drift_vec3_sub(camera->target, camera->position)),
         .tiles_x = (gbuffer->width + TILE - 1) / TILE,
     };
+    if (prev_camera) {
+        job.prev_camera = drift_camera_frame_make(prev_camera, gbuffer->width, gbuffer->height);
+    }
     int32_t tiles_y = (gbuffer->height + TILE - 1) / TILE;
     drift_parallel_for(ctx, (size_t)job.tiles_x * (size_t)tiles_y, 1, render_tiles, &job);
     *rays += (uint64_t)gbuffer->width * (uint64_t)gbuffer->height;

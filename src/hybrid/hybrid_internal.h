@@ -17,15 +17,6 @@ void drift_gbuffer_render(drift_context *ctx, const drift_scene *scene, const dr
                           const drift_camera *camera, const drift_camera *prev_camera,
                           drift_gbuffer *gbuffer, uint64_t *rays);
 
-// The pinhole ray through the centre of pixel (x, y): what the G-buffer traced.
-drift_ray drift_gbuffer_ray(const drift_camera *camera, int32_t width, int32_t height, int32_t x,
-                            int32_t y);
-
-// Film position (pixels, top-left origin) of world point p seen by a pinhole camera; false
-// when p is behind the camera.
-bool drift_camera_project(const drift_camera *camera, int32_t width, int32_t height, drift_vec3 p,
-                          drift_vec2 *out_film);
-
 // --- LIGHTS AS THE HYBRID FRAME SEES THEM (lights.c) ---
 
 // One light of the frame: a scene light, or every triangle light of one emissive mesh

@@ -19,7 +19,7 @@ struct drift_pt {
     const drift_scene *scene;
     const drift_accel *accel;
     drift_pt_params params;
-    const drift_camera *camera; // params.camera or the scene's
+    drift_camera_frame camera; // params.camera or the scene's, pinhole when asked, per image
     double *sums;     // SUM_CHANNELS a pixel
     uint32_t *counts; // samples a pixel
     thread_stats *thread_stats;
@@ -87,7 +87,11 @@ drift_result drift_pt_create(drift_context *ctx, const drift_scene *scene, const
     pt->scene = scene;
     pt->accel = accel;
     pt->params = p;
-    pt->camera = p.camera ? p.camera : &scene->camera;
+    drift_camera camera = p.camera ? *p.camera : scene->camera;
+    if (p.pinhole) {
+        camera.aperture_radius = 0.0f;
+    }
+    pt->camera = drift_camera_frame_make(&camera, p.width, p.height);
     pt->thread_count = drift_context_thread_count(ctx);
     size_t pixels = (size_t)p.width * (size_t)p.height;
     pt->sums = drift_alloc(ctx, pixels * SUM_CHANNELS * sizeof(double));
@@ -251,12 +255,7 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
     if (p->pixel_centre) {
         film = drift_vec2_make(0.5f, 0.5f); // the dimensions are still drawn: same layout
     }
-    drift_camera camera = *pt->camera;
-    if (p->pinhole) {
-        camera.aperture_radius = 0.0f;
-    }
-    drift_ray ray = drift_camera_ray(&camera, p->width, p->height, (float)x + film.x,
-                                     (float)y + film.y, lens);
+    drift_ray ray = drift_camera_frame_ray(&pt->camera, (float)x + film.x, (float)y + film.y, lens);
     *out = (path_result){ 0 };
     drift_vec3 radiance = drift_vec3_splat(0.0f);
     drift_vec3 beta = drift_vec3_splat(1.0f);

@@ -11,33 +11,60 @@ drift_camera drift_camera_look_at(drift_vec3 position, drift_vec3 target, drift_
                            .height = height };
 }
 
-drift_ray drift_camera_ray(const drift_camera *camera, int32_t width, int32_t height, float film_x,
-                           float film_y, drift_vec2 lens)
+drift_camera_frame drift_camera_frame_make(const drift_camera *camera, int32_t width,
+                                           int32_t height)
 {
-    // Right-handed camera frame: w forward, u image-right, v image-up.
+    drift_camera_frame f = { .camera = *camera, .width = width, .height = height };
     drift_vec3 forward = drift_vec3_sub(camera->target, camera->position);
-    drift_vec3 w = drift_vec3_normalize(forward);
-    drift_vec3 u = drift_vec3_normalize(drift_vec3_cross(w, camera->up));
-    drift_vec3 v = drift_vec3_cross(u, w);
-    float tan_half = tanf(0.5f * camera->fov_y);
-    float aspect = (float)width / (float)height;
-    float sx = (2.0f * film_x / (float)width - 1.0f) * tan_half * aspect;
-    float sy = (1.0f - 2.0f * film_y / (float)height) * tan_half;
-    drift_vec3 dir = drift_vec3_add(w, drift_vec3_add(drift_vec3_scale(u, sx), drift_vec3_scale(v, sy)));
+    f.w = drift_vec3_normalize(forward);
+    f.u = drift_vec3_normalize(drift_vec3_cross(f.w, camera->up));
+    f.v = drift_vec3_cross(f.u, f.w);
+    f.tan_half = tanf(0.5f * camera->fov_y);
+    f.aspect = (float)width / (float)height;
+    f.focus = camera->focus_distance > 0.0f ? camera->focus_distance : drift_vec3_length(forward);
+    return f;
+}
+
+drift_ray drift_camera_frame_ray(const drift_camera_frame *f, float film_x, float film_y,
+                                 drift_vec2 lens)
+{
+    const drift_camera *camera = &f->camera;
+    float sx = (2.0f * film_x / (float)f->width - 1.0f) * f->tan_half * f->aspect;
+    float sy = (1.0f - 2.0f * film_y / (float)f->height) * f->tan_half;
+    drift_vec3 dir = drift_vec3_add(f->w, drift_vec3_add(drift_vec3_scale(f->u, sx), drift_vec3_scale(f->v, sy)));
     drift_ray ray = { .origin = camera->position, .tmin = 0.0f, .tmax = INFINITY };
     if (camera->aperture_radius > 0.0f) {
         // Thin lens: every ray through the lens meets the pinhole ray on the focus plane.
-        float focus = camera->focus_distance > 0.0f ? camera->focus_distance
-                                                    : drift_vec3_length(forward);
-        drift_vec3 focus_point = drift_vec3_fma(camera->position, dir, focus);
+        drift_vec3 focus_point = drift_vec3_fma(camera->position, dir, f->focus);
         drift_vec2 d = drift_sample_disk_concentric(lens);
         drift_vec3 lens_point = drift_vec3_add(
             camera->position,
-            drift_vec3_add(drift_vec3_scale(u, d.x * camera->aperture_radius),
-                           drift_vec3_scale(v, d.y * camera->aperture_radius)));
+            drift_vec3_add(drift_vec3_scale(f->u, d.x * camera->aperture_radius),
+                           drift_vec3_scale(f->v, d.y * camera->aperture_radius)));
         ray.origin = lens_point;
         dir = drift_vec3_sub(focus_point, lens_point);
     }
     ray.dir = drift_vec3_normalize(dir);
     return ray;
+}
+
+bool drift_camera_frame_project(const drift_camera_frame *f, drift_vec3 p, drift_vec2 *out_film)
+{
+    drift_vec3 d = drift_vec3_sub(p, f->camera.position);
+    float z = drift_vec3_dot(d, f->w);
+    if (!(z > 0.0f)) {
+        return false;
+    }
+    float sx = drift_vec3_dot(d, f->u) / (z * f->tan_half * f->aspect);
+    float sy = drift_vec3_dot(d, f->v) / (z * f->tan_half);
+    *out_film = drift_vec2_make(0.5f * (sx + 1.0f) * (float)f->width,
+                                0.5f * (1.0f - sy) * (float)f->height);
+    return true;
+}
+
+drift_ray drift_camera_ray(const drift_camera *camera, int32_t width, int32_t height, float film_x,
+                           float film_y, drift_vec2 lens)
+{
+    drift_camera_frame f = drift_camera_frame_make(camera, width, height);
+    return drift_camera_frame_ray(&f, film_x, film_y, lens);
 }
