@@ -38,22 +38,45 @@ static void unshadowed_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *ra
                                            f->params.light_samples, &sampler, rays));
 }
 
-static void hard_shadow_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays, void *user)
+// Hard shadows of one row toward one light, traced as coherent packets: neighbouring
+// pixels aim at the same centre.
+#define SHADOW_BATCH 64
+
+static void hard_shadow_row(drift_hybrid *f, int32_t y, uint64_t *rays, void *user)
 {
     (void)user;
-    const drift_surface *s = &f->gbuffer.surfaces[pixel_index(f, x, y)];
+    drift_ray batch[SHADOW_BATCH];
+    drift_hit hits[SHADOW_BATCH];
+    int32_t xs[SHADOW_BATCH];
+    float light_distance[SHADOW_BATCH];
     for (uint32_t l = 0; l < f->light_count; ++l) {
         drift_hybrid_light_buffers *b = &f->light_buffers[l];
-        float *out = drift_image_pixel(&b->hard_shadow, x, y);
-        if (s->material == DRIFT_INVALID_INDEX) {
-            out[0] = 0.0f;
-            out[1] = out[2] = INFINITY;
-        } else {
-            ++*rays;
-            out[0] = drift_hybrid_hard_shadow(f->accel, &f->lights[l], s, &out[1], &out[2]) ? 1.0f
-                                                                                            : 0.0f;
+        for (int32_t x0 = 0; x0 < f->params.width; x0 += SHADOW_BATCH) {
+            int32_t x1 = x0 + SHADOW_BATCH < f->params.width ? x0 + SHADOW_BATCH : f->params.width;
+            uint32_t n = 0;
+            for (int32_t x = x0; x < x1; ++x) {
+                const drift_surface *s = &f->gbuffer.surfaces[pixel_index(f, x, y)];
+                float *out = drift_image_pixel(&b->hard_shadow, x, y);
+                if (s->material == DRIFT_INVALID_INDEX) {
+                    out[0] = 0.0f;
+                    out[1] = out[2] = INFINITY;
+                    drift_image_pixel(&b->shadow, x, y)[0] = 0.0f;
+                    continue;
+                }
+                xs[n] = x;
+                batch[n] = drift_hybrid_hard_shadow_ray(&f->lights[l], s, &light_distance[n]);
+                ++n;
+            }
+            drift_accel_intersect_coherent(f->accel, batch, hits, n);
+            *rays += n;
+            for (uint32_t k = 0; k < n; ++k) {
+                float *out = drift_image_pixel(&b->hard_shadow, xs[k], y);
+                bool visible = drift_hybrid_hard_shadow_visible(&f->lights[l], &hits[k], &out[1]);
+                out[0] = visible ? 1.0f : 0.0f;
+                out[2] = light_distance[k];
+                drift_image_pixel(&b->shadow, xs[k], y)[0] = out[0];
+            }
         }
-        drift_image_pixel(&b->shadow, x, y)[0] = out[0];
     }
 }
 
@@ -117,7 +140,7 @@ drift_result drift_hybrid_pass_direct(drift_hybrid *f)
 
     t = drift_time_now();
     if (f->params.shadows == DRIFT_SHADOWS_HARD) {
-        st->rays[DRIFT_PASS_HARD_SHADOWS] += drift_hybrid_for_each_pixel(f, hard_shadow_pixel, NULL);
+        st->rays[DRIFT_PASS_HARD_SHADOWS] += drift_hybrid_for_each_row(f, hard_shadow_row, NULL);
         st->ms[DRIFT_PASS_HARD_SHADOWS] = 1000.0 * (drift_time_now() - t);
     } else {
         drift_result r = build_shadow_maps(f);

@@ -298,35 +298,52 @@ drift_hybrid_params drift_hybrid_get_params(const drift_hybrid *f)
 
 // --- SHARED PIECES OF THE PASSES ---
 
-typedef struct pixel_job {
+typedef struct row_job {
     drift_hybrid *frame;
-    drift_hybrid_pixel_fn fn;
+    drift_hybrid_row_fn fn;
     void *user;
-} pixel_job;
+} row_job;
 
 static void run_rows(size_t begin, size_t end, int thread_index, void *user)
 {
-    const pixel_job *job = user;
+    const row_job *job = user;
     uint64_t *rays = &job->frame->counters[thread_index].rays;
     for (size_t y = begin; y < end; ++y) {
-        for (int32_t x = 0; x < job->frame->params.width; ++x) {
-            job->fn(job->frame, x, (int32_t)y, rays, job->user);
-        }
+        job->fn(job->frame, (int32_t)y, rays, job->user);
     }
 }
 
-uint64_t drift_hybrid_for_each_pixel(drift_hybrid *frame, drift_hybrid_pixel_fn fn, void *user)
+uint64_t drift_hybrid_for_each_row(drift_hybrid *frame, drift_hybrid_row_fn fn, void *user)
 {
     for (int t = 0; t < frame->thread_count; ++t) {
         frame->counters[t].rays = 0;
     }
-    pixel_job job = { frame, fn, user };
+    row_job job = { frame, fn, user };
     drift_parallel_for(frame->ctx, (size_t)frame->params.height, 1, run_rows, &job);
     uint64_t total = 0;
     for (int t = 0; t < frame->thread_count; ++t) {
         total += frame->counters[t].rays;
     }
     return total;
+}
+
+typedef struct pixel_job {
+    drift_hybrid_pixel_fn fn;
+    void *user;
+} pixel_job;
+
+static void pixels_of_row(drift_hybrid *frame, int32_t y, uint64_t *rays, void *user)
+{
+    const pixel_job *job = user;
+    for (int32_t x = 0; x < frame->params.width; ++x) {
+        job->fn(frame, x, y, rays, job->user);
+    }
+}
+
+uint64_t drift_hybrid_for_each_pixel(drift_hybrid *frame, drift_hybrid_pixel_fn fn, void *user)
+{
+    pixel_job job = { fn, user };
+    return drift_hybrid_for_each_row(frame, pixels_of_row, &job);
 }
 
 drift_sampler drift_hybrid_sampler(const drift_hybrid *frame, uint32_t stream, int32_t x,

@@ -74,10 +74,12 @@ struct drift_hybrid {
     uint32_t plane_count, plane_capacity;
 };
 
-// Runs fn for every pixel, rows in parallel. `rays` is the calling thread's ray counter.
+// Runs fn for every row, or every pixel, rows in parallel. `rays` is the calling thread's ray
+// counter. Both return the rays the pass counted.
+typedef void (*drift_hybrid_row_fn)(drift_hybrid *frame, int32_t y, uint64_t *rays, void *user);
 typedef void (*drift_hybrid_pixel_fn)(drift_hybrid *frame, int32_t x, int32_t y, uint64_t *rays,
                                       void *user);
-// Returns the rays the pass counted.
+uint64_t drift_hybrid_for_each_row(drift_hybrid *frame, drift_hybrid_row_fn fn, void *user);
 uint64_t drift_hybrid_for_each_pixel(drift_hybrid *frame, drift_hybrid_pixel_fn fn, void *user);
 
 // Passes (each returns DRIFT_OK or an error already logged).

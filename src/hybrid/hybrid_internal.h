@@ -83,6 +83,13 @@ drift_vec3 drift_hybrid_environment_direct(const drift_scene *scene, const drift
 bool drift_hybrid_hard_shadow(const drift_accel *accel, const drift_hybrid_light *light,
                               const drift_surface *surface, float *out_occluder_distance,
                               float *out_light_distance);
+// The same in two halves, for callers that trace the rays in coherent batches: the ray, and
+// what its closest hit means (a hit with mesh and light both invalid is a miss, as
+// drift_accel_intersect_coherent reports it).
+drift_ray drift_hybrid_hard_shadow_ray(const drift_hybrid_light *light,
+                                       const drift_surface *surface, float *out_light_distance);
+bool drift_hybrid_hard_shadow_visible(const drift_hybrid_light *light, const drift_hit *hit,
+                                      float *out_occluder_distance);
 
 // Radiance leaving a hit point back along ray->dir, split in two: what it emits, and direct
 // light from every light with a hard shadow (one shadow ray each, counted in *rays). This is

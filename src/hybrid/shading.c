@@ -194,9 +194,8 @@ drift_vec3 drift_hybrid_environment_direct(const drift_scene *scene, const drift
     return drift_vec3_scale(sum, 1.0f / (float)n);
 }
 
-bool drift_hybrid_hard_shadow(const drift_accel *accel, const drift_hybrid_light *light,
-                              const drift_surface *surface, float *out_occluder_distance,
-                              float *out_light_distance)
+drift_ray drift_hybrid_hard_shadow_ray(const drift_hybrid_light *light,
+                                       const drift_surface *surface, float *out_light_distance)
 {
     drift_vec3 dir;
     float distance;
@@ -209,19 +208,34 @@ bool drift_hybrid_hard_shadow(const drift_accel *accel, const drift_hybrid_light
         dir = distance > 0.0f ? drift_vec3_scale(d, 1.0f / distance) : surface->ns;
     }
     *out_light_distance = distance;
-    *out_occluder_distance = INFINITY;
+    return (drift_ray){ .origin = drift_offset_origin(surface->position, surface->ng, dir),
+                        .dir = dir,
+                        .tmin = 0.0f,
+                        .tmax = isfinite(distance) ? distance * (1.0f - 1e-4f) : INFINITY };
+}
+
+bool drift_hybrid_hard_shadow_visible(const drift_hybrid_light *light, const drift_hit *hit,
+                                      float *out_occluder_distance)
+{
     // Closest hit rather than any hit: the buffer needs the occluder's distance, and a ray
     // toward the centre of a sphere light meets the light's own surface, which is no occluder.
-    drift_ray ray = { .origin = drift_offset_origin(surface->position, surface->ng, dir),
-                      .dir = dir,
-                      .tmin = 0.0f,
-                      .tmax = isfinite(distance) ? distance * (1.0f - 1e-4f) : INFINITY };
-    drift_hit hit;
-    if (!drift_accel_intersect(accel, &ray, &hit) || drift_hybrid_light_owns(light, hit.light)) {
+    bool missed = hit->mesh == DRIFT_INVALID_INDEX && hit->light == DRIFT_INVALID_INDEX;
+    if (missed || drift_hybrid_light_owns(light, hit->light)) {
+        *out_occluder_distance = INFINITY;
         return true;
     }
-    *out_occluder_distance = hit.t;
+    *out_occluder_distance = hit->t;
     return false;
+}
+
+bool drift_hybrid_hard_shadow(const drift_accel *accel, const drift_hybrid_light *light,
+                              const drift_surface *surface, float *out_occluder_distance,
+                              float *out_light_distance)
+{
+    drift_ray ray = drift_hybrid_hard_shadow_ray(light, surface, out_light_distance);
+    drift_hit hit = { .mesh = DRIFT_INVALID_INDEX, .light = DRIFT_INVALID_INDEX };
+    drift_accel_intersect(accel, &ray, &hit); // a miss leaves `hit` as it was: missed
+    return drift_hybrid_hard_shadow_visible(light, &hit, out_occluder_distance);
 }
 
 // Direct light at a secondary hit from every light, each with its hard shadow.
