@@ -43,7 +43,11 @@ typedef struct dof_job {
     drift_image *out;
     const drift_vec2 *taps; // offsets on the unit disk; taps[0] is the centre
     uint32_t tap_count;
+    uint8_t *uniform;       // per UNIFORM_TILE tile: every pixel its gathers read is alike
+    int32_t tiles_x;
 } dof_job;
+
+#define UNIFORM_TILE 16
 
 // The centre, then the concentric-disk image of a scrambled Sobol (0,2)-sequence: its first
 // 2^k points are stratified over [0,1)^2, so the taps cover the disk evenly.
@@ -127,19 +131,62 @@ static void gather_pixel(const dof_job *job, int32_t x, int32_t y, float radius,
     }
 }
 
+// Whether every pixel the gathers of tile (tx, ty) can read holds the same value. Each
+// gather then returns its centre exactly (it sums differences from the centre), so the tile
+// is copied instead: the background of a frame, with the largest circle of confusion and a
+// single colour, costs a scan instead of a gather.
+static bool tile_is_uniform(const dof_job *job, int32_t tx, int32_t ty)
+{
+    const drift_image *in = job->in;
+    int32_t x0 = tx * UNIFORM_TILE, y0 = ty * UNIFORM_TILE;
+    int32_t x1 = x0 + UNIFORM_TILE < in->width ? x0 + UNIFORM_TILE : in->width;
+    int32_t y1 = y0 + UNIFORM_TILE < in->height ? y0 + UNIFORM_TILE : in->height;
+    float reach = 0.0f;
+    for (int32_t y = y0; y < y1; ++y) {
+        for (int32_t x = x0; x < x1; ++x) {
+            reach = fmaxf(reach, drift_image_pixel(job->coc, x, y)[0]); // fmaxf drops NaN
+        }
+    }
+    // A tap lands within the radius; its bilinear fetch reads one pixel further.
+    int32_t pad = (int32_t)ceilf(fminf(reach, (float)(in->width + in->height))) + 1;
+    const float *first = drift_image_pixel(in, x0, y0);
+    for (int32_t y = clamp_index(y0 - pad, in->height); y <= clamp_index(y1 - 1 + pad, in->height); ++y) {
+        for (int32_t x = clamp_index(x0 - pad, in->width); x <= clamp_index(x1 - 1 + pad, in->width); ++x) {
+            const float *p = drift_image_pixel(in, x, y);
+            for (int32_t c = 0; c < in->channels; ++c) {
+                if (p[c] != first[c]) {
+                    return false;
+                }
+            }
+        }
+    }
+    return true;
+}
+
+static void classify_tiles(size_t begin, size_t end, int thread_index, void *user)
+{
+    (void)thread_index;
+    const dof_job *job = user;
+    for (size_t t = begin; t < end; ++t) {
+        job->uniform[t] = tile_is_uniform(job, (int32_t)(t % (size_t)job->tiles_x),
+                                          (int32_t)(t / (size_t)job->tiles_x));
+    }
+}
+
 static void dof_rows(size_t begin, size_t end, int thread_index, void *user)
 {
     (void)thread_index;
     const dof_job *job = user;
     int32_t channels = job->in->channels;
     for (int32_t y = (int32_t)begin; y < (int32_t)end; ++y) {
+        const uint8_t *uniform_row = job->uniform + (size_t)(y / UNIFORM_TILE) * (size_t)job->tiles_x;
         for (int32_t x = 0; x < job->in->width; ++x) {
             float radius = drift_image_pixel(job->coc, x, y)[0];
             const float *src = drift_image_pixel(job->in, x, y);
             float *dst = drift_image_pixel(job->out, x, y);
             // Below half a pixel the disk stays inside the pixel: copy, bit for bit (and
-            // NaN or negative radii count as in focus).
-            if (!(radius >= 0.5f)) {
+            // NaN or negative radii count as in focus). A uniform tile copies too (above).
+            if (!(radius >= 0.5f) || uniform_row[x / UNIFORM_TILE]) {
                 for (int32_t c = 0; c < channels; ++c) {
                     dst[c] = src[c];
                 }
@@ -189,8 +236,21 @@ drift_result drift_post_dof(drift_context *ctx, const drift_image *in, const dri
         return DRIFT_ERR_OUT_OF_MEMORY;
     }
     make_taps(table, tap_count);
-    dof_job job = { .in = in, .coc = coc, .out = out, .taps = table, .tap_count = tap_count };
+    int32_t tiles_x = (in->width + UNIFORM_TILE - 1) / UNIFORM_TILE;
+    int32_t tiles_y = (in->height + UNIFORM_TILE - 1) / UNIFORM_TILE;
+    size_t tile_count = (size_t)tiles_x * (size_t)tiles_y;
+    uint8_t *uniform = drift_alloc(ctx, tile_count);
+    if (!uniform) {
+        drift_free(ctx, table);
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_OUT_OF_MEMORY, __FILE__, __LINE__,
+                  "post dof: out of memory for %zu tiles", tile_count);
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    dof_job job = { .in = in, .coc = coc, .out = out, .taps = table, .tap_count = tap_count,
+                    .uniform = uniform, .tiles_x = tiles_x };
+    drift_parallel_for(ctx, tile_count, 1, classify_tiles, &job);
     drift_parallel_for(ctx, (size_t)in->height, 1, dof_rows, &job);
+    drift_free(ctx, uniform);
     drift_free(ctx, table);
     return DRIFT_OK;
 }
