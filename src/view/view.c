@@ -213,23 +213,8 @@ static void cycle_technique(drift_view *view, drift_effect effect)
     if (count <= 0) {
         return;
     }
-    drift_hybrid_params *p = &view->params;
-    switch (effect) {
-    case DRIFT_EFFECT_SHADOWS:
-        p->shadows = (drift_shadow_technique)(((int)p->shadows + 1) % count);
-        break;
-    case DRIFT_EFFECT_REFLECTIONS:
-        p->reflections = (drift_reflection_technique)(((int)p->reflections + 1) % count);
-        break;
-    case DRIFT_EFFECT_DOF:
-        p->dof = (drift_dof_technique)(((int)p->dof + 1) % count);
-        break;
-    case DRIFT_EFFECT_INDIRECT:
-        p->indirect = (drift_indirect_technique)(((int)p->indirect + 1) % count);
-        break;
-    default:
-        return;
-    }
+    int next = (drift_hybrid_params_technique(&view->params, effect) + 1) % count;
+    drift_hybrid_params_set_technique(&view->params, effect, next);
     view->params_changed = true;
 }
 
