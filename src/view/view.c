@@ -99,10 +99,9 @@ static drift_pt_params reference_params(const drift_view *view)
                               .camera = &view->reference_camera };
 }
 
+// Called only without a reference (drift_view_frame drops it when the camera moves).
 static drift_result reference_restart(drift_view *view)
 {
-    drift_pt_destroy(view->reference);
-    view->reference = NULL;
     view->reference_camera = view->camera;
     view->reference_camera.width = view->width;
     view->reference_camera.height = view->height;
@@ -328,11 +327,10 @@ drift_result drift_view_frame(drift_view *view, const atomic_bool *cancel)
     if (view->params_changed) {
         r = drift_hybrid_set_params(view->hybrid, &view->params);
         view->params_changed = false;
+        view->params = drift_hybrid_get_params(view->hybrid); // what the frame has, if refused too
         if (r != DRIFT_OK) {
-            view->params = drift_hybrid_get_params(view->hybrid); // keep what the frame has
             return r;
         }
-        view->params = drift_hybrid_get_params(view->hybrid);
     }
     r = drift_hybrid_render(view->hybrid, &view->camera, cancel);
     if (r != DRIFT_OK) {
