@@ -354,46 +354,19 @@ static float unit(uint32_t key, uint32_t i)
     return drift_u32_to_unit(drift_hash_combine(key, i));
 }
 
-// A random point on the first area light, or a point above the scene without one.
-static drift_vec3 shadow_target(const drift_scene *scene, uint32_t light, uint32_t i)
+// A random point on the first area light as the renderer samples it from `from`
+// (drift_light_sample_li), or a point above the scene without one.
+static drift_vec3 shadow_target(const drift_scene *scene, uint32_t light, drift_vec3 from,
+                                uint32_t i)
 {
-    drift_vec2 u = drift_vec2_make(unit(11, i), unit(12, i));
     if (light == DRIFT_INVALID_INDEX) {
         drift_bounds3 b = scene->bounds;
         drift_vec3 c = drift_vec3_scale(drift_vec3_add(b.min, b.max), 0.5f);
         float extent = drift_vec3_length(drift_vec3_sub(b.max, b.min));
         return drift_vec3_make(c.x, b.max.y + 0.5f * extent, c.z);
     }
-    const drift_light *l = &scene->lights[light];
-    switch (l->type) {
-    case DRIFT_LIGHT_QUAD:
-        return drift_vec3_add(l->position, drift_vec3_add(drift_vec3_scale(l->edge_u, u.x),
-                                                          drift_vec3_scale(l->edge_v, u.y)));
-    case DRIFT_LIGHT_DISK: {
-        drift_frame f = drift_frame_from_normal(l->direction);
-        drift_vec2 d = drift_sample_disk_concentric(u);
-        return drift_vec3_add(
-            l->position,
-            drift_frame_to_world(&f, drift_vec3_make(d.x * l->radius, d.y * l->radius, 0)));
-    }
-    case DRIFT_LIGHT_SPHERE:
-        return drift_vec3_fma(l->position, drift_sample_uniform_sphere(u), l->radius);
-    case DRIFT_LIGHT_TRIANGLE: {
-        const drift_mesh *mesh = &scene->meshes[l->mesh];
-        const uint32_t *tri = mesh->indices + 3 * (size_t)l->triangle;
-        drift_vec2 b = drift_sample_triangle(u);
-        drift_vec3 p[3];
-        for (int k = 0; k < 3; ++k) {
-            const float *q = mesh->positions + 3 * (size_t)tri[k];
-            p[k] = drift_vec3_make(q[0], q[1], q[2]);
-        }
-        return drift_vec3_add(
-            drift_vec3_scale(p[0], 1.0f - b.x - b.y),
-            drift_vec3_add(drift_vec3_scale(p[1], b.x), drift_vec3_scale(p[2], b.y)));
-    }
-    default:
-        return l->position;
-    }
+    drift_vec2 u = drift_vec2_make(unit(11, i), unit(12, i));
+    return drift_light_sample_li(scene, light, from, u).point;
 }
 
 static bool make_ray_sets(bench_state *s)
@@ -444,7 +417,7 @@ static bool make_ray_sets(bench_state *s)
         if (drift_vec3_dot(ng, pr->dir) > 0.0f) {
             ng = drift_vec3_neg(ng);
         }
-        drift_vec3 target = shadow_target(s->scene, light, i);
+        drift_vec3 target = shadow_target(s->scene, light, p, i);
         drift_vec3 o = drift_offset_origin(p, ng, drift_vec3_sub(target, p));
         // Unnormalized: t = 1 is the target, so tmax just below 1 excludes the light itself.
         s->sets[KIND_SHADOW].rays[m] = (drift_ray){

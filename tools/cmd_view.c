@@ -569,17 +569,10 @@ int drift_cmd_view(int argc, char **argv)
         goto done;
     }
     drift_hybrid_params params = { .spp = (uint32_t)o.spp };
-    if (o.techniques[DRIFT_EFFECT_SHADOWS] >= 0) {
-        params.shadows = (drift_shadow_technique)o.techniques[DRIFT_EFFECT_SHADOWS];
-    }
-    if (o.techniques[DRIFT_EFFECT_REFLECTIONS] >= 0) {
-        params.reflections = (drift_reflection_technique)o.techniques[DRIFT_EFFECT_REFLECTIONS];
-    }
-    if (o.techniques[DRIFT_EFFECT_DOF] >= 0) {
-        params.dof = (drift_dof_technique)o.techniques[DRIFT_EFFECT_DOF];
-    }
-    if (o.techniques[DRIFT_EFFECT_INDIRECT] >= 0) {
-        params.indirect = (drift_indirect_technique)o.techniques[DRIFT_EFFECT_INDIRECT];
+    for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
+        if (o.techniques[e] >= 0) {
+            drift_hybrid_params_set_technique(&params, (drift_effect)e, o.techniques[e]);
+        }
     }
     r = drift_view_create(ctx, scene, accel,
                           &(drift_view_desc){ .width = (int32_t)o.width,

@@ -57,25 +57,10 @@ bool render_parse_hybrid_option(int argc, char **argv, int *i, render_options *o
     drift_hybrid_params *h = &o->hybrid;
     long n = 0;
     int t = 0;
-    switch (effect) {
-    case DRIFT_EFFECT_SHADOWS:
-        *ok = cli_parse_technique("render", DRIFT_EFFECT_SHADOWS, a, v, &t);
-        h->shadows = (drift_shadow_technique)t;
+    if (effect >= 0) {
+        *ok = cli_parse_technique("render", (drift_effect)effect, a, v, &t);
+        drift_hybrid_params_set_technique(h, (drift_effect)effect, t);
         return true;
-    case DRIFT_EFFECT_REFLECTIONS:
-        *ok = cli_parse_technique("render", DRIFT_EFFECT_REFLECTIONS, a, v, &t);
-        h->reflections = (drift_reflection_technique)t;
-        return true;
-    case DRIFT_EFFECT_DOF:
-        *ok = cli_parse_technique("render", DRIFT_EFFECT_DOF, a, v, &t);
-        h->dof = (drift_dof_technique)t;
-        return true;
-    case DRIFT_EFFECT_INDIRECT:
-        *ok = cli_parse_technique("render", DRIFT_EFFECT_INDIRECT, a, v, &t);
-        h->indirect = (drift_indirect_technique)t;
-        return true;
-    default:
-        break;
     }
     switch (other) {
     case 0:

@@ -128,6 +128,11 @@ typedef struct drift_hybrid_params {
 
 drift_hybrid_params drift_hybrid_params_resolve(const drift_hybrid_params *params,
                                                 const drift_scene *scene);
+// The technique `params` chooses for `effect` (-1 for an invalid effect), and setting it: one
+// int per effect for code that walks the effects (the viewer's keys and overlay, the CLI).
+int drift_hybrid_params_technique(const drift_hybrid_params *params, drift_effect effect);
+void drift_hybrid_params_set_technique(drift_hybrid_params *params, drift_effect effect,
+                                       int technique);
 
 // --- G-BUFFER ---
 

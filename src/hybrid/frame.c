@@ -85,6 +85,44 @@ const char *drift_hybrid_pass_name(drift_hybrid_pass pass)
 
 // --- PARAMETERS ---
 
+int drift_hybrid_params_technique(const drift_hybrid_params *params, drift_effect effect)
+{
+    switch (effect) {
+    case DRIFT_EFFECT_SHADOWS:
+        return (int)params->shadows;
+    case DRIFT_EFFECT_REFLECTIONS:
+        return (int)params->reflections;
+    case DRIFT_EFFECT_DOF:
+        return (int)params->dof;
+    case DRIFT_EFFECT_INDIRECT:
+        return (int)params->indirect;
+    case DRIFT_EFFECT_COUNT:
+        break;
+    }
+    return -1;
+}
+
+void drift_hybrid_params_set_technique(drift_hybrid_params *params, drift_effect effect,
+                                       int technique)
+{
+    switch (effect) {
+    case DRIFT_EFFECT_SHADOWS:
+        params->shadows = (drift_shadow_technique)technique;
+        break;
+    case DRIFT_EFFECT_REFLECTIONS:
+        params->reflections = (drift_reflection_technique)technique;
+        break;
+    case DRIFT_EFFECT_DOF:
+        params->dof = (drift_dof_technique)technique;
+        break;
+    case DRIFT_EFFECT_INDIRECT:
+        params->indirect = (drift_indirect_technique)technique;
+        break;
+    case DRIFT_EFFECT_COUNT:
+        break;
+    }
+}
+
 drift_hybrid_params drift_hybrid_params_resolve(const drift_hybrid_params *params,
                                                 const drift_scene *scene)
 {

@@ -37,7 +37,7 @@ static float display_luma(const drift_image *image, int32_t x, int32_t y)
         // fmaxf/fminf also send NaN to 0.
         s[c] = drift_linear_to_srgb(fminf(fmaxf(rgb[c], 0.0f), 1.0f));
     }
-    return 0.2126f * s[0] + 0.7152f * s[1] + 0.0722f * s[2];
+    return drift_luminance(drift_vec3_make(s[0], s[1], s[2]));
 }
 
 static void luma_row(int32_t y, void *user)

@@ -99,10 +99,9 @@ static drift_pt_params reference_params(const drift_view *view)
                               .camera = &view->reference_camera };
 }
 
+// Called only without a reference (drift_view_frame drops it when the camera moves).
 static drift_result reference_restart(drift_view *view)
 {
-    drift_pt_destroy(view->reference);
-    view->reference = NULL;
     view->reference_camera = view->camera;
     view->reference_camera.width = view->width;
     view->reference_camera.height = view->height;
@@ -213,23 +212,8 @@ static void cycle_technique(drift_view *view, drift_effect effect)
     if (count <= 0) {
         return;
     }
-    drift_hybrid_params *p = &view->params;
-    switch (effect) {
-    case DRIFT_EFFECT_SHADOWS:
-        p->shadows = (drift_shadow_technique)(((int)p->shadows + 1) % count);
-        break;
-    case DRIFT_EFFECT_REFLECTIONS:
-        p->reflections = (drift_reflection_technique)(((int)p->reflections + 1) % count);
-        break;
-    case DRIFT_EFFECT_DOF:
-        p->dof = (drift_dof_technique)(((int)p->dof + 1) % count);
-        break;
-    case DRIFT_EFFECT_INDIRECT:
-        p->indirect = (drift_indirect_technique)(((int)p->indirect + 1) % count);
-        break;
-    default:
-        return;
-    }
+    int next = (drift_hybrid_params_technique(&view->params, effect) + 1) % count;
+    drift_hybrid_params_set_technique(&view->params, effect, next);
     view->params_changed = true;
 }
 
@@ -343,11 +327,10 @@ drift_result drift_view_frame(drift_view *view, const atomic_bool *cancel)
     if (view->params_changed) {
         r = drift_hybrid_set_params(view->hybrid, &view->params);
         view->params_changed = false;
+        view->params = drift_hybrid_get_params(view->hybrid); // what the frame has, if refused too
         if (r != DRIFT_OK) {
-            view->params = drift_hybrid_get_params(view->hybrid); // keep what the frame has
             return r;
         }
-        view->params = drift_hybrid_get_params(view->hybrid);
     }
     r = drift_hybrid_render(view->hybrid, &view->camera, cancel);
     if (r != DRIFT_OK) {

@@ -136,11 +136,7 @@ append(char *buf, size_t *len, const char *fmt, ...)
 
 static const char *technique_of(const drift_hybrid_params *p, drift_effect effect)
 {
-    int t = effect == DRIFT_EFFECT_SHADOWS       ? (int)p->shadows
-            : effect == DRIFT_EFFECT_REFLECTIONS ? (int)p->reflections
-            : effect == DRIFT_EFFECT_DOF         ? (int)p->dof
-                                                 : (int)p->indirect;
-    const char *name = drift_technique_name(effect, t);
+    const char *name = drift_technique_name(effect, drift_hybrid_params_technique(p, effect));
     return name ? name : "?";
 }
 

@@ -4,14 +4,8 @@
 # Usage: test_bad_input.sh path/to/drift
 set -u
 drift=${1:?usage: test_bad_input.sh path/to/drift}
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
-failures=0
-
-fail() {
-    echo "FAIL: $*" >&2
-    failures=$((failures + 1))
-}
+source "$(dirname "$0")/common.sh"
+dir="$tmp"
 
 # expect_failure NAME: runs drift info on $dir/NAME and checks status and message.
 expect_failure() {

@@ -45,7 +45,10 @@ done
 # and is finite here; the exact equality is tested in unit.hybrid.
 expect 0 "$drift" render --mode hybrid "${small[@]}" --shadows reference --reflections reference \
     --indirect reference --out "$tmp/ref.exr"
+# Against itself the MSE is 0 only where every value is finite (NaN or inf give null).
 expect 0 "$drift" diff "$tmp/ref.exr" "$tmp/ref.exr" --json
+python3 -c "import json,sys; d=json.load(open('$tmp/out')); sys.exit(0 if d['mse']==0 else 1)" \
+    || fail "all-reference image is not finite"
 
 # Usage errors: unknown technique names, hybrid options in reference mode, bad values.
 expect 2 "$drift" render --mode hybrid --shadows soft --out "$tmp/x.exr"
