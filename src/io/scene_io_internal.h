@@ -64,6 +64,9 @@ drift_result drift__read_file(drift_context *ctx, const char *path, bool gzip, c
 // before a trailing ".gz". *out_gz tells whether the name ended in .gz.
 void drift__path_extension(const char *path, char *out, size_t out_size, bool *out_gz);
 
+// True for the mesh file extensions assimp is asked to read (obj, gltf, glb, ply; lower case).
+bool drift__is_mesh_extension(const char *ext);
+
 // base_dir + "/" + relative (relative unchanged when absolute or base_dir is NULL/empty).
 bool drift__path_join(const char *base_dir, const char *relative, char *out, size_t out_size);
 

@@ -717,12 +717,6 @@ static drift_result read_transform(const json_reader *r, const cJSON *obj, const
     return DRIFT_OK;
 }
 
-static bool is_mesh_extension(const char *ext)
-{
-    return strcmp(ext, "obj") == 0 || strcmp(ext, "gltf") == 0 || strcmp(ext, "glb") == 0 ||
-           strcmp(ext, "ply") == 0;
-}
-
 static drift_result read_mesh(json_reader *r, const cJSON *item, const char *path)
 {
     drift_result res = expect_object(r, item, path);
@@ -751,7 +745,7 @@ static drift_result read_mesh(json_reader *r, const cJSON *item, const char *pat
     char ext[16];
     bool gz = false;
     drift__path_extension(rel, ext, sizeof(ext), &gz);
-    if (!is_mesh_extension(ext)) {
+    if (!drift__is_mesh_extension(ext)) {
         return FAIL(r, path_item, DRIFT_ERR_UNSUPPORTED,
                     "%s.path '%s': meshes must be .obj, .gltf, .glb or .ply (optionally .gz)", path,
                     rel);

@@ -312,7 +312,7 @@ static drift_result add_default_lights(drift_scene *scene, const char *path)
     return DRIFT_OK;
 }
 
-static bool is_mesh_extension(const char *ext)
+bool drift__is_mesh_extension(const char *ext)
 {
     return strcmp(ext, "obj") == 0 || strcmp(ext, "gltf") == 0 || strcmp(ext, "glb") == 0 ||
            strcmp(ext, "ply") == 0;
@@ -396,7 +396,7 @@ drift_result drift_scene_load(drift_context *ctx, const char *path, drift_scene 
         drift_free(ctx, text);
         return r;
     }
-    if (is_mesh_extension(ext)) {
+    if (drift__is_mesh_extension(ext)) {
         return load_mesh_scene(ctx, path, out_scene);
     }
     drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_UNSUPPORTED, path, 0,
