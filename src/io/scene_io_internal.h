@@ -29,13 +29,21 @@ drift_result drift__texture_cache_get(drift_scene *scene, drift__texture_cache *
                                       uint32_t *out_index);
 void drift__texture_cache_clear(drift_context *ctx, drift__texture_cache *cache);
 
+// Row-major 4x4 affine transform (the layout of aiMatrix4x4 and of the JSON "matrix").
+typedef struct drift__mat4 {
+    float m[16];
+} drift__mat4;
+
+drift__mat4 drift__mat4_identity(void);
+drift__mat4 drift__mat4_mul(const drift__mat4 *a, const drift__mat4 *b);
+
 // How to bring one mesh file into a scene.
 typedef struct drift__import_params {
-    const char *path;           // the mesh file
-    const char *where;          // file named in messages about this import (NULL: path)
-    int line;                   // line of `where` that asked for the import (0: none)
-    const float *transform;     // 4x4 row-major, applied after the file's own; NULL: identity
-    uint32_t material_override; // DRIFT_INVALID_INDEX: the file's materials
+    const char *path;             // the mesh file
+    const char *where;            // file named in messages about this import (NULL: path)
+    int line;                     // line of `where` that asked for the import (0: none)
+    const drift__mat4 *transform; // applied after the file's own; NULL: identity
+    uint32_t material_override;   // DRIFT_INVALID_INDEX: the file's materials
     drift__texture_cache *textures;
 } drift__import_params;
 

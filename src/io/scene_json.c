@@ -589,44 +589,27 @@ static bool find_material(const json_reader *r, const char *name, uint32_t *out_
 
 // --- MESHES ---
 
-typedef struct mat4 {
-    float m[16];
-} mat4;
-
-static mat4 mat4_mul(const mat4 *a, const mat4 *b)
-{
-    mat4 out;
-    for (int i = 0; i < 4; ++i) {
-        for (int j = 0; j < 4; ++j) {
-            float s = 0.0f;
-            for (int k = 0; k < 4; ++k) {
-                s += a->m[4 * i + k] * b->m[4 * k + j];
-            }
-            out.m[4 * i + j] = s;
-        }
-    }
-    return out;
-}
-
 // Rotation by `degrees` about `axis` (right-handed: counter-clockwise looking down the axis).
-static mat4 mat4_rotation(drift_vec3 axis, float degrees)
+static drift__mat4 mat4_rotation(drift_vec3 axis, float degrees)
 {
     drift_vec3 a = drift_vec3_normalize(axis);
     float t = degrees * DRIFT_PI / 180.0f;
     float c = cosf(t), s = sinf(t), k = 1.0f - c;
-    return (mat4){ { k * a.x * a.x + c, k * a.x * a.y - s * a.z, k * a.x * a.z + s * a.y, 0.0f,
-                     k * a.x * a.y + s * a.z, k * a.y * a.y + c, k * a.y * a.z - s * a.x, 0.0f,
-                     k * a.x * a.z - s * a.y, k * a.y * a.z + s * a.x, k * a.z * a.z + c, 0.0f,
-                     0.0f, 0.0f, 0.0f, 1.0f } };
+    return (drift__mat4){
+        { k * a.x * a.x + c, k * a.x * a.y - s * a.z, k * a.x * a.z + s * a.y, 0.0f, //
+          k * a.x * a.y + s * a.z, k * a.y * a.y + c, k * a.y * a.z - s * a.x, 0.0f, //
+          k * a.x * a.z - s * a.y, k * a.y * a.z + s * a.x, k * a.z * a.z + c, 0.0f, //
+          0.0f, 0.0f, 0.0f, 1.0f }
+    };
 }
 
 // "transform": { translate, rotate: { axis, degrees }, scale } (applied scale, rotate,
 // translate) or { matrix: 16 numbers, row-major }.
 static drift_result read_transform(const json_reader *r, const cJSON *obj, const char *parent,
-                                   mat4 *out)
+                                   drift__mat4 *out)
 {
     const cJSON *item = cJSON_GetObjectItemCaseSensitive(obj, "transform");
-    *out = (mat4){ { 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1 } };
+    *out = drift__mat4_identity();
     if (!item) {
         return DRIFT_OK;
     }
@@ -692,7 +675,7 @@ static drift_result read_transform(const json_reader *r, const cJSON *obj, const
                         "%s must be non-zero on every axis", spath);
         }
     }
-    mat4 rotation = { { 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1 } };
+    drift__mat4 rotation = drift__mat4_identity();
     const cJSON *rotate = cJSON_GetObjectItemCaseSensitive(item, "rotate");
     if (rotate) {
         char rpath[KEY_PATH_MAX];
@@ -710,10 +693,13 @@ static drift_result read_transform(const json_reader *r, const cJSON *obj, const
         }
         rotation = mat4_rotation(axis, degrees);
     }
-    mat4 s = { { scale.x, 0, 0, 0, 0, scale.y, 0, 0, 0, 0, scale.z, 0, 0, 0, 0, 1 } };
-    mat4 t = { { 1, 0, 0, translate.x, 0, 1, 0, translate.y, 0, 0, 1, translate.z, 0, 0, 0, 1 } };
-    mat4 rs = mat4_mul(&rotation, &s);
-    *out = mat4_mul(&t, &rs);
+    drift__mat4 s = { { scale.x, 0, 0, 0, 0, scale.y, 0, 0, 0, 0, scale.z, 0, 0, 0, 0, 1 } };
+    drift__mat4 t = { { 1, 0, 0, translate.x, //
+                        0, 1, 0, translate.y, //
+                        0, 0, 1, translate.z, //
+                        0, 0, 0, 1 } };
+    drift__mat4 rs = drift__mat4_mul(&rotation, &s);
+    *out = drift__mat4_mul(&t, &rs);
     return DRIFT_OK;
 }
 
@@ -738,7 +724,7 @@ static drift_result read_mesh(json_reader *r, const cJSON *item, const char *pat
                     DRIFT_ERR_INVALID_ARGUMENT, "%s.material '%s' is not in materials", path,
                     material_name);
     }
-    mat4 transform;
+    drift__mat4 transform;
     if ((res = read_transform(r, item, path, &transform)) != DRIFT_OK) {
         return res;
     }
@@ -758,7 +744,7 @@ static drift_result read_mesh(json_reader *r, const cJSON *item, const char *pat
     drift__import_params params = { .path = full,
                                     .where = r->file,
                                     .line = line_of(r, path_item),
-                                    .transform = transform.m,
+                                    .transform = &transform,
                                     .material_override = material,
                                     .textures = &r->textures };
     res = drift__scene_import_mesh_file(r->scene, &params, &info);
