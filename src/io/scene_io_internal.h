@@ -5,6 +5,7 @@
 
 #include "drift/scene.h"
 #include "drift/scene_io.h"
+#include "scene/scene_internal.h" // drift__scene_mesh_bounds
 
 #include <stdbool.h>
 #include <stddef.h>
@@ -78,8 +79,6 @@ bool drift__is_mesh_extension(const char *ext);
 // base_dir + "/" + relative (relative unchanged when absolute or base_dir is NULL/empty).
 bool drift__path_join(const char *base_dir, const char *relative, char *out, size_t out_size);
 
-// Bounds of all mesh vertices added so far.
-drift_bounds3 drift__scene_mesh_bounds(const drift_scene *scene);
 // The framing camera of a bare mesh file (see scene_io.h).
 drift_camera drift__framing_camera(drift_bounds3 bounds);
 

@@ -253,19 +253,6 @@ void drift__texture_cache_clear(drift_context *ctx, drift__texture_cache *cache)
     *cache = (drift__texture_cache){ 0 };
 }
 
-drift_bounds3 drift__scene_mesh_bounds(const drift_scene *scene)
-{
-    drift_bounds3 b = drift_bounds3_empty();
-    for (uint32_t m = 0; m < scene->mesh_count; ++m) {
-        const drift_mesh *mesh = &scene->meshes[m];
-        for (uint32_t v = 0; v < mesh->vertex_count; ++v) {
-            const float *p = mesh->positions + 3 * (size_t)v;
-            b = drift_bounds3_extend(b, drift_vec3_make(p[0], p[1], p[2]));
-        }
-    }
-    return b;
-}
-
 drift_camera drift__framing_camera(drift_bounds3 bounds)
 {
     const float fov_y = 45.0f * DRIFT_PI / 180.0f;
