@@ -31,9 +31,7 @@ typedef struct json_reader {
     const char *base_dir; // paths in the file are relative to this
     node_line *lines;     // sorted by node address
     size_t line_count;
-    const cJSON *materials;   // the "materials" object, or NULL
-    uint32_t *material_index; // scene index of each child of `materials`
-    uint32_t material_count;
+    uint32_t material_count; // the file's materials: scene materials 0 .. material_count - 1
     drift__texture_cache textures;
     bool file_camera_found;
     drift_camera file_camera;
@@ -468,7 +466,7 @@ static drift_result load_texture(json_reader *r, const cJSON *obj, const char *p
 
 // --- MATERIALS ---
 
-static drift_result read_material(json_reader *r, const cJSON *item, uint32_t slot)
+static drift_result read_material(json_reader *r, const cJSON *item)
 {
     char path[KEY_PATH_MAX];
     key_path(path, "materials", item->string);
@@ -529,7 +527,7 @@ static drift_result read_material(json_reader *r, const cJSON *item, uint32_t sl
         (res = load_texture(r, item, path, "diffuse_texture", &m.diffuse_texture)) != DRIFT_OK) {
         return res;
     }
-    res = drift_scene_add_material(r->scene, &m, &r->material_index[slot]);
+    res = drift_scene_add_material(r->scene, &m, NULL);
     if (res != DRIFT_OK) {
         return FAIL(r, item, res, "%s is not valid", path);
     }
@@ -556,31 +554,23 @@ static drift_result read_materials(json_reader *r, const cJSON *root)
     if (res != DRIFT_OK) {
         return res;
     }
-    r->materials = materials;
-    r->material_index = drift_alloc(r->ctx, ((size_t)count + 1) * sizeof(uint32_t));
-    if (!r->material_index) {
-        return DRIFT_ERR_OUT_OF_MEMORY;
-    }
-    uint32_t slot = 0;
-    for (const cJSON *c = materials->child; c; c = c->next, ++slot) {
-        res = read_material(r, c, slot);
+    // They are read before anything else adds materials, so the n-th is scene material n.
+    for (const cJSON *c = materials->child; c; c = c->next) {
+        res = read_material(r, c);
         if (res != DRIFT_OK) {
             return res;
         }
-        r->material_count = slot + 1;
+        r->material_count++;
     }
     return DRIFT_OK;
 }
 
 static bool find_material(const json_reader *r, const char *name, uint32_t *out_index)
 {
-    if (!r->materials) {
-        return false;
-    }
-    uint32_t slot = 0;
-    for (const cJSON *c = r->materials->child; c && slot < r->material_count; c = c->next, ++slot) {
-        if (strcmp(c->string, name) == 0) {
-            *out_index = r->material_index[slot];
+    // Names are whole (read_material rejects any DRIFT_NAME_MAX would cut) and unique.
+    for (uint32_t i = 0; i < r->material_count; ++i) {
+        if (strcmp(r->scene->materials[i].name, name) == 0) {
+            *out_index = i;
             return true;
         }
     }
@@ -1096,7 +1086,6 @@ drift_result drift_scene_load_json_text(drift_context *ctx, const char *text, si
     cJSON_Delete(root);
     drift_free(ctx, copy);
     drift_free(ctx, r.lines);
-    drift_free(ctx, r.material_index);
     drift__texture_cache_clear(ctx, &r.textures);
     if (res != DRIFT_OK) {
         drift_scene_destroy(r.scene);
