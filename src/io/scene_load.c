@@ -2,6 +2,7 @@
 // the texture cache, and the camera and light a bare mesh file is given.
 #include "drift/image_io.h"
 #include "drift/scene_io.h"
+#include "image_io_internal.h" // drift__errno_text
 #include "scene_io_internal.h"
 
 #include <ctype.h>
@@ -64,9 +65,10 @@ drift_result drift__check_file(drift_context *ctx, const char *path, const char 
 {
     *out_size = 0;
     struct stat st;
+    char why[128];
     if (stat(path, &st) != 0) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, where, line, "cannot open '%s': %s", path,
-                  strerror(errno));
+                  drift__errno_text(errno, why, sizeof(why)));
         return DRIFT_ERR_IO;
     }
     if (!S_ISREG(st.st_mode)) {
@@ -120,8 +122,9 @@ drift_result drift__read_file(drift_context *ctx, const char *path, bool gzip, c
     // both kinds; gzdirect says which kind the file is, and it must match its name.
     gzFile gz = gzopen(path, "rb");
     if (!gz) {
+        char why[128];
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, where, line, "cannot open '%s': %s", path,
-                  strerror(errno));
+                  drift__errno_text(errno, why, sizeof(why)));
         return DRIFT_ERR_IO;
     }
     if (gzdirect(gz) == (int)gzip) {
