@@ -27,8 +27,7 @@ typedef struct pool_job {
 } pool_job;
 
 struct drift_context {
-    drift_context_desc desc;
-    int thread_count;
+    drift_context_desc desc; // resolved: thread_count is the pool size
     pthread_t workers[MAX_THREADS];
     worker_arg worker_args[MAX_THREADS];
     int worker_count;
@@ -124,12 +123,11 @@ drift_result drift_context_create(const drift_context_desc *desc, drift_context 
     drift_context *ctx = mem;
     memset(ctx, 0, sizeof(*ctx));
     ctx->desc = d;
-    ctx->thread_count = d.thread_count;
     pthread_mutex_init(&ctx->mutex, NULL);
     pthread_cond_init(&ctx->wake, NULL);
     pthread_cond_init(&ctx->done, NULL);
     // The calling thread is worker 0; the pool adds thread_count - 1 more.
-    for (int i = 1; i < ctx->thread_count; ++i) {
+    for (int i = 1; i < d.thread_count; ++i) {
         ctx->worker_args[i] = (worker_arg){ ctx, i };
         if (pthread_create(&ctx->workers[ctx->worker_count], NULL, worker_main,
                            &ctx->worker_args[i]) != 0) {
@@ -167,7 +165,7 @@ void drift_context_destroy(drift_context *ctx)
 
 int drift_context_thread_count(const drift_context *ctx)
 {
-    return ctx ? ctx->thread_count : 1;
+    return ctx ? ctx->desc.thread_count : 1;
 }
 
 drift_logger drift_context_logger(const drift_context *ctx)

@@ -65,7 +65,7 @@ static image_format format_from_path(const char *path)
     return FORMAT_UNKNOWN;
 }
 
-static const char *errno_text(int err, char *buf, size_t cap)
+const char *drift__errno_text(int err, char *buf, size_t cap)
 {
     // XSI strerror_r (we build with _POSIX_C_SOURCE=200809L) fills buf and returns int;
     // plain strerror is not thread-safe.
@@ -86,7 +86,7 @@ drift_result drift__image_read_file(drift_context *ctx, const char *path, uint8_
     int fd = open(path, O_RDONLY);
     if (fd < 0) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, path, 0, "cannot open image: %s",
-                  errno_text(errno, why, sizeof(why)));
+                  drift__errno_text(errno, why, sizeof(why)));
         return DRIFT_ERR_IO;
     }
     struct stat st;
@@ -110,7 +110,8 @@ drift_result drift__image_read_file(drift_context *ctx, const char *path, uint8_
         }
         if (n <= 0) {
             drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, path, 0, "read failed: %s",
-                      n < 0 ? errno_text(errno, why, sizeof(why)) : "file shrank while reading");
+                      n < 0 ? drift__errno_text(errno, why, sizeof(why))
+                            : "file shrank while reading");
             drift_free(ctx, data);
             close(fd);
             return DRIFT_ERR_IO;
@@ -150,7 +151,7 @@ drift_result drift__image_temp_open(drift_context *ctx, const char *path, drift_
         }
     }
     drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, path, 0, "cannot create file: %s",
-              errno_text(errno, why, sizeof(why)));
+              drift__errno_text(errno, why, sizeof(why)));
     out->temp_path[0] = '\0';
     return DRIFT_ERR_IO;
 }
@@ -183,14 +184,14 @@ drift_result drift__image_temp_close(drift_context *ctx, drift__image_temp *t, d
         // close() can report a delayed write error (NFS, full disk); it counts as a failure.
         if (close(t->fd) != 0 && result == DRIFT_OK) {
             drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, t->path, 0, "write failed: %s",
-                      errno_text(errno, why, sizeof(why)));
+                      drift__errno_text(errno, why, sizeof(why)));
             result = DRIFT_ERR_IO;
         }
         t->fd = -1;
     }
     if (result == DRIFT_OK && rename(t->temp_path, t->path) != 0) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, t->path, 0, "cannot rename %s: %s",
-                  t->temp_path, errno_text(errno, why, sizeof(why)));
+                  t->temp_path, drift__errno_text(errno, why, sizeof(why)));
         result = DRIFT_ERR_IO;
     }
     if (result != DRIFT_OK && t->temp_path[0]) {
@@ -394,7 +395,8 @@ drift_result drift_image_save_png(drift_context *ctx, const char *path, const dr
         if (!ok || sink.failed) {
             char why[128];
             drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, path, 0, "PNG write failed: %s",
-                      sink.failed ? errno_text(sink.error, why, sizeof(why)) : "encoder failed");
+                      sink.failed ? drift__errno_text(sink.error, why, sizeof(why))
+                                  : "encoder failed");
             r = DRIFT_ERR_IO;
         }
         r = drift__image_temp_close(ctx, &temp, r);

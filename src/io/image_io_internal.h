@@ -1,5 +1,5 @@
 // Private to src/io/image_*.c: whole-file reads, the temp-file-then-rename writer protocol and
-// the format back ends.
+// the format back ends; and the errno text every src/io file logs with.
 #ifndef DRIFT_IO_IMAGE_IO_INTERNAL_H
 #define DRIFT_IO_IMAGE_IO_INTERNAL_H
 
@@ -8,6 +8,9 @@
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
+
+// strerror_r's text for `err` in buf (plain strerror is not thread-safe); returns buf.
+const char *drift__errno_text(int err, char *buf, size_t cap);
 
 // Reads a whole file into memory from drift_alloc (free with drift_free). Logs and returns
 // DRIFT_ERR_IO when the file cannot be opened or read.

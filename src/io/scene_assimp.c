@@ -14,19 +14,14 @@
 #include <stdio.h>
 #include <string.h>
 
-// Row-major 4x4 affine transforms (the layout of aiMatrix4x4 and of the JSON "matrix").
-typedef struct mat4 {
-    float m[16];
-} mat4;
-
-static mat4 mat4_identity(void)
+drift__mat4 drift__mat4_identity(void)
 {
-    return (mat4){ { 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1 } };
+    return (drift__mat4){ { 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1 } };
 }
 
-static mat4 mat4_mul(const mat4 *a, const mat4 *b)
+drift__mat4 drift__mat4_mul(const drift__mat4 *a, const drift__mat4 *b)
 {
-    mat4 r;
+    drift__mat4 r;
     for (int i = 0; i < 4; ++i) {
         for (int j = 0; j < 4; ++j) {
             float s = 0.0f;
@@ -39,13 +34,13 @@ static mat4 mat4_mul(const mat4 *a, const mat4 *b)
     return r;
 }
 
-static mat4 mat4_from_ai(const struct aiMatrix4x4 *a)
+static drift__mat4 mat4_from_ai(const struct aiMatrix4x4 *a)
 {
-    return (mat4){ { a->a1, a->a2, a->a3, a->a4, a->b1, a->b2, a->b3, a->b4, a->c1, a->c2, a->c3,
-                     a->c4, a->d1, a->d2, a->d3, a->d4 } };
+    return (drift__mat4){ { a->a1, a->a2, a->a3, a->a4, a->b1, a->b2, a->b3, a->b4, a->c1, a->c2,
+                            a->c3, a->c4, a->d1, a->d2, a->d3, a->d4 } };
 }
 
-static drift_vec3 transform_point(const mat4 *t, drift_vec3 p)
+static drift_vec3 transform_point(const drift__mat4 *t, drift_vec3 p)
 {
     const float *m = t->m;
     return drift_vec3_make(m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3],
@@ -53,7 +48,7 @@ static drift_vec3 transform_point(const mat4 *t, drift_vec3 p)
                            m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]);
 }
 
-static drift_vec3 transform_vector(const mat4 *t, drift_vec3 v)
+static drift_vec3 transform_vector(const drift__mat4 *t, drift_vec3 v)
 {
     const float *m = t->m;
     return drift_vec3_make(m[0] * v.x + m[1] * v.y + m[2] * v.z,
@@ -61,7 +56,7 @@ static drift_vec3 transform_vector(const mat4 *t, drift_vec3 v)
                            m[8] * v.x + m[9] * v.y + m[10] * v.z);
 }
 
-static float mat3_determinant(const mat4 *t)
+static float mat3_determinant(const drift__mat4 *t)
 {
     const float *m = t->m;
     return m[0] * (m[5] * m[10] - m[6] * m[9]) - m[1] * (m[4] * m[10] - m[6] * m[8]) +
@@ -69,7 +64,7 @@ static float mat3_determinant(const mat4 *t)
 }
 
 // Cofactor matrix of the upper 3x3 (= det * inverse transpose): maps normals up to scale.
-static void mat3_cofactor(const mat4 *t, float c[9])
+static void mat3_cofactor(const drift__mat4 *t, float c[9])
 {
     const float *m = t->m;
     c[0] = m[5] * m[10] - m[6] * m[9];
@@ -219,7 +214,7 @@ static drift_result convert_materials(import_state *s)
     return DRIFT_OK;
 }
 
-static drift_result add_mesh(import_state *s, const struct aiMesh *mesh, const mat4 *world,
+static drift_result add_mesh(import_state *s, const struct aiMesh *mesh, const drift__mat4 *world,
                              const char *node_name)
 {
     drift_context *ctx = s->ctx;
@@ -319,7 +314,7 @@ done:
     return r;
 }
 
-static drift_result add_light(import_state *s, const struct aiLight *l, const mat4 *world)
+static drift_result add_light(import_state *s, const struct aiLight *l, const drift__mat4 *world)
 {
     drift_light light = { 0 };
     drift_vec3 position =
@@ -367,7 +362,7 @@ static drift_result add_light(import_state *s, const struct aiLight *l, const ma
     return DRIFT_OK;
 }
 
-static void set_camera(import_state *s, const struct aiCamera *cam, const mat4 *world)
+static void set_camera(import_state *s, const struct aiCamera *cam, const drift__mat4 *world)
 {
     drift_vec3 local_eye = drift_vec3_make(cam->mPosition.x, cam->mPosition.y, cam->mPosition.z);
     drift_vec3 local_look = drift_vec3_make(cam->mLookAt.x, cam->mLookAt.y, cam->mLookAt.z);
@@ -399,8 +394,8 @@ static void set_camera(import_state *s, const struct aiCamera *cam, const mat4 *
     s->info->has_camera = true;
 }
 
-static drift_result walk_nodes(import_state *s, const struct aiNode *node, const mat4 *parent,
-                               int depth)
+static drift_result walk_nodes(import_state *s, const struct aiNode *node,
+                               const drift__mat4 *parent, int depth)
 {
     if (depth > DRIFT__SCENE_MAX_NODE_DEPTH) {
         drift_log(s->ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, s->where, s->line,
@@ -408,8 +403,8 @@ static drift_result walk_nodes(import_state *s, const struct aiNode *node, const
                   DRIFT__SCENE_MAX_NODE_DEPTH);
         return DRIFT_ERR_PARSE;
     }
-    mat4 local = mat4_from_ai(&node->mTransformation);
-    mat4 world = mat4_mul(parent, &local);
+    drift__mat4 local = mat4_from_ai(&node->mTransformation);
+    drift__mat4 world = drift__mat4_mul(parent, &local);
     char node_name[DRIFT_NAME_MAX];
     ai_name(&node->mName, node_name, sizeof(node_name));
     for (unsigned i = 0; i < node->mNumMeshes; ++i) {
@@ -450,10 +445,7 @@ static drift_result import_scene(import_state *s)
 {
     const struct aiScene *ai = s->ai;
     drift_context *ctx = s->ctx;
-    mat4 root = mat4_identity();
-    if (s->params->transform) {
-        memcpy(root.m, s->params->transform, sizeof(root.m));
-    }
+    drift__mat4 root = s->params->transform ? *s->params->transform : drift__mat4_identity();
     drift_result r = DRIFT_OK;
     s->material_map = drift_alloc(ctx, ((size_t)ai->mNumMaterials + 1) * sizeof(uint32_t));
     s->light_placed = drift_alloc(ctx, ((size_t)ai->mNumLights + 1) * sizeof(bool));

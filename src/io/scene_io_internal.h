@@ -5,6 +5,7 @@
 
 #include "drift/scene.h"
 #include "drift/scene_io.h"
+#include "scene/scene_internal.h" // drift__scene_mesh_bounds
 
 #include <stdbool.h>
 #include <stddef.h>
@@ -29,13 +30,21 @@ drift_result drift__texture_cache_get(drift_scene *scene, drift__texture_cache *
                                       uint32_t *out_index);
 void drift__texture_cache_clear(drift_context *ctx, drift__texture_cache *cache);
 
+// Row-major 4x4 affine transform (the layout of aiMatrix4x4 and of the JSON "matrix").
+typedef struct drift__mat4 {
+    float m[16];
+} drift__mat4;
+
+drift__mat4 drift__mat4_identity(void);
+drift__mat4 drift__mat4_mul(const drift__mat4 *a, const drift__mat4 *b);
+
 // How to bring one mesh file into a scene.
 typedef struct drift__import_params {
-    const char *path;           // the mesh file
-    const char *where;          // file named in messages about this import (NULL: path)
-    int line;                   // line of `where` that asked for the import (0: none)
-    const float *transform;     // 4x4 row-major, applied after the file's own; NULL: identity
-    uint32_t material_override; // DRIFT_INVALID_INDEX: the file's materials
+    const char *path;             // the mesh file
+    const char *where;            // file named in messages about this import (NULL: path)
+    int line;                     // line of `where` that asked for the import (0: none)
+    const drift__mat4 *transform; // applied after the file's own; NULL: identity
+    uint32_t material_override;   // DRIFT_INVALID_INDEX: the file's materials
     drift__texture_cache *textures;
 } drift__import_params;
 
@@ -64,11 +73,12 @@ drift_result drift__read_file(drift_context *ctx, const char *path, bool gzip, c
 // before a trailing ".gz". *out_gz tells whether the name ended in .gz.
 void drift__path_extension(const char *path, char *out, size_t out_size, bool *out_gz);
 
+// True for the mesh file extensions assimp is asked to read (obj, gltf, glb, ply; lower case).
+bool drift__is_mesh_extension(const char *ext);
+
 // base_dir + "/" + relative (relative unchanged when absolute or base_dir is NULL/empty).
 bool drift__path_join(const char *base_dir, const char *relative, char *out, size_t out_size);
 
-// Bounds of all mesh vertices added so far.
-drift_bounds3 drift__scene_mesh_bounds(const drift_scene *scene);
 // The framing camera of a bare mesh file (see scene_io.h).
 drift_camera drift__framing_camera(drift_bounds3 bounds);
 

@@ -31,9 +31,7 @@ typedef struct json_reader {
     const char *base_dir; // paths in the file are relative to this
     node_line *lines;     // sorted by node address
     size_t line_count;
-    const cJSON *materials;   // the "materials" object, or NULL
-    uint32_t *material_index; // scene index of each child of `materials`
-    uint32_t material_count;
+    uint32_t material_count; // the file's materials: scene materials 0 .. material_count - 1
     drift__texture_cache textures;
     bool file_camera_found;
     drift_camera file_camera;
@@ -468,7 +466,7 @@ static drift_result load_texture(json_reader *r, const cJSON *obj, const char *p
 
 // --- MATERIALS ---
 
-static drift_result read_material(json_reader *r, const cJSON *item, uint32_t slot)
+static drift_result read_material(json_reader *r, const cJSON *item)
 {
     char path[KEY_PATH_MAX];
     key_path(path, "materials", item->string);
@@ -529,7 +527,7 @@ static drift_result read_material(json_reader *r, const cJSON *item, uint32_t sl
         (res = load_texture(r, item, path, "diffuse_texture", &m.diffuse_texture)) != DRIFT_OK) {
         return res;
     }
-    res = drift_scene_add_material(r->scene, &m, &r->material_index[slot]);
+    res = drift_scene_add_material(r->scene, &m, NULL);
     if (res != DRIFT_OK) {
         return FAIL(r, item, res, "%s is not valid", path);
     }
@@ -556,31 +554,23 @@ static drift_result read_materials(json_reader *r, const cJSON *root)
     if (res != DRIFT_OK) {
         return res;
     }
-    r->materials = materials;
-    r->material_index = drift_alloc(r->ctx, ((size_t)count + 1) * sizeof(uint32_t));
-    if (!r->material_index) {
-        return DRIFT_ERR_OUT_OF_MEMORY;
-    }
-    uint32_t slot = 0;
-    for (const cJSON *c = materials->child; c; c = c->next, ++slot) {
-        res = read_material(r, c, slot);
+    // They are read before anything else adds materials, so the n-th is scene material n.
+    for (const cJSON *c = materials->child; c; c = c->next) {
+        res = read_material(r, c);
         if (res != DRIFT_OK) {
             return res;
         }
-        r->material_count = slot + 1;
+        r->material_count++;
     }
     return DRIFT_OK;
 }
 
 static bool find_material(const json_reader *r, const char *name, uint32_t *out_index)
 {
-    if (!r->materials) {
-        return false;
-    }
-    uint32_t slot = 0;
-    for (const cJSON *c = r->materials->child; c && slot < r->material_count; c = c->next, ++slot) {
-        if (strcmp(c->string, name) == 0) {
-            *out_index = r->material_index[slot];
+    // Names are whole (read_material rejects any DRIFT_NAME_MAX would cut) and unique.
+    for (uint32_t i = 0; i < r->material_count; ++i) {
+        if (strcmp(r->scene->materials[i].name, name) == 0) {
+            *out_index = i;
             return true;
         }
     }
@@ -589,44 +579,27 @@ static bool find_material(const json_reader *r, const char *name, uint32_t *out_
 
 // --- MESHES ---
 
-typedef struct mat4 {
-    float m[16];
-} mat4;
-
-static mat4 mat4_mul(const mat4 *a, const mat4 *b)
-{
-    mat4 out;
-    for (int i = 0; i < 4; ++i) {
-        for (int j = 0; j < 4; ++j) {
-            float s = 0.0f;
-            for (int k = 0; k < 4; ++k) {
-                s += a->m[4 * i + k] * b->m[4 * k + j];
-            }
-            out.m[4 * i + j] = s;
-        }
-    }
-    return out;
-}
-
 // Rotation by `degrees` about `axis` (right-handed: counter-clockwise looking down the axis).
-static mat4 mat4_rotation(drift_vec3 axis, float degrees)
+static drift__mat4 mat4_rotation(drift_vec3 axis, float degrees)
 {
     drift_vec3 a = drift_vec3_normalize(axis);
     float t = degrees * DRIFT_PI / 180.0f;
     float c = cosf(t), s = sinf(t), k = 1.0f - c;
-    return (mat4){ { k * a.x * a.x + c, k * a.x * a.y - s * a.z, k * a.x * a.z + s * a.y, 0.0f,
-                     k * a.x * a.y + s * a.z, k * a.y * a.y + c, k * a.y * a.z - s * a.x, 0.0f,
-                     k * a.x * a.z - s * a.y, k * a.y * a.z + s * a.x, k * a.z * a.z + c, 0.0f,
-                     0.0f, 0.0f, 0.0f, 1.0f } };
+    return (drift__mat4){
+        { k * a.x * a.x + c, k * a.x * a.y - s * a.z, k * a.x * a.z + s * a.y, 0.0f, //
+          k * a.x * a.y + s * a.z, k * a.y * a.y + c, k * a.y * a.z - s * a.x, 0.0f, //
+          k * a.x * a.z - s * a.y, k * a.y * a.z + s * a.x, k * a.z * a.z + c, 0.0f, //
+          0.0f, 0.0f, 0.0f, 1.0f }
+    };
 }
 
 // "transform": { translate, rotate: { axis, degrees }, scale } (applied scale, rotate,
 // translate) or { matrix: 16 numbers, row-major }.
 static drift_result read_transform(const json_reader *r, const cJSON *obj, const char *parent,
-                                   mat4 *out)
+                                   drift__mat4 *out)
 {
     const cJSON *item = cJSON_GetObjectItemCaseSensitive(obj, "transform");
-    *out = (mat4){ { 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1 } };
+    *out = drift__mat4_identity();
     if (!item) {
         return DRIFT_OK;
     }
@@ -692,7 +665,7 @@ static drift_result read_transform(const json_reader *r, const cJSON *obj, const
                         "%s must be non-zero on every axis", spath);
         }
     }
-    mat4 rotation = { { 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1 } };
+    drift__mat4 rotation = drift__mat4_identity();
     const cJSON *rotate = cJSON_GetObjectItemCaseSensitive(item, "rotate");
     if (rotate) {
         char rpath[KEY_PATH_MAX];
@@ -710,17 +683,14 @@ static drift_result read_transform(const json_reader *r, const cJSON *obj, const
         }
         rotation = mat4_rotation(axis, degrees);
     }
-    mat4 s = { { scale.x, 0, 0, 0, 0, scale.y, 0, 0, 0, 0, scale.z, 0, 0, 0, 0, 1 } };
-    mat4 t = { { 1, 0, 0, translate.x, 0, 1, 0, translate.y, 0, 0, 1, translate.z, 0, 0, 0, 1 } };
-    mat4 rs = mat4_mul(&rotation, &s);
-    *out = mat4_mul(&t, &rs);
+    drift__mat4 s = { { scale.x, 0, 0, 0, 0, scale.y, 0, 0, 0, 0, scale.z, 0, 0, 0, 0, 1 } };
+    drift__mat4 t = { { 1, 0, 0, translate.x, //
+                        0, 1, 0, translate.y, //
+                        0, 0, 1, translate.z, //
+                        0, 0, 0, 1 } };
+    drift__mat4 rs = drift__mat4_mul(&rotation, &s);
+    *out = drift__mat4_mul(&t, &rs);
     return DRIFT_OK;
-}
-
-static bool is_mesh_extension(const char *ext)
-{
-    return strcmp(ext, "obj") == 0 || strcmp(ext, "gltf") == 0 || strcmp(ext, "glb") == 0 ||
-           strcmp(ext, "ply") == 0;
 }
 
 static drift_result read_mesh(json_reader *r, const cJSON *item, const char *path)
@@ -744,14 +714,14 @@ static drift_result read_mesh(json_reader *r, const cJSON *item, const char *pat
                     DRIFT_ERR_INVALID_ARGUMENT, "%s.material '%s' is not in materials", path,
                     material_name);
     }
-    mat4 transform;
+    drift__mat4 transform;
     if ((res = read_transform(r, item, path, &transform)) != DRIFT_OK) {
         return res;
     }
     char ext[16];
     bool gz = false;
     drift__path_extension(rel, ext, sizeof(ext), &gz);
-    if (!is_mesh_extension(ext)) {
+    if (!drift__is_mesh_extension(ext)) {
         return FAIL(r, path_item, DRIFT_ERR_UNSUPPORTED,
                     "%s.path '%s': meshes must be .obj, .gltf, .glb or .ply (optionally .gz)", path,
                     rel);
@@ -764,7 +734,7 @@ static drift_result read_mesh(json_reader *r, const cJSON *item, const char *pat
     drift__import_params params = { .path = full,
                                     .where = r->file,
                                     .line = line_of(r, path_item),
-                                    .transform = transform.m,
+                                    .transform = &transform,
                                     .material_override = material,
                                     .textures = &r->textures };
     res = drift__scene_import_mesh_file(r->scene, &params, &info);
@@ -1116,7 +1086,6 @@ drift_result drift_scene_load_json_text(drift_context *ctx, const char *text, si
     cJSON_Delete(root);
     drift_free(ctx, copy);
     drift_free(ctx, r.lines);
-    drift_free(ctx, r.material_index);
     drift__texture_cache_clear(ctx, &r.textures);
     if (res != DRIFT_OK) {
         drift_scene_destroy(r.scene);

@@ -2,6 +2,7 @@
 // the texture cache, and the camera and light a bare mesh file is given.
 #include "drift/image_io.h"
 #include "drift/scene_io.h"
+#include "image_io_internal.h" // drift__errno_text
 #include "scene_io_internal.h"
 
 #include <ctype.h>
@@ -64,9 +65,10 @@ drift_result drift__check_file(drift_context *ctx, const char *path, const char 
 {
     *out_size = 0;
     struct stat st;
+    char why[128];
     if (stat(path, &st) != 0) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, where, line, "cannot open '%s': %s", path,
-                  strerror(errno));
+                  drift__errno_text(errno, why, sizeof(why)));
         return DRIFT_ERR_IO;
     }
     if (!S_ISREG(st.st_mode)) {
@@ -120,8 +122,9 @@ drift_result drift__read_file(drift_context *ctx, const char *path, bool gzip, c
     // both kinds; gzdirect says which kind the file is, and it must match its name.
     gzFile gz = gzopen(path, "rb");
     if (!gz) {
+        char why[128];
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, where, line, "cannot open '%s': %s", path,
-                  strerror(errno));
+                  drift__errno_text(errno, why, sizeof(why)));
         return DRIFT_ERR_IO;
     }
     if (gzdirect(gz) == (int)gzip) {
@@ -253,19 +256,6 @@ void drift__texture_cache_clear(drift_context *ctx, drift__texture_cache *cache)
     *cache = (drift__texture_cache){ 0 };
 }
 
-drift_bounds3 drift__scene_mesh_bounds(const drift_scene *scene)
-{
-    drift_bounds3 b = drift_bounds3_empty();
-    for (uint32_t m = 0; m < scene->mesh_count; ++m) {
-        const drift_mesh *mesh = &scene->meshes[m];
-        for (uint32_t v = 0; v < mesh->vertex_count; ++v) {
-            const float *p = mesh->positions + 3 * (size_t)v;
-            b = drift_bounds3_extend(b, drift_vec3_make(p[0], p[1], p[2]));
-        }
-    }
-    return b;
-}
-
 drift_camera drift__framing_camera(drift_bounds3 bounds)
 {
     const float fov_y = 45.0f * DRIFT_PI / 180.0f;
@@ -312,7 +302,7 @@ static drift_result add_default_lights(drift_scene *scene, const char *path)
     return DRIFT_OK;
 }
 
-static bool is_mesh_extension(const char *ext)
+bool drift__is_mesh_extension(const char *ext)
 {
     return strcmp(ext, "obj") == 0 || strcmp(ext, "gltf") == 0 || strcmp(ext, "glb") == 0 ||
            strcmp(ext, "ply") == 0;
@@ -396,7 +386,7 @@ drift_result drift_scene_load(drift_context *ctx, const char *path, drift_scene 
         drift_free(ctx, text);
         return r;
     }
-    if (is_mesh_extension(ext)) {
+    if (drift__is_mesh_extension(ext)) {
         return load_mesh_scene(ctx, path, out_scene);
     }
     drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_UNSUPPORTED, path, 0,

@@ -345,6 +345,15 @@ drift_result drift_scene_add_texture(drift_scene *scene, drift_image image, uint
     return DRIFT_OK;
 }
 
+drift_bounds3 drift__scene_mesh_bounds(const drift_scene *scene)
+{
+    drift_bounds3 b = drift_bounds3_empty();
+    for (uint32_t m = 0; m < scene->mesh_count; ++m) {
+        b = drift_bounds3_union(b, drift_mesh_bounds(&scene->meshes[m]));
+    }
+    return b;
+}
+
 // Removes previously generated triangle lights (commit regenerates them).
 static void drop_triangle_lights(drift_scene *scene)
 {
@@ -425,10 +434,7 @@ drift_result drift_scene_commit(drift_scene *scene)
     }
 
     // Bounds over meshes and light shapes.
-    drift_bounds3 bounds = drift_bounds3_empty();
-    for (uint32_t m = 0; m < scene->mesh_count; ++m) {
-        bounds = drift_bounds3_union(bounds, drift_mesh_bounds(&scene->meshes[m]));
-    }
+    drift_bounds3 bounds = drift__scene_mesh_bounds(scene);
     for (uint32_t i = 0; i < scene->light_count; ++i) {
         const drift_light *l = &scene->lights[i];
         if (l->type == DRIFT_LIGHT_QUAD) {

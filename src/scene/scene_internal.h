@@ -1,8 +1,13 @@
-// Private to src/scene: pieces shared between scene.c and the light/BSDF code.
+// Private to src/scene (and the scene loaders in src/io): pieces shared between scene.c and
+// the light/BSDF code.
 #ifndef DRIFT_SCENE_INTERNAL_H
 #define DRIFT_SCENE_INTERNAL_H
 
 #include "drift/scene.h"
+
+// Bounds of all mesh vertices added so far (commit adds the light shapes for scene->bounds;
+// the loaders frame a default camera on it before commit).
+drift_bounds3 drift__scene_mesh_bounds(const drift_scene *scene);
 
 // Builds scene->light_table (power distribution over lights and the environment).
 drift_result drift__light_table_build(drift_scene *scene);

@@ -475,6 +475,8 @@ static void test_scene_io_gzip(void **state)
     assert_int_equal(drift_scene_load(ctx, dst, &scene), DRIFT_OK);
     // From memory the .mtl is not found, so there is no emitter: the default light is added.
     assert_int_equal(drift_scene_triangle_count(scene), 32);
+    assert_int_equal(scene->light_count, 1);
+    assert_int_equal(scene->lights[0].type, DRIFT_LIGHT_DIRECTIONAL);
     drift_scene_destroy(scene);
 
     // A truncated gzip stream is an error, not a short mesh.
