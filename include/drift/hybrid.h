@@ -134,11 +134,14 @@ typedef struct drift_hybrid_params {
     //   isg_sigma = 0 -> (0.01 x scene diagonal)^2, sigma of eq. 6 and 10 in squared scene units
     //   isg_a, isg_b = 0 -> 1 and 100 sigma (eq. 10: a normal difference n = 0.1 costs 1/e)
     //   blur_radius = 0 -> 4 pixels, the disk of the `blur` baselines
+    //   isg_layers = 0 -> 1; 2 adds a second depth layer (one more ray a pixel) that ISG depth
+    //                of field reads behind foreground objects
     int32_t isg_search;
     int32_t isg_gather;
     float isg_sigma;
     float isg_a, isg_b;
     float blur_radius;
+    int32_t isg_layers;
 } drift_hybrid_params;
 
 drift_hybrid_params drift_hybrid_params_resolve(const drift_hybrid_params *params,

@@ -39,7 +39,8 @@ float drift_isg_filter(const drift_isg_kernel *k, const drift_image *image, int3
         if (!(w > 0.0f)) {
             continue; // rejected; skipping also keeps an infinite value of a rejected sample out
         }
-        const float *v = drift_image_pixel(image, sx, sy) + first;
+        const float *v = k->value ? k->value(k->user, sx, sy) : NULL;
+        v = v ? v : drift_image_pixel(image, sx, sy) + first;
         for (int32_t c = 0; c < channels; ++c) {
             sum[c] += w * (v[c] - ref[c]);
         }
@@ -104,6 +105,7 @@ void drift_isg_params_resolve(drift_hybrid_params *p, const drift_scene *scene)
     p->isg_a = p->isg_a > 0.0f ? p->isg_a : 1.0f;
     p->isg_b = p->isg_b > 0.0f ? p->isg_b : 100.0f * p->isg_sigma;
     p->blur_radius = p->blur_radius > 0.0f ? p->blur_radius : 4.0f;
+    p->isg_layers = p->isg_layers ? p->isg_layers : 1;
 }
 
 const char *drift_isg_params_problem(const drift_hybrid_params *p)
@@ -114,6 +116,9 @@ const char *drift_isg_params_problem(const drift_hybrid_params *p)
     if (!isfinite(p->isg_sigma) || !isfinite(p->isg_a) || !isfinite(p->isg_b) ||
         !isfinite(p->blur_radius) || p->blur_radius > 1024.0f) {
         return "isg sigma, a, b or blur radius out of range";
+    }
+    if (p->isg_layers != 1 && p->isg_layers != 2) {
+        return "isg layers must be 1 or 2";
     }
     return NULL;
 }
@@ -145,6 +150,12 @@ drift_result drift_isg_prepare(drift_hybrid *f)
         if (r == DRIFT_OK) {
             r = drift_image_create(ctx, w, h, 1, &s->dof_search);
         }
+        if (r == DRIFT_OK) {
+            r = drift_image_create(ctx, w, h, 1, &s->layer_depth);
+        }
+        if (r == DRIFT_OK) {
+            r = drift_image_create(ctx, w, h, 3, &s->layer_colour);
+        }
         if (r != DRIFT_OK) {
             return r;
         }
@@ -171,6 +182,8 @@ void drift_isg_destroy(drift_hybrid *f)
     drift_free(f->ctx, s->light_search);
     drift_image_destroy(f->ctx, &s->reflection_search);
     drift_image_destroy(f->ctx, &s->dof_search);
+    drift_image_destroy(f->ctx, &s->layer_depth);
+    drift_image_destroy(f->ctx, &s->layer_colour);
     drift_free(f->ctx, s);
     f->isg = NULL;
 }
@@ -193,5 +206,9 @@ void drift_isg_add_planes(drift_hybrid *f, drift_isg_add_plane_fn add)
     }
     if (p->dof == DRIFT_DOF_ISG) {
         add(f, "isg.dof", &f->isg->dof_search);
+        if (p->isg_layers == 2) {
+            add(f, "isg.layer2.depth", &f->isg->layer_depth);
+            add(f, "isg.layer2.colour", &f->isg->layer_colour);
+        }
     }
 }

@@ -13,7 +13,8 @@
 //           background, while a blurred foreground still spreads over what is behind it.
 // Eq. 16 and 17 in the paper give the weights c_i and c_inf for the two cases; with c_i <=
 // c_inf that only halves a case, so the smoothstep weights above go from 1 to 0 instead
-// (docs/isg.md).
+// (docs/isg.md). With isg_layers = 2 the gather also reads the second depth layer behind a
+// blurred object (value_behind).
 #include "hybrid/isg_internal.h"
 
 #include <math.h>
@@ -27,6 +28,7 @@ typedef struct range_ctx {
     const drift_image *depth;
     int32_t x0, y0;
     float z0, c0;
+    const float *behind; // the second layer's colour at the centre, or NULL
 } range_ctx;
 
 static float depth_at(const drift_image *depth, int32_t x, int32_t y)
@@ -59,6 +61,15 @@ static float range_gather(const void *user, int32_t x, int32_t y)
     return 1.0f - in_front;
 }
 
+// With a second layer: a sample that lands past a blurred centre's object stands for a lens
+// ray that misses the object, and that ray sees what lies behind the centre, not the
+// neighbouring pixel's first surface.
+static const float *value_behind(const void *user, int32_t x, int32_t y)
+{
+    const range_ctx *c = user;
+    return depth_at(c->depth, x, y) > c->z0 * (1.0f + DEPTH_RAMP) ? c->behind : NULL;
+}
+
 typedef struct dof_job {
     float c_inf;
     float search_radius;
@@ -79,7 +90,7 @@ static void dof_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays, voi
     drift_isg_jitter jitter =
         drift_isg_jitter_make(drift_hash_combine(f->params.seed ^ STREAM_ISG_DOF, pixel));
     drift_isg_kernel search = { &s->search, jitter, drift_vec2_make(job->search_radius, job->search_radius),
-                                range_search, &rc };
+                                range_search, &rc, NULL };
     float radius;
     drift_isg_filter(&search, &f->coc, 0, 1, x, y, &radius); // the centre always counts
     drift_image_pixel(&s->dof_search, x, y)[0] = radius;
@@ -88,8 +99,14 @@ static void dof_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays, voi
         drift_image_set3(&f->final, x, y, drift_image_get3(&f->focus, x, y));
         return;
     }
+    drift_isg_value_fn value = NULL;
+    if (f->params.isg_layers == 2 && rc.c0 >= 1.0f &&
+        drift_image_pixel(&s->layer_depth, x, y)[0] > rc.z0) {
+        rc.behind = drift_image_pixel(&s->layer_colour, x, y);
+        value = value_behind;
+    }
     drift_isg_kernel gather = { &s->gather, jitter, drift_vec2_make(radius, radius), range_gather,
-                                &rc };
+                                &rc, value };
     drift_isg_filter(&gather, &f->focus, 0, 3, x, y, out);
 }
 
@@ -118,6 +135,12 @@ drift_result drift_isg_pass_dof(drift_hybrid *f)
             }
         }
     } else {
+        if (f->params.isg_layers == 2) {
+            r = drift_isg_pass_layer(f);
+            if (r != DRIFT_OK) {
+                return r;
+            }
+        }
         drift_hybrid_for_each_pixel(f, dof_pixel, &job);
     }
     f->stats.ms[DRIFT_PASS_ISG] += 1000.0 * (drift_time_now() - t);

@@ -52,6 +52,9 @@ drift_vec2 drift_isg_offset(const drift_isg_pattern *pattern, const drift_isg_ji
 // Range function times spatial weight of the sample at pixel (x, y) for the centre the
 // caller's `user` describes; 0 rejects the sample.
 typedef float (*drift_isg_range_fn)(const void *user, int32_t x, int32_t y);
+// Optional: the channels to read for the sample at (x, y) instead of the image's (NULL: the
+// image's). The second depth layer substitutes what lies behind the centre this way.
+typedef const float *(*drift_isg_value_fn)(const void *user, int32_t x, int32_t y);
 
 typedef struct drift_isg_kernel {
     const drift_isg_pattern *pattern;
@@ -59,6 +62,7 @@ typedef struct drift_isg_kernel {
     drift_vec2 radius;          // half extents in pixels along x and y
     drift_isg_range_fn range;
     const void *user;
+    drift_isg_value_fn value; // may be NULL
 } drift_isg_kernel;
 
 // Eq. 4 at pixel (x, y): the average of `image` channels [first, first + channels) over the
@@ -84,7 +88,7 @@ static inline float drift_isg_smoothstep(float e0, float e1, float x)
 
 // --- FRAME STATE, PARAMETERS, PLANES (isg.c) ---
 
-#define DRIFT_ISG_FIXED_PLANES 2     // isg.reflection, isg.dof
+#define DRIFT_ISG_FIXED_PLANES 4     // isg.reflection, isg.dof, isg.layer2.depth, .colour
 #define DRIFT_ISG_PLANES_PER_LIGHT 1 // lightN.isg
 
 typedef struct drift_isg_state {
@@ -92,6 +96,8 @@ typedef struct drift_isg_state {
     uint32_t light_count;
     drift_image reflection_search; // 2: average reflected distance E, gather radius (px)
     drift_image dof_search;        // 1: gather radius (px) found by the search
+    drift_image layer_depth;       // 1: view depth of the second layer (0: none; 1e30: a miss)
+    drift_image layer_colour;      // 3: its radiance (isg_layers.c)
     drift_isg_pattern search, gather, search_rect, gather_rect;
 } drift_isg_state;
 
@@ -113,6 +119,8 @@ void drift_isg_add_planes(drift_hybrid *frame, drift_isg_add_plane_fn add);
 drift_result drift_isg_pass_shadows(drift_hybrid *frame);     // isg or blur: bits -> S_l
 drift_result drift_isg_pass_reflections(drift_hybrid *frame); // isg or blur: sharp -> R
 drift_result drift_isg_pass_dof(drift_hybrid *frame);         // focus -> final
+// The second depth layer, for isg_layers = 2 (isg_layers.c).
+drift_result drift_isg_pass_layer(drift_hybrid *frame);
 
 // --- THE PIECES THE PASSES ARE MADE OF, FOR TESTS ---
 

@@ -88,7 +88,7 @@ static void reflection_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *ra
     drift_vec3 gathered;
     if (p->reflections == DRIFT_REFLECTIONS_BLUR) {
         drift_isg_kernel k = { &s->gather, jitter, drift_vec2_make(p->blur_radius, p->blur_radius),
-                               range_lobe, &rc };
+                               range_lobe, &rc, NULL };
         drift_isg_filter(&k, &f->reflection_reflected, 0, 3, x, y, &gathered.x);
     } else {
         float scale_x = (float)p->width / job->fov_x, scale_y = (float)p->height / job->fov_y;
@@ -96,7 +96,7 @@ static void reflection_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *ra
         if (fmaxf(search_radius.x, search_radius.y) < 0.5f) {
             return; // a lobe under half a pixel: the sharp reflection
         }
-        drift_isg_kernel search = { &s->search, jitter, search_radius, range_eq10, &rc };
+        drift_isg_kernel search = { &s->search, jitter, search_radius, range_eq10, &rc, NULL };
         float reflected_distance;
         if (!(drift_isg_filter(&search, &f->reflection_distance, 0, 1, x, y, &reflected_distance) > 0.0f)) {
             reflected_distance = INFINITY; // nothing reflected in reach: the environment
@@ -112,7 +112,7 @@ static void reflection_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *ra
             return;
         }
         rc.distance = NULL; // the gather reads radiance; a miss has radiance too
-        drift_isg_kernel gather = { &s->gather, jitter, gather_radius, range_eq10, &rc };
+        drift_isg_kernel gather = { &s->gather, jitter, gather_radius, range_eq10, &rc, NULL };
         drift_isg_filter(&gather, &f->reflection_reflected, 0, 3, x, y, &gathered.x);
     }
     drift_image_set3(&f->reflections, x, y,

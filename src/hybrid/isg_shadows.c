@@ -130,7 +130,7 @@ static void shadow_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays, 
         drift_isg_jitter jitter = drift_isg_jitter_make(drift_hash_u32(hash + l));
         if (f->params.shadows == DRIFT_SHADOWS_BLUR) {
             float r = f->params.blur_radius;
-            drift_isg_kernel k = { &s->gather, jitter, drift_vec2_make(r, r), range_surface, &rc };
+            drift_isg_kernel k = { &s->gather, jitter, drift_vec2_make(r, r), range_surface, &rc, NULL };
             drift_isg_filter(&k, &b->hard_shadow, 0, 1, x, y, shadow);
             continue;
         }
@@ -145,7 +145,7 @@ static void shadow_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays, 
         }
         bool rect = shape->layout == DRIFT_ISG_RECT;
         drift_isg_kernel search = { rect ? &s->search_rect : &s->search, jitter, search_radius,
-                                    range_search, &rc };
+                                    range_search, &rc, NULL };
         float d;
         if (!(drift_isg_filter(&search, &b->hard_shadow, 1, 1, x, y, &d) > 0.0f)) {
             continue; // no occluder in reach (every sample rejected): the centre's bit
@@ -160,7 +160,7 @@ static void shadow_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays, 
             continue;
         }
         drift_isg_kernel gather = { rect ? &s->gather_rect : &s->gather, jitter, gather_radius,
-                                    range_gather, &rc };
+                                    range_gather, &rc, NULL };
         drift_isg_filter(&gather, &b->hard_shadow, 0, 1, x, y, shadow);
     }
 }

@@ -417,6 +417,70 @@ static void test_dof_foreground_spreads(void **state)
     rig_destroy(&r);
 }
 
+// A thin near bar, blurred, in front of an in-focus wall with a red stripe hidden behind the
+// bar: the lens sees the stripe through the blurred bar, the one-layer gather cannot.
+static double bar_error(int layers, const drift_image *reference, rig *r)
+{
+    rig_frame(r, &(drift_hybrid_params){ .dof = DRIFT_DOF_ISG, .isg_search = 49, .isg_gather = 81,
+                                         .isg_layers = layers });
+    const drift_gbuffer *g = drift_hybrid_gbuffer(r->frame);
+    const drift_image *final = plane(r, "final");
+    double sum = 0.0;
+    int n = 0;
+    for (int y = 8; y < 40; ++y) {
+        for (int x = 0; x < 64; ++x) {
+            if (drift_image_pixel(&g->depth, x, y)[0] > 3.0f) {
+                continue; // the bar's pixels only
+            }
+            for (int c = 0; c < 3; ++c) {
+                double d = (double)drift_image_pixel(final, x, y)[c] -
+                           (double)drift_image_pixel(reference, x, y)[c];
+                sum += d * d;
+            }
+            ++n;
+        }
+    }
+    assert_true(n > 100);
+    return sqrt(sum / (3.0 * n));
+}
+
+static void test_second_layer_sees_behind_blurred_bar(void **state)
+{
+    (void)state;
+    rig r = rig_begin();
+    uint32_t white = add_material(r.scene, drift_material_make(drift_vec3_splat(0.8f)));
+    uint32_t red = add_material(r.scene, drift_material_make(drift_vec3_make(0.9f, 0.05f, 0.05f)));
+    uint32_t dark = add_material(r.scene, drift_material_make(drift_vec3_splat(0.05f)));
+    const uint32_t idx[] = { 0, 2, 1, 0, 3, 2 };
+    const float wall[] = { -20, -20, 10, 20, -20, 10, 20, 20, 10, -20, 20, 10 };
+    const float stripe[] = { -0.5f, -20, 9.99f, 0.5f, -20, 9.99f, 0.5f, 20, 9.99f, -0.5f, 20, 9.99f };
+    const float bar[] = { -0.15f, -5, 2, 0.15f, -5, 2, 0.15f, 5, 2, -0.15f, 5, 2 };
+    test_add_mesh(r.scene, wall, 4, idx, 2, white);
+    test_add_mesh(r.scene, stripe, 4, idx, 2, red);
+    test_add_mesh(r.scene, bar, 4, idx, 2, dark);
+    assert_int_equal(drift_scene_add_light(r.scene,
+                                           &(drift_light){ .type = DRIFT_LIGHT_DIRECTIONAL,
+                                                           .direction = { 0.45f, 0.0f, 0.89f },
+                                                           .color = { 3, 3, 3 } },
+                                           NULL),
+                     DRIFT_OK);
+    r.scene->camera = drift_camera_look_at(drift_vec3_make(0, 0, -0.001f), drift_vec3_make(0, 0, 10),
+                                           drift_vec3_make(0, 1, 0), 0.9f, 64, 48);
+    r.scene->camera.aperture_radius = 0.3f;
+    r.scene->camera.focus_distance = 10.0f;
+    rig_commit(&r);
+    uint32_t spp = (uint32_t)(128.0 * test_intensity());
+    rig_frame(&r, &(drift_hybrid_params){ .dof = DRIFT_DOF_REFERENCE, .spp = spp });
+    drift_image reference;
+    assert_int_equal(drift_image_create(r.ctx, 64, 48, 3, &reference), DRIFT_OK);
+    memcpy(reference.pixels, plane(&r, "final")->pixels, sizeof(float) * 3 * 64 * 48);
+    double one = bar_error(1, &reference, &r), two = bar_error(2, &reference, &r);
+    print_message("DOF rms error over the blurred bar: 1 layer %.4f, 2 layers %.4f\n", one, two);
+    assert_true(two < 0.8 * one);
+    drift_image_destroy(r.ctx, &reference);
+    rig_destroy(&r);
+}
+
 // --- THE FILTER ---
 
 static float range_one(const void *user, int32_t x, int32_t y)
@@ -446,7 +510,7 @@ static void test_constant_image_stays_constant(void **state)
     drift_isg_pattern_make(81, DRIFT_ISG_DISK, &pattern);
     for (uint32_t k = 0; k < 50; ++k) {
         drift_isg_kernel kernel = { &pattern, drift_isg_jitter_make(k), drift_vec2_make(9.0f, 5.0f),
-                                    range_one, NULL };
+                                    range_one, NULL, NULL };
         float out[3];
         int32_t x = (int32_t)(k % 32), y = (int32_t)((k * 7) % 32);
         assert_true(drift_isg_filter(&kernel, &image, 0, 3, x, y, out) > 0.0f);
@@ -471,7 +535,7 @@ static void test_all_rejected_falls_back_to_centre(void **state)
     static drift_isg_pattern pattern;
     drift_isg_pattern_make(25, DRIFT_ISG_RECT, &pattern);
     drift_isg_kernel kernel = { &pattern, drift_isg_jitter_make(7), drift_vec2_make(3.0f, 3.0f),
-                                range_none, NULL };
+                                range_none, NULL, NULL };
     float out;
     assert_true(drift_isg_filter(&kernel, &image, 0, 1, 4, 4, &out) == 0.0f);
     assert_true(out == 36.0f);
@@ -498,7 +562,7 @@ static double gather_variance(const drift_image *image, uint32_t count)
     double sum = 0.0, sum2 = 0.0;
     for (uint32_t k = 0; k < trials; ++k) {
         drift_isg_kernel kernel = { &pattern, drift_isg_jitter_make(drift_hash_u32(k)),
-                                    drift_vec2_make(12.0f, 12.0f), range_unit, NULL };
+                                    drift_vec2_make(12.0f, 12.0f), range_unit, NULL, NULL };
         float out;
         drift_isg_filter(&kernel, image, 0, 1, 32, 32, &out);
         sum += (double)out;
@@ -555,6 +619,7 @@ int main(void)
         cmocka_unit_test(test_zero_aperture_dof_is_identity),
         cmocka_unit_test(test_dof_foreground_spreads),
         cmocka_unit_test(test_dof_in_focus_foreground_does_not_bleed),
+        cmocka_unit_test(test_second_layer_sees_behind_blurred_bar),
         cmocka_unit_test(test_constant_image_stays_constant),
         cmocka_unit_test(test_all_rejected_falls_back_to_centre),
         cmocka_unit_test(test_more_gather_samples_lower_variance),
