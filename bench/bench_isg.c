@@ -9,6 +9,8 @@
 //       (the passes that technique adds) so the times can be matched:
 //         shadows      hard, pcss, blur (the hard bits over a fixed disk), isg
 //         reflections  sharp, envmap, blur (the sharp buffer over a fixed disk), isg
+//       and isg-9x9 (ISG at 9 x 9 samples, its cheapest) for every effect, isg-2layers (with
+//       the second depth layer) for depth of field
 //         dof          none, post, isg; the focused frame has reference (path-traced)
 //                      shadows so that only depth of field differs from the lens reference
 #include "bench.h"
@@ -46,7 +48,7 @@ static void print_help(FILE *out)
             "  --ref-spp N       samples per pixel of the references (default 256)\n"
             "  --search, --gather ISG samples of the quality runs (default 25 and 49)\n"
             "  --aperture A      lens radius for the DOF runs (default: the scene camera's, or\n"
-            "                    0.5%% of the scene diagonal when it has none)\n"
+            "                    2%% of the scene diagonal when it has none)\n"
             "  --threads T       worker threads (default 1: per-thread figures)\n"
             "  --no-table, --no-quality  skip a part\n"
             "  --json            one JSON object on stdout\n");
@@ -210,7 +212,7 @@ typedef struct quality_row {
     double flip, rmse, ms;
 } quality_row;
 
-#define MAX_ROWS 4
+#define MAX_ROWS 5
 
 // (b) for one effect: the reference, then every technique against it.
 static drift_result quality(const bench_ctx *b, drift_effect effect, quality_row *rows,
@@ -218,9 +220,9 @@ static drift_result quality(const bench_ctx *b, drift_effect effect, quality_row
 {
     const isg_options *o = b->o;
     static const char *const names[DRIFT_EFFECT_COUNT][MAX_ROWS] = {
-        { "hard", "pcss", "blur", "isg" },
-        { "sharp", "envmap", "blur", "isg" },
-        { "none", "post", "isg", NULL },
+        { "hard", "pcss", "blur", "isg", "isg-9x9" },
+        { "sharp", "envmap", "blur", "isg", "isg-9x9" },
+        { "none", "post", "isg", "isg-9x9", "isg-2layers" },
         { NULL },
     };
     drift_hybrid_params ref = effect_params(effect, drift_technique_parse(effect, "reference"));
@@ -232,12 +234,18 @@ static drift_result quality(const bench_ctx *b, drift_effect effect, quality_row
     drift_result r = render(b, ref, false, &st, &reference);
     *out_count = 0;
     for (int t = 0; r == DRIFT_OK && t < MAX_ROWS && names[effect][t]; ++t) {
-        drift_hybrid_params p = effect_params(effect, drift_technique_parse(effect, names[effect][t]));
+        // "isg-9x9" is ISG at its cheapest sample counts: the time-matched variant.
+        // "isg-2layers" adds the second depth layer.
+        bool cheap = strcmp(names[effect][t], "isg-9x9") == 0;
+        bool layers = strcmp(names[effect][t], "isg-2layers") == 0;
+        drift_hybrid_params p = effect_params(effect, cheap || layers ? isg_technique(effect)
+                                                                      : drift_technique_parse(effect, names[effect][t]));
+        p.isg_layers = layers ? 2 : 1;
         p.width = ref.width;
         p.height = ref.height;
         p.spp = ref.spp; // the DOF runs' path-traced shadows
-        p.isg_search = (int32_t)o->search;
-        p.isg_gather = (int32_t)o->gather;
+        p.isg_search = cheap ? 9 : (int32_t)o->search;
+        p.isg_gather = cheap ? 9 : (int32_t)o->gather;
         drift_image test = { 0 };
         // Warm for timing (shadow maps and probes are cached), except around path tracing.
         r = render(b, p, effect != DRIFT_EFFECT_DOF, &st, &test);
@@ -345,7 +353,7 @@ int drift_bench_isg(int argc, char **argv)
         scene->camera.aperture_radius = (float)o.aperture;
     } else if (!(scene->camera.aperture_radius > 0.0f)) {
         scene->camera.aperture_radius =
-            0.005f * drift_vec3_length(drift_vec3_sub(scene->bounds.max, scene->bounds.min));
+            0.02f * drift_vec3_length(drift_vec3_sub(scene->bounds.max, scene->bounds.min));
     }
     bench_ctx b = { ctx, scene, accel, &o };
     static double tables[3][4][4];

@@ -81,6 +81,7 @@ static void print_help(void)
            "  --isg-sigma S         range sigma of eq. 6 and 10, squared scene units\n"
            "                        (default (0.01 x scene diagonal)^2)\n"
            "  --blur-radius R       disk radius in pixels of the blur baselines (default 4)\n"
+           "  --isg-layers 1|2      2: a second depth layer behind objects for --dof isg\n"
            "\n"
            "Ctrl-C stops the render and writes what it has.\n");
 }

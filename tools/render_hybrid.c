@@ -56,7 +56,7 @@ bool render_parse_hybrid_option(int argc, char **argv, int *i, render_options *o
                                           "--envmap-size",   "--probe",           "--ambient",
                                           "--aperture",      "--focus-distance",
                                           "--isg-search",    "--isg-gather",      "--isg-sigma",
-                                          "--blur-radius" };
+                                          "--blur-radius",   "--isg-layers" };
     const char *a = argv[*i];
     int effect = -1, other = -1;
     for (int k = 0; k < DRIFT_EFFECT_COUNT; ++k) {
@@ -130,6 +130,10 @@ bool render_parse_hybrid_option(int argc, char **argv, int *i, render_options *o
         *(other == 10 ? &h->isg_sigma : &h->blur_radius) = (float)value;
         break;
     }
+    case 12:
+        *ok = cli_parse_int("render", a, v, 1, 2, &n);
+        h->isg_layers = (int32_t)n;
+        break;
     default:
         break;
     }

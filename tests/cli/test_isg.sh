@@ -20,6 +20,11 @@ for n in 9 25 49 81; do
         --isg-gather "$n" --isg-sigma 100 --out "$tmp/n$n.exr"
 done
 
+# The second depth layer for depth of field, and its planes.
+expect 0 "$drift" render --mode hybrid "${small[@]}" --dof isg --isg-layers 2 --aperture 5 \
+    --out "$tmp/l2.exr" --aov "$tmp/l2-aov.exr"
+grep -aq "isg.layer2.colour" "$tmp/l2-aov.exr" || fail "AOV file lacks isg.layer2.colour"
+
 # Stats and planes.
 expect 0 "$drift" render --mode hybrid "${small[@]}" --shadows isg --reflections isg --dof isg \
     --aperture 5 --out "$tmp/s.exr" --stats "$tmp/s.json" --aov "$tmp/s-aov.exr"
@@ -41,6 +46,7 @@ expect 2 "$drift" render --mode hybrid --isg-gather 0 --out "$tmp/x.exr"
 expect 2 "$drift" render --mode hybrid --isg-gather 2000 --out "$tmp/x.exr"
 expect 2 "$drift" render --mode hybrid --isg-sigma -1 --out "$tmp/x.exr"
 expect 2 "$drift" render --mode hybrid --blur-radius 0 --out "$tmp/x.exr"
+expect 2 "$drift" render --mode hybrid --isg-layers 3 --out "$tmp/x.exr"
 expect 2 "$drift" render --mode hybrid --dof blur --out "$tmp/x.exr"
 grep -q "isg" "$tmp/err" || fail "unknown dof technique: the message does not list isg"
 expect 2 "$drift" render --isg-search 9 --out "$tmp/x.exr"
