@@ -7,8 +7,9 @@
 //           (eq. 12) -> E, their average (misses rejected; none found: E = infinity)
 //   support tan alpha = E tan theta_max / (e + E) (eq. 13), e the eye distance; alpha / fov
 //           per axis, times cos(theta_incident) (eq. 14)
-//   gather  over the reflected radiance with range eq. 10 and a constant spatial weight (the
-//           Phong lobe's cone, flat inside)
+//   gather  over the reflected radiance with range eq. 10 and a spatial weight shaped like
+//           the Phong lobe across the cone, 0.1^(rho^2) at fraction rho of the support (the
+//           search's weight is constant, as in the paper)
 // theta_max comes per pixel from the gloss plane (90% of the Phong lobe). The gathered
 // radiance is weighted by the centre's lobe albedo, as the sharp buffer is. Samples on
 // pixels without a specular lobe are rejected (their buffer holds no reflection). Mirrors
@@ -24,6 +25,8 @@ typedef struct range_ctx {
     const drift_image *distance; // NULL: any distance
     drift_vec3 p0, n0;
     float a_over_sigma, b_over_sigma;
+    int32_t x0, y0;
+    float inv_rx, inv_ry; // 1 / the gather's half extents; 0 in the search (constant weight)
 } range_ctx;
 
 static bool has_lobe(const drift_gbuffer *g, int32_t x, int32_t y)
@@ -43,7 +46,12 @@ static float range_eq10(const void *user, int32_t x, int32_t y)
     // l to the centre's tangent plane, as for shadows (isg_shadows.c, docs/isg.md).
     float l = drift_vec3_dot(drift_vec3_sub(drift_image_get3(&c->g->position, x, y), c->p0), c->n0);
     float n = 1.0f - drift_vec3_dot(drift_image_get3(&c->g->normal, x, y), c->n0);
-    return expf(-(c->a_over_sigma * l * l + c->b_over_sigma * n * n));
+    // The spatial weight: the Phong lobe across the cone. A sample at fraction rho of the
+    // support stands for a direction rho * theta_max off the mirror direction, where
+    // cos^n(rho theta_max) ~ 0.1^(rho^2) since cos^n(theta_max) ~ 0.1 (90% of the lobe).
+    float u = (float)(x - c->x0) * c->inv_rx, v = (float)(y - c->y0) * c->inv_ry;
+    float lobe = -2.3026f * (u * u + v * v);
+    return expf(lobe - (c->a_over_sigma * l * l + c->b_over_sigma * n * n));
 }
 
 static float range_lobe(const void *user, int32_t x, int32_t y)
@@ -82,7 +90,9 @@ static void reflection_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *ra
                      .p0 = drift_image_get3(&g->position, x, y),
                      .n0 = drift_image_get3(&g->normal, x, y),
                      .a_over_sigma = p->isg_a / p->isg_sigma,
-                     .b_over_sigma = p->isg_b / p->isg_sigma };
+                     .b_over_sigma = p->isg_b / p->isg_sigma,
+                     .x0 = x,
+                     .y0 = y };
     uint32_t hash = drift_hash_combine(p->seed ^ STREAM_ISG_REFLECTIONS, (uint32_t)index);
     drift_isg_jitter jitter = drift_isg_jitter_make(hash);
     drift_vec3 gathered;
@@ -112,6 +122,8 @@ static void reflection_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *ra
             return;
         }
         rc.distance = NULL; // the gather reads radiance; a miss has radiance too
+        rc.inv_rx = 1.0f / fmaxf(gather_radius.x, 1e-6f);
+        rc.inv_ry = 1.0f / fmaxf(gather_radius.y, 1e-6f);
         drift_isg_kernel gather = { &s->gather, jitter, gather_radius, range_eq10, &rc, NULL };
         drift_isg_filter(&gather, &f->reflection_reflected, 0, 3, x, y, &gathered.x);
     }
