@@ -79,9 +79,11 @@ static void print_help(void)
            "  --isg-search N        image space gathering (docs/isg.md): parameter-search\n"
            "  --isg-gather M        and gather samples, perfect squares (default 25 and 49)\n"
            "  --isg-sigma S         range sigma of eq. 6 and 10, squared scene units\n"
-           "                        (default (0.01 x scene diagonal)^2)\n"
+           "                        (default (0.02 x scene diagonal)^2)\n"
            "  --blur-radius R       disk radius in pixels of the blur baselines (default 4)\n"
            "  --isg-layers 1|2      2: a second depth layer behind objects for --dof isg\n"
+           "  --isg-range full|plane  l of the range functions: world distance (default, the\n"
+           "                        paper) or distance to the centre's tangent plane\n"
            "\n"
            "Ctrl-C stops the render and writes what it has.\n");
 }

@@ -56,7 +56,7 @@ bool render_parse_hybrid_option(int argc, char **argv, int *i, render_options *o
                                           "--envmap-size",   "--probe",           "--ambient",
                                           "--aperture",      "--focus-distance",
                                           "--isg-search",    "--isg-gather",      "--isg-sigma",
-                                          "--blur-radius",   "--isg-layers" };
+                                          "--blur-radius",   "--isg-layers",      "--isg-range" };
     const char *a = argv[*i];
     int effect = -1, other = -1;
     for (int k = 0; k < DRIFT_EFFECT_COUNT; ++k) {
@@ -133,6 +133,13 @@ bool render_parse_hybrid_option(int argc, char **argv, int *i, render_options *o
     case 12:
         *ok = cli_parse_int("render", a, v, 1, 2, &n);
         h->isg_layers = (int32_t)n;
+        break;
+    case 13:
+        *ok = strcmp(v, "full") == 0 || strcmp(v, "plane") == 0;
+        h->isg_range_plane = strcmp(v, "plane") == 0;
+        if (!*ok) {
+            fprintf(stderr, "drift render: %s expects full or plane, got '%s'\n", a, v);
+        }
         break;
     default:
         break;

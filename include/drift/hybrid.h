@@ -131,17 +131,20 @@ typedef struct drift_hybrid_params {
     drift_vec3 ambient;
     // Image space gathering (docs/isg.md); 0 picks the default:
     //   isg_search, isg_gather = 0 -> 25, 49 samples (perfect squares 1..1024: 9, 25, 49, 81)
-    //   isg_sigma = 0 -> (0.01 x scene diagonal)^2, sigma of eq. 6 and 10 in squared scene units
+    //   isg_sigma = 0 -> (0.02 x scene diagonal)^2, sigma of eq. 6 and 10 in squared scene units
     //   isg_a, isg_b = 0 -> 1 and 100 sigma (eq. 10: a normal difference n = 0.1 costs 1/e)
     //   blur_radius = 0 -> 4 pixels, the disk of the `blur` baselines
     //   isg_layers = 0 -> 1; 2 adds a second depth layer (one more ray a pixel) that ISG depth
     //                of field reads behind foreground objects
+    //   isg_range_plane = false: l of eq. 7 and 11 is the world distance (the paper); true: the
+    //                distance to the centre's tangent plane (docs/isg.md)
     int32_t isg_search;
     int32_t isg_gather;
     float isg_sigma;
     float isg_a, isg_b;
     float blur_radius;
     int32_t isg_layers;
+    bool isg_range_plane;
 } drift_hybrid_params;
 
 drift_hybrid_params drift_hybrid_params_resolve(const drift_hybrid_params *params,

@@ -99,7 +99,7 @@ void drift_isg_params_resolve(drift_hybrid_params *p, const drift_scene *scene)
         if (scene && !drift_bounds3_is_empty(scene->bounds)) {
             diagonal = drift_vec3_length(drift_vec3_sub(scene->bounds.max, scene->bounds.min));
         }
-        float width = 0.01f * (diagonal > 0.0f ? diagonal : 1.0f);
+        float width = 0.02f * (diagonal > 0.0f ? diagonal : 1.0f);
         p->isg_sigma = width * width;
     }
     p->isg_a = p->isg_a > 0.0f ? p->isg_a : 1.0f;

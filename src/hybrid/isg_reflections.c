@@ -2,8 +2,8 @@
 // buffer (one mirror ray per pixel: radiance seen, hit distance):
 //   search  half extents R_p = theta_max / fov in texture space, per axis (fov_x along x,
 //           fov_y along y: the aspect correction), over the reflected distances, range eq. 10:
-//           r = exp(-(a l^2 + b n^2) / sigma), l (eq. 11) from the sample's point to the
-//           centre's tangent plane (as for shadows), n = 1 - N_i . N_0
+//           r = exp(-(a l^2 + b n^2) / sigma), l the world distance (eq. 11; or to the
+//           centre's tangent plane with isg_range_plane), n = 1 - N_i . N_0
 //           (eq. 12) -> E, their average (misses rejected; none found: E = infinity)
 //   support tan alpha = E tan theta_max / (e + E) (eq. 13), e the eye distance; alpha / fov
 //           per axis, times cos(theta_incident) (eq. 14)
@@ -25,6 +25,7 @@ typedef struct range_ctx {
     const drift_image *distance; // NULL: any distance
     drift_vec3 p0, n0;
     float a_over_sigma, b_over_sigma;
+    bool plane;
     int32_t x0, y0;
     float inv_rx, inv_ry; // 1 / the gather's half extents; 0 in the search (constant weight)
 } range_ctx;
@@ -43,8 +44,9 @@ static float range_eq10(const void *user, int32_t x, int32_t y)
         (c->distance && !isfinite(drift_image_pixel(c->distance, x, y)[0]))) {
         return 0.0f;
     }
-    // l to the centre's tangent plane, as for shadows (isg_shadows.c, docs/isg.md).
-    float l = drift_vec3_dot(drift_vec3_sub(drift_image_get3(&c->g->position, x, y), c->p0), c->n0);
+    // l: the world distance (eq. 11), or the distance to the centre's tangent plane.
+    drift_vec3 d = drift_vec3_sub(drift_image_get3(&c->g->position, x, y), c->p0);
+    float l = c->plane ? drift_vec3_dot(d, c->n0) : drift_vec3_length(d);
     float n = 1.0f - drift_vec3_dot(drift_image_get3(&c->g->normal, x, y), c->n0);
     // The spatial weight: the Phong lobe across the cone. A sample at fraction rho of the
     // support stands for a direction rho * theta_max off the mirror direction, where
@@ -91,6 +93,7 @@ static void reflection_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *ra
                      .n0 = drift_image_get3(&g->normal, x, y),
                      .a_over_sigma = p->isg_a / p->isg_sigma,
                      .b_over_sigma = p->isg_b / p->isg_sigma,
+                     .plane = p->isg_range_plane,
                      .x0 = x,
                      .y0 = y };
     uint32_t hash = drift_hash_combine(p->seed ^ STREAM_ISG_REFLECTIONS, (uint32_t)index);

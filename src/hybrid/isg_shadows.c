@@ -1,8 +1,8 @@
 // ISG soft shadows (Robison & Shirley 2009, section 3.1), light by light over the hard-shadow
 // buffer (visible bit, occluder distance, light distance; one ray to the light's centre):
 //   search  radius R_p = L / z_eye (eq. 5) over the occluder distances, range eq. 6:
-//           r = exp(-l^2 / sigma) * inShadow -> d, their average. l (eq. 7) is measured along
-//           the centre's normal, from the sample's point to the centre's tangent plane
+//           r = exp(-l^2 / sigma) * inShadow -> d, their average. l (eq. 7) is the world
+//           distance, or with isg_range_plane the distance to the centre's tangent plane
 //   penumbra R_s = L d / (D - d) (eq. 8), D the distance to the light's centre
 //   gather  radius R_g = R_s / z_eye (eq. 9) over the visible bits, range exp(-l^2 / sigma)
 // "/ z_eye" projects scene units to pixels: times H / (2 tan(fov_y / 2)) / z_eye. The light's
@@ -59,6 +59,7 @@ typedef struct range_ctx {
     const drift_image *hard;
     drift_vec3 p0, n0;
     float inv_sigma;
+    bool plane;
 } range_ctx;
 
 static float range_position(const range_ctx *c, int32_t x, int32_t y)
@@ -66,11 +67,11 @@ static float range_position(const range_ctx *c, int32_t x, int32_t y)
     if (drift_image_pixel(c->material_id, x, y)[0] < 0.0f) {
         return 0.0f; // a miss or a light: no receiver there
     }
-    // l: the distance to the centre's tangent plane (docs/isg.md: the paper's full distance
-    // would also weigh down the receiver's own plane, narrowing every penumbra wider than
-    // sqrt(sigma)).
-    float l = drift_vec3_dot(drift_vec3_sub(drift_image_get3(c->position, x, y), c->p0), c->n0);
-    return expf(-l * l * c->inv_sigma);
+    // l: the world distance (eq. 7), or with isg_range_plane the distance to the centre's
+    // tangent plane, which does not weigh down the receiver's own plane (docs/isg.md).
+    drift_vec3 d = drift_vec3_sub(drift_image_get3(c->position, x, y), c->p0);
+    float l = drift_vec3_dot(d, c->n0);
+    return expf(-(c->plane ? l * l : drift_vec3_dot(d, d)) * c->inv_sigma);
 }
 
 // Eq. 6.
@@ -120,7 +121,8 @@ static void shadow_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays, 
                      .material_id = &g->material_id,
                      .p0 = drift_image_get3(&g->position, x, y),
                      .n0 = drift_image_get3(&g->normal, x, y),
-                     .inv_sigma = 1.0f / f->params.isg_sigma };
+                     .inv_sigma = 1.0f / f->params.isg_sigma,
+                     .plane = f->params.isg_range_plane };
     for (uint32_t l = 0; l < f->light_count; ++l) {
         drift_hybrid_light_buffers *b = &f->light_buffers[l];
         const float *hard = drift_image_pixel(&b->hard_shadow, x, y);

@@ -17,7 +17,7 @@ done
 # Every sample count of the paper's table, and sigma.
 for n in 9 25 49 81; do
     expect 0 "$drift" render --mode hybrid "${small[@]}" --shadows isg --isg-search "$n" \
-        --isg-gather "$n" --isg-sigma 100 --out "$tmp/n$n.exr"
+        --isg-gather "$n" --isg-sigma 100 --isg-range plane --out "$tmp/n$n.exr"
 done
 
 # The second depth layer for depth of field, and its planes.
@@ -47,6 +47,7 @@ expect 2 "$drift" render --mode hybrid --isg-gather 2000 --out "$tmp/x.exr"
 expect 2 "$drift" render --mode hybrid --isg-sigma -1 --out "$tmp/x.exr"
 expect 2 "$drift" render --mode hybrid --blur-radius 0 --out "$tmp/x.exr"
 expect 2 "$drift" render --mode hybrid --isg-layers 3 --out "$tmp/x.exr"
+expect 2 "$drift" render --mode hybrid --isg-range near --out "$tmp/x.exr"
 expect 2 "$drift" render --mode hybrid --dof blur --out "$tmp/x.exr"
 grep -q "isg" "$tmp/err" || fail "unknown dof technique: the message does not list isg"
 expect 2 "$drift" render --isg-search 9 --out "$tmp/x.exr"

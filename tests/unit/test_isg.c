@@ -180,9 +180,12 @@ static void test_contact_hardening_follows_eq8(void **state)
         rig r = rig_begin();
         build_occluder(&r, heights[i], light_radius);
         rig_commit(&r);
+        // The tangent-plane range: the world distance would also weigh the floor down over
+        // the penumbra (docs/isg.md); eq. 8 is what is under test.
         rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_ISG,
                                               .isg_search = 49,
-                                              .isg_gather = 81 });
+                                              .isg_gather = 81,
+                                              .isg_range_plane = true });
         double width = measured_penumbra(&r);
         // Eq. 8: the occluder distance d and light distance D along the ray share the ratio
         // h / H, so R_s = L h / (H - h).
