@@ -29,6 +29,7 @@ typedef struct range_ctx {
     int32_t x0, y0;
     float z0, c0;
     const float *behind; // the second layer's colour at the centre, or NULL
+    float z_behind;      // and its depth
 } range_ctx;
 
 static float depth_at(const drift_image *depth, int32_t x, int32_t y)
@@ -61,13 +62,18 @@ static float range_gather(const void *user, int32_t x, int32_t y)
     return 1.0f - in_front;
 }
 
-// With a second layer: a sample that lands past a blurred centre's object stands for a lens
+// With a second layer: a sample that lands past a blurred centre's object, on the layer the
+// object hides (its depth within 20% of the second layer's at the centre), stands for a lens
 // ray that misses the object, and that ray sees what lies behind the centre, not the
-// neighbouring pixel's first surface.
+// neighbouring pixel's first surface. Samples further along the centre's own receding
+// surface, or on a surface that meets it at a corner, are not at the hidden layer's depth and
+// keep their own colour.
 static const float *value_behind(const void *user, int32_t x, int32_t y)
 {
     const range_ctx *c = user;
-    return depth_at(c->depth, x, y) > c->z0 * (1.0f + DEPTH_RAMP) ? c->behind : NULL;
+    float z = depth_at(c->depth, x, y);
+    bool past = z > c->z0 * (1.0f + DEPTH_RAMP);
+    return past && fabsf(z - c->z_behind) < 0.2f * c->z_behind ? c->behind : NULL;
 }
 
 typedef struct dof_job {
@@ -103,6 +109,7 @@ static void dof_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays, voi
     if (f->params.isg_layers == 2 && rc.c0 >= 1.0f &&
         drift_image_pixel(&s->layer_depth, x, y)[0] > rc.z0) {
         rc.behind = drift_image_pixel(&s->layer_colour, x, y);
+        rc.z_behind = drift_image_pixel(&s->layer_depth, x, y)[0];
         value = value_behind;
     }
     drift_isg_kernel gather = { &s->gather, jitter, drift_vec2_make(radius, radius), range_gather,
