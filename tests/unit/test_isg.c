@@ -1,6 +1,6 @@
 // Image space gathering against closed forms and properties: contact hardening that follows
 // eq. 8, the limits L -> 0 (hard shadow), theta_max -> 0 (sharp reflection) and zero aperture
-// (identity), normalized weights, the fallback when every sample is rejected, variance that
+// (identity), one gather per light, normalized weights, the fallback when every sample is rejected, variance that
 // falls with the gather's sample count, and depth of field that spreads a blurred foreground
 // without bleeding an in-focus one.
 #include "drift_test.h"
@@ -233,6 +233,38 @@ static void test_point_like_light_gives_hard_shadow(void **state)
     }
     assert_true(partial > 200);
     rig_destroy(&r2);
+    rig_destroy(&r);
+}
+
+// Two lights: each gets its own search and gather. A point-sized second light keeps its hard
+// shadow bit for bit while the first light's shadow softens.
+static void test_each_light_gathers_its_own_shadow(void **state)
+{
+    (void)state;
+    rig r = rig_begin();
+    build_occluder(&r, 1.0f, 0.5f);
+    assert_int_equal(drift_scene_add_light(r.scene,
+                                           &(drift_light){ .type = DRIFT_LIGHT_SPHERE,
+                                                           .position = { -4.0f, LIGHT_HEIGHT, 0.0f },
+                                                           .radius = 1e-4f,
+                                                           .color = { 5, 5, 5 } },
+                                           NULL),
+                     DRIFT_OK);
+    rig_commit(&r);
+    rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_ISG });
+    const drift_image *hard1 = plane(&r, "light1.hard_shadow"), *shadow1 = plane(&r, "light1.shadow");
+    const drift_image *shadow0 = plane(&r, "light0.shadow");
+    int partial0 = 0, shadowed1 = 0;
+    for (int y = 0; y < SHADOW_H; ++y) {
+        for (int x = 0; x < SHADOW_W; ++x) {
+            assert_true(drift_image_pixel(shadow1, x, y)[0] == drift_image_pixel(hard1, x, y)[0]);
+            shadowed1 += drift_image_pixel(hard1, x, y)[0] == 0.0f;
+            float v = drift_image_pixel(shadow0, x, y)[0];
+            partial0 += v > 0.0f && v < 1.0f;
+        }
+    }
+    assert_true(shadowed1 > 100);
+    assert_true(partial0 > 200);
     rig_destroy(&r);
 }
 
@@ -617,6 +649,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_contact_hardening_follows_eq8),
         cmocka_unit_test(test_point_like_light_gives_hard_shadow),
+        cmocka_unit_test(test_each_light_gathers_its_own_shadow),
         cmocka_unit_test(test_narrow_lobe_gives_sharp_reflection),
         cmocka_unit_test(test_gloss_support_eq13),
         cmocka_unit_test(test_zero_aperture_dof_is_identity),
