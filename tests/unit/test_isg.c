@@ -1,8 +1,8 @@
 // Image space gathering against closed forms and properties: contact hardening that follows
 // eq. 8, the limits L -> 0 (hard shadow), theta_max -> 0 (sharp reflection) and zero aperture
-// (identity), one gather per light, normalized weights, the fallback when every sample is rejected, variance that
-// falls with the gather's sample count, and depth of field that spreads a blurred foreground
-// without bleeding an in-focus one.
+// (identity), one gather per light, normalized weights, the fallback when every sample is
+// rejected, variance that falls with the gather's sample count, depth of field that spreads a
+// blurred foreground without bleeding an in-focus one, and the second depth layer.
 #include "drift_test.h"
 
 #include <math.h>
