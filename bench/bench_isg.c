@@ -15,16 +15,15 @@
 //                      shadows so that only depth of field differs from the lens reference
 #include "bench.h"
 #include "cli.h"
+#include "drift/accel.h"
+#include "drift/hybrid.h"
+#include "drift/metric.h"
+#include "drift/scene_io.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-#include "drift/accel.h"
-#include "drift/hybrid.h"
-#include "drift/metric.h"
-#include "drift/scene_io.h"
 
 typedef struct isg_options {
     const char *scene_path;
@@ -35,32 +34,40 @@ typedef struct isg_options {
 
 static void print_help(FILE *out)
 {
-    fprintf(out,
-            "usage: drift bench isg [SCENE] [--width W] [--height H] [--qwidth W] [--qheight H]\n"
-            "                       [--ref-spp N] [--search N] [--gather M] [--aperture A]\n"
-            "                       [--frames N] [--threads T] [--no-table] [--no-quality] [--json]\n\n"
-            "(a) ms of the ISG pass for search x gather in {9,25,49,81}^2 per effect, and the\n"
-            "    base time of the rest of the frame (the paper's Table 1);\n"
-            "(b) FLIP and RMSE against each effect's reference technique for ISG and baselines.\n\n"
-            "  SCENE             default scenes/cornell-glossy/cornell_glossy.json\n"
-            "  --width, --height timing size (default 1024x768)\n"
-            "  --qwidth, --qheight quality size (default 320x240)\n"
-            "  --ref-spp N       samples per pixel of the references (default 256)\n"
-            "  --search, --gather ISG samples of the quality runs (default 25 and 49)\n"
-            "  --frames N        timing: the least of N frames per cell (default 1)\n"
-            "  --aperture A      lens radius for the DOF runs (default: the scene camera's; when\n"
-            "                    it has none, 1%% of the scene diagonal, focused on the surface\n"
-            "                    at the image centre)\n"
-            "  --threads T       worker threads (default 1: per-thread figures)\n"
-            "  --no-table, --no-quality  skip a part\n"
-            "  --json            one JSON object on stdout\n");
+    fprintf(
+        out,
+        "usage: drift bench isg [SCENE] [--width W] [--height H] [--qwidth W] [--qheight H]\n"
+        "                       [--ref-spp N] [--search N] [--gather M] [--aperture A]\n"
+        "                       [--frames N] [--threads T] [--no-table] [--no-quality] [--json]\n\n"
+        "(a) ms of the ISG pass for search x gather in {9,25,49,81}^2 per effect, and the\n"
+        "    base time of the rest of the frame (the paper's Table 1);\n"
+        "(b) FLIP and RMSE against each effect's reference technique for ISG and baselines.\n\n"
+        "  SCENE             default scenes/cornell-glossy/cornell_glossy.json\n"
+        "  --width, --height timing size (default 1024x768)\n"
+        "  --qwidth, --qheight quality size (default 320x240)\n"
+        "  --ref-spp N       samples per pixel of the references (default 256)\n"
+        "  --search, --gather ISG samples of the quality runs (default 25 and 49)\n"
+        "  --frames N        timing: the least of N frames per cell (default 1)\n"
+        "  --aperture A      lens radius for the DOF runs (default: the scene camera's; when\n"
+        "                    it has none, 1%% of the scene diagonal, focused on the surface\n"
+        "                    at the image centre)\n"
+        "  --threads T       worker threads (default 1: per-thread figures)\n"
+        "  --no-table, --no-quality  skip a part\n"
+        "  --json            one JSON object on stdout\n");
 }
 
 static int parse(int argc, char **argv, isg_options *o)
 {
-    *o = (isg_options){ .width = 1024, .height = 768, .qwidth = 320, .qheight = 240,
-                        .ref_spp = 256, .threads = 1, .search = 25, .gather = 49,
-                        .frames = 1, .aperture = -1.0 };
+    *o = (isg_options){ .width = 1024,
+                        .height = 768,
+                        .qwidth = 320,
+                        .qheight = 240,
+                        .ref_spp = 256,
+                        .threads = 1,
+                        .search = 25,
+                        .gather = 49,
+                        .frames = 1,
+                        .aperture = -1.0 };
     const char *cmd = "bench isg";
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i], *v = NULL;
@@ -109,7 +116,8 @@ static int parse(int argc, char **argv, isg_options *o)
             ok = false;
         }
         if (ok && target) {
-            ok = (v = cli_next_value(cmd, argc, argv, &i)) && cli_parse_int(cmd, a, v, lo, hi, target);
+            ok = (v = cli_next_value(cmd, argc, argv, &i)) &&
+                 cli_parse_int(cmd, a, v, lo, hi, target);
         }
         if (!ok) {
             return 2;
@@ -155,7 +163,8 @@ static drift_hybrid_params effect_params(drift_effect effect, int technique)
 {
     drift_hybrid_params p = { .shadows = DRIFT_SHADOWS_HARD };
     if (effect == DRIFT_EFFECT_DOF) {
-        p.shadows = DRIFT_SHADOWS_REFERENCE; // only the depth of field differs from the lens reference
+        p.shadows =
+            DRIFT_SHADOWS_REFERENCE; // only the depth of field differs from the lens reference
     }
     drift_hybrid_params_set_technique(&p, effect, technique);
     return p;
@@ -247,8 +256,9 @@ static drift_result quality(const bench_ctx *b, drift_effect effect, quality_row
         // "isg-2layers" adds the second depth layer.
         bool cheap = strcmp(names[effect][t], "isg-9x9") == 0;
         bool layers = strcmp(names[effect][t], "isg-2layers") == 0;
-        drift_hybrid_params p = effect_params(effect, cheap || layers ? isg_technique(effect)
-                                                                      : drift_technique_parse(effect, names[effect][t]));
+        drift_hybrid_params p = effect_params(
+            effect, cheap || layers ? isg_technique(effect)
+                                    : drift_technique_parse(effect, names[effect][t]));
         p.isg_layers = layers ? 2 : 1;
         p.width = ref.width;
         p.height = ref.height;
@@ -260,11 +270,12 @@ static drift_result quality(const bench_ctx *b, drift_effect effect, quality_row
         r = render(b, p, effect != DRIFT_EFFECT_DOF, &st, &test);
         drift_metric_report rep;
         if (r == DRIFT_OK) {
-            r = drift_metric_compare(b->ctx, &reference, &test, &(drift_metric_params){ 0 }, &rep, NULL);
+            r = drift_metric_compare(b->ctx, &reference, &test, &(drift_metric_params){ 0 }, &rep,
+                                     NULL);
         }
         if (r == DRIFT_OK) {
-            rows[(*out_count)++] = (quality_row){ names[effect][t], rep.flip, rep.rmse,
-                                                  technique_ms(effect, &st) };
+            rows[(*out_count)++] =
+                (quality_row){ names[effect][t], rep.flip, rep.rmse, technique_ms(effect, &st) };
         }
         drift_image_destroy(b->ctx, &test);
     }
@@ -281,11 +292,12 @@ static void print_results(const bench_ctx *b, double tables[3][4][4], const doub
     const isg_options *o = b->o;
     int threads = drift_context_thread_count(b->ctx);
     if (o->json) {
-        printf("{\"scene\": \"%s\", \"threads\": %d, \"frames\": %ld, \"width\": %ld, \"height\": %ld, "
+        printf("{\"scene\": \"%s\", \"threads\": %d, \"frames\": %ld, \"width\": %ld, \"height\": "
+               "%ld, "
                "\"qwidth\": %ld, \"qheight\": %ld, \"ref_spp\": %ld, \"search\": %ld, "
                "\"gather\": %ld, \"effects\": {",
-               path, threads, o->frames, o->width, o->height, o->qwidth, o->qheight, o->ref_spp, o->search,
-               o->gather);
+               path, threads, o->frames, o->width, o->height, o->qwidth, o->qheight, o->ref_spp,
+               o->search, o->gather);
         for (int e = 0; e < 3; ++e) {
             printf("%s\"%s\": {", e ? ", " : "", drift_effect_name(effects[e]));
             if (!o->skip_table) {
@@ -300,9 +312,10 @@ static void print_results(const bench_ctx *b, double tables[3][4][4], const doub
             if (!o->skip_quality) {
                 printf("\"quality\": [");
                 for (int t = 0; t < row_count[e]; ++t) {
-                    printf("%s{\"technique\": \"%s\", \"flip\": %.5f, \"rmse\": %.5f, \"ms\": %.3f}",
-                           t ? ", " : "", rows[e][t].technique, rows[e][t].flip, rows[e][t].rmse,
-                           rows[e][t].ms);
+                    printf(
+                        "%s{\"technique\": \"%s\", \"flip\": %.5f, \"rmse\": %.5f, \"ms\": %.3f}",
+                        t ? ", " : "", rows[e][t].technique, rows[e][t].flip, rows[e][t].rmse,
+                        rows[e][t].ms);
                 }
                 printf("]");
             }
@@ -319,8 +332,8 @@ static void print_results(const bench_ctx *b, double tables[3][4][4], const doub
                    o->height, base[e]);
             printf("%8s %9d %9d %9d %9d\n", "", 9, 25, 49, 81);
             for (int g = 0; g < 4; ++g) {
-                printf("%8d %9.1f %9.1f %9.1f %9.1f\n", counts[g], tables[e][g][0],
-                       tables[e][g][1], tables[e][g][2], tables[e][g][3]);
+                printf("%8d %9.1f %9.1f %9.1f %9.1f\n", counts[g], tables[e][g][0], tables[e][g][1],
+                       tables[e][g][2], tables[e][g][3]);
             }
         }
         if (!o->skip_quality) {
@@ -342,7 +355,8 @@ int drift_bench_isg(int argc, char **argv)
     if (status != 0) {
         return status < 0 ? 0 : status;
     }
-    static const char default_scene[] = DRIFT_SOURCE_DIR "/scenes/cornell-glossy/cornell_glossy.json";
+    static const char default_scene[] =
+        DRIFT_SOURCE_DIR "/scenes/cornell-glossy/cornell_glossy.json";
     const char *scene_path = o.scene_path ? o.scene_path : default_scene;
     drift_context *ctx = NULL;
     drift_scene *scene = NULL;
@@ -369,8 +383,8 @@ int drift_bench_isg(int argc, char **argv)
         drift_ray ray = drift_camera_ray(&pinhole, 2, 2, 1.0f, 1.0f, drift_vec2_make(0.5f, 0.5f));
         drift_hit hit;
         if (drift_accel_intersect(accel, &ray, &hit)) {
-            drift_vec3 forward = drift_vec3_normalize(
-                drift_vec3_sub(scene->camera.target, scene->camera.position));
+            drift_vec3 forward =
+                drift_vec3_normalize(drift_vec3_sub(scene->camera.target, scene->camera.position));
             scene->camera.focus_distance = hit.t * drift_vec3_dot(ray.dir, forward);
         }
     }

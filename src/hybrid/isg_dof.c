@@ -1,8 +1,9 @@
 // ISG depth of field (Robison & Shirley 2009, section 3.3) over the focused frame and its
 // circle-of-confusion plane c (eq. 15: c = c_inf |z - z_f| / z, in pixels):
 //   search  a disk of radius c_inf (or the frame's largest circle when a near object's is
-//           larger: the paper's search misses blur from nearer than z_f / 2); a sample spreads onto the centre when its own circle
-//           covers it (distance <= c_i, softened over a pixel); eq. 16 with smoothstep: a
+//           larger: the paper's search misses blur from nearer than z_f / 2); a sample
+//           spreads onto the centre when its own circle covers it (distance <= c_i,
+//           softened over a pixel); eq. 16 with smoothstep: a
 //           sample behind the centre (z_i > z_0) with a larger circle (c_i > c_0) is turned
 //           down by smoothstep(0, 5%, (z_i - z_0) / z_0) * smoothstep(0, 1 px, c_i - c_0),
 //           so a blurred background does not spread over an in-focus foreground -> R, the
@@ -19,7 +20,9 @@
 
 #include <math.h>
 
-enum { STREAM_ISG_DOF = 13 };
+enum {
+    STREAM_ISG_DOF = 13
+};
 
 #define DEPTH_RAMP 0.05f // relative depth difference over which "behind" turns on
 
@@ -95,8 +98,10 @@ static void dof_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays, voi
     uint32_t pixel = (uint32_t)y * (uint32_t)f->params.width + (uint32_t)x;
     drift_isg_jitter jitter =
         drift_isg_jitter_make(drift_hash_combine(f->params.seed ^ STREAM_ISG_DOF, pixel));
-    drift_isg_kernel search = { &s->search, jitter, drift_vec2_make(job->search_radius, job->search_radius),
-                                range_search, &rc, NULL };
+    drift_isg_kernel search = {
+        &s->search,   jitter, drift_vec2_make(job->search_radius, job->search_radius),
+        range_search, &rc,    NULL
+    };
     float radius;
     drift_isg_filter(&search, &f->coc, 0, 1, x, y, &radius); // the centre always counts
     drift_image_pixel(&s->dof_search, x, y)[0] = radius;
@@ -112,8 +117,8 @@ static void dof_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays, voi
         rc.z_behind = drift_image_pixel(&s->layer_depth, x, y)[0];
         value = value_behind;
     }
-    drift_isg_kernel gather = { &s->gather, jitter, drift_vec2_make(radius, radius), range_gather,
-                                &rc, value };
+    drift_isg_kernel gather = { &s->gather,   jitter, drift_vec2_make(radius, radius),
+                                range_gather, &rc,    value };
     drift_isg_filter(&gather, &f->focus, 0, 3, x, y, out);
 }
 
@@ -133,7 +138,8 @@ drift_result drift_isg_pass_dof(drift_hybrid *f)
             widest = fmaxf(widest, drift_image_pixel(&f->coc, x, y)[0]); // fmaxf drops NaN
         }
     }
-    job.search_radius = fmaxf(job.c_inf, fminf(widest, (float)(f->params.width + f->params.height)));
+    job.search_radius =
+        fmaxf(job.c_inf, fminf(widest, (float)(f->params.width + f->params.height)));
     if (!(job.c_inf >= 0.5f)) {
         drift_hybrid_copy_rgb(&f->focus, &f->final); // a pinhole, or nearly: the identity
         for (int32_t y = 0; y < f->params.height; ++y) {

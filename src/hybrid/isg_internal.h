@@ -59,7 +59,7 @@ typedef const float *(*drift_isg_value_fn)(const void *user, int32_t x, int32_t 
 typedef struct drift_isg_kernel {
     const drift_isg_pattern *pattern;
     drift_isg_jitter jitter;
-    drift_vec2 radius;          // half extents in pixels along x and y
+    drift_vec2 radius; // half extents in pixels along x and y
     drift_isg_range_fn range;
     const void *user;
     drift_isg_value_fn value; // may be NULL
@@ -88,7 +88,7 @@ static inline float drift_isg_smoothstep(float e0, float e1, float x)
 
 // --- FRAME STATE, PARAMETERS, PLANES (isg.c) ---
 
-#define DRIFT_ISG_FIXED_PLANES 4     // isg.reflection, isg.dof, isg.layer2.depth, .colour
+#define DRIFT_ISG_FIXED_PLANES     4 // isg.reflection, isg.dof, isg.layer2.depth, .colour
 #define DRIFT_ISG_PLANES_PER_LIGHT 1 // lightN.isg
 
 typedef struct drift_isg_state {

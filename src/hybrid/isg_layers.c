@@ -7,7 +7,9 @@
 
 #include <math.h>
 
-enum { STREAM_ISG_LAYER = 14 };
+enum {
+    STREAM_ISG_LAYER = 14
+};
 
 static void layer_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays, void *user)
 {

@@ -18,7 +18,9 @@
 
 #include <math.h>
 
-enum { STREAM_ISG_REFLECTIONS = 12 };
+enum {
+    STREAM_ISG_REFLECTIONS = 12
+};
 
 typedef struct range_ctx {
     const drift_gbuffer *g;
@@ -101,7 +103,7 @@ static void reflection_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *ra
     drift_vec3 gathered;
     if (p->reflections == DRIFT_REFLECTIONS_BLUR) {
         drift_isg_kernel k = { &s->gather, jitter, drift_vec2_make(p->blur_radius, p->blur_radius),
-                               range_lobe, &rc, NULL };
+                               range_lobe, &rc,    NULL };
         drift_isg_filter(&k, &f->reflection_reflected, 0, 3, x, y, &gathered.x);
     } else {
         float scale_x = (float)p->width / job->fov_x, scale_y = (float)p->height / job->fov_y;
@@ -111,14 +113,15 @@ static void reflection_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *ra
         }
         drift_isg_kernel search = { &s->search, jitter, search_radius, range_eq10, &rc, NULL };
         float reflected_distance;
-        if (!(drift_isg_filter(&search, &f->reflection_distance, 0, 1, x, y, &reflected_distance) > 0.0f)) {
+        if (!(drift_isg_filter(&search, &f->reflection_distance, 0, 1, x, y, &reflected_distance) >
+              0.0f)) {
             reflected_distance = INFINITY; // nothing reflected in reach: the environment
         }
         float eye_distance = drift_vec3_length(drift_vec3_sub(f->camera.position, rc.p0));
         float alpha = drift_isg_gloss_alpha(theta, eye_distance, reflected_distance);
         float cos_incident = fmaxf(0.0f, drift_vec3_dot(rc.n0, wo));
-        drift_vec2 gather_radius = drift_vec2_make(alpha * scale_x * cos_incident,
-                                                   alpha * scale_y * cos_incident);
+        drift_vec2 gather_radius =
+            drift_vec2_make(alpha * scale_x * cos_incident, alpha * scale_y * cos_incident);
         search_out[0] = reflected_distance;
         search_out[1] = fmaxf(gather_radius.x, gather_radius.y);
         if (search_out[1] < 0.5f) {

@@ -21,7 +21,8 @@ void drift_isg_pattern_make(uint32_t count, drift_isg_layout layout, drift_isg_p
     out->count = k * k;
     for (uint32_t j = 0; j < k; ++j) {
         for (uint32_t i = 0; i < k; ++i) {
-            drift_vec2 u = drift_vec2_make(((float)i + 0.5f) / (float)k, ((float)j + 0.5f) / (float)k);
+            drift_vec2 u =
+                drift_vec2_make(((float)i + 0.5f) / (float)k, ((float)j + 0.5f) / (float)k);
             out->points[j * k + i] = layout == DRIFT_ISG_DISK
                                          ? drift_sample_disk_concentric(u)
                                          : drift_vec2_make(2.0f * u.x - 1.0f, 2.0f * u.y - 1.0f);
@@ -35,8 +36,9 @@ drift_isg_jitter drift_isg_jitter_make(uint32_t hash)
     uint32_t h2 = drift_hash_u32(hash);
     return (drift_isg_jitter){ .cos_a = cosf(angle),
                                .sin_a = sinf(angle),
-                               .shift = drift_vec2_make(drift_u32_to_unit(h2) - 0.5f,
-                                                        drift_u32_to_unit(drift_hash_u32(h2)) - 0.5f) };
+                               .shift =
+                                   drift_vec2_make(drift_u32_to_unit(h2) - 0.5f,
+                                                   drift_u32_to_unit(drift_hash_u32(h2)) - 0.5f) };
 }
 
 // Wraps v into [-1, 1).

@@ -14,7 +14,9 @@
 
 #include <math.h>
 
-enum { STREAM_ISG_SHADOWS = 11 };
+enum {
+    STREAM_ISG_SHADOWS = 11
+};
 
 // The light's size as the search sees it: half extents in scene units and the layout.
 typedef struct light_shape {
@@ -27,8 +29,9 @@ static light_shape shape_of(const drift_scene *scene, const drift_hybrid_light *
     const drift_light *l = &scene->lights[light->first_light];
     switch (light->type) {
     case DRIFT_LIGHT_QUAD:
-        return (light_shape){ DRIFT_ISG_RECT, drift_vec2_make(0.5f * drift_vec3_length(l->edge_u),
-                                                              0.5f * drift_vec3_length(l->edge_v)) };
+        return (light_shape){ DRIFT_ISG_RECT,
+                              drift_vec2_make(0.5f * drift_vec3_length(l->edge_u),
+                                              0.5f * drift_vec3_length(l->edge_v)) };
     case DRIFT_LIGHT_SPHERE:
     case DRIFT_LIGHT_DISK:
         return (light_shape){ DRIFT_ISG_DISK, drift_vec2_make(l->radius, l->radius) };
@@ -38,8 +41,8 @@ static light_shape shape_of(const drift_scene *scene, const drift_hybrid_light *
             drift_vec3 c[3];
             drift_light_triangle_vertices(scene, &scene->lights[light->first_light + t], &c[0],
                                           &c[1], &c[2]);
-            area += 0.5 * (double)drift_vec3_length(
-                              drift_vec3_cross(drift_vec3_sub(c[1], c[0]), drift_vec3_sub(c[2], c[0])));
+            area += 0.5 * (double)drift_vec3_length(drift_vec3_cross(drift_vec3_sub(c[1], c[0]),
+                                                                     drift_vec3_sub(c[2], c[0])));
         }
         float r = (float)sqrt(area / (double)DRIFT_PI);
         return (light_shape){ DRIFT_ISG_DISK, drift_vec2_make(r, r) };
@@ -132,7 +135,8 @@ static void shadow_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays, 
         drift_isg_jitter jitter = drift_isg_jitter_make(drift_hash_u32(hash + l));
         if (f->params.shadows == DRIFT_SHADOWS_BLUR) {
             float r = f->params.blur_radius;
-            drift_isg_kernel k = { &s->gather, jitter, drift_vec2_make(r, r), range_surface, &rc, NULL };
+            drift_isg_kernel k = { &s->gather,    jitter, drift_vec2_make(r, r),
+                                   range_surface, &rc,    NULL };
             drift_isg_filter(&k, &b->hard_shadow, 0, 1, x, y, shadow);
             continue;
         }
@@ -146,8 +150,9 @@ static void shadow_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays, 
             continue; // the light is under half a pixel: the hard shadow
         }
         bool rect = shape->layout == DRIFT_ISG_RECT;
-        drift_isg_kernel search = { rect ? &s->search_rect : &s->search, jitter, search_radius,
-                                    range_search, &rc, NULL };
+        drift_isg_kernel search = {
+            rect ? &s->search_rect : &s->search, jitter, search_radius, range_search, &rc, NULL
+        };
         float d;
         if (!(drift_isg_filter(&search, &b->hard_shadow, 1, 1, x, y, &d) > 0.0f)) {
             continue; // no occluder in reach (every sample rejected): the centre's bit
@@ -161,8 +166,9 @@ static void shadow_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays, 
         if (search_out[1] < 0.5f) {
             continue;
         }
-        drift_isg_kernel gather = { rect ? &s->gather_rect : &s->gather, jitter, gather_radius,
-                                    range_gather, &rc, NULL };
+        drift_isg_kernel gather = {
+            rect ? &s->gather_rect : &s->gather, jitter, gather_radius, range_gather, &rc, NULL
+        };
         drift_isg_filter(&gather, &b->hard_shadow, 0, 1, x, y, shadow);
     }
 }

@@ -3,16 +3,15 @@
 // (identity), one gather per light, normalized weights, the fallback when every sample is
 // rejected, variance that falls with the gather's sample count, depth of field that spreads a
 // blurred foreground without bleeding an in-focus one, and the second depth layer.
+#include "drift/accel.h"
+#include "drift/hybrid.h"
+#include "drift/scene.h"
 #include "drift_test.h"
+#include "hybrid/isg_internal.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-#include "drift/accel.h"
-#include "drift/hybrid.h"
-#include "drift/scene.h"
-#include "hybrid/isg_internal.h"
 
 typedef struct rig {
     drift_context *ctx;
@@ -85,25 +84,25 @@ static void add_rect(drift_scene *scene, float x0, float x1, float z0, float z1,
 // A floor, a half plane x < 0 at height h above it, and a sphere light of radius L at
 // (-2, H, 0): the hard shadow's edge lies at x = 2h / (H - h) on the floor, seen from above.
 #define LIGHT_HEIGHT 4.0f
-#define SHADOW_W 200
-#define SHADOW_H 100
+#define SHADOW_W     200
+#define SHADOW_H     100
 
 static void build_occluder(rig *r, float h, float light_radius)
 {
     uint32_t white = add_material(r->scene, drift_material_make(drift_vec3_splat(0.5f)));
     add_rect(r->scene, -10.0f, 10.0f, -10.0f, 10.0f, 0.0f, white);
     add_rect(r->scene, -6.0f, 0.0f, -6.0f, 6.0f, h, white);
-    assert_int_equal(drift_scene_add_light(r->scene,
-                                           &(drift_light){ .type = DRIFT_LIGHT_SPHERE,
-                                                           .position = { -2.0f, LIGHT_HEIGHT, 0.0f },
-                                                           .radius = light_radius,
-                                                           .color = { 5, 5, 5 } },
-                                           NULL),
-                     DRIFT_OK);
-    r->scene->camera = drift_camera_look_at(drift_vec3_make(0.75f, 8.0f, 0.0f),
-                                            drift_vec3_make(0.75f, 0.0f, 0.0f),
-                                            drift_vec3_make(0.0f, 0.0f, 1.0f), 0.25f, SHADOW_W,
-                                            SHADOW_H);
+    assert_int_equal(
+        drift_scene_add_light(r->scene,
+                              &(drift_light){ .type = DRIFT_LIGHT_SPHERE,
+                                              .position = { -2.0f, LIGHT_HEIGHT, 0.0f },
+                                              .radius = light_radius,
+                                              .color = { 5, 5, 5 } },
+                              NULL),
+        DRIFT_OK);
+    r->scene->camera =
+        drift_camera_look_at(drift_vec3_make(0.75f, 8.0f, 0.0f), drift_vec3_make(0.75f, 0.0f, 0.0f),
+                             drift_vec3_make(0.0f, 0.0f, 1.0f), 0.25f, SHADOW_W, SHADOW_H);
 }
 
 // Fraction of the unit disk beyond x = t (the shadow a disk-shaped gather makes of a step).
@@ -243,16 +242,18 @@ static void test_each_light_gathers_its_own_shadow(void **state)
     (void)state;
     rig r = rig_begin();
     build_occluder(&r, 1.0f, 0.5f);
-    assert_int_equal(drift_scene_add_light(r.scene,
-                                           &(drift_light){ .type = DRIFT_LIGHT_SPHERE,
-                                                           .position = { -4.0f, LIGHT_HEIGHT, 0.0f },
-                                                           .radius = 1e-4f,
-                                                           .color = { 5, 5, 5 } },
-                                           NULL),
-                     DRIFT_OK);
+    assert_int_equal(
+        drift_scene_add_light(r.scene,
+                              &(drift_light){ .type = DRIFT_LIGHT_SPHERE,
+                                              .position = { -4.0f, LIGHT_HEIGHT, 0.0f },
+                                              .radius = 1e-4f,
+                                              .color = { 5, 5, 5 } },
+                              NULL),
+        DRIFT_OK);
     rig_commit(&r);
     rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_ISG });
-    const drift_image *hard1 = plane(&r, "light1.hard_shadow"), *shadow1 = plane(&r, "light1.shadow");
+    const drift_image *hard1 = plane(&r, "light1.hard_shadow"),
+                      *shadow1 = plane(&r, "light1.shadow");
     const drift_image *shadow0 = plane(&r, "light0.shadow");
     int partial0 = 0, shadowed1 = 0;
     for (int y = 0; y < SHADOW_H; ++y) {
@@ -275,9 +276,11 @@ static void test_each_light_gathers_its_own_shadow(void **state)
 static double reflection_difference(float exponent)
 {
     rig r = rig_begin();
-    uint32_t floor = add_material(
-        r.scene, (drift_material){ .diffuse = { 0.2f, 0.2f, 0.2f }, .specular = { 0.6f, 0.6f, 0.6f },
-                                   .exponent = exponent, .diffuse_texture = DRIFT_INVALID_INDEX });
+    uint32_t floor =
+        add_material(r.scene, (drift_material){ .diffuse = { 0.2f, 0.2f, 0.2f },
+                                                .specular = { 0.6f, 0.6f, 0.6f },
+                                                .exponent = exponent,
+                                                .diffuse_texture = DRIFT_INVALID_INDEX });
     uint32_t red = add_material(r.scene, drift_material_make(drift_vec3_make(0.8f, 0.1f, 0.1f)));
     add_rect(r.scene, -5.0f, 5.0f, -5.0f, 5.0f, 0.0f, floor);
     const float p[] = { -0.5f, 0.0f, 0.0f, 0.5f, 0.0f, 0.0f, 0.5f, 1.0f, 0.0f, -0.5f, 1.0f, 0.0f };
@@ -289,9 +292,9 @@ static double reflection_difference(float exponent)
                                                            .color = { 20, 20, 20 } },
                                            NULL),
                      DRIFT_OK);
-    r.scene->camera = drift_camera_look_at(drift_vec3_make(0.0f, 1.0f, -3.0f),
-                                           drift_vec3_make(0.0f, 0.0f, 0.0f),
-                                           drift_vec3_make(0.0f, 1.0f, 0.0f), 0.8f, 64, 48);
+    r.scene->camera =
+        drift_camera_look_at(drift_vec3_make(0.0f, 1.0f, -3.0f), drift_vec3_make(0.0f, 0.0f, 0.0f),
+                             drift_vec3_make(0.0f, 1.0f, 0.0f), 0.8f, 64, 48);
     rig_commit(&r);
     rig_frame(&r, &(drift_hybrid_params){ .reflections = DRIFT_REFLECTIONS_SHARP });
     drift_image sharp;
@@ -341,7 +344,8 @@ static void test_gloss_support_eq13(void **state)
 static void build_dof(rig *r, float aperture)
 {
     uint32_t white = add_material(r->scene, drift_material_make(drift_vec3_splat(0.8f)));
-    uint32_t dark = add_material(r->scene, drift_material_make(drift_vec3_make(0.05f, 0.05f, 0.4f)));
+    uint32_t dark =
+        add_material(r->scene, drift_material_make(drift_vec3_make(0.05f, 0.05f, 0.4f)));
     const float wall[] = { -20, -20, 10, 20, -20, 10, 20, 20, 10, -20, 20, 10 };
     const float near[] = { -5, -5, 2, 0, -5, 2, 0, 5, 2, -5, 5, 2 };
     const uint32_t idx[] = { 0, 2, 1, 0, 3, 2 };
@@ -353,8 +357,9 @@ static void build_dof(rig *r, float aperture)
                                                            .color = { 3, 3, 3 } },
                                            NULL),
                      DRIFT_OK);
-    r->scene->camera = drift_camera_look_at(drift_vec3_make(0, 0, -0.001f), drift_vec3_make(0, 0, 10),
-                                            drift_vec3_make(0, 1, 0), 0.9f, 64, 48);
+    r->scene->camera =
+        drift_camera_look_at(drift_vec3_make(0, 0, -0.001f), drift_vec3_make(0, 0, 10),
+                             drift_vec3_make(0, 1, 0), 0.9f, 64, 48);
     r->scene->camera.aperture_radius = aperture;
     r->scene->camera.focus_distance = 10.0f;
 }
@@ -395,7 +400,8 @@ static void test_dof_in_focus_foreground_does_not_bleed(void **state)
                                               .isg_gather = 81 });
         g = drift_hybrid_gbuffer(r.frame);
         for (int x = 1; x < 64 && edge < 0; ++x) {
-            if (fabsf(drift_image_pixel(&g->depth, x - 1, y)[0] - drift_image_pixel(&g->depth, x, y)[0]) > 1.0f) {
+            if (fabsf(drift_image_pixel(&g->depth, x - 1, y)[0] -
+                      drift_image_pixel(&g->depth, x, y)[0]) > 1.0f) {
                 edge = x;
             }
         }
@@ -419,14 +425,16 @@ static void test_dof_foreground_spreads(void **state)
     rig r = rig_begin();
     build_dof(&r, 0.5f);
     rig_commit(&r);
-    rig_frame(&r, &(drift_hybrid_params){ .dof = DRIFT_DOF_ISG, .isg_search = 81, .isg_gather = 81 });
+    rig_frame(&r,
+              &(drift_hybrid_params){ .dof = DRIFT_DOF_ISG, .isg_search = 81, .isg_gather = 81 });
     const drift_image *focus = plane(&r, "focus"), *final = plane(&r, "final");
     const drift_image *coc = plane(&r, "coc");
     const drift_gbuffer *g = drift_hybrid_gbuffer(r.frame);
     // Find the edge in the middle row: the first wall pixel after a near-quad pixel.
     int y = 24, edge = -1;
     for (int x = 1; x < 64 && edge < 0; ++x) {
-        float z0 = drift_image_pixel(&g->depth, x - 1, y)[0], z1 = drift_image_pixel(&g->depth, x, y)[0];
+        float z0 = drift_image_pixel(&g->depth, x - 1, y)[0],
+              z1 = drift_image_pixel(&g->depth, x, y)[0];
         if (fabsf(z0 - z1) > 1.0f) {
             edge = x;
         }
@@ -456,8 +464,9 @@ static void test_dof_foreground_spreads(void **state)
 // bar: the lens sees the stripe through the blurred bar, the one-layer gather cannot.
 static double bar_error(int layers, const drift_image *reference, rig *r)
 {
-    rig_frame(r, &(drift_hybrid_params){ .dof = DRIFT_DOF_ISG, .isg_search = 49, .isg_gather = 81,
-                                         .isg_layers = layers });
+    rig_frame(r,
+              &(drift_hybrid_params){
+                  .dof = DRIFT_DOF_ISG, .isg_search = 49, .isg_gather = 81, .isg_layers = layers });
     const drift_gbuffer *g = drift_hybrid_gbuffer(r->frame);
     const drift_image *final = plane(r, "final");
     double sum = 0.0;
@@ -488,7 +497,9 @@ static void test_second_layer_sees_behind_blurred_bar(void **state)
     uint32_t dark = add_material(r.scene, drift_material_make(drift_vec3_splat(0.05f)));
     const uint32_t idx[] = { 0, 2, 1, 0, 3, 2 };
     const float wall[] = { -20, -20, 10, 20, -20, 10, 20, 20, 10, -20, 20, 10 };
-    const float stripe[] = { -0.5f, -20, 9.99f, 0.5f, -20, 9.99f, 0.5f, 20, 9.99f, -0.5f, 20, 9.99f };
+    const float stripe[] = {
+        -0.5f, -20, 9.99f, 0.5f, -20, 9.99f, 0.5f, 20, 9.99f, -0.5f, 20, 9.99f
+    };
     const float bar[] = { -0.15f, -5, 2, 0.15f, -5, 2, 0.15f, 5, 2, -0.15f, 5, 2 };
     test_add_mesh(r.scene, wall, 4, idx, 2, white);
     test_add_mesh(r.scene, stripe, 4, idx, 2, red);
@@ -499,8 +510,9 @@ static void test_second_layer_sees_behind_blurred_bar(void **state)
                                                            .color = { 3, 3, 3 } },
                                            NULL),
                      DRIFT_OK);
-    r.scene->camera = drift_camera_look_at(drift_vec3_make(0, 0, -0.001f), drift_vec3_make(0, 0, 10),
-                                           drift_vec3_make(0, 1, 0), 0.9f, 64, 48);
+    r.scene->camera =
+        drift_camera_look_at(drift_vec3_make(0, 0, -0.001f), drift_vec3_make(0, 0, 10),
+                             drift_vec3_make(0, 1, 0), 0.9f, 64, 48);
     r.scene->camera.aperture_radius = 0.3f;
     r.scene->camera.focus_distance = 10.0f;
     rig_commit(&r);
@@ -544,8 +556,9 @@ static void test_constant_image_stays_constant(void **state)
     static drift_isg_pattern pattern;
     drift_isg_pattern_make(81, DRIFT_ISG_DISK, &pattern);
     for (uint32_t k = 0; k < 50; ++k) {
-        drift_isg_kernel kernel = { &pattern, drift_isg_jitter_make(k), drift_vec2_make(9.0f, 5.0f),
-                                    range_one, NULL, NULL };
+        drift_isg_kernel kernel = {
+            &pattern, drift_isg_jitter_make(k), drift_vec2_make(9.0f, 5.0f), range_one, NULL, NULL
+        };
         float out[3];
         int32_t x = (int32_t)(k % 32), y = (int32_t)((k * 7) % 32);
         assert_true(drift_isg_filter(&kernel, &image, 0, 3, x, y, out) > 0.0f);
@@ -569,8 +582,9 @@ static void test_all_rejected_falls_back_to_centre(void **state)
     image.pixels[3 * 8 + 3] = INFINITY; // an occluder distance of "none"
     static drift_isg_pattern pattern;
     drift_isg_pattern_make(25, DRIFT_ISG_RECT, &pattern);
-    drift_isg_kernel kernel = { &pattern, drift_isg_jitter_make(7), drift_vec2_make(3.0f, 3.0f),
-                                range_none, NULL, NULL };
+    drift_isg_kernel kernel = {
+        &pattern, drift_isg_jitter_make(7), drift_vec2_make(3.0f, 3.0f), range_none, NULL, NULL
+    };
     float out;
     assert_true(drift_isg_filter(&kernel, &image, 0, 1, 4, 4, &out) == 0.0f);
     assert_true(out == 36.0f);
@@ -596,8 +610,12 @@ static double gather_variance(const drift_image *image, uint32_t count)
     uint32_t trials = (uint32_t)(400.0 * test_intensity());
     double sum = 0.0, sum2 = 0.0;
     for (uint32_t k = 0; k < trials; ++k) {
-        drift_isg_kernel kernel = { &pattern, drift_isg_jitter_make(drift_hash_u32(k)),
-                                    drift_vec2_make(12.0f, 12.0f), range_unit, NULL, NULL };
+        drift_isg_kernel kernel = { &pattern,
+                                    drift_isg_jitter_make(drift_hash_u32(k)),
+                                    drift_vec2_make(12.0f, 12.0f),
+                                    range_unit,
+                                    NULL,
+                                    NULL };
         float out;
         drift_isg_filter(&kernel, image, 0, 1, 32, 32, &out);
         sum += (double)out;
@@ -629,7 +647,8 @@ static void test_rejects_bad_counts(void **state)
 {
     (void)state;
     assert_true(drift_isg_count_valid(9) && drift_isg_count_valid(81) && drift_isg_count_valid(1));
-    assert_false(drift_isg_count_valid(10) || drift_isg_count_valid(0) || drift_isg_count_valid(1025));
+    assert_false(drift_isg_count_valid(10) || drift_isg_count_valid(0) ||
+                 drift_isg_count_valid(1025));
     rig r = rig_begin();
     build_occluder(&r, 1.0f, 0.5f);
     rig_commit(&r);
