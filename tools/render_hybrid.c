@@ -28,13 +28,35 @@ static bool parse_vec3(const char *flag, const char *v, drift_vec3 *out)
     return true;
 }
 
+// ISG sample counts are k x k grids on the disk: 9, 25, 49, 81 (any square up to 1024).
+static bool parse_isg_count(const char *flag, const char *v, int32_t *out)
+{
+    long n = 0;
+    if (!cli_parse_int("render", flag, v, 1, 1024, &n)) {
+        return false;
+    }
+    long k = 1;
+    while (k * k < n) {
+        ++k;
+    }
+    if (k * k != n) {
+        fprintf(stderr, "drift render: %s expects a perfect square (9, 25, 49, 81, ...), got '%s'\n",
+                flag, v);
+        return false;
+    }
+    *out = (int32_t)n;
+    return true;
+}
+
 bool render_parse_hybrid_option(int argc, char **argv, int *i, render_options *o, bool *ok)
 {
     static const char *const effects[DRIFT_EFFECT_COUNT] = { "--shadows", "--reflections",
                                                              "--dof", "--indirect" };
     static const char *const others[] = { "--light-samples", "--shadow-map-size", "--pcf-kernel",
                                           "--envmap-size",   "--probe",           "--ambient",
-                                          "--aperture",      "--focus-distance" };
+                                          "--aperture",      "--focus-distance",
+                                          "--isg-search",    "--isg-gather",      "--isg-sigma",
+                                          "--blur-radius",   "--isg-layers",      "--isg-range" };
     const char *a = argv[*i];
     int effect = -1, other = -1;
     for (int k = 0; k < DRIFT_EFFECT_COUNT; ++k) {
@@ -96,6 +118,28 @@ bool render_parse_hybrid_option(int argc, char **argv, int *i, render_options *o
         break;
     case 7:
         *ok = cli_parse_float("render", a, v, 1e-30, 1e30, &o->focus_distance);
+        break;
+    case 8:
+    case 9:
+        *ok = parse_isg_count(a, v, other == 8 ? &h->isg_search : &h->isg_gather);
+        break;
+    case 10:
+    case 11: {
+        double value = 0.0;
+        *ok = cli_parse_float("render", a, v, 1e-30, other == 10 ? 1e30 : 1024.0, &value);
+        *(other == 10 ? &h->isg_sigma : &h->blur_radius) = (float)value;
+        break;
+    }
+    case 12:
+        *ok = cli_parse_int("render", a, v, 1, 2, &n);
+        h->isg_layers = (int32_t)n;
+        break;
+    case 13:
+        *ok = strcmp(v, "full") == 0 || strcmp(v, "plane") == 0;
+        h->isg_range_plane = strcmp(v, "plane") == 0;
+        if (!*ok) {
+            fprintf(stderr, "drift render: %s expects full or plane, got '%s'\n", a, v);
+        }
         break;
     default:
         break;

@@ -57,6 +57,8 @@ typedef enum drift_shadow_technique {
     DRIFT_SHADOWS_PCF,        // shadow map, percentage-closer filtering
     DRIFT_SHADOWS_PCSS,       // shadow map, percentage-closer soft shadows (Fernando 2005)
     DRIFT_SHADOWS_REFERENCE,  // path-traced direct light at --spp
+    DRIFT_SHADOWS_ISG,        // image space gathering over the hard-shadow buffer (docs/isg.md)
+    DRIFT_SHADOWS_BLUR,       // baseline: the hard-shadow bits blurred over a fixed disk
     DRIFT_SHADOWS_COUNT
 } drift_shadow_technique;
 
@@ -65,6 +67,8 @@ typedef enum drift_reflection_technique {
     DRIFT_REFLECTIONS_ENVMAP,    // cube map captured at a probe point
     DRIFT_REFLECTIONS_SHARP,     // one mirror ray per pixel
     DRIFT_REFLECTIONS_REFERENCE, // path-traced first-bounce glossy/mirror light at --spp
+    DRIFT_REFLECTIONS_ISG,       // image space gathering over the sharp buffer (docs/isg.md)
+    DRIFT_REFLECTIONS_BLUR,      // baseline: the sharp buffer blurred over a fixed disk
     DRIFT_REFLECTIONS_COUNT
 } drift_reflection_technique;
 
@@ -72,6 +76,7 @@ typedef enum drift_dof_technique {
     DRIFT_DOF_NONE = 0,      // pinhole
     DRIFT_DOF_POST,          // gather over the circle of confusion in image space
     DRIFT_DOF_REFERENCE,     // the whole frame path-traced through the thin lens
+    DRIFT_DOF_ISG,           // image space gathering over the focused frame (docs/isg.md)
     DRIFT_DOF_COUNT
 } drift_dof_technique;
 
@@ -124,6 +129,22 @@ typedef struct drift_hybrid_params {
     bool probe_per_object;
     bool has_ambient;
     drift_vec3 ambient;
+    // Image space gathering (docs/isg.md); 0 picks the default:
+    //   isg_search, isg_gather = 0 -> 25, 49 samples (perfect squares 1..1024: 9, 25, 49, 81)
+    //   isg_sigma = 0 -> (0.02 x scene diagonal)^2, sigma of eq. 6 and 10 in squared scene units
+    //   isg_a, isg_b = 0 -> 1 and 100 sigma (eq. 10: a normal difference n = 0.1 costs 1/e)
+    //   blur_radius = 0 -> 4 pixels, the disk of the `blur` baselines
+    //   isg_layers = 0 -> 1; 2 adds a second depth layer (one more ray a pixel) that ISG depth
+    //                of field reads behind foreground objects
+    //   isg_range_plane = false: l of eq. 7 and 11 is the world distance (the paper); true: the
+    //                distance to the centre's tangent plane (docs/isg.md)
+    int32_t isg_search;
+    int32_t isg_gather;
+    float isg_sigma;
+    float isg_a, isg_b;
+    float blur_radius;
+    int32_t isg_layers;
+    bool isg_range_plane;
 } drift_hybrid_params;
 
 drift_hybrid_params drift_hybrid_params_resolve(const drift_hybrid_params *params,
@@ -168,6 +189,7 @@ typedef enum drift_hybrid_pass {
     DRIFT_PASS_REFERENCE,      // every `reference` effect
     DRIFT_PASS_COMPOSE,
     DRIFT_PASS_DOF,            // post-process depth of field
+    DRIFT_PASS_ISG,            // image space gathering (every effect) and the blur baselines
     DRIFT_PASS_COUNT
 } drift_hybrid_pass;
 

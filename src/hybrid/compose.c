@@ -1,6 +1,7 @@
 // Composition of the hybrid frame: focus = E + D + R + I per pixel, the circle-of-confusion
 // plane, then depth of field (none, the post-process gather, or the reference lens render).
 #include "hybrid/frame_internal.h"
+#include "hybrid/isg_internal.h"
 
 typedef struct compose_job {
     drift_vec3 ambient;
@@ -99,6 +100,9 @@ drift_result drift_hybrid_pass_compose(drift_hybrid *f, const atomic_bool *cance
         drift_result r = drift_post_dof(f->ctx, &f->focus, &f->coc, 0, &f->final);
         f->stats.ms[DRIFT_PASS_DOF] = 1000.0 * (drift_time_now() - t);
         return r;
+    }
+    if (p->dof == DRIFT_DOF_ISG) {
+        return drift_isg_pass_dof(f); // focus -> final (isg_dof.c)
     }
     return DRIFT_OK;
 }

@@ -2,6 +2,7 @@
 // light (shading.c); S_l the shadow term of the chosen technique: the hard-shadow buffer, or
 // a shadow map filtered by PCF or PCSS. The reference technique leaves D to reference.c.
 #include "hybrid/frame_internal.h"
+#include "hybrid/isg_internal.h"
 
 #include <math.h>
 
@@ -139,9 +140,17 @@ drift_result drift_hybrid_pass_direct(drift_hybrid *f)
     st->ms[DRIFT_PASS_UNSHADOWED] = 1000.0 * (drift_time_now() - t);
 
     t = drift_time_now();
-    if (f->params.shadows == DRIFT_SHADOWS_HARD) {
+    drift_shadow_technique shadows = f->params.shadows;
+    if (shadows == DRIFT_SHADOWS_HARD || shadows == DRIFT_SHADOWS_ISG ||
+        shadows == DRIFT_SHADOWS_BLUR) {
         st->rays[DRIFT_PASS_HARD_SHADOWS] += drift_hybrid_for_each_row(f, hard_shadow_row, NULL);
         st->ms[DRIFT_PASS_HARD_SHADOWS] = 1000.0 * (drift_time_now() - t);
+        if (shadows != DRIFT_SHADOWS_HARD) {
+            drift_result r = drift_isg_pass_shadows(f); // gathers the bits into S_l
+            if (r != DRIFT_OK) {
+                return r;
+            }
+        }
     } else {
         drift_result r = build_shadow_maps(f);
         st->ms[DRIFT_PASS_SHADOW_MAPS] = 1000.0 * (drift_time_now() - t);

@@ -2,6 +2,7 @@
 // (--aov, the viewer). The passes themselves live in direct.c, reflections.c, reference.c
 // and compose.c.
 #include "hybrid/frame_internal.h"
+#include "hybrid/isg_internal.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -9,14 +10,17 @@
 
 // --- NAMES ---
 
-static const char *const shadow_names[] = { "hard", "pcf", "pcss", "reference" };
-static const char *const reflection_names[] = { "none", "envmap", "sharp", "reference" };
-static const char *const dof_names[] = { "none", "post", "reference" };
+static const char *const shadow_names[] = { "hard", "pcf", "pcss", "reference",
+                                                   "isg",  "blur" };
+static const char *const reflection_names[] = { "none", "envmap", "sharp",
+                                                       "reference", "isg", "blur" };
+static const char *const dof_names[] = { "none", "post", "reference", "isg" };
 static const char *const indirect_names[] = { "none", "ambient", "reference" };
 static const char *const effect_names[] = { "shadows", "reflections", "dof", "indirect" };
 static const char *const pass_names[] = { "primary",     "unshadowed", "hard_shadows",
                                           "shadow_maps", "shadow_filter", "reflections",
-                                          "envmap",      "reference",  "compose", "dof" };
+                                          "envmap",      "reference",  "compose", "dof",
+                                          "isg" };
 
 _Static_assert(sizeof shadow_names / sizeof *shadow_names == DRIFT_SHADOWS_COUNT, "names");
 _Static_assert(sizeof reflection_names / sizeof *reflection_names == DRIFT_REFLECTIONS_COUNT,
@@ -140,6 +144,7 @@ drift_hybrid_params drift_hybrid_params_resolve(const drift_hybrid_params *param
     p.shadow_bias = p.shadow_bias > 0.0f ? p.shadow_bias : 1.5f;
     p.pcf_kernel = p.pcf_kernel ? p.pcf_kernel : 3;
     p.envmap_size = p.envmap_size ? p.envmap_size : 128;
+    drift_isg_params_resolve(&p, scene);
     return p;
 }
 
@@ -164,6 +169,8 @@ static bool params_valid(const drift_context *ctx, const drift_hybrid_params *p)
     } else if (!isfinite(p->shadow_bias) || (p->has_probe && !drift_vec3_is_finite(p->probe)) ||
                (p->has_ambient && !drift_vec3_is_finite(p->ambient))) {
         problem = "non-finite bias, probe or ambient";
+    } else {
+        problem = drift_isg_params_problem(p);
     }
     if (problem) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, NULL, 0, "hybrid frame: %s",
@@ -234,7 +241,8 @@ drift_result drift_hybrid_create(drift_context *ctx, const drift_scene *scene,
         // + 1: a scene with no lights still gets an allocation.
         f->light_buffers =
             drift_alloc(ctx, sizeof(drift_hybrid_light_buffers) * (f->light_count + 1u));
-        f->plane_capacity = DRIFT_HYBRID_FIXED_PLANES + DRIFT_HYBRID_PLANES_PER_LIGHT * f->light_count;
+        f->plane_capacity = DRIFT_HYBRID_FIXED_PLANES + DRIFT_HYBRID_PLANES_PER_LIGHT * f->light_count +
+                            DRIFT_ISG_FIXED_PLANES + DRIFT_ISG_PLANES_PER_LIGHT * f->light_count;
         f->planes = drift_alloc(ctx, sizeof(drift_hybrid_plane_ref) * f->plane_capacity);
         r = f->counters && f->light_buffers && f->planes ? DRIFT_OK : DRIFT_ERR_OUT_OF_MEMORY;
     }
@@ -287,6 +295,7 @@ void drift_hybrid_destroy(drift_hybrid *f)
         }
     }
     destroy_probes(f);
+    drift_isg_destroy(f);
     drift_gbuffer_destroy(ctx, &f->gbuffer);
     drift_image *images[] = { &f->environment_direct, &f->direct,      &f->reflection_emitted,
                               &f->reflection_reflected, &f->reflection_distance, &f->reflections,
@@ -446,18 +455,21 @@ static void collect_planes(drift_hybrid *f)
         char name[DRIFT_HYBRID_PLANE_NAME];
         snprintf(name, sizeof name, "light%u.unshadowed", l);
         add_plane(f, name, &f->light_buffers[l].unshadowed);
-        if (p->shadows == DRIFT_SHADOWS_HARD) {
+        if (p->shadows == DRIFT_SHADOWS_HARD || p->shadows == DRIFT_SHADOWS_ISG ||
+            p->shadows == DRIFT_SHADOWS_BLUR) {
             snprintf(name, sizeof name, "light%u.hard_shadow", l);
             add_plane(f, name, &f->light_buffers[l].hard_shadow);
         }
         snprintf(name, sizeof name, "light%u.shadow", l);
         add_plane(f, name, &f->light_buffers[l].shadow);
     }
-    if (p->reflections == DRIFT_REFLECTIONS_SHARP) {
+    if (p->reflections == DRIFT_REFLECTIONS_SHARP || p->reflections == DRIFT_REFLECTIONS_ISG ||
+        p->reflections == DRIFT_REFLECTIONS_BLUR) {
         add_plane(f, "reflection.emitted", &f->reflection_emitted);
         add_plane(f, "reflection.reflected", &f->reflection_reflected);
         add_plane(f, "reflection.distance", &f->reflection_distance);
     }
+    drift_isg_add_planes(f, add_plane);
 }
 
 bool drift_hybrid_plane(const drift_hybrid *f, uint32_t index, const char **out_name,

@@ -72,6 +72,7 @@ struct drift_hybrid {
     drift_hybrid_stats stats;
     drift_hybrid_plane_ref *planes; // room for every plane (sized at create)
     uint32_t plane_count, plane_capacity;
+    struct drift_isg_state *isg; // image space gathering's buffers (isg.c), made on first use
 };
 
 // Runs fn for every row, or every pixel, rows in parallel. `rays` is the calling thread's ray
@@ -100,6 +101,10 @@ void drift_hybrid_copy_rgb(const drift_image *from, drift_image *to);
 // A per-pixel sampler keyed on the frame's seed and a pass-specific stream.
 drift_sampler drift_hybrid_sampler(const drift_hybrid *frame, uint32_t stream, int32_t x,
                                    int32_t y);
+
+// Directional albedo of a specular lobe toward wo (reflections.c): what the radiance seen in
+// the mirror direction is weighted by in R.
+drift_vec3 drift_hybrid_reflection_weight(const drift_bsdf *bsdf, drift_vec3 wo);
 
 // Outgoing direction at the pixel's surface (toward the camera); pixels with a hit only.
 drift_vec3 drift_hybrid_wo(const drift_hybrid *frame, int32_t x, int32_t y);

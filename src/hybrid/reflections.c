@@ -5,6 +5,7 @@
 // lobe's directional albedo (reflection_weight). Emission seen in the mirror direction
 // belongs to R only for mirrors: for glossy lobes the direct pass already has it.
 #include "hybrid/frame_internal.h"
+#include "hybrid/isg_internal.h"
 
 #include <math.h>
 
@@ -18,7 +19,7 @@ static size_t pixel_index(const drift_hybrid *f, int32_t x, int32_t y)
 // Directional albedo of the specular lobe toward wo: ks for a mirror; for the normalized
 // Phong lobe around the mirror direction r, integral of f cos = ks (n+2)/(n+1) cos(theta_r)
 // when the lobe is narrow (clamped to ks).
-static drift_vec3 reflection_weight(const drift_bsdf *bsdf, drift_vec3 wo)
+drift_vec3 drift_hybrid_reflection_weight(const drift_bsdf *bsdf, drift_vec3 wo)
 {
     if (bsdf->type == DRIFT_MATERIAL_MIRROR) {
         return bsdf->specular;
@@ -42,7 +43,7 @@ static drift_vec3 combine(const drift_bsdf *bsdf, drift_vec3 wo, drift_hybrid_ra
 {
     drift_vec3 seen = bsdf->type == DRIFT_MATERIAL_MIRROR ? drift_vec3_add(l.emitted, l.reflected)
                                                           : l.reflected;
-    return drift_vec3_mul(reflection_weight(bsdf, wo), seen);
+    return drift_vec3_mul(drift_hybrid_reflection_weight(bsdf, wo), seen);
 }
 
 static void sharp_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays, void *user)
@@ -172,9 +173,12 @@ drift_result drift_hybrid_pass_reflections(drift_hybrid *f)
     double t = drift_time_now();
     switch (f->params.reflections) {
     case DRIFT_REFLECTIONS_SHARP:
+    case DRIFT_REFLECTIONS_ISG:  // gathers over the sharp buffer (isg_reflections.c)
+    case DRIFT_REFLECTIONS_BLUR:
         st->rays[DRIFT_PASS_REFLECTIONS] += drift_hybrid_for_each_pixel(f, sharp_pixel, NULL);
         st->ms[DRIFT_PASS_REFLECTIONS] = 1000.0 * (drift_time_now() - t);
-        return DRIFT_OK;
+        return f->params.reflections == DRIFT_REFLECTIONS_SHARP ? DRIFT_OK
+                                                                 : drift_isg_pass_reflections(f);
     case DRIFT_REFLECTIONS_ENVMAP: {
         drift_result r = capture_probes(f);
         if (r != DRIFT_OK) {

@@ -1,0 +1,415 @@
+// drift bench isg: image space gathering against the paper's Table 1 and against the
+// baselines of each effect.
+//   (a) timing: milliseconds of the ISG pass at --width x --height (default 1024x768, the
+//       paper's) for search x gather in {9, 25, 49, 81}^2, per effect, and the base time
+//       (the rest of the frame with ISG on: primary, U_l, the sharp buffers, composition)
+//   (b) quality at --qwidth x --qheight: FLIP and RMSE of the final image against the
+//       `reference` technique of the same effect at --ref-spp, with every other effect the
+//       same in both, for ISG and the baselines, with each technique's own milliseconds
+//       (the passes that technique adds) so the times can be matched:
+//         shadows      hard, pcss, blur (the hard bits over a fixed disk), isg
+//         reflections  sharp, envmap, blur (the sharp buffer over a fixed disk), isg
+//       and isg-9x9 (ISG at 9 x 9 samples, its cheapest) for every effect, isg-2layers (with
+//       the second depth layer) for depth of field
+//         dof          none, post, isg; the focused frame has reference (path-traced)
+//                      shadows so that only depth of field differs from the lens reference
+#include "bench.h"
+#include "cli.h"
+#include "drift/accel.h"
+#include "drift/hybrid.h"
+#include "drift/metric.h"
+#include "drift/scene_io.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct isg_options {
+    const char *scene_path;
+    long width, height, qwidth, qheight, ref_spp, threads, search, gather, frames;
+    double aperture;
+    bool json, skip_table, skip_quality;
+} isg_options;
+
+static void print_help(FILE *out)
+{
+    fprintf(
+        out,
+        "usage: drift bench isg [SCENE] [--width W] [--height H] [--qwidth W] [--qheight H]\n"
+        "                       [--ref-spp N] [--search N] [--gather M] [--aperture A]\n"
+        "                       [--frames N] [--threads T] [--no-table] [--no-quality] [--json]\n\n"
+        "(a) ms of the ISG pass for search x gather in {9,25,49,81}^2 per effect, and the\n"
+        "    base time of the rest of the frame (the paper's Table 1);\n"
+        "(b) FLIP and RMSE against each effect's reference technique for ISG and baselines.\n\n"
+        "  SCENE             default scenes/cornell-glossy/cornell_glossy.json\n"
+        "  --width, --height timing size (default 1024x768)\n"
+        "  --qwidth, --qheight quality size (default 320x240)\n"
+        "  --ref-spp N       samples per pixel of the references (default 256)\n"
+        "  --search, --gather ISG samples of the quality runs (default 25 and 49)\n"
+        "  --frames N        timing: the least of N frames per cell (default 1)\n"
+        "  --aperture A      lens radius for the DOF runs (default: the scene camera's; when\n"
+        "                    it has none, 1%% of the scene diagonal, focused on the surface\n"
+        "                    at the image centre)\n"
+        "  --threads T       worker threads (default 1: per-thread figures)\n"
+        "  --no-table, --no-quality  skip a part\n"
+        "  --json            one JSON object on stdout\n");
+}
+
+static int parse(int argc, char **argv, isg_options *o)
+{
+    *o = (isg_options){ .width = 1024,
+                        .height = 768,
+                        .qwidth = 320,
+                        .qheight = 240,
+                        .ref_spp = 256,
+                        .threads = 1,
+                        .search = 25,
+                        .gather = 49,
+                        .frames = 1,
+                        .aperture = -1.0 };
+    const char *cmd = "bench isg";
+    for (int i = 1; i < argc; ++i) {
+        const char *a = argv[i], *v = NULL;
+        bool ok = true;
+        long *target = NULL, lo = 1, hi = DRIFT_IMAGE_MAX_DIMENSION;
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            print_help(stdout);
+            return -1;
+        } else if (strcmp(a, "--json") == 0) {
+            o->json = true;
+        } else if (strcmp(a, "--no-table") == 0) {
+            o->skip_table = true;
+        } else if (strcmp(a, "--no-quality") == 0) {
+            o->skip_quality = true;
+        } else if (strcmp(a, "--width") == 0) {
+            target = &o->width;
+        } else if (strcmp(a, "--height") == 0) {
+            target = &o->height;
+        } else if (strcmp(a, "--qwidth") == 0) {
+            target = &o->qwidth;
+        } else if (strcmp(a, "--qheight") == 0) {
+            target = &o->qheight;
+        } else if (strcmp(a, "--ref-spp") == 0) {
+            target = &o->ref_spp;
+            hi = 1 << 20;
+        } else if (strcmp(a, "--search") == 0 || strcmp(a, "--gather") == 0) {
+            target = a[2] == 's' ? &o->search : &o->gather;
+            hi = 1024;
+        } else if (strcmp(a, "--frames") == 0) {
+            target = &o->frames;
+            hi = 100;
+        } else if (strcmp(a, "--threads") == 0) {
+            target = &o->threads;
+            lo = 0;
+            hi = 256;
+        } else if (strcmp(a, "--aperture") == 0) {
+            ok = (v = cli_next_value(cmd, argc, argv, &i)) &&
+                 cli_parse_float(cmd, a, v, 0.0, 1e30, &o->aperture);
+        } else if (a[0] == '-') {
+            fprintf(stderr, "drift bench isg: unknown option '%s'\n", a);
+            ok = false;
+        } else if (!o->scene_path) {
+            o->scene_path = a;
+        } else {
+            fprintf(stderr, "drift bench isg: more than one scene given\n");
+            ok = false;
+        }
+        if (ok && target) {
+            ok = (v = cli_next_value(cmd, argc, argv, &i)) &&
+                 cli_parse_int(cmd, a, v, lo, hi, target);
+        }
+        if (!ok) {
+            return 2;
+        }
+    }
+    return 0;
+}
+
+typedef struct bench_ctx {
+    drift_context *ctx;
+    drift_scene *scene;
+    const drift_accel *accel;
+    const isg_options *o;
+} bench_ctx;
+
+// Renders one frame of `params` (after one warm-up frame when `warm`), returns its stats.
+static drift_result render(const bench_ctx *b, drift_hybrid_params params, bool warm,
+                           drift_hybrid_stats *out_stats, drift_image *out_copy)
+{
+    drift_hybrid *frame = NULL;
+    drift_result r = drift_hybrid_create(b->ctx, b->scene, b->accel, &params, &frame);
+    for (int k = 0; r == DRIFT_OK && k < (warm ? 2 : 1); ++k) {
+        r = drift_hybrid_render(frame, &b->scene->camera, NULL);
+    }
+    if (r == DRIFT_OK) {
+        *out_stats = drift_hybrid_get_stats(frame);
+        if (out_copy) {
+            const drift_image *img = drift_hybrid_image(frame);
+            r = drift_image_create(b->ctx, img->width, img->height, 3, out_copy);
+            if (r == DRIFT_OK) {
+                memcpy(out_copy->pixels, img->pixels,
+                       sizeof(float) * 3 * (size_t)img->width * (size_t)img->height);
+            }
+        }
+    }
+    drift_hybrid_destroy(frame);
+    return r;
+}
+
+static const int counts[4] = { 9, 25, 49, 81 };
+
+static drift_hybrid_params effect_params(drift_effect effect, int technique)
+{
+    drift_hybrid_params p = { .shadows = DRIFT_SHADOWS_HARD };
+    if (effect == DRIFT_EFFECT_DOF) {
+        p.shadows =
+            DRIFT_SHADOWS_REFERENCE; // only the depth of field differs from the lens reference
+    }
+    drift_hybrid_params_set_technique(&p, effect, technique);
+    return p;
+}
+
+static int isg_technique(drift_effect effect)
+{
+    return drift_technique_parse(effect, "isg");
+}
+
+// (a) The paper's Table 1 for one effect: rows gather, columns search.
+static drift_result timing_table(const bench_ctx *b, drift_effect effect, double table[4][4],
+                                 double *out_base)
+{
+    const isg_options *o = b->o;
+    drift_hybrid_params p = effect_params(effect, isg_technique(effect));
+    if (effect == DRIFT_EFFECT_DOF) {
+        p.shadows = DRIFT_SHADOWS_HARD; // timing only: no path tracing
+    }
+    p.width = (int32_t)o->width;
+    p.height = (int32_t)o->height;
+    *out_base = INFINITY;
+    for (int g = 0; g < 4; ++g) {
+        for (int s = 0; s < 4; ++s) {
+            p.isg_search = counts[s];
+            p.isg_gather = counts[g];
+            // The least of N frames: other processes on the machine only ever add time.
+            table[g][s] = INFINITY;
+            for (long k = 0; k < o->frames; ++k) {
+                drift_hybrid_stats st;
+                drift_result r = render(b, p, false, &st, NULL);
+                if (r != DRIFT_OK) {
+                    return r;
+                }
+                table[g][s] = fmin(table[g][s], st.ms[DRIFT_PASS_ISG]);
+                *out_base = fmin(*out_base, st.frame_ms - st.ms[DRIFT_PASS_ISG]);
+            }
+        }
+    }
+    return DRIFT_OK;
+}
+
+// The milliseconds a technique of an effect adds to the frame.
+static double technique_ms(drift_effect effect, const drift_hybrid_stats *s)
+{
+    switch (effect) {
+    case DRIFT_EFFECT_SHADOWS:
+        return s->ms[DRIFT_PASS_HARD_SHADOWS] + s->ms[DRIFT_PASS_SHADOW_MAPS] +
+               s->ms[DRIFT_PASS_SHADOW_FILTER] + s->ms[DRIFT_PASS_ISG];
+    case DRIFT_EFFECT_REFLECTIONS:
+        return s->ms[DRIFT_PASS_REFLECTIONS] + s->ms[DRIFT_PASS_ENVMAP] + s->ms[DRIFT_PASS_ISG];
+    case DRIFT_EFFECT_DOF:
+        return s->ms[DRIFT_PASS_DOF] + s->ms[DRIFT_PASS_ISG];
+    case DRIFT_EFFECT_INDIRECT:
+    case DRIFT_EFFECT_COUNT:
+        break;
+    }
+    return 0.0;
+}
+
+typedef struct quality_row {
+    const char *technique;
+    double flip, rmse, ms;
+} quality_row;
+
+#define MAX_ROWS 5
+
+// (b) for one effect: the reference, then every technique against it.
+static drift_result quality(const bench_ctx *b, drift_effect effect, quality_row *rows,
+                            int *out_count)
+{
+    const isg_options *o = b->o;
+    static const char *const names[DRIFT_EFFECT_COUNT][MAX_ROWS] = {
+        { "hard", "pcss", "blur", "isg", "isg-9x9" },
+        { "sharp", "envmap", "blur", "isg", "isg-9x9" },
+        { "none", "post", "isg", "isg-9x9", "isg-2layers" },
+        { NULL },
+    };
+    drift_hybrid_params ref = effect_params(effect, drift_technique_parse(effect, "reference"));
+    ref.width = (int32_t)o->qwidth;
+    ref.height = (int32_t)o->qheight;
+    ref.spp = (uint32_t)o->ref_spp;
+    drift_image reference = { 0 };
+    drift_hybrid_stats st;
+    drift_result r = render(b, ref, false, &st, &reference);
+    *out_count = 0;
+    for (int t = 0; r == DRIFT_OK && t < MAX_ROWS && names[effect][t]; ++t) {
+        // "isg-9x9" is ISG at its cheapest sample counts: the time-matched variant.
+        // "isg-2layers" adds the second depth layer.
+        bool cheap = strcmp(names[effect][t], "isg-9x9") == 0;
+        bool layers = strcmp(names[effect][t], "isg-2layers") == 0;
+        drift_hybrid_params p = effect_params(
+            effect, cheap || layers ? isg_technique(effect)
+                                    : drift_technique_parse(effect, names[effect][t]));
+        p.isg_layers = layers ? 2 : 1;
+        p.width = ref.width;
+        p.height = ref.height;
+        p.spp = ref.spp; // the DOF runs' path-traced shadows
+        p.isg_search = cheap ? 9 : (int32_t)o->search;
+        p.isg_gather = cheap ? 9 : (int32_t)o->gather;
+        drift_image test = { 0 };
+        // Warm for timing (shadow maps and probes are cached), except around path tracing.
+        r = render(b, p, effect != DRIFT_EFFECT_DOF, &st, &test);
+        drift_metric_report rep;
+        if (r == DRIFT_OK) {
+            r = drift_metric_compare(b->ctx, &reference, &test, &(drift_metric_params){ 0 }, &rep,
+                                     NULL);
+        }
+        if (r == DRIFT_OK) {
+            rows[(*out_count)++] =
+                (quality_row){ names[effect][t], rep.flip, rep.rmse, technique_ms(effect, &st) };
+        }
+        drift_image_destroy(b->ctx, &test);
+    }
+    drift_image_destroy(b->ctx, &reference);
+    return r;
+}
+
+static const drift_effect effects[3] = { DRIFT_EFFECT_SHADOWS, DRIFT_EFFECT_REFLECTIONS,
+                                         DRIFT_EFFECT_DOF };
+
+static void print_results(const bench_ctx *b, double tables[3][4][4], const double base[3],
+                          quality_row rows[3][MAX_ROWS], const int row_count[3], const char *path)
+{
+    const isg_options *o = b->o;
+    int threads = drift_context_thread_count(b->ctx);
+    if (o->json) {
+        printf("{\"scene\": \"%s\", \"threads\": %d, \"frames\": %ld, \"width\": %ld, \"height\": "
+               "%ld, "
+               "\"qwidth\": %ld, \"qheight\": %ld, \"ref_spp\": %ld, \"search\": %ld, "
+               "\"gather\": %ld, \"effects\": {",
+               path, threads, o->frames, o->width, o->height, o->qwidth, o->qheight, o->ref_spp,
+               o->search, o->gather);
+        for (int e = 0; e < 3; ++e) {
+            printf("%s\"%s\": {", e ? ", " : "", drift_effect_name(effects[e]));
+            if (!o->skip_table) {
+                printf("\"base_ms\": %.3f, \"isg_ms\": [", base[e]);
+                for (int g = 0; g < 4; ++g) {
+                    printf("%s{\"gather\": %d, \"search_ms\": [%.3f, %.3f, %.3f, %.3f]}",
+                           g ? ", " : "", counts[g], tables[e][g][0], tables[e][g][1],
+                           tables[e][g][2], tables[e][g][3]);
+                }
+                printf("]%s", o->skip_quality ? "" : ", ");
+            }
+            if (!o->skip_quality) {
+                printf("\"quality\": [");
+                for (int t = 0; t < row_count[e]; ++t) {
+                    printf(
+                        "%s{\"technique\": \"%s\", \"flip\": %.5f, \"rmse\": %.5f, \"ms\": %.3f}",
+                        t ? ", " : "", rows[e][t].technique, rows[e][t].flip, rows[e][t].rmse,
+                        rows[e][t].ms);
+                }
+                printf("]");
+            }
+            printf("}");
+        }
+        printf("}}\n");
+        return;
+    }
+    printf("%s, %d thread(s)\n", path, threads);
+    for (int e = 0; e < 3; ++e) {
+        printf("\n== %s ==\n", drift_effect_name(effects[e]));
+        if (!o->skip_table) {
+            printf("ISG pass ms at %ldx%ld, rows gather, columns search (base %.1f ms)\n", o->width,
+                   o->height, base[e]);
+            printf("%8s %9d %9d %9d %9d\n", "", 9, 25, 49, 81);
+            for (int g = 0; g < 4; ++g) {
+                printf("%8d %9.1f %9.1f %9.1f %9.1f\n", counts[g], tables[e][g][0], tables[e][g][1],
+                       tables[e][g][2], tables[e][g][3]);
+            }
+        }
+        if (!o->skip_quality) {
+            printf("quality at %ldx%ld vs reference at %ld spp (isg %ld x %ld)\n", o->qwidth,
+                   o->qheight, o->ref_spp, o->search, o->gather);
+            printf("%-10s %9s %9s %9s\n", "technique", "FLIP", "RMSE", "ms");
+            for (int t = 0; t < row_count[e]; ++t) {
+                printf("%-10s %9.4f %9.4f %9.1f\n", rows[e][t].technique, rows[e][t].flip,
+                       rows[e][t].rmse, rows[e][t].ms);
+            }
+        }
+    }
+}
+
+int drift_bench_isg(int argc, char **argv)
+{
+    isg_options o;
+    int status = parse(argc, argv, &o);
+    if (status != 0) {
+        return status < 0 ? 0 : status;
+    }
+    static const char default_scene[] =
+        DRIFT_SOURCE_DIR "/scenes/cornell-glossy/cornell_glossy.json";
+    const char *scene_path = o.scene_path ? o.scene_path : default_scene;
+    drift_context *ctx = NULL;
+    drift_scene *scene = NULL;
+    drift_accel *accel = NULL;
+    int exit_code = 1;
+    drift_result r = drift_context_create(
+        &(drift_context_desc){ .thread_count = (int)o.threads, .logger = cli_stderr_logger(false) },
+        &ctx);
+    if (r != DRIFT_OK) {
+        fprintf(stderr, "drift bench isg: %s\n", drift_result_string(r));
+        goto done;
+    }
+    if (!cli_open_scene(ctx, "bench isg", scene_path, &scene, &accel, NULL)) {
+        goto done;
+    }
+    if (o.aperture >= 0.0) {
+        scene->camera.aperture_radius = (float)o.aperture;
+    } else if (!(scene->camera.aperture_radius > 0.0f)) {
+        // A scene without a lens: 1% of its diagonal, focused on what the image centre sees.
+        scene->camera.aperture_radius =
+            0.01f * drift_vec3_length(drift_vec3_sub(scene->bounds.max, scene->bounds.min));
+        drift_camera pinhole = scene->camera;
+        pinhole.aperture_radius = 0.0f;
+        drift_ray ray = drift_camera_ray(&pinhole, 2, 2, 1.0f, 1.0f, drift_vec2_make(0.5f, 0.5f));
+        drift_hit hit;
+        if (drift_accel_intersect(accel, &ray, &hit)) {
+            drift_vec3 forward =
+                drift_vec3_normalize(drift_vec3_sub(scene->camera.target, scene->camera.position));
+            scene->camera.focus_distance = hit.t * drift_vec3_dot(ray.dir, forward);
+        }
+    }
+    bench_ctx b = { ctx, scene, accel, &o };
+    static double tables[3][4][4];
+    double base[3] = { 0.0, 0.0, 0.0 };
+    static quality_row rows[3][MAX_ROWS];
+    int row_count[3] = { 0, 0, 0 };
+    for (int e = 0; e < 3; ++e) {
+        if (!o.skip_table && (r = timing_table(&b, effects[e], tables[e], &base[e])) != DRIFT_OK) {
+            break;
+        }
+        if (!o.skip_quality && (r = quality(&b, effects[e], rows[e], &row_count[e])) != DRIFT_OK) {
+            break;
+        }
+    }
+    if (r != DRIFT_OK) {
+        fprintf(stderr, "drift bench isg: %s\n", drift_result_string(r));
+        goto done;
+    }
+    print_results(&b, tables, base, rows, row_count, scene_path);
+    exit_code = 0;
+done:
+    drift_accel_destroy(accel);
+    drift_scene_destroy(scene);
+    drift_context_destroy(ctx);
+    return exit_code;
+}
