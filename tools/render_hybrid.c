@@ -34,7 +34,8 @@ bool render_parse_hybrid_option(int argc, char **argv, int *i, render_options *o
                                                              "--dof", "--indirect" };
     static const char *const others[] = { "--light-samples", "--shadow-map-size", "--pcf-kernel",
                                           "--envmap-size",   "--probe",           "--ambient",
-                                          "--aperture",      "--focus-distance" };
+                                          "--aperture",      "--focus-distance",
+                                          "--aaf-max-spp",   "--aaf-sampling",    "--aaf-filter" };
     const char *a = argv[*i];
     int effect = -1, other = -1;
     for (int k = 0; k < DRIFT_EFFECT_COUNT; ++k) {
@@ -96,6 +97,24 @@ bool render_parse_hybrid_option(int argc, char **argv, int *i, render_options *o
         break;
     case 7:
         *ok = cli_parse_float("render", a, v, 1e-30, 1e30, &o->focus_distance);
+        break;
+    case 8:
+        *ok = cli_parse_int("render", a, v, 1, 65536, &n);
+        h->aaf_max_spp = (uint32_t)n;
+        break;
+    case 9:
+        *ok = strcmp(v, "adaptive") == 0 || strcmp(v, "uniform") == 0;
+        h->aaf_uniform = strcmp(v, "uniform") == 0;
+        if (!*ok) {
+            fprintf(stderr, "drift render: --aaf-sampling expects adaptive or uniform, got '%s'\n", v);
+        }
+        break;
+    case 10:
+        *ok = strcmp(v, "on") == 0 || strcmp(v, "off") == 0;
+        h->aaf_unfiltered = strcmp(v, "off") == 0;
+        if (!*ok) {
+            fprintf(stderr, "drift render: --aaf-filter expects on or off, got '%s'\n", v);
+        }
         break;
     default:
         break;

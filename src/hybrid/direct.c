@@ -1,7 +1,7 @@
 // Direct light of the hybrid frame: D = sum_l U_l * S_l + environment. U_l is the unshadowed
 // light (shading.c); S_l the shadow term of the chosen technique: the hard-shadow buffer, or
 // a shadow map filtered by PCF or PCSS. The reference technique leaves D to reference.c.
-#include "hybrid/frame_internal.h"
+#include "hybrid/aaf_internal.h"
 
 #include <math.h>
 
@@ -142,6 +142,11 @@ drift_result drift_hybrid_pass_direct(drift_hybrid *f)
     if (f->params.shadows == DRIFT_SHADOWS_HARD) {
         st->rays[DRIFT_PASS_HARD_SHADOWS] += drift_hybrid_for_each_row(f, hard_shadow_row, NULL);
         st->ms[DRIFT_PASS_HARD_SHADOWS] = 1000.0 * (drift_time_now() - t);
+    } else if (f->params.shadows == DRIFT_SHADOWS_AAF) {
+        drift_result r = drift_hybrid_pass_aaf_shadows(f); // times its own passes
+        if (r != DRIFT_OK) {
+            return r;
+        }
     } else {
         drift_result r = build_shadow_maps(f);
         st->ms[DRIFT_PASS_SHADOW_MAPS] = 1000.0 * (drift_time_now() - t);
