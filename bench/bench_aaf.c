@@ -21,9 +21,9 @@
 typedef struct aaf_options {
     const char *scene_path;
     const char *csv_path, *svg_path;
-    long width, height, ref_spp, threads, timing_width, timing_height, timing_spp;
-    long spps[MAX_SPPS];
-    int spp_count;
+    long width, height, ref_spp, threads, timing_width, timing_height, timing_spp, light_samples;
+    long spps[MAX_SPPS], mc_spps[MAX_SPPS];
+    int spp_count, mc_spp_count;
     bool shadows, indirect, json;
 } aaf_options;
 
@@ -33,13 +33,17 @@ static void print_help(FILE *out)
             "usage: drift bench aaf [SCENE] [--effect shadows|indirect|both] [--spp LIST]\n"
             "                       [--ref-spp N] [--width W] [--height H] [--threads T]\n"
             "                       [--timing-size WxH] [--timing-spp N] [--csv FILE]\n"
-            "                       [--svg FILE] [--json]\n\n"
+            "                       [--svg FILE] [--mc-spp LIST] [--light-samples N] [--json]\n\n"
             "RMSE of AAF and of plain Monte Carlo (same sampler: uniform spp, no filter) against\n"
             "a path-traced reference of the effect's term, for each average spp; the equal-error\n"
             "sample ratio; and filter vs sampling milliseconds of one AAF frame.\n\n"
             "  SCENE         default scenes/grids/grids.json (needs ../shared)\n"
             "  --effect E    shadows (default), indirect or both\n"
             "  --spp LIST    comma-separated average spp (default 4,8,16,32,64)\n"
+            "  --mc-spp LIST plain Monte Carlo's spp (default: --spp); longer lists avoid\n"
+            "                extrapolating the equal-error ratio\n"
+            "  --light-samples N  samples of U_l's sampled lobes (default 256: keeps the\n"
+            "                unshadowed light's own noise under the shadows' error)\n"
             "  --ref-spp N   reference samples a pixel (default 4096)\n"
             "  --width, --height  error images (default 160x120)\n"
             "  --timing-size WxH  timing frame (default 640x480); --timing-spp N (default 16)\n"
@@ -49,29 +53,28 @@ static void print_help(FILE *out)
             "  --json        one JSON object on stdout\n");
 }
 
-static bool parse_spps(const char *text, aaf_options *o)
+// A comma-separated, increasing list of 2..MAX_SPPS counts into spps[0 .. *spp_count - 1].
+static bool parse_spps(const char *text, long *spps, int *spp_count)
 {
-    o->spp_count = 0;
+    int count = 0;
     const char *p = text;
-    while (*p && o->spp_count < MAX_SPPS) {
+    while (*p && count < MAX_SPPS) {
         char *end;
         long v = strtol(p, &end, 10);
-        if (end == p || v < 1 || v > 65536 || (*end != ',' && *end != '\0')) {
-            fprintf(stderr, "drift bench aaf: --spp expects a comma-separated list of counts "
-                            "in 1..65536, got '%s'\n", text);
+        if (end == p || v < 1 || v > 65536 || (*end != ',' && *end != '\0') ||
+            (count > 0 && v <= spps[count - 1])) {
+            fprintf(stderr, "drift bench aaf: expected an increasing comma-separated list of "
+                            "counts in 1..65536, got '%s'\n", text);
             return false;
         }
-        if (o->spp_count > 0 && v <= o->spps[o->spp_count - 1]) {
-            fprintf(stderr, "drift bench aaf: --spp values must increase, got '%s'\n", text);
-            return false;
-        }
-        o->spps[o->spp_count++] = v;
+        spps[count++] = v;
         p = *end == ',' ? end + 1 : end;
     }
-    if (o->spp_count < 2 || *p) {
-        fprintf(stderr, "drift bench aaf: --spp needs 2..%d values, got '%s'\n", MAX_SPPS, text);
+    if (count < 2 || *p) {
+        fprintf(stderr, "drift bench aaf: a spp list needs 2..%d values, got '%s'\n", MAX_SPPS, text);
         return false;
     }
+    *spp_count = count;
     return true;
 }
 
@@ -79,8 +82,9 @@ static int parse(int argc, char **argv, aaf_options *o)
 {
     *o = (aaf_options){ .width = 160, .height = 120, .ref_spp = 4096, .threads = 1,
                         .timing_width = 640, .timing_height = 480, .timing_spp = 16,
-                        .shadows = true };
-    parse_spps("4,8,16,32,64", o);
+                        .light_samples = 256, .shadows = true };
+    parse_spps("4,8,16,32,64", o->spps, &o->spp_count);
+    o->mc_spp_count = 0;
     const char *cmd = "bench aaf";
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i], *v = NULL;
@@ -102,7 +106,13 @@ static int parse(int argc, char **argv, aaf_options *o)
                 }
             }
         } else if (strcmp(a, "--spp") == 0) {
-            ok = (v = cli_next_value(cmd, argc, argv, &i)) && parse_spps(v, o);
+            ok = (v = cli_next_value(cmd, argc, argv, &i)) && parse_spps(v, o->spps, &o->spp_count);
+        } else if (strcmp(a, "--mc-spp") == 0) {
+            ok = (v = cli_next_value(cmd, argc, argv, &i)) &&
+                 parse_spps(v, o->mc_spps, &o->mc_spp_count);
+        } else if (strcmp(a, "--light-samples") == 0) {
+            ok = (v = cli_next_value(cmd, argc, argv, &i)) &&
+                 cli_parse_int(cmd, a, v, 1, 4096, &o->light_samples);
         } else if (strcmp(a, "--ref-spp") == 0) {
             ok = (v = cli_next_value(cmd, argc, argv, &i)) &&
                  cli_parse_int(cmd, a, v, 1, 1 << 20, &o->ref_spp);
@@ -145,6 +155,10 @@ static int parse(int argc, char **argv, aaf_options *o)
             return 2;
         }
     }
+    if (o->mc_spp_count == 0) {
+        memcpy(o->mc_spps, o->spps, sizeof o->spps);
+        o->mc_spp_count = o->spp_count;
+    }
     return 0;
 }
 
@@ -157,7 +171,7 @@ typedef struct point {
 typedef struct curve {
     drift_effect effect;
     point aaf[MAX_SPPS], plain[MAX_SPPS];
-    int count;
+    int count, plain_count;
     double ratio[MAX_SPPS]; // equal-error sample ratio at each AAF point
     bool extrapolated[MAX_SPPS];
     double timing_sampling_ms, timing_filter_ms, timing_frame_ms;
@@ -220,7 +234,8 @@ static drift_hybrid_params effect_params(drift_effect effect, int technique, con
                                          long spp)
 {
     drift_hybrid_params p = { .width = (int32_t)o->width, .height = (int32_t)o->height,
-                              .spp = (uint32_t)spp, .seed = 11 };
+                              .spp = (uint32_t)spp, .seed = 11,
+                              .light_samples = (uint32_t)o->light_samples };
     drift_hybrid_params_set_technique(&p, effect, technique);
     return p;
 }
@@ -260,13 +275,19 @@ static drift_result measure(drift_context *ctx, const drift_scene *scene, const 
     int reference = effect == DRIFT_EFFECT_SHADOWS ? DRIFT_SHADOWS_REFERENCE : DRIFT_INDIRECT_REFERENCE;
     out->effect = effect;
     out->count = o->spp_count;
+    out->plain_count = o->mc_spp_count;
     drift_hybrid *ref = NULL, *frame = NULL;
     drift_hybrid_params p = effect_params(effect, reference, o, o->ref_spp);
     drift_result r = render(ctx, scene, accel, &p, &ref);
     const drift_image *truth = r == DRIFT_OK ? find_plane(ref, term) : NULL;
-    for (int k = 0; r == DRIFT_OK && k < o->spp_count; ++k) {
+    int most = o->spp_count > o->mc_spp_count ? o->spp_count : o->mc_spp_count;
+    for (int k = 0; r == DRIFT_OK && k < most; ++k) {
         for (int method = 0; r == DRIFT_OK && method < 2; ++method) {
-            p = effect_params(effect, aaf, o, o->spps[k]);
+            if (k >= (method == 0 ? o->spp_count : o->mc_spp_count)) {
+                continue;
+            }
+            long spp = method == 0 ? o->spps[k] : o->mc_spps[k];
+            p = effect_params(effect, aaf, o, spp);
             p.aaf_uniform = p.aaf_unfiltered = method == 1;
             r = render(ctx, scene, accel, &p, &frame);
             if (r != DRIFT_OK) {
@@ -274,7 +295,7 @@ static drift_result measure(drift_context *ctx, const drift_scene *scene, const 
             }
             drift_hybrid_stats s = drift_hybrid_get_stats(frame);
             point *pt = method == 0 ? &out->aaf[k] : &out->plain[k];
-            *pt = (point){ .spp = (double)o->spps[k],
+            *pt = (point){ .spp = (double)spp,
                            .actual_spp = actual_spp(frame, effect),
                            .rmse = rmse(find_plane(frame, term), truth),
                            .sampling_ms = s.ms[DRIFT_PASS_AAF_SAMPLING],
@@ -285,7 +306,7 @@ static drift_result measure(drift_context *ctx, const drift_scene *scene, const 
         }
     }
     for (int k = 0; r == DRIFT_OK && k < o->spp_count; ++k) {
-        double spp = equal_error_spp(out->plain, o->spp_count, out->aaf[k].rmse, &out->extrapolated[k]);
+        double spp = equal_error_spp(out->plain, o->mc_spp_count, out->aaf[k].rmse, &out->extrapolated[k]);
         out->ratio[k] = spp / out->aaf[k].actual_spp;
     }
     if (r == DRIFT_OK) {
@@ -317,7 +338,7 @@ static bool write_csv(const char *path, const curve *curves, int count)
     fprintf(f, "effect,method,spp,actual_spp,rmse,sampling_ms,filter_ms\n");
     for (int c = 0; c < count; ++c) {
         for (int method = 0; method < 2; ++method) {
-            for (int k = 0; k < curves[c].count; ++k) {
+            for (int k = 0; k < (method == 0 ? curves[c].count : curves[c].plain_count); ++k) {
                 const point *p = method == 0 ? &curves[c].aaf[k] : &curves[c].plain[k];
                 fprintf(f, "%s,%s,%.0f,%.3f,%.6g,%.3f,%.3f\n", drift_effect_name(curves[c].effect),
                         method == 0 ? "aaf" : "plain_mc", p->spp, p->actual_spp, p->rmse,
@@ -333,9 +354,12 @@ static bool write_svg(const char *path, const char *scene, const curve *curves, 
 {
     double xmin = INFINITY, xmax = 0.0, ymin = INFINITY, ymax = 0.0;
     for (int c = 0; c < count; ++c) {
-        for (int k = 0; k < curves[c].count; ++k) {
+        for (int k = 0; k < MAX_SPPS; ++k) {
             const point *pts[2] = { &curves[c].aaf[k], &curves[c].plain[k] };
             for (int m = 0; m < 2; ++m) {
+                if (k >= (m == 0 ? curves[c].count : curves[c].plain_count)) {
+                    continue;
+                }
                 xmin = fmin(xmin, pts[m]->actual_spp);
                 xmax = fmax(xmax, pts[m]->actual_spp);
                 ymin = fmin(ymin, pts[m]->rmse);
@@ -386,12 +410,13 @@ static bool write_svg(const char *path, const char *scene, const curve *curves, 
             const char *colour = colours[m];
             fprintf(f, "<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"2\"%s points=\"", colour,
                     curves[c].effect == DRIFT_EFFECT_INDIRECT ? " stroke-dasharray=\"6 4\"" : "");
-            for (int k = 0; k < curves[c].count; ++k) {
+            int n = m == 0 ? curves[c].count : curves[c].plain_count;
+            for (int k = 0; k < n; ++k) {
                 const point *p = m == 0 ? &curves[c].aaf[k] : &curves[c].plain[k];
                 fprintf(f, "%.1f,%.1f ", PX(p->actual_spp), PY(p->rmse));
             }
             fprintf(f, "\"/>\n");
-            for (int k = 0; k < curves[c].count; ++k) {
+            for (int k = 0; k < n; ++k) {
                 const point *p = m == 0 ? &curves[c].aaf[k] : &curves[c].plain[k];
                 fprintf(f, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"3\" fill=\"%s\"/>\n", PX(p->actual_spp),
                         PY(p->rmse), colour);
@@ -415,17 +440,21 @@ static void print_json(const aaf_options *o, const char *scene_path, int threads
                        const curve *curves, int count)
 {
     printf("{\"scene\": \"%s\", \"width\": %ld, \"height\": %ld, \"ref_spp\": %ld, \"threads\": %d, "
-           "\"effects\": [",
-           scene_path, o->width, o->height, o->ref_spp, threads);
+           "\"light_samples\": %ld, \"effects\": [",
+           scene_path, o->width, o->height, o->ref_spp, threads, o->light_samples);
     for (int c = 0; c < count; ++c) {
         const curve *cv = &curves[c];
-        printf("%s{\"effect\": \"%s\", \"points\": [", c ? ", " : "", drift_effect_name(cv->effect));
+        printf("%s{\"effect\": \"%s\", \"aaf\": [", c ? ", " : "", drift_effect_name(cv->effect));
         for (int k = 0; k < cv->count; ++k) {
-            printf("%s{\"spp\": %.0f, \"aaf_spp\": %.3f, \"aaf_rmse\": %.6g, \"mc_spp\": %.3f, "
-                   "\"mc_rmse\": %.6g, \"equal_error_ratio\": %.3f, \"extrapolated\": %s}",
+            printf("%s{\"spp\": %.0f, \"actual_spp\": %.3f, \"rmse\": %.6g, "
+                   "\"equal_error_ratio\": %.3f, \"extrapolated\": %s}",
                    k ? ", " : "", cv->aaf[k].spp, cv->aaf[k].actual_spp, cv->aaf[k].rmse,
-                   cv->plain[k].actual_spp, cv->plain[k].rmse, cv->ratio[k],
-                   cv->extrapolated[k] ? "true" : "false");
+                   cv->ratio[k], cv->extrapolated[k] ? "true" : "false");
+        }
+        printf("], \"plain_mc\": [");
+        for (int k = 0; k < cv->plain_count; ++k) {
+            printf("%s{\"spp\": %.0f, \"rmse\": %.6g}", k ? ", " : "", cv->plain[k].spp,
+                   cv->plain[k].rmse);
         }
         printf("], \"timing\": {\"width\": %ld, \"height\": %ld, \"spp\": %ld, \"sampling_ms\": %.3f, "
                "\"filter_ms\": %.3f, \"frame_ms\": %.3f, \"filter_fraction\": %.4f}}",
@@ -442,12 +471,16 @@ static void print_text(const aaf_options *o, const char *scene_path, int threads
            o->ref_spp, threads);
     for (int c = 0; c < count; ++c) {
         const curve *cv = &curves[c];
-        printf("\n%s\n%8s %10s %12s %10s %12s %10s\n", drift_effect_name(cv->effect), "spp",
-               "aaf spp", "aaf rmse", "mc spp", "mc rmse", "ratio");
+        printf("\n%s\n%8s %10s %12s %10s\n", drift_effect_name(cv->effect), "spp", "aaf spp",
+               "aaf rmse", "ratio");
         for (int k = 0; k < cv->count; ++k) {
-            printf("%8.0f %10.2f %12.4g %10.2f %12.4g %9.2fx%s\n", cv->aaf[k].spp,
-                   cv->aaf[k].actual_spp, cv->aaf[k].rmse, cv->plain[k].actual_spp,
-                   cv->plain[k].rmse, cv->ratio[k], cv->extrapolated[k] ? " (extrapolated)" : "");
+            printf("%8.0f %10.2f %12.4g %9.2fx%s\n", cv->aaf[k].spp, cv->aaf[k].actual_spp,
+                   cv->aaf[k].rmse, cv->ratio[k], cv->extrapolated[k] ? " (extrapolated)" : "");
+        }
+        printf("plain MC:");
+        for (int k = 0; k < cv->plain_count; ++k) {
+            printf(" %.0f spp %.4g%s", cv->plain[k].spp, cv->plain[k].rmse,
+                   k + 1 < cv->plain_count ? "," : "\n");
         }
         printf("timing %ldx%ld at %ld spp: sampling %.1f ms, filter %.1f ms, frame %.1f ms "
                "(filter %.1f%% of the frame)\n",

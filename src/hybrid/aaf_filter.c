@@ -81,8 +81,17 @@ void drift_aaf_allocate(const float *want, size_t count, size_t active, uint32_t
 
 // --- THE FILTER ---
 
+// What the filter reads of a pixel, packed so a tap touches one cache line, not six planes.
+typedef struct filter_texel {
+    drift_vec3 position;
+    float depth; // negative: no surface
+    drift_vec3 normal;
+    float beta;
+} filter_texel;
+
 typedef struct filter_job {
     const drift_aaf_filter_desc *desc;
+    const filter_texel *texels;
     const drift_image *in;
     drift_image *out;
     int dx, dy; // the 1-D pass's step; both 0 for the exact 2-D filter
@@ -97,25 +106,16 @@ static float distance_sq(const drift_aaf_filter_desc *d, drift_vec3 a, drift_vec
     return drift_vec3_dot(v, v);
 }
 
-// Whether neighbour (x, y) may share its samples with the centre: a surface like it (depth,
+// Whether a neighbour may share its samples with the centre: a surface like it (depth,
 // normal) whose filter width is not too different (eq. 3.7 holds while beta varies slowly).
-static bool accept(const drift_aaf_filter_desc *d, float beta, float depth, drift_vec3 normal,
-                   int32_t x, int32_t y)
+static bool accept(const filter_texel *centre, const filter_texel *n)
 {
-    const drift_gbuffer *g = d->gbuffer;
-    if (drift_image_pixel(&g->material_id, x, y)[0] < 0.0f) {
+    if (n->depth < 0.0f || fabsf(n->depth - centre->depth) > DRIFT_AAF_DEPTH_TOLERANCE * centre->depth ||
+        drift_vec3_dot(n->normal, centre->normal) < DRIFT_AAF_NORMAL_COS) {
         return false;
     }
-    float z = drift_image_pixel(&g->depth, x, y)[0];
-    if (fabsf(z - depth) > DRIFT_AAF_DEPTH_TOLERANCE * depth) {
-        return false;
-    }
-    if (drift_vec3_dot(drift_image_get3(&g->normal, x, y), normal) < DRIFT_AAF_NORMAL_COS) {
-        return false;
-    }
-    float b = drift_image_pixel(d->beta, x, y)[0];
-    if (b > 0.0f) {
-        float ratio = b > beta ? b / beta : beta / b;
+    if (n->beta > 0.0f) {
+        float ratio = n->beta > centre->beta ? n->beta / centre->beta : centre->beta / n->beta;
         return ratio <= DRIFT_AAF_BETA_RATIO;
     }
     return true;
@@ -124,28 +124,23 @@ static bool accept(const drift_aaf_filter_desc *d, float beta, float depth, drif
 static void filter_pixel(const filter_job *job, int32_t x, int32_t y)
 {
     const drift_aaf_filter_desc *d = job->desc;
-    const drift_gbuffer *g = d->gbuffer;
     int channels = job->in->channels;
+    int32_t w = job->in->width, h = job->in->height;
     float *out = drift_image_pixel(job->out, x, y);
     const float *centre = drift_image_pixel(job->in, x, y);
-    float beta = drift_image_pixel(d->beta, x, y)[0];
-    bool surface = drift_image_pixel(&g->material_id, x, y)[0] >= 0.0f;
-    if (!surface || !(beta > 0.0f)) {
-        for (int c = 0; c < channels; ++c) {
-            out[c] = centre[c];
+    const filter_texel *c = &job->texels[(size_t)y * (size_t)w + (size_t)x];
+    if (c->depth < 0.0f || !(c->beta > 0.0f)) {
+        for (int k = 0; k < channels; ++k) {
+            out[k] = centre[k];
         }
         return;
     }
     float footprint = drift_image_pixel(d->footprint, x, y)[0];
-    float reach = footprint > 0.0f ? ceilf(3.0f * beta / footprint) : (float)d->max_radius;
+    float reach = footprint > 0.0f ? ceilf(3.0f * c->beta / footprint) : (float)d->max_radius;
     int32_t radius = reach < (float)d->max_radius ? (int32_t)reach : d->max_radius;
-    float depth = drift_image_pixel(&g->depth, x, y)[0];
-    drift_vec3 normal = drift_image_get3(&g->normal, x, y);
-    drift_vec3 p = drift_image_get3(&g->position, x, y);
-    float inv = -0.5f / (beta * beta);
-    float sum[3] = { 0.0f, 0.0f, 0.0f };
+    float inv = -0.5f / (c->beta * c->beta);
+    float sum[4] = { 0.0f, 0.0f, 0.0f, 0.0f };
     float weight = 0.0f;
-    int32_t w = job->in->width, h = job->in->height;
     bool exact = job->dx == 0 && job->dy == 0;
     for (int32_t j = exact ? -radius : 0; j <= (exact ? radius : 0); ++j) {
         for (int32_t k = -radius; k <= radius; ++k) {
@@ -154,22 +149,58 @@ static void filter_pixel(const filter_job *job, int32_t x, int32_t y)
             if (nx < 0 || ny < 0 || nx >= w || ny >= h) {
                 continue;
             }
-            bool self = nx == x && ny == y;
-            if (!self && !accept(d, beta, depth, normal, nx, ny)) {
+            const filter_texel *n = &job->texels[(size_t)ny * (size_t)w + (size_t)nx];
+            bool self = n == c;
+            if (!self && !accept(c, n)) {
                 continue;
             }
-            float wk = self ? 1.0f
-                            : expf(inv * distance_sq(d, p, drift_image_get3(&g->position, nx, ny)));
+            float wk = self ? 1.0f : expf(inv * distance_sq(d, c->position, n->position));
             const float *v = drift_image_pixel(job->in, nx, ny);
-            for (int c = 0; c < channels; ++c) {
-                sum[c] += wk * v[c];
+            for (int m = 0; m < channels; ++m) {
+                sum[m] += wk * v[m];
             }
             weight += wk;
         }
     }
-    for (int c = 0; c < channels; ++c) {
-        out[c] = sum[c] / weight;
+    for (int m = 0; m < channels; ++m) {
+        out[m] = sum[m] / weight;
     }
+}
+
+typedef struct pack_job {
+    const drift_aaf_filter_desc *desc;
+    filter_texel *texels;
+    int32_t width;
+} pack_job;
+
+static void pack_rows(size_t begin, size_t end, int thread_index, void *user)
+{
+    (void)thread_index;
+    const pack_job *job = user;
+    const drift_gbuffer *g = job->desc->gbuffer;
+    for (size_t y = begin; y < end; ++y) {
+        for (int32_t x = 0; x < job->width; ++x) {
+            int32_t yy = (int32_t)y;
+            bool surface = drift_image_pixel(&g->material_id, x, yy)[0] >= 0.0f;
+            job->texels[y * (size_t)job->width + (size_t)x] = (filter_texel){
+                .position = drift_image_get3(&g->position, x, yy),
+                .depth = surface ? drift_image_pixel(&g->depth, x, yy)[0] : -1.0f,
+                .normal = drift_image_get3(&g->normal, x, yy),
+                .beta = drift_image_pixel(job->desc->beta, x, yy)[0]
+            };
+        }
+    }
+}
+
+static filter_texel *pack(drift_context *ctx, const drift_aaf_filter_desc *desc, int32_t width,
+                          int32_t height)
+{
+    filter_texel *texels = drift_alloc(ctx, sizeof(filter_texel) * (size_t)width * (size_t)height);
+    if (texels) {
+        pack_job job = { desc, texels, width };
+        drift_parallel_for(ctx, (size_t)height, 8, pack_rows, &job);
+    }
+    return texels;
 }
 
 static void filter_rows(size_t begin, size_t end, int thread_index, void *user)
@@ -188,18 +219,31 @@ static void run_filter(drift_context *ctx, filter_job *job)
     drift_parallel_for(ctx, (size_t)job->in->height, 4, filter_rows, job);
 }
 
-void drift_aaf_filter_separable(drift_context *ctx, const drift_aaf_filter_desc *desc,
-                                const drift_image *in, drift_image *scratch, drift_image *out)
+drift_result drift_aaf_filter_separable(drift_context *ctx, const drift_aaf_filter_desc *desc,
+                                        const drift_image *in, drift_image *scratch,
+                                        drift_image *out)
 {
-    filter_job job = { .desc = desc, .in = in, .out = scratch, .dx = 1, .dy = 0 };
+    filter_texel *texels = pack(ctx, desc, in->width, in->height);
+    if (!texels) {
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    filter_job job = { .desc = desc, .texels = texels, .in = in, .out = scratch, .dx = 1 };
     run_filter(ctx, &job);
-    job = (filter_job){ .desc = desc, .in = scratch, .out = out, .dx = 0, .dy = 1 };
+    job = (filter_job){ .desc = desc, .texels = texels, .in = scratch, .out = out, .dy = 1 };
     run_filter(ctx, &job);
+    drift_free(ctx, texels);
+    return DRIFT_OK;
 }
 
-void drift_aaf_filter_exact(drift_context *ctx, const drift_aaf_filter_desc *desc,
-                            const drift_image *in, drift_image *out)
+drift_result drift_aaf_filter_exact(drift_context *ctx, const drift_aaf_filter_desc *desc,
+                                    const drift_image *in, drift_image *out)
 {
-    filter_job job = { .desc = desc, .in = in, .out = out, .dx = 0, .dy = 0 };
+    filter_texel *texels = pack(ctx, desc, in->width, in->height);
+    if (!texels) {
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    filter_job job = { .desc = desc, .texels = texels, .in = in, .out = out };
     run_filter(ctx, &job);
+    drift_free(ctx, texels);
+    return DRIFT_OK;
 }

@@ -252,8 +252,11 @@ drift_result drift_hybrid_pass_aaf_indirect(drift_hybrid *f)
                                        .footprint = &st->footprint,
                                        .gbuffer = &f->gbuffer,
                                        .max_radius = DRIFT_AAF_MAX_RADIUS };
-        drift_aaf_filter_separable(f->ctx, &desc, &st->indirect_radiance, &st->scratch3,
-                                   &st->indirect_filtered);
+        r = drift_aaf_filter_separable(f->ctx, &desc, &st->indirect_radiance, &st->scratch3,
+                                       &st->indirect_filtered);
+        if (r != DRIFT_OK) {
+            return r;
+        }
     }
     drift_hybrid_for_each_pixel(f, modulate_pixel, NULL);
     stats->ms[DRIFT_PASS_AAF_FILTER] += 1000.0 * (drift_time_now() - t);

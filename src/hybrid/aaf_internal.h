@@ -40,11 +40,13 @@ typedef struct drift_aaf_filter_desc {
 // The separable filter of eq. 3.7: a horizontal then a vertical 1-D Gaussian, both with the
 // centre pixel's beta, over neighbours that pass the beta-ratio, depth and normal tests.
 // in, scratch and out have the same size and channel count; out may not be in or scratch.
-void drift_aaf_filter_separable(drift_context *ctx, const drift_aaf_filter_desc *desc,
-                                const drift_image *in, drift_image *scratch, drift_image *out);
+// Errors: DRIFT_ERR_OUT_OF_MEMORY (its packed copy of the per-pixel inputs).
+drift_result drift_aaf_filter_separable(drift_context *ctx, const drift_aaf_filter_desc *desc,
+                                        const drift_image *in, drift_image *scratch,
+                                        drift_image *out);
 // The exact 2-D filter of eq. 3.2 with the same tests (quadratic in the radius: for tests).
-void drift_aaf_filter_exact(drift_context *ctx, const drift_aaf_filter_desc *desc,
-                            const drift_image *in, drift_image *out);
+drift_result drift_aaf_filter_exact(drift_context *ctx, const drift_aaf_filter_desc *desc,
+                                    const drift_image *in, drift_image *out);
 
 // The consistent filter width (paper reference [51]): beta times this factor, which is 1 up
 // to from_spp samples a pixel and falls as (spp / from_spp)^-exponent after, so the filter's

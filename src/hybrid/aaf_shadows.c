@@ -311,7 +311,10 @@ drift_result drift_hybrid_pass_aaf_shadows(drift_hybrid *f)
                                            .has_axis = false,
                                            .axis = light->direction,
                                            .max_radius = DRIFT_AAF_MAX_RADIUS };
-            drift_aaf_filter_separable(f->ctx, &desc, &al->unfiltered, &st->scratch1, shadow);
+            r = drift_aaf_filter_separable(f->ctx, &desc, &al->unfiltered, &st->scratch1, shadow);
+            if (r != DRIFT_OK) {
+                return r;
+            }
         }
         stats->ms[DRIFT_PASS_AAF_FILTER] += 1000.0 * (drift_time_now() - t);
     }
