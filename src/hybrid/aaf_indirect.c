@@ -131,7 +131,7 @@ static void add_samples(drift_hybrid *f, const indirect_job *job, int32_t x, int
 {
     size_t i = pixel_index(f, x, y);
     const drift_surface *s = &f->gbuffer.surfaces[i];
-    indirect_sums *sums = (indirect_sums *)&f->aaf->aux[4 * i];
+    indirect_sums *sums = (indirect_sums *)&f->aaf->aux[DRIFT_AAF_AUX * i];
     float *radiance = drift_image_pixel(&f->aaf->indirect_radiance, x, y);
     drift_vec3 sum = drift_vec3_scale(drift_vec3_make(radiance[0], radiance[1], radiance[2]), sums->count);
     for (uint32_t k = first; k < end; ++k) {
@@ -155,7 +155,7 @@ static void sparse_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays, 
     const indirect_job *job = user;
     drift_aaf_state *st = f->aaf;
     size_t i = pixel_index(f, x, y);
-    indirect_sums *sums = (indirect_sums *)&st->aux[4 * i];
+    indirect_sums *sums = (indirect_sums *)&st->aux[DRIFT_AAF_AUX * i];
     *sums = (indirect_sums){ INFINITY, 0.0f, 0.0f, 0.0f };
     drift_image_set3(&st->indirect_radiance, x, y, drift_vec3_splat(0.0f));
     drift_image_pixel(&st->indirect_beta, x, y)[0] = 0.0f;

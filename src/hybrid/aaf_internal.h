@@ -71,6 +71,8 @@ void drift_aaf_allocate(const float *want, size_t count, size_t active, uint32_t
 
 // --- STATE AND PASSES ---
 
+#define DRIFT_AAF_AUX 6 // floats of running sums a pixel keeps between the passes
+
 typedef struct drift_aaf_light {
     drift_image beta;       // 1: filter width (0: not filtered)
     drift_image spp;        // 1: n(x), the samples the pixel took
@@ -85,7 +87,7 @@ typedef struct drift_aaf_state {
     drift_image scratch1, scratch3;
     float *want;            // width*height
     uint32_t *counts;       // width*height
-    float *aux;             // 4 * width*height: per-pixel sparse results
+    float *aux;             // DRIFT_AAF_AUX * width*height: per-pixel running sums
     // indirect
     drift_image indirect_beta, indirect_spp, indirect_unfiltered; // the planes of --aov
     drift_image indirect_radiance, indirect_filtered; // 3: the demodulated estimate, filtered

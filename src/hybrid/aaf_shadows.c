@@ -62,19 +62,26 @@ static float light_area(const drift_scene *scene, const drift_hybrid_light *ligh
     return area;
 }
 
-// Per-pixel running sums kept in state->aux: light-weighted visibility, total weight, and
-// the largest and smallest s = d1/d2 - 1 of the occluded rays (s1 and s2 of eq. 3.5).
+// Per-pixel running sums kept in state->aux: light-weighted visibility, total weight, the
+// largest and smallest s = d1/d2 - 1 of the occluded rays (s1 and s2 of eq. 3.5), the
+// samples traced and the next index of the pixel's sample sequence.
 typedef struct shadow_sums {
-    float visible, weight, s1, s2;
+    float visible, weight, s1, s2, taken, next;
 } shadow_sums;
 
-// Traces samples first .. end - 1 of the pixel toward the light, adding to *sums.
+// Traces samples of the pixel toward the light until `target` have been traced, adding to
+// *sums. Points the light sampler gives that cannot light the pixel (w = 0: the far side of
+// a sphere light, behind the surface) are skipped, not counted: a sun sphere returns such
+// points half the time, and a pixel whose few sparse points all fell there would look lit.
+// At most 4 target + 4 points are drawn.
 static void trace_samples(drift_hybrid *f, const shadow_job *job, const drift_surface *s,
-                          const drift_bsdf *bsdf, drift_vec3 wo, uint32_t pixel, uint32_t first,
-                          uint32_t end, shadow_sums *sums, uint64_t *rays)
+                          const drift_bsdf *bsdf, drift_vec3 wo, uint32_t pixel, uint32_t target,
+                          shadow_sums *sums, uint64_t *rays)
 {
     const drift_hybrid_light *light = &f->lights[job->light];
-    for (uint32_t k = first; k < end; ++k) {
+    while (sums->taken < (float)target && sums->next < 4.0f * (float)target + 4.0f) {
+        uint32_t k = (uint32_t)sums->next;
+        sums->next += 1.0f;
         drift_sampler sampler = drift_sampler_make(job->key, pixel, k);
         float pick = drift_sampler_next1(&sampler);
         drift_vec2 u = drift_sampler_next2(&sampler);
@@ -94,6 +101,7 @@ static void trace_samples(drift_hybrid *f, const shadow_job *job, const drift_su
                           .tmax = isfinite(ls.distance) ? ls.distance * (1.0f - 1e-4f) : INFINITY };
         drift_hit hit = { .mesh = DRIFT_INVALID_INDEX, .light = DRIFT_INVALID_INDEX };
         ++*rays;
+        sums->taken += 1.0f;
         drift_accel_intersect(f->accel, &ray, &hit);
         float occluder;
         sums->weight += w;
@@ -119,8 +127,8 @@ static void sparse_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays, 
     const shadow_job *job = user;
     drift_aaf_state *st = f->aaf;
     size_t i = pixel_index(f, x, y);
-    shadow_sums *sums = (shadow_sums *)&st->aux[4 * i];
-    *sums = (shadow_sums){ 0.0f, 0.0f, 0.0f, INFINITY };
+    shadow_sums *sums = (shadow_sums *)&st->aux[DRIFT_AAF_AUX * i];
+    *sums = (shadow_sums){ 0.0f, 0.0f, 0.0f, INFINITY, 0.0f, 0.0f };
     const drift_surface *s = &f->gbuffer.surfaces[i];
     if (s->material == DRIFT_INVALID_INDEX) {
         return;
@@ -128,22 +136,22 @@ static void sparse_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays, 
     drift_bsdf bsdf = drift_bsdf_make(f->scene, s);
     drift_vec3 wo = drift_hybrid_wo(f, x, y);
     uint32_t n = job->uniform ? f->params.spp : job->sparse;
-    trace_samples(f, job, s, &bsdf, wo, (uint32_t)i, 0, n, sums, rays);
+    trace_samples(f, job, s, &bsdf, wo, (uint32_t)i, n, sums, rays);
 }
 
 // s1 and s2 of the pixel: its own when its sparse rays met an occluder, else the extremes of
 // its neighbours' (same surface) within DRIFT_AAF_DILATE pixels, so that a penumbra pixel
-// whose few sparse rays all happened to miss still gets samples and a filter. False when no
-// occluder is near: the pixel keeps its sparse estimate, unfiltered (exact in full light).
+// whose few sparse rays all happened to miss still gets samples and a filter. False when the
+// pixel is in full light or full shadow: no occluder near, or no ray of the pixel or of
+// those neighbours reached the light (an umbra, as flat as full light). Such a pixel keeps
+// its sparse estimate, unfiltered: exactly 1 or 0.
 static bool occluder_ratios(const drift_hybrid *f, int32_t x, int32_t y, float *s1, float *s2)
 {
     const drift_aaf_state *st = f->aaf;
-    const shadow_sums *own = (const shadow_sums *)&st->aux[4 * pixel_index(f, x, y)];
+    const shadow_sums *own = (const shadow_sums *)&st->aux[DRIFT_AAF_AUX * pixel_index(f, x, y)];
     *s1 = own->s1;
     *s2 = own->s2;
-    if (isfinite(own->s2)) {
-        return true;
-    }
+    bool lit = own->visible > 0.0f;
     const drift_gbuffer *g = &f->gbuffer;
     float depth = drift_image_pixel(&g->depth, x, y)[0];
     drift_vec3 normal = drift_image_get3(&g->normal, x, y);
@@ -153,17 +161,19 @@ static bool occluder_ratios(const drift_hybrid *f, int32_t x, int32_t y, float *
                 drift_image_pixel(&g->material_id, nx, ny)[0] < 0.0f) {
                 continue;
             }
-            const shadow_sums *n = (const shadow_sums *)&st->aux[4 * pixel_index(f, nx, ny)];
-            if (!isfinite(n->s2) ||
-                fabsf(drift_image_pixel(&g->depth, nx, ny)[0] - depth) > DRIFT_AAF_DEPTH_TOLERANCE * depth ||
+            const shadow_sums *n = (const shadow_sums *)&st->aux[DRIFT_AAF_AUX * pixel_index(f, nx, ny)];
+            if (fabsf(drift_image_pixel(&g->depth, nx, ny)[0] - depth) > DRIFT_AAF_DEPTH_TOLERANCE * depth ||
                 drift_vec3_dot(drift_image_get3(&g->normal, nx, ny), normal) < DRIFT_AAF_NORMAL_COS) {
                 continue;
             }
-            *s1 = fmaxf(*s1, n->s1);
-            *s2 = fminf(*s2, n->s2);
+            lit = lit || n->visible > 0.0f;
+            if (!isfinite(own->s2) && isfinite(n->s2)) {
+                *s1 = fmaxf(*s1, n->s1);
+                *s2 = fminf(*s2, n->s2);
+            }
         }
     }
-    return isfinite(*s2);
+    return isfinite(*s2) && lit;
 }
 
 // beta (eq. 3.4) and the wanted rate n(x) (eq. 3.5) from the sparse pass.
@@ -199,17 +209,15 @@ static void adaptive_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays
     drift_aaf_state *st = f->aaf;
     drift_aaf_light *al = &st->lights[job->light];
     size_t i = pixel_index(f, x, y);
-    shadow_sums *sums = (shadow_sums *)&st->aux[4 * i];
+    shadow_sums *sums = (shadow_sums *)&st->aux[DRIFT_AAF_AUX * i];
     const drift_surface *s = &f->gbuffer.surfaces[i];
-    uint32_t taken = job->uniform ? f->params.spp : job->sparse;
-    uint32_t n = job->uniform ? taken : st->counts[i];
-    if (s->material != DRIFT_INVALID_INDEX && n > taken) {
+    bool surface = s->material != DRIFT_INVALID_INDEX;
+    if (surface && !job->uniform && st->counts[i] > (uint32_t)sums->taken) {
         drift_bsdf bsdf = drift_bsdf_make(f->scene, s);
-        trace_samples(f, job, s, &bsdf, drift_hybrid_wo(f, x, y), (uint32_t)i, taken, n, sums,
+        trace_samples(f, job, s, &bsdf, drift_hybrid_wo(f, x, y), (uint32_t)i, st->counts[i], sums,
                       rays);
     }
-    bool surface = s->material != DRIFT_INVALID_INDEX;
-    drift_image_pixel(&al->spp, x, y)[0] = surface ? (float)(n > taken ? n : taken) : 0.0f;
+    drift_image_pixel(&al->spp, x, y)[0] = surface ? sums->taken : 0.0f;
     drift_image_pixel(&al->unfiltered, x, y)[0] = surface ? sums_visibility(sums) : 0.0f;
 }
 

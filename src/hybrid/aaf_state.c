@@ -43,7 +43,7 @@ drift_result drift_aaf_state_ensure(drift_hybrid *f)
     s->lights = drift_alloc(ctx, sizeof(drift_aaf_light) * (f->light_count + 1u));
     s->want = drift_alloc(ctx, sizeof(float) * pixels);
     s->counts = drift_alloc(ctx, sizeof(uint32_t) * pixels);
-    s->aux = drift_alloc(ctx, sizeof(float) * 4 * pixels);
+    s->aux = drift_alloc(ctx, sizeof(float) * DRIFT_AAF_AUX * pixels);
     drift_result r = s->lights && s->want && s->counts && s->aux ? DRIFT_OK : DRIFT_ERR_OUT_OF_MEMORY;
     drift_image *ones[] = { &s->footprint, &s->scratch1, &s->indirect_beta, &s->indirect_spp };
     drift_image *threes[] = { &s->scratch3, &s->indirect_unfiltered, &s->indirect_radiance,
