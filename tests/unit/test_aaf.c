@@ -163,7 +163,7 @@ static void test_shadows_converge(void **state)
     build_shadow_scene(&r);
     rig_commit(&r);
     drift_pt *pt = NULL;
-    uint32_t truth_spp = (uint32_t)(1024 * test_intensity());
+    uint32_t truth_spp = (uint32_t)(512 * test_intensity());
     drift_image truth = render_pt(&r, DRIFT_PT_COMPONENT_EMISSION | DRIFT_PT_COMPONENT_DIRECT, 1,
                                   truth_spp < 256 ? 256 : truth_spp, &pt);
     const uint32_t spps[3] = { 4, 16, 64 };
