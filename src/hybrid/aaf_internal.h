@@ -9,7 +9,7 @@
 // Defaults (docs/aaf.md explains each).
 #define DRIFT_AAF_SPARSE_MIN 4       // sparse samples a pixel, at least (when spp allows)
 #define DRIFT_AAF_DILATE 4          // pixels searched for occluders a pixel's sparse rays missed
-#define DRIFT_AAF_MAX_RADIUS 24      // filter half width in pixels (the paper's "large constant")
+#define DRIFT_AAF_MAX_RADIUS 16      // filter half width in pixels (the paper's "large constant")
 #define DRIFT_AAF_BETA_RATIO 2.0f    // neighbours whose beta differs by more are rejected
 #define DRIFT_AAF_NORMAL_COS 0.9f    // ... and those whose normal turns by more than ~25 degrees
 #define DRIFT_AAF_DEPTH_TOLERANCE 0.1f // ... or whose depth differs by more than 10%
