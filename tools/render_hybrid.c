@@ -56,7 +56,8 @@ bool render_parse_hybrid_option(int argc, char **argv, int *i, render_options *o
                                           "--envmap-size",   "--probe",           "--ambient",
                                           "--aperture",      "--focus-distance",
                                           "--isg-search",    "--isg-gather",      "--isg-sigma",
-                                          "--blur-radius",   "--isg-layers",      "--isg-range" };
+                                          "--blur-radius",   "--isg-layers",      "--isg-range",
+                                          "--aaf-max-spp",   "--aaf-sampling",    "--aaf-filter" };
     const char *a = argv[*i];
     int effect = -1, other = -1;
     for (int k = 0; k < DRIFT_EFFECT_COUNT; ++k) {
@@ -139,6 +140,24 @@ bool render_parse_hybrid_option(int argc, char **argv, int *i, render_options *o
         h->isg_range_plane = strcmp(v, "plane") == 0;
         if (!*ok) {
             fprintf(stderr, "drift render: %s expects full or plane, got '%s'\n", a, v);
+        }
+        break;
+    case 14:
+        *ok = cli_parse_int("render", a, v, 1, 65536, &n);
+        h->aaf_max_spp = (uint32_t)n;
+        break;
+    case 15:
+        *ok = strcmp(v, "adaptive") == 0 || strcmp(v, "uniform") == 0;
+        h->aaf_uniform = strcmp(v, "uniform") == 0;
+        if (!*ok) {
+            fprintf(stderr, "drift render: --aaf-sampling expects adaptive or uniform, got '%s'\n", v);
+        }
+        break;
+    case 16:
+        *ok = strcmp(v, "on") == 0 || strcmp(v, "off") == 0;
+        h->aaf_unfiltered = strcmp(v, "off") == 0;
+        if (!*ok) {
+            fprintf(stderr, "drift render: --aaf-filter expects on or off, got '%s'\n", v);
         }
         break;
     default:

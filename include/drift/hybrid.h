@@ -59,6 +59,8 @@ typedef enum drift_shadow_technique {
     DRIFT_SHADOWS_REFERENCE,  // path-traced direct light at --spp
     DRIFT_SHADOWS_ISG,        // image space gathering over the hard-shadow buffer (docs/isg.md)
     DRIFT_SHADOWS_BLUR,       // baseline: the hard-shadow bits blurred over a fixed disk
+    DRIFT_SHADOWS_AAF,        // axis-aligned filtering of ray-traced area-light visibility
+                              // (Mehta et al. 2012; docs/aaf.md), --spp rays a pixel on average
     DRIFT_SHADOWS_COUNT
 } drift_shadow_technique;
 
@@ -84,6 +86,8 @@ typedef enum drift_indirect_technique {
     DRIFT_INDIRECT_NONE = 0,
     DRIFT_INDIRECT_AMBIENT,   // diffuse albedo x a constant radiance
     DRIFT_INDIRECT_REFERENCE, // path-traced first-bounce diffuse light at --spp
+    DRIFT_INDIRECT_AAF,       // path-traced diffuse indirect, adaptively sampled and filtered
+                              // (Mehta et al. 2013; docs/aaf.md), --spp paths a pixel on average
     DRIFT_INDIRECT_COUNT
 } drift_indirect_technique;
 
@@ -110,6 +114,10 @@ int drift_technique_parse(drift_effect effect, const char *name);
 //   envmap_size      = 0 -> 128 texels a cube face
 //   probe_per_object = false: one probe at the scene centre (or `probe` when has_probe)
 //   ambient          = used when has_ambient; otherwise the mean direct radiance of the frame
+//   aaf_max_spp      = 0 -> 8 x spp (at most 4096): the cap on AAF's adaptive n(x)
+//   aaf_uniform      = false: AAF samples adaptively; true: every pixel takes spp samples
+//   aaf_unfiltered   = false: AAF filters; true: the noisy estimate is used as it is
+//                      (both true: plain Monte Carlo with AAF's sampler, the benchmark baseline)
 typedef struct drift_hybrid_params {
     int32_t width, height;
     drift_shadow_technique shadows;
@@ -145,6 +153,9 @@ typedef struct drift_hybrid_params {
     float blur_radius;
     int32_t isg_layers;
     bool isg_range_plane;
+    uint32_t aaf_max_spp;
+    bool aaf_uniform;
+    bool aaf_unfiltered;
 } drift_hybrid_params;
 
 drift_hybrid_params drift_hybrid_params_resolve(const drift_hybrid_params *params,
@@ -190,6 +201,8 @@ typedef enum drift_hybrid_pass {
     DRIFT_PASS_COMPOSE,
     DRIFT_PASS_DOF,            // post-process depth of field
     DRIFT_PASS_ISG,            // image space gathering (every effect) and the blur baselines
+    DRIFT_PASS_AAF_SAMPLING,   // AAF sparse and adaptive sampling (shadows and indirect)
+    DRIFT_PASS_AAF_FILTER,     // AAF's separable filter
     DRIFT_PASS_COUNT
 } drift_hybrid_pass;
 

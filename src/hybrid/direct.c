@@ -3,6 +3,7 @@
 // a shadow map filtered by PCF or PCSS. The reference technique leaves D to reference.c.
 #include "hybrid/frame_internal.h"
 #include "hybrid/isg_internal.h"
+#include "hybrid/aaf_internal.h"
 
 #include <math.h>
 
@@ -150,6 +151,11 @@ drift_result drift_hybrid_pass_direct(drift_hybrid *f)
             if (r != DRIFT_OK) {
                 return r;
             }
+        }
+    } else if (f->params.shadows == DRIFT_SHADOWS_AAF) {
+        drift_result r = drift_hybrid_pass_aaf_shadows(f); // times its own passes
+        if (r != DRIFT_OK) {
+            return r;
         }
     } else {
         drift_result r = build_shadow_maps(f);

@@ -3,6 +3,7 @@
 // and compose.c.
 #include "hybrid/frame_internal.h"
 #include "hybrid/isg_internal.h"
+#include "hybrid/aaf_internal.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -11,16 +12,16 @@
 // --- NAMES ---
 
 static const char *const shadow_names[] = { "hard", "pcf", "pcss", "reference",
-                                                   "isg",  "blur" };
+                                           "isg",  "blur", "aaf" };
 static const char *const reflection_names[] = { "none", "envmap", "sharp",
-                                                       "reference", "isg", "blur" };
+                                               "reference", "isg", "blur" };
 static const char *const dof_names[] = { "none", "post", "reference", "isg" };
-static const char *const indirect_names[] = { "none", "ambient", "reference" };
+static const char *const indirect_names[] = { "none", "ambient", "reference", "aaf" };
 static const char *const effect_names[] = { "shadows", "reflections", "dof", "indirect" };
 static const char *const pass_names[] = { "primary",     "unshadowed", "hard_shadows",
                                           "shadow_maps", "shadow_filter", "reflections",
                                           "envmap",      "reference",  "compose", "dof",
-                                          "isg" };
+                                          "isg", "aaf_sampling", "aaf_filter" };
 
 _Static_assert(sizeof shadow_names / sizeof *shadow_names == DRIFT_SHADOWS_COUNT, "names");
 _Static_assert(sizeof reflection_names / sizeof *reflection_names == DRIFT_REFLECTIONS_COUNT,
@@ -145,6 +146,9 @@ drift_hybrid_params drift_hybrid_params_resolve(const drift_hybrid_params *param
     p.pcf_kernel = p.pcf_kernel ? p.pcf_kernel : 3;
     p.envmap_size = p.envmap_size ? p.envmap_size : 128;
     drift_isg_params_resolve(&p, scene);
+    if (p.aaf_max_spp == 0) {
+        p.aaf_max_spp = p.spp > 512 ? 4096 : 8 * p.spp;
+    }
     return p;
 }
 
@@ -166,6 +170,8 @@ static bool params_valid(const drift_context *ctx, const drift_hybrid_params *p)
         problem = "shadow map or environment map size out of range";
     } else if (p->pcf_kernel < 1 || p->pcf_kernel > 63 || p->light_samples > 4096) {
         problem = "pcf kernel outside 1..63 or light samples over 4096";
+    } else if (p->aaf_max_spp < p->spp || p->aaf_max_spp > 65536) {
+        problem = "aaf max spp below spp or over 65536";
     } else if (!isfinite(p->shadow_bias) || (p->has_probe && !drift_vec3_is_finite(p->probe)) ||
                (p->has_ambient && !drift_vec3_is_finite(p->ambient))) {
         problem = "non-finite bias, probe or ambient";
@@ -296,6 +302,7 @@ void drift_hybrid_destroy(drift_hybrid *f)
     }
     destroy_probes(f);
     drift_isg_destroy(f);
+    drift_aaf_state_destroy(ctx, f->aaf);
     drift_gbuffer_destroy(ctx, &f->gbuffer);
     drift_image *images[] = { &f->environment_direct, &f->direct,      &f->reflection_emitted,
                               &f->reflection_reflected, &f->reflection_distance, &f->reflections,
@@ -463,6 +470,21 @@ static void collect_planes(drift_hybrid *f)
         snprintf(name, sizeof name, "light%u.shadow", l);
         add_plane(f, name, &f->light_buffers[l].shadow);
     }
+    for (uint32_t l = 0; l < f->light_count && p->shadows == DRIFT_SHADOWS_AAF && f->aaf; ++l) {
+        const char *names[3] = { "beta", "spp", "unfiltered" };
+        const drift_image *images[3] = { &f->aaf->lights[l].beta, &f->aaf->lights[l].spp,
+                                         &f->aaf->lights[l].unfiltered };
+        for (int k = 0; k < 3; ++k) {
+            char name[DRIFT_HYBRID_PLANE_NAME];
+            snprintf(name, sizeof name, "light%u.aaf.%s", l, names[k]);
+            add_plane(f, name, images[k]);
+        }
+    }
+    if (p->indirect == DRIFT_INDIRECT_AAF && f->aaf) {
+        add_plane(f, "indirect.aaf.beta", &f->aaf->indirect_beta);
+        add_plane(f, "indirect.aaf.spp", &f->aaf->indirect_spp);
+        add_plane(f, "indirect.aaf.unfiltered", &f->aaf->indirect_unfiltered);
+    }
     if (p->reflections == DRIFT_REFLECTIONS_SHARP || p->reflections == DRIFT_REFLECTIONS_ISG ||
         p->reflections == DRIFT_REFLECTIONS_BLUR) {
         add_plane(f, "reflection.emitted", &f->reflection_emitted);
@@ -506,6 +528,10 @@ drift_result drift_hybrid_render(drift_hybrid *f, const drift_camera *camera,
     drift_result r = drift_hybrid_pass_direct(f);
     if (r == DRIFT_OK) {
         r = drift_hybrid_pass_reflections(f);
+    }
+    if (r == DRIFT_OK && f->params.indirect == DRIFT_INDIRECT_AAF &&
+        f->params.dof != DRIFT_DOF_REFERENCE) {
+        r = drift_hybrid_pass_aaf_indirect(f);
     }
     if (r == DRIFT_OK) {
         r = drift_hybrid_pass_reference(f, cancel);

@@ -8,9 +8,9 @@
 #include "hybrid/hybrid_internal.h"
 #include "drift/pt.h"
 
-// Planes the frame can list: the fixed ones, plus three a light.
-#define DRIFT_HYBRID_FIXED_PLANES 24
-#define DRIFT_HYBRID_PLANES_PER_LIGHT 3
+// Planes the frame can list: the fixed ones, plus six a light (three of them AAF's).
+#define DRIFT_HYBRID_FIXED_PLANES 27
+#define DRIFT_HYBRID_PLANES_PER_LIGHT 6
 #define DRIFT_HYBRID_PLANE_NAME 48
 
 typedef struct drift_hybrid_plane_ref {
@@ -73,6 +73,7 @@ struct drift_hybrid {
     drift_hybrid_plane_ref *planes; // room for every plane (sized at create)
     uint32_t plane_count, plane_capacity;
     struct drift_isg_state *isg; // image space gathering's buffers (isg.c), made on first use
+    struct drift_aaf_state *aaf;    // AAF's buffers, made on first use (aaf_internal.h)
 };
 
 // Runs fn for every row, or every pixel, rows in parallel. `rays` is the calling thread's ray

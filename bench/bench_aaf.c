@@ -1,0 +1,548 @@
+// drift bench aaf: axis-aligned filtering against plain Monte Carlo with the same sampler
+// (the paper's Figs. 3.6 and 4.2): RMSE of the effect's term (the frame's `direct` plane for
+// shadows, `indirect` for indirect light) against a reference rendered by the path tracer at
+// --ref-spp, over a list of average spp; the equal-error sample ratio (the spp plain MC needs
+// to reach AAF's error, interpolated on the log-log curve); and the filter's milliseconds
+// against the sampling's at 640x480 (Tables 3.1 and 4.1). Writes CSV and an SVG plot.
+#include "bench.h"
+#include "cli.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "drift/accel.h"
+#include "drift/hybrid.h"
+#include "drift/scene_io.h"
+
+#define MAX_SPPS 16
+
+typedef struct aaf_options {
+    const char *scene_path;
+    const char *csv_path, *svg_path;
+    long width, height, ref_spp, threads, timing_width, timing_height, timing_spp, light_samples;
+    long spps[MAX_SPPS], mc_spps[MAX_SPPS];
+    int spp_count, mc_spp_count;
+    bool shadows, indirect, json;
+} aaf_options;
+
+static void print_help(FILE *out)
+{
+    fprintf(out,
+            "usage: drift bench aaf [SCENE] [--effect shadows|indirect|both] [--spp LIST]\n"
+            "                       [--ref-spp N] [--width W] [--height H] [--threads T]\n"
+            "                       [--timing-size WxH] [--timing-spp N] [--csv FILE]\n"
+            "                       [--svg FILE] [--mc-spp LIST] [--light-samples N] [--json]\n\n"
+            "RMSE of AAF and of plain Monte Carlo (same sampler: uniform spp, no filter) against\n"
+            "a path-traced reference of the effect's term, for each average spp; the equal-error\n"
+            "sample ratio; and filter vs sampling milliseconds of one AAF frame.\n\n"
+            "  SCENE         default scenes/grids/grids.json (needs ../shared)\n"
+            "  --effect E    shadows (default), indirect or both\n"
+            "  --spp LIST    comma-separated average spp (default 4,8,16,32,64)\n"
+            "  --mc-spp LIST plain Monte Carlo's spp (default: --spp); longer lists avoid\n"
+            "                extrapolating the equal-error ratio\n"
+            "  --light-samples N  samples of U_l's sampled lobes (default 256: keeps the\n"
+            "                unshadowed light's own noise under the shadows' error)\n"
+            "  --ref-spp N   reference samples a pixel (default 4096)\n"
+            "  --width, --height  error images (default 160x120)\n"
+            "  --timing-size WxH  timing frame (default 640x480); --timing-spp N (default 16)\n"
+            "  --threads T   worker threads (default 1: per-thread figures)\n"
+            "  --csv FILE    effect,method,spp,actual_spp,rmse,sampling_ms,filter_ms rows\n"
+            "  --svg FILE    the log-log plot\n"
+            "  --json        one JSON object on stdout\n");
+}
+
+// A comma-separated, increasing list of 2..MAX_SPPS counts into spps[0 .. *spp_count - 1].
+static bool parse_spps(const char *text, long *spps, int *spp_count)
+{
+    int count = 0;
+    const char *p = text;
+    while (*p && count < MAX_SPPS) {
+        char *end;
+        long v = strtol(p, &end, 10);
+        if (end == p || v < 1 || v > 65536 || (*end != ',' && *end != '\0') ||
+            (count > 0 && v <= spps[count - 1])) {
+            fprintf(stderr, "drift bench aaf: expected an increasing comma-separated list of "
+                            "counts in 1..65536, got '%s'\n", text);
+            return false;
+        }
+        spps[count++] = v;
+        p = *end == ',' ? end + 1 : end;
+    }
+    if (count < 2 || *p) {
+        fprintf(stderr, "drift bench aaf: a spp list needs 2..%d values, got '%s'\n", MAX_SPPS, text);
+        return false;
+    }
+    *spp_count = count;
+    return true;
+}
+
+static int parse(int argc, char **argv, aaf_options *o)
+{
+    *o = (aaf_options){ .width = 160, .height = 120, .ref_spp = 4096, .threads = 1,
+                        .timing_width = 640, .timing_height = 480, .timing_spp = 16,
+                        .light_samples = 256, .shadows = true };
+    parse_spps("4,8,16,32,64", o->spps, &o->spp_count);
+    o->mc_spp_count = 0;
+    const char *cmd = "bench aaf";
+    for (int i = 1; i < argc; ++i) {
+        const char *a = argv[i], *v = NULL;
+        bool ok = true;
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            print_help(stdout);
+            return -1;
+        } else if (strcmp(a, "--json") == 0) {
+            o->json = true;
+        } else if (strcmp(a, "--effect") == 0) {
+            ok = (v = cli_next_value(cmd, argc, argv, &i)) != NULL;
+            if (ok) {
+                o->shadows = strcmp(v, "shadows") == 0 || strcmp(v, "both") == 0;
+                o->indirect = strcmp(v, "indirect") == 0 || strcmp(v, "both") == 0;
+                ok = o->shadows || o->indirect;
+                if (!ok) {
+                    fprintf(stderr, "drift bench aaf: --effect expects shadows, indirect or both, "
+                                    "got '%s'\n", v);
+                }
+            }
+        } else if (strcmp(a, "--spp") == 0) {
+            ok = (v = cli_next_value(cmd, argc, argv, &i)) && parse_spps(v, o->spps, &o->spp_count);
+        } else if (strcmp(a, "--mc-spp") == 0) {
+            ok = (v = cli_next_value(cmd, argc, argv, &i)) &&
+                 parse_spps(v, o->mc_spps, &o->mc_spp_count);
+        } else if (strcmp(a, "--light-samples") == 0) {
+            ok = (v = cli_next_value(cmd, argc, argv, &i)) &&
+                 cli_parse_int(cmd, a, v, 1, 4096, &o->light_samples);
+        } else if (strcmp(a, "--ref-spp") == 0) {
+            ok = (v = cli_next_value(cmd, argc, argv, &i)) &&
+                 cli_parse_int(cmd, a, v, 1, 1 << 20, &o->ref_spp);
+        } else if (strcmp(a, "--width") == 0) {
+            ok = (v = cli_next_value(cmd, argc, argv, &i)) &&
+                 cli_parse_int(cmd, a, v, 1, DRIFT_IMAGE_MAX_DIMENSION, &o->width);
+        } else if (strcmp(a, "--height") == 0) {
+            ok = (v = cli_next_value(cmd, argc, argv, &i)) &&
+                 cli_parse_int(cmd, a, v, 1, DRIFT_IMAGE_MAX_DIMENSION, &o->height);
+        } else if (strcmp(a, "--timing-size") == 0) {
+            ok = (v = cli_next_value(cmd, argc, argv, &i)) != NULL;
+            char tail;
+            if (ok && (sscanf(v, "%ldx%ld%c", &o->timing_width, &o->timing_height, &tail) != 2 ||
+                       o->timing_width < 1 || o->timing_height < 1 ||
+                       o->timing_width > DRIFT_IMAGE_MAX_DIMENSION ||
+                       o->timing_height > DRIFT_IMAGE_MAX_DIMENSION)) {
+                fprintf(stderr, "drift bench aaf: --timing-size expects WxH, got '%s'\n", v);
+                ok = false;
+            }
+        } else if (strcmp(a, "--timing-spp") == 0) {
+            ok = (v = cli_next_value(cmd, argc, argv, &i)) &&
+                 cli_parse_int(cmd, a, v, 1, 65536, &o->timing_spp);
+        } else if (strcmp(a, "--threads") == 0) {
+            ok = (v = cli_next_value(cmd, argc, argv, &i)) &&
+                 cli_parse_int(cmd, a, v, 0, 256, &o->threads);
+        } else if (strcmp(a, "--csv") == 0) {
+            ok = (o->csv_path = cli_next_value(cmd, argc, argv, &i)) != NULL;
+        } else if (strcmp(a, "--svg") == 0) {
+            ok = (o->svg_path = cli_next_value(cmd, argc, argv, &i)) != NULL;
+        } else if (a[0] == '-') {
+            fprintf(stderr, "drift bench aaf: unknown option '%s'\n", a);
+            ok = false;
+        } else if (!o->scene_path) {
+            o->scene_path = a;
+        } else {
+            fprintf(stderr, "drift bench aaf: more than one scene given\n");
+            ok = false;
+        }
+        if (!ok) {
+            return 2;
+        }
+    }
+    if (o->mc_spp_count == 0) {
+        memcpy(o->mc_spps, o->spps, sizeof o->spps);
+        o->mc_spp_count = o->spp_count;
+    }
+    return 0;
+}
+
+// --- MEASURING ---
+
+typedef struct point {
+    double spp, actual_spp, rmse, sampling_ms, filter_ms;
+} point;
+
+typedef struct curve {
+    drift_effect effect;
+    point aaf[MAX_SPPS], plain[MAX_SPPS];
+    int count, plain_count;
+    double ratio[MAX_SPPS]; // equal-error sample ratio at each AAF point
+    bool extrapolated[MAX_SPPS];
+    double timing_sampling_ms, timing_filter_ms, timing_frame_ms;
+} curve;
+
+static const drift_image *find_plane(const drift_hybrid *frame, const char *wanted)
+{
+    const char *name;
+    const drift_image *image;
+    for (uint32_t i = 0; drift_hybrid_plane(frame, i, &name, &image); ++i) {
+        if (strcmp(name, wanted) == 0) {
+            return image;
+        }
+    }
+    return NULL;
+}
+
+static double rmse(const drift_image *a, const drift_image *b)
+{
+    double sum = 0.0;
+    for (int32_t y = 0; y < a->height; ++y) {
+        for (int32_t x = 0; x < a->width; ++x) {
+            for (int c = 0; c < 3; ++c) {
+                double d = (double)drift_image_pixel(a, x, y)[c] - (double)drift_image_pixel(b, x, y)[c];
+                sum += d * d;
+            }
+        }
+    }
+    return sqrt(sum / (3.0 * (double)a->width * (double)a->height));
+}
+
+// Mean of the n(x) planes over pixels that took samples: the spp the frame really spent.
+static double actual_spp(const drift_hybrid *frame, drift_effect effect)
+{
+    double sum = 0.0;
+    size_t count = 0;
+    const char *name;
+    const drift_image *image;
+    const char *suffix = effect == DRIFT_EFFECT_SHADOWS ? ".aaf.spp" : "indirect.aaf.spp";
+    for (uint32_t i = 0; drift_hybrid_plane(frame, i, &name, &image); ++i) {
+        size_t n = strlen(name), m = strlen(suffix);
+        if (n < m || strcmp(name + n - m, suffix) != 0 ||
+            (effect == DRIFT_EFFECT_SHADOWS && strncmp(name, "light", 5) != 0)) {
+            continue;
+        }
+        for (int32_t y = 0; y < image->height; ++y) {
+            for (int32_t x = 0; x < image->width; ++x) {
+                float v = drift_image_pixel(image, x, y)[0];
+                if (v > 0.0f) {
+                    sum += (double)v;
+                    ++count;
+                }
+            }
+        }
+    }
+    return count ? sum / (double)count : 0.0;
+}
+
+static drift_hybrid_params effect_params(drift_effect effect, int technique, const aaf_options *o,
+                                         long spp)
+{
+    drift_hybrid_params p = { .width = (int32_t)o->width, .height = (int32_t)o->height,
+                              .spp = (uint32_t)spp, .seed = 11,
+                              .light_samples = (uint32_t)o->light_samples };
+    drift_hybrid_params_set_technique(&p, effect, technique);
+    return p;
+}
+
+static drift_result render(drift_context *ctx, const drift_scene *scene, const drift_accel *accel,
+                           const drift_hybrid_params *params, drift_hybrid **frame)
+{
+    drift_hybrid_destroy(*frame);
+    *frame = NULL;
+    drift_result r = drift_hybrid_create(ctx, scene, accel, params, frame);
+    return r == DRIFT_OK ? drift_hybrid_render(*frame, &scene->camera, NULL) : r;
+}
+
+// log spp at which the plain curve reaches `error`, linear in log-log between its points
+// (extrapolated from the nearest two outside them).
+static double equal_error_spp(const point *plain, int count, double error, bool *extrapolated)
+{
+    int k = 0;
+    while (k + 2 < count && plain[k + 1].rmse > error) {
+        ++k;
+    }
+    double x0 = log(plain[k].actual_spp), x1 = log(plain[k + 1].actual_spp);
+    double y0 = log(plain[k].rmse), y1 = log(plain[k + 1].rmse);
+    double y = log(error);
+    *extrapolated = error > plain[0].rmse || error < plain[count - 1].rmse;
+    if (y1 == y0) {
+        return exp(x1);
+    }
+    return exp(x0 + (y - y0) * (x1 - x0) / (y1 - y0));
+}
+
+static drift_result measure(drift_context *ctx, const drift_scene *scene, const drift_accel *accel,
+                            const aaf_options *o, drift_effect effect, curve *out)
+{
+    const char *term = effect == DRIFT_EFFECT_SHADOWS ? "direct" : "indirect";
+    int aaf = effect == DRIFT_EFFECT_SHADOWS ? DRIFT_SHADOWS_AAF : DRIFT_INDIRECT_AAF;
+    int reference = effect == DRIFT_EFFECT_SHADOWS ? DRIFT_SHADOWS_REFERENCE : DRIFT_INDIRECT_REFERENCE;
+    out->effect = effect;
+    out->count = o->spp_count;
+    out->plain_count = o->mc_spp_count;
+    drift_hybrid *ref = NULL, *frame = NULL;
+    drift_hybrid_params p = effect_params(effect, reference, o, o->ref_spp);
+    drift_result r = render(ctx, scene, accel, &p, &ref);
+    const drift_image *truth = r == DRIFT_OK ? find_plane(ref, term) : NULL;
+    int most = o->spp_count > o->mc_spp_count ? o->spp_count : o->mc_spp_count;
+    for (int k = 0; r == DRIFT_OK && k < most; ++k) {
+        for (int method = 0; r == DRIFT_OK && method < 2; ++method) {
+            if (k >= (method == 0 ? o->spp_count : o->mc_spp_count)) {
+                continue;
+            }
+            long spp = method == 0 ? o->spps[k] : o->mc_spps[k];
+            p = effect_params(effect, aaf, o, spp);
+            p.aaf_uniform = p.aaf_unfiltered = method == 1;
+            r = render(ctx, scene, accel, &p, &frame);
+            if (r != DRIFT_OK) {
+                break;
+            }
+            drift_hybrid_stats s = drift_hybrid_get_stats(frame);
+            point *pt = method == 0 ? &out->aaf[k] : &out->plain[k];
+            *pt = (point){ .spp = (double)spp,
+                           .actual_spp = actual_spp(frame, effect),
+                           .rmse = rmse(find_plane(frame, term), truth),
+                           .sampling_ms = s.ms[DRIFT_PASS_AAF_SAMPLING],
+                           .filter_ms = s.ms[DRIFT_PASS_AAF_FILTER] };
+            if (!(pt->actual_spp > 0.0)) {
+                pt->actual_spp = pt->spp;
+            }
+        }
+    }
+    for (int k = 0; r == DRIFT_OK && k < o->spp_count; ++k) {
+        double spp = equal_error_spp(out->plain, o->mc_spp_count, out->aaf[k].rmse, &out->extrapolated[k]);
+        out->ratio[k] = spp / out->aaf[k].actual_spp;
+    }
+    if (r == DRIFT_OK) {
+        p = effect_params(effect, aaf, o, o->timing_spp);
+        p.width = (int32_t)o->timing_width;
+        p.height = (int32_t)o->timing_height;
+        r = render(ctx, scene, accel, &p, &frame);
+        if (r == DRIFT_OK) {
+            drift_hybrid_stats s = drift_hybrid_get_stats(frame);
+            out->timing_sampling_ms = s.ms[DRIFT_PASS_AAF_SAMPLING];
+            out->timing_filter_ms = s.ms[DRIFT_PASS_AAF_FILTER];
+            out->timing_frame_ms = s.frame_ms;
+        }
+    }
+    drift_hybrid_destroy(ref);
+    drift_hybrid_destroy(frame);
+    return r;
+}
+
+// --- OUTPUT ---
+
+static bool write_csv(const char *path, const curve *curves, int count)
+{
+    FILE *f = fopen(path, "w");
+    if (!f) {
+        fprintf(stderr, "drift bench aaf: cannot write %s\n", path);
+        return false;
+    }
+    fprintf(f, "effect,method,spp,actual_spp,rmse,sampling_ms,filter_ms\n");
+    for (int c = 0; c < count; ++c) {
+        for (int method = 0; method < 2; ++method) {
+            for (int k = 0; k < (method == 0 ? curves[c].count : curves[c].plain_count); ++k) {
+                const point *p = method == 0 ? &curves[c].aaf[k] : &curves[c].plain[k];
+                fprintf(f, "%s,%s,%.0f,%.3f,%.6g,%.3f,%.3f\n", drift_effect_name(curves[c].effect),
+                        method == 0 ? "aaf" : "plain_mc", p->spp, p->actual_spp, p->rmse,
+                        p->sampling_ms, p->filter_ms);
+            }
+        }
+    }
+    return fclose(f) == 0;
+}
+
+// A log-log plot: one panel, both effects, AAF solid and plain MC dashed.
+static bool write_svg(const char *path, const char *scene, const curve *curves, int count)
+{
+    double xmin = INFINITY, xmax = 0.0, ymin = INFINITY, ymax = 0.0;
+    for (int c = 0; c < count; ++c) {
+        for (int k = 0; k < MAX_SPPS; ++k) {
+            const point *pts[2] = { &curves[c].aaf[k], &curves[c].plain[k] };
+            for (int m = 0; m < 2; ++m) {
+                if (k >= (m == 0 ? curves[c].count : curves[c].plain_count)) {
+                    continue;
+                }
+                xmin = fmin(xmin, pts[m]->actual_spp);
+                xmax = fmax(xmax, pts[m]->actual_spp);
+                ymin = fmin(ymin, pts[m]->rmse);
+                ymax = fmax(ymax, pts[m]->rmse);
+            }
+        }
+    }
+    // Whole decades around the data.
+    double lx0 = floor(log10(xmin)), lx1 = ceil(log10(xmax)), ly0 = floor(log10(ymin)),
+           ly1 = ceil(log10(ymax));
+    lx1 = lx1 > lx0 ? lx1 : lx0 + 1.0;
+    ly1 = ly1 > ly0 ? ly1 : ly0 + 1.0;
+    const double W = 560, H = 400, left = 70, right = 20, top = 40, bottom = 50;
+    FILE *f = fopen(path, "w");
+    if (!f) {
+        fprintf(stderr, "drift bench aaf: cannot write %s\n", path);
+        return false;
+    }
+#define PX(v) (left + (log10(v) - lx0) / (lx1 - lx0) * (W - left - right))
+#define PY(v) (top + (ly1 - log10(v)) / (ly1 - ly0) * (H - top - bottom))
+    fprintf(f, "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" "
+               "font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n",
+            W, H);
+    const char *base = strrchr(scene, '/');
+    fprintf(f, "<text x=\"%.0f\" y=\"20\" font-size=\"14\">RMSE vs average spp: %s</text>\n", left,
+            base ? base + 1 : scene);
+    for (double d = lx0; d <= lx1; d += 1.0) {
+        double x = PX(pow(10.0, d));
+        fprintf(f, "<line x1=\"%.1f\" y1=\"%.0f\" x2=\"%.1f\" y2=\"%.0f\" stroke=\"#ddd\"/>\n"
+                   "<text x=\"%.1f\" y=\"%.0f\" text-anchor=\"middle\">%g</text>\n",
+                x, top, x, H - bottom, x, H - bottom + 16, pow(10.0, d));
+    }
+    for (double d = ly0; d <= ly1; d += 1.0) {
+        double y = PY(pow(10.0, d));
+        fprintf(f, "<line x1=\"%.0f\" y1=\"%.1f\" x2=\"%.0f\" y2=\"%.1f\" stroke=\"#ddd\"/>\n"
+                   "<text x=\"%.0f\" y=\"%.1f\" text-anchor=\"end\">1e%.0f</text>\n",
+                left, y, W - right, y, left - 6, y + 4, d);
+    }
+    fprintf(f, "<rect x=\"%.0f\" y=\"%.0f\" width=\"%.0f\" height=\"%.0f\" fill=\"none\" stroke=\"black\"/>\n",
+            left, top, W - left - right, H - top - bottom);
+    fprintf(f, "<text x=\"%.0f\" y=\"%.0f\" text-anchor=\"middle\">average samples per pixel</text>\n",
+            (left + W - right) / 2, H - 12);
+    fprintf(f, "<text x=\"16\" y=\"%.0f\" transform=\"rotate(-90 16 %.0f)\" text-anchor=\"middle\">RMSE</text>\n",
+            (top + H - bottom) / 2, (top + H - bottom) / 2);
+    static const char *const colours[] = { "#1f63c6", "#c62f1f" };
+    for (int c = 0; c < count; ++c) {
+        for (int m = 0; m < 2; ++m) {
+            const char *colour = colours[m];
+            fprintf(f, "<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"2\"%s points=\"", colour,
+                    curves[c].effect == DRIFT_EFFECT_INDIRECT ? " stroke-dasharray=\"6 4\"" : "");
+            int n = m == 0 ? curves[c].count : curves[c].plain_count;
+            for (int k = 0; k < n; ++k) {
+                const point *p = m == 0 ? &curves[c].aaf[k] : &curves[c].plain[k];
+                fprintf(f, "%.1f,%.1f ", PX(p->actual_spp), PY(p->rmse));
+            }
+            fprintf(f, "\"/>\n");
+            for (int k = 0; k < n; ++k) {
+                const point *p = m == 0 ? &curves[c].aaf[k] : &curves[c].plain[k];
+                fprintf(f, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"3\" fill=\"%s\"/>\n", PX(p->actual_spp),
+                        PY(p->rmse), colour);
+            }
+            double ly = top + 16 + 16 * (2 * c + m);
+            fprintf(f, "<line x1=\"%.0f\" y1=\"%.0f\" x2=\"%.0f\" y2=\"%.0f\" stroke=\"%s\" stroke-width=\"2\"%s/>"
+                       "<text x=\"%.0f\" y=\"%.0f\">%s %s</text>\n",
+                    W - right - 190, ly, W - right - 160, ly, colour,
+                    curves[c].effect == DRIFT_EFFECT_INDIRECT ? " stroke-dasharray=\"6 4\"" : "",
+                    W - right - 154, ly + 4, drift_effect_name(curves[c].effect),
+                    m == 0 ? "AAF" : "plain MC");
+        }
+    }
+#undef PX
+#undef PY
+    fprintf(f, "</svg>\n");
+    return fclose(f) == 0;
+}
+
+static void print_json(const aaf_options *o, const char *scene_path, int threads,
+                       const curve *curves, int count)
+{
+    printf("{\"scene\": \"%s\", \"width\": %ld, \"height\": %ld, \"ref_spp\": %ld, \"threads\": %d, "
+           "\"light_samples\": %ld, \"effects\": [",
+           scene_path, o->width, o->height, o->ref_spp, threads, o->light_samples);
+    for (int c = 0; c < count; ++c) {
+        const curve *cv = &curves[c];
+        printf("%s{\"effect\": \"%s\", \"aaf\": [", c ? ", " : "", drift_effect_name(cv->effect));
+        for (int k = 0; k < cv->count; ++k) {
+            printf("%s{\"spp\": %.0f, \"actual_spp\": %.3f, \"rmse\": %.6g, "
+                   "\"equal_error_ratio\": %.3f, \"extrapolated\": %s}",
+                   k ? ", " : "", cv->aaf[k].spp, cv->aaf[k].actual_spp, cv->aaf[k].rmse,
+                   cv->ratio[k], cv->extrapolated[k] ? "true" : "false");
+        }
+        printf("], \"plain_mc\": [");
+        for (int k = 0; k < cv->plain_count; ++k) {
+            printf("%s{\"spp\": %.0f, \"rmse\": %.6g}", k ? ", " : "", cv->plain[k].spp,
+                   cv->plain[k].rmse);
+        }
+        printf("], \"timing\": {\"width\": %ld, \"height\": %ld, \"spp\": %ld, \"sampling_ms\": %.3f, "
+               "\"filter_ms\": %.3f, \"frame_ms\": %.3f, \"filter_fraction\": %.4f}}",
+               o->timing_width, o->timing_height, o->timing_spp, cv->timing_sampling_ms,
+               cv->timing_filter_ms, cv->timing_frame_ms, cv->timing_filter_ms / cv->timing_frame_ms);
+    }
+    printf("]}\n");
+}
+
+static void print_text(const aaf_options *o, const char *scene_path, int threads,
+                       const curve *curves, int count)
+{
+    printf("%s, %ldx%ld, reference %ld spp, %d thread(s)\n", scene_path, o->width, o->height,
+           o->ref_spp, threads);
+    for (int c = 0; c < count; ++c) {
+        const curve *cv = &curves[c];
+        printf("\n%s\n%8s %10s %12s %10s\n", drift_effect_name(cv->effect), "spp", "aaf spp",
+               "aaf rmse", "ratio");
+        for (int k = 0; k < cv->count; ++k) {
+            printf("%8.0f %10.2f %12.4g %9.2fx%s\n", cv->aaf[k].spp, cv->aaf[k].actual_spp,
+                   cv->aaf[k].rmse, cv->ratio[k], cv->extrapolated[k] ? " (extrapolated)" : "");
+        }
+        printf("plain MC:");
+        for (int k = 0; k < cv->plain_count; ++k) {
+            printf(" %.0f spp %.4g%s", cv->plain[k].spp, cv->plain[k].rmse,
+                   k + 1 < cv->plain_count ? "," : "\n");
+        }
+        printf("timing %ldx%ld at %ld spp: sampling %.1f ms, filter %.1f ms, frame %.1f ms "
+               "(filter %.1f%% of the frame)\n",
+               o->timing_width, o->timing_height, o->timing_spp, cv->timing_sampling_ms,
+               cv->timing_filter_ms, cv->timing_frame_ms,
+               100.0 * cv->timing_filter_ms / cv->timing_frame_ms);
+    }
+}
+
+int drift_bench_aaf(int argc, char **argv)
+{
+    aaf_options o;
+    int status = parse(argc, argv, &o);
+    if (status != 0) {
+        return status < 0 ? 0 : status;
+    }
+    static const char default_scene[] = DRIFT_SOURCE_DIR "/scenes/grids/grids.json";
+    const char *scene_path = o.scene_path ? o.scene_path : default_scene;
+    drift_context *ctx = NULL;
+    drift_scene *scene = NULL;
+    drift_accel *accel = NULL;
+    int exit_code = 1;
+    drift_result r = drift_context_create(
+        &(drift_context_desc){ .thread_count = (int)o.threads, .logger = cli_stderr_logger(false) },
+        &ctx);
+    if (r != DRIFT_OK) {
+        fprintf(stderr, "drift bench aaf: %s\n", drift_result_string(r));
+        goto done;
+    }
+    if (!cli_open_scene(ctx, "bench aaf", scene_path, &scene, &accel, NULL)) {
+        goto done;
+    }
+    curve curves[2];
+    int count = 0;
+    drift_effect effects[2] = { DRIFT_EFFECT_SHADOWS, DRIFT_EFFECT_INDIRECT };
+    bool wanted[2] = { o.shadows, o.indirect };
+    for (int e = 0; e < 2; ++e) {
+        if (!wanted[e]) {
+            continue;
+        }
+        r = measure(ctx, scene, accel, &o, effects[e], &curves[count]);
+        if (r != DRIFT_OK) {
+            fprintf(stderr, "drift bench aaf: %s failed: %s\n", drift_effect_name(effects[e]),
+                    drift_result_string(r));
+            goto done;
+        }
+        ++count;
+    }
+    int threads = drift_context_thread_count(ctx);
+    if (o.json) {
+        print_json(&o, scene_path, threads, curves, count);
+    } else {
+        print_text(&o, scene_path, threads, curves, count);
+    }
+    if ((o.csv_path && !write_csv(o.csv_path, curves, count)) ||
+        (o.svg_path && !write_svg(o.svg_path, scene_path, curves, count))) {
+        goto done;
+    }
+    exit_code = 0;
+done:
+    drift_accel_destroy(accel);
+    drift_scene_destroy(scene);
+    drift_context_destroy(ctx);
+    return exit_code;
+}

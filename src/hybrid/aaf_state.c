@@ -1,0 +1,72 @@
+// AAF's per-frame buffers: made the first time a frame uses AAF (most frames never do), kept
+// until the frame is destroyed.
+#include "hybrid/aaf_internal.h"
+
+void drift_aaf_state_destroy(drift_context *ctx, drift_aaf_state *s)
+{
+    if (!s) {
+        return;
+    }
+    for (uint32_t l = 0; s->lights && l < s->light_count; ++l) {
+        drift_image_destroy(ctx, &s->lights[l].beta);
+        drift_image_destroy(ctx, &s->lights[l].spp);
+        drift_image_destroy(ctx, &s->lights[l].unfiltered);
+    }
+    drift_image *images[] = { &s->footprint,          &s->scratch1,          &s->scratch3,
+                              &s->indirect_beta,      &s->indirect_spp,      &s->indirect_unfiltered,
+                              &s->indirect_radiance,  &s->indirect_filtered };
+    for (size_t i = 0; i < sizeof images / sizeof *images; ++i) {
+        drift_image_destroy(ctx, images[i]);
+    }
+    drift_free(ctx, s->lights);
+    drift_free(ctx, s->want);
+    drift_free(ctx, s->counts);
+    drift_free(ctx, s->aux);
+    drift_free(ctx, s);
+}
+
+drift_result drift_aaf_state_ensure(drift_hybrid *f)
+{
+    if (f->aaf) {
+        return DRIFT_OK;
+    }
+    drift_context *ctx = f->ctx;
+    int32_t w = f->params.width, h = f->params.height;
+    size_t pixels = (size_t)w * (size_t)h;
+    drift_aaf_state *s = drift_alloc(ctx, sizeof *s);
+    if (!s) {
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    s->width = w;
+    s->height = h;
+    s->light_count = f->light_count;
+    s->lights = drift_alloc(ctx, sizeof(drift_aaf_light) * (f->light_count + 1u));
+    s->want = drift_alloc(ctx, sizeof(float) * pixels);
+    s->counts = drift_alloc(ctx, sizeof(uint32_t) * pixels);
+    s->aux = drift_alloc(ctx, sizeof(float) * DRIFT_AAF_AUX * pixels);
+    drift_result r = s->lights && s->want && s->counts && s->aux ? DRIFT_OK : DRIFT_ERR_OUT_OF_MEMORY;
+    drift_image *ones[] = { &s->footprint, &s->scratch1, &s->indirect_beta, &s->indirect_spp };
+    drift_image *threes[] = { &s->scratch3, &s->indirect_unfiltered, &s->indirect_radiance,
+                              &s->indirect_filtered };
+    for (size_t i = 0; r == DRIFT_OK && i < sizeof ones / sizeof *ones; ++i) {
+        r = drift_image_create(ctx, w, h, 1, ones[i]);
+    }
+    for (size_t i = 0; r == DRIFT_OK && i < sizeof threes / sizeof *threes; ++i) {
+        r = drift_image_create(ctx, w, h, 3, threes[i]);
+    }
+    for (uint32_t l = 0; r == DRIFT_OK && l < f->light_count; ++l) {
+        r = drift_image_create(ctx, w, h, 1, &s->lights[l].beta);
+        if (r == DRIFT_OK) {
+            r = drift_image_create(ctx, w, h, 1, &s->lights[l].spp);
+        }
+        if (r == DRIFT_OK) {
+            r = drift_image_create(ctx, w, h, 1, &s->lights[l].unfiltered);
+        }
+    }
+    if (r != DRIFT_OK) {
+        drift_aaf_state_destroy(ctx, s);
+        return r;
+    }
+    f->aaf = s;
+    return DRIFT_OK;
+}

@@ -1,0 +1,444 @@
+// Axis-aligned filtering (src/hybrid/aaf_*.c) against the reference path tracer and against
+// properties: the error falls as spp grows (the filter shrinks with samples) and beats plain
+// Monte Carlo at equal spp; full light and full shadow stay exactly 1 and 0; beta grows with
+// the receiver-to-occluder distance and n(x) peaks at contact edges; the separable filter
+// stays close to the exact 2-D filter on a smooth penumbra; the sample budget holds its mean.
+#include "drift_test.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "drift/accel.h"
+#include "drift/hybrid.h"
+#include "drift/pt.h"
+#include "drift/scene.h"
+#include "hybrid/aaf_internal.h"
+
+typedef struct rig {
+    drift_context *ctx;
+    drift_scene *scene;
+    drift_accel *accel;
+    drift_hybrid *frame;
+} rig;
+
+static rig rig_begin(void)
+{
+    rig r = { .ctx = test_context(2, NULL) };
+    assert_int_equal(drift_scene_create(r.ctx, &r.scene), DRIFT_OK);
+    return r;
+}
+
+static void rig_commit(rig *r)
+{
+    assert_int_equal(drift_scene_commit(r->scene), DRIFT_OK);
+    assert_int_equal(drift_accel_create(r->ctx, r->scene, &(drift_accel_desc){ 0 }, &r->accel),
+                     DRIFT_OK);
+}
+
+static void rig_frame(rig *r, const drift_hybrid_params *params)
+{
+    drift_hybrid_destroy(r->frame);
+    r->frame = NULL;
+    assert_int_equal(drift_hybrid_create(r->ctx, r->scene, r->accel, params, &r->frame), DRIFT_OK);
+    assert_int_equal(drift_hybrid_render(r->frame, &r->scene->camera, NULL), DRIFT_OK);
+}
+
+static void rig_destroy(rig *r)
+{
+    drift_hybrid_destroy(r->frame);
+    drift_accel_destroy(r->accel);
+    drift_scene_destroy(r->scene);
+    drift_context_destroy(r->ctx);
+}
+
+static const drift_image *plane(const rig *r, const char *wanted)
+{
+    const char *name;
+    const drift_image *image;
+    for (uint32_t i = 0; drift_hybrid_plane(r->frame, i, &name, &image); ++i) {
+        if (strcmp(name, wanted) == 0) {
+            return image;
+        }
+    }
+    fail_msg("no plane %s", wanted);
+    return NULL;
+}
+
+static drift_image render_pt(rig *r, uint32_t components, int32_t max_depth, uint32_t spp,
+                             drift_pt **pt)
+{
+    drift_pt_params params = { .width = r->scene->camera.width,
+                               .height = r->scene->camera.height,
+                               .seed = 1234,
+                               .max_depth = max_depth,
+                               .components = components,
+                               .pixel_centre = true,
+                               .pinhole = true };
+    assert_int_equal(drift_pt_create(r->ctx, r->scene, r->accel, &params, pt), DRIFT_OK);
+    assert_int_equal(drift_pt_render_samples(*pt, spp, NULL), DRIFT_OK);
+    drift_image img;
+    assert_int_equal(drift_pt_resolve(*pt, DRIFT_PT_AOV_BEAUTY, &img), DRIFT_OK);
+    return img;
+}
+
+static double rmse(const drift_image *a, const drift_image *b)
+{
+    double sum = 0.0;
+    for (int y = 0; y < a->height; ++y) {
+        for (int x = 0; x < a->width; ++x) {
+            for (int c = 0; c < 3; ++c) {
+                double d = (double)drift_image_pixel(a, x, y)[c] - (double)drift_image_pixel(b, x, y)[c];
+                sum += d * d;
+            }
+        }
+    }
+    return sqrt(sum / (3.0 * a->width * a->height));
+}
+
+static void add_quad(drift_scene *scene, drift_vec3 corner, drift_vec3 u, drift_vec3 v,
+                     uint32_t material)
+{
+    drift_vec3 c[4] = { corner, drift_vec3_add(corner, u), drift_vec3_add(drift_vec3_add(corner, u), v),
+                        drift_vec3_add(corner, v) };
+    float p[12];
+    for (int k = 0; k < 4; ++k) {
+        p[3 * k] = c[k].x;
+        p[3 * k + 1] = c[k].y;
+        p[3 * k + 2] = c[k].z;
+    }
+    const uint32_t idx[] = { 0, 1, 2, 0, 2, 3 };
+    test_add_mesh(scene, p, 4, idx, 2, material);
+}
+
+// Horizontal square of half size `half` centred at (x, h, z).
+static void add_square(drift_scene *scene, float x, float h, float z, float half, uint32_t material)
+{
+    add_quad(scene, drift_vec3_make(x - half, h, z - half), drift_vec3_make(2 * half, 0, 0),
+             drift_vec3_make(0, 0, 2 * half), material);
+}
+
+// A 1x1 quad light at height 3 centred over the origin, emitting down.
+static void add_light(drift_scene *scene)
+{
+    assert_int_equal(drift_scene_add_light(scene,
+                                           &(drift_light){ .type = DRIFT_LIGHT_QUAD,
+                                                           .position = { -0.5f, 3.0f, -0.5f },
+                                                           .edge_u = { 1, 0, 0 },
+                                                           .edge_v = { 0, 0, 1 },
+                                                           .color = { 5, 5, 5 } },
+                                           NULL),
+                     DRIFT_OK);
+}
+
+enum { W = 64, H = 48 };
+
+// A floor under the light with a low square (h 0.6, x < 0), a high one (h 1.2, x > 0) and a
+// wall standing on the floor at z = -1.2 (a contact edge), seen from below the light. Large
+// enough (96x72) that the penumbrae span a few pixels.
+enum { SW = 96, SH = 72 };
+
+static void build_shadow_scene(rig *r)
+{
+    uint32_t white;
+    drift_material m = drift_material_make(drift_vec3_splat(0.6f));
+    assert_int_equal(drift_scene_add_material(r->scene, &m, &white), DRIFT_OK);
+    add_square(r->scene, 0.0f, 0.0f, 0.0f, 4.0f, white);
+    add_square(r->scene, -1.2f, 0.6f, 0.0f, 0.3f, white);
+    add_square(r->scene, 0.7f, 1.2f, 0.0f, 0.2f, white);
+    add_quad(r->scene, drift_vec3_make(-0.4f, 0.0f, -1.2f), drift_vec3_make(0.8f, 0, 0),
+             drift_vec3_make(0, 0.6f, 0), white);
+    add_light(r->scene);
+    // Over the wall's far side, so the floor behind its foot is in view.
+    r->scene->camera = drift_camera_look_at(drift_vec3_make(0, 2.5f, -1.25f), drift_vec3_make(0, 0, -1.24f),
+                                            drift_vec3_make(0, 0, 1), 1.4f, SW, SH);
+}
+
+// The shadow frame's error against the path-traced direct light falls as spp grows, and at
+// low equal spp AAF beats plain Monte Carlo with the same sampler.
+static void test_shadows_converge(void **state)
+{
+    (void)state;
+    rig r = rig_begin();
+    build_shadow_scene(&r);
+    rig_commit(&r);
+    drift_pt *pt = NULL;
+    uint32_t truth_spp = (uint32_t)(512 * test_intensity());
+    drift_image truth = render_pt(&r, DRIFT_PT_COMPONENT_EMISSION | DRIFT_PT_COMPONENT_DIRECT, 1,
+                                  truth_spp < 256 ? 256 : truth_spp, &pt);
+    const uint32_t spps[3] = { 4, 16, 64 };
+    double aaf[3], plain[3];
+    for (int k = 0; k < 3; ++k) {
+        rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_AAF, .spp = spps[k], .seed = 3 });
+        aaf[k] = rmse(drift_hybrid_image(r.frame), &truth);
+        rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_AAF, .spp = spps[k], .seed = 3,
+                                              .aaf_uniform = true, .aaf_unfiltered = true });
+        plain[k] = rmse(drift_hybrid_image(r.frame), &truth);
+    }
+    print_message("shadows rmse aaf %g %g %g, plain MC %g %g %g\n", aaf[0], aaf[1], aaf[2],
+                  plain[0], plain[1], plain[2]);
+    assert_true(aaf[1] < 0.9 * aaf[0]);
+    assert_true(aaf[2] < 0.9 * aaf[1]);
+    // At 64 spp the penumbrae of this small image are well sampled and the filter's bias
+    // matches its gain (docs/aaf.md): AAF ties plain Monte Carlo there.
+    assert_true(aaf[0] < 0.75 * plain[0]);
+    assert_true(aaf[1] < 0.75 * plain[1]);
+    assert_true(aaf[2] < 1.1 * plain[2]);
+    drift_pt_destroy(pt);
+    rig_destroy(&r);
+}
+
+// Regions on the floor (y = 0) of the shadow scene.
+typedef enum region { REGION_NONE, REGION_LOW, REGION_HIGH, REGION_CONTACT } region;
+
+static region floor_region(drift_vec3 p)
+{
+    if (fabsf(p.y) > 1e-3f) {
+        return REGION_NONE;
+    }
+    if (p.z < -1.2f && p.z > -1.35f && fabsf(p.x) < 0.35f) {
+        return REGION_CONTACT; // just behind the wall's foot, away from the light
+    }
+    if (fabsf(p.z) < 0.8f) {
+        return p.x < -0.2f ? REGION_LOW : (p.x > 0.2f ? REGION_HIGH : REGION_NONE);
+    }
+    return REGION_NONE;
+}
+
+// beta grows with the receiver-to-occluder distance (the high square's penumbra is wider
+// than the low one's, which is wider than the wall's foot), and the sample rate n(x) is
+// highest at the hard contact edge.
+static void test_beta_and_rate_follow_the_geometry(void **state)
+{
+    (void)state;
+    rig r = rig_begin();
+    build_shadow_scene(&r);
+    rig_commit(&r);
+    rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_AAF, .spp = 16, .seed = 2 });
+    const drift_gbuffer *g = drift_hybrid_gbuffer(r.frame);
+    const drift_image *beta = plane(&r, "light0.aaf.beta"), *spp = plane(&r, "light0.aaf.spp");
+    double beta_sum[4] = { 0 }, spp_sum[4] = { 0 };
+    int count[4] = { 0 };
+    for (int y = 0; y < SH; ++y) {
+        for (int x = 0; x < SW; ++x) {
+            region k = floor_region(drift_image_get3(&g->position, x, y));
+            float b = drift_image_pixel(beta, x, y)[0];
+            if (k == REGION_NONE || !(b > 0.0f)) {
+                continue;
+            }
+            beta_sum[k] += (double)b;
+            spp_sum[k] += (double)drift_image_pixel(spp, x, y)[0];
+            ++count[k];
+        }
+    }
+    for (int k = REGION_LOW; k <= REGION_CONTACT; ++k) {
+        assert_true(count[k] > 0);
+        beta_sum[k] /= count[k];
+        spp_sum[k] /= count[k];
+    }
+    print_message("beta low %g high %g contact %g; n low %g high %g contact %g\n", beta_sum[1],
+                  beta_sum[2], beta_sum[3], spp_sum[1], spp_sum[2], spp_sum[3]);
+    assert_true(beta_sum[REGION_HIGH] > 1.5 * beta_sum[REGION_LOW]);
+    assert_true(beta_sum[REGION_LOW] > beta_sum[REGION_CONTACT]);
+    assert_true(spp_sum[REGION_CONTACT] > spp_sum[REGION_LOW]);
+    assert_true(spp_sum[REGION_LOW] > spp_sum[REGION_HIGH]);
+    rig_destroy(&r);
+}
+
+// A plane in full light keeps S = 1 exactly; a plane under a roof that hides the whole light
+// keeps S = 0 exactly (both are flat: no pixel is filtered; the filter's own exactness on
+// constant images is checked in test_separable_filter_close_to_exact).
+static void test_full_light_and_full_shadow_are_exact(void **state)
+{
+    (void)state;
+    for (int roofed = 0; roofed < 2; ++roofed) {
+        rig r = rig_begin();
+        drift_material m = drift_material_make(drift_vec3_splat(0.5f));
+        uint32_t white;
+        assert_int_equal(drift_scene_add_material(r.scene, &m, &white), DRIFT_OK);
+        add_square(r.scene, 0.0f, 0.0f, 0.0f, 4.0f, white);
+        if (roofed) {
+            add_square(r.scene, 0.0f, 1.5f, 0.0f, 20.0f, white);
+        }
+        add_light(r.scene);
+        r.scene->camera = drift_camera_look_at(drift_vec3_make(0, 1.2f, -0.01f), drift_vec3_make(0, 0, 0),
+                                               drift_vec3_make(0, 0, 1), 1.0f, W, H);
+        rig_commit(&r);
+        rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_AAF, .spp = 16, .seed = 4 });
+        const drift_image *s = plane(&r, "light0.shadow"), *beta = plane(&r, "light0.aaf.beta");
+        int filtered = 0;
+        for (int y = 0; y < H; ++y) {
+            for (int x = 0; x < W; ++x) {
+                assert_true(drift_image_pixel(s, x, y)[0] == (roofed ? 0.0f : 1.0f));
+                filtered += drift_image_pixel(beta, x, y)[0] > 0.0f;
+            }
+        }
+        assert_int_equal(filtered, 0);
+        rig_destroy(&r);
+    }
+}
+
+// The separable filter (eq. 3.7) against the exact 2-D filter (eq. 3.2) on a smooth, curved
+// penumbra with a slowly varying beta: the largest difference stays under 0.02 (visibility
+// units) and the mean under 0.002, while the filter itself moves values by far more.
+static void test_separable_filter_close_to_exact(void **state)
+{
+    (void)state;
+    drift_context *ctx = test_context(2, NULL);
+    enum { FW = 160, FH = 120 };
+    drift_gbuffer g;
+    assert_int_equal(drift_gbuffer_create(ctx, FW, FH, &g), DRIFT_OK);
+    drift_image in, sep, exact, scratch, beta, footprint;
+    assert_int_equal(drift_image_create(ctx, FW, FH, 1, &in), DRIFT_OK);
+    assert_int_equal(drift_image_create(ctx, FW, FH, 1, &sep), DRIFT_OK);
+    assert_int_equal(drift_image_create(ctx, FW, FH, 1, &exact), DRIFT_OK);
+    assert_int_equal(drift_image_create(ctx, FW, FH, 1, &scratch), DRIFT_OK);
+    assert_int_equal(drift_image_create(ctx, FW, FH, 1, &beta), DRIFT_OK);
+    assert_int_equal(drift_image_create(ctx, FW, FH, 1, &footprint), DRIFT_OK);
+    const float pixel = 0.01f;
+    for (int y = 0; y < FH; ++y) {
+        for (int x = 0; x < FW; ++x) {
+            drift_image_set3(&g.position, x, y, drift_vec3_make((float)x * pixel, 0.0f, (float)y * pixel));
+            drift_image_set3(&g.normal, x, y, drift_vec3_make(0, 1, 0));
+            drift_image_pixel(&g.depth, x, y)[0] = 1.0f;
+            drift_image_pixel(&g.material_id, x, y)[0] = 0.0f;
+            drift_image_pixel(&footprint, x, y)[0] = pixel;
+            // A curved edge whose penumbra widens to the right, beta following it.
+            float edge = 60.0f + 12.0f * sinf((float)y / 15.0f);
+            float width = 6.0f + 0.08f * (float)x;
+            float t = ((float)x - edge) / width;
+            t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
+            drift_image_pixel(&in, x, y)[0] = t * t * (3.0f - 2.0f * t);
+            // beta varies along both axes, so the two passes see different betas.
+            drift_image_pixel(&beta, x, y)[0] =
+                0.25f * width * pixel * (1.0f + 0.3f * sinf((float)y / 9.0f + (float)x / 23.0f));
+        }
+    }
+    drift_aaf_filter_desc desc = { .beta = &beta, .footprint = &footprint, .gbuffer = &g,
+                                   .max_radius = DRIFT_AAF_MAX_RADIUS };
+    assert_int_equal(drift_aaf_filter_separable(ctx, &desc, &in, &scratch, &sep), DRIFT_OK);
+    assert_int_equal(drift_aaf_filter_exact(ctx, &desc, &in, &exact), DRIFT_OK);
+    double max_diff = 0.0, sum_diff = 0.0, max_change = 0.0;
+    for (int y = 0; y < FH; ++y) {
+        for (int x = 0; x < FW; ++x) {
+            double a = drift_image_pixel(&sep, x, y)[0], b = drift_image_pixel(&exact, x, y)[0];
+            max_diff = fmax(max_diff, fabs(a - b));
+            sum_diff += fabs(a - b);
+            max_change = fmax(max_change, fabs(b - (double)drift_image_pixel(&in, x, y)[0]));
+        }
+    }
+    double mean_diff = sum_diff / (FW * FH);
+    print_message("separable vs exact: max %g mean %g (filter changes up to %g)\n", max_diff,
+                  mean_diff, max_change);
+    assert_true(max_diff < 0.02);
+    assert_true(mean_diff < 0.002);
+    assert_true(max_change > 0.05);
+    // Constant images stay exactly constant through both filters (a normalised sum).
+    for (int value = 0; value < 2; ++value) {
+        for (int y = 0; y < FH; ++y) {
+            for (int x = 0; x < FW; ++x) {
+                drift_image_pixel(&in, x, y)[0] = (float)value;
+            }
+        }
+        assert_int_equal(drift_aaf_filter_separable(ctx, &desc, &in, &scratch, &sep), DRIFT_OK);
+        assert_int_equal(drift_aaf_filter_exact(ctx, &desc, &in, &exact), DRIFT_OK);
+        for (int y = 0; y < FH; ++y) {
+            for (int x = 0; x < FW; ++x) {
+                assert_true(drift_image_pixel(&sep, x, y)[0] == (float)value);
+                assert_true(drift_image_pixel(&exact, x, y)[0] == (float)value);
+            }
+        }
+    }
+    drift_image *images[] = { &in, &sep, &exact, &scratch, &beta, &footprint };
+    for (size_t i = 0; i < sizeof images / sizeof *images; ++i) {
+        drift_image_destroy(ctx, images[i]);
+    }
+    drift_gbuffer_destroy(ctx, &g);
+    drift_context_destroy(ctx);
+}
+
+// The budget: the mean count over the active pixels is the target, no count passes the cap
+// or falls under the sparse count, and a larger wanted rate never gets fewer samples.
+static void test_budget_keeps_the_mean(void **state)
+{
+    (void)state;
+    enum { N = 4000 };
+    float *want = malloc(sizeof(float) * N);
+    uint32_t *counts = malloc(sizeof(uint32_t) * N);
+    assert_non_null(want);
+    assert_non_null(counts);
+    for (int i = 0; i < N; ++i) {
+        want[i] = i % 3 == 0 ? 0.0f : 1.0f + 200.0f * test_hash_unit((uint32_t)i) * test_hash_unit((uint32_t)i + N);
+    }
+    drift_aaf_allocate(want, N, N, 4, 16, 128, 7, counts);
+    double sum = 0.0;
+    for (int i = 0; i < N; ++i) {
+        assert_true(counts[i] >= 4 && counts[i] <= 128);
+        if (want[i] == 0.0f) {
+            assert_int_equal(counts[i], 4);
+        }
+        sum += counts[i];
+    }
+    assert_near(sum / N, 16.0, 0.2);
+    free(want);
+    free(counts);
+}
+
+// Indirect light of a closed room lit by a quad light: AAF's error against the path-traced
+// first-diffuse-bounce light falls as spp grows and beats plain Monte Carlo at equal spp.
+static void test_indirect_converges(void **state)
+{
+    (void)state;
+    rig r = rig_begin();
+    drift_material m = drift_material_make(drift_vec3_make(0.7f, 0.6f, 0.5f));
+    drift_material red = drift_material_make(drift_vec3_make(0.7f, 0.1f, 0.1f));
+    uint32_t white, reddish;
+    assert_int_equal(drift_scene_add_material(r.scene, &m, &white), DRIFT_OK);
+    assert_int_equal(drift_scene_add_material(r.scene, &red, &reddish), DRIFT_OK);
+    const float h = 1.5f;
+    add_quad(r.scene, drift_vec3_make(-h, 0, -h), drift_vec3_make(0, 0, 2 * h), drift_vec3_make(2 * h, 0, 0), white); // floor, up
+    add_quad(r.scene, drift_vec3_make(-h, 3.05f, -h), drift_vec3_make(2 * h, 0, 0), drift_vec3_make(0, 0, 2 * h), white); // ceiling
+    add_quad(r.scene, drift_vec3_make(-h, 0, -h), drift_vec3_make(0, 3.05f, 0), drift_vec3_make(0, 0, 2 * h), reddish); // left wall
+    add_quad(r.scene, drift_vec3_make(h, 0, -h), drift_vec3_make(0, 0, 2 * h), drift_vec3_make(0, 3.05f, 0), white);
+    add_quad(r.scene, drift_vec3_make(-h, 0, h), drift_vec3_make(0, 3.05f, 0), drift_vec3_make(2 * h, 0, 0), white);
+    add_square(r.scene, 0.3f, 0.8f, 0.2f, 0.4f, white);
+    add_light(r.scene);
+    r.scene->camera = drift_camera_look_at(drift_vec3_make(0, 1.5f, -1.45f), drift_vec3_make(0, 0.8f, 0.5f),
+                                           drift_vec3_make(0, 1, 0), 1.4f, W, H);
+    rig_commit(&r);
+    drift_pt *pt = NULL;
+    uint32_t truth_spp = (uint32_t)(512 * test_intensity());
+    drift_image truth = render_pt(&r, DRIFT_PT_COMPONENT_DIFFUSE, 2, truth_spp < 256 ? 256 : truth_spp, &pt);
+    const uint32_t spps[3] = { 4, 16, 64 };
+    double aaf[3], plain[3];
+    for (int k = 0; k < 3; ++k) {
+        drift_hybrid_params p = { .indirect = DRIFT_INDIRECT_AAF, .spp = spps[k], .seed = 5 };
+        rig_frame(&r, &p);
+        aaf[k] = rmse(plane(&r, "indirect"), &truth);
+        p.aaf_uniform = p.aaf_unfiltered = true;
+        rig_frame(&r, &p);
+        plain[k] = rmse(plane(&r, "indirect"), &truth);
+    }
+    print_message("indirect rmse aaf %g %g %g, plain MC %g %g %g\n", aaf[0], aaf[1], aaf[2],
+                  plain[0], plain[1], plain[2]);
+    assert_true(aaf[1] < 0.9 * aaf[0]);
+    assert_true(aaf[2] < 0.9 * aaf[1]);
+    for (int k = 0; k < 3; ++k) {
+        assert_true(aaf[k] < plain[k]);
+    }
+    drift_pt_destroy(pt);
+    rig_destroy(&r);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_shadows_converge),
+        cmocka_unit_test(test_beta_and_rate_follow_the_geometry),
+        cmocka_unit_test(test_full_light_and_full_shadow_are_exact),
+        cmocka_unit_test(test_separable_filter_close_to_exact),
+        cmocka_unit_test(test_budget_keeps_the_mean),
+        cmocka_unit_test(test_indirect_converges),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
