@@ -77,6 +77,15 @@ static void print_help(void)
            "  --aperture R          lens radius in scene units (default: the scene camera's)\n"
            "  --focus-distance F    distance to the plane in focus (default: the camera's)\n"
            "\n"
+           "smart image refinement (hybrid mode; docs/sir.md):\n"
+           "  --refine sir          refine the frame by ray tracing, worst estimated error first\n"
+           "  --budget N            samples (primary rays) an iteration (default: all pixels)\n"
+           "  --refine-iterations N stop after N iterations;  --refine-time S  after S seconds\n"
+           "                        (default: until every error pixel is refined)\n"
+           "  --refine-spp N        samples that make a pixel refined (default 16)\n"
+           "  --refine-all          refine zero-error pixels too, after all the others\n"
+           "  --lambda FILE         combine the metrics with fitted weights (drift refine fit)\n"
+           "\n"
            "Ctrl-C stops the render and writes what it has.\n");
 }
 
