@@ -11,7 +11,8 @@
 // X(name, function, one-line summary)
 #define DRIFT_BENCH_LIST(X) \
     X("rays", drift_bench_rays, "rays/s through drift's accel vs raw Embree, one thread")   \
-    X("frame", drift_bench_frame, "hybrid frame passes vs the primary-visibility pass")
+    X("frame", drift_bench_frame, "hybrid frame passes vs the primary-visibility pass") \
+    X("sir", drift_bench_sir, "smart image refinement vs pure ray tracing (Table 1)")
 
 #define DRIFT__BENCH_DECLARE(name, fn, summary) int fn(int argc, char **argv);
 DRIFT_BENCH_LIST(DRIFT__BENCH_DECLARE)

@@ -5,6 +5,9 @@
 // two agree: emission, direct light of the non-delta lobes (shadow rays instead of shadow
 // maps), the environment's direct light, and reflections (mirror: everything seen; glossy:
 // the reflected part, as the direct term already holds the emitters seen through the lobe).
+// The environment has no centre and no shadow map: the hybrid frame ray-traces its direct
+// light in every technique, and so does this tracer, with the same estimator and ray count
+// (docs/sir.md).
 #include "refine/refine_internal.h"
 
 #include <math.h>
@@ -22,35 +25,45 @@ drift_refine_tracer drift_refine_tracer_make(const drift_hybrid *frame, uint32_t
                                                                     frame->params.width,
                                                                     frame->params.height),
                                   .seed = drift_hash_combine(seed, STREAM_TRACE),
-                                  .max_depth = max_depth };
+                                  .max_depth = max_depth,
+                                  .light_samples = frame->params.light_samples };
 }
 
-// One sampled point on each light, with a shadow ray: an unbiased estimate of sum_l U_l S_l.
+// light_samples sampled points on each light, each with a shadow ray: an unbiased estimate of
+// sum_l U_l S_l with as many samples as the raster spends on U_l (delta lights take one).
 static drift_vec3 direct_light(const drift_refine_tracer *t, const drift_surface *s,
                                const drift_bsdf *bsdf, drift_vec3 wo, drift_sampler *sampler,
                                uint64_t *rays)
 {
     drift_vec3 sum = drift_vec3_splat(0.0f);
     for (uint32_t l = 0; l < t->light_count; ++l) {
-        float pick = drift_sampler_next1(sampler);
-        drift_vec2 u = drift_sampler_next2(sampler);
-        drift_light_sample ls = drift_hybrid_light_sample(t->scene, &t->lights[l], s->position, pick, u);
-        if (!(ls.pdf > 0.0f) || drift_vec3_is_zero(ls.radiance)) {
-            continue;
+        const drift_hybrid_light *light = &t->lights[l];
+        uint32_t n = drift_light_is_area(light->type) || light->light_cdf ? t->light_samples : 1;
+        n = n ? n : 1;
+        drift_vec3 light_sum = drift_vec3_splat(0.0f);
+        for (uint32_t k = 0; k < n; ++k) {
+            float pick = drift_sampler_next1(sampler);
+            drift_vec2 u = drift_sampler_next2(sampler);
+            drift_light_sample ls = drift_hybrid_light_sample(t->scene, light, s->position, pick, u);
+            if (!(ls.pdf > 0.0f) || drift_vec3_is_zero(ls.radiance)) {
+                continue;
+            }
+            drift_vec3 f = drift_bsdf_eval(bsdf, wo, ls.wi);
+            float cos_i = fabsf(drift_vec3_dot(ls.wi, s->ns));
+            if (drift_vec3_is_zero(f) || cos_i <= 0.0f) {
+                continue;
+            }
+            drift_ray shadow = { .origin = drift_offset_origin(s->position, s->ng, ls.wi),
+                                 .dir = ls.wi,
+                                 .tmin = 0.0f,
+                                 .tmax = isfinite(ls.distance) ? ls.distance * (1.0f - 1e-4f)
+                                                               : INFINITY };
+            ++*rays;
+            if (!drift_accel_occluded(t->accel, &shadow)) {
+                light_sum = drift_vec3_fma(light_sum, drift_vec3_mul(f, ls.radiance), cos_i / ls.pdf);
+            }
         }
-        drift_vec3 f = drift_bsdf_eval(bsdf, wo, ls.wi);
-        float cos_i = fabsf(drift_vec3_dot(ls.wi, s->ns));
-        if (drift_vec3_is_zero(f) || cos_i <= 0.0f) {
-            continue;
-        }
-        drift_ray shadow = { .origin = drift_offset_origin(s->position, s->ng, ls.wi),
-                             .dir = ls.wi,
-                             .tmin = 0.0f,
-                             .tmax = isfinite(ls.distance) ? ls.distance * (1.0f - 1e-4f) : INFINITY };
-        ++*rays;
-        if (!drift_accel_occluded(t->accel, &shadow)) {
-            sum = drift_vec3_fma(sum, drift_vec3_mul(f, ls.radiance), cos_i / ls.pdf);
-        }
+        sum = drift_vec3_fma(sum, light_sum, 1.0f / (float)n);
     }
     return sum;
 }
@@ -96,8 +109,9 @@ static drift_vec3 radiance(const drift_refine_tracer *t, drift_ray ray, int32_t 
     drift_vec3 wo = drift_vec3_neg(ray.dir);
     if (!drift_bsdf_is_delta(&bsdf)) {
         l = drift_vec3_add(l, direct_light(t, &s, &bsdf, wo, sampler, rays));
-        l = drift_vec3_add(l, drift_hybrid_environment_direct(t->scene, t->accel, &s, &bsdf, wo, 1,
-                                                              sampler, rays));
+        l = drift_vec3_add(l, drift_hybrid_environment_direct(t->scene, t->accel, &s, &bsdf, wo,
+                                                              t->light_samples, sampler,
+                                                              rays));
     }
     bool mirror = bsdf.type == DRIFT_MATERIAL_MIRROR;
     bool reflective = !drift_vec3_is_zero(bsdf.specular) && (mirror || bsdf.exponent > 0.0f);

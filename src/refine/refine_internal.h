@@ -19,6 +19,8 @@ typedef struct drift_refine_tracer {
     drift_camera_frame camera;
     uint32_t seed;
     int32_t max_depth; // reflection bounces
+    uint32_t light_samples; // shadow rays a light (and toward the environment) at each hit:
+                            // the frame's light_samples, the raster's count for U_l
 } drift_refine_tracer;
 
 drift_refine_tracer drift_refine_tracer_make(const drift_hybrid *frame, uint32_t seed,
