@@ -12,6 +12,7 @@
 
 #include "drift/accel.h"
 #include "drift/hybrid.h"
+#include "drift/image_io.h"
 #include "drift/metric.h"
 #include "drift/refine.h"
 #include "drift/scene.h"
@@ -28,6 +29,7 @@ typedef struct sir_options {
     long spp, budget, threads, light_samples;
     double threshold;
     const char *lambda_path;
+    const char *figures_dir;
     bool json;
 } sir_options;
 
@@ -50,6 +52,8 @@ static void print_help(FILE *out)
             "                (default 8, the hybrid frame's)\n"
             "  --threshold T real error: largest display-value channel difference > T (0.02)\n"
             "  --lambda FILE also measure the fitted combination\n"
+            "  --figures DIR PNGs per row: raster, pure, sir, combined error, and the\n"
+            "                recall map (white: real error flagged, red: missed, blue: flagged only)\n"
             "  --threads T   worker threads (default 1: per-thread figures)\n"
             "  --json        one JSON object on stdout\n");
 }
@@ -106,6 +110,8 @@ static int parse(int argc, char **argv, sir_options *o)
                  cli_parse_float("bench sir", a, v, 1e-6, 1.0, &o->threshold);
         } else if (strcmp(a, "--lambda") == 0) {
             ok = (o->lambda_path = cli_next_value("bench sir", argc, argv, &i)) != NULL;
+        } else if (strcmp(a, "--figures") == 0) {
+            ok = (o->figures_dir = cli_next_value("bench sir", argc, argv, &i)) != NULL;
         } else if (strcmp(a, "--threads") == 0) {
             ok = (v = cli_next_value("bench sir", argc, argv, &i)) &&
                  cli_parse_int("bench sir", a, v, 0, 256, &o->threads);
@@ -161,6 +167,42 @@ typedef struct sir_row {
     uint32_t iterations;
     quality q[QUALITY_ROWS]; // the metrics, the averaged sum, lambda (when given)
 } sir_row;
+
+static void save_png(drift_context *ctx, const sir_options *o, const char *scene, int32_t w,
+                     int32_t h, const char *what, const drift_image *image)
+{
+    char path[4096];
+    snprintf(path, sizeof path, "%s/sir_%s_%dx%d_%s.png", o->figures_dir, scene, w, h, what);
+    drift_image_save_png(ctx, path, image, &(drift_tonemap_params){ 0 });
+}
+
+// White: real error the combined metric flags; red: real error it misses; blue: flagged
+// without real error.
+static void save_figures(drift_context *ctx, const sir_options *o, const char *scene,
+                         const drift_image *raster, const drift_image *pure,
+                         const drift_image *refined, const drift_image *error,
+                         const drift_image *real)
+{
+    int32_t w = raster->width, h = raster->height;
+    save_png(ctx, o, scene, w, h, "raster", raster);
+    save_png(ctx, o, scene, w, h, "pure", pure);
+    save_png(ctx, o, scene, w, h, "sir", refined);
+    save_png(ctx, o, scene, w, h, "error", error);
+    drift_image map;
+    if (drift_image_create(ctx, w, h, 3, &map) != DRIFT_OK) {
+        return;
+    }
+    for (int32_t y = 0; y < h; ++y) {
+        for (int32_t x = 0; x < w; ++x) {
+            bool f = drift_image_pixel(error, x, y)[0] > 0.0f, t = drift_image_pixel(real, x, y)[0] > 0.0f;
+            drift_vec3 c = t ? (f ? drift_vec3_splat(1.0f) : drift_vec3_make(1, 0, 0))
+                             : (f ? drift_vec3_make(0, 0, 0.5f) : drift_vec3_splat(0.0f));
+            drift_image_set3(&map, x, y, c);
+        }
+    }
+    save_png(ctx, o, scene, w, h, "recall", &map);
+    drift_image_destroy(ctx, &map);
+}
 
 static drift_result run_one(drift_context *ctx, const drift_scene *scene, const drift_accel *accel,
                             const sir_options *o, int32_t w, int32_t h, const float *lambda,
@@ -240,6 +282,10 @@ static drift_result run_one(drift_context *ctx, const drift_scene *scene, const 
         row->q[m] = measure_quality(drift_refine_metric_image(sir, (drift_refine_metric)m), &real);
     }
     row->q[DRIFT_METRIC_COUNT] = measure_quality(drift_refine_error(sir), &real);
+    if (o->figures_dir) {
+        save_figures(ctx, o, row->scene, drift_hybrid_image(frame), &pure, drift_refine_image(sir),
+                     drift_refine_error(sir), &real);
+    }
     if (lambda) {
         drift_image metrics[DRIFT_METRIC_COUNT];
         for (int m = 0; m < DRIFT_METRIC_COUNT; ++m) {

@@ -608,10 +608,22 @@ float drift_shadow_map_pcss(const drift_shadow_map *map, drift_vec3 p, drift_vec
 // the cost of every texel of a wide search region.
 #define PENUMBRA_GRID 8
 
+// Offset radius within which a blocker at depth z can hide part of the light from the
+// receiver: the cone from the receiver to the light (radius L) seen from the centre,
+// L (d_r - z) / (d_r z) (directional: L (d_r - z)), plus a texel for the tap's own footprint.
+static float blocker_cone(const drift_shadow_map *map, const receiver *rec, float z)
+{
+    float L = map->radius, d_r = rec->depth;
+    float cone = map->directional ? L * (d_r - z) : (z > 0.0f ? L * (d_r - z) / (d_r * z) : INFINITY);
+    return cone + rec->texel;
+}
+
 // Taps of a grid of PENUMBRA_GRID^2 over the square of half width `radius`: how many see a
-// blocker, and the nearest blocker's depth.
+// blocker (a nearer surface inside the cone to the light: Guennebaud's backprojection test of
+// whether its shadow can reach the receiver), and the nearest blocker's depth. Without
+// `in_cone`, any nearer surface counts (the umbra test: is the whole region covered?).
 static int32_t count_blockers(const drift_shadow_map *map, const receiver *rec, float radius,
-                              float *out_nearest)
+                              bool in_cone, float *out_nearest)
 {
     int32_t blockers = 0;
     float nearest = INFINITY;
@@ -620,7 +632,8 @@ static int32_t count_blockers(const drift_shadow_map *map, const receiver *rec, 
             float ox = radius * (2.0f * ((float)i + 0.5f) / PENUMBRA_GRID - 1.0f);
             float oy = radius * (2.0f * ((float)j + 0.5f) / PENUMBRA_GRID - 1.0f);
             tap_result t = tap(map, rec, ox, oy);
-            if (!tap_lit(rec, t)) {
+            if (!tap_lit(rec, t) &&
+                (!in_cone || sqrtf(ox * ox + oy * oy) <= blocker_cone(map, rec, t.stored))) {
                 blockers++;
                 nearest = fminf(nearest, t.stored);
             }
@@ -649,8 +662,13 @@ float drift_shadow_map_penumbra(const drift_shadow_map *map, drift_vec3 p, drift
     }
     search = drift_clampf(search, rec.texel, max_radius(map));
     float nearest;
-    int32_t center_blocked = !tap_lit(&rec, tap(map, &rec, 0.0f, 0.0f));
-    if (count_blockers(map, &rec, search, &nearest) + center_blocked == 0) {
+    tap_result centre = tap(map, &rec, 0.0f, 0.0f);
+    int32_t center_blocked = !tap_lit(&rec, centre);
+    int32_t blockers = count_blockers(map, &rec, search, true, &nearest);
+    if (center_blocked) {
+        nearest = fminf(nearest, centre.stored);
+    }
+    if (blockers + center_blocked == 0) {
         return 0.0f; // fully lit: nothing between the receiver and any point of the light
     }
     if (!center_blocked) {
@@ -664,6 +682,6 @@ float drift_shadow_map_penumbra(const drift_shadow_map *map, drift_vec3 p, drift
                                                       : max_radius(map));
     region = drift_clampf(region, rec.texel, max_radius(map));
     float unused;
-    int32_t blocked = count_blockers(map, &rec, region, &unused);
+    int32_t blocked = count_blockers(map, &rec, region, false, &unused);
     return blocked == PENUMBRA_GRID * PENUMBRA_GRID ? 0.0f : 1.0f;
 }

@@ -4,8 +4,8 @@
 //                   occlusion k_a (fraction of ao_samples cosine rays that hit within ao_radius)
 //   dof             Sobel edges of the depth plane, each dilated by a square of radius
 //                   C_max(p) = max(C(z_p), C_inf) pixels; zero for a pinhole or no DOF
-//   shadow          1 where drift_shadow_map_penumbra says a light's penumbra may fall
-//                   (area lights only)
+//   shadow          1 where drift_shadow_map_penumbra says a light's penumbra may fall, or
+//                   where an area light straddles the receiver's tangent plane; dilated 2 px
 #include "refine/refine_internal.h"
 
 #include <math.h>
@@ -107,10 +107,20 @@ static void shadow_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays, 
     const drift_surface *s = &f->gbuffer.surfaces[index];
     float e = 0.0f;
     for (uint32_t l = 0; e == 0.0f && s->material != DRIFT_INVALID_INDEX && l < f->light_count; ++l) {
+        const drift_hybrid_light *light = &f->lights[l];
         const drift_shadow_map *map = f->light_buffers[l].shadow_map;
-        if (map && f->lights[l].radius > 0.0f) {
-            e = drift_shadow_map_penumbra(map, s->position, s->ng);
+        if (!map || !(light->radius > 0.0f)) {
+            continue;
         }
+        // A light that straddles the receiver's tangent plane is cut by the horizon: there the
+        // shadow map's depth test is at grazing angles and its bias decides, so the estimate
+        // counts it as penumbra (the raster's U_l clips the light exactly; S_l does not).
+        float height = drift_vec3_dot(s->ng, drift_vec3_sub(light->centre, s->position));
+        if (light->type != DRIFT_LIGHT_DIRECTIONAL && fabsf(height) < light->radius) {
+            e = 1.0f;
+            break;
+        }
+        e = drift_shadow_map_penumbra(map, s->position, s->ng);
     }
     drift_image_pixel(&job->out[DRIFT_METRIC_SHADOW], x, y)[0] = e;
 }
@@ -185,6 +195,33 @@ static void dof_metric(drift_hybrid *f, float threshold, drift_image *out)
     }
 }
 
+// The penumbra estimate grown by SHADOW_DILATION pixels each way (a 5x5 structuring element,
+// as Knauer et al. 2010 dilate theirs): the shadow-map taps are coarser than the image.
+#define SHADOW_DILATION 2
+
+static void dilate(drift_image *plane, float *scratch)
+{
+    int32_t w = plane->width, h = plane->height;
+    for (int32_t y = 0; y < h; ++y) { // rows, then columns: a square element
+        for (int32_t x = 0; x < w; ++x) {
+            float m = 0.0f;
+            for (int32_t u = x - SHADOW_DILATION; u <= x + SHADOW_DILATION; ++u) {
+                m = u >= 0 && u < w ? fmaxf(m, drift_image_pixel(plane, u, y)[0]) : m;
+            }
+            scratch[(size_t)y * (size_t)w + (size_t)x] = m;
+        }
+    }
+    for (int32_t y = 0; y < h; ++y) {
+        for (int32_t x = 0; x < w; ++x) {
+            float m = 0.0f;
+            for (int32_t v = y - SHADOW_DILATION; v <= y + SHADOW_DILATION; ++v) {
+                m = v >= 0 && v < h ? fmaxf(m, scratch[(size_t)v * (size_t)w + (size_t)x]) : m;
+            }
+            drift_image_pixel(plane, x, y)[0] = m;
+        }
+    }
+}
+
 void drift_refine_compute_metrics(drift_hybrid *f, const drift_refine_metric_params *params,
                                   drift_image out[DRIFT_METRIC_COUNT])
 {
@@ -196,6 +233,11 @@ void drift_refine_compute_metrics(drift_hybrid *f, const drift_refine_metric_par
     drift_hybrid_for_each_pixel(f, reflection_pixel, &job);
     ensure_shadow_maps(f);
     drift_hybrid_for_each_pixel(f, shadow_pixel, &job);
+    float *scratch = drift_alloc(f->ctx, sizeof(float) * (size_t)f->params.width * (size_t)f->params.height);
+    if (scratch) { // without memory the estimate stays undilated
+        dilate(&out[DRIFT_METRIC_SHADOW], scratch);
+        drift_free(f->ctx, scratch);
+    }
     dof_metric(f, params->edge_threshold, &out[DRIFT_METRIC_DOF]);
 }
 
