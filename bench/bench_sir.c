@@ -31,6 +31,7 @@ typedef struct sir_options {
     const char *lambda_path;
     const char *figures_dir;
     bool json;
+    bool noise_floor;
 } sir_options;
 
 static void print_help(FILE *out)
@@ -54,6 +55,8 @@ static void print_help(FILE *out)
             "  --lambda FILE also measure the fitted combination\n"
             "  --figures DIR PNGs per row: raster, pure, sir, combined error, and the\n"
             "                recall map (white: real error flagged, red: missed, blue: flagged only)\n"
+            "  --noise-floor also the FLIP between two pure images of different seeds:\n"
+            "                how close two equally good images of the scene are\n"
             "  --threads T   worker threads (default 1: per-thread figures)\n"
             "  --json        one JSON object on stdout\n");
 }
@@ -110,6 +113,8 @@ static int parse(int argc, char **argv, sir_options *o)
                  cli_parse_float("bench sir", a, v, 1e-6, 1.0, &o->threshold);
         } else if (strcmp(a, "--lambda") == 0) {
             ok = (o->lambda_path = cli_next_value("bench sir", argc, argv, &i)) != NULL;
+        } else if (strcmp(a, "--noise-floor") == 0) {
+            o->noise_floor = true;
         } else if (strcmp(a, "--figures") == 0) {
             ok = (o->figures_dir = cli_next_value("bench sir", argc, argv, &i)) != NULL;
         } else if (strcmp(a, "--threads") == 0) {
@@ -163,6 +168,7 @@ typedef struct sir_row {
     uint64_t error_pixels, real_pixels;
     double error_percent, real_percent;
     double raster_ms, metrics_ms, sort_ms, trace_ms, sir_ms, prt_ms, flip;
+    double noise_flip; // FLIP between two pure images of different seeds (-1: not measured)
     uint64_t sir_rays, prt_rays;
     uint32_t iterations;
     quality q[QUALITY_ROWS]; // the metrics, the averaged sum, lambda (when given)
@@ -216,7 +222,7 @@ static drift_result run_one(drift_context *ctx, const drift_scene *scene, const 
                                .light_samples = (uint32_t)o->light_samples };
     drift_hybrid *frame = NULL;
     drift_refine *sir = NULL;
-    drift_image pure = { 0 }, real = { 0 }, combined = { 0 };
+    drift_image pure = { 0 }, real = { 0 }, combined = { 0 }, pure_other = { 0 };
     drift_result r = drift_hybrid_create(ctx, scene, accel, &hp, &frame);
     // Two frames: the first builds the shadow maps and captures the environment maps.
     for (int k = 0; r == DRIFT_OK && k < 2; ++k) {
@@ -236,6 +242,9 @@ static drift_result run_one(drift_context *ctx, const drift_scene *scene, const 
     }
     if (r == DRIFT_OK) {
         r = drift_image_create(ctx, w, h, 1, &combined);
+    }
+    if (r == DRIFT_OK) {
+        r = drift_image_create(ctx, w, h, 3, &pure_other);
     }
     if (r != DRIFT_OK) {
         goto done;
@@ -269,6 +278,21 @@ static drift_result run_one(drift_context *ctx, const drift_scene *scene, const 
     r = drift_metric_flip(ctx, &pure, drift_refine_image(sir), NULL, &row->flip, NULL);
     if (r != DRIFT_OK) {
         goto done;
+    }
+    row->noise_flip = -1.0;
+    if (o->noise_floor) {
+        drift_refine_params other = { .spp = (uint32_t)o->spp, .budget = (uint32_t)o->budget,
+                                      .seed = 1 };
+        r = drift_refine_set_params(sir, &other);
+        if (r == DRIFT_OK) {
+            r = drift_refine_render_pure(sir, (uint32_t)o->spp, &pure_other, NULL, NULL);
+        }
+        if (r == DRIFT_OK) {
+            r = drift_metric_flip(ctx, &pure, &pure_other, NULL, &row->noise_flip, NULL);
+        }
+        if (r != DRIFT_OK) {
+            goto done;
+        }
     }
     // The real error: pixels whose raster value differs from the ray-traced one.
     drift_refine_real_error(drift_hybrid_image(frame), &pure, (float)o->threshold, &real);
@@ -310,6 +334,7 @@ done:
     drift_image_destroy(ctx, &pure);
     drift_image_destroy(ctx, &real);
     drift_image_destroy(ctx, &combined);
+    drift_image_destroy(ctx, &pure_other);
     drift_refine_destroy(sir);
     drift_hybrid_destroy(frame);
     return r;
@@ -329,13 +354,15 @@ static void print_json_row(const sir_row *row, bool first, bool lambda)
            "\"error_percent\": %.3f, \"real_error_pixels\": %llu, \"real_error_percent\": %.3f, "
            "\"raster_ms\": %.2f, \"metrics_ms\": %.2f, \"sort_ms\": %.2f, \"trace_ms\": %.2f, "
            "\"sir_ms\": %.2f, \"prt_ms\": %.2f, \"speedup\": %.3f, \"flip\": %.5f, "
+           "\"noise_flip\": %.5f, "
            "\"same_image\": %s, \"iterations\": %u, \"sir_rays\": %llu, \"prt_rays\": %llu, "
            "\"quality\": {",
            first ? "" : ", ", row->scene, row->width, row->height,
            (unsigned long long)row->error_pixels, row->error_percent,
            (unsigned long long)row->real_pixels, row->real_percent, row->raster_ms,
            row->metrics_ms, row->sort_ms, row->trace_ms, row->sir_ms, row->prt_ms,
-           row->prt_ms / row->sir_ms, row->flip, row->flip <= FLIP_TARGET ? "true" : "false",
+           row->prt_ms / row->sir_ms, row->flip, row->noise_flip,
+           row->flip <= FLIP_TARGET ? "true" : "false",
            row->iterations, (unsigned long long)row->sir_rays, (unsigned long long)row->prt_rays);
     int rows = lambda ? QUALITY_ROWS : QUALITY_ROWS - 1;
     for (int k = 0; k < rows; ++k) {
@@ -353,9 +380,9 @@ static void print_text_row(const sir_row *row, bool lambda)
            row->sir_ms, row->prt_ms / row->sir_ms, row->flip,
            row->flip <= FLIP_TARGET ? "yes" : "NO");
     printf("    raster %.1f + metrics %.1f + sort %.1f + trace %.1f ms, %u iterations; real error "
-           "pixels %.2f%%\n    recall/precision:",
+           "pixels %.2f%%; pure vs pure FLIP %.5f\n    recall/precision:",
            row->raster_ms, row->metrics_ms, row->sort_ms, row->trace_ms, row->iterations,
-           row->real_percent);
+           row->real_percent, row->noise_flip);
     int rows = lambda ? QUALITY_ROWS : QUALITY_ROWS - 1;
     for (int k = 0; k < rows; ++k) {
         printf(" %s %.3f/%.3f", quality_name(k), row->q[k].recall, row->q[k].precision);

@@ -604,8 +604,7 @@ float drift_shadow_map_pcss(const drift_shadow_map *map, drift_vec3 p, drift_vec
 
 // --- PENUMBRA ESTIMATE (SIR's shadow error; in the spirit of Guennebaud et al. 2006) ---
 
-// Taps a side of the square grids below: enough to find blockers a few texels wide without
-// the cost of every texel of a wide search region.
+// Taps a side of the square grids below (the blocker search repeats it at shrinking radii).
 #define PENUMBRA_GRID 8
 
 // Offset radius within which a blocker at depth z can hide part of the light from the
@@ -664,7 +663,18 @@ float drift_shadow_map_penumbra(const drift_shadow_map *map, drift_vec3 p, drift
     float nearest;
     tap_result centre = tap(map, &rec, 0.0f, 0.0f);
     int32_t center_blocked = !tap_lit(&rec, centre);
-    int32_t blockers = count_blockers(map, &rec, search, true, &nearest);
+    // Blockers near the receiver have narrow cones: a grid spaced for the whole search region
+    // steps over them. Search again at each third of the radius, down to two texels.
+    int32_t blockers = 0;
+    nearest = INFINITY;
+    for (float r = search; blockers == 0; r *= 1.0f / 3.0f) {
+        float scale_nearest;
+        blockers += count_blockers(map, &rec, r, true, &scale_nearest);
+        nearest = fminf(nearest, scale_nearest);
+        if (r < 2.0f * rec.texel) {
+            break;
+        }
+    }
     if (center_blocked) {
         nearest = fminf(nearest, centre.stored);
     }
