@@ -32,6 +32,9 @@ typedef struct sir_options {
     const char *figures_dir;
     bool json;
     bool noise_floor;
+    bool has_target;
+    drift_vec3 target; // --target: look here instead of the scene camera's target
+    double fov;        // --fov: vertical field of view, degrees (0: the camera's)
 } sir_options;
 
 static void print_help(FILE *out)
@@ -55,8 +58,12 @@ static void print_help(FILE *out)
             "  --lambda FILE also measure the fitted combination\n"
             "  --figures DIR PNGs per row: raster, pure, sir, combined error, and the\n"
             "                recall map (white: real error flagged, red: missed, blue: flagged only)\n"
-            "  --noise-floor also the FLIP between two pure images of different seeds:\n"
-            "                how close two equally good images of the scene are\n"
+            "  --noise-floor also the FLIP between two pure images of different seeds (how\n"
+            "                close two equally good images are), and a real error must exceed\n"
+            "                the threshold plus the two pure images' difference at the pixel\n"
+            "  --target X,Y,Z  look at this point instead of the camera's target (other views,\n"
+            "                as the paper's rows are views with more or fewer error pixels)\n"
+            "  --fov DEG     vertical field of view (default: the camera's)\n"
             "  --threads T   worker threads (default 1: per-thread figures)\n"
             "  --json        one JSON object on stdout\n");
 }
@@ -113,6 +120,19 @@ static int parse(int argc, char **argv, sir_options *o)
                  cli_parse_float("bench sir", a, v, 1e-6, 1.0, &o->threshold);
         } else if (strcmp(a, "--lambda") == 0) {
             ok = (o->lambda_path = cli_next_value("bench sir", argc, argv, &i)) != NULL;
+        } else if (strcmp(a, "--target") == 0) {
+            float x = 0.0f, y = 0.0f, z = 0.0f;
+            char tail;
+            ok = (v = cli_next_value("bench sir", argc, argv, &i)) &&
+                 sscanf(v, "%f,%f,%f%c", &x, &y, &z, &tail) == 3;
+            if (v && !ok) {
+                fprintf(stderr, "drift bench sir: --target expects X,Y,Z, got '%s'\n", v);
+            }
+            o->target = drift_vec3_make(x, y, z);
+            o->has_target = ok;
+        } else if (strcmp(a, "--fov") == 0) {
+            ok = (v = cli_next_value("bench sir", argc, argv, &i)) &&
+                 cli_parse_float("bench sir", a, v, 0.1, 179.0, &o->fov);
         } else if (strcmp(a, "--noise-floor") == 0) {
             o->noise_floor = true;
         } else if (strcmp(a, "--figures") == 0) {
@@ -294,11 +314,18 @@ static drift_result run_one(drift_context *ctx, const drift_scene *scene, const 
             goto done;
         }
     }
-    // The real error: pixels whose raster value differs from the ray-traced one.
-    drift_refine_real_error(drift_hybrid_image(frame), &pure, (float)o->threshold, &real);
+    // The real error: pixels whose raster value differs from the ray-traced one by more than
+    // the threshold (display values) - and, with --noise-floor, by more than the threshold
+    // plus what two pure images differ by there: error beyond the estimators' own noise.
+    drift_refine_real_error(drift_hybrid_image(frame), &pure, 1.0f, &real);
     size_t n = (size_t)w * (size_t)h;
+    if (o->noise_floor) {
+        drift_refine_real_error(&pure_other, &pure, 1.0f, &combined);
+    } else {
+        memset(combined.pixels, 0, sizeof(float) * n);
+    }
     for (size_t i = 0; i < n; ++i) {
-        real.pixels[i] = real.pixels[i] >= 1.0f ? 1.0f : 0.0f; // > threshold
+        real.pixels[i] = real.pixels[i] > (float)o->threshold + combined.pixels[i] ? 1.0f : 0.0f;
         row->real_pixels += real.pixels[i] > 0.0f;
     }
     row->real_percent = 100.0 * (double)row->real_pixels / (double)n;
@@ -435,6 +462,12 @@ int drift_bench_sir(int argc, char **argv)
         if (!cli_open_scene(ctx, "bench sir", o.scenes[s], &scene, &accel, NULL)) {
             exit_code = 1;
             break;
+        }
+        if (o.has_target) {
+            scene->camera.target = o.target;
+        }
+        if (o.fov > 0.0) {
+            scene->camera.fov_y = (float)(o.fov * 3.14159265358979323846 / 180.0);
         }
         for (int k = 0; k < o.size_count; ++k) {
             sir_row row = { .scene = short_name(o.scenes[s]) };

@@ -74,7 +74,7 @@ typedef enum drift_refine_combine {
 //                       every non-zero one (the whole image converges to the pure one)
 //   edge_threshold    = 0 -> 0.05: relative depth step per pixel that counts as an edge
 //   ao_radius         = 0 -> 5% of the scene's bounding diagonal
-//   ao_samples        = 0 -> 16 occlusion rays a reflective pixel
+//   ao_samples        = 0 -> 8 occlusion rays a reflective pixel
 //   seed              = 0
 typedef struct drift_refine_params {
     uint32_t budget;

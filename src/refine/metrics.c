@@ -169,6 +169,20 @@ static void dof_metric(drift_hybrid *f, float threshold, drift_image *out)
     }
     float miss = far > 0.0f ? 4.0f * far : 1.0f;
     float c_inf = drift_coc_radius_pixels(&f->camera, h, 1e30f);
+    // reach[p]: 1 + the square's radius around an edge pixel, 0 elsewhere; then spread along
+    // rows (the largest reach covering each pixel) and along columns: a square of each edge
+    // pixel's own radius in O(pixels x radius) instead of O(edges x radius^2).
+    size_t n = (size_t)w * (size_t)h;
+    int32_t *reach = drift_alloc(f->ctx, sizeof(int32_t) * n);
+    int32_t *rows = drift_alloc(f->ctx, sizeof(int32_t) * n);
+    if (!reach || !rows) {
+        drift_free(f->ctx, reach);
+        drift_free(f->ctx, rows);
+        for (size_t i = 0; i < n; ++i) {
+            out->pixels[i] = 1.0f; // no memory for the estimate: conservatively everything
+        }
+        return;
+    }
     for (int32_t y = 0; y < h; ++y) {
         for (int32_t x = 0; x < w; ++x) {
             float z[3][3];
@@ -180,19 +194,31 @@ static void dof_metric(drift_hybrid *f, float threshold, drift_image *out)
             float gx = (z[0][2] + 2.0f * z[1][2] + z[2][2]) - (z[0][0] + 2.0f * z[1][0] + z[2][0]);
             float gy = (z[2][0] + 2.0f * z[2][1] + z[2][2]) - (z[0][0] + 2.0f * z[0][1] + z[0][2]);
             // Sobel weights sum to 8 a side: |G| / 8 is the depth step a pixel, relative to z.
-            if (sqrtf(gx * gx + gy * gy) / 8.0f <= threshold * z[1][1]) {
-                continue;
-            }
+            bool edge = sqrtf(gx * gx + gy * gy) / 8.0f > threshold * z[1][1];
             float c = fmaxf(drift_coc_radius_pixels(&f->camera, h, z[1][1]), c_inf);
-            int32_t r = (int32_t)ceilf(c);
-            for (int32_t v = y - r < 0 ? 0 : y - r; v <= y + r && v < h; ++v) {
-                float *row = drift_image_pixel(out, 0, v);
-                for (int32_t u = x - r < 0 ? 0 : x - r; u <= x + r && u < w; ++u) {
-                    row[u] = 1.0f;
-                }
+            float r = fminf(ceilf(c), (float)(w > h ? w : h));
+            reach[(size_t)y * (size_t)w + (size_t)x] = edge ? (int32_t)r + 1 : 0;
+        }
+    }
+    for (int32_t y = 0; y < h; ++y) {
+        int32_t *in = reach + (size_t)y * (size_t)w, *row = rows + (size_t)y * (size_t)w;
+        for (int32_t x = 0; x < w; ++x) {
+            int32_t r = in[x] - 1;
+            for (int32_t u = x - r < 0 ? 0 : x - r; r >= 0 && u <= x + r && u < w; ++u) {
+                row[u] = row[u] > in[x] ? row[u] : in[x];
             }
         }
     }
+    for (int32_t y = 0; y < h; ++y) {
+        for (int32_t x = 0; x < w; ++x) {
+            int32_t r = rows[(size_t)y * (size_t)w + (size_t)x] - 1;
+            for (int32_t v = y - r < 0 ? 0 : y - r; r >= 0 && v <= y + r && v < h; ++v) {
+                drift_image_pixel(out, x, v)[0] = 1.0f;
+            }
+        }
+    }
+    drift_free(f->ctx, reach);
+    drift_free(f->ctx, rows);
 }
 
 // The penumbra estimate grown by SHADOW_DILATION pixels each way (a 5x5 structuring element,

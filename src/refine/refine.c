@@ -9,7 +9,7 @@
 #define DEFAULT_SPP 16
 #define DEFAULT_DEPTH 3
 #define DEFAULT_EDGE 0.05f
-#define DEFAULT_AO_SAMPLES 16
+#define DEFAULT_AO_SAMPLES 8
 
 static const char *const metric_names[] = { "reflection1", "reflection2", "reflection3",
                                             "reflection4", "reflection5", "dof",

@@ -14,6 +14,7 @@
 #include "drift/hybrid.h"
 #include "drift/refine.h"
 #include "drift/scene.h"
+#include "drift/view.h"
 #include "refine/refine_internal.h"
 
 #define PI_F 3.14159265f
@@ -506,6 +507,53 @@ static void test_rejects_bad_input(void **state)
     rig_destroy(&r);
 }
 
+// --- VIEWER ---
+
+// A refining view lists the refiner's planes after the frame's and shows the combined error as
+// a heat map: black exactly where the error is zero (the pixels SIR never traces).
+static void test_view_refines_while_still(void **state)
+{
+    (void)state;
+    rig r = rig_begin();
+    build_effects_scene(&r, 40, 30, drift_vec3_make(0.5f, 2.2f, -3.5f));
+    rig_commit(&r, NULL);
+    drift_view *view = NULL;
+    assert_int_equal(drift_view_create(r.ctx, r.scene, r.accel,
+                                       &(drift_view_desc){ .hybrid = raster_params,
+                                                           .refine = true,
+                                                           .refine_budget = 40 * 30 * 16,
+                                                           .hide_overlay = true },
+                                       &view),
+                     DRIFT_OK);
+    assert_int_equal(drift_view_frame(view, NULL), DRIFT_OK);
+    bool seen_error = false, seen_mask = false;
+    for (int i = 0; i < 64; ++i) {
+        drift_view_handle_event(view, &(drift_view_event){ .type = DRIFT_VIEW_EVENT_KEY,
+                                                           .key = DRIFT_VIEW_KEY_NEXT_BUFFER });
+        assert_int_equal(drift_view_frame(view, NULL), DRIFT_OK);
+        const char *name = drift_view_get_state(view).buffer_name;
+        seen_error = seen_error || strcmp(name, "error.combined") == 0;
+        seen_mask = seen_mask || strcmp(name, "refine.mask") == 0;
+        if (strcmp(name, "error.combined") == 0) {
+            // The heat map: zero error black, some pixel coloured.
+            const uint8_t *px = drift_view_pixels(view);
+            const drift_image *e = drift_refine_error(r.sir);
+            bool coloured = false;
+            for (int32_t k = 0; k < 40 * 30; ++k) {
+                if (e->pixels[k] == 0.0f) {
+                    assert_true(px[3 * k] == 0 && px[3 * k + 1] == 0 && px[3 * k + 2] == 0);
+                } else {
+                    coloured = coloured || px[3 * k] || px[3 * k + 1] || px[3 * k + 2];
+                }
+            }
+            assert_true(coloured);
+        }
+    }
+    assert_true(seen_error && seen_mask);
+    drift_view_destroy(view);
+    rig_destroy(&r);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -518,6 +566,7 @@ int main(void)
         cmocka_unit_test(test_refines_errors_first),
         cmocka_unit_test(test_lambda_fit_not_worse_than_average),
         cmocka_unit_test(test_rejects_bad_input),
+        cmocka_unit_test(test_view_refines_while_still),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
