@@ -367,10 +367,6 @@ drift_result drift_view_frame(drift_view *view, const atomic_bool *cancel)
         return r;
     }
     view->hybrid_rendered = true; // its planes exist from now on
-    if (view->pending_buffer_steps != 0) {
-        step_buffer(view, view->pending_buffer_steps);
-        view->pending_buffer_steps = 0;
-    }
     if (view->sir) {
         // Re-sort only when the camera or the techniques changed; a standing view refines on.
         if (!view->sir_begun || view->sir_dirty ||
@@ -386,6 +382,10 @@ drift_result drift_view_frame(drift_view *view, const atomic_bool *cancel)
         if (r != DRIFT_OK) {
             return r;
         }
+    }
+    if (view->pending_buffer_steps != 0) {
+        step_buffer(view, view->pending_buffer_steps);
+        view->pending_buffer_steps = 0;
     }
     if (view->camera_moved) {
         drift_pt_destroy(view->reference);
