@@ -335,6 +335,64 @@ static void test_metrics_see_effects(void **state)
     rig_destroy(&r);
 }
 
+// The penumbra estimate is conservative: every pixel from which the quad light is partly
+// hidden (by ray-traced visibility of an 8 x 8 grid of its points) is flagged, up to 5%, by the
+// shadow map's estimate itself (before the metric's dilation) and by the metric.
+static void test_shadow_metric_conservative(void **state)
+{
+    (void)state;
+    rig r = rig_begin();
+    const int32_t w = 64, h = 48;
+    build_effects_scene(&r, w, h, drift_vec3_make(0.5f, 2.2f, -3.5f));
+    rig_commit(&r, NULL);
+    const drift_gbuffer *g = drift_hybrid_gbuffer(r.frame);
+    const drift_image *shadow = drift_refine_metric_image(r.sir, DRIFT_METRIC_SHADOW);
+    uint32_t partial = 0, flagged = 0, estimated = 0, umbra = 0, lit_unflagged = 0;
+    const drift_shadow_map *map = r.frame->light_buffers[0].shadow_map;
+    assert_non_null(map);
+    for (int32_t y = 0; y < h; ++y) {
+        for (int32_t x = 0; x < w; ++x) {
+            const drift_surface *s = &g->surfaces[(size_t)y * (size_t)w + (size_t)x];
+            if (s->material == DRIFT_INVALID_INDEX) {
+                continue;
+            }
+            int visible = 0, facing = 0;
+            for (int j = 0; j < 8; ++j) {
+                for (int i = 0; i < 8; ++i) {
+                    drift_vec3 q = drift_vec3_make(-0.8f + 0.6f * ((float)i + 0.5f) / 8.0f, 3.0f,
+                                                   -0.3f + 0.6f * ((float)j + 0.5f) / 8.0f);
+                    drift_vec3 d = drift_vec3_sub(q, s->position);
+                    float len = drift_vec3_length(d);
+                    d = drift_vec3_scale(d, 1.0f / len);
+                    if (drift_vec3_dot(d, s->ng) <= 0.0f) {
+                        continue;
+                    }
+                    ++facing;
+                    drift_ray ray = { .origin = drift_offset_origin(s->position, s->ng, d),
+                                      .dir = d,
+                                      .tmin = 0.0f,
+                                      .tmax = len * 0.999f };
+                    visible += !drift_accel_occluded(r.accel, &ray);
+                }
+            }
+            float e = drift_image_pixel(shadow, x, y)[0];
+            if (facing == 64 && visible > 0 && visible < 64) {
+                ++partial;
+                flagged += e > 0.0f;
+                estimated += drift_shadow_map_penumbra(map, s->position, s->ng) > 0.0f;
+            }
+            umbra += facing == 64 && visible == 0;
+            lit_unflagged += facing == 64 && visible == 64 && e == 0.0f;
+        }
+    }
+    // The scene has all three: penumbra, umbra (under the box and the spheres) and full light.
+    assert_true(partial > 20 && umbra > 0 && lit_unflagged > 0);
+    if ((double)flagged < 0.95 * (double)partial || (double)estimated < 0.95 * (double)partial) {
+        fail_msg("penumbra recall: metric %u, estimate %u of %u", flagged, estimated, partial);
+    }
+    rig_destroy(&r);
+}
+
 // --- SORT ---
 
 static void test_radix_sort_stable_and_complete(void **state)
@@ -562,6 +620,7 @@ int main(void)
         cmocka_unit_test(test_error_pixels_only),
         cmocka_unit_test(test_zero_error_scene),
         cmocka_unit_test(test_metrics_see_effects),
+        cmocka_unit_test(test_shadow_metric_conservative),
         cmocka_unit_test(test_radix_sort_stable_and_complete),
         cmocka_unit_test(test_refines_errors_first),
         cmocka_unit_test(test_lambda_fit_not_worse_than_average),
