@@ -54,7 +54,7 @@ void drift_refine_combine_metrics(const drift_image metrics[DRIFT_METRIC_COUNT],
 #define DRIFT_REFINE_ZERO_KEY 0xffffu
 uint32_t drift_refine_encode_error(float error);
 // Stable LSD radix sort of pixel indices 0..count-1 by key (16 bits, two 8-bit passes).
-// order and scratch hold count entries. Returns DRIFT_OK or DRIFT_ERR_OUT_OF_MEMORY.
+// order and scratch hold count entries; order gets the pixels, scratch is work space.
 void drift_refine_radix_sort(const uint16_t *keys, uint32_t count, uint32_t *order,
                              uint32_t *scratch);
 
