@@ -16,6 +16,7 @@ int drift_cmd_diff(int argc, char **argv);
 int drift_cmd_info(int argc, char **argv);
 int drift_cmd_bench(int argc, char **argv);
 int drift_cmd_view(int argc, char **argv);
+int drift_cmd_refine(int argc, char **argv); // drift refine fit (tools/cmd_refine.c)
 
 // Option values: print "drift <cmd>: <flag> expects ..." and return false when malformed or
 // out of [lo, hi].

@@ -90,6 +90,15 @@ static void print_help(void)
            "  --aaf-sampling M      adaptive (default) or uniform: spp in every pixel\n"
            "  --aaf-filter on|off   off: AAF's unfiltered estimate (with uniform: plain MC)\n"
            "\n"
+           "smart image refinement (hybrid mode; docs/sir.md):\n"
+           "  --refine sir          refine the frame by ray tracing, worst estimated error first\n"
+           "  --budget N            samples (primary rays) an iteration (default: all pixels)\n"
+           "  --refine-iterations N stop after N iterations;  --refine-time S  after S seconds\n"
+           "                        (default: until every error pixel is refined)\n"
+           "  --refine-spp N        samples that make a pixel refined (default 16)\n"
+           "  --refine-all          refine zero-error pixels too, after all the others\n"
+           "  --lambda FILE         combine the metrics with fitted weights (drift refine fit)\n"
+           "\n"
            "Ctrl-C stops the render and writes what it has.\n");
 }
 

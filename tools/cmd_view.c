@@ -37,6 +37,8 @@ typedef struct view_options {
     double exposure;
     int techniques[DRIFT_EFFECT_COUNT]; // -1: not given
     bool split, no_overlay, verbose;
+    bool refine;       // --refine sir
+    long refine_budget; // --budget: SIR samples a frame (0: the default)
 } view_options;
 
 // The key bindings, shown by the help key in the overlay (a tab separates the columns; ASCII
@@ -92,6 +94,9 @@ static void print_help(void)
         "  --spp-per-frame N        reference samples added per frame in split view (default 1)\n"
         "  --seed S                 the reference's seed (default 0)\n"
         "  --split                  start in split view\n"
+        "  --refine sir             smart image refinement while the camera stands; the\n"
+        "                           planes add error.combined (heat map) and refine.mask\n"
+        "  --budget N               SIR samples a frame (default 16384; docs/sir.md)\n"
         "  --exposure STOPS         display exposure (default 0)\n"
         "  --no-overlay             start without the text overlay\n"
         "  --press KEY,KEY,...      apply view keys before the first frame, by their names\n"
@@ -187,6 +192,15 @@ static int parse_options(int argc, char **argv, view_options *o)
             o->press = v;
         } else if (strcmp(a, "--split") == 0) {
             o->split = true;
+        } else if (strcmp(a, "--refine") == 0) {
+            ok = VALUE() != NULL;
+            if (ok && strcmp(v, "sir") != 0) {
+                fprintf(stderr, "drift view: --refine expects 'sir', got '%s'\n", v);
+                ok = false;
+            }
+            o->refine = true;
+        } else if (strcmp(a, "--budget") == 0) {
+            ok = VALUE() && cli_parse_int("view", a, v, 1, 1L << 30, &o->refine_budget);
         } else if (strcmp(a, "--no-overlay") == 0) {
             o->no_overlay = true;
         } else if (strcmp(a, "--verbose") == 0) {
@@ -583,7 +597,9 @@ int drift_cmd_view(int argc, char **argv)
                                               .exposure_stops = (float)o.exposure,
                                               .split = o.split,
                                               .hide_overlay = o.no_overlay,
-                                              .help_text = help_text },
+                                              .help_text = help_text,
+                                              .refine = o.refine,
+                                              .refine_budget = (uint32_t)o.refine_budget },
                           &view);
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift view: %s\n", drift_result_string(r));

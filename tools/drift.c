@@ -16,6 +16,7 @@ static const subcommand subcommands[] = {
     { "info", drift_cmd_info, "print a scene's triangle, material, light, texture counts" },
     { "bench", drift_cmd_bench, "benchmarks (drift bench --help)" },
     { "view", drift_cmd_view, "interactive viewer: hybrid techniques against the reference" },
+    { "refine", drift_cmd_refine, "smart image refinement: fit the metric weights (lambda)" },
 };
 
 static void print_usage(FILE *out)

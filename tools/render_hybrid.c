@@ -58,6 +58,9 @@ bool render_parse_hybrid_option(int argc, char **argv, int *i, render_options *o
                                           "--isg-search",    "--isg-gather",      "--isg-sigma",
                                           "--blur-radius",   "--isg-layers",      "--isg-range",
                                           "--aaf-max-spp",   "--aaf-sampling",    "--aaf-filter" };
+    if (render_parse_refine_option(argc, argv, i, o, ok)) {
+        return true; // --refine sir and its options (tools/render_refine.c)
+    }
     const char *a = argv[*i];
     int effect = -1, other = -1;
     for (int k = 0; k < DRIFT_EFFECT_COUNT; ++k) {
@@ -253,6 +256,9 @@ static drift_result write_outputs(drift_context *ctx, const render_options *o,
 
 int render_hybrid(const render_options *o)
 {
+    if (!render_refine_validate(o)) {
+        return 2;
+    }
     double t_start = drift_time_now();
     drift_context *ctx = NULL;
     drift_result r = drift_context_create(
@@ -315,6 +321,10 @@ int render_hybrid(const render_options *o)
     }
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift render: the hybrid frame failed: %s\n", drift_result_string(r));
+        goto done;
+    }
+    if (o->refine.enabled) {
+        exit_code = render_refine_run(ctx, o, frame, scene_path);
         goto done;
     }
     if (write_outputs(ctx, o, frame) != DRIFT_OK) {

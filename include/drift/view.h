@@ -100,6 +100,11 @@ typedef struct drift_view_desc {
     float split_position;
     bool hide_overlay;
     const char *help_text;
+    // Smart image refinement (docs/sir.md): with `refine`, the frame is refined by ray
+    // tracing `refine_budget` samples a frame (0 -> 16384) while the camera stands; the
+    // planes gain error.combined (a heat map), refine.mask and the metrics.
+    bool refine;
+    uint32_t refine_budget;
 } drift_view_desc;
 
 // What the view shows now.

@@ -149,6 +149,10 @@ float drift_shadow_map_pcf(const drift_shadow_map *map, drift_vec3 p, drift_vec3
                            int32_t kernel);
 float drift_shadow_map_pcss(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n,
                             uint32_t rotation_hash);
+// Penumbra estimate for SIR's shadow error: 1 where the light may be partly hidden from p
+// (blockers in the cone to the light and an unblocked tap in their backprojected region),
+// 0 in umbra and where nothing blocks. Conservative up to the tap spacing. 0 for point lights.
+float drift_shadow_map_penumbra(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n);
 
 // --- ENVIRONMENT MAP (envmap.c) ---
 

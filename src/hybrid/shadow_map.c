@@ -601,3 +601,97 @@ float drift_shadow_map_pcss(const drift_shadow_map *map, drift_vec3 p, drift_vec
     }
     return (float)lit / (float)FILTER_TAPS;
 }
+
+// --- PENUMBRA ESTIMATE (SIR's shadow error; in the spirit of Guennebaud et al. 2006) ---
+
+// Taps a side of the square grids below (the blocker search repeats it at shrinking radii).
+#define PENUMBRA_GRID 8
+
+// Offset radius within which a blocker at depth z can hide part of the light from the
+// receiver: the cone from the receiver to the light (radius L) seen from the centre,
+// L (d_r - z) / (d_r z) (directional: L (d_r - z)), plus a texel for the tap's own footprint.
+static float blocker_cone(const drift_shadow_map *map, const receiver *rec, float z)
+{
+    float L = map->radius, d_r = rec->depth;
+    float cone = map->directional ? L * (d_r - z) : (z > 0.0f ? L * (d_r - z) / (d_r * z) : INFINITY);
+    return cone + rec->texel;
+}
+
+// Taps of a grid of PENUMBRA_GRID^2 over the square of half width `radius`: how many see a
+// blocker (a nearer surface inside the cone to the light: Guennebaud's backprojection test of
+// whether its shadow can reach the receiver), and the nearest blocker's depth. Without
+// `in_cone`, any nearer surface counts (the umbra test: is the whole region covered?).
+static int32_t count_blockers(const drift_shadow_map *map, const receiver *rec, float radius,
+                              bool in_cone, float *out_nearest)
+{
+    int32_t blockers = 0;
+    float nearest = INFINITY;
+    for (int32_t j = 0; j < PENUMBRA_GRID; ++j) {
+        for (int32_t i = 0; i < PENUMBRA_GRID; ++i) {
+            float ox = radius * (2.0f * ((float)i + 0.5f) / PENUMBRA_GRID - 1.0f);
+            float oy = radius * (2.0f * ((float)j + 0.5f) / PENUMBRA_GRID - 1.0f);
+            tap_result t = tap(map, rec, ox, oy);
+            if (!tap_lit(rec, t) &&
+                (!in_cone || sqrtf(ox * ox + oy * oy) <= blocker_cone(map, rec, t.stored))) {
+                blockers++;
+                nearest = fminf(nearest, t.stored);
+            }
+        }
+    }
+    *out_nearest = nearest;
+    return blockers;
+}
+
+float drift_shadow_map_penumbra(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n)
+{
+    if (!(map->radius > 0.0f)) {
+        return 0.0f; // a point light casts no penumbra
+    }
+    receiver rec = make_receiver(map, p, n);
+    float L = map->radius, d_r = rec.depth;
+    // Blocker search over the whole cone from the receiver to the light, with the near plane
+    // at the light's own size (PCSS trims it to a quarter of the way: here nothing is trimmed,
+    // the estimate must be conservative).
+    float search;
+    if (map->directional) {
+        search = L * d_r;
+    } else {
+        float near = fmaxf(L, 1e-3f * d_r);
+        search = d_r > near ? L * (d_r - near) / (d_r * near) : 0.0f;
+    }
+    search = drift_clampf(search, rec.texel, max_radius(map));
+    float nearest;
+    tap_result centre = tap(map, &rec, 0.0f, 0.0f);
+    int32_t center_blocked = !tap_lit(&rec, centre);
+    // Blockers near the receiver have narrow cones: a grid spaced for the whole search region
+    // steps over them. Search again at each third of the radius, down to two texels.
+    int32_t blockers = 0;
+    nearest = INFINITY;
+    for (float r = search; blockers == 0; r *= 1.0f / 3.0f) {
+        float scale_nearest;
+        blockers += count_blockers(map, &rec, r, true, &scale_nearest);
+        nearest = fminf(nearest, scale_nearest);
+        if (r < 2.0f * rec.texel) {
+            break;
+        }
+    }
+    if (center_blocked) {
+        nearest = fminf(nearest, centre.stored);
+    }
+    if (blockers + center_blocked == 0) {
+        return 0.0f; // fully lit: nothing between the receiver and any point of the light
+    }
+    if (!center_blocked) {
+        return 1.0f; // blockers in the cone, light centre visible: partly covered
+    }
+    // Backprojection bound: the nearest blocker (closest to the light) spreads the widest
+    // penumbra, L (d_r - d_b) / d_b at the receiver. When every tap of that region blocks,
+    // the light is hidden from the whole region: umbra.
+    float region = map->directional ? L * (d_r - nearest)
+                                    : (nearest > 0.0f ? L * (d_r - nearest) / (nearest * d_r)
+                                                      : max_radius(map));
+    region = drift_clampf(region, rec.texel, max_radius(map));
+    float unused;
+    int32_t blocked = count_blockers(map, &rec, region, false, &unused);
+    return blocked == PENUMBRA_GRID * PENUMBRA_GRID ? 0.0f : 1.0f;
+}

@@ -33,6 +33,25 @@ static int32_t split_column(const drift_view *view)
     return (int32_t)(x < 0 ? 0 : (x > view->width ? view->width : x));
 }
 
+// Plane `index` of the last frame: the hybrid frame's, then the refiner's (when refining).
+static bool view_plane(const drift_view *view, uint32_t index, const char **out_name,
+                       const drift_image **out_image)
+{
+    if (drift_hybrid_plane(view->hybrid, index, out_name, out_image)) {
+        return true;
+    }
+    if (!view->sir || !view->sir_begun) {
+        return false;
+    }
+    uint32_t hybrid_count = 0;
+    const char *name;
+    const drift_image *image;
+    while (drift_hybrid_plane(view->hybrid, hybrid_count, &name, &image)) {
+        ++hybrid_count;
+    }
+    return drift_refine_plane(view->sir, index - hybrid_count, out_name, out_image);
+}
+
 // The index (1-based; 0 = the composed frame) of the plane called `name` in the last frame.
 static uint32_t buffer_index(const drift_view *view, const char *name)
 {
@@ -41,7 +60,7 @@ static uint32_t buffer_index(const drift_view *view, const char *name)
     }
     const char *plane_name = NULL;
     const drift_image *image = NULL;
-    for (uint32_t i = 0; drift_hybrid_plane(view->hybrid, i, &plane_name, &image); ++i) {
+    for (uint32_t i = 0; view_plane(view, i, &plane_name, &image); ++i) {
         if (plane_name && strcmp(plane_name, name) == 0) {
             return i + 1;
         }
@@ -57,7 +76,7 @@ static uint32_t plane_count(const drift_view *view)
     const char *name = NULL;
     const drift_image *image = NULL;
     uint32_t count = 0;
-    while (drift_hybrid_plane(view->hybrid, count, &name, &image)) {
+    while (view_plane(view, count, &name, &image)) {
         ++count;
     }
     return count;
@@ -67,7 +86,7 @@ static void select_buffer(drift_view *view, uint32_t index)
 {
     const char *name = NULL;
     const drift_image *image = NULL;
-    if (index == 0 || !drift_hybrid_plane(view->hybrid, index - 1, &name, &image) || !name) {
+    if (index == 0 || !view_plane(view, index - 1, &name, &image) || !name) {
         name = "frame";
     }
     snprintf(view->buffer_name, sizeof(view->buffer_name), "%s", name);
@@ -182,6 +201,15 @@ drift_result drift_view_create(drift_context *ctx, const drift_scene *scene,
         goto fail;
     }
     view->params = drift_hybrid_get_params(view->hybrid);
+    if (d.refine) {
+        r = drift_refine_create(ctx, view->hybrid,
+                                &(drift_refine_params){ .budget = d.refine_budget ? d.refine_budget
+                                                                                  : 16384u },
+                                &view->sir);
+        if (r != DRIFT_OK) {
+            goto fail;
+        }
+    }
     *out_view = view;
     return DRIFT_OK;
 
@@ -196,6 +224,7 @@ void drift_view_destroy(drift_view *view)
         return;
     }
     drift_context *ctx = view->ctx;
+    drift_refine_destroy(view->sir);
     drift_hybrid_destroy(view->hybrid);
     drift_pt_destroy(view->reference);
     drift_free(ctx, view->pixels);
@@ -327,6 +356,7 @@ drift_result drift_view_frame(drift_view *view, const atomic_bool *cancel)
     if (view->params_changed) {
         r = drift_hybrid_set_params(view->hybrid, &view->params);
         view->params_changed = false;
+        view->sir_dirty = true;
         view->params = drift_hybrid_get_params(view->hybrid); // what the frame has, if refused too
         if (r != DRIFT_OK) {
             return r;
@@ -337,6 +367,22 @@ drift_result drift_view_frame(drift_view *view, const atomic_bool *cancel)
         return r;
     }
     view->hybrid_rendered = true; // its planes exist from now on
+    if (view->sir) {
+        // Re-sort only when the camera or the techniques changed; a standing view refines on.
+        if (!view->sir_begun || view->sir_dirty ||
+            memcmp(&view->sir_camera, &view->camera, sizeof view->camera) != 0) {
+            r = drift_refine_begin(view->sir);
+            view->sir_camera = view->camera;
+            view->sir_dirty = false;
+            view->sir_begun = r == DRIFT_OK;
+        }
+        if (r == DRIFT_OK && !drift_refine_done(view->sir)) {
+            r = drift_refine_iterate(view->sir, cancel);
+        }
+        if (r != DRIFT_OK) {
+            return r;
+        }
+    }
     if (view->pending_buffer_steps != 0) {
         step_buffer(view, view->pending_buffer_steps);
         view->pending_buffer_steps = 0;
@@ -366,12 +412,13 @@ drift_result drift_view_frame(drift_view *view, const atomic_bool *cancel)
 
     // The shown buffer: the composed frame, or a plane by name (it may have disappeared with
     // a technique change; then the frame again).
-    const drift_image *shown = drift_hybrid_image(view->hybrid);
+    const drift_image *shown =
+        view->sir ? drift_refine_image(view->sir) : drift_hybrid_image(view->hybrid);
     const char *plane_name = NULL; // NULL: the composed frame
     uint32_t index = buffer_index(view, view->buffer_name);
     const char *name = NULL;
     const drift_image *plane = NULL;
-    if (index > 0 && drift_hybrid_plane(view->hybrid, index - 1, &name, &plane) && plane &&
+    if (index > 0 && view_plane(view, index - 1, &name, &plane) && plane &&
         drift_image_is_valid(plane) && plane->width == view->width &&
         plane->height == view->height) {
         shown = plane;

@@ -23,6 +23,7 @@ typedef enum buffer_look {
     LOOK_NORMAL,       // 0.5 + 0.5 n; black where there is no normal (a miss)
     LOOK_POSITION,     // normalized to the scene's bounds
     LOOK_MOTION,       // 2 channels: 0.5 + 0.5 m / max|m| as red and green
+    LOOK_HEAT,         // 1 channel in [0,1] (SIR's error.*): black, blue, red, yellow
 } buffer_look;
 
 typedef struct buffer_range {
@@ -57,6 +58,9 @@ static buffer_look look_of(const char *name, const drift_image *image, buffer_ra
         return LOOK_MOTION;
     }
     if (image->channels == 1) {
+        if (strncmp(name, "error.", 6) == 0) {
+            return LOOK_HEAT;
+        }
         if (strstr(name, "depth")) {
             *range = image_range(image, false, true);
             return LOOK_DEPTH;
@@ -120,6 +124,16 @@ static void show_row(drift_view *view, const drift_image *image, buffer_look loo
             float scale = range.hi > 1.0f ? range.hi : 1.0f;
             v[0] = 0.5f + 0.5f * p[0] / scale;
             v[1] = 0.5f + 0.5f * p[1] / scale;
+            break;
+        }
+        case LOOK_HEAT: {
+            // Zero stays black so the pixels SIR will never trace stand out.
+            float e = drift_clampf(p[0], 0.0f, 1.0f);
+            if (e > 0.0f) {
+                v[0] = drift_clampf(3.0f * e - 0.5f, 0.0f, 1.0f);
+                v[1] = drift_clampf(3.0f * e - 2.0f, 0.0f, 1.0f);
+                v[2] = drift_clampf(1.0f - 2.0f * e, 0.25f, 1.0f) * (e < 0.5f ? 1.0f : 0.0f);
+            }
             break;
         }
         }

@@ -7,6 +7,7 @@
 
 #include "drift/image.h"
 #include "drift/math.h"
+#include "drift/refine.h"
 #include "drift/view.h"
 
 #define VIEW_BUFFER_NAME_MAX 128
@@ -41,6 +42,11 @@ struct drift_view {
     float split_position;
     bool overlay, help;
     char *help_text;
+
+    drift_refine *sir;             // NULL unless the view refines (desc.refine)
+    drift_camera sir_camera; // the camera of the last sort: a move (or new techniques,
+    bool sir_dirty;          // sir_dirty) re-sorts, a standing view keeps refining
+    bool sir_begun;
 
     uint8_t *pixels;
     void *text_vertices; // VIEW_TEXT_VERTEX_BYTES for the overlay's glyph quads
