@@ -59,9 +59,9 @@ static void print_help(void)
            "  --tonemap OP          PNG operator: clamp (default) or reinhard\n"
            "  --debug-sample X,Y,S  trace one sample of one pixel and print its radiance\n"
            "  --quiet               no progress output;  --verbose  more log output\n"
-           "\n"
-           "\n"
-           "hybrid mode (docs/hybrid.md):\n"
+           "\n");
+    // Split in parts: C99 guarantees string literals of 4095 characters only.
+    printf("hybrid mode (docs/hybrid.md):\n"
            "  --shadows T           hard (default), pcf, pcss, reference, isg, blur or aaf\n"
            "  --reflections T       none (default), envmap, sharp, reference, isg or blur\n"
            "  --dof T               none (default), post, reference or isg\n"
@@ -89,8 +89,8 @@ static void print_help(void)
            "  --aaf-max-spp N       cap on AAF's adaptive samples a pixel (default 8 x spp)\n"
            "  --aaf-sampling M      adaptive (default) or uniform: spp in every pixel\n"
            "  --aaf-filter on|off   off: AAF's unfiltered estimate (with uniform: plain MC)\n"
-           "\n"
-           "smart image refinement (hybrid mode; docs/sir.md):\n"
+           "\n");
+    printf("smart image refinement (hybrid mode; docs/sir.md):\n"
            "  --refine sir          refine the frame by ray tracing, worst estimated error first\n"
            "  --budget N            samples (primary rays) an iteration (default: all pixels)\n"
            "  --refine-iterations N stop after N iterations;  --refine-time S  after S seconds\n"
