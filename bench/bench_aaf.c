@@ -352,7 +352,7 @@ static bool write_csv(const char *path, const curve *curves, int count)
 // A log-log plot: one panel, both effects, AAF solid and plain MC dashed.
 static bool write_svg(const char *path, const char *scene, const curve *curves, int count)
 {
-    double xmin = INFINITY, xmax = 0.0, ymin = INFINITY, ymax = 0.0;
+    double xmin = HUGE_VAL, xmax = 0.0, ymin = HUGE_VAL, ymax = 0.0;
     for (int c = 0; c < count; ++c) {
         for (int k = 0; k < MAX_SPPS; ++k) {
             const point *pts[2] = { &curves[c].aaf[k], &curves[c].plain[k] };

@@ -186,13 +186,13 @@ static drift_result timing_table(const bench_ctx *b, drift_effect effect, double
     }
     p.width = (int32_t)o->width;
     p.height = (int32_t)o->height;
-    *out_base = INFINITY;
+    *out_base = HUGE_VAL;
     for (int g = 0; g < 4; ++g) {
         for (int s = 0; s < 4; ++s) {
             p.isg_search = counts[s];
             p.isg_gather = counts[g];
             // The least of N frames: other processes on the machine only ever add time.
-            table[g][s] = INFINITY;
+            table[g][s] = HUGE_VAL;
             for (long k = 0; k < o->frames; ++k) {
                 drift_hybrid_stats st;
                 drift_result r = render(b, p, false, &st, NULL);

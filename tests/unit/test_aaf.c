@@ -321,7 +321,8 @@ static void test_separable_filter_close_to_exact(void **state)
     double max_diff = 0.0, sum_diff = 0.0, max_change = 0.0;
     for (int y = 0; y < FH; ++y) {
         for (int x = 0; x < FW; ++x) {
-            double a = drift_image_pixel(&sep, x, y)[0], b = drift_image_pixel(&exact, x, y)[0];
+            double a = (double)drift_image_pixel(&sep, x, y)[0];
+            double b = (double)drift_image_pixel(&exact, x, y)[0];
             max_diff = fmax(max_diff, fabs(a - b));
             sum_diff += fabs(a - b);
             max_change = fmax(max_change, fabs(b - (double)drift_image_pixel(&in, x, y)[0]));
