@@ -2,73 +2,20 @@
 // plane and a sphere, reference effects summing to the full path tracer, the hard-shadow
 // buffer's distances, environment-map reflections of a mirror sphere at its probe, post DOF
 // with a pinhole, and determinism across thread counts.
+#include "drift/accel.h"
+#include "drift/hybrid.h"
+#include "drift/pt.h"
+#include "drift/scene.h"
 #include "drift_test.h"
+#include "hybrid/hybrid_internal.h"
+#include "test_rig.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "drift/accel.h"
-#include "drift/hybrid.h"
-#include "drift/pt.h"
-#include "drift/scene.h"
-#include "hybrid/hybrid_internal.h"
-
 #define PI_F 3.14159265f
 #define M_PI 3.14159265358979323846
-
-typedef struct rig {
-    drift_context *ctx;
-    drift_scene *scene;
-    drift_accel *accel;
-    drift_hybrid *frame;
-} rig;
-
-static rig rig_begin(int threads)
-{
-    rig r = { .ctx = test_context(threads, NULL) };
-    assert_int_equal(drift_scene_create(r.ctx, &r.scene), DRIFT_OK);
-    return r;
-}
-
-static void rig_commit(rig *r)
-{
-    assert_int_equal(drift_scene_commit(r->scene), DRIFT_OK);
-    assert_int_equal(drift_accel_create(r->ctx, r->scene, &(drift_accel_desc){ 0 }, &r->accel),
-                     DRIFT_OK);
-}
-
-static void rig_frame(rig *r, const drift_hybrid_params *params)
-{
-    drift_hybrid_destroy(r->frame);
-    r->frame = NULL;
-    assert_int_equal(drift_hybrid_create(r->ctx, r->scene, r->accel, params, &r->frame), DRIFT_OK);
-    assert_int_equal(drift_hybrid_render(r->frame, &r->scene->camera, NULL), DRIFT_OK);
-}
-
-static void rig_destroy(rig *r)
-{
-    drift_hybrid_destroy(r->frame);
-    drift_accel_destroy(r->accel);
-    drift_scene_destroy(r->scene);
-    drift_context_destroy(r->ctx);
-}
-
-static uint32_t add_material(drift_scene *scene, drift_material m)
-{
-    uint32_t index;
-    assert_int_equal(drift_scene_add_material(scene, &m, &index), DRIFT_OK);
-    return index;
-}
-
-// Square of half size `half` in the plane y = height, facing +y.
-static void add_floor(drift_scene *scene, float half, float height, uint32_t material)
-{
-    const float p[] = { -half, height, -half, half, height, -half,
-                        half,  height, half,  -half, height, half };
-    const uint32_t idx[] = { 0, 2, 1, 0, 3, 2 };
-    test_add_mesh(scene, p, 4, idx, 2, material);
-}
 
 // Axis-aligned box [-h, h]^3 with triangles facing inward.
 static void add_room(drift_scene *scene, float h, uint32_t material)
@@ -78,58 +25,6 @@ static void add_room(drift_scene *scene, float h, uint32_t material)
     const uint32_t idx[] = { 0, 1, 2, 0, 2, 3, 4, 7, 6, 4, 6, 5, 0, 4, 5, 0, 5, 1,
                              3, 2, 6, 3, 6, 7, 0, 3, 7, 0, 7, 4, 1, 5, 6, 1, 6, 2 };
     test_add_mesh(scene, p, 8, idx, 12, material);
-}
-
-// UV sphere with smooth normals; returns its mesh index.
-static uint32_t add_sphere(drift_scene *scene, drift_vec3 c, float radius, uint32_t material)
-{
-    enum { SLICES = 192, STACKS = 96 };
-    uint32_t vcount = (SLICES + 1) * (STACKS + 1);
-    float *p = malloc(sizeof(float) * 3 * vcount);
-    float *n = malloc(sizeof(float) * 3 * vcount);
-    uint32_t *idx = malloc(sizeof(uint32_t) * 6 * SLICES * STACKS);
-    assert_non_null(p);
-    assert_non_null(n);
-    assert_non_null(idx);
-    for (uint32_t j = 0; j <= STACKS; ++j) {
-        float theta = PI_F * (float)j / STACKS;
-        for (uint32_t i = 0; i <= SLICES; ++i) {
-            float phi = 2.0f * PI_F * (float)i / SLICES;
-            uint32_t v = j * (SLICES + 1) + i;
-            float d[3] = { sinf(theta) * cosf(phi), cosf(theta), sinf(theta) * sinf(phi) };
-            const float cc[3] = { c.x, c.y, c.z };
-            for (int k = 0; k < 3; ++k) {
-                n[3 * v + k] = d[k];
-                p[3 * v + k] = cc[k] + radius * d[k];
-            }
-        }
-    }
-    uint32_t t = 0;
-    for (uint32_t j = 0; j < STACKS; ++j) {
-        for (uint32_t i = 0; i < SLICES; ++i) {
-            uint32_t a = j * (SLICES + 1) + i, b = a + SLICES + 1;
-            // Outward winding; the poles' degenerate triangles are dropped by the scene.
-            uint32_t quad[6] = { a, a + 1, b, a + 1, b + 1, b };
-            for (int k = 0; k < 6; ++k) {
-                idx[t * 3 + (uint32_t)k] = quad[k];
-            }
-            t += 2;
-        }
-    }
-    uint32_t mesh;
-    assert_int_equal(drift_scene_add_mesh(scene,
-                                          &(drift_mesh_desc){ .positions = p,
-                                                              .normals = n,
-                                                              .vertex_count = vcount,
-                                                              .indices = idx,
-                                                              .triangle_count = t,
-                                                              .material = material },
-                                          &mesh),
-                     DRIFT_OK);
-    free(p);
-    free(n);
-    free(idx);
-    return mesh;
 }
 
 static void add_point_light(drift_scene *scene, drift_vec3 position, drift_vec3 intensity)
@@ -149,15 +44,15 @@ static drift_vec3 pixel3(const drift_image *img, int x, int y)
 static void test_gbuffer_plane(void **state)
 {
     (void)state;
-    rig r = rig_begin(2);
-    uint32_t white = add_material(r.scene, drift_material_make(drift_vec3_splat(0.5f)));
-    add_floor(r.scene, 100.0f, 0.0f, white);
+    test_rig r = test_rig_begin(2);
+    uint32_t white = test_add_material(r.scene, drift_material_make(drift_vec3_splat(0.5f)));
+    test_add_floor(r.scene, 100.0f, 0.0f, white);
     const float height = 3.0f;
     r.scene->camera = drift_camera_look_at(drift_vec3_make(0, height, 0), drift_vec3_make(0, 0, 0),
                                            drift_vec3_make(0, 0, 1), 0.8f, 48, 32);
     add_point_light(r.scene, drift_vec3_make(0, 5, 0), drift_vec3_splat(1));
-    rig_commit(&r);
-    rig_frame(&r, &(drift_hybrid_params){ 0 });
+    test_rig_commit(&r);
+    test_rig_frame(&r, &(drift_hybrid_params){ 0 });
     const drift_gbuffer *g = drift_hybrid_gbuffer(r.frame);
     for (int y = 0; y < g->height; ++y) {
         for (int x = 0; x < g->width; ++x) {
@@ -177,26 +72,28 @@ static void test_gbuffer_plane(void **state)
             assert_near(drift_image_pixel(&g->gloss, x, y)[0], 0.5 * M_PI, 1e-6);
         }
     }
-    rig_destroy(&r);
+    test_rig_destroy(&r);
 }
 
 // A sphere seen from outside: the ray-sphere intersection in closed form.
 static void test_gbuffer_sphere(void **state)
 {
     (void)state;
-    rig r = rig_begin(2);
-    uint32_t glossy = add_material(
-        r.scene, (drift_material){ .type = DRIFT_MATERIAL_DEFAULT, .diffuse = { 0.2f, 0.2f, 0.2f },
-                                   .specular = { 0.5f, 0.5f, 0.5f }, .exponent = 100.0f,
-                                   .diffuse_texture = DRIFT_INVALID_INDEX });
+    test_rig r = test_rig_begin(2);
+    uint32_t glossy =
+        test_add_material(r.scene, (drift_material){ .type = DRIFT_MATERIAL_DEFAULT,
+                                                     .diffuse = { 0.2f, 0.2f, 0.2f },
+                                                     .specular = { 0.5f, 0.5f, 0.5f },
+                                                     .exponent = 100.0f,
+                                                     .diffuse_texture = DRIFT_INVALID_INDEX });
     const drift_vec3 c = drift_vec3_make(0.3f, -0.2f, 5.0f);
     const float radius = 1.0f;
-    add_sphere(r.scene, c, radius, glossy);
+    test_add_sphere(r.scene, c, radius, 192, 96, glossy);
     r.scene->camera = drift_camera_look_at(drift_vec3_make(0, 0, 0), drift_vec3_make(0, 0, 1),
                                            drift_vec3_make(0, 1, 0), 0.5f, 64, 64);
     add_point_light(r.scene, drift_vec3_make(0, 5, 0), drift_vec3_splat(1));
-    rig_commit(&r);
-    rig_frame(&r, &(drift_hybrid_params){ 0 });
+    test_rig_commit(&r);
+    test_rig_frame(&r, &(drift_hybrid_params){ 0 });
     const drift_gbuffer *g = drift_hybrid_gbuffer(r.frame);
     int hits = 0, misses = 0;
     // Tessellation with 192x96 facets: the flat facets lie within r (1 - cos(pi/96)) of the sphere.
@@ -231,38 +128,43 @@ static void test_gbuffer_sphere(void **state)
     }
     assert_true(hits > 500);
     assert_true(misses > 500);
-    rig_destroy(&r);
+    test_rig_destroy(&r);
 }
 
 // --- EFFECT ISOLATION ---
 
 // A small room with a quad light, a glossy sphere and a mirror sphere.
-static void build_room(rig *r, int32_t size)
+static void build_room(test_rig *r, int32_t size)
 {
-    uint32_t white = add_material(r->scene, drift_material_make(drift_vec3_make(0.7f, 0.6f, 0.5f)));
-    uint32_t glossy = add_material(
-        r->scene, (drift_material){ .diffuse = { 0.3f, 0.1f, 0.1f }, .specular = { 0.5f, 0.5f, 0.5f },
-                                    .exponent = 40.0f, .diffuse_texture = DRIFT_INVALID_INDEX });
-    uint32_t mirror = add_material(
-        r->scene, (drift_material){ .type = DRIFT_MATERIAL_MIRROR, .specular = { 0.9f, 0.9f, 0.9f },
-                                    .diffuse_texture = DRIFT_INVALID_INDEX });
+    uint32_t white =
+        test_add_material(r->scene, drift_material_make(drift_vec3_make(0.7f, 0.6f, 0.5f)));
+    uint32_t glossy =
+        test_add_material(r->scene, (drift_material){ .diffuse = { 0.3f, 0.1f, 0.1f },
+                                                      .specular = { 0.5f, 0.5f, 0.5f },
+                                                      .exponent = 40.0f,
+                                                      .diffuse_texture = DRIFT_INVALID_INDEX });
+    uint32_t mirror =
+        test_add_material(r->scene, (drift_material){ .type = DRIFT_MATERIAL_MIRROR,
+                                                      .specular = { 0.9f, 0.9f, 0.9f },
+                                                      .diffuse_texture = DRIFT_INVALID_INDEX });
     add_room(r->scene, 2.0f, white);
-    add_sphere(r->scene, drift_vec3_make(-0.7f, -1.3f, 0.3f), 0.6f, glossy);
-    add_sphere(r->scene, drift_vec3_make(0.8f, -1.4f, -0.2f), 0.5f, mirror);
-    assert_int_equal(
-        drift_scene_add_light(r->scene,
-                              &(drift_light){ .type = DRIFT_LIGHT_QUAD,
-                                              .position = { -0.5f, 1.95f, -0.5f },
-                                              .edge_u = { 1, 0, 0 },
-                                              .edge_v = { 0, 0, 1 }, // emits down
-                                              .color = { 8, 8, 8 } },
-                              NULL),
-        DRIFT_OK);
-    r->scene->camera = drift_camera_look_at(drift_vec3_make(0, 0, -1.9f), drift_vec3_make(0, -0.8f, 0),
-                                            drift_vec3_make(0, 1, 0), 1.3f, size, size);
+    test_add_sphere(r->scene, drift_vec3_make(-0.7f, -1.3f, 0.3f), 0.6f, 192, 96, glossy);
+    test_add_sphere(r->scene, drift_vec3_make(0.8f, -1.4f, -0.2f), 0.5f, 192, 96, mirror);
+    assert_int_equal(drift_scene_add_light(r->scene,
+                                           &(drift_light){ .type = DRIFT_LIGHT_QUAD,
+                                                           .position = { -0.5f, 1.95f, -0.5f },
+                                                           .edge_u = { 1, 0, 0 },
+                                                           .edge_v = { 0, 0, 1 }, // emits down
+                                                           .color = { 8, 8, 8 } },
+                                           NULL),
+                     DRIFT_OK);
+    r->scene->camera =
+        drift_camera_look_at(drift_vec3_make(0, 0, -1.9f), drift_vec3_make(0, -0.8f, 0),
+                             drift_vec3_make(0, 1, 0), 1.3f, size, size);
 }
 
-static drift_image render_pt(rig *r, const drift_pt_params *params, uint32_t spp, drift_pt **pt)
+static drift_image render_pt(test_rig *r, const drift_pt_params *params, uint32_t spp,
+                             drift_pt **pt)
 {
     assert_int_equal(drift_pt_create(r->ctx, r->scene, r->accel, params, pt), DRIFT_OK);
     assert_int_equal(drift_pt_render_samples(*pt, spp, NULL), DRIFT_OK);
@@ -276,19 +178,23 @@ static drift_image render_pt(rig *r, const drift_pt_params *params, uint32_t spp
 static void test_all_reference_equals_path_tracer(void **state)
 {
     (void)state;
-    rig r = rig_begin(2);
+    test_rig r = test_rig_begin(2);
     build_room(&r, 40);
-    rig_commit(&r);
+    test_rig_commit(&r);
     const uint32_t spp = 8;
-    rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_REFERENCE,
-                                          .reflections = DRIFT_REFLECTIONS_REFERENCE,
-                                          .indirect = DRIFT_INDIRECT_REFERENCE,
-                                          .spp = spp,
-                                          .seed = 5 });
+    test_rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_REFERENCE,
+                                               .reflections = DRIFT_REFLECTIONS_REFERENCE,
+                                               .indirect = DRIFT_INDIRECT_REFERENCE,
+                                               .spp = spp,
+                                               .seed = 5 });
     drift_pt *pt = NULL;
-    drift_image truth = render_pt(&r, &(drift_pt_params){ .width = 40, .height = 40, .seed = 5,
-                                                          .max_depth = 2, .pixel_centre = true,
-                                                          .pinhole = true },
+    drift_image truth = render_pt(&r,
+                                  &(drift_pt_params){ .width = 40,
+                                                      .height = 40,
+                                                      .seed = 5,
+                                                      .max_depth = 2,
+                                                      .pixel_centre = true,
+                                                      .pinhole = true },
                                   spp, &pt);
     const drift_image *img = drift_hybrid_image(r.frame);
     double sum = 0.0;
@@ -303,21 +209,7 @@ static void test_all_reference_equals_path_tracer(void **state)
     }
     assert_true(sum > 1.0); // the room is lit
     drift_pt_destroy(pt);
-    rig_destroy(&r);
-}
-
-static double rmse(const drift_image *a, const drift_image *b)
-{
-    double sum = 0.0;
-    for (int y = 0; y < a->height; ++y) {
-        for (int x = 0; x < a->width; ++x) {
-            for (int c = 0; c < 3; ++c) {
-                double d = (double)drift_image_pixel(a, x, y)[c] - (double)drift_image_pixel(b, x, y)[c];
-                sum += d * d;
-            }
-        }
-    }
-    return sqrt(sum / (3.0 * a->width * a->height));
+    test_rig_destroy(&r);
 }
 
 // Reference shadows alone converge to the direct-lighting render, emission plus direct light
@@ -326,30 +218,33 @@ static double rmse(const drift_image *a, const drift_image *b)
 static void test_reference_shadows_converge(void **state)
 {
     (void)state;
-    rig r = rig_begin(2);
+    test_rig r = test_rig_begin(2);
     build_room(&r, 32);
-    rig_commit(&r);
+    test_rig_commit(&r);
     drift_pt *pt = NULL;
     uint32_t truth_spp = (uint32_t)(512 * test_intensity());
-    drift_image truth = render_pt(&r, &(drift_pt_params){ .width = 32, .height = 32, .seed = 99,
-                                                          .max_depth = 1, .pixel_centre = true,
-                                                          .pinhole = true,
-                                                          .components = DRIFT_PT_COMPONENT_EMISSION |
-                                                                        DRIFT_PT_COMPONENT_DIRECT },
-                                  truth_spp < 64 ? 64 : truth_spp, &pt);
+    drift_image truth = render_pt(
+        &r,
+        &(drift_pt_params){ .width = 32,
+                            .height = 32,
+                            .seed = 99,
+                            .max_depth = 1,
+                            .pixel_centre = true,
+                            .pinhole = true,
+                            .components = DRIFT_PT_COMPONENT_EMISSION | DRIFT_PT_COMPONENT_DIRECT },
+        truth_spp < 64 ? 64 : truth_spp, &pt);
     double errors[3];
     const uint32_t spps[3] = { 2, 8, 32 };
     for (int k = 0; k < 3; ++k) {
-        rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_REFERENCE, .spp = spps[k],
-                                              .seed = 1 });
-        errors[k] = rmse(drift_hybrid_image(r.frame), &truth);
-
+        test_rig_frame(&r, &(drift_hybrid_params){
+                               .shadows = DRIFT_SHADOWS_REFERENCE, .spp = spps[k], .seed = 1 });
+        errors[k] = test_rmse(drift_hybrid_image(r.frame), &truth);
     }
     print_message("reference shadows rmse %g %g %g\n", errors[0], errors[1], errors[2]);
     assert_true(errors[1] < 0.75 * errors[0]);
     assert_true(errors[2] < 0.75 * errors[1]);
     drift_pt_destroy(pt);
-    rig_destroy(&r);
+    test_rig_destroy(&r);
 }
 
 // --- SHARP BUFFERS ---
@@ -361,9 +256,9 @@ static void test_reference_shadows_converge(void **state)
 static void test_hard_shadow_buffer_distances(void **state)
 {
     (void)state;
-    rig r = rig_begin(2);
-    uint32_t white = add_material(r.scene, drift_material_make(drift_vec3_splat(0.5f)));
-    add_floor(r.scene, 10.0f, 0.0f, white);
+    test_rig r = test_rig_begin(2);
+    uint32_t white = test_add_material(r.scene, drift_material_make(drift_vec3_splat(0.5f)));
+    test_add_floor(r.scene, 10.0f, 0.0f, white);
     const float h = 1.0f, light_height = 4.0f, light_x = 2.0f;
     const float occ[] = { -0.5f, h, -0.5f, 0.5f, h, -0.5f, 0.5f, h, 0.5f, -0.5f, h, 0.5f };
     const uint32_t occ_idx[] = { 0, 2, 1, 0, 3, 2 };
@@ -371,8 +266,8 @@ static void test_hard_shadow_buffer_distances(void **state)
     add_point_light(r.scene, drift_vec3_make(light_x, light_height, 0), drift_vec3_splat(10));
     r.scene->camera = drift_camera_look_at(drift_vec3_make(0, 8, -0.01f), drift_vec3_make(0, 0, 0),
                                            drift_vec3_make(0, 1, 0), 0.6f, 32, 32);
-    rig_commit(&r);
-    rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_HARD });
+    test_rig_commit(&r);
+    test_rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_HARD });
     const drift_gbuffer *g = drift_hybrid_gbuffer(r.frame);
     const char *name;
     const drift_image *hard = NULL, *plane;
@@ -410,14 +305,14 @@ static void test_hard_shadow_buffer_distances(void **state)
     }
     assert_true(shadowed > 10);
     assert_true(lit > 100);
-    rig_destroy(&r);
+    test_rig_destroy(&r);
 }
 
 // --- ENVIRONMENT MAP ---
 
 // Mean relative difference over the mirror's pixels between the sharp reflection and the
 // environment-map reflection rendered with params p.
-static double envmap_difference(rig *r, const drift_hybrid_params *p, const drift_image *sharp,
+static double envmap_difference(test_rig *r, const drift_hybrid_params *p, const drift_image *sharp,
                                 uint32_t mirror)
 {
     assert_int_equal(drift_hybrid_set_params(r->frame, p), DRIFT_OK);
@@ -437,7 +332,8 @@ static double envmap_difference(rig *r, const drift_hybrid_params *p, const drif
                 continue;
             }
             drift_vec3 a = pixel3(sharp, x, y), b = pixel3(env, x, y);
-            diff += fabs((double)(a.x - b.x)) + fabs((double)(a.y - b.y)) + fabs((double)(a.z - b.z));
+            diff +=
+                fabs((double)(a.x - b.x)) + fabs((double)(a.y - b.y)) + fabs((double)(a.z - b.z));
             total += (double)(a.x + a.y + a.z);
             ++pixels;
         }
@@ -452,14 +348,16 @@ static double envmap_difference(rig *r, const drift_hybrid_params *p, const drif
 static void test_envmap_mirror_sphere_matches_ray_traced(void **state)
 {
     (void)state;
-    rig r = rig_begin(2);
-    uint32_t white = add_material(r.scene, drift_material_make(drift_vec3_make(0.7f, 0.5f, 0.3f)));
-    uint32_t mirror = add_material(
-        r.scene, (drift_material){ .type = DRIFT_MATERIAL_MIRROR, .specular = { 1, 1, 1 },
-                                   .diffuse_texture = DRIFT_INVALID_INDEX });
+    test_rig r = test_rig_begin(2);
+    uint32_t white =
+        test_add_material(r.scene, drift_material_make(drift_vec3_make(0.7f, 0.5f, 0.3f)));
+    uint32_t mirror =
+        test_add_material(r.scene, (drift_material){ .type = DRIFT_MATERIAL_MIRROR,
+                                                     .specular = { 1, 1, 1 },
+                                                     .diffuse_texture = DRIFT_INVALID_INDEX });
     add_room(r.scene, 10.0f, white);
     const drift_vec3 centre = drift_vec3_make(0.3f, -0.5f, 0.2f);
-    add_sphere(r.scene, centre, 0.05f, mirror);
+    test_add_sphere(r.scene, centre, 0.05f, 192, 96, mirror);
     assert_int_equal(drift_scene_add_light(r.scene,
                                            &(drift_light){ .type = DRIFT_LIGHT_QUAD,
                                                            .position = { -3, 9.9f, -3 },
@@ -468,14 +366,15 @@ static void test_envmap_mirror_sphere_matches_ray_traced(void **state)
                                                            .color = { 5, 5, 5 } },
                                            NULL),
                      DRIFT_OK);
-    r.scene->camera = drift_camera_look_at(drift_vec3_add(centre, drift_vec3_make(0.1f, 0.05f, -0.3f)),
-                                           centre, drift_vec3_make(0, 1, 0), 0.35f, 48, 48);
-    rig_commit(&r);
+    r.scene->camera =
+        drift_camera_look_at(drift_vec3_add(centre, drift_vec3_make(0.1f, 0.05f, -0.3f)), centre,
+                             drift_vec3_make(0, 1, 0), 0.35f, 48, 48);
+    test_rig_commit(&r);
     drift_hybrid_params p = { .reflections = DRIFT_REFLECTIONS_SHARP,
                               .probe_per_object = true,
                               .envmap_size = 256,
                               .light_samples = 64 };
-    rig_frame(&r, &p);
+    test_rig_frame(&r, &p);
     drift_image sharp;
     assert_int_equal(drift_image_create(r.ctx, 48, 48, 3, &sharp), DRIFT_OK);
     const char *name;
@@ -499,7 +398,7 @@ static void test_envmap_mirror_sphere_matches_ray_traced(void **state)
     assert_true(at_probe < 0.04);
     assert_true(far_away > 3.0 * at_probe);
     drift_image_destroy(r.ctx, &sharp);
-    rig_destroy(&r);
+    test_rig_destroy(&r);
 }
 
 // --- DEPTH OF FIELD ---
@@ -507,40 +406,42 @@ static void test_envmap_mirror_sphere_matches_ray_traced(void **state)
 static void test_post_dof_pinhole_is_identity(void **state)
 {
     (void)state;
-    rig r = rig_begin(2);
+    test_rig r = test_rig_begin(2);
     build_room(&r, 32);
     r.scene->camera.aperture_radius = 0.0f;
-    rig_commit(&r);
-    rig_frame(&r, &(drift_hybrid_params){ .dof = DRIFT_DOF_NONE });
+    test_rig_commit(&r);
+    test_rig_frame(&r, &(drift_hybrid_params){ .dof = DRIFT_DOF_NONE });
     drift_image none;
     assert_int_equal(drift_image_create(r.ctx, 32, 32, 3, &none), DRIFT_OK);
     memcpy(none.pixels, drift_hybrid_image(r.frame)->pixels, sizeof(float) * 3 * 32 * 32);
-    rig_frame(&r, &(drift_hybrid_params){ .dof = DRIFT_DOF_POST });
-    assert_memory_equal(none.pixels, drift_hybrid_image(r.frame)->pixels, sizeof(float) * 3 * 32 * 32);
+    test_rig_frame(&r, &(drift_hybrid_params){ .dof = DRIFT_DOF_POST });
+    assert_memory_equal(none.pixels, drift_hybrid_image(r.frame)->pixels,
+                        sizeof(float) * 3 * 32 * 32);
     // With an aperture the same frame does change.
     r.scene->camera.aperture_radius = 0.2f;
-    rig_frame(&r, &(drift_hybrid_params){ .dof = DRIFT_DOF_POST });
-    assert_true(memcmp(none.pixels, drift_hybrid_image(r.frame)->pixels, sizeof(float) * 3 * 32 * 32) != 0);
+    test_rig_frame(&r, &(drift_hybrid_params){ .dof = DRIFT_DOF_POST });
+    assert_true(
+        memcmp(none.pixels, drift_hybrid_image(r.frame)->pixels, sizeof(float) * 3 * 32 * 32) != 0);
     drift_image_destroy(r.ctx, &none);
-    rig_destroy(&r);
+    test_rig_destroy(&r);
 }
 
 // --- DETERMINISM ---
 
 static void render_room_with_threads(int threads, drift_shadow_technique shadows, float *out)
 {
-    rig r = rig_begin(threads);
+    test_rig r = test_rig_begin(threads);
     build_room(&r, 24);
     r.scene->camera.aperture_radius = 0.05f;
     r.scene->camera.focus_distance = 2.0f;
-    rig_commit(&r);
-    rig_frame(&r, &(drift_hybrid_params){ .shadows = shadows,
-                                          .reflections = DRIFT_REFLECTIONS_SHARP,
-                                          .dof = DRIFT_DOF_POST,
-                                          .indirect = DRIFT_INDIRECT_AMBIENT,
-                                          .shadow_map_size = 64 });
+    test_rig_commit(&r);
+    test_rig_frame(&r, &(drift_hybrid_params){ .shadows = shadows,
+                                               .reflections = DRIFT_REFLECTIONS_SHARP,
+                                               .dof = DRIFT_DOF_POST,
+                                               .indirect = DRIFT_INDIRECT_AMBIENT,
+                                               .shadow_map_size = 64 });
     memcpy(out, drift_hybrid_image(r.frame)->pixels, sizeof(float) * 3 * 24 * 24);
-    rig_destroy(&r);
+    test_rig_destroy(&r);
 }
 
 static void test_deterministic_across_threads(void **state)
@@ -563,9 +464,10 @@ static void test_deterministic_across_threads(void **state)
 static void test_unshadowed_quad_matches_monte_carlo(void **state)
 {
     (void)state;
-    rig r = rig_begin(1);
-    uint32_t white = add_material(r.scene, drift_material_make(drift_vec3_make(0.8f, 0.5f, 0.2f)));
-    add_floor(r.scene, 10.0f, -5.0f, white);
+    test_rig r = test_rig_begin(1);
+    uint32_t white =
+        test_add_material(r.scene, drift_material_make(drift_vec3_make(0.8f, 0.5f, 0.2f)));
+    test_add_floor(r.scene, 10.0f, -5.0f, white);
     assert_int_equal(drift_scene_add_light(r.scene,
                                            &(drift_light){ .type = DRIFT_LIGHT_QUAD,
                                                            .position = { -0.5f, 1.0f, -0.5f },
@@ -574,29 +476,37 @@ static void test_unshadowed_quad_matches_monte_carlo(void **state)
                                                            .color = { 3, 3, 3 } },
                                            NULL),
                      DRIFT_OK);
-    rig_commit(&r);
+    test_rig_commit(&r);
     drift_hybrid_light *lights = NULL;
     uint32_t count = 0;
     assert_int_equal(drift_hybrid_lights_build(r.ctx, r.scene, &lights, &count), DRIFT_OK);
     assert_int_equal(count, 1);
-    const struct { drift_vec3 p, n; } cases[] = {
-        { { 0, 0, 0 }, { 0, 1, 0 } },            // straight below
+
+    const struct {
+        drift_vec3 p, n;
+    } cases[] = {
+        { { 0, 0, 0 }, { 0, 1, 0 } },              // straight below
         { { 2, 0.5f, 0.3f }, { -0.6f, 0.8f, 0 } }, // off to the side, tilted
-        { { 0.2f, 0.9f, 0 }, { 1, 0, 0 } },      // a wall just below: the quad crosses its horizon
-        { { 0, 2, 0 }, { 0, -1, 0 } },           // above the light: behind its emitting side
+        { { 0.2f, 0.9f, 0 }, { 1, 0, 0 } }, // a wall just below: the quad crosses its horizon
+        { { 0, 2, 0 }, { 0, -1, 0 } },      // above the light: behind its emitting side
     };
+
     for (size_t c = 0; c < sizeof cases / sizeof *cases; ++c) {
-        drift_surface s = { .position = cases[c].p, .material = white, .light = DRIFT_INVALID_INDEX };
+        drift_surface s = { .position = cases[c].p,
+                            .material = white,
+                            .light = DRIFT_INVALID_INDEX };
         s.ns = s.ng = drift_vec3_normalize(cases[c].n);
         drift_bsdf bsdf = drift_bsdf_make(r.scene, &s);
         drift_vec3 wo = s.ns;
         drift_sampler sampler = drift_sampler_make(1, 0, 0);
-        drift_vec3 closed = drift_hybrid_unshadowed(r.scene, &lights[0], &s, &bsdf, wo, 8, &sampler);
+        drift_vec3 closed =
+            drift_hybrid_unshadowed(r.scene, &lights[0], &s, &bsdf, wo, 8, &sampler);
         double mc = 0.0;
         const int n = 200000;
         for (int k = 0; k < n; ++k) {
             drift_sampler ks = drift_sampler_make(7, 0, (uint32_t)k);
-            drift_light_sample ls = drift_light_sample_li(r.scene, 0, s.position, drift_sampler_next2(&ks));
+            drift_light_sample ls =
+                drift_light_sample_li(r.scene, 0, s.position, drift_sampler_next2(&ks));
             if (ls.pdf > 0.0f) {
                 drift_vec3 f = drift_bsdf_eval(&bsdf, wo, ls.wi);
                 mc += (double)(f.x * ls.radiance.x * fabsf(drift_vec3_dot(ls.wi, s.ns)) / ls.pdf);
@@ -610,7 +520,7 @@ static void test_unshadowed_quad_matches_monte_carlo(void **state)
         }
     }
     drift_hybrid_lights_destroy(r.ctx, lights, count);
-    rig_destroy(&r);
+    test_rig_destroy(&r);
 }
 
 // --- NAMES AND ARGUMENTS ---
@@ -635,14 +545,14 @@ static void test_rejects_bad_params(void **state)
 {
     (void)state;
     test_log_capture capture = { 0 };
-    rig r = { .ctx = test_context(1, &capture) };
+    test_rig r = { .ctx = test_context(1, &capture) };
     assert_int_equal(drift_scene_create(r.ctx, &r.scene), DRIFT_OK);
     build_room(&r, 16);
-    rig_commit(&r);
+    test_rig_commit(&r);
     drift_hybrid *frame = NULL;
-    assert_int_equal(drift_hybrid_create(r.ctx, r.scene, r.accel,
-                                         &(drift_hybrid_params){ .shadows = (drift_shadow_technique)17 },
-                                         &frame),
+    assert_int_equal(drift_hybrid_create(
+                         r.ctx, r.scene, r.accel,
+                         &(drift_hybrid_params){ .shadows = (drift_shadow_technique)17 }, &frame),
                      DRIFT_ERR_INVALID_ARGUMENT);
     assert_null(frame);
     assert_int_equal(drift_hybrid_create(r.ctx, r.scene, r.accel,
@@ -653,7 +563,7 @@ static void test_rejects_bad_params(void **state)
     assert_int_equal(drift_hybrid_set_params(frame, &(drift_hybrid_params){ .width = 7 }),
                      DRIFT_ERR_INVALID_ARGUMENT);
     drift_hybrid_destroy(frame);
-    rig_destroy(&r);
+    test_rig_destroy(&r);
 }
 
 int main(void)

@@ -8,67 +8,11 @@
 #include "drift/scene.h"
 #include "drift_test.h"
 #include "hybrid/isg_internal.h"
+#include "test_rig.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-typedef struct rig {
-    drift_context *ctx;
-    drift_scene *scene;
-    drift_accel *accel;
-    drift_hybrid *frame;
-} rig;
-
-static rig rig_begin(void)
-{
-    rig r = { .ctx = test_context(2, NULL) };
-    assert_int_equal(drift_scene_create(r.ctx, &r.scene), DRIFT_OK);
-    return r;
-}
-
-static void rig_commit(rig *r)
-{
-    assert_int_equal(drift_scene_commit(r->scene), DRIFT_OK);
-    assert_int_equal(drift_accel_create(r->ctx, r->scene, &(drift_accel_desc){ 0 }, &r->accel),
-                     DRIFT_OK);
-}
-
-static void rig_frame(rig *r, const drift_hybrid_params *params)
-{
-    drift_hybrid_destroy(r->frame);
-    r->frame = NULL;
-    assert_int_equal(drift_hybrid_create(r->ctx, r->scene, r->accel, params, &r->frame), DRIFT_OK);
-    assert_int_equal(drift_hybrid_render(r->frame, &r->scene->camera, NULL), DRIFT_OK);
-}
-
-static void rig_destroy(rig *r)
-{
-    drift_hybrid_destroy(r->frame);
-    drift_accel_destroy(r->accel);
-    drift_scene_destroy(r->scene);
-    drift_context_destroy(r->ctx);
-}
-
-static const drift_image *plane(const rig *r, const char *wanted)
-{
-    const char *name;
-    const drift_image *image;
-    for (uint32_t i = 0; drift_hybrid_plane(r->frame, i, &name, &image); ++i) {
-        if (strcmp(name, wanted) == 0) {
-            return image;
-        }
-    }
-    fail_msg("no plane %s", wanted);
-    return NULL;
-}
-
-static uint32_t add_material(drift_scene *scene, drift_material m)
-{
-    uint32_t index;
-    assert_int_equal(drift_scene_add_material(scene, &m, &index), DRIFT_OK);
-    return index;
-}
 
 // Axis-aligned rectangle [x0, x1] x [z0, z1] at height y, facing +y.
 static void add_rect(drift_scene *scene, float x0, float x1, float z0, float z1, float y,
@@ -87,9 +31,9 @@ static void add_rect(drift_scene *scene, float x0, float x1, float z0, float z1,
 #define SHADOW_W     200
 #define SHADOW_H     100
 
-static void build_occluder(rig *r, float h, float light_radius)
+static void build_occluder(test_rig *r, float h, float light_radius)
 {
-    uint32_t white = add_material(r->scene, drift_material_make(drift_vec3_splat(0.5f)));
+    uint32_t white = test_add_material(r->scene, drift_material_make(drift_vec3_splat(0.5f)));
     add_rect(r->scene, -10.0f, 10.0f, -10.0f, 10.0f, 0.0f, white);
     add_rect(r->scene, -6.0f, 0.0f, -6.0f, 6.0f, h, white);
     assert_int_equal(
@@ -128,9 +72,9 @@ static double disk_t10(void)
 
 // The 10-90% width in scene units of the shadow across x on the floor, from the shadow plane
 // averaged over the middle rows.
-static double measured_penumbra(const rig *r)
+static double measured_penumbra(const test_rig *r)
 {
-    const drift_image *shadow = plane(r, "light0.shadow");
+    const drift_image *shadow = test_rig_plane(r, "light0.shadow");
     const drift_gbuffer *g = drift_hybrid_gbuffer(r->frame);
     double profile[SHADOW_W], xs[SHADOW_W];
     for (int x = 0; x < SHADOW_W; ++x) {
@@ -176,15 +120,15 @@ static void test_contact_hardening_follows_eq8(void **state)
     const float light_radius = 0.5f, heights[] = { 0.5f, 1.0f, 1.5f };
     double previous = 0.0;
     for (int i = 0; i < 3; ++i) {
-        rig r = rig_begin();
+        test_rig r = test_rig_begin(2);
         build_occluder(&r, heights[i], light_radius);
-        rig_commit(&r);
+        test_rig_commit(&r);
         // The tangent-plane range: the world distance would also weigh the floor down over
         // the penumbra (docs/isg.md); eq. 8 is what is under test.
-        rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_ISG,
-                                              .isg_search = 49,
-                                              .isg_gather = 81,
-                                              .isg_range_plane = true });
+        test_rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_ISG,
+                                                   .isg_search = 49,
+                                                   .isg_gather = 81,
+                                                   .isg_range_plane = true });
         double width = measured_penumbra(&r);
         // Eq. 8: the occluder distance d and light distance D along the ray share the ratio
         // h / H, so R_s = L h / (H - h).
@@ -196,19 +140,19 @@ static void test_contact_hardening_follows_eq8(void **state)
         assert_true(fabs(width - expected) <= 0.2 * expected);
         assert_true(width > previous * 1.3); // grows with the occluder's height
         previous = width;
-        rig_destroy(&r);
+        test_rig_destroy(&r);
     }
 }
 
 static void test_point_like_light_gives_hard_shadow(void **state)
 {
     (void)state;
-    rig r = rig_begin();
+    test_rig r = test_rig_begin(2);
     build_occluder(&r, 1.0f, 1e-4f);
-    rig_commit(&r);
-    rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_ISG });
-    const drift_image *hard = plane(&r, "light0.hard_shadow");
-    const drift_image *shadow = plane(&r, "light0.shadow");
+    test_rig_commit(&r);
+    test_rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_ISG });
+    const drift_image *hard = test_rig_plane(&r, "light0.hard_shadow");
+    const drift_image *shadow = test_rig_plane(&r, "light0.shadow");
     int shadowed = 0;
     for (int y = 0; y < SHADOW_H; ++y) {
         for (int x = 0; x < SHADOW_W; ++x) {
@@ -218,12 +162,12 @@ static void test_point_like_light_gives_hard_shadow(void **state)
     }
     assert_true(shadowed > 100);
     // The same light at full size does soften the shadow (the test can fail).
-    rig r2 = rig_begin();
+    test_rig r2 = test_rig_begin(2);
     build_occluder(&r2, 1.0f, 0.5f);
-    rig_commit(&r2);
-    rig_frame(&r2, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_ISG });
+    test_rig_commit(&r2);
+    test_rig_frame(&r2, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_ISG });
     int partial = 0;
-    shadow = plane(&r2, "light0.shadow");
+    shadow = test_rig_plane(&r2, "light0.shadow");
     for (int y = 0; y < SHADOW_H; ++y) {
         for (int x = 0; x < SHADOW_W; ++x) {
             float v = drift_image_pixel(shadow, x, y)[0];
@@ -231,8 +175,8 @@ static void test_point_like_light_gives_hard_shadow(void **state)
         }
     }
     assert_true(partial > 200);
-    rig_destroy(&r2);
-    rig_destroy(&r);
+    test_rig_destroy(&r2);
+    test_rig_destroy(&r);
 }
 
 // Two lights: each gets its own search and gather. A point-sized second light keeps its hard
@@ -240,7 +184,7 @@ static void test_point_like_light_gives_hard_shadow(void **state)
 static void test_each_light_gathers_its_own_shadow(void **state)
 {
     (void)state;
-    rig r = rig_begin();
+    test_rig r = test_rig_begin(2);
     build_occluder(&r, 1.0f, 0.5f);
     assert_int_equal(
         drift_scene_add_light(r.scene,
@@ -250,11 +194,11 @@ static void test_each_light_gathers_its_own_shadow(void **state)
                                               .color = { 5, 5, 5 } },
                               NULL),
         DRIFT_OK);
-    rig_commit(&r);
-    rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_ISG });
-    const drift_image *hard1 = plane(&r, "light1.hard_shadow"),
-                      *shadow1 = plane(&r, "light1.shadow");
-    const drift_image *shadow0 = plane(&r, "light0.shadow");
+    test_rig_commit(&r);
+    test_rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_ISG });
+    const drift_image *hard1 = test_rig_plane(&r, "light1.hard_shadow"),
+                      *shadow1 = test_rig_plane(&r, "light1.shadow");
+    const drift_image *shadow0 = test_rig_plane(&r, "light0.shadow");
     int partial0 = 0, shadowed1 = 0;
     for (int y = 0; y < SHADOW_H; ++y) {
         for (int x = 0; x < SHADOW_W; ++x) {
@@ -266,7 +210,7 @@ static void test_each_light_gathers_its_own_shadow(void **state)
     }
     assert_true(shadowed1 > 100);
     assert_true(partial0 > 200);
-    rig_destroy(&r);
+    test_rig_destroy(&r);
 }
 
 // --- GLOSSY REFLECTIONS ---
@@ -275,13 +219,14 @@ static void test_each_light_gathers_its_own_shadow(void **state)
 // at an angle: returns the RMS difference between the ISG and sharp reflection planes.
 static double reflection_difference(float exponent)
 {
-    rig r = rig_begin();
+    test_rig r = test_rig_begin(2);
     uint32_t floor =
-        add_material(r.scene, (drift_material){ .diffuse = { 0.2f, 0.2f, 0.2f },
-                                                .specular = { 0.6f, 0.6f, 0.6f },
-                                                .exponent = exponent,
-                                                .diffuse_texture = DRIFT_INVALID_INDEX });
-    uint32_t red = add_material(r.scene, drift_material_make(drift_vec3_make(0.8f, 0.1f, 0.1f)));
+        test_add_material(r.scene, (drift_material){ .diffuse = { 0.2f, 0.2f, 0.2f },
+                                                     .specular = { 0.6f, 0.6f, 0.6f },
+                                                     .exponent = exponent,
+                                                     .diffuse_texture = DRIFT_INVALID_INDEX });
+    uint32_t red =
+        test_add_material(r.scene, drift_material_make(drift_vec3_make(0.8f, 0.1f, 0.1f)));
     add_rect(r.scene, -5.0f, 5.0f, -5.0f, 5.0f, 0.0f, floor);
     const float p[] = { -0.5f, 0.0f, 0.0f, 0.5f, 0.0f, 0.0f, 0.5f, 1.0f, 0.0f, -0.5f, 1.0f, 0.0f };
     const uint32_t idx[] = { 0, 1, 2, 0, 2, 3 };
@@ -295,13 +240,13 @@ static double reflection_difference(float exponent)
     r.scene->camera =
         drift_camera_look_at(drift_vec3_make(0.0f, 1.0f, -3.0f), drift_vec3_make(0.0f, 0.0f, 0.0f),
                              drift_vec3_make(0.0f, 1.0f, 0.0f), 0.8f, 64, 48);
-    rig_commit(&r);
-    rig_frame(&r, &(drift_hybrid_params){ .reflections = DRIFT_REFLECTIONS_SHARP });
+    test_rig_commit(&r);
+    test_rig_frame(&r, &(drift_hybrid_params){ .reflections = DRIFT_REFLECTIONS_SHARP });
     drift_image sharp;
     assert_int_equal(drift_image_create(r.ctx, 64, 48, 3, &sharp), DRIFT_OK);
-    memcpy(sharp.pixels, plane(&r, "reflections")->pixels, sizeof(float) * 3 * 64 * 48);
-    rig_frame(&r, &(drift_hybrid_params){ .reflections = DRIFT_REFLECTIONS_ISG });
-    const drift_image *isg = plane(&r, "reflections");
+    memcpy(sharp.pixels, test_rig_plane(&r, "reflections")->pixels, sizeof(float) * 3 * 64 * 48);
+    test_rig_frame(&r, &(drift_hybrid_params){ .reflections = DRIFT_REFLECTIONS_ISG });
+    const drift_image *isg = test_rig_plane(&r, "reflections");
     double sum = 0.0;
     for (size_t i = 0; i < 3u * 64u * 48u; ++i) {
         double d = (double)isg->pixels[i] - (double)sharp.pixels[i];
@@ -309,7 +254,7 @@ static double reflection_difference(float exponent)
         sum += d * d;
     }
     drift_image_destroy(r.ctx, &sharp);
-    rig_destroy(&r);
+    test_rig_destroy(&r);
     return sqrt(sum / (3.0 * 64.0 * 48.0));
 }
 
@@ -341,11 +286,11 @@ static void test_gloss_support_eq13(void **state)
 // --- DEPTH OF FIELD ---
 
 // A far white wall and a near dark quad over half the view, evenly lit.
-static void build_dof(rig *r, float aperture)
+static void build_dof(test_rig *r, float aperture)
 {
-    uint32_t white = add_material(r->scene, drift_material_make(drift_vec3_splat(0.8f)));
+    uint32_t white = test_add_material(r->scene, drift_material_make(drift_vec3_splat(0.8f)));
     uint32_t dark =
-        add_material(r->scene, drift_material_make(drift_vec3_make(0.05f, 0.05f, 0.4f)));
+        test_add_material(r->scene, drift_material_make(drift_vec3_make(0.05f, 0.05f, 0.4f)));
     const float wall[] = { -20, -20, 10, 20, -20, 10, 20, 20, 10, -20, 20, 10 };
     const float near[] = { -5, -5, 2, 0, -5, 2, 0, 5, 2, -5, 5, 2 };
     const uint32_t idx[] = { 0, 2, 1, 0, 3, 2 };
@@ -367,17 +312,17 @@ static void build_dof(rig *r, float aperture)
 static void test_zero_aperture_dof_is_identity(void **state)
 {
     (void)state;
-    rig r = rig_begin();
+    test_rig r = test_rig_begin(2);
     build_dof(&r, 0.0f);
-    rig_commit(&r);
-    rig_frame(&r, &(drift_hybrid_params){ .dof = DRIFT_DOF_ISG });
-    assert_memory_equal(plane(&r, "focus")->pixels, plane(&r, "final")->pixels,
+    test_rig_commit(&r);
+    test_rig_frame(&r, &(drift_hybrid_params){ .dof = DRIFT_DOF_ISG });
+    assert_memory_equal(test_rig_plane(&r, "focus")->pixels, test_rig_plane(&r, "final")->pixels,
                         sizeof(float) * 3 * 64 * 48);
     r.scene->camera.aperture_radius = 0.5f;
-    rig_frame(&r, &(drift_hybrid_params){ .dof = DRIFT_DOF_ISG });
-    assert_true(memcmp(plane(&r, "focus")->pixels, plane(&r, "final")->pixels,
+    test_rig_frame(&r, &(drift_hybrid_params){ .dof = DRIFT_DOF_ISG });
+    assert_true(memcmp(test_rig_plane(&r, "focus")->pixels, test_rig_plane(&r, "final")->pixels,
                        sizeof(float) * 3 * 64 * 48) != 0);
-    rig_destroy(&r);
+    test_rig_destroy(&r);
 }
 
 // The blurred near quad (one side) spreads over the in-focus wall (right of the edge), and the
@@ -387,17 +332,17 @@ static void test_zero_aperture_dof_is_identity(void **state)
 static void test_dof_in_focus_foreground_does_not_bleed(void **state)
 {
     (void)state;
-    rig r = rig_begin();
+    test_rig r = test_rig_begin(2);
     build_dof(&r, 0.5f);
     r.scene->camera.focus_distance = 2.0f;
-    rig_commit(&r);
+    test_rig_commit(&r);
     const drift_gbuffer *g = NULL;
     int y = 24, edge = -1;
     float isg_err = 0.0f, post_err = 0.0f;
     for (int pass = 0; pass < 2; ++pass) {
-        rig_frame(&r, &(drift_hybrid_params){ .dof = pass ? DRIFT_DOF_POST : DRIFT_DOF_ISG,
-                                              .isg_search = 81,
-                                              .isg_gather = 81 });
+        test_rig_frame(&r, &(drift_hybrid_params){ .dof = pass ? DRIFT_DOF_POST : DRIFT_DOF_ISG,
+                                                   .isg_search = 81,
+                                                   .isg_gather = 81 });
         g = drift_hybrid_gbuffer(r.frame);
         for (int x = 1; x < 64 && edge < 0; ++x) {
             if (fabsf(drift_image_pixel(&g->depth, x - 1, y)[0] -
@@ -408,27 +353,27 @@ static void test_dof_in_focus_foreground_does_not_bleed(void **state)
         assert_true(edge > 4 && edge < 60);
         int side = drift_image_pixel(&g->depth, edge, y)[0] > 5.0f ? 1 : -1;
         int wall = edge + 2 * side;
-        float in_focus = drift_image_get3(plane(&r, "focus"), wall + 6 * side, y).x;
-        float got = drift_image_get3(plane(&r, "final"), wall, y).x;
+        float in_focus = drift_image_get3(test_rig_plane(&r, "focus"), wall + 6 * side, y).x;
+        float got = drift_image_get3(test_rig_plane(&r, "final"), wall, y).x;
         *(pass ? &post_err : &isg_err) = fabsf(got - in_focus) / in_focus;
     }
     print_message("wall beside an in-focus quad: isg error %.4f, post %.4f\n", (double)isg_err,
                   (double)post_err);
     assert_true(isg_err < 0.05f);
     assert_true(post_err > 2.0f * isg_err);
-    rig_destroy(&r);
+    test_rig_destroy(&r);
 }
 
 static void test_dof_foreground_spreads(void **state)
 {
     (void)state;
-    rig r = rig_begin();
+    test_rig r = test_rig_begin(2);
     build_dof(&r, 0.5f);
-    rig_commit(&r);
-    rig_frame(&r,
-              &(drift_hybrid_params){ .dof = DRIFT_DOF_ISG, .isg_search = 81, .isg_gather = 81 });
-    const drift_image *focus = plane(&r, "focus"), *final = plane(&r, "final");
-    const drift_image *coc = plane(&r, "coc");
+    test_rig_commit(&r);
+    test_rig_frame(
+        &r, &(drift_hybrid_params){ .dof = DRIFT_DOF_ISG, .isg_search = 81, .isg_gather = 81 });
+    const drift_image *focus = test_rig_plane(&r, "focus"), *final = test_rig_plane(&r, "final");
+    const drift_image *coc = test_rig_plane(&r, "coc");
     const drift_gbuffer *g = drift_hybrid_gbuffer(r.frame);
     // Find the edge in the middle row: the first wall pixel after a near-quad pixel.
     int y = 24, edge = -1;
@@ -449,7 +394,7 @@ static void test_dof_foreground_spreads(void **state)
     drift_vec3 blurred = drift_image_get3(final, edge + side, y);
     print_message("edge %d side %d c_near %.2f wall %.4f -> %.4f (search radius %.2f)\n", edge,
                   side, (double)c_near, (double)in_focus.x, (double)blurred.x,
-                  (double)drift_image_pixel(plane(&r, "isg.dof"), edge + side, y)[0]);
+                  (double)drift_image_pixel(test_rig_plane(&r, "isg.dof"), edge + side, y)[0]);
     // Pulled toward the near quad's colour by at least a tenth of the way.
     float near_colour = drift_image_get3(focus, edge - 4 * side, y).x;
     assert_true(fabsf(blurred.x - near_colour) < 0.9f * fabsf(in_focus.x - near_colour));
@@ -457,18 +402,18 @@ static void test_dof_foreground_spreads(void **state)
     int far = wall_right ? 62 : 1;
     drift_vec3 a = drift_image_get3(focus, far, y), b = drift_image_get3(final, far, y);
     assert_near(a.x, b.x, 1e-6 * (double)a.x);
-    rig_destroy(&r);
+    test_rig_destroy(&r);
 }
 
 // A thin near bar, blurred, in front of an in-focus wall with a red stripe hidden behind the
 // bar: the lens sees the stripe through the blurred bar, the one-layer gather cannot.
-static double bar_error(int layers, const drift_image *reference, rig *r)
+static double bar_error(int layers, const drift_image *reference, test_rig *r)
 {
-    rig_frame(r,
-              &(drift_hybrid_params){
-                  .dof = DRIFT_DOF_ISG, .isg_search = 49, .isg_gather = 81, .isg_layers = layers });
+    test_rig_frame(
+        r, &(drift_hybrid_params){
+               .dof = DRIFT_DOF_ISG, .isg_search = 49, .isg_gather = 81, .isg_layers = layers });
     const drift_gbuffer *g = drift_hybrid_gbuffer(r->frame);
-    const drift_image *final = plane(r, "final");
+    const drift_image *final = test_rig_plane(r, "final");
     double sum = 0.0;
     int n = 0;
     for (int y = 8; y < 40; ++y) {
@@ -491,10 +436,11 @@ static double bar_error(int layers, const drift_image *reference, rig *r)
 static void test_second_layer_sees_behind_blurred_bar(void **state)
 {
     (void)state;
-    rig r = rig_begin();
-    uint32_t white = add_material(r.scene, drift_material_make(drift_vec3_splat(0.8f)));
-    uint32_t red = add_material(r.scene, drift_material_make(drift_vec3_make(0.9f, 0.05f, 0.05f)));
-    uint32_t dark = add_material(r.scene, drift_material_make(drift_vec3_splat(0.05f)));
+    test_rig r = test_rig_begin(2);
+    uint32_t white = test_add_material(r.scene, drift_material_make(drift_vec3_splat(0.8f)));
+    uint32_t red =
+        test_add_material(r.scene, drift_material_make(drift_vec3_make(0.9f, 0.05f, 0.05f)));
+    uint32_t dark = test_add_material(r.scene, drift_material_make(drift_vec3_splat(0.05f)));
     const uint32_t idx[] = { 0, 2, 1, 0, 3, 2 };
     const float wall[] = { -20, -20, 10, 20, -20, 10, 20, 20, 10, -20, 20, 10 };
     const float stripe[] = {
@@ -515,17 +461,17 @@ static void test_second_layer_sees_behind_blurred_bar(void **state)
                              drift_vec3_make(0, 1, 0), 0.9f, 64, 48);
     r.scene->camera.aperture_radius = 0.3f;
     r.scene->camera.focus_distance = 10.0f;
-    rig_commit(&r);
+    test_rig_commit(&r);
     uint32_t spp = (uint32_t)(128.0 * test_intensity());
-    rig_frame(&r, &(drift_hybrid_params){ .dof = DRIFT_DOF_REFERENCE, .spp = spp });
+    test_rig_frame(&r, &(drift_hybrid_params){ .dof = DRIFT_DOF_REFERENCE, .spp = spp });
     drift_image reference;
     assert_int_equal(drift_image_create(r.ctx, 64, 48, 3, &reference), DRIFT_OK);
-    memcpy(reference.pixels, plane(&r, "final")->pixels, sizeof(float) * 3 * 64 * 48);
+    memcpy(reference.pixels, test_rig_plane(&r, "final")->pixels, sizeof(float) * 3 * 64 * 48);
     double one = bar_error(1, &reference, &r), two = bar_error(2, &reference, &r);
     print_message("DOF rms error over the blurred bar: 1 layer %.4f, 2 layers %.4f\n", one, two);
     assert_true(two < 0.8 * one);
     drift_image_destroy(r.ctx, &reference);
-    rig_destroy(&r);
+    test_rig_destroy(&r);
 }
 
 // --- THE FILTER ---
@@ -649,9 +595,9 @@ static void test_rejects_bad_counts(void **state)
     assert_true(drift_isg_count_valid(9) && drift_isg_count_valid(81) && drift_isg_count_valid(1));
     assert_false(drift_isg_count_valid(10) || drift_isg_count_valid(0) ||
                  drift_isg_count_valid(1025));
-    rig r = rig_begin();
+    test_rig r = test_rig_begin(2);
     build_occluder(&r, 1.0f, 0.5f);
-    rig_commit(&r);
+    test_rig_commit(&r);
     assert_int_equal(drift_hybrid_create(r.ctx, r.scene, r.accel,
                                          &(drift_hybrid_params){ .isg_search = 10 }, &r.frame),
                      DRIFT_ERR_INVALID_ARGUMENT);
@@ -660,7 +606,7 @@ static void test_rejects_bad_counts(void **state)
     assert_int_equal(drift_technique_parse(DRIFT_EFFECT_REFLECTIONS, "isg"), DRIFT_REFLECTIONS_ISG);
     assert_int_equal(drift_technique_parse(DRIFT_EFFECT_DOF, "isg"), DRIFT_DOF_ISG);
     assert_string_equal(drift_hybrid_pass_name(DRIFT_PASS_ISG), "isg");
-    rig_destroy(&r);
+    test_rig_destroy(&r);
 }
 
 int main(void)

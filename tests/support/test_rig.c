@@ -1,0 +1,132 @@
+// Test support for the hybrid-frame tests (see test_rig.h).
+#include "test_rig.h"
+
+#include "drift_test.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+test_rig test_rig_begin(int threads)
+{
+    test_rig r = { .ctx = test_context(threads, NULL) };
+    assert_int_equal(drift_scene_create(r.ctx, &r.scene), DRIFT_OK);
+    return r;
+}
+
+void test_rig_commit(test_rig *r)
+{
+    assert_int_equal(drift_scene_commit(r->scene), DRIFT_OK);
+    assert_int_equal(drift_accel_create(r->ctx, r->scene, &(drift_accel_desc){ 0 }, &r->accel),
+                     DRIFT_OK);
+}
+
+void test_rig_frame(test_rig *r, const drift_hybrid_params *params)
+{
+    drift_hybrid_destroy(r->frame);
+    r->frame = NULL;
+    assert_int_equal(drift_hybrid_create(r->ctx, r->scene, r->accel, params, &r->frame), DRIFT_OK);
+    assert_int_equal(drift_hybrid_render(r->frame, &r->scene->camera, NULL), DRIFT_OK);
+}
+
+void test_rig_destroy(test_rig *r)
+{
+    drift_hybrid_destroy(r->frame);
+    drift_accel_destroy(r->accel);
+    drift_scene_destroy(r->scene);
+    drift_context_destroy(r->ctx);
+}
+
+const drift_image *test_rig_plane(const test_rig *r, const char *wanted)
+{
+    const char *name;
+    const drift_image *image;
+    for (uint32_t i = 0; drift_hybrid_plane(r->frame, i, &name, &image); ++i) {
+        if (strcmp(name, wanted) == 0) {
+            return image;
+        }
+    }
+    fail_msg("no plane %s", wanted);
+    return NULL;
+}
+
+uint32_t test_add_material(drift_scene *scene, drift_material m)
+{
+    uint32_t index;
+    assert_int_equal(drift_scene_add_material(scene, &m, &index), DRIFT_OK);
+    return index;
+}
+
+void test_add_floor(drift_scene *scene, float half, float height, uint32_t material)
+{
+    const float p[] = { -half, height, -half, half,  height, -half,
+                        half,  height, half,  -half, height, half };
+    const uint32_t idx[] = { 0, 2, 1, 0, 3, 2 };
+    test_add_mesh(scene, p, 4, idx, 2, material);
+}
+
+uint32_t test_add_sphere(drift_scene *scene, drift_vec3 centre, float radius, uint32_t slices,
+                         uint32_t stacks, uint32_t material)
+{
+    uint32_t vcount = (slices + 1) * (stacks + 1);
+    float *p = malloc(sizeof(float) * 3 * vcount);
+    float *n = malloc(sizeof(float) * 3 * vcount);
+    uint32_t *idx = malloc(sizeof(uint32_t) * 6 * slices * stacks);
+    assert_non_null(p);
+    assert_non_null(n);
+    assert_non_null(idx);
+    const float c[3] = { centre.x, centre.y, centre.z };
+    for (uint32_t j = 0; j <= stacks; ++j) {
+        float theta = 3.14159265f * (float)j / (float)stacks;
+        for (uint32_t i = 0; i <= slices; ++i) {
+            float phi = 2.0f * 3.14159265f * (float)i / (float)slices;
+            uint32_t v = j * (slices + 1) + i;
+            float d[3] = { sinf(theta) * cosf(phi), cosf(theta), sinf(theta) * sinf(phi) };
+            for (int k = 0; k < 3; ++k) {
+                n[3 * v + k] = d[k];
+                p[3 * v + k] = c[k] + radius * d[k];
+            }
+        }
+    }
+    uint32_t t = 0;
+    for (uint32_t j = 0; j < stacks; ++j) {
+        for (uint32_t i = 0; i < slices; ++i) {
+            uint32_t a = j * (slices + 1) + i, b = a + slices + 1;
+            // Outward winding; the poles' degenerate triangles are dropped by the scene.
+            uint32_t quad[6] = { a, a + 1, b, a + 1, b + 1, b };
+            for (int k = 0; k < 6; ++k) {
+                idx[t * 3 + (uint32_t)k] = quad[k];
+            }
+            t += 2;
+        }
+    }
+    uint32_t mesh;
+    assert_int_equal(drift_scene_add_mesh(scene,
+                                          &(drift_mesh_desc){ .positions = p,
+                                                              .normals = n,
+                                                              .vertex_count = vcount,
+                                                              .indices = idx,
+                                                              .triangle_count = t,
+                                                              .material = material },
+                                          &mesh),
+                     DRIFT_OK);
+    free(p);
+    free(n);
+    free(idx);
+    return mesh;
+}
+
+double test_rmse(const drift_image *a, const drift_image *b)
+{
+    double sum = 0.0;
+    for (int y = 0; y < a->height; ++y) {
+        for (int x = 0; x < a->width; ++x) {
+            for (int c = 0; c < 3; ++c) {
+                double d =
+                    (double)drift_image_pixel(a, x, y)[c] - (double)drift_image_pixel(b, x, y)[c];
+                sum += d * d;
+            }
+        }
+    }
+    return sqrt(sum / (3.0 * a->width * a->height));
+}

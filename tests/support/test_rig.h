@@ -1,0 +1,37 @@
+// Test support for the hybrid-frame tests: a scene, its accelerator and one frame held
+// together (a "rig"), and the small scene pieces several tests build with.
+#ifndef DRIFT_TEST_RIG_H
+#define DRIFT_TEST_RIG_H
+
+#include "drift/accel.h"
+#include "drift/hybrid.h"
+#include "drift/scene.h"
+
+typedef struct test_rig {
+    drift_context *ctx;
+    drift_scene *scene;
+    drift_accel *accel;
+    drift_hybrid *frame;
+} test_rig;
+
+// A context with `threads` threads and an empty scene.
+test_rig test_rig_begin(int threads);
+// Commits the scene and builds its accelerator.
+void test_rig_commit(test_rig *r);
+// Replaces the rig's frame by one made with `params` and renders it from the scene camera.
+void test_rig_frame(test_rig *r, const drift_hybrid_params *params);
+void test_rig_destroy(test_rig *r);
+// The frame's plane named `wanted`; fails the test when there is none.
+const drift_image *test_rig_plane(const test_rig *r, const char *wanted);
+
+uint32_t test_add_material(drift_scene *scene, drift_material m);
+// Square of half size `half` in the plane y = height, facing +y.
+void test_add_floor(drift_scene *scene, float half, float height, uint32_t material);
+// UV sphere with smooth normals and outward winding; returns its mesh index.
+uint32_t test_add_sphere(drift_scene *scene, drift_vec3 centre, float radius, uint32_t slices,
+                         uint32_t stacks, uint32_t material);
+
+// RMSE over the three colour channels of two images of one size.
+double test_rmse(const drift_image *a, const drift_image *b);
+
+#endif
