@@ -155,13 +155,11 @@ int drift_bench_frame(int argc, char **argv)
     drift_scene *scene = NULL;
     drift_accel *accel = NULL;
     int exit_code = 1;
-    drift_result r = drift_context_create(
-        &(drift_context_desc){ .thread_count = (int)o.threads, .logger = cli_stderr_logger(false) },
-        &ctx);
-    if (r != DRIFT_OK) {
-        fprintf(stderr, "drift bench frame: %s\n", drift_result_string(r));
+    ctx = cli_open_context("bench frame", (int)o.threads, false);
+    if (!ctx) {
         goto done;
     }
+    drift_result r = DRIFT_OK;
     if (!cli_open_scene(ctx, "bench frame", scene_path, &scene, &accel, NULL)) {
         goto done;
     }

@@ -35,6 +35,10 @@ const char *cli_next_value(const char *cmd, int argc, char **argv, int *i);
 // "drift: FILE:LINE: level: message" on stderr.
 drift_logger cli_stderr_logger(bool verbose);
 
+// A context with `threads` worker threads (0: one a core) and the stderr logger, or NULL after
+// printing "drift <cmd>: <why>".
+drift_context *cli_open_context(const char *cmd, int threads, bool verbose);
+
 // Directory of the built-in default scene (the repository's scenes/ folder).
 const char *cli_default_scene_path(void);
 

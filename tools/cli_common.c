@@ -1,5 +1,4 @@
 #include "cli.h"
-
 #include "drift/accel.h"
 #include "drift/scene_io.h"
 
@@ -9,8 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-bool cli_parse_int(const char *cmd, const char *flag, const char *text, long lo, long hi,
-                   long *out)
+bool cli_parse_int(const char *cmd, const char *flag, const char *text, long lo, long hi, long *out)
 {
     char *end = NULL;
     errno = 0;
@@ -91,14 +89,27 @@ drift_logger cli_stderr_logger(bool verbose)
     return (drift_logger){ .func = stderr_log, .user = verbose ? &verbose_marker : NULL };
 }
 
+drift_context *cli_open_context(const char *cmd, int threads, bool verbose)
+{
+    drift_context *ctx = NULL;
+    drift_result r = drift_context_create(
+        &(drift_context_desc){ .thread_count = threads, .logger = cli_stderr_logger(verbose) },
+        &ctx);
+    if (r != DRIFT_OK) {
+        fprintf(stderr, "drift %s: %s\n", cmd, drift_result_string(r));
+        return NULL;
+    }
+    return ctx;
+}
+
 const char *cli_default_scene_path(void)
 {
     const char *env = getenv("DRIFT_DEFAULT_SCENE");
     return env && *env ? env : DRIFT_SOURCE_DIR "/scenes/cornell-box/cornell_box.json";
 }
 
-bool cli_open_scene(drift_context *ctx, const char *cmd, const char *path,
-                    drift_scene **out_scene, drift_accel **out_accel, double *out_loaded_time)
+bool cli_open_scene(drift_context *ctx, const char *cmd, const char *path, drift_scene **out_scene,
+                    drift_accel **out_accel, double *out_loaded_time)
 {
     *out_accel = NULL;
     const char *scene_path = path ? path : cli_default_scene_path();

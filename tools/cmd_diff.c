@@ -92,13 +92,11 @@ int drift_cmd_diff(int argc, char **argv)
         return 2;
     }
 
-    drift_context *ctx = NULL;
-    drift_result r = drift_context_create(
-        &(drift_context_desc){ .logger = cli_stderr_logger(verbose) }, &ctx);
-    if (r != DRIFT_OK) {
-        fprintf(stderr, "drift diff: %s\n", drift_result_string(r));
+    drift_context *ctx = cli_open_context("diff", 0, verbose);
+    if (!ctx) {
         return 1;
     }
+    drift_result r = DRIFT_OK;
     int status = 1;
     drift_image ref = { 0 }, test = { 0 }, flip_map = { 0 }, heat = { 0 };
     drift_metric_report rep;

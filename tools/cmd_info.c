@@ -150,13 +150,11 @@ int drift_cmd_info(int argc, char **argv)
     if (!path) {
         path = cli_default_scene_path();
     }
-    drift_context *ctx = NULL;
-    drift_result r = drift_context_create(
-        &(drift_context_desc){ .thread_count = 1, .logger = cli_stderr_logger(verbose) }, &ctx);
-    if (r != DRIFT_OK) {
-        fprintf(stderr, "drift info: %s\n", drift_result_string(r));
+    drift_context *ctx = cli_open_context("info", 1, verbose);
+    if (!ctx) {
         return 1;
     }
+    drift_result r = DRIFT_OK;
     drift_scene *scene = NULL;
     r = drift_scene_load(ctx, path, &scene);
     if (r != DRIFT_OK) {

@@ -118,14 +118,11 @@ typedef struct fit_view {
 
 static int fit(const fit_options *o)
 {
-    drift_context *ctx = NULL;
-    drift_result r = drift_context_create(
-        &(drift_context_desc){ .thread_count = (int)o->threads, .logger = cli_stderr_logger(false) },
-        &ctx);
-    if (r != DRIFT_OK) {
-        fprintf(stderr, "drift refine fit: %s\n", drift_result_string(r));
+    drift_context *ctx = cli_open_context("refine fit", (int)o->threads, false);
+    if (!ctx) {
         return 1;
     }
+    drift_result r = DRIFT_OK;
     const char *scene_path = o->scene_path ? o->scene_path : cli_default_scene_path();
     drift_scene *scene = NULL;
     drift_accel *accel = NULL;

@@ -321,14 +321,11 @@ int drift_cmd_render(int argc, char **argv)
         return render_hybrid(&o);
     }
     double t_start = drift_time_now();
-    drift_context *ctx = NULL;
-    drift_result r = drift_context_create(
-        &(drift_context_desc){ .thread_count = (int)o.threads, .logger = cli_stderr_logger(o.verbose) },
-        &ctx);
-    if (r != DRIFT_OK) {
-        fprintf(stderr, "drift render: %s\n", drift_result_string(r));
+    drift_context *ctx = cli_open_context("render", (int)o.threads, o.verbose);
+    if (!ctx) {
         return 1;
     }
+    drift_result r = DRIFT_OK;
     const char *scene_path = o.scene_path ? o.scene_path : cli_default_scene_path();
     drift_scene *scene = NULL;
     drift_accel *accel = NULL;

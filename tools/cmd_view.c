@@ -570,14 +570,11 @@ int drift_cmd_view(int argc, char **argv)
     drift_view *view = NULL;
     window w = { 0 };
     int exit_code = 1;
-    drift_result r =
-        drift_context_create(&(drift_context_desc){ .thread_count = (int)o.threads,
-                                                    .logger = cli_stderr_logger(o.verbose) },
-                             &ctx);
-    if (r != DRIFT_OK) {
-        fprintf(stderr, "drift view: %s\n", drift_result_string(r));
+    ctx = cli_open_context("view", (int)o.threads, o.verbose);
+    if (!ctx) {
         goto done;
     }
+    drift_result r = DRIFT_OK;
     const char *scene_path = o.scene_path ? o.scene_path : cli_default_scene_path();
     if (!cli_open_scene(ctx, "view", scene_path, &scene, &accel, NULL)) {
         goto done;
