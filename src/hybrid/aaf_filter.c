@@ -200,13 +200,14 @@ static void filter_pixel_exact(const filter_job *job, int32_t x, int32_t y)
     }
 }
 
-// One pixel of a 1-D pass (eq. 3.3 along dx, dy): the taps are clamped to the image once and
-// walked by pointer steps, so the loop holds only the tests and the Gaussian. The sums run in
-// the same order as the exact filter's, so the output is that of a plain loop.
-static void filter_pixel_line(const filter_job *job, int32_t x, int32_t y)
+// One pixel of a 1-D pass (eq. 3.3 along dx, dy) for an image of `channels` channels (a
+// constant where it is inlined, so the sums stay in registers): the taps are clamped to the
+// image once and walked by pointer steps, so the loop holds only the tests and the Gaussian.
+// The sums run in the same order as the exact filter's, so the output is that of a plain loop.
+static inline void filter_pixel_line_n(const filter_job *job, int32_t x, int32_t y,
+                                       const int channels)
 {
     const drift_aaf_filter_desc *d = job->desc;
-    const int channels = job->in->channels;
     const int32_t w = job->in->width;
     const filter_texel *c = &job->texels[(size_t)y * (size_t)w + (size_t)x];
     const float *centre = drift_image_pixel(job->in, x, y);
@@ -221,6 +222,8 @@ static void filter_pixel_line(const filter_job *job, int32_t x, int32_t y)
     ptrdiff_t texel_step = job->dx ? 1 : (ptrdiff_t)w;
     ptrdiff_t value_step = job->dx ? (ptrdiff_t)channels : job->in->stride;
     centre_tests tests = centre_tests_make(c);
+    const drift_aaf_filter_desc axis = { .has_axis = d->has_axis, .axis = d->axis };
+    const drift_vec3 p = c->position;
     float inv = -0.5f / (c->beta * c->beta);
     float sum[4] = { 0.0f, 0.0f, 0.0f, 0.0f };
     float weight = 0.0f;
@@ -232,19 +235,30 @@ static void filter_pixel_line(const filter_job *job, int32_t x, int32_t y)
             if (!accept(&tests, n)) {
                 continue;
             }
-            wk = expf(inv * distance_sq(d, c->position, n->position));
+            wk = expf(inv * distance_sq(&axis, p, n->position));
         }
-        if (channels == 1) {
-            sum[0] += wk * v[0];
-        } else {
-            for (int m = 0; m < channels; ++m) {
-                sum[m] += wk * v[m];
-            }
+        for (int m = 0; m < channels; ++m) {
+            sum[m] += wk * v[m];
         }
         weight += wk;
     }
     for (int m = 0; m < channels; ++m) {
         out[m] = sum[m] / weight;
+    }
+}
+
+static void filter_pixel_line(const filter_job *job, int32_t x, int32_t y)
+{
+    switch (job->in->channels) {
+    case 1:
+        filter_pixel_line_n(job, x, y, 1);
+        break;
+    case 3:
+        filter_pixel_line_n(job, x, y, 3);
+        break;
+    default:
+        filter_pixel_line_n(job, x, y, job->in->channels);
+        break;
     }
 }
 
@@ -272,10 +286,19 @@ static void pack_rows(size_t begin, size_t end, int thread_index, void *user)
     }
 }
 
+size_t drift_aaf_filter_workspace_bytes(int32_t width, int32_t height)
+{
+    return sizeof(filter_texel) * (size_t)width * (size_t)height;
+}
+
+// The packed inputs, in the caller's workspace when it gives one (no allocation, no page
+// faults per call), else in a buffer of the filter's own.
 static filter_texel *pack(drift_context *ctx, const drift_aaf_filter_desc *desc, int32_t width,
                           int32_t height)
 {
-    filter_texel *texels = drift_alloc(ctx, sizeof(filter_texel) * (size_t)width * (size_t)height);
+    filter_texel *texels = desc->workspace
+                               ? desc->workspace
+                               : drift_alloc(ctx, drift_aaf_filter_workspace_bytes(width, height));
     if (texels) {
         pack_job job = { desc, texels, width };
         drift_parallel_for(ctx, (size_t)height, 8, pack_rows, &job);
@@ -340,7 +363,9 @@ drift_result drift_aaf_filter_separable(drift_context *ctx, const drift_aaf_filt
     run_filter(ctx, &job);
     job = (filter_job){ .desc = desc, .texels = texels, .in = scratch, .out = out, .dy = 1 };
     run_filter(ctx, &job);
-    drift_free(ctx, texels);
+    if (texels != desc->workspace) {
+        drift_free(ctx, texels);
+    }
     return DRIFT_OK;
 }
 
@@ -353,6 +378,8 @@ drift_result drift_aaf_filter_exact(drift_context *ctx, const drift_aaf_filter_d
     }
     filter_job job = { .desc = desc, .texels = texels, .in = in, .out = out };
     run_filter(ctx, &job);
-    drift_free(ctx, texels);
+    if (texels != desc->workspace) {
+        drift_free(ctx, texels);
+    }
     return DRIFT_OK;
 }

@@ -294,7 +294,8 @@ drift_result drift_aaf_lobe_pass(drift_hybrid *f, const drift_aaf_lobe *lobe)
         drift_aaf_filter_desc desc = { .beta = &b->beta,
                                        .footprint = &st->footprint,
                                        .gbuffer = &f->gbuffer,
-                                       .max_radius = DRIFT_AAF_MAX_RADIUS };
+                                       .max_radius = DRIFT_AAF_MAX_RADIUS,
+                                       .workspace = st->filter_workspace };
         r = drift_aaf_filter_separable(f->ctx, &desc, &b->radiance, &st->scratch3, &b->filtered);
         if (r != DRIFT_OK) {
             return r;

@@ -69,7 +69,11 @@ typedef struct drift_aaf_filter_desc {
     bool has_axis;
     drift_vec3 axis;
     int32_t max_radius; // pixels
+    void *workspace;    // drift_aaf_filter_workspace_bytes for the image, or NULL: allocated
 } drift_aaf_filter_desc;
+
+// Bytes of the filter's packed per-pixel inputs for an image of this size.
+size_t drift_aaf_filter_workspace_bytes(int32_t width, int32_t height);
 
 // The separable filter of eq. 3.7: a horizontal then a vertical 1-D Gaussian, both with the
 // centre pixel's beta, over neighbours that pass the beta-ratio, depth and normal tests.
@@ -125,9 +129,10 @@ typedef struct drift_aaf_state {
     drift_aaf_light *lights;
     drift_image footprint; // 1
     drift_image scratch1, scratch3;
-    float *want;      // width*height
-    uint32_t *counts; // width*height
-    float *aux;       // DRIFT_AAF_AUX * width*height: per-pixel running sums
+    float *want;            // width*height
+    uint32_t *counts;       // width*height
+    float *aux;             // DRIFT_AAF_AUX * width*height: per-pixel running sums
+    void *filter_workspace; // the filter's packed inputs, reused by every filter call
     drift_aaf_lobe_buffers indirect, specular;
 } drift_aaf_state;
 

@@ -330,7 +330,8 @@ drift_result drift_hybrid_pass_aaf_shadows(drift_hybrid *f)
                                            // (docs/aaf.md, departures).
                                            .has_axis = false,
                                            .axis = light->direction,
-                                           .max_radius = DRIFT_AAF_MAX_RADIUS };
+                                           .max_radius = DRIFT_AAF_MAX_RADIUS,
+                                           .workspace = st->filter_workspace };
             r = drift_aaf_filter_separable(f->ctx, &desc, &al->unfiltered, &st->scratch1, shadow);
             if (r != DRIFT_OK) {
                 return r;

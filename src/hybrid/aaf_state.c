@@ -32,6 +32,7 @@ void drift_aaf_state_destroy(drift_context *ctx, drift_aaf_state *s)
     drift_free(ctx, s->want);
     drift_free(ctx, s->counts);
     drift_free(ctx, s->aux);
+    drift_free(ctx, s->filter_workspace);
     drift_free(ctx, s);
 }
 
@@ -54,8 +55,10 @@ drift_result drift_aaf_state_ensure(drift_hybrid *f)
     s->want = drift_alloc(ctx, sizeof(float) * pixels);
     s->counts = drift_alloc(ctx, sizeof(uint32_t) * pixels);
     s->aux = drift_alloc(ctx, sizeof(float) * DRIFT_AAF_AUX * pixels);
-    drift_result r =
-        s->lights && s->want && s->counts && s->aux ? DRIFT_OK : DRIFT_ERR_OUT_OF_MEMORY;
+    s->filter_workspace = drift_alloc(ctx, drift_aaf_filter_workspace_bytes(w, h));
+    drift_result r = s->lights && s->want && s->counts && s->aux && s->filter_workspace
+                         ? DRIFT_OK
+                         : DRIFT_ERR_OUT_OF_MEMORY;
     drift_image *ones[] = { &s->footprint,    &s->scratch1,      &s->indirect.beta,
                             &s->indirect.spp, &s->specular.beta, &s->specular.spp };
     drift_image *threes[] = { &s->scratch3,          &s->indirect.unfiltered, &s->indirect.radiance,
