@@ -134,7 +134,7 @@ static drift_vec3 trace_path(drift_hybrid *f, const indirect_job *job, const dri
 
 // Running sums a pixel keeps between the passes, in state->aux and the lobe's radiance.
 typedef struct indirect_sums {
-    float z_min, z_max, count, unused;
+    float z_min, z_max, count, has_lobe;
 } indirect_sums;
 
 // Whether the pixel has the job's lobe, with its albedo and Omega_h^max.
@@ -176,9 +176,9 @@ static void add_samples(drift_hybrid *f, const indirect_job *job, int32_t x, int
     radiance[2] = mean.z;
 }
 
-float drift_aaf_indirect_beta(float z_min, float footprint, float omega)
+float drift_aaf_indirect_beta(float z_min, float footprint, float omega, float pixel_width)
 {
-    return fmaxf(2.0f * z_min / omega, footprint / 0.15f);
+    return fmaxf(2.0f * z_min / omega, pixel_width * footprint);
 }
 
 float drift_aaf_omega_specular(float phong_exponent)
@@ -202,13 +202,15 @@ static void sparse_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays, 
     if (!lobe_at(f, job, x, y, &albedo, &omega)) {
         return;
     }
+    sums->has_lobe = 1.0f;
     add_samples(f, job, x, y, 0, job->uniform ? f->params.spp : job->sparse, rays);
     if (!isfinite(sums->z_min) || !(omega > 0.0f)) {
         return; // open to the sky, or a mirror: nothing to filter
     }
     float z_min = fmaxf(sums->z_min, 1e-4f), z_max = fmaxf(sums->z_max, z_min);
     float d = drift_image_pixel(&st->footprint, x, y)[0];
-    drift_image_pixel(&b->beta, x, y)[0] = drift_aaf_indirect_beta(z_min, d, omega) * job->shrink;
+    drift_image_pixel(&b->beta, x, y)[0] =
+        drift_aaf_indirect_beta(z_min, d, omega, job->lobe->pixel_width) * job->shrink;
     // eq. 4.6 with sqrt(A_p) = d.
     float a = 0.9f * omega * d / z_min + 0.3f;
     float c = 1.0f + 0.9f * z_max / z_min;
@@ -250,8 +252,8 @@ static void modulate_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays
 
 drift_result drift_aaf_lobe_pass(drift_hybrid *f, const drift_aaf_lobe *lobe)
 {
-    size_t active = 0;
-    drift_result r = drift_aaf_prepare(f, &active);
+    size_t surfaces = 0;
+    drift_result r = drift_aaf_prepare(f, &surfaces);
     if (r != DRIFT_OK) {
         return r;
     }
@@ -270,6 +272,12 @@ drift_result drift_aaf_lobe_pass(drift_hybrid *f, const drift_aaf_lobe *lobe)
     double t = drift_time_now();
     if (job.bounces > 0) {
         stats->rays[DRIFT_PASS_AAF_SAMPLING] += drift_hybrid_for_each_pixel(f, sparse_pixel, &job);
+        // The average --spp is over the pixels that have the lobe: a glossy floor in a diffuse
+        // room must not receive the budget of every diffuse pixel.
+        size_t active = 0;
+        for (size_t i = 0; i < pixels; ++i) {
+            active += ((const indirect_sums *)&st->aux[DRIFT_AAF_AUX * i])->has_lobe > 0.0f;
+        }
         if (!job.uniform) {
             drift_aaf_allocate(st->want, pixels, active, job.sparse, f->params.spp,
                                f->params.aaf_max_spp, job.key, st->counts);
@@ -337,6 +345,7 @@ drift_result drift_hybrid_pass_aaf_indirect(drift_hybrid *f)
                             .out = &f->indirect,
                             .shrink_from_spp = DRIFT_AAF_INDIRECT_SHRINK_SPP,
                             .shrink_exponent = DRIFT_AAF_INDIRECT_SHRINK_EXP,
+                            .pixel_width = 1.0f / 0.15f,
                             .at = diffuse_at,
                             .sample = diffuse_sample };
     return drift_aaf_lobe_pass(f, &lobe);

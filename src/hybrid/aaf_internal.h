@@ -157,6 +157,7 @@ typedef struct drift_aaf_lobe {
     drift_aaf_lobe_buffers *buffers; // in frame->aaf
     drift_image *out;                // the frame's term
     float shrink_from_spp, shrink_exponent;
+    float pixel_width; // beta's floor in pixel footprints d (eq. 4.4: 1 / 0.15 for diffuse)
     // Whether the pixel has the lobe; then *albedo (what the estimate is divided by before the
     // filter) and *omega (Omega_h^max of eq. 4.5; 0: a delta lobe, kept sharp: no filter and
     // no adaptive samples).
@@ -172,8 +173,9 @@ typedef struct drift_aaf_lobe {
 // adaptive, and the separable world-space filter of the demodulated estimate.
 drift_result drift_aaf_lobe_pass(drift_hybrid *frame, const drift_aaf_lobe *lobe);
 
-// eq. 4.4: the filter width for the nearest reflector at z_min and a pixel of world size d.
-float drift_aaf_indirect_beta(float z_min, float footprint, float omega);
+// eq. 4.4: the filter width for the nearest reflector at z_min and a pixel of world size d,
+// max(2 z_min / omega, pixel_width d); the paper's pixel_width is 1 / 0.15.
+float drift_aaf_indirect_beta(float z_min, float footprint, float omega, float pixel_width);
 // eq. 4.5 for a glossy lobe of Phong exponent n: Omega = 3.6 + 0.084 m with m = 4 n, the
 // Blinn-Phong exponent of the same lobe width (cos^m of the half angle ~ cos^n(2 x it)).
 float drift_aaf_omega_specular(float phong_exponent);

@@ -177,8 +177,8 @@ static void test_beta_shrinks_with_the_exponent(void **state)
 {
     (void)state;
     assert_float_equal(drift_aaf_omega_specular(25.0f), 3.6f + 0.084f * 100.0f, 1e-5f);
-    assert_true(drift_aaf_indirect_beta(1.0f, 0.01f, 10.0f) <
-                drift_aaf_indirect_beta(1.0f, 0.01f, 5.0f));
+    assert_true(drift_aaf_indirect_beta(1.0f, 0.01f, 10.0f, 1.0f) <
+                drift_aaf_indirect_beta(1.0f, 0.01f, 5.0f, 1.0f));
     const float exponents[3] = { 1.0f, 4.0f, 16.0f };
     double beta[3];
     for (int k = 0; k < 3; ++k) {
