@@ -9,7 +9,8 @@
 //      blurred), then multiplied back by the albedo.
 // Each sample is one bounce (max_depth 2, the reference's default) or more (max_depth 3:
 // two bounces), with next-event estimation at every vertex after the first: emission that a
-// bounce ray meets is direct light, which the frame computes apart (shadows technique).
+// bounce ray meets is direct light, which the frame computes apart (shadows technique),
+// except along a mirror's sharp ray (aaf_specular.c), where it is R's.
 #include "hybrid/aaf_internal.h"
 
 #include <math.h>

@@ -137,8 +137,8 @@ static void test_specular_converges(void **state)
                            .pinhole = true };
     drift_pt *pt = NULL;
     assert_int_equal(drift_pt_create(r.ctx, r.scene, r.accel, &pp, &pt), DRIFT_OK);
-    uint32_t truth_spp = (uint32_t)(1024 * test_intensity());
-    assert_int_equal(drift_pt_render_samples(pt, truth_spp < 512 ? 512 : truth_spp, NULL),
+    uint32_t truth_spp = (uint32_t)(512 * test_intensity());
+    assert_int_equal(drift_pt_render_samples(pt, truth_spp < 256 ? 256 : truth_spp, NULL),
                      DRIFT_OK);
     drift_image truth;
     assert_int_equal(drift_pt_resolve(pt, DRIFT_PT_AOV_BEAUTY, &truth), DRIFT_OK);
