@@ -38,19 +38,16 @@ static void add_quad(drift_scene *scene, drift_vec3 corner, drift_vec3 u, drift_
     test_add_mesh(scene, p, 4, idx, 2, material);
 }
 
-// A glossy floor (Phong exponent `exponent`) reflecting a lit red wall at z = 1.5 and a
-// white one at x = -1.5, under a 1x1 quad light at height 3, seen from above the floor.
-static rig build(float exponent)
+// A reflective floor reflecting a lit red wall at z = 1.5 and a white one at x = -1.5, under a
+// 1x1 quad light at height 3, seen from above the floor looking at `target`.
+static rig build_floor(const drift_material *floor, drift_vec3 target)
 {
     rig r = { .ctx = test_context(2, NULL) };
     assert_int_equal(drift_scene_create(r.ctx, &r.scene), DRIFT_OK);
-    drift_material glossy = drift_material_make(drift_vec3_splat(0.2f));
-    glossy.specular = drift_vec3_splat(0.6f);
-    glossy.exponent = exponent;
     drift_material red = drift_material_make(drift_vec3_make(0.8f, 0.2f, 0.1f));
     drift_material white = drift_material_make(drift_vec3_splat(0.7f));
     uint32_t g, rd, wh;
-    assert_int_equal(drift_scene_add_material(r.scene, &glossy, &g), DRIFT_OK);
+    assert_int_equal(drift_scene_add_material(r.scene, floor, &g), DRIFT_OK);
     assert_int_equal(drift_scene_add_material(r.scene, &red, &rd), DRIFT_OK);
     assert_int_equal(drift_scene_add_material(r.scene, &white, &wh), DRIFT_OK);
     const float h = 1.5f;
@@ -70,13 +67,21 @@ static rig build(float exponent)
                                                            .color = { 5, 5, 5 } },
                                            NULL),
                      DRIFT_OK);
-    r.scene->camera =
-        drift_camera_look_at(drift_vec3_make(0.3f, 1.2f, -1.4f), drift_vec3_make(0, 0.3f, 0.8f),
-                             drift_vec3_make(0, 1, 0), 1.2f, W, H);
+    r.scene->camera = drift_camera_look_at(drift_vec3_make(0.3f, 1.2f, -1.4f), target,
+                                           drift_vec3_make(0, 1, 0), 1.2f, W, H);
     assert_int_equal(drift_scene_commit(r.scene), DRIFT_OK);
     assert_int_equal(drift_accel_create(r.ctx, r.scene, &(drift_accel_desc){ 0 }, &r.accel),
                      DRIFT_OK);
     return r;
+}
+
+// The floor glossy, of Phong exponent `exponent`.
+static rig build(float exponent)
+{
+    drift_material glossy = drift_material_make(drift_vec3_splat(0.2f));
+    glossy.specular = drift_vec3_splat(0.6f);
+    glossy.exponent = exponent;
+    return build_floor(&glossy, drift_vec3_make(0, 0.3f, 0.8f));
 }
 
 static void render(rig *r, const drift_hybrid_params *params)
@@ -123,11 +128,9 @@ static double rmse(const drift_image *a, const drift_image *b)
     return sqrt(sum / (3.0 * a->width * a->height));
 }
 
-// The R term against the pt's SPECULAR component (first bounce glossy, one bounce).
-static void test_specular_converges(void **state)
+// The pt's SPECULAR component (first bounce glossy or mirror, one bounce): the R term's truth.
+static drift_image render_truth(rig *r, drift_pt **pt)
 {
-    (void)state;
-    rig r = build(20.0f);
     drift_pt_params pp = { .width = W,
                            .height = H,
                            .seed = 1234,
@@ -135,13 +138,21 @@ static void test_specular_converges(void **state)
                            .components = DRIFT_PT_COMPONENT_SPECULAR,
                            .pixel_centre = true,
                            .pinhole = true };
-    drift_pt *pt = NULL;
-    assert_int_equal(drift_pt_create(r.ctx, r.scene, r.accel, &pp, &pt), DRIFT_OK);
+    assert_int_equal(drift_pt_create(r->ctx, r->scene, r->accel, &pp, pt), DRIFT_OK);
     uint32_t truth_spp = (uint32_t)(512 * test_intensity());
-    assert_int_equal(drift_pt_render_samples(pt, truth_spp < 256 ? 256 : truth_spp, NULL),
+    assert_int_equal(drift_pt_render_samples(*pt, truth_spp < 256 ? 256 : truth_spp, NULL),
                      DRIFT_OK);
     drift_image truth;
-    assert_int_equal(drift_pt_resolve(pt, DRIFT_PT_AOV_BEAUTY, &truth), DRIFT_OK);
+    assert_int_equal(drift_pt_resolve(*pt, DRIFT_PT_AOV_BEAUTY, &truth), DRIFT_OK);
+    return truth;
+}
+
+static void test_specular_converges(void **state)
+{
+    (void)state;
+    rig r = build(20.0f);
+    drift_pt *pt = NULL;
+    drift_image truth = render_truth(&r, &pt);
     const uint32_t spps[3] = { 4, 16, 64 };
     double aaf[3];
     for (int k = 0; k < 3; ++k) {
@@ -152,6 +163,41 @@ static void test_specular_converges(void **state)
     print_message("specular rmse aaf %g %g %g\n", aaf[0], aaf[1], aaf[2]);
     assert_true(aaf[1] < 0.9 * aaf[0]);
     assert_true(aaf[2] < 0.9 * aaf[1]);
+    drift_pt_destroy(pt);
+    destroy(&r);
+}
+
+// A mirror floor keeps a sharp ray: nothing is filtered (beta 0 everywhere), the light's
+// emission seen in the mirror is R's, and the estimate converges to the reference.
+static void test_mirror_stays_sharp(void **state)
+{
+    (void)state;
+    drift_material mirror = drift_material_make(drift_vec3_splat(0.0f));
+    mirror.type = DRIFT_MATERIAL_MIRROR;
+    mirror.specular = drift_vec3_splat(0.8f);
+    rig r = build_floor(&mirror, drift_vec3_make(0, -0.5f, 0)); // the light is in the mirror
+    drift_pt *pt = NULL;
+    drift_image truth = render_truth(&r, &pt);
+    double error[2], brightest = 0.0, brightest_truth = 0.0;
+    const uint32_t spps[2] = { 4, 64 };
+    for (int k = 0; k < 2; ++k) {
+        drift_hybrid_params p = { .reflections = DRIFT_REFLECTIONS_AAF, .spp = spps[k], .seed = 5 };
+        render(&r, &p);
+        error[k] = rmse(plane(&r, "reflections"), &truth);
+        const drift_image *beta = plane(&r, "reflections.aaf.beta");
+        const drift_image *refl = plane(&r, "reflections");
+        for (int y = 0; y < H; ++y) {
+            for (int x = 0; x < W; ++x) {
+                assert_true(drift_image_pixel(beta, x, y)[0] == 0.0f);
+                brightest = fmax(brightest, (double)drift_image_pixel(refl, x, y)[0]);
+                brightest_truth = fmax(brightest_truth, (double)drift_image_pixel(&truth, x, y)[0]);
+            }
+        }
+    }
+    print_message("mirror rmse %g %g, brightest %g (truth %g)\n", error[0], error[1], brightest,
+                  brightest_truth);
+    assert_true(error[1] < 0.7 * error[0]);
+    assert_true(brightest > 0.9 * brightest_truth); // the light itself, seen in the mirror
     drift_pt_destroy(pt);
     destroy(&r);
 }
@@ -197,6 +243,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_specular_converges),
+        cmocka_unit_test(test_mirror_stays_sharp),
         cmocka_unit_test(test_beta_shrinks_with_the_exponent),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
