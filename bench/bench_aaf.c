@@ -1,20 +1,20 @@
 // drift bench aaf: axis-aligned filtering against plain Monte Carlo with the same sampler
 // (the paper's Figs. 3.6 and 4.2): RMSE of the effect's term (the frame's `direct` plane for
-// shadows, `indirect` for indirect light) against a reference rendered by the path tracer at
+// shadows, `indirect` for indirect light, `reflections` for the glossy specular buffer)
+// against a reference rendered by the path tracer at
 // --ref-spp, over a list of average spp; the equal-error sample ratio (the spp plain MC needs
 // to reach AAF's error, interpolated on the log-log curve); and the filter's milliseconds
 // against the sampling's at 640x480 (Tables 3.1 and 4.1). Writes CSV and an SVG plot.
 #include "bench.h"
 #include "cli.h"
+#include "drift/accel.h"
+#include "drift/hybrid.h"
+#include "drift/scene_io.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-#include "drift/accel.h"
-#include "drift/hybrid.h"
-#include "drift/scene_io.h"
 
 #define MAX_SPPS 16
 
@@ -24,26 +24,31 @@ typedef struct aaf_options {
     long width, height, ref_spp, threads, timing_width, timing_height, timing_spp, light_samples;
     long spps[MAX_SPPS], mc_spps[MAX_SPPS];
     int spp_count, mc_spp_count;
-    bool shadows, indirect, json;
+    bool shadows, indirect, reflections, json;
+    bool random; // --sampler random: AAF and plain MC both take independent random numbers
 } aaf_options;
 
 static void print_help(FILE *out)
 {
     fprintf(out,
-            "usage: drift bench aaf [SCENE] [--effect shadows|indirect|both] [--spp LIST]\n"
+            "usage: drift bench aaf [SCENE] [--effect E] [--spp LIST]\n"
             "                       [--ref-spp N] [--width W] [--height H] [--threads T]\n"
             "                       [--timing-size WxH] [--timing-spp N] [--csv FILE]\n"
-            "                       [--svg FILE] [--mc-spp LIST] [--light-samples N] [--json]\n\n"
+            "                       [--svg FILE] [--mc-spp LIST] [--light-samples N]\n"
+            "                       [--sampler sobol|random] [--json]\n\n"
             "RMSE of AAF and of plain Monte Carlo (same sampler: uniform spp, no filter) against\n"
             "a path-traced reference of the effect's term, for each average spp; the equal-error\n"
             "sample ratio; and filter vs sampling milliseconds of one AAF frame.\n\n"
             "  SCENE         default scenes/grids/grids.json (needs ../shared)\n"
-            "  --effect E    shadows (default), indirect or both\n"
+            "  --effect E    shadows (default), indirect, both (those two) or reflections\n"
+            "                (the specular buffer, --reflections aaf)\n"
             "  --spp LIST    comma-separated average spp (default 4,8,16,32,64)\n"
             "  --mc-spp LIST plain Monte Carlo's spp (default: --spp); longer lists avoid\n"
             "                extrapolating the equal-error ratio\n"
             "  --light-samples N  samples of U_l's sampled lobes (default 256: keeps the\n"
             "                unshadowed light's own noise under the shadows' error)\n"
+            "  --sampler S   sobol (default) or random, for AAF and plain MC alike: random is\n"
+            "                the paper's traditional Monte Carlo (Fig. 3.6)\n"
             "  --ref-spp N   reference samples a pixel (default 4096)\n"
             "  --width, --height  error images (default 160x120)\n"
             "  --timing-size WxH  timing frame (default 640x480); --timing-spp N (default 16)\n"
@@ -63,15 +68,18 @@ static bool parse_spps(const char *text, long *spps, int *spp_count)
         long v = strtol(p, &end, 10);
         if (end == p || v < 1 || v > 65536 || (*end != ',' && *end != '\0') ||
             (count > 0 && v <= spps[count - 1])) {
-            fprintf(stderr, "drift bench aaf: expected an increasing comma-separated list of "
-                            "counts in 1..65536, got '%s'\n", text);
+            fprintf(stderr,
+                    "drift bench aaf: expected an increasing comma-separated list of "
+                    "counts in 1..65536, got '%s'\n",
+                    text);
             return false;
         }
         spps[count++] = v;
         p = *end == ',' ? end + 1 : end;
     }
     if (count < 2 || *p) {
-        fprintf(stderr, "drift bench aaf: a spp list needs 2..%d values, got '%s'\n", MAX_SPPS, text);
+        fprintf(stderr, "drift bench aaf: a spp list needs 2..%d values, got '%s'\n", MAX_SPPS,
+                text);
         return false;
     }
     *spp_count = count;
@@ -80,9 +88,15 @@ static bool parse_spps(const char *text, long *spps, int *spp_count)
 
 static int parse(int argc, char **argv, aaf_options *o)
 {
-    *o = (aaf_options){ .width = 160, .height = 120, .ref_spp = 4096, .threads = 1,
-                        .timing_width = 640, .timing_height = 480, .timing_spp = 16,
-                        .light_samples = 256, .shadows = true };
+    *o = (aaf_options){ .width = 160,
+                        .height = 120,
+                        .ref_spp = 4096,
+                        .threads = 1,
+                        .timing_width = 640,
+                        .timing_height = 480,
+                        .timing_spp = 16,
+                        .light_samples = 256,
+                        .shadows = true };
     parse_spps("4,8,16,32,64", o->spps, &o->spp_count);
     o->mc_spp_count = 0;
     const char *cmd = "bench aaf";
@@ -99,10 +113,14 @@ static int parse(int argc, char **argv, aaf_options *o)
             if (ok) {
                 o->shadows = strcmp(v, "shadows") == 0 || strcmp(v, "both") == 0;
                 o->indirect = strcmp(v, "indirect") == 0 || strcmp(v, "both") == 0;
-                ok = o->shadows || o->indirect;
+                o->reflections = strcmp(v, "reflections") == 0;
+                ok = o->shadows || o->indirect || o->reflections;
                 if (!ok) {
-                    fprintf(stderr, "drift bench aaf: --effect expects shadows, indirect or both, "
-                                    "got '%s'\n", v);
+                    fprintf(
+                        stderr,
+                        "drift bench aaf: --effect expects shadows, indirect, both or reflections, "
+                        "got '%s'\n",
+                        v);
                 }
             }
         } else if (strcmp(a, "--spp") == 0) {
@@ -138,6 +156,14 @@ static int parse(int argc, char **argv, aaf_options *o)
         } else if (strcmp(a, "--threads") == 0) {
             ok = (v = cli_next_value(cmd, argc, argv, &i)) &&
                  cli_parse_int(cmd, a, v, 0, 256, &o->threads);
+        } else if (strcmp(a, "--sampler") == 0) {
+            ok = (v = cli_next_value(cmd, argc, argv, &i)) != NULL;
+            if (ok && strcmp(v, "sobol") != 0 && strcmp(v, "random") != 0) {
+                fprintf(stderr, "drift bench aaf: --sampler expects sobol or random, got '%s'\n",
+                        v);
+                ok = false;
+            }
+            o->random = ok && strcmp(v, "random") == 0;
         } else if (strcmp(a, "--csv") == 0) {
             ok = (o->csv_path = cli_next_value(cmd, argc, argv, &i)) != NULL;
         } else if (strcmp(a, "--svg") == 0) {
@@ -195,7 +221,8 @@ static double rmse(const drift_image *a, const drift_image *b)
     for (int32_t y = 0; y < a->height; ++y) {
         for (int32_t x = 0; x < a->width; ++x) {
             for (int c = 0; c < 3; ++c) {
-                double d = (double)drift_image_pixel(a, x, y)[c] - (double)drift_image_pixel(b, x, y)[c];
+                double d =
+                    (double)drift_image_pixel(a, x, y)[c] - (double)drift_image_pixel(b, x, y)[c];
                 sum += d * d;
             }
         }
@@ -210,7 +237,9 @@ static double actual_spp(const drift_hybrid *frame, drift_effect effect)
     size_t count = 0;
     const char *name;
     const drift_image *image;
-    const char *suffix = effect == DRIFT_EFFECT_SHADOWS ? ".aaf.spp" : "indirect.aaf.spp";
+    const char *suffix = effect == DRIFT_EFFECT_SHADOWS    ? ".aaf.spp"
+                         : effect == DRIFT_EFFECT_INDIRECT ? "indirect.aaf.spp"
+                                                           : "reflections.aaf.spp";
     for (uint32_t i = 0; drift_hybrid_plane(frame, i, &name, &image); ++i) {
         size_t n = strlen(name), m = strlen(suffix);
         if (n < m || strcmp(name + n - m, suffix) != 0 ||
@@ -233,9 +262,12 @@ static double actual_spp(const drift_hybrid *frame, drift_effect effect)
 static drift_hybrid_params effect_params(drift_effect effect, int technique, const aaf_options *o,
                                          long spp)
 {
-    drift_hybrid_params p = { .width = (int32_t)o->width, .height = (int32_t)o->height,
-                              .spp = (uint32_t)spp, .seed = 11,
-                              .light_samples = (uint32_t)o->light_samples };
+    drift_hybrid_params p = { .width = (int32_t)o->width,
+                              .height = (int32_t)o->height,
+                              .spp = (uint32_t)spp,
+                              .seed = 11,
+                              .light_samples = (uint32_t)o->light_samples,
+                              .aaf_random = o->random };
     drift_hybrid_params_set_technique(&p, effect, technique);
     return p;
 }
@@ -270,9 +302,15 @@ static double equal_error_spp(const point *plain, int count, double error, bool 
 static drift_result measure(drift_context *ctx, const drift_scene *scene, const drift_accel *accel,
                             const aaf_options *o, drift_effect effect, curve *out)
 {
-    const char *term = effect == DRIFT_EFFECT_SHADOWS ? "direct" : "indirect";
-    int aaf = effect == DRIFT_EFFECT_SHADOWS ? DRIFT_SHADOWS_AAF : DRIFT_INDIRECT_AAF;
-    int reference = effect == DRIFT_EFFECT_SHADOWS ? DRIFT_SHADOWS_REFERENCE : DRIFT_INDIRECT_REFERENCE;
+    const char *term = effect == DRIFT_EFFECT_SHADOWS    ? "direct"
+                       : effect == DRIFT_EFFECT_INDIRECT ? "indirect"
+                                                         : "reflections";
+    int aaf = effect == DRIFT_EFFECT_SHADOWS    ? DRIFT_SHADOWS_AAF
+              : effect == DRIFT_EFFECT_INDIRECT ? DRIFT_INDIRECT_AAF
+                                                : DRIFT_REFLECTIONS_AAF;
+    int reference = effect == DRIFT_EFFECT_SHADOWS    ? DRIFT_SHADOWS_REFERENCE
+                    : effect == DRIFT_EFFECT_INDIRECT ? DRIFT_INDIRECT_REFERENCE
+                                                      : DRIFT_REFLECTIONS_REFERENCE;
     out->effect = effect;
     out->count = o->spp_count;
     out->plain_count = o->mc_spp_count;
@@ -306,7 +344,8 @@ static drift_result measure(drift_context *ctx, const drift_scene *scene, const 
         }
     }
     for (int k = 0; r == DRIFT_OK && k < o->spp_count; ++k) {
-        double spp = equal_error_spp(out->plain, o->mc_spp_count, out->aaf[k].rmse, &out->extrapolated[k]);
+        double spp =
+            equal_error_spp(out->plain, o->mc_spp_count, out->aaf[k].rmse, &out->extrapolated[k]);
         out->ratio[k] = spp / out->aaf[k].actual_spp;
     }
     if (r == DRIFT_OK) {
@@ -380,36 +419,46 @@ static bool write_svg(const char *path, const char *scene, const curve *curves, 
     }
 #define PX(v) (left + (log10(v) - lx0) / (lx1 - lx0) * (W - left - right))
 #define PY(v) (top + (ly1 - log10(v)) / (ly1 - ly0) * (H - top - bottom))
-    fprintf(f, "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" "
-               "font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n",
+    fprintf(f,
+            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" "
+            "font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%%\" height=\"100%%\" "
+            "fill=\"white\"/>\n",
             W, H);
     const char *base = strrchr(scene, '/');
     fprintf(f, "<text x=\"%.0f\" y=\"20\" font-size=\"14\">RMSE vs average spp: %s</text>\n", left,
             base ? base + 1 : scene);
     for (double d = lx0; d <= lx1; d += 1.0) {
         double x = PX(pow(10.0, d));
-        fprintf(f, "<line x1=\"%.1f\" y1=\"%.0f\" x2=\"%.1f\" y2=\"%.0f\" stroke=\"#ddd\"/>\n"
-                   "<text x=\"%.1f\" y=\"%.0f\" text-anchor=\"middle\">%g</text>\n",
+        fprintf(f,
+                "<line x1=\"%.1f\" y1=\"%.0f\" x2=\"%.1f\" y2=\"%.0f\" stroke=\"#ddd\"/>\n"
+                "<text x=\"%.1f\" y=\"%.0f\" text-anchor=\"middle\">%g</text>\n",
                 x, top, x, H - bottom, x, H - bottom + 16, pow(10.0, d));
     }
     for (double d = ly0; d <= ly1; d += 1.0) {
         double y = PY(pow(10.0, d));
-        fprintf(f, "<line x1=\"%.0f\" y1=\"%.1f\" x2=\"%.0f\" y2=\"%.1f\" stroke=\"#ddd\"/>\n"
-                   "<text x=\"%.0f\" y=\"%.1f\" text-anchor=\"end\">1e%.0f</text>\n",
+        fprintf(f,
+                "<line x1=\"%.0f\" y1=\"%.1f\" x2=\"%.0f\" y2=\"%.1f\" stroke=\"#ddd\"/>\n"
+                "<text x=\"%.0f\" y=\"%.1f\" text-anchor=\"end\">1e%.0f</text>\n",
                 left, y, W - right, y, left - 6, y + 4, d);
     }
-    fprintf(f, "<rect x=\"%.0f\" y=\"%.0f\" width=\"%.0f\" height=\"%.0f\" fill=\"none\" stroke=\"black\"/>\n",
+    fprintf(f,
+            "<rect x=\"%.0f\" y=\"%.0f\" width=\"%.0f\" height=\"%.0f\" fill=\"none\" "
+            "stroke=\"black\"/>\n",
             left, top, W - left - right, H - top - bottom);
-    fprintf(f, "<text x=\"%.0f\" y=\"%.0f\" text-anchor=\"middle\">average samples per pixel</text>\n",
+    fprintf(f,
+            "<text x=\"%.0f\" y=\"%.0f\" text-anchor=\"middle\">average samples per pixel</text>\n",
             (left + W - right) / 2, H - 12);
-    fprintf(f, "<text x=\"16\" y=\"%.0f\" transform=\"rotate(-90 16 %.0f)\" text-anchor=\"middle\">RMSE</text>\n",
+    fprintf(f,
+            "<text x=\"16\" y=\"%.0f\" transform=\"rotate(-90 16 %.0f)\" "
+            "text-anchor=\"middle\">RMSE</text>\n",
             (top + H - bottom) / 2, (top + H - bottom) / 2);
     static const char *const colours[] = { "#1f63c6", "#c62f1f" };
     for (int c = 0; c < count; ++c) {
         for (int m = 0; m < 2; ++m) {
             const char *colour = colours[m];
-            fprintf(f, "<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"2\"%s points=\"", colour,
-                    curves[c].effect == DRIFT_EFFECT_INDIRECT ? " stroke-dasharray=\"6 4\"" : "");
+            fprintf(f, "<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"2\"%s points=\"",
+                    colour,
+                    curves[c].effect != DRIFT_EFFECT_SHADOWS ? " stroke-dasharray=\"6 4\"" : "");
             int n = m == 0 ? curves[c].count : curves[c].plain_count;
             for (int k = 0; k < n; ++k) {
                 const point *p = m == 0 ? &curves[c].aaf[k] : &curves[c].plain[k];
@@ -418,14 +467,16 @@ static bool write_svg(const char *path, const char *scene, const curve *curves, 
             fprintf(f, "\"/>\n");
             for (int k = 0; k < n; ++k) {
                 const point *p = m == 0 ? &curves[c].aaf[k] : &curves[c].plain[k];
-                fprintf(f, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"3\" fill=\"%s\"/>\n", PX(p->actual_spp),
-                        PY(p->rmse), colour);
+                fprintf(f, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"3\" fill=\"%s\"/>\n",
+                        PX(p->actual_spp), PY(p->rmse), colour);
             }
             double ly = top + 16 + 16 * (2 * c + m);
-            fprintf(f, "<line x1=\"%.0f\" y1=\"%.0f\" x2=\"%.0f\" y2=\"%.0f\" stroke=\"%s\" stroke-width=\"2\"%s/>"
-                       "<text x=\"%.0f\" y=\"%.0f\">%s %s</text>\n",
+            fprintf(f,
+                    "<line x1=\"%.0f\" y1=\"%.0f\" x2=\"%.0f\" y2=\"%.0f\" stroke=\"%s\" "
+                    "stroke-width=\"2\"%s/>"
+                    "<text x=\"%.0f\" y=\"%.0f\">%s %s</text>\n",
                     W - right - 190, ly, W - right - 160, ly, colour,
-                    curves[c].effect == DRIFT_EFFECT_INDIRECT ? " stroke-dasharray=\"6 4\"" : "",
+                    curves[c].effect != DRIFT_EFFECT_SHADOWS ? " stroke-dasharray=\"6 4\"" : "",
                     W - right - 154, ly + 4, drift_effect_name(curves[c].effect),
                     m == 0 ? "AAF" : "plain MC");
         }
@@ -439,9 +490,11 @@ static bool write_svg(const char *path, const char *scene, const curve *curves, 
 static void print_json(const aaf_options *o, const char *scene_path, int threads,
                        const curve *curves, int count)
 {
-    printf("{\"scene\": \"%s\", \"width\": %ld, \"height\": %ld, \"ref_spp\": %ld, \"threads\": %d, "
-           "\"light_samples\": %ld, \"effects\": [",
-           scene_path, o->width, o->height, o->ref_spp, threads, o->light_samples);
+    printf(
+        "{\"scene\": \"%s\", \"width\": %ld, \"height\": %ld, \"ref_spp\": %ld, \"threads\": %d, "
+        "\"light_samples\": %ld, \"sampler\": \"%s\", \"effects\": [",
+        scene_path, o->width, o->height, o->ref_spp, threads, o->light_samples,
+        o->random ? "random" : "sobol");
     for (int c = 0; c < count; ++c) {
         const curve *cv = &curves[c];
         printf("%s{\"effect\": \"%s\", \"aaf\": [", c ? ", " : "", drift_effect_name(cv->effect));
@@ -456,10 +509,11 @@ static void print_json(const aaf_options *o, const char *scene_path, int threads
             printf("%s{\"spp\": %.0f, \"rmse\": %.6g}", k ? ", " : "", cv->plain[k].spp,
                    cv->plain[k].rmse);
         }
-        printf("], \"timing\": {\"width\": %ld, \"height\": %ld, \"spp\": %ld, \"sampling_ms\": %.3f, "
-               "\"filter_ms\": %.3f, \"frame_ms\": %.3f, \"filter_fraction\": %.4f}}",
-               o->timing_width, o->timing_height, o->timing_spp, cv->timing_sampling_ms,
-               cv->timing_filter_ms, cv->timing_frame_ms, cv->timing_filter_ms / cv->timing_frame_ms);
+        printf(
+            "], \"timing\": {\"width\": %ld, \"height\": %ld, \"spp\": %ld, \"sampling_ms\": %.3f, "
+            "\"filter_ms\": %.3f, \"frame_ms\": %.3f, \"filter_fraction\": %.4f}}",
+            o->timing_width, o->timing_height, o->timing_spp, cv->timing_sampling_ms,
+            cv->timing_filter_ms, cv->timing_frame_ms, cv->timing_filter_ms / cv->timing_frame_ms);
     }
     printf("]}\n");
 }
@@ -467,8 +521,8 @@ static void print_json(const aaf_options *o, const char *scene_path, int threads
 static void print_text(const aaf_options *o, const char *scene_path, int threads,
                        const curve *curves, int count)
 {
-    printf("%s, %ldx%ld, reference %ld spp, %d thread(s)\n", scene_path, o->width, o->height,
-           o->ref_spp, threads);
+    printf("%s, %ldx%ld, reference %ld spp, %d thread(s), %s sampler\n", scene_path, o->width,
+           o->height, o->ref_spp, threads, o->random ? "random" : "sobol");
     for (int c = 0; c < count; ++c) {
         const curve *cv = &curves[c];
         printf("\n%s\n%8s %10s %12s %10s\n", drift_effect_name(cv->effect), "spp", "aaf spp",
@@ -513,11 +567,12 @@ int drift_bench_aaf(int argc, char **argv)
     if (!cli_open_scene(ctx, "bench aaf", scene_path, &scene, &accel, NULL)) {
         goto done;
     }
-    curve curves[2];
+    curve curves[3];
     int count = 0;
-    drift_effect effects[2] = { DRIFT_EFFECT_SHADOWS, DRIFT_EFFECT_INDIRECT };
-    bool wanted[2] = { o.shadows, o.indirect };
-    for (int e = 0; e < 2; ++e) {
+    drift_effect effects[3] = { DRIFT_EFFECT_SHADOWS, DRIFT_EFFECT_INDIRECT,
+                                DRIFT_EFFECT_REFLECTIONS };
+    bool wanted[3] = { o.shadows, o.indirect, o.reflections };
+    for (int e = 0; e < 3; ++e) {
         if (!wanted[e]) {
             continue;
         }

@@ -63,7 +63,7 @@ static void print_help(void)
     // Split in parts: C99 guarantees string literals of 4095 characters only.
     printf("hybrid mode (docs/hybrid.md):\n"
            "  --shadows T           hard (default), pcf, pcss, reference, isg, blur or aaf\n"
-           "  --reflections T       none (default), envmap, sharp, reference, isg or blur\n"
+           "  --reflections T       none (default), envmap, sharp, reference, isg, blur or aaf\n"
            "  --dof T               none (default), post, reference or isg\n"
            "  --indirect T          none (default), ambient, reference or aaf\n"
            "                        reference = that effect alone path-traced at --spp\n"
@@ -89,6 +89,8 @@ static void print_help(void)
            "  --aaf-max-spp N       cap on AAF's adaptive samples a pixel (default 8 x spp)\n"
            "  --aaf-sampling M      adaptive (default) or uniform: spp in every pixel\n"
            "  --aaf-filter on|off   off: AAF's unfiltered estimate (with uniform: plain MC)\n"
+           "  --aaf-sampler S       sobol (default: Owen-scrambled Sobol) or random (independent\n"
+           "                        uniform numbers, the paper's Monte Carlo)\n"
            "\n");
     printf("smart image refinement (hybrid mode; docs/sir.md):\n"
            "  --refine sir          refine the frame by ray tracing, worst estimated error first\n"

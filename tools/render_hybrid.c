@@ -57,7 +57,8 @@ bool render_parse_hybrid_option(int argc, char **argv, int *i, render_options *o
                                           "--aperture",      "--focus-distance",
                                           "--isg-search",    "--isg-gather",      "--isg-sigma",
                                           "--blur-radius",   "--isg-layers",      "--isg-range",
-                                          "--aaf-max-spp",   "--aaf-sampling",    "--aaf-filter" };
+                                          "--aaf-max-spp",   "--aaf-sampling",    "--aaf-filter",
+                                          "--aaf-sampler" };
     if (render_parse_refine_option(argc, argv, i, o, ok)) {
         return true; // --refine sir and its options (tools/render_refine.c)
     }
@@ -161,6 +162,13 @@ bool render_parse_hybrid_option(int argc, char **argv, int *i, render_options *o
         h->aaf_unfiltered = strcmp(v, "off") == 0;
         if (!*ok) {
             fprintf(stderr, "drift render: --aaf-filter expects on or off, got '%s'\n", v);
+        }
+        break;
+    case 17:
+        *ok = strcmp(v, "sobol") == 0 || strcmp(v, "random") == 0;
+        h->aaf_random = strcmp(v, "random") == 0;
+        if (!*ok) {
+            fprintf(stderr, "drift render: --aaf-sampler expects sobol or random, got '%s'\n", v);
         }
         break;
     default:

@@ -71,6 +71,8 @@ typedef enum drift_reflection_technique {
     DRIFT_REFLECTIONS_REFERENCE, // path-traced first-bounce glossy/mirror light at --spp
     DRIFT_REFLECTIONS_ISG,       // image space gathering over the sharp buffer (docs/isg.md)
     DRIFT_REFLECTIONS_BLUR,      // baseline: the sharp buffer blurred over a fixed disk
+    DRIFT_REFLECTIONS_AAF,       // path-traced first-bounce glossy light, adaptively sampled and
+                                 // filtered (AAF's specular buffer; docs/aaf.md), mirrors sharp
     DRIFT_REFLECTIONS_COUNT
 } drift_reflection_technique;
 
@@ -118,6 +120,8 @@ int drift_technique_parse(drift_effect effect, const char *name);
 //   aaf_uniform      = false: AAF samples adaptively; true: every pixel takes spp samples
 //   aaf_unfiltered   = false: AAF filters; true: the noisy estimate is used as it is
 //                      (both true: plain Monte Carlo with AAF's sampler, the benchmark baseline)
+//   aaf_random       = false: AAF's samples are Owen-scrambled Sobol points; true: independent
+//                      uniform random numbers (the paper's traditional Monte Carlo sampling)
 typedef struct drift_hybrid_params {
     int32_t width, height;
     drift_shadow_technique shadows;
@@ -156,6 +160,7 @@ typedef struct drift_hybrid_params {
     uint32_t aaf_max_spp;
     bool aaf_uniform;
     bool aaf_unfiltered;
+    bool aaf_random;
 } drift_hybrid_params;
 
 drift_hybrid_params drift_hybrid_params_resolve(const drift_hybrid_params *params,

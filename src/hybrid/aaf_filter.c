@@ -114,52 +114,77 @@ static float distance_sq(const drift_aaf_filter_desc *d, drift_vec3 a, drift_vec
     return drift_vec3_dot(v, v);
 }
 
-// Whether a neighbour may share its samples with the centre: a surface like it (depth,
-// normal) whose filter width is not too different (eq. 3.7 holds while beta varies slowly).
-static bool accept(const filter_texel *centre, const filter_texel *n)
+// The centre's tests, precomputed once for all its taps.
+typedef struct centre_tests {
+    float depth, depth_tolerance;
+    drift_vec3 normal;
+    float beta_low, beta_high;
+} centre_tests;
+
+static centre_tests centre_tests_make(const filter_texel *c)
 {
-    if (n->depth < 0.0f || fabsf(n->depth - centre->depth) > DRIFT_AAF_DEPTH_TOLERANCE * centre->depth ||
-        drift_vec3_dot(n->normal, centre->normal) < DRIFT_AAF_NORMAL_COS) {
-        return false;
-    }
-    if (n->beta > 0.0f) {
-        float ratio = n->beta > centre->beta ? n->beta / centre->beta : centre->beta / n->beta;
-        return ratio <= DRIFT_AAF_BETA_RATIO;
-    }
-    return true;
+    return (centre_tests){ .depth = c->depth,
+                           .depth_tolerance = DRIFT_AAF_DEPTH_TOLERANCE * c->depth,
+                           .normal = c->normal,
+                           .beta_low = c->beta / DRIFT_AAF_BETA_RATIO,
+                           .beta_high = c->beta * DRIFT_AAF_BETA_RATIO };
 }
 
-static void filter_pixel(const filter_job *job, int32_t x, int32_t y)
+// Whether a neighbour may share its samples with the centre: a surface like it (depth,
+// normal) whose filter width is not too different (eq. 3.7 holds while beta varies slowly).
+// The beta ratio test is max(a, b) / min(a, b) <= ratio, written without the division.
+static bool accept(const centre_tests *c, const filter_texel *n)
+{
+    if (n->depth < 0.0f || fabsf(n->depth - c->depth) > c->depth_tolerance ||
+        drift_vec3_dot(n->normal, c->normal) < DRIFT_AAF_NORMAL_COS) {
+        return false;
+    }
+    return !(n->beta > 0.0f) || (n->beta <= c->beta_high && n->beta >= c->beta_low);
+}
+
+static int32_t filter_radius(const drift_aaf_filter_desc *d, const filter_texel *c, float footprint)
+{
+    float reach = footprint > 0.0f ? ceilf(3.0f * c->beta / footprint) : (float)d->max_radius;
+    return reach < (float)d->max_radius ? (int32_t)reach : d->max_radius;
+}
+
+static bool filtered(const filter_texel *c)
+{
+    return c->depth >= 0.0f && c->beta > 0.0f;
+}
+
+static void copy_pixel(const float *in, float *out, int channels)
+{
+    for (int k = 0; k < channels; ++k) {
+        out[k] = in[k];
+    }
+}
+
+// The exact 2-D filter (eq. 3.2) at one pixel.
+static void filter_pixel_exact(const filter_job *job, int32_t x, int32_t y)
 {
     const drift_aaf_filter_desc *d = job->desc;
     int channels = job->in->channels;
     int32_t w = job->in->width, h = job->in->height;
     float *out = drift_image_pixel(job->out, x, y);
-    const float *centre = drift_image_pixel(job->in, x, y);
     const filter_texel *c = &job->texels[(size_t)y * (size_t)w + (size_t)x];
-    if (c->depth < 0.0f || !(c->beta > 0.0f)) {
-        for (int k = 0; k < channels; ++k) {
-            out[k] = centre[k];
-        }
+    if (!filtered(c)) {
+        copy_pixel(drift_image_pixel(job->in, x, y), out, channels);
         return;
     }
-    float footprint = drift_image_pixel(d->footprint, x, y)[0];
-    float reach = footprint > 0.0f ? ceilf(3.0f * c->beta / footprint) : (float)d->max_radius;
-    int32_t radius = reach < (float)d->max_radius ? (int32_t)reach : d->max_radius;
+    int32_t radius = filter_radius(d, c, drift_image_pixel(d->footprint, x, y)[0]);
+    centre_tests tests = centre_tests_make(c);
     float inv = -0.5f / (c->beta * c->beta);
     float sum[4] = { 0.0f, 0.0f, 0.0f, 0.0f };
     float weight = 0.0f;
-    bool exact = job->dx == 0 && job->dy == 0;
-    for (int32_t j = exact ? -radius : 0; j <= (exact ? radius : 0); ++j) {
-        for (int32_t k = -radius; k <= radius; ++k) {
-            int32_t nx = exact ? x + k : x + k * job->dx;
-            int32_t ny = exact ? y + j : y + k * job->dy;
+    for (int32_t ny = y - radius; ny <= y + radius; ++ny) {
+        for (int32_t nx = x - radius; nx <= x + radius; ++nx) {
             if (nx < 0 || ny < 0 || nx >= w || ny >= h) {
                 continue;
             }
             const filter_texel *n = &job->texels[(size_t)ny * (size_t)w + (size_t)nx];
             bool self = n == c;
-            if (!self && !accept(c, n)) {
+            if (!self && !accept(&tests, n)) {
                 continue;
             }
             float wk = self ? 1.0f : expf(inv * distance_sq(d, c->position, n->position));
@@ -172,6 +197,68 @@ static void filter_pixel(const filter_job *job, int32_t x, int32_t y)
     }
     for (int m = 0; m < channels; ++m) {
         out[m] = sum[m] / weight;
+    }
+}
+
+// One pixel of a 1-D pass (eq. 3.3 along dx, dy) for an image of `channels` channels (a
+// constant where it is inlined, so the sums stay in registers): the taps are clamped to the
+// image once and walked by pointer steps, so the loop holds only the tests and the Gaussian.
+// The sums run in the same order as the exact filter's, so the output is that of a plain loop.
+static inline void filter_pixel_line_n(const filter_job *job, int32_t x, int32_t y,
+                                       const int channels)
+{
+    const drift_aaf_filter_desc *d = job->desc;
+    const int32_t w = job->in->width;
+    const filter_texel *c = &job->texels[(size_t)y * (size_t)w + (size_t)x];
+    const float *centre = drift_image_pixel(job->in, x, y);
+    float *out = drift_image_pixel(job->out, x, y);
+    if (!filtered(c)) {
+        copy_pixel(centre, out, channels);
+        return;
+    }
+    int32_t radius = filter_radius(d, c, drift_image_pixel(d->footprint, x, y)[0]);
+    int32_t at = job->dx ? x : y, last = (job->dx ? w : job->in->height) - 1 - at;
+    int32_t lo = at < radius ? -at : -radius, hi = last < radius ? last : radius;
+    ptrdiff_t texel_step = job->dx ? 1 : (ptrdiff_t)w;
+    ptrdiff_t value_step = job->dx ? (ptrdiff_t)channels : job->in->stride;
+    centre_tests tests = centre_tests_make(c);
+    const drift_aaf_filter_desc axis = { .has_axis = d->has_axis, .axis = d->axis };
+    const drift_vec3 p = c->position;
+    float inv = -0.5f / (c->beta * c->beta);
+    float sum[4] = { 0.0f, 0.0f, 0.0f, 0.0f };
+    float weight = 0.0f;
+    const filter_texel *n = c + lo * texel_step;
+    const float *v = centre + lo * value_step;
+    for (int32_t k = lo; k <= hi; ++k, n += texel_step, v += value_step) {
+        float wk = 1.0f;
+        if (k != 0) {
+            if (!accept(&tests, n)) {
+                continue;
+            }
+            wk = expf(inv * distance_sq(&axis, p, n->position));
+        }
+        for (int m = 0; m < channels; ++m) {
+            sum[m] += wk * v[m];
+        }
+        weight += wk;
+    }
+    for (int m = 0; m < channels; ++m) {
+        out[m] = sum[m] / weight;
+    }
+}
+
+static void filter_pixel_line(const filter_job *job, int32_t x, int32_t y)
+{
+    switch (job->in->channels) {
+    case 1:
+        filter_pixel_line_n(job, x, y, 1);
+        break;
+    case 3:
+        filter_pixel_line_n(job, x, y, 3);
+        break;
+    default:
+        filter_pixel_line_n(job, x, y, job->in->channels);
+        break;
     }
 }
 
@@ -190,20 +277,28 @@ static void pack_rows(size_t begin, size_t end, int thread_index, void *user)
         for (int32_t x = 0; x < job->width; ++x) {
             int32_t yy = (int32_t)y;
             bool surface = drift_image_pixel(&g->material_id, x, yy)[0] >= 0.0f;
-            job->texels[y * (size_t)job->width + (size_t)x] = (filter_texel){
-                .position = drift_image_get3(&g->position, x, yy),
-                .depth = surface ? drift_image_pixel(&g->depth, x, yy)[0] : -1.0f,
-                .normal = drift_image_get3(&g->normal, x, yy),
-                .beta = drift_image_pixel(job->desc->beta, x, yy)[0]
-            };
+            job->texels[y * (size_t)job->width + (size_t)x] =
+                (filter_texel){ .position = drift_image_get3(&g->position, x, yy),
+                                .depth = surface ? drift_image_pixel(&g->depth, x, yy)[0] : -1.0f,
+                                .normal = drift_image_get3(&g->normal, x, yy),
+                                .beta = drift_image_pixel(job->desc->beta, x, yy)[0] };
         }
     }
 }
 
+size_t drift_aaf_filter_workspace_bytes(int32_t width, int32_t height)
+{
+    return sizeof(filter_texel) * (size_t)width * (size_t)height;
+}
+
+// The packed inputs, in the caller's workspace when it gives one (no allocation, no page
+// faults per call), else in a buffer of the filter's own.
 static filter_texel *pack(drift_context *ctx, const drift_aaf_filter_desc *desc, int32_t width,
                           int32_t height)
 {
-    filter_texel *texels = drift_alloc(ctx, sizeof(filter_texel) * (size_t)width * (size_t)height);
+    filter_texel *texels = desc->workspace
+                               ? desc->workspace
+                               : drift_alloc(ctx, drift_aaf_filter_workspace_bytes(width, height));
     if (texels) {
         pack_job job = { desc, texels, width };
         drift_parallel_for(ctx, (size_t)height, 8, pack_rows, &job);
@@ -215,16 +310,45 @@ static void filter_rows(size_t begin, size_t end, int thread_index, void *user)
 {
     (void)thread_index;
     const filter_job *job = user;
+    bool exact = job->dx == 0 && job->dy == 0;
     for (size_t y = begin; y < end; ++y) {
         for (int32_t x = 0; x < job->in->width; ++x) {
-            filter_pixel(job, x, (int32_t)y);
+            if (exact) {
+                filter_pixel_exact(job, x, (int32_t)y);
+            } else {
+                filter_pixel_line(job, x, (int32_t)y);
+            }
+        }
+    }
+}
+
+// The vertical pass by strips of columns: a strip's taps (2 radius + 1 rows of a few
+// columns) stay in the cache while the strip walks down, where whole rows would not.
+#define FILTER_STRIP 16
+
+static void filter_strips(size_t begin, size_t end, int thread_index, void *user)
+{
+    (void)thread_index;
+    const filter_job *job = user;
+    for (size_t s = begin; s < end; ++s) {
+        int32_t x0 = (int32_t)s * FILTER_STRIP;
+        int32_t x1 = x0 + FILTER_STRIP < job->in->width ? x0 + FILTER_STRIP : job->in->width;
+        for (int32_t y = 0; y < job->in->height; ++y) {
+            for (int32_t x = x0; x < x1; ++x) {
+                filter_pixel_line(job, x, y);
+            }
         }
     }
 }
 
 static void run_filter(drift_context *ctx, filter_job *job)
 {
-    drift_parallel_for(ctx, (size_t)job->in->height, 4, filter_rows, job);
+    if (job->dy) {
+        size_t strips = ((size_t)job->in->width + FILTER_STRIP - 1) / FILTER_STRIP;
+        drift_parallel_for(ctx, strips, 1, filter_strips, job);
+    } else {
+        drift_parallel_for(ctx, (size_t)job->in->height, 4, filter_rows, job);
+    }
 }
 
 drift_result drift_aaf_filter_separable(drift_context *ctx, const drift_aaf_filter_desc *desc,
@@ -239,7 +363,9 @@ drift_result drift_aaf_filter_separable(drift_context *ctx, const drift_aaf_filt
     run_filter(ctx, &job);
     job = (filter_job){ .desc = desc, .texels = texels, .in = scratch, .out = out, .dy = 1 };
     run_filter(ctx, &job);
-    drift_free(ctx, texels);
+    if (texels != desc->workspace) {
+        drift_free(ctx, texels);
+    }
     return DRIFT_OK;
 }
 
@@ -252,6 +378,8 @@ drift_result drift_aaf_filter_exact(drift_context *ctx, const drift_aaf_filter_d
     }
     filter_job job = { .desc = desc, .texels = texels, .in = in, .out = out };
     run_filter(ctx, &job);
-    drift_free(ctx, texels);
+    if (texels != desc->workspace) {
+        drift_free(ctx, texels);
+    }
     return DRIFT_OK;
 }

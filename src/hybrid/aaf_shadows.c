@@ -15,16 +15,19 @@
 
 #include <math.h>
 
-enum { STREAM_AAF_SHADOWS = 0x5aaf0001u };
+enum {
+    STREAM_AAF_SHADOWS = 0x5aaf0001u
+};
 
 typedef struct shadow_job {
     uint32_t light;
-    uint32_t key;     // sampler key of this light
-    uint32_t sparse;  // sparse samples a pixel
-    float area;       // A_l
-    float sigma;      // the light's Gaussian standard deviation
-    float shrink;     // drift_aaf_beta_shrink(spp)
-    bool uniform;     // plain sampling: every pixel takes spp
+    uint32_t key;    // sampler key of this light
+    uint32_t sparse; // sparse samples a pixel
+    float area;      // A_l
+    float sigma;     // the light's Gaussian standard deviation
+    float shrink;    // drift_aaf_beta_shrink(spp)
+    bool uniform;    // plain sampling: every pixel takes spp
+    bool random;     // independent random numbers, not Sobol points
 } shadow_job;
 
 static size_t pixel_index(const drift_hybrid *f, int32_t x, int32_t y)
@@ -49,7 +52,8 @@ static float light_area(const drift_scene *scene, const drift_hybrid_light *ligh
         case DRIFT_LIGHT_TRIANGLE: {
             drift_vec3 a, b, c;
             drift_light_triangle_vertices(scene, l, &a, &b, &c);
-            area += 0.5f * drift_vec3_length(drift_vec3_cross(drift_vec3_sub(b, a), drift_vec3_sub(c, a)));
+            area += 0.5f *
+                    drift_vec3_length(drift_vec3_cross(drift_vec3_sub(b, a), drift_vec3_sub(c, a)));
             break;
         }
         case DRIFT_LIGHT_POINT:
@@ -82,9 +86,9 @@ static void trace_samples(drift_hybrid *f, const shadow_job *job, const drift_su
     while (sums->taken < (float)target && sums->next < 4.0f * (float)target + 4.0f) {
         uint32_t k = (uint32_t)sums->next;
         sums->next += 1.0f;
-        drift_sampler sampler = drift_sampler_make(job->key, pixel, k);
-        float pick = drift_sampler_next1(&sampler);
-        drift_vec2 u = drift_sampler_next2(&sampler);
+        drift_aaf_sampler sampler = drift_aaf_sampler_make(job->key, pixel, k, job->random);
+        float pick = drift_aaf_next1(&sampler);
+        drift_vec2 u = drift_aaf_next2(&sampler);
         drift_light_sample ls = drift_hybrid_light_sample(f->scene, light, s->position, pick, u);
         if (!(ls.pdf > 0.0f)) {
             continue;
@@ -161,9 +165,12 @@ static bool occluder_ratios(const drift_hybrid *f, int32_t x, int32_t y, float *
                 drift_image_pixel(&g->material_id, nx, ny)[0] < 0.0f) {
                 continue;
             }
-            const shadow_sums *n = (const shadow_sums *)&st->aux[DRIFT_AAF_AUX * pixel_index(f, nx, ny)];
-            if (fabsf(drift_image_pixel(&g->depth, nx, ny)[0] - depth) > DRIFT_AAF_DEPTH_TOLERANCE * depth ||
-                drift_vec3_dot(drift_image_get3(&g->normal, nx, ny), normal) < DRIFT_AAF_NORMAL_COS) {
+            const shadow_sums *n =
+                (const shadow_sums *)&st->aux[DRIFT_AAF_AUX * pixel_index(f, nx, ny)];
+            if (fabsf(drift_image_pixel(&g->depth, nx, ny)[0] - depth) >
+                    DRIFT_AAF_DEPTH_TOLERANCE * depth ||
+                drift_vec3_dot(drift_image_get3(&g->normal, nx, ny), normal) <
+                    DRIFT_AAF_NORMAL_COS) {
                 continue;
             }
             lit = lit || n->visible > 0.0f;
@@ -280,16 +287,20 @@ drift_result drift_hybrid_pass_aaf_shadows(drift_hybrid *f)
                            .key = drift_hash_combine(f->params.seed, STREAM_AAF_SHADOWS + l),
                            .sparse = drift_aaf_sparse_count(f->params.spp),
                            .area = light_area(f->scene, light),
-                           .shrink = drift_aaf_beta_shrink(f->params.spp, DRIFT_AAF_SHADOW_SHRINK_SPP,
-                                                           DRIFT_AAF_SHADOW_SHRINK_EXP),
-                           .uniform = f->params.aaf_uniform };
+                           .shrink =
+                               drift_aaf_beta_shrink(f->params.spp, DRIFT_AAF_SHADOW_SHRINK_SPP,
+                                                     DRIFT_AAF_SHADOW_SHRINK_EXP),
+                           .uniform = f->params.aaf_uniform,
+                           .random = f->params.aaf_random };
         job.sigma = DRIFT_AAF_LIGHT_SIGMA * sqrtf(job.area);
         double t = drift_time_now();
         bool area = job.area > 0.0f && light->type != DRIFT_LIGHT_DIRECTIONAL;
         if (!area) {
-            stats->rays[DRIFT_PASS_AAF_SAMPLING] += drift_hybrid_for_each_pixel(f, hard_pixel, &job);
+            stats->rays[DRIFT_PASS_AAF_SAMPLING] +=
+                drift_hybrid_for_each_pixel(f, hard_pixel, &job);
         } else {
-            stats->rays[DRIFT_PASS_AAF_SAMPLING] += drift_hybrid_for_each_pixel(f, sparse_pixel, &job);
+            stats->rays[DRIFT_PASS_AAF_SAMPLING] +=
+                drift_hybrid_for_each_pixel(f, sparse_pixel, &job);
             drift_hybrid_for_each_pixel(f, rates_pixel, &job);
             if (!job.uniform) {
                 drift_aaf_allocate(st->want, pixels, active, job.sparse, f->params.spp,
@@ -306,7 +317,8 @@ drift_result drift_hybrid_pass_aaf_shadows(drift_hybrid *f)
         if (!area || f->params.aaf_unfiltered) {
             for (int32_t y = 0; y < shadow->height; ++y) {
                 for (int32_t x = 0; x < shadow->width; ++x) {
-                    drift_image_pixel(shadow, x, y)[0] = drift_image_pixel(&al->unfiltered, x, y)[0];
+                    drift_image_pixel(shadow, x, y)[0] =
+                        drift_image_pixel(&al->unfiltered, x, y)[0];
                 }
             }
         } else {
@@ -318,7 +330,8 @@ drift_result drift_hybrid_pass_aaf_shadows(drift_hybrid *f)
                                            // (docs/aaf.md, departures).
                                            .has_axis = false,
                                            .axis = light->direction,
-                                           .max_radius = DRIFT_AAF_MAX_RADIUS };
+                                           .max_radius = DRIFT_AAF_MAX_RADIUS,
+                                           .workspace = st->filter_workspace };
             r = drift_aaf_filter_separable(f->ctx, &desc, &al->unfiltered, &st->scratch1, shadow);
             if (r != DRIFT_OK) {
                 return r;

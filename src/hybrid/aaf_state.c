@@ -12,9 +12,19 @@ void drift_aaf_state_destroy(drift_context *ctx, drift_aaf_state *s)
         drift_image_destroy(ctx, &s->lights[l].spp);
         drift_image_destroy(ctx, &s->lights[l].unfiltered);
     }
-    drift_image *images[] = { &s->footprint,          &s->scratch1,          &s->scratch3,
-                              &s->indirect_beta,      &s->indirect_spp,      &s->indirect_unfiltered,
-                              &s->indirect_radiance,  &s->indirect_filtered };
+    drift_image *images[] = { &s->footprint,
+                              &s->scratch1,
+                              &s->scratch3,
+                              &s->indirect.beta,
+                              &s->indirect.spp,
+                              &s->indirect.unfiltered,
+                              &s->indirect.radiance,
+                              &s->indirect.filtered,
+                              &s->specular.beta,
+                              &s->specular.spp,
+                              &s->specular.unfiltered,
+                              &s->specular.radiance,
+                              &s->specular.filtered };
     for (size_t i = 0; i < sizeof images / sizeof *images; ++i) {
         drift_image_destroy(ctx, images[i]);
     }
@@ -22,6 +32,7 @@ void drift_aaf_state_destroy(drift_context *ctx, drift_aaf_state *s)
     drift_free(ctx, s->want);
     drift_free(ctx, s->counts);
     drift_free(ctx, s->aux);
+    drift_free(ctx, s->filter_workspace);
     drift_free(ctx, s);
 }
 
@@ -44,10 +55,15 @@ drift_result drift_aaf_state_ensure(drift_hybrid *f)
     s->want = drift_alloc(ctx, sizeof(float) * pixels);
     s->counts = drift_alloc(ctx, sizeof(uint32_t) * pixels);
     s->aux = drift_alloc(ctx, sizeof(float) * DRIFT_AAF_AUX * pixels);
-    drift_result r = s->lights && s->want && s->counts && s->aux ? DRIFT_OK : DRIFT_ERR_OUT_OF_MEMORY;
-    drift_image *ones[] = { &s->footprint, &s->scratch1, &s->indirect_beta, &s->indirect_spp };
-    drift_image *threes[] = { &s->scratch3, &s->indirect_unfiltered, &s->indirect_radiance,
-                              &s->indirect_filtered };
+    s->filter_workspace = drift_alloc(ctx, drift_aaf_filter_workspace_bytes(w, h));
+    drift_result r = s->lights && s->want && s->counts && s->aux && s->filter_workspace
+                         ? DRIFT_OK
+                         : DRIFT_ERR_OUT_OF_MEMORY;
+    drift_image *ones[] = { &s->footprint,    &s->scratch1,      &s->indirect.beta,
+                            &s->indirect.spp, &s->specular.beta, &s->specular.spp };
+    drift_image *threes[] = { &s->scratch3,          &s->indirect.unfiltered, &s->indirect.radiance,
+                              &s->indirect.filtered, &s->specular.unfiltered, &s->specular.radiance,
+                              &s->specular.filtered };
     for (size_t i = 0; r == DRIFT_OK && i < sizeof ones / sizeof *ones; ++i) {
         r = drift_image_create(ctx, w, h, 1, ones[i]);
     }

@@ -14,7 +14,7 @@
 static const char *const shadow_names[] = { "hard", "pcf", "pcss", "reference",
                                            "isg",  "blur", "aaf" };
 static const char *const reflection_names[] = { "none", "envmap", "sharp",
-                                               "reference", "isg", "blur" };
+                                               "reference", "isg", "blur", "aaf" };
 static const char *const dof_names[] = { "none", "post", "reference", "isg" };
 static const char *const indirect_names[] = { "none", "ambient", "reference", "aaf" };
 static const char *const effect_names[] = { "shadows", "reflections", "dof", "indirect" };
@@ -481,9 +481,14 @@ static void collect_planes(drift_hybrid *f)
         }
     }
     if (p->indirect == DRIFT_INDIRECT_AAF && f->aaf) {
-        add_plane(f, "indirect.aaf.beta", &f->aaf->indirect_beta);
-        add_plane(f, "indirect.aaf.spp", &f->aaf->indirect_spp);
-        add_plane(f, "indirect.aaf.unfiltered", &f->aaf->indirect_unfiltered);
+        add_plane(f, "indirect.aaf.beta", &f->aaf->indirect.beta);
+        add_plane(f, "indirect.aaf.spp", &f->aaf->indirect.spp);
+        add_plane(f, "indirect.aaf.unfiltered", &f->aaf->indirect.unfiltered);
+    }
+    if (p->reflections == DRIFT_REFLECTIONS_AAF && f->aaf) {
+        add_plane(f, "reflections.aaf.beta", &f->aaf->specular.beta);
+        add_plane(f, "reflections.aaf.spp", &f->aaf->specular.spp);
+        add_plane(f, "reflections.aaf.unfiltered", &f->aaf->specular.unfiltered);
     }
     if (p->reflections == DRIFT_REFLECTIONS_SHARP || p->reflections == DRIFT_REFLECTIONS_ISG ||
         p->reflections == DRIFT_REFLECTIONS_BLUR) {

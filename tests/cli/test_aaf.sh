@@ -30,12 +30,23 @@ expect 0 "$drift" render "${small[@]}" --shadows aaf --aaf-sampling uniform --aa
 expect 0 "$drift" render "${small[@]}" --indirect aaf --aaf-max-spp 16 --max-depth 3 \
     --out "$tmp/b.exr"
 [ -s "$tmp/b.exr" ] || fail "two-bounce aaf wrote no image"
+expect 0 "$drift" render "${small[@]}" --shadows aaf --indirect aaf --aaf-sampler random \
+    --out "$tmp/r.exr"
+[ -s "$tmp/r.exr" ] || fail "random-sampled aaf wrote no image"
+# The specular buffer: --reflections aaf, its planes in --aov.
+expect 0 "$drift" render "${small[@]}" --reflections aaf --indirect aaf --out "$tmp/s.exr" \
+    --aov "$tmp/s-aov.exr"
+for layer in reflections.aaf.beta.Y reflections.aaf.spp.Y reflections.aaf.unfiltered.R; do
+    grep -aq "$layer" "$tmp/s-aov.exr" || fail "AOV file lacks $layer"
+done
 
 # Usage errors.
 expect 2 "$drift" render "${small[@]}" --aaf-sampling sometimes --out "$tmp/x.exr"
 grep -q "adaptive or uniform" "$tmp/err" || fail "--aaf-sampling error does not list the choices"
 expect 2 "$drift" render "${small[@]}" --aaf-filter maybe --out "$tmp/x.exr"
 grep -q "on or off" "$tmp/err" || fail "--aaf-filter error does not list the choices"
+expect 2 "$drift" render "${small[@]}" --aaf-sampler halton --out "$tmp/x.exr"
+grep -q "sobol or random" "$tmp/err" || fail "--aaf-sampler error does not list the choices"
 expect 2 "$drift" render "${small[@]}" --aaf-max-spp 0 --out "$tmp/x.exr"
 expect 2 "$drift" render "${small[@]}" --shadows aaf --aaf-max-spp 4 --out "$tmp/x.exr"
 grep -q "aaf max spp below spp" "$tmp/err" || fail "a cap under --spp is not explained"
@@ -44,5 +55,7 @@ grep -q "needs --mode hybrid" "$tmp/err" || fail "aaf option in reference mode n
 [ -e "$tmp/x.exr" ] && fail "an output was written after a usage error"
 expect 0 "$drift" render --help
 grep -q -- "--aaf-max-spp" "$tmp/out" || fail "--help does not list --aaf-max-spp"
+grep -q -- "--aaf-sampler" "$tmp/out" || fail "--help does not list --aaf-sampler"
+grep -q -- "isg, blur or aaf" "$tmp/out" || fail "--help does not list --reflections aaf"
 
 exit $((failures > 0))

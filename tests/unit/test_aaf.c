@@ -3,17 +3,16 @@
 // Monte Carlo at equal spp; full light and full shadow stay exactly 1 and 0; beta grows with
 // the receiver-to-occluder distance and n(x) peaks at contact edges; the separable filter
 // stays close to the exact 2-D filter on a smooth penumbra; the sample budget holds its mean.
-#include "drift_test.h"
-
-#include <math.h>
-#include <stdlib.h>
-#include <string.h>
-
 #include "drift/accel.h"
 #include "drift/hybrid.h"
 #include "drift/pt.h"
 #include "drift/scene.h"
+#include "drift_test.h"
 #include "hybrid/aaf_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
 
 typedef struct rig {
     drift_context *ctx;
@@ -88,7 +87,8 @@ static double rmse(const drift_image *a, const drift_image *b)
     for (int y = 0; y < a->height; ++y) {
         for (int x = 0; x < a->width; ++x) {
             for (int c = 0; c < 3; ++c) {
-                double d = (double)drift_image_pixel(a, x, y)[c] - (double)drift_image_pixel(b, x, y)[c];
+                double d =
+                    (double)drift_image_pixel(a, x, y)[c] - (double)drift_image_pixel(b, x, y)[c];
                 sum += d * d;
             }
         }
@@ -99,8 +99,8 @@ static double rmse(const drift_image *a, const drift_image *b)
 static void add_quad(drift_scene *scene, drift_vec3 corner, drift_vec3 u, drift_vec3 v,
                      uint32_t material)
 {
-    drift_vec3 c[4] = { corner, drift_vec3_add(corner, u), drift_vec3_add(drift_vec3_add(corner, u), v),
-                        drift_vec3_add(corner, v) };
+    drift_vec3 c[4] = { corner, drift_vec3_add(corner, u),
+                        drift_vec3_add(drift_vec3_add(corner, u), v), drift_vec3_add(corner, v) };
     float p[12];
     for (int k = 0; k < 4; ++k) {
         p[3 * k] = c[k].x;
@@ -131,12 +131,18 @@ static void add_light(drift_scene *scene)
                      DRIFT_OK);
 }
 
-enum { W = 64, H = 48 };
+enum {
+    W = 64,
+    H = 48
+};
 
 // A floor under the light with a low square (h 0.6, x < 0), a high one (h 1.2, x > 0) and a
 // wall standing on the floor at z = -1.2 (a contact edge), seen from below the light. Large
 // enough (96x72) that the penumbrae span a few pixels.
-enum { SW = 96, SH = 72 };
+enum {
+    SW = 96,
+    SH = 72
+};
 
 static void build_shadow_scene(rig *r)
 {
@@ -150,8 +156,9 @@ static void build_shadow_scene(rig *r)
              drift_vec3_make(0, 0.6f, 0), white);
     add_light(r->scene);
     // Over the wall's far side, so the floor behind its foot is in view.
-    r->scene->camera = drift_camera_look_at(drift_vec3_make(0, 2.5f, -1.25f), drift_vec3_make(0, 0, -1.24f),
-                                            drift_vec3_make(0, 0, 1), 1.4f, SW, SH);
+    r->scene->camera =
+        drift_camera_look_at(drift_vec3_make(0, 2.5f, -1.25f), drift_vec3_make(0, 0, -1.24f),
+                             drift_vec3_make(0, 0, 1), 1.4f, SW, SH);
 }
 
 // The shadow frame's error against the path-traced direct light falls as spp grows, and at
@@ -169,10 +176,14 @@ static void test_shadows_converge(void **state)
     const uint32_t spps[3] = { 4, 16, 64 };
     double aaf[3], plain[3];
     for (int k = 0; k < 3; ++k) {
-        rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_AAF, .spp = spps[k], .seed = 3 });
+        rig_frame(
+            &r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_AAF, .spp = spps[k], .seed = 3 });
         aaf[k] = rmse(drift_hybrid_image(r.frame), &truth);
-        rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_AAF, .spp = spps[k], .seed = 3,
-                                              .aaf_uniform = true, .aaf_unfiltered = true });
+        rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_AAF,
+                                              .spp = spps[k],
+                                              .seed = 3,
+                                              .aaf_uniform = true,
+                                              .aaf_unfiltered = true });
         plain[k] = rmse(drift_hybrid_image(r.frame), &truth);
     }
     print_message("shadows rmse aaf %g %g %g, plain MC %g %g %g\n", aaf[0], aaf[1], aaf[2],
@@ -189,7 +200,12 @@ static void test_shadows_converge(void **state)
 }
 
 // Regions on the floor (y = 0) of the shadow scene.
-typedef enum region { REGION_NONE, REGION_LOW, REGION_HIGH, REGION_CONTACT } region;
+typedef enum region {
+    REGION_NONE,
+    REGION_LOW,
+    REGION_HIGH,
+    REGION_CONTACT
+} region;
 
 static region floor_region(drift_vec3 p)
 {
@@ -261,8 +277,9 @@ static void test_full_light_and_full_shadow_are_exact(void **state)
             add_square(r.scene, 0.0f, 1.5f, 0.0f, 20.0f, white);
         }
         add_light(r.scene);
-        r.scene->camera = drift_camera_look_at(drift_vec3_make(0, 1.2f, -0.01f), drift_vec3_make(0, 0, 0),
-                                               drift_vec3_make(0, 0, 1), 1.0f, W, H);
+        r.scene->camera =
+            drift_camera_look_at(drift_vec3_make(0, 1.2f, -0.01f), drift_vec3_make(0, 0, 0),
+                                 drift_vec3_make(0, 0, 1), 1.0f, W, H);
         rig_commit(&r);
         rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_AAF, .spp = 16, .seed = 4 });
         const drift_image *s = plane(&r, "light0.shadow"), *beta = plane(&r, "light0.aaf.beta");
@@ -285,7 +302,12 @@ static void test_separable_filter_close_to_exact(void **state)
 {
     (void)state;
     drift_context *ctx = test_context(2, NULL);
-    enum { FW = 160, FH = 120 };
+
+    enum {
+        FW = 160,
+        FH = 120
+    };
+
     drift_gbuffer g;
     assert_int_equal(drift_gbuffer_create(ctx, FW, FH, &g), DRIFT_OK);
     drift_image in, sep, exact, scratch, beta, footprint;
@@ -298,7 +320,8 @@ static void test_separable_filter_close_to_exact(void **state)
     const float pixel = 0.01f;
     for (int y = 0; y < FH; ++y) {
         for (int x = 0; x < FW; ++x) {
-            drift_image_set3(&g.position, x, y, drift_vec3_make((float)x * pixel, 0.0f, (float)y * pixel));
+            drift_image_set3(&g.position, x, y,
+                             drift_vec3_make((float)x * pixel, 0.0f, (float)y * pixel));
             drift_image_set3(&g.normal, x, y, drift_vec3_make(0, 1, 0));
             drift_image_pixel(&g.depth, x, y)[0] = 1.0f;
             drift_image_pixel(&g.material_id, x, y)[0] = 0.0f;
@@ -314,8 +337,9 @@ static void test_separable_filter_close_to_exact(void **state)
                 0.25f * width * pixel * (1.0f + 0.3f * sinf((float)y / 9.0f + (float)x / 23.0f));
         }
     }
-    drift_aaf_filter_desc desc = { .beta = &beta, .footprint = &footprint, .gbuffer = &g,
-                                   .max_radius = DRIFT_AAF_MAX_RADIUS };
+    drift_aaf_filter_desc desc = {
+        .beta = &beta, .footprint = &footprint, .gbuffer = &g, .max_radius = DRIFT_AAF_MAX_RADIUS
+    };
     assert_int_equal(drift_aaf_filter_separable(ctx, &desc, &in, &scratch, &sep), DRIFT_OK);
     assert_int_equal(drift_aaf_filter_exact(ctx, &desc, &in, &exact), DRIFT_OK);
     double max_diff = 0.0, sum_diff = 0.0, max_change = 0.0;
@@ -363,13 +387,19 @@ static void test_separable_filter_close_to_exact(void **state)
 static void test_budget_keeps_the_mean(void **state)
 {
     (void)state;
-    enum { N = 4000 };
+
+    enum {
+        N = 4000
+    };
+
     float *want = malloc(sizeof(float) * N);
     uint32_t *counts = malloc(sizeof(uint32_t) * N);
     assert_non_null(want);
     assert_non_null(counts);
     for (int i = 0; i < N; ++i) {
-        want[i] = i % 3 == 0 ? 0.0f : 1.0f + 200.0f * test_hash_unit((uint32_t)i) * test_hash_unit((uint32_t)i + N);
+        want[i] = i % 3 == 0 ? 0.0f
+                             : 1.0f + 200.0f * test_hash_unit((uint32_t)i) *
+                                          test_hash_unit((uint32_t)i + N);
     }
     drift_aaf_allocate(want, N, N, 4, 16, 128, 7, counts);
     double sum = 0.0;
@@ -397,19 +427,26 @@ static void test_indirect_converges(void **state)
     assert_int_equal(drift_scene_add_material(r.scene, &m, &white), DRIFT_OK);
     assert_int_equal(drift_scene_add_material(r.scene, &red, &reddish), DRIFT_OK);
     const float h = 1.5f;
-    add_quad(r.scene, drift_vec3_make(-h, 0, -h), drift_vec3_make(0, 0, 2 * h), drift_vec3_make(2 * h, 0, 0), white); // floor, up
-    add_quad(r.scene, drift_vec3_make(-h, 3.05f, -h), drift_vec3_make(2 * h, 0, 0), drift_vec3_make(0, 0, 2 * h), white); // ceiling
-    add_quad(r.scene, drift_vec3_make(-h, 0, -h), drift_vec3_make(0, 3.05f, 0), drift_vec3_make(0, 0, 2 * h), reddish); // left wall
-    add_quad(r.scene, drift_vec3_make(h, 0, -h), drift_vec3_make(0, 0, 2 * h), drift_vec3_make(0, 3.05f, 0), white);
-    add_quad(r.scene, drift_vec3_make(-h, 0, h), drift_vec3_make(0, 3.05f, 0), drift_vec3_make(2 * h, 0, 0), white);
+    add_quad(r.scene, drift_vec3_make(-h, 0, -h), drift_vec3_make(0, 0, 2 * h),
+             drift_vec3_make(2 * h, 0, 0), white); // floor, up
+    add_quad(r.scene, drift_vec3_make(-h, 3.05f, -h), drift_vec3_make(2 * h, 0, 0),
+             drift_vec3_make(0, 0, 2 * h), white); // ceiling
+    add_quad(r.scene, drift_vec3_make(-h, 0, -h), drift_vec3_make(0, 3.05f, 0),
+             drift_vec3_make(0, 0, 2 * h), reddish); // left wall
+    add_quad(r.scene, drift_vec3_make(h, 0, -h), drift_vec3_make(0, 0, 2 * h),
+             drift_vec3_make(0, 3.05f, 0), white);
+    add_quad(r.scene, drift_vec3_make(-h, 0, h), drift_vec3_make(0, 3.05f, 0),
+             drift_vec3_make(2 * h, 0, 0), white);
     add_square(r.scene, 0.3f, 0.8f, 0.2f, 0.4f, white);
     add_light(r.scene);
-    r.scene->camera = drift_camera_look_at(drift_vec3_make(0, 1.5f, -1.45f), drift_vec3_make(0, 0.8f, 0.5f),
-                                           drift_vec3_make(0, 1, 0), 1.4f, W, H);
+    r.scene->camera =
+        drift_camera_look_at(drift_vec3_make(0, 1.5f, -1.45f), drift_vec3_make(0, 0.8f, 0.5f),
+                             drift_vec3_make(0, 1, 0), 1.4f, W, H);
     rig_commit(&r);
     drift_pt *pt = NULL;
     uint32_t truth_spp = (uint32_t)(512 * test_intensity());
-    drift_image truth = render_pt(&r, DRIFT_PT_COMPONENT_DIFFUSE, 2, truth_spp < 256 ? 256 : truth_spp, &pt);
+    drift_image truth =
+        render_pt(&r, DRIFT_PT_COMPONENT_DIFFUSE, 2, truth_spp < 256 ? 256 : truth_spp, &pt);
     const uint32_t spps[3] = { 4, 16, 64 };
     double aaf[3], plain[3];
     for (int k = 0; k < 3; ++k) {
@@ -431,6 +468,51 @@ static void test_indirect_converges(void **state)
     rig_destroy(&r);
 }
 
+// --aaf-sampler random: independent uniform numbers, a pure function of (key, pixel, sample,
+// dimension); the Sobol default stratifies a pixel's samples, the random stream does not have
+// to (its mean and variance are those of U(0,1), its dimensions uncorrelated).
+static void test_random_sampler_is_uniform_and_independent(void **state)
+{
+    (void)state;
+    const int n = 8192;
+    double sx = 0.0, sxx = 0.0, sy = 0.0, sxy = 0.0, sz = 0.0, sxz = 0.0;
+    for (int k = 0; k < n; ++k) {
+        drift_aaf_sampler s =
+            drift_aaf_sampler_make(7, (uint32_t)(k % 97), (uint32_t)(k / 97), true);
+        drift_vec2 a = drift_aaf_next2(&s), b = drift_aaf_next2(&s);
+        drift_aaf_sampler again =
+            drift_aaf_sampler_make(7, (uint32_t)(k % 97), (uint32_t)(k / 97), true);
+        drift_vec2 a2 = drift_aaf_next2(&again);
+        assert_true(a.x == a2.x && a.y == a2.y);
+        assert_true(a.x >= 0.0f && a.x < 1.0f && a.y >= 0.0f && a.y < 1.0f);
+        double x = (double)a.x, y = (double)a.y, z = (double)b.x;
+        sx += x;
+        sxx += x * x;
+        sy += y;
+        sxy += x * y;
+        sz += z;
+        sxz += x * z;
+    }
+    double mx = sx / n, my = sy / n, mz = sz / n, var = sxx / n - mx * mx;
+    assert_true(fabs(mx - 0.5) < 0.01 && fabs(my - 0.5) < 0.01 && fabs(mz - 0.5) < 0.01);
+    assert_true(fabs(var - 1.0 / 12.0) < 0.005);
+    assert_true(fabs((sxy / n - mx * my) / var) < 0.05); // the two halves of a pair
+    assert_true(fabs((sxz / n - mx * mz) / var) < 0.05); // two dimensions
+    // Sobol: 16 samples of a pixel fall one in each sixteenth; 16 random ones rarely do.
+    int sobol_strata = 0, random_strata = 0;
+    bool sobol_seen[16] = { false }, random_seen[16] = { false };
+    for (uint32_t k = 0; k < 16; ++k) {
+        drift_aaf_sampler a = drift_aaf_sampler_make(7, 3, k, false);
+        drift_aaf_sampler b = drift_aaf_sampler_make(7, 3, k, true);
+        int i = (int)(16.0f * drift_aaf_next2(&a).x), j = (int)(16.0f * drift_aaf_next2(&b).x);
+        sobol_strata += !sobol_seen[i];
+        random_strata += !random_seen[j];
+        sobol_seen[i] = random_seen[j] = true;
+    }
+    assert_int_equal(sobol_strata, 16);
+    assert_true(random_strata < 16);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -440,6 +522,7 @@ int main(void)
         cmocka_unit_test(test_separable_filter_close_to_exact),
         cmocka_unit_test(test_budget_keeps_the_mean),
         cmocka_unit_test(test_indirect_converges),
+        cmocka_unit_test(test_random_sampler_is_uniform_and_independent),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
