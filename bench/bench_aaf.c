@@ -557,13 +557,11 @@ int drift_bench_aaf(int argc, char **argv)
     drift_scene *scene = NULL;
     drift_accel *accel = NULL;
     int exit_code = 1;
-    drift_result r = drift_context_create(
-        &(drift_context_desc){ .thread_count = (int)o.threads, .logger = cli_stderr_logger(false) },
-        &ctx);
-    if (r != DRIFT_OK) {
-        fprintf(stderr, "drift bench aaf: %s\n", drift_result_string(r));
+    ctx = cli_open_context("bench aaf", (int)o.threads, false);
+    if (!ctx) {
         goto done;
     }
+    drift_result r = DRIFT_OK;
     if (!cli_open_scene(ctx, "bench aaf", scene_path, &scene, &accel, NULL)) {
         goto done;
     }

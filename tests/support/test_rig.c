@@ -57,6 +57,21 @@ uint32_t test_add_material(drift_scene *scene, drift_material m)
     return index;
 }
 
+void test_add_quad(drift_scene *scene, drift_vec3 corner, drift_vec3 u, drift_vec3 v,
+                   uint32_t material)
+{
+    drift_vec3 c[4] = { corner, drift_vec3_add(corner, u),
+                        drift_vec3_add(drift_vec3_add(corner, u), v), drift_vec3_add(corner, v) };
+    float p[12];
+    for (int k = 0; k < 4; ++k) {
+        p[3 * k] = c[k].x;
+        p[3 * k + 1] = c[k].y;
+        p[3 * k + 2] = c[k].z;
+    }
+    const uint32_t idx[] = { 0, 1, 2, 0, 2, 3 };
+    test_add_mesh(scene, p, 4, idx, 2, material);
+}
+
 void test_add_floor(drift_scene *scene, float half, float height, uint32_t material)
 {
     const float p[] = { -half, height, -half, half,  height, -half,

@@ -25,6 +25,9 @@ void test_rig_destroy(test_rig *r);
 const drift_image *test_rig_plane(const test_rig *r, const char *wanted);
 
 uint32_t test_add_material(drift_scene *scene, drift_material m);
+// The quad corner, corner + u, corner + u + v, corner + v (two triangles, wound as listed).
+void test_add_quad(drift_scene *scene, drift_vec3 corner, drift_vec3 u, drift_vec3 v,
+                   uint32_t material);
 // Square of half size `half` in the plane y = height, facing +y.
 void test_add_floor(drift_scene *scene, float half, float height, uint32_t material);
 // UV sphere with smooth normals and outward winding; returns its mesh index.

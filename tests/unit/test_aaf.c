@@ -9,62 +9,13 @@
 #include "drift/scene.h"
 #include "drift_test.h"
 #include "hybrid/aaf_internal.h"
+#include "test_rig.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-typedef struct rig {
-    drift_context *ctx;
-    drift_scene *scene;
-    drift_accel *accel;
-    drift_hybrid *frame;
-} rig;
-
-static rig rig_begin(void)
-{
-    rig r = { .ctx = test_context(2, NULL) };
-    assert_int_equal(drift_scene_create(r.ctx, &r.scene), DRIFT_OK);
-    return r;
-}
-
-static void rig_commit(rig *r)
-{
-    assert_int_equal(drift_scene_commit(r->scene), DRIFT_OK);
-    assert_int_equal(drift_accel_create(r->ctx, r->scene, &(drift_accel_desc){ 0 }, &r->accel),
-                     DRIFT_OK);
-}
-
-static void rig_frame(rig *r, const drift_hybrid_params *params)
-{
-    drift_hybrid_destroy(r->frame);
-    r->frame = NULL;
-    assert_int_equal(drift_hybrid_create(r->ctx, r->scene, r->accel, params, &r->frame), DRIFT_OK);
-    assert_int_equal(drift_hybrid_render(r->frame, &r->scene->camera, NULL), DRIFT_OK);
-}
-
-static void rig_destroy(rig *r)
-{
-    drift_hybrid_destroy(r->frame);
-    drift_accel_destroy(r->accel);
-    drift_scene_destroy(r->scene);
-    drift_context_destroy(r->ctx);
-}
-
-static const drift_image *plane(const rig *r, const char *wanted)
-{
-    const char *name;
-    const drift_image *image;
-    for (uint32_t i = 0; drift_hybrid_plane(r->frame, i, &name, &image); ++i) {
-        if (strcmp(name, wanted) == 0) {
-            return image;
-        }
-    }
-    fail_msg("no plane %s", wanted);
-    return NULL;
-}
-
-static drift_image render_pt(rig *r, uint32_t components, int32_t max_depth, uint32_t spp,
+static drift_image render_pt(test_rig *r, uint32_t components, int32_t max_depth, uint32_t spp,
                              drift_pt **pt)
 {
     drift_pt_params params = { .width = r->scene->camera.width,
@@ -81,41 +32,11 @@ static drift_image render_pt(rig *r, uint32_t components, int32_t max_depth, uin
     return img;
 }
 
-static double rmse(const drift_image *a, const drift_image *b)
-{
-    double sum = 0.0;
-    for (int y = 0; y < a->height; ++y) {
-        for (int x = 0; x < a->width; ++x) {
-            for (int c = 0; c < 3; ++c) {
-                double d =
-                    (double)drift_image_pixel(a, x, y)[c] - (double)drift_image_pixel(b, x, y)[c];
-                sum += d * d;
-            }
-        }
-    }
-    return sqrt(sum / (3.0 * a->width * a->height));
-}
-
-static void add_quad(drift_scene *scene, drift_vec3 corner, drift_vec3 u, drift_vec3 v,
-                     uint32_t material)
-{
-    drift_vec3 c[4] = { corner, drift_vec3_add(corner, u),
-                        drift_vec3_add(drift_vec3_add(corner, u), v), drift_vec3_add(corner, v) };
-    float p[12];
-    for (int k = 0; k < 4; ++k) {
-        p[3 * k] = c[k].x;
-        p[3 * k + 1] = c[k].y;
-        p[3 * k + 2] = c[k].z;
-    }
-    const uint32_t idx[] = { 0, 1, 2, 0, 2, 3 };
-    test_add_mesh(scene, p, 4, idx, 2, material);
-}
-
 // Horizontal square of half size `half` centred at (x, h, z).
 static void add_square(drift_scene *scene, float x, float h, float z, float half, uint32_t material)
 {
-    add_quad(scene, drift_vec3_make(x - half, h, z - half), drift_vec3_make(2 * half, 0, 0),
-             drift_vec3_make(0, 0, 2 * half), material);
+    test_add_quad(scene, drift_vec3_make(x - half, h, z - half), drift_vec3_make(2 * half, 0, 0),
+                  drift_vec3_make(0, 0, 2 * half), material);
 }
 
 // A 1x1 quad light at height 3 centred over the origin, emitting down.
@@ -144,7 +65,7 @@ enum {
     SH = 72
 };
 
-static void build_shadow_scene(rig *r)
+static void build_shadow_scene(test_rig *r)
 {
     uint32_t white;
     drift_material m = drift_material_make(drift_vec3_splat(0.6f));
@@ -152,8 +73,8 @@ static void build_shadow_scene(rig *r)
     add_square(r->scene, 0.0f, 0.0f, 0.0f, 4.0f, white);
     add_square(r->scene, -1.2f, 0.6f, 0.0f, 0.3f, white);
     add_square(r->scene, 0.7f, 1.2f, 0.0f, 0.2f, white);
-    add_quad(r->scene, drift_vec3_make(-0.4f, 0.0f, -1.2f), drift_vec3_make(0.8f, 0, 0),
-             drift_vec3_make(0, 0.6f, 0), white);
+    test_add_quad(r->scene, drift_vec3_make(-0.4f, 0.0f, -1.2f), drift_vec3_make(0.8f, 0, 0),
+                  drift_vec3_make(0, 0.6f, 0), white);
     add_light(r->scene);
     // Over the wall's far side, so the floor behind its foot is in view.
     r->scene->camera =
@@ -166,9 +87,9 @@ static void build_shadow_scene(rig *r)
 static void test_shadows_converge(void **state)
 {
     (void)state;
-    rig r = rig_begin();
+    test_rig r = test_rig_begin(2);
     build_shadow_scene(&r);
-    rig_commit(&r);
+    test_rig_commit(&r);
     drift_pt *pt = NULL;
     uint32_t truth_spp = (uint32_t)(512 * test_intensity());
     drift_image truth = render_pt(&r, DRIFT_PT_COMPONENT_EMISSION | DRIFT_PT_COMPONENT_DIRECT, 1,
@@ -176,15 +97,15 @@ static void test_shadows_converge(void **state)
     const uint32_t spps[3] = { 4, 16, 64 };
     double aaf[3], plain[3];
     for (int k = 0; k < 3; ++k) {
-        rig_frame(
+        test_rig_frame(
             &r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_AAF, .spp = spps[k], .seed = 3 });
-        aaf[k] = rmse(drift_hybrid_image(r.frame), &truth);
-        rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_AAF,
-                                              .spp = spps[k],
-                                              .seed = 3,
-                                              .aaf_uniform = true,
-                                              .aaf_unfiltered = true });
-        plain[k] = rmse(drift_hybrid_image(r.frame), &truth);
+        aaf[k] = test_rmse(drift_hybrid_image(r.frame), &truth);
+        test_rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_AAF,
+                                                   .spp = spps[k],
+                                                   .seed = 3,
+                                                   .aaf_uniform = true,
+                                                   .aaf_unfiltered = true });
+        plain[k] = test_rmse(drift_hybrid_image(r.frame), &truth);
     }
     print_message("shadows rmse aaf %g %g %g, plain MC %g %g %g\n", aaf[0], aaf[1], aaf[2],
                   plain[0], plain[1], plain[2]);
@@ -196,7 +117,7 @@ static void test_shadows_converge(void **state)
     assert_true(aaf[1] < 0.75 * plain[1]);
     assert_true(aaf[2] < 1.1 * plain[2]);
     drift_pt_destroy(pt);
-    rig_destroy(&r);
+    test_rig_destroy(&r);
 }
 
 // Regions on the floor (y = 0) of the shadow scene.
@@ -227,12 +148,14 @@ static region floor_region(drift_vec3 p)
 static void test_beta_and_rate_follow_the_geometry(void **state)
 {
     (void)state;
-    rig r = rig_begin();
+    test_rig r = test_rig_begin(2);
     build_shadow_scene(&r);
-    rig_commit(&r);
-    rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_AAF, .spp = 16, .seed = 2 });
+    test_rig_commit(&r);
+    test_rig_frame(&r,
+                   &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_AAF, .spp = 16, .seed = 2 });
     const drift_gbuffer *g = drift_hybrid_gbuffer(r.frame);
-    const drift_image *beta = plane(&r, "light0.aaf.beta"), *spp = plane(&r, "light0.aaf.spp");
+    const drift_image *beta = test_rig_plane(&r, "light0.aaf.beta"),
+                      *spp = test_rig_plane(&r, "light0.aaf.spp");
     double beta_sum[4] = { 0 }, spp_sum[4] = { 0 };
     int count[4] = { 0 };
     for (int y = 0; y < SH; ++y) {
@@ -258,7 +181,7 @@ static void test_beta_and_rate_follow_the_geometry(void **state)
     assert_true(beta_sum[REGION_LOW] > beta_sum[REGION_CONTACT]);
     assert_true(spp_sum[REGION_CONTACT] > spp_sum[REGION_LOW]);
     assert_true(spp_sum[REGION_LOW] > spp_sum[REGION_HIGH]);
-    rig_destroy(&r);
+    test_rig_destroy(&r);
 }
 
 // A plane in full light keeps S = 1 exactly; a plane under a roof that hides the whole light
@@ -268,7 +191,7 @@ static void test_full_light_and_full_shadow_are_exact(void **state)
 {
     (void)state;
     for (int roofed = 0; roofed < 2; ++roofed) {
-        rig r = rig_begin();
+        test_rig r = test_rig_begin(2);
         drift_material m = drift_material_make(drift_vec3_splat(0.5f));
         uint32_t white;
         assert_int_equal(drift_scene_add_material(r.scene, &m, &white), DRIFT_OK);
@@ -280,9 +203,11 @@ static void test_full_light_and_full_shadow_are_exact(void **state)
         r.scene->camera =
             drift_camera_look_at(drift_vec3_make(0, 1.2f, -0.01f), drift_vec3_make(0, 0, 0),
                                  drift_vec3_make(0, 0, 1), 1.0f, W, H);
-        rig_commit(&r);
-        rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_AAF, .spp = 16, .seed = 4 });
-        const drift_image *s = plane(&r, "light0.shadow"), *beta = plane(&r, "light0.aaf.beta");
+        test_rig_commit(&r);
+        test_rig_frame(
+            &r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_AAF, .spp = 16, .seed = 4 });
+        const drift_image *s = test_rig_plane(&r, "light0.shadow"),
+                          *beta = test_rig_plane(&r, "light0.aaf.beta");
         int filtered = 0;
         for (int y = 0; y < H; ++y) {
             for (int x = 0; x < W; ++x) {
@@ -291,7 +216,7 @@ static void test_full_light_and_full_shadow_are_exact(void **state)
             }
         }
         assert_int_equal(filtered, 0);
-        rig_destroy(&r);
+        test_rig_destroy(&r);
     }
 }
 
@@ -420,29 +345,29 @@ static void test_budget_keeps_the_mean(void **state)
 static void test_indirect_converges(void **state)
 {
     (void)state;
-    rig r = rig_begin();
+    test_rig r = test_rig_begin(2);
     drift_material m = drift_material_make(drift_vec3_make(0.7f, 0.6f, 0.5f));
     drift_material red = drift_material_make(drift_vec3_make(0.7f, 0.1f, 0.1f));
     uint32_t white, reddish;
     assert_int_equal(drift_scene_add_material(r.scene, &m, &white), DRIFT_OK);
     assert_int_equal(drift_scene_add_material(r.scene, &red, &reddish), DRIFT_OK);
     const float h = 1.5f;
-    add_quad(r.scene, drift_vec3_make(-h, 0, -h), drift_vec3_make(0, 0, 2 * h),
-             drift_vec3_make(2 * h, 0, 0), white); // floor, up
-    add_quad(r.scene, drift_vec3_make(-h, 3.05f, -h), drift_vec3_make(2 * h, 0, 0),
-             drift_vec3_make(0, 0, 2 * h), white); // ceiling
-    add_quad(r.scene, drift_vec3_make(-h, 0, -h), drift_vec3_make(0, 3.05f, 0),
-             drift_vec3_make(0, 0, 2 * h), reddish); // left wall
-    add_quad(r.scene, drift_vec3_make(h, 0, -h), drift_vec3_make(0, 0, 2 * h),
-             drift_vec3_make(0, 3.05f, 0), white);
-    add_quad(r.scene, drift_vec3_make(-h, 0, h), drift_vec3_make(0, 3.05f, 0),
-             drift_vec3_make(2 * h, 0, 0), white);
+    test_add_quad(r.scene, drift_vec3_make(-h, 0, -h), drift_vec3_make(0, 0, 2 * h),
+                  drift_vec3_make(2 * h, 0, 0), white); // floor, up
+    test_add_quad(r.scene, drift_vec3_make(-h, 3.05f, -h), drift_vec3_make(2 * h, 0, 0),
+                  drift_vec3_make(0, 0, 2 * h), white); // ceiling
+    test_add_quad(r.scene, drift_vec3_make(-h, 0, -h), drift_vec3_make(0, 3.05f, 0),
+                  drift_vec3_make(0, 0, 2 * h), reddish); // left wall
+    test_add_quad(r.scene, drift_vec3_make(h, 0, -h), drift_vec3_make(0, 0, 2 * h),
+                  drift_vec3_make(0, 3.05f, 0), white);
+    test_add_quad(r.scene, drift_vec3_make(-h, 0, h), drift_vec3_make(0, 3.05f, 0),
+                  drift_vec3_make(2 * h, 0, 0), white);
     add_square(r.scene, 0.3f, 0.8f, 0.2f, 0.4f, white);
     add_light(r.scene);
     r.scene->camera =
         drift_camera_look_at(drift_vec3_make(0, 1.5f, -1.45f), drift_vec3_make(0, 0.8f, 0.5f),
                              drift_vec3_make(0, 1, 0), 1.4f, W, H);
-    rig_commit(&r);
+    test_rig_commit(&r);
     drift_pt *pt = NULL;
     uint32_t truth_spp = (uint32_t)(512 * test_intensity());
     drift_image truth =
@@ -451,11 +376,11 @@ static void test_indirect_converges(void **state)
     double aaf[3], plain[3];
     for (int k = 0; k < 3; ++k) {
         drift_hybrid_params p = { .indirect = DRIFT_INDIRECT_AAF, .spp = spps[k], .seed = 5 };
-        rig_frame(&r, &p);
-        aaf[k] = rmse(plane(&r, "indirect"), &truth);
+        test_rig_frame(&r, &p);
+        aaf[k] = test_rmse(test_rig_plane(&r, "indirect"), &truth);
         p.aaf_uniform = p.aaf_unfiltered = true;
-        rig_frame(&r, &p);
-        plain[k] = rmse(plane(&r, "indirect"), &truth);
+        test_rig_frame(&r, &p);
+        plain[k] = test_rmse(test_rig_plane(&r, "indirect"), &truth);
     }
     print_message("indirect rmse aaf %g %g %g, plain MC %g %g %g\n", aaf[0], aaf[1], aaf[2],
                   plain[0], plain[1], plain[2]);
@@ -465,7 +390,7 @@ static void test_indirect_converges(void **state)
         assert_true(aaf[k] < plain[k]);
     }
     drift_pt_destroy(pt);
-    rig_destroy(&r);
+    test_rig_destroy(&r);
 }
 
 // --aaf-sampler random: independent uniform numbers, a pure function of (key, pixel, sample,

@@ -7,6 +7,7 @@
 #include "drift/scene.h"
 #include "drift_test.h"
 #include "hybrid/aaf_internal.h"
+#include "test_rig.h"
 
 #include <math.h>
 #include <string.h>
@@ -16,34 +17,11 @@ enum {
     H = 48
 };
 
-typedef struct rig {
-    drift_context *ctx;
-    drift_scene *scene;
-    drift_accel *accel;
-    drift_hybrid *frame;
-} rig;
-
-static void add_quad(drift_scene *scene, drift_vec3 corner, drift_vec3 u, drift_vec3 v,
-                     uint32_t material)
-{
-    drift_vec3 c[4] = { corner, drift_vec3_add(corner, u),
-                        drift_vec3_add(drift_vec3_add(corner, u), v), drift_vec3_add(corner, v) };
-    float p[12];
-    for (int k = 0; k < 4; ++k) {
-        p[3 * k] = c[k].x;
-        p[3 * k + 1] = c[k].y;
-        p[3 * k + 2] = c[k].z;
-    }
-    const uint32_t idx[] = { 0, 1, 2, 0, 2, 3 };
-    test_add_mesh(scene, p, 4, idx, 2, material);
-}
-
 // A reflective floor reflecting a lit red wall at z = 1.5 and a white one at x = -1.5, under a
 // 1x1 quad light at height 3, seen from above the floor looking at `target`.
-static rig build_floor(const drift_material *floor, drift_vec3 target)
+static test_rig build_floor(const drift_material *floor, drift_vec3 target)
 {
-    rig r = { .ctx = test_context(2, NULL) };
-    assert_int_equal(drift_scene_create(r.ctx, &r.scene), DRIFT_OK);
+    test_rig r = test_rig_begin(2);
     drift_material red = drift_material_make(drift_vec3_make(0.8f, 0.2f, 0.1f));
     drift_material white = drift_material_make(drift_vec3_splat(0.7f));
     uint32_t g, rd, wh;
@@ -51,14 +29,14 @@ static rig build_floor(const drift_material *floor, drift_vec3 target)
     assert_int_equal(drift_scene_add_material(r.scene, &red, &rd), DRIFT_OK);
     assert_int_equal(drift_scene_add_material(r.scene, &white, &wh), DRIFT_OK);
     const float h = 1.5f;
-    add_quad(r.scene, drift_vec3_make(-h, 0, -h), drift_vec3_make(0, 0, 2 * h),
-             drift_vec3_make(2 * h, 0, 0), g); // floor, up
-    add_quad(r.scene, drift_vec3_make(-h, 0, h), drift_vec3_make(0, 3, 0),
-             drift_vec3_make(2 * h, 0, 0),
-             rd); // back wall, facing -z
-    add_quad(r.scene, drift_vec3_make(-h, 0, -h), drift_vec3_make(0, 3, 0),
-             drift_vec3_make(0, 0, 2 * h),
-             wh); // left wall, facing +x
+    test_add_quad(r.scene, drift_vec3_make(-h, 0, -h), drift_vec3_make(0, 0, 2 * h),
+                  drift_vec3_make(2 * h, 0, 0), g); // floor, up
+    test_add_quad(r.scene, drift_vec3_make(-h, 0, h), drift_vec3_make(0, 3, 0),
+                  drift_vec3_make(2 * h, 0, 0),
+                  rd); // back wall, facing -z
+    test_add_quad(r.scene, drift_vec3_make(-h, 0, -h), drift_vec3_make(0, 3, 0),
+                  drift_vec3_make(0, 0, 2 * h),
+                  wh); // left wall, facing +x
     assert_int_equal(drift_scene_add_light(r.scene,
                                            &(drift_light){ .type = DRIFT_LIGHT_QUAD,
                                                            .position = { -0.5f, 3.0f, -0.5f },
@@ -69,14 +47,12 @@ static rig build_floor(const drift_material *floor, drift_vec3 target)
                      DRIFT_OK);
     r.scene->camera = drift_camera_look_at(drift_vec3_make(0.3f, 1.2f, -1.4f), target,
                                            drift_vec3_make(0, 1, 0), 1.2f, W, H);
-    assert_int_equal(drift_scene_commit(r.scene), DRIFT_OK);
-    assert_int_equal(drift_accel_create(r.ctx, r.scene, &(drift_accel_desc){ 0 }, &r.accel),
-                     DRIFT_OK);
+    test_rig_commit(&r);
     return r;
 }
 
 // The floor glossy, of Phong exponent `exponent`.
-static rig build(float exponent)
+static test_rig build(float exponent)
 {
     drift_material glossy = drift_material_make(drift_vec3_splat(0.2f));
     glossy.specular = drift_vec3_splat(0.6f);
@@ -84,52 +60,8 @@ static rig build(float exponent)
     return build_floor(&glossy, drift_vec3_make(0, 0.3f, 0.8f));
 }
 
-static void render(rig *r, const drift_hybrid_params *params)
-{
-    drift_hybrid_destroy(r->frame);
-    r->frame = NULL;
-    assert_int_equal(drift_hybrid_create(r->ctx, r->scene, r->accel, params, &r->frame), DRIFT_OK);
-    assert_int_equal(drift_hybrid_render(r->frame, &r->scene->camera, NULL), DRIFT_OK);
-}
-
-static void destroy(rig *r)
-{
-    drift_hybrid_destroy(r->frame);
-    drift_accel_destroy(r->accel);
-    drift_scene_destroy(r->scene);
-    drift_context_destroy(r->ctx);
-}
-
-static const drift_image *plane(const rig *r, const char *wanted)
-{
-    const char *name;
-    const drift_image *image;
-    for (uint32_t i = 0; drift_hybrid_plane(r->frame, i, &name, &image); ++i) {
-        if (strcmp(name, wanted) == 0) {
-            return image;
-        }
-    }
-    fail_msg("no plane %s", wanted);
-    return NULL;
-}
-
-static double rmse(const drift_image *a, const drift_image *b)
-{
-    double sum = 0.0;
-    for (int y = 0; y < a->height; ++y) {
-        for (int x = 0; x < a->width; ++x) {
-            for (int c = 0; c < 3; ++c) {
-                double d =
-                    (double)drift_image_pixel(a, x, y)[c] - (double)drift_image_pixel(b, x, y)[c];
-                sum += d * d;
-            }
-        }
-    }
-    return sqrt(sum / (3.0 * a->width * a->height));
-}
-
 // The pt's SPECULAR component (first bounce glossy or mirror, one bounce): the R term's truth.
-static drift_image render_truth(rig *r, drift_pt **pt)
+static drift_image render_truth(test_rig *r, drift_pt **pt)
 {
     drift_pt_params pp = { .width = W,
                            .height = H,
@@ -150,21 +82,21 @@ static drift_image render_truth(rig *r, drift_pt **pt)
 static void test_specular_converges(void **state)
 {
     (void)state;
-    rig r = build(20.0f);
+    test_rig r = build(20.0f);
     drift_pt *pt = NULL;
     drift_image truth = render_truth(&r, &pt);
     const uint32_t spps[3] = { 4, 16, 64 };
     double aaf[3];
     for (int k = 0; k < 3; ++k) {
         drift_hybrid_params p = { .reflections = DRIFT_REFLECTIONS_AAF, .spp = spps[k], .seed = 5 };
-        render(&r, &p);
-        aaf[k] = rmse(plane(&r, "reflections"), &truth);
+        test_rig_frame(&r, &p);
+        aaf[k] = test_rmse(test_rig_plane(&r, "reflections"), &truth);
     }
     print_message("specular rmse aaf %g %g %g\n", aaf[0], aaf[1], aaf[2]);
     assert_true(aaf[1] < 0.9 * aaf[0]);
     assert_true(aaf[2] < 0.9 * aaf[1]);
     drift_pt_destroy(pt);
-    destroy(&r);
+    test_rig_destroy(&r);
 }
 
 // A mirror floor keeps a sharp ray: nothing is filtered (beta 0 everywhere), the light's
@@ -175,17 +107,17 @@ static void test_mirror_stays_sharp(void **state)
     drift_material mirror = drift_material_make(drift_vec3_splat(0.0f));
     mirror.type = DRIFT_MATERIAL_MIRROR;
     mirror.specular = drift_vec3_splat(0.8f);
-    rig r = build_floor(&mirror, drift_vec3_make(0, -0.5f, 0)); // the light is in the mirror
+    test_rig r = build_floor(&mirror, drift_vec3_make(0, -0.5f, 0)); // the light is in the mirror
     drift_pt *pt = NULL;
     drift_image truth = render_truth(&r, &pt);
     double error[2], brightest = 0.0, brightest_truth = 0.0;
     const uint32_t spps[2] = { 4, 64 };
     for (int k = 0; k < 2; ++k) {
         drift_hybrid_params p = { .reflections = DRIFT_REFLECTIONS_AAF, .spp = spps[k], .seed = 5 };
-        render(&r, &p);
-        error[k] = rmse(plane(&r, "reflections"), &truth);
-        const drift_image *beta = plane(&r, "reflections.aaf.beta");
-        const drift_image *refl = plane(&r, "reflections");
+        test_rig_frame(&r, &p);
+        error[k] = test_rmse(test_rig_plane(&r, "reflections"), &truth);
+        const drift_image *beta = test_rig_plane(&r, "reflections.aaf.beta");
+        const drift_image *refl = test_rig_plane(&r, "reflections");
         for (int y = 0; y < H; ++y) {
             for (int x = 0; x < W; ++x) {
                 assert_true(drift_image_pixel(beta, x, y)[0] == 0.0f);
@@ -199,12 +131,12 @@ static void test_mirror_stays_sharp(void **state)
     assert_true(error[1] < 0.7 * error[0]);
     assert_true(brightest > 0.9 * brightest_truth); // the light itself, seen in the mirror
     drift_pt_destroy(pt);
-    destroy(&r);
+    test_rig_destroy(&r);
 }
 
-static double mean_beta(const rig *r)
+static double mean_beta(const test_rig *r)
 {
-    const drift_image *beta = plane(r, "reflections.aaf.beta");
+    const drift_image *beta = test_rig_plane(r, "reflections.aaf.beta");
     double sum = 0.0;
     int count = 0;
     for (int y = 0; y < beta->height; ++y) {
@@ -228,11 +160,11 @@ static void test_beta_shrinks_with_the_exponent(void **state)
     const float exponents[3] = { 1.0f, 4.0f, 16.0f };
     double beta[3];
     for (int k = 0; k < 3; ++k) {
-        rig r = build(exponents[k]);
+        test_rig r = build(exponents[k]);
         drift_hybrid_params p = { .reflections = DRIFT_REFLECTIONS_AAF, .spp = 4, .seed = 5 };
-        render(&r, &p);
+        test_rig_frame(&r, &p);
         beta[k] = mean_beta(&r);
-        destroy(&r);
+        test_rig_destroy(&r);
     }
     print_message("specular mean beta %g %g %g\n", beta[0], beta[1], beta[2]);
     assert_true(beta[1] < 0.95 * beta[0]);
