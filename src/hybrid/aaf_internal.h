@@ -18,9 +18,9 @@
 #define DRIFT_AAF_INDIRECT_SHRINK_SPP 4.0f // indirect: as (spp / 4)^(-1/3)
 #define DRIFT_AAF_INDIRECT_SHRINK_EXP (1.0f / 3.0f)
 #define DRIFT_AAF_OMEGA_DIFFUSE       2.8f // eq. 4.5, Lambertian
-#define DRIFT_AAF_LIGHT_SIGMA \
-    0.2887f // the light as a Gaussian: sigma = sqrt(area / 12), the
-            // standard deviation of a uniform square of that area
+// The light as a Gaussian: sigma = sqrt(area / 12), the standard deviation of a uniform square
+// of that area.
+#define DRIFT_AAF_LIGHT_SIGMA 0.2887f
 
 // --- SAMPLES ---
 
