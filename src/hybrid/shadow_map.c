@@ -724,10 +724,6 @@ float drift_shadow_map_pcss(const drift_shadow_map *map, drift_vec3 p, drift_vec
 
 // Taps a side of the square grids below (the blocker search repeats it at shrinking radii).
 #define PENUMBRA_GRID 8
-// The grid's inner block: taps with both indices in [INNER_LO, INNER_HI], at most half the
-// radius from the receiver; the rest, the outer ring, are at least 5/8 of it away.
-#define INNER_LO 2
-#define INNER_HI 5
 
 typedef struct penumbra_search {
     const drift_shadow_map *map;
@@ -758,36 +754,41 @@ static float cone_depth_bound(const penumbra_search *s, float o)
     return s->map->directional ? d_r - excess / L : L * d_r / (excess * d_r + L);
 }
 
-// Least depth stored in any texel a tap with |ox|, |oy| <= r can read. Cube maps: the square
-// of directions dir + ox t1 + oy t2 is convex, and so is its central projection onto a face
-// plane when every corner is in front of it; the corners' bounding box then holds every tap
-// that lands on the face (padded two texels for rounding). A face the square straddles is
-// read whole; one behind every corner gets no tap.
-static float region_min_depth(const penumbra_search *s, float r)
+// Least depth stored in any texel a tap with ox in [x0, x1], oy in [y0, y1] can read. Cube
+// maps: the rectangle of directions dir + ox t1 + oy t2 is convex, and so is its central
+// projection onto a face plane when every corner is in front of it; the corners' bounding box
+// then holds every tap that lands on the face (padded two texels for rounding). When all four
+// corners land on one face, so does the whole rectangle (its image is convex, and so is the
+// face's square). A face the rectangle straddles is read whole; one behind every corner gets
+// no tap.
+static float region_min_depth(const penumbra_search *s, float x0, float y0, float x1, float y1)
 {
     const drift_shadow_map *map = s->map;
     const receiver *rec = s->rec;
     int32_t last = map->size - 1;
     if (map->directional) {
-        float x0 = (rec->x - r) / map->texel_size - 2.0f,
-              x1 = (rec->x + r) / map->texel_size + 2.0f;
-        float y0 = (rec->y - r) / map->texel_size - 2.0f,
-              y1 = (rec->y + r) / map->texel_size + 2.0f;
-        if (x1 < 0.0f || y1 < 0.0f || x0 > (float)last || y0 > (float)last) {
+        float fx0 = (rec->x + x0) / map->texel_size - 2.0f,
+              fx1 = (rec->x + x1) / map->texel_size + 2.0f;
+        float fy0 = (rec->y + y0) / map->texel_size - 2.0f,
+              fy1 = (rec->y + y1) / map->texel_size + 2.0f;
+        if (fx1 < 0.0f || fy1 < 0.0f || fx0 > (float)last || fy0 > (float)last) {
             return INFINITY;
         }
-        int32_t ix0 = x0 < 0.0f ? 0 : (int32_t)x0, iy0 = y0 < 0.0f ? 0 : (int32_t)y0;
-        int32_t ix1 = x1 > (float)last ? last : (int32_t)x1,
-                iy1 = y1 > (float)last ? last : (int32_t)y1;
+        int32_t ix0 = fx0 < 0.0f ? 0 : (int32_t)fx0, iy0 = fy0 < 0.0f ? 0 : (int32_t)fy0;
+        int32_t ix1 = fx1 > (float)last ? last : (int32_t)fx1;
+        int32_t iy1 = fy1 > (float)last ? last : (int32_t)fy1;
         return min_depth_rect(map, 0, ix0, iy0, ix1, iy1);
     }
     drift_vec3 corner[4];
+    int faces[4];
     for (int k = 0; k < 4; ++k) {
-        float a = (k & 1) ? r : -r, b = (k & 2) ? r : -r;
-        corner[k] = drift_vec3_fma(drift_vec3_fma(rec->dir, rec->t1, a), rec->t2, b);
+        corner[k] = drift_vec3_fma(drift_vec3_fma(rec->dir, rec->t1, (k & 1) ? x1 : x0), rec->t2,
+                                   (k & 2) ? y1 : y0);
+        faces[k] = major_face(corner[k]);
     }
+    bool one_face = faces[0] == faces[1] && faces[0] == faces[2] && faces[0] == faces[3];
     float best = INFINITY, pad = 4.0f / (float)map->size;
-    for (int f = 0; f < CUBE_FACES; ++f) {
+    for (int f = one_face ? faces[0] : 0; f < (one_face ? faces[0] + 1 : CUBE_FACES); ++f) {
         int slot = map->face_slot[f];
         if (slot < 0) {
             continue;
@@ -811,63 +812,75 @@ static float region_min_depth(const penumbra_search *s, float r)
         if (in_front == 0) {
             continue;
         }
-        int32_t x0 = 0, x1 = last, y0 = 0, y1 = last;
+        int32_t tx0 = 0, tx1 = last, ty0 = 0, ty1 = last;
         if (in_front == 4) {
             if (u0 - pad > 1.0f || u1 + pad < -1.0f || v0 - pad > 1.0f || v1 + pad < -1.0f) {
                 continue;
             }
-            x0 = texel_index(u0 - pad, map->size);
-            x1 = texel_index(u1 + pad, map->size);
-            y0 = texel_index(v0 - pad, map->size);
-            y1 = texel_index(v1 + pad, map->size);
+            tx0 = texel_index(u0 - pad, map->size);
+            tx1 = texel_index(u1 + pad, map->size);
+            ty0 = texel_index(v0 - pad, map->size);
+            ty1 = texel_index(v1 + pad, map->size);
         }
-        best = fminf(best, min_depth_rect(map, slot, x0, y0, x1, y1));
+        best = fminf(best, min_depth_rect(map, slot, tx0, ty0, tx1, ty1));
     }
     return best;
 }
 
 // Whether the mip proves that no tap of a group finds a blocker: every texel the group can
-// read is deeper than the cone allows at the group's nearest tap (rounding slack on the
-// side of tapping).
-static bool proven_free(const penumbra_search *s, float reach, float nearest_offset)
+// read (offsets in the rectangle) is deeper than the cone allows at the group's nearest tap
+// (rounding slack on the side of tapping).
+static bool proven_free(const penumbra_search *s, float x0, float y0, float x1, float y1,
+                        float nearest_offset)
 {
     float bound = cone_depth_bound(s, nearest_offset);
-    return bound < INFINITY && region_min_depth(s, reach) > bound * 1.001f;
+    return bound < INFINITY && region_min_depth(s, x0, y0, x1, y1) > bound * 1.001f;
 }
 
 // Taps of a grid of PENUMBRA_GRID^2 over the square of half width `radius` that see a blocker
 // (a nearer surface inside the cone to the light: Guennebaud's backprojection test of whether
 // its shadow can reach the receiver), and the nearest blocker's depth; with `first_only`, stops
-// at the first. The hierarchical search skips the inner block and the outer ring when the
-// mip proves them free, so it finds exactly the exhaustive search's blockers.
+// at the first. The hierarchical search skips the inner 4 x 4 block and the outer ring when
+// the mip proves them free (finer groups cost more in proofs than they save in taps), so it
+// finds exactly the exhaustive search's blockers. A texel just found lit is not tested again
+// (the same texel, the same answer).
 static int32_t search_level(const penumbra_search *s, float radius, bool first_only,
                             float *out_nearest)
 {
     *out_nearest = INFINITY;
+    // Tap (i, j) is at odd multiples of step: (2i + 1 - GRID) step.
     const float step = radius / (float)PENUMBRA_GRID;
     bool skip_inner = false, skip_outer = false;
     if (s->hierarchical) {
-        // Inner taps are at least sqrt(2) step away and read within 4 steps; outer taps at
-        // least 5 steps away, within the whole radius.
-        skip_outer = proven_free(s, radius, 5.0f * step);
-        skip_inner = proven_free(s, 4.0f * step, 1.41421356f * step);
+        // Inner taps (1 or 3 steps out each way) are at least sqrt(2) steps from the centre and
+        // read within 4; outer taps at least 5 steps away, within the radius.
+        float in = 4.0f * step;
+        skip_outer = proven_free(s, -radius, -radius, radius, radius, 5.0f * step);
+        skip_inner = proven_free(s, -in, -in, in, in, 1.41421356f * step);
         if (skip_inner && skip_outer) {
             return 0;
         }
     }
     int32_t blockers = 0;
+    tap_texel lit = { .face = -2 }; // the last texel found lit
     for (int32_t j = 0; j < PENUMBRA_GRID; ++j) {
         for (int32_t i = 0; i < PENUMBRA_GRID; ++i) {
-            bool inner = i >= INNER_LO && i <= INNER_HI && j >= INNER_LO && j <= INNER_HI;
+            int32_t mx = 2 * i + 1 - PENUMBRA_GRID, my = 2 * j + 1 - PENUMBRA_GRID;
+            bool inner = mx >= -3 && mx <= 3 && my >= -3 && my <= 3;
             if (inner ? skip_inner : skip_outer) {
                 continue;
             }
-            float ox = radius * (2.0f * ((float)i + 0.5f) / PENUMBRA_GRID - 1.0f);
-            float oy = radius * (2.0f * ((float)j + 0.5f) / PENUMBRA_GRID - 1.0f);
+            float ox = step * (float)mx, oy = step * (float)my;
             tap_texel t = tap_lands(s->map, s->rec, ox, oy);
+            if (t.face == lit.face && t.x == lit.x && t.y == lit.y) {
+                continue;
+            }
             // The cone test first: it needs only the stored depth, and most taps fail it.
-            if (sqrtf(ox * ox + oy * oy) > blocker_cone(s, t.stored) ||
-                t.stored >= receiver_at(s->map, s->rec, &t) - s->rec->bias) {
+            if (sqrtf(ox * ox + oy * oy) > blocker_cone(s, t.stored)) {
+                continue;
+            }
+            if (t.stored >= receiver_at(s->map, s->rec, &t) - s->rec->bias) {
+                lit = t;
                 continue;
             }
             blockers++;
