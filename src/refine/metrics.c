@@ -197,22 +197,30 @@ static void shadow_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays, 
         // A light that straddles the receiver's tangent plane is cut by the horizon: there the
         // shadow map's depth test is at grazing angles and its bias decides, so the estimate
         // counts it as penumbra (the raster's U_l clips the light exactly; S_l does not). With
-        // corners the test is exact: some on each side; else the bounding sphere's.
+        // corners the test is exact: some on each side; else the bounding sphere's. A light
+        // below both the geometric and the shading normal's horizon casts no light there, so
+        // neither raster nor ray tracer has anything to get wrong.
         if (light->type != DRIFT_LIGHT_DIRECTIONAL) {
-            bool straddles;
+            float lo = INFINITY, hi = -INFINITY, hi_shading = -INFINITY;
             if (shape && shape->count > 0) {
-                float lo = INFINITY, hi = -INFINITY;
                 for (uint32_t k = 0; k < shape->count; ++k) {
-                    float h = drift_vec3_dot(s->ng, drift_vec3_sub(shape->corner[k], s->position));
+                    drift_vec3 d = drift_vec3_sub(shape->corner[k], s->position);
+                    float h = drift_vec3_dot(s->ng, d);
                     lo = fminf(lo, h);
                     hi = fmaxf(hi, h);
+                    hi_shading = fmaxf(hi_shading, drift_vec3_dot(s->ns, d));
                 }
-                straddles = lo <= 0.0f && hi >= 0.0f;
             } else {
-                float height = drift_vec3_dot(s->ng, drift_vec3_sub(light->centre, s->position));
-                straddles = fabsf(height) < light->radius;
+                drift_vec3 d = drift_vec3_sub(light->centre, s->position);
+                float h = drift_vec3_dot(s->ng, d);
+                lo = h - light->radius;
+                hi = h + light->radius;
+                hi_shading = drift_vec3_dot(s->ns, d) + light->radius;
             }
-            if (straddles) {
+            if (hi <= 0.0f && hi_shading <= 0.0f) {
+                continue; // the light is wholly below the receiver's horizon: it gets none
+            }
+            if (lo <= 0.0f && hi >= 0.0f) {
                 e = 1.0f;
                 break;
             }

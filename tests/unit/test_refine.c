@@ -393,6 +393,56 @@ static void test_shadow_metric_conservative(void **state)
     rig_destroy(&r);
 }
 
+// A pillar lit from one side: the two faces the camera sees face away from the quad light, so
+// nothing on them is lit, by raster or ray tracer, and the shadow metric flags none of them
+// (the light's corners are all below the receiver's horizon), beyond the dilation's 2 pixels
+// from their edges. The shadow map alone would call their edges penumbra: their texels border
+// the lit faces.
+static void test_shadow_metric_skips_unlit(void **state)
+{
+    (void)state;
+    rig r = rig_begin();
+    const int32_t w = 48, h = 36;
+    uint32_t white = add_material(r.scene, drift_material_make(drift_vec3_splat(0.6f)));
+    add_floor(r.scene, 4.0f, 0.0f, white);
+    add_box(r.scene, drift_vec3_make(-0.5f, 0.0f, 0.0f), drift_vec3_make(0.5f, 2.0f, 1.0f), white);
+    assert_int_equal(drift_scene_add_light(r.scene,
+                                           &(drift_light){ .type = DRIFT_LIGHT_QUAD,
+                                                           .position = { 1.2f, 2.6f, 0.2f },
+                                                           .edge_u = { 0.6f, 0, 0 },
+                                                           .edge_v = { 0, 0, 0.6f },
+                                                           .color = { 12, 12, 12 } },
+                                           NULL),
+                     DRIFT_OK);
+    r.scene->camera = drift_camera_look_at(drift_vec3_make(-2.5f, 1.2f, -2.0f),
+                                           drift_vec3_make(-0.5f, 1.1f, 0.0f),
+                                           drift_vec3_make(0, 1, 0), 0.7f, w, h);
+    rig_commit(&r, NULL);
+    const drift_gbuffer *g = drift_hybrid_gbuffer(r.frame);
+    const drift_image *shadow = drift_refine_metric_image(r.sir, DRIFT_METRIC_SHADOW);
+    uint32_t dark = 0;
+    for (int32_t y = 2; y < h - 2; ++y) {
+        for (int32_t x = 2; x < w - 2; ++x) {
+            bool inside = true; // the 5 x 5 neighbourhood is all on the two dark faces
+            for (int32_t v = y - 2; inside && v <= y + 2; ++v) {
+                for (int32_t u = x - 2; inside && u <= x + 2; ++u) {
+                    const drift_surface *s = &g->surfaces[(size_t)v * (size_t)w + (size_t)u];
+                    inside = s->material != DRIFT_INVALID_INDEX && s->position.y > 0.01f &&
+                             (fabsf(s->position.x + 0.5f) < 1e-3f || fabsf(s->position.z) < 1e-3f);
+                }
+            }
+            if (inside) {
+                ++dark;
+                if (drift_image_pixel(shadow, x, y)[0] != 0.0f) {
+                    fail_msg("pixel (%d, %d) gets no light but is flagged", x, y);
+                }
+            }
+        }
+    }
+    assert_true(dark > 100);
+    rig_destroy(&r);
+}
+
 // The hierarchical blocker search (regions the min-depth mip proves free are not tapped) gives
 // exactly the exhaustive search's estimate, for the frame's quad light, a sphere light (all six
 // cube faces) and a directional light with an angular radius (orthographic map), at the
@@ -691,6 +741,7 @@ int main(void)
         cmocka_unit_test(test_metrics_see_effects),
         cmocka_unit_test(test_shadow_metric_conservative),
         cmocka_unit_test(test_hierarchical_search_matches_exhaustive),
+        cmocka_unit_test(test_shadow_metric_skips_unlit),
         cmocka_unit_test(test_radix_sort_stable_and_complete),
         cmocka_unit_test(test_refines_errors_first),
         cmocka_unit_test(test_lambda_fit_not_worse_than_average),
