@@ -724,12 +724,15 @@ float drift_shadow_map_pcss(const drift_shadow_map *map, drift_vec3 p, drift_vec
 
 // Taps a side of the square grids below (the blocker search repeats it at shrinking radii).
 #define PENUMBRA_GRID 8
+// Levels of the blocker search at most this many texels in radius test texels, not taps.
+#define TEXEL_LEVEL 2.0f
 
 typedef struct penumbra_search {
     const drift_shadow_map *map;
     const receiver *rec;
     float L;           // light size for the cone (the map's radius unless the query is tighter)
     bool hierarchical; // prove regions blocker-free from the min-depth mip before tapping
+    bool texel_levels; // test texels instead of taps at the finest levels
 } penumbra_search;
 
 // Offset radius within which a blocker at depth z can hide part of the light from the
@@ -827,14 +830,111 @@ static float region_min_depth(const penumbra_search *s, float x0, float y0, floa
     return best;
 }
 
-// Whether the mip proves that no tap of a group finds a blocker: every texel the group can
-// read (offsets in the rectangle) is deeper than the cone allows at the group's nearest tap
-// (rounding slack on the side of tapping).
-static bool proven_free(const penumbra_search *s, float x0, float y0, float x1, float y1,
-                        float nearest_offset)
+// The texels a square of taps (|ox|, |oy| <= r) can read, when it lands on one face (cube) or
+// on the map (orthographic): slot and inclusive texel rectangle. False when it spans faces.
+typedef struct texel_rect {
+    int face, slot;
+    int32_t x0, y0, x1, y1;
+} texel_rect;
+
+static bool square_texels(const penumbra_search *s, float r, texel_rect *out)
 {
-    float bound = cone_depth_bound(s, nearest_offset);
-    return bound < INFINITY && region_min_depth(s, x0, y0, x1, y1) > bound * 1.001f;
+    const drift_shadow_map *map = s->map;
+    const receiver *rec = s->rec;
+    int32_t last = map->size - 1;
+    if (map->directional) {
+        float fx0 = (rec->x - r) / map->texel_size, fx1 = (rec->x + r) / map->texel_size;
+        float fy0 = (rec->y - r) / map->texel_size, fy1 = (rec->y + r) / map->texel_size;
+        if (!(fx0 >= 0.0f && fy0 >= 0.0f && fx1 < (float)map->size && fy1 < (float)map->size)) {
+            return false; // partly outside the map: taps there see nothing, rectangle clipped
+        }
+        *out = (texel_rect){ 0, 0, (int32_t)fx0, (int32_t)fy0, (int32_t)fx1, (int32_t)fy1 };
+        return out->x1 <= last && out->y1 <= last;
+    }
+    drift_vec3 corner[4];
+    int face = -1;
+    for (int k = 0; k < 4; ++k) {
+        corner[k] = drift_vec3_fma(drift_vec3_fma(rec->dir, rec->t1, (k & 1) ? r : -r), rec->t2,
+                                   (k & 2) ? r : -r);
+        int f = major_face(corner[k]);
+        if (face >= 0 && f != face) {
+            return false;
+        }
+        face = f;
+    }
+    if (map->face_slot[face] < 0) {
+        return false;
+    }
+    int a = face / 2;
+    float u0 = INFINITY, u1 = -INFINITY, v0 = INFINITY, v1 = -INFINITY;
+    for (int k = 0; k < 4; ++k) {
+        float major = fabsf(vec3_axis(corner[k], a));
+        float u = vec3_axis(corner[k], (a + 1) % 3) / major,
+              v = vec3_axis(corner[k], (a + 2) % 3) / major;
+        u0 = fminf(u0, u);
+        u1 = fmaxf(u1, u);
+        v0 = fminf(v0, v);
+        v1 = fmaxf(v1, v);
+    }
+    *out = (texel_rect){ face,
+                         map->face_slot[face],
+                         texel_index(u0, map->size),
+                         texel_index(v0, map->size),
+                         texel_index(u1, map->size),
+                         texel_index(v1, map->size) };
+    return true;
+}
+
+// The finest levels, a couple of texels wide, would put many of their 64 taps in each texel:
+// instead every texel the square can read is tested once, against the receiver plane alone
+// (the cone test at these offsets accepts nearly any depth; skipping it only adds blockers).
+// -1 when the square spans faces (the caller taps it).
+static int32_t search_texels(const penumbra_search *s, float radius, bool first_only,
+                             float *out_nearest)
+{
+    texel_rect rect;
+    if (!square_texels(s, radius, &rect)) {
+        return -1;
+    }
+    const drift_shadow_map *map = s->map;
+    size_t size = (size_t)map->size;
+    int32_t blockers = 0;
+    for (int32_t y = rect.y0; y <= rect.y1; ++y) {
+        for (int32_t x = rect.x0; x <= rect.x1; ++x) {
+            tap_texel t = {
+                .stored = map->depth[((size_t)rect.slot * size + (size_t)y) * size + (size_t)x],
+                .face = rect.face,
+                .x = x,
+                .y = y
+            };
+            if (t.stored >= receiver_at(map, s->rec, &t) - s->rec->bias) {
+                continue;
+            }
+            blockers++;
+            *out_nearest = fminf(*out_nearest, t.stored);
+            if (first_only) {
+                return blockers;
+            }
+        }
+    }
+    return blockers;
+}
+
+// Whether the mip proves that no tap of a group finds a blocker: every texel the group can
+// read (offsets in the square of half width `reach`) is deeper than the cone allows at the
+// group's nearest tap (rounding slack on the side of tapping). *lower is a known lower bound on
+// those depths (from a larger square); raised to the square's least depth when it is read.
+static bool proven_free(const penumbra_search *s, float reach, float nearest_offset, float *lower)
+{
+    float bound = cone_depth_bound(s, nearest_offset) * 1.001f;
+    if (!(bound < INFINITY)) {
+        return false;
+    }
+    if (*lower > bound) {
+        return true;
+    }
+    *lower = fmaxf(*lower, region_min_depth(s, -reach, -reach, reach, reach));
+    return *lower > bound;
 }
 
 // Taps of a grid of PENUMBRA_GRID^2 over the square of half width `radius` that see a blocker
@@ -844,19 +944,26 @@ static bool proven_free(const penumbra_search *s, float x0, float y0, float x1, 
 // the mip proves them free (finer groups cost more in proofs than they save in taps), so it
 // finds exactly the exhaustive search's blockers. A texel just found lit is not tested again
 // (the same texel, the same answer).
-static int32_t search_level(const penumbra_search *s, float radius, bool first_only,
+static int32_t search_level(const penumbra_search *s, float radius, bool first_only, float *lower,
                             float *out_nearest)
 {
     *out_nearest = INFINITY;
     // Tap (i, j) is at odd multiples of step: (2i + 1 - GRID) step.
     const float step = radius / (float)PENUMBRA_GRID;
+    if (s->texel_levels && radius <= TEXEL_LEVEL * s->rec->texel) {
+        int32_t blockers = search_texels(s, radius, first_only, out_nearest);
+        if (blockers >= 0) {
+            return blockers;
+        }
+    }
     bool skip_inner = false, skip_outer = false;
     if (s->hierarchical) {
         // Inner taps (1 or 3 steps out each way) are at least sqrt(2) steps from the centre and
-        // read within 4; outer taps at least 5 steps away, within the radius.
-        float in = 4.0f * step;
-        skip_outer = proven_free(s, -radius, -radius, radius, radius, 5.0f * step);
-        skip_inner = proven_free(s, -in, -in, in, in, 1.41421356f * step);
+        // read within 4; outer taps at least 5 steps away, within the radius. *lower bounds
+        // the depths over the whole square and leaves bounding those of the inner block, which
+        // holds the next level's square (a third of the radius).
+        skip_outer = proven_free(s, radius, 5.0f * step, lower);
+        skip_inner = proven_free(s, 4.0f * step, 1.41421356f * step, lower);
         if (skip_inner && skip_outer) {
             return 0;
         }
@@ -922,7 +1029,11 @@ float drift_shadow_map_penumbra_query(const drift_shadow_map *map, drift_vec3 p,
     }
     receiver rec = make_receiver(map, p, n);
     float L = query->light_size > 0.0f ? fminf(query->light_size, map->radius) : map->radius;
-    penumbra_search s = { .map = map, .rec = &rec, .L = L, .hierarchical = !query->exhaustive };
+    penumbra_search s = { .map = map,
+                          .rec = &rec,
+                          .L = L,
+                          .hierarchical = !query->exhaustive,
+                          .texel_levels = !query->taps_only };
     float d_r = rec.depth;
     // Blocker search over the whole cone from the receiver to the light, with the near plane
     // at the light's own size (PCSS trims it to a quarter of the way: here nothing is trimmed,
@@ -941,9 +1052,9 @@ float drift_shadow_map_penumbra_query(const drift_shadow_map *map, drift_vec3 p,
     // steps over them. Search again at each third of the radius, down to two texels. With the
     // centre visible, one blocker anywhere decides (penumbra).
     int32_t blockers = 0;
-    float nearest = INFINITY;
+    float nearest = INFINITY, lower = -INFINITY;
     for (float r = search; blockers == 0; r *= 1.0f / 3.0f) {
-        blockers += search_level(&s, r, !centre_blocked, &nearest);
+        blockers += search_level(&s, r, !centre_blocked, &lower, &nearest);
         if (r < 2.0f * rec.texel) {
             break;
         }
