@@ -58,7 +58,7 @@ static void print_help(FILE *out)
         out,
         "usage: drift bench sir [SCENE...] [--sizes WxH,...] [--spp N] [--budget N]\n"
         "                       [--threshold T] [--lambda FILE] [--threads T] [--json]\n"
-        "                       [--light-samples N]\n\n"
+        "                       [--light-samples N] [--views FILE]\n\n"
         "Table 1 of Amann et al. 2012: pure ray tracing (PRT) time vs SIR time to the same\n"
         "image, error pixels, FLIP of SIR against PRT, and recall/precision of each metric\n"
         "against the real error. The raster is the hybrid frame with PCSS shadows,\n"
