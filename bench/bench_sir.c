@@ -5,11 +5,6 @@
 // and precision against the real error |raster - ray traced| > threshold.
 #include "bench.h"
 #include "cli.h"
-
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-
 #include "drift/accel.h"
 #include "drift/hybrid.h"
 #include "drift/image_io.h"
@@ -17,9 +12,26 @@
 #include "drift/refine.h"
 #include "drift/scene.h"
 
+#include <cjson/cJSON.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
 #define MAX_SCENES 8
 #define MAX_SIZES 8
+#define MAX_VIEWS   16
 #define FLIP_TARGET 0.01
+
+// One camera of --views: what it changes from the scene camera (the paper's Table 1 rows are
+// views of one scene with more or fewer error pixels).
+typedef struct sir_view {
+    char name[64];
+    drift_vec3 position, target;
+    bool has_position, has_target;
+    double fov;      // degrees; 0: the camera's
+    double aperture; // < 0: the camera's
+} sir_view;
 
 typedef struct sir_options {
     const char *scenes[MAX_SCENES];
@@ -35,37 +47,45 @@ typedef struct sir_options {
     bool has_target;
     drift_vec3 target; // --target: look here instead of the scene camera's target
     double fov;        // --fov: vertical field of view, degrees (0: the camera's)
+    const char *views_path;
+    sir_view views[MAX_VIEWS];
+    int view_count; // 0: the one camera (with --target and --fov)
 } sir_options;
 
 static void print_help(FILE *out)
 {
-    fprintf(out,
-            "usage: drift bench sir [SCENE...] [--sizes WxH,...] [--spp N] [--budget N]\n"
-            "                       [--threshold T] [--lambda FILE] [--threads T] [--json]\n"
-            "                       [--light-samples N]\n\n"
-            "Table 1 of Amann et al. 2012: pure ray tracing (PRT) time vs SIR time to the same\n"
-            "image, error pixels, FLIP of SIR against PRT, and recall/precision of each metric\n"
-            "against the real error. The raster is the hybrid frame with PCSS shadows,\n"
-            "environment-map reflections and post DOF (second frame: cached maps, as the\n"
-            "paper's precomputed environment maps).\n\n"
-            "  SCENE         default: breakfast-room and cornell-glossy (need ../shared)\n"
-            "  --sizes       default 800x600,1024x768,1920x1080\n"
-            "  --spp N       samples a pixel in both PRT and SIR (default 4)\n"
-            "  --budget N    SIR samples an iteration (default 8192, the paper's ray count)\n"
-            "  --light-samples N  the raster's samples per area light and environment\n"
-            "                (default 8, the hybrid frame's)\n"
-            "  --threshold T real error: largest display-value channel difference > T (0.02)\n"
-            "  --lambda FILE also measure the fitted combination\n"
-            "  --figures DIR PNGs per row: raster, pure, sir, combined error, and the\n"
-            "                recall map (white: real error flagged, red: missed, blue: flagged only)\n"
-            "  --noise-floor also the FLIP between two pure images of different seeds (how\n"
-            "                close two equally good images are), and a real error must exceed\n"
-            "                the threshold plus the two pure images' difference at the pixel\n"
-            "  --target X,Y,Z  look at this point instead of the camera's target (other views,\n"
-            "                as the paper's rows are views with more or fewer error pixels)\n"
-            "  --fov DEG     vertical field of view (default: the camera's)\n"
-            "  --threads T   worker threads (default 1: per-thread figures)\n"
-            "  --json        one JSON object on stdout\n");
+    fprintf(
+        out,
+        "usage: drift bench sir [SCENE...] [--sizes WxH,...] [--spp N] [--budget N]\n"
+        "                       [--threshold T] [--lambda FILE] [--threads T] [--json]\n"
+        "                       [--light-samples N] [--views FILE]\n\n"
+        "Table 1 of Amann et al. 2012: pure ray tracing (PRT) time vs SIR time to the same\n"
+        "image, error pixels, FLIP of SIR against PRT, and recall/precision of each metric\n"
+        "against the real error. The raster is the hybrid frame with PCSS shadows,\n"
+        "environment-map reflections and post DOF (second frame: cached maps, as the\n"
+        "paper's precomputed environment maps).\n\n"
+        "  SCENE         default: breakfast-room and cornell-glossy (need ../shared)\n"
+        "  --sizes       default 800x600,1024x768,1920x1080\n"
+        "  --spp N       samples a pixel in both PRT and SIR (default 4)\n"
+        "  --budget N    SIR samples an iteration (default 8192, the paper's ray count)\n"
+        "  --light-samples N  the raster's samples per area light and environment\n"
+        "                (default 8, the hybrid frame's)\n"
+        "  --threshold T real error: largest display-value channel difference > T (0.02)\n"
+        "  --lambda FILE also measure the fitted combination\n"
+        "  --figures DIR PNGs per row: raster, pure, sir, combined error, and the\n"
+        "                recall map (white: real error flagged, red: missed, blue: flagged only)\n"
+        "  --noise-floor also the FLIP between two pure images of different seeds (how\n"
+        "                close two equally good images are), and a real error must exceed\n"
+        "                the threshold plus the two pure images' difference at the pixel\n"
+        "  --target X,Y,Z  look at this point instead of the camera's target (other views,\n"
+        "                as the paper's rows are views with more or fewer error pixels)\n"
+        "  --fov DEG     vertical field of view (default: the camera's)\n"
+        "  --views FILE  rows for several views of each scene, from JSON:\n"
+        "                {\"views\": [{\"name\": \"high\", \"position\": [x, y, z],\n"
+        "                \"target\": [x, y, z], \"fov_y\": degrees, \"aperture_radius\": r}]}\n"
+        "                (every field but name optional: the scene camera's)\n"
+        "  --threads T   worker threads (default 1: per-thread figures)\n"
+        "  --json        one JSON object on stdout\n");
 }
 
 static bool parse_sizes(const char *v, sir_options *o)
@@ -90,6 +110,122 @@ static bool parse_sizes(const char *v, sir_options *o)
         }
     }
     return o->size_count > 0;
+}
+
+// Line of the k-th object inside the top-level object's array (brace depth 2), for messages.
+static int view_line(const char *text, int k)
+{
+    int line = 1, depth = 0, seen = -1;
+    bool in_string = false;
+    for (const char *c = text; *c; ++c) {
+        line += *c == '\n';
+        if (in_string) {
+            c += *c == '\\' && c[1];
+            in_string = *c != '"';
+        } else if (*c == '"') {
+            in_string = true;
+        } else if (*c == '{' && ++depth == 2 && ++seen == k) {
+            return line;
+        } else if (*c == '}') {
+            --depth;
+        }
+    }
+    return 0;
+}
+
+static bool read_vec3(const cJSON *item, drift_vec3 *out)
+{
+    if (!cJSON_IsArray(item) || cJSON_GetArraySize(item) != 3) {
+        return false;
+    }
+    float v[3];
+    for (int k = 0; k < 3; ++k) {
+        const cJSON *e = cJSON_GetArrayItem(item, k);
+        if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble)) {
+            return false;
+        }
+        v[k] = (float)e->valuedouble;
+    }
+    *out = drift_vec3_make(v[0], v[1], v[2]);
+    return true;
+}
+
+// Reads --views FILE; every problem is reported with the file and line.
+static bool load_views(const char *path, sir_options *o)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        fprintf(stderr, "drift bench sir: --views: cannot open %s\n", path);
+        return false;
+    }
+    static char text[1 << 16];
+    size_t length = fread(text, 1, sizeof text - 1, f);
+    bool too_long = !feof(f);
+    fclose(f);
+    text[length] = '\0';
+    if (too_long) {
+        fprintf(stderr, "%s: views file longer than %zu bytes\n", path, sizeof text - 1);
+        return false;
+    }
+    const char *end = NULL;
+    cJSON *root = cJSON_ParseWithOpts(text, &end, true);
+    if (!root) {
+        int line = 1;
+        for (const char *c = text; end && c < end; ++c) {
+            line += *c == '\n';
+        }
+        fprintf(stderr, "%s:%d: JSON syntax error\n", path, line);
+        return false;
+    }
+    const cJSON *views = cJSON_GetObjectItemCaseSensitive(root, "views");
+    bool ok = cJSON_IsArray(views) && cJSON_GetArraySize(views) > 0 &&
+              cJSON_GetArraySize(views) <= MAX_VIEWS;
+    if (!ok) {
+        fprintf(stderr, "%s:1: expected {\"views\": [1 to %d view objects]}\n", path, MAX_VIEWS);
+    }
+    o->view_count = 0;
+    const cJSON *v = NULL, *list = ok ? views : NULL;
+    cJSON_ArrayForEach(v, list)
+    {
+        int k = o->view_count;
+        sir_view *view = &o->views[o->view_count++];
+        *view = (sir_view){ .aperture = -1.0 };
+        const char *problem = NULL;
+        const cJSON *name = cJSON_GetObjectItemCaseSensitive(v, "name");
+        const cJSON *position = cJSON_GetObjectItemCaseSensitive(v, "position");
+        const cJSON *target = cJSON_GetObjectItemCaseSensitive(v, "target");
+        const cJSON *fov = cJSON_GetObjectItemCaseSensitive(v, "fov_y");
+        const cJSON *aperture = cJSON_GetObjectItemCaseSensitive(v, "aperture_radius");
+        if (!cJSON_IsObject(v)) {
+            problem = "a view must be an object";
+        } else if (!cJSON_IsString(name) || !name->valuestring[0] ||
+                   strlen(name->valuestring) >= sizeof view->name ||
+                   strspn(name->valuestring,
+                          "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-") !=
+                       strlen(name->valuestring)) {
+            problem = "\"name\" must be a string of 1-63 letters, digits, '_' or '-'";
+        } else if (position && !(view->has_position = read_vec3(position, &view->position))) {
+            problem = "\"position\" must be [x, y, z]";
+        } else if (target && !(view->has_target = read_vec3(target, &view->target))) {
+            problem = "\"target\" must be [x, y, z]";
+        } else if (fov && (!cJSON_IsNumber(fov) ||
+                           !(fov->valuedouble >= 0.1 && fov->valuedouble <= 179.0))) {
+            problem = "\"fov_y\" must be a number of degrees in [0.1, 179]";
+        } else if (aperture && (!cJSON_IsNumber(aperture) || !(aperture->valuedouble >= 0.0) ||
+                                !isfinite(aperture->valuedouble))) {
+            problem = "\"aperture_radius\" must be a number >= 0";
+        }
+        if (problem) {
+            fprintf(stderr, "%s:%d: view %d: %s\n", path, view_line(text, k), k + 1, problem);
+            ok = false;
+            break;
+        }
+        snprintf(view->name, sizeof view->name, "%s", name->valuestring);
+        view->fov = fov ? fov->valuedouble : 0.0;
+        view->aperture = aperture ? aperture->valuedouble : -1.0;
+    }
+    cJSON_Delete(root);
+    return ok;
 }
 
 static int parse(int argc, char **argv, sir_options *o)
@@ -133,6 +269,9 @@ static int parse(int argc, char **argv, sir_options *o)
         } else if (strcmp(a, "--fov") == 0) {
             ok = (v = cli_next_value("bench sir", argc, argv, &i)) &&
                  cli_parse_float("bench sir", a, v, 0.1, 179.0, &o->fov);
+        } else if (strcmp(a, "--views") == 0) {
+            ok = (o->views_path = cli_next_value("bench sir", argc, argv, &i)) != NULL &&
+                 load_views(o->views_path, o);
         } else if (strcmp(a, "--noise-floor") == 0) {
             o->noise_floor = true;
         } else if (strcmp(a, "--figures") == 0) {
@@ -184,6 +323,7 @@ static quality measure_quality(const drift_image *flag, const drift_image *real)
 
 typedef struct sir_row {
     const char *scene;
+    const char *view; // --views name, or "camera"
     int32_t width, height;
     uint64_t error_pixels, real_pixels;
     double error_percent, real_percent;
@@ -355,7 +495,10 @@ static drift_result run_one(drift_context *ctx, const drift_scene *scene, const 
     }
     row->q[DRIFT_METRIC_COUNT] = measure_quality(drift_refine_error(sir), &real);
     if (o->figures_dir) {
-        save_figures(ctx, o, row->scene, drift_hybrid_image(frame), &pure, drift_refine_image(sir),
+        char label[160];
+        snprintf(label, sizeof label, "%s%s%s", row->scene, o->view_count ? "_" : "",
+                 o->view_count ? row->view : "");
+        save_figures(ctx, o, label, drift_hybrid_image(frame), &pure, drift_refine_image(sir),
                      drift_refine_error(sir), &real);
     }
     if (lambda) {
@@ -398,21 +541,22 @@ static const char *quality_name(int k)
 
 static void print_json_row(const sir_row *row, bool first, bool lambda)
 {
-    printf("%s{\"scene\": \"%s\", \"width\": %d, \"height\": %d, \"error_pixels\": %llu, "
+    printf("%s{\"scene\": \"%s\", \"view\": \"%s\", \"width\": %d, \"height\": %d, "
+           "\"error_pixels\": %llu, "
            "\"error_percent\": %.3f, \"real_error_pixels\": %llu, \"real_error_percent\": %.3f, "
            "\"raster_ms\": %.2f, \"metrics_ms\": %.2f, \"sort_ms\": %.2f, \"trace_ms\": %.2f, "
            "\"sir_ms\": %.2f, \"prt_ms\": %.2f, \"speedup\": %.3f, \"flip\": %.5f, "
            "\"noise_flip\": %.5f, \"sir_to_flip_ms\": %.2f, \"speedup_to_flip\": %.3f, "
            "\"same_image\": %s, \"iterations\": %u, \"sir_rays\": %llu, \"prt_rays\": %llu, "
            "\"quality\": {",
-           first ? "" : ", ", row->scene, row->width, row->height,
+           first ? "" : ", ", row->scene, row->view, row->width, row->height,
            (unsigned long long)row->error_pixels, row->error_percent,
-           (unsigned long long)row->real_pixels, row->real_percent, row->raster_ms,
-           row->metrics_ms, row->sort_ms, row->trace_ms, row->sir_ms, row->prt_ms,
-           row->prt_ms / row->sir_ms, row->flip, row->noise_flip, row->reached_ms,
+           (unsigned long long)row->real_pixels, row->real_percent, row->raster_ms, row->metrics_ms,
+           row->sort_ms, row->trace_ms, row->sir_ms, row->prt_ms, row->prt_ms / row->sir_ms,
+           row->flip, row->noise_flip, row->reached_ms,
            row->reached_ms > 0.0 ? row->prt_ms / row->reached_ms : 0.0,
-           row->flip <= FLIP_TARGET ? "true" : "false",
-           row->iterations, (unsigned long long)row->sir_rays, (unsigned long long)row->prt_rays);
+           row->flip <= FLIP_TARGET ? "true" : "false", row->iterations,
+           (unsigned long long)row->sir_rays, (unsigned long long)row->prt_rays);
     int rows = lambda ? QUALITY_ROWS : QUALITY_ROWS - 1;
     for (int k = 0; k < rows; ++k) {
         printf("%s\"%s\": {\"recall\": %.4f, \"precision\": %.4f, \"flagged\": %.4f}",
@@ -424,9 +568,9 @@ static void print_json_row(const sir_row *row, bool first, bool lambda)
 
 static void print_text_row(const sir_row *row, bool lambda)
 {
-    printf("%-16s %5dx%-5d %9llu (%5.2f%%) %9.1f %9.1f %7.2fx %8.5f %s\n", row->scene, row->width,
-           row->height, (unsigned long long)row->error_pixels, row->error_percent, row->prt_ms,
-           row->sir_ms, row->prt_ms / row->sir_ms, row->flip,
+    printf("%-16s %-10s %5dx%-5d %9llu (%5.2f%%) %9.1f %9.1f %7.2fx %8.5f %s\n", row->scene,
+           row->view, row->width, row->height, (unsigned long long)row->error_pixels,
+           row->error_percent, row->prt_ms, row->sir_ms, row->prt_ms / row->sir_ms, row->flip,
            row->flip <= FLIP_TARGET ? "yes" : "NO");
     if (row->reached_ms > 0.0) {
         printf("    FLIP <= %.2f after %.1f ms: %.2fx faster than PRT\n", FLIP_TARGET, row->reached_ms,
@@ -481,8 +625,8 @@ int drift_bench_sir(int argc, char **argv)
     } else {
         printf("%d thread(s), %ld spp, budget %ld samples an iteration, real error > %.3f\n",
                drift_context_thread_count(ctx), o.spp, o.budget, o.threshold);
-        printf("%-16s %-11s %20s %9s %9s %8s %8s %s\n", "scene", "size", "error pixels", "PRT ms",
-               "SIR ms", "speedup", "FLIP", "same");
+        printf("%-16s %-10s %-11s %20s %9s %9s %8s %8s %s\n", "scene", "view", "size",
+               "error pixels", "PRT ms", "SIR ms", "speedup", "FLIP", "same");
     }
     for (int s = 0; s < o.scene_count && exit_code == 0; ++s) {
         drift_scene *scene = NULL;
@@ -497,22 +641,41 @@ int drift_bench_sir(int argc, char **argv)
         if (o.fov > 0.0) {
             scene->camera.fov_y = (float)(o.fov * 3.14159265358979323846 / 180.0);
         }
-        for (int k = 0; k < o.size_count; ++k) {
-            sir_row row = { .scene = short_name(o.scenes[s]) };
-            r = run_one(ctx, scene, accel, &o, o.widths[k], o.heights[k],
-                        o.lambda_path ? lambda : NULL, &row);
-            if (r != DRIFT_OK) {
-                fprintf(stderr, "drift bench sir: %s failed: %s\n", o.scenes[s], drift_result_string(r));
-                exit_code = 1;
-                break;
+        const drift_camera camera = scene->camera;
+        for (int v = 0; v < (o.view_count ? o.view_count : 1) && exit_code == 0; ++v) {
+            const sir_view *view = o.view_count ? &o.views[v] : NULL;
+            scene->camera = camera;
+            if (view && view->has_position) {
+                scene->camera.position = view->position;
             }
-            if (o.json) {
-                print_json_row(&row, first, o.lambda_path != NULL);
-            } else {
-                print_text_row(&row, o.lambda_path != NULL);
+            if (view && view->has_target) {
+                scene->camera.target = view->target;
             }
-            first = false;
-            fflush(stdout);
+            if (view && view->fov > 0.0) {
+                scene->camera.fov_y = (float)(view->fov * 3.14159265358979323846 / 180.0);
+            }
+            if (view && view->aperture >= 0.0) {
+                scene->camera.aperture_radius = (float)view->aperture;
+            }
+            for (int k = 0; k < o.size_count; ++k) {
+                sir_row row = { .scene = short_name(o.scenes[s]),
+                                .view = view ? view->name : "camera" };
+                r = run_one(ctx, scene, accel, &o, o.widths[k], o.heights[k],
+                            o.lambda_path ? lambda : NULL, &row);
+                if (r != DRIFT_OK) {
+                    fprintf(stderr, "drift bench sir: %s failed: %s\n", o.scenes[s],
+                            drift_result_string(r));
+                    exit_code = 1;
+                    break;
+                }
+                if (o.json) {
+                    print_json_row(&row, first, o.lambda_path != NULL);
+                } else {
+                    print_text_row(&row, o.lambda_path != NULL);
+                }
+                first = false;
+                fflush(stdout);
+            }
         }
         drift_accel_destroy(accel);
         drift_scene_destroy(scene);

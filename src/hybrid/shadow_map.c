@@ -48,6 +48,13 @@ struct drift_shadow_map {
     drift_vec3 origin;            // orthographic: world point of texel corner (0, 0) at depth 0
     float texel_size;             // orthographic: scene units a texel
     float *depth;                 // slot_count * size * size; INFINITY where rays miss
+    // Min-depth mip chain of each slot (level k: cells of 2^k x 2^k texels, k = 1 ..
+    // mip_levels), so the penumbra estimate can prove a tap region free of blockers with a
+    // few reads (see search_level).
+    float *min_mip;
+    int32_t mip_levels;
+    size_t mip_offset[32]; // level k of slot s at min_mip + s * mip_slot + mip_offset[k]
+    size_t mip_slot;
     drift_vec2 search_taps[SEARCH_TAPS];
     drift_vec2 filter_taps[FILTER_TAPS];
 };
@@ -183,6 +190,73 @@ static void fill_rows(size_t begin, size_t end, int thread_index, void *user)
     atomic_fetch_add(&job->rays, rays);
 }
 
+static int32_t mip_size(int32_t size, int32_t level)
+{
+    return (int32_t)(((int64_t)size + (1 << level) - 1) >> level);
+}
+
+// The min-depth chain: each cell the least of its (up to) four children.
+static drift_result build_min_mip(drift_context *ctx, drift_shadow_map *map)
+{
+    map->mip_levels = 0;
+    size_t total = 0;
+    for (int32_t k = 1; k < 31 && mip_size(map->size, k - 1) > 1; ++k) {
+        map->mip_offset[k] = total;
+        total += (size_t)mip_size(map->size, k) * (size_t)mip_size(map->size, k);
+        map->mip_levels = k;
+    }
+    map->mip_slot = total;
+    if (total == 0) {
+        return DRIFT_OK;
+    }
+    map->min_mip = drift_alloc(ctx, sizeof(float) * total * map->slot_count);
+    if (!map->min_mip) {
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    for (uint32_t slot = 0; slot < map->slot_count; ++slot) {
+        for (int32_t k = 1; k <= map->mip_levels; ++k) {
+            int32_t from = mip_size(map->size, k - 1), to = mip_size(map->size, k);
+            const float *src =
+                k == 1 ? map->depth + (size_t)slot * (size_t)map->size * (size_t)map->size
+                       : map->min_mip + slot * map->mip_slot + map->mip_offset[k - 1];
+            float *dst = map->min_mip + slot * map->mip_slot + map->mip_offset[k];
+            for (int32_t y = 0; y < to; ++y) {
+                for (int32_t x = 0; x < to; ++x) {
+                    float m = INFINITY;
+                    for (int32_t j = 2 * y; j < 2 * y + 2 && j < from; ++j) {
+                        for (int32_t i = 2 * x; i < 2 * x + 2 && i < from; ++i) {
+                            m = fminf(m, src[(size_t)j * (size_t)from + (size_t)i]);
+                        }
+                    }
+                    dst[(size_t)y * (size_t)to + (size_t)x] = m;
+                }
+            }
+        }
+    }
+    return DRIFT_OK;
+}
+
+// Least stored depth over texels [x0, x1] x [y0, y1] of a slot (inclusive, in range): at most
+// four cells of the coarsest level whose cells are at least the rectangle's size.
+static float min_depth_rect(const drift_shadow_map *map, int32_t slot, int32_t x0, int32_t y0,
+                            int32_t x1, int32_t y1)
+{
+    int32_t extent = (x1 - x0 > y1 - y0 ? x1 - x0 : y1 - y0) + 1, k = 0;
+    while ((1 << k) < extent && k < map->mip_levels) {
+        ++k;
+    }
+    int32_t size = mip_size(map->size, k);
+    const float *level = k == 0 ? map->depth + (size_t)slot * (size_t)map->size * (size_t)map->size
+                                : map->min_mip + (size_t)slot * map->mip_slot + map->mip_offset[k];
+    float m = INFINITY;
+    for (int32_t y = y0 >> k; y <= y1 >> k && y < size; ++y) {
+        for (int32_t x = x0 >> k; x <= x1 >> k && x < size; ++x) {
+            m = fminf(m, level[(size_t)y * (size_t)size + (size_t)x]);
+        }
+    }
+    return m;
+}
+
 // Fixed tap sets: stratified points of [0,1)^2 mapped to the unit disk (Shirley & Chiu),
 // so taps cover the disk evenly without a random pattern to store.
 static void make_disk_taps(drift_vec2 *taps, int32_t columns, int32_t rows)
@@ -310,6 +384,10 @@ drift_result drift_shadow_map_build(drift_context *ctx, const drift_scene *scene
     }
     atomic_init(&job.rays, 0);
     drift_parallel_for(ctx, rows, 4, fill_rows, &job);
+    if (build_min_mip(ctx, map) != DRIFT_OK) {
+        drift_shadow_map_destroy(ctx, map);
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
     if (out_rays) {
         *out_rays += atomic_load(&job.rays);
     }
@@ -323,6 +401,7 @@ void drift_shadow_map_destroy(drift_context *ctx, drift_shadow_map *map)
         return;
     }
     drift_free(ctx, map->depth);
+    drift_free(ctx, map->min_mip);
     drift_free(ctx, map);
 }
 
@@ -427,52 +506,91 @@ static float receiver_depth(const receiver *rec, float plane_depth, bool meets_p
     return rec->depth + drift_clampf(change, -cap, cap);
 }
 
-static tap_result cube_tap(const drift_shadow_map *map, const receiver *rec, float ox, float oy)
+// Where a tap lands: the texel it reads (face and slot for cube maps) and the depth stored
+// there; INFINITY behind a one-sided light or outside an orthographic map.
+typedef struct tap_texel {
+    float stored;
+    int face;
+    int32_t x, y;
+} tap_texel;
+
+static tap_texel cube_texel(const drift_shadow_map *map, const receiver *rec, float ox, float oy)
 {
     drift_vec3 d = drift_vec3_fma(drift_vec3_fma(rec->dir, rec->t1, ox), rec->t2, oy);
-    int face = major_face(d);
-    int slot = map->face_slot[face];
+    tap_texel t = { .stored = INFINITY, .face = major_face(d) };
+    int slot = map->face_slot[t.face];
     if (slot < 0) {
         // Behind a one-sided light: it sends nothing there, so nothing can block it.
-        return (tap_result){ INFINITY, rec->depth };
+        return t;
     }
-    int a = face / 2;
+    int a = t.face / 2;
     float major = fabsf(vec3_axis(d, a));
-    int32_t x = texel_index(vec3_axis(d, (a + 1) % 3) / major, map->size);
-    int32_t y = texel_index(vec3_axis(d, (a + 2) % 3) / major, map->size);
+    t.x = texel_index(vec3_axis(d, (a + 1) % 3) / major, map->size);
+    t.y = texel_index(vec3_axis(d, (a + 2) % 3) / major, map->size);
     size_t size = (size_t)map->size;
-    float stored = map->depth[((size_t)slot * size + (size_t)y) * size + (size_t)x];
+    t.stored = map->depth[((size_t)slot * size + (size_t)t.y) * size + (size_t)t.x];
+    return t;
+}
+
+// The receiver plane's depth along the ray through the tap's texel centre.
+static float cube_receiver_at(const drift_shadow_map *map, const receiver *rec, const tap_texel *t)
+{
+    if (map->face_slot[t->face] < 0) {
+        return rec->depth;
+    }
     // Plane through p with normal n (toward the centre): a ray from the centre along unit dc
     // meets it at t = h / (-n . dc), h = n . (centre - p) = -(n . dir) depth.
     drift_vec3 dc = drift_vec3_normalize(
-        face_direction(face, texel_centre(x, map->size), texel_centre(y, map->size)));
+        face_direction(t->face, texel_centre(t->x, map->size), texel_centre(t->y, map->size)));
     float h = -drift_vec3_dot(rec->n, rec->dir) * rec->depth;
     float cos_c = -drift_vec3_dot(rec->n, dc);
     float lateral = drift_vec3_length(drift_vec3_sub(dc, rec->dir)) * rec->depth;
-    return (tap_result){ stored, receiver_depth(rec, h / cos_c, cos_c > 0.0f, lateral) };
+    return receiver_depth(rec, h / cos_c, cos_c > 0.0f, lateral);
 }
 
-static tap_result ortho_tap(const drift_shadow_map *map, const receiver *rec, float ox, float oy)
+static tap_texel ortho_texel(const drift_shadow_map *map, const receiver *rec, float ox, float oy)
 {
+    tap_texel t = { .stored = INFINITY, .face = -1 };
     float fx = (rec->x + ox) / map->texel_size, fy = (rec->y + oy) / map->texel_size;
     if (!(fx >= 0.0f && fy >= 0.0f && fx < (float)map->size && fy < (float)map->size)) {
-        return (tap_result){ INFINITY, rec->depth }; // outside the scene: nothing there
+        return t; // outside the scene: nothing there
     }
-    int32_t x = (int32_t)fx, y = (int32_t)fy;
-    float stored = map->depth[(size_t)y * (size_t)map->size + (size_t)x];
+    t.face = 0;
+    t.x = (int32_t)fx;
+    t.y = (int32_t)fy;
+    t.stored = map->depth[(size_t)t.y * (size_t)map->size + (size_t)t.x];
+    return t;
+}
+
+static float ortho_receiver_at(const drift_shadow_map *map, const receiver *rec, const tap_texel *t)
+{
+    if (t->face < 0) {
+        return rec->depth;
+    }
     // Plane n . (q - p) = 0 in map coordinates: dz = -(n.x dx + n.y dy) / n.z.
-    float dx = ((float)x + 0.5f) * map->texel_size - rec->x;
-    float dy = ((float)y + 0.5f) * map->texel_size - rec->y;
+    float dx = ((float)t->x + 0.5f) * map->texel_size - rec->x;
+    float dy = ((float)t->y + 0.5f) * map->texel_size - rec->y;
     float rise = -(rec->n.x * dx + rec->n.y * dy);
     float run = rec->n.z;
     bool meets = run < 0.0f;
     float plane = meets ? rec->depth + rise / run : rec->depth;
-    return (tap_result){ stored, receiver_depth(rec, plane, meets, sqrtf(dx * dx + dy * dy)) };
+    return receiver_depth(rec, plane, meets, sqrtf(dx * dx + dy * dy));
+}
+
+static tap_texel tap_lands(const drift_shadow_map *map, const receiver *rec, float ox, float oy)
+{
+    return map->directional ? ortho_texel(map, rec, ox, oy) : cube_texel(map, rec, ox, oy);
+}
+
+static float receiver_at(const drift_shadow_map *map, const receiver *rec, const tap_texel *t)
+{
+    return map->directional ? ortho_receiver_at(map, rec, t) : cube_receiver_at(map, rec, t);
 }
 
 static tap_result tap(const drift_shadow_map *map, const receiver *rec, float ox, float oy)
 {
-    return map->directional ? ortho_tap(map, rec, ox, oy) : cube_tap(map, rec, ox, oy);
+    tap_texel t = tap_lands(map, rec, ox, oy);
+    return (tap_result){ t.stored, receiver_at(map, rec, &t) };
 }
 
 static bool tap_lit(const receiver *rec, tap_result t)
@@ -606,49 +724,317 @@ float drift_shadow_map_pcss(const drift_shadow_map *map, drift_vec3 p, drift_vec
 
 // Taps a side of the square grids below (the blocker search repeats it at shrinking radii).
 #define PENUMBRA_GRID 8
+// Levels of the blocker search at most this many texels in radius test texels, not taps.
+#define TEXEL_LEVEL 2.0f
+
+typedef struct penumbra_search {
+    const drift_shadow_map *map;
+    const receiver *rec;
+    float L;           // light size for the cone (the map's radius unless the query is tighter)
+    bool hierarchical; // prove regions blocker-free from the min-depth mip before tapping
+    bool texel_levels; // test texels instead of taps at the finest levels
+} penumbra_search;
 
 // Offset radius within which a blocker at depth z can hide part of the light from the
 // receiver: the cone from the receiver to the light (radius L) seen from the centre,
 // L (d_r - z) / (d_r z) (directional: L (d_r - z)), plus a texel for the tap's own footprint.
-static float blocker_cone(const drift_shadow_map *map, const receiver *rec, float z)
+static float blocker_cone(const penumbra_search *s, float z)
 {
-    float L = map->radius, d_r = rec->depth;
-    float cone = map->directional ? L * (d_r - z) : (z > 0.0f ? L * (d_r - z) / (d_r * z) : INFINITY);
-    return cone + rec->texel;
+    float L = s->L, d_r = s->rec->depth;
+    float cone =
+        s->map->directional ? L * (d_r - z) : (z > 0.0f ? L * (d_r - z) / (d_r * z) : INFINITY);
+    return cone + s->rec->texel;
 }
 
-// Taps of a grid of PENUMBRA_GRID^2 over the square of half width `radius`: how many see a
-// blocker (a nearer surface inside the cone to the light: Guennebaud's backprojection test of
-// whether its shadow can reach the receiver), and the nearest blocker's depth. Without
-// `in_cone`, any nearer surface counts (the umbra test: is the whole region covered?).
-static int32_t count_blockers(const drift_shadow_map *map, const receiver *rec, float radius,
-                              bool in_cone, float *out_nearest)
+// The cone test inverted: a blocker at offset radius o passes it only at depth <= this
+// (INFINITY when every depth passes, within a texel of the receiver's direction).
+static float cone_depth_bound(const penumbra_search *s, float o)
 {
+    float excess = o - s->rec->texel, L = s->L, d_r = s->rec->depth;
+    if (!(excess > 0.0f)) {
+        return INFINITY;
+    }
+    return s->map->directional ? d_r - excess / L : L * d_r / (excess * d_r + L);
+}
+
+// Least depth stored in any texel a tap with ox in [x0, x1], oy in [y0, y1] can read. Cube
+// maps: the rectangle of directions dir + ox t1 + oy t2 is convex, and so is its central
+// projection onto a face plane when every corner is in front of it; the corners' bounding box
+// then holds every tap that lands on the face (padded two texels for rounding). When all four
+// corners land on one face, so does the whole rectangle (its image is convex, and so is the
+// face's square). A face the rectangle straddles is read whole; one behind every corner gets
+// no tap.
+static float region_min_depth(const penumbra_search *s, float x0, float y0, float x1, float y1)
+{
+    const drift_shadow_map *map = s->map;
+    const receiver *rec = s->rec;
+    int32_t last = map->size - 1;
+    if (map->directional) {
+        float fx0 = (rec->x + x0) / map->texel_size - 2.0f,
+              fx1 = (rec->x + x1) / map->texel_size + 2.0f;
+        float fy0 = (rec->y + y0) / map->texel_size - 2.0f,
+              fy1 = (rec->y + y1) / map->texel_size + 2.0f;
+        if (fx1 < 0.0f || fy1 < 0.0f || fx0 > (float)last || fy0 > (float)last) {
+            return INFINITY;
+        }
+        int32_t ix0 = fx0 < 0.0f ? 0 : (int32_t)fx0, iy0 = fy0 < 0.0f ? 0 : (int32_t)fy0;
+        int32_t ix1 = fx1 > (float)last ? last : (int32_t)fx1;
+        int32_t iy1 = fy1 > (float)last ? last : (int32_t)fy1;
+        return min_depth_rect(map, 0, ix0, iy0, ix1, iy1);
+    }
+    drift_vec3 corner[4];
+    int faces[4];
+    for (int k = 0; k < 4; ++k) {
+        corner[k] = drift_vec3_fma(drift_vec3_fma(rec->dir, rec->t1, (k & 1) ? x1 : x0), rec->t2,
+                                   (k & 2) ? y1 : y0);
+        faces[k] = major_face(corner[k]);
+    }
+    bool one_face = faces[0] == faces[1] && faces[0] == faces[2] && faces[0] == faces[3];
+    float best = INFINITY, pad = 4.0f / (float)map->size;
+    for (int f = one_face ? faces[0] : 0; f < (one_face ? faces[0] + 1 : CUBE_FACES); ++f) {
+        int slot = map->face_slot[f];
+        if (slot < 0) {
+            continue;
+        }
+        int a = f / 2;
+        float sign = f % 2 == 0 ? 1.0f : -1.0f;
+        int in_front = 0;
+        float u0 = INFINITY, u1 = -INFINITY, v0 = INFINITY, v1 = -INFINITY;
+        for (int k = 0; k < 4; ++k) {
+            float along = sign * vec3_axis(corner[k], a);
+            if (along > 0.0f) {
+                ++in_front;
+                float u = vec3_axis(corner[k], (a + 1) % 3) / along;
+                float v = vec3_axis(corner[k], (a + 2) % 3) / along;
+                u0 = fminf(u0, u);
+                u1 = fmaxf(u1, u);
+                v0 = fminf(v0, v);
+                v1 = fmaxf(v1, v);
+            }
+        }
+        if (in_front == 0) {
+            continue;
+        }
+        int32_t tx0 = 0, tx1 = last, ty0 = 0, ty1 = last;
+        if (in_front == 4) {
+            if (u0 - pad > 1.0f || u1 + pad < -1.0f || v0 - pad > 1.0f || v1 + pad < -1.0f) {
+                continue;
+            }
+            tx0 = texel_index(u0 - pad, map->size);
+            tx1 = texel_index(u1 + pad, map->size);
+            ty0 = texel_index(v0 - pad, map->size);
+            ty1 = texel_index(v1 + pad, map->size);
+        }
+        best = fminf(best, min_depth_rect(map, slot, tx0, ty0, tx1, ty1));
+    }
+    return best;
+}
+
+// The texels a square of taps (|ox|, |oy| <= r) can read, when it lands on one face (cube) or
+// on the map (orthographic): slot and inclusive texel rectangle. False when it spans faces.
+typedef struct texel_rect {
+    int face, slot;
+    int32_t x0, y0, x1, y1;
+} texel_rect;
+
+static bool square_texels(const penumbra_search *s, float r, texel_rect *out)
+{
+    const drift_shadow_map *map = s->map;
+    const receiver *rec = s->rec;
+    int32_t last = map->size - 1;
+    if (map->directional) {
+        float fx0 = (rec->x - r) / map->texel_size, fx1 = (rec->x + r) / map->texel_size;
+        float fy0 = (rec->y - r) / map->texel_size, fy1 = (rec->y + r) / map->texel_size;
+        if (!(fx0 >= 0.0f && fy0 >= 0.0f && fx1 < (float)map->size && fy1 < (float)map->size)) {
+            return false; // partly outside the map: taps there see nothing, rectangle clipped
+        }
+        *out = (texel_rect){ 0, 0, (int32_t)fx0, (int32_t)fy0, (int32_t)fx1, (int32_t)fy1 };
+        return out->x1 <= last && out->y1 <= last;
+    }
+    drift_vec3 corner[4];
+    int face = -1;
+    for (int k = 0; k < 4; ++k) {
+        corner[k] = drift_vec3_fma(drift_vec3_fma(rec->dir, rec->t1, (k & 1) ? r : -r), rec->t2,
+                                   (k & 2) ? r : -r);
+        int f = major_face(corner[k]);
+        if (face >= 0 && f != face) {
+            return false;
+        }
+        face = f;
+    }
+    if (map->face_slot[face] < 0) {
+        return false;
+    }
+    int a = face / 2;
+    float u0 = INFINITY, u1 = -INFINITY, v0 = INFINITY, v1 = -INFINITY;
+    for (int k = 0; k < 4; ++k) {
+        float major = fabsf(vec3_axis(corner[k], a));
+        float u = vec3_axis(corner[k], (a + 1) % 3) / major,
+              v = vec3_axis(corner[k], (a + 2) % 3) / major;
+        u0 = fminf(u0, u);
+        u1 = fmaxf(u1, u);
+        v0 = fminf(v0, v);
+        v1 = fmaxf(v1, v);
+    }
+    *out = (texel_rect){ face,
+                         map->face_slot[face],
+                         texel_index(u0, map->size),
+                         texel_index(v0, map->size),
+                         texel_index(u1, map->size),
+                         texel_index(v1, map->size) };
+    return true;
+}
+
+// The finest levels, a couple of texels wide, would put many of their 64 taps in each texel:
+// instead every texel the square can read is tested once, against the receiver plane alone
+// (the cone test at these offsets accepts nearly any depth; skipping it only adds blockers).
+// -1 when the square spans faces (the caller taps it).
+static int32_t search_texels(const penumbra_search *s, float radius, bool first_only,
+                             float *out_nearest)
+{
+    texel_rect rect;
+    if (!square_texels(s, radius, &rect)) {
+        return -1;
+    }
+    const drift_shadow_map *map = s->map;
+    size_t size = (size_t)map->size;
     int32_t blockers = 0;
-    float nearest = INFINITY;
+    for (int32_t y = rect.y0; y <= rect.y1; ++y) {
+        for (int32_t x = rect.x0; x <= rect.x1; ++x) {
+            tap_texel t = {
+                .stored = map->depth[((size_t)rect.slot * size + (size_t)y) * size + (size_t)x],
+                .face = rect.face,
+                .x = x,
+                .y = y
+            };
+            if (t.stored >= receiver_at(map, s->rec, &t) - s->rec->bias) {
+                continue;
+            }
+            blockers++;
+            *out_nearest = fminf(*out_nearest, t.stored);
+            if (first_only) {
+                return blockers;
+            }
+        }
+    }
+    return blockers;
+}
+
+// Whether the mip proves that no tap of a group finds a blocker: every texel the group can
+// read (offsets in the square of half width `reach`) is deeper than the cone allows at the
+// group's nearest tap (rounding slack on the side of tapping). *lower is a known lower bound on
+// those depths (from a larger square); raised to the square's least depth when it is read.
+static bool proven_free(const penumbra_search *s, float reach, float nearest_offset, float *lower)
+{
+    float bound = cone_depth_bound(s, nearest_offset) * 1.001f;
+    if (!(bound < INFINITY)) {
+        return false;
+    }
+    if (*lower > bound) {
+        return true;
+    }
+    *lower = fmaxf(*lower, region_min_depth(s, -reach, -reach, reach, reach));
+    return *lower > bound;
+}
+
+// Taps of a grid of PENUMBRA_GRID^2 over the square of half width `radius` that see a blocker
+// (a nearer surface inside the cone to the light: Guennebaud's backprojection test of whether
+// its shadow can reach the receiver), and the nearest blocker's depth; with `first_only`, stops
+// at the first. The hierarchical search skips the inner 4 x 4 block and the outer ring when
+// the mip proves them free (finer groups cost more in proofs than they save in taps), so it
+// finds exactly the exhaustive search's blockers. A texel just found lit is not tested again
+// (the same texel, the same answer).
+static int32_t search_level(const penumbra_search *s, float radius, bool first_only, float *lower,
+                            float *out_nearest)
+{
+    *out_nearest = INFINITY;
+    // Tap (i, j) is at odd multiples of step: (2i + 1 - GRID) step.
+    const float step = radius / (float)PENUMBRA_GRID;
+    if (s->texel_levels && radius <= TEXEL_LEVEL * s->rec->texel) {
+        int32_t blockers = search_texels(s, radius, first_only, out_nearest);
+        if (blockers >= 0) {
+            return blockers;
+        }
+    }
+    bool skip_inner = false, skip_outer = false;
+    if (s->hierarchical) {
+        // Inner taps (1 or 3 steps out each way) are at least sqrt(2) steps from the centre and
+        // read within 4; outer taps at least 5 steps away, within the radius. *lower bounds
+        // the depths over the whole square and leaves bounding those of the inner block, which
+        // holds the next level's square (a third of the radius).
+        skip_outer = proven_free(s, radius, 5.0f * step, lower);
+        skip_inner = proven_free(s, 4.0f * step, 1.41421356f * step, lower);
+        if (skip_inner && skip_outer) {
+            return 0;
+        }
+    }
+    int32_t blockers = 0;
+    tap_texel lit = { .face = -2 }; // the last texel found lit
+    for (int32_t j = 0; j < PENUMBRA_GRID; ++j) {
+        for (int32_t i = 0; i < PENUMBRA_GRID; ++i) {
+            int32_t mx = 2 * i + 1 - PENUMBRA_GRID, my = 2 * j + 1 - PENUMBRA_GRID;
+            bool inner = mx >= -3 && mx <= 3 && my >= -3 && my <= 3;
+            if (inner ? skip_inner : skip_outer) {
+                continue;
+            }
+            float ox = step * (float)mx, oy = step * (float)my;
+            tap_texel t = tap_lands(s->map, s->rec, ox, oy);
+            if (t.face == lit.face && t.x == lit.x && t.y == lit.y) {
+                continue;
+            }
+            // The cone test first: it needs only the stored depth, and most taps fail it.
+            if (sqrtf(ox * ox + oy * oy) > blocker_cone(s, t.stored)) {
+                continue;
+            }
+            if (t.stored >= receiver_at(s->map, s->rec, &t) - s->rec->bias) {
+                lit = t;
+                continue;
+            }
+            blockers++;
+            *out_nearest = fminf(*out_nearest, t.stored);
+            if (first_only) {
+                return blockers;
+            }
+        }
+    }
+    return blockers;
+}
+
+// Whether every tap of the grid over the square of half width `radius` is behind a nearer
+// surface (the umbra test).
+static bool all_blocked(const penumbra_search *s, float radius)
+{
     for (int32_t j = 0; j < PENUMBRA_GRID; ++j) {
         for (int32_t i = 0; i < PENUMBRA_GRID; ++i) {
             float ox = radius * (2.0f * ((float)i + 0.5f) / PENUMBRA_GRID - 1.0f);
             float oy = radius * (2.0f * ((float)j + 0.5f) / PENUMBRA_GRID - 1.0f);
-            tap_result t = tap(map, rec, ox, oy);
-            if (!tap_lit(rec, t) &&
-                (!in_cone || sqrtf(ox * ox + oy * oy) <= blocker_cone(map, rec, t.stored))) {
-                blockers++;
-                nearest = fminf(nearest, t.stored);
+            if (tap_lit(s->rec, tap(s->map, s->rec, ox, oy))) {
+                return false;
             }
         }
     }
-    *out_nearest = nearest;
-    return blockers;
+    return true;
 }
 
 float drift_shadow_map_penumbra(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n)
+{
+    return drift_shadow_map_penumbra_query(map, p, n, &(drift_penumbra_query){ 0 });
+}
+
+float drift_shadow_map_penumbra_query(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n,
+                                      const drift_penumbra_query *query)
 {
     if (!(map->radius > 0.0f)) {
         return 0.0f; // a point light casts no penumbra
     }
     receiver rec = make_receiver(map, p, n);
-    float L = map->radius, d_r = rec.depth;
+    float L = query->light_size > 0.0f ? fminf(query->light_size, map->radius) : map->radius;
+    penumbra_search s = { .map = map,
+                          .rec = &rec,
+                          .L = L,
+                          .hierarchical = !query->exhaustive,
+                          .texel_levels = !query->taps_only };
+    float d_r = rec.depth;
     // Blocker search over the whole cone from the receiver to the light, with the near plane
     // at the light's own size (PCSS trims it to a quarter of the way: here nothing is trimmed,
     // the estimate must be conservative).
@@ -660,38 +1046,31 @@ float drift_shadow_map_penumbra(const drift_shadow_map *map, drift_vec3 p, drift
         search = d_r > near ? L * (d_r - near) / (d_r * near) : 0.0f;
     }
     search = drift_clampf(search, rec.texel, max_radius(map));
-    float nearest;
     tap_result centre = tap(map, &rec, 0.0f, 0.0f);
-    int32_t center_blocked = !tap_lit(&rec, centre);
+    bool centre_blocked = !tap_lit(&rec, centre);
     // Blockers near the receiver have narrow cones: a grid spaced for the whole search region
-    // steps over them. Search again at each third of the radius, down to two texels.
+    // steps over them. Search again at each third of the radius, down to two texels. With the
+    // centre visible, one blocker anywhere decides (penumbra).
     int32_t blockers = 0;
-    nearest = INFINITY;
+    float nearest = INFINITY, lower = -INFINITY;
     for (float r = search; blockers == 0; r *= 1.0f / 3.0f) {
-        float scale_nearest;
-        blockers += count_blockers(map, &rec, r, true, &scale_nearest);
-        nearest = fminf(nearest, scale_nearest);
+        blockers += search_level(&s, r, !centre_blocked, &lower, &nearest);
         if (r < 2.0f * rec.texel) {
             break;
         }
     }
-    if (center_blocked) {
-        nearest = fminf(nearest, centre.stored);
+    if (!centre_blocked) {
+        // Fully lit when nothing lies between the receiver and any point of the light; blockers
+        // in the cone with the light's centre visible: partly covered.
+        return blockers == 0 ? 0.0f : 1.0f;
     }
-    if (blockers + center_blocked == 0) {
-        return 0.0f; // fully lit: nothing between the receiver and any point of the light
-    }
-    if (!center_blocked) {
-        return 1.0f; // blockers in the cone, light centre visible: partly covered
-    }
+    nearest = fminf(nearest, centre.stored);
     // Backprojection bound: the nearest blocker (closest to the light) spreads the widest
     // penumbra, L (d_r - d_b) / d_b at the receiver. When every tap of that region blocks,
     // the light is hidden from the whole region: umbra.
-    float region = map->directional ? L * (d_r - nearest)
-                                    : (nearest > 0.0f ? L * (d_r - nearest) / (nearest * d_r)
-                                                      : max_radius(map));
+    float region = map->directional
+                       ? L * (d_r - nearest)
+                       : (nearest > 0.0f ? L * (d_r - nearest) / (nearest * d_r) : max_radius(map));
     region = drift_clampf(region, rec.texel, max_radius(map));
-    float unused;
-    int32_t blocked = count_blockers(map, &rec, region, false, &unused);
-    return blocked == PENUMBRA_GRID * PENUMBRA_GRID ? 0.0f : 1.0f;
+    return all_blocked(&s, region) ? 0.0f : 1.0f;
 }

@@ -14,11 +14,22 @@
 
 enum { STREAM_AO = 0x5150 };
 
+// A polygonal light's corners (a quad's four, a triangle's three, a small emissive mesh's
+// vertices): the shadow metric bounds the light by them instead of its bounding sphere.
+#define MAX_CORNERS 64
+
+typedef struct light_shape {
+    uint32_t count; // 0: use the bounding sphere
+    bool planar;    // one-sided and every part faces `direction`: nothing lights its back
+    drift_vec3 corner[MAX_CORNERS];
+} light_shape;
+
 typedef struct metric_job {
     const drift_refine_metric_params *params;
     drift_image *out;
     float ao_radius;
     uint64_t ao_rays;
+    light_shape *shapes; // one a frame light, or NULL: bounding spheres
 } metric_job;
 
 static bool is_reflective(const drift_hybrid *f, const drift_surface *s)
@@ -99,6 +110,72 @@ static void reflection_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *ra
     }
 }
 
+// The corners of a light, or count 0 when it has too many or none (spheres, disks).
+static void light_corners(const drift_scene *scene, const drift_hybrid_light *light,
+                          light_shape *out)
+{
+    out->count = 0;
+    out->planar = false;
+    const drift_light *l = &scene->lights[light->first_light];
+    if (light->mesh == DRIFT_INVALID_INDEX && l->type == DRIFT_LIGHT_QUAD) {
+        out->corner[0] = l->position;
+        out->corner[1] = drift_vec3_add(l->position, l->edge_u);
+        out->corner[2] = drift_vec3_add(drift_vec3_add(l->position, l->edge_u), l->edge_v);
+        out->corner[3] = drift_vec3_add(l->position, l->edge_v);
+        out->count = 4;
+        out->planar = light->one_sided;
+        return;
+    }
+    if (l->type != DRIFT_LIGHT_TRIANGLE || 3u * light->light_count > MAX_CORNERS) {
+        return;
+    }
+    // Triangle lights (one, or a small emissive mesh): every vertex; planar when each
+    // triangle faces the mean normal (then the back of the plane gets no light).
+    bool planar = light->one_sided;
+    for (uint32_t t = 0; t < light->light_count; ++t) {
+        drift_vec3 *c = out->corner + 3u * t;
+        drift_light_triangle_vertices(scene, &scene->lights[light->first_light + t], &c[0], &c[1],
+                                      &c[2]);
+        drift_vec3 cross = drift_vec3_cross(drift_vec3_sub(c[1], c[0]), drift_vec3_sub(c[2], c[0]));
+        float area2 = drift_vec3_length(cross);
+        planar =
+            planar && area2 > 0.0f && drift_vec3_dot(cross, light->direction) > 0.9999f * area2;
+        for (int k = 0; k < 3 && planar; ++k) {
+            planar = fabsf(drift_vec3_dot(drift_vec3_sub(c[k], light->centre), light->direction)) <=
+                     1e-4f * light->radius;
+        }
+    }
+    out->count = 3u * light->light_count;
+    out->planar = planar;
+}
+
+// The light's size as the cone from p sees it, for the penumbra estimate: a blocker d from the
+// light's centre c (on the way to p, d_r from c) hides a corner q = c + delta when its offset
+// from the direction to p is |delta_perp| d_r / (d_r - delta_par) (d_r - d) / (d_r d), and the
+// largest over the light is at a corner (the ratio is quasi-convex). 1% wider for the map's
+// normal offset of the receiver. The bounding radius when a corner is beyond p.
+static float light_size_from(const drift_hybrid_light *light, const light_shape *shape,
+                             drift_vec3 p)
+{
+    drift_vec3 to_p = drift_vec3_sub(p, light->centre);
+    float d_r = drift_vec3_length(to_p);
+    if (shape->count == 0 || !(d_r > 0.0f)) {
+        return light->radius;
+    }
+    drift_vec3 dir = drift_vec3_scale(to_p, 1.0f / d_r);
+    float size = 0.0f;
+    for (uint32_t k = 0; k < shape->count; ++k) {
+        drift_vec3 delta = drift_vec3_sub(shape->corner[k], light->centre);
+        float along = drift_vec3_dot(delta, dir);
+        if (!(d_r - along > 0.01f * d_r)) {
+            return light->radius;
+        }
+        float across = drift_vec3_length(drift_vec3_fma(delta, dir, -along));
+        size = fmaxf(size, across * d_r / (d_r - along));
+    }
+    return fminf(1.01f * size, light->radius);
+}
+
 static void shadow_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays, void *user)
 {
     (void)rays;
@@ -112,15 +189,46 @@ static void shadow_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays, 
         if (!map || !(light->radius > 0.0f)) {
             continue;
         }
+        const light_shape *shape = job->shapes ? &job->shapes[l] : NULL;
+        if (shape && shape->planar &&
+            drift_vec3_dot(light->direction, drift_vec3_sub(s->position, light->centre)) <= 0.0f) {
+            continue; // behind a one-sided planar light: neither raster nor ray tracer sees it
+        }
         // A light that straddles the receiver's tangent plane is cut by the horizon: there the
         // shadow map's depth test is at grazing angles and its bias decides, so the estimate
-        // counts it as penumbra (the raster's U_l clips the light exactly; S_l does not).
-        float height = drift_vec3_dot(s->ng, drift_vec3_sub(light->centre, s->position));
-        if (light->type != DRIFT_LIGHT_DIRECTIONAL && fabsf(height) < light->radius) {
-            e = 1.0f;
-            break;
+        // counts it as penumbra (the raster's U_l clips the light exactly; S_l does not). With
+        // corners the test is exact: some on each side; else the bounding sphere's. A light
+        // below both the geometric and the shading normal's horizon casts no light there, so
+        // neither raster nor ray tracer has anything to get wrong.
+        if (light->type != DRIFT_LIGHT_DIRECTIONAL) {
+            float lo = INFINITY, hi = -INFINITY, hi_shading = -INFINITY;
+            if (shape && shape->count > 0) {
+                for (uint32_t k = 0; k < shape->count; ++k) {
+                    drift_vec3 d = drift_vec3_sub(shape->corner[k], s->position);
+                    float h = drift_vec3_dot(s->ng, d);
+                    lo = fminf(lo, h);
+                    hi = fmaxf(hi, h);
+                    hi_shading = fmaxf(hi_shading, drift_vec3_dot(s->ns, d));
+                }
+            } else {
+                drift_vec3 d = drift_vec3_sub(light->centre, s->position);
+                float h = drift_vec3_dot(s->ng, d);
+                lo = h - light->radius;
+                hi = h + light->radius;
+                hi_shading = drift_vec3_dot(s->ns, d) + light->radius;
+            }
+            if (hi <= 0.0f && hi_shading <= 0.0f) {
+                continue; // the light is wholly below the receiver's horizon: it gets none
+            }
+            if (lo <= 0.0f && hi >= 0.0f) {
+                e = 1.0f;
+                break;
+            }
         }
-        e = drift_shadow_map_penumbra(map, s->position, s->ng);
+        drift_penumbra_query query = {
+            .light_size = shape ? light_size_from(light, shape, s->position) : 0.0f
+        };
+        e = drift_shadow_map_penumbra_query(map, s->position, s->ng, &query);
     }
     drift_image_pixel(&job->out[DRIFT_METRIC_SHADOW], x, y)[0] = e;
 }
@@ -258,7 +366,12 @@ void drift_refine_compute_metrics(drift_hybrid *f, const drift_refine_metric_par
                        .ao_radius = params->ao_radius > 0.0f ? params->ao_radius : 0.05f * diagonal };
     drift_hybrid_for_each_pixel(f, reflection_pixel, &job);
     ensure_shadow_maps(f);
-    drift_hybrid_for_each_pixel(f, shadow_pixel, &job);
+    job.shapes = f->light_count ? drift_alloc(f->ctx, sizeof(light_shape) * f->light_count) : NULL;
+    for (uint32_t l = 0; job.shapes && l < f->light_count; ++l) {
+        light_corners(f->scene, &f->lights[l], &job.shapes[l]);
+    }
+    drift_hybrid_for_each_pixel(f, shadow_pixel, &job); // without memory: bounding spheres
+    drift_free(f->ctx, job.shapes);
     float *scratch = drift_alloc(f->ctx, sizeof(float) * (size_t)f->params.width * (size_t)f->params.height);
     if (scratch) { // without memory the estimate stays undilated
         dilate(&out[DRIFT_METRIC_SHADOW], scratch);

@@ -58,6 +58,19 @@ expect 0 "$drift" bench sir "$(dirname "$0")/../../scenes/cornell-box/cornell_bo
 python3 -c "import json; d=json.load(open('$tmp/out')); r=d['rows'][0]; assert r['width']==24 and 'shadow' in r['quality'], d" \
     || fail "bench sir JSON incomplete"
 
+# --views: one row per view and size, named; bad files are reported with file and line.
+printf '{"views": [\n  {"name": "camera2"},\n  {"name": "up", "target": [278, 500, 0], "fov_y": 30, "aperture_radius": 0}\n]}\n' > "$tmp/views.json"
+expect 0 "$drift" bench sir "$(dirname "$0")/../../scenes/cornell-box/cornell_box.json" \
+    --sizes 16x12 --spp 1 --threads 2 --json --views "$tmp/views.json"
+python3 -c "import json; d=json.load(open('$tmp/out')); assert [r['view'] for r in d['rows']]==['camera2','up'], d" \
+    || fail "bench sir --views rows"
+printf '{"views": [\n  {"name": "a"},\n  {"name": "b", "fov_y": "wide"}\n]}\n' > "$tmp/bad_views.json"
+expect 2 "$drift" bench sir --views "$tmp/bad_views.json"
+grep -q "bad_views.json:3: view 2: \"fov_y\"" "$tmp/err" || fail "bad view not located"
+printf '{"views": [\n  {"name": "a",}\n]}\n' > "$tmp/bad_views.json"
+expect 2 "$drift" bench sir --views "$tmp/bad_views.json"
+grep -q "bad_views.json:2: JSON syntax error" "$tmp/err" || fail "views syntax error not located"
+
 # Usage errors: exit 2, nothing written.
 expect 2 "$drift" render --mode hybrid --refine bogus --out "$tmp/x.exr"
 grep -q "expects 'sir'" "$tmp/err" || fail "--refine bogus not explained"
