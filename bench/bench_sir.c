@@ -18,8 +18,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define MAX_SCENES 8
-#define MAX_SIZES 8
+#define MAX_SCENES  8
+#define MAX_SIZES   8
 #define MAX_VIEWS   16
 #define FLIP_TARGET 0.01
 
@@ -96,7 +96,8 @@ static bool parse_sizes(const char *v, sir_options *o)
         int w, h, used = 0;
         if (o->size_count == MAX_SIZES || sscanf(p, "%dx%d%n", &w, &h, &used) != 2 || w < 8 ||
             h < 8 || w > 16384 || h > 16384) {
-            fprintf(stderr, "drift bench sir: --sizes expects WxH[,WxH...] (8..16384), got '%s'\n", v);
+            fprintf(stderr, "drift bench sir: --sizes expects WxH[,WxH...] (8..16384), got '%s'\n",
+                    v);
             return false;
         }
         o->widths[o->size_count] = w;
@@ -361,7 +362,8 @@ static void save_figures(drift_context *ctx, const sir_options *o, const char *s
     }
     for (int32_t y = 0; y < h; ++y) {
         for (int32_t x = 0; x < w; ++x) {
-            bool f = drift_image_pixel(error, x, y)[0] > 0.0f, t = drift_image_pixel(real, x, y)[0] > 0.0f;
+            bool f = drift_image_pixel(error, x, y)[0] > 0.0f,
+                 t = drift_image_pixel(real, x, y)[0] > 0.0f;
             drift_vec3 c = t ? (f ? drift_vec3_splat(1.0f) : drift_vec3_make(1, 0, 0))
                              : (f ? drift_vec3_make(0, 0, 0.5f) : drift_vec3_splat(0.0f));
             drift_image_set3(&map, x, y, c);
@@ -390,10 +392,9 @@ static drift_result run_one(drift_context *ctx, const drift_scene *scene, const 
         r = drift_hybrid_render(frame, &scene->camera, NULL);
     }
     if (r == DRIFT_OK) {
-        r = drift_refine_create(ctx, frame,
-                                &(drift_refine_params){ .spp = (uint32_t)o->spp,
-                                                        .budget = (uint32_t)o->budget },
-                                &sir);
+        r = drift_refine_create(
+            ctx, frame,
+            &(drift_refine_params){ .spp = (uint32_t)o->spp, .budget = (uint32_t)o->budget }, &sir);
     }
     if (r == DRIFT_OK) {
         r = drift_image_create(ctx, w, h, 3, &pure);
@@ -462,7 +463,8 @@ static drift_result run_one(drift_context *ctx, const drift_scene *scene, const 
     }
     row->noise_flip = -1.0;
     if (o->noise_floor) {
-        drift_refine_params other = { .spp = (uint32_t)o->spp, .budget = (uint32_t)o->budget,
+        drift_refine_params other = { .spp = (uint32_t)o->spp,
+                                      .budget = (uint32_t)o->budget,
                                       .seed = 1 };
         r = drift_refine_set_params(sir, &other);
         if (r == DRIFT_OK) {
@@ -573,8 +575,8 @@ static void print_text_row(const sir_row *row, bool lambda)
            row->error_percent, row->prt_ms, row->sir_ms, row->prt_ms / row->sir_ms, row->flip,
            row->flip <= FLIP_TARGET ? "yes" : "NO");
     if (row->reached_ms > 0.0) {
-        printf("    FLIP <= %.2f after %.1f ms: %.2fx faster than PRT\n", FLIP_TARGET, row->reached_ms,
-               row->prt_ms / row->reached_ms);
+        printf("    FLIP <= %.2f after %.1f ms: %.2fx faster than PRT\n", FLIP_TARGET,
+               row->reached_ms, row->prt_ms / row->reached_ms);
     } else {
         printf("    FLIP <= %.2f not reached\n", FLIP_TARGET);
     }
@@ -602,14 +604,11 @@ int drift_bench_sir(int argc, char **argv)
     if (pr != 0) {
         return pr < 0 ? 0 : pr;
     }
-    drift_context *ctx = NULL;
-    drift_result r = drift_context_create(
-        &(drift_context_desc){ .thread_count = (int)o.threads, .logger = cli_stderr_logger(false) },
-        &ctx);
-    if (r != DRIFT_OK) {
-        fprintf(stderr, "drift bench sir: %s\n", drift_result_string(r));
+    drift_context *ctx = cli_open_context("bench sir", (int)o.threads, false);
+    if (!ctx) {
         return 1;
     }
+    drift_result r = DRIFT_OK;
     float lambda[DRIFT_METRIC_COUNT];
     if (o.lambda_path && drift_refine_lambda_load(ctx, o.lambda_path, lambda) != DRIFT_OK) {
         fprintf(stderr, "drift bench sir: --lambda: cannot use %s\n", o.lambda_path);

@@ -3,19 +3,19 @@
 // raster matches the ray tracer there); the sort is stable and refines every non-zero error
 // pixel before any zero one; the lambda fit is never worse than the averaged sum on its own
 // training views, and its file round-trips.
-#include "drift_test.h"
-
-#include <math.h>
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-
 #include "drift/accel.h"
 #include "drift/hybrid.h"
 #include "drift/refine.h"
 #include "drift/scene.h"
 #include "drift/view.h"
+#include "drift_test.h"
 #include "refine/refine_internal.h"
+#include "test_rig.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 
 #define PI_F 3.14159265f
 
@@ -62,21 +62,6 @@ static void rig_destroy(rig *r)
     drift_context_destroy(r->ctx);
 }
 
-static uint32_t add_material(drift_scene *scene, drift_material m)
-{
-    uint32_t index;
-    assert_int_equal(drift_scene_add_material(scene, &m, &index), DRIFT_OK);
-    return index;
-}
-
-static void add_floor(drift_scene *scene, float half, float height, uint32_t material)
-{
-    const float p[] = { -half, height, -half, half, height, -half,
-                        half,  height, half,  -half, height, half };
-    const uint32_t idx[] = { 0, 2, 1, 0, 3, 2 };
-    test_add_mesh(scene, p, 4, idx, 2, material);
-}
-
 // Axis-aligned box [lo, hi] with outward-facing triangles.
 static void add_box(drift_scene *scene, drift_vec3 lo, drift_vec3 hi, uint32_t material)
 {
@@ -87,79 +72,34 @@ static void add_box(drift_scene *scene, drift_vec3 lo, drift_vec3 hi, uint32_t m
     test_add_mesh(scene, p, 8, idx, 12, material);
 }
 
-static void add_sphere(drift_scene *scene, drift_vec3 c, float radius, uint32_t material)
-{
-    enum { SLICES = 48, STACKS = 24 };
-    uint32_t vcount = (SLICES + 1) * (STACKS + 1);
-    float *p = malloc(sizeof(float) * 3 * vcount);
-    float *n = malloc(sizeof(float) * 3 * vcount);
-    uint32_t *idx = malloc(sizeof(uint32_t) * 6 * SLICES * STACKS);
-    assert_non_null(p);
-    assert_non_null(n);
-    assert_non_null(idx);
-    for (uint32_t j = 0; j <= STACKS; ++j) {
-        float theta = PI_F * (float)j / STACKS;
-        for (uint32_t i = 0; i <= SLICES; ++i) {
-            float phi = 2.0f * PI_F * (float)i / SLICES;
-            uint32_t v = j * (SLICES + 1) + i;
-            float d[3] = { sinf(theta) * cosf(phi), cosf(theta), sinf(theta) * sinf(phi) };
-            const float cc[3] = { c.x, c.y, c.z };
-            for (int k = 0; k < 3; ++k) {
-                n[3 * v + k] = d[k];
-                p[3 * v + k] = cc[k] + radius * d[k];
-            }
-        }
-    }
-    uint32_t t = 0;
-    for (uint32_t j = 0; j < STACKS; ++j) {
-        for (uint32_t i = 0; i < SLICES; ++i) {
-            uint32_t a = j * (SLICES + 1) + i, b = a + SLICES + 1;
-            uint32_t quad[6] = { a, a + 1, b, a + 1, b + 1, b };
-            for (int k = 0; k < 6; ++k) {
-                idx[t * 3 + (uint32_t)k] = quad[k];
-            }
-            t += 2;
-        }
-    }
-    assert_int_equal(drift_scene_add_mesh(scene,
-                                          &(drift_mesh_desc){ .positions = p,
-                                                              .normals = n,
-                                                              .vertex_count = vcount,
-                                                              .indices = idx,
-                                                              .triangle_count = t,
-                                                              .material = material },
-                                          NULL),
-                     DRIFT_OK);
-    free(p);
-    free(n);
-    free(idx);
-}
-
 // Every effect SIR refines: a mirror and a glossy sphere (reflections), a box on a floor under
 // a quad light (penumbrae), depth edges seen through a lens.
 static void build_effects_scene(rig *r, int32_t width, int32_t height, drift_vec3 eye)
 {
-    uint32_t white = add_material(r->scene, drift_material_make(drift_vec3_splat(0.6f)));
-    uint32_t glossy = add_material(
-        r->scene, (drift_material){ .type = DRIFT_MATERIAL_DEFAULT, .diffuse = { 0.2f, 0.3f, 0.2f },
-                                    .specular = { 0.5f, 0.5f, 0.5f }, .exponent = 60.0f,
-                                    .diffuse_texture = DRIFT_INVALID_INDEX });
-    uint32_t mirror = add_material(
-        r->scene, (drift_material){ .type = DRIFT_MATERIAL_MIRROR, .specular = { 0.9f, 0.9f, 0.9f },
-                                    .diffuse_texture = DRIFT_INVALID_INDEX });
-    add_floor(r->scene, 4.0f, 0.0f, white);
-    add_box(r->scene, drift_vec3_make(-1.6f, 0.0f, 0.2f), drift_vec3_make(-0.9f, 0.9f, 0.9f), white);
-    add_sphere(r->scene, drift_vec3_make(0.2f, 0.5f, 0.0f), 0.5f, mirror);
-    add_sphere(r->scene, drift_vec3_make(1.3f, 0.4f, 0.6f), 0.4f, glossy);
-    assert_int_equal(
-        drift_scene_add_light(r->scene,
-                              &(drift_light){ .type = DRIFT_LIGHT_QUAD,
-                                              .position = { -0.8f, 3.0f, -0.3f },
-                                              .edge_u = { 0.6f, 0, 0 },
-                                              .edge_v = { 0, 0, 0.6f }, // emits down
-                                              .color = { 12, 12, 12 } },
-                              NULL),
-        DRIFT_OK);
+    uint32_t white = test_add_material(r->scene, drift_material_make(drift_vec3_splat(0.6f)));
+    uint32_t glossy =
+        test_add_material(r->scene, (drift_material){ .type = DRIFT_MATERIAL_DEFAULT,
+                                                      .diffuse = { 0.2f, 0.3f, 0.2f },
+                                                      .specular = { 0.5f, 0.5f, 0.5f },
+                                                      .exponent = 60.0f,
+                                                      .diffuse_texture = DRIFT_INVALID_INDEX });
+    uint32_t mirror =
+        test_add_material(r->scene, (drift_material){ .type = DRIFT_MATERIAL_MIRROR,
+                                                      .specular = { 0.9f, 0.9f, 0.9f },
+                                                      .diffuse_texture = DRIFT_INVALID_INDEX });
+    test_add_floor(r->scene, 4.0f, 0.0f, white);
+    add_box(r->scene, drift_vec3_make(-1.6f, 0.0f, 0.2f), drift_vec3_make(-0.9f, 0.9f, 0.9f),
+            white);
+    test_add_sphere(r->scene, drift_vec3_make(0.2f, 0.5f, 0.0f), 0.5f, 48, 24, mirror);
+    test_add_sphere(r->scene, drift_vec3_make(1.3f, 0.4f, 0.6f), 0.4f, 48, 24, glossy);
+    assert_int_equal(drift_scene_add_light(r->scene,
+                                           &(drift_light){ .type = DRIFT_LIGHT_QUAD,
+                                                           .position = { -0.8f, 3.0f, -0.3f },
+                                                           .edge_u = { 0.6f, 0, 0 },
+                                                           .edge_v = { 0, 0, 0.6f }, // emits down
+                                                           .color = { 12, 12, 12 } },
+                                           NULL),
+                     DRIFT_OK);
     r->scene->camera = drift_camera_look_at(eye, drift_vec3_make(0.0f, 0.4f, 0.2f),
                                             drift_vec3_make(0, 1, 0), 0.9f, width, height);
     r->scene->camera.aperture_radius = 0.05f;
@@ -273,8 +213,8 @@ static void test_zero_error_scene(void **state)
 {
     (void)state;
     rig r = rig_begin();
-    uint32_t white = add_material(r.scene, drift_material_make(drift_vec3_splat(0.5f)));
-    add_floor(r.scene, 100.0f, 0.0f, white);
+    uint32_t white = test_add_material(r.scene, drift_material_make(drift_vec3_splat(0.5f)));
+    test_add_floor(r.scene, 100.0f, 0.0f, white);
     r.scene->camera = drift_camera_look_at(drift_vec3_make(0, 3, 0), drift_vec3_make(0, 0, 0),
                                            drift_vec3_make(0, 0, 1), 0.8f, 32, 24);
     r.scene->camera.aperture_radius = 0.1f;
@@ -329,7 +269,8 @@ static void test_metrics_see_effects(void **state)
             max = fmaxf(max, e->pixels[i]);
         }
         if (max <= 0.0f) {
-            fail_msg("metric %s is zero everywhere", drift_refine_metric_name((drift_refine_metric)m));
+            fail_msg("metric %s is zero everywhere",
+                     drift_refine_metric_name((drift_refine_metric)m));
         }
     }
     rig_destroy(&r);
@@ -403,8 +344,8 @@ static void test_shadow_metric_skips_unlit(void **state)
     (void)state;
     rig r = rig_begin();
     const int32_t w = 48, h = 36;
-    uint32_t white = add_material(r.scene, drift_material_make(drift_vec3_splat(0.6f)));
-    add_floor(r.scene, 4.0f, 0.0f, white);
+    uint32_t white = test_add_material(r.scene, drift_material_make(drift_vec3_splat(0.6f)));
+    test_add_floor(r.scene, 4.0f, 0.0f, white);
     add_box(r.scene, drift_vec3_make(-0.5f, 0.0f, 0.0f), drift_vec3_make(0.5f, 2.0f, 1.0f), white);
     assert_int_equal(drift_scene_add_light(r.scene,
                                            &(drift_light){ .type = DRIFT_LIGHT_QUAD,
@@ -536,7 +477,11 @@ static void test_hierarchical_search_matches_exhaustive(void **state)
 static void test_radix_sort_stable_and_complete(void **state)
 {
     (void)state;
-    enum { N = 5000 };
+
+    enum {
+        N = 5000
+    };
+
     uint16_t *keys = malloc(sizeof(uint16_t) * N);
     uint32_t *order = malloc(sizeof(uint32_t) * N), *scratch = malloc(sizeof(uint32_t) * N);
     assert_non_null(keys);
@@ -614,7 +559,8 @@ static void test_refines_errors_first(void **state)
             }
         }
         // Every visited pixel's error key is at least as high as every unvisited one's.
-        assert_true(drift_refine_encode_error(min_visited) <= drift_refine_encode_error(max_waiting) ||
+        assert_true(drift_refine_encode_error(min_visited) <=
+                        drift_refine_encode_error(max_waiting) ||
                     max_waiting < 0.0f);
         for (int32_t i = 0; zero_started && i < w * h; ++i) {
             if (error->pixels[i] > 0.0f) {
@@ -631,8 +577,14 @@ static void test_refines_errors_first(void **state)
 static void test_lambda_fit_not_worse_than_average(void **state)
 {
     (void)state;
-    enum { VIEWS = 3 };
-    const drift_vec3 eyes[VIEWS] = { { 0.5f, 2.2f, -3.5f }, { -2.0f, 1.5f, -3.0f }, { 2.5f, 2.8f, -2.0f } };
+
+    enum {
+        VIEWS = 3
+    };
+
+    const drift_vec3 eyes[VIEWS] = { { 0.5f, 2.2f, -3.5f },
+                                     { -2.0f, 1.5f, -3.0f },
+                                     { 2.5f, 2.8f, -2.0f } };
     rig rigs[VIEWS];
     drift_image real[VIEWS], pure[VIEWS];
     drift_refine_view views[VIEWS];
@@ -690,7 +642,8 @@ static void test_rejects_bad_input(void **state)
     bad = (drift_refine_params){ .combine = DRIFT_COMBINE_LAMBDA, .lambda = { -1.0f } };
     assert_int_equal(drift_refine_set_params(r.sir, &bad), DRIFT_ERR_INVALID_ARGUMENT);
     float lambda[DRIFT_METRIC_COUNT];
-    assert_int_equal(drift_refine_lambda_load(r.ctx, "/nonexistent/lambda.json", lambda), DRIFT_ERR_IO);
+    assert_int_equal(drift_refine_lambda_load(r.ctx, "/nonexistent/lambda.json", lambda),
+                     DRIFT_ERR_IO);
     char path[1024];
     test_out_path(path, "refine_bad_lambda.json");
     FILE *f = fopen(path, "wb");
