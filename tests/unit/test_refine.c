@@ -41,16 +41,21 @@ static const drift_hybrid_params raster_params = { .shadows = DRIFT_SHADOWS_PCSS
                                                    .envmap_size = 32,
                                                    .shadow_map_size = 256 };
 
-static void rig_commit(rig *r, const drift_refine_params *params)
+static void rig_commit_raster(rig *r, const drift_hybrid_params *raster,
+                              const drift_refine_params *params)
 {
     assert_int_equal(drift_scene_commit(r->scene), DRIFT_OK);
     assert_int_equal(drift_accel_create(r->ctx, r->scene, &(drift_accel_desc){ 0 }, &r->accel),
                      DRIFT_OK);
-    assert_int_equal(drift_hybrid_create(r->ctx, r->scene, r->accel, &raster_params, &r->frame),
-                     DRIFT_OK);
+    assert_int_equal(drift_hybrid_create(r->ctx, r->scene, r->accel, raster, &r->frame), DRIFT_OK);
     assert_int_equal(drift_hybrid_render(r->frame, &r->scene->camera, NULL), DRIFT_OK);
     assert_int_equal(drift_refine_create(r->ctx, r->frame, params, &r->sir), DRIFT_OK);
     assert_int_equal(drift_refine_begin(r->sir), DRIFT_OK);
+}
+
+static void rig_commit(rig *r, const drift_refine_params *params)
+{
+    rig_commit_raster(r, &raster_params, params);
 }
 
 static void rig_destroy(rig *r)
@@ -332,6 +337,43 @@ static void test_shadow_metric_conservative(void **state)
         fail_msg("penumbra recall: metric %u, estimate %u of %u", flagged, estimated, partial);
     }
     rig_destroy(&r);
+}
+
+// Share of the surface pixels the shadow metric flags, the effects scene at width x height
+// with a 64-texel shadow map.
+static double shadow_flagged_share(int32_t width, int32_t height)
+{
+    rig r = rig_begin();
+    build_effects_scene(&r, width, height, drift_vec3_make(0.5f, 2.2f, -3.5f));
+    drift_hybrid_params raster = raster_params;
+    raster.shadow_map_size = 64;
+    rig_commit_raster(&r, &raster, NULL);
+    const drift_gbuffer *g = drift_hybrid_gbuffer(r.frame);
+    const drift_image *shadow = drift_refine_metric_image(r.sir, DRIFT_METRIC_SHADOW);
+    uint32_t surface = 0, flagged = 0;
+    for (int32_t y = 0; y < height; ++y) {
+        for (int32_t x = 0; x < width; ++x) {
+            if (g->surfaces[(size_t)y * (size_t)width + (size_t)x].material !=
+                DRIFT_INVALID_INDEX) {
+                ++surface;
+                flagged += drift_image_pixel(shadow, x, y)[0] > 0.0f;
+            }
+        }
+    }
+    rig_destroy(&r);
+    return (double)flagged / (double)surface;
+}
+
+// The shadow metric's dilation covers the coarseness of the shadow-map taps, a band of the
+// same world width at any image size: doubling the resolution keeps the flagged share (a
+// fixed pixel radius would cover half the band and flag visibly less).
+static void test_shadow_dilation_follows_resolution(void **state)
+{
+    (void)state;
+    double coarse = shadow_flagged_share(100, 75), fine = shadow_flagged_share(200, 150);
+    if (fine < 0.93 * coarse) {
+        fail_msg("flagged share %.4f at 200x150 against %.4f at 100x75", fine, coarse);
+    }
 }
 
 // A pillar lit from one side: the two faces the camera sees face away from the quad light, so
@@ -714,6 +756,7 @@ int main(void)
         cmocka_unit_test(test_shadow_metric_conservative),
         cmocka_unit_test(test_hierarchical_search_matches_exhaustive),
         cmocka_unit_test(test_shadow_metric_skips_unlit),
+        cmocka_unit_test(test_shadow_dilation_follows_resolution),
         cmocka_unit_test(test_radix_sort_stable_and_complete),
         cmocka_unit_test(test_refines_errors_first),
         cmocka_unit_test(test_lambda_fit_not_worse_than_average),
