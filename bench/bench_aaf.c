@@ -9,6 +9,7 @@
 #include "cli.h"
 #include "drift/accel.h"
 #include "drift/hybrid.h"
+#include "drift/metric.h"
 #include "drift/scene_io.h"
 
 #include <math.h>
@@ -203,33 +204,6 @@ typedef struct curve {
     double timing_sampling_ms, timing_filter_ms, timing_frame_ms;
 } curve;
 
-static const drift_image *find_plane(const drift_hybrid *frame, const char *wanted)
-{
-    const char *name;
-    const drift_image *image;
-    for (uint32_t i = 0; drift_hybrid_plane(frame, i, &name, &image); ++i) {
-        if (strcmp(name, wanted) == 0) {
-            return image;
-        }
-    }
-    return NULL;
-}
-
-static double rmse(const drift_image *a, const drift_image *b)
-{
-    double sum = 0.0;
-    for (int32_t y = 0; y < a->height; ++y) {
-        for (int32_t x = 0; x < a->width; ++x) {
-            for (int c = 0; c < 3; ++c) {
-                double d =
-                    (double)drift_image_pixel(a, x, y)[c] - (double)drift_image_pixel(b, x, y)[c];
-                sum += d * d;
-            }
-        }
-    }
-    return sqrt(sum / (3.0 * (double)a->width * (double)a->height));
-}
-
 // Mean of the n(x) planes over pixels that took samples: the spp the frame really spent.
 static double actual_spp(const drift_hybrid *frame, drift_effect effect)
 {
@@ -317,7 +291,7 @@ static drift_result measure(drift_context *ctx, const drift_scene *scene, const 
     drift_hybrid *ref = NULL, *frame = NULL;
     drift_hybrid_params p = effect_params(effect, reference, o, o->ref_spp);
     drift_result r = render(ctx, scene, accel, &p, &ref);
-    const drift_image *truth = r == DRIFT_OK ? find_plane(ref, term) : NULL;
+    const drift_image *truth = r == DRIFT_OK ? drift_hybrid_plane_named(ref, term) : NULL;
     int most = o->spp_count > o->mc_spp_count ? o->spp_count : o->mc_spp_count;
     for (int k = 0; r == DRIFT_OK && k < most; ++k) {
         for (int method = 0; r == DRIFT_OK && method < 2; ++method) {
@@ -331,11 +305,18 @@ static drift_result measure(drift_context *ctx, const drift_scene *scene, const 
             if (r != DRIFT_OK) {
                 break;
             }
+            const drift_image *test = drift_hybrid_plane_named(frame, term);
+            double mse = 0.0;
+            r = test && truth ? drift_metric_mse(ctx, truth, test, &mse)
+                              : DRIFT_ERR_INVALID_ARGUMENT; // the term's plane is missing
+            if (r != DRIFT_OK) {
+                break;
+            }
             drift_hybrid_stats s = drift_hybrid_get_stats(frame);
             point *pt = method == 0 ? &out->aaf[k] : &out->plain[k];
             *pt = (point){ .spp = (double)spp,
                            .actual_spp = actual_spp(frame, effect),
-                           .rmse = rmse(find_plane(frame, term), truth),
+                           .rmse = sqrt(mse),
                            .sampling_ms = s.ms[DRIFT_PASS_AAF_SAMPLING],
                            .filter_ms = s.ms[DRIFT_PASS_AAF_FILTER] };
             if (!(pt->actual_spp > 0.0)) {

@@ -249,6 +249,8 @@ drift_hybrid_stats drift_hybrid_get_stats(const drift_hybrid *frame);
 // Planes a technique did not need this frame are absent.
 bool drift_hybrid_plane(const drift_hybrid *frame, uint32_t index, const char **out_name,
                         const drift_image **out_image);
+// The plane called `name`, or NULL when the last frame has none.
+const drift_image *drift_hybrid_plane_named(const drift_hybrid *frame, const char *name);
 
 #ifdef __cplusplus
 }

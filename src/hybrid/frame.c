@@ -510,6 +510,16 @@ bool drift_hybrid_plane(const drift_hybrid *f, uint32_t index, const char **out_
     return true;
 }
 
+const drift_image *drift_hybrid_plane_named(const drift_hybrid *f, const char *name)
+{
+    for (uint32_t i = 0; i < f->plane_count; ++i) {
+        if (strcmp(f->planes[i].name, name) == 0) {
+            return f->planes[i].image;
+        }
+    }
+    return NULL;
+}
+
 // --- RENDER ---
 
 drift_result drift_hybrid_render(drift_hybrid *f, const drift_camera *camera,

@@ -1,6 +1,7 @@
 // Test support for the hybrid-frame tests (see test_rig.h).
 #include "test_rig.h"
 
+#include "drift/metric.h"
 #include "drift_test.h"
 
 #include <math.h>
@@ -39,15 +40,11 @@ void test_rig_destroy(test_rig *r)
 
 const drift_image *test_rig_plane(const test_rig *r, const char *wanted)
 {
-    const char *name;
-    const drift_image *image;
-    for (uint32_t i = 0; drift_hybrid_plane(r->frame, i, &name, &image); ++i) {
-        if (strcmp(name, wanted) == 0) {
-            return image;
-        }
+    const drift_image *image = drift_hybrid_plane_named(r->frame, wanted);
+    if (!image) {
+        fail_msg("no plane %s", wanted);
     }
-    fail_msg("no plane %s", wanted);
-    return NULL;
+    return image;
 }
 
 uint32_t test_add_material(drift_scene *scene, drift_material m)
@@ -131,17 +128,9 @@ uint32_t test_add_sphere(drift_scene *scene, drift_vec3 centre, float radius, ui
     return mesh;
 }
 
-double test_rmse(const drift_image *a, const drift_image *b)
+double test_rmse(drift_context *ctx, const drift_image *a, const drift_image *b)
 {
-    double sum = 0.0;
-    for (int y = 0; y < a->height; ++y) {
-        for (int x = 0; x < a->width; ++x) {
-            for (int c = 0; c < 3; ++c) {
-                double d =
-                    (double)drift_image_pixel(a, x, y)[c] - (double)drift_image_pixel(b, x, y)[c];
-                sum += d * d;
-            }
-        }
-    }
-    return sqrt(sum / (3.0 * a->width * a->height));
+    double mse = 0.0;
+    assert_int_equal(drift_metric_mse(ctx, a, b, &mse), DRIFT_OK);
+    return sqrt(mse);
 }

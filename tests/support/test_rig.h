@@ -34,7 +34,7 @@ void test_add_floor(drift_scene *scene, float half, float height, uint32_t mater
 uint32_t test_add_sphere(drift_scene *scene, drift_vec3 centre, float radius, uint32_t slices,
                          uint32_t stacks, uint32_t material);
 
-// RMSE over the three colour channels of two images of one size.
-double test_rmse(const drift_image *a, const drift_image *b);
+// RMSE over the three colour channels of two images of one size (drift_metric_mse).
+double test_rmse(drift_context *ctx, const drift_image *a, const drift_image *b);
 
 #endif

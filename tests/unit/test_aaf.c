@@ -99,13 +99,13 @@ static void test_shadows_converge(void **state)
     for (int k = 0; k < 3; ++k) {
         test_rig_frame(
             &r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_AAF, .spp = spps[k], .seed = 3 });
-        aaf[k] = test_rmse(drift_hybrid_image(r.frame), &truth);
+        aaf[k] = test_rmse(r.ctx, drift_hybrid_image(r.frame), &truth);
         test_rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_AAF,
                                                    .spp = spps[k],
                                                    .seed = 3,
                                                    .aaf_uniform = true,
                                                    .aaf_unfiltered = true });
-        plain[k] = test_rmse(drift_hybrid_image(r.frame), &truth);
+        plain[k] = test_rmse(r.ctx, drift_hybrid_image(r.frame), &truth);
     }
     print_message("shadows rmse aaf %g %g %g, plain MC %g %g %g\n", aaf[0], aaf[1], aaf[2],
                   plain[0], plain[1], plain[2]);
@@ -377,10 +377,10 @@ static void test_indirect_converges(void **state)
     for (int k = 0; k < 3; ++k) {
         drift_hybrid_params p = { .indirect = DRIFT_INDIRECT_AAF, .spp = spps[k], .seed = 5 };
         test_rig_frame(&r, &p);
-        aaf[k] = test_rmse(test_rig_plane(&r, "indirect"), &truth);
+        aaf[k] = test_rmse(r.ctx, test_rig_plane(&r, "indirect"), &truth);
         p.aaf_uniform = p.aaf_unfiltered = true;
         test_rig_frame(&r, &p);
-        plain[k] = test_rmse(test_rig_plane(&r, "indirect"), &truth);
+        plain[k] = test_rmse(r.ctx, test_rig_plane(&r, "indirect"), &truth);
     }
     print_message("indirect rmse aaf %g %g %g, plain MC %g %g %g\n", aaf[0], aaf[1], aaf[2],
                   plain[0], plain[1], plain[2]);

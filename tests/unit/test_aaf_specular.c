@@ -90,7 +90,7 @@ static void test_specular_converges(void **state)
     for (int k = 0; k < 3; ++k) {
         drift_hybrid_params p = { .reflections = DRIFT_REFLECTIONS_AAF, .spp = spps[k], .seed = 5 };
         test_rig_frame(&r, &p);
-        aaf[k] = test_rmse(test_rig_plane(&r, "reflections"), &truth);
+        aaf[k] = test_rmse(r.ctx, test_rig_plane(&r, "reflections"), &truth);
     }
     print_message("specular rmse aaf %g %g %g\n", aaf[0], aaf[1], aaf[2]);
     assert_true(aaf[1] < 0.9 * aaf[0]);
@@ -115,7 +115,7 @@ static void test_mirror_stays_sharp(void **state)
     for (int k = 0; k < 2; ++k) {
         drift_hybrid_params p = { .reflections = DRIFT_REFLECTIONS_AAF, .spp = spps[k], .seed = 5 };
         test_rig_frame(&r, &p);
-        error[k] = test_rmse(test_rig_plane(&r, "reflections"), &truth);
+        error[k] = test_rmse(r.ctx, test_rig_plane(&r, "reflections"), &truth);
         const drift_image *beta = test_rig_plane(&r, "reflections.aaf.beta");
         const drift_image *refl = test_rig_plane(&r, "reflections");
         for (int y = 0; y < H; ++y) {

@@ -238,7 +238,7 @@ static void test_reference_shadows_converge(void **state)
     for (int k = 0; k < 3; ++k) {
         test_rig_frame(&r, &(drift_hybrid_params){
                                .shadows = DRIFT_SHADOWS_REFERENCE, .spp = spps[k], .seed = 1 });
-        errors[k] = test_rmse(drift_hybrid_image(r.frame), &truth);
+        errors[k] = test_rmse(r.ctx, drift_hybrid_image(r.frame), &truth);
     }
     print_message("reference shadows rmse %g %g %g\n", errors[0], errors[1], errors[2]);
     assert_true(errors[1] < 0.75 * errors[0]);
@@ -269,14 +269,7 @@ static void test_hard_shadow_buffer_distances(void **state)
     test_rig_commit(&r);
     test_rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_HARD });
     const drift_gbuffer *g = drift_hybrid_gbuffer(r.frame);
-    const char *name;
-    const drift_image *hard = NULL, *plane;
-    for (uint32_t i = 0; drift_hybrid_plane(r.frame, i, &name, &plane); ++i) {
-        if (strcmp(name, "light0.hard_shadow") == 0) {
-            hard = plane;
-        }
-    }
-    assert_non_null(hard);
+    const drift_image *hard = test_rig_plane(&r, "light0.hard_shadow");
     int shadowed = 0, lit = 0;
     for (int y = 0; y < 32; ++y) {
         for (int x = 0; x < 32; ++x) {
@@ -318,12 +311,7 @@ static double envmap_difference(test_rig *r, const drift_hybrid_params *p, const
     assert_int_equal(drift_hybrid_set_params(r->frame, p), DRIFT_OK);
     assert_int_equal(drift_hybrid_render(r->frame, &r->scene->camera, NULL), DRIFT_OK);
     const drift_gbuffer *g = drift_hybrid_gbuffer(r->frame);
-    const char *name;
-    const drift_image *plane, *env = NULL;
-    for (uint32_t i = 0; drift_hybrid_plane(r->frame, i, &name, &plane); ++i) {
-        env = strcmp(name, "reflections") == 0 ? plane : env;
-    }
-    assert_non_null(env);
+    const drift_image *env = test_rig_plane(r, "reflections");
     double diff = 0.0, total = 0.0;
     int pixels = 0;
     for (int y = 0; y < g->height; ++y) {
@@ -377,13 +365,7 @@ static void test_envmap_mirror_sphere_matches_ray_traced(void **state)
     test_rig_frame(&r, &p);
     drift_image sharp;
     assert_int_equal(drift_image_create(r.ctx, 48, 48, 3, &sharp), DRIFT_OK);
-    const char *name;
-    const drift_image *plane;
-    for (uint32_t i = 0; drift_hybrid_plane(r.frame, i, &name, &plane); ++i) {
-        if (strcmp(name, "reflections") == 0) {
-            memcpy(sharp.pixels, plane->pixels, sizeof(float) * 3 * 48 * 48);
-        }
-    }
+    memcpy(sharp.pixels, test_rig_plane(&r, "reflections")->pixels, sizeof(float) * 3 * 48 * 48);
     p.reflections = DRIFT_REFLECTIONS_ENVMAP;
     double at_probe = envmap_difference(&r, &p, &sharp, mirror);
     // The same lookup from a probe far from the sphere sees the room from elsewhere.
