@@ -265,6 +265,10 @@ drift_sampler drift_sampler_make(uint32_t seed, uint32_t pixel, uint32_t sample)
 drift_vec2 drift_sampler_next2(drift_sampler *s);
 // Next dimension alone (uses a pair and drops one half).
 float drift_sampler_next1(drift_sampler *s);
+// Next two dimensions as independent uniform numbers hashed from (key, sample, dimension):
+// plain random sampling over the same keys, the baseline against which the Sobol points are
+// judged (error ~ 1/sqrt(N) where Sobol's falls nearly as 1/N on smooth integrands).
+drift_vec2 drift_sampler_next2_random(drift_sampler *s);
 
 // --- WARPS ([0,1)^2 -> shapes and directions; each with its pdf) ---
 

@@ -223,9 +223,8 @@ static void adaptive_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays
     const indirect_job *job = user;
     drift_aaf_state *st = f->aaf;
     size_t i = pixel_index(f, x, y);
-    drift_vec3 albedo;
-    float omega;
-    bool has = lobe_at(f, job, x, y, &albedo, &omega);
+    // The sparse pass recorded whether the pixel has the lobe.
+    bool has = ((const indirect_sums *)&st->aux[DRIFT_AAF_AUX * i])->has_lobe > 0.0f;
     uint32_t taken = job->uniform ? f->params.spp : job->sparse;
     uint32_t n = job->uniform ? taken : st->counts[i];
     if (has && n > taken) {
@@ -253,8 +252,7 @@ static void modulate_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays
 
 drift_result drift_aaf_lobe_pass(drift_hybrid *f, const drift_aaf_lobe *lobe)
 {
-    size_t surfaces = 0;
-    drift_result r = drift_aaf_prepare(f, &surfaces);
+    drift_result r = drift_aaf_prepare(f, NULL);
     if (r != DRIFT_OK) {
         return r;
     }

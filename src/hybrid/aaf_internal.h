@@ -29,7 +29,7 @@
 // integrates a pixel's smooth visibility of a quad light at nearly 1/N; the paper's
 // comparison (Fig. 3.6) is against random sampling's 1/sqrt(N), with AAF random-sampled too.
 typedef struct drift_aaf_sampler {
-    drift_sampler sobol;
+    drift_sampler base; // keys and dimension; its Sobol points unless `random`
     bool random;
 } drift_aaf_sampler;
 
@@ -41,13 +41,7 @@ static inline drift_aaf_sampler drift_aaf_sampler_make(uint32_t key, uint32_t pi
 
 static inline drift_vec2 drift_aaf_next2(drift_aaf_sampler *s)
 {
-    if (!s->random) {
-        return drift_sampler_next2(&s->sobol);
-    }
-    uint32_t base =
-        drift_hash_combine(drift_hash_combine(s->sobol.key, s->sobol.sample), s->sobol.dimension++);
-    return (drift_vec2){ drift_u32_to_unit(drift_hash_combine(base, 1u)),
-                         drift_u32_to_unit(drift_hash_combine(base, 2u)) };
+    return s->random ? drift_sampler_next2_random(&s->base) : drift_sampler_next2(&s->base);
 }
 
 static inline float drift_aaf_next1(drift_aaf_sampler *s)
@@ -137,8 +131,8 @@ typedef struct drift_aaf_state {
 } drift_aaf_state;
 
 drift_result drift_aaf_state_ensure(drift_hybrid *frame);
-// Makes the state if needed and fills its footprint plane; *out_active gets the number of
-// pixels that see a surface (the pixels the average spp is over).
+// Makes the state if needed and fills its footprint plane; *out_active (may be NULL) gets the
+// number of pixels that see a surface (the pixels the average spp is over).
 drift_result drift_aaf_prepare(drift_hybrid *frame, size_t *out_active);
 void drift_aaf_state_destroy(drift_context *ctx, drift_aaf_state *state); // NULL-safe
 

@@ -263,11 +263,13 @@ drift_result drift_aaf_prepare(drift_hybrid *f, size_t *out_active)
         return r;
     }
     drift_hybrid_for_each_pixel(f, footprint_pixel, NULL);
-    size_t active = 0, pixels = (size_t)f->params.width * (size_t)f->params.height;
-    for (size_t i = 0; i < pixels; ++i) {
-        active += f->gbuffer.surfaces[i].material != DRIFT_INVALID_INDEX;
+    if (out_active) {
+        size_t active = 0, pixels = (size_t)f->params.width * (size_t)f->params.height;
+        for (size_t i = 0; i < pixels; ++i) {
+            active += f->gbuffer.surfaces[i].material != DRIFT_INVALID_INDEX;
+        }
+        *out_active = active;
     }
-    *out_active = active;
     return DRIFT_OK;
 }
 

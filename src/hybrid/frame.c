@@ -544,8 +544,12 @@ drift_result drift_hybrid_render(drift_hybrid *f, const drift_camera *camera,
     if (r == DRIFT_OK) {
         r = drift_hybrid_pass_reflections(f);
     }
-    if (r == DRIFT_OK && f->params.indirect == DRIFT_INDIRECT_AAF &&
-        f->params.dof != DRIFT_DOF_REFERENCE) {
+    // AAF's path-traced terms are skipped when the lens render replaces every term.
+    bool lens_reference = f->params.dof == DRIFT_DOF_REFERENCE;
+    if (r == DRIFT_OK && f->params.reflections == DRIFT_REFLECTIONS_AAF && !lens_reference) {
+        r = drift_hybrid_pass_aaf_specular(f);
+    }
+    if (r == DRIFT_OK && f->params.indirect == DRIFT_INDIRECT_AAF && !lens_reference) {
         r = drift_hybrid_pass_aaf_indirect(f);
     }
     if (r == DRIFT_OK) {

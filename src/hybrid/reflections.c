@@ -4,7 +4,6 @@
 // probe (blurred over the lobe's cone for glossy pixels). Both weight the radiance by the
 // lobe's directional albedo (reflection_weight). Emission seen in the mirror direction
 // belongs to R only for mirrors: for glossy lobes the direct pass already has it.
-#include "hybrid/aaf_internal.h"
 #include "hybrid/frame_internal.h"
 #include "hybrid/isg_internal.h"
 
@@ -189,8 +188,7 @@ drift_result drift_hybrid_pass_reflections(drift_hybrid *f)
         st->ms[DRIFT_PASS_ENVMAP] = 1000.0 * (drift_time_now() - t);
         return DRIFT_OK;
     }
-    case DRIFT_REFLECTIONS_AAF: // times its own passes
-        return f->params.dof == DRIFT_DOF_REFERENCE ? DRIFT_OK : drift_hybrid_pass_aaf_specular(f);
+    case DRIFT_REFLECTIONS_AAF: // aaf_specular.c fills `reflections` (frame.c runs it)
     case DRIFT_REFLECTIONS_NONE:
     case DRIFT_REFLECTIONS_REFERENCE: // reference.c fills `reflections`
     case DRIFT_REFLECTIONS_COUNT:

@@ -57,3 +57,10 @@ float drift_sampler_next1(drift_sampler *s)
 {
     return drift_sampler_next2(s).x;
 }
+
+drift_vec2 drift_sampler_next2_random(drift_sampler *s)
+{
+    uint32_t base = drift_hash_combine(drift_hash_combine(s->key, s->sample), s->dimension++);
+    return (drift_vec2){ drift_u32_to_unit(drift_hash_combine(base, 1u)),
+                         drift_u32_to_unit(drift_hash_combine(base, 2u)) };
+}
