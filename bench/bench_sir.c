@@ -11,9 +11,8 @@
 #include "drift/metric.h"
 #include "drift/refine.h"
 #include "drift/scene.h"
+#include "drift/scene_io.h"
 
-#include <cjson/cJSON.h>
-#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -22,16 +21,6 @@
 #define MAX_SIZES   8
 #define MAX_VIEWS   16
 #define FLIP_TARGET 0.01
-
-// One camera of --views: what it changes from the scene camera (the paper's Table 1 rows are
-// views of one scene with more or fewer error pixels).
-typedef struct sir_view {
-    char name[64];
-    drift_vec3 position, target;
-    bool has_position, has_target;
-    double fov;      // degrees; 0: the camera's
-    double aperture; // < 0: the camera's
-} sir_view;
 
 typedef struct sir_options {
     const char *scenes[MAX_SCENES];
@@ -48,8 +37,8 @@ typedef struct sir_options {
     drift_vec3 target; // --target: look here instead of the scene camera's target
     double fov;        // --fov: vertical field of view, degrees (0: the camera's)
     const char *views_path;
-    sir_view views[MAX_VIEWS];
-    int view_count; // 0: the one camera (with --target and --fov)
+    drift_camera_view views[MAX_VIEWS];
+    uint32_t view_count; // 0: the one camera (with --target and --fov)
 } sir_options;
 
 static void print_help(FILE *out)
@@ -113,122 +102,6 @@ static bool parse_sizes(const char *v, sir_options *o)
     return o->size_count > 0;
 }
 
-// Line of the k-th object inside the top-level object's array (brace depth 2), for messages.
-static int view_line(const char *text, int k)
-{
-    int line = 1, depth = 0, seen = -1;
-    bool in_string = false;
-    for (const char *c = text; *c; ++c) {
-        line += *c == '\n';
-        if (in_string) {
-            c += *c == '\\' && c[1];
-            in_string = *c != '"';
-        } else if (*c == '"') {
-            in_string = true;
-        } else if (*c == '{' && ++depth == 2 && ++seen == k) {
-            return line;
-        } else if (*c == '}') {
-            --depth;
-        }
-    }
-    return 0;
-}
-
-static bool read_vec3(const cJSON *item, drift_vec3 *out)
-{
-    if (!cJSON_IsArray(item) || cJSON_GetArraySize(item) != 3) {
-        return false;
-    }
-    float v[3];
-    for (int k = 0; k < 3; ++k) {
-        const cJSON *e = cJSON_GetArrayItem(item, k);
-        if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble)) {
-            return false;
-        }
-        v[k] = (float)e->valuedouble;
-    }
-    *out = drift_vec3_make(v[0], v[1], v[2]);
-    return true;
-}
-
-// Reads --views FILE; every problem is reported with the file and line.
-static bool load_views(const char *path, sir_options *o)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        fprintf(stderr, "drift bench sir: --views: cannot open %s\n", path);
-        return false;
-    }
-    static char text[1 << 16];
-    size_t length = fread(text, 1, sizeof text - 1, f);
-    bool too_long = !feof(f);
-    fclose(f);
-    text[length] = '\0';
-    if (too_long) {
-        fprintf(stderr, "%s: views file longer than %zu bytes\n", path, sizeof text - 1);
-        return false;
-    }
-    const char *end = NULL;
-    cJSON *root = cJSON_ParseWithOpts(text, &end, true);
-    if (!root) {
-        int line = 1;
-        for (const char *c = text; end && c < end; ++c) {
-            line += *c == '\n';
-        }
-        fprintf(stderr, "%s:%d: JSON syntax error\n", path, line);
-        return false;
-    }
-    const cJSON *views = cJSON_GetObjectItemCaseSensitive(root, "views");
-    bool ok = cJSON_IsArray(views) && cJSON_GetArraySize(views) > 0 &&
-              cJSON_GetArraySize(views) <= MAX_VIEWS;
-    if (!ok) {
-        fprintf(stderr, "%s:1: expected {\"views\": [1 to %d view objects]}\n", path, MAX_VIEWS);
-    }
-    o->view_count = 0;
-    const cJSON *v = NULL, *list = ok ? views : NULL;
-    cJSON_ArrayForEach(v, list)
-    {
-        int k = o->view_count;
-        sir_view *view = &o->views[o->view_count++];
-        *view = (sir_view){ .aperture = -1.0 };
-        const char *problem = NULL;
-        const cJSON *name = cJSON_GetObjectItemCaseSensitive(v, "name");
-        const cJSON *position = cJSON_GetObjectItemCaseSensitive(v, "position");
-        const cJSON *target = cJSON_GetObjectItemCaseSensitive(v, "target");
-        const cJSON *fov = cJSON_GetObjectItemCaseSensitive(v, "fov_y");
-        const cJSON *aperture = cJSON_GetObjectItemCaseSensitive(v, "aperture_radius");
-        if (!cJSON_IsObject(v)) {
-            problem = "a view must be an object";
-        } else if (!cJSON_IsString(name) || !name->valuestring[0] ||
-                   strlen(name->valuestring) >= sizeof view->name ||
-                   strspn(name->valuestring,
-                          "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-") !=
-                       strlen(name->valuestring)) {
-            problem = "\"name\" must be a string of 1-63 letters, digits, '_' or '-'";
-        } else if (position && !(view->has_position = read_vec3(position, &view->position))) {
-            problem = "\"position\" must be [x, y, z]";
-        } else if (target && !(view->has_target = read_vec3(target, &view->target))) {
-            problem = "\"target\" must be [x, y, z]";
-        } else if (fov && (!cJSON_IsNumber(fov) ||
-                           !(fov->valuedouble >= 0.1 && fov->valuedouble <= 179.0))) {
-            problem = "\"fov_y\" must be a number of degrees in [0.1, 179]";
-        } else if (aperture && (!cJSON_IsNumber(aperture) || !(aperture->valuedouble >= 0.0) ||
-                                !isfinite(aperture->valuedouble))) {
-            problem = "\"aperture_radius\" must be a number >= 0";
-        }
-        if (problem) {
-            fprintf(stderr, "%s:%d: view %d: %s\n", path, view_line(text, k), k + 1, problem);
-            ok = false;
-            break;
-        }
-        snprintf(view->name, sizeof view->name, "%s", name->valuestring);
-        view->fov = fov ? fov->valuedouble : 0.0;
-        view->aperture = aperture ? aperture->valuedouble : -1.0;
-    }
-    cJSON_Delete(root);
-    return ok;
-}
-
 static int parse(int argc, char **argv, sir_options *o)
 {
     *o = (sir_options){ .spp = 4, .budget = 8192, .threads = 1, .threshold = 0.02 };
@@ -271,8 +144,7 @@ static int parse(int argc, char **argv, sir_options *o)
             ok = (v = cli_next_value("bench sir", argc, argv, &i)) &&
                  cli_parse_float("bench sir", a, v, 0.1, 179.0, &o->fov);
         } else if (strcmp(a, "--views") == 0) {
-            ok = (o->views_path = cli_next_value("bench sir", argc, argv, &i)) != NULL &&
-                 load_views(o->views_path, o);
+            ok = (o->views_path = cli_next_value("bench sir", argc, argv, &i)) != NULL;
         } else if (strcmp(a, "--noise-floor") == 0) {
             o->noise_floor = true;
         } else if (strcmp(a, "--figures") == 0) {
@@ -615,6 +487,12 @@ int drift_bench_sir(int argc, char **argv)
         drift_context_destroy(ctx);
         return 2;
     }
+    if (o.views_path &&
+        drift_camera_views_load(ctx, o.views_path, o.views, MAX_VIEWS, &o.view_count) != DRIFT_OK) {
+        fprintf(stderr, "drift bench sir: --views: cannot use %s\n", o.views_path);
+        drift_context_destroy(ctx);
+        return 2;
+    }
     int exit_code = 0;
     bool first = true;
     if (o.json) {
@@ -641,20 +519,11 @@ int drift_bench_sir(int argc, char **argv)
             scene->camera.fov_y = (float)(o.fov * 3.14159265358979323846 / 180.0);
         }
         const drift_camera camera = scene->camera;
-        for (int v = 0; v < (o.view_count ? o.view_count : 1) && exit_code == 0; ++v) {
-            const sir_view *view = o.view_count ? &o.views[v] : NULL;
+        for (uint32_t v = 0; v < (o.view_count ? o.view_count : 1) && exit_code == 0; ++v) {
+            const drift_camera_view *view = o.view_count ? &o.views[v] : NULL;
             scene->camera = camera;
-            if (view && view->has_position) {
-                scene->camera.position = view->position;
-            }
-            if (view && view->has_target) {
-                scene->camera.target = view->target;
-            }
-            if (view && view->fov > 0.0) {
-                scene->camera.fov_y = (float)(view->fov * 3.14159265358979323846 / 180.0);
-            }
-            if (view && view->aperture >= 0.0) {
-                scene->camera.aperture_radius = (float)view->aperture;
+            if (view) {
+                drift_camera_view_apply(view, &scene->camera);
             }
             for (int k = 0; k < o.size_count; ++k) {
                 sir_row row = { .scene = short_name(o.scenes[s]),

@@ -53,6 +53,35 @@ drift_result drift_scene_load_json_text(drift_context *ctx, const char *text, si
                                         const char *base_dir, const char *name_for_messages,
                                         drift_scene **out_scene);
 
+// --- CAMERA VIEWS ---
+//
+// A views file names cameras of one scene by what they change from its camera (the rows of
+// `drift bench sir --views`):
+//   {"views": [{"name": "high", "position": [x, y, z], "target": [x, y, z], "fov_y": 40,
+//               "aperture_radius": 0}, ...]}
+// Every field but "name" (letters, digits, '_', '-': it names output files) is optional.
+// Errors are logged with the file and line, as for scene files.
+
+#define DRIFT_CAMERA_VIEWS_MAX_FILE_BYTES ((size_t)1 << 20)
+
+typedef struct drift_camera_view {
+    char name[64];
+    bool has_position, has_target, has_fov, has_aperture;
+    drift_vec3 position, target;
+    float fov_y; // radians
+    float aperture_radius;
+} drift_camera_view;
+
+// Reads up to `capacity` views (more is an error) into views[0 .. *out_count).
+drift_result drift_camera_views_load(drift_context *ctx, const char *path, drift_camera_view *views,
+                                     uint32_t capacity, uint32_t *out_count);
+drift_result drift_camera_views_load_json_text(drift_context *ctx, const char *text, size_t length,
+                                               const char *name_for_messages,
+                                               drift_camera_view *views, uint32_t capacity,
+                                               uint32_t *out_count);
+// Overrides the camera's fields the view sets.
+void drift_camera_view_apply(const drift_camera_view *view, drift_camera *camera);
+
 #ifdef __cplusplus
 }
 #endif

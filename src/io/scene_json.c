@@ -1035,6 +1035,51 @@ static drift_result read_scene(json_reader *r, const cJSON *root)
     return DRIFT_OK;
 }
 
+// Checks, copies and parses the text and indexes its lines: on success *out_copy (the
+// terminated text the tree points into) and *out_root are the caller's to free.
+static drift_result parse_document(json_reader *r, const char *text, size_t length,
+                                   size_t max_bytes, char **out_copy, cJSON **out_root)
+{
+    *out_copy = NULL;
+    *out_root = NULL;
+    if (length > max_bytes) {
+        drift_log(r->ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, r->file, 0,
+                  "file is larger than %zu bytes", max_bytes);
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    // cJSON reads up to a NUL, so an embedded NUL would hide the rest of the file.
+    const char *nul = length ? memchr(text, '\0', length) : NULL;
+    if (nul) {
+        return report_syntax_error(r, text, length, nul);
+    }
+    // A terminated copy: the caller's text need not be NUL-terminated, and cJSON's
+    // require_null_terminated check then rejects trailing garbage.
+    char *copy = drift_alloc(r->ctx, length + 1);
+    if (!copy) {
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    if (length) {
+        memcpy(copy, text, length);
+    }
+    const char *parse_end = NULL;
+    // return_parse_end points where cJSON_GetErrorPtr would, without cJSON's global state.
+    cJSON *root = cJSON_ParseWithLengthOpts(copy, length + 1, &parse_end, true);
+    if (!root) {
+        drift_result res = report_syntax_error(r, copy, length, parse_end);
+        drift_free(r->ctx, copy);
+        return res;
+    }
+    drift_result res = index_lines(r, root, copy, length);
+    if (res != DRIFT_OK) {
+        cJSON_Delete(root);
+        drift_free(r->ctx, copy);
+        return res;
+    }
+    *out_copy = copy;
+    *out_root = root;
+    return DRIFT_OK;
+}
+
 drift_result drift_scene_load_json_text(drift_context *ctx, const char *text, size_t length,
                                         const char *base_dir, const char *name_for_messages,
                                         drift_scene **out_scene)
@@ -1049,34 +1094,9 @@ drift_result drift_scene_load_json_text(drift_context *ctx, const char *text, si
     json_reader r = { .ctx = ctx,
                       .file = name_for_messages ? name_for_messages : "<memory>",
                       .base_dir = base_dir };
-    if (length > DRIFT_SCENE_MAX_FILE_BYTES) {
-        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, r.file, 0,
-                  "scene file is larger than %zu bytes", DRIFT_SCENE_MAX_FILE_BYTES);
-        return DRIFT_ERR_INVALID_ARGUMENT;
-    }
-    // cJSON reads up to a NUL, so an embedded NUL would hide the rest of the file.
-    const char *nul = length ? memchr(text, '\0', length) : NULL;
-    if (nul) {
-        return report_syntax_error(&r, text, length, nul);
-    }
-    // A terminated copy: the caller's text need not be NUL-terminated, and cJSON's
-    // require_null_terminated check then rejects trailing garbage.
-    char *copy = drift_alloc(ctx, length + 1);
-    if (!copy) {
-        return DRIFT_ERR_OUT_OF_MEMORY;
-    }
-    if (length) {
-        memcpy(copy, text, length);
-    }
-    const char *parse_end = NULL;
-    // return_parse_end points where cJSON_GetErrorPtr would, without cJSON's global state.
-    cJSON *root = cJSON_ParseWithLengthOpts(copy, length + 1, &parse_end, true);
-    if (!root) {
-        drift_result res = report_syntax_error(&r, copy, length, parse_end);
-        drift_free(ctx, copy);
-        return res;
-    }
-    drift_result res = index_lines(&r, root, copy, length);
+    char *copy;
+    cJSON *root;
+    drift_result res = parse_document(&r, text, length, DRIFT_SCENE_MAX_FILE_BYTES, &copy, &root);
     if (res == DRIFT_OK) {
         res = drift_scene_create(ctx, &r.scene);
     }
@@ -1093,4 +1113,120 @@ drift_result drift_scene_load_json_text(drift_context *ctx, const char *text, si
     }
     *out_scene = r.scene;
     return DRIFT_OK;
+}
+
+// --- CAMERA VIEWS ---
+
+// One view: a name of letters, digits, '_' and '-' (it names output files) and the camera
+// fields it overrides.
+static drift_result read_view(const json_reader *r, const cJSON *item, const char *path,
+                              drift_camera_view *out)
+{
+    drift_result res = expect_object(r, item, path);
+    if (res != DRIFT_OK || (res = CHECK_KEYS(r, item, path, "name", "position", "target", "fov_y",
+                                             "aperture_radius")) != DRIFT_OK) {
+        return res;
+    }
+    *out = (drift_camera_view){ 0 };
+    const char *name = NULL;
+    if ((res = read_string(r, item, path, "name", true, &name)) != DRIFT_OK) {
+        return res;
+    }
+    static const char allowed[] =
+        "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-";
+    if (strlen(name) >= sizeof out->name || strspn(name, allowed) != strlen(name)) {
+        return FAIL(r, cJSON_GetObjectItemCaseSensitive(item, "name"), DRIFT_ERR_INVALID_ARGUMENT,
+                    "%s.name must be 1-%zu letters, digits, '_' or '-'", path,
+                    sizeof out->name - 1);
+    }
+    snprintf(out->name, sizeof out->name, "%s", name);
+    float fov_deg = 0.0f;
+    out->has_position = cJSON_GetObjectItemCaseSensitive(item, "position") != NULL;
+    out->has_target = cJSON_GetObjectItemCaseSensitive(item, "target") != NULL;
+    out->has_fov = cJSON_GetObjectItemCaseSensitive(item, "fov_y") != NULL;
+    out->has_aperture = cJSON_GetObjectItemCaseSensitive(item, "aperture_radius") != NULL;
+    if ((res = read_vec3(r, item, path, "position", false, VEC3_ANY, &out->position)) != DRIFT_OK ||
+        (res = read_vec3(r, item, path, "target", false, VEC3_ANY, &out->target)) != DRIFT_OK ||
+        (res = read_float(r, item, path, "fov_y", false, 0.1, 179.0, &fov_deg)) != DRIFT_OK ||
+        (res = read_float(r, item, path, "aperture_radius", false, 0.0, (double)FLT_MAX,
+                          &out->aperture_radius)) != DRIFT_OK) {
+        return res;
+    }
+    out->fov_y = fov_deg * DRIFT_PI / 180.0f;
+    return DRIFT_OK;
+}
+
+drift_result drift_camera_views_load_json_text(drift_context *ctx, const char *text, size_t length,
+                                               const char *name_for_messages,
+                                               drift_camera_view *views, uint32_t capacity,
+                                               uint32_t *out_count)
+{
+    if (!out_count || (!text && length > 0) || (!views && capacity > 0)) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    *out_count = 0;
+    json_reader r = { .ctx = ctx, .file = name_for_messages ? name_for_messages : "<memory>" };
+    char *copy;
+    cJSON *root;
+    drift_result res =
+        parse_document(&r, text, length, DRIFT_CAMERA_VIEWS_MAX_FILE_BYTES, &copy, &root);
+    if (res != DRIFT_OK) {
+        return res;
+    }
+    const cJSON *list = cJSON_GetObjectItemCaseSensitive(root, "views");
+    if ((res = expect_object(&r, root, "the views file")) != DRIFT_OK ||
+        (res = CHECK_KEYS(&r, root, "", "views")) != DRIFT_OK) {
+        // reported
+    } else if (!cJSON_IsArray(list)) {
+        res = list ? FAIL(&r, list, DRIFT_ERR_PARSE, "views must be an array, not %s",
+                          type_name(list))
+                   : missing(&r, root, "", "views");
+    } else if (cJSON_GetArraySize(list) < 1 || (uint32_t)cJSON_GetArraySize(list) > capacity) {
+        res = FAIL(&r, list, DRIFT_ERR_INVALID_ARGUMENT, "views must hold 1 to %u views", capacity);
+    } else {
+        size_t k = 0;
+        for (const cJSON *item = list->child; item && res == DRIFT_OK; item = item->next, ++k) {
+            char path[KEY_PATH_MAX];
+            index_path(path, "views", k);
+            res = read_view(&r, item, path, &views[k]);
+        }
+        *out_count = res == DRIFT_OK ? (uint32_t)k : 0;
+    }
+    cJSON_Delete(root);
+    drift_free(ctx, copy);
+    drift_free(ctx, r.lines);
+    return res;
+}
+
+drift_result drift_camera_views_load(drift_context *ctx, const char *path, drift_camera_view *views,
+                                     uint32_t capacity, uint32_t *out_count)
+{
+    if (!path || !out_count) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    *out_count = 0;
+    char *text = NULL;
+    size_t size = 0;
+    drift_result r = drift__read_file(ctx, path, false, path, 0, &text, &size);
+    if (r == DRIFT_OK) {
+        r = drift_camera_views_load_json_text(ctx, text, size, path, views, capacity, out_count);
+    }
+    drift_free(ctx, text);
+    return r;
+}
+
+void drift_camera_view_apply(const drift_camera_view *view, drift_camera *camera)
+{
+    if (view->has_position) {
+        camera->position = view->position;
+    }
+    if (view->has_target) {
+        camera->target = view->target;
+    }
+    if (view->has_fov) {
+        camera->fov_y = view->fov_y;
+    }
+    if (view->has_aperture) {
+        camera->aperture_radius = view->aperture_radius;
+    }
 }

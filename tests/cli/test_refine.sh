@@ -66,10 +66,10 @@ python3 -c "import json; d=json.load(open('$tmp/out')); assert [r['view'] for r 
     || fail "bench sir --views rows"
 printf '{"views": [\n  {"name": "a"},\n  {"name": "b", "fov_y": "wide"}\n]}\n' > "$tmp/bad_views.json"
 expect 2 "$drift" bench sir --views "$tmp/bad_views.json"
-grep -q "bad_views.json:3: view 2: \"fov_y\"" "$tmp/err" || fail "bad view not located"
+grep -q 'bad_views.json:3: error: views\[1\]\.fov_y must be a number' "$tmp/err" || fail "bad view not located"
 printf '{"views": [\n  {"name": "a",}\n]}\n' > "$tmp/bad_views.json"
 expect 2 "$drift" bench sir --views "$tmp/bad_views.json"
-grep -q "bad_views.json:2: JSON syntax error" "$tmp/err" || fail "views syntax error not located"
+grep -q "bad_views.json:2: error: malformed JSON" "$tmp/err" || fail "views syntax error not located"
 
 # Usage errors: exit 2, nothing written.
 expect 2 "$drift" render --mode hybrid --refine bogus --out "$tmp/x.exr"

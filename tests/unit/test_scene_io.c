@@ -1,5 +1,6 @@
 // Scene loading: the default Cornell box, the real scenes in ../shared/scenes, JSON errors
-// with their lines, unknown keys, gzip, transforms, glTF cameras and lights, textures.
+// with their lines, unknown keys, gzip, transforms, glTF cameras and lights, textures, and
+// the camera views files of drift bench sir --views.
 #include "drift/image_io.h"
 #include "drift/scene.h"
 #include "drift/scene_io.h"
@@ -742,6 +743,84 @@ static void test_scene_io_textures_are_shared(void **state)
     drift_context_destroy(ctx);
 }
 
+// --- CAMERA VIEWS ---
+
+// The hall's views file loads; a view overrides only the camera fields it names; bad files
+// fail with the right code and line.
+static void test_scene_io_camera_views(void **state)
+{
+    (void)state;
+    located_log log;
+    drift_context *ctx = located_context(&log);
+    char path[1024];
+    drift_camera_view views[16];
+    uint32_t count = 0;
+    assert_int_equal(drift_camera_views_load(ctx,
+                                             test_repo_path(path, "scenes/sir-hall/sir_views.json"),
+                                             views, 16, &count),
+                     DRIFT_OK);
+    assert_int_equal(count, 6);
+    assert_string_equal(views[0].name, "closeup");
+
+    const char *text = "{\"views\": [\n"
+                       "  {\"name\": \"a\", \"target\": [1, 2, 3], \"fov_y\": 90},\n"
+                       "  {\"name\": \"b_2\", \"position\": [4, 5, 6], \"aperture_radius\": 0.5}\n"
+                       "]}\n";
+    assert_int_equal(
+        drift_camera_views_load_json_text(ctx, text, strlen(text), "v.json", views, 16, &count),
+        DRIFT_OK);
+    assert_int_equal(count, 2);
+    drift_camera base = { .position = { 0, 0, -1 },
+                          .target = { 0, 0, 0 },
+                          .fov_y = 0.5f,
+                          .aperture_radius = 0.1f,
+                          .width = 8,
+                          .height = 6 };
+    drift_camera a = base, b = base;
+    drift_camera_view_apply(&views[0], &a);
+    drift_camera_view_apply(&views[1], &b);
+    assert_near(a.target.z, 3.0f, 0.0f);
+    assert_near(a.position.z, -1.0f, 0.0f);
+    assert_near(a.fov_y, 3.14159265f / 2.0f, 1e-6f);
+    assert_near(a.aperture_radius, 0.1f, 0.0f);
+    assert_near(b.position.x, 4.0f, 0.0f);
+    assert_near(b.target.x, 0.0f, 0.0f);
+    assert_near(b.fov_y, 0.5f, 0.0f);
+    assert_near(b.aperture_radius, 0.5f, 0.0f);
+
+    const struct {
+        const char *text;
+        drift_result code;
+        int line;
+    } cases[] = {
+        { "{\"views\": [\n  {\"target\": [1, 2, 3]}\n]}", DRIFT_ERR_PARSE, 2 },        // no name
+        { "{\"views\": [\n  {\"name\": \"a b\"}\n]}", DRIFT_ERR_INVALID_ARGUMENT, 2 }, // file name
+        { "{\"views\": [\n  {\"name\": \"a\",\n   \"fov_y\": 500}\n]}", DRIFT_ERR_INVALID_ARGUMENT,
+          3 },
+        { "{\"views\": [\n  {\"name\": \"a\", \"position\": [1, 2]}\n]}", DRIFT_ERR_PARSE, 2 },
+        { "{\"views\": []}", DRIFT_ERR_INVALID_ARGUMENT, 1 },
+        { "{\"views\": 3}", DRIFT_ERR_PARSE, 1 },
+        { "{}", DRIFT_ERR_PARSE, 1 },
+        { "{\"views\": [\n  {\"name\": \"a\",}\n]}", DRIFT_ERR_PARSE, 2 }, // syntax
+    };
+
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; ++i) {
+        drift_context_destroy(ctx);
+        ctx = located_context(&log);
+        count = 99;
+        drift_result r = drift_camera_views_load_json_text(
+            ctx, cases[i].text, strlen(cases[i].text), "bad.json", views, 16, &count);
+        if (r != cases[i].code || log.first_error_line != cases[i].line || count != 0) {
+            fail_msg("case %zu: code %d line %d count %u", i, (int)r, log.first_error_line, count);
+        }
+    }
+    // More views than the caller holds is an error, not a silent cut.
+    assert_int_equal(
+        drift_camera_views_load_json_text(ctx, text, strlen(text), "v.json", views, 1, &count),
+        DRIFT_ERR_INVALID_ARGUMENT);
+    drift_context_destroy(ctx);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -757,6 +836,7 @@ int main(void)
         cmocka_unit_test(test_scene_io_every_light_type),
         cmocka_unit_test(test_scene_io_gltf_camera_lights_emission),
         cmocka_unit_test(test_scene_io_textures_are_shared),
+        cmocka_unit_test(test_scene_io_camera_views),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
