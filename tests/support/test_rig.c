@@ -69,6 +69,17 @@ void test_add_quad(drift_scene *scene, drift_vec3 corner, drift_vec3 u, drift_ve
     test_add_mesh(scene, p, 4, idx, 2, material);
 }
 
+void test_add_quad_light(drift_scene *scene, drift_vec3 corner, drift_vec3 u, drift_vec3 v,
+                         float radiance)
+{
+    drift_light light = { .type = DRIFT_LIGHT_QUAD,
+                          .position = corner,
+                          .edge_u = u,
+                          .edge_v = v,
+                          .color = drift_vec3_splat(radiance) };
+    assert_int_equal(drift_scene_add_light(scene, &light, NULL), DRIFT_OK);
+}
+
 void test_add_floor(drift_scene *scene, float half, float height, uint32_t material)
 {
     const float p[] = { -half, height, -half, half,  height, -half,

@@ -28,6 +28,10 @@ uint32_t test_add_material(drift_scene *scene, drift_material m);
 // The quad corner, corner + u, corner + u + v, corner + v (two triangles, wound as listed).
 void test_add_quad(drift_scene *scene, drift_vec3 corner, drift_vec3 u, drift_vec3 v,
                    uint32_t material);
+// A quad light of `radiance` at corner, corner + u, corner + u + v, corner + v, emitting along
+// cross(u, v).
+void test_add_quad_light(drift_scene *scene, drift_vec3 corner, drift_vec3 u, drift_vec3 v,
+                         float radiance);
 // Square of half size `half` in the plane y = height, facing +y.
 void test_add_floor(drift_scene *scene, float half, float height, uint32_t material);
 // UV sphere with smooth normals and outward winding; returns its mesh index.

@@ -42,14 +42,8 @@ static void add_square(drift_scene *scene, float x, float h, float z, float half
 // A 1x1 quad light at height 3 centred over the origin, emitting down.
 static void add_light(drift_scene *scene)
 {
-    assert_int_equal(drift_scene_add_light(scene,
-                                           &(drift_light){ .type = DRIFT_LIGHT_QUAD,
-                                                           .position = { -0.5f, 3.0f, -0.5f },
-                                                           .edge_u = { 1, 0, 0 },
-                                                           .edge_v = { 0, 0, 1 },
-                                                           .color = { 5, 5, 5 } },
-                                           NULL),
-                     DRIFT_OK);
+    test_add_quad_light(scene, drift_vec3_make(-0.5f, 3.0f, -0.5f), drift_vec3_make(1, 0, 0),
+                        drift_vec3_make(0, 0, 1), 5.0f);
 }
 
 enum {

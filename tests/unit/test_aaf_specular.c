@@ -37,14 +37,8 @@ static test_rig build_floor(const drift_material *floor, drift_vec3 target)
     test_add_quad(r.scene, drift_vec3_make(-h, 0, -h), drift_vec3_make(0, 3, 0),
                   drift_vec3_make(0, 0, 2 * h),
                   wh); // left wall, facing +x
-    assert_int_equal(drift_scene_add_light(r.scene,
-                                           &(drift_light){ .type = DRIFT_LIGHT_QUAD,
-                                                           .position = { -0.5f, 3.0f, -0.5f },
-                                                           .edge_u = { 1, 0, 0 },
-                                                           .edge_v = { 0, 0, 1 },
-                                                           .color = { 5, 5, 5 } },
-                                           NULL),
-                     DRIFT_OK);
+    test_add_quad_light(r.scene, drift_vec3_make(-0.5f, 3.0f, -0.5f), drift_vec3_make(1, 0, 0),
+                        drift_vec3_make(0, 0, 1), 5.0f);
     r.scene->camera = drift_camera_look_at(drift_vec3_make(0.3f, 1.2f, -1.4f), target,
                                            drift_vec3_make(0, 1, 0), 1.2f, W, H);
     test_rig_commit(&r);
