@@ -253,6 +253,9 @@ static void modulate_pixel(drift_hybrid *f, int32_t x, int32_t y, uint64_t *rays
 drift_result drift_aaf_lobe_pass(drift_hybrid *f, const drift_aaf_lobe *lobe)
 {
     drift_result r = drift_aaf_prepare(f, NULL);
+    if (r == DRIFT_OK) {
+        r = drift_aaf_lobe_buffers_ensure(f->ctx, lobe->buffers, f->params.width, f->params.height);
+    }
     if (r != DRIFT_OK) {
         return r;
     }

@@ -131,6 +131,10 @@ typedef struct drift_aaf_state {
 } drift_aaf_state;
 
 drift_result drift_aaf_state_ensure(drift_hybrid *frame);
+// Makes a lobe's buffers the first time the lobe runs (a frame that filters only shadows, or
+// only one lobe, does not hold the others').
+drift_result drift_aaf_lobe_buffers_ensure(drift_context *ctx, drift_aaf_lobe_buffers *buffers,
+                                           int32_t width, int32_t height);
 // Makes the state if needed and fills its footprint plane; *out_active (may be NULL) gets the
 // number of pixels that see a surface (the pixels the average spp is over).
 drift_result drift_aaf_prepare(drift_hybrid *frame, size_t *out_active);

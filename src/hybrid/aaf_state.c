@@ -1,5 +1,5 @@
 // AAF's per-frame buffers: made the first time a frame uses AAF (most frames never do), kept
-// until the frame is destroyed.
+// until the frame is destroyed; an indirect lobe's only when that lobe first runs.
 #include "hybrid/aaf_internal.h"
 
 void drift_aaf_state_destroy(drift_context *ctx, drift_aaf_state *s)
@@ -59,11 +59,8 @@ drift_result drift_aaf_state_ensure(drift_hybrid *f)
     drift_result r = s->lights && s->want && s->counts && s->aux && s->filter_workspace
                          ? DRIFT_OK
                          : DRIFT_ERR_OUT_OF_MEMORY;
-    drift_image *ones[] = { &s->footprint,    &s->scratch1,      &s->indirect.beta,
-                            &s->indirect.spp, &s->specular.beta, &s->specular.spp };
-    drift_image *threes[] = { &s->scratch3,          &s->indirect.unfiltered, &s->indirect.radiance,
-                              &s->indirect.filtered, &s->specular.unfiltered, &s->specular.radiance,
-                              &s->specular.filtered };
+    drift_image *ones[] = { &s->footprint, &s->scratch1 };
+    drift_image *threes[] = { &s->scratch3 };
     for (size_t i = 0; r == DRIFT_OK && i < sizeof ones / sizeof *ones; ++i) {
         r = drift_image_create(ctx, w, h, 1, ones[i]);
     }
@@ -85,4 +82,31 @@ drift_result drift_aaf_state_ensure(drift_hybrid *f)
     }
     f->aaf = s;
     return DRIFT_OK;
+}
+
+drift_result drift_aaf_lobe_buffers_ensure(drift_context *ctx, drift_aaf_lobe_buffers *b,
+                                           int32_t width, int32_t height)
+{
+    if (b->beta.pixels) {
+        return DRIFT_OK;
+    }
+    drift_image *ones[] = { &b->beta, &b->spp };
+    drift_image *threes[] = { &b->unfiltered, &b->radiance, &b->filtered };
+    drift_result r = DRIFT_OK;
+    for (size_t i = 0; r == DRIFT_OK && i < sizeof threes / sizeof *threes; ++i) {
+        r = drift_image_create(ctx, width, height, 3, threes[i]);
+    }
+    // beta last: its pixels say the set is complete.
+    for (size_t i = sizeof ones / sizeof *ones; r == DRIFT_OK && i-- > 0;) {
+        r = drift_image_create(ctx, width, height, 1, ones[i]);
+    }
+    if (r != DRIFT_OK) {
+        for (size_t i = 0; i < sizeof threes / sizeof *threes; ++i) {
+            drift_image_destroy(ctx, threes[i]);
+        }
+        for (size_t i = 0; i < sizeof ones / sizeof *ones; ++i) {
+            drift_image_destroy(ctx, ones[i]);
+        }
+    }
+    return r;
 }

@@ -480,12 +480,12 @@ static void collect_planes(drift_hybrid *f)
             add_plane(f, name, images[k]);
         }
     }
-    if (p->indirect == DRIFT_INDIRECT_AAF && f->aaf) {
+    if (p->indirect == DRIFT_INDIRECT_AAF && f->aaf && f->aaf->indirect.beta.pixels) {
         add_plane(f, "indirect.aaf.beta", &f->aaf->indirect.beta);
         add_plane(f, "indirect.aaf.spp", &f->aaf->indirect.spp);
         add_plane(f, "indirect.aaf.unfiltered", &f->aaf->indirect.unfiltered);
     }
-    if (p->reflections == DRIFT_REFLECTIONS_AAF && f->aaf) {
+    if (p->reflections == DRIFT_REFLECTIONS_AAF && f->aaf && f->aaf->specular.beta.pixels) {
         add_plane(f, "reflections.aaf.beta", &f->aaf->specular.beta);
         add_plane(f, "reflections.aaf.spp", &f->aaf->specular.spp);
         add_plane(f, "reflections.aaf.unfiltered", &f->aaf->specular.unfiltered);
