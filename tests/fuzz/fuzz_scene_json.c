@@ -4,6 +4,7 @@
 // leaks are not.
 #include "drift/scene.h"
 #include "drift/scene_io.h"
+#include "fuzz_context.h"
 
 #include <stddef.h>
 #include <stdint.h>
@@ -11,24 +12,11 @@
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
-// Reads every message so that a bad format argument or dangling file name shows up under ASan.
-static void check_log(drift_log_level level, drift_result code, const char *file, int line,
-                      const char *message, void *user)
-{
-    size_t *total = user;
-    *total += strlen(message) + (size_t)level + (size_t)code + (size_t)(line > 0);
-    if (file) {
-        *total += strlen(file);
-    }
-}
-
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     size_t total = 0;
-    drift_context *ctx = NULL;
-    drift_context_desc desc = { .thread_count = 1,
-                                .logger = { .func = check_log, .user = &total } };
-    if (drift_context_create(&desc, &ctx) != DRIFT_OK) {
+    drift_context *ctx = fuzz_context(&total);
+    if (!ctx) {
         return 0;
     }
     drift_scene *scene = NULL;
