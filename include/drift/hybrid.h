@@ -35,6 +35,7 @@
 #include "drift/core.h"
 #include "drift/image.h"
 #include "drift/scene.h"
+#include "drift/techniques.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -50,53 +51,38 @@ typedef enum drift_effect {
     DRIFT_EFFECT_COUNT
 } drift_effect;
 
-// Technique values per effect. The names (drift_technique_name) are stable: the command
-// line, stats files and the viewer use them, and later issues append to these lists.
+// Technique values per effect, generated from the technique table (drift/techniques.h). The
+// names (drift_technique_name) are stable: the command line, stats files and the viewer use
+// them, and later techniques append rows to the table.
+#define DRIFT_TECHNIQUE_ENUM_(prefix, ENUM)      prefix##ENUM,
+#define DRIFT_SHADOWS_ENUM_(ENUM, name, ...)     DRIFT_TECHNIQUE_ENUM_(DRIFT_SHADOWS_, ENUM)
+#define DRIFT_REFLECTIONS_ENUM_(ENUM, name, ...) DRIFT_TECHNIQUE_ENUM_(DRIFT_REFLECTIONS_, ENUM)
+#define DRIFT_DOF_ENUM_(ENUM, name, ...)         DRIFT_TECHNIQUE_ENUM_(DRIFT_DOF_, ENUM)
+#define DRIFT_INDIRECT_ENUM_(ENUM, name, ...)    DRIFT_TECHNIQUE_ENUM_(DRIFT_INDIRECT_, ENUM)
+
 typedef enum drift_shadow_technique {
-    DRIFT_SHADOWS_HARD = 0,   // ray-traced visibility of the light's centre
-    DRIFT_SHADOWS_PCF,        // shadow map, percentage-closer filtering
-    DRIFT_SHADOWS_PCSS,       // shadow map, percentage-closer soft shadows (Fernando 2005)
-    DRIFT_SHADOWS_REFERENCE,  // path-traced direct light at --spp
-    DRIFT_SHADOWS_ISG,        // image space gathering over the hard-shadow buffer (docs/isg.md)
-    DRIFT_SHADOWS_BLUR,       // baseline: the hard-shadow bits blurred over a fixed disk
-    DRIFT_SHADOWS_AAF,        // axis-aligned filtering of ray-traced area-light visibility
-                              // (Mehta et al. 2012; docs/aaf.md), --spp rays a pixel on average
-    DRIFT_SHADOWS_COUNT
+    DRIFT_SHADOW_TECHNIQUES(DRIFT_SHADOWS_ENUM_) DRIFT_SHADOWS_COUNT
 } drift_shadow_technique;
 
 typedef enum drift_reflection_technique {
-    DRIFT_REFLECTIONS_NONE = 0,
-    DRIFT_REFLECTIONS_ENVMAP,    // cube map captured at a probe point
-    DRIFT_REFLECTIONS_SHARP,     // one mirror ray per pixel
-    DRIFT_REFLECTIONS_REFERENCE, // path-traced first-bounce glossy/mirror light at --spp
-    DRIFT_REFLECTIONS_ISG,       // image space gathering over the sharp buffer (docs/isg.md)
-    DRIFT_REFLECTIONS_BLUR,      // baseline: the sharp buffer blurred over a fixed disk
-    DRIFT_REFLECTIONS_AAF,       // path-traced first-bounce glossy light, adaptively sampled and
-                                 // filtered (AAF's specular buffer; docs/aaf.md), mirrors sharp
-    DRIFT_REFLECTIONS_COUNT
+    DRIFT_REFLECTION_TECHNIQUES(DRIFT_REFLECTIONS_ENUM_) DRIFT_REFLECTIONS_COUNT
 } drift_reflection_technique;
 
 typedef enum drift_dof_technique {
-    DRIFT_DOF_NONE = 0,      // pinhole
-    DRIFT_DOF_POST,          // gather over the circle of confusion in image space
-    DRIFT_DOF_REFERENCE,     // the whole frame path-traced through the thin lens
-    DRIFT_DOF_ISG,           // image space gathering over the focused frame (docs/isg.md)
-    DRIFT_DOF_COUNT
+    DRIFT_DOF_TECHNIQUES(DRIFT_DOF_ENUM_) DRIFT_DOF_COUNT
 } drift_dof_technique;
 
 typedef enum drift_indirect_technique {
-    DRIFT_INDIRECT_NONE = 0,
-    DRIFT_INDIRECT_AMBIENT,   // diffuse albedo x a constant radiance
-    DRIFT_INDIRECT_REFERENCE, // path-traced first-bounce diffuse light at --spp
-    DRIFT_INDIRECT_AAF,       // path-traced diffuse indirect, adaptively sampled and filtered
-                              // (Mehta et al. 2013; docs/aaf.md), --spp paths a pixel on average
-    DRIFT_INDIRECT_COUNT
+    DRIFT_INDIRECT_TECHNIQUES(DRIFT_INDIRECT_ENUM_) DRIFT_INDIRECT_COUNT
 } drift_indirect_technique;
 
 const char *drift_effect_name(drift_effect effect); // "shadows", "reflections", "dof", "indirect"
 int drift_technique_count(drift_effect effect);
 // NULL when technique is out of range.
 const char *drift_technique_name(drift_effect effect, int technique);
+// One line describing the technique (the table's summary), for --help and the viewer; NULL
+// when technique is out of range.
+const char *drift_technique_summary(drift_effect effect, int technique);
 // The technique called `name`, or -1.
 int drift_technique_parse(drift_effect effect, const char *name);
 
@@ -195,28 +181,28 @@ typedef struct drift_gbuffer {
 // --- FRAME ---
 
 typedef enum drift_hybrid_pass {
-    DRIFT_PASS_PRIMARY = 0,    // G-buffer
-    DRIFT_PASS_UNSHADOWED,     // U_l for every pixel and light
-    DRIFT_PASS_HARD_SHADOWS,   // hard-shadow buffer
-    DRIFT_PASS_SHADOW_MAPS,    // building the shadow maps (cached while the scene stands)
-    DRIFT_PASS_SHADOW_FILTER,  // PCF or PCSS lookups
-    DRIFT_PASS_REFLECTIONS,    // sharp reflection buffer
-    DRIFT_PASS_ENVMAP,         // capturing the cube map (cached) and looking it up
-    DRIFT_PASS_REFERENCE,      // every `reference` effect
+    DRIFT_PASS_PRIMARY = 0,   // G-buffer
+    DRIFT_PASS_UNSHADOWED,    // U_l for every pixel and light
+    DRIFT_PASS_HARD_SHADOWS,  // hard-shadow buffer
+    DRIFT_PASS_SHADOW_MAPS,   // building the shadow maps (cached while the scene stands)
+    DRIFT_PASS_SHADOW_FILTER, // PCF or PCSS lookups
+    DRIFT_PASS_REFLECTIONS,   // sharp reflection buffer
+    DRIFT_PASS_ENVMAP,        // capturing the cube map (cached) and looking it up
+    DRIFT_PASS_REFERENCE,     // every `reference` effect
     DRIFT_PASS_COMPOSE,
-    DRIFT_PASS_DOF,            // post-process depth of field
-    DRIFT_PASS_ISG,            // image space gathering (every effect) and the blur baselines
-    DRIFT_PASS_AAF_SAMPLING,   // AAF sparse and adaptive sampling (shadows and indirect)
-    DRIFT_PASS_AAF_FILTER,     // AAF's separable filter
+    DRIFT_PASS_DOF,          // post-process depth of field
+    DRIFT_PASS_ISG,          // image space gathering (every effect) and the blur baselines
+    DRIFT_PASS_AAF_SAMPLING, // AAF sparse and adaptive sampling (shadows and indirect)
+    DRIFT_PASS_AAF_FILTER,   // AAF's separable filter
     DRIFT_PASS_COUNT
 } drift_hybrid_pass;
 
 const char *drift_hybrid_pass_name(drift_hybrid_pass pass);
 
 typedef struct drift_hybrid_stats {
-    double ms[DRIFT_PASS_COUNT];    // wall milliseconds of the last frame, per pass
+    double ms[DRIFT_PASS_COUNT]; // wall milliseconds of the last frame, per pass
     uint64_t rays[DRIFT_PASS_COUNT];
-    double frame_ms;                // the whole drift_hybrid_render call
+    double frame_ms; // the whole drift_hybrid_render call
 } drift_hybrid_stats;
 
 typedef struct drift_hybrid drift_hybrid;
@@ -244,8 +230,8 @@ const drift_image *drift_hybrid_image(const drift_hybrid *frame);
 const drift_gbuffer *drift_hybrid_gbuffer(const drift_hybrid *frame);
 drift_hybrid_stats drift_hybrid_get_stats(const drift_hybrid *frame);
 
-// Every plane and buffer of the last frame, by name ("depth", "hard_shadow.visible",
-// "reflection.sharp", ...): for --aov and the viewer. Returns false past the last index.
+// Every plane and buffer of the last frame, by name ("depth", "light0.hard_shadow",
+// "reflection.emitted", ...): for --aov and the viewer. Returns false past the last index.
 // Planes a technique did not need this frame are absent.
 bool drift_hybrid_plane(const drift_hybrid *frame, uint32_t index, const char **out_name,
                         const drift_image **out_image);

@@ -1,87 +1,35 @@
-// The hybrid frame: lifecycle, technique names, the pass order, and the table of planes
-// (--aov, the viewer). The passes themselves live in direct.c, reflections.c, reference.c
-// and compose.c.
-#include "hybrid/frame_internal.h"
-#include "hybrid/isg_internal.h"
-#include "hybrid/aaf_internal.h"
+// The hybrid frame's conductor: lifecycle, parameters, the pass order and the table of
+// planes (--aov, the viewer). It runs the chosen row of the technique table for every effect
+// (hybrid/techniques.h); the passes live in the technique folders (src/realtime, src/isg,
+// src/aaf, ...) and reach the frame's buffers through frame/frame.h, never through here.
+#include "aaf/aaf.h"
+#include "hybrid/frame_access.h"
+#include "hybrid/techniques.h"
+#include "isg/isg.h"
+#include "realtime/realtime.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
-// --- NAMES ---
+typedef struct plane_ref {
+    char name[DRIFT_FRAME_PLANE_NAME];
+    const drift_image *image;
+} plane_ref;
 
-static const char *const shadow_names[] = { "hard", "pcf", "pcss", "reference",
-                                           "isg",  "blur", "aaf" };
-static const char *const reflection_names[] = { "none", "envmap", "sharp",
-                                               "reference", "isg", "blur", "aaf" };
-static const char *const dof_names[] = { "none", "post", "reference", "isg" };
-static const char *const indirect_names[] = { "none", "ambient", "reference", "aaf" };
-static const char *const effect_names[] = { "shadows", "reflections", "dof", "indirect" };
-static const char *const pass_names[] = { "primary",     "unshadowed", "hard_shadows",
+struct drift_hybrid {
+    drift_frame_state frame; // the buffers every pass reads and writes
+    plane_ref *planes;       // the last frame's planes, in a stable order
+    uint32_t plane_count, plane_capacity;
+    bool planes_out_of_memory;
+};
+
+static const char *const pass_names[] = { "primary",     "unshadowed",    "hard_shadows",
                                           "shadow_maps", "shadow_filter", "reflections",
-                                          "envmap",      "reference",  "compose", "dof",
-                                          "isg", "aaf_sampling", "aaf_filter" };
-
-_Static_assert(sizeof shadow_names / sizeof *shadow_names == DRIFT_SHADOWS_COUNT, "names");
-_Static_assert(sizeof reflection_names / sizeof *reflection_names == DRIFT_REFLECTIONS_COUNT,
-               "names");
-_Static_assert(sizeof dof_names / sizeof *dof_names == DRIFT_DOF_COUNT, "names");
-_Static_assert(sizeof indirect_names / sizeof *indirect_names == DRIFT_INDIRECT_COUNT, "names");
+                                          "envmap",      "reference",     "compose",
+                                          "dof",         "isg",           "aaf_sampling",
+                                          "aaf_filter" };
 _Static_assert(sizeof pass_names / sizeof *pass_names == DRIFT_PASS_COUNT, "names");
-
-static const char *const *technique_table(drift_effect effect, int *out_count)
-{
-    switch (effect) {
-    case DRIFT_EFFECT_SHADOWS:
-        *out_count = DRIFT_SHADOWS_COUNT;
-        return shadow_names;
-    case DRIFT_EFFECT_REFLECTIONS:
-        *out_count = DRIFT_REFLECTIONS_COUNT;
-        return reflection_names;
-    case DRIFT_EFFECT_DOF:
-        *out_count = DRIFT_DOF_COUNT;
-        return dof_names;
-    case DRIFT_EFFECT_INDIRECT:
-        *out_count = DRIFT_INDIRECT_COUNT;
-        return indirect_names;
-    case DRIFT_EFFECT_COUNT:
-        break;
-    }
-    *out_count = 0;
-    return NULL;
-}
-
-const char *drift_effect_name(drift_effect effect)
-{
-    return (unsigned)effect < DRIFT_EFFECT_COUNT ? effect_names[effect] : NULL;
-}
-
-int drift_technique_count(drift_effect effect)
-{
-    int count;
-    technique_table(effect, &count);
-    return count;
-}
-
-const char *drift_technique_name(drift_effect effect, int technique)
-{
-    int count;
-    const char *const *names = technique_table(effect, &count);
-    return technique >= 0 && technique < count ? names[technique] : NULL;
-}
-
-int drift_technique_parse(drift_effect effect, const char *name)
-{
-    int count;
-    const char *const *names = technique_table(effect, &count);
-    for (int i = 0; name && i < count; ++i) {
-        if (strcmp(names[i], name) == 0) {
-            return i;
-        }
-    }
-    return -1;
-}
 
 const char *drift_hybrid_pass_name(drift_hybrid_pass pass)
 {
@@ -158,10 +106,10 @@ static bool params_valid(const drift_context *ctx, const drift_hybrid_params *p)
     if (p->width <= 0 || p->height <= 0 || p->width > DRIFT_IMAGE_MAX_DIMENSION ||
         p->height > DRIFT_IMAGE_MAX_DIMENSION) {
         problem = "image size out of range";
-    } else if ((unsigned)p->shadows >= DRIFT_SHADOWS_COUNT ||
-               (unsigned)p->reflections >= DRIFT_REFLECTIONS_COUNT ||
-               (unsigned)p->dof >= DRIFT_DOF_COUNT ||
-               (unsigned)p->indirect >= DRIFT_INDIRECT_COUNT) {
+    } else if (!drift_technique_row_chosen(p, DRIFT_EFFECT_SHADOWS) ||
+               !drift_technique_row_chosen(p, DRIFT_EFFECT_REFLECTIONS) ||
+               !drift_technique_row_chosen(p, DRIFT_EFFECT_DOF) ||
+               !drift_technique_row_chosen(p, DRIFT_EFFECT_INDIRECT)) {
         problem = "unknown technique";
     } else if (p->max_depth < 1 || p->max_depth > 1024) {
         problem = "max_depth outside 1..1024";
@@ -187,14 +135,20 @@ static bool params_valid(const drift_context *ctx, const drift_hybrid_params *p)
 
 // --- LIFECYCLE ---
 
-static drift_result create_images(drift_hybrid *f)
+static drift_result create_images(drift_frame_state *f)
 {
     drift_context *ctx = f->ctx;
     int32_t w = f->params.width, h = f->params.height;
     drift_result r = drift_gbuffer_create(ctx, w, h, &f->gbuffer);
-    drift_image *rgb[] = { &f->environment_direct, &f->direct,     &f->reflection_emitted,
-                           &f->reflection_reflected, &f->reflections, &f->indirect,
-                           &f->reference,           &f->focus,      &f->final };
+    drift_image *rgb[] = { &f->environment_direct,
+                           &f->direct,
+                           &f->reflection_emitted,
+                           &f->reflection_reflected,
+                           &f->reflections,
+                           &f->indirect,
+                           &f->reference,
+                           &f->focus,
+                           &f->final };
     for (size_t i = 0; r == DRIFT_OK && i < sizeof rgb / sizeof *rgb; ++i) {
         r = drift_image_create(ctx, w, h, 3, rgb[i]);
     }
@@ -205,7 +159,7 @@ static drift_result create_images(drift_hybrid *f)
         r = drift_image_create(ctx, w, h, 1, &f->coc);
     }
     for (uint32_t l = 0; r == DRIFT_OK && l < f->light_count; ++l) {
-        drift_hybrid_light_buffers *b = &f->light_buffers[l];
+        drift_frame_light_buffers *b = &f->light_buffers[l];
         r = drift_image_create(ctx, w, h, 3, &b->unshadowed);
         if (r == DRIFT_OK) {
             r = drift_image_create(ctx, w, h, 3, &b->hard_shadow);
@@ -232,43 +186,41 @@ drift_result drift_hybrid_create(drift_context *ctx, const drift_scene *scene,
     if (!params_valid(ctx, &p)) {
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
-    drift_hybrid *f = drift_alloc(ctx, sizeof(drift_hybrid));
-    if (!f) {
+    drift_hybrid *h = drift_alloc(ctx, sizeof(drift_hybrid));
+    if (!h) {
         return DRIFT_ERR_OUT_OF_MEMORY;
     }
+    drift_frame_state *f = &h->frame;
     f->ctx = ctx;
     f->scene = scene;
     f->accel = accel;
     f->params = p;
     f->thread_count = drift_context_thread_count(ctx);
-    drift_result r = drift_hybrid_lights_build(ctx, scene, &f->lights, &f->light_count);
+    drift_result r = drift_raster_lights_build(ctx, scene, &f->lights, &f->light_count);
     if (r == DRIFT_OK) {
         f->counters = drift_alloc(ctx, sizeof(drift_ray_counter) * (size_t)f->thread_count);
         // + 1: a scene with no lights still gets an allocation.
         f->light_buffers =
-            drift_alloc(ctx, sizeof(drift_hybrid_light_buffers) * (f->light_count + 1u));
-        f->plane_capacity = DRIFT_HYBRID_FIXED_PLANES + DRIFT_HYBRID_PLANES_PER_LIGHT * f->light_count +
-                            DRIFT_ISG_FIXED_PLANES + DRIFT_ISG_PLANES_PER_LIGHT * f->light_count;
-        f->planes = drift_alloc(ctx, sizeof(drift_hybrid_plane_ref) * f->plane_capacity);
-        r = f->counters && f->light_buffers && f->planes ? DRIFT_OK : DRIFT_ERR_OUT_OF_MEMORY;
+            drift_alloc(ctx, sizeof(drift_frame_light_buffers) * (f->light_count + 1u));
+        r = f->counters && f->light_buffers ? DRIFT_OK : DRIFT_ERR_OUT_OF_MEMORY;
     }
     if (r == DRIFT_OK) {
         r = create_images(f);
     }
     if (r != DRIFT_OK) {
-        drift_hybrid_destroy(f);
+        drift_hybrid_destroy(h);
         return r;
     }
-    f->shading = (drift_hybrid_shading){ .scene = scene,
+    f->shading = (drift_raster_shading){ .scene = scene,
                                          .accel = accel,
                                          .lights = f->lights,
                                          .light_count = f->light_count,
                                          .light_samples = p.light_samples };
-    *out_frame = f;
+    *out_frame = h;
     return DRIFT_OK;
 }
 
-static void destroy_probes(drift_hybrid *f)
+static void destroy_probes(drift_frame_state *f)
 {
     for (uint32_t i = 0; i < f->probe_count; ++i) {
         drift_envmap_destroy(f->ctx, f->probes[i].map);
@@ -278,7 +230,7 @@ static void destroy_probes(drift_hybrid *f)
     f->probe_count = 0;
 }
 
-static void destroy_shadow_maps(drift_hybrid *f)
+static void destroy_shadow_maps(drift_frame_state *f)
 {
     for (uint32_t l = 0; l < f->light_count; ++l) {
         drift_shadow_map_destroy(f->ctx, f->light_buffers[l].shadow_map);
@@ -286,11 +238,12 @@ static void destroy_shadow_maps(drift_hybrid *f)
     }
 }
 
-void drift_hybrid_destroy(drift_hybrid *f)
+void drift_hybrid_destroy(drift_hybrid *h)
 {
-    if (!f) {
+    if (!h) {
         return;
     }
+    drift_frame_state *f = &h->frame;
     drift_context *ctx = f->ctx;
     if (f->light_buffers) {
         destroy_shadow_maps(f);
@@ -304,22 +257,30 @@ void drift_hybrid_destroy(drift_hybrid *f)
     drift_isg_destroy(f);
     drift_aaf_state_destroy(ctx, f->aaf);
     drift_gbuffer_destroy(ctx, &f->gbuffer);
-    drift_image *images[] = { &f->environment_direct, &f->direct,      &f->reflection_emitted,
-                              &f->reflection_reflected, &f->reflection_distance, &f->reflections,
-                              &f->indirect,           &f->reference,   &f->coc,
-                              &f->focus,              &f->final };
+    drift_image *images[] = { &f->environment_direct,
+                              &f->direct,
+                              &f->reflection_emitted,
+                              &f->reflection_reflected,
+                              &f->reflection_distance,
+                              &f->reflections,
+                              &f->indirect,
+                              &f->reference,
+                              &f->coc,
+                              &f->focus,
+                              &f->final };
     for (size_t i = 0; i < sizeof images / sizeof *images; ++i) {
         drift_image_destroy(ctx, images[i]);
     }
-    drift_hybrid_lights_destroy(ctx, f->lights, f->light_count);
+    drift_raster_lights_destroy(ctx, f->lights, f->light_count);
     drift_free(ctx, f->light_buffers);
-    drift_free(ctx, f->planes);
     drift_free(ctx, f->counters);
-    drift_free(ctx, f);
+    drift_free(ctx, h->planes);
+    drift_free(ctx, h);
 }
 
-drift_result drift_hybrid_set_params(drift_hybrid *f, const drift_hybrid_params *params)
+drift_result drift_hybrid_set_params(drift_hybrid *h, const drift_hybrid_params *params)
 {
+    drift_frame_state *f = &h->frame;
     drift_hybrid_params p = drift_hybrid_params_resolve(params, f->scene);
     if (!params_valid(f->ctx, &p)) {
         return DRIFT_ERR_INVALID_ARGUMENT;
@@ -345,176 +306,118 @@ drift_result drift_hybrid_set_params(drift_hybrid *f, const drift_hybrid_params 
     return DRIFT_OK;
 }
 
-drift_hybrid_params drift_hybrid_get_params(const drift_hybrid *f)
+drift_hybrid_params drift_hybrid_get_params(const drift_hybrid *h)
 {
-    return f->params;
-}
-
-// --- SHARED PIECES OF THE PASSES ---
-
-typedef struct row_job {
-    drift_hybrid *frame;
-    drift_hybrid_row_fn fn;
-    void *user;
-} row_job;
-
-static void run_rows(size_t begin, size_t end, int thread_index, void *user)
-{
-    const row_job *job = user;
-    uint64_t *rays = &job->frame->counters[thread_index].rays;
-    for (size_t y = begin; y < end; ++y) {
-        job->fn(job->frame, (int32_t)y, rays, job->user);
-    }
-}
-
-uint64_t drift_hybrid_for_each_row(drift_hybrid *frame, drift_hybrid_row_fn fn, void *user)
-{
-    for (int t = 0; t < frame->thread_count; ++t) {
-        frame->counters[t].rays = 0;
-    }
-    row_job job = { frame, fn, user };
-    drift_parallel_for(frame->ctx, (size_t)frame->params.height, 1, run_rows, &job);
-    uint64_t total = 0;
-    for (int t = 0; t < frame->thread_count; ++t) {
-        total += frame->counters[t].rays;
-    }
-    return total;
-}
-
-typedef struct pixel_job {
-    drift_hybrid_pixel_fn fn;
-    void *user;
-} pixel_job;
-
-static void pixels_of_row(drift_hybrid *frame, int32_t y, uint64_t *rays, void *user)
-{
-    const pixel_job *job = user;
-    for (int32_t x = 0; x < frame->params.width; ++x) {
-        job->fn(frame, x, y, rays, job->user);
-    }
-}
-
-uint64_t drift_hybrid_for_each_pixel(drift_hybrid *frame, drift_hybrid_pixel_fn fn, void *user)
-{
-    pixel_job job = { fn, user };
-    return drift_hybrid_for_each_row(frame, pixels_of_row, &job);
-}
-
-drift_sampler drift_hybrid_sampler(const drift_hybrid *frame, uint32_t stream, int32_t x,
-                                   int32_t y)
-{
-    uint32_t pixel = (uint32_t)y * (uint32_t)frame->params.width + (uint32_t)x;
-    return drift_sampler_make(drift_hash_combine(frame->params.seed, stream), pixel, 0);
-}
-
-drift_vec3 drift_hybrid_wo(const drift_hybrid *frame, int32_t x, int32_t y)
-{
-    // The primary ray is a pinhole ray from the camera's position: toward the eye from the hit.
-    const drift_surface *s = &frame->gbuffer.surfaces[(size_t)y * (size_t)frame->params.width + (size_t)x];
-    return drift_vec3_normalize(drift_vec3_sub(frame->camera.position, s->position));
-}
-
-void drift_hybrid_copy_rgb(const drift_image *from, drift_image *to)
-{
-    for (int32_t y = 0; y < to->height; ++y) {
-        for (int32_t x = 0; x < to->width; ++x) {
-            drift_image_set3(to, x, y, drift_image_get3(from, x, y));
-        }
-    }
+    return h->frame.params;
 }
 
 // --- PLANES ---
 
-static void add_plane(drift_hybrid *f, const char *name, const drift_image *image)
+static void add_plane(void *sink, const char *name, const drift_image *image)
 {
-    DRIFT_CHECK(f->plane_count < f->plane_capacity); // sized for every plane at create
-    drift_hybrid_plane_ref *p = &f->planes[f->plane_count++];
+    drift_hybrid *h = sink;
+    if (h->plane_count == h->plane_capacity) {
+        uint32_t capacity = h->plane_capacity ? 2 * h->plane_capacity : 64;
+        plane_ref *grown =
+            drift_realloc(h->frame.ctx, h->planes, sizeof(plane_ref) * h->plane_capacity,
+                          sizeof(plane_ref) * capacity);
+        if (!grown) {
+            h->planes_out_of_memory = true;
+            return;
+        }
+        h->planes = grown;
+        h->plane_capacity = capacity;
+    }
+    plane_ref *p = &h->planes[h->plane_count++];
     snprintf(p->name, sizeof p->name, "%s", name);
     p->image = image;
 }
 
-// The planes this frame filled, in a stable order: final image first.
-static void collect_planes(drift_hybrid *f)
+// The planes of the inputs the chosen rows asked for, per light: U_l, the hard-shadow bits,
+// S_l (the order --aov has always listed them in).
+static void input_planes(drift_hybrid *h, uint32_t inputs)
 {
-    const drift_hybrid_params *p = &f->params;
-    const drift_gbuffer *g = &f->gbuffer;
-    f->plane_count = 0;
-    add_plane(f, "final", &f->final);
-    add_plane(f, "focus", &f->focus);
-    add_plane(f, "direct", &f->direct);
-    add_plane(f, "reflections", &f->reflections);
-    add_plane(f, "indirect", &f->indirect);
-    add_plane(f, "depth", &g->depth);
-    add_plane(f, "position", &g->position);
-    add_plane(f, "normal", &g->normal);
-    add_plane(f, "geometric_normal", &g->geometric_normal);
-    add_plane(f, "albedo", &g->albedo);
-    add_plane(f, "specular", &g->specular);
-    add_plane(f, "gloss", &g->gloss);
-    add_plane(f, "material_id", &g->material_id);
-    add_plane(f, "emission", &g->emission);
-    add_plane(f, "motion", &g->motion);
-    add_plane(f, "coc", &f->coc);
-    if (drift_scene_has_environment(f->scene) && p->shadows != DRIFT_SHADOWS_REFERENCE) {
-        add_plane(f, "environment_direct", &f->environment_direct);
+    const drift_frame_state *f = &h->frame;
+    if (!(inputs & DRIFT_INPUT_UNSHADOWED)) {
+        return;
     }
-    for (uint32_t l = 0; l < f->light_count && p->shadows != DRIFT_SHADOWS_REFERENCE; ++l) {
-        char name[DRIFT_HYBRID_PLANE_NAME];
+    if (drift_scene_has_environment(f->scene)) {
+        add_plane(h, "environment_direct", &f->environment_direct);
+    }
+    for (uint32_t l = 0; l < f->light_count; ++l) {
+        char name[DRIFT_FRAME_PLANE_NAME];
         snprintf(name, sizeof name, "light%u.unshadowed", l);
-        add_plane(f, name, &f->light_buffers[l].unshadowed);
-        if (p->shadows == DRIFT_SHADOWS_HARD || p->shadows == DRIFT_SHADOWS_ISG ||
-            p->shadows == DRIFT_SHADOWS_BLUR) {
+        add_plane(h, name, &f->light_buffers[l].unshadowed);
+        if (inputs & DRIFT_INPUT_HARD_SHADOWS) {
             snprintf(name, sizeof name, "light%u.hard_shadow", l);
-            add_plane(f, name, &f->light_buffers[l].hard_shadow);
+            add_plane(h, name, &f->light_buffers[l].hard_shadow);
         }
         snprintf(name, sizeof name, "light%u.shadow", l);
-        add_plane(f, name, &f->light_buffers[l].shadow);
+        add_plane(h, name, &f->light_buffers[l].shadow);
     }
-    for (uint32_t l = 0; l < f->light_count && p->shadows == DRIFT_SHADOWS_AAF && f->aaf; ++l) {
-        const char *names[3] = { "beta", "spp", "unfiltered" };
-        const drift_image *images[3] = { &f->aaf->lights[l].beta, &f->aaf->lights[l].spp,
-                                         &f->aaf->lights[l].unfiltered };
-        for (int k = 0; k < 3; ++k) {
-            char name[DRIFT_HYBRID_PLANE_NAME];
-            snprintf(name, sizeof name, "light%u.aaf.%s", l, names[k]);
-            add_plane(f, name, images[k]);
-        }
-    }
-    if (p->indirect == DRIFT_INDIRECT_AAF && f->aaf && f->aaf->indirect.beta.pixels) {
-        add_plane(f, "indirect.aaf.beta", &f->aaf->indirect.beta);
-        add_plane(f, "indirect.aaf.spp", &f->aaf->indirect.spp);
-        add_plane(f, "indirect.aaf.unfiltered", &f->aaf->indirect.unfiltered);
-    }
-    if (p->reflections == DRIFT_REFLECTIONS_AAF && f->aaf && f->aaf->specular.beta.pixels) {
-        add_plane(f, "reflections.aaf.beta", &f->aaf->specular.beta);
-        add_plane(f, "reflections.aaf.spp", &f->aaf->specular.spp);
-        add_plane(f, "reflections.aaf.unfiltered", &f->aaf->specular.unfiltered);
-    }
-    if (p->reflections == DRIFT_REFLECTIONS_SHARP || p->reflections == DRIFT_REFLECTIONS_ISG ||
-        p->reflections == DRIFT_REFLECTIONS_BLUR) {
-        add_plane(f, "reflection.emitted", &f->reflection_emitted);
-        add_plane(f, "reflection.reflected", &f->reflection_reflected);
-        add_plane(f, "reflection.distance", &f->reflection_distance);
-    }
-    drift_isg_add_planes(f, add_plane);
 }
 
-bool drift_hybrid_plane(const drift_hybrid *f, uint32_t index, const char **out_name,
+// The planes this frame filled, in a stable order: final image first, then the G-buffer,
+// the inputs, and each effect's row's own planes.
+static void collect_planes(drift_hybrid *h, uint32_t inputs)
+{
+    const drift_frame_state *f = &h->frame;
+    const drift_gbuffer *g = &f->gbuffer;
+    h->plane_count = 0;
+
+    const struct {
+        const char *name;
+        const drift_image *image;
+    } fixed[] = { { "final", &f->final },
+                  { "focus", &f->focus },
+                  { "direct", &f->direct },
+                  { "reflections", &f->reflections },
+                  { "indirect", &f->indirect },
+                  { "depth", &g->depth },
+                  { "position", &g->position },
+                  { "normal", &g->normal },
+                  { "geometric_normal", &g->geometric_normal },
+                  { "albedo", &g->albedo },
+                  { "specular", &g->specular },
+                  { "gloss", &g->gloss },
+                  { "material_id", &g->material_id },
+                  { "emission", &g->emission },
+                  { "motion", &g->motion },
+                  { "coc", &f->coc } };
+
+    for (size_t i = 0; i < sizeof fixed / sizeof *fixed; ++i) {
+        add_plane(h, fixed[i].name, fixed[i].image);
+    }
+    input_planes(h, inputs);
+    if (inputs & DRIFT_INPUT_SHARP_REFLECTIONS) {
+        add_plane(h, "reflection.emitted", &f->reflection_emitted);
+        add_plane(h, "reflection.reflected", &f->reflection_reflected);
+        add_plane(h, "reflection.distance", &f->reflection_distance);
+    }
+    for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
+        const drift_technique_row *row = drift_technique_row_chosen(&f->params, (drift_effect)e);
+        if (row->planes) {
+            row->planes(f, add_plane, h);
+        }
+    }
+}
+
+bool drift_hybrid_plane(const drift_hybrid *h, uint32_t index, const char **out_name,
                         const drift_image **out_image)
 {
-    if (index >= f->plane_count) {
+    if (index >= h->plane_count) {
         return false;
     }
-    *out_name = f->planes[index].name;
-    *out_image = f->planes[index].image;
+    *out_name = h->planes[index].name;
+    *out_image = h->planes[index].image;
     return true;
 }
 
-const drift_image *drift_hybrid_plane_named(const drift_hybrid *f, const char *name)
+const drift_image *drift_hybrid_plane_named(const drift_hybrid *h, const char *name)
 {
-    for (uint32_t i = 0; i < f->plane_count; ++i) {
-        if (strcmp(f->planes[i].name, name) == 0) {
-            return f->planes[i].image;
+    for (uint32_t i = 0; i < h->plane_count; ++i) {
+        if (strcmp(h->planes[i].name, name) == 0) {
+            return h->planes[i].image;
         }
     }
     return NULL;
@@ -522,12 +425,50 @@ const drift_image *drift_hybrid_plane_named(const drift_hybrid *f, const char *n
 
 // --- RENDER ---
 
-drift_result drift_hybrid_render(drift_hybrid *f, const drift_camera *camera,
+// The inputs rows share, each prepared once whichever rows asked for it.
+static drift_result prepare_inputs(drift_frame_state *f, uint32_t inputs)
+{
+    drift_result r = DRIFT_OK;
+    if (inputs & DRIFT_INPUT_UNSHADOWED) {
+        r = drift_realtime_pass_unshadowed(f);
+    }
+    if (r == DRIFT_OK && (inputs & DRIFT_INPUT_HARD_SHADOWS)) {
+        r = drift_realtime_pass_hard_shadows(f);
+    }
+    if (r == DRIFT_OK && (inputs & DRIFT_INPUT_SHADOW_MAPS)) {
+        r = drift_realtime_build_shadow_maps(f);
+    }
+    if (r == DRIFT_OK && (inputs & DRIFT_INPUT_SHARP_REFLECTIONS)) {
+        r = drift_realtime_pass_sharp_reflections(f);
+    }
+    if (r == DRIFT_OK && (inputs & DRIFT_INPUT_PROBES)) {
+        r = drift_realtime_capture_probes(f);
+    }
+    return r;
+}
+
+static drift_result run_row(drift_frame_state *f, const drift_technique_row *row,
+                            const atomic_bool *cancel)
+{
+    drift_pass_args args = { .effect = row->effect,
+                             .technique = row->technique,
+                             .stream = row->stream,
+                             .components = row->components,
+                             .cancel = cancel };
+    drift_result r = row->pass ? row->pass(f, &args) : DRIFT_OK;
+    if (r == DRIFT_OK && (row->flags & DRIFT_ROW_SUMS_DIRECT)) {
+        r = drift_realtime_pass_sum_direct(f);
+    }
+    return r;
+}
+
+drift_result drift_hybrid_render(drift_hybrid *h, const drift_camera *camera,
                                  const atomic_bool *cancel)
 {
-    if (!f || !camera) {
+    if (!h || !camera) {
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
+    drift_frame_state *f = &h->frame;
     double start = drift_time_now();
     f->stats = (drift_hybrid_stats){ 0 };
     f->camera = *camera;
@@ -538,44 +479,60 @@ drift_result drift_hybrid_render(drift_hybrid *f, const drift_camera *camera,
     drift_gbuffer_render(f->ctx, f->scene, f->accel, &f->camera,
                          f->has_prev_camera ? &f->prev_camera : NULL, &f->gbuffer,
                          &f->stats.rays[DRIFT_PASS_PRIMARY]);
-    f->stats.ms[DRIFT_PASS_PRIMARY] = 1000.0 * (drift_time_now() - t);
+    drift_pass_time(f, DRIFT_PASS_PRIMARY, t);
 
-    drift_result r = drift_hybrid_pass_direct(f);
+    const drift_technique_row *rows[DRIFT_EFFECT_COUNT];
+    uint32_t inputs = 0;
+    bool replaced = false; // a row renders the whole frame: path-traced terms are not needed
+    for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
+        rows[e] = drift_technique_row_chosen(&f->params, (drift_effect)e);
+        inputs |= rows[e]->inputs;
+        replaced |= (rows[e]->flags & DRIFT_ROW_REPLACES_FRAME) != 0;
+    }
+    drift_result r = prepare_inputs(f, inputs);
+    // The terms first (direct light before indirect: ambient reads D), then composition and
+    // depth of field, which turns focus into final.
+    static const drift_effect term_order[] = { DRIFT_EFFECT_SHADOWS, DRIFT_EFFECT_REFLECTIONS,
+                                               DRIFT_EFFECT_INDIRECT };
+    for (size_t i = 0; r == DRIFT_OK && i < sizeof term_order / sizeof *term_order; ++i) {
+        const drift_technique_row *row = rows[term_order[i]];
+        if (!(replaced && (row->flags & DRIFT_ROW_PATH_TRACED))) {
+            r = run_row(f, row, cancel);
+        }
+    }
+    if (r == DRIFT_OK && !replaced) {
+        r = drift_hybrid_pass_compose(f);
+    }
     if (r == DRIFT_OK) {
-        r = drift_hybrid_pass_reflections(f);
-    }
-    // AAF's path-traced terms are skipped when the lens render replaces every term.
-    bool lens_reference = f->params.dof == DRIFT_DOF_REFERENCE;
-    if (r == DRIFT_OK && f->params.reflections == DRIFT_REFLECTIONS_AAF && !lens_reference) {
-        r = drift_hybrid_pass_aaf_specular(f);
-    }
-    if (r == DRIFT_OK && f->params.indirect == DRIFT_INDIRECT_AAF && !lens_reference) {
-        r = drift_hybrid_pass_aaf_indirect(f);
-    }
-    if (r == DRIFT_OK) {
-        r = drift_hybrid_pass_reference(f, cancel);
-    }
-    if (r == DRIFT_OK) {
-        r = drift_hybrid_pass_compose(f, cancel);
+        r = run_row(f, rows[DRIFT_EFFECT_DOF], cancel);
     }
     f->prev_camera = f->camera;
     f->has_prev_camera = true;
-    collect_planes(f);
+    collect_planes(h, inputs);
+    if (r == DRIFT_OK && h->planes_out_of_memory) {
+        h->planes_out_of_memory = false;
+        r = DRIFT_ERR_OUT_OF_MEMORY;
+    }
     f->stats.frame_ms = 1000.0 * (drift_time_now() - start);
     return r;
 }
 
-const drift_image *drift_hybrid_image(const drift_hybrid *f)
+const drift_image *drift_hybrid_image(const drift_hybrid *h)
 {
-    return &f->final;
+    return &h->frame.final;
 }
 
-const drift_gbuffer *drift_hybrid_gbuffer(const drift_hybrid *f)
+const drift_gbuffer *drift_hybrid_gbuffer(const drift_hybrid *h)
 {
-    return &f->gbuffer;
+    return &h->frame.gbuffer;
 }
 
-drift_hybrid_stats drift_hybrid_get_stats(const drift_hybrid *f)
+drift_hybrid_stats drift_hybrid_get_stats(const drift_hybrid *h)
 {
-    return f->stats;
+    return h->frame.stats;
+}
+
+drift_frame_state *drift_hybrid_frame(drift_hybrid *h)
+{
+    return &h->frame;
 }

@@ -3,12 +3,12 @@
 // Monte Carlo at equal spp; full light and full shadow stay exactly 1 and 0; beta grows with
 // the receiver-to-occluder distance and n(x) peaks at contact edges; the separable filter
 // stays close to the exact 2-D filter on a smooth penumbra; the sample budget holds its mean.
+#include "aaf/aaf.h"
 #include "drift/accel.h"
 #include "drift/hybrid.h"
 #include "drift/pt.h"
 #include "drift/scene.h"
 #include "drift_test.h"
-#include "hybrid/aaf_internal.h"
 #include "test_rig.h"
 
 #include <math.h>

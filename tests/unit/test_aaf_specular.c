@@ -1,12 +1,12 @@
 // AAF's specular buffer (--reflections aaf, src/hybrid/aaf_specular.c): its R term converges
 // to the path-traced first-bounce glossy light as spp grows, and the filter width of eq. 4.4
 // with Omega_spec = 3.6 + 0.084 m (eq. 4.5) narrows as the lobe sharpens.
+#include "aaf/aaf.h"
 #include "drift/accel.h"
 #include "drift/hybrid.h"
 #include "drift/pt.h"
 #include "drift/scene.h"
 #include "drift_test.h"
-#include "hybrid/aaf_internal.h"
 #include "test_rig.h"
 
 #include <math.h>

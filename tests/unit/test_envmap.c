@@ -1,14 +1,13 @@
 // Environment map: cube-face addressing, capture and lookup against synthetic radiance
 // functions of direction (drift_envmap_capture_fn), mip levels by cone angle, and one
-// capture of a real scene through drift_hybrid_trace_radiance.
+// capture of a real scene through drift_raster_trace_radiance.
+#include "drift/accel.h"
 #include "drift_test.h"
+#include "raster/raster.h"
 
 #include <math.h>
 #include <stdatomic.h>
 #include <string.h>
-
-#include "drift/accel.h"
-#include "hybrid/hybrid_internal.h"
 
 #define HALF_PI 1.57079632679489661923
 
@@ -39,26 +38,26 @@ static drift_vec3 linear_reflected(drift_vec3 d)
     return drift_vec3_make(0.25f + 0.25f * d.z, 0.75f - 0.25f * d.x, 2.0f + d.y);
 }
 
-static drift_hybrid_radiance linear_fn(void *user, drift_ray ray, drift_sampler *sampler,
+static drift_raster_radiance linear_fn(void *user, drift_ray ray, drift_sampler *sampler,
                                        uint64_t *rays)
 {
     (void)sampler;
     check_ray(user, ray);
     *rays += 1;
-    return (drift_hybrid_radiance){ linear_emitted(ray.dir), linear_reflected(ray.dir) };
+    return (drift_raster_radiance){ linear_emitted(ray.dir), linear_reflected(ray.dir) };
 }
 
-static drift_hybrid_radiance constant_fn(void *user, drift_ray ray, drift_sampler *sampler,
+static drift_raster_radiance constant_fn(void *user, drift_ray ray, drift_sampler *sampler,
                                          uint64_t *rays)
 {
     (void)sampler;
     check_ray(user, ray);
     *rays += 1;
-    return (drift_hybrid_radiance){ { 0.3f, 0.6f, 0.9f }, { 2.0f, 1.0f, 0.5f } };
+    return (drift_raster_radiance){ { 0.3f, 0.6f, 0.9f }, { 2.0f, 1.0f, 0.5f } };
 }
 
 // Varies over a few texels' worth of angle at the sizes used here.
-static drift_hybrid_radiance wave_fn(void *user, drift_ray ray, drift_sampler *sampler,
+static drift_raster_radiance wave_fn(void *user, drift_ray ray, drift_sampler *sampler,
                                      uint64_t *rays)
 {
     (void)sampler;
@@ -66,18 +65,18 @@ static drift_hybrid_radiance wave_fn(void *user, drift_ray ray, drift_sampler *s
     *rays += 1;
     drift_vec3 d = ray.dir;
     float v = 0.5f + 0.5f * sinf(9.0f * d.x) * cosf(7.0f * d.y + 3.0f * d.z);
-    return (drift_hybrid_radiance){ drift_vec3_splat(v), drift_vec3_splat(1.0f - v) };
+    return (drift_raster_radiance){ drift_vec3_splat(v), drift_vec3_splat(1.0f - v) };
 }
 
 // The sampler's first pair as the radiance: shows which sample each texel drew.
-static drift_hybrid_radiance sampler_fn(void *user, drift_ray ray, drift_sampler *sampler,
+static drift_raster_radiance sampler_fn(void *user, drift_ray ray, drift_sampler *sampler,
                                         uint64_t *rays)
 {
     (void)user;
     (void)ray;
     *rays += 1;
     drift_vec2 u = drift_sampler_next2(sampler);
-    return (drift_hybrid_radiance){ { u.x, u.y, 0.0f }, { 0.0f, u.x, u.y } };
+    return (drift_raster_radiance){ { u.x, u.y, 0.0f }, { 0.0f, u.x, u.y } };
 }
 
 static drift_vec3 random_direction(uint32_t i)
@@ -250,7 +249,7 @@ static void test_envmap_level0_matches_the_function(void **state)
         for (int32_t j = 0; j < n; ++j) {
             for (int32_t i = 0; i < n; ++i) {
                 drift_vec3 d = drift_cube_texel_direction(n, f, i, j);
-                drift_hybrid_radiance r = drift_envmap_lookup(map, d, 0.0f);
+                drift_raster_radiance r = drift_envmap_lookup(map, d, 0.0f);
                 assert_vec3_near(r.emitted, linear_emitted(d), 1e-6, __LINE__);
                 assert_vec3_near(r.reflected, linear_reflected(d), 1e-6, __LINE__);
             }
@@ -262,7 +261,7 @@ static void test_envmap_level0_matches_the_function(void **state)
     double inner_max = 0.0, edge_max = 0.0;
     for (uint32_t k = 0; k < 4000; ++k) {
         drift_vec3 d = random_direction(k);
-        drift_hybrid_radiance r = drift_envmap_lookup(map, d, 0.0f);
+        drift_raster_radiance r = drift_envmap_lookup(map, d, 0.0f);
         drift_vec3 e = drift_vec3_sub(r.emitted, linear_emitted(d));
         drift_vec3 g = drift_vec3_sub(r.reflected, linear_reflected(d));
         double err = fmax(drift_vec3_max_component(drift_vec3_max(e, drift_vec3_neg(e))),
@@ -292,7 +291,7 @@ static void test_envmap_constant_stays_constant_at_every_cone(void **state)
     const float cones[] = { 0.0f, 0.05f, 0.2f, 0.3f, 0.7f, 1.5f, 3.2f };
     for (size_t c = 0; c < sizeof(cones) / sizeof(cones[0]); ++c) {
         for (uint32_t k = 0; k < 200; ++k) {
-            drift_hybrid_radiance r = drift_envmap_lookup(map, random_direction(k), cones[c]);
+            drift_raster_radiance r = drift_envmap_lookup(map, random_direction(k), cones[c]);
             assert_vec3_near(r.emitted, drift_vec3_make(0.3f, 0.6f, 0.9f), 1e-6, __LINE__);
             assert_vec3_near(r.reflected, drift_vec3_make(2.0f, 1.0f, 0.5f), 1e-6, __LINE__);
         }
@@ -323,13 +322,13 @@ static void test_envmap_cone_angle_selects_the_mip_level(void **state)
                 }
                 face_mean = drift_vec3_fma(face_mean, mean, 1.0f / (float)(n * n / 4));
                 drift_vec3 centre = drift_cube_texel_direction(n / 2, f, i, j);
-                drift_hybrid_radiance r =
+                drift_raster_radiance r =
                     drift_envmap_lookup(map, centre, (float)HALF_PI / (float)(n / 2));
                 assert_vec3_near(r.emitted, mean, 1e-5, __LINE__);
             }
         }
         drift_vec3 anywhere = drift_cube_texel_direction(n, f, 1, 6);
-        drift_hybrid_radiance wide = drift_envmap_lookup(map, anywhere, 2.0f);
+        drift_raster_radiance wide = drift_envmap_lookup(map, anywhere, 2.0f);
         assert_vec3_near(wide.emitted, face_mean, 1e-5, __LINE__);
     }
     drift_envmap_destroy(ctx, map);
@@ -350,9 +349,9 @@ static void test_envmap_cones_between_levels_blend_trilinearly(void **state)
     double largest_step = 0.0;
     for (uint32_t k = 0; k < 500; ++k) {
         drift_vec3 d = random_direction(k);
-        drift_hybrid_radiance a = drift_envmap_lookup(map, d, angle1);
-        drift_hybrid_radiance b = drift_envmap_lookup(map, d, angle2);
-        drift_hybrid_radiance m = drift_envmap_lookup(map, d, halfway);
+        drift_raster_radiance a = drift_envmap_lookup(map, d, angle1);
+        drift_raster_radiance b = drift_envmap_lookup(map, d, angle2);
+        drift_raster_radiance m = drift_envmap_lookup(map, d, halfway);
         assert_near(m.emitted.x, 0.5f * (a.emitted.x + b.emitted.x), 1e-5);
         assert_near(m.reflected.y, 0.5f * (a.reflected.y + b.reflected.y), 1e-5);
         largest_step = fmax(largest_step, fabs(a.emitted.x - b.emitted.x));
@@ -411,8 +410,8 @@ static void test_envmap_capture_is_deterministic_across_threads(void **state)
         for (int32_t j = 0; j < n; ++j) {
             for (int32_t i = 0; i < n; ++i) {
                 drift_vec3 d = drift_cube_texel_direction(n, f, i, j);
-                drift_hybrid_radiance ra = drift_envmap_lookup(a, d, 0.0f);
-                drift_hybrid_radiance rb = drift_envmap_lookup(b, d, 0.0f);
+                drift_raster_radiance ra = drift_envmap_lookup(a, d, 0.0f);
+                drift_raster_radiance rb = drift_envmap_lookup(b, d, 0.0f);
                 assert_memory_equal(&ra, &rb, sizeof(ra));
                 differ_between_texels |= fabsf(ra.emitted.x - first) > 1e-3f;
             }
@@ -449,7 +448,7 @@ static void test_envmap_capture_sees_the_scene(void **state)
     assert_int_equal(drift_scene_commit(scene), DRIFT_OK);
     drift_accel *accel = NULL;
     assert_int_equal(drift_accel_create(ctx, scene, &(drift_accel_desc){ 0 }, &accel), DRIFT_OK);
-    drift_hybrid_shading shading = { .scene = scene, .accel = accel, .light_samples = 16 };
+    drift_raster_shading shading = { .scene = scene, .accel = accel, .light_samples = 16 };
     const int32_t n = 8;
     const drift_vec3 probe = { 0.0f, 0.0f, 0.0f };
     drift_vec3 down = { 0.0f, -1.0f, 0.0f }, up = { 0.0f, 1.0f, 0.0f };
@@ -460,10 +459,10 @@ static void test_envmap_capture_sees_the_scene(void **state)
         drift_envmap_capture(ctx, &shading, probe, DRIFT_INVALID_INDEX, n, 3, &map, &rays),
         DRIFT_OK);
     assert_true(rays > 6u * (uint64_t)(n * n)); // camera rays plus the floor's shadow rays
-    drift_hybrid_radiance r_up = drift_envmap_lookup(map, up, 0.0f);
+    drift_raster_radiance r_up = drift_envmap_lookup(map, up, 0.0f);
     assert_vec3_near(r_up.emitted, sky, 1e-6, __LINE__);
     assert_vec3_near(r_up.reflected, drift_vec3_splat(0.0f), 0.0, __LINE__);
-    drift_hybrid_radiance r_down = drift_envmap_lookup(map, down, 2.0f); // the face's mean
+    drift_raster_radiance r_down = drift_envmap_lookup(map, down, 2.0f); // the face's mean
     assert_vec3_near(r_down.emitted, drift_vec3_splat(0.0f), 0.0, __LINE__);
     assert_vec3_near(r_down.reflected, drift_vec3_scale(sky, 0.5f), 0.01, __LINE__);
     drift_envmap_destroy(ctx, map);

@@ -7,7 +7,7 @@
 #include "drift/pt.h"
 #include "drift/scene.h"
 #include "drift_test.h"
-#include "hybrid/hybrid_internal.h"
+#include "raster/raster.h"
 #include "test_rig.h"
 
 #include <math.h>
@@ -459,9 +459,9 @@ static void test_unshadowed_quad_matches_monte_carlo(void **state)
                                            NULL),
                      DRIFT_OK);
     test_rig_commit(&r);
-    drift_hybrid_light *lights = NULL;
+    drift_raster_light *lights = NULL;
     uint32_t count = 0;
-    assert_int_equal(drift_hybrid_lights_build(r.ctx, r.scene, &lights, &count), DRIFT_OK);
+    assert_int_equal(drift_raster_lights_build(r.ctx, r.scene, &lights, &count), DRIFT_OK);
     assert_int_equal(count, 1);
 
     const struct {
@@ -482,7 +482,7 @@ static void test_unshadowed_quad_matches_monte_carlo(void **state)
         drift_vec3 wo = s.ns;
         drift_sampler sampler = drift_sampler_make(1, 0, 0);
         drift_vec3 closed =
-            drift_hybrid_unshadowed(r.scene, &lights[0], &s, &bsdf, wo, 8, &sampler);
+            drift_raster_unshadowed(r.scene, &lights[0], &s, &bsdf, wo, 8, &sampler);
         double mc = 0.0;
         const int n = 200000;
         for (int k = 0; k < n; ++k) {
@@ -501,7 +501,7 @@ static void test_unshadowed_quad_matches_monte_carlo(void **state)
             assert_near(closed.x, 0.0, 0.0);
         }
     }
-    drift_hybrid_lights_destroy(r.ctx, lights, count);
+    drift_raster_lights_destroy(r.ctx, lights, count);
     test_rig_destroy(&r);
 }
 

@@ -7,7 +7,7 @@
 #include "drift/hybrid.h"
 #include "drift/scene.h"
 #include "drift_test.h"
-#include "hybrid/isg_internal.h"
+#include "isg/isg.h"
 #include "test_rig.h"
 
 #include <math.h>

@@ -9,7 +9,7 @@
 #include "drift/scene.h"
 #include "drift/view.h"
 #include "drift_test.h"
-#include "refine/refine_internal.h"
+#include "sir/sir.h"
 #include "test_rig.h"
 
 #include <math.h>
@@ -294,7 +294,7 @@ static void test_shadow_metric_conservative(void **state)
     const drift_gbuffer *g = drift_hybrid_gbuffer(r.frame);
     const drift_image *shadow = drift_refine_metric_image(r.sir, DRIFT_METRIC_SHADOW);
     uint32_t partial = 0, flagged = 0, estimated = 0, umbra = 0, lit_unflagged = 0;
-    const drift_shadow_map *map = r.frame->light_buffers[0].shadow_map;
+    const drift_shadow_map *map = drift_hybrid_frame(r.frame)->light_buffers[0].shadow_map;
     assert_non_null(map);
     for (int32_t y = 0; y < h; ++y) {
         for (int32_t x = 0; x < w; ++x) {
@@ -490,12 +490,13 @@ static void test_hierarchical_search_matches_exhaustive(void **state)
     build_effects_scene(&r, w, h, drift_vec3_make(0.5f, 2.2f, -3.5f));
     rig_commit(&r, NULL);
     const drift_gbuffer *g = drift_hybrid_gbuffer(r.frame);
-    const drift_hybrid_light lights[2] = {
+    const drift_raster_light lights[2] = {
         { .type = DRIFT_LIGHT_SPHERE, .centre = { 0.3f, 1.8f, 0.4f }, .radius = 0.25f },
         { .type = DRIFT_LIGHT_DIRECTIONAL, .direction = { 0.3f, -1.0f, 0.2f }, .radius = 0.05f },
     };
     uint32_t ones = 0, zeros = 0, extra[2] = { 0, 0 };
-    check_hierarchical_matches(r.frame->light_buffers[0].shadow_map, g, w, h, &ones, &zeros, extra);
+    check_hierarchical_matches(drift_hybrid_frame(r.frame)->light_buffers[0].shadow_map, g, w, h,
+                               &ones, &zeros, extra);
     for (int l = 0; l < 2; ++l) {
         drift_shadow_map *map = NULL;
         drift_shadow_map_params params = { .size = 128, .bias_texels = 1.5f };

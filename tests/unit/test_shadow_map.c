@@ -5,7 +5,7 @@
 #include "drift/accel.h"
 #include "drift/scene.h"
 #include "drift_test.h"
-#include "hybrid/hybrid_internal.h"
+#include "raster/raster.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -20,7 +20,7 @@ typedef struct rig {
     drift_context *ctx;
     drift_scene *scene;
     drift_accel *accel;
-    drift_hybrid_light light;
+    drift_raster_light light;
     drift_shadow_map *map;
     uint64_t rays;
 } rig;
@@ -62,7 +62,7 @@ static uint32_t add_light(rig *r, drift_light light)
 static void set_light(rig *r, drift_light_type type, drift_vec3 centre, float radius,
                       drift_vec3 direction, bool one_sided, uint32_t index)
 {
-    r->light = (drift_hybrid_light){ .type = type,
+    r->light = (drift_raster_light){ .type = type,
                                      .centre = centre,
                                      .direction = direction,
                                      .radius = radius,
@@ -393,7 +393,7 @@ static void test_faces_behind_one_sided_light_are_skipped(void **state)
     rig_destroy(&r);
 }
 
-// An emissive ceiling quad (two triangles facing down) as drift_hybrid_lights_build makes
+// An emissive ceiling quad (two triangles facing down) as drift_raster_lights_build makes
 // it: one one-sided light over both triangles, so 5 faces, and its own triangles are no
 // occluders. One PCF tap agrees with the frame's hard-shadow ray away from edges.
 static void test_mesh_light_matches_hybrid_hard_shadow(void **state)
@@ -411,9 +411,9 @@ static void test_mesh_light_matches_hybrid_hard_shadow(void **state)
     const uint32_t idx[] = { 0, 1, 2, 0, 2, 3 }; // normal -y
     test_add_mesh(r.scene, p, 4, idx, 2, emissive);
     assert_int_equal(drift_scene_commit(r.scene), DRIFT_OK);
-    drift_hybrid_light *lights = NULL;
+    drift_raster_light *lights = NULL;
     uint32_t light_count = 0;
-    assert_int_equal(drift_hybrid_lights_build(r.ctx, r.scene, &lights, &light_count), DRIFT_OK);
+    assert_int_equal(drift_raster_lights_build(r.ctx, r.scene, &lights, &light_count), DRIFT_OK);
     assert_int_equal(light_count, 1);
     assert_int_equal(lights[0].type, DRIFT_LIGHT_TRIANGLE);
     assert_int_equal(lights[0].light_count, 2);
@@ -430,7 +430,7 @@ static void test_mesh_light_matches_hybrid_hard_shadow(void **state)
             .position = ground_point(grid_coord(k % GRID), grid_coord(k / GRID)), .ng = up, .ns = up
         };
         float occluder, distance;
-        visible[k] = drift_hybrid_hard_shadow(r.accel, &r.light, &surface, &occluder, &distance);
+        visible[k] = drift_raster_hard_shadow(r.accel, &r.light, &surface, &occluder, &distance);
     }
     int compared = 0, mismatches = 0, shadowed = 0;
     for (int j = 2; j < GRID - 2; ++j) {
@@ -452,7 +452,7 @@ static void test_mesh_light_matches_hybrid_hard_shadow(void **state)
     test_free(visible);
     assert_int_equal(mismatches, 0);
     assert_true(compared > GRID * GRID / 2 && shadowed > 10);
-    drift_hybrid_lights_destroy(r.ctx, lights, light_count);
+    drift_raster_lights_destroy(r.ctx, lights, light_count);
     rig_destroy(&r);
 }
 

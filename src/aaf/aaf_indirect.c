@@ -1,0 +1,350 @@
+// AAF indirect light (Mehta, Wang, Ramamoorthi 2013; docs/aaf.md) for one lobe of the first
+// bounce: the diffuse lobe here (--indirect aaf, the frame's I term) and the glossy lobe in
+// aaf_specular.c (--reflections aaf, R), each in its own buffers, filtered apart (sec. 4.3),
+// path-traced per pixel and filtered in world space:
+//   1. sparse: a few rays sampled from the lobe; their hit distances give z_min and z_max,
+//      which set beta (eq. 4.4, with the lobe's Omega_h^max of eq. 4.5) and n(x) (eq. 4.6);
+//   2. adaptive: the --spp budget spread in proportion to n(x), capped at aaf_max_spp;
+//   3. the separable filter on the estimate divided by the lobe's albedo (so texture is not
+//      blurred), then multiplied back by the albedo.
+// Each sample is one bounce (max_depth 2, the reference's default) or more (max_depth 3:
+// two bounces), with next-event estimation at every vertex after the first: emission that a
+// bounce ray meets is direct light, which the frame computes apart (shadows technique),
+// except along a mirror's sharp ray (aaf_specular.c), where it is R's.
+#include "aaf/aaf.h"
+
+#include <math.h>
+
+typedef struct indirect_job {
+    const drift_aaf_lobe *lobe;
+    uint32_t key;
+    uint32_t sparse;
+    float shrink;
+    bool uniform;
+    bool random;
+    int32_t bounces;
+} indirect_job;
+
+static size_t pixel_index(const drift_frame_state *f, int32_t x, int32_t y)
+{
+    return (size_t)y * (size_t)f->params.width + (size_t)x;
+}
+
+// Direct light leaving surface y toward wo: one sample of every light and of the environment,
+// each with its shadow ray.
+static drift_vec3 next_event(drift_frame_state *f, const drift_surface *y, const drift_bsdf *bsdf,
+                             drift_vec3 wo, drift_aaf_sampler *sampler, uint64_t *rays)
+{
+    drift_vec3 sum = drift_vec3_splat(0.0f);
+    uint32_t count = f->light_count + (drift_scene_has_environment(f->scene) ? 1u : 0u);
+    for (uint32_t l = 0; l < count; ++l) {
+        float pick = drift_aaf_next1(sampler);
+        drift_vec2 u = drift_aaf_next2(sampler);
+        drift_light_sample ls =
+            l < f->light_count
+                ? drift_raster_light_sample(f->scene, &f->lights[l], y->position, pick, u)
+                : drift_environment_sample(f->scene, u);
+        if (!(ls.pdf > 0.0f) || drift_vec3_is_zero(ls.radiance)) {
+            continue;
+        }
+        drift_vec3 fr = drift_bsdf_eval(bsdf, wo, ls.wi);
+        float cos_i = fabsf(drift_vec3_dot(ls.wi, y->ns));
+        drift_vec3 c = drift_vec3_scale(drift_vec3_mul(fr, ls.radiance), cos_i / ls.pdf);
+        if (drift_vec3_is_zero(c) || !drift_vec3_is_finite(c)) {
+            continue;
+        }
+        drift_ray shadow = { .origin = drift_offset_origin(y->position, y->ng, ls.wi),
+                             .dir = ls.wi,
+                             .tmin = 0.0f,
+                             .tmax =
+                                 isfinite(ls.distance) ? ls.distance * (1.0f - 1e-4f) : INFINITY };
+        ++*rays;
+        if (!drift_accel_occluded(f->accel, &shadow)) {
+            sum = drift_vec3_add(sum, c);
+        }
+    }
+    return sum;
+}
+
+// Radiance arriving at the pixel's surface along one direction sampled from the lobe, times
+// the sample's weight over the albedo. *out_distance: the first hit, INFINITY for none.
+static drift_vec3 trace_path(drift_frame_state *f, const indirect_job *job, const drift_surface *s,
+                             const drift_bsdf *first, drift_vec3 wo, drift_aaf_sampler *sampler,
+                             float *out_distance, uint64_t *rays)
+{
+    *out_distance = INFINITY;
+    drift_vec3 total = drift_vec3_splat(0.0f);
+    drift_vec3 dir;
+    float weight;
+    bool emission;
+    job->lobe->sample(first, wo, drift_aaf_next2(sampler), &dir, &weight, &emission);
+    if (!(weight > 0.0f) || !(drift_vec3_dot(dir, s->ng) > 0.0f)) {
+        return total; // below the geometric surface: no light arrives this way
+    }
+    drift_ray ray = { .origin = drift_offset_origin(s->position, s->ng, dir),
+                      .dir = dir,
+                      .tmin = 0.0f,
+                      .tmax = INFINITY };
+    drift_vec3 throughput = drift_vec3_splat(weight);
+    for (int32_t bounce = 0; bounce < job->bounces; ++bounce) {
+        drift_hit hit;
+        ++*rays;
+        bool seen = bounce == 0 && emission;
+        if (!drift_accel_intersect(f->accel, &ray, &hit)) {
+            // The environment seen by a bounce ray is direct light (or was NEE's), but a
+            // mirror's.
+            if (seen && drift_scene_has_environment(f->scene)) {
+                total = drift_vec3_mul(throughput, drift_environment_eval(f->scene, ray.dir));
+            }
+            break;
+        }
+        if (bounce == 0) {
+            *out_distance = hit.t;
+        }
+        drift_surface y = drift_scene_surface(f->scene, &ray, &hit);
+        if (seen) {
+            total = drift_vec3_add(total, drift_vec3_mul(throughput, y.emission));
+        }
+        if (y.material == DRIFT_INVALID_INDEX) {
+            break; // a light's shape: its emission is counted by next-event estimation
+        }
+        drift_bsdf bsdf = drift_bsdf_make(f->scene, &y);
+        drift_vec3 wo_y = drift_vec3_neg(ray.dir);
+        total = drift_vec3_add(
+            total, drift_vec3_mul(throughput, next_event(f, &y, &bsdf, wo_y, sampler, rays)));
+        if (bounce + 1 == job->bounces) {
+            break;
+        }
+        float u_lobe = drift_aaf_next1(sampler);
+        drift_bsdf_sample bs = drift_bsdf_sample_wi(&bsdf, wo_y, u_lobe, drift_aaf_next2(sampler));
+        if (!(bs.pdf > 0.0f) || bs.is_delta) {
+            break; // after a mirror only emission would follow; NEE has none to add
+        }
+        throughput = drift_vec3_mul(throughput, bs.weight);
+        ray = (drift_ray){ .origin = drift_offset_origin(y.position, y.ng, bs.wi),
+                           .dir = bs.wi,
+                           .tmin = 0.0f,
+                           .tmax = INFINITY };
+    }
+    return drift_vec3_is_finite(total) ? total : drift_vec3_splat(0.0f);
+}
+
+// Running sums a pixel keeps between the passes, in state->aux and the lobe's radiance.
+typedef struct indirect_sums {
+    float z_min, z_max, count, has_lobe;
+} indirect_sums;
+
+// Whether the pixel has the job's lobe, with its albedo and Omega_h^max.
+static bool lobe_at(const drift_frame_state *f, const indirect_job *job, int32_t x, int32_t y,
+                    drift_vec3 *albedo, float *omega)
+{
+    const drift_surface *s = &f->gbuffer.surfaces[pixel_index(f, x, y)];
+    if (s->material == DRIFT_INVALID_INDEX) {
+        return false;
+    }
+    drift_bsdf bsdf = drift_bsdf_make(f->scene, s);
+    return job->lobe->at(&bsdf, drift_pass_wo(f, x, y), albedo, omega);
+}
+
+static void add_samples(drift_frame_state *f, const indirect_job *job, int32_t x, int32_t y,
+                        uint32_t first, uint32_t end, uint64_t *rays)
+{
+    size_t i = pixel_index(f, x, y);
+    const drift_surface *s = &f->gbuffer.surfaces[i];
+    drift_bsdf bsdf = drift_bsdf_make(f->scene, s);
+    drift_vec3 wo = drift_pass_wo(f, x, y);
+    indirect_sums *sums = (indirect_sums *)&f->aaf->aux[DRIFT_AAF_AUX * i];
+    float *radiance = drift_image_pixel(&job->lobe->buffers->radiance, x, y);
+    drift_vec3 sum =
+        drift_vec3_scale(drift_vec3_make(radiance[0], radiance[1], radiance[2]), sums->count);
+    for (uint32_t k = first; k < end; ++k) {
+        drift_aaf_sampler sampler = drift_aaf_sampler_make(job->key, (uint32_t)i, k, job->random);
+        float distance;
+        sum = drift_vec3_add(sum, trace_path(f, job, s, &bsdf, wo, &sampler, &distance, rays));
+        if (isfinite(distance)) {
+            sums->z_min = fminf(sums->z_min, distance);
+            sums->z_max = fmaxf(sums->z_max, distance);
+        }
+    }
+    sums->count = (float)end;
+    drift_vec3 mean = end > 0 ? drift_vec3_scale(sum, 1.0f / (float)end) : sum;
+    radiance[0] = mean.x;
+    radiance[1] = mean.y;
+    radiance[2] = mean.z;
+}
+
+float drift_aaf_indirect_beta(float z_min, float footprint, float omega, float pixel_width)
+{
+    return fmaxf(2.0f * z_min / omega, pixel_width * footprint);
+}
+
+float drift_aaf_omega_specular(float phong_exponent)
+{
+    return 3.6f + 0.084f * (4.0f * phong_exponent);
+}
+
+static void sparse_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
+{
+    const indirect_job *job = user;
+    drift_aaf_state *st = f->aaf;
+    drift_aaf_lobe_buffers *b = job->lobe->buffers;
+    size_t i = pixel_index(f, x, y);
+    indirect_sums *sums = (indirect_sums *)&st->aux[DRIFT_AAF_AUX * i];
+    *sums = (indirect_sums){ INFINITY, 0.0f, 0.0f, 0.0f };
+    drift_image_set3(&b->radiance, x, y, drift_vec3_splat(0.0f));
+    drift_image_pixel(&b->beta, x, y)[0] = 0.0f;
+    st->want[i] = 0.0f;
+    drift_vec3 albedo;
+    float omega;
+    if (!lobe_at(f, job, x, y, &albedo, &omega)) {
+        return;
+    }
+    sums->has_lobe = 1.0f;
+    add_samples(f, job, x, y, 0, job->uniform ? f->params.spp : job->sparse, rays);
+    if (!isfinite(sums->z_min) || !(omega > 0.0f)) {
+        return; // open to the sky, or a mirror: nothing to filter
+    }
+    float z_min = fmaxf(sums->z_min, 1e-4f), z_max = fmaxf(sums->z_max, z_min);
+    float d = drift_image_pixel(&st->footprint, x, y)[0];
+    drift_image_pixel(&b->beta, x, y)[0] =
+        drift_aaf_indirect_beta(z_min, d, omega, job->lobe->pixel_width) * job->shrink;
+    // eq. 4.6 with sqrt(A_p) = d.
+    float a = 0.9f * omega * d / z_min + 0.3f;
+    float c = 1.0f + 0.9f * z_max / z_min;
+    st->want[i] = fmaxf(0.4f * a * a * omega * omega * c * c, 1e-3f);
+}
+
+static void adaptive_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
+{
+    const indirect_job *job = user;
+    drift_aaf_state *st = f->aaf;
+    size_t i = pixel_index(f, x, y);
+    // The sparse pass recorded whether the pixel has the lobe.
+    bool has = ((const indirect_sums *)&st->aux[DRIFT_AAF_AUX * i])->has_lobe > 0.0f;
+    uint32_t taken = job->uniform ? f->params.spp : job->sparse;
+    uint32_t n = job->uniform ? taken : st->counts[i];
+    if (has && n > taken) {
+        add_samples(f, job, x, y, taken, n, rays);
+    }
+    drift_image_pixel(&job->lobe->buffers->spp, x, y)[0] =
+        has ? (float)(n > taken ? n : taken) : 0.0f;
+}
+
+static void modulate_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
+{
+    (void)rays;
+    const indirect_job *job = user;
+    drift_aaf_lobe_buffers *b = job->lobe->buffers;
+    drift_vec3 albedo;
+    float omega;
+    if (!lobe_at(f, job, x, y, &albedo, &omega)) {
+        albedo = drift_vec3_splat(0.0f);
+    }
+    drift_image_set3(&b->unfiltered, x, y,
+                     drift_vec3_mul(albedo, drift_image_get3(&b->radiance, x, y)));
+    drift_image_set3(job->lobe->out, x, y,
+                     drift_vec3_mul(albedo, drift_image_get3(&b->filtered, x, y)));
+}
+
+drift_result drift_aaf_lobe_pass(drift_frame_state *f, const drift_aaf_lobe *lobe)
+{
+    drift_result r = drift_aaf_prepare(f, NULL);
+    if (r == DRIFT_OK) {
+        r = drift_aaf_lobe_buffers_ensure(f->ctx, lobe->buffers, f->params.width, f->params.height);
+    }
+    if (r != DRIFT_OK) {
+        return r;
+    }
+    drift_aaf_state *st = f->aaf;
+    drift_aaf_lobe_buffers *b = lobe->buffers;
+    drift_hybrid_stats *stats = &f->stats;
+    size_t pixels = (size_t)f->params.width * (size_t)f->params.height;
+    indirect_job job = { .lobe = lobe,
+                         .key = drift_hash_combine(f->params.seed, lobe->stream),
+                         .sparse = drift_aaf_sparse_count(f->params.spp),
+                         .shrink = drift_aaf_beta_shrink(f->params.spp, lobe->shrink_from_spp,
+                                                         lobe->shrink_exponent),
+                         .uniform = f->params.aaf_uniform,
+                         .random = f->params.aaf_random,
+                         .bounces = f->params.max_depth - 1 };
+    double t = drift_time_now();
+    if (job.bounces > 0) {
+        stats->rays[DRIFT_PASS_AAF_SAMPLING] += drift_pass_for_each_pixel(f, sparse_pixel, &job);
+        // The average --spp is over the pixels that have the lobe: a glossy floor in a diffuse
+        // room must not receive the budget of every diffuse pixel.
+        size_t active = 0;
+        for (size_t i = 0; i < pixels; ++i) {
+            active += ((const indirect_sums *)&st->aux[DRIFT_AAF_AUX * i])->has_lobe > 0.0f;
+        }
+        if (!job.uniform) {
+            drift_aaf_allocate(st->want, pixels, active, job.sparse, f->params.spp,
+                               f->params.aaf_max_spp, job.key, st->counts);
+        }
+        stats->rays[DRIFT_PASS_AAF_SAMPLING] += drift_pass_for_each_pixel(f, adaptive_pixel, &job);
+    } else {
+        for (int32_t y = 0; y < f->params.height; ++y) {
+            for (int32_t x = 0; x < f->params.width; ++x) {
+                drift_image_set3(&b->radiance, x, y, drift_vec3_splat(0.0f));
+                drift_image_pixel(&b->beta, x, y)[0] = 0.0f;
+                drift_image_pixel(&b->spp, x, y)[0] = 0.0f;
+            }
+        }
+    }
+    stats->ms[DRIFT_PASS_AAF_SAMPLING] += 1000.0 * (drift_time_now() - t);
+
+    t = drift_time_now();
+    if (f->params.aaf_unfiltered) {
+        drift_pass_copy_rgb(&b->radiance, &b->filtered);
+    } else {
+        drift_aaf_filter_desc desc = { .beta = &b->beta,
+                                       .footprint = &st->footprint,
+                                       .gbuffer = &f->gbuffer,
+                                       .max_radius = DRIFT_AAF_MAX_RADIUS,
+                                       .workspace = st->filter_workspace };
+        r = drift_aaf_filter_separable(f->ctx, &desc, &b->radiance, &st->scratch3, &b->filtered);
+        if (r != DRIFT_OK) {
+            return r;
+        }
+    }
+    drift_pass_for_each_pixel(f, modulate_pixel, &job);
+    stats->ms[DRIFT_PASS_AAF_FILTER] += 1000.0 * (drift_time_now() - t);
+    return DRIFT_OK;
+}
+
+// --- THE DIFFUSE LOBE (--indirect aaf) ---
+
+static bool diffuse_at(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec3 *albedo, float *omega)
+{
+    (void)wo;
+    *albedo = bsdf->diffuse;
+    *omega = DRIFT_AAF_OMEGA_DIFFUSE;
+    return !drift_bsdf_is_delta(bsdf) && !drift_vec3_is_zero(bsdf->diffuse);
+}
+
+// Cosine-weighted: f cos / (pdf albedo) = 1.
+static void diffuse_sample(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec2 u, drift_vec3 *wi,
+                           float *weight, bool *emission)
+{
+    (void)wo;
+    *wi = drift_frame_to_world(&bsdf->frame, drift_sample_cosine_hemisphere(u));
+    *weight = 1.0f;
+    *emission = false;
+}
+
+drift_result drift_aaf_pass_indirect(drift_frame_state *f, const drift_pass_args *args)
+{
+    (void)args;
+    drift_result r = drift_aaf_state_ensure(f);
+    if (r != DRIFT_OK) {
+        return r;
+    }
+    drift_aaf_lobe lobe = { .stream = DRIFT_STREAM_AAF_INDIRECT,
+                            .buffers = &f->aaf->indirect,
+                            .out = &f->indirect,
+                            .shrink_from_spp = DRIFT_AAF_INDIRECT_SHRINK_SPP,
+                            .shrink_exponent = DRIFT_AAF_INDIRECT_SHRINK_EXP,
+                            .pixel_width = 1.0f / 0.15f,
+                            .at = diffuse_at,
+                            .sample = diffuse_sample };
+    return drift_aaf_lobe_pass(f, &lobe);
+}

@@ -1,0 +1,159 @@
+// AAF's per-frame buffers: made the first time a frame uses AAF (most frames never do), kept
+// until the frame is destroyed; an indirect lobe's only when that lobe first runs.
+#include "aaf/aaf.h"
+
+#include <stdio.h>
+
+void drift_aaf_state_destroy(drift_context *ctx, drift_aaf_state *s)
+{
+    if (!s) {
+        return;
+    }
+    for (uint32_t l = 0; s->lights && l < s->light_count; ++l) {
+        drift_image_destroy(ctx, &s->lights[l].beta);
+        drift_image_destroy(ctx, &s->lights[l].spp);
+        drift_image_destroy(ctx, &s->lights[l].unfiltered);
+    }
+    drift_image *images[] = { &s->footprint,
+                              &s->scratch1,
+                              &s->scratch3,
+                              &s->indirect.beta,
+                              &s->indirect.spp,
+                              &s->indirect.unfiltered,
+                              &s->indirect.radiance,
+                              &s->indirect.filtered,
+                              &s->specular.beta,
+                              &s->specular.spp,
+                              &s->specular.unfiltered,
+                              &s->specular.radiance,
+                              &s->specular.filtered };
+    for (size_t i = 0; i < sizeof images / sizeof *images; ++i) {
+        drift_image_destroy(ctx, images[i]);
+    }
+    drift_free(ctx, s->lights);
+    drift_free(ctx, s->want);
+    drift_free(ctx, s->counts);
+    drift_free(ctx, s->aux);
+    drift_free(ctx, s->filter_workspace);
+    drift_free(ctx, s);
+}
+
+drift_result drift_aaf_state_ensure(drift_frame_state *f)
+{
+    if (f->aaf) {
+        return DRIFT_OK;
+    }
+    drift_context *ctx = f->ctx;
+    int32_t w = f->params.width, h = f->params.height;
+    size_t pixels = (size_t)w * (size_t)h;
+    drift_aaf_state *s = drift_alloc(ctx, sizeof *s);
+    if (!s) {
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    s->width = w;
+    s->height = h;
+    s->light_count = f->light_count;
+    s->lights = drift_alloc(ctx, sizeof(drift_aaf_light) * (f->light_count + 1u));
+    s->want = drift_alloc(ctx, sizeof(float) * pixels);
+    s->counts = drift_alloc(ctx, sizeof(uint32_t) * pixels);
+    s->aux = drift_alloc(ctx, sizeof(float) * DRIFT_AAF_AUX * pixels);
+    s->filter_workspace = drift_alloc(ctx, drift_aaf_filter_workspace_bytes(w, h));
+    drift_result r = s->lights && s->want && s->counts && s->aux && s->filter_workspace
+                         ? DRIFT_OK
+                         : DRIFT_ERR_OUT_OF_MEMORY;
+    drift_image *ones[] = { &s->footprint, &s->scratch1 };
+    drift_image *threes[] = { &s->scratch3 };
+    for (size_t i = 0; r == DRIFT_OK && i < sizeof ones / sizeof *ones; ++i) {
+        r = drift_image_create(ctx, w, h, 1, ones[i]);
+    }
+    for (size_t i = 0; r == DRIFT_OK && i < sizeof threes / sizeof *threes; ++i) {
+        r = drift_image_create(ctx, w, h, 3, threes[i]);
+    }
+    for (uint32_t l = 0; r == DRIFT_OK && l < f->light_count; ++l) {
+        r = drift_image_create(ctx, w, h, 1, &s->lights[l].beta);
+        if (r == DRIFT_OK) {
+            r = drift_image_create(ctx, w, h, 1, &s->lights[l].spp);
+        }
+        if (r == DRIFT_OK) {
+            r = drift_image_create(ctx, w, h, 1, &s->lights[l].unfiltered);
+        }
+    }
+    if (r != DRIFT_OK) {
+        drift_aaf_state_destroy(ctx, s);
+        return r;
+    }
+    f->aaf = s;
+    return DRIFT_OK;
+}
+
+drift_result drift_aaf_lobe_buffers_ensure(drift_context *ctx, drift_aaf_lobe_buffers *b,
+                                           int32_t width, int32_t height)
+{
+    if (b->beta.pixels) {
+        return DRIFT_OK;
+    }
+    drift_image *ones[] = { &b->beta, &b->spp };
+    drift_image *threes[] = { &b->unfiltered, &b->radiance, &b->filtered };
+    drift_result r = DRIFT_OK;
+    for (size_t i = 0; r == DRIFT_OK && i < sizeof threes / sizeof *threes; ++i) {
+        r = drift_image_create(ctx, width, height, 3, threes[i]);
+    }
+    // beta last: its pixels say the set is complete.
+    for (size_t i = sizeof ones / sizeof *ones; r == DRIFT_OK && i-- > 0;) {
+        r = drift_image_create(ctx, width, height, 1, ones[i]);
+    }
+    if (r != DRIFT_OK) {
+        for (size_t i = 0; i < sizeof threes / sizeof *threes; ++i) {
+            drift_image_destroy(ctx, threes[i]);
+        }
+        for (size_t i = 0; i < sizeof ones / sizeof *ones; ++i) {
+            drift_image_destroy(ctx, ones[i]);
+        }
+    }
+    return r;
+}
+
+// --- PLANES ---
+
+static void lobe_planes(const drift_aaf_lobe_buffers *b, const char *lobe, drift_pass_plane_fn add,
+                        void *sink)
+{
+    if (!b->beta.pixels) {
+        return; // the lobe has not run
+    }
+    const char *names[3] = { "beta", "spp", "unfiltered" };
+    const drift_image *images[3] = { &b->beta, &b->spp, &b->unfiltered };
+    for (int k = 0; k < 3; ++k) {
+        char name[DRIFT_FRAME_PLANE_NAME];
+        snprintf(name, sizeof name, "%s.aaf.%s", lobe, names[k]);
+        add(sink, name, images[k]);
+    }
+}
+
+void drift_aaf_shadow_planes(const drift_frame_state *f, drift_pass_plane_fn add, void *sink)
+{
+    for (uint32_t l = 0; f->aaf && l < f->light_count; ++l) {
+        const char *names[3] = { "beta", "spp", "unfiltered" };
+        const drift_image *images[3] = { &f->aaf->lights[l].beta, &f->aaf->lights[l].spp,
+                                         &f->aaf->lights[l].unfiltered };
+        for (int k = 0; k < 3; ++k) {
+            char name[DRIFT_FRAME_PLANE_NAME];
+            snprintf(name, sizeof name, "light%u.aaf.%s", l, names[k]);
+            add(sink, name, images[k]);
+        }
+    }
+}
+
+void drift_aaf_indirect_planes(const drift_frame_state *f, drift_pass_plane_fn add, void *sink)
+{
+    if (f->aaf) {
+        lobe_planes(&f->aaf->indirect, "indirect", add, sink);
+    }
+}
+
+void drift_aaf_specular_planes(const drift_frame_state *f, drift_pass_plane_fn add, void *sink)
+{
+    if (f->aaf) {
+        lobe_planes(&f->aaf->specular, "reflections", add, sink);
+    }
+}

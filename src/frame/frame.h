@@ -1,0 +1,165 @@
+// The frame's buffers: everything the passes of the hybrid frame read and write, and the
+// helpers every pass shares (rows and pixels in parallel, per-pixel samplers, the outgoing
+// direction, path-traced components). This layer sits below every technique folder
+// (src/realtime, src/isg, src/aaf, ...) and above the raster primitives (src/raster): a
+// pass includes this header and its own folder's, never the conductor (src/hybrid), which
+// owns the frame's lifecycle, the technique table and the pass order.
+#ifndef DRIFT_FRAME_H
+#define DRIFT_FRAME_H
+
+#include "drift/pt.h"
+#include "raster/raster.h"
+
+// --- SAMPLER STREAMS ---
+
+// One list of the stream ids the passes key their per-pixel random numbers on, so that two
+// passes never draw the same numbers for a pixel (tests/unit/test_hybrid.c checks that they
+// differ). The values are those the passes used before the list (images stay as they were).
+typedef enum drift_stream {
+    DRIFT_STREAM_UNSHADOWED = 1,       // U_l's Hammersley rotation (realtime/direct.c)
+    DRIFT_STREAM_PCSS = 2,             // PCSS tap rotation (realtime/direct.c)
+    DRIFT_STREAM_REFLECTION = 3,       // the sharp mirror ray's shading (realtime/reflections.c)
+    DRIFT_STREAM_PROBE = 4,            // environment-map capture (realtime/reflections.c)
+    DRIFT_STREAM_ISG_SHADOWS = 11,     // isg/isg_shadows.c
+    DRIFT_STREAM_ISG_REFLECTIONS = 12, // isg/isg_reflections.c
+    DRIFT_STREAM_ISG_DOF = 13,         // isg/isg_dof.c
+    DRIFT_STREAM_ISG_LAYER = 14,       // isg/isg_layers.c
+    DRIFT_STREAM_SIR_AO = 0x5150,      // SIR's ambient-occlusion metric (sir/metrics.c)
+    DRIFT_STREAM_SIR_TRACE = 0x51f0,   // SIR's ray tracer (sir/raytrace.c)
+    DRIFT_STREAM_AAF_SHADOWS = 0x5aaf0001,  // + light index (aaf/aaf_shadows.c)
+    DRIFT_STREAM_AAF_INDIRECT = 0x5aaf1000, // aaf/aaf_indirect.c
+    DRIFT_STREAM_AAF_SPECULAR = 0x5aaf2000, // aaf/aaf_specular.c
+} drift_stream;
+
+// --- THE FRAME'S BUFFERS ---
+
+// Per-thread ray counter, padded so threads do not share a cache line.
+typedef struct drift_ray_counter {
+    uint64_t rays;
+    uint8_t padding[56];
+} drift_ray_counter;
+
+// Per-light image-space buffers.
+typedef struct drift_frame_light_buffers {
+    drift_image unshadowed;  // 3: U_l
+    drift_image hard_shadow; // 3: visible (0/1), occluder distance (INFINITY: none), light distance
+    drift_image shadow;      // 1: S_l of the chosen technique
+    drift_shadow_map *shadow_map; // built on first use, kept while the scene stands
+} drift_frame_light_buffers;
+
+// An environment probe: one for the whole scene, or one per reflective mesh.
+typedef struct drift_frame_probe {
+    uint32_t mesh; // DRIFT_INVALID_INDEX for the scene probe
+    drift_envmap *map;
+} drift_frame_probe;
+
+typedef struct drift_frame_state {
+    drift_context *ctx;
+    const drift_scene *scene;
+    const drift_accel *accel;
+    drift_hybrid_params params;
+    drift_camera camera, prev_camera;
+    bool has_prev_camera;
+
+    drift_raster_light *lights;
+    uint32_t light_count;
+    drift_frame_light_buffers *light_buffers;
+    drift_raster_shading shading;
+
+    drift_gbuffer gbuffer;
+    drift_image environment_direct;   // 3: direct light from the environment (ray-traced)
+    drift_image direct;               // 3: D = sum_l U_l S_l + environment
+    drift_image reflection_emitted;   // 3: sharp mirror ray, emitted radiance at its hit
+    drift_image reflection_reflected; // 3: ... direct light with hard shadows at its hit
+    drift_image reflection_distance;  // 1: hit distance (INFINITY: miss)
+    drift_image reflections;          // 3: R
+    drift_image indirect;             // 3: I
+    drift_image reference;            // 3: scratch copy of the last reference pass
+    drift_image coc;                  // 1: circle-of-confusion radius, pixels
+    drift_image focus;                // 3: the composed in-focus frame
+    drift_image final;                // 3: after depth of field
+
+    drift_frame_probe *probes;
+    uint32_t probe_count;
+
+    drift_ray_counter *counters; // one per thread
+    int thread_count;
+    drift_hybrid_stats stats;
+    // Technique state, made by each technique on first use and freed by the conductor through
+    // the technique's destroy function (opaque here: this layer knows no technique).
+    struct drift_isg_state *isg; // image space gathering's buffers (isg/isg.h)
+    struct drift_aaf_state *aaf; // AAF's buffers (aaf/aaf.h)
+} drift_frame_state;
+
+// --- PASSES ---
+
+// What the conductor hands a technique's pass besides the frame: which row runs (effect and
+// technique), that row's sampler stream and path-traced components (the table's columns),
+// and the flag that cancels a long pass (may be NULL; path-traced passes poll it).
+typedef struct drift_pass_args {
+    drift_effect effect;
+    int technique;
+    uint32_t stream;
+    uint32_t components;
+    const atomic_bool *cancel;
+} drift_pass_args;
+
+// A technique's pass: fills its effect's term (S_l, R, I, or final for depth of field).
+// Returns DRIFT_OK or an error it has logged.
+typedef drift_result (*drift_pass_fn)(drift_frame_state *frame, const drift_pass_args *args);
+
+// Where a row lists its --aov planes: add(sink, name, image) once a plane.
+typedef void (*drift_pass_plane_fn)(void *sink, const char *name, const drift_image *image);
+#define DRIFT_FRAME_PLANE_NAME 48 // the longest plane name, with its terminator
+typedef void (*drift_pass_planes_fn)(const drift_frame_state *frame, drift_pass_plane_fn add,
+                                     void *sink);
+
+// Inputs a row needs, prepared by the conductor before any row's pass (each at most once a
+// frame, whichever rows ask): the table's `inputs` column.
+enum {
+    DRIFT_INPUT_UNSHADOWED = 1u << 0,        // U_l per light and the environment term
+    DRIFT_INPUT_HARD_SHADOWS = 1u << 1,      // the hard-shadow buffer (S_l = its bits)
+    DRIFT_INPUT_SHADOW_MAPS = 1u << 2,       // a shadow map per light (cached)
+    DRIFT_INPUT_SHARP_REFLECTIONS = 1u << 3, // one mirror ray a pixel (R = its light)
+    DRIFT_INPUT_PROBES = 1u << 4,            // the environment-map probes (cached)
+};
+
+// How the conductor treats a row: the table's `flags` column.
+enum {
+    DRIFT_ROW_NO_TERM = 1u << 0,        // the effect adds nothing to the frame
+    DRIFT_ROW_SUMS_DIRECT = 1u << 1,    // the pass writes S_l; the conductor sums D after it
+    DRIFT_ROW_PATH_TRACED = 1u << 2,    // skipped when a row replaces the frame
+    DRIFT_ROW_REPLACES_FRAME = 1u << 3, // the pass renders `final` whole (the lens reference)
+};
+
+// Runs fn for every row, or every pixel, rows in parallel. `rays` is the calling thread's ray
+// counter. Both return the rays the pass counted.
+typedef void (*drift_pass_row_fn)(drift_frame_state *frame, int32_t y, uint64_t *rays, void *user);
+typedef void (*drift_pass_pixel_fn)(drift_frame_state *frame, int32_t x, int32_t y, uint64_t *rays,
+                                    void *user);
+uint64_t drift_pass_for_each_row(drift_frame_state *frame, drift_pass_row_fn fn, void *user);
+uint64_t drift_pass_for_each_pixel(drift_frame_state *frame, drift_pass_pixel_fn fn, void *user);
+
+// Times a pass: adds the milliseconds since `start` (drift_time_now) to the pass's entry.
+static inline void drift_pass_time(drift_frame_state *frame, drift_hybrid_pass pass, double start)
+{
+    frame->stats.ms[pass] += 1000.0 * (drift_time_now() - start);
+}
+
+// Renders `components` of the pt (DRIFT_PT_COMPONENT_*) at the frame's spp through the pixel
+// centres, pinhole unless `lens`, into the RGB image `out`.
+drift_result drift_pass_reference_render(drift_frame_state *frame, uint32_t components,
+                                         int32_t max_depth, bool lens, const atomic_bool *cancel,
+                                         drift_image *out);
+
+// Copies the RGB channels of `from` into `to` (same size).
+void drift_pass_copy_rgb(const drift_image *from, drift_image *to);
+
+// A per-pixel sampler keyed on the frame's seed and a pass-specific stream.
+drift_sampler drift_pass_sampler(const drift_frame_state *frame, uint32_t stream, int32_t x,
+                                 int32_t y);
+
+// Outgoing direction at the pixel's surface (toward the camera); pixels with a hit only.
+drift_vec3 drift_pass_wo(const drift_frame_state *frame, int32_t x, int32_t y);
+
+#endif // DRIFT_FRAME_H

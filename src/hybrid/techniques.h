@@ -1,0 +1,42 @@
+// The conductor's view of the technique table (drift/techniques.h): a row per (effect,
+// technique) with its pass, the inputs it needs, how its output is treated, its planes,
+// sampler stream and reference components. frame.c runs the chosen row of every effect;
+// nothing else in the conductor names a technique.
+#ifndef DRIFT_HYBRID_TECHNIQUES_H
+#define DRIFT_HYBRID_TECHNIQUES_H
+
+#include "frame/frame.h"
+
+typedef struct drift_technique_row {
+    drift_effect effect;
+    int technique;
+    const char *name;
+    const char *summary;
+    drift_pass_fn pass;          // NULL: the inputs already are the term
+    uint32_t inputs;             // DRIFT_INPUT_*
+    uint32_t flags;              // DRIFT_ROW_*
+    drift_pass_planes_fn planes; // NULL: no planes of its own
+    uint32_t stream;
+    uint32_t components;
+} drift_technique_row;
+
+// The row of `technique` in `effect`, or NULL when either is out of range.
+const drift_technique_row *drift_technique_row_of(drift_effect effect, int technique);
+// The row the frame's parameters choose for `effect`.
+const drift_technique_row *drift_technique_row_chosen(const drift_hybrid_params *params,
+                                                      drift_effect effect);
+
+// --- THE CONDUCTOR'S OWN PASSES ---
+
+// reference.c: the effect's term alone, path-traced at the frame's spp with the row's
+// components (shadows -> D at depth 1, reflections -> R and indirect -> I at max_depth).
+drift_result drift_hybrid_pass_reference(drift_frame_state *frame, const drift_pass_args *args);
+// compose.c: focus = E + D + R + I (terms of NO_TERM rows left out), and the coc plane.
+drift_result drift_hybrid_pass_compose(drift_frame_state *frame);
+// compose.c: the depth-of-field rows the conductor owns: final = focus (pinhole), and the
+// whole frame path-traced through the lens with every enabled term.
+drift_result drift_hybrid_pass_pinhole(drift_frame_state *frame, const drift_pass_args *args);
+drift_result drift_hybrid_pass_lens_reference(drift_frame_state *frame,
+                                              const drift_pass_args *args);
+
+#endif // DRIFT_HYBRID_TECHNIQUES_H

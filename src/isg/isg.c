@@ -1,0 +1,217 @@
+// Image space gathering's building block, the point-sampled cross-bilateral filter of eq. 4
+// (the same samples in numerator and denominator, the centre included: consistent, not
+// unbiased), and the frame's ISG state: parameters, buffers, sample patterns and planes.
+// Each effect runs it twice, a parameter search and then a gather (isg_shadows.c,
+// isg_reflections.c, isg_dof.c).
+#include "isg/isg.h"
+
+#include <math.h>
+#include <stdio.h>
+
+// --- THE FILTER ---
+
+static inline int32_t nearest(float v)
+{
+    return (int32_t)floorf(v + 0.5f);
+}
+
+float drift_isg_filter(const drift_isg_kernel *k, const drift_image *image, int32_t first,
+                       int32_t channels, int32_t x, int32_t y, float *out)
+{
+    const float *centre = drift_image_pixel(image, x, y) + first;
+    float ref[4], sum[4] = { 0.0f, 0.0f, 0.0f, 0.0f };
+    for (int32_t c = 0; c < channels; ++c) {
+        ref[c] = isfinite(centre[c]) ? centre[c] : 0.0f;
+    }
+    float weight_sum = 0.0f;
+    uint32_t n = k->pattern->count;
+    for (uint32_t i = 0; i <= n; ++i) {
+        int32_t sx = x, sy = y;
+        if (i > 0) { // i = 0 is the centre itself
+            drift_vec2 o = drift_isg_offset(k->pattern, &k->jitter, i - 1, k->radius);
+            sx = nearest((float)x + o.x);
+            sy = nearest((float)y + o.y);
+            if (sx < 0 || sy < 0 || sx >= image->width || sy >= image->height) {
+                continue;
+            }
+        }
+        float w = k->range(k->user, sx, sy);
+        if (!(w > 0.0f)) {
+            continue; // rejected; skipping also keeps an infinite value of a rejected sample out
+        }
+        const float *v = k->value ? k->value(k->user, sx, sy) : NULL;
+        v = v ? v : drift_image_pixel(image, sx, sy) + first;
+        for (int32_t c = 0; c < channels; ++c) {
+            sum[c] += w * (v[c] - ref[c]);
+        }
+        weight_sum += w;
+    }
+    for (int32_t c = 0; c < channels; ++c) {
+        out[c] = weight_sum > 0.0f ? ref[c] + sum[c] / weight_sum : centre[c];
+    }
+    return weight_sum;
+}
+
+float drift_isg_pixels_per_unit(const drift_camera *camera, int32_t height)
+{
+    return (float)height / (2.0f * tanf(0.5f * camera->fov_y));
+}
+
+float drift_isg_fov_x(const drift_camera *camera, int32_t width, int32_t height)
+{
+    float aspect = (float)width / (float)height;
+    return 2.0f * atanf(aspect * tanf(0.5f * camera->fov_y));
+}
+
+float drift_isg_penumbra(float light_size, float occluder_distance, float light_distance)
+{
+    if (!(light_size > 0.0f) || !isfinite(occluder_distance) || !(occluder_distance > 0.0f)) {
+        return 0.0f;
+    }
+    if (!isfinite(light_distance)) {
+        return 0.0f; // a directional light has no size here
+    }
+    // An occluder at the light (d -> D) would give an infinite penumbra: cap d / (D - d) at 1e3.
+    float gap = fmaxf(light_distance - occluder_distance, 1e-3f * occluder_distance);
+    return light_size * occluder_distance / gap;
+}
+
+float drift_isg_gloss_alpha(float theta_max, float eye_distance, float reflected_distance)
+{
+    if (!(theta_max > 0.0f)) {
+        return 0.0f;
+    }
+    float t = tanf(fminf(theta_max, 1.5f)); // under pi/2: tan stays finite
+    if (!isfinite(reflected_distance)) {
+        return atanf(t); // E -> infinity: alpha = theta_max
+    }
+    return atanf(reflected_distance * t / (eye_distance + reflected_distance));
+}
+
+// --- PARAMETERS ---
+
+void drift_isg_params_resolve(drift_hybrid_params *p, const drift_scene *scene)
+{
+    p->isg_search = p->isg_search ? p->isg_search : 25;
+    p->isg_gather = p->isg_gather ? p->isg_gather : 49;
+    if (!(p->isg_sigma > 0.0f)) {
+        float diagonal = 1.0f;
+        if (scene && !drift_bounds3_is_empty(scene->bounds)) {
+            diagonal = drift_vec3_length(drift_vec3_sub(scene->bounds.max, scene->bounds.min));
+        }
+        float width = 0.02f * (diagonal > 0.0f ? diagonal : 1.0f);
+        p->isg_sigma = width * width;
+    }
+    p->isg_a = p->isg_a > 0.0f ? p->isg_a : 1.0f;
+    p->isg_b = p->isg_b > 0.0f ? p->isg_b : 100.0f * p->isg_sigma;
+    p->blur_radius = p->blur_radius > 0.0f ? p->blur_radius : 4.0f;
+    p->isg_layers = p->isg_layers ? p->isg_layers : 1;
+}
+
+const char *drift_isg_params_problem(const drift_hybrid_params *p)
+{
+    if (!drift_isg_count_valid(p->isg_search) || !drift_isg_count_valid(p->isg_gather)) {
+        return "isg search and gather sample counts must be perfect squares in 1..1024";
+    }
+    if (!isfinite(p->isg_sigma) || !isfinite(p->isg_a) || !isfinite(p->isg_b) ||
+        !isfinite(p->blur_radius) || p->blur_radius > 1024.0f) {
+        return "isg sigma, a, b or blur radius out of range";
+    }
+    if (p->isg_layers != 1 && p->isg_layers != 2) {
+        return "isg layers must be 1 or 2";
+    }
+    return NULL;
+}
+
+// --- STATE ---
+
+drift_result drift_isg_prepare(drift_frame_state *f)
+{
+    drift_context *ctx = f->ctx;
+    int32_t w = f->params.width, h = f->params.height;
+    if (!f->isg) {
+        drift_isg_state *s = drift_alloc(ctx, sizeof(drift_isg_state));
+        if (!s) {
+            return DRIFT_ERR_OUT_OF_MEMORY;
+        }
+        f->isg = s;
+        s->light_search = drift_alloc(ctx, sizeof(drift_image) * (f->light_count + 1u));
+        if (!s->light_search) {
+            return DRIFT_ERR_OUT_OF_MEMORY;
+        }
+        s->light_count = f->light_count;
+        drift_result r = DRIFT_OK;
+        for (uint32_t l = 0; r == DRIFT_OK && l < f->light_count; ++l) {
+            r = drift_image_create(ctx, w, h, 2, &s->light_search[l]);
+        }
+        if (r == DRIFT_OK) {
+            r = drift_image_create(ctx, w, h, 2, &s->reflection_search);
+        }
+        if (r == DRIFT_OK) {
+            r = drift_image_create(ctx, w, h, 1, &s->dof_search);
+        }
+        if (r == DRIFT_OK) {
+            r = drift_image_create(ctx, w, h, 1, &s->layer_depth);
+        }
+        if (r == DRIFT_OK) {
+            r = drift_image_create(ctx, w, h, 3, &s->layer_colour);
+        }
+        if (r != DRIFT_OK) {
+            return r;
+        }
+    }
+    drift_isg_state *s = f->isg;
+    drift_isg_pattern_make((uint32_t)f->params.isg_search, DRIFT_ISG_DISK, &s->search);
+    drift_isg_pattern_make((uint32_t)f->params.isg_gather, DRIFT_ISG_DISK, &s->gather);
+    drift_isg_pattern_make((uint32_t)f->params.isg_search, DRIFT_ISG_RECT, &s->search_rect);
+    drift_isg_pattern_make((uint32_t)f->params.isg_gather, DRIFT_ISG_RECT, &s->gather_rect);
+    return DRIFT_OK;
+}
+
+void drift_isg_destroy(drift_frame_state *f)
+{
+    drift_isg_state *s = f->isg;
+    if (!s) {
+        return;
+    }
+    if (s->light_search) {
+        for (uint32_t l = 0; l < s->light_count; ++l) {
+            drift_image_destroy(f->ctx, &s->light_search[l]);
+        }
+    }
+    drift_free(f->ctx, s->light_search);
+    drift_image_destroy(f->ctx, &s->reflection_search);
+    drift_image_destroy(f->ctx, &s->dof_search);
+    drift_image_destroy(f->ctx, &s->layer_depth);
+    drift_image_destroy(f->ctx, &s->layer_colour);
+    drift_free(f->ctx, s);
+    f->isg = NULL;
+}
+
+void drift_isg_shadow_planes(const drift_frame_state *f, drift_pass_plane_fn add, void *sink)
+{
+    for (uint32_t l = 0; f->isg && l < f->light_count; ++l) {
+        char name[DRIFT_FRAME_PLANE_NAME];
+        snprintf(name, sizeof name, "light%u.isg", l);
+        add(sink, name, &f->isg->light_search[l]);
+    }
+}
+
+void drift_isg_reflection_planes(const drift_frame_state *f, drift_pass_plane_fn add, void *sink)
+{
+    if (f->isg) {
+        add(sink, "isg.reflection", &f->isg->reflection_search);
+    }
+}
+
+void drift_isg_dof_planes(const drift_frame_state *f, drift_pass_plane_fn add, void *sink)
+{
+    if (!f->isg) {
+        return;
+    }
+    add(sink, "isg.dof", &f->isg->dof_search);
+    if (f->params.isg_layers == 2) {
+        add(sink, "isg.layer2.depth", &f->isg->layer_depth);
+        add(sink, "isg.layer2.colour", &f->isg->layer_colour);
+    }
+}

@@ -1,0 +1,134 @@
+// Image space gathering (Robison & Shirley 2009), the pieces shared by its files:
+//   isg_samples.c      sample sets on the disk (Shirley-Chiu concentric map of a regular grid,
+//                      rotated per pixel) or the rectangle (grid shifted per pixel)
+//   isg.c              the two-phase cross-bilateral filter's one building block, eq. 4, the
+//                      frame's ISG buffers, parameters and planes
+//   isg_shadows.c      soft shadows (section 3.1) and the `blur` shadow baseline
+//   isg_reflections.c  glossy reflections (section 3.2) and the `blur` reflection baseline
+//   isg_dof.c          depth of field (section 3.3)
+// docs/isg.md has the equations and where this departs from the paper.
+#ifndef DRIFT_ISG_INTERNAL_H
+#define DRIFT_ISG_INTERNAL_H
+
+#include "frame/frame.h"
+
+// --- SAMPLE SETS (isg_samples.c) ---
+
+#define DRIFT_ISG_MAX_SAMPLES 1024 // 32 x 32
+
+typedef enum drift_isg_layout {
+    DRIFT_ISG_DISK = 0, // sphere and disk lights, glossy lobes, the lens
+    DRIFT_ISG_RECT,     // quad lights
+} drift_isg_layout;
+
+// `count` points (a perfect square k*k) at the centres of a regular k x k grid, mapped to the
+// unit disk by the concentric map (DISK) or to [-1,1]^2 (RECT).
+typedef struct drift_isg_pattern {
+    drift_isg_layout layout;
+    uint32_t count;
+    drift_vec2 points[DRIFT_ISG_MAX_SAMPLES];
+} drift_isg_pattern;
+
+// False when count is not a perfect square in 1..DRIFT_ISG_MAX_SAMPLES.
+bool drift_isg_count_valid(int32_t count);
+void drift_isg_pattern_make(uint32_t count, drift_isg_layout layout, drift_isg_pattern *out);
+
+// Per-pixel decorrelation, to trade the banding of one fixed pattern for noise: a rotation
+// for the disk (keeps the disk), a toroidal shift by less than a grid cell for the rectangle
+// (keeps the rectangle and its orientation).
+typedef struct drift_isg_jitter {
+    float cos_a, sin_a;
+    drift_vec2 shift;
+} drift_isg_jitter;
+
+drift_isg_jitter drift_isg_jitter_make(uint32_t hash);
+
+// Offset in pixels of sample i of the pattern for a kernel of half extents `radius`.
+drift_vec2 drift_isg_offset(const drift_isg_pattern *pattern, const drift_isg_jitter *jitter,
+                            uint32_t i, drift_vec2 radius);
+
+// --- THE FILTER (isg.c) ---
+
+// Range function times spatial weight of the sample at pixel (x, y) for the centre the
+// caller's `user` describes; 0 rejects the sample.
+typedef float (*drift_isg_range_fn)(const void *user, int32_t x, int32_t y);
+// Optional: the channels to read for the sample at (x, y) instead of the image's (NULL: the
+// image's). The second depth layer substitutes what lies behind the centre this way.
+typedef const float *(*drift_isg_value_fn)(const void *user, int32_t x, int32_t y);
+
+typedef struct drift_isg_kernel {
+    const drift_isg_pattern *pattern;
+    drift_isg_jitter jitter;
+    drift_vec2 radius; // half extents in pixels along x and y
+    drift_isg_range_fn range;
+    const void *user;
+    drift_isg_value_fn value; // may be NULL
+} drift_isg_kernel;
+
+// Eq. 4 at pixel (x, y): the average of `image` channels [first, first + channels) over the
+// centre and the pattern's samples (each read at the nearest pixel; samples off the image are
+// dropped), weighted by the range function, the same weights in numerator and denominator.
+// Returns the weight sum; where it is 0 (every sample rejected), out is the centre's value.
+// Sums differences from the centre (when finite) so that a constant image stays exact.
+float drift_isg_filter(const drift_isg_kernel *kernel, const drift_image *image, int32_t first,
+                       int32_t channels, int32_t x, int32_t y, float *out);
+
+// Pixels per scene unit at view depth 1 (the projection's scale, H / (2 tan(fov_y / 2))), and
+// the horizontal field of view.
+float drift_isg_pixels_per_unit(const drift_camera *camera, int32_t height);
+float drift_isg_fov_x(const drift_camera *camera, int32_t width, int32_t height);
+
+// GLSL smoothstep.
+static inline float drift_isg_smoothstep(float e0, float e1, float x)
+{
+    float t = (x - e0) / (e1 - e0);
+    t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
+    return t * t * (3.0f - 2.0f * t);
+}
+
+// --- FRAME STATE, PARAMETERS, PLANES (isg.c) ---
+
+typedef struct drift_isg_state {
+    drift_image *light_search; // per light, 2: average occluder distance d, gather radius (px)
+    uint32_t light_count;
+    drift_image reflection_search; // 2: average reflected distance E, gather radius (px)
+    drift_image dof_search;        // 1: gather radius (px) found by the search
+    drift_image layer_depth;       // 1: view depth of the second layer (0: none; 1e30: a miss)
+    drift_image layer_colour;      // 3: its radiance (isg_layers.c)
+    drift_isg_pattern search, gather, search_rect, gather_rect;
+} drift_isg_state;
+
+// Fills ISG's zero fields with their defaults (hybrid.h) for this scene.
+void drift_isg_params_resolve(drift_hybrid_params *params, const drift_scene *scene);
+// What is wrong with resolved ISG parameters, or NULL.
+const char *drift_isg_params_problem(const drift_hybrid_params *params);
+
+// Creates the state on first use and the patterns for the current parameters.
+drift_result drift_isg_prepare(drift_frame_state *frame);
+void drift_isg_destroy(drift_frame_state *frame); // NULL-safe state
+
+// The --aov planes of the ISG rows (light search radii, the reflection and lens searches,
+// the second layer).
+void drift_isg_shadow_planes(const drift_frame_state *frame, drift_pass_plane_fn add, void *sink);
+void drift_isg_reflection_planes(const drift_frame_state *frame, drift_pass_plane_fn add,
+                                 void *sink);
+void drift_isg_dof_planes(const drift_frame_state *frame, drift_pass_plane_fn add, void *sink);
+
+// The passes (they add their milliseconds to DRIFT_PASS_ISG).
+drift_result drift_isg_pass_shadows(drift_frame_state *frame,
+                                    const drift_pass_args *args); // isg or blur: bits -> S_l
+drift_result drift_isg_pass_reflections(drift_frame_state *frame,
+                                        const drift_pass_args *args); // isg or blur: sharp -> R
+drift_result drift_isg_pass_dof(drift_frame_state *frame,
+                                const drift_pass_args *args); // focus -> final
+// The second depth layer, for isg_layers = 2 (isg_layers.c).
+drift_result drift_isg_pass_layer(drift_frame_state *frame);
+
+// --- THE PIECES THE PASSES ARE MADE OF, FOR TESTS ---
+
+// Soft-shadow penumbra radius in scene units, eq. 8: L d / (D - d); 0 without occluder.
+float drift_isg_penumbra(float light_size, float occluder_distance, float light_distance);
+// Glossy gather half angle alpha (radians), eq. 13: tan alpha = E tan theta / (e + E).
+float drift_isg_gloss_alpha(float theta_max, float eye_distance, float reflected_distance);
+
+#endif // DRIFT_ISG_INTERNAL_H

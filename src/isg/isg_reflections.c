@@ -1,0 +1,149 @@
+// ISG glossy reflections (Robison & Shirley 2009, section 3.2) over the sharp reflection
+// buffer (one mirror ray per pixel: radiance seen, hit distance):
+//   search  half extents R_p = theta_max / fov in texture space, per axis (fov_x along x,
+//           fov_y along y: the aspect correction), over the reflected distances, range eq. 10:
+//           r = exp(-(a l^2 + b n^2) / sigma), l the world distance (eq. 11; or to the
+//           centre's tangent plane with isg_range_plane), n = 1 - N_i . N_0
+//           (eq. 12) -> E, their average (misses rejected; none found: E = infinity)
+//   support tan alpha = E tan theta_max / (e + E) (eq. 13), e the eye distance; alpha / fov
+//           per axis, times cos(theta_incident) (eq. 14)
+//   gather  over the reflected radiance with range eq. 10 and a spatial weight shaped like
+//           the Phong lobe across the cone, 0.1^(rho^2) at fraction rho of the support (the
+//           search's weight is constant, as in the paper)
+// theta_max comes per pixel from the gloss plane (90% of the Phong lobe). The gathered
+// radiance is weighted by the centre's lobe albedo, as the sharp buffer is. Samples on
+// pixels without a specular lobe are rejected (their buffer holds no reflection). Mirrors
+// keep the sharp reflection. The `blur` baseline gathers over a fixed disk instead.
+#include "isg/isg.h"
+
+#include <math.h>
+
+typedef struct range_ctx {
+    const drift_gbuffer *g;
+    const drift_image *distance; // NULL: any distance
+    drift_vec3 p0, n0;
+    float a_over_sigma, b_over_sigma;
+    bool plane;
+    int32_t x0, y0;
+    float inv_rx, inv_ry; // 1 / the gather's half extents; 0 in the search (constant weight)
+} range_ctx;
+
+static bool has_lobe(const drift_gbuffer *g, int32_t x, int32_t y)
+{
+    return drift_image_pixel(&g->material_id, x, y)[0] >= 0.0f &&
+           !drift_vec3_is_zero(drift_image_get3(&g->specular, x, y));
+}
+
+// Eq. 10.
+static float range_eq10(const void *user, int32_t x, int32_t y)
+{
+    const range_ctx *c = user;
+    if (!has_lobe(c->g, x, y) ||
+        (c->distance && !isfinite(drift_image_pixel(c->distance, x, y)[0]))) {
+        return 0.0f;
+    }
+    // l: the world distance (eq. 11), or the distance to the centre's tangent plane.
+    drift_vec3 d = drift_vec3_sub(drift_image_get3(&c->g->position, x, y), c->p0);
+    float l = c->plane ? drift_vec3_dot(d, c->n0) : drift_vec3_length(d);
+    float n = 1.0f - drift_vec3_dot(drift_image_get3(&c->g->normal, x, y), c->n0);
+    // The spatial weight: the Phong lobe across the cone. A sample at fraction rho of the
+    // support stands for a direction rho * theta_max off the mirror direction, where
+    // cos^n(rho theta_max) ~ 0.1^(rho^2) since cos^n(theta_max) ~ 0.1 (90% of the lobe).
+    float u = (float)(x - c->x0) * c->inv_rx, v = (float)(y - c->y0) * c->inv_ry;
+    float lobe = -2.3026f * (u * u + v * v);
+    return expf(lobe - (c->a_over_sigma * l * l + c->b_over_sigma * n * n));
+}
+
+static float range_lobe(const void *user, int32_t x, int32_t y)
+{
+    const range_ctx *c = user;
+    return has_lobe(c->g, x, y) ? 1.0f : 0.0f;
+}
+
+typedef struct reflection_job {
+    float fov_x, fov_y;
+} reflection_job;
+
+static void reflection_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
+{
+    (void)rays;
+    const reflection_job *job = user;
+    const drift_gbuffer *g = &f->gbuffer;
+    const drift_hybrid_params *p = &f->params;
+    drift_isg_state *s = f->isg;
+    float *search_out = drift_image_pixel(&s->reflection_search, x, y);
+    search_out[0] = INFINITY;
+    search_out[1] = 0.0f;
+    size_t index = (size_t)y * (size_t)p->width + (size_t)x;
+    const drift_surface *surface = &g->surfaces[index];
+    float theta = drift_image_pixel(&g->gloss, x, y)[0];
+    if (!has_lobe(g, x, y) || !(theta > 0.0f) || surface->material == DRIFT_INVALID_INDEX) {
+        return; // no reflection, or a mirror: the sharp buffer stands
+    }
+    drift_bsdf bsdf = drift_bsdf_make(f->scene, surface);
+    if (bsdf.type == DRIFT_MATERIAL_MIRROR) {
+        return;
+    }
+    drift_vec3 wo = drift_pass_wo(f, x, y);
+    range_ctx rc = { .g = g,
+                     .distance = &f->reflection_distance,
+                     .p0 = drift_image_get3(&g->position, x, y),
+                     .n0 = drift_image_get3(&g->normal, x, y),
+                     .a_over_sigma = p->isg_a / p->isg_sigma,
+                     .b_over_sigma = p->isg_b / p->isg_sigma,
+                     .plane = p->isg_range_plane,
+                     .x0 = x,
+                     .y0 = y };
+    uint32_t hash = drift_hash_combine(p->seed ^ DRIFT_STREAM_ISG_REFLECTIONS, (uint32_t)index);
+    drift_isg_jitter jitter = drift_isg_jitter_make(hash);
+    drift_vec3 gathered;
+    if (p->reflections == DRIFT_REFLECTIONS_BLUR) {
+        drift_isg_kernel k = { &s->gather, jitter, drift_vec2_make(p->blur_radius, p->blur_radius),
+                               range_lobe, &rc,    NULL };
+        drift_isg_filter(&k, &f->reflection_reflected, 0, 3, x, y, &gathered.x);
+    } else {
+        float scale_x = (float)p->width / job->fov_x, scale_y = (float)p->height / job->fov_y;
+        drift_vec2 search_radius = drift_vec2_make(theta * scale_x, theta * scale_y);
+        if (fmaxf(search_radius.x, search_radius.y) < 0.5f) {
+            return; // a lobe under half a pixel: the sharp reflection
+        }
+        drift_isg_kernel search = { &s->search, jitter, search_radius, range_eq10, &rc, NULL };
+        float reflected_distance;
+        if (!(drift_isg_filter(&search, &f->reflection_distance, 0, 1, x, y, &reflected_distance) >
+              0.0f)) {
+            reflected_distance = INFINITY; // nothing reflected in reach: the environment
+        }
+        float eye_distance = drift_vec3_length(drift_vec3_sub(f->camera.position, rc.p0));
+        float alpha = drift_isg_gloss_alpha(theta, eye_distance, reflected_distance);
+        float cos_incident = fmaxf(0.0f, drift_vec3_dot(rc.n0, wo));
+        drift_vec2 gather_radius =
+            drift_vec2_make(alpha * scale_x * cos_incident, alpha * scale_y * cos_incident);
+        search_out[0] = reflected_distance;
+        search_out[1] = fmaxf(gather_radius.x, gather_radius.y);
+        if (search_out[1] < 0.5f) {
+            return;
+        }
+        rc.distance = NULL; // the gather reads radiance; a miss has radiance too
+        rc.inv_rx = 1.0f / fmaxf(gather_radius.x, 1e-6f);
+        rc.inv_ry = 1.0f / fmaxf(gather_radius.y, 1e-6f);
+        drift_isg_kernel gather = { &s->gather, jitter, gather_radius, range_eq10, &rc, NULL };
+        drift_isg_filter(&gather, &f->reflection_reflected, 0, 3, x, y, &gathered.x);
+    }
+    drift_image_set3(&f->reflections, x, y,
+                     drift_vec3_mul(drift_raster_reflection_weight(&bsdf, wo), gathered));
+}
+
+drift_result drift_isg_pass_reflections(drift_frame_state *f, const drift_pass_args *args)
+{
+    (void)args;
+    double t = drift_time_now();
+    drift_result r = drift_isg_prepare(f);
+    if (r != DRIFT_OK) {
+        return r;
+    }
+    reflection_job job = { .fov_x = drift_isg_fov_x(&f->camera, f->params.width, f->params.height),
+                           .fov_y = f->camera.fov_y };
+    drift_pass_for_each_pixel(f, reflection_pixel, &job);
+    f->stats.ms[DRIFT_PASS_ISG] += 1000.0 * (drift_time_now() - t);
+    return DRIFT_OK;
+}

@@ -1,0 +1,65 @@
+// ISG's sample sets: a regular grid passed through the square-to-disk map of Shirley and Chiu
+// (the paper's section 4 pattern), or kept as a rectangle for quad lights, and the per-pixel
+// rotation or shift that turns one pattern's banding into noise.
+#include "isg/isg.h"
+
+#include <math.h>
+
+bool drift_isg_count_valid(int32_t count)
+{
+    if (count < 1 || count > DRIFT_ISG_MAX_SAMPLES) {
+        return false;
+    }
+    int32_t k = (int32_t)lrint(sqrt((double)count));
+    return k * k == count;
+}
+
+void drift_isg_pattern_make(uint32_t count, drift_isg_layout layout, drift_isg_pattern *out)
+{
+    uint32_t k = (uint32_t)lrint(sqrt((double)count));
+    out->layout = layout;
+    out->count = k * k;
+    for (uint32_t j = 0; j < k; ++j) {
+        for (uint32_t i = 0; i < k; ++i) {
+            drift_vec2 u =
+                drift_vec2_make(((float)i + 0.5f) / (float)k, ((float)j + 0.5f) / (float)k);
+            out->points[j * k + i] = layout == DRIFT_ISG_DISK
+                                         ? drift_sample_disk_concentric(u)
+                                         : drift_vec2_make(2.0f * u.x - 1.0f, 2.0f * u.y - 1.0f);
+        }
+    }
+}
+
+drift_isg_jitter drift_isg_jitter_make(uint32_t hash)
+{
+    float angle = 2.0f * DRIFT_PI * drift_u32_to_unit(hash);
+    uint32_t h2 = drift_hash_u32(hash);
+    return (drift_isg_jitter){ .cos_a = cosf(angle),
+                               .sin_a = sinf(angle),
+                               .shift =
+                                   drift_vec2_make(drift_u32_to_unit(h2) - 0.5f,
+                                                   drift_u32_to_unit(drift_hash_u32(h2)) - 0.5f) };
+}
+
+// Wraps v into [-1, 1).
+static float wrap_unit(float v)
+{
+    float t = 0.5f * (v + 1.0f);
+    return 2.0f * (t - floorf(t)) - 1.0f;
+}
+
+drift_vec2 drift_isg_offset(const drift_isg_pattern *pattern, const drift_isg_jitter *jitter,
+                            uint32_t i, drift_vec2 radius)
+{
+    drift_vec2 p = pattern->points[i];
+    if (pattern->layout == DRIFT_ISG_DISK) {
+        p = drift_vec2_make(jitter->cos_a * p.x - jitter->sin_a * p.y,
+                            jitter->sin_a * p.x + jitter->cos_a * p.y);
+    } else {
+        // A shift of under one cell (2 / k) keeps the grid stratified over the rectangle.
+        float cell = 2.0f / sqrtf((float)pattern->count);
+        p = drift_vec2_make(wrap_unit(p.x + cell * jitter->shift.x),
+                            wrap_unit(p.y + cell * jitter->shift.y));
+    }
+    return drift_vec2_make(p.x * radius.x, p.y * radius.y);
+}

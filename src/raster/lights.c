@@ -1,0 +1,177 @@
+// The lights as the hybrid frame sees them: scene lights one by one, except that every
+// triangle light of one emissive mesh becomes one light, so that a quad modelled as two
+// triangles casts one shadow map and one hard-shadow ray, not two.
+#include "raster/raster.h"
+
+#include <math.h>
+
+static drift_raster_light single_light(const drift_scene *scene, uint32_t index)
+{
+    const drift_light *l = &scene->lights[index];
+    drift_raster_light h = { .type = l->type,
+                             .centre = l->position,
+                             .first_light = index,
+                             .light_count = 1,
+                             .mesh = DRIFT_INVALID_INDEX };
+    switch (l->type) {
+    case DRIFT_LIGHT_SPOT:
+    case DRIFT_LIGHT_DIRECTIONAL:
+        h.direction = l->direction;
+        break;
+    case DRIFT_LIGHT_QUAD: {
+        drift_vec3 half = drift_vec3_scale(drift_vec3_add(l->edge_u, l->edge_v), 0.5f);
+        h.centre = drift_vec3_add(l->position, half);
+        h.radius = drift_vec3_length(half);
+        h.direction = drift_vec3_normalize(drift_vec3_cross(l->edge_u, l->edge_v));
+        h.one_sided = true;
+        break;
+    }
+    case DRIFT_LIGHT_DISK:
+        h.direction = l->direction;
+        h.radius = l->radius;
+        h.one_sided = true;
+        break;
+    case DRIFT_LIGHT_SPHERE:
+        h.radius = l->radius;
+        break;
+    case DRIFT_LIGHT_TRIANGLE: {
+        drift_vec3 c[3];
+        drift_light_triangle_vertices(scene, l, &c[0], &c[1], &c[2]);
+        h.centre = drift_vec3_scale(drift_vec3_add(c[0], drift_vec3_add(c[1], c[2])), 1.0f / 3.0f);
+        h.direction = drift_vec3_normalize(
+            drift_vec3_cross(drift_vec3_sub(c[1], c[0]), drift_vec3_sub(c[2], c[0])));
+        for (int k = 0; k < 3; ++k) {
+            h.radius = fmaxf(h.radius, drift_vec3_length(drift_vec3_sub(c[k], h.centre)));
+        }
+        h.one_sided = true;
+        break;
+    }
+    case DRIFT_LIGHT_POINT:
+    case DRIFT_LIGHT_COUNT:
+        break;
+    }
+    return h;
+}
+
+// Gathers the triangle lights first_light .. first_light + count - 1 of one mesh: area CDF,
+// area-weighted centroid and mean normal, bounding radius about the centroid.
+static drift_result mesh_light(drift_context *ctx, const drift_scene *scene, uint32_t mesh,
+                               drift_raster_light *out)
+{
+    const drift_mesh *m = &scene->meshes[mesh];
+    *out = (drift_raster_light){ .type = DRIFT_LIGHT_TRIANGLE,
+                                 .first_light = m->first_light,
+                                 .light_count = m->triangle_count,
+                                 .mesh = mesh,
+                                 .one_sided = true };
+    out->light_cdf = drift_alloc(ctx, sizeof(float) * m->triangle_count);
+    if (!out->light_cdf) {
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    double total = 0.0;
+    drift_vec3 centroid = drift_vec3_splat(0.0f), normal = drift_vec3_splat(0.0f);
+    for (uint32_t t = 0; t < m->triangle_count; ++t) {
+        drift_vec3 c[3];
+        drift_light_triangle_vertices(scene, &scene->lights[m->first_light + t], &c[0], &c[1],
+                                      &c[2]);
+        drift_vec3 cross = drift_vec3_cross(drift_vec3_sub(c[1], c[0]), drift_vec3_sub(c[2], c[0]));
+        float area = 0.5f * drift_vec3_length(cross);
+        total += (double)area;
+        out->light_cdf[t] = (float)total;
+        drift_vec3 mid =
+            drift_vec3_scale(drift_vec3_add(c[0], drift_vec3_add(c[1], c[2])), 1.0f / 3.0f);
+        centroid = drift_vec3_fma(centroid, mid, area);
+        normal = drift_vec3_add(normal, drift_vec3_scale(cross, 0.5f));
+    }
+    for (uint32_t t = 0; t < m->triangle_count; ++t) {
+        out->light_cdf[t] = (float)((double)out->light_cdf[t] / total);
+    }
+    out->light_cdf[m->triangle_count - 1] = 1.0f;
+    out->centre = drift_vec3_scale(centroid, (float)(1.0 / total));
+    // A closed emitter has no mean normal: treat it as emitting all around.
+    float normal_length = drift_vec3_length(normal);
+    out->one_sided = normal_length > 0.5f * (float)total;
+    out->direction =
+        out->one_sided ? drift_vec3_scale(normal, 1.0f / normal_length) : drift_vec3_splat(0.0f);
+    for (uint32_t v = 0; v < m->vertex_count; ++v) {
+        const float *p = m->positions + 3u * v;
+        drift_vec3 d = drift_vec3_sub(drift_vec3_make(p[0], p[1], p[2]), out->centre);
+        out->radius = fmaxf(out->radius, drift_vec3_length(d));
+    }
+    return DRIFT_OK;
+}
+
+drift_result drift_raster_lights_build(drift_context *ctx, const drift_scene *scene,
+                                       drift_raster_light **out_lights, uint32_t *out_count)
+{
+    *out_lights = NULL;
+    *out_count = 0;
+    if (!scene->committed) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    uint32_t count = 0;
+    for (uint32_t i = 0; i < scene->light_count; ++i) {
+        const drift_light *l = &scene->lights[i];
+        // A mesh's triangle lights are consecutive from mesh.first_light: count its first.
+        if (l->type != DRIFT_LIGHT_TRIANGLE || scene->meshes[l->mesh].first_light == i) {
+            ++count;
+        }
+    }
+    if (count == 0) {
+        return DRIFT_OK;
+    }
+    drift_raster_light *lights = drift_alloc(ctx, sizeof(drift_raster_light) * count);
+    if (!lights) {
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < scene->light_count; ++i) {
+        const drift_light *l = &scene->lights[i];
+        if (l->type != DRIFT_LIGHT_TRIANGLE) {
+            lights[n++] = single_light(scene, i);
+        } else if (scene->meshes[l->mesh].first_light == i) {
+            drift_result r = mesh_light(ctx, scene, l->mesh, &lights[n++]);
+            if (r != DRIFT_OK) {
+                drift_raster_lights_destroy(ctx, lights, n);
+                return r;
+            }
+        }
+    }
+    *out_lights = lights;
+    *out_count = count;
+    return DRIFT_OK;
+}
+
+void drift_raster_lights_destroy(drift_context *ctx, drift_raster_light *lights, uint32_t count)
+{
+    if (!lights) {
+        return;
+    }
+    for (uint32_t i = 0; i < count; ++i) {
+        drift_free(ctx, lights[i].light_cdf);
+    }
+    drift_free(ctx, lights);
+}
+
+drift_light_sample drift_raster_light_sample(const drift_scene *scene,
+                                             const drift_raster_light *light, drift_vec3 ref,
+                                             float u_pick, drift_vec2 u)
+{
+    if (!light->light_cdf) {
+        return drift_light_sample_li(scene, light->first_light, ref, u);
+    }
+    // Pick a triangle in proportion to its area (binary search of the CDF).
+    uint32_t lo = 0, hi = light->light_count - 1;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (light->light_cdf[mid] <= u_pick) {
+            lo = mid + 1;
+        } else {
+            hi = mid;
+        }
+    }
+    float pmf = light->light_cdf[lo] - (lo > 0 ? light->light_cdf[lo - 1] : 0.0f);
+    drift_light_sample s = drift_light_sample_li(scene, light->first_light + lo, ref, u);
+    s.pdf *= pmf;
+    return s;
+}

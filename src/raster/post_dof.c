@@ -1,0 +1,264 @@
+// Post-process depth of field: the thin lens's circle of confusion per pixel, and the usual
+// real-time gather over it.
+//
+// The gather averages taps on a disk of the pixel's own CoC radius, whatever depth the taps
+// land on. That is the known artefact of this technique, kept on purpose because it is what
+// the technique does: colour leaks across depth edges. A blurred background pixel next to a
+// sharp foreground object averages the foreground in (a halo around the object), and a
+// blurred foreground object's edge stays sharp against the background behind it, because
+// background pixels with small CoC do not gather it. The reference technique has neither.
+#include "raster/raster.h"
+
+#include <math.h>
+
+#define DEFAULT_TAPS 64u
+#define TAP_SEED     0x6d0f5a3bu // one fixed pattern for every pixel and frame
+
+// --- CIRCLE OF CONFUSION ---
+
+// drift_camera_ray aims every lens ray at the pinhole ray's point at view depth F, so two
+// lens points 2A apart see a point at depth z through film points 2 A |z - F| / z scene
+// units apart on the focus plane; the focus plane spans 2 F tan(fov_y / 2) over H pixels.
+float drift_coc_radius_pixels(const drift_camera *camera, int32_t image_height, float z)
+{
+    if (!camera || !(camera->aperture_radius > 0.0f) || !(z > 0.0f) || image_height <= 0) {
+        return 0.0f;
+    }
+    float focus = camera->focus_distance > 0.0f
+                      ? camera->focus_distance
+                      : drift_vec3_length(drift_vec3_sub(camera->target, camera->position));
+    float tan_half = tanf(0.5f * camera->fov_y);
+    if (!(focus > 0.0f) || !(tan_half > 0.0f)) {
+        return 0.0f;
+    }
+    float pixels_per_unit = (float)image_height / (2.0f * focus * tan_half);
+    return camera->aperture_radius * fabsf(z - focus) / z * pixels_per_unit;
+}
+
+// --- GATHER ---
+
+typedef struct dof_job {
+    const drift_image *in;
+    const drift_image *coc;
+    drift_image *out;
+    const drift_vec2 *taps; // offsets on the unit disk; taps[0] is the centre
+    uint32_t tap_count;
+    uint8_t *uniform; // per UNIFORM_TILE tile: every pixel its gathers read is alike
+    int32_t tiles_x;
+} dof_job;
+
+#define UNIFORM_TILE 16
+
+// The centre, then the concentric-disk image of a scrambled Sobol (0,2)-sequence: its first
+// 2^k points are stratified over [0,1)^2, so the taps cover the disk evenly.
+static void make_taps(drift_vec2 *taps, uint32_t count)
+{
+    taps[0] = drift_vec2_make(0.0f, 0.0f);
+    for (uint32_t k = 1; k < count; ++k) {
+        drift_sampler s = drift_sampler_make(TAP_SEED, 0, k - 1);
+        taps[k] = drift_sample_disk_concentric(drift_sampler_next2(&s));
+    }
+}
+
+static int32_t clamp_index(int32_t v, int32_t n)
+{
+    return v < 0 ? 0 : (v >= n ? n - 1 : v);
+}
+
+static float lerp(float a, float b, float t)
+{
+    return a + (b - a) * t; // exact when a == b, so a constant image stays constant
+}
+
+// Bilinear fetch at (x, y) in pixel-centre units (pixel p's centre at p), clamped to the image.
+static inline void fetch_bilinear(const drift_image *image, float x, float y, float *out,
+                                  const int32_t channels)
+{
+    float x0f = floorf(x), y0f = floorf(y);
+    float fx = x - x0f, fy = y - y0f;
+    int32_t xa = clamp_index((int32_t)x0f, image->width);
+    int32_t xb = clamp_index((int32_t)x0f + 1, image->width);
+    int32_t ya = clamp_index((int32_t)y0f, image->height);
+    int32_t yb = clamp_index((int32_t)y0f + 1, image->height);
+    const float *p00 = drift_image_pixel(image, xa, ya), *p10 = drift_image_pixel(image, xb, ya);
+    const float *p01 = drift_image_pixel(image, xa, yb), *p11 = drift_image_pixel(image, xb, yb);
+    for (int32_t c = 0; c < channels; ++c) {
+        out[c] = lerp(lerp(p00[c], p10[c], fx), lerp(p01[c], p11[c], fx), fy);
+    }
+}
+
+// Taps for a disk of `radius` pixels: the centre plus a power of two of the stratified set
+// (a prefix of 2^k points stays stratified), one per four pixels of the disk's area, at most
+// the table: each bilinear tap reads a 2x2 footprint, so together they read about every pixel.
+static uint32_t taps_for_radius(float radius, uint32_t table_size)
+{
+    float quarter_area = 0.25f * 3.14159265f * radius * radius;
+    uint32_t n = 4;
+    while ((float)n < quarter_area && n < table_size - 1) {
+        n *= 2;
+    }
+    return n + 1 < table_size ? n + 1 : table_size;
+}
+
+// Equal weights. Summing differences from the centre pixel keeps a flat region exactly flat
+// (a float sum of 64 equal values would not return the value). Inlined with a constant
+// channel count for RGB, so the channel loops unroll.
+static inline void gather(const dof_job *job, int32_t x, int32_t y, float radius, float *out,
+                          const int32_t channels)
+{
+    const float *centre = drift_image_pixel(job->in, x, y);
+    float sum[4] = { 0.0f, 0.0f, 0.0f, 0.0f }, tap[4];
+    uint32_t tap_count = taps_for_radius(radius, job->tap_count);
+    for (uint32_t k = 0; k < tap_count; ++k) {
+        float tx = (float)x + job->taps[k].x * radius, ty = (float)y + job->taps[k].y * radius;
+        fetch_bilinear(job->in, tx, ty, tap, channels);
+        for (int32_t c = 0; c < channels; ++c) {
+            sum[c] += tap[c] - centre[c];
+        }
+    }
+    float inv = 1.0f / (float)tap_count;
+    for (int32_t c = 0; c < channels; ++c) {
+        out[c] = centre[c] + sum[c] * inv;
+    }
+}
+
+static void gather_pixel(const dof_job *job, int32_t x, int32_t y, float radius, float *out)
+{
+    if (job->in->channels == 3) {
+        gather(job, x, y, radius, out, 3);
+    } else {
+        gather(job, x, y, radius, out, job->in->channels);
+    }
+}
+
+// Whether every pixel the gathers of tile (tx, ty) can read holds the same value. Each
+// gather then returns its centre exactly (it sums differences from the centre), so the tile
+// is copied instead: the background of a frame, with the largest circle of confusion and a
+// single colour, costs a scan instead of a gather.
+static bool tile_is_uniform(const dof_job *job, int32_t tx, int32_t ty)
+{
+    const drift_image *in = job->in;
+    int32_t x0 = tx * UNIFORM_TILE, y0 = ty * UNIFORM_TILE;
+    int32_t x1 = x0 + UNIFORM_TILE < in->width ? x0 + UNIFORM_TILE : in->width;
+    int32_t y1 = y0 + UNIFORM_TILE < in->height ? y0 + UNIFORM_TILE : in->height;
+    float reach = 0.0f;
+    for (int32_t y = y0; y < y1; ++y) {
+        for (int32_t x = x0; x < x1; ++x) {
+            reach = fmaxf(reach, drift_image_pixel(job->coc, x, y)[0]); // fmaxf drops NaN
+        }
+    }
+    // A tap lands within the radius; its bilinear fetch reads one pixel further.
+    int32_t pad = (int32_t)ceilf(fminf(reach, (float)(in->width + in->height))) + 1;
+    const float *first = drift_image_pixel(in, x0, y0);
+    for (int32_t y = clamp_index(y0 - pad, in->height); y <= clamp_index(y1 - 1 + pad, in->height);
+         ++y) {
+        for (int32_t x = clamp_index(x0 - pad, in->width);
+             x <= clamp_index(x1 - 1 + pad, in->width); ++x) {
+            const float *p = drift_image_pixel(in, x, y);
+            for (int32_t c = 0; c < in->channels; ++c) {
+                if (p[c] != first[c]) {
+                    return false;
+                }
+            }
+        }
+    }
+    return true;
+}
+
+static void classify_tiles(size_t begin, size_t end, int thread_index, void *user)
+{
+    (void)thread_index;
+    const dof_job *job = user;
+    for (size_t t = begin; t < end; ++t) {
+        job->uniform[t] = tile_is_uniform(job, (int32_t)(t % (size_t)job->tiles_x),
+                                          (int32_t)(t / (size_t)job->tiles_x));
+    }
+}
+
+static void dof_rows(size_t begin, size_t end, int thread_index, void *user)
+{
+    (void)thread_index;
+    const dof_job *job = user;
+    int32_t channels = job->in->channels;
+    for (int32_t y = (int32_t)begin; y < (int32_t)end; ++y) {
+        const uint8_t *uniform_row =
+            job->uniform + (size_t)(y / UNIFORM_TILE) * (size_t)job->tiles_x;
+        for (int32_t x = 0; x < job->in->width; ++x) {
+            float radius = drift_image_pixel(job->coc, x, y)[0];
+            const float *src = drift_image_pixel(job->in, x, y);
+            float *dst = drift_image_pixel(job->out, x, y);
+            // Below half a pixel the disk stays inside the pixel: copy, bit for bit (and
+            // NaN or negative radii count as in focus). A uniform tile copies too (above).
+            if (!(radius >= 0.5f) || uniform_row[x / UNIFORM_TILE]) {
+                for (int32_t c = 0; c < channels; ++c) {
+                    dst[c] = src[c];
+                }
+                continue;
+            }
+            gather_pixel(job, x, y, radius, dst);
+        }
+    }
+}
+
+static drift_result check_dof_args(drift_context *ctx, const drift_image *in,
+                                   const drift_image *coc, uint32_t taps, const drift_image *out)
+{
+    const char *why = NULL;
+    if (!drift_image_is_valid(in) || !drift_image_is_valid(coc) || !drift_image_is_valid(out)) {
+        why = "an image is missing or invalid";
+    } else if (out->width != in->width || out->height != in->height ||
+               out->channels != in->channels) {
+        why = "out must have the size and channels of in";
+    } else if (coc->width != in->width || coc->height != in->height) {
+        why = "the circle-of-confusion image must have the size of in";
+    } else if (out->pixels == in->pixels || out->pixels == coc->pixels) {
+        why = "out must not be in or coc";
+    } else if (taps > DRIFT_POST_DOF_MAX_TAPS) {
+        why = "too many taps";
+    }
+    if (why) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, __FILE__, __LINE__,
+                  "post dof: %s", why);
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    return DRIFT_OK;
+}
+
+drift_result drift_post_dof(drift_context *ctx, const drift_image *in, const drift_image *coc,
+                            uint32_t taps, drift_image *out)
+{
+    drift_result r = check_dof_args(ctx, in, coc, taps, out);
+    if (r != DRIFT_OK) {
+        return r;
+    }
+    uint32_t tap_count = taps == 0 ? DEFAULT_TAPS : taps;
+    drift_vec2 *table = drift_alloc(ctx, sizeof(drift_vec2) * tap_count);
+    if (!table) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_OUT_OF_MEMORY, __FILE__, __LINE__,
+                  "post dof: out of memory for %u taps", tap_count);
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    make_taps(table, tap_count);
+    int32_t tiles_x = (in->width + UNIFORM_TILE - 1) / UNIFORM_TILE;
+    int32_t tiles_y = (in->height + UNIFORM_TILE - 1) / UNIFORM_TILE;
+    size_t tile_count = (size_t)tiles_x * (size_t)tiles_y;
+    uint8_t *uniform = drift_alloc(ctx, tile_count);
+    if (!uniform) {
+        drift_free(ctx, table);
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_OUT_OF_MEMORY, __FILE__, __LINE__,
+                  "post dof: out of memory for %zu tiles", tile_count);
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    dof_job job = { .in = in,
+                    .coc = coc,
+                    .out = out,
+                    .taps = table,
+                    .tap_count = tap_count,
+                    .uniform = uniform,
+                    .tiles_x = tiles_x };
+    drift_parallel_for(ctx, tile_count, 1, classify_tiles, &job);
+    drift_parallel_for(ctx, (size_t)in->height, 1, dof_rows, &job);
+    drift_free(ctx, uniform);
+    drift_free(ctx, table);
+    return DRIFT_OK;
+}

@@ -1,0 +1,325 @@
+// Shading shared by every pass of the hybrid frame: the unshadowed light U_l, the hard
+// shadow toward a light's centre, and the radiance a secondary ray sees (what the sharp
+// reflection buffer and the environment map store). It calls the same BSDF and light code
+// as the reference path tracer, so a technique's error is its own.
+#include "raster/raster.h"
+
+#include <math.h>
+
+// Point k of a Hammersley set of n points in [0,1)^2 shifted by `shift` modulo 1.
+static drift_vec2 shifted_hammersley(uint32_t k, uint32_t n, drift_vec2 shift)
+{
+    float x = ((float)k + 0.5f) / (float)n + shift.x;
+    float y = (float)drift_reverse_bits(k) * 0x1p-32f + shift.y;
+    return drift_vec2_make(x - floorf(x), y - floorf(y));
+}
+
+// f * L * cos / pdf of one light sample, without visibility (the pt's NEE, minus the ray);
+// with glossy_only, f is the glossy lobe alone.
+static drift_vec3 light_sample_contribution(const drift_surface *surface, const drift_bsdf *bsdf,
+                                            drift_vec3 wo, const drift_light_sample *ls,
+                                            bool glossy_only)
+{
+    if (!(ls->pdf > 0.0f) || drift_vec3_is_zero(ls->radiance)) {
+        return drift_vec3_splat(0.0f);
+    }
+    drift_vec3 diffuse, glossy;
+    drift_bsdf_eval_lobes(bsdf, wo, ls->wi, &diffuse, &glossy);
+    drift_vec3 f = glossy_only ? glossy : drift_vec3_add(diffuse, glossy);
+    float cos_i = fabsf(drift_vec3_dot(ls->wi, surface->ns));
+    return drift_vec3_scale(drift_vec3_mul(f, ls->radiance), cos_i / ls->pdf);
+}
+
+// --- POLYGON LIGHTS IN CLOSED FORM ---
+
+// Meshes with more triangles than this are sampled rather than summed triangle by triangle.
+#define MAX_CLOSED_FORM_TRIANGLES 8
+
+// Clips the convex polygon `in` to the half space above the plane through p with normal n
+// (Sutherland-Hodgman); returns the vertex count of `out` (room for count + 1).
+static int clip_to_hemisphere(drift_vec3 p, drift_vec3 n, const drift_vec3 *in, int count,
+                              drift_vec3 *out)
+{
+    int m = 0;
+    for (int i = 0; i < count; ++i) {
+        drift_vec3 a = in[i], b = in[(i + 1) % count];
+        float da = drift_vec3_dot(drift_vec3_sub(a, p), n);
+        float db = drift_vec3_dot(drift_vec3_sub(b, p), n);
+        if (da >= 0.0f) {
+            out[m++] = a;
+        }
+        if ((da >= 0.0f) != (db >= 0.0f)) {
+            out[m++] = drift_vec3_add(a, drift_vec3_scale(drift_vec3_sub(b, a), da / (da - db)));
+        }
+    }
+    return m;
+}
+
+// Irradiance at p (normal n) from a polygon of unit radiance: Lambert's formula,
+// E = 1/2 sum_i theta_i (n . gamma_i) over the edges (Arvo 1994), after clipping the polygon
+// to the hemisphere above p.
+static float polygon_irradiance(drift_vec3 p, drift_vec3 n, const drift_vec3 *polygon, int count)
+{
+    drift_vec3 clipped[8];
+    int m = clip_to_hemisphere(p, n, polygon, count, clipped);
+    if (m < 3) {
+        return 0.0f;
+    }
+    drift_vec3 dirs[8];
+    for (int i = 0; i < m; ++i) {
+        dirs[i] = drift_vec3_normalize(drift_vec3_sub(clipped[i], p));
+    }
+    float sum = 0.0f;
+    for (int i = 0; i < m; ++i) {
+        drift_vec3 a = dirs[i], b = dirs[(i + 1) % m];
+        drift_vec3 c = drift_vec3_cross(a, b);
+        float length = drift_vec3_length(c);
+        if (length > 1e-12f) {
+            float theta = acosf(drift_clampf(drift_vec3_dot(a, b), -1.0f, 1.0f));
+            sum += theta * drift_vec3_dot(c, n) / length;
+        }
+    }
+    return 0.5f * fabsf(sum);
+}
+
+// The corners of a quad or triangle light, and its emitting normal.
+static int light_polygon(const drift_scene *scene, const drift_light *l, drift_vec3 *out,
+                         drift_vec3 *out_normal)
+{
+    if (l->type == DRIFT_LIGHT_QUAD) {
+        out[0] = l->position;
+        out[1] = drift_vec3_add(l->position, l->edge_u);
+        out[2] = drift_vec3_add(out[1], l->edge_v);
+        out[3] = drift_vec3_add(l->position, l->edge_v);
+        *out_normal = drift_vec3_cross(l->edge_u, l->edge_v);
+        return 4;
+    }
+    drift_light_triangle_vertices(scene, l, &out[0], &out[1], &out[2]);
+    *out_normal = drift_vec3_cross(drift_vec3_sub(out[1], out[0]), drift_vec3_sub(out[2], out[0]));
+    return 3;
+}
+
+static bool has_closed_form(const drift_raster_light *light)
+{
+    return light->type == DRIFT_LIGHT_QUAD ||
+           (light->type == DRIFT_LIGHT_TRIANGLE && light->light_count <= MAX_CLOSED_FORM_TRIANGLES);
+}
+
+// The diffuse lobe's share of U_l in closed form: kd / pi * sum over polygons of L_e * E.
+// Each polygon emits from its front face only.
+static drift_vec3 polygon_diffuse(const drift_scene *scene, const drift_raster_light *light,
+                                  const drift_surface *surface, const drift_bsdf *bsdf,
+                                  drift_vec3 wo)
+{
+    drift_vec3 n = bsdf->frame.z;
+    drift_vec3 sum = drift_vec3_splat(0.0f);
+    if (drift_vec3_dot(wo, n) <= 0.0f) {
+        return sum; // the diffuse lobe is zero for a viewer below the shading normal
+    }
+    for (uint32_t i = 0; i < light->light_count; ++i) {
+        const drift_light *l = &scene->lights[light->first_light + i];
+        drift_vec3 polygon[4], normal;
+        int count = light_polygon(scene, l, polygon, &normal);
+        if (drift_vec3_dot(drift_vec3_sub(surface->position, polygon[0]), normal) <= 0.0f) {
+            continue; // behind the emitting side
+        }
+        float e = polygon_irradiance(surface->position, n, polygon, count);
+        sum = drift_vec3_fma(sum, l->color, e);
+    }
+    return drift_vec3_scale(drift_vec3_mul(sum, bsdf->diffuse), DRIFT_INV_PI);
+}
+
+drift_vec3 drift_raster_unshadowed(const drift_scene *scene, const drift_raster_light *light,
+                                   const drift_surface *surface, const drift_bsdf *bsdf,
+                                   drift_vec3 wo, uint32_t sample_count, drift_sampler *sampler)
+{
+    drift_vec3 sum = drift_vec3_splat(0.0f);
+    if (drift_bsdf_is_delta(bsdf)) {
+        return sum;
+    }
+    if (!drift_light_is_area(light->type)) {
+        drift_light_sample ls = drift_raster_light_sample(scene, light, surface->position, 0.0f,
+                                                          drift_vec2_make(0.5f, 0.5f));
+        return light_sample_contribution(surface, bsdf, wo, &ls, false);
+    }
+    // Polygons: the diffuse lobe in closed form (no noise), samples for the glossy lobe only.
+    bool closed_form = has_closed_form(light);
+    if (closed_form) {
+        sum = polygon_diffuse(scene, light, surface, bsdf, wo);
+        if (drift_vec3_is_zero(bsdf->specular)) {
+            return sum;
+        }
+    }
+    drift_vec3 sampled = drift_vec3_splat(0.0f);
+    uint32_t n = sample_count > 0 ? sample_count : 1;
+    drift_vec2 shift = drift_sampler_next2(sampler);
+    float pick_shift = drift_sampler_next1(sampler);
+    for (uint32_t k = 0; k < n; ++k) {
+        drift_vec2 u = shifted_hammersley(k, n, shift);
+        // Golden-ratio sequence for the triangle pick of mesh lights.
+        float pick = (float)k * 0.618034f + pick_shift;
+        drift_light_sample ls =
+            drift_raster_light_sample(scene, light, surface->position, pick - floorf(pick), u);
+        sampled =
+            drift_vec3_add(sampled, light_sample_contribution(surface, bsdf, wo, &ls, closed_form));
+    }
+    return drift_vec3_fma(sum, sampled, 1.0f / (float)n);
+}
+
+drift_vec3 drift_raster_environment_direct(const drift_scene *scene, const drift_accel *accel,
+                                           const drift_surface *surface, const drift_bsdf *bsdf,
+                                           drift_vec3 wo, uint32_t sample_count,
+                                           drift_sampler *sampler, uint64_t *rays)
+{
+    drift_vec3 sum = drift_vec3_splat(0.0f);
+    if (!drift_scene_has_environment(scene) || drift_bsdf_is_delta(bsdf)) {
+        return sum;
+    }
+    uint32_t n = sample_count > 0 ? sample_count : 1;
+    drift_vec2 shift = drift_sampler_next2(sampler);
+    for (uint32_t k = 0; k < n; ++k) {
+        drift_light_sample ls = drift_environment_sample(scene, shifted_hammersley(k, n, shift));
+        drift_vec3 c = light_sample_contribution(surface, bsdf, wo, &ls, false);
+        if (drift_vec3_is_zero(c)) {
+            continue;
+        }
+        drift_ray shadow = { .origin = drift_offset_origin(surface->position, surface->ng, ls.wi),
+                             .dir = ls.wi,
+                             .tmin = 0.0f,
+                             .tmax = INFINITY };
+        ++*rays;
+        if (!drift_accel_occluded(accel, &shadow)) {
+            sum = drift_vec3_add(sum, c);
+        }
+    }
+    return drift_vec3_scale(sum, 1.0f / (float)n);
+}
+
+drift_ray drift_raster_hard_shadow_ray(const drift_raster_light *light,
+                                       const drift_surface *surface, float *out_light_distance)
+{
+    drift_vec3 dir;
+    float distance;
+    if (light->type == DRIFT_LIGHT_DIRECTIONAL) {
+        dir = drift_vec3_neg(light->direction);
+        distance = INFINITY;
+    } else {
+        drift_vec3 d = drift_vec3_sub(light->centre, surface->position);
+        distance = drift_vec3_length(d);
+        dir = distance > 0.0f ? drift_vec3_scale(d, 1.0f / distance) : surface->ns;
+    }
+    *out_light_distance = distance;
+    return (drift_ray){ .origin = drift_offset_origin(surface->position, surface->ng, dir),
+                        .dir = dir,
+                        .tmin = 0.0f,
+                        .tmax = isfinite(distance) ? distance * (1.0f - 1e-4f) : INFINITY };
+}
+
+bool drift_raster_hard_shadow_visible(const drift_raster_light *light, const drift_hit *hit,
+                                      float *out_occluder_distance)
+{
+    // Closest hit rather than any hit: the buffer needs the occluder's distance, and a ray
+    // toward the centre of a sphere light meets the light's own surface, which is no occluder.
+    bool missed = hit->mesh == DRIFT_INVALID_INDEX && hit->light == DRIFT_INVALID_INDEX;
+    if (missed || drift_raster_light_owns(light, hit->light)) {
+        *out_occluder_distance = INFINITY;
+        return true;
+    }
+    *out_occluder_distance = hit->t;
+    return false;
+}
+
+bool drift_raster_hard_shadow(const drift_accel *accel, const drift_raster_light *light,
+                              const drift_surface *surface, float *out_occluder_distance,
+                              float *out_light_distance)
+{
+    drift_ray ray = drift_raster_hard_shadow_ray(light, surface, out_light_distance);
+    drift_hit hit = { .mesh = DRIFT_INVALID_INDEX, .light = DRIFT_INVALID_INDEX };
+    drift_accel_intersect(accel, &ray, &hit); // a miss leaves `hit` as it was: missed
+    return drift_raster_hard_shadow_visible(light, &hit, out_occluder_distance);
+}
+
+// Direct light at a secondary hit from every light, each with its hard shadow.
+static drift_vec3 direct_with_hard_shadows(const drift_raster_shading *shading,
+                                           const drift_surface *surface, const drift_bsdf *bsdf,
+                                           drift_vec3 wo, drift_sampler *sampler, uint64_t *rays)
+{
+    drift_vec3 sum = drift_vec3_splat(0.0f);
+    for (uint32_t l = 0; l < shading->light_count; ++l) {
+        const drift_raster_light *light = &shading->lights[l];
+        drift_vec3 u = drift_raster_unshadowed(shading->scene, light, surface, bsdf, wo,
+                                               shading->light_samples, sampler);
+        if (drift_vec3_is_zero(u)) {
+            continue;
+        }
+        float occluder, distance;
+        ++*rays;
+        if (drift_raster_hard_shadow(shading->accel, light, surface, &occluder, &distance)) {
+            sum = drift_vec3_add(sum, u);
+        }
+    }
+    drift_vec3 env = drift_raster_environment_direct(shading->scene, shading->accel, surface, bsdf,
+                                                     wo, shading->light_samples, sampler, rays);
+    return drift_vec3_add(sum, env);
+}
+
+drift_raster_radiance drift_raster_trace_radiance(const drift_raster_shading *shading,
+                                                  drift_ray ray, uint32_t skip_mesh,
+                                                  drift_sampler *sampler, uint64_t *rays,
+                                                  float *out_distance)
+{
+    const drift_scene *scene = shading->scene;
+    drift_raster_radiance out = { drift_vec3_splat(0.0f), drift_vec3_splat(0.0f) };
+    *out_distance = INFINITY;
+    drift_hit hit;
+    // Pass through the skipped mesh (a probe inside its own object); a few layers at most.
+    for (int layer = 0;; ++layer) {
+        ++*rays;
+        if (!drift_accel_intersect(shading->accel, &ray, &hit)) {
+            if (drift_scene_has_environment(scene)) {
+                out.emitted = drift_environment_eval(scene, ray.dir);
+            }
+            return out;
+        }
+        if (hit.mesh != skip_mesh || skip_mesh == DRIFT_INVALID_INDEX || layer == 8) {
+            break;
+        }
+        ray.tmin = hit.t * (1.0f + 1e-5f) + 1e-6f;
+    }
+    *out_distance = hit.t;
+    drift_surface surface = drift_scene_surface(scene, &ray, &hit);
+    out.emitted = surface.emission;
+    if (surface.material == DRIFT_INVALID_INDEX) {
+        return out;
+    }
+    drift_bsdf bsdf = drift_bsdf_make(scene, &surface);
+    out.reflected =
+        direct_with_hard_shadows(shading, &surface, &bsdf, drift_vec3_neg(ray.dir), sampler, rays);
+    return out;
+}
+
+float drift_gloss_theta_max(const drift_material *material)
+{
+    if (material->type == DRIFT_MATERIAL_MIRROR) {
+        return 0.0f;
+    }
+    if (drift_vec3_is_zero(material->specular) || !(material->exponent > 0.0f)) {
+        return 0.5f * DRIFT_PI;
+    }
+    // The Phong lobe's pdf is proportional to cos^n: the cone of half angle theta holds
+    // 1 - cos^(n+1)(theta) of it; 90% gives cos(theta) = 0.1^(1/(n+1)).
+    return acosf(powf(0.1f, 1.0f / (material->exponent + 1.0f)));
+}
+
+// Directional albedo of the specular lobe toward wo: ks for a mirror; for the normalized
+// Phong lobe around the mirror direction r, integral of f cos = ks (n+2)/(n+1) cos(theta_r)
+// when the lobe is narrow (clamped to ks).
+drift_vec3 drift_raster_reflection_weight(const drift_bsdf *bsdf, drift_vec3 wo)
+{
+    if (bsdf->type == DRIFT_MATERIAL_MIRROR) {
+        return bsdf->specular;
+    }
+    float cos_o = fmaxf(0.0f, drift_vec3_dot(wo, bsdf->frame.z));
+    float n = bsdf->exponent;
+    return drift_vec3_scale(bsdf->specular, fminf(1.0f, (n + 2.0f) / (n + 1.0f) * cos_o));
+}

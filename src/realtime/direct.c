@@ -1,0 +1,177 @@
+// Direct light of the hybrid frame: D = sum_l U_l * S_l + environment. U_l is the unshadowed
+// light (raster/shading.c); S_l the shadow term of the chosen technique: the hard-shadow
+// buffer, or a shadow map filtered by PCF or PCSS. Techniques of other folders write S_l
+// too (ISG, AAF) and the conductor then sums D here; `reference` writes D itself.
+#include "realtime/realtime.h"
+
+#include <math.h>
+
+static size_t pixel_index(const drift_frame_state *f, int32_t x, int32_t y)
+{
+    return (size_t)y * (size_t)f->params.width + (size_t)x;
+}
+
+static void unshadowed_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
+{
+    (void)user;
+    const drift_surface *s = &f->gbuffer.surfaces[pixel_index(f, x, y)];
+    drift_vec3 zero = drift_vec3_splat(0.0f);
+    if (s->material == DRIFT_INVALID_INDEX) {
+        for (uint32_t l = 0; l < f->light_count; ++l) {
+            drift_image_set3(&f->light_buffers[l].unshadowed, x, y, zero);
+        }
+        drift_image_set3(&f->environment_direct, x, y, zero);
+        return;
+    }
+    drift_bsdf bsdf = drift_bsdf_make(f->scene, s);
+    drift_vec3 wo = drift_pass_wo(f, x, y);
+    drift_sampler sampler = drift_pass_sampler(f, DRIFT_STREAM_UNSHADOWED, x, y);
+    for (uint32_t l = 0; l < f->light_count; ++l) {
+        drift_vec3 u = drift_raster_unshadowed(f->scene, &f->lights[l], s, &bsdf, wo,
+                                               f->params.light_samples, &sampler);
+        drift_image_set3(&f->light_buffers[l].unshadowed, x, y, u);
+    }
+    drift_image_set3(&f->environment_direct, x, y,
+                     drift_raster_environment_direct(f->scene, f->accel, s, &bsdf, wo,
+                                                     f->params.light_samples, &sampler, rays));
+}
+
+// Hard shadows of one row toward one light, traced as coherent packets: neighbouring
+// pixels aim at the same centre.
+#define SHADOW_BATCH 64
+
+static void hard_shadow_row(drift_frame_state *f, int32_t y, uint64_t *rays, void *user)
+{
+    (void)user;
+    drift_ray batch[SHADOW_BATCH];
+    drift_hit hits[SHADOW_BATCH];
+    int32_t xs[SHADOW_BATCH];
+    float light_distance[SHADOW_BATCH];
+    for (uint32_t l = 0; l < f->light_count; ++l) {
+        drift_frame_light_buffers *b = &f->light_buffers[l];
+        for (int32_t x0 = 0; x0 < f->params.width; x0 += SHADOW_BATCH) {
+            int32_t x1 = x0 + SHADOW_BATCH < f->params.width ? x0 + SHADOW_BATCH : f->params.width;
+            uint32_t n = 0;
+            for (int32_t x = x0; x < x1; ++x) {
+                const drift_surface *s = &f->gbuffer.surfaces[pixel_index(f, x, y)];
+                float *out = drift_image_pixel(&b->hard_shadow, x, y);
+                if (s->material == DRIFT_INVALID_INDEX) {
+                    out[0] = 0.0f;
+                    out[1] = out[2] = INFINITY;
+                    drift_image_pixel(&b->shadow, x, y)[0] = 0.0f;
+                    continue;
+                }
+                xs[n] = x;
+                batch[n] = drift_raster_hard_shadow_ray(&f->lights[l], s, &light_distance[n]);
+                ++n;
+            }
+            drift_accel_intersect_coherent(f->accel, batch, hits, n);
+            *rays += n;
+            for (uint32_t k = 0; k < n; ++k) {
+                float *out = drift_image_pixel(&b->hard_shadow, xs[k], y);
+                bool visible = drift_raster_hard_shadow_visible(&f->lights[l], &hits[k], &out[1]);
+                out[0] = visible ? 1.0f : 0.0f;
+                out[2] = light_distance[k];
+                drift_image_pixel(&b->shadow, xs[k], y)[0] = out[0];
+            }
+        }
+    }
+}
+
+static void shadow_filter_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays,
+                                void *user)
+{
+    (void)rays;
+    bool pcss = *(const bool *)user;
+    const drift_surface *s = &f->gbuffer.surfaces[pixel_index(f, x, y)];
+    uint32_t hash =
+        drift_hash_combine(f->params.seed ^ DRIFT_STREAM_PCSS, (uint32_t)pixel_index(f, x, y));
+    for (uint32_t l = 0; l < f->light_count; ++l) {
+        const drift_shadow_map *map = f->light_buffers[l].shadow_map;
+        float v = 0.0f;
+        if (s->material != DRIFT_INVALID_INDEX) {
+            v = pcss ? drift_shadow_map_pcss(map, s->position, s->ng, drift_hash_u32(hash + l))
+                     : drift_shadow_map_pcf(map, s->position, s->ng, f->params.pcf_kernel);
+        }
+        drift_image_pixel(&f->light_buffers[l].shadow, x, y)[0] = v;
+    }
+}
+
+static void sum_direct_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
+{
+    (void)rays;
+    (void)user;
+    drift_vec3 d = drift_image_get3(&f->environment_direct, x, y);
+    for (uint32_t l = 0; l < f->light_count; ++l) {
+        const drift_frame_light_buffers *b = &f->light_buffers[l];
+        d = drift_vec3_fma(d, drift_image_get3(&b->unshadowed, x, y),
+                           drift_image_pixel(&b->shadow, x, y)[0]);
+    }
+    drift_image_set3(&f->direct, x, y, d);
+}
+
+drift_result drift_realtime_ensure_shadow_map(drift_frame_state *f, uint32_t light, uint64_t *rays)
+{
+    if (f->light_buffers[light].shadow_map) {
+        return DRIFT_OK; // cached: the scene has not changed
+    }
+    drift_shadow_map_params params = { .size = f->params.shadow_map_size,
+                                       .bias_texels = f->params.shadow_bias };
+    return drift_shadow_map_build(f->ctx, f->scene, f->accel, &f->lights[light], &params,
+                                  &f->light_buffers[light].shadow_map, rays);
+}
+
+drift_result drift_realtime_build_shadow_maps(drift_frame_state *f)
+{
+    double t = drift_time_now();
+    drift_result r = DRIFT_OK;
+    for (uint32_t l = 0; r == DRIFT_OK && l < f->light_count; ++l) {
+        r = drift_realtime_ensure_shadow_map(f, l, &f->stats.rays[DRIFT_PASS_SHADOW_MAPS]);
+    }
+    drift_pass_time(f, DRIFT_PASS_SHADOW_MAPS, t);
+    return r;
+}
+
+drift_result drift_realtime_pass_unshadowed(drift_frame_state *f)
+{
+    double t = drift_time_now();
+    f->stats.rays[DRIFT_PASS_UNSHADOWED] += drift_pass_for_each_pixel(f, unshadowed_pixel, NULL);
+    drift_pass_time(f, DRIFT_PASS_UNSHADOWED, t);
+    return DRIFT_OK;
+}
+
+drift_result drift_realtime_pass_hard_shadows(drift_frame_state *f)
+{
+    double t = drift_time_now();
+    f->stats.rays[DRIFT_PASS_HARD_SHADOWS] += drift_pass_for_each_row(f, hard_shadow_row, NULL);
+    drift_pass_time(f, DRIFT_PASS_HARD_SHADOWS, t);
+    return DRIFT_OK;
+}
+
+static drift_result shadow_filter(drift_frame_state *f, bool pcss)
+{
+    double t = drift_time_now();
+    drift_pass_for_each_pixel(f, shadow_filter_pixel, &pcss);
+    drift_pass_time(f, DRIFT_PASS_SHADOW_FILTER, t);
+    return DRIFT_OK;
+}
+
+drift_result drift_realtime_pass_pcf(drift_frame_state *f, const drift_pass_args *args)
+{
+    (void)args;
+    return shadow_filter(f, false);
+}
+
+drift_result drift_realtime_pass_pcss(drift_frame_state *f, const drift_pass_args *args)
+{
+    (void)args;
+    return shadow_filter(f, true);
+}
+
+drift_result drift_realtime_pass_sum_direct(drift_frame_state *f)
+{
+    double t = drift_time_now(); // summing is part of composition
+    drift_pass_for_each_pixel(f, sum_direct_pixel, NULL);
+    drift_pass_time(f, DRIFT_PASS_COMPOSE, t);
+    return DRIFT_OK;
+}

@@ -1,0 +1,44 @@
+// The real-time renderer's techniques, the baselines every later technique is measured
+// against: direct light as U_l x S_l with hard ray-traced shadows or shadow maps filtered by
+// PCF or PCSS (direct.c), and reflections from one sharp mirror ray or a cube environment map
+// captured at a probe (reflections.c), ambient light and post-process depth of field (screen.c).
+// docs/hybrid.md has the equations.
+#ifndef DRIFT_REALTIME_H
+#define DRIFT_REALTIME_H
+
+#include "frame/frame.h"
+
+// --- INPUTS OTHER TECHNIQUES READ TOO (direct.c, reflections.c) ---
+
+// U_l of every light and the ray-traced environment term for every pixel.
+drift_result drift_realtime_pass_unshadowed(drift_frame_state *frame);
+// The hard-shadow buffer: one ray toward each light's centre; S_l = those bits.
+drift_result drift_realtime_pass_hard_shadows(drift_frame_state *frame);
+// Shadow maps of every light, built on first use and kept while the scene and the map
+// settings stand (SIR's penumbra metric reads them too).
+drift_result drift_realtime_build_shadow_maps(drift_frame_state *frame);
+// One light's shadow map, built if the cache has none; adds the rays it casts to *rays.
+drift_result drift_realtime_ensure_shadow_map(drift_frame_state *frame, uint32_t light,
+                                              uint64_t *rays);
+// The sharp reflection buffer: one mirror ray a glossy or mirror pixel, R from it.
+drift_result drift_realtime_pass_sharp_reflections(drift_frame_state *frame);
+// The environment-map probes, captured on first use (kept while the settings stand).
+drift_result drift_realtime_capture_probes(drift_frame_state *frame);
+
+// --- TECHNIQUES ---
+
+// S_l by a shadow-map lookup: percentage-closer filtering over params.pcf_kernel texels, or
+// percentage-closer soft shadows (Fernando 2005: blocker search, penumbra estimate, PCF).
+drift_result drift_realtime_pass_pcf(drift_frame_state *frame, const drift_pass_args *args);
+drift_result drift_realtime_pass_pcss(drift_frame_state *frame, const drift_pass_args *args);
+// D = sum_l U_l S_l + environment: after any technique that writes S_l.
+drift_result drift_realtime_pass_sum_direct(drift_frame_state *frame);
+// R from the environment map (probes captured first).
+drift_result drift_realtime_pass_envmap_reflections(drift_frame_state *frame,
+                                                    const drift_pass_args *args);
+// I = albedo x a constant ambient radiance (params.ambient, or the mean of D) (screen.c).
+drift_result drift_realtime_pass_ambient(drift_frame_state *frame, const drift_pass_args *args);
+// final = the post-process depth of field of focus over the coc plane (screen.c).
+drift_result drift_realtime_pass_post_dof(drift_frame_state *frame, const drift_pass_args *args);
+
+#endif // DRIFT_REALTIME_H

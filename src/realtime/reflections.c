@@ -1,0 +1,180 @@
+// Reflections of the hybrid frame, R: light whose first bounce is the glossy or mirror lobe.
+// `sharp` traces one mirror ray per glossy or mirror pixel and shades its hit with direct
+// light and hard shadows; `envmap` looks the mirror direction up in a cube map captured at a
+// probe (blurred over the lobe's cone for glossy pixels). Both weight the radiance by the
+// lobe's directional albedo (drift_raster_reflection_weight). Emission seen in the mirror direction
+// belongs to R only for mirrors: for glossy lobes the direct pass already has it.
+#include "realtime/realtime.h"
+
+#include <math.h>
+
+static size_t pixel_index(const drift_frame_state *f, int32_t x, int32_t y)
+{
+    return (size_t)y * (size_t)f->params.width + (size_t)x;
+}
+
+static bool has_reflection(const drift_frame_state *f, const drift_surface *s, drift_bsdf *out_bsdf)
+{
+    if (s->material == DRIFT_INVALID_INDEX) {
+        return false;
+    }
+    *out_bsdf = drift_bsdf_make(f->scene, s);
+    return !drift_vec3_is_zero(out_bsdf->specular) &&
+           (out_bsdf->type == DRIFT_MATERIAL_MIRROR || out_bsdf->exponent > 0.0f);
+}
+
+static drift_vec3 combine(const drift_bsdf *bsdf, drift_vec3 wo, drift_raster_radiance l)
+{
+    drift_vec3 seen =
+        bsdf->type == DRIFT_MATERIAL_MIRROR ? drift_vec3_add(l.emitted, l.reflected) : l.reflected;
+    return drift_vec3_mul(drift_raster_reflection_weight(bsdf, wo), seen);
+}
+
+static void sharp_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
+{
+    (void)user;
+    const drift_surface *s = &f->gbuffer.surfaces[pixel_index(f, x, y)];
+    drift_vec3 zero = drift_vec3_splat(0.0f);
+    drift_bsdf bsdf;
+    if (!has_reflection(f, s, &bsdf)) {
+        drift_image_set3(&f->reflection_emitted, x, y, zero);
+        drift_image_set3(&f->reflection_reflected, x, y, zero);
+        drift_image_pixel(&f->reflection_distance, x, y)[0] = INFINITY;
+        drift_image_set3(&f->reflections, x, y, zero);
+        return;
+    }
+    drift_vec3 wo = drift_pass_wo(f, x, y);
+    drift_vec3 dir = drift_vec3_reflect(wo, s->ns);
+    drift_ray ray = { .origin = drift_offset_origin(s->position, s->ng, dir),
+                      .dir = dir,
+                      .tmin = 0.0f,
+                      .tmax = INFINITY };
+    drift_sampler sampler = drift_pass_sampler(f, DRIFT_STREAM_REFLECTION, x, y);
+    float distance;
+    drift_raster_radiance l = drift_raster_trace_radiance(&f->shading, ray, DRIFT_INVALID_INDEX,
+                                                          &sampler, rays, &distance);
+    drift_image_set3(&f->reflection_emitted, x, y, l.emitted);
+    drift_image_set3(&f->reflection_reflected, x, y, l.reflected);
+    drift_image_pixel(&f->reflection_distance, x, y)[0] = distance;
+    drift_image_set3(&f->reflections, x, y, combine(&bsdf, wo, l));
+}
+
+static const drift_envmap *probe_for(const drift_frame_state *f, uint32_t mesh)
+{
+    for (uint32_t i = 0; i < f->probe_count; ++i) {
+        if (f->probes[i].mesh == mesh || f->probes[i].mesh == DRIFT_INVALID_INDEX) {
+            return f->probes[i].map;
+        }
+    }
+    return NULL;
+}
+
+static void envmap_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
+{
+    (void)rays;
+    (void)user;
+    size_t index = pixel_index(f, x, y);
+    const drift_surface *s = &f->gbuffer.surfaces[index];
+    drift_bsdf bsdf;
+    const drift_envmap *map = NULL;
+    if (has_reflection(f, s, &bsdf)) {
+        map = probe_for(f, f->gbuffer.mesh_index[index]);
+    }
+    if (!map) {
+        drift_image_set3(&f->reflections, x, y, drift_vec3_splat(0.0f));
+        return;
+    }
+    drift_vec3 wo = drift_pass_wo(f, x, y);
+    drift_vec3 dir = drift_vec3_reflect(wo, s->ns);
+    float cone = bsdf.type == DRIFT_MATERIAL_MIRROR
+                     ? 0.0f
+                     : drift_gloss_theta_max(&f->scene->materials[s->material]);
+    drift_image_set3(&f->reflections, x, y,
+                     combine(&bsdf, wo, drift_envmap_lookup(map, dir, cone)));
+}
+
+static bool mesh_is_reflective(const drift_scene *scene, uint32_t mesh)
+{
+    const drift_material *m = &scene->materials[scene->meshes[mesh].material];
+    return !drift_vec3_is_zero(m->specular);
+}
+
+static drift_vec3 mesh_centre(const drift_scene *scene, uint32_t mesh)
+{
+    drift_bounds3 b = drift_mesh_bounds(&scene->meshes[mesh]);
+    return drift_vec3_scale(drift_vec3_add(b.min, b.max), 0.5f);
+}
+
+// Captures the probes on first use; they hold while the scene and settings stand.
+static drift_result capture_probes(drift_frame_state *f)
+{
+    if (f->probes) {
+        return DRIFT_OK;
+    }
+    const drift_scene *scene = f->scene;
+    uint32_t count = 1;
+    if (f->params.probe_per_object) {
+        count = 0;
+        for (uint32_t m = 0; m < scene->mesh_count; ++m) {
+            count += mesh_is_reflective(scene, m) ? 1u : 0u;
+        }
+        if (count == 0) {
+            return DRIFT_OK;
+        }
+    }
+    f->probes = drift_alloc(f->ctx, sizeof(drift_frame_probe) * count);
+    if (!f->probes) {
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    uint64_t *rays = &f->stats.rays[DRIFT_PASS_ENVMAP];
+    uint32_t seed = drift_hash_combine(f->params.seed, DRIFT_STREAM_PROBE);
+    if (!f->params.probe_per_object) {
+        drift_vec3 centre =
+            f->params.has_probe
+                ? f->params.probe
+                : drift_vec3_scale(drift_vec3_add(scene->bounds.min, scene->bounds.max), 0.5f);
+        f->probes[0].mesh = DRIFT_INVALID_INDEX;
+        f->probe_count = 1;
+        return drift_envmap_capture(f->ctx, &f->shading, centre, DRIFT_INVALID_INDEX,
+                                    f->params.envmap_size, seed, &f->probes[0].map, rays);
+    }
+    for (uint32_t m = 0; m < scene->mesh_count; ++m) {
+        if (!mesh_is_reflective(scene, m)) {
+            continue;
+        }
+        drift_frame_probe *probe = &f->probes[f->probe_count++];
+        probe->mesh = m;
+        drift_result r = drift_envmap_capture(f->ctx, &f->shading, mesh_centre(scene, m), m,
+                                              f->params.envmap_size, seed, &probe->map, rays);
+        if (r != DRIFT_OK) {
+            return r;
+        }
+    }
+    return DRIFT_OK;
+}
+
+drift_result drift_realtime_pass_sharp_reflections(drift_frame_state *f)
+{
+    double t = drift_time_now();
+    f->stats.rays[DRIFT_PASS_REFLECTIONS] += drift_pass_for_each_pixel(f, sharp_pixel, NULL);
+    drift_pass_time(f, DRIFT_PASS_REFLECTIONS, t);
+    return DRIFT_OK;
+}
+
+drift_result drift_realtime_capture_probes(drift_frame_state *f)
+{
+    double t = drift_time_now();
+    drift_result r = capture_probes(f);
+    drift_pass_time(f, DRIFT_PASS_ENVMAP, t);
+    return r;
+}
+
+drift_result drift_realtime_pass_envmap_reflections(drift_frame_state *f,
+                                                    const drift_pass_args *args)
+{
+    (void)args;
+    double t = drift_time_now();
+    drift_pass_for_each_pixel(f, envmap_pixel, NULL);
+    drift_pass_time(f, DRIFT_PASS_ENVMAP, t);
+    return DRIFT_OK;
+}

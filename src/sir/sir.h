@@ -1,0 +1,63 @@
+// Smart Image Refinement's state, shared by its files: refine.c (lifecycle, begin/iterate,
+// planes), metrics.c (the error metrics), raytrace.c (the pure ray tracer), schedule.c (the
+// sort and the request list), lambda.c (the lambda fit and its file).
+#ifndef DRIFT_SIR_H
+#define DRIFT_SIR_H
+
+#include "drift/refine.h"
+#include "hybrid/frame_access.h"
+#include "realtime/realtime.h"
+
+// --- THE PURE RAY TRACER (raytrace.c) ---
+
+// What every sample of one view shares. The lights are the hybrid frame's (a mesh light is
+// one light), so ray tracer and raster sum the same terms.
+typedef struct drift_refine_tracer {
+    const drift_scene *scene;
+    const drift_accel *accel;
+    const drift_raster_light *lights;
+    uint32_t light_count;
+    drift_camera_frame camera;
+    uint32_t seed;
+    int32_t max_depth;      // reflection bounces
+    uint32_t light_samples; // shadow rays a light (and toward the environment) at each hit:
+                            // the frame's light_samples, the raster's count for U_l
+} drift_refine_tracer;
+
+drift_refine_tracer drift_refine_tracer_make(const drift_frame_state *frame, uint32_t seed,
+                                             int32_t max_depth);
+// One sample of pixel (x, y): the same for a sample index whoever asks (refinement or the pure
+// image), adding the rays it traced to *rays.
+drift_vec3 drift_refine_trace_sample(const drift_refine_tracer *tracer, int32_t x, int32_t y,
+                                     uint32_t sample, uint64_t *rays);
+
+// --- METRICS (metrics.c) ---
+
+typedef struct drift_refine_metric_params {
+    float edge_threshold;
+    float ao_radius;
+    uint32_t ao_samples;
+    uint32_t seed;
+} drift_refine_metric_params;
+
+// Fills out[m] (1 channel, the frame's size) for every metric from the frame's last render.
+void drift_refine_compute_metrics(drift_frame_state *frame,
+                                  const drift_refine_metric_params *params,
+                                  drift_image out[DRIFT_METRIC_COUNT]);
+// E = average or min(1, sum lambda_i E_i); written to `combined` (1 channel).
+void drift_refine_combine_metrics(const drift_image metrics[DRIFT_METRIC_COUNT],
+                                  drift_refine_combine combine,
+                                  const float lambda[DRIFT_METRIC_COUNT], drift_image *combined);
+
+// --- SCHEDULE (schedule.c) ---
+
+// Sort key of an error in [0,1]: descending error ascending key; any non-zero error keys
+// below zero's (DRIFT_REFINE_ZERO_KEY), however small.
+#define DRIFT_REFINE_ZERO_KEY 0xffffu
+uint32_t drift_refine_encode_error(float error);
+// Stable LSD radix sort of pixel indices 0..count-1 by key (16 bits, two 8-bit passes).
+// order and scratch hold count entries; order gets the pixels, scratch is work space.
+void drift_refine_radix_sort(const uint16_t *keys, uint32_t count, uint32_t *order,
+                             uint32_t *scratch);
+
+#endif
