@@ -9,8 +9,8 @@
 // STEP BY STEP
 //   drift_scene *scene = NULL;
 //   drift_scene_create(ctx, &scene);
-//   uint32_t white;  drift_scene_add_material(scene, &(drift_material){ .diffuse = {.8f,.8f,.8f} }, &white);
-//   drift_scene_add_mesh(scene, &(drift_mesh_desc){ .positions = p, .vertex_count = 4,
+//   uint32_t white;  drift_scene_add_material(scene, &(drift_material){ .diffuse = {.8f,.8f,.8f} },
+//   &white); drift_scene_add_mesh(scene, &(drift_mesh_desc){ .positions = p, .vertex_count = 4,
 //                        .indices = idx, .triangle_count = 2, .material = white }, NULL);
 //   drift_scene_add_light(scene, &(drift_light){ .type = DRIFT_LIGHT_SPHERE, ... }, NULL);
 //   scene->camera = drift_camera_look_at(eye, target, up, fov_y, width, height);
@@ -41,9 +41,9 @@ extern "C" {
 #define DRIFT_INVALID_INDEX UINT32_MAX
 // Limits the loaders and commit enforce ("absurd sizes").
 #define DRIFT_SCENE_MAX_TRIANGLES (1u << 28)
-#define DRIFT_SCENE_MAX_VERTICES (1u << 28)
-#define DRIFT_SCENE_MAX_LIGHTS (1u << 24)
-#define DRIFT_NAME_MAX 64
+#define DRIFT_SCENE_MAX_VERTICES  (1u << 28)
+#define DRIFT_SCENE_MAX_LIGHTS    (1u << 24)
+#define DRIFT_NAME_MAX            64
 
 // --- CAMERA ---
 
@@ -67,9 +67,9 @@ drift_camera drift_camera_look_at(drift_vec3 position, drift_vec3 target, drift_
 typedef struct drift_camera_frame {
     drift_camera camera;
     drift_vec3 u, v, w;
-    float tan_half;       // tan(fov_y / 2)
-    float aspect;         // width / height
-    float focus;          // focus_distance, or |target - position| when that is 0
+    float tan_half; // tan(fov_y / 2)
+    float aspect;   // width / height
+    float focus;    // focus_distance, or |target - position| when that is 0
     int32_t width, height;
 } drift_camera_frame;
 
@@ -141,10 +141,10 @@ bool drift_light_is_area(drift_light_type type);
 
 typedef struct drift_mesh {
     char name[DRIFT_NAME_MAX];
-    float *positions;   // 3 floats a vertex, plus 1 padding float at the end
-    float *normals;     // 3 floats a vertex (unit), or NULL for flat shading
-    float *uvs;         // 2 floats a vertex, or NULL
-    uint32_t *indices;  // 3 a triangle
+    float *positions;  // 3 floats a vertex, plus 1 padding float at the end
+    float *normals;    // 3 floats a vertex (unit), or NULL for flat shading
+    float *uvs;        // 2 floats a vertex, or NULL
+    uint32_t *indices; // 3 a triangle
     uint32_t vertex_count;
     uint32_t triangle_count;
     uint32_t material;
@@ -189,7 +189,7 @@ typedef struct drift_scene {
     uint32_t light_count;
     drift_image *textures; // linear RGB(A); owned
     uint32_t texture_count;
-    drift_bounds3 bounds;  // of all geometry, set by commit
+    drift_bounds3 bounds;           // of all geometry, set by commit
     drift_light_table *light_table; // set by commit
     bool committed;
 } drift_scene;
@@ -232,18 +232,18 @@ void drift_light_triangle_vertices(const drift_scene *scene, const drift_light *
 // What the accel reports about a hit: which geometry, which primitive, where.
 typedef struct drift_hit {
     float t;
-    float u, v;       // barycentrics of vertices 1 and 2 (triangles); unused otherwise
-    uint32_t mesh;    // mesh index, or DRIFT_INVALID_INDEX when an area light's shape was hit
-    uint32_t prim;    // triangle index within the mesh
-    uint32_t light;   // area light index (shape hit, or emissive mesh triangle), else invalid
-    drift_vec3 ng;    // geometric normal, unnormalized, as the accel computed it
+    float u, v;     // barycentrics of vertices 1 and 2 (triangles); unused otherwise
+    uint32_t mesh;  // mesh index, or DRIFT_INVALID_INDEX when an area light's shape was hit
+    uint32_t prim;  // triangle index within the mesh
+    uint32_t light; // area light index (shape hit, or emissive mesh triangle), else invalid
+    drift_vec3 ng;  // geometric normal, unnormalized, as the accel computed it
 } drift_hit;
 
 // Everything shading needs at a hit point.
 typedef struct drift_surface {
     drift_vec3 position;
-    drift_vec3 ng;       // unit geometric normal, flipped to face the incoming ray
-    drift_vec3 ns;       // unit shading normal, on the same side as ng
+    drift_vec3 ng; // unit geometric normal, flipped to face the incoming ray
+    drift_vec3 ns; // unit shading normal, on the same side as ng
     drift_vec2 uv;
     uint32_t material;   // DRIFT_INVALID_INDEX for light shapes (pure emitters)
     uint32_t light;      // area light at this point, or DRIFT_INVALID_INDEX
@@ -290,18 +290,22 @@ typedef struct drift_bsdf_sample {
 // Samples wi. u_lobe picks the lobe, u the direction. pdf == 0 means no sample.
 drift_bsdf_sample drift_bsdf_sample_wi(const drift_bsdf *bsdf, drift_vec3 wo, float u_lobe,
                                        drift_vec2 u);
+// A direction from the glossy lobe's cos^n(alpha) distribution around the mirror direction of
+// wo (cos alpha = u.x^(1/(n+1)), phi = 2 pi u.y): the one place the Phong lobe is sampled
+// (the path tracer, AAF's specular buffer and SIR's ray tracer). It may point below the surface.
+drift_vec3 drift_bsdf_sample_glossy_lobe(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec2 u);
 bool drift_bsdf_is_delta(const drift_bsdf *bsdf);
 
 // --- LIGHT SAMPLING ---
 
 typedef struct drift_light_sample {
-    drift_vec3 wi;        // unit direction from the reference point toward the light
-    float distance;       // to the sampled point; INFINITY for directional/environment
-    drift_vec3 radiance;  // L arriving along -wi (intensity / d^2 for point lights)
-    float pdf;            // solid-angle pdf of this light's sampling (times nothing else);
-                          // for delta lights the pdf is 1 and is_delta is set
+    drift_vec3 wi;       // unit direction from the reference point toward the light
+    float distance;      // to the sampled point; INFINITY for directional/environment
+    drift_vec3 radiance; // L arriving along -wi (intensity / d^2 for point lights)
+    float pdf;           // solid-angle pdf of this light's sampling (times nothing else);
+                         // for delta lights the pdf is 1 and is_delta is set
     bool is_delta;
-    drift_vec3 point;     // the sampled point on the light (for shadow rays)
+    drift_vec3 point; // the sampled point on the light (for shadow rays)
     drift_vec3 light_normal;
 } drift_light_sample;
 

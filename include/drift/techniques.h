@@ -65,7 +65,7 @@
       DRIFT_STREAM_AAF_SPECULAR, DRIFT_PT_COMPONENT_SPECULAR)
 
 #define DRIFT_DOF_TECHNIQUES(X)                                                                    \
-    X(NONE, "none", "pinhole", drift_hybrid_pass_pinhole, 0, 0, NULL, 0, 0)                        \
+    X(NONE, "none", "pinhole: everything in focus", drift_hybrid_pass_pinhole, 0, 0, NULL, 0, 0)   \
     X(POST, "post", "gather over the circle of confusion in image space",                          \
       drift_realtime_pass_post_dof, 0, 0, NULL, 0, DRIFT_PT_COMPONENT_ALL)                         \
     X(REFERENCE, "reference", "the whole frame path-traced through the thin lens",                 \

@@ -24,20 +24,14 @@ static bool specular_at(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec3 *albed
 static void specular_sample(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec2 u, drift_vec3 *wi,
                             float *weight, bool *emission)
 {
-    drift_vec3 r = drift_vec3_reflect(wo, bsdf->frame.z);
     *emission = bsdf->type == DRIFT_MATERIAL_MIRROR;
     if (*emission) {
-        *wi = r;
+        *wi = drift_vec3_reflect(wo, bsdf->frame.z);
         *weight = 1.0f;
         return;
     }
-    drift_frame frame = drift_frame_from_normal(r);
     float n = bsdf->exponent;
-    float cos_a = powf(u.x, 1.0f / (n + 1.0f));
-    float sin_a = sqrtf(fmaxf(0.0f, 1.0f - cos_a * cos_a));
-    float phi = 2.0f * DRIFT_PI * u.y;
-    *wi =
-        drift_frame_to_world(&frame, drift_vec3_make(sin_a * cosf(phi), sin_a * sinf(phi), cos_a));
+    *wi = drift_bsdf_sample_glossy_lobe(bsdf, wo, u);
     *weight = fmaxf(0.0f, (n + 2.0f) / (n + 1.0f) * drift_vec3_dot(*wi, bsdf->frame.z));
 }
 

@@ -69,8 +69,8 @@ drift_result drift__check_file(drift_context *ctx, const char *path, const char 
 drift_result drift__read_file(drift_context *ctx, const char *path, bool gzip, const char *where,
                               int line, char **out_data, size_t *out_size);
 
-// Lower-case extension of path without the dot ("" when none); with strip_gz, the extension
-// before a trailing ".gz". *out_gz tells whether the name ended in .gz.
+// Lower-case extension of path without the dot ("" when none). A trailing ".gz" is looked
+// through: "x.obj.gz" gives "obj" and sets *out_gz (false for any other name).
 void drift__path_extension(const char *path, char *out, size_t out_size, bool *out_gz);
 
 // True for the mesh file extensions assimp is asked to read (obj, gltf, glb, ply; lower case).

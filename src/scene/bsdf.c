@@ -1,9 +1,9 @@
 // Lambertian diffuse plus a normalized modified-Phong glossy lobe (Lafortune & Willems 1994,
 // "Using the Modified Phong Reflectance Model for Physically Based Rendering"), and a perfect
 // mirror. Directions are world space; the lobe frame's z is the shading normal.
-#include <math.h>
-
 #include "scene_internal.h"
+
+#include <math.h>
 
 drift_bsdf drift_bsdf_make(const drift_scene *scene, const drift_surface *surface)
 {
@@ -78,6 +78,15 @@ float drift_bsdf_pdf(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec3 wi)
     return pdf;
 }
 
+drift_vec3 drift_bsdf_sample_glossy_lobe(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec2 u)
+{
+    drift_frame f = drift_frame_from_normal(drift_vec3_reflect(wo, bsdf->frame.z));
+    float cos_a = powf(u.x, 1.0f / (bsdf->exponent + 1.0f));
+    float sin_a = sqrtf(fmaxf(0.0f, 1.0f - cos_a * cos_a));
+    float phi = 2.0f * DRIFT_PI * u.y;
+    return drift_frame_to_world(&f, drift_vec3_make(sin_a * cosf(phi), sin_a * sinf(phi), cos_a));
+}
+
 drift_bsdf_sample drift_bsdf_sample_wi(const drift_bsdf *bsdf, drift_vec3 wo, float u_lobe,
                                        drift_vec2 u)
 {
@@ -98,13 +107,7 @@ drift_bsdf_sample drift_bsdf_sample_wi(const drift_bsdf *bsdf, drift_vec3 wo, fl
         return s;
     }
     if (u_lobe < ps) {
-        // Sample cos(alpha) = u^(1/(n+1)) around the mirror direction.
-        drift_vec3 r = drift_vec3_reflect(wo, bsdf->frame.z);
-        drift_frame f = drift_frame_from_normal(r);
-        float cos_a = powf(u.x, 1.0f / (bsdf->exponent + 1.0f));
-        float sin_a = sqrtf(fmaxf(0.0f, 1.0f - cos_a * cos_a));
-        float phi = 2.0f * DRIFT_PI * u.y;
-        s.wi = drift_frame_to_world(&f, drift_vec3_make(sin_a * cosf(phi), sin_a * sinf(phi), cos_a));
+        s.wi = drift_bsdf_sample_glossy_lobe(bsdf, wo, u);
     } else {
         s.wi = drift_frame_to_world(&bsdf->frame, drift_sample_cosine_hemisphere(u));
     }

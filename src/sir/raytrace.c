@@ -72,14 +72,8 @@ static drift_vec3 direct_light(const drift_refine_tracer *t, const drift_surface
 static drift_vec3 sample_glossy(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec3 ng, drift_vec2 u,
                                 drift_vec3 *out_dir)
 {
-    drift_vec3 r = drift_vec3_reflect(wo, bsdf->frame.z);
     float n = bsdf->exponent;
-    float cos_a = powf(u.x, 1.0f / (n + 1.0f));
-    float sin_a = sqrtf(fmaxf(0.0f, 1.0f - cos_a * cos_a));
-    float phi = 2.0f * DRIFT_PI * u.y;
-    drift_frame frame = drift_frame_from_normal(r);
-    drift_vec3 wi =
-        drift_frame_to_world(&frame, drift_vec3_make(sin_a * cosf(phi), sin_a * sinf(phi), cos_a));
+    drift_vec3 wi = drift_bsdf_sample_glossy_lobe(bsdf, wo, u);
     *out_dir = wi;
     float cos_i = drift_vec3_dot(wi, bsdf->frame.z);
     if (cos_i <= 0.0f || drift_vec3_dot(wi, ng) * drift_vec3_dot(wo, ng) <= 0.0f) {

@@ -1,0 +1,169 @@
+// The technique table (drift/techniques.h, src/hybrid/techniques.c): every row renders, every
+// row is what the table says it is, and the frame prepares only the inputs the chosen rows ask
+// for (a technique that does not list shadow maps never gets them silently).
+#include "drift_test.h"
+#include "hybrid/techniques.h"
+#include "test_rig.h"
+
+#include <math.h>
+#include <string.h>
+
+// A floor, a back wall, a glossy and a mirror sphere under one quad light.
+static void build_scene(test_rig *r, int32_t size)
+{
+    uint32_t white =
+        test_add_material(r->scene, drift_material_make(drift_vec3_make(0.7f, 0.6f, 0.5f)));
+    uint32_t glossy =
+        test_add_material(r->scene, (drift_material){ .diffuse = { 0.3f, 0.1f, 0.1f },
+                                                      .specular = { 0.5f, 0.5f, 0.5f },
+                                                      .exponent = 40.0f,
+                                                      .diffuse_texture = DRIFT_INVALID_INDEX });
+    uint32_t mirror =
+        test_add_material(r->scene, (drift_material){ .type = DRIFT_MATERIAL_MIRROR,
+                                                      .specular = { 0.9f, 0.9f, 0.9f },
+                                                      .diffuse_texture = DRIFT_INVALID_INDEX });
+    test_add_floor(r->scene, 3.0f, -1.0f, white);
+    test_add_quad(r->scene, drift_vec3_make(-3, -1, 2), drift_vec3_make(6, 0, 0),
+                  drift_vec3_make(0, 4, 0), white);
+    test_add_sphere(r->scene, drift_vec3_make(-0.6f, -0.5f, 0.5f), 0.5f, 32, 16, glossy);
+    test_add_sphere(r->scene, drift_vec3_make(0.7f, -0.6f, 0.2f), 0.4f, 32, 16, mirror);
+    test_add_quad_light(r->scene, drift_vec3_make(-0.5f, 2.0f, -0.5f), drift_vec3_make(1, 0, 0),
+                        drift_vec3_make(0, 0, 1), 8.0f); // emits down
+    r->scene->camera =
+        drift_camera_look_at(drift_vec3_make(0, 0.5f, -3.0f), drift_vec3_make(0, -0.5f, 0.5f),
+                             drift_vec3_make(0, 1, 0), 1.0f, size, size);
+    r->scene->camera.aperture_radius = 0.05f;
+    r->scene->camera.focus_distance = 3.0f;
+}
+
+static const char *const term_plane[DRIFT_EFFECT_COUNT] = {
+    [DRIFT_EFFECT_SHADOWS] = "direct",
+    [DRIFT_EFFECT_REFLECTIONS] = "reflections",
+    [DRIFT_EFFECT_DOF] = "final",
+    [DRIFT_EFFECT_INDIRECT] = "indirect",
+};
+
+static double plane_sum(const drift_image *image)
+{
+    double sum = 0.0;
+    size_t n = (size_t)image->width * (size_t)image->height * (size_t)image->channels;
+    for (size_t i = 0; i < n; ++i) {
+        assert_true(isfinite(image->pixels[i]) || image->pixels[i] == INFINITY);
+        sum += isfinite(image->pixels[i]) ? fabs((double)image->pixels[i]) : 0.0;
+    }
+    return sum;
+}
+
+// Every row of every effect, chosen alone: the frame renders, the final image is finite, the
+// effect's term holds light unless the row adds none, plane names are unique, and passes that
+// the row's inputs do not ask for did not run.
+static void test_every_row_renders(void **state)
+{
+    (void)state;
+    test_rig r = test_rig_begin(2);
+    build_scene(&r, 20);
+    test_rig_commit(&r);
+    int rows = 0;
+    for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
+        for (int t = 0; t < drift_technique_count((drift_effect)e); ++t) {
+            const drift_technique_row *row = drift_technique_row_of((drift_effect)e, t);
+            drift_hybrid_params p = { .spp = 2, .seed = 3 };
+            drift_hybrid_params_set_technique(&p, (drift_effect)e, t);
+            print_message("%s %s\n", drift_effect_name((drift_effect)e), row->name);
+            test_rig_frame(&r, &p);
+            const drift_image *final = drift_hybrid_image(r.frame);
+            double total = plane_sum(final);
+            assert_true(total > 0.0);
+            if (!(row->flags & DRIFT_ROW_NO_TERM)) {
+                assert_true(plane_sum(test_rig_plane(&r, term_plane[e])) > 0.0);
+            }
+            const char *names[256];
+            const drift_image *image;
+            uint32_t count = 0;
+            while (count < 256 && drift_hybrid_plane(r.frame, count, &names[count], &image)) {
+                for (uint32_t k = 0; k < count; ++k) {
+                    assert_string_not_equal(names[k], names[count]);
+                }
+                ++count;
+            }
+            drift_hybrid_stats stats = drift_hybrid_get_stats(r.frame);
+            if (!(row->inputs & DRIFT_INPUT_SHADOW_MAPS) && e == DRIFT_EFFECT_SHADOWS) {
+                assert_true(stats.rays[DRIFT_PASS_SHADOW_MAPS] == 0);
+            }
+            if (!(row->inputs & DRIFT_INPUT_HARD_SHADOWS) && e == DRIFT_EFFECT_SHADOWS) {
+                assert_true(stats.rays[DRIFT_PASS_HARD_SHADOWS] == 0);
+            }
+            if (!(row->inputs & DRIFT_INPUT_SHARP_REFLECTIONS) && e == DRIFT_EFFECT_REFLECTIONS) {
+                assert_true(stats.rays[DRIFT_PASS_REFLECTIONS] == 0);
+            }
+            if (!(row->flags & DRIFT_ROW_PATH_TRACED)) {
+                assert_true(stats.rays[DRIFT_PASS_REFERENCE] == 0);
+            }
+            ++rows;
+        }
+    }
+    assert_int_equal(rows, DRIFT_SHADOWS_COUNT + DRIFT_REFLECTIONS_COUNT + DRIFT_DOF_COUNT +
+                               DRIFT_INDIRECT_COUNT);
+    test_rig_destroy(&r);
+}
+
+// The rows are what the table says: in enum order, named uniquely with a summary, reference
+// rows path-traced with their effect's components, and no two different passes keyed on one
+// sampler stream (nor on a stream of the frame's shared inputs or of SIR).
+static void test_rows_are_consistent(void **state)
+{
+    (void)state;
+    const uint32_t reserved[] = { DRIFT_STREAM_UNSHADOWED, DRIFT_STREAM_REFLECTION,
+                                  DRIFT_STREAM_PROBE,      DRIFT_STREAM_ISG_LAYER,
+                                  DRIFT_STREAM_SIR_AO,     DRIFT_STREAM_SIR_TRACE };
+    const drift_technique_row *seen[64];
+    int seen_count = 0;
+    for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
+        uint32_t components = 0;
+        for (int t = 0; t < drift_technique_count((drift_effect)e); ++t) {
+            const drift_technique_row *row = drift_technique_row_of((drift_effect)e, t);
+            assert_non_null(row);
+            assert_int_equal(row->effect, e);
+            assert_int_equal(row->technique, t);
+            assert_true(row->summary && strlen(row->summary) > 8);
+            assert_string_equal(drift_technique_summary((drift_effect)e, t), row->summary);
+            for (int k = 0; k < t; ++k) {
+                assert_string_not_equal(drift_technique_name((drift_effect)e, k), row->name);
+            }
+            if (strcmp(row->name, "reference") == 0) {
+                assert_true(row->flags & DRIFT_ROW_PATH_TRACED);
+                assert_non_null(row->pass);
+            }
+            if (e != DRIFT_EFFECT_DOF) { // one truth an effect
+                assert_true(components == 0 || components == row->components);
+                components = row->components;
+            }
+            if (row->pass == NULL) { // the inputs are the term: there must be some, or no term
+                assert_true(row->inputs != 0 || (row->flags & DRIFT_ROW_NO_TERM));
+            }
+            for (size_t k = 0; row->stream && k < sizeof reserved / sizeof *reserved; ++k) {
+                assert_true(row->stream != reserved[k]);
+            }
+            for (int k = 0; row->stream && k < seen_count; ++k) {
+                if (seen[k]->stream == row->stream) {
+                    assert_true(seen[k]->pass == row->pass);
+                }
+            }
+            assert_true(seen_count < 64);
+            seen[seen_count++] = row;
+        }
+        assert_null(
+            drift_technique_row_of((drift_effect)e, drift_technique_count((drift_effect)e)));
+        assert_null(drift_technique_summary((drift_effect)e, -1));
+    }
+    assert_null(drift_technique_row_of(DRIFT_EFFECT_COUNT, 0));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_rows_are_consistent),
+        cmocka_unit_test(test_every_row_renders),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
