@@ -3,6 +3,22 @@
 // reference path tracer restricted to some components.
 #include "frame/frame.h"
 
+// --- NO-OPS OF THE TABLE ---
+
+drift_result drift_pass_none(drift_frame_state *frame, const drift_pass_args *args)
+{
+    (void)frame;
+    (void)args;
+    return DRIFT_OK;
+}
+
+void drift_planes_none(const drift_frame_state *frame, drift_pass_plane_fn add, void *sink)
+{
+    (void)frame;
+    (void)add;
+    (void)sink;
+}
+
 // --- ROWS AND PIXELS ---
 
 typedef struct row_job {

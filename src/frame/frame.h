@@ -114,6 +114,11 @@ typedef void (*drift_pass_plane_fn)(void *sink, const char *name, const drift_im
 typedef void (*drift_pass_planes_fn)(const drift_frame_state *frame, drift_pass_plane_fn add,
                                      void *sink);
 
+// The pass of a row whose inputs already are its term (hard shadows, sharp reflections) or
+// that adds none, and the planes of a row with none of its own.
+drift_result drift_pass_none(drift_frame_state *frame, const drift_pass_args *args);
+void drift_planes_none(const drift_frame_state *frame, drift_pass_plane_fn add, void *sink);
+
 // Inputs a row needs, prepared by the conductor before any row's pass (each at most once a
 // frame, whichever rows ask): the table's `inputs` column.
 enum {

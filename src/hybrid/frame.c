@@ -396,9 +396,7 @@ static void collect_planes(drift_hybrid *h, uint32_t inputs)
     }
     for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
         const drift_technique_row *row = drift_technique_row_chosen(&f->params, (drift_effect)e);
-        if (row->planes) {
-            row->planes(f, add_plane, h);
-        }
+        row->planes(f, add_plane, h);
     }
 }
 
@@ -455,7 +453,7 @@ static drift_result run_row(drift_frame_state *f, const drift_technique_row *row
                              .stream = row->stream,
                              .components = row->components,
                              .cancel = cancel };
-    drift_result r = row->pass ? row->pass(f, &args) : DRIFT_OK;
+    drift_result r = row->pass(f, &args);
     if (r == DRIFT_OK && (row->flags & DRIFT_ROW_SUMS_DIRECT)) {
         r = drift_realtime_pass_sum_direct(f);
     }

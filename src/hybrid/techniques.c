@@ -2,11 +2,17 @@
 // public names, summaries and counts read from them.
 #include "hybrid/techniques.h"
 
-#include "aaf/aaf.h"
-#include "isg/isg.h"
-#include "realtime/realtime.h"
-
 #include <string.h>
+
+// The table names each row's pass and planes function; their prototypes come from the table
+// too (each folder's header declares the same), so a new row needs no include here.
+#define DECLARE_(ENUM, name, summary, pass, inputs, flags, planes, stream, components) \
+    drift_result pass(drift_frame_state *frame, const drift_pass_args *args);          \
+    void planes(const drift_frame_state *frame, drift_pass_plane_fn add, void *sink);
+DRIFT_SHADOW_TECHNIQUES(DECLARE_)
+DRIFT_REFLECTION_TECHNIQUES(DECLARE_)
+DRIFT_DOF_TECHNIQUES(DECLARE_)
+DRIFT_INDIRECT_TECHNIQUES(DECLARE_)
 
 #define ROW_(effect, prefix, ENUM, name, summary, pass, inputs, flags, planes, stream, components) \
     { effect, prefix##ENUM, name, summary, pass, inputs, flags, planes, stream, components },

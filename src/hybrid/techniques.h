@@ -12,10 +12,10 @@ typedef struct drift_technique_row {
     int technique;
     const char *name;
     const char *summary;
-    drift_pass_fn pass;          // NULL: the inputs already are the term
+    drift_pass_fn pass;          // drift_pass_none: the inputs already are the term
     uint32_t inputs;             // DRIFT_INPUT_*
     uint32_t flags;              // DRIFT_ROW_*
-    drift_pass_planes_fn planes; // NULL: no planes of its own
+    drift_pass_planes_fn planes; // drift_planes_none: no planes of its own
     uint32_t stream;
     uint32_t components;
 } drift_technique_row;
