@@ -154,25 +154,6 @@ float drift_shadow_map_hard(const drift_shadow_map *map, drift_vec3 p, drift_vec
 float drift_shadow_map_pcf(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n, int32_t kernel);
 float drift_shadow_map_pcss(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n,
                             uint32_t rotation_hash);
-// Penumbra estimate for SIR's shadow error: 1 where the light may be partly hidden from p
-// (blockers in the cone to the light and an unblocked tap in their backprojected region),
-// 0 in umbra and where nothing blocks. Conservative up to the tap spacing. 0 for point lights.
-float drift_shadow_map_penumbra(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n);
-
-// The same with options: light_size > 0 replaces the map's bounding radius in the cone and
-// backprojection (clamped to it: a tighter bound of the light as seen from p); exhaustive taps
-// every grid point instead of skipping regions the min-depth mip proves free of blockers (the
-// same result, slower: for tests); taps_only taps the finest levels too instead of testing
-// every texel they cover (which finds the same blockers and maybe more: for tests).
-typedef struct drift_penumbra_query {
-    float light_size;
-    bool exhaustive;
-    bool taps_only;
-} drift_penumbra_query;
-
-float drift_shadow_map_penumbra_query(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n,
-                                      const drift_penumbra_query *query);
-
 // --- ENVIRONMENT MAP (envmap.c) ---
 
 // A cube map of the radiance seen from a probe point, emitted and reflected parts apart,

@@ -16,14 +16,11 @@
 // Plus a normal offset of NORMAL_OFFSET_TEXELS footprints: the receiver plane alone left acne
 // on planes nearly edge-on to the light's centre (the Cornell box's tall block under PCSS);
 // the offset moves shadow edges by about a texel.
-#include "raster/raster.h"
+#include "raster/shadow_map_internal.h"
 
 #include <math.h>
 
-#define CUBE_FACES  6
-#define MAX_SIZE    16384
-#define SEARCH_TAPS 16 // PCSS blocker search, a 4 x 4 stratified concentric disk
-#define FILTER_TAPS 32 // PCSS filter, an 8 x 4 stratified concentric disk
+#define MAX_SIZE 16384
 // Rays that keep hitting the light's own shape give up after this many (a light is never
 // that many layers deep in practice).
 #define MAX_OWN_HITS       16
@@ -36,38 +33,10 @@
 // Widest tap region of an orthographic lookup, as a fraction of the map's width.
 #define MAX_ORTHO_RADIUS 0.25f
 
-struct drift_shadow_map {
-    bool directional;
-    int32_t size;
-    float bias_texels;
-    float radius;                 // light size L (directional: angular radius, radians)
-    drift_vec3 centre;            // cube: where the map looks from
-    int8_t face_slot[CUBE_FACES]; // cube: slot of each face in `depth`, -1 when skipped
-    uint32_t slot_count;          // faces stored (1 for orthographic maps)
-    drift_frame frame;            // orthographic: z = the way light travels
-    drift_vec3 origin;            // orthographic: world point of texel corner (0, 0) at depth 0
-    float texel_size;             // orthographic: scene units a texel
-    float *depth;                 // slot_count * size * size; INFINITY where rays miss
-    // Min-depth mip chain of each slot (level k: cells of 2^k x 2^k texels, k = 1 ..
-    // mip_levels), so the penumbra estimate can prove a tap region free of blockers with a
-    // few reads (see search_level).
-    float *min_mip;
-    int32_t mip_levels;
-    size_t mip_offset[32]; // level k of slot s at min_mip + s * mip_slot + mip_offset[k]
-    size_t mip_slot;
-    drift_vec2 search_taps[SEARCH_TAPS];
-    drift_vec2 filter_taps[FILTER_TAPS];
-};
-
 // --- CUBE FACES ---
 // Face f looks along axis a = f / 2 with sign s = + for even f. Its texel (x, y) looks along
 // s e_a + u e_b + v e_c with b = (a + 1) % 3, c = (a + 2) % 3 and u, v in [-1, 1] the texel
 // centre; any fixed layout works, as build and lookup share these functions.
-
-static float vec3_axis(drift_vec3 v, int axis)
-{
-    return axis == 0 ? v.x : (axis == 1 ? v.y : v.z);
-}
 
 static drift_vec3 axis_vec3(int axis, float value)
 {
@@ -91,11 +60,11 @@ static drift_vec3 face_direction(int face, float u, float v)
     return drift_vec3_add(d, axis_vec3((a + 2) % 3, v));
 }
 
-static int major_face(drift_vec3 d)
+int drift_shadow_map_major_face(drift_vec3 d)
 {
     float ax = fabsf(d.x), ay = fabsf(d.y), az = fabsf(d.z);
     int a = ax >= ay && ax >= az ? 0 : (ay >= az ? 1 : 2);
-    return 2 * a + (vec3_axis(d, a) >= 0.0f ? 0 : 1);
+    return 2 * a + (drift_shadow_map_axis(d, a) >= 0.0f ? 0 : 1);
 }
 
 // Whether any direction of the face has dot(dir, n) > 0: the largest dot over the face
@@ -104,8 +73,8 @@ static bool face_faces(int face, drift_vec3 n)
 {
     int a = face / 2;
     float s = face % 2 == 0 ? 1.0f : -1.0f;
-    float best =
-        s * vec3_axis(n, a) + fabsf(vec3_axis(n, (a + 1) % 3)) + fabsf(vec3_axis(n, (a + 2) % 3));
+    float best = s * drift_shadow_map_axis(n, a) + fabsf(drift_shadow_map_axis(n, (a + 1) % 3)) +
+                 fabsf(drift_shadow_map_axis(n, (a + 2) % 3));
     return best > 0.0f;
 }
 
@@ -114,7 +83,7 @@ static float texel_centre(int32_t i, int32_t size)
     return ((float)i + 0.5f) * 2.0f / (float)size - 1.0f;
 }
 
-static int32_t texel_index(float u, int32_t size)
+int32_t drift_shadow_map_texel_index(float u, int32_t size)
 {
     int32_t i = (int32_t)floorf((u + 1.0f) * 0.5f * (float)size);
     return i < 0 ? 0 : (i >= size ? size - 1 : i);
@@ -238,8 +207,8 @@ static drift_result build_min_mip(drift_context *ctx, drift_shadow_map *map)
 
 // Least stored depth over texels [x0, x1] x [y0, y1] of a slot (inclusive, in range): at most
 // four cells of the coarsest level whose cells are at least the rectangle's size.
-static float min_depth_rect(const drift_shadow_map *map, int32_t slot, int32_t x0, int32_t y0,
-                            int32_t x1, int32_t y1)
+float drift_shadow_map_min_depth_rect(const drift_shadow_map *map, int32_t slot, int32_t x0,
+                                      int32_t y0, int32_t x1, int32_t y1)
 {
     int32_t extent = (x1 - x0 > y1 - y0 ? x1 - x0 : y1 - y0) + 1, k = 0;
     while ((1 << k) < extent && k < map->mip_levels) {
@@ -405,25 +374,6 @@ void drift_shadow_map_destroy(drift_context *ctx, drift_shadow_map *map)
 
 // --- TAPS ---
 
-// A lookup's receiver, in the map's own terms. Cube maps take tap offsets as angles along
-// t1 and t2 (tangents of the direction, aligned with the face's texel axes); orthographic
-// maps as distances along the map's x and y.
-typedef struct receiver {
-    drift_vec3 dir;    // cube: unit direction centre -> p
-    drift_vec3 t1, t2; // cube: tangent axes of dir
-    drift_vec3 n;      // unit normal turned toward the light (map coordinates for ortho)
-    float x, y;        // orthographic: position on the map
-    float depth;       // cube: distance from the centre; ortho: depth below the near plane
-    float texel;       // one texel in offset units (radians or scene units)
-    float bias;        // depth bias, scene units
-} receiver;
-
-// What one tap saw: the stored depth, and the receiver plane's depth along the same texel.
-typedef struct tap_result {
-    float stored;
-    float receiver;
-} tap_result;
-
 // Normal offset (Holbert 2011): the lookup point moves this many texel footprints along the
 // normal toward the light, which removes the acne left where the receiver plane is nearly
 // edge-on to the light's centre (there the plane's depth is ill-conditioned and capped).
@@ -442,9 +392,9 @@ static drift_vec3 offset_along_normal(drift_vec3 p, drift_vec3 n, drift_vec3 to_
     return drift_vec3_fma(p, n, NORMAL_OFFSET_TEXELS * footprint);
 }
 
-static receiver cube_receiver(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n)
+static drift_shadow_receiver cube_receiver(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n)
 {
-    receiver rec = { 0 };
+    drift_shadow_receiver rec = { 0 };
     drift_vec3 to_centre = drift_vec3_sub(map->centre, p);
     // The footprint at the receiver: the face-centre texel angle times the distance.
     float footprint = 2.0f / (float)map->size * drift_vec3_length(to_centre);
@@ -457,10 +407,11 @@ static receiver cube_receiver(const drift_shadow_map *map, drift_vec3 p, drift_v
     if (drift_vec3_dot(rec.n, rec.dir) > 0.0f) {
         rec.n = drift_vec3_neg(rec.n); // as drift_offset_origin: the side the light is on
     }
-    int face = major_face(rec.dir);
+    int face = drift_shadow_map_major_face(rec.dir);
     int a = face / 2;
-    float major = fabsf(vec3_axis(rec.dir, a));
-    float u = vec3_axis(rec.dir, (a + 1) % 3) / major, v = vec3_axis(rec.dir, (a + 2) % 3) / major;
+    float major = fabsf(drift_shadow_map_axis(rec.dir, a));
+    float u = drift_shadow_map_axis(rec.dir, (a + 1) % 3) / major,
+          v = drift_shadow_map_axis(rec.dir, (a + 2) % 3) / major;
     // Tangents along the face's u axis and its perpendicular: |dir . e_b| <= 1/sqrt(2),
     // so the projection never degenerates.
     drift_vec3 eb = axis_vec3((a + 1) % 3, 1.0f);
@@ -471,9 +422,9 @@ static receiver cube_receiver(const drift_shadow_map *map, drift_vec3 p, drift_v
     return rec;
 }
 
-static receiver ortho_receiver(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n)
+static drift_shadow_receiver ortho_receiver(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n)
 {
-    receiver rec = { 0 };
+    drift_shadow_receiver rec = { 0 };
     p = offset_along_normal(p, n, drift_vec3_neg(map->frame.z), map->texel_size);
     drift_vec3 local = drift_frame_to_local(&map->frame, drift_vec3_sub(p, map->origin));
     rec.x = local.x;
@@ -489,7 +440,8 @@ static receiver ortho_receiver(const drift_shadow_map *map, drift_vec3 p, drift_
     return rec;
 }
 
-static receiver make_receiver(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n)
+drift_shadow_receiver drift_shadow_map_receiver(const drift_shadow_map *map, drift_vec3 p,
+                                                drift_vec3 n)
 {
     return map->directional ? ortho_receiver(map, p, n) : cube_receiver(map, p, n);
 }
@@ -498,41 +450,36 @@ static receiver make_receiver(const drift_shadow_map *map, drift_vec3 p, drift_v
 // ray meets the receiver's tangent plane (plane_depth), with the change from the receiver's
 // own depth capped at a slope of MAX_RECEIVER_SLOPE. A ray that never meets the plane takes
 // the cap.
-static float receiver_depth(const receiver *rec, float plane_depth, bool meets_plane, float lateral)
+static float receiver_depth(const drift_shadow_receiver *rec, float plane_depth, bool meets_plane,
+                            float lateral)
 {
     float cap = MAX_RECEIVER_SLOPE * lateral;
     float change = meets_plane ? plane_depth - rec->depth : cap;
     return rec->depth + drift_clampf(change, -cap, cap);
 }
 
-// Where a tap lands: the texel it reads (face and slot for cube maps) and the depth stored
-// there; INFINITY behind a one-sided light or outside an orthographic map.
-typedef struct tap_texel {
-    float stored;
-    int face;
-    int32_t x, y;
-} tap_texel;
-
-static tap_texel cube_texel(const drift_shadow_map *map, const receiver *rec, float ox, float oy)
+static drift_shadow_texel cube_texel(const drift_shadow_map *map, const drift_shadow_receiver *rec,
+                                     float ox, float oy)
 {
     drift_vec3 d = drift_vec3_fma(drift_vec3_fma(rec->dir, rec->t1, ox), rec->t2, oy);
-    tap_texel t = { .stored = INFINITY, .face = major_face(d) };
+    drift_shadow_texel t = { .stored = INFINITY, .face = drift_shadow_map_major_face(d) };
     int slot = map->face_slot[t.face];
     if (slot < 0) {
         // Behind a one-sided light: it sends nothing there, so nothing can block it.
         return t;
     }
     int a = t.face / 2;
-    float major = fabsf(vec3_axis(d, a));
-    t.x = texel_index(vec3_axis(d, (a + 1) % 3) / major, map->size);
-    t.y = texel_index(vec3_axis(d, (a + 2) % 3) / major, map->size);
+    float major = fabsf(drift_shadow_map_axis(d, a));
+    t.x = drift_shadow_map_texel_index(drift_shadow_map_axis(d, (a + 1) % 3) / major, map->size);
+    t.y = drift_shadow_map_texel_index(drift_shadow_map_axis(d, (a + 2) % 3) / major, map->size);
     size_t size = (size_t)map->size;
     t.stored = map->depth[((size_t)slot * size + (size_t)t.y) * size + (size_t)t.x];
     return t;
 }
 
 // The receiver plane's depth along the ray through the tap's texel centre.
-static float cube_receiver_at(const drift_shadow_map *map, const receiver *rec, const tap_texel *t)
+static float cube_receiver_at(const drift_shadow_map *map, const drift_shadow_receiver *rec,
+                              const drift_shadow_texel *t)
 {
     if (map->face_slot[t->face] < 0) {
         return rec->depth;
@@ -547,9 +494,10 @@ static float cube_receiver_at(const drift_shadow_map *map, const receiver *rec, 
     return receiver_depth(rec, h / cos_c, cos_c > 0.0f, lateral);
 }
 
-static tap_texel ortho_texel(const drift_shadow_map *map, const receiver *rec, float ox, float oy)
+static drift_shadow_texel ortho_texel(const drift_shadow_map *map, const drift_shadow_receiver *rec,
+                                      float ox, float oy)
 {
-    tap_texel t = { .stored = INFINITY, .face = -1 };
+    drift_shadow_texel t = { .stored = INFINITY, .face = -1 };
     float fx = (rec->x + ox) / map->texel_size, fy = (rec->y + oy) / map->texel_size;
     if (!(fx >= 0.0f && fy >= 0.0f && fx < (float)map->size && fy < (float)map->size)) {
         return t; // outside the scene: nothing there
@@ -561,7 +509,8 @@ static tap_texel ortho_texel(const drift_shadow_map *map, const receiver *rec, f
     return t;
 }
 
-static float ortho_receiver_at(const drift_shadow_map *map, const receiver *rec, const tap_texel *t)
+static float ortho_receiver_at(const drift_shadow_map *map, const drift_shadow_receiver *rec,
+                               const drift_shadow_texel *t)
 {
     if (t->face < 0) {
         return rec->depth;
@@ -576,23 +525,26 @@ static float ortho_receiver_at(const drift_shadow_map *map, const receiver *rec,
     return receiver_depth(rec, plane, meets, sqrtf(dx * dx + dy * dy));
 }
 
-static tap_texel tap_lands(const drift_shadow_map *map, const receiver *rec, float ox, float oy)
+drift_shadow_texel drift_shadow_map_tap_lands(const drift_shadow_map *map,
+                                              const drift_shadow_receiver *rec, float ox, float oy)
 {
     return map->directional ? ortho_texel(map, rec, ox, oy) : cube_texel(map, rec, ox, oy);
 }
 
-static float receiver_at(const drift_shadow_map *map, const receiver *rec, const tap_texel *t)
+float drift_shadow_map_receiver_at(const drift_shadow_map *map, const drift_shadow_receiver *rec,
+                                   const drift_shadow_texel *t)
 {
     return map->directional ? ortho_receiver_at(map, rec, t) : cube_receiver_at(map, rec, t);
 }
 
-static tap_result tap(const drift_shadow_map *map, const receiver *rec, float ox, float oy)
+drift_shadow_tap drift_shadow_map_tap(const drift_shadow_map *map, const drift_shadow_receiver *rec,
+                                      float ox, float oy)
 {
-    tap_texel t = tap_lands(map, rec, ox, oy);
-    return (tap_result){ t.stored, receiver_at(map, rec, &t) };
+    drift_shadow_texel t = drift_shadow_map_tap_lands(map, rec, ox, oy);
+    return (drift_shadow_tap){ t.stored, drift_shadow_map_receiver_at(map, rec, &t) };
 }
 
-static bool tap_lit(const receiver *rec, tap_result t)
+bool drift_shadow_map_tap_lit(const drift_shadow_receiver *rec, drift_shadow_tap t)
 {
     return t.stored >= t.receiver - rec->bias;
 }
@@ -600,26 +552,26 @@ static bool tap_lit(const receiver *rec, tap_result t)
 // --- LOOKUPS ---
 
 // One tap at the receiver itself: the nearest texel.
-static float hard_lookup(const drift_shadow_map *map, const receiver *rec)
+static float hard_lookup(const drift_shadow_map *map, const drift_shadow_receiver *rec)
 {
-    return tap_lit(rec, tap(map, rec, 0.0f, 0.0f)) ? 1.0f : 0.0f;
+    return drift_shadow_map_tap_lit(rec, drift_shadow_map_tap(map, rec, 0.0f, 0.0f)) ? 1.0f : 0.0f;
 }
 
 float drift_shadow_map_hard(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n)
 {
-    receiver rec = make_receiver(map, p, n);
+    drift_shadow_receiver rec = drift_shadow_map_receiver(map, p, n);
     return hard_lookup(map, &rec);
 }
 
 // Box of kernel x kernel taps a texel apart, centred on the receiver.
-static float pcf_box(const drift_shadow_map *map, const receiver *rec, int32_t kernel)
+static float pcf_box(const drift_shadow_map *map, const drift_shadow_receiver *rec, int32_t kernel)
 {
     float half = 0.5f * (float)(kernel - 1);
     int32_t lit = 0;
     for (int32_t j = 0; j < kernel; ++j) {
         for (int32_t i = 0; i < kernel; ++i) {
             float ox = ((float)i - half) * rec->texel, oy = ((float)j - half) * rec->texel;
-            lit += tap_lit(rec, tap(map, rec, ox, oy));
+            lit += drift_shadow_map_tap_lit(rec, drift_shadow_map_tap(map, rec, ox, oy));
         }
     }
     return (float)lit / (float)(kernel * kernel);
@@ -627,7 +579,7 @@ static float pcf_box(const drift_shadow_map *map, const receiver *rec, int32_t k
 
 float drift_shadow_map_pcf(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n, int32_t kernel)
 {
-    receiver rec = make_receiver(map, p, n);
+    drift_shadow_receiver rec = drift_shadow_map_receiver(map, p, n);
     return pcf_box(map, &rec, kernel < 1 ? 1 : kernel);
 }
 
@@ -648,7 +600,7 @@ static drift_vec2 rotate(rotation r, drift_vec2 v, float radius)
     return (drift_vec2){ (r.c * v.x - r.s * v.y) * radius, (r.s * v.x + r.c * v.y) * radius };
 }
 
-static float max_radius(const drift_shadow_map *map)
+float drift_shadow_map_max_radius(const drift_shadow_map *map)
 {
     return map->directional ? MAX_ORTHO_RADIUS * map->texel_size * (float)map->size
                             : MAX_CUBE_RADIUS;
@@ -662,7 +614,7 @@ static float max_radius(const drift_shadow_map *map)
 // trims the outer penumbra of blockers closer to the light, the usual PCSS trade-off.
 // Directional lights (L an angle, map depth from the near plane) have a cone L (d_r - z)
 // wide, widest at the near plane: L d_r.
-static float pcss_search_radius(const drift_shadow_map *map, const receiver *rec)
+static float pcss_search_radius(const drift_shadow_map *map, const drift_shadow_receiver *rec)
 {
     float L = map->radius, d_r = rec->depth, radius;
     if (map->directional) {
@@ -671,27 +623,28 @@ static float pcss_search_radius(const drift_shadow_map *map, const receiver *rec
         float near = fmaxf(PCSS_NEAR_FRACTION * d_r, L);
         radius = d_r > near ? L * (d_r - near) / (d_r * near) : 0.0f;
     }
-    return drift_clampf(radius, rec->texel, max_radius(map));
+    return drift_clampf(radius, rec->texel, drift_shadow_map_max_radius(map));
 }
 
 // Filter radius in offset units for a mean blocker depth d_b: the penumbra width at the
 // receiver w = L (d_r - d_b) / d_b (directional: L (d_r - d_b)), as an angle w / d_r for
 // cube maps.
-static float pcss_filter_radius(const drift_shadow_map *map, const receiver *rec, float d_b)
+static float pcss_filter_radius(const drift_shadow_map *map, const drift_shadow_receiver *rec,
+                                float d_b)
 {
     float L = map->radius, d_r = rec->depth, radius;
     if (map->directional) {
         radius = L * (d_r - d_b);
     } else {
-        radius = d_b > 0.0f ? L * (d_r - d_b) / (d_b * d_r) : max_radius(map);
+        radius = d_b > 0.0f ? L * (d_r - d_b) / (d_b * d_r) : drift_shadow_map_max_radius(map);
     }
-    return drift_clampf(radius, 0.0f, max_radius(map));
+    return drift_clampf(radius, 0.0f, drift_shadow_map_max_radius(map));
 }
 
 float drift_shadow_map_pcss(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n,
                             uint32_t rotation_hash)
 {
-    receiver rec = make_receiver(map, p, n);
+    drift_shadow_receiver rec = drift_shadow_map_receiver(map, p, n);
     if (!(map->radius > 0.0f)) {
         return hard_lookup(map, &rec); // a point light casts no penumbra
     }
@@ -701,8 +654,8 @@ float drift_shadow_map_pcss(const drift_shadow_map *map, drift_vec3 p, drift_vec
     int32_t blockers = 0;
     for (int i = 0; i < SEARCH_TAPS; ++i) {
         drift_vec2 o = rotate(rot, map->search_taps[i], search);
-        tap_result t = tap(map, &rec, o.x, o.y);
-        if (!tap_lit(&rec, t)) {
+        drift_shadow_tap t = drift_shadow_map_tap(map, &rec, o.x, o.y);
+        if (!drift_shadow_map_tap_lit(&rec, t)) {
             blocker_sum += t.stored;
             blockers++;
         }
@@ -714,362 +667,7 @@ float drift_shadow_map_pcss(const drift_shadow_map *map, drift_vec3 p, drift_vec
     int32_t lit = 0;
     for (int i = 0; i < FILTER_TAPS; ++i) {
         drift_vec2 o = rotate(rot, map->filter_taps[i], filter);
-        lit += tap_lit(&rec, tap(map, &rec, o.x, o.y));
+        lit += drift_shadow_map_tap_lit(&rec, drift_shadow_map_tap(map, &rec, o.x, o.y));
     }
     return (float)lit / (float)FILTER_TAPS;
-}
-
-// --- PENUMBRA ESTIMATE (SIR's shadow error; in the spirit of Guennebaud et al. 2006) ---
-
-// Taps a side of the square grids below (the blocker search repeats it at shrinking radii).
-#define PENUMBRA_GRID 8
-// Levels of the blocker search at most this many texels in radius test texels, not taps.
-#define TEXEL_LEVEL 2.0f
-
-typedef struct penumbra_search {
-    const drift_shadow_map *map;
-    const receiver *rec;
-    float L;           // light size for the cone (the map's radius unless the query is tighter)
-    bool hierarchical; // prove regions blocker-free from the min-depth mip before tapping
-    bool texel_levels; // test texels instead of taps at the finest levels
-} penumbra_search;
-
-// Offset radius within which a blocker at depth z can hide part of the light from the
-// receiver: the cone from the receiver to the light (radius L) seen from the centre,
-// L (d_r - z) / (d_r z) (directional: L (d_r - z)), plus a texel for the tap's own footprint.
-static float blocker_cone(const penumbra_search *s, float z)
-{
-    float L = s->L, d_r = s->rec->depth;
-    float cone =
-        s->map->directional ? L * (d_r - z) : (z > 0.0f ? L * (d_r - z) / (d_r * z) : INFINITY);
-    return cone + s->rec->texel;
-}
-
-// The cone test inverted: a blocker at offset radius o passes it only at depth <= this
-// (INFINITY when every depth passes, within a texel of the receiver's direction).
-static float cone_depth_bound(const penumbra_search *s, float o)
-{
-    float excess = o - s->rec->texel, L = s->L, d_r = s->rec->depth;
-    if (!(excess > 0.0f)) {
-        return INFINITY;
-    }
-    return s->map->directional ? d_r - excess / L : L * d_r / (excess * d_r + L);
-}
-
-// Least depth stored in any texel a tap with ox in [x0, x1], oy in [y0, y1] can read. Cube
-// maps: the rectangle of directions dir + ox t1 + oy t2 is convex, and so is its central
-// projection onto a face plane when every corner is in front of it; the corners' bounding box
-// then holds every tap that lands on the face (padded two texels for rounding). When all four
-// corners land on one face, so does the whole rectangle (its image is convex, and so is the
-// face's square). A face the rectangle straddles is read whole; one behind every corner gets
-// no tap.
-static float region_min_depth(const penumbra_search *s, float x0, float y0, float x1, float y1)
-{
-    const drift_shadow_map *map = s->map;
-    const receiver *rec = s->rec;
-    int32_t last = map->size - 1;
-    if (map->directional) {
-        float fx0 = (rec->x + x0) / map->texel_size - 2.0f,
-              fx1 = (rec->x + x1) / map->texel_size + 2.0f;
-        float fy0 = (rec->y + y0) / map->texel_size - 2.0f,
-              fy1 = (rec->y + y1) / map->texel_size + 2.0f;
-        if (fx1 < 0.0f || fy1 < 0.0f || fx0 > (float)last || fy0 > (float)last) {
-            return INFINITY;
-        }
-        int32_t ix0 = fx0 < 0.0f ? 0 : (int32_t)fx0, iy0 = fy0 < 0.0f ? 0 : (int32_t)fy0;
-        int32_t ix1 = fx1 > (float)last ? last : (int32_t)fx1;
-        int32_t iy1 = fy1 > (float)last ? last : (int32_t)fy1;
-        return min_depth_rect(map, 0, ix0, iy0, ix1, iy1);
-    }
-    drift_vec3 corner[4];
-    int faces[4];
-    for (int k = 0; k < 4; ++k) {
-        corner[k] = drift_vec3_fma(drift_vec3_fma(rec->dir, rec->t1, (k & 1) ? x1 : x0), rec->t2,
-                                   (k & 2) ? y1 : y0);
-        faces[k] = major_face(corner[k]);
-    }
-    bool one_face = faces[0] == faces[1] && faces[0] == faces[2] && faces[0] == faces[3];
-    float best = INFINITY, pad = 4.0f / (float)map->size;
-    for (int f = one_face ? faces[0] : 0; f < (one_face ? faces[0] + 1 : CUBE_FACES); ++f) {
-        int slot = map->face_slot[f];
-        if (slot < 0) {
-            continue;
-        }
-        int a = f / 2;
-        float sign = f % 2 == 0 ? 1.0f : -1.0f;
-        int in_front = 0;
-        float u0 = INFINITY, u1 = -INFINITY, v0 = INFINITY, v1 = -INFINITY;
-        for (int k = 0; k < 4; ++k) {
-            float along = sign * vec3_axis(corner[k], a);
-            if (along > 0.0f) {
-                ++in_front;
-                float u = vec3_axis(corner[k], (a + 1) % 3) / along;
-                float v = vec3_axis(corner[k], (a + 2) % 3) / along;
-                u0 = fminf(u0, u);
-                u1 = fmaxf(u1, u);
-                v0 = fminf(v0, v);
-                v1 = fmaxf(v1, v);
-            }
-        }
-        if (in_front == 0) {
-            continue;
-        }
-        int32_t tx0 = 0, tx1 = last, ty0 = 0, ty1 = last;
-        if (in_front == 4) {
-            if (u0 - pad > 1.0f || u1 + pad < -1.0f || v0 - pad > 1.0f || v1 + pad < -1.0f) {
-                continue;
-            }
-            tx0 = texel_index(u0 - pad, map->size);
-            tx1 = texel_index(u1 + pad, map->size);
-            ty0 = texel_index(v0 - pad, map->size);
-            ty1 = texel_index(v1 + pad, map->size);
-        }
-        best = fminf(best, min_depth_rect(map, slot, tx0, ty0, tx1, ty1));
-    }
-    return best;
-}
-
-// The texels a square of taps (|ox|, |oy| <= r) can read, when it lands on one face (cube) or
-// on the map (orthographic): slot and inclusive texel rectangle. False when it spans faces.
-typedef struct texel_rect {
-    int face, slot;
-    int32_t x0, y0, x1, y1;
-} texel_rect;
-
-static bool square_texels(const penumbra_search *s, float r, texel_rect *out)
-{
-    const drift_shadow_map *map = s->map;
-    const receiver *rec = s->rec;
-    int32_t last = map->size - 1;
-    if (map->directional) {
-        float fx0 = (rec->x - r) / map->texel_size, fx1 = (rec->x + r) / map->texel_size;
-        float fy0 = (rec->y - r) / map->texel_size, fy1 = (rec->y + r) / map->texel_size;
-        if (!(fx0 >= 0.0f && fy0 >= 0.0f && fx1 < (float)map->size && fy1 < (float)map->size)) {
-            return false; // partly outside the map: taps there see nothing, rectangle clipped
-        }
-        *out = (texel_rect){ 0, 0, (int32_t)fx0, (int32_t)fy0, (int32_t)fx1, (int32_t)fy1 };
-        return out->x1 <= last && out->y1 <= last;
-    }
-    drift_vec3 corner[4];
-    int face = -1;
-    for (int k = 0; k < 4; ++k) {
-        corner[k] = drift_vec3_fma(drift_vec3_fma(rec->dir, rec->t1, (k & 1) ? r : -r), rec->t2,
-                                   (k & 2) ? r : -r);
-        int f = major_face(corner[k]);
-        if (face >= 0 && f != face) {
-            return false;
-        }
-        face = f;
-    }
-    if (map->face_slot[face] < 0) {
-        return false;
-    }
-    int a = face / 2;
-    float u0 = INFINITY, u1 = -INFINITY, v0 = INFINITY, v1 = -INFINITY;
-    for (int k = 0; k < 4; ++k) {
-        float major = fabsf(vec3_axis(corner[k], a));
-        float u = vec3_axis(corner[k], (a + 1) % 3) / major,
-              v = vec3_axis(corner[k], (a + 2) % 3) / major;
-        u0 = fminf(u0, u);
-        u1 = fmaxf(u1, u);
-        v0 = fminf(v0, v);
-        v1 = fmaxf(v1, v);
-    }
-    *out = (texel_rect){ face,
-                         map->face_slot[face],
-                         texel_index(u0, map->size),
-                         texel_index(v0, map->size),
-                         texel_index(u1, map->size),
-                         texel_index(v1, map->size) };
-    return true;
-}
-
-// The finest levels, a couple of texels wide, would put many of their 64 taps in each texel:
-// instead every texel the square can read is tested once, against the receiver plane alone
-// (the cone test at these offsets accepts nearly any depth; skipping it only adds blockers).
-// -1 when the square spans faces (the caller taps it).
-static int32_t search_texels(const penumbra_search *s, float radius, bool first_only,
-                             float *out_nearest)
-{
-    texel_rect rect;
-    if (!square_texels(s, radius, &rect)) {
-        return -1;
-    }
-    const drift_shadow_map *map = s->map;
-    size_t size = (size_t)map->size;
-    int32_t blockers = 0;
-    for (int32_t y = rect.y0; y <= rect.y1; ++y) {
-        for (int32_t x = rect.x0; x <= rect.x1; ++x) {
-            tap_texel t = {
-                .stored = map->depth[((size_t)rect.slot * size + (size_t)y) * size + (size_t)x],
-                .face = rect.face,
-                .x = x,
-                .y = y
-            };
-            if (t.stored >= receiver_at(map, s->rec, &t) - s->rec->bias) {
-                continue;
-            }
-            blockers++;
-            *out_nearest = fminf(*out_nearest, t.stored);
-            if (first_only) {
-                return blockers;
-            }
-        }
-    }
-    return blockers;
-}
-
-// Whether the mip proves that no tap of a group finds a blocker: every texel the group can
-// read (offsets in the square of half width `reach`) is deeper than the cone allows at the
-// group's nearest tap (rounding slack on the side of tapping). *lower is a known lower bound on
-// those depths (from a larger square); raised to the square's least depth when it is read.
-static bool proven_free(const penumbra_search *s, float reach, float nearest_offset, float *lower)
-{
-    float bound = cone_depth_bound(s, nearest_offset) * 1.001f;
-    if (!(bound < INFINITY)) {
-        return false;
-    }
-    if (*lower > bound) {
-        return true;
-    }
-    *lower = fmaxf(*lower, region_min_depth(s, -reach, -reach, reach, reach));
-    return *lower > bound;
-}
-
-// Taps of a grid of PENUMBRA_GRID^2 over the square of half width `radius` that see a blocker
-// (a nearer surface inside the cone to the light: Guennebaud's backprojection test of whether
-// its shadow can reach the receiver), and the nearest blocker's depth; with `first_only`, stops
-// at the first. The hierarchical search skips the inner 4 x 4 block and the outer ring when
-// the mip proves them free (finer groups cost more in proofs than they save in taps), so it
-// finds exactly the exhaustive search's blockers. A texel just found lit is not tested again
-// (the same texel, the same answer).
-static int32_t search_level(const penumbra_search *s, float radius, bool first_only, float *lower,
-                            float *out_nearest)
-{
-    *out_nearest = INFINITY;
-    // Tap (i, j) is at odd multiples of step: (2i + 1 - GRID) step.
-    const float step = radius / (float)PENUMBRA_GRID;
-    if (s->texel_levels && radius <= TEXEL_LEVEL * s->rec->texel) {
-        int32_t blockers = search_texels(s, radius, first_only, out_nearest);
-        if (blockers >= 0) {
-            return blockers;
-        }
-    }
-    bool skip_inner = false, skip_outer = false;
-    if (s->hierarchical) {
-        // Inner taps (1 or 3 steps out each way) are at least sqrt(2) steps from the centre and
-        // read within 4; outer taps at least 5 steps away, within the radius. *lower bounds
-        // the depths over the whole square and leaves bounding those of the inner block, which
-        // holds the next level's square (a third of the radius).
-        skip_outer = proven_free(s, radius, 5.0f * step, lower);
-        skip_inner = proven_free(s, 4.0f * step, 1.41421356f * step, lower);
-        if (skip_inner && skip_outer) {
-            return 0;
-        }
-    }
-    int32_t blockers = 0;
-    tap_texel lit = { .face = -2 }; // the last texel found lit
-    for (int32_t j = 0; j < PENUMBRA_GRID; ++j) {
-        for (int32_t i = 0; i < PENUMBRA_GRID; ++i) {
-            int32_t mx = 2 * i + 1 - PENUMBRA_GRID, my = 2 * j + 1 - PENUMBRA_GRID;
-            bool inner = mx >= -3 && mx <= 3 && my >= -3 && my <= 3;
-            if (inner ? skip_inner : skip_outer) {
-                continue;
-            }
-            float ox = step * (float)mx, oy = step * (float)my;
-            tap_texel t = tap_lands(s->map, s->rec, ox, oy);
-            if (t.face == lit.face && t.x == lit.x && t.y == lit.y) {
-                continue;
-            }
-            // The cone test first: it needs only the stored depth, and most taps fail it.
-            if (sqrtf(ox * ox + oy * oy) > blocker_cone(s, t.stored)) {
-                continue;
-            }
-            if (t.stored >= receiver_at(s->map, s->rec, &t) - s->rec->bias) {
-                lit = t;
-                continue;
-            }
-            blockers++;
-            *out_nearest = fminf(*out_nearest, t.stored);
-            if (first_only) {
-                return blockers;
-            }
-        }
-    }
-    return blockers;
-}
-
-// Whether every tap of the grid over the square of half width `radius` is behind a nearer
-// surface (the umbra test).
-static bool all_blocked(const penumbra_search *s, float radius)
-{
-    for (int32_t j = 0; j < PENUMBRA_GRID; ++j) {
-        for (int32_t i = 0; i < PENUMBRA_GRID; ++i) {
-            float ox = radius * (2.0f * ((float)i + 0.5f) / PENUMBRA_GRID - 1.0f);
-            float oy = radius * (2.0f * ((float)j + 0.5f) / PENUMBRA_GRID - 1.0f);
-            if (tap_lit(s->rec, tap(s->map, s->rec, ox, oy))) {
-                return false;
-            }
-        }
-    }
-    return true;
-}
-
-float drift_shadow_map_penumbra(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n)
-{
-    return drift_shadow_map_penumbra_query(map, p, n, &(drift_penumbra_query){ 0 });
-}
-
-float drift_shadow_map_penumbra_query(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n,
-                                      const drift_penumbra_query *query)
-{
-    if (!(map->radius > 0.0f)) {
-        return 0.0f; // a point light casts no penumbra
-    }
-    receiver rec = make_receiver(map, p, n);
-    float L = query->light_size > 0.0f ? fminf(query->light_size, map->radius) : map->radius;
-    penumbra_search s = { .map = map,
-                          .rec = &rec,
-                          .L = L,
-                          .hierarchical = !query->exhaustive,
-                          .texel_levels = !query->taps_only };
-    float d_r = rec.depth;
-    // Blocker search over the whole cone from the receiver to the light, with the near plane
-    // at the light's own size (PCSS trims it to a quarter of the way: here nothing is trimmed,
-    // the estimate must be conservative).
-    float search;
-    if (map->directional) {
-        search = L * d_r;
-    } else {
-        float near = fmaxf(L, 1e-3f * d_r);
-        search = d_r > near ? L * (d_r - near) / (d_r * near) : 0.0f;
-    }
-    search = drift_clampf(search, rec.texel, max_radius(map));
-    tap_result centre = tap(map, &rec, 0.0f, 0.0f);
-    bool centre_blocked = !tap_lit(&rec, centre);
-    // Blockers near the receiver have narrow cones: a grid spaced for the whole search region
-    // steps over them. Search again at each third of the radius, down to two texels. With the
-    // centre visible, one blocker anywhere decides (penumbra).
-    int32_t blockers = 0;
-    float nearest = INFINITY, lower = -INFINITY;
-    for (float r = search; blockers == 0; r *= 1.0f / 3.0f) {
-        blockers += search_level(&s, r, !centre_blocked, &lower, &nearest);
-        if (r < 2.0f * rec.texel) {
-            break;
-        }
-    }
-    if (!centre_blocked) {
-        // Fully lit when nothing lies between the receiver and any point of the light; blockers
-        // in the cone with the light's centre visible: partly covered.
-        return blockers == 0 ? 0.0f : 1.0f;
-    }
-    nearest = fminf(nearest, centre.stored);
-    // Backprojection bound: the nearest blocker (closest to the light) spreads the widest
-    // penumbra, L (d_r - d_b) / d_b at the receiver. When every tap of that region blocks,
-    // the light is hidden from the whole region: umbra.
-    float region = map->directional
-                       ? L * (d_r - nearest)
-                       : (nearest > 0.0f ? L * (d_r - nearest) / (nearest * d_r) : max_radius(map));
-    region = drift_clampf(region, rec.texel, max_radius(map));
-    return all_blocked(&s, region) ? 0.0f : 1.0f;
 }

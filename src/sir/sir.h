@@ -31,6 +31,27 @@ drift_refine_tracer drift_refine_tracer_make(const drift_frame_state *frame, uin
 drift_vec3 drift_refine_trace_sample(const drift_refine_tracer *tracer, int32_t x, int32_t y,
                                      uint32_t sample, uint64_t *rays);
 
+// --- PENUMBRA ESTIMATE (penumbra.c) ---
+
+// Penumbra estimate for SIR's shadow error: 1 where the light may be partly hidden from p
+// (blockers in the cone to the light and an unblocked tap in their backprojected region),
+// 0 in umbra and where nothing blocks. Conservative up to the tap spacing. 0 for point lights.
+float drift_shadow_map_penumbra(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n);
+
+// The same with options: light_size > 0 replaces the map's bounding radius in the cone and
+// backprojection (clamped to it: a tighter bound of the light as seen from p); exhaustive taps
+// every grid point instead of skipping regions the min-depth mip proves free of blockers (the
+// same result, slower: for tests); taps_only taps the finest levels too instead of testing
+// every texel they cover (which finds the same blockers and maybe more: for tests).
+typedef struct drift_penumbra_query {
+    float light_size;
+    bool exhaustive;
+    bool taps_only;
+} drift_penumbra_query;
+
+float drift_shadow_map_penumbra_query(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n,
+                                      const drift_penumbra_query *query);
+
 // --- METRICS (metrics.c) ---
 
 typedef struct drift_refine_metric_params {
