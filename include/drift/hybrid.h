@@ -43,38 +43,20 @@ extern "C" {
 
 // --- EFFECTS AND TECHNIQUES ---
 
+// Effects and their techniques' values, generated from the technique table
+// (drift/techniques.h). The names (drift_effect_name, drift_technique_name) are stable: the
+// command line, stats files and the viewer use them, and later techniques append rows.
+#define DRIFT_EFFECT_ENUM_(ENUM, name, type, TECHNIQUES, kind, plane) DRIFT_EFFECT_##ENUM,
+
 typedef enum drift_effect {
-    DRIFT_EFFECT_SHADOWS = 0,
-    DRIFT_EFFECT_REFLECTIONS,
-    DRIFT_EFFECT_DOF,
-    DRIFT_EFFECT_INDIRECT,
-    DRIFT_EFFECT_COUNT
+    DRIFT_EFFECTS(DRIFT_EFFECT_ENUM_) DRIFT_EFFECT_COUNT
 } drift_effect;
 
-// Technique values per effect, generated from the technique table (drift/techniques.h). The
-// names (drift_technique_name) are stable: the command line, stats files and the viewer use
-// them, and later techniques append rows to the table.
-#define DRIFT_TECHNIQUE_ENUM_(prefix, ENUM)      prefix##ENUM,
-#define DRIFT_SHADOWS_ENUM_(ENUM, name, ...)     DRIFT_TECHNIQUE_ENUM_(DRIFT_SHADOWS_, ENUM)
-#define DRIFT_REFLECTIONS_ENUM_(ENUM, name, ...) DRIFT_TECHNIQUE_ENUM_(DRIFT_REFLECTIONS_, ENUM)
-#define DRIFT_DOF_ENUM_(ENUM, name, ...)         DRIFT_TECHNIQUE_ENUM_(DRIFT_DOF_, ENUM)
-#define DRIFT_INDIRECT_ENUM_(ENUM, name, ...)    DRIFT_TECHNIQUE_ENUM_(DRIFT_INDIRECT_, ENUM)
-
-typedef enum drift_shadow_technique {
-    DRIFT_SHADOW_TECHNIQUES(DRIFT_SHADOWS_ENUM_) DRIFT_SHADOWS_COUNT
-} drift_shadow_technique;
-
-typedef enum drift_reflection_technique {
-    DRIFT_REFLECTION_TECHNIQUES(DRIFT_REFLECTIONS_ENUM_) DRIFT_REFLECTIONS_COUNT
-} drift_reflection_technique;
-
-typedef enum drift_dof_technique {
-    DRIFT_DOF_TECHNIQUES(DRIFT_DOF_ENUM_) DRIFT_DOF_COUNT
-} drift_dof_technique;
-
-typedef enum drift_indirect_technique {
-    DRIFT_INDIRECT_TECHNIQUES(DRIFT_INDIRECT_ENUM_) DRIFT_INDIRECT_COUNT
-} drift_indirect_technique;
+#define DRIFT_TECHNIQUE_ENUM_(P, ENUM, ...) P##ENUM,
+#define DRIFT_TECHNIQUE_TYPE_(ENUM, name, type, TECHNIQUES, kind, plane)                      \
+    typedef enum drift_##type##_technique{ TECHNIQUES(DRIFT_TECHNIQUE_ENUM_, DRIFT_##ENUM##_) \
+                                               DRIFT_##ENUM##_COUNT } drift_##type##_technique;
+DRIFT_EFFECTS(DRIFT_TECHNIQUE_TYPE_)
 
 const char *drift_effect_name(drift_effect effect); // "shadows", "reflections", "dof", "indirect"
 int drift_technique_count(drift_effect effect);
@@ -108,12 +90,22 @@ int drift_technique_parse(drift_effect effect, const char *name);
 //                      (both true: plain Monte Carlo with AAF's sampler, the benchmark baseline)
 //   aaf_random       = false: AAF's samples are Owen-scrambled Sobol points; true: independent
 //                      uniform random numbers (the paper's traditional Monte Carlo sampling)
+#define DRIFT_TECHNIQUE_FIELD_(ENUM, name, type, TECHNIQUES, kind, plane) \
+    drift_##type##_technique name;
+
 typedef struct drift_hybrid_params {
     int32_t width, height;
-    drift_shadow_technique shadows;
-    drift_reflection_technique reflections;
-    drift_dof_technique dof;
-    drift_indirect_technique indirect;
+
+    // One technique an effect, by name (params.shadows = DRIFT_SHADOWS_PCSS) or by effect
+    // (params.techniques[DRIFT_EFFECT_SHADOWS]): the fields come from the technique table.
+    union {
+        struct {
+            DRIFT_EFFECTS(DRIFT_TECHNIQUE_FIELD_)
+        };
+
+        int techniques[DRIFT_EFFECT_COUNT];
+    };
+
     uint32_t seed;
     uint32_t spp;
     int32_t max_depth;
@@ -201,6 +193,9 @@ const char *drift_hybrid_pass_name(drift_hybrid_pass pass);
 
 typedef struct drift_hybrid_stats {
     double ms[DRIFT_PASS_COUNT]; // wall milliseconds of the last frame, per pass
+    // Per effect: its chosen technique's own work (the row's pass, and summing D after a
+    // shadow technique), without the inputs rows share (U_l, hard shadows, shadow maps, ...).
+    double effect_ms[DRIFT_EFFECT_COUNT];
     uint64_t rays[DRIFT_PASS_COUNT];
     double frame_ms; // the whole drift_hybrid_render call
 } drift_hybrid_stats;

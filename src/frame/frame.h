@@ -10,6 +10,8 @@
 #include "drift/pt.h"
 #include "raster/raster.h"
 
+#include <stddef.h>
+
 // --- SAMPLER STREAMS ---
 
 // One list of the stream ids the passes key their per-pixel random numbers on, so that two
@@ -67,17 +69,26 @@ typedef struct drift_frame_state {
     drift_raster_shading shading;
 
     drift_gbuffer gbuffer;
+
+    // 3 channels each: what each effect's rows write, by effect (the table's order), and by
+    // name for the effects every pass knows.
+    union {
+        drift_image terms[DRIFT_EFFECT_COUNT];
+
+        struct {
+            drift_image direct;      // D = sum_l U_l S_l + environment (shadows)
+            drift_image reflections; // R
+            drift_image final;       // after depth of field (dof: a post effect)
+            drift_image indirect;    // I
+        };
+    };
+
     drift_image environment_direct;   // 3: direct light from the environment (ray-traced)
-    drift_image direct;               // 3: D = sum_l U_l S_l + environment
     drift_image reflection_emitted;   // 3: sharp mirror ray, emitted radiance at its hit
     drift_image reflection_reflected; // 3: ... direct light with hard shadows at its hit
     drift_image reflection_distance;  // 1: hit distance (INFINITY: miss)
-    drift_image reflections;          // 3: R
-    drift_image indirect;             // 3: I
-    drift_image reference;            // 3: scratch copy of the last reference pass
     drift_image coc;                  // 1: circle-of-confusion radius, pixels
     drift_image focus;                // 3: the composed in-focus frame
-    drift_image final;                // 3: after depth of field
 
     drift_frame_probe *probes;
     uint32_t probe_count;
@@ -90,6 +101,15 @@ typedef struct drift_frame_state {
     struct drift_isg_state *isg; // image space gathering's buffers (isg/isg.h)
     struct drift_aaf_state *aaf; // AAF's buffers (aaf/aaf.h)
 } drift_frame_state;
+
+#define DRIFT_TERM_SLOT_(field, effect)    \
+    (offsetof(drift_frame_state, field) == \
+     offsetof(drift_frame_state, terms) + (size_t)(effect) * sizeof(drift_image))
+_Static_assert(DRIFT_TERM_SLOT_(direct, DRIFT_EFFECT_SHADOWS) &&
+                   DRIFT_TERM_SLOT_(reflections, DRIFT_EFFECT_REFLECTIONS) &&
+                   DRIFT_TERM_SLOT_(final, DRIFT_EFFECT_DOF) &&
+                   DRIFT_TERM_SLOT_(indirect, DRIFT_EFFECT_INDIRECT),
+               "the named terms are their effects' slots");
 
 // --- PASSES ---
 

@@ -1,10 +1,12 @@
-// Composition of the hybrid frame: focus = E + D + R + I per pixel (a term whose row adds
-// nothing, `none`, is left out) and the circle-of-confusion plane; and the two depth-of-field
-// rows the conductor owns: the pinhole copy and the reference lens render.
+// Composition of the hybrid frame: focus = E + D + R + I (+ the terms of later effects, in the
+// table's order) per pixel (a term whose row adds nothing, `none`, is left out) and the
+// circle-of-confusion plane; and the two depth-of-field rows the conductor owns: the pinhole copy
+// and the reference lens render.
 #include "hybrid/techniques.h"
 
 typedef struct compose_job {
-    bool reflections, indirect; // whether the term is part of the frame
+    int terms[DRIFT_EFFECT_COUNT]; // the effects added after D, in the table's order
+    int count;
 } compose_job;
 
 static void compose_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
@@ -15,11 +17,8 @@ static void compose_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *
     bool surface = drift_image_pixel(&f->gbuffer.material_id, x, y)[0] >= 0.0f;
     if (surface) {
         l = drift_vec3_add(l, drift_image_get3(&f->direct, x, y));
-        if (job->reflections) {
-            l = drift_vec3_add(l, drift_image_get3(&f->reflections, x, y));
-        }
-        if (job->indirect) {
-            l = drift_vec3_add(l, drift_image_get3(&f->indirect, x, y));
+        for (int k = 0; k < job->count; ++k) {
+            l = drift_vec3_add(l, drift_image_get3(&f->terms[job->terms[k]], x, y));
         }
     }
     drift_image_set3(&f->focus, x, y, l);
@@ -29,16 +28,24 @@ static void compose_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *
         drift_coc_radius_pixels(&f->camera, f->params.height, z > 0.0f ? z : 1e30f);
 }
 
-static bool has_term(const drift_frame_state *f, drift_effect effect)
+// Whether the effect's term is part of the frame: a term effect (other than D, always there)
+// whose row adds something.
+static bool adds_term(const drift_frame_state *f, drift_effect effect)
 {
-    return !(drift_technique_row_chosen(&f->params, effect)->flags & DRIFT_ROW_NO_TERM);
+    return effect != DRIFT_EFFECT_SHADOWS &&
+           drift_effect_info_of(effect)->kind == DRIFT_EFFECT_KIND_TERM &&
+           !(drift_technique_row_chosen(&f->params, effect)->flags & DRIFT_ROW_NO_TERM);
 }
 
 drift_result drift_hybrid_pass_compose(drift_frame_state *f)
 {
     double t = drift_time_now();
-    compose_job job = { .reflections = has_term(f, DRIFT_EFFECT_REFLECTIONS),
-                        .indirect = has_term(f, DRIFT_EFFECT_INDIRECT) };
+    compose_job job = { .count = 0 };
+    for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
+        if (adds_term(f, (drift_effect)e)) {
+            job.terms[job.count++] = e;
+        }
+    }
     drift_pass_for_each_pixel(f, compose_pixel, &job);
     drift_pass_time(f, DRIFT_PASS_COMPOSE, t);
     return DRIFT_OK;
@@ -58,13 +65,11 @@ drift_result drift_hybrid_pass_lens_reference(drift_frame_state *f, const drift_
 {
     uint32_t components = DRIFT_PT_COMPONENT_EMISSION | DRIFT_PT_COMPONENT_DIRECT;
     int32_t depth = 1;
-    if (has_term(f, DRIFT_EFFECT_REFLECTIONS)) {
-        components |= DRIFT_PT_COMPONENT_SPECULAR;
-        depth = f->params.max_depth;
-    }
-    if (has_term(f, DRIFT_EFFECT_INDIRECT)) {
-        components |= DRIFT_PT_COMPONENT_DIFFUSE;
-        depth = f->params.max_depth;
+    for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
+        if (adds_term(f, (drift_effect)e)) { // the term's truth, through the lens
+            components |= drift_technique_row_chosen(&f->params, (drift_effect)e)->components;
+            depth = f->params.max_depth;
+        }
     }
     double t = drift_time_now();
     drift_result r =

@@ -40,39 +40,14 @@ const char *drift_hybrid_pass_name(drift_hybrid_pass pass)
 
 int drift_hybrid_params_technique(const drift_hybrid_params *params, drift_effect effect)
 {
-    switch (effect) {
-    case DRIFT_EFFECT_SHADOWS:
-        return (int)params->shadows;
-    case DRIFT_EFFECT_REFLECTIONS:
-        return (int)params->reflections;
-    case DRIFT_EFFECT_DOF:
-        return (int)params->dof;
-    case DRIFT_EFFECT_INDIRECT:
-        return (int)params->indirect;
-    case DRIFT_EFFECT_COUNT:
-        break;
-    }
-    return -1;
+    return (unsigned)effect < DRIFT_EFFECT_COUNT ? params->techniques[effect] : -1;
 }
 
 void drift_hybrid_params_set_technique(drift_hybrid_params *params, drift_effect effect,
                                        int technique)
 {
-    switch (effect) {
-    case DRIFT_EFFECT_SHADOWS:
-        params->shadows = (drift_shadow_technique)technique;
-        break;
-    case DRIFT_EFFECT_REFLECTIONS:
-        params->reflections = (drift_reflection_technique)technique;
-        break;
-    case DRIFT_EFFECT_DOF:
-        params->dof = (drift_dof_technique)technique;
-        break;
-    case DRIFT_EFFECT_INDIRECT:
-        params->indirect = (drift_indirect_technique)technique;
-        break;
-    case DRIFT_EFFECT_COUNT:
-        break;
+    if ((unsigned)effect < DRIFT_EFFECT_COUNT) {
+        params->techniques[effect] = technique;
     }
 }
 
@@ -100,16 +75,23 @@ drift_hybrid_params drift_hybrid_params_resolve(const drift_hybrid_params *param
     return p;
 }
 
+static bool techniques_valid(const drift_hybrid_params *p)
+{
+    for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
+        if (!drift_technique_row_chosen(p, (drift_effect)e)) {
+            return false;
+        }
+    }
+    return true;
+}
+
 static bool params_valid(const drift_context *ctx, const drift_hybrid_params *p)
 {
     const char *problem = NULL;
     if (p->width <= 0 || p->height <= 0 || p->width > DRIFT_IMAGE_MAX_DIMENSION ||
         p->height > DRIFT_IMAGE_MAX_DIMENSION) {
         problem = "image size out of range";
-    } else if (!drift_technique_row_chosen(p, DRIFT_EFFECT_SHADOWS) ||
-               !drift_technique_row_chosen(p, DRIFT_EFFECT_REFLECTIONS) ||
-               !drift_technique_row_chosen(p, DRIFT_EFFECT_DOF) ||
-               !drift_technique_row_chosen(p, DRIFT_EFFECT_INDIRECT)) {
+    } else if (!techniques_valid(p)) {
         problem = "unknown technique";
     } else if (p->max_depth < 1 || p->max_depth > 1024) {
         problem = "max_depth outside 1..1024";
@@ -140,17 +122,13 @@ static drift_result create_images(drift_frame_state *f)
     drift_context *ctx = f->ctx;
     int32_t w = f->params.width, h = f->params.height;
     drift_result r = drift_gbuffer_create(ctx, w, h, &f->gbuffer);
-    drift_image *rgb[] = { &f->environment_direct,
-                           &f->direct,
-                           &f->reflection_emitted,
-                           &f->reflection_reflected,
-                           &f->reflections,
-                           &f->indirect,
-                           &f->reference,
-                           &f->focus,
-                           &f->final };
+    drift_image *rgb[] = { &f->environment_direct, &f->reflection_emitted, &f->reflection_reflected,
+                           &f->focus };
     for (size_t i = 0; r == DRIFT_OK && i < sizeof rgb / sizeof *rgb; ++i) {
         r = drift_image_create(ctx, w, h, 3, rgb[i]);
+    }
+    for (int e = 0; r == DRIFT_OK && e < DRIFT_EFFECT_COUNT; ++e) {
+        r = drift_image_create(ctx, w, h, 3, &f->terms[e]);
     }
     if (r == DRIFT_OK) {
         r = drift_image_create(ctx, w, h, 1, &f->reflection_distance);
@@ -258,18 +236,16 @@ void drift_hybrid_destroy(drift_hybrid *h)
     drift_aaf_state_destroy(ctx, f->aaf);
     drift_gbuffer_destroy(ctx, &f->gbuffer);
     drift_image *images[] = { &f->environment_direct,
-                              &f->direct,
                               &f->reflection_emitted,
                               &f->reflection_reflected,
                               &f->reflection_distance,
-                              &f->reflections,
-                              &f->indirect,
-                              &f->reference,
                               &f->coc,
-                              &f->focus,
-                              &f->final };
+                              &f->focus };
     for (size_t i = 0; i < sizeof images / sizeof *images; ++i) {
         drift_image_destroy(ctx, images[i]);
+    }
+    for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
+        drift_image_destroy(ctx, &f->terms[e]);
     }
     drift_raster_lights_destroy(ctx, f->lights, f->light_count);
     drift_free(ctx, f->light_buffers);
@@ -368,12 +344,7 @@ static void collect_planes(drift_hybrid *h, uint32_t inputs)
     const struct {
         const char *name;
         const drift_image *image;
-    } fixed[] = { { "final", &f->final },
-                  { "focus", &f->focus },
-                  { "direct", &f->direct },
-                  { "reflections", &f->reflections },
-                  { "indirect", &f->indirect },
-                  { "depth", &g->depth },
+    } fixed[] = { { "depth", &g->depth },
                   { "position", &g->position },
                   { "normal", &g->normal },
                   { "geometric_normal", &g->geometric_normal },
@@ -385,6 +356,14 @@ static void collect_planes(drift_hybrid *h, uint32_t inputs)
                   { "motion", &g->motion },
                   { "coc", &f->coc } };
 
+    add_plane(h, "final", &f->final);
+    add_plane(h, "focus", &f->focus);
+    for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
+        const drift_effect_info *effect = drift_effect_info_of((drift_effect)e);
+        if (effect->kind == DRIFT_EFFECT_KIND_TERM) {
+            add_plane(h, effect->plane, &f->terms[e]);
+        }
+    }
     for (size_t i = 0; i < sizeof fixed / sizeof *fixed; ++i) {
         add_plane(h, fixed[i].name, fixed[i].image);
     }
@@ -453,10 +432,12 @@ static drift_result run_row(drift_frame_state *f, const drift_technique_row *row
                              .stream = row->stream,
                              .components = row->components,
                              .cancel = cancel };
+    double t = drift_time_now();
     drift_result r = row->pass(f, &args);
     if (r == DRIFT_OK && (row->flags & DRIFT_ROW_SUMS_DIRECT)) {
         r = drift_realtime_pass_sum_direct(f);
     }
+    f->stats.effect_ms[row->effect] += 1000.0 * (drift_time_now() - t);
     return r;
 }
 
@@ -488,21 +469,23 @@ drift_result drift_hybrid_render(drift_hybrid *h, const drift_camera *camera,
         replaced |= (rows[e]->flags & DRIFT_ROW_REPLACES_FRAME) != 0;
     }
     drift_result r = prepare_inputs(f, inputs);
-    // The terms first (direct light before indirect: ambient reads D), then composition and
-    // depth of field, which turns focus into final.
-    static const drift_effect term_order[] = { DRIFT_EFFECT_SHADOWS, DRIFT_EFFECT_REFLECTIONS,
-                                               DRIFT_EFFECT_INDIRECT };
-    for (size_t i = 0; r == DRIFT_OK && i < sizeof term_order / sizeof *term_order; ++i) {
-        const drift_technique_row *row = rows[term_order[i]];
-        if (!(replaced && (row->flags & DRIFT_ROW_PATH_TRACED))) {
+    // The terms in the table's order (direct light first: ambient light reads D), then the
+    // composition, then the post effects (depth of field turns focus into final).
+    for (int e = 0; r == DRIFT_OK && e < DRIFT_EFFECT_COUNT; ++e) {
+        const drift_technique_row *row = rows[e];
+        bool skipped = replaced && (row->flags & DRIFT_ROW_PATH_TRACED) &&
+                       !(row->flags & DRIFT_ROW_REPLACES_FRAME);
+        if (drift_effect_info_of((drift_effect)e)->kind == DRIFT_EFFECT_KIND_TERM && !skipped) {
             r = run_row(f, row, cancel);
         }
     }
     if (r == DRIFT_OK && !replaced) {
         r = drift_hybrid_pass_compose(f);
     }
-    if (r == DRIFT_OK) {
-        r = run_row(f, rows[DRIFT_EFFECT_DOF], cancel);
+    for (int e = 0; r == DRIFT_OK && e < DRIFT_EFFECT_COUNT; ++e) {
+        if (drift_effect_info_of((drift_effect)e)->kind == DRIFT_EFFECT_KIND_POST) {
+            r = run_row(f, rows[e], cancel);
+        }
     }
     f->prev_camera = f->camera;
     f->has_prev_camera = true;

@@ -11,14 +11,12 @@
 
 drift_result drift_hybrid_pass_reference(drift_frame_state *f, const drift_pass_args *args)
 {
-    drift_image *term[DRIFT_EFFECT_COUNT] = { [DRIFT_EFFECT_SHADOWS] = &f->direct,
-                                              [DRIFT_EFFECT_REFLECTIONS] = &f->reflections,
-                                              [DRIFT_EFFECT_INDIRECT] = &f->indirect };
-    DRIFT_CHECK((unsigned)args->effect < DRIFT_EFFECT_COUNT && term[args->effect]);
-    int32_t depth = args->effect == DRIFT_EFFECT_SHADOWS ? 1 : f->params.max_depth;
+    DRIFT_CHECK((unsigned)args->effect < DRIFT_EFFECT_COUNT);
+    // Direct light is one scattering event; every other term follows paths to max_depth.
+    int32_t depth = args->components == DRIFT_PT_COMPONENT_DIRECT ? 1 : f->params.max_depth;
     double t = drift_time_now();
     drift_result r = drift_pass_reference_render(f, args->components, depth, false, args->cancel,
-                                                 term[args->effect]);
+                                                 &f->terms[args->effect]);
     drift_pass_time(f, DRIFT_PASS_REFERENCE, t);
     return r;
 }

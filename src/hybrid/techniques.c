@@ -6,45 +6,31 @@
 
 // The table names each row's pass and planes function; their prototypes come from the table
 // too (each folder's header declares the same), so a new row needs no include here.
-#define DECLARE_(ENUM, name, summary, pass, inputs, flags, planes, stream, components) \
-    drift_result pass(drift_frame_state *frame, const drift_pass_args *args);          \
+#define DECLARE_(P, ENUM, name, summary, pass, inputs, flags, planes, stream, components) \
+    drift_result pass(drift_frame_state *frame, const drift_pass_args *args);             \
     void planes(const drift_frame_state *frame, drift_pass_plane_fn add, void *sink);
-DRIFT_SHADOW_TECHNIQUES(DECLARE_)
-DRIFT_REFLECTION_TECHNIQUES(DECLARE_)
-DRIFT_DOF_TECHNIQUES(DECLARE_)
-DRIFT_INDIRECT_TECHNIQUES(DECLARE_)
+#define DECLARE_EFFECT_(ENUM, name, type, TECHNIQUES, kind, plane) TECHNIQUES(DECLARE_, ENUM)
+DRIFT_EFFECTS(DECLARE_EFFECT_)
 
-#define ROW_(effect, prefix, ENUM, name, summary, pass, inputs, flags, planes, stream, components) \
-    { effect, prefix##ENUM, name, summary, pass, inputs, flags, planes, stream, components },
-#define SHADOW_ROW_(ENUM, ...) ROW_(DRIFT_EFFECT_SHADOWS, DRIFT_SHADOWS_, ENUM, __VA_ARGS__)
-#define REFLECTION_ROW_(ENUM, ...) \
-    ROW_(DRIFT_EFFECT_REFLECTIONS, DRIFT_REFLECTIONS_, ENUM, __VA_ARGS__)
-#define DOF_ROW_(ENUM, ...)      ROW_(DRIFT_EFFECT_DOF, DRIFT_DOF_, ENUM, __VA_ARGS__)
-#define INDIRECT_ROW_(ENUM, ...) ROW_(DRIFT_EFFECT_INDIRECT, DRIFT_INDIRECT_, ENUM, __VA_ARGS__)
+// Each effect's rows, in the order of its enum.
+#define ROW_(P, ENUM, name, summary, pass, inputs, flags, planes, stream, components)   \
+    { DRIFT_EFFECT_##P, DRIFT_##P##_##ENUM, name, summary, pass, inputs, flags, planes, \
+      stream,           components },
+#define ROWS_(ENUM, name, type, TECHNIQUES, kind, plane)                                      \
+    static const drift_technique_row name##_rows[] = { TECHNIQUES(ROW_, ENUM) };              \
+    _Static_assert(sizeof name##_rows / sizeof *name##_rows == DRIFT_##ENUM##_COUNT, "rows"); \
+    _Static_assert(sizeof(drift_##type##_technique) == sizeof(int), "params.techniques");
+DRIFT_EFFECTS(ROWS_)
 
-static const drift_technique_row shadow_rows[] = { DRIFT_SHADOW_TECHNIQUES(SHADOW_ROW_) };
-static const drift_technique_row reflection_rows[] = { DRIFT_REFLECTION_TECHNIQUES(
-    REFLECTION_ROW_) };
-static const drift_technique_row dof_rows[] = { DRIFT_DOF_TECHNIQUES(DOF_ROW_) };
-static const drift_technique_row indirect_rows[] = { DRIFT_INDIRECT_TECHNIQUES(INDIRECT_ROW_) };
+#define EFFECT_(ENUM, name, type, TECHNIQUES, kind, plane)                         \
+    [DRIFT_EFFECT_##ENUM] = { #name, plane, DRIFT_EFFECT_KIND_##kind, name##_rows, \
+                              (int)(sizeof name##_rows / sizeof *name##_rows) },
+static const drift_effect_info effects[DRIFT_EFFECT_COUNT] = { DRIFT_EFFECTS(EFFECT_) };
 
-typedef struct effect_table {
-    const char *name;
-    const drift_technique_row *rows;
-    int count;
-} effect_table;
-
-#define COUNT_(array) ((int)(sizeof array / sizeof *array))
-static const effect_table effects[DRIFT_EFFECT_COUNT] = {
-    [DRIFT_EFFECT_SHADOWS] = { "shadows", shadow_rows, COUNT_(shadow_rows) },
-    [DRIFT_EFFECT_REFLECTIONS] = { "reflections", reflection_rows, COUNT_(reflection_rows) },
-    [DRIFT_EFFECT_DOF] = { "dof", dof_rows, COUNT_(dof_rows) },
-    [DRIFT_EFFECT_INDIRECT] = { "indirect", indirect_rows, COUNT_(indirect_rows) },
-};
-_Static_assert(COUNT_(shadow_rows) == DRIFT_SHADOWS_COUNT, "one row a technique");
-_Static_assert(COUNT_(reflection_rows) == DRIFT_REFLECTIONS_COUNT, "one row a technique");
-_Static_assert(COUNT_(dof_rows) == DRIFT_DOF_COUNT, "one row a technique");
-_Static_assert(COUNT_(indirect_rows) == DRIFT_INDIRECT_COUNT, "one row a technique");
+const drift_effect_info *drift_effect_info_of(drift_effect effect)
+{
+    return (unsigned)effect < DRIFT_EFFECT_COUNT ? &effects[effect] : NULL;
+}
 
 const drift_technique_row *drift_technique_row_of(drift_effect effect, int technique)
 {

@@ -20,6 +20,22 @@ typedef struct drift_technique_row {
     uint32_t components;
 } drift_technique_row;
 
+typedef enum drift_effect_kind {
+    DRIFT_EFFECT_KIND_TERM, // its rows fill a term of the composed frame
+    DRIFT_EFFECT_KIND_POST, // its rows turn the composed frame into the final image
+} drift_effect_kind;
+
+typedef struct drift_effect_info {
+    const char *name;
+    const char *plane; // what its rows write, by --aov plane name
+    drift_effect_kind kind;
+    const drift_technique_row *rows;
+    int count;
+} drift_effect_info;
+
+// The effect's row of the table of effects, or NULL out of range.
+const drift_effect_info *drift_effect_info_of(drift_effect effect);
+
 // The row of `technique` in `effect`, or NULL when either is out of range.
 const drift_technique_row *drift_technique_row_of(drift_effect effect, int technique);
 // The row the frame's parameters choose for `effect`.
