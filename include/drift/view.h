@@ -37,13 +37,14 @@
 extern "C" {
 #endif
 
-// Keys the view understands (the window maps physical keys to these; docs/viewer.md).
+// Keys the view understands (the window maps physical keys to these; docs/viewer.md). The
+// first keys step an effect to its next technique (wrapping around), one key an effect of the
+// technique table in its order: DRIFT_VIEW_KEY_SHADOWS, ..._REFLECTIONS, ..._DOF, ..._INDIRECT.
+#define DRIFT_VIEW_EFFECT_KEY_(ENUM, ...) DRIFT_VIEW_KEY_##ENUM,
+
 typedef enum drift_view_key {
     DRIFT_VIEW_KEY_NONE = 0,
-    DRIFT_VIEW_KEY_SHADOWS,     // next shadow technique (wraps around)
-    DRIFT_VIEW_KEY_REFLECTIONS, // next reflection technique
-    DRIFT_VIEW_KEY_DOF,         // next depth-of-field technique
-    DRIFT_VIEW_KEY_INDIRECT,    // next indirect-light technique
+    DRIFT_EFFECTS(DRIFT_VIEW_EFFECT_KEY_)
     DRIFT_VIEW_KEY_NEXT_BUFFER, // show the next buffer: the frame, then every plane
     DRIFT_VIEW_KEY_PREV_BUFFER,
     DRIFT_VIEW_KEY_SPLIT,      // split view on/off
@@ -62,6 +63,11 @@ typedef enum drift_view_key {
     DRIFT_VIEW_KEY_HELP,          // key list in the overlay on/off
     DRIFT_VIEW_KEY_COUNT
 } drift_view_key;
+
+// The key that steps `effect`'s technique (DRIFT_VIEW_KEY_NONE out of range), and the effect a
+// key steps (-1 for any other key).
+drift_view_key drift_view_key_of_effect(drift_effect effect);
+int drift_view_key_effect(drift_view_key key);
 
 typedef enum drift_view_event_type {
     DRIFT_VIEW_EVENT_KEY = 0,  // key pressed (or auto-repeated)

@@ -15,16 +15,37 @@
 
 // --- SMALL HELPERS ---
 
-static const char *const key_names[DRIFT_VIEW_KEY_COUNT] = {
-    "none",         "shadows", "reflections", "dof",         "indirect",    "next-buffer",
-    "prev-buffer",  "split",   "split-left",  "split-right", "forward",     "back",
-    "left",         "right",   "up",          "down",        "exposure-up", "exposure-down",
-    "reset-camera", "overlay", "help",
+// The keys after the effects' (those are named after their effects).
+static const char *const key_names[DRIFT_VIEW_KEY_COUNT - DRIFT_VIEW_KEY_NEXT_BUFFER] = {
+    "next-buffer",   "prev-buffer",  "split",   "split-left", "split-right", "forward",
+    "back",          "left",         "right",   "up",         "down",        "exposure-up",
+    "exposure-down", "reset-camera", "overlay", "help",
 };
+
+drift_view_key drift_view_key_of_effect(drift_effect effect)
+{
+    return (unsigned)effect < DRIFT_EFFECT_COUNT
+               ? (drift_view_key)(DRIFT_VIEW_KEY_NONE + 1 + effect)
+               : DRIFT_VIEW_KEY_NONE;
+}
+
+int drift_view_key_effect(drift_view_key key)
+{
+    int effect = (int)key - (int)DRIFT_VIEW_KEY_NONE - 1;
+    return effect >= 0 && effect < DRIFT_EFFECT_COUNT ? effect : -1;
+}
 
 const char *drift_view_key_name(drift_view_key key)
 {
-    return (unsigned)key < DRIFT_VIEW_KEY_COUNT ? key_names[key] : NULL;
+    if (key == DRIFT_VIEW_KEY_NONE) {
+        return "none";
+    }
+    int effect = drift_view_key_effect(key);
+    if (effect >= 0) {
+        return drift_effect_name((drift_effect)effect);
+    }
+    return (unsigned)key < DRIFT_VIEW_KEY_COUNT ? key_names[key - DRIFT_VIEW_KEY_NEXT_BUFFER]
+                                                : NULL;
 }
 
 static int32_t split_column(const drift_view *view)
@@ -202,10 +223,10 @@ drift_result drift_view_create(drift_context *ctx, const drift_scene *scene,
     }
     view->params = drift_hybrid_get_params(view->hybrid);
     if (d.refine) {
-        r = drift_refine_create(ctx, view->hybrid,
-                                &(drift_refine_params){ .budget = d.refine_budget ? d.refine_budget
-                                                                                  : 16384u },
-                                &view->sir);
+        r = drift_refine_create(
+            ctx, view->hybrid,
+            &(drift_refine_params){ .budget = d.refine_budget ? d.refine_budget : 16384u },
+            &view->sir);
         if (r != DRIFT_OK) {
             goto fail;
         }
@@ -255,19 +276,12 @@ static bool note_camera_move(drift_view *view, bool moved)
 
 static bool handle_key(drift_view *view, drift_view_key key)
 {
+    int effect = drift_view_key_effect(key);
+    if (effect >= 0) {
+        cycle_technique(view, (drift_effect)effect);
+        return true;
+    }
     switch (key) {
-    case DRIFT_VIEW_KEY_SHADOWS:
-        cycle_technique(view, DRIFT_EFFECT_SHADOWS);
-        return true;
-    case DRIFT_VIEW_KEY_REFLECTIONS:
-        cycle_technique(view, DRIFT_EFFECT_REFLECTIONS);
-        return true;
-    case DRIFT_VIEW_KEY_DOF:
-        cycle_technique(view, DRIFT_EFFECT_DOF);
-        return true;
-    case DRIFT_VIEW_KEY_INDIRECT:
-        cycle_technique(view, DRIFT_EFFECT_INDIRECT);
-        return true;
     case DRIFT_VIEW_KEY_NEXT_BUFFER:
     case DRIFT_VIEW_KEY_PREV_BUFFER:
         step_buffer(view, key == DRIFT_VIEW_KEY_NEXT_BUFFER ? 1 : -1);

@@ -184,20 +184,17 @@ static void test_view_technique_keys_cycle(void **state)
     (void)state;
     rig r = rig_make(&(drift_view_desc){ .hybrid = cheap_params() });
     frame(&r);
-    const drift_view_key keys[DRIFT_EFFECT_COUNT] = { DRIFT_VIEW_KEY_SHADOWS,
-                                                      DRIFT_VIEW_KEY_REFLECTIONS,
-                                                      DRIFT_VIEW_KEY_DOF, DRIFT_VIEW_KEY_INDIRECT };
     for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
+        drift_view_key effect_key = drift_view_key_of_effect((drift_effect)e);
+        assert_int_equal(drift_view_key_effect(effect_key), e);
+        assert_string_equal(drift_view_key_name(effect_key), drift_effect_name((drift_effect)e));
         int count = drift_technique_count((drift_effect)e);
         assert_true(count >= 2);
         for (int press = 1; press <= count; ++press) {
-            assert_true(key(&r, keys[e]));
+            assert_true(key(&r, effect_key));
             frame(&r);
             drift_hybrid_params p = drift_hybrid_get_params(drift_view_hybrid(r.view));
-            int got = e == DRIFT_EFFECT_SHADOWS       ? (int)p.shadows
-                      : e == DRIFT_EFFECT_REFLECTIONS ? (int)p.reflections
-                      : e == DRIFT_EFFECT_DOF         ? (int)p.dof
-                                                      : (int)p.indirect;
+            int got = drift_hybrid_params_technique(&p, (drift_effect)e);
             // Every technique starts at 0 (the default), so after `press` presses it is
             // press mod count: all of them once, then back to the first.
             if (got != press % count) {
@@ -421,6 +418,9 @@ static void test_view_rejects_bad_input(void **state)
     assert_null(view);
     assert_string_equal(drift_view_key_name(DRIFT_VIEW_KEY_SHADOWS), "shadows");
     assert_null(drift_view_key_name(DRIFT_VIEW_KEY_COUNT));
+    assert_string_equal(drift_view_key_name(DRIFT_VIEW_KEY_NEXT_BUFFER), "next-buffer");
+    assert_string_equal(drift_view_key_name(DRIFT_VIEW_KEY_HELP), "help");
+    assert_int_equal(drift_view_key_effect(DRIFT_VIEW_KEY_HELP), -1);
     drift_view_destroy(NULL);
     assert_false(drift_view_handle_event(NULL, NULL));
     drift_scene_destroy(scene);
