@@ -19,6 +19,41 @@ void drift_planes_none(const drift_frame_state *frame, drift_pass_plane_fn add, 
     (void)sink;
 }
 
+// --- TECHNIQUE STATE ---
+
+void *drift_pass_state(const drift_frame_state *f, const drift_pass_args *args)
+{
+    DRIFT_CHECK((unsigned)args->effect < DRIFT_EFFECT_COUNT);
+    const drift_pass_state_slot *slot = &f->effect_state[args->effect];
+    return slot->data && slot->technique == args->technique ? slot->data : NULL;
+}
+
+static void free_state(drift_frame_state *f, int effect)
+{
+    if (f->effect_state[effect].data && f->effect_state[effect].destroy) {
+        f->effect_state[effect].destroy(f->ctx, f->effect_state[effect].data);
+    }
+    f->effect_state[effect].data = NULL;
+    f->effect_state[effect].destroy = NULL;
+}
+
+void drift_pass_set_state(drift_frame_state *f, const drift_pass_args *args, void *data,
+                          void (*destroy)(drift_context *ctx, void *data))
+{
+    DRIFT_CHECK((unsigned)args->effect < DRIFT_EFFECT_COUNT);
+    free_state(f, args->effect);
+    f->effect_state[args->effect].data = data;
+    f->effect_state[args->effect].destroy = destroy;
+    f->effect_state[args->effect].technique = args->technique;
+}
+
+void drift_pass_free_states(drift_frame_state *f)
+{
+    for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
+        free_state(f, e);
+    }
+}
+
 // --- ROWS AND PIXELS ---
 
 typedef struct row_job {

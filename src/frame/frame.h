@@ -49,6 +49,13 @@ typedef struct drift_frame_light_buffers {
     drift_shadow_map *shadow_map; // built on first use, kept while the scene stands
 } drift_frame_light_buffers;
 
+// A technique's state kept across frames (drift_pass_state).
+typedef struct drift_pass_state_slot {
+    void *data;
+    void (*destroy)(drift_context *ctx, void *data);
+    int technique; // the technique of the slot's effect that owns data
+} drift_pass_state_slot;
+
 // An environment probe: one for the whole scene, or one per reflective mesh.
 typedef struct drift_frame_probe {
     uint32_t mesh; // DRIFT_INVALID_INDEX for the scene probe
@@ -96,6 +103,9 @@ typedef struct drift_frame_state {
     drift_ray_counter *counters; // one per thread
     int thread_count;
     drift_hybrid_stats stats;
+    // State a technique keeps across frames (caches, atlases), one slot an effect, owned by
+    // the technique that made it: drift_pass_state / drift_pass_set_state.
+    drift_pass_state_slot effect_state[DRIFT_EFFECT_COUNT];
     // Technique state, made by each technique on first use and freed by the conductor through
     // the technique's destroy function (opaque here: this layer knows no technique).
     struct drift_isg_state *isg; // image space gathering's buffers (isg/isg.h)
@@ -133,6 +143,17 @@ typedef void (*drift_pass_plane_fn)(void *sink, const char *name, const drift_im
 #define DRIFT_FRAME_PLANE_NAME 48 // the longest plane name, with its terminator
 typedef void (*drift_pass_planes_fn)(const drift_frame_state *frame, drift_pass_plane_fn add,
                                      void *sink);
+
+// The state `args`'s technique keeps across frames in its effect's slot, or NULL when it has
+// none yet (or another technique of the effect holds the slot).
+void *drift_pass_state(const drift_frame_state *frame, const drift_pass_args *args);
+// Gives the slot to `args`'s technique: `data`, freed by destroy(ctx, data) when the frame is
+// destroyed or another technique of the effect takes the slot (the previous holder's state
+// is freed now).
+void drift_pass_set_state(drift_frame_state *frame, const drift_pass_args *args, void *data,
+                          void (*destroy)(drift_context *ctx, void *data));
+// Frees every slot (the conductor, at destroy).
+void drift_pass_free_states(drift_frame_state *frame);
 
 // The pass of a row whose inputs already are its term (hard shadows, sharp reflections) or
 // that adds none, and the planes of a row with none of its own.

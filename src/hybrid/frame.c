@@ -232,6 +232,7 @@ void drift_hybrid_destroy(drift_hybrid *h)
         }
     }
     destroy_probes(f);
+    drift_pass_free_states(f);
     drift_isg_destroy(f);
     drift_aaf_state_destroy(ctx, f->aaf);
     drift_gbuffer_destroy(ctx, &f->gbuffer);
