@@ -153,10 +153,45 @@ static void test_rows_are_consistent(void **state)
     assert_null(drift_technique_row_of(DRIFT_EFFECT_COUNT, 0));
 }
 
+static int freed;
+static void count_free(drift_context *ctx, void *data)
+{
+    drift_free(ctx, data);
+    ++freed;
+}
+
+// A technique's state stays with it across frames, and is freed once: when another technique
+// of the effect takes the slot, or when the frame goes.
+static void test_state_slots(void **state)
+{
+    (void)state;
+    drift_frame_state f = { .ctx = test_context(1, NULL) };
+    drift_pass_args ism = { .effect = DRIFT_EFFECT_INDIRECT, .technique = 3 };
+    drift_pass_args other = { .effect = DRIFT_EFFECT_INDIRECT, .technique = 1 };
+    drift_pass_args shadows = { .effect = DRIFT_EFFECT_SHADOWS, .technique = 3 };
+    freed = 0;
+    assert_null(drift_pass_state(&f, &ism));
+    void *a = drift_alloc(f.ctx, 16), *b = drift_alloc(f.ctx, 16), *c = drift_alloc(f.ctx, 16);
+    drift_pass_set_state(&f, &ism, a, count_free);
+    drift_pass_set_state(&f, &shadows, c, count_free);
+    assert_ptr_equal(drift_pass_state(&f, &ism), a);
+    assert_null(drift_pass_state(&f, &other));
+    assert_ptr_equal(drift_pass_state(&f, &shadows), c);
+    drift_pass_set_state(&f, &other, b, count_free);
+    assert_int_equal(freed, 1);
+    assert_null(drift_pass_state(&f, &ism));
+    assert_ptr_equal(drift_pass_state(&f, &other), b);
+    drift_pass_free_states(&f);
+    assert_int_equal(freed, 3);
+    assert_null(drift_pass_state(&f, &other));
+    drift_context_destroy(f.ctx);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_rows_are_consistent),
+        cmocka_unit_test(test_state_slots),
         cmocka_unit_test(test_every_row_renders),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
