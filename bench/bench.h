@@ -9,10 +9,10 @@
 #define DRIFT_BENCH_H
 
 // X(name, function, one-line summary)
-#define DRIFT_BENCH_LIST(X) \
-    X("rays", drift_bench_rays, "rays/s through drift's accel vs raw Embree, one thread")   \
-    X("frame", drift_bench_frame, "hybrid frame passes vs the primary-visibility pass")      \
-    X("isg", drift_bench_isg, "image space gathering: Table 1 timings, FLIP vs baselines")  \
+#define DRIFT_BENCH_LIST(X)                                                                    \
+    X("rays", drift_bench_rays, "rays/s through drift's accel vs raw Embree, one thread")      \
+    X("frame", drift_bench_frame, "hybrid frame passes vs the primary-visibility pass")        \
+    X("isg", drift_bench_isg, "image space gathering: Table 1 timings, FLIP vs baselines")     \
     X("aaf", drift_bench_aaf, "axis-aligned filtering: RMSE vs spp against plain Monte Carlo") \
     X("sir", drift_bench_sir, "smart image refinement vs pure ray tracing (Table 1)")
 

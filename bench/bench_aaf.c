@@ -106,7 +106,8 @@ static const cli_option aaf_table[] = {
                "sobol (default) or random, for AAF and plain MC alike: random is\n"
                "the paper's traditional Monte Carlo (Fig. 3.6)"),
     CLI_INT("--ref-spp", "N", O, ref_spp, 1, 1 << 20, "reference samples a pixel (default 4096)"),
-    CLI_INT("--width", "W", O, width, 1, DRIFT_IMAGE_MAX_DIMENSION, "error images (default 160x120)"),
+    CLI_INT("--width", "W", O, width, 1, DRIFT_IMAGE_MAX_DIMENSION,
+            "error images (default 160x120)"),
     CLI_INT("--height", "H", O, height, 1, DRIFT_IMAGE_MAX_DIMENSION, "error images"),
     { .name = "--timing-size",
       .arg = "WxH",
@@ -518,12 +519,12 @@ int drift_bench_aaf(int argc, char **argv)
     }
     int exit_code = 1;
     cli_session session;
-    if (!cli_session_open(&(cli_session_desc){ .cmd = "bench aaf",
-                                               .scene_path = o.scene_path,
-                                               .default_scene =
-                                                   DRIFT_SOURCE_DIR "/scenes/grids/grids.json",
-                                               .threads = (int)o.threads },
-                          &session)) {
+    if (!cli_session_open(
+            &(cli_session_desc){ .cmd = "bench aaf",
+                                 .scene_path = o.scene_path,
+                                 .default_scene = DRIFT_SOURCE_DIR "/scenes/grids/grids.json",
+                                 .threads = (int)o.threads },
+            &session)) {
         goto done;
     }
     drift_context *ctx = session.ctx;

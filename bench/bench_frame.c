@@ -3,14 +3,13 @@
 // on the Cornell box with a glossy bunny cost at most 4x the primary pass.
 #include "bench.h"
 #include "cli.h"
+#include "drift/accel.h"
+#include "drift/hybrid.h"
+#include "drift/scene_io.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-#include "drift/accel.h"
-#include "drift/hybrid.h"
-#include "drift/scene_io.h"
 
 typedef struct frame_options {
     const char *scene_path;
@@ -65,8 +64,7 @@ typedef struct frame_result {
 } frame_result;
 
 static drift_result measure(drift_context *ctx, const drift_scene *scene, const drift_accel *accel,
-                            const frame_options *o, const frame_config *config,
-                            frame_result *out)
+                            const frame_options *o, const frame_config *config, frame_result *out)
 {
     drift_hybrid_params params = config->params;
     params.width = (int32_t)o->width;
@@ -111,22 +109,24 @@ int drift_bench_frame(int argc, char **argv)
     }
     const frame_config configs[] = {
         { "hard+sharp+post",
-          { .shadows = DRIFT_SHADOWS_HARD, .reflections = DRIFT_REFLECTIONS_SHARP, .dof = DRIFT_DOF_POST } },
+          { .shadows = DRIFT_SHADOWS_HARD,
+            .reflections = DRIFT_REFLECTIONS_SHARP,
+            .dof = DRIFT_DOF_POST } },
         { "hard", { .shadows = DRIFT_SHADOWS_HARD } },
         { "pcf", { .shadows = DRIFT_SHADOWS_PCF } },
         { "pcss", { .shadows = DRIFT_SHADOWS_PCSS } },
-        { "hard+envmap", { .shadows = DRIFT_SHADOWS_HARD, .reflections = DRIFT_REFLECTIONS_ENVMAP } },
+        { "hard+envmap",
+          { .shadows = DRIFT_SHADOWS_HARD, .reflections = DRIFT_REFLECTIONS_ENVMAP } },
     };
     const int config_count = (int)(sizeof configs / sizeof *configs);
     int exit_code = 1;
     cli_session session;
-    if (!cli_session_open(
-            &(cli_session_desc){ .cmd = "bench frame",
-                                 .scene_path = o.scene_path,
-                                 .default_scene = DRIFT_SOURCE_DIR
-                                 "/scenes/cornell-bunny/cornell_bunny.json",
-                                 .threads = (int)o.threads },
-            &session)) {
+    if (!cli_session_open(&(cli_session_desc){ .cmd = "bench frame",
+                                               .scene_path = o.scene_path,
+                                               .default_scene = DRIFT_SOURCE_DIR
+                                               "/scenes/cornell-bunny/cornell_bunny.json",
+                                               .threads = (int)o.threads },
+                          &session)) {
         goto done;
     }
     drift_context *ctx = session.ctx;
@@ -178,7 +178,8 @@ int drift_bench_frame(int argc, char **argv)
         printf("\npasses of %s (ms):", configs[0].name);
         for (int p = 0; p < DRIFT_PASS_COUNT; ++p) {
             if (results[0].pass_ms[p] > 0.0) {
-                printf(" %s %.2f", drift_hybrid_pass_name((drift_hybrid_pass)p), results[0].pass_ms[p]);
+                printf(" %s %.2f", drift_hybrid_pass_name((drift_hybrid_pass)p),
+                       results[0].pass_ms[p]);
             }
         }
         printf("\ntarget: %s frame <= 4x primary: %s\n", configs[0].name,

@@ -35,15 +35,18 @@ typedef struct isg_options {
 #define O isg_options
 static const cli_option isg_table[] = {
     CLI_SECTION("options:", 0),
-    CLI_INT("--width", "W", O, width, 1, DRIFT_IMAGE_MAX_DIMENSION, "timing size (default 1024x768)"),
+    CLI_INT("--width", "W", O, width, 1, DRIFT_IMAGE_MAX_DIMENSION,
+            "timing size (default 1024x768)"),
     CLI_INT("--height", "H", O, height, 1, DRIFT_IMAGE_MAX_DIMENSION, "timing size"),
-    CLI_INT("--qwidth", "W", O, qwidth, 1, DRIFT_IMAGE_MAX_DIMENSION, "quality size (default 320x240)"),
+    CLI_INT("--qwidth", "W", O, qwidth, 1, DRIFT_IMAGE_MAX_DIMENSION,
+            "quality size (default 320x240)"),
     CLI_INT("--qheight", "H", O, qheight, 1, DRIFT_IMAGE_MAX_DIMENSION, "quality size"),
     CLI_INT("--ref-spp", "N", O, ref_spp, 1, 1 << 20,
             "samples per pixel of the references (default 256)"),
     CLI_INT("--search", "N", O, search, 1, 1024, "ISG samples of the quality runs (default 25"),
     CLI_INT("--gather", "M", O, gather, 1, 1024, "and 49)"),
-    CLI_INT("--frames", "N", O, frames, 1, 100, "timing: the least of N frames per cell (default 1)"),
+    CLI_INT("--frames", "N", O, frames, 1, 100,
+            "timing: the least of N frames per cell (default 1)"),
     CLI_NUMBER("--aperture", "A", O, aperture, 0.0, 1e30,
                "lens radius for the DOF runs (default: the scene camera's; when\n"
                "it has none, 1% of the scene diagonal, focused on the surface\n"
@@ -233,10 +236,10 @@ static bool print_json(const bench_ctx *b, double tables[3][4][4], const double 
     cJSON *root = cJSON_CreateObject();
     cJSON_AddStringToObject(root, "scene", path);
     cJSON_AddNumberToObject(root, "threads", drift_context_thread_count(b->ctx));
-    const char *const keys[] = { "frames", "width", "height", "qwidth", "qheight",
-                                 "ref_spp", "search", "gather" };
-    const long values[] = { o->frames, o->width, o->height, o->qwidth, o->qheight,
-                            o->ref_spp, o->search, o->gather };
+    const char *const keys[] = { "frames",  "width",   "height", "qwidth",
+                                 "qheight", "ref_spp", "search", "gather" };
+    const long values[] = { o->frames,  o->width,   o->height, o->qwidth,
+                            o->qheight, o->ref_spp, o->search, o->gather };
     for (size_t k = 0; k < sizeof keys / sizeof *keys; ++k) {
         cJSON_AddNumberToObject(root, keys[k], (double)values[k]);
     }
@@ -252,7 +255,8 @@ static bool print_json(const bench_ctx *b, double tables[3][4][4], const double 
                 cJSON_AddNumberToObject(row, "gather", counts[g]);
                 cJSON *ms = cJSON_AddArrayToObject(row, "search_ms");
                 for (int s = 0; s < 4; ++s) {
-                    cJSON_AddItemToArray(ms, cJSON_CreateNumber(round(tables[e][g][s] * 1e3) / 1e3));
+                    cJSON_AddItemToArray(ms,
+                                         cJSON_CreateNumber(round(tables[e][g][s] * 1e3) / 1e3));
                 }
             }
         }
@@ -318,13 +322,12 @@ int drift_bench_isg(int argc, char **argv)
     }
     int exit_code = 1;
     cli_session session;
-    if (!cli_session_open(
-            &(cli_session_desc){ .cmd = "bench isg",
-                                 .scene_path = o.scene_path,
-                                 .default_scene = DRIFT_SOURCE_DIR
-                                 "/scenes/cornell-glossy/cornell_glossy.json",
-                                 .threads = (int)o.threads },
-            &session)) {
+    if (!cli_session_open(&(cli_session_desc){ .cmd = "bench isg",
+                                               .scene_path = o.scene_path,
+                                               .default_scene = DRIFT_SOURCE_DIR
+                                               "/scenes/cornell-glossy/cornell_glossy.json",
+                                               .threads = (int)o.threads },
+                          &session)) {
         goto done;
     }
     drift_context *ctx = session.ctx;

@@ -657,9 +657,11 @@ static double timed(bench_state *s, enum ray_kind kind, raw_primary_fn raw, doub
 #define O rays_options
 static const cli_option rays_table[] = {
     CLI_SECTION("options:", 0),
-    CLI_INT("--width", "W", O, width, 1, 16384, "image size for primary rays (default: the camera's)"),
+    CLI_INT("--width", "W", O, width, 1, 16384,
+            "image size for primary rays (default: the camera's)"),
     CLI_INT("--height", "H", O, height, 1, 16384, "image size for primary rays"),
-    CLI_NUMBER("--seconds", "S", O, seconds, 0.01, 3600.0, "total time to spend measuring (default 6)"),
+    CLI_NUMBER("--seconds", "S", O, seconds, 0.01, 3600.0,
+               "total time to spend measuring (default 6)"),
     CLI_INT("--repeats", "N", O, repeats, 1, 1000, "alternations of the two sides (default 5)"),
     CLI_FLAG("--json", O, json, "one JSON object on stdout instead of the table"),
     CLI_FLAG("--variants", O, variants,

@@ -50,8 +50,8 @@ static bool parse_sizes(const char *cmd, const char *flag, const char *v, void *
         int w, h, used = 0;
         if (o->size_count == MAX_SIZES || sscanf(p, "%dx%d%n", &w, &h, &used) != 2 || w < 8 ||
             h < 8 || w > 16384 || h > 16384) {
-            fprintf(stderr, "drift %s: %s expects WxH[,WxH...] (8..16384), got '%s'\n", cmd,
-                    flag, v);
+            fprintf(stderr, "drift %s: %s expects WxH[,WxH...] (8..16384), got '%s'\n", cmd, flag,
+                    v);
             return false;
         }
         o->widths[o->size_count] = w;
@@ -111,7 +111,8 @@ static const cli_option sir_table[] = {
               "as the paper's rows are views with more or fewer error pixels)",
       .kind = CLI_KIND_CUSTOM,
       .parse = parse_target },
-    CLI_NUMBER("--fov", "DEG", O, fov, 0.1, 179.0, "vertical field of view (default: the camera's)"),
+    CLI_NUMBER("--fov", "DEG", O, fov, 0.1, 179.0,
+               "vertical field of view (default: the camera's)"),
     CLI_STRING("--views", "FILE", O, views_path,
                "rows for several views of each scene, from JSON:\n"
                "{\"views\": [{\"name\": \"high\", \"position\": [x, y, z],\n"
@@ -417,8 +418,8 @@ static void add_json_row(cJSON *rows, const sir_row *row, bool lambda)
     cli_json_number(r, "flip", row->flip, 5);
     cli_json_number(r, "noise_flip", row->noise_flip, 5);
     cli_json_number(r, "sir_to_flip_ms", row->reached_ms, 2);
-    cli_json_number(r, "speedup_to_flip", row->reached_ms > 0.0 ? row->prt_ms / row->reached_ms : 0.0,
-                    3);
+    cli_json_number(r, "speedup_to_flip",
+                    row->reached_ms > 0.0 ? row->prt_ms / row->reached_ms : 0.0, 3);
     cJSON_AddBoolToObject(r, "same_image", row->flip <= FLIP_TARGET);
     cli_json_count(r, "iterations", row->iterations);
     cli_json_count(r, "sir_rays", row->sir_rays);

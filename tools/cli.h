@@ -5,11 +5,10 @@
 #ifndef DRIFT_TOOLS_CLI_H
 #define DRIFT_TOOLS_CLI_H
 
+#include "cli_json.h"
+#include "cli_options.h"
 #include "drift/core.h"
 #include "drift/hybrid.h"
-
-#include "cli_options.h"
-#include "cli_json.h"
 
 #include <stdbool.h>
 #include <stdint.h>
@@ -19,12 +18,12 @@
 // (the prototype and tools/drift.c's dispatch table come from it). Each takes the arguments
 // after its own name (argv[0] is the subcommand) and returns the process exit status: 0
 // success, 1 failure, 2 usage error. Benchmarks are listed in bench/bench.h.
-#define DRIFT_COMMAND_LIST(X)                                                                   \
-    X("render", drift_cmd_render, "render a scene (reference path tracer or hybrid frame)")     \
-    X("diff", drift_cmd_diff, "compare two images: MSE, RMSE, relMSE, PSNR, SSIM, FLIP")        \
-    X("info", drift_cmd_info, "print a scene's triangle, material, light, texture counts")      \
-    X("bench", drift_cmd_bench, "benchmarks (drift bench --help)")                              \
-    X("view", drift_cmd_view, "interactive viewer: hybrid techniques against the reference")    \
+#define DRIFT_COMMAND_LIST(X)                                                                \
+    X("render", drift_cmd_render, "render a scene (reference path tracer or hybrid frame)")  \
+    X("diff", drift_cmd_diff, "compare two images: MSE, RMSE, relMSE, PSNR, SSIM, FLIP")     \
+    X("info", drift_cmd_info, "print a scene's triangle, material, light, texture counts")   \
+    X("bench", drift_cmd_bench, "benchmarks (drift bench --help)")                           \
+    X("view", drift_cmd_view, "interactive viewer: hybrid techniques against the reference") \
     X("refine", drift_cmd_refine, "smart image refinement: fit the metric weights (lambda)")
 
 #define DRIFT__COMMAND_DECLARE(name, fn, summary) int fn(int argc, char **argv);
@@ -81,6 +80,7 @@ typedef struct cli_session_desc {
 
 struct drift_scene;
 struct drift_accel;
+
 typedef struct cli_session {
     drift_context *ctx;
     struct drift_scene *scene;

@@ -153,7 +153,7 @@ bool cli_session_open(const cli_session_desc *desc, cli_session *s)
     if (desc->no_scene) {
         return true;
     }
-    const char *path = desc->scene_path     ? desc->scene_path
+    const char *path = desc->scene_path      ? desc->scene_path
                        : desc->default_scene ? desc->default_scene
                                              : cli_default_scene_path();
     return cli_session_load(s, desc->cmd, path, desc->no_accel);

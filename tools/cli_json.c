@@ -5,7 +5,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
 #include <unistd.h>
 
 cJSON *cli_json_number(cJSON *object, const char *key, double value, int decimals)
@@ -72,13 +71,14 @@ static bool print_item(FILE *out, const cJSON *item, int indent, int depth)
     bool lines = indent >= 0 && nested && item->child;
     for (const cJSON *c = item->child; ok && c; c = c->next) {
         if (lines) {
-            ok = fprintf(out, "%s\n%*s", c == item->child ? "" : ",", indent * (depth + 1), "") >= 0;
+            ok =
+                fprintf(out, "%s\n%*s", c == item->child ? "" : ",", indent * (depth + 1), "") >= 0;
         } else if (c != item->child) {
             ok = fputs(", ", out) >= 0;
         }
         if (ok && object) {
-            char *key = cJSON_PrintUnformatted(&(cJSON){ .type = cJSON_String,
-                                                         .valuestring = c->string });
+            char *key =
+                cJSON_PrintUnformatted(&(cJSON){ .type = cJSON_String, .valuestring = c->string });
             ok = key && fprintf(out, "%s: ", key) >= 0;
             cJSON_free(key);
         }

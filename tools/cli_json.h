@@ -5,10 +5,9 @@
 #ifndef DRIFT_TOOLS_CLI_JSON_H
 #define DRIFT_TOOLS_CLI_JSON_H
 
+#include <cjson/cJSON.h>
 #include <stdbool.h>
 #include <stdint.h>
-
-#include <cjson/cJSON.h>
 
 // Adds key: value rounded to `decimals` places (< 0: as is); NaN and infinities become null.
 // Returns the new item (NULL when out of memory: cli_json_write then fails).

@@ -1,12 +1,12 @@
 // The option-table parser and help printer (tools/cli_options.h).
-#include "cli.h"
 #include "cli_options.h"
+
+#include "cli.h"
+#include "drift/hybrid.h"
 
 #include <stdint.h>
 #include <stdio.h>
 #include <string.h>
-
-#include "drift/hybrid.h"
 
 // Whether `arg` is one of the ", "-separated names of `names`.
 static bool name_matches(const char *names, const char *arg)
@@ -146,7 +146,8 @@ static bool read_value(const char *cmd, const char *flag, const cli_option *opt,
 static int effect_of(const char *arg)
 {
     for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
-        if (strncmp(arg, "--", 2) == 0 && strcmp(arg + 2, drift_effect_name((drift_effect)e)) == 0) {
+        if (strncmp(arg, "--", 2) == 0 &&
+            strcmp(arg + 2, drift_effect_name((drift_effect)e)) == 0) {
             return e;
         }
     }
@@ -255,7 +256,10 @@ static void print_techniques(FILE *out, drift_effect effect)
     }
     int count = drift_technique_count(effect);
     for (int t = 0; t < count; ++t) {
-        fprintf(out, "%s%s%s", t == 0 ? "" : t + 1 < count ? ", " : " or ",
+        fprintf(out, "%s%s%s",
+                t == 0          ? ""
+                : t + 1 < count ? ", "
+                                : " or ",
                 drift_technique_name(effect, t), t == 0 ? " (default)" : "");
     }
     fprintf(out, "\n");

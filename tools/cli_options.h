@@ -30,16 +30,16 @@
 #include <stdio.h>
 
 typedef enum cli_kind {
-    CLI_KIND_FLAG,      // no value: stores true
-    CLI_KIND_INT,       // an integer in [lo, hi]
-    CLI_KIND_NUMBER,    // a finite number in [lo, hi]
-    CLI_KIND_STRING,    // any text
-    CLI_KIND_CHOICE,    // one of `choices` ("full|plane"): stores its index
+    CLI_KIND_FLAG,       // no value: stores true
+    CLI_KIND_INT,        // an integer in [lo, hi]
+    CLI_KIND_NUMBER,     // a finite number in [lo, hi]
+    CLI_KIND_STRING,     // any text
+    CLI_KIND_CHOICE,     // one of `choices` ("full|plane"): stores its index
     CLI_KIND_TECHNIQUES, // one row for every effect: --<effect name> T sets that effect's
                          // technique in the drift_hybrid_params at `offset`
-    CLI_KIND_CUSTOM,    // `parse` reads the value (NULL when the option takes none)
-    CLI_KIND_SECTION,   // help only: a heading; the options after it join its `groups`
-    CLI_KIND_NOTE,      // help only: a line under the option before it
+    CLI_KIND_CUSTOM,     // `parse` reads the value (NULL when the option takes none)
+    CLI_KIND_SECTION,    // help only: a heading; the options after it join its `groups`
+    CLI_KIND_NOTE,       // help only: a line under the option before it
 } cli_kind;
 
 typedef enum cli_store {
@@ -54,16 +54,19 @@ typedef enum cli_store {
 } cli_store;
 
 // The store type of a field, from its C type (enums with no negative values are unsigned).
-#define CLI_STORE_OF(x)                                                                          \
-    _Generic((x), long                                                                           \
-             : CLI_STORE_LONG, int                                                               \
-             : CLI_STORE_INT, unsigned                                                           \
-             : CLI_STORE_UINT, double                                                            \
-             : CLI_STORE_DOUBLE, float                                                           \
-             : CLI_STORE_FLOAT, bool                                                             \
-             : CLI_STORE_BOOL, const char *                                                      \
-             : CLI_STORE_STRING, default                                                         \
-             : CLI_STORE_NONE)
+// (clang-format 14 would break _Generic's associations at the colons.)
+// clang-format off
+#define CLI_STORE_OF(x)                      \
+    _Generic((x),                            \
+             long: CLI_STORE_LONG,           \
+             int: CLI_STORE_INT,             \
+             unsigned: CLI_STORE_UINT,       \
+             double: CLI_STORE_DOUBLE,       \
+             float: CLI_STORE_FLOAT,         \
+             bool: CLI_STORE_BOOL,           \
+             const char *: CLI_STORE_STRING, \
+             default: CLI_STORE_NONE)
+// clang-format on
 
 // A custom value reader: `field` is the options struct plus the row's offset. Prints its own
 // "drift <cmd>: <flag> expects ..." and returns false on a bad value.
@@ -85,60 +88,60 @@ typedef struct cli_option {
 
 #define CLI_AT(T, f) .offset = offsetof(T, f), .store = CLI_STORE_OF(((T *)0)->f)
 
-#define CLI_FLAG(n, T, f, h)                                                                     \
-    {                                                                                            \
-        .name = (n), .help = (h), .kind = CLI_KIND_FLAG, CLI_AT(T, f)                            \
+#define CLI_FLAG(n, T, f, h)                                          \
+    {                                                                 \
+        .name = (n), .help = (h), .kind = CLI_KIND_FLAG, CLI_AT(T, f) \
     }
-#define CLI_INT(n, a, T, f, l, u, h)                                                             \
-    {                                                                                            \
-        .name = (n), .arg = (a), .help = (h), .kind = CLI_KIND_INT, .lo = (double)(l),           \
-        .hi = (double)(u), CLI_AT(T, f)                                                          \
+#define CLI_INT(n, a, T, f, l, u, h)                                                   \
+    {                                                                                  \
+        .name = (n), .arg = (a), .help = (h), .kind = CLI_KIND_INT, .lo = (double)(l), \
+        .hi = (double)(u), CLI_AT(T, f)                                                \
     }
-#define CLI_NUMBER(n, a, T, f, l, u, h)                                                          \
-    {                                                                                            \
-        .name = (n), .arg = (a), .help = (h), .kind = CLI_KIND_NUMBER, .lo = (l), .hi = (u),     \
-        CLI_AT(T, f)                                                                             \
+#define CLI_NUMBER(n, a, T, f, l, u, h)                                                      \
+    {                                                                                        \
+        .name = (n), .arg = (a), .help = (h), .kind = CLI_KIND_NUMBER, .lo = (l), .hi = (u), \
+        CLI_AT(T, f)                                                                         \
     }
-#define CLI_STRING(n, a, T, f, h)                                                                \
-    {                                                                                            \
-        .name = (n), .arg = (a), .help = (h), .kind = CLI_KIND_STRING, CLI_AT(T, f)              \
+#define CLI_STRING(n, a, T, f, h)                                                   \
+    {                                                                               \
+        .name = (n), .arg = (a), .help = (h), .kind = CLI_KIND_STRING, CLI_AT(T, f) \
     }
-#define CLI_CHOICE(n, a, T, f, c, h)                                                             \
-    {                                                                                            \
-        .name = (n), .arg = (a), .help = (h), .kind = CLI_KIND_CHOICE, .choices = (c),           \
-        CLI_AT(T, f)                                                                             \
+#define CLI_CHOICE(n, a, T, f, c, h)                                                   \
+    {                                                                                  \
+        .name = (n), .arg = (a), .help = (h), .kind = CLI_KIND_CHOICE, .choices = (c), \
+        CLI_AT(T, f)                                                                   \
     }
 // --shadows T, --reflections T, ...: one option per drift_effect, named after
 // drift_effect_name, with the help generated from drift_technique_count/name (the first, the
 // zero default, marked "(default)"). A new technique or effect needs no row of its own.
-#define CLI_TECHNIQUES(a, T, f)                                                                  \
-    {                                                                                            \
-        .arg = (a), .kind = CLI_KIND_TECHNIQUES, .offset = offsetof(T, f)                        \
+#define CLI_TECHNIQUES(a, T, f)                                           \
+    {                                                                     \
+        .arg = (a), .kind = CLI_KIND_TECHNIQUES, .offset = offsetof(T, f) \
     }
-#define CLI_CUSTOM(n, a, T, f, fn, h)                                                            \
-    {                                                                                            \
-        .name = (n), .arg = (a), .help = (h), .kind = CLI_KIND_CUSTOM, .parse = (fn),            \
-        .offset = offsetof(T, f)                                                                 \
+#define CLI_CUSTOM(n, a, T, f, fn, h)                                                 \
+    {                                                                                 \
+        .name = (n), .arg = (a), .help = (h), .kind = CLI_KIND_CUSTOM, .parse = (fn), \
+        .offset = offsetof(T, f)                                                      \
     }
-#define CLI_SECTION(h, g)                                                                        \
-    {                                                                                            \
-        .help = (h), .kind = CLI_KIND_SECTION, .groups = (g)                                     \
+#define CLI_SECTION(h, g)                                    \
+    {                                                        \
+        .help = (h), .kind = CLI_KIND_SECTION, .groups = (g) \
     }
-#define CLI_NOTE(h)                                                                              \
-    {                                                                                            \
-        .help = (h), .kind = CLI_KIND_NOTE                                                       \
+#define CLI_NOTE(h)                        \
+    {                                      \
+        .help = (h), .kind = CLI_KIND_NOTE \
     }
 
 // A macro's value as a string literal, for defaults in help texts.
-#define CLI_STR(x)        CLI_STR_INNER(x)
-#define CLI_STR_INNER(x)  #x
+#define CLI_STR(x)       CLI_STR_INNER(x)
+#define CLI_STR_INNER(x) #x
 
 #define CLI_GROUP_COUNT 8
 
 typedef struct cli_command {
-    const char *name;  // "render", "bench isg": in messages and help
-    const char *usage; // printed before the options: the usage line and what the command does
-    const char *epilogue;     // printed after the options (may be NULL)
+    const char *name;     // "render", "bench isg": in messages and help
+    const char *usage;    // printed before the options: the usage line and what the command does
+    const char *epilogue; // printed after the options (may be NULL)
     void (*more_help)(FILE *out); // prints what the epilogue cannot hold (may be NULL)
     const cli_option *options;
     size_t option_count;
@@ -149,7 +152,7 @@ typedef struct cli_command {
 } cli_command;
 
 #define CLI_TABLE(t) .options = (t), .option_count = sizeof(t) / sizeof((t)[0])
-#define CLI_POSITIONAL(label, T, f, max)                                                         \
+#define CLI_POSITIONAL(label, T, f, max) \
     .positional = (label), .positional_offset = offsetof(T, f), .positional_max = (max)
 
 enum {

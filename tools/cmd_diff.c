@@ -1,14 +1,13 @@
 // drift diff: compares a test image against a reference with MSE, RMSE, relMSE, PSNR, SSIM
 // and LDR-FLIP (docs/metrics.md), optionally writing the FLIP error as a magma heat map.
 #include "cli.h"
+#include "drift/image.h"
+#include "drift/image_io.h"
+#include "drift/metric.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
-
-#include "drift/image.h"
-#include "drift/image_io.h"
-#include "drift/metric.h"
 
 typedef struct diff_options {
     const char *paths[2]; // REF TEST
@@ -27,7 +26,8 @@ static const cli_option diff_table[] = {
              "print {\"mse\":..,\"rmse\":..,\"relmse\":..,\"psnr\":..,\n"
              "\"ssim\":..,\"flip\":..}; psnr is null for identical images"),
     CLI_NUMBER("--difftol", "X", O, difftol, 0.0, 1.0, "exit with status 1 when FLIP > X"),
-    CLI_NUMBER("--ppd", "P", O, ppd, 1.0, 2000.0, "FLIP pixels per degree (default " CLI_STR(DRIFT_METRIC_DEFAULT_PPD) ")"),
+    CLI_NUMBER("--ppd", "P", O, ppd, 1.0, 2000.0,
+               "FLIP pixels per degree (default " CLI_STR(DRIFT_METRIC_DEFAULT_PPD) ")"),
     CLI_FLAG("-v, --verbose", O, verbose, "more log output"),
 };
 #undef O
@@ -68,8 +68,9 @@ int drift_cmd_diff(int argc, char **argv)
     const char *paths[2] = { o.paths[0], o.paths[1] };
     const char *heatmap_path = o.heatmap_path;
     cli_session session;
-    if (!cli_session_open(&(cli_session_desc){ .cmd = "diff", .verbose = o.verbose, .no_scene = true },
-                          &session)) {
+    if (!cli_session_open(
+            &(cli_session_desc){ .cmd = "diff", .verbose = o.verbose, .no_scene = true },
+            &session)) {
         cli_session_close(&session);
         return 1;
     }

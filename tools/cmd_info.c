@@ -16,7 +16,8 @@ typedef struct info_options {
 static const cli_option info_table[] = {
     CLI_SECTION("options:", 0),
     CLI_FLAG("--json", info_options, json, "machine-readable output (one JSON object on stdout)"),
-    CLI_FLAG("--verbose", info_options, verbose, "also print informational messages from the loader"),
+    CLI_FLAG("--verbose", info_options, verbose,
+             "also print informational messages from the loader"),
 };
 
 static const cli_command info_command = {

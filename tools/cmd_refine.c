@@ -3,18 +3,17 @@
 // pure ray tracing), takes the real error |raster - ray traced| of each, and keeps the best of
 // `trials` random lambda tuples (the averaged sum is the first candidate).
 #include "cli.h"
+#include "drift/accel.h"
+#include "drift/hybrid.h"
+#include "drift/refine.h"
+#include "drift/scene.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "drift/accel.h"
-#include "drift/hybrid.h"
-#include "drift/refine.h"
-#include "drift/scene.h"
-
-#define MAX_VIEWS 32
+#define MAX_VIEWS        32
 #define REAL_ERROR_SCALE 0.1f // display-value difference that counts as full error
 
 typedef struct fit_options {
@@ -27,8 +26,10 @@ typedef struct fit_options {
 static const cli_option fit_table[] = {
     CLI_SECTION("options:", 0),
     CLI_STRING("--out", "LAMBDA.json", O, out_path, "where the weights go (required)"),
-    CLI_INT("--views", "N", O, views, 1, MAX_VIEWS, "views orbiting the camera's target (default 4)"),
-    CLI_NUMBER("--degrees", "D", O, degrees, 0.0, 180.0, "the orbit spans +-D degrees (default 20)"),
+    CLI_INT("--views", "N", O, views, 1, MAX_VIEWS,
+            "views orbiting the camera's target (default 4)"),
+    CLI_NUMBER("--degrees", "D", O, degrees, 0.0, 180.0,
+               "the orbit spans +-D degrees (default 20)"),
     CLI_INT("--width", "W", O, width, 1, 8192, "view size (default 160x120)"),
     CLI_INT("--height", "H", O, height, 1, 8192, "view size"),
     CLI_INT("--spp", "N", O, spp, 1, 65536, "samples a pixel of the pure ray tracer (default 8)"),
@@ -40,20 +41,22 @@ static const cli_option fit_table[] = {
 
 static const cli_command fit_command = {
     .name = "refine fit",
-    .usage = "usage: drift refine fit [SCENE] --out LAMBDA.json [options]\n\n"
-             "Fits the weights lambda of SIR's linear metric combination for one scene (the\n"
-             "paper's pre-process): N views orbiting the scene camera's target over +-D degrees,\n"
-             "each rendered by the hybrid frame (PCSS, envmap, post DOF) and by the pure ray\n"
-             "tracer at --spp, at W x H; the best of --trials random tuples against the real\n"
-             "error is written as {\"lambda\": {...}} for `drift render ... --refine sir --lambda`.\n\n",
+    .usage =
+        "usage: drift refine fit [SCENE] --out LAMBDA.json [options]\n\n"
+        "Fits the weights lambda of SIR's linear metric combination for one scene (the\n"
+        "paper's pre-process): N views orbiting the scene camera's target over +-D degrees,\n"
+        "each rendered by the hybrid frame (PCSS, envmap, post DOF) and by the pure ray\n"
+        "tracer at --spp, at W x H; the best of --trials random tuples against the real\n"
+        "error is written as {\"lambda\": {...}} for `drift render ... --refine sir --lambda`.\n\n",
     CLI_TABLE(fit_table),
     CLI_POSITIONAL("SCENE", fit_options, scene_path, 1),
 };
 
 static int parse(int argc, char **argv, fit_options *o)
 {
-    *o = (fit_options){ .views = 4, .width = 160, .height = 120, .spp = 8, .trials = 2000,
-                        .degrees = 20.0 };
+    *o = (fit_options){
+        .views = 4, .width = 160, .height = 120, .spp = 8, .trials = 2000, .degrees = 20.0
+    };
     int status = cli_parse(&fit_command, argc, argv, o, NULL);
     if (status != CLI_PARSED) {
         return status;
@@ -73,10 +76,10 @@ static drift_camera orbit(const drift_camera *camera, long k, long n, double deg
     drift_vec3 d = drift_vec3_sub(camera->position, camera->target);
     drift_vec3 up = drift_vec3_normalize(camera->up);
     // Rodrigues' rotation of d about up.
-    drift_vec3 rotated = drift_vec3_add(
-        drift_vec3_add(drift_vec3_scale(d, cosf(angle)),
-                       drift_vec3_scale(drift_vec3_cross(up, d), sinf(angle))),
-        drift_vec3_scale(up, drift_vec3_dot(up, d) * (1.0f - cosf(angle))));
+    drift_vec3 rotated =
+        drift_vec3_add(drift_vec3_add(drift_vec3_scale(d, cosf(angle)),
+                                      drift_vec3_scale(drift_vec3_cross(up, d), sinf(angle))),
+                       drift_vec3_scale(up, drift_vec3_dot(up, d) * (1.0f - cosf(angle))));
     drift_camera c = *camera;
     c.position = drift_vec3_add(camera->target, rotated);
     return c;
@@ -117,8 +120,8 @@ static int fit(const fit_options *o)
             r = drift_hybrid_render(v->frame, &camera, NULL);
         }
         if (r == DRIFT_OK) {
-            r = drift_refine_create(ctx, v->frame, &(drift_refine_params){ .seed = (uint32_t)o->seed },
-                                    &v->sir);
+            r = drift_refine_create(ctx, v->frame,
+                                    &(drift_refine_params){ .seed = (uint32_t)o->seed }, &v->sir);
         }
         if (r == DRIFT_OK) {
             r = drift_refine_begin(v->sir);
@@ -156,7 +159,8 @@ static int fit(const fit_options *o)
     printf("wrote %s: mean |E - real| %.5f (averaged sum %.5f) over %ld views of %ldx%ld\n",
            o->out_path, cost, average_cost, o->views, o->width, o->height);
     for (int m = 0; m < DRIFT_METRIC_COUNT; ++m) {
-        printf("  %-12s %.4f\n", drift_refine_metric_name((drift_refine_metric)m), (double)lambda[m]);
+        printf("  %-12s %.4f\n", drift_refine_metric_name((drift_refine_metric)m),
+               (double)lambda[m]);
     }
     exit_code = 0;
 done:

@@ -3,6 +3,10 @@
 // Reads like the API walk-through: load the scene, build the accel, create the path tracer,
 // add samples in passes (progress, checkpoints, Ctrl-C), resolve and write the images.
 #include "cli.h"
+#include "drift/accel.h"
+#include "drift/image_io.h"
+#include "drift/pt.h"
+#include "drift/scene_io.h"
 #include "render.h"
 
 #include <math.h>
@@ -10,13 +14,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
 #include <unistd.h>
-
-#include "drift/accel.h"
-#include "drift/image_io.h"
-#include "drift/pt.h"
-#include "drift/scene_io.h"
 
 // Set from the SIGINT handler; the render loop polls it between tiles.
 static atomic_bool interrupted;
@@ -32,7 +30,6 @@ const atomic_bool *render_catch_sigint(void)
     signal(SIGINT, on_sigint);
     return &interrupted;
 }
-
 
 // --- OPTIONS ---
 
@@ -125,7 +122,10 @@ static bool parse_isg_count(const char *cmd, const char *flag, const char *v, vo
 }
 
 // Groups of options (cli_parse's first_in_group): hybrid-only, and refinement-only.
-enum { GROUP_HYBRID = 1u << 0, GROUP_REFINE = 1u << 1 };
+enum {
+    GROUP_HYBRID = 1u << 0,
+    GROUP_REFINE = 1u << 1
+};
 
 #define O render_options
 static const cli_option render_table[] = {
@@ -154,7 +154,8 @@ static const cli_option render_table[] = {
       .kind = CLI_KIND_CUSTOM,
       .parse = parse_aov,
       .optional_if = ".exr" },
-    CLI_STRING("--stats", "FILE.json", O, stats_path, "spp, rays traced and milliseconds per phase"),
+    CLI_STRING("--stats", "FILE.json", O, stats_path,
+               "spp, rays traced and milliseconds per phase"),
     CLI_NUMBER("--checkpoint", "SECONDS", O, checkpoint_seconds, 0.0, 1e9,
                "write the image so far every SECONDS (default 60; 0 = never)"),
     CLI_NUMBER("--exposure", "STOPS", O, exposure, -64.0, 64.0, "PNG exposure (default 0)"),
@@ -232,11 +233,12 @@ static const cli_option render_table[] = {
 
 static const cli_command render_command = {
     .name = "render",
-    .usage = "usage: drift render [SCENE] [options]\n"
-             "\n"
-             "Renders SCENE (a drift .json scene, or .obj/.gltf/.glb/.ply[.gz]); without SCENE, the\n"
-             "built-in Cornell box. Writes a linear EXR and a tone-mapped sRGB PNG beside it.\n"
-             "\n",
+    .usage =
+        "usage: drift render [SCENE] [options]\n"
+        "\n"
+        "Renders SCENE (a drift .json scene, or .obj/.gltf/.glb/.ply[.gz]); without SCENE, the\n"
+        "built-in Cornell box. Writes a linear EXR and a tone-mapped sRGB PNG beside it.\n"
+        "\n",
     .epilogue = "\nCtrl-C stops the render and writes what it has.\n",
     CLI_TABLE(render_table),
     CLI_POSITIONAL("SCENE", render_options, scene_path, 1),

@@ -37,7 +37,7 @@ typedef struct view_options {
     double exposure;
     drift_hybrid_params hybrid; // the techniques given (zero: the defaults)
     bool split, no_overlay, verbose;
-    bool refine;       // --refine sir
+    bool refine;        // --refine sir
     long refine_budget; // --budget: SIR samples a frame (0: the default)
 } view_options;
 
@@ -68,7 +68,8 @@ static void print_keys(FILE *out)
         int len = end ? (int)(end - line) : (int)strlen(line);
         const char *tab = memchr(line, '\t', (size_t)len);
         int key_len = tab ? (int)(tab - line) : len;
-        fprintf(out, "  %-18.*s%.*s\n", key_len, line, tab ? len - key_len - 1 : 0, tab ? tab + 1 : "");
+        fprintf(out, "  %-18.*s%.*s\n", key_len, line, tab ? len - key_len - 1 : 0,
+                tab ? tab + 1 : "");
         line = end ? end + 1 : line + len;
     }
 }
@@ -84,7 +85,8 @@ static bool parse_press(const char *cmd, const char *flag, const char *v, void *
 #define O view_options
 static const cli_option view_table[] = {
     CLI_SECTION("options:", 0),
-    CLI_INT("--width", "W", O, width, 1, 16384, "window and image size (default: the scene camera's)"),
+    CLI_INT("--width", "W", O, width, 1, 16384,
+            "window and image size (default: the scene camera's)"),
     CLI_INT("--height", "H", O, height, 1, 16384, "window and image size"),
     CLI_INT("--threads", "T", O, threads, 0, 256, "worker threads (default: all cores)"),
     CLI_TECHNIQUES("NAME", O, hybrid),
@@ -125,10 +127,11 @@ static const cli_command view_command = {
              "and the milliseconds of each pass on screen.\n"
              "\n",
     .more_help = print_more_help,
-    .epilogue = "\n"
-                "A window needs a display: without one, run it under a virtual X server\n"
-                "(xvfb-run -a drift view ...). Exit status: 0 success, 1 failure (no display, scene,\n"
-                "render), 2 usage error, 130 interrupted.\n",
+    .epilogue =
+        "\n"
+        "A window needs a display: without one, run it under a virtual X server\n"
+        "(xvfb-run -a drift view ...). Exit status: 0 success, 1 failure (no display, scene,\n"
+        "render), 2 usage error, 130 interrupted.\n",
     CLI_TABLE(view_table),
     CLI_POSITIONAL("SCENE", view_options, scene_path, 1),
     .help_column = 27,
@@ -541,7 +544,8 @@ int drift_cmd_view(int argc, char **argv)
     const char *scene_path = session.scene_path;
     drift_hybrid_params params = o.hybrid;
     params.spp = (uint32_t)o.spp;
-    drift_result r = drift_view_create(ctx, session.scene, session.accel,
+    drift_result r =
+        drift_view_create(ctx, session.scene, session.accel,
                           &(drift_view_desc){ .width = (int32_t)o.width,
                                               .height = (int32_t)o.height,
                                               .hybrid = params,

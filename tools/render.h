@@ -2,14 +2,13 @@
 #ifndef DRIFT_TOOLS_RENDER_H
 #define DRIFT_TOOLS_RENDER_H
 
-#include <stdatomic.h>
-#include <stdbool.h>
-#include <stddef.h>
-
+#include "cli.h"
 #include "drift/hybrid.h"
 #include "drift/image.h"
 
-#include "cli.h"
+#include <stdatomic.h>
+#include <stdbool.h>
+#include <stddef.h>
 
 // --refine sir and its options (hybrid mode; tools/render_refine.c, docs/sir.md).
 typedef struct render_refine_options {
@@ -28,7 +27,7 @@ typedef struct render_options {
     const char *out_path;
     const char *stats_path;
     const char *aov_path; // hybrid: every plane as layers of this EXR
-    bool hybrid_mode; // --mode hybrid (else reference)
+    bool hybrid_mode;     // --mode hybrid (else reference)
     long spp, seed, threads, max_depth, width, height;
     double checkpoint_seconds;
     double exposure;
@@ -65,8 +64,8 @@ drift_result render_write_image(drift_context *ctx, const render_options *o,
 // Writes the refiner's planes (sir may be NULL), then every plane of the frame, as the
 // layers of one EXR.
 struct drift_refine;
-drift_result render_write_aov(drift_context *ctx, const char *path, const struct drift_hybrid *frame,
-                              const struct drift_refine *sir);
+drift_result render_write_aov(drift_context *ctx, const char *path,
+                              const struct drift_hybrid *frame, const struct drift_refine *sir);
 
 // FILE.exr -> FILE.png
 void render_png_path(const char *exr_path, char *out, size_t size);

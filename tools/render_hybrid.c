@@ -1,14 +1,13 @@
 // drift render --mode hybrid: one hybrid frame with a technique per effect, written as EXR
 // and PNG, with every plane (--aov FILE.exr) and per-pass milliseconds and rays (--stats).
 #include "cli.h"
+#include "drift/image_io.h"
+#include "drift/refine.h"
 #include "render.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-#include "drift/image_io.h"
-#include "drift/refine.h"
 
 static bool write_stats(const render_options *o, const cli_session *session,
                         const drift_hybrid *frame, double t_done)
@@ -18,9 +17,9 @@ static bool write_stats(const render_options *o, const cli_session *session,
     cJSON *root = render_stats_begin(o, session, "hybrid", p.width, p.height);
     cJSON *techniques = cJSON_AddObjectToObject(root, "techniques");
     for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
-        cJSON_AddStringToObject(
-            techniques, drift_effect_name((drift_effect)e),
-            drift_technique_name((drift_effect)e, drift_hybrid_params_technique(&p, (drift_effect)e)));
+        cJSON_AddStringToObject(techniques, drift_effect_name((drift_effect)e),
+                                drift_technique_name((drift_effect)e, drift_hybrid_params_technique(
+                                                                          &p, (drift_effect)e)));
     }
     cli_json_count(root, "spp", p.spp);
     cli_json_count(root, "seed", p.seed);
@@ -130,14 +129,16 @@ int render_hybrid(const render_options *o, const cli_session *session)
         for (int e = 0, n = 0; e < DRIFT_EFFECT_COUNT && n < (int)sizeof techniques; ++e) {
             n += snprintf(techniques + n, sizeof techniques - (size_t)n, ", %s %s",
                           drift_effect_name((drift_effect)e),
-                          drift_technique_name((drift_effect)e,
-                                               drift_hybrid_params_technique(&params, (drift_effect)e)));
+                          drift_technique_name((drift_effect)e, drift_hybrid_params_technique(
+                                                                    &params, (drift_effect)e)));
         }
         fprintf(stderr, "drift render: hybrid frame of %s, %dx%d%s, %d threads\n", scene_path,
                 params.width, params.height, techniques, drift_context_thread_count(ctx));
         if (params.dof == DRIFT_DOF_REFERENCE) {
-            fprintf(stderr, "drift render: --dof reference path-traces every enabled effect "
-                            "through the lens at %u spp\n", params.spp);
+            fprintf(stderr,
+                    "drift render: --dof reference path-traces every enabled effect "
+                    "through the lens at %u spp\n",
+                    params.spp);
         }
     }
     r = drift_hybrid_render(frame, &scene->camera, render_catch_sigint());
@@ -175,7 +176,8 @@ int render_hybrid(const render_options *o, const cli_session *session)
     char png[4096];
     render_png_path(o->out_path, png, sizeof png);
     printf("wrote %s and %s (hybrid, %dx%d) in %.2f s (frame %.1f ms)\n", o->out_path, png,
-           params.width, params.height, t_done - session->t_start, drift_hybrid_get_stats(frame).frame_ms);
+           params.width, params.height, t_done - session->t_start,
+           drift_hybrid_get_stats(frame).frame_ms);
     exit_code = 0;
 done:
     drift_hybrid_destroy(frame);

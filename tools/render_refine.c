@@ -1,16 +1,16 @@
 // drift render --mode hybrid --refine sir: Smart Image Refinement of the hybrid frame. Checks
-// the refine options (tools/cmd_render.c's table reads them), runs iterations of `--budget` samples until the image is refined or
-// an iteration/time limit, and writes the refined image (EXR + PNG), every plane of the frame
-// and of the refiner with --aov, and the refinement's figures with --stats.
+// the refine options (tools/cmd_render.c's table reads them), runs iterations of `--budget` samples
+// until the image is refined or an iteration/time limit, and writes the refined image (EXR + PNG),
+// every plane of the frame and of the refiner with --aov, and the refinement's figures with
+// --stats.
 #include "cli.h"
+#include "drift/image_io.h"
+#include "drift/refine.h"
 #include "render.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-#include "drift/image_io.h"
-#include "drift/refine.h"
 
 bool render_refine_validate(const render_options *o)
 {
@@ -86,7 +86,8 @@ int render_refine_run(const render_options *o, const cli_session *session, drift
     r = drift_refine_begin(sir);
     const atomic_bool *cancel = render_catch_sigint();
     while (r == DRIFT_OK && !drift_refine_done(sir)) {
-        if (ro->iterations > 0 && drift_refine_get_stats(sir).iterations >= (uint32_t)ro->iterations) {
+        if (ro->iterations > 0 &&
+            drift_refine_get_stats(sir).iterations >= (uint32_t)ro->iterations) {
             break;
         }
         if (ro->seconds > 0.0 && drift_time_now() - start >= ro->seconds) {

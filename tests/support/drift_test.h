@@ -4,14 +4,13 @@
 #define DRIFT_TEST_H
 
 // cmocka needs these before its header.
+#include "drift/core.h"
+
+#include <cmocka.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
-
-#include <cmocka.h>
-
-#include "drift/core.h"
 
 // Remembers the codes and levels of messages so tests can assert on codes, not text.
 typedef struct test_log_capture {
@@ -44,7 +43,7 @@ float test_hash_unit(uint32_t i);
 // Adds a mesh to a test scene and returns its index; fails the test if the scene rejects it.
 struct drift_scene;
 uint32_t test_add_mesh(struct drift_scene *scene, const float *positions, uint32_t vertex_count,
-                   const uint32_t *indices, uint32_t triangle_count, uint32_t material);
+                       const uint32_t *indices, uint32_t triangle_count, uint32_t material);
 
 // DRIFT_TEST_INTENSITY (default 1) scales sample counts in statistical tests.
 double test_intensity(void);

@@ -1,14 +1,13 @@
 // Environment map: cube-face addressing, capture and lookup against synthetic radiance
 // functions of direction (drift_envmap_capture_fn), mip levels by cone angle, and one
 // capture of a real scene through drift_hybrid_trace_radiance.
+#include "drift/accel.h"
 #include "drift_test.h"
+#include "hybrid/hybrid_internal.h"
 
 #include <math.h>
 #include <stdatomic.h>
 #include <string.h>
-
-#include "drift/accel.h"
-#include "hybrid/hybrid_internal.h"
 
 #define HALF_PI 1.57079632679489661923
 

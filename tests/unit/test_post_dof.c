@@ -1,11 +1,10 @@
 // Post-process depth of field: the circle of confusion against the thin-lens camera's own
 // rays, and the gather's identity, normalization, blur width and known colour leak.
 #include "drift_test.h"
+#include "hybrid/hybrid_internal.h"
 
 #include <math.h>
 #include <string.h>
-
-#include "hybrid/hybrid_internal.h"
 
 #define M_PI 3.14159265358979323846
 
