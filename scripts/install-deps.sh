@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages drift needs to build, test, check formatting and fuzz (SDL2 for `drift view`;
-# Xvfb and xauth for its window test under xvfb-run). Idempotent: when everything is present
+# Installs the Debian 12 packages drift needs to build, test, check formatting and fuzz (SDL2
+# for `drift view`; Xvfb and xauth for its window test under xvfb-run). Idempotent: when everything is present
 # it does nothing (no apt-get update), so repeated runs are fast.
 set -euo pipefail
 
