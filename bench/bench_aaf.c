@@ -115,11 +115,11 @@ static const cli_option aaf_table[] = {
       .kind = CLI_KIND_CUSTOM,
       .parse = parse_size },
     CLI_INT("--timing-spp", "N", O, timing_spp, 1, 65536, "timing frame's spp (default 16)"),
-    CLI_INT("--threads", "T", O, threads, 0, 256, "worker threads (default 1: per-thread figures)"),
+    BENCH_OPTION_THREADS(O),
     CLI_STRING("--csv", "FILE", O, csv_path,
                "effect,method,spp,actual_spp,rmse,sampling_ms,filter_ms rows"),
     CLI_STRING("--svg", "FILE", O, svg_path, "the log-log plot"),
-    CLI_FLAG("--json", O, json, "one JSON object on stdout"),
+    BENCH_OPTION_JSON(O),
 };
 #undef O
 
@@ -519,12 +519,7 @@ int drift_bench_aaf(int argc, char **argv)
     }
     int exit_code = 1;
     cli_session session;
-    if (!cli_session_open(
-            &(cli_session_desc){ .cmd = "bench aaf",
-                                 .scene_path = o.scene_path,
-                                 .default_scene = DRIFT_SOURCE_DIR "/scenes/grids/grids.json",
-                                 .threads = (int)o.threads },
-            &session)) {
+    if (!bench_open(&session, "bench aaf", o.scene_path, "scenes/grids/grids.json", o.threads)) {
         goto done;
     }
     drift_context *ctx = session.ctx;

@@ -30,8 +30,8 @@ static const cli_option frame_table[] = {
     CLI_INT("--height", "H", O, height, 1, DRIFT_IMAGE_MAX_DIMENSION, "frame size"),
     CLI_INT("--frames", "N", O, frames, 1, 1000,
             "frames per configuration after one warm-up frame (default 5)"),
-    CLI_INT("--threads", "T", O, threads, 0, 256, "worker threads (default 1: per-thread figures)"),
-    CLI_FLAG("--json", O, json, "one JSON object on stdout"),
+    BENCH_OPTION_THREADS(O),
+    BENCH_OPTION_JSON(O),
 };
 #undef O
 
@@ -121,12 +121,8 @@ int drift_bench_frame(int argc, char **argv)
     const int config_count = (int)(sizeof configs / sizeof *configs);
     int exit_code = 1;
     cli_session session;
-    if (!cli_session_open(&(cli_session_desc){ .cmd = "bench frame",
-                                               .scene_path = o.scene_path,
-                                               .default_scene = DRIFT_SOURCE_DIR
-                                               "/scenes/cornell-bunny/cornell_bunny.json",
-                                               .threads = (int)o.threads },
-                          &session)) {
+    if (!bench_open(&session, "bench frame", o.scene_path,
+                    "scenes/cornell-bunny/cornell_bunny.json", o.threads)) {
         goto done;
     }
     drift_context *ctx = session.ctx;

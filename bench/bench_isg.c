@@ -51,10 +51,10 @@ static const cli_option isg_table[] = {
                "lens radius for the DOF runs (default: the scene camera's; when\n"
                "it has none, 1% of the scene diagonal, focused on the surface\n"
                "at the image centre)"),
-    CLI_INT("--threads", "T", O, threads, 0, 256, "worker threads (default 1: per-thread figures)"),
+    BENCH_OPTION_THREADS(O),
     CLI_FLAG("--no-table", O, skip_table, "skip part (a)"),
     CLI_FLAG("--no-quality", O, skip_quality, "skip part (b)"),
-    CLI_FLAG("--json", O, json, "one JSON object on stdout"),
+    BENCH_OPTION_JSON(O),
 };
 #undef O
 
@@ -322,12 +322,8 @@ int drift_bench_isg(int argc, char **argv)
     }
     int exit_code = 1;
     cli_session session;
-    if (!cli_session_open(&(cli_session_desc){ .cmd = "bench isg",
-                                               .scene_path = o.scene_path,
-                                               .default_scene = DRIFT_SOURCE_DIR
-                                               "/scenes/cornell-glossy/cornell_glossy.json",
-                                               .threads = (int)o.threads },
-                          &session)) {
+    if (!bench_open(&session, "bench isg", o.scene_path,
+                    "scenes/cornell-glossy/cornell_glossy.json", o.threads)) {
         goto done;
     }
     drift_context *ctx = session.ctx;

@@ -70,15 +70,8 @@ static bool parse_sizes(const char *cmd, const char *flag, const char *v, void *
 static bool parse_target(const char *cmd, const char *flag, const char *v, void *field)
 {
     sir_options *o = field;
-    float x = 0.0f, y = 0.0f, z = 0.0f;
-    char tail;
-    if (sscanf(v, "%f,%f,%f%c", &x, &y, &z, &tail) != 3) {
-        fprintf(stderr, "drift %s: %s expects X,Y,Z, got '%s'\n", cmd, flag, v);
-        return false;
-    }
-    o->target = drift_vec3_make(x, y, z);
-    o->has_target = true;
-    return true;
+    o->has_target = cli_parse_vec3(cmd, flag, v, false, &o->target);
+    return o->has_target;
 }
 
 #define O sir_options
@@ -118,8 +111,8 @@ static const cli_option sir_table[] = {
                "{\"views\": [{\"name\": \"high\", \"position\": [x, y, z],\n"
                "\"target\": [x, y, z], \"fov_y\": degrees, \"aperture_radius\": r}]}\n"
                "(every field but name optional: the scene camera's)"),
-    CLI_INT("--threads", "T", O, threads, 0, 256, "worker threads (default 1: per-thread figures)"),
-    CLI_FLAG("--json", O, json, "one JSON object on stdout"),
+    BENCH_OPTION_THREADS(O),
+    BENCH_OPTION_JSON(O),
 };
 #undef O
 

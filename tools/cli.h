@@ -53,6 +53,10 @@ bool cli_parse_float(const char *cmd, const char *flag, const char *text, double
 // "drift <cmd>: <flag> expects one of <the techniques>, got '<text>'" and returns false.
 bool cli_parse_technique(const char *cmd, drift_effect effect, const char *flag, const char *text,
                          int *out);
+// X,Y,Z (or, with `scalar`, one number for all three), finite; otherwise prints
+// "drift <cmd>: <flag> expects X,Y,Z, got '<text>'" and returns false.
+bool cli_parse_vec3(const char *cmd, const char *flag, const char *text, bool scalar,
+                    drift_vec3 *out);
 // --refine sir (render and view): sets the bool at `field`, or prints
 // "drift <cmd>: <flag> expects 'sir', got '<value>'" and returns false.
 bool cli_parse_refine(const char *cmd, const char *flag, const char *value, void *field);
@@ -85,10 +89,11 @@ typedef struct cli_session {
     drift_context *ctx;
     struct drift_scene *scene;
     struct drift_accel *accel;
-    const char *scene_path; // the scene loaded (the default resolved)
+    const char *scene_path; // the scene loaded (the default resolved; points into `path`)
     double t_start;         // drift_time_now() at open, after loading and after the accel:
     double t_loaded;        // for phase timings
     double t_built;
+    char path[4096];
 } cli_session;
 
 // Opens what `desc` asks for into *s, printing "drift <cmd>: ..." on failure (the scene's

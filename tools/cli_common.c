@@ -53,6 +53,24 @@ bool cli_parse_technique(const char *cmd, drift_effect effect, const char *flag,
     return false;
 }
 
+bool cli_parse_vec3(const char *cmd, const char *flag, const char *text, bool scalar,
+                    drift_vec3 *out)
+{
+    float a, b, c;
+    char tail;
+    int n = sscanf(text, "%f,%f,%f%c", &a, &b, &c, &tail);
+    if (n == 1 && scalar) {
+        b = c = a; // one value: grey
+    }
+    if (!(n == 3 || (n == 1 && scalar)) || !drift_vec3_is_finite(drift_vec3_make(a, b, c))) {
+        fprintf(stderr, "drift %s: %s expects X,Y,Z%s, got '%s'\n", cmd, flag,
+                scalar ? " (or one number)" : "", text);
+        return false;
+    }
+    *out = drift_vec3_make(a, b, c);
+    return true;
+}
+
 bool cli_parse_refine(const char *cmd, const char *flag, const char *value, void *field)
 {
     if (strcmp(value, "sir") != 0) {
@@ -124,10 +142,12 @@ bool cli_session_load(cli_session *s, const char *cmd, const char *path, bool no
     drift_scene_destroy(s->scene);
     s->accel = NULL;
     s->scene = NULL;
-    s->scene_path = path;
-    drift_result r = drift_scene_load(s->ctx, path, &s->scene);
+    snprintf(s->path, sizeof s->path, "%s", path);
+    s->scene_path = s->path;
+    drift_result r = drift_scene_load(s->ctx, s->path, &s->scene);
     if (r != DRIFT_OK) {
-        fprintf(stderr, "drift %s: cannot load scene %s: %s\n", cmd, path, drift_result_string(r));
+        fprintf(stderr, "drift %s: cannot load scene %s: %s\n", cmd, s->path,
+                drift_result_string(r));
         return false;
     }
     s->t_loaded = drift_time_now();

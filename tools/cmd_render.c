@@ -67,22 +67,6 @@ static bool parse_aov(const char *cmd, const char *flag, const char *v, void *fi
     return true;
 }
 
-static bool parse_vec3(const char *cmd, const char *flag, const char *v, drift_vec3 *out)
-{
-    float a, b, c;
-    char tail;
-    int n = sscanf(v, "%f,%f,%f%c", &a, &b, &c, &tail);
-    if (n == 1) {
-        b = c = a; // one value: grey
-    }
-    if ((n != 1 && n != 3) || !drift_vec3_is_finite(drift_vec3_make(a, b, c))) {
-        fprintf(stderr, "drift %s: %s expects X,Y,Z (or one number), got '%s'\n", cmd, flag, v);
-        return false;
-    }
-    *out = drift_vec3_make(a, b, c);
-    return true;
-}
-
 static bool parse_probe(const char *cmd, const char *flag, const char *v, void *field)
 {
     drift_hybrid_params *h = field;
@@ -91,14 +75,14 @@ static bool parse_probe(const char *cmd, const char *flag, const char *v, void *
         return true;
     }
     h->has_probe = true;
-    return parse_vec3(cmd, flag, v, &h->probe);
+    return cli_parse_vec3(cmd, flag, v, true, &h->probe);
 }
 
 static bool parse_ambient(const char *cmd, const char *flag, const char *v, void *field)
 {
     drift_hybrid_params *h = field;
     h->has_ambient = true;
-    return parse_vec3(cmd, flag, v, &h->ambient);
+    return cli_parse_vec3(cmd, flag, v, true, &h->ambient);
 }
 
 // ISG sample counts are k x k grids on the disk: 9, 25, 49, 81 (any square up to 1024).
