@@ -3,14 +3,17 @@
 #ifndef DRIFT_TEST_H
 #define DRIFT_TEST_H
 
-// cmocka needs these before its header.
-#include "drift/core.h"
-
-#include <cmocka.h>
+// cmocka needs these before its header (clang-format's include sorting would move it first).
+// clang-format off
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+
+#include <cmocka.h>
+// clang-format on
+
+#include "drift/core.h"
 
 // Remembers the codes and levels of messages so tests can assert on codes, not text.
 typedef struct test_log_capture {
