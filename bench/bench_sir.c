@@ -77,11 +77,8 @@ static bool parse_target(const char *cmd, const char *flag, const char *v, void 
 #define O sir_options
 static const cli_option sir_table[] = {
     CLI_SECTION("options:", 0),
-    { .name = "--sizes",
-      .arg = "WxH,...",
-      .help = "image sizes (default 800x600,1024x768,1920x1080)",
-      .kind = CLI_KIND_CUSTOM,
-      .parse = parse_sizes },
+    CLI_CUSTOM_ALL("--sizes", "WxH,...", parse_sizes,
+                   "image sizes (default 800x600,1024x768,1920x1080)"),
     CLI_INT("--spp", "N", O, spp, 1, 65536, "samples a pixel in both PRT and SIR (default 4)"),
     CLI_INT("--budget", "N", O, budget, 1, 1L << 30,
             "SIR samples an iteration (default 8192, the paper's ray count)"),
@@ -98,12 +95,9 @@ static const cli_option sir_table[] = {
              "also the FLIP between two pure images of different seeds (how\n"
              "close two equally good images are), and a real error must exceed\n"
              "the threshold plus the two pure images' difference at the pixel"),
-    { .name = "--target",
-      .arg = "X,Y,Z",
-      .help = "look at this point instead of the camera's target (other views,\n"
-              "as the paper's rows are views with more or fewer error pixels)",
-      .kind = CLI_KIND_CUSTOM,
-      .parse = parse_target },
+    CLI_CUSTOM_ALL("--target", "X,Y,Z", parse_target,
+                   "look at this point instead of the camera's target (other views,\n"
+                   "as the paper's rows are views with more or fewer error pixels)"),
     CLI_NUMBER("--fov", "DEG", O, fov, 0.1, 179.0,
                "vertical field of view (default: the camera's)"),
     CLI_STRING("--views", "FILE", O, views_path,

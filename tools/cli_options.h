@@ -123,6 +123,11 @@ typedef struct cli_option {
         .name = (n), .arg = (a), .help = (h), .kind = CLI_KIND_CUSTOM, .parse = (fn), \
         .offset = offsetof(T, f)                                                      \
     }
+// A custom reader that sets several fields: `field` is the whole options struct.
+#define CLI_CUSTOM_ALL(n, a, fn, h)                                                  \
+    {                                                                                \
+        .name = (n), .arg = (a), .help = (h), .kind = CLI_KIND_CUSTOM, .parse = (fn) \
+    }
 #define CLI_SECTION(h, g)                                    \
     {                                                        \
         .help = (h), .kind = CLI_KIND_SECTION, .groups = (g) \

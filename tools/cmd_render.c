@@ -145,11 +145,8 @@ static const cli_option render_table[] = {
     CLI_NUMBER("--exposure", "STOPS", O, exposure, -64.0, 64.0, "PNG exposure (default 0)"),
     CLI_CUSTOM("--tonemap", "OP", O, tonemap, parse_tonemap,
                "PNG operator: clamp (default) or reinhard"),
-    { .name = "--debug-sample",
-      .arg = "X,Y,S",
-      .help = "trace one sample of one pixel and print its radiance",
-      .kind = CLI_KIND_CUSTOM,
-      .parse = parse_debug_sample },
+    CLI_CUSTOM_ALL("--debug-sample", "X,Y,S", parse_debug_sample,
+                   "trace one sample of one pixel and print its radiance"),
     CLI_FLAG("--quiet", O, quiet, "no progress output"),
     CLI_FLAG("--verbose", O, verbose, "more log output"),
 
