@@ -9,15 +9,28 @@
 #define DRIFT_BENCH_H
 
 // X(name, function, one-line summary)
-#define DRIFT_BENCH_LIST(X) \
-    X("rays", drift_bench_rays, "rays/s through drift's accel vs raw Embree, one thread")   \
-    X("frame", drift_bench_frame, "hybrid frame passes vs the primary-visibility pass")      \
-    X("isg", drift_bench_isg, "image space gathering: Table 1 timings, FLIP vs baselines")  \
+#define DRIFT_BENCH_LIST(X)                                                                    \
+    X("rays", drift_bench_rays, "rays/s through drift's accel vs raw Embree, one thread")      \
+    X("frame", drift_bench_frame, "hybrid frame passes vs the primary-visibility pass")        \
+    X("isg", drift_bench_isg, "image space gathering: Table 1 timings, FLIP vs baselines")     \
     X("aaf", drift_bench_aaf, "axis-aligned filtering: RMSE vs spp against plain Monte Carlo") \
     X("sir", drift_bench_sir, "smart image refinement vs pure ray tracing (Table 1)")
+
+#include "cli.h"
 
 #define DRIFT__BENCH_DECLARE(name, fn, summary) int fn(int argc, char **argv);
 DRIFT_BENCH_LIST(DRIFT__BENCH_DECLARE)
 #undef DRIFT__BENCH_DECLARE
+
+// Option rows every benchmark has (T: its options struct, with `long threads; bool json;`).
+#define BENCH_OPTION_THREADS(T) \
+    CLI_INT("--threads", "T", T, threads, 0, 256, "worker threads (default 1: per-thread figures)")
+#define BENCH_OPTION_JSON(T) CLI_FLAG("--json", T, json, "one JSON object on stdout")
+
+// Opens the context and the scene `scene_path` (NULL: DRIFT_SOURCE_DIR/`default_scene`, a
+// path in the repository) with its accel (cli_session_open); close it with
+// cli_session_close whatever this returns.
+bool bench_open(cli_session *s, const char *cmd, const char *scene_path, const char *default_scene,
+                long threads);
 
 #endif // DRIFT_BENCH_H

@@ -25,39 +25,10 @@ typedef struct aaf_options {
     long width, height, ref_spp, threads, timing_width, timing_height, timing_spp, light_samples;
     long spps[MAX_SPPS], mc_spps[MAX_SPPS];
     int spp_count, mc_spp_count;
+    int effect; // --effect: shadows, indirect, both, reflections
     bool shadows, indirect, reflections, json;
     bool random; // --sampler random: AAF and plain MC both take independent random numbers
 } aaf_options;
-
-static void print_help(FILE *out)
-{
-    fprintf(out,
-            "usage: drift bench aaf [SCENE] [--effect E] [--spp LIST]\n"
-            "                       [--ref-spp N] [--width W] [--height H] [--threads T]\n"
-            "                       [--timing-size WxH] [--timing-spp N] [--csv FILE]\n"
-            "                       [--svg FILE] [--mc-spp LIST] [--light-samples N]\n"
-            "                       [--sampler sobol|random] [--json]\n\n"
-            "RMSE of AAF and of plain Monte Carlo (same sampler: uniform spp, no filter) against\n"
-            "a path-traced reference of the effect's term, for each average spp; the equal-error\n"
-            "sample ratio; and filter vs sampling milliseconds of one AAF frame.\n\n"
-            "  SCENE         default scenes/grids/grids.json (needs ../shared)\n"
-            "  --effect E    shadows (default), indirect, both (those two) or reflections\n"
-            "                (the specular buffer, --reflections aaf)\n"
-            "  --spp LIST    comma-separated average spp (default 4,8,16,32,64)\n"
-            "  --mc-spp LIST plain Monte Carlo's spp (default: --spp); longer lists avoid\n"
-            "                extrapolating the equal-error ratio\n"
-            "  --light-samples N  samples of U_l's sampled lobes (default 256: keeps the\n"
-            "                unshadowed light's own noise under the shadows' error)\n"
-            "  --sampler S   sobol (default) or random, for AAF and plain MC alike: random is\n"
-            "                the paper's traditional Monte Carlo (Fig. 3.6)\n"
-            "  --ref-spp N   reference samples a pixel (default 4096)\n"
-            "  --width, --height  error images (default 160x120)\n"
-            "  --timing-size WxH  timing frame (default 640x480); --timing-spp N (default 16)\n"
-            "  --threads T   worker threads (default 1: per-thread figures)\n"
-            "  --csv FILE    effect,method,spp,actual_spp,rmse,sampling_ms,filter_ms rows\n"
-            "  --svg FILE    the log-log plot\n"
-            "  --json        one JSON object on stdout\n");
-}
 
 // A comma-separated, increasing list of 2..MAX_SPPS counts into spps[0 .. *spp_count - 1].
 static bool parse_spps(const char *text, long *spps, int *spp_count)
@@ -87,6 +58,72 @@ static bool parse_spps(const char *text, long *spps, int *spp_count)
     return true;
 }
 
+// --spp and --mc-spp: `field` is the list, followed by its count.
+static bool parse_spp_list(const char *cmd, const char *flag, const char *v, void *field)
+{
+    (void)cmd;
+    (void)flag;
+    aaf_options *o = field;
+    return strcmp(flag, "--spp") == 0 ? parse_spps(v, o->spps, &o->spp_count)
+                                      : parse_spps(v, o->mc_spps, &o->mc_spp_count);
+}
+
+static bool parse_size(const char *cmd, const char *flag, const char *v, void *field)
+{
+    aaf_options *o = field;
+    char tail;
+    if (sscanf(v, "%ldx%ld%c", &o->timing_width, &o->timing_height, &tail) != 2 ||
+        o->timing_width < 1 || o->timing_height < 1 ||
+        o->timing_width > DRIFT_IMAGE_MAX_DIMENSION ||
+        o->timing_height > DRIFT_IMAGE_MAX_DIMENSION) {
+        fprintf(stderr, "drift %s: %s expects WxH, got '%s'\n", cmd, flag, v);
+        return false;
+    }
+    return true;
+}
+
+#define O aaf_options
+static const cli_option aaf_table[] = {
+    CLI_SECTION("options:", 0),
+    CLI_CHOICE("--effect", "E", O, effect, "shadows|indirect|both|reflections",
+               "shadows (default), indirect, both (those two) or reflections\n"
+               "(the specular buffer, --reflections aaf)"),
+    CLI_CUSTOM_ALL("--spp", "LIST", parse_spp_list,
+                   "comma-separated average spp (default 4,8,16,32,64)"),
+    CLI_CUSTOM_ALL("--mc-spp", "LIST", parse_spp_list,
+                   "plain Monte Carlo's spp (default: --spp); longer lists avoid\n"
+                   "extrapolating the equal-error ratio"),
+    CLI_INT("--light-samples", "N", O, light_samples, 1, 4096,
+            "samples of U_l's sampled lobes (default 256: keeps the\n"
+            "unshadowed light's own noise under the shadows' error)"),
+    CLI_CHOICE("--sampler", "S", O, random, "sobol|random",
+               "sobol (default) or random, for AAF and plain MC alike: random is\n"
+               "the paper's traditional Monte Carlo (Fig. 3.6)"),
+    CLI_INT("--ref-spp", "N", O, ref_spp, 1, 1 << 20, "reference samples a pixel (default 4096)"),
+    CLI_INT("--width", "W", O, width, 1, DRIFT_IMAGE_MAX_DIMENSION,
+            "error images (default 160x120)"),
+    CLI_INT("--height", "H", O, height, 1, DRIFT_IMAGE_MAX_DIMENSION, "error images"),
+    CLI_CUSTOM_ALL("--timing-size", "WxH", parse_size, "timing frame (default 640x480)"),
+    CLI_INT("--timing-spp", "N", O, timing_spp, 1, 65536, "timing frame's spp (default 16)"),
+    BENCH_OPTION_THREADS(O),
+    CLI_STRING("--csv", "FILE", O, csv_path,
+               "effect,method,spp,actual_spp,rmse,sampling_ms,filter_ms rows"),
+    CLI_STRING("--svg", "FILE", O, svg_path, "the log-log plot"),
+    BENCH_OPTION_JSON(O),
+};
+#undef O
+
+static const cli_command aaf_command = {
+    .name = "bench aaf",
+    .usage = "usage: drift bench aaf [SCENE] [options]\n\n"
+             "RMSE of AAF and of plain Monte Carlo (same sampler: uniform spp, no filter) against\n"
+             "a path-traced reference of the effect's term, for each average spp; the equal-error\n"
+             "sample ratio; and filter vs sampling milliseconds of one AAF frame. SCENE defaults\n"
+             "to scenes/grids/grids.json (needs ../shared).\n\n",
+    CLI_TABLE(aaf_table),
+    CLI_POSITIONAL("SCENE", aaf_options, scene_path, 1),
+};
+
 static int parse(int argc, char **argv, aaf_options *o)
 {
     *o = (aaf_options){ .width = 160,
@@ -96,92 +133,15 @@ static int parse(int argc, char **argv, aaf_options *o)
                         .timing_width = 640,
                         .timing_height = 480,
                         .timing_spp = 16,
-                        .light_samples = 256,
-                        .shadows = true };
+                        .light_samples = 256 };
     parse_spps("4,8,16,32,64", o->spps, &o->spp_count);
-    o->mc_spp_count = 0;
-    const char *cmd = "bench aaf";
-    for (int i = 1; i < argc; ++i) {
-        const char *a = argv[i], *v = NULL;
-        bool ok = true;
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            print_help(stdout);
-            return -1;
-        } else if (strcmp(a, "--json") == 0) {
-            o->json = true;
-        } else if (strcmp(a, "--effect") == 0) {
-            ok = (v = cli_next_value(cmd, argc, argv, &i)) != NULL;
-            if (ok) {
-                o->shadows = strcmp(v, "shadows") == 0 || strcmp(v, "both") == 0;
-                o->indirect = strcmp(v, "indirect") == 0 || strcmp(v, "both") == 0;
-                o->reflections = strcmp(v, "reflections") == 0;
-                ok = o->shadows || o->indirect || o->reflections;
-                if (!ok) {
-                    fprintf(
-                        stderr,
-                        "drift bench aaf: --effect expects shadows, indirect, both or reflections, "
-                        "got '%s'\n",
-                        v);
-                }
-            }
-        } else if (strcmp(a, "--spp") == 0) {
-            ok = (v = cli_next_value(cmd, argc, argv, &i)) && parse_spps(v, o->spps, &o->spp_count);
-        } else if (strcmp(a, "--mc-spp") == 0) {
-            ok = (v = cli_next_value(cmd, argc, argv, &i)) &&
-                 parse_spps(v, o->mc_spps, &o->mc_spp_count);
-        } else if (strcmp(a, "--light-samples") == 0) {
-            ok = (v = cli_next_value(cmd, argc, argv, &i)) &&
-                 cli_parse_int(cmd, a, v, 1, 4096, &o->light_samples);
-        } else if (strcmp(a, "--ref-spp") == 0) {
-            ok = (v = cli_next_value(cmd, argc, argv, &i)) &&
-                 cli_parse_int(cmd, a, v, 1, 1 << 20, &o->ref_spp);
-        } else if (strcmp(a, "--width") == 0) {
-            ok = (v = cli_next_value(cmd, argc, argv, &i)) &&
-                 cli_parse_int(cmd, a, v, 1, DRIFT_IMAGE_MAX_DIMENSION, &o->width);
-        } else if (strcmp(a, "--height") == 0) {
-            ok = (v = cli_next_value(cmd, argc, argv, &i)) &&
-                 cli_parse_int(cmd, a, v, 1, DRIFT_IMAGE_MAX_DIMENSION, &o->height);
-        } else if (strcmp(a, "--timing-size") == 0) {
-            ok = (v = cli_next_value(cmd, argc, argv, &i)) != NULL;
-            char tail;
-            if (ok && (sscanf(v, "%ldx%ld%c", &o->timing_width, &o->timing_height, &tail) != 2 ||
-                       o->timing_width < 1 || o->timing_height < 1 ||
-                       o->timing_width > DRIFT_IMAGE_MAX_DIMENSION ||
-                       o->timing_height > DRIFT_IMAGE_MAX_DIMENSION)) {
-                fprintf(stderr, "drift bench aaf: --timing-size expects WxH, got '%s'\n", v);
-                ok = false;
-            }
-        } else if (strcmp(a, "--timing-spp") == 0) {
-            ok = (v = cli_next_value(cmd, argc, argv, &i)) &&
-                 cli_parse_int(cmd, a, v, 1, 65536, &o->timing_spp);
-        } else if (strcmp(a, "--threads") == 0) {
-            ok = (v = cli_next_value(cmd, argc, argv, &i)) &&
-                 cli_parse_int(cmd, a, v, 0, 256, &o->threads);
-        } else if (strcmp(a, "--sampler") == 0) {
-            ok = (v = cli_next_value(cmd, argc, argv, &i)) != NULL;
-            if (ok && strcmp(v, "sobol") != 0 && strcmp(v, "random") != 0) {
-                fprintf(stderr, "drift bench aaf: --sampler expects sobol or random, got '%s'\n",
-                        v);
-                ok = false;
-            }
-            o->random = ok && strcmp(v, "random") == 0;
-        } else if (strcmp(a, "--csv") == 0) {
-            ok = (o->csv_path = cli_next_value(cmd, argc, argv, &i)) != NULL;
-        } else if (strcmp(a, "--svg") == 0) {
-            ok = (o->svg_path = cli_next_value(cmd, argc, argv, &i)) != NULL;
-        } else if (a[0] == '-') {
-            fprintf(stderr, "drift bench aaf: unknown option '%s'\n", a);
-            ok = false;
-        } else if (!o->scene_path) {
-            o->scene_path = a;
-        } else {
-            fprintf(stderr, "drift bench aaf: more than one scene given\n");
-            ok = false;
-        }
-        if (!ok) {
-            return 2;
-        }
+    int status = cli_parse(&aaf_command, argc, argv, o, NULL);
+    if (status != CLI_PARSED) {
+        return status;
     }
+    o->shadows = o->effect == 0 || o->effect == 2;
+    o->indirect = o->effect == 1 || o->effect == 2;
+    o->reflections = o->effect == 3;
     if (o->mc_spp_count == 0) {
         memcpy(o->mc_spps, o->spps, sizeof o->spps);
         o->mc_spp_count = o->spp_count;
@@ -468,35 +428,50 @@ static bool write_svg(const char *path, const char *scene, const curve *curves, 
     return fclose(f) == 0;
 }
 
-static void print_json(const aaf_options *o, const char *scene_path, int threads,
+static bool print_json(const aaf_options *o, const char *scene_path, int threads,
                        const curve *curves, int count)
 {
-    printf(
-        "{\"scene\": \"%s\", \"width\": %ld, \"height\": %ld, \"ref_spp\": %ld, \"threads\": %d, "
-        "\"light_samples\": %ld, \"sampler\": \"%s\", \"effects\": [",
-        scene_path, o->width, o->height, o->ref_spp, threads, o->light_samples,
-        o->random ? "random" : "sobol");
+    cJSON *root = cJSON_CreateObject();
+    cJSON_AddStringToObject(root, "scene", scene_path);
+    cJSON_AddNumberToObject(root, "width", (double)o->width);
+    cJSON_AddNumberToObject(root, "height", (double)o->height);
+    cJSON_AddNumberToObject(root, "ref_spp", (double)o->ref_spp);
+    cJSON_AddNumberToObject(root, "threads", threads);
+    cJSON_AddNumberToObject(root, "light_samples", (double)o->light_samples);
+    cJSON_AddStringToObject(root, "sampler", o->random ? "random" : "sobol");
+    cJSON *effects = cJSON_AddArrayToObject(root, "effects");
     for (int c = 0; c < count; ++c) {
         const curve *cv = &curves[c];
-        printf("%s{\"effect\": \"%s\", \"aaf\": [", c ? ", " : "", drift_effect_name(cv->effect));
+        cJSON *effect = cJSON_CreateObject();
+        cJSON_AddItemToArray(effects, effect);
+        cJSON_AddStringToObject(effect, "effect", drift_effect_name(cv->effect));
+        cJSON *aaf = cJSON_AddArrayToObject(effect, "aaf");
         for (int k = 0; k < cv->count; ++k) {
-            printf("%s{\"spp\": %.0f, \"actual_spp\": %.3f, \"rmse\": %.6g, "
-                   "\"equal_error_ratio\": %.3f, \"extrapolated\": %s}",
-                   k ? ", " : "", cv->aaf[k].spp, cv->aaf[k].actual_spp, cv->aaf[k].rmse,
-                   cv->ratio[k], cv->extrapolated[k] ? "true" : "false");
+            cJSON *item = cJSON_CreateObject();
+            cJSON_AddItemToArray(aaf, item);
+            cli_json_number(item, "spp", cv->aaf[k].spp, 0);
+            cli_json_number(item, "actual_spp", cv->aaf[k].actual_spp, 3);
+            cli_json_number(item, "rmse", cv->aaf[k].rmse, -1);
+            cli_json_number(item, "equal_error_ratio", cv->ratio[k], 3);
+            cJSON_AddBoolToObject(item, "extrapolated", cv->extrapolated[k]);
         }
-        printf("], \"plain_mc\": [");
+        cJSON *plain = cJSON_AddArrayToObject(effect, "plain_mc");
         for (int k = 0; k < cv->plain_count; ++k) {
-            printf("%s{\"spp\": %.0f, \"rmse\": %.6g}", k ? ", " : "", cv->plain[k].spp,
-                   cv->plain[k].rmse);
+            cJSON *item = cJSON_CreateObject();
+            cJSON_AddItemToArray(plain, item);
+            cli_json_number(item, "spp", cv->plain[k].spp, 0);
+            cli_json_number(item, "rmse", cv->plain[k].rmse, -1);
         }
-        printf(
-            "], \"timing\": {\"width\": %ld, \"height\": %ld, \"spp\": %ld, \"sampling_ms\": %.3f, "
-            "\"filter_ms\": %.3f, \"frame_ms\": %.3f, \"filter_fraction\": %.4f}}",
-            o->timing_width, o->timing_height, o->timing_spp, cv->timing_sampling_ms,
-            cv->timing_filter_ms, cv->timing_frame_ms, cv->timing_filter_ms / cv->timing_frame_ms);
+        cJSON *timing = cJSON_AddObjectToObject(effect, "timing");
+        cJSON_AddNumberToObject(timing, "width", (double)o->timing_width);
+        cJSON_AddNumberToObject(timing, "height", (double)o->timing_height);
+        cJSON_AddNumberToObject(timing, "spp", (double)o->timing_spp);
+        cli_json_number(timing, "sampling_ms", cv->timing_sampling_ms, 3);
+        cli_json_number(timing, "filter_ms", cv->timing_filter_ms, 3);
+        cli_json_number(timing, "frame_ms", cv->timing_frame_ms, 3);
+        cli_json_number(timing, "filter_fraction", cv->timing_filter_ms / cv->timing_frame_ms, 4);
     }
-    printf("]}\n");
+    return cli_json_write("bench aaf", root, NULL);
 }
 
 static void print_text(const aaf_options *o, const char *scene_path, int threads,
@@ -530,22 +505,16 @@ int drift_bench_aaf(int argc, char **argv)
     aaf_options o;
     int status = parse(argc, argv, &o);
     if (status != 0) {
-        return status < 0 ? 0 : status;
+        return cli_parse_exit(status);
     }
-    static const char default_scene[] = DRIFT_SOURCE_DIR "/scenes/grids/grids.json";
-    const char *scene_path = o.scene_path ? o.scene_path : default_scene;
-    drift_context *ctx = NULL;
-    drift_scene *scene = NULL;
-    drift_accel *accel = NULL;
     int exit_code = 1;
-    ctx = cli_open_context("bench aaf", (int)o.threads, false);
-    if (!ctx) {
+    cli_session session;
+    if (!bench_open(&session, "bench aaf", o.scene_path, "scenes/grids/grids.json", o.threads)) {
         goto done;
     }
+    drift_context *ctx = session.ctx;
+    const char *scene_path = session.scene_path;
     drift_result r = DRIFT_OK;
-    if (!cli_open_scene(ctx, "bench aaf", scene_path, &scene, &accel, NULL)) {
-        goto done;
-    }
     curve curves[3];
     int count = 0;
     drift_effect effects[3] = { DRIFT_EFFECT_SHADOWS, DRIFT_EFFECT_INDIRECT,
@@ -555,7 +524,7 @@ int drift_bench_aaf(int argc, char **argv)
         if (!wanted[e]) {
             continue;
         }
-        r = measure(ctx, scene, accel, &o, effects[e], &curves[count]);
+        r = measure(ctx, session.scene, session.accel, &o, effects[e], &curves[count]);
         if (r != DRIFT_OK) {
             fprintf(stderr, "drift bench aaf: %s failed: %s\n", drift_effect_name(effects[e]),
                     drift_result_string(r));
@@ -565,7 +534,9 @@ int drift_bench_aaf(int argc, char **argv)
     }
     int threads = drift_context_thread_count(ctx);
     if (o.json) {
-        print_json(&o, scene_path, threads, curves, count);
+        if (!print_json(&o, scene_path, threads, curves, count)) {
+            goto done;
+        }
     } else {
         print_text(&o, scene_path, threads, curves, count);
     }
@@ -575,8 +546,6 @@ int drift_bench_aaf(int argc, char **argv)
     }
     exit_code = 0;
 done:
-    drift_accel_destroy(accel);
-    drift_scene_destroy(scene);
-    drift_context_destroy(ctx);
+    cli_session_close(&session);
     return exit_code;
 }

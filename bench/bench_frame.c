@@ -3,14 +3,13 @@
 // on the Cornell box with a glossy bunny cost at most 4x the primary pass.
 #include "bench.h"
 #include "cli.h"
+#include "drift/accel.h"
+#include "drift/hybrid.h"
+#include "drift/scene_io.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-#include "drift/accel.h"
-#include "drift/hybrid.h"
-#include "drift/scene_io.h"
 
 typedef struct frame_options {
     const char *scene_path;
@@ -24,59 +23,28 @@ typedef struct frame_config {
     drift_hybrid_params params;
 } frame_config;
 
-static void print_help(FILE *out)
-{
-    fprintf(out,
-            "usage: drift bench frame [SCENE] [--width W] [--height H] [--frames N] [--threads T]\n"
-            "                         [--json]\n\n"
-            "Renders hybrid frames and reports the median milliseconds of the primary pass and\n"
-            "of the whole frame for several technique sets; the first, hard shadows + sharp\n"
-            "reflections + post DOF, is the one the 4x target is about.\n\n"
-            "  SCENE       default scenes/cornell-bunny/cornell_bunny.json (needs ../shared)\n"
-            "  --width, --height  default 640x480\n"
-            "  --frames N  frames per configuration after one warm-up frame (default 5)\n"
-            "  --threads T worker threads (default 1: per-thread figures)\n"
-            "  --json      one JSON object on stdout\n");
-}
+#define O frame_options
+static const cli_option frame_table[] = {
+    CLI_SECTION("options:", 0),
+    CLI_INT("--width", "W", O, width, 1, DRIFT_IMAGE_MAX_DIMENSION, "frame size (default 640x480)"),
+    CLI_INT("--height", "H", O, height, 1, DRIFT_IMAGE_MAX_DIMENSION, "frame size"),
+    CLI_INT("--frames", "N", O, frames, 1, 1000,
+            "frames per configuration after one warm-up frame (default 5)"),
+    BENCH_OPTION_THREADS(O),
+    BENCH_OPTION_JSON(O),
+};
+#undef O
 
-static int parse(int argc, char **argv, frame_options *o)
-{
-    *o = (frame_options){ .width = 640, .height = 480, .frames = 5, .threads = 1 };
-    for (int i = 1; i < argc; ++i) {
-        const char *a = argv[i], *v = NULL;
-        bool ok = true;
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            print_help(stdout);
-            return -1;
-        } else if (strcmp(a, "--json") == 0) {
-            o->json = true;
-        } else if (strcmp(a, "--width") == 0) {
-            ok = (v = cli_next_value("bench frame", argc, argv, &i)) &&
-                 cli_parse_int("bench frame", a, v, 1, DRIFT_IMAGE_MAX_DIMENSION, &o->width);
-        } else if (strcmp(a, "--height") == 0) {
-            ok = (v = cli_next_value("bench frame", argc, argv, &i)) &&
-                 cli_parse_int("bench frame", a, v, 1, DRIFT_IMAGE_MAX_DIMENSION, &o->height);
-        } else if (strcmp(a, "--frames") == 0) {
-            ok = (v = cli_next_value("bench frame", argc, argv, &i)) &&
-                 cli_parse_int("bench frame", a, v, 1, 1000, &o->frames);
-        } else if (strcmp(a, "--threads") == 0) {
-            ok = (v = cli_next_value("bench frame", argc, argv, &i)) &&
-                 cli_parse_int("bench frame", a, v, 0, 256, &o->threads);
-        } else if (a[0] == '-') {
-            fprintf(stderr, "drift bench frame: unknown option '%s'\n", a);
-            ok = false;
-        } else if (!o->scene_path) {
-            o->scene_path = a;
-        } else {
-            fprintf(stderr, "drift bench frame: more than one scene given\n");
-            ok = false;
-        }
-        if (!ok) {
-            return 2;
-        }
-    }
-    return 0;
-}
+static const cli_command frame_command = {
+    .name = "bench frame",
+    .usage = "usage: drift bench frame [SCENE] [options]\n\n"
+             "Renders hybrid frames and reports the median milliseconds of the primary pass and\n"
+             "of the whole frame for several technique sets; the first, hard shadows + sharp\n"
+             "reflections + post DOF, is the one the 4x target is about. SCENE defaults to\n"
+             "scenes/cornell-bunny/cornell_bunny.json (needs ../shared).\n\n",
+    CLI_TABLE(frame_table),
+    CLI_POSITIONAL("SCENE", frame_options, scene_path, 1),
+};
 
 static int compare_double(const void *a, const void *b)
 {
@@ -96,8 +64,7 @@ typedef struct frame_result {
 } frame_result;
 
 static drift_result measure(drift_context *ctx, const drift_scene *scene, const drift_accel *accel,
-                            const frame_options *o, const frame_config *config,
-                            frame_result *out)
+                            const frame_options *o, const frame_config *config, frame_result *out)
 {
     drift_hybrid_params params = config->params;
     params.width = (int32_t)o->width;
@@ -135,37 +102,35 @@ static drift_result measure(drift_context *ctx, const drift_scene *scene, const 
 
 int drift_bench_frame(int argc, char **argv)
 {
-    frame_options o;
-    int status = parse(argc, argv, &o);
-    if (status != 0) {
-        return status < 0 ? 0 : status;
+    frame_options o = { .width = 640, .height = 480, .frames = 5, .threads = 1 };
+    int status = cli_parse(&frame_command, argc, argv, &o, NULL);
+    if (status != CLI_PARSED) {
+        return cli_parse_exit(status);
     }
-    static const char default_scene[] = DRIFT_SOURCE_DIR "/scenes/cornell-bunny/cornell_bunny.json";
-    const char *scene_path = o.scene_path ? o.scene_path : default_scene;
     const frame_config configs[] = {
         { "hard+sharp+post",
-          { .shadows = DRIFT_SHADOWS_HARD, .reflections = DRIFT_REFLECTIONS_SHARP, .dof = DRIFT_DOF_POST } },
+          { .shadows = DRIFT_SHADOWS_HARD,
+            .reflections = DRIFT_REFLECTIONS_SHARP,
+            .dof = DRIFT_DOF_POST } },
         { "hard", { .shadows = DRIFT_SHADOWS_HARD } },
         { "pcf", { .shadows = DRIFT_SHADOWS_PCF } },
         { "pcss", { .shadows = DRIFT_SHADOWS_PCSS } },
-        { "hard+envmap", { .shadows = DRIFT_SHADOWS_HARD, .reflections = DRIFT_REFLECTIONS_ENVMAP } },
+        { "hard+envmap",
+          { .shadows = DRIFT_SHADOWS_HARD, .reflections = DRIFT_REFLECTIONS_ENVMAP } },
     };
     const int config_count = (int)(sizeof configs / sizeof *configs);
-    drift_context *ctx = NULL;
-    drift_scene *scene = NULL;
-    drift_accel *accel = NULL;
     int exit_code = 1;
-    ctx = cli_open_context("bench frame", (int)o.threads, false);
-    if (!ctx) {
+    cli_session session;
+    if (!bench_open(&session, "bench frame", o.scene_path,
+                    "scenes/cornell-bunny/cornell_bunny.json", o.threads)) {
         goto done;
     }
+    drift_context *ctx = session.ctx;
+    const char *scene_path = session.scene_path;
     drift_result r = DRIFT_OK;
-    if (!cli_open_scene(ctx, "bench frame", scene_path, &scene, &accel, NULL)) {
-        goto done;
-    }
     frame_result results[sizeof configs / sizeof *configs];
     for (int c = 0; c < config_count; ++c) {
-        r = measure(ctx, scene, accel, &o, &configs[c], &results[c]);
+        r = measure(ctx, session.scene, session.accel, &o, &configs[c], &results[c]);
         if (r != DRIFT_OK) {
             fprintf(stderr, "drift bench frame: %s failed: %s\n", configs[c].name,
                     drift_result_string(r));
@@ -173,22 +138,30 @@ int drift_bench_frame(int argc, char **argv)
         }
     }
     if (o.json) {
-        printf("{\"scene\": \"%s\", \"width\": %ld, \"height\": %ld, \"threads\": %d, "
-               "\"frames\": %ld, \"configs\": [",
-               scene_path, o.width, o.height, drift_context_thread_count(ctx), o.frames);
+        cJSON *root = cJSON_CreateObject();
+        cJSON_AddStringToObject(root, "scene", scene_path);
+        cJSON_AddNumberToObject(root, "width", (double)o.width);
+        cJSON_AddNumberToObject(root, "height", (double)o.height);
+        cJSON_AddNumberToObject(root, "threads", drift_context_thread_count(ctx));
+        cJSON_AddNumberToObject(root, "frames", (double)o.frames);
+        cJSON *array = cJSON_AddArrayToObject(root, "configs");
         for (int c = 0; c < config_count; ++c) {
             double primary = results[c].pass_ms[DRIFT_PASS_PRIMARY];
-            printf("%s{\"name\": \"%s\", \"primary_ms\": %.3f, \"frame_ms\": %.3f, \"ratio\": %.3f, "
-                   "\"passes\": {",
-                   c ? ", " : "", configs[c].name, primary, results[c].frame_ms,
-                   results[c].frame_ms / primary);
+            cJSON *item = cJSON_CreateObject();
+            cJSON_AddItemToArray(array, item);
+            cJSON_AddStringToObject(item, "name", configs[c].name);
+            cli_json_number(item, "primary_ms", primary, 3);
+            cli_json_number(item, "frame_ms", results[c].frame_ms, 3);
+            cli_json_number(item, "ratio", results[c].frame_ms / primary, 3);
+            cJSON *passes = cJSON_AddObjectToObject(item, "passes");
             for (int p = 0; p < DRIFT_PASS_COUNT; ++p) {
-                printf("%s\"%s\": %.3f", p ? ", " : "", drift_hybrid_pass_name((drift_hybrid_pass)p),
-                       results[c].pass_ms[p]);
+                cli_json_number(passes, drift_hybrid_pass_name((drift_hybrid_pass)p),
+                                results[c].pass_ms[p], 3);
             }
-            printf("}}");
         }
-        printf("]}\n");
+        if (!cli_json_write("bench frame", root, NULL)) {
+            goto done;
+        }
     } else {
         printf("%s, %ldx%ld, %d thread(s), median of %ld frames\n", scene_path, o.width, o.height,
                drift_context_thread_count(ctx), o.frames);
@@ -201,7 +174,8 @@ int drift_bench_frame(int argc, char **argv)
         printf("\npasses of %s (ms):", configs[0].name);
         for (int p = 0; p < DRIFT_PASS_COUNT; ++p) {
             if (results[0].pass_ms[p] > 0.0) {
-                printf(" %s %.2f", drift_hybrid_pass_name((drift_hybrid_pass)p), results[0].pass_ms[p]);
+                printf(" %s %.2f", drift_hybrid_pass_name((drift_hybrid_pass)p),
+                       results[0].pass_ms[p]);
             }
         }
         printf("\ntarget: %s frame <= 4x primary: %s\n", configs[0].name,
@@ -210,8 +184,6 @@ int drift_bench_frame(int argc, char **argv)
     }
     exit_code = 0;
 done:
-    drift_accel_destroy(accel);
-    drift_scene_destroy(scene);
-    drift_context_destroy(ctx);
+    cli_session_close(&session);
     return exit_code;
 }

@@ -32,99 +32,42 @@ typedef struct isg_options {
     bool json, skip_table, skip_quality;
 } isg_options;
 
-static void print_help(FILE *out)
-{
-    fprintf(
-        out,
-        "usage: drift bench isg [SCENE] [--width W] [--height H] [--qwidth W] [--qheight H]\n"
-        "                       [--ref-spp N] [--search N] [--gather M] [--aperture A]\n"
-        "                       [--frames N] [--threads T] [--no-table] [--no-quality] [--json]\n\n"
-        "(a) ms of the ISG pass for search x gather in {9,25,49,81}^2 per effect, and the\n"
-        "    base time of the rest of the frame (the paper's Table 1);\n"
-        "(b) FLIP and RMSE against each effect's reference technique for ISG and baselines.\n\n"
-        "  SCENE             default scenes/cornell-glossy/cornell_glossy.json\n"
-        "  --width, --height timing size (default 1024x768)\n"
-        "  --qwidth, --qheight quality size (default 320x240)\n"
-        "  --ref-spp N       samples per pixel of the references (default 256)\n"
-        "  --search, --gather ISG samples of the quality runs (default 25 and 49)\n"
-        "  --frames N        timing: the least of N frames per cell (default 1)\n"
-        "  --aperture A      lens radius for the DOF runs (default: the scene camera's; when\n"
-        "                    it has none, 1%% of the scene diagonal, focused on the surface\n"
-        "                    at the image centre)\n"
-        "  --threads T       worker threads (default 1: per-thread figures)\n"
-        "  --no-table, --no-quality  skip a part\n"
-        "  --json            one JSON object on stdout\n");
-}
+#define O isg_options
+static const cli_option isg_table[] = {
+    CLI_SECTION("options:", 0),
+    CLI_INT("--width", "W", O, width, 1, DRIFT_IMAGE_MAX_DIMENSION,
+            "timing size (default 1024x768)"),
+    CLI_INT("--height", "H", O, height, 1, DRIFT_IMAGE_MAX_DIMENSION, "timing size"),
+    CLI_INT("--qwidth", "W", O, qwidth, 1, DRIFT_IMAGE_MAX_DIMENSION,
+            "quality size (default 320x240)"),
+    CLI_INT("--qheight", "H", O, qheight, 1, DRIFT_IMAGE_MAX_DIMENSION, "quality size"),
+    CLI_INT("--ref-spp", "N", O, ref_spp, 1, 1 << 20,
+            "samples per pixel of the references (default 256)"),
+    CLI_INT("--search", "N", O, search, 1, 1024, "ISG samples of the quality runs (default 25"),
+    CLI_INT("--gather", "M", O, gather, 1, 1024, "and 49)"),
+    CLI_INT("--frames", "N", O, frames, 1, 100,
+            "timing: the least of N frames per cell (default 1)"),
+    CLI_NUMBER("--aperture", "A", O, aperture, 0.0, 1e30,
+               "lens radius for the DOF runs (default: the scene camera's; when\n"
+               "it has none, 1% of the scene diagonal, focused on the surface\n"
+               "at the image centre)"),
+    BENCH_OPTION_THREADS(O),
+    CLI_FLAG("--no-table", O, skip_table, "skip part (a)"),
+    CLI_FLAG("--no-quality", O, skip_quality, "skip part (b)"),
+    BENCH_OPTION_JSON(O),
+};
+#undef O
 
-static int parse(int argc, char **argv, isg_options *o)
-{
-    *o = (isg_options){ .width = 1024,
-                        .height = 768,
-                        .qwidth = 320,
-                        .qheight = 240,
-                        .ref_spp = 256,
-                        .threads = 1,
-                        .search = 25,
-                        .gather = 49,
-                        .frames = 1,
-                        .aperture = -1.0 };
-    const char *cmd = "bench isg";
-    for (int i = 1; i < argc; ++i) {
-        const char *a = argv[i], *v = NULL;
-        bool ok = true;
-        long *target = NULL, lo = 1, hi = DRIFT_IMAGE_MAX_DIMENSION;
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            print_help(stdout);
-            return -1;
-        } else if (strcmp(a, "--json") == 0) {
-            o->json = true;
-        } else if (strcmp(a, "--no-table") == 0) {
-            o->skip_table = true;
-        } else if (strcmp(a, "--no-quality") == 0) {
-            o->skip_quality = true;
-        } else if (strcmp(a, "--width") == 0) {
-            target = &o->width;
-        } else if (strcmp(a, "--height") == 0) {
-            target = &o->height;
-        } else if (strcmp(a, "--qwidth") == 0) {
-            target = &o->qwidth;
-        } else if (strcmp(a, "--qheight") == 0) {
-            target = &o->qheight;
-        } else if (strcmp(a, "--ref-spp") == 0) {
-            target = &o->ref_spp;
-            hi = 1 << 20;
-        } else if (strcmp(a, "--search") == 0 || strcmp(a, "--gather") == 0) {
-            target = a[2] == 's' ? &o->search : &o->gather;
-            hi = 1024;
-        } else if (strcmp(a, "--frames") == 0) {
-            target = &o->frames;
-            hi = 100;
-        } else if (strcmp(a, "--threads") == 0) {
-            target = &o->threads;
-            lo = 0;
-            hi = 256;
-        } else if (strcmp(a, "--aperture") == 0) {
-            ok = (v = cli_next_value(cmd, argc, argv, &i)) &&
-                 cli_parse_float(cmd, a, v, 0.0, 1e30, &o->aperture);
-        } else if (a[0] == '-') {
-            fprintf(stderr, "drift bench isg: unknown option '%s'\n", a);
-            ok = false;
-        } else if (!o->scene_path) {
-            o->scene_path = a;
-        } else {
-            fprintf(stderr, "drift bench isg: more than one scene given\n");
-            ok = false;
-        }
-        if (ok && target) {
-            ok = (v = cli_next_value(cmd, argc, argv, &i)) &&
-                 cli_parse_int(cmd, a, v, lo, hi, target);
-        }
-        if (!ok) {
-            return 2;
-        }
-    }
-    return 0;
-}
+static const cli_command isg_command = {
+    .name = "bench isg",
+    .usage = "usage: drift bench isg [SCENE] [options]\n\n"
+             "(a) ms of the ISG pass for search x gather in {9,25,49,81}^2 per effect, and the\n"
+             "    base time of the rest of the frame (the paper's Table 1);\n"
+             "(b) FLIP and RMSE against each effect's reference technique for ISG and baselines.\n"
+             "SCENE defaults to scenes/cornell-glossy/cornell_glossy.json.\n\n",
+    CLI_TABLE(isg_table),
+    CLI_POSITIONAL("SCENE", isg_options, scene_path, 1),
+};
 
 typedef struct bench_ctx {
     drift_context *ctx;
@@ -286,44 +229,57 @@ static drift_result quality(const bench_ctx *b, drift_effect effect, quality_row
 static const drift_effect effects[3] = { DRIFT_EFFECT_SHADOWS, DRIFT_EFFECT_REFLECTIONS,
                                          DRIFT_EFFECT_DOF };
 
-static void print_results(const bench_ctx *b, double tables[3][4][4], const double base[3],
-                          quality_row rows[3][MAX_ROWS], const int row_count[3], const char *path)
+static bool print_json(const bench_ctx *b, double tables[3][4][4], const double base[3],
+                       quality_row rows[3][MAX_ROWS], const int row_count[3], const char *path)
+{
+    const isg_options *o = b->o;
+    cJSON *root = cJSON_CreateObject();
+    cJSON_AddStringToObject(root, "scene", path);
+    cJSON_AddNumberToObject(root, "threads", drift_context_thread_count(b->ctx));
+    const char *const keys[] = { "frames",  "width",   "height", "qwidth",
+                                 "qheight", "ref_spp", "search", "gather" };
+    const long values[] = { o->frames,  o->width,   o->height, o->qwidth,
+                            o->qheight, o->ref_spp, o->search, o->gather };
+    for (size_t k = 0; k < sizeof keys / sizeof *keys; ++k) {
+        cJSON_AddNumberToObject(root, keys[k], (double)values[k]);
+    }
+    cJSON *by_effect = cJSON_AddObjectToObject(root, "effects");
+    for (int e = 0; e < 3; ++e) {
+        cJSON *effect = cJSON_AddObjectToObject(by_effect, drift_effect_name(effects[e]));
+        if (!o->skip_table) {
+            cli_json_number(effect, "base_ms", base[e], 3);
+            cJSON *isg = cJSON_AddArrayToObject(effect, "isg_ms");
+            for (int g = 0; g < 4; ++g) {
+                cJSON *row = cJSON_CreateObject();
+                cJSON_AddItemToArray(isg, row);
+                cJSON_AddNumberToObject(row, "gather", counts[g]);
+                cJSON *ms = cJSON_AddArrayToObject(row, "search_ms");
+                for (int s = 0; s < 4; ++s) {
+                    cJSON_AddItemToArray(ms,
+                                         cJSON_CreateNumber(round(tables[e][g][s] * 1e3) / 1e3));
+                }
+            }
+        }
+        if (!o->skip_quality) {
+            cJSON *quality = cJSON_AddArrayToObject(effect, "quality");
+            for (int t = 0; t < row_count[e]; ++t) {
+                cJSON *row = cJSON_CreateObject();
+                cJSON_AddItemToArray(quality, row);
+                cJSON_AddStringToObject(row, "technique", rows[e][t].technique);
+                cli_json_number(row, "flip", rows[e][t].flip, 5);
+                cli_json_number(row, "rmse", rows[e][t].rmse, 5);
+                cli_json_number(row, "ms", rows[e][t].ms, 3);
+            }
+        }
+    }
+    return cli_json_write("bench isg", root, NULL);
+}
+
+static void print_text(const bench_ctx *b, double tables[3][4][4], const double base[3],
+                       quality_row rows[3][MAX_ROWS], const int row_count[3], const char *path)
 {
     const isg_options *o = b->o;
     int threads = drift_context_thread_count(b->ctx);
-    if (o->json) {
-        printf("{\"scene\": \"%s\", \"threads\": %d, \"frames\": %ld, \"width\": %ld, \"height\": "
-               "%ld, "
-               "\"qwidth\": %ld, \"qheight\": %ld, \"ref_spp\": %ld, \"search\": %ld, "
-               "\"gather\": %ld, \"effects\": {",
-               path, threads, o->frames, o->width, o->height, o->qwidth, o->qheight, o->ref_spp,
-               o->search, o->gather);
-        for (int e = 0; e < 3; ++e) {
-            printf("%s\"%s\": {", e ? ", " : "", drift_effect_name(effects[e]));
-            if (!o->skip_table) {
-                printf("\"base_ms\": %.3f, \"isg_ms\": [", base[e]);
-                for (int g = 0; g < 4; ++g) {
-                    printf("%s{\"gather\": %d, \"search_ms\": [%.3f, %.3f, %.3f, %.3f]}",
-                           g ? ", " : "", counts[g], tables[e][g][0], tables[e][g][1],
-                           tables[e][g][2], tables[e][g][3]);
-                }
-                printf("]%s", o->skip_quality ? "" : ", ");
-            }
-            if (!o->skip_quality) {
-                printf("\"quality\": [");
-                for (int t = 0; t < row_count[e]; ++t) {
-                    printf(
-                        "%s{\"technique\": \"%s\", \"flip\": %.5f, \"rmse\": %.5f, \"ms\": %.3f}",
-                        t ? ", " : "", rows[e][t].technique, rows[e][t].flip, rows[e][t].rmse,
-                        rows[e][t].ms);
-                }
-                printf("]");
-            }
-            printf("}");
-        }
-        printf("}}\n");
-        return;
-    }
     printf("%s, %d thread(s)\n", path, threads);
     for (int e = 0; e < 3; ++e) {
         printf("\n== %s ==\n", drift_effect_name(effects[e]));
@@ -350,26 +306,31 @@ static void print_results(const bench_ctx *b, double tables[3][4][4], const doub
 
 int drift_bench_isg(int argc, char **argv)
 {
-    isg_options o;
-    int status = parse(argc, argv, &o);
-    if (status != 0) {
-        return status < 0 ? 0 : status;
+    isg_options o = { .width = 1024,
+                      .height = 768,
+                      .qwidth = 320,
+                      .qheight = 240,
+                      .ref_spp = 256,
+                      .threads = 1,
+                      .search = 25,
+                      .gather = 49,
+                      .frames = 1,
+                      .aperture = -1.0 };
+    int status = cli_parse(&isg_command, argc, argv, &o, NULL);
+    if (status != CLI_PARSED) {
+        return cli_parse_exit(status);
     }
-    static const char default_scene[] =
-        DRIFT_SOURCE_DIR "/scenes/cornell-glossy/cornell_glossy.json";
-    const char *scene_path = o.scene_path ? o.scene_path : default_scene;
-    drift_context *ctx = NULL;
-    drift_scene *scene = NULL;
-    drift_accel *accel = NULL;
     int exit_code = 1;
-    ctx = cli_open_context("bench isg", (int)o.threads, false);
-    if (!ctx) {
+    cli_session session;
+    if (!bench_open(&session, "bench isg", o.scene_path,
+                    "scenes/cornell-glossy/cornell_glossy.json", o.threads)) {
         goto done;
     }
+    drift_context *ctx = session.ctx;
+    drift_scene *scene = session.scene;
+    const drift_accel *accel = session.accel;
+    const char *scene_path = session.scene_path;
     drift_result r = DRIFT_OK;
-    if (!cli_open_scene(ctx, "bench isg", scene_path, &scene, &accel, NULL)) {
-        goto done;
-    }
     if (o.aperture >= 0.0) {
         scene->camera.aperture_radius = (float)o.aperture;
     } else if (!(scene->camera.aperture_radius > 0.0f)) {
@@ -403,11 +364,13 @@ int drift_bench_isg(int argc, char **argv)
         fprintf(stderr, "drift bench isg: %s\n", drift_result_string(r));
         goto done;
     }
-    print_results(&b, tables, base, rows, row_count, scene_path);
-    exit_code = 0;
+    if (o.json) {
+        exit_code = print_json(&b, tables, base, rows, row_count, scene_path) ? 0 : 1;
+    } else {
+        print_text(&b, tables, base, rows, row_count, scene_path);
+        exit_code = 0;
+    }
 done:
-    drift_accel_destroy(accel);
-    drift_scene_destroy(scene);
-    drift_context_destroy(ctx);
+    cli_session_close(&session);
     return exit_code;
 }

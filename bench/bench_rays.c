@@ -654,77 +654,37 @@ static double timed(bench_state *s, enum ray_kind kind, raw_primary_fn raw, doub
 
 // --- COMMAND ---
 
-static void print_help(FILE *out)
-{
-    fprintf(out,
-            "usage: drift bench rays [SCENE] [--width W --height H] [--seconds S] [--repeats N]\n"
-            "                        [--json] [--variants]\n\n"
-            "Rays per second on one thread through drift's accel and through raw Embree calls\n"
-            "on an identical Embree scene, with identical ray sets: primary (coherent 16x16\n"
-            "tiles), shadow (occlusion toward the first area light) and bounce (cosine-\n"
-            "sampled from the primary hits, incoherent). The two sides alternate N times\n"
-            "(default 5) and the best run of each counts; drift/raw near 1 means the wrapper\n"
-            "is free.\n\n"
-            "  SCENE        a scene or mesh file (drift_scene_load), or builtin:cornell or\n"
-            "               builtin:sphere (a ~100k-triangle sphere on a plane); default: the\n"
-            "               built-in Cornell box file (%s),\n"
-            "               or builtin:cornell when that file cannot be loaded\n"
-            "  --width W, --height H   image size for primary rays (default: the camera's)\n"
-            "  --seconds S  total time to spend measuring (default 6)\n"
-            "  --json       one JSON object on stdout instead of the table\n"
-            "  --variants   also time raw Embree's other ways of tracing primary rays\n"
-            "               (rtcIntersect1M stream, rtcIntersect1 one by one)\n",
-            cli_default_scene_path());
-}
+#define O rays_options
+static const cli_option rays_table[] = {
+    CLI_SECTION("options:", 0),
+    CLI_INT("--width", "W", O, width, 1, 16384,
+            "image size for primary rays (default: the camera's)"),
+    CLI_INT("--height", "H", O, height, 1, 16384, "image size for primary rays"),
+    CLI_NUMBER("--seconds", "S", O, seconds, 0.01, 3600.0,
+               "total time to spend measuring (default 6)"),
+    CLI_INT("--repeats", "N", O, repeats, 1, 1000, "alternations of the two sides (default 5)"),
+    CLI_FLAG("--json", O, json, "one JSON object on stdout instead of the table"),
+    CLI_FLAG("--variants", O, variants,
+             "also time raw Embree's other ways of tracing primary rays\n"
+             "(rtcIntersect1M stream, rtcIntersect1 one by one)"),
+};
+#undef O
 
-static int parse(int argc, char **argv, rays_options *o)
-{
-    const char *cmd = "bench rays";
-    *o = (rays_options){ .seconds = 6.0, .repeats = 5 };
-    for (int i = 1; i < argc; ++i) {
-        const char *a = argv[i];
-        const char *v = NULL;
-        double dv = 0.0;
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            print_help(stdout);
-            return 0;
-        } else if (strcmp(a, "--json") == 0) {
-            o->json = true;
-        } else if (strcmp(a, "--variants") == 0) {
-            o->variants = true;
-        } else if (strcmp(a, "--width") == 0) {
-            if (!(v = cli_next_value(cmd, argc, argv, &i)) ||
-                !cli_parse_int(cmd, a, v, 1, 16384, &o->width)) {
-                return 2;
-            }
-        } else if (strcmp(a, "--height") == 0) {
-            if (!(v = cli_next_value(cmd, argc, argv, &i)) ||
-                !cli_parse_int(cmd, a, v, 1, 16384, &o->height)) {
-                return 2;
-            }
-        } else if (strcmp(a, "--repeats") == 0) {
-            if (!(v = cli_next_value(cmd, argc, argv, &i)) ||
-                !cli_parse_int(cmd, a, v, 1, 1000, &o->repeats)) {
-                return 2;
-            }
-        } else if (strcmp(a, "--seconds") == 0) {
-            if (!(v = cli_next_value(cmd, argc, argv, &i)) ||
-                !cli_parse_float(cmd, a, v, 0.01, 3600.0, &dv)) {
-                return 2;
-            }
-            o->seconds = dv;
-        } else if (a[0] == '-' && a[1] != '\0') {
-            fprintf(stderr, "drift bench rays: unknown option '%s'\n", a);
-            return 2;
-        } else if (o->scene) {
-            fprintf(stderr, "drift bench rays: one scene only ('%s' and '%s')\n", o->scene, a);
-            return 2;
-        } else {
-            o->scene = a;
-        }
-    }
-    return -1; // go on
-}
+static const cli_command rays_command = {
+    .name = "bench rays",
+    .usage = "usage: drift bench rays [SCENE] [options]\n\n"
+             "Rays per second on one thread through drift's accel and through raw Embree calls\n"
+             "on an identical Embree scene, with identical ray sets: primary (coherent 16x16\n"
+             "tiles), shadow (occlusion toward the first area light) and bounce (cosine-\n"
+             "sampled from the primary hits, incoherent). The two sides alternate N times\n"
+             "and the best run of each counts; drift/raw near 1 means the wrapper is free.\n\n"
+             "SCENE is a scene or mesh file (drift_scene_load), or builtin:cornell or\n"
+             "builtin:sphere (a ~100k-triangle sphere on a plane); default: the built-in\n"
+             "Cornell box file, or builtin:cornell when that file cannot be loaded.\n\n",
+    CLI_TABLE(rays_table),
+    CLI_POSITIONAL("SCENE", rays_options, scene, 1),
+    .help_column = 15,
+};
 
 static void state_destroy(bench_state *s)
 {
@@ -742,24 +702,25 @@ static void state_destroy(bench_state *s)
     }
     drift_accel_destroy(s->accel);
     drift_scene_destroy(s->scene);
-    drift_context_destroy(s->ctx);
 }
 
 int drift_bench_rays(int argc, char **argv)
 {
-    rays_options o;
-    int status = parse(argc, argv, &o);
-    if (status >= 0) {
-        return status;
+    rays_options o = { .seconds = 6.0, .repeats = 5 };
+    int status = cli_parse(&rays_command, argc, argv, &o, NULL);
+    if (status != CLI_PARSED) {
+        return cli_parse_exit(status);
     }
     const char *scene_name = o.scene ? o.scene : cli_default_scene_path();
     bench_state s = { 0 };
     // One thread: the figures are per thread, and Embree builds with one thread too.
-    if (drift_context_create(
-            &(drift_context_desc){ .thread_count = 1, .logger = cli_stderr_logger(false) },
-            &s.ctx) != DRIFT_OK) {
+    cli_session session;
+    if (!cli_session_open(
+            &(cli_session_desc){ .cmd = "bench rays", .threads = 1, .no_scene = true }, &session)) {
+        cli_session_close(&session);
         return 1;
     }
+    s.ctx = session.ctx;
     drift_result r = load_scene(s.ctx, scene_name, &s.scene);
     if (r != DRIFT_OK && !o.scene) {
         // The default scene file may be missing (or unreadable) in a partial checkout: the
@@ -772,6 +733,7 @@ int drift_bench_rays(int argc, char **argv)
         fprintf(stderr, "drift bench rays: cannot load '%s': %s\n", scene_name,
                 drift_result_string(r));
         state_destroy(&s);
+        cli_session_close(&session);
         return 1;
     }
     s.width = o.width ? (int32_t)o.width : s.scene->camera.width;
@@ -782,6 +744,7 @@ int drift_bench_rays(int argc, char **argv)
     if (r != DRIFT_OK || !build_raw(&s) || !make_ray_sets(&s)) {
         fprintf(stderr, "drift bench rays: setup failed (%s)\n", drift_result_string(r));
         state_destroy(&s);
+        cli_session_close(&session);
         return 1;
     }
 
@@ -821,20 +784,27 @@ int drift_bench_rays(int argc, char **argv)
     }
 
     if (o.json) {
-        printf("{\"scene\": \"%s\", \"triangles\": %llu, \"width\": %d, \"height\": %d, "
-               "\"threads\": 1, \"build_seconds\": %.4f, \"results_match\": %s",
-               scene_name, (unsigned long long)drift_scene_triangle_count(s.scene), s.width,
-               s.height, build_s, mismatch ? "false" : "true");
+        cJSON *root = cJSON_CreateObject();
+        cJSON_AddStringToObject(root, "scene", scene_name);
+        cli_json_count(root, "triangles", drift_scene_triangle_count(s.scene));
+        cJSON_AddNumberToObject(root, "width", s.width);
+        cJSON_AddNumberToObject(root, "height", s.height);
+        cJSON_AddNumberToObject(root, "threads", 1);
+        cli_json_number(root, "build_seconds", build_s, 4);
+        cJSON_AddBoolToObject(root, "results_match", !mismatch);
         for (int k = 0; k < KIND_COUNT; ++k) {
-            printf(", \"%s\": {\"rays\": %u, \"drift_rays_per_s\": %.0f, "
-                   "\"raw_rays_per_s\": %.0f, \"ratio\": %.4f}",
-                   kind_names[k], s.sets[k].count, best_drift[k], best_raw[k],
-                   best_drift[k] / best_raw[k]);
+            cJSON *kind = cJSON_AddObjectToObject(root, kind_names[k]);
+            cli_json_count(kind, "rays", s.sets[k].count);
+            cli_json_number(kind, "drift_rays_per_s", best_drift[k], 0);
+            cli_json_number(kind, "raw_rays_per_s", best_raw[k], 0);
+            cli_json_number(kind, "ratio", best_drift[k] / best_raw[k], 4);
         }
         for (int v = 1; v < variant_count; ++v) {
-            printf(", \"raw_primary_%s_rays_per_s\": %.0f", variant_names[v], best_variant[v]);
+            char key[64];
+            snprintf(key, sizeof key, "raw_primary_%s_rays_per_s", variant_names[v]);
+            cli_json_number(root, key, best_variant[v], 0);
         }
-        printf("}\n");
+        mismatch |= !cli_json_write("bench rays", root, NULL);
     } else {
         printf("scene %s: %llu triangles, %dx%d, 1 thread, accel build %.3f s, best of %ld\n",
                scene_name, (unsigned long long)drift_scene_triangle_count(s.scene), s.width,
@@ -851,5 +821,6 @@ int drift_bench_rays(int argc, char **argv)
         }
     }
     state_destroy(&s);
+    cli_session_close(&session);
     return mismatch ? 1 : 0;
 }

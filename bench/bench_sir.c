@@ -41,51 +41,16 @@ typedef struct sir_options {
     uint32_t view_count; // 0: the one camera (with --target and --fov)
 } sir_options;
 
-static void print_help(FILE *out)
+static bool parse_sizes(const char *cmd, const char *flag, const char *v, void *field)
 {
-    fprintf(
-        out,
-        "usage: drift bench sir [SCENE...] [--sizes WxH,...] [--spp N] [--budget N]\n"
-        "                       [--threshold T] [--lambda FILE] [--threads T] [--json]\n"
-        "                       [--light-samples N] [--views FILE]\n\n"
-        "Table 1 of Amann et al. 2012: pure ray tracing (PRT) time vs SIR time to the same\n"
-        "image, error pixels, FLIP of SIR against PRT, and recall/precision of each metric\n"
-        "against the real error. The raster is the hybrid frame with PCSS shadows,\n"
-        "environment-map reflections and post DOF (second frame: cached maps, as the\n"
-        "paper's precomputed environment maps).\n\n"
-        "  SCENE         default: breakfast-room and cornell-glossy (need ../shared)\n"
-        "  --sizes       default 800x600,1024x768,1920x1080\n"
-        "  --spp N       samples a pixel in both PRT and SIR (default 4)\n"
-        "  --budget N    SIR samples an iteration (default 8192, the paper's ray count)\n"
-        "  --light-samples N  the raster's samples per area light and environment\n"
-        "                (default 8, the hybrid frame's)\n"
-        "  --threshold T real error: largest display-value channel difference > T (0.02)\n"
-        "  --lambda FILE also measure the fitted combination\n"
-        "  --figures DIR PNGs per row: raster, pure, sir, combined error, and the\n"
-        "                recall map (white: real error flagged, red: missed, blue: flagged only)\n"
-        "  --noise-floor also the FLIP between two pure images of different seeds (how\n"
-        "                close two equally good images are), and a real error must exceed\n"
-        "                the threshold plus the two pure images' difference at the pixel\n"
-        "  --target X,Y,Z  look at this point instead of the camera's target (other views,\n"
-        "                as the paper's rows are views with more or fewer error pixels)\n"
-        "  --fov DEG     vertical field of view (default: the camera's)\n"
-        "  --views FILE  rows for several views of each scene, from JSON:\n"
-        "                {\"views\": [{\"name\": \"high\", \"position\": [x, y, z],\n"
-        "                \"target\": [x, y, z], \"fov_y\": degrees, \"aperture_radius\": r}]}\n"
-        "                (every field but name optional: the scene camera's)\n"
-        "  --threads T   worker threads (default 1: per-thread figures)\n"
-        "  --json        one JSON object on stdout\n");
-}
-
-static bool parse_sizes(const char *v, sir_options *o)
-{
+    sir_options *o = field;
     o->size_count = 0;
     const char *p = v;
     while (*p) {
         int w, h, used = 0;
         if (o->size_count == MAX_SIZES || sscanf(p, "%dx%d%n", &w, &h, &used) != 2 || w < 8 ||
             h < 8 || w > 16384 || h > 16384) {
-            fprintf(stderr, "drift bench sir: --sizes expects WxH[,WxH...] (8..16384), got '%s'\n",
+            fprintf(stderr, "drift %s: %s expects WxH[,WxH...] (8..16384), got '%s'\n", cmd, flag,
                     v);
             return false;
         }
@@ -95,75 +60,80 @@ static bool parse_sizes(const char *v, sir_options *o)
         if (*p == ',') {
             ++p;
         } else if (*p) {
-            fprintf(stderr, "drift bench sir: --sizes expects WxH[,WxH...], got '%s'\n", v);
+            fprintf(stderr, "drift %s: %s expects WxH[,WxH...], got '%s'\n", cmd, flag, v);
             return false;
         }
     }
     return o->size_count > 0;
 }
 
+static bool parse_target(const char *cmd, const char *flag, const char *v, void *field)
+{
+    sir_options *o = field;
+    o->has_target = cli_parse_vec3(cmd, flag, v, false, &o->target);
+    return o->has_target;
+}
+
+#define O sir_options
+static const cli_option sir_table[] = {
+    CLI_SECTION("options:", 0),
+    CLI_CUSTOM_ALL("--sizes", "WxH,...", parse_sizes,
+                   "image sizes (default 800x600,1024x768,1920x1080)"),
+    CLI_INT("--spp", "N", O, spp, 1, 65536, "samples a pixel in both PRT and SIR (default 4)"),
+    CLI_INT("--budget", "N", O, budget, 1, 1L << 30,
+            "SIR samples an iteration (default 8192, the paper's ray count)"),
+    CLI_INT("--light-samples", "N", O, light_samples, 1, 4096,
+            "the raster's samples per area light and environment\n"
+            "(default 8, the hybrid frame's)"),
+    CLI_NUMBER("--threshold", "T", O, threshold, 1e-6, 1.0,
+               "real error: largest display-value channel difference > T (0.02)"),
+    CLI_STRING("--lambda", "FILE", O, lambda_path, "also measure the fitted combination"),
+    CLI_STRING("--figures", "DIR", O, figures_dir,
+               "PNGs per row: raster, pure, sir, combined error, and the\n"
+               "recall map (white: real error flagged, red: missed, blue: flagged only)"),
+    CLI_FLAG("--noise-floor", O, noise_floor,
+             "also the FLIP between two pure images of different seeds (how\n"
+             "close two equally good images are), and a real error must exceed\n"
+             "the threshold plus the two pure images' difference at the pixel"),
+    CLI_CUSTOM_ALL("--target", "X,Y,Z", parse_target,
+                   "look at this point instead of the camera's target (other views,\n"
+                   "as the paper's rows are views with more or fewer error pixels)"),
+    CLI_NUMBER("--fov", "DEG", O, fov, 0.1, 179.0,
+               "vertical field of view (default: the camera's)"),
+    CLI_STRING("--views", "FILE", O, views_path,
+               "rows for several views of each scene, from JSON:\n"
+               "{\"views\": [{\"name\": \"high\", \"position\": [x, y, z],\n"
+               "\"target\": [x, y, z], \"fov_y\": degrees, \"aperture_radius\": r}]}\n"
+               "(every field but name optional: the scene camera's)"),
+    BENCH_OPTION_THREADS(O),
+    BENCH_OPTION_JSON(O),
+};
+#undef O
+
+static const cli_command sir_command = {
+    .name = "bench sir",
+    .usage = "usage: drift bench sir [SCENE...] [options]\n\n"
+             "Table 1 of Amann et al. 2012: pure ray tracing (PRT) time vs SIR time to the same\n"
+             "image, error pixels, FLIP of SIR against PRT, and recall/precision of each metric\n"
+             "against the real error. The raster is the hybrid frame with PCSS shadows,\n"
+             "environment-map reflections and post DOF (second frame: cached maps, as the\n"
+             "paper's precomputed environment maps). SCENE defaults to breakfast-room and\n"
+             "cornell-glossy (need ../shared); at most " CLI_STR(MAX_SCENES) ".\n\n",
+    CLI_TABLE(sir_table),
+    CLI_POSITIONAL("SCENE", sir_options, scenes, MAX_SCENES),
+    .help_column = 17,
+};
+
 static int parse(int argc, char **argv, sir_options *o)
 {
     *o = (sir_options){ .spp = 4, .budget = 8192, .threads = 1, .threshold = 0.02 };
-    parse_sizes("800x600,1024x768,1920x1080", o);
-    for (int i = 1; i < argc; ++i) {
-        const char *a = argv[i], *v = NULL;
-        bool ok = true;
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            print_help(stdout);
-            return -1;
-        } else if (strcmp(a, "--json") == 0) {
-            o->json = true;
-        } else if (strcmp(a, "--sizes") == 0) {
-            ok = (v = cli_next_value("bench sir", argc, argv, &i)) && parse_sizes(v, o);
-        } else if (strcmp(a, "--spp") == 0) {
-            ok = (v = cli_next_value("bench sir", argc, argv, &i)) &&
-                 cli_parse_int("bench sir", a, v, 1, 65536, &o->spp);
-        } else if (strcmp(a, "--budget") == 0) {
-            ok = (v = cli_next_value("bench sir", argc, argv, &i)) &&
-                 cli_parse_int("bench sir", a, v, 1, 1L << 30, &o->budget);
-        } else if (strcmp(a, "--light-samples") == 0) {
-            ok = (v = cli_next_value("bench sir", argc, argv, &i)) &&
-                 cli_parse_int("bench sir", a, v, 1, 4096, &o->light_samples);
-        } else if (strcmp(a, "--threshold") == 0) {
-            ok = (v = cli_next_value("bench sir", argc, argv, &i)) &&
-                 cli_parse_float("bench sir", a, v, 1e-6, 1.0, &o->threshold);
-        } else if (strcmp(a, "--lambda") == 0) {
-            ok = (o->lambda_path = cli_next_value("bench sir", argc, argv, &i)) != NULL;
-        } else if (strcmp(a, "--target") == 0) {
-            float x = 0.0f, y = 0.0f, z = 0.0f;
-            char tail;
-            ok = (v = cli_next_value("bench sir", argc, argv, &i)) &&
-                 sscanf(v, "%f,%f,%f%c", &x, &y, &z, &tail) == 3;
-            if (v && !ok) {
-                fprintf(stderr, "drift bench sir: --target expects X,Y,Z, got '%s'\n", v);
-            }
-            o->target = drift_vec3_make(x, y, z);
-            o->has_target = ok;
-        } else if (strcmp(a, "--fov") == 0) {
-            ok = (v = cli_next_value("bench sir", argc, argv, &i)) &&
-                 cli_parse_float("bench sir", a, v, 0.1, 179.0, &o->fov);
-        } else if (strcmp(a, "--views") == 0) {
-            ok = (o->views_path = cli_next_value("bench sir", argc, argv, &i)) != NULL;
-        } else if (strcmp(a, "--noise-floor") == 0) {
-            o->noise_floor = true;
-        } else if (strcmp(a, "--figures") == 0) {
-            ok = (o->figures_dir = cli_next_value("bench sir", argc, argv, &i)) != NULL;
-        } else if (strcmp(a, "--threads") == 0) {
-            ok = (v = cli_next_value("bench sir", argc, argv, &i)) &&
-                 cli_parse_int("bench sir", a, v, 0, 256, &o->threads);
-        } else if (a[0] == '-') {
-            fprintf(stderr, "drift bench sir: unknown option '%s'\n", a);
-            ok = false;
-        } else if (o->scene_count < MAX_SCENES) {
-            o->scenes[o->scene_count++] = a;
-        } else {
-            fprintf(stderr, "drift bench sir: at most %d scenes\n", MAX_SCENES);
-            ok = false;
-        }
-        if (!ok) {
-            return 2;
-        }
+    parse_sizes("bench sir", "--sizes", "800x600,1024x768,1920x1080", o);
+    int status = cli_parse(&sir_command, argc, argv, o, NULL);
+    if (status != CLI_PARSED) {
+        return status;
+    }
+    while (o->scene_count < MAX_SCENES && o->scenes[o->scene_count]) {
+        ++o->scene_count;
     }
     if (o->scene_count == 0) {
         o->scenes[0] = DRIFT_SOURCE_DIR "/scenes/breakfast-room/breakfast_room.json";
@@ -413,31 +383,42 @@ static const char *quality_name(int k)
     return k == DRIFT_METRIC_COUNT ? "average" : "lambda";
 }
 
-static void print_json_row(const sir_row *row, bool first, bool lambda)
+static void add_json_row(cJSON *rows, const sir_row *row, bool lambda)
 {
-    printf("%s{\"scene\": \"%s\", \"view\": \"%s\", \"width\": %d, \"height\": %d, "
-           "\"error_pixels\": %llu, "
-           "\"error_percent\": %.3f, \"real_error_pixels\": %llu, \"real_error_percent\": %.3f, "
-           "\"raster_ms\": %.2f, \"metrics_ms\": %.2f, \"sort_ms\": %.2f, \"trace_ms\": %.2f, "
-           "\"sir_ms\": %.2f, \"prt_ms\": %.2f, \"speedup\": %.3f, \"flip\": %.5f, "
-           "\"noise_flip\": %.5f, \"sir_to_flip_ms\": %.2f, \"speedup_to_flip\": %.3f, "
-           "\"same_image\": %s, \"iterations\": %u, \"sir_rays\": %llu, \"prt_rays\": %llu, "
-           "\"quality\": {",
-           first ? "" : ", ", row->scene, row->view, row->width, row->height,
-           (unsigned long long)row->error_pixels, row->error_percent,
-           (unsigned long long)row->real_pixels, row->real_percent, row->raster_ms, row->metrics_ms,
-           row->sort_ms, row->trace_ms, row->sir_ms, row->prt_ms, row->prt_ms / row->sir_ms,
-           row->flip, row->noise_flip, row->reached_ms,
-           row->reached_ms > 0.0 ? row->prt_ms / row->reached_ms : 0.0,
-           row->flip <= FLIP_TARGET ? "true" : "false", row->iterations,
-           (unsigned long long)row->sir_rays, (unsigned long long)row->prt_rays);
-    int rows = lambda ? QUALITY_ROWS : QUALITY_ROWS - 1;
-    for (int k = 0; k < rows; ++k) {
-        printf("%s\"%s\": {\"recall\": %.4f, \"precision\": %.4f, \"flagged\": %.4f}",
-               k ? ", " : "", quality_name(k), row->q[k].recall, row->q[k].precision,
-               row->q[k].flagged);
+    cJSON *r = cJSON_CreateObject();
+    cJSON_AddItemToArray(rows, r);
+    cJSON_AddStringToObject(r, "scene", row->scene);
+    cJSON_AddStringToObject(r, "view", row->view);
+    cJSON_AddNumberToObject(r, "width", row->width);
+    cJSON_AddNumberToObject(r, "height", row->height);
+    cli_json_count(r, "error_pixels", row->error_pixels);
+    cli_json_number(r, "error_percent", row->error_percent, 3);
+    cli_json_count(r, "real_error_pixels", row->real_pixels);
+    cli_json_number(r, "real_error_percent", row->real_percent, 3);
+    cli_json_number(r, "raster_ms", row->raster_ms, 2);
+    cli_json_number(r, "metrics_ms", row->metrics_ms, 2);
+    cli_json_number(r, "sort_ms", row->sort_ms, 2);
+    cli_json_number(r, "trace_ms", row->trace_ms, 2);
+    cli_json_number(r, "sir_ms", row->sir_ms, 2);
+    cli_json_number(r, "prt_ms", row->prt_ms, 2);
+    cli_json_number(r, "speedup", row->prt_ms / row->sir_ms, 3);
+    cli_json_number(r, "flip", row->flip, 5);
+    cli_json_number(r, "noise_flip", row->noise_flip, 5);
+    cli_json_number(r, "sir_to_flip_ms", row->reached_ms, 2);
+    cli_json_number(r, "speedup_to_flip",
+                    row->reached_ms > 0.0 ? row->prt_ms / row->reached_ms : 0.0, 3);
+    cJSON_AddBoolToObject(r, "same_image", row->flip <= FLIP_TARGET);
+    cli_json_count(r, "iterations", row->iterations);
+    cli_json_count(r, "sir_rays", row->sir_rays);
+    cli_json_count(r, "prt_rays", row->prt_rays);
+    cJSON *by_metric = cJSON_AddObjectToObject(r, "quality");
+    int count = lambda ? QUALITY_ROWS : QUALITY_ROWS - 1;
+    for (int k = 0; k < count; ++k) {
+        cJSON *q = cJSON_AddObjectToObject(by_metric, quality_name(k));
+        cli_json_number(q, "recall", row->q[k].recall, 4);
+        cli_json_number(q, "precision", row->q[k].precision, 4);
+        cli_json_number(q, "flagged", row->q[k].flagged, 4);
     }
-    printf("}}");
 }
 
 static void print_text_row(const sir_row *row, bool lambda)
@@ -474,31 +455,39 @@ int drift_bench_sir(int argc, char **argv)
     sir_options o;
     int pr = parse(argc, argv, &o);
     if (pr != 0) {
-        return pr < 0 ? 0 : pr;
+        return cli_parse_exit(pr);
     }
-    drift_context *ctx = cli_open_context("bench sir", (int)o.threads, false);
-    if (!ctx) {
+    cli_session session;
+    if (!cli_session_open(
+            &(cli_session_desc){ .cmd = "bench sir", .threads = (int)o.threads, .no_scene = true },
+            &session)) {
+        cli_session_close(&session);
         return 1;
     }
+    drift_context *ctx = session.ctx;
     drift_result r = DRIFT_OK;
     float lambda[DRIFT_METRIC_COUNT];
     if (o.lambda_path && drift_refine_lambda_load(ctx, o.lambda_path, lambda) != DRIFT_OK) {
         fprintf(stderr, "drift bench sir: --lambda: cannot use %s\n", o.lambda_path);
-        drift_context_destroy(ctx);
+        cli_session_close(&session);
         return 2;
     }
     if (o.views_path &&
         drift_camera_views_load(ctx, o.views_path, o.views, MAX_VIEWS, &o.view_count) != DRIFT_OK) {
         fprintf(stderr, "drift bench sir: --views: cannot use %s\n", o.views_path);
-        drift_context_destroy(ctx);
+        cli_session_close(&session);
         return 2;
     }
     int exit_code = 0;
-    bool first = true;
+    cJSON *root = NULL, *rows = NULL;
     if (o.json) {
-        printf("{\"threads\": %d, \"spp\": %ld, \"budget\": %ld, \"threshold\": %.4f, "
-               "\"flip_target\": %.3f, \"rows\": [",
-               drift_context_thread_count(ctx), o.spp, o.budget, o.threshold, FLIP_TARGET);
+        root = cJSON_CreateObject();
+        cJSON_AddNumberToObject(root, "threads", drift_context_thread_count(ctx));
+        cJSON_AddNumberToObject(root, "spp", (double)o.spp);
+        cJSON_AddNumberToObject(root, "budget", (double)o.budget);
+        cli_json_number(root, "threshold", o.threshold, 4);
+        cli_json_number(root, "flip_target", FLIP_TARGET, 3);
+        rows = cJSON_AddArrayToObject(root, "rows");
     } else {
         printf("%d thread(s), %ld spp, budget %ld samples an iteration, real error > %.3f\n",
                drift_context_thread_count(ctx), o.spp, o.budget, o.threshold);
@@ -506,12 +495,11 @@ int drift_bench_sir(int argc, char **argv)
                "error pixels", "PRT ms", "SIR ms", "speedup", "FLIP", "same");
     }
     for (int s = 0; s < o.scene_count && exit_code == 0; ++s) {
-        drift_scene *scene = NULL;
-        drift_accel *accel = NULL;
-        if (!cli_open_scene(ctx, "bench sir", o.scenes[s], &scene, &accel, NULL)) {
+        if (!cli_session_load(&session, "bench sir", o.scenes[s], false)) {
             exit_code = 1;
             break;
         }
+        drift_scene *scene = session.scene;
         if (o.has_target) {
             scene->camera.target = o.target;
         }
@@ -528,7 +516,7 @@ int drift_bench_sir(int argc, char **argv)
             for (int k = 0; k < o.size_count; ++k) {
                 sir_row row = { .scene = short_name(o.scenes[s]),
                                 .view = view ? view->name : "camera" };
-                r = run_one(ctx, scene, accel, &o, o.widths[k], o.heights[k],
+                r = run_one(ctx, scene, session.accel, &o, o.widths[k], o.heights[k],
                             o.lambda_path ? lambda : NULL, &row);
                 if (r != DRIFT_OK) {
                     fprintf(stderr, "drift bench sir: %s failed: %s\n", o.scenes[s],
@@ -536,21 +524,20 @@ int drift_bench_sir(int argc, char **argv)
                     exit_code = 1;
                     break;
                 }
-                if (o.json) {
-                    print_json_row(&row, first, o.lambda_path != NULL);
+                if (rows) {
+                    add_json_row(rows, &row, o.lambda_path != NULL);
                 } else {
                     print_text_row(&row, o.lambda_path != NULL);
+                    fflush(stdout);
                 }
-                first = false;
-                fflush(stdout);
             }
         }
-        drift_accel_destroy(accel);
-        drift_scene_destroy(scene);
     }
-    if (o.json) {
-        printf("]}\n");
+    if (root && exit_code != 0) {
+        cJSON_Delete(root);
+    } else if (root && !cli_json_write("bench sir", root, NULL)) {
+        exit_code = 1;
     }
-    drift_context_destroy(ctx);
+    cli_session_close(&session);
     return exit_code;
 }

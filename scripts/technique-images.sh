@@ -11,7 +11,9 @@ scene=${3:-$(dirname "$0")/../scenes/cornell-glossy/cornell_glossy.json}
 mkdir -p "$out"
 size=(--width 48 --height 36 --spp 4 --threads 2 --quiet)
 effects=(shadows reflections dof indirect)
-# The technique names come from the binary itself: `drift render --help` lists them.
+# The technique names come from the binary itself: `drift render --help` lists them, one
+# "  --EFFECT T  a (default), b or c" line an effect (tools/cli_options.c prints those lines
+# from the technique table; the pre-refactor binary printed the same format by hand).
 for effect in "${effects[@]}"; do
   techniques=$("$bin" render --help | grep -E "^  --$effect T" | sed -E 's/.*  (.*)/\1/;s/\(default\)//g;s/,| or / /g')
   for t in $techniques; do

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The whole test suite: installs dependencies, builds with ASan+UBSan and -Werror, runs every
+# The whole test suite: installs dependencies, checks the formatting (clang-format, the
+# repository's .clang-format), builds with ASan+UBSan and -Werror, runs every
 # unit and CLI test, builds the Release configuration (-Werror at -O2 sees more), runs the
 # fuzzers for a bounded time and the core tests under valgrind.
 # DRIFT_TEST_INTENSITY scales statistical sample counts; DRIFT_FUZZ_SECONDS the fuzz time.
@@ -7,6 +8,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 jobs=$(nproc)
+
+echo "== format (clang-format --dry-run -Werror over every tracked .c and .h)"
+git ls-files -z '*.c' '*.h' | xargs -0 clang-format --dry-run -Werror
 
 echo "== build (Debug, ASan+UBSan, -Werror)"
 cmake -S . -B build/dev -DCMAKE_BUILD_TYPE=Debug -DDRIFT_SANITIZE=address,undefined -DDRIFT_WERROR=ON >/dev/null

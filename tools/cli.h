@@ -1,22 +1,47 @@
-// Shared pieces of the drift command-line tool: subcommand entry points, option parsing
-// helpers that reject malformed numbers, and a logger that prints to stderr.
+// Shared pieces of the drift command-line tool: subcommand entry points, option value
+// parsers that reject malformed numbers, a logger that prints to stderr, and the one place
+// that opens and closes a command's context, scene and accel (cli_session). Option tables
+// are in cli_options.h, the JSON writer in cli_json.h.
 #ifndef DRIFT_TOOLS_CLI_H
 #define DRIFT_TOOLS_CLI_H
 
+#include "cli_json.h"
+#include "cli_options.h"
 #include "drift/core.h"
 #include "drift/hybrid.h"
 
 #include <stdbool.h>
 #include <stdint.h>
 
-// Subcommands. Each takes the arguments after its own name (argv[0] is the subcommand) and
-// returns the process exit status: 0 success, 1 failure, 2 usage error.
-int drift_cmd_render(int argc, char **argv);
-int drift_cmd_diff(int argc, char **argv);
-int drift_cmd_info(int argc, char **argv);
-int drift_cmd_bench(int argc, char **argv);
-int drift_cmd_view(int argc, char **argv);
-int drift_cmd_refine(int argc, char **argv); // drift refine fit (tools/cmd_refine.c)
+// The subcommands of `drift`, X(name, function, one-line summary). To add one: write
+// tools/cmd_<name>.c with `int drift_cmd_<name>(int argc, char **argv)` and add its line here
+// (the prototype and tools/drift.c's dispatch table come from it). Each takes the arguments
+// after its own name (argv[0] is the subcommand) and returns the process exit status: 0
+// success, 1 failure, 2 usage error. Benchmarks are listed in bench/bench.h.
+#define DRIFT_COMMAND_LIST(X)                                                                \
+    X("render", drift_cmd_render, "render a scene (reference path tracer or hybrid frame)")  \
+    X("diff", drift_cmd_diff, "compare two images: MSE, RMSE, relMSE, PSNR, SSIM, FLIP")     \
+    X("info", drift_cmd_info, "print a scene's triangle, material, light, texture counts")   \
+    X("bench", drift_cmd_bench, "benchmarks (drift bench --help)")                           \
+    X("view", drift_cmd_view, "interactive viewer: hybrid techniques against the reference") \
+    X("refine", drift_cmd_refine, "smart image refinement: fit the metric weights (lambda)")
+
+#define DRIFT__COMMAND_DECLARE(name, fn, summary) int fn(int argc, char **argv);
+DRIFT_COMMAND_LIST(DRIFT__COMMAND_DECLARE)
+#undef DRIFT__COMMAND_DECLARE
+
+// A name -> entry point table (drift's commands, drift bench's benchmarks).
+typedef struct cli_subcommand {
+    const char *name;
+    int (*run)(int argc, char **argv);
+    const char *summary;
+} cli_subcommand;
+
+// Runs the entry of `table` that argv[1] names with argv + 1. Without one, or with --help,
+// prints "usage: drift <cmd> <name> [options]" and the `heading` list (stderr and status 2
+// when missing or unknown; stdout and 0 after --help), then `footer`.
+int cli_dispatch(const char *cmd, const char *heading, const char *footer,
+                 const cli_subcommand *table, size_t count, int argc, char **argv);
 
 // Option values: print "drift <cmd>: <flag> expects ..." and return false when malformed or
 // out of [lo, hi].
@@ -28,6 +53,13 @@ bool cli_parse_float(const char *cmd, const char *flag, const char *text, double
 // "drift <cmd>: <flag> expects one of <the techniques>, got '<text>'" and returns false.
 bool cli_parse_technique(const char *cmd, drift_effect effect, const char *flag, const char *text,
                          int *out);
+// X,Y,Z (or, with `scalar`, one number for all three), finite; otherwise prints
+// "drift <cmd>: <flag> expects X,Y,Z, got '<text>'" and returns false.
+bool cli_parse_vec3(const char *cmd, const char *flag, const char *text, bool scalar,
+                    drift_vec3 *out);
+// --refine sir (render and view): sets the bool at `field`, or prints
+// "drift <cmd>: <flag> expects 'sir', got '<value>'" and returns false.
+bool cli_parse_refine(const char *cmd, const char *flag, const char *value, void *field);
 // Returns argv[*i + 1] and advances *i, or prints a usage error and returns NULL.
 const char *cli_next_value(const char *cmd, int argc, char **argv, int *i);
 
@@ -35,22 +67,41 @@ const char *cli_next_value(const char *cmd, int argc, char **argv, int *i);
 // "drift: FILE:LINE: level: message" on stderr.
 drift_logger cli_stderr_logger(bool verbose);
 
-// A context with `threads` worker threads (0: one a core) and the stderr logger, or NULL after
-// printing "drift <cmd>: <why>".
-drift_context *cli_open_context(const char *cmd, int threads, bool verbose);
-
 // Directory of the built-in default scene (the repository's scenes/ folder).
 const char *cli_default_scene_path(void);
 
-// Loads the scene at `path` (NULL: the default scene) and builds its ray-tracing structure,
-// printing "drift <cmd>: ..." on failure (the scene's problem is already logged). On success
-// *out_loaded_time is the drift_time_now() between the two steps (for phase timings; may be
-// NULL). Either out pointer holds NULL on failure; free with drift_accel_destroy and
-// drift_scene_destroy.
+// What a command opens: a context, and unless told otherwise the scene and its ray-tracing
+// structure. Zero is the default: all cores, the built-in Cornell box, scene and accel.
+typedef struct cli_session_desc {
+    const char *cmd;           // "render", "bench isg": in messages
+    const char *scene_path;    // NULL: default_scene
+    const char *default_scene; // NULL: cli_default_scene_path()
+    int threads;               // worker threads; 0: one a core
+    bool verbose;              // info-level log messages too
+    bool no_scene;             // the context only (load scenes later with cli_session_load)
+    bool no_accel;             // the scene without its ray-tracing structure
+} cli_session_desc;
+
 struct drift_scene;
 struct drift_accel;
-bool cli_open_scene(drift_context *ctx, const char *cmd, const char *path,
-                    struct drift_scene **out_scene, struct drift_accel **out_accel,
-                    double *out_loaded_time);
+
+typedef struct cli_session {
+    drift_context *ctx;
+    struct drift_scene *scene;
+    struct drift_accel *accel;
+    const char *scene_path; // the scene loaded (the default resolved; points into `path`)
+    double t_start;         // drift_time_now() at open, after loading and after the accel:
+    double t_loaded;        // for phase timings
+    double t_built;
+    char path[4096];
+} cli_session;
+
+// Opens what `desc` asks for into *s, printing "drift <cmd>: ..." on failure (the scene's
+// problem is already logged by the context's logger). Call cli_session_close in both cases.
+bool cli_session_open(const cli_session_desc *desc, cli_session *s);
+// Replaces the session's scene (and accel unless no_accel) by the one at `path`.
+bool cli_session_load(cli_session *s, const char *cmd, const char *path, bool no_accel);
+// Destroys the accel, the scene and the context (each may be NULL); *s becomes zero.
+void cli_session_close(cli_session *s);
 
 #endif

@@ -53,6 +53,34 @@ bool cli_parse_technique(const char *cmd, drift_effect effect, const char *flag,
     return false;
 }
 
+bool cli_parse_vec3(const char *cmd, const char *flag, const char *text, bool scalar,
+                    drift_vec3 *out)
+{
+    float a, b, c;
+    char tail;
+    int n = sscanf(text, "%f,%f,%f%c", &a, &b, &c, &tail);
+    if (n == 1 && scalar) {
+        b = c = a; // one value: grey
+    }
+    if (!(n == 3 || (n == 1 && scalar)) || !drift_vec3_is_finite(drift_vec3_make(a, b, c))) {
+        fprintf(stderr, "drift %s: %s expects X,Y,Z%s, got '%s'\n", cmd, flag,
+                scalar ? " (or one number)" : "", text);
+        return false;
+    }
+    *out = drift_vec3_make(a, b, c);
+    return true;
+}
+
+bool cli_parse_refine(const char *cmd, const char *flag, const char *value, void *field)
+{
+    if (strcmp(value, "sir") != 0) {
+        fprintf(stderr, "drift %s: %s expects 'sir', got '%s'\n", cmd, flag, value);
+        return false;
+    }
+    *(bool *)field = true;
+    return true;
+}
+
 const char *cli_next_value(const char *cmd, int argc, char **argv, int *i)
 {
     if (*i + 1 >= argc) {
@@ -89,7 +117,13 @@ drift_logger cli_stderr_logger(bool verbose)
     return (drift_logger){ .func = stderr_log, .user = verbose ? &verbose_marker : NULL };
 }
 
-drift_context *cli_open_context(const char *cmd, int threads, bool verbose)
+const char *cli_default_scene_path(void)
+{
+    const char *env = getenv("DRIFT_DEFAULT_SCENE");
+    return env && *env ? env : DRIFT_SOURCE_DIR "/scenes/cornell-box/cornell_box.json";
+}
+
+static drift_context *open_context(const char *cmd, int threads, bool verbose)
 {
     drift_context *ctx = NULL;
     drift_result r = drift_context_create(
@@ -102,31 +136,82 @@ drift_context *cli_open_context(const char *cmd, int threads, bool verbose)
     return ctx;
 }
 
-const char *cli_default_scene_path(void)
+bool cli_session_load(cli_session *s, const char *cmd, const char *path, bool no_accel)
 {
-    const char *env = getenv("DRIFT_DEFAULT_SCENE");
-    return env && *env ? env : DRIFT_SOURCE_DIR "/scenes/cornell-box/cornell_box.json";
+    drift_accel_destroy(s->accel);
+    drift_scene_destroy(s->scene);
+    s->accel = NULL;
+    s->scene = NULL;
+    snprintf(s->path, sizeof s->path, "%s", path);
+    s->scene_path = s->path;
+    drift_result r = drift_scene_load(s->ctx, s->path, &s->scene);
+    if (r != DRIFT_OK) {
+        fprintf(stderr, "drift %s: cannot load scene %s: %s\n", cmd, s->path,
+                drift_result_string(r));
+        return false;
+    }
+    s->t_loaded = drift_time_now();
+    if (!no_accel) {
+        r = drift_accel_create(s->ctx, s->scene, &(drift_accel_desc){ 0 }, &s->accel);
+        if (r != DRIFT_OK) {
+            fprintf(stderr, "drift %s: cannot build the ray-tracing structure: %s\n", cmd,
+                    drift_result_string(r));
+            return false;
+        }
+    }
+    s->t_built = drift_time_now();
+    return true;
 }
 
-bool cli_open_scene(drift_context *ctx, const char *cmd, const char *path, drift_scene **out_scene,
-                    drift_accel **out_accel, double *out_loaded_time)
+bool cli_session_open(const cli_session_desc *desc, cli_session *s)
 {
-    *out_accel = NULL;
-    const char *scene_path = path ? path : cli_default_scene_path();
-    drift_result r = drift_scene_load(ctx, scene_path, out_scene);
-    if (r != DRIFT_OK) {
-        fprintf(stderr, "drift %s: cannot load scene %s: %s\n", cmd, scene_path,
-                drift_result_string(r));
+    *s = (cli_session){ .t_start = drift_time_now() };
+    s->ctx = open_context(desc->cmd, desc->threads, desc->verbose);
+    if (!s->ctx) {
         return false;
     }
-    if (out_loaded_time) {
-        *out_loaded_time = drift_time_now();
+    if (desc->no_scene) {
+        return true;
     }
-    r = drift_accel_create(ctx, *out_scene, &(drift_accel_desc){ 0 }, out_accel);
-    if (r != DRIFT_OK) {
-        fprintf(stderr, "drift %s: cannot build the ray-tracing structure: %s\n", cmd,
-                drift_result_string(r));
-        return false;
+    const char *path = desc->scene_path      ? desc->scene_path
+                       : desc->default_scene ? desc->default_scene
+                                             : cli_default_scene_path();
+    return cli_session_load(s, desc->cmd, path, desc->no_accel);
+}
+
+void cli_session_close(cli_session *s)
+{
+    drift_accel_destroy(s->accel);
+    drift_scene_destroy(s->scene);
+    drift_context_destroy(s->ctx);
+    *s = (cli_session){ 0 };
+}
+
+static void print_subcommands(FILE *out, const char *cmd, const char *heading, const char *footer,
+                              const cli_subcommand *table, size_t count)
+{
+    fprintf(out, "usage: drift %s%s<%s> [options]\n\n%s:\n", cmd ? cmd : "", cmd ? " " : "",
+            cmd ? "name" : "command", heading);
+    for (size_t i = 0; i < count; ++i) {
+        fprintf(out, "  %-10s %s\n", table[i].name, table[i].summary);
     }
-    return true;
+    fprintf(out, "\n%s", footer);
+}
+
+int cli_dispatch(const char *cmd, const char *heading, const char *footer,
+                 const cli_subcommand *table, size_t count, int argc, char **argv)
+{
+    if (argc < 2 || strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0) {
+        print_subcommands(argc < 2 ? stderr : stdout, cmd, heading, footer, table, count);
+        return argc < 2 ? 2 : 0;
+    }
+    for (size_t i = 0; i < count; ++i) {
+        if (strcmp(argv[1], table[i].name) == 0) {
+            return table[i].run(argc - 1, argv + 1);
+        }
+    }
+    fprintf(stderr, "drift%s%s: unknown %s '%s'\n\n", cmd ? " " : "", cmd ? cmd : "",
+            cmd ? "benchmark" : "command", argv[1]);
+    print_subcommands(stderr, cmd, heading, footer, table, count);
+    return 2;
 }

@@ -1,45 +1,53 @@
 // drift diff: compares a test image against a reference with MSE, RMSE, relMSE, PSNR, SSIM
 // and LDR-FLIP (docs/metrics.md), optionally writing the FLIP error as a magma heat map.
 #include "cli.h"
+#include "drift/image.h"
+#include "drift/image_io.h"
+#include "drift/metric.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
-#include "drift/image.h"
-#include "drift/image_io.h"
-#include "drift/metric.h"
+typedef struct diff_options {
+    const char *paths[2]; // REF TEST
+    const char *heatmap_path;
+    bool json, verbose;
+    double difftol; // < 0: none
+    double ppd;     // 0: DRIFT_METRIC_DEFAULT_PPD
+} diff_options;
 
-static void print_usage(FILE *out)
-{
-    fprintf(out,
-            "usage: drift diff REF TEST [options]\n"
-            "\n"
-            "Compares TEST against the reference REF (.exr, .png, .jpg, .jpeg, .hdr; same size)\n"
-            "and prints one line per metric: mse, rmse, relmse, psnr (dB, peak 1.0), ssim, flip.\n"
-            "\n"
-            "options:\n"
-            "  --heatmap FILE.png  write the per-pixel FLIP error as a magma heat map\n"
-            "  --json              print {\"mse\":..,\"rmse\":..,\"relmse\":..,\"psnr\":..,\n"
-            "                      \"ssim\":..,\"flip\":..}; psnr is null for identical images\n"
-            "  --difftol X         exit with status 1 when FLIP > X\n"
-            "  --ppd P             FLIP pixels per degree (default %.2f)\n"
-            "  -v, --verbose       more log output\n"
-            "  -h, --help          this text\n"
-            "\n"
-            "exit status: 0 ok, 1 error or FLIP over --difftol, 2 usage error\n",
-            DRIFT_METRIC_DEFAULT_PPD);
-}
+#define O diff_options
+static const cli_option diff_table[] = {
+    CLI_SECTION("options:", 0),
+    CLI_STRING("--heatmap", "FILE.png", O, heatmap_path,
+               "write the per-pixel FLIP error as a magma heat map"),
+    CLI_FLAG("--json", O, json,
+             "print {\"mse\":..,\"rmse\":..,\"relmse\":..,\"psnr\":..,\n"
+             "\"ssim\":..,\"flip\":..}; psnr is null for identical images"),
+    CLI_NUMBER("--difftol", "X", O, difftol, 0.0, 1.0, "exit with status 1 when FLIP > X"),
+    CLI_NUMBER("--ppd", "P", O, ppd, 1.0, 2000.0,
+               "FLIP pixels per degree (default " CLI_STR(DRIFT_METRIC_DEFAULT_PPD) ")"),
+    CLI_FLAG("-v, --verbose", O, verbose, "more log output"),
+};
+#undef O
 
-static void print_number(const char *key, double v, bool json, bool last)
+static const cli_command diff_command = {
+    .name = "diff",
+    .usage = "usage: drift diff REF TEST [options]\n"
+             "\n"
+             "Compares TEST against the reference REF (.exr, .png, .jpg, .jpeg, .hdr; same size)\n"
+             "and prints one line per metric: mse, rmse, relmse, psnr (dB, peak 1.0), ssim, flip.\n"
+             "\n",
+    .epilogue = "\nexit status: 0 ok, 1 error or FLIP over --difftol, 2 usage error\n",
+    CLI_TABLE(diff_table),
+    CLI_POSITIONAL("REF TEST", diff_options, paths, 2),
+    .help_column = 22,
+};
+
+static void print_number(const char *key, double v)
 {
-    if (json) {
-        if (isfinite(v)) {
-            printf("\"%s\": %.17g%s", key, v, last ? "" : ", ");
-        } else {
-            printf("\"%s\": null%s", key, last ? "" : ", ");
-        }
-    } else if (isinf(v) && v > 0.0) {
+    if (isinf(v) && v > 0.0) {
         printf("%-7s inf\n", key);
     } else {
         printf("%-7s %.9g\n", key, v);
@@ -48,56 +56,27 @@ static void print_number(const char *key, double v, bool json, bool last)
 
 int drift_cmd_diff(int argc, char **argv)
 {
-    const char *paths[2] = { NULL, NULL };
-    int path_count = 0;
-    const char *heatmap_path = NULL;
-    bool json = false, verbose = false, has_tol = false;
-    double difftol = 0.0, ppd = 0.0;
-    for (int i = 1; i < argc; ++i) {
-        const char *a = argv[i];
-        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
-            print_usage(stdout);
-            return 0;
-        } else if (strcmp(a, "--json") == 0) {
-            json = true;
-        } else if (strcmp(a, "-v") == 0 || strcmp(a, "--verbose") == 0) {
-            verbose = true;
-        } else if (strcmp(a, "--heatmap") == 0) {
-            if (!(heatmap_path = cli_next_value("diff", argc, argv, &i))) {
-                return 2;
-            }
-        } else if (strcmp(a, "--difftol") == 0) {
-            const char *v = cli_next_value("diff", argc, argv, &i);
-            if (!v || !cli_parse_float("diff", "--difftol", v, 0.0, 1.0, &difftol)) {
-                return 2;
-            }
-            has_tol = true;
-        } else if (strcmp(a, "--ppd") == 0) {
-            const char *v = cli_next_value("diff", argc, argv, &i);
-            if (!v || !cli_parse_float("diff", "--ppd", v, 1.0, 2000.0, &ppd)) {
-                return 2;
-            }
-        } else if (a[0] == '-' && a[1] != '\0') {
-            fprintf(stderr, "drift diff: unknown option '%s' (see drift diff --help)\n", a);
-            return 2;
-        } else if (path_count < 2) {
-            paths[path_count++] = a;
-        } else {
-            fprintf(stderr, "drift diff: too many arguments (see drift diff --help)\n");
-            return 2;
-        }
+    diff_options o = { .difftol = -1.0 };
+    int status = cli_parse(&diff_command, argc, argv, &o, NULL);
+    if (status != CLI_PARSED) {
+        return cli_parse_exit(status);
     }
-    if (path_count != 2) {
-        print_usage(stderr);
+    if (!o.paths[1]) {
+        cli_print_help(&diff_command, stderr);
         return 2;
     }
-
-    drift_context *ctx = cli_open_context("diff", 0, verbose);
-    if (!ctx) {
+    const char *paths[2] = { o.paths[0], o.paths[1] };
+    const char *heatmap_path = o.heatmap_path;
+    cli_session session;
+    if (!cli_session_open(
+            &(cli_session_desc){ .cmd = "diff", .verbose = o.verbose, .no_scene = true },
+            &session)) {
+        cli_session_close(&session);
         return 1;
     }
+    drift_context *ctx = session.ctx;
     drift_result r = DRIFT_OK;
-    int status = 1;
+    status = 1;
     drift_image ref = { 0 }, test = { 0 }, flip_map = { 0 }, heat = { 0 };
     drift_metric_report rep;
     if ((r = drift_image_load(ctx, paths[0], &ref)) != DRIFT_OK) {
@@ -115,7 +94,7 @@ int drift_cmd_diff(int argc, char **argv)
                 ref.width, ref.height, paths[1], test.width, test.height);
         goto done;
     }
-    r = drift_metric_compare(ctx, &ref, &test, &(drift_metric_params){ .ppd = ppd }, &rep,
+    r = drift_metric_compare(ctx, &ref, &test, &(drift_metric_params){ .ppd = o.ppd }, &rep,
                              heatmap_path ? &flip_map : NULL);
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift diff: %s\n", drift_result_string(r));
@@ -132,21 +111,22 @@ int drift_cmd_diff(int argc, char **argv)
             goto done;
         }
     }
-    if (json) {
-        printf("{");
+    const char *const keys[6] = { "mse", "rmse", "relmse", "psnr", "ssim", "flip" };
+    const double values[6] = { rep.mse, rep.rmse, rep.relmse, rep.psnr, rep.ssim, rep.flip };
+    cJSON *root = o.json ? cJSON_CreateObject() : NULL;
+    for (int k = 0; k < 6; ++k) {
+        if (root) {
+            cli_json_number(root, keys[k], values[k], -1);
+        } else {
+            print_number(keys[k], values[k]);
+        }
     }
-    print_number("mse", rep.mse, json, false);
-    print_number("rmse", rep.rmse, json, false);
-    print_number("relmse", rep.relmse, json, false);
-    print_number("psnr", rep.psnr, json, false);
-    print_number("ssim", rep.ssim, json, false);
-    print_number("flip", rep.flip, json, true);
-    if (json) {
-        printf("}\n");
+    if (root && !cli_json_write("diff", root, NULL)) {
+        goto done;
     }
     status = 0;
-    if (has_tol && rep.flip > difftol) {
-        fprintf(stderr, "drift diff: FLIP %.6f exceeds --difftol %g\n", rep.flip, difftol);
+    if (o.difftol >= 0.0 && rep.flip > o.difftol) {
+        fprintf(stderr, "drift diff: FLIP %.6f exceeds --difftol %g\n", rep.flip, o.difftol);
         status = 1;
     }
 done:
@@ -154,6 +134,6 @@ done:
     drift_image_destroy(ctx, &flip_map);
     drift_image_destroy(ctx, &test);
     drift_image_destroy(ctx, &ref);
-    drift_context_destroy(ctx);
+    cli_session_close(&session);
     return status;
 }

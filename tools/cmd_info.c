@@ -8,79 +8,72 @@
 #include <stdio.h>
 #include <string.h>
 
-static void print_help(FILE *out)
-{
-    fprintf(out,
-            "usage: drift info [options] [SCENE]\n"
-            "\n"
-            "Loads SCENE (.json, .obj, .gltf, .glb, .ply, optionally .gz; default: the built-in\n"
-            "Cornell box) and prints its triangle, mesh, material, light (by type) and texture\n"
-            "counts, its bounding box and its camera.\n"
-            "\n"
-            "options:\n"
-            "  --json       machine-readable output (one JSON object on stdout)\n"
-            "  --verbose    also print informational messages from the loader\n"
-            "  -h, --help   this text\n"
-            "\n"
-            "Exit status: 0 success, 1 the scene could not be loaded, 2 usage error.\n");
-}
+typedef struct info_options {
+    const char *scene_path;
+    bool json, verbose;
+} info_options;
+
+static const cli_option info_table[] = {
+    CLI_SECTION("options:", 0),
+    CLI_FLAG("--json", info_options, json, "machine-readable output (one JSON object on stdout)"),
+    CLI_FLAG("--verbose", info_options, verbose,
+             "also print informational messages from the loader"),
+};
+
+static const cli_command info_command = {
+    .name = "info",
+    .usage = "usage: drift info [options] [SCENE]\n"
+             "\n"
+             "Loads SCENE (.json, .obj, .gltf, .glb, .ply, optionally .gz; default: the built-in\n"
+             "Cornell box) and prints its triangle, mesh, material, light (by type) and texture\n"
+             "counts, its bounding box and its camera.\n"
+             "\n",
+    .epilogue = "\nExit status: 0 success, 1 the scene could not be loaded, 2 usage error.\n",
+    CLI_TABLE(info_table),
+    CLI_POSITIONAL("SCENE", info_options, scene_path, 1),
+    .help_column = 15,
+};
 
 static const char *const light_type_names[DRIFT_LIGHT_COUNT] = {
     "point", "spot", "directional", "quad", "disk", "sphere", "triangle",
 };
 
-// Writes s as a JSON string literal (names come from files and may hold anything).
-static void print_json_string(const char *s)
+static void add_vec3(cJSON *object, const char *key, drift_vec3 v)
 {
-    putchar('"');
-    for (const unsigned char *p = (const unsigned char *)s; *p; ++p) {
-        if (*p == '"' || *p == '\\') {
-            printf("\\%c", *p);
-        } else if (*p < 0x20) {
-            printf("\\u%04x", *p);
-        } else {
-            putchar(*p);
-        }
-    }
-    putchar('"');
+    cli_json_vec3(object, key, v.x, v.y, v.z);
 }
 
-static void print_vec3_json(drift_vec3 v)
-{
-    printf("[%.9g, %.9g, %.9g]", (double)v.x, (double)v.y, (double)v.z);
-}
-
-static void print_json(const char *path, const drift_scene *scene, const uint32_t *light_counts)
+static bool print_json(const char *path, const drift_scene *scene, const uint32_t *light_counts)
 {
     const drift_camera *c = &scene->camera;
-    printf("{\n  \"scene\": ");
-    print_json_string(path);
-    printf(",\n  \"triangles\": %llu,\n  \"meshes\": %u,\n  \"materials\": %u,\n",
-           (unsigned long long)drift_scene_triangle_count(scene), scene->mesh_count,
-           scene->material_count);
-    printf("  \"lights\": { \"total\": %u", scene->light_count);
+    cJSON *root = cJSON_CreateObject();
+    cJSON_AddStringToObject(root, "scene", path);
+    cli_json_count(root, "triangles", drift_scene_triangle_count(scene));
+    cli_json_count(root, "meshes", scene->mesh_count);
+    cli_json_count(root, "materials", scene->material_count);
+    cJSON *lights = cJSON_AddObjectToObject(root, "lights");
+    cli_json_count(lights, "total", scene->light_count);
     for (int t = 0; t < DRIFT_LIGHT_COUNT; ++t) {
-        printf(", \"%s\": %u", light_type_names[t], light_counts[t]);
+        cli_json_count(lights, light_type_names[t], light_counts[t]);
     }
-    printf(" },\n  \"textures\": %u,\n", scene->texture_count);
-    printf("  \"environment\": { \"color\": ");
-    print_vec3_json(scene->environment.color);
-    printf(", \"textured\": %s },\n",
-           scene->environment.texture != DRIFT_INVALID_INDEX ? "true" : "false");
-    printf("  \"bounds\": { \"min\": ");
-    print_vec3_json(scene->bounds.min);
-    printf(", \"max\": ");
-    print_vec3_json(scene->bounds.max);
-    printf(" },\n  \"camera\": { \"position\": ");
-    print_vec3_json(c->position);
-    printf(", \"target\": ");
-    print_vec3_json(c->target);
-    printf(", \"up\": ");
-    print_vec3_json(c->up);
-    printf(", \"fov_y_degrees\": %.9g, \"aperture_radius\": %.9g, \"focus_distance\": %.9g, "
-           "\"width\": %d, \"height\": %d }\n}\n",
-           (double)(c->fov_y * 180.0f / DRIFT_PI), (double)c->aperture_radius,
-           (double)c->focus_distance, c->width, c->height);
+    cli_json_count(root, "textures", scene->texture_count);
+    cJSON *environment = cJSON_AddObjectToObject(root, "environment");
+    add_vec3(environment, "color", scene->environment.color);
+    cJSON_AddBoolToObject(environment, "textured",
+                          scene->environment.texture != DRIFT_INVALID_INDEX);
+    cJSON *bounds = cJSON_AddObjectToObject(root, "bounds");
+    add_vec3(bounds, "min", scene->bounds.min);
+    add_vec3(bounds, "max", scene->bounds.max);
+    cJSON *camera = cJSON_AddObjectToObject(root, "camera");
+    add_vec3(camera, "position", c->position);
+    add_vec3(camera, "target", c->target);
+    add_vec3(camera, "up", c->up);
+    cli_json_float(camera, "fov_y_degrees", c->fov_y * 180.0f / DRIFT_PI);
+    cli_json_float(camera, "aperture_radius", c->aperture_radius);
+    cli_json_float(camera, "focus_distance", c->focus_distance);
+    cJSON_AddNumberToObject(camera, "width", c->width);
+    cJSON_AddNumberToObject(camera, "height", c->height);
+    return cli_json_write("info", root, NULL);
 }
 
 static void print_text(const char *path, const drift_scene *scene, const uint32_t *light_counts)
@@ -126,54 +119,34 @@ static void print_text(const char *path, const drift_scene *scene, const uint32_
 
 int drift_cmd_info(int argc, char **argv)
 {
-    bool json = false, verbose = false;
-    const char *path = NULL;
-    for (int i = 1; i < argc; ++i) {
-        if (strcmp(argv[i], "-h") == 0 || strcmp(argv[i], "--help") == 0) {
-            print_help(stdout);
-            return 0;
-        } else if (strcmp(argv[i], "--json") == 0) {
-            json = true;
-        } else if (strcmp(argv[i], "--verbose") == 0) {
-            verbose = true;
-        } else if (argv[i][0] == '-' && argv[i][1] != '\0') {
-            fprintf(stderr, "drift info: unknown option '%s' (see drift info --help)\n", argv[i]);
-            return 2;
-        } else if (path) {
-            fprintf(stderr, "drift info: one scene at a time ('%s' and '%s' given)\n", path,
-                    argv[i]);
-            return 2;
-        } else {
-            path = argv[i];
-        }
+    info_options o = { 0 };
+    int status = cli_parse(&info_command, argc, argv, &o, NULL);
+    if (status != CLI_PARSED) {
+        return cli_parse_exit(status);
     }
-    if (!path) {
-        path = cli_default_scene_path();
-    }
-    drift_context *ctx = cli_open_context("info", 1, verbose);
-    if (!ctx) {
+    cli_session session;
+    if (!cli_session_open(&(cli_session_desc){ .cmd = "info",
+                                               .scene_path = o.scene_path,
+                                               .threads = 1,
+                                               .verbose = o.verbose,
+                                               .no_accel = true },
+                          &session)) {
+        cli_session_close(&session);
         return 1;
     }
-    drift_result r = DRIFT_OK;
-    drift_scene *scene = NULL;
-    r = drift_scene_load(ctx, path, &scene);
-    if (r != DRIFT_OK) {
-        fprintf(stderr, "drift info: cannot load '%s': %s\n", path, drift_result_string(r));
-        drift_context_destroy(ctx);
-        return 1;
-    }
+    const drift_scene *scene = session.scene;
     uint32_t light_counts[DRIFT_LIGHT_COUNT] = { 0 };
     for (uint32_t i = 0; i < scene->light_count; ++i) {
         if ((unsigned)scene->lights[i].type < DRIFT_LIGHT_COUNT) {
             light_counts[scene->lights[i].type]++;
         }
     }
-    if (json) {
-        print_json(path, scene, light_counts);
+    int exit_code = 0;
+    if (o.json) {
+        exit_code = print_json(session.scene_path, scene, light_counts) ? 0 : 1;
     } else {
-        print_text(path, scene, light_counts);
+        print_text(session.scene_path, scene, light_counts);
     }
-    drift_scene_destroy(scene);
-    drift_context_destroy(ctx);
-    return 0;
+    cli_session_close(&session);
+    return exit_code;
 }

@@ -3,18 +3,17 @@
 // pure ray tracing), takes the real error |raster - ray traced| of each, and keeps the best of
 // `trials` random lambda tuples (the averaged sum is the first candidate).
 #include "cli.h"
+#include "drift/accel.h"
+#include "drift/hybrid.h"
+#include "drift/refine.h"
+#include "drift/scene.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "drift/accel.h"
-#include "drift/hybrid.h"
-#include "drift/refine.h"
-#include "drift/scene.h"
-
-#define MAX_VIEWS 32
+#define MAX_VIEWS        32
 #define REAL_ERROR_SCALE 0.1f // display-value difference that counts as full error
 
 typedef struct fit_options {
@@ -23,68 +22,44 @@ typedef struct fit_options {
     double degrees;
 } fit_options;
 
-static void print_help(FILE *out)
-{
-    fprintf(out,
-            "usage: drift refine fit [SCENE] --out LAMBDA.json [--views N] [--degrees D]\n"
-            "                        [--width W] [--height H] [--spp N] [--trials N]\n"
-            "                        [--threads T] [--seed S]\n\n"
-            "Fits the weights lambda of SIR's linear metric combination for one scene (the\n"
-            "paper's pre-process): N views orbiting the scene camera's target over +-D degrees\n"
-            "(default 4 views, 20 degrees), each rendered by the hybrid frame (PCSS, envmap,\n"
-            "post DOF) and by the pure ray tracer at --spp (default 8), at W x H (default\n"
-            "160x120); the best of --trials random tuples (default 2000) against the real error\n"
-            "is written as {\"lambda\": {...}} for `drift render ... --refine sir --lambda`.\n");
-}
+#define O fit_options
+static const cli_option fit_table[] = {
+    CLI_SECTION("options:", 0),
+    CLI_STRING("--out", "LAMBDA.json", O, out_path, "where the weights go (required)"),
+    CLI_INT("--views", "N", O, views, 1, MAX_VIEWS,
+            "views orbiting the camera's target (default 4)"),
+    CLI_NUMBER("--degrees", "D", O, degrees, 0.0, 180.0,
+               "the orbit spans +-D degrees (default 20)"),
+    CLI_INT("--width", "W", O, width, 1, 8192, "view size (default 160x120)"),
+    CLI_INT("--height", "H", O, height, 1, 8192, "view size"),
+    CLI_INT("--spp", "N", O, spp, 1, 65536, "samples a pixel of the pure ray tracer (default 8)"),
+    CLI_INT("--trials", "N", O, trials, 0, 10000000, "random lambda tuples tried (default 2000)"),
+    CLI_INT("--threads", "T", O, threads, 0, 256, "worker threads (default: all cores)"),
+    CLI_INT("--seed", "S", O, seed, 0, 0xffffffffL, "seed of the views and trials (default 0)"),
+};
+#undef O
+
+static const cli_command fit_command = {
+    .name = "refine fit",
+    .usage =
+        "usage: drift refine fit [SCENE] --out LAMBDA.json [options]\n\n"
+        "Fits the weights lambda of SIR's linear metric combination for one scene (the\n"
+        "paper's pre-process): N views orbiting the scene camera's target over +-D degrees,\n"
+        "each rendered by the hybrid frame (PCSS, envmap, post DOF) and by the pure ray\n"
+        "tracer at --spp, at W x H; the best of --trials random tuples against the real\n"
+        "error is written as {\"lambda\": {...}} for `drift render ... --refine sir --lambda`.\n\n",
+    CLI_TABLE(fit_table),
+    CLI_POSITIONAL("SCENE", fit_options, scene_path, 1),
+};
 
 static int parse(int argc, char **argv, fit_options *o)
 {
-    *o = (fit_options){ .views = 4, .width = 160, .height = 120, .spp = 8, .trials = 2000,
-                        .degrees = 20.0 };
-    for (int i = 1; i < argc; ++i) {
-        const char *a = argv[i], *v = NULL;
-        bool ok = true;
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            print_help(stdout);
-            return -1;
-        } else if (strcmp(a, "--out") == 0) {
-            ok = (o->out_path = cli_next_value("refine fit", argc, argv, &i)) != NULL;
-        } else if (strcmp(a, "--views") == 0) {
-            ok = (v = cli_next_value("refine fit", argc, argv, &i)) &&
-                 cli_parse_int("refine fit", a, v, 1, MAX_VIEWS, &o->views);
-        } else if (strcmp(a, "--degrees") == 0) {
-            ok = (v = cli_next_value("refine fit", argc, argv, &i)) &&
-                 cli_parse_float("refine fit", a, v, 0.0, 180.0, &o->degrees);
-        } else if (strcmp(a, "--width") == 0) {
-            ok = (v = cli_next_value("refine fit", argc, argv, &i)) &&
-                 cli_parse_int("refine fit", a, v, 1, 8192, &o->width);
-        } else if (strcmp(a, "--height") == 0) {
-            ok = (v = cli_next_value("refine fit", argc, argv, &i)) &&
-                 cli_parse_int("refine fit", a, v, 1, 8192, &o->height);
-        } else if (strcmp(a, "--spp") == 0) {
-            ok = (v = cli_next_value("refine fit", argc, argv, &i)) &&
-                 cli_parse_int("refine fit", a, v, 1, 65536, &o->spp);
-        } else if (strcmp(a, "--trials") == 0) {
-            ok = (v = cli_next_value("refine fit", argc, argv, &i)) &&
-                 cli_parse_int("refine fit", a, v, 0, 10000000, &o->trials);
-        } else if (strcmp(a, "--threads") == 0) {
-            ok = (v = cli_next_value("refine fit", argc, argv, &i)) &&
-                 cli_parse_int("refine fit", a, v, 0, 256, &o->threads);
-        } else if (strcmp(a, "--seed") == 0) {
-            ok = (v = cli_next_value("refine fit", argc, argv, &i)) &&
-                 cli_parse_int("refine fit", a, v, 0, 0xffffffffL, &o->seed);
-        } else if (a[0] == '-') {
-            fprintf(stderr, "drift refine fit: unknown option '%s'\n", a);
-            ok = false;
-        } else if (!o->scene_path) {
-            o->scene_path = a;
-        } else {
-            fprintf(stderr, "drift refine fit: more than one scene given\n");
-            ok = false;
-        }
-        if (!ok) {
-            return 2;
-        }
+    *o = (fit_options){
+        .views = 4, .width = 160, .height = 120, .spp = 8, .trials = 2000, .degrees = 20.0
+    };
+    int status = cli_parse(&fit_command, argc, argv, o, NULL);
+    if (status != CLI_PARSED) {
+        return status;
     }
     if (!o->out_path) {
         fprintf(stderr, "drift refine fit: --out LAMBDA.json is required\n");
@@ -101,10 +76,10 @@ static drift_camera orbit(const drift_camera *camera, long k, long n, double deg
     drift_vec3 d = drift_vec3_sub(camera->position, camera->target);
     drift_vec3 up = drift_vec3_normalize(camera->up);
     // Rodrigues' rotation of d about up.
-    drift_vec3 rotated = drift_vec3_add(
-        drift_vec3_add(drift_vec3_scale(d, cosf(angle)),
-                       drift_vec3_scale(drift_vec3_cross(up, d), sinf(angle))),
-        drift_vec3_scale(up, drift_vec3_dot(up, d) * (1.0f - cosf(angle))));
+    drift_vec3 rotated =
+        drift_vec3_add(drift_vec3_add(drift_vec3_scale(d, cosf(angle)),
+                                      drift_vec3_scale(drift_vec3_cross(up, d), sinf(angle))),
+                       drift_vec3_scale(up, drift_vec3_dot(up, d) * (1.0f - cosf(angle))));
     drift_camera c = *camera;
     c.position = drift_vec3_add(camera->target, rotated);
     return c;
@@ -118,20 +93,19 @@ typedef struct fit_view {
 
 static int fit(const fit_options *o)
 {
-    drift_context *ctx = cli_open_context("refine fit", (int)o->threads, false);
-    if (!ctx) {
-        return 1;
-    }
-    drift_result r = DRIFT_OK;
-    const char *scene_path = o->scene_path ? o->scene_path : cli_default_scene_path();
-    drift_scene *scene = NULL;
-    drift_accel *accel = NULL;
     fit_view views[MAX_VIEWS] = { 0 };
     drift_refine_view training[MAX_VIEWS];
     int exit_code = 1;
-    if (!cli_open_scene(ctx, "refine fit", scene_path, &scene, &accel, NULL)) {
+    drift_result r = DRIFT_OK;
+    cli_session session;
+    if (!cli_session_open(&(cli_session_desc){ .cmd = "refine fit",
+                                               .scene_path = o->scene_path,
+                                               .threads = (int)o->threads },
+                          &session)) {
         goto done;
     }
+    drift_context *ctx = session.ctx;
+    const drift_scene *scene = session.scene;
     drift_hybrid_params hp = { .width = (int32_t)o->width,
                                .height = (int32_t)o->height,
                                .shadows = DRIFT_SHADOWS_PCSS,
@@ -141,13 +115,13 @@ static int fit(const fit_options *o)
     for (long k = 0; k < o->views; ++k) {
         fit_view *v = &views[k];
         drift_camera camera = orbit(&scene->camera, k, o->views, o->degrees);
-        r = drift_hybrid_create(ctx, scene, accel, &hp, &v->frame);
+        r = drift_hybrid_create(ctx, scene, session.accel, &hp, &v->frame);
         if (r == DRIFT_OK) {
             r = drift_hybrid_render(v->frame, &camera, NULL);
         }
         if (r == DRIFT_OK) {
-            r = drift_refine_create(ctx, v->frame, &(drift_refine_params){ .seed = (uint32_t)o->seed },
-                                    &v->sir);
+            r = drift_refine_create(ctx, v->frame,
+                                    &(drift_refine_params){ .seed = (uint32_t)o->seed }, &v->sir);
         }
         if (r == DRIFT_OK) {
             r = drift_refine_begin(v->sir);
@@ -185,28 +159,25 @@ static int fit(const fit_options *o)
     printf("wrote %s: mean |E - real| %.5f (averaged sum %.5f) over %ld views of %ldx%ld\n",
            o->out_path, cost, average_cost, o->views, o->width, o->height);
     for (int m = 0; m < DRIFT_METRIC_COUNT; ++m) {
-        printf("  %-12s %.4f\n", drift_refine_metric_name((drift_refine_metric)m), (double)lambda[m]);
+        printf("  %-12s %.4f\n", drift_refine_metric_name((drift_refine_metric)m),
+               (double)lambda[m]);
     }
     exit_code = 0;
 done:
     for (long k = 0; k < o->views; ++k) {
-        drift_image_destroy(ctx, &views[k].pure);
-        drift_image_destroy(ctx, &views[k].real);
+        drift_image_destroy(session.ctx, &views[k].pure);
+        drift_image_destroy(session.ctx, &views[k].real);
         drift_refine_destroy(views[k].sir);
         drift_hybrid_destroy(views[k].frame);
     }
-    drift_accel_destroy(accel);
-    drift_scene_destroy(scene);
-    drift_context_destroy(ctx);
+    cli_session_close(&session);
     return exit_code;
 }
 
 int drift_cmd_refine(int argc, char **argv)
 {
     if (argc < 2 || strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0) {
-        FILE *out = argc < 2 ? stderr : stdout;
-        fprintf(out, "usage: drift refine fit [SCENE] --out LAMBDA.json [options]\n\n");
-        print_help(out);
+        cli_print_help(&fit_command, argc < 2 ? stderr : stdout);
         return argc < 2 ? 2 : 0;
     }
     if (strcmp(argv[1], "fit") != 0) {
@@ -216,7 +187,7 @@ int drift_cmd_refine(int argc, char **argv)
     fit_options o;
     int pr = parse(argc - 1, argv + 1, &o);
     if (pr != 0) {
-        return pr < 0 ? 0 : pr;
+        return cli_parse_exit(pr);
     }
     return fit(&o);
 }

@@ -3,6 +3,10 @@
 // Reads like the API walk-through: load the scene, build the accel, create the path tracer,
 // add samples in passes (progress, checkpoints, Ctrl-C), resolve and write the images.
 #include "cli.h"
+#include "drift/accel.h"
+#include "drift/image_io.h"
+#include "drift/pt.h"
+#include "drift/scene_io.h"
 #include "render.h"
 
 #include <math.h>
@@ -10,13 +14,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
 #include <unistd.h>
-
-#include "drift/accel.h"
-#include "drift/image_io.h"
-#include "drift/pt.h"
-#include "drift/scene_io.h"
 
 // Set from the SIGINT handler; the render loop polls it between tiles.
 static atomic_bool interrupted;
@@ -33,82 +31,204 @@ const atomic_bool *render_catch_sigint(void)
     return &interrupted;
 }
 
+// --- OPTIONS ---
 
-static void print_help(void)
+// Value readers for the rows below that are more than a number or a name.
+static bool parse_tonemap(const char *cmd, const char *flag, const char *v, void *field)
 {
-    printf("usage: drift render [SCENE] [options]\n"
-           "\n"
-           "Renders SCENE (a drift .json scene, or .obj/.gltf/.glb/.ply[.gz]); without SCENE, the\n"
-           "built-in Cornell box. Writes a linear EXR and a tone-mapped sRGB PNG beside it.\n"
-           "\n"
-           "options:\n"
-           "  --mode MODE           reference (path tracer, default) or hybrid (the hybrid\n"
-           "                        frame: one sample a pixel plus a technique per effect)\n"
-           "  --spp N               samples per pixel (default 64)\n"
-           "  --seed S              random seed (default 0); same seed, same image, any threads\n"
-           "  --threads T           worker threads (default: all cores)\n"
-           "  --max-depth D         scattering vertices per path, pbrt's convention: 1 = direct\n"
-           "                        light only (default 8)\n"
-           "  --width W, --height H image size (default: the scene camera's)\n"
-           "  --out FILE.exr        output (default out/render.exr); FILE.png is written too\n"
-           "  --aov [FILE.exr]      reference: add albedo, normal and depth layers to the EXR;\n"
-           "                        hybrid: write every plane and buffer as layers of FILE.exr\n"
-           "  --stats FILE.json     spp, rays traced and milliseconds per phase\n"
-           "  --checkpoint SECONDS  write the image so far every SECONDS (default 60; 0 = never)\n"
-           "  --exposure STOPS      PNG exposure (default 0)\n"
-           "  --tonemap OP          PNG operator: clamp (default) or reinhard\n"
-           "  --debug-sample X,Y,S  trace one sample of one pixel and print its radiance\n"
-           "  --quiet               no progress output;  --verbose  more log output\n"
-           "\n");
-    // Split in parts: C99 guarantees string literals of 4095 characters only.
-    printf("hybrid mode (docs/hybrid.md):\n"
-           "  --shadows T           hard (default), pcf, pcss, reference, isg, blur or aaf\n"
-           "  --reflections T       none (default), envmap, sharp, reference, isg, blur or aaf\n"
-           "  --dof T               none (default), post, reference or isg\n"
-           "  --indirect T          none (default), ambient, reference or aaf\n"
-           "                        reference = that effect alone path-traced at --spp\n"
-           "                        aaf = axis-aligned filtering (docs/aaf.md), --spp rays a\n"
-           "                        pixel on average (shadows: per area light)\n"
-           "  --max-depth D         depth of reference reflections and indirect (default 2)\n"
-           "  --light-samples N     samples per area light for unshadowed light (default 8)\n"
-           "  --shadow-map-size N   texels a cube face (default 512); --pcf-kernel K (3)\n"
-           "  --envmap-size N       texels a cube face (default 128)\n"
-           "  --probe X,Y,Z|object  environment-map probe: a point, or one per reflective mesh\n"
-           "                        (default: the scene's centre)\n"
-           "  --ambient R,G,B       ambient radiance (default: the frame's mean direct light)\n"
-           "  --aperture R          lens radius in scene units (default: the scene camera's)\n"
-           "  --focus-distance F    distance to the plane in focus (default: the camera's)\n"
-           "  --isg-search N        image space gathering (docs/isg.md): parameter-search\n"
-           "  --isg-gather M        and gather samples, perfect squares (default 25 and 49)\n"
-           "  --isg-sigma S         range sigma of eq. 6 and 10, squared scene units\n"
-           "                        (default (0.02 x scene diagonal)^2)\n"
-           "  --blur-radius R       disk radius in pixels of the blur baselines (default 4)\n"
-           "  --isg-layers 1|2      2: a second depth layer behind objects for --dof isg\n"
-           "  --isg-range full|plane  l of the range functions: world distance (default, the\n"
-           "                        paper) or distance to the centre's tangent plane\n"
-           "  --aaf-max-spp N       cap on AAF's adaptive samples a pixel (default 8 x spp)\n"
-           "  --aaf-sampling M      adaptive (default) or uniform: spp in every pixel\n"
-           "  --aaf-filter on|off   off: AAF's unfiltered estimate (with uniform: plain MC)\n"
-           "  --aaf-sampler S       sobol (default: Owen-scrambled Sobol) or random (independent\n"
-           "                        uniform numbers, the paper's Monte Carlo)\n"
-           "\n");
-    printf("smart image refinement (hybrid mode; docs/sir.md):\n"
-           "  --refine sir          refine the frame by ray tracing, worst estimated error first\n"
-           "  --budget N            samples (primary rays) an iteration (default: all pixels)\n"
-           "  --refine-iterations N stop after N iterations;  --refine-time S  after S seconds\n"
-           "                        (default: until every error pixel is refined)\n"
-           "  --refine-spp N        samples that make a pixel refined (default 16)\n"
-           "  --refine-all          refine zero-error pixels too, after all the others\n"
-           "  --lambda FILE         combine the metrics with fitted weights (drift refine fit)\n"
-           "\n"
-           "Ctrl-C stops the render and writes what it has.\n");
+    drift_tonemap_operator *op = field;
+    if (strcmp(v, "clamp") == 0 || strcmp(v, "reinhard") == 0) {
+        *op = strcmp(v, "clamp") == 0 ? DRIFT_TONEMAP_CLAMP : DRIFT_TONEMAP_REINHARD;
+        return true;
+    }
+    fprintf(stderr, "drift %s: %s expects clamp or reinhard, got '%s'\n", cmd, flag, v);
+    return false;
 }
 
-// Returns 0 on success, 2 on a usage error (message printed).
+static bool parse_debug_sample(const char *cmd, const char *flag, const char *v, void *field)
+{
+    render_options *o = field;
+    char tail;
+    if (sscanf(v, "%ld,%ld,%ld%c", &o->debug_x, &o->debug_y, &o->debug_sample, &tail) != 3) {
+        fprintf(stderr, "drift %s: %s expects X,Y,S, got '%s'\n", cmd, flag, v);
+        return false;
+    }
+    return true;
+}
+
+// --aov [FILE.exr]: the value is taken only when the next argument names an .exr file.
+static bool parse_aov(const char *cmd, const char *flag, const char *v, void *field)
+{
+    (void)cmd;
+    (void)flag;
+    render_options *o = field;
+    o->aov = true;
+    o->aov_path = v;
+    return true;
+}
+
+static bool parse_probe(const char *cmd, const char *flag, const char *v, void *field)
+{
+    drift_hybrid_params *h = field;
+    if (strcmp(v, "object") == 0) {
+        h->probe_per_object = true;
+        return true;
+    }
+    h->has_probe = true;
+    return cli_parse_vec3(cmd, flag, v, true, &h->probe);
+}
+
+static bool parse_ambient(const char *cmd, const char *flag, const char *v, void *field)
+{
+    drift_hybrid_params *h = field;
+    h->has_ambient = true;
+    return cli_parse_vec3(cmd, flag, v, true, &h->ambient);
+}
+
+// ISG sample counts are k x k grids on the disk: 9, 25, 49, 81 (any square up to 1024).
+static bool parse_isg_count(const char *cmd, const char *flag, const char *v, void *field)
+{
+    long n = 0;
+    if (!cli_parse_int(cmd, flag, v, 1, 1024, &n)) {
+        return false;
+    }
+    long k = 1;
+    while (k * k < n) {
+        ++k;
+    }
+    if (k * k != n) {
+        fprintf(stderr, "drift %s: %s expects a perfect square (9, 25, 49, 81, ...), got '%s'\n",
+                cmd, flag, v);
+        return false;
+    }
+    *(int32_t *)field = (int32_t)n;
+    return true;
+}
+
+// Groups of options (cli_parse's first_in_group): hybrid-only, and refinement-only.
+enum {
+    GROUP_HYBRID = 1u << 0,
+    GROUP_REFINE = 1u << 1
+};
+
+#define O render_options
+static const cli_option render_table[] = {
+    CLI_SECTION("options:", 0),
+    CLI_CHOICE("--mode", "MODE", O, hybrid_mode, "reference|hybrid",
+               "reference (path tracer, default) or hybrid (the hybrid\n"
+               "frame: one sample a pixel plus a technique per effect)"),
+    CLI_INT("--spp", "N", O, spp, 1, 1 << 24, "samples per pixel (default 64)"),
+    CLI_INT("--seed", "S", O, seed, 0, UINT32_MAX,
+            "random seed (default 0); same seed, same image, any threads"),
+    CLI_INT("--threads", "T", O, threads, 0, 256, "worker threads (default: all cores)"),
+    CLI_INT("--max-depth", "D", O, max_depth, 1, 1024,
+            "scattering vertices per path, pbrt's convention: 1 = direct\n"
+            "light only (default 8; hybrid: depth of reference reflections\n"
+            "and indirect, default 2)"),
+    CLI_INT("--width", "W", O, width, 1, DRIFT_IMAGE_MAX_DIMENSION,
+            "image size (default: the scene camera's)"),
+    CLI_INT("--height", "H", O, height, 1, DRIFT_IMAGE_MAX_DIMENSION,
+            "image size (default: the scene camera's)"),
+    CLI_STRING("--out", "FILE.exr", O, out_path,
+               "output (default out/render.exr); FILE.png is written too"),
+    { .name = "--aov",
+      .arg = "[FILE.exr]",
+      .help = "reference: add albedo, normal and depth layers to the EXR;\n"
+              "hybrid: write every plane and buffer as layers of FILE.exr",
+      .kind = CLI_KIND_CUSTOM,
+      .parse = parse_aov,
+      .optional_if = ".exr" },
+    CLI_STRING("--stats", "FILE.json", O, stats_path,
+               "spp, rays traced and milliseconds per phase"),
+    CLI_NUMBER("--checkpoint", "SECONDS", O, checkpoint_seconds, 0.0, 1e9,
+               "write the image so far every SECONDS (default 60; 0 = never)"),
+    CLI_NUMBER("--exposure", "STOPS", O, exposure, -64.0, 64.0, "PNG exposure (default 0)"),
+    CLI_CUSTOM("--tonemap", "OP", O, tonemap, parse_tonemap,
+               "PNG operator: clamp (default) or reinhard"),
+    CLI_CUSTOM_ALL("--debug-sample", "X,Y,S", parse_debug_sample,
+                   "trace one sample of one pixel and print its radiance"),
+    CLI_FLAG("--quiet", O, quiet, "no progress output"),
+    CLI_FLAG("--verbose", O, verbose, "more log output"),
+
+    CLI_SECTION("hybrid mode (docs/hybrid.md):", GROUP_HYBRID),
+    CLI_TECHNIQUES("T", O, hybrid),
+    CLI_NOTE("reference = that effect alone path-traced at --spp\n"
+             "aaf = axis-aligned filtering (docs/aaf.md), --spp rays a\n"
+             "pixel on average (shadows: per area light)"),
+    CLI_INT("--light-samples", "N", O, hybrid.light_samples, 1, 4096,
+            "samples per area light for unshadowed light (default 8)"),
+    CLI_INT("--shadow-map-size", "N", O, hybrid.shadow_map_size, 1, 8192,
+            "texels a cube face (default 512)"),
+    CLI_INT("--pcf-kernel", "K", O, hybrid.pcf_kernel, 1, 63, "PCF texels across (default 3)"),
+    CLI_INT("--envmap-size", "N", O, hybrid.envmap_size, 1, 4096,
+            "texels a cube face (default 128)"),
+    CLI_CUSTOM("--probe", "X,Y,Z|object", O, hybrid, parse_probe,
+               "environment-map probe: a point, or one per reflective mesh\n"
+               "(default: the scene's centre)"),
+    CLI_CUSTOM("--ambient", "R,G,B", O, hybrid, parse_ambient,
+               "ambient radiance (default: the frame's mean direct light)"),
+    CLI_NUMBER("--aperture", "R", O, aperture, 0.0, 1e30,
+               "lens radius in scene units (default: the scene camera's)"),
+    CLI_NUMBER("--focus-distance", "F", O, focus_distance, 1e-30, 1e30,
+               "distance to the plane in focus (default: the camera's)"),
+    CLI_CUSTOM("--isg-search", "N", O, hybrid.isg_search, parse_isg_count,
+               "image space gathering (docs/isg.md): parameter-search"),
+    CLI_CUSTOM("--isg-gather", "M", O, hybrid.isg_gather, parse_isg_count,
+               "and gather samples, perfect squares (default 25 and 49)"),
+    CLI_NUMBER("--isg-sigma", "S", O, hybrid.isg_sigma, 1e-30, 1e30,
+               "range sigma of eq. 6 and 10, squared scene units\n"
+               "(default (0.02 x scene diagonal)^2)"),
+    CLI_NUMBER("--blur-radius", "R", O, hybrid.blur_radius, 1e-30, 1024.0,
+               "disk radius in pixels of the blur baselines (default 4)"),
+    CLI_INT("--isg-layers", "1|2", O, hybrid.isg_layers, 1, 2,
+            "2: a second depth layer behind objects for --dof isg"),
+    CLI_CHOICE("--isg-range", "full|plane", O, hybrid.isg_range_plane, "full|plane",
+               "l of the range functions: world distance (default, the\n"
+               "paper) or distance to the centre's tangent plane"),
+    CLI_INT("--aaf-max-spp", "N", O, hybrid.aaf_max_spp, 1, 65536,
+            "cap on AAF's adaptive samples a pixel (default 8 x spp)"),
+    CLI_CHOICE("--aaf-sampling", "M", O, hybrid.aaf_uniform, "adaptive|uniform",
+               "adaptive (default) or uniform: spp in every pixel"),
+    CLI_CHOICE("--aaf-filter", "on|off", O, hybrid.aaf_unfiltered, "on|off",
+               "off: AAF's unfiltered estimate (with uniform: plain MC)"),
+    CLI_CHOICE("--aaf-sampler", "S", O, hybrid.aaf_random, "sobol|random",
+               "sobol (default: Owen-scrambled Sobol) or random (independent\n"
+               "uniform numbers, the paper's Monte Carlo)"),
+
+    CLI_SECTION("smart image refinement (hybrid mode; docs/sir.md):", GROUP_HYBRID | GROUP_REFINE),
+    CLI_CUSTOM("--refine", "sir", O, refine.enabled, cli_parse_refine,
+               "refine the frame by ray tracing, worst estimated error first"),
+    CLI_INT("--budget", "N", O, refine.budget, 1, 1L << 30,
+            "samples (primary rays) an iteration (default: all pixels)"),
+    CLI_INT("--refine-iterations", "N", O, refine.iterations, 1, 1L << 30,
+            "stop after N iterations (default: until every error pixel\n"
+            "is refined)"),
+    CLI_NUMBER("--refine-time", "S", O, refine.seconds, 1e-6, 1e9, "stop after S seconds"),
+    CLI_INT("--refine-spp", "N", O, refine.spp, 1, 65536,
+            "samples that make a pixel refined (default 16)"),
+    CLI_FLAG("--refine-all", O, refine.all, "refine zero-error pixels too, after all the others"),
+    CLI_STRING("--lambda", "FILE", O, refine.lambda_path,
+               "combine the metrics with fitted weights (drift refine fit)"),
+};
+#undef O
+
+static const cli_command render_command = {
+    .name = "render",
+    .usage =
+        "usage: drift render [SCENE] [options]\n"
+        "\n"
+        "Renders SCENE (a drift .json scene, or .obj/.gltf/.glb/.ply[.gz]); without SCENE, the\n"
+        "built-in Cornell box. Writes a linear EXR and a tone-mapped sRGB PNG beside it.\n"
+        "\n",
+    .epilogue = "\nCtrl-C stops the render and writes what it has.\n",
+    CLI_TABLE(render_table),
+    CLI_POSITIONAL("SCENE", render_options, scene_path, 1),
+};
+
+// Returns 0 on success, 2 on a usage error (message printed), -1 after --help.
 static int parse_options(int argc, char **argv, render_options *o)
 {
     *o = (render_options){ .out_path = "out/render.exr",
-                           .mode = "reference",
                            .spp = 64,
                            .checkpoint_seconds = 60.0,
                            .debug_x = -1,
@@ -116,95 +236,18 @@ static int parse_options(int argc, char **argv, render_options *o)
                            .debug_sample = -1,
                            .aperture = -1.0,
                            .focus_distance = -1.0 };
-    for (int i = 1; i < argc; ++i) {
-        const char *a = argv[i];
-        const char *v = NULL;
-        bool ok = true;
-#define VALUE() (v = cli_next_value("render", argc, argv, &i))
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            print_help();
-            return -1;
-        } else if (strcmp(a, "--mode") == 0) {
-            ok = VALUE() != NULL;
-            o->mode = v;
-        } else if (strcmp(a, "--spp") == 0) {
-            ok = VALUE() && cli_parse_int("render", a, v, 1, 1 << 24, &o->spp);
-        } else if (strcmp(a, "--seed") == 0) {
-            ok = VALUE() && cli_parse_int("render", a, v, 0, UINT32_MAX, &o->seed);
-        } else if (strcmp(a, "--threads") == 0) {
-            ok = VALUE() && cli_parse_int("render", a, v, 0, 256, &o->threads);
-        } else if (strcmp(a, "--max-depth") == 0) {
-            ok = VALUE() && cli_parse_int("render", a, v, 1, 1024, &o->max_depth);
-        } else if (strcmp(a, "--width") == 0) {
-            ok = VALUE() && cli_parse_int("render", a, v, 1, DRIFT_IMAGE_MAX_DIMENSION, &o->width);
-        } else if (strcmp(a, "--height") == 0) {
-            ok = VALUE() && cli_parse_int("render", a, v, 1, DRIFT_IMAGE_MAX_DIMENSION, &o->height);
-        } else if (strcmp(a, "--out") == 0) {
-            ok = VALUE() != NULL;
-            o->out_path = v;
-        } else if (strcmp(a, "--stats") == 0) {
-            ok = VALUE() != NULL;
-            o->stats_path = v;
-        } else if (strcmp(a, "--checkpoint") == 0) {
-            ok = VALUE() && cli_parse_float("render", a, v, 0.0, 1e9, &o->checkpoint_seconds);
-        } else if (strcmp(a, "--exposure") == 0) {
-            ok = VALUE() && cli_parse_float("render", a, v, -64.0, 64.0, &o->exposure);
-        } else if (strcmp(a, "--tonemap") == 0) {
-            ok = VALUE() != NULL;
-            if (ok && strcmp(v, "clamp") == 0) {
-                o->tonemap = DRIFT_TONEMAP_CLAMP;
-            } else if (ok && strcmp(v, "reinhard") == 0) {
-                o->tonemap = DRIFT_TONEMAP_REINHARD;
-            } else if (ok) {
-                fprintf(stderr, "drift render: --tonemap expects clamp or reinhard, got '%s'\n", v);
-                ok = false;
-            }
-        } else if (strcmp(a, "--debug-sample") == 0) {
-            ok = VALUE() != NULL;
-            if (ok && sscanf(v, "%ld,%ld,%ld", &o->debug_x, &o->debug_y, &o->debug_sample) != 3) {
-                fprintf(stderr, "drift render: --debug-sample expects X,Y,S, got '%s'\n", v);
-                ok = false;
-            }
-        } else if (strcmp(a, "--aov") == 0) {
-            o->aov = true;
-            // An optional value: a following argument that names an .exr file.
-            const char *next = i + 1 < argc ? argv[i + 1] : NULL;
-            size_t next_len = next ? strlen(next) : 0;
-            if (next && next[0] != '-' && next_len > 4 && strcmp(next + next_len - 4, ".exr") == 0) {
-                o->aov_path = next;
-                ++i;
-            }
-        } else if (render_parse_hybrid_option(argc, argv, &i, o, &ok)) {
-            // handled: a hybrid-mode option
-        } else if (strcmp(a, "--quiet") == 0) {
-            o->quiet = true;
-        } else if (strcmp(a, "--verbose") == 0) {
-            o->verbose = true;
-        } else if (a[0] == '-' && a[1] != '\0') {
-            fprintf(stderr, "drift render: unknown option '%s' (see drift render --help)\n", a);
-            ok = false;
-        } else if (!o->scene_path) {
-            o->scene_path = a;
-        } else {
-            fprintf(stderr, "drift render: more than one scene given ('%s', '%s')\n",
-                    o->scene_path, a);
-            ok = false;
-        }
-#undef VALUE
-        if (!ok) {
-            return 2;
-        }
+    const char *first[CLI_GROUP_COUNT] = { 0 };
+    int status = cli_parse(&render_command, argc, argv, o, first);
+    if (status != CLI_PARSED) {
+        return status;
     }
-    if (strcmp(o->mode, "reference") != 0 && strcmp(o->mode, "hybrid") != 0) {
-        fprintf(stderr, "drift render: unknown --mode '%s' (modes: reference, hybrid)\n", o->mode);
-        return 2;
-    }
-    bool hybrid = strcmp(o->mode, "hybrid") == 0;
-    if (!hybrid && o->hybrid_option) {
+    o->hybrid_option = first[0];
+    o->refine.first_option = first[1];
+    if (!o->hybrid_mode && o->hybrid_option) {
         fprintf(stderr, "drift render: %s needs --mode hybrid\n", o->hybrid_option);
         return 2;
     }
-    if (!hybrid && o->aov_path) {
+    if (!o->hybrid_mode && o->aov_path) {
         fprintf(stderr, "drift render: --aov FILE needs --mode hybrid (reference mode: --aov "
                         "adds layers to --out)\n");
         return 2;
@@ -254,39 +297,41 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
         &(drift_tonemap_params){ .exposure_stops = (float)o->exposure, .op = o->tonemap });
 }
 
-static drift_result write_stats(const render_options *o, const drift_pt *pt, double ms_load,
-                                double ms_accel, double ms_render, double ms_write, double ms_total,
-                                int threads)
+static bool write_stats(const render_options *o, const cli_session *session, const drift_pt *pt,
+                        double t_render, double t_rendered, double t_written)
 {
-    char tmp[4096];
-    snprintf(tmp, sizeof(tmp), "%s.tmp%ld", o->stats_path, (long)getpid());
-    FILE *f = fopen(tmp, "w");
-    if (!f) {
-        fprintf(stderr, "drift render: cannot write %s\n", o->stats_path);
-        return DRIFT_ERR_IO;
-    }
     drift_pt_stats s = drift_pt_get_stats(pt);
     drift_pt_params p = drift_pt_get_params(pt);
-    fprintf(f,
-            "{\n  \"scene\": \"%s\",\n  \"mode\": \"reference\",\n  \"width\": %d,\n"
-            "  \"height\": %d,\n  \"spp\": %u,\n  \"seed\": %u,\n  \"max_depth\": %d,\n"
-            "  \"threads\": %d,\n  \"nan_samples\": %llu,\n"
-            "  \"rays\": { \"camera\": %llu, \"shadow\": %llu, \"bounce\": %llu, \"total\": %llu },\n"
-            "  \"milliseconds\": { \"load\": %.3f, \"accel\": %.3f, \"render\": %.3f, "
-            "\"write\": %.3f, \"total\": %.3f }\n}\n",
-            o->scene_path ? o->scene_path : "(built-in cornell box)", p.width, p.height,
-            drift_pt_sample_count(pt), p.seed, p.max_depth, threads,
-            (unsigned long long)s.nan_samples, (unsigned long long)s.camera_rays,
-            (unsigned long long)s.shadow_rays, (unsigned long long)s.bounce_rays,
-            (unsigned long long)(s.camera_rays + s.shadow_rays + s.bounce_rays), ms_load,
-            ms_accel, ms_render, ms_write, ms_total);
-    bool ok = fclose(f) == 0;
-    if (!ok || rename(tmp, o->stats_path) != 0) {
-        remove(tmp);
-        fprintf(stderr, "drift render: cannot write %s\n", o->stats_path);
-        return DRIFT_ERR_IO;
-    }
-    return DRIFT_OK;
+    cJSON *root = render_stats_begin(o, session, "reference", p.width, p.height);
+    cli_json_count(root, "spp", drift_pt_sample_count(pt));
+    cli_json_count(root, "seed", p.seed);
+    cJSON_AddNumberToObject(root, "max_depth", p.max_depth);
+    cJSON_AddNumberToObject(root, "threads", drift_context_thread_count(session->ctx));
+    cli_json_count(root, "nan_samples", s.nan_samples);
+    cJSON *rays = cJSON_AddObjectToObject(root, "rays");
+    cli_json_count(rays, "camera", s.camera_rays);
+    cli_json_count(rays, "shadow", s.shadow_rays);
+    cli_json_count(rays, "bounce", s.bounce_rays);
+    cli_json_count(rays, "total", s.camera_rays + s.shadow_rays + s.bounce_rays);
+    cJSON *ms = cJSON_AddObjectToObject(root, "milliseconds");
+    cli_json_number(ms, "load", 1e3 * (session->t_loaded - session->t_start), 3);
+    cli_json_number(ms, "accel", 1e3 * (session->t_built - session->t_loaded), 3);
+    cli_json_number(ms, "render", 1e3 * (t_rendered - t_render), 3);
+    cli_json_number(ms, "write", 1e3 * (t_written - t_rendered), 3);
+    cli_json_number(ms, "total", 1e3 * (t_written - session->t_start), 3);
+    return cli_json_write("render", root, o->stats_path);
+}
+
+cJSON *render_stats_begin(const render_options *o, const cli_session *session, const char *mode,
+                          int width, int height)
+{
+    cJSON *root = cJSON_CreateObject();
+    (void)o;
+    cJSON_AddStringToObject(root, "scene", session->scene_path);
+    cJSON_AddStringToObject(root, "mode", mode);
+    cJSON_AddNumberToObject(root, "width", width);
+    cJSON_AddNumberToObject(root, "height", height);
+    return root;
 }
 
 static void print_progress(bool tty, uint32_t done, uint32_t total, double elapsed, bool final)
@@ -312,56 +357,37 @@ static void print_progress(bool tty, uint32_t done, uint32_t total, double elaps
     fflush(stderr);
 }
 
-int drift_cmd_render(int argc, char **argv)
+// The reference path tracer: passes of samples with progress, checkpoints and Ctrl-C.
+static int render_reference(const render_options *o, const cli_session *session)
 {
-    render_options o;
-    int status = parse_options(argc, argv, &o);
-    if (status != 0) {
-        return status < 0 ? 0 : status;
-    }
-    if (strcmp(o.mode, "hybrid") == 0) {
-        return render_hybrid(&o);
-    }
-    double t_start = drift_time_now();
-    drift_context *ctx = cli_open_context("render", (int)o.threads, o.verbose);
-    if (!ctx) {
-        return 1;
-    }
-    drift_result r = DRIFT_OK;
-    const char *scene_path = o.scene_path ? o.scene_path : cli_default_scene_path();
-    drift_scene *scene = NULL;
-    drift_accel *accel = NULL;
+    drift_context *ctx = session->ctx;
+    const char *scene_path = session->scene_path;
     drift_pt *pt = NULL;
+    drift_result r = DRIFT_OK;
     int exit_code = 1;
-
-    double t_loaded = 0.0;
-    if (!cli_open_scene(ctx, "render", scene_path, &scene, &accel, &t_loaded)) {
-        goto done;
-    }
-    double t_accel = drift_time_now();
-    drift_pt_params params = { .width = (int32_t)o.width,
-                               .height = (int32_t)o.height,
-                               .seed = (uint32_t)o.seed,
-                               .max_depth = (int32_t)o.max_depth };
-    r = drift_pt_create(ctx, scene, accel, &params, &pt);
+    drift_pt_params params = { .width = (int32_t)o->width,
+                               .height = (int32_t)o->height,
+                               .seed = (uint32_t)o->seed,
+                               .max_depth = (int32_t)o->max_depth };
+    r = drift_pt_create(ctx, session->scene, session->accel, &params, &pt);
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift render: %s\n", drift_result_string(r));
         goto done;
     }
     params = drift_pt_get_params(pt);
 
-    if (o.debug_sample >= 0) {
-        if (o.debug_x >= params.width || o.debug_y >= params.height || o.debug_x < 0 ||
-            o.debug_y < 0) {
+    if (o->debug_sample >= 0) {
+        if (o->debug_x >= params.width || o->debug_y >= params.height || o->debug_x < 0 ||
+            o->debug_y < 0) {
             fprintf(stderr, "drift render: --debug-sample pixel outside the %dx%d image\n",
                     params.width, params.height);
             exit_code = 2;
             goto done;
         }
-        drift_vec3 L = drift_pt_trace_sample(pt, (int32_t)o.debug_x, (int32_t)o.debug_y,
-                                             (uint32_t)o.debug_sample);
-        printf("pixel (%ld, %ld) sample %ld seed %ld: radiance %.9g %.9g %.9g\n", o.debug_x,
-               o.debug_y, o.debug_sample, o.seed, (double)L.x, (double)L.y, (double)L.z);
+        drift_vec3 L = drift_pt_trace_sample(pt, (int32_t)o->debug_x, (int32_t)o->debug_y,
+                                             (uint32_t)o->debug_sample);
+        printf("pixel (%ld, %ld) sample %ld seed %ld: radiance %.9g %.9g %.9g\n", o->debug_x,
+               o->debug_y, o->debug_sample, o->seed, (double)L.x, (double)L.y, (double)L.z);
         exit_code = 0;
         goto done;
     }
@@ -370,9 +396,9 @@ int drift_cmd_render(int argc, char **argv)
     // Ctrl-C, without per-pass overhead dominating small images.
     render_catch_sigint();
     bool tty = isatty(STDERR_FILENO) != 0;
-    uint32_t total = (uint32_t)o.spp, done_spp = 0, pass = 1;
+    uint32_t total = (uint32_t)o->spp, done_spp = 0, pass = 1;
     double t_render = drift_time_now(), last_checkpoint = t_render, last_report = 0.0;
-    if (!o.quiet) {
+    if (!o->quiet) {
         fprintf(stderr, "drift render: %s, %dx%d, %u spp, depth %d, %d threads\n", scene_path,
                 params.width, params.height, total, params.max_depth,
                 drift_context_thread_count(ctx));
@@ -390,15 +416,15 @@ int drift_cmd_render(int argc, char **argv)
             pass *= 2;
         }
         double now = drift_time_now();
-        if (!o.quiet && (tty || now - last_report > 5.0 || done_spp == total)) {
+        if (!o->quiet && (tty || now - last_report > 5.0 || done_spp == total)) {
             print_progress(tty, done_spp, total, now - t_render, done_spp == total);
             last_report = now;
         }
-        if (o.checkpoint_seconds > 0.0 && now - last_checkpoint > o.checkpoint_seconds &&
+        if (o->checkpoint_seconds > 0.0 && now - last_checkpoint > o->checkpoint_seconds &&
             done_spp < total) {
-            if (write_images(ctx, pt, &o) == DRIFT_OK && !o.quiet) {
+            if (write_images(ctx, pt, o) == DRIFT_OK && !o->quiet) {
                 fprintf(stderr, "%sdrift render: checkpoint at %u spp written to %s\n",
-                        tty ? "\n" : "", done_spp, o.out_path);
+                        tty ? "\n" : "", done_spp, o->out_path);
             }
             last_checkpoint = now;
         }
@@ -409,16 +435,13 @@ int drift_cmd_render(int argc, char **argv)
         fprintf(stderr, "%sdrift render: interrupted at %u spp; writing what was rendered\n",
                 tty ? "\n" : "", drift_pt_sample_count(pt));
     }
-    r = write_images(ctx, pt, &o);
+    r = write_images(ctx, pt, o);
     if (r != DRIFT_OK) {
-        fprintf(stderr, "drift render: cannot write %s: %s\n", o.out_path, drift_result_string(r));
+        fprintf(stderr, "drift render: cannot write %s: %s\n", o->out_path, drift_result_string(r));
         goto done;
     }
     double t_written = drift_time_now();
-    if (o.stats_path &&
-        write_stats(&o, pt, 1e3 * (t_loaded - t_start), 1e3 * (t_accel - t_loaded),
-                    1e3 * (t_rendered - t_render), 1e3 * (t_written - t_rendered),
-                    1e3 * (t_written - t_start), drift_context_thread_count(ctx)) != DRIFT_OK) {
+    if (o->stats_path && !write_stats(o, session, pt, t_render, t_rendered, t_written)) {
         goto done;
     }
     drift_pt_stats stats = drift_pt_get_stats(pt);
@@ -427,16 +450,36 @@ int drift_cmd_render(int argc, char **argv)
                 (unsigned long long)stats.nan_samples);
     }
     char png[4096];
-    render_png_path(o.out_path, png, sizeof(png));
-    printf("wrote %s and %s (%u spp, %dx%d) in %.2f s (render %.2f s)\n", o.out_path, png,
-           drift_pt_sample_count(pt), params.width, params.height, t_written - t_start,
+    render_png_path(o->out_path, png, sizeof(png));
+    printf("wrote %s and %s (%u spp, %dx%d) in %.2f s (render %.2f s)\n", o->out_path, png,
+           drift_pt_sample_count(pt), params.width, params.height, t_written - session->t_start,
            t_rendered - t_render);
     exit_code = cancelled ? 130 : 0;
 
 done:
     drift_pt_destroy(pt);
-    drift_accel_destroy(accel);
-    drift_scene_destroy(scene);
-    drift_context_destroy(ctx);
+    return exit_code;
+}
+
+int drift_cmd_render(int argc, char **argv)
+{
+    render_options o;
+    int status = parse_options(argc, argv, &o);
+    if (status != 0) {
+        return status < 0 ? 0 : status;
+    }
+    if (o.hybrid_mode && !render_refine_validate(&o)) {
+        return 2;
+    }
+    cli_session session;
+    int exit_code = 1;
+    if (cli_session_open(&(cli_session_desc){ .cmd = "render",
+                                              .scene_path = o.scene_path,
+                                              .threads = (int)o.threads,
+                                              .verbose = o.verbose },
+                         &session)) {
+        exit_code = o.hybrid_mode ? render_hybrid(&o, &session) : render_reference(&o, &session);
+    }
+    cli_session_close(&session);
     return exit_code;
 }

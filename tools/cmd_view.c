@@ -35,9 +35,9 @@ typedef struct view_options {
     const char *press; // --press: view keys applied before the first frame
     long width, height, threads, spp_per_frame, spp, seed, frames;
     double exposure;
-    int techniques[DRIFT_EFFECT_COUNT]; // -1: not given
+    drift_hybrid_params hybrid; // the techniques given (zero: the defaults)
     bool split, no_overlay, verbose;
-    bool refine;       // --refine sir
+    bool refine;        // --refine sir
     long refine_budget; // --budget: SIR samples a frame (0: the default)
 } view_options;
 
@@ -60,7 +60,7 @@ static const char help_text[] =
     "Esc\tquit";
 
 // The key table for a terminal: the first column padded instead of tabbed.
-static void print_keys(void)
+static void print_keys(FILE *out)
 {
     const char *line = help_text;
     while (*line) {
@@ -68,54 +68,74 @@ static void print_keys(void)
         int len = end ? (int)(end - line) : (int)strlen(line);
         const char *tab = memchr(line, '\t', (size_t)len);
         int key_len = tab ? (int)(tab - line) : len;
-        printf("  %-18.*s%.*s\n", key_len, line, tab ? len - key_len - 1 : 0, tab ? tab + 1 : "");
+        fprintf(out, "  %-18.*s%.*s\n", key_len, line, tab ? len - key_len - 1 : 0,
+                tab ? tab + 1 : "");
         line = end ? end + 1 : line + len;
     }
 }
 
-static void print_help(void)
+static void print_more_help(FILE *out)
 {
-    printf(
-        "usage: drift view [SCENE] [options]\n"
-        "\n"
-        "Opens a window on SCENE (default: the built-in Cornell box) rendered by the hybrid\n"
-        "frame renderer, with a camera you move, a technique per effect you switch, every\n"
-        "buffer of the frame, a split view against the progressive reference path tracer\n"
-        "and the milliseconds of each pass on screen.\n"
-        "\n"
-        "options:\n"
-        "  --width W, --height H    window and image size (default: the scene camera's)\n"
-        "  --threads T              worker threads (default: all cores)\n"
-        "  --shadows NAME           hard, pcf, pcss, reference (default hard)\n"
-        "  --reflections NAME       none, envmap, sharp, reference (default none)\n"
-        "  --dof NAME               none, post, reference (default none)\n"
-        "  --indirect NAME          none, ambient, reference (default none)\n"
-        "  --spp N                  samples a pixel for `reference` techniques (default 4)\n"
-        "  --spp-per-frame N        reference samples added per frame in split view (default 1)\n"
-        "  --seed S                 the reference's seed (default 0)\n"
-        "  --split                  start in split view\n"
-        "  --refine sir             smart image refinement while the camera stands; the\n"
-        "                           planes add error.combined (heat map) and refine.mask\n"
-        "  --budget N               SIR samples a frame (default 16384; docs/sir.md)\n"
-        "  --exposure STOPS         display exposure (default 0)\n"
-        "  --no-overlay             start without the text overlay\n"
-        "  --press KEY,KEY,...      apply view keys before the first frame, by their names\n"
-        "                           (shadows, next-buffer, split, help, ...: docs/viewer.md)\n"
-        "  --frames N               render N frames, then exit (default: until closed)\n"
-        "  --screenshot FILE.png    after the last frame (--frames, default 1) save the\n"
-        "                           window's contents and print on stdout one line:\n"
-        "                           'wrote FILE (WxH, N frames, SOURCE): mean M, C colours'\n"
-        "                           (M the mean 8-bit value / 255, C the distinct RGB colours)\n"
-        "  --verbose                more log output\n"
-        "  -h, --help               this text\n"
-        "\n"
-        "keys:\n");
-    print_keys();
-    printf("\n"
-           "A window needs a display: without one, run it under a virtual X server\n"
-           "(xvfb-run -a drift view ...). Exit status: 0 success, 1 failure (no display, scene,\n"
-           "render), 2 usage error, 130 interrupted.\n");
+    fprintf(out, "\nkeys:\n");
+    print_keys(out);
 }
+
+static bool parse_press(const char *cmd, const char *flag, const char *v, void *field);
+
+#define O view_options
+static const cli_option view_table[] = {
+    CLI_SECTION("options:", 0),
+    CLI_INT("--width", "W", O, width, 1, 16384,
+            "window and image size (default: the scene camera's)"),
+    CLI_INT("--height", "H", O, height, 1, 16384, "window and image size"),
+    CLI_INT("--threads", "T", O, threads, 0, 256, "worker threads (default: all cores)"),
+    CLI_TECHNIQUES("NAME", O, hybrid),
+    CLI_INT("--spp", "N", O, spp, 1, 1 << 20,
+            "samples a pixel for `reference` techniques (default 4)"),
+    CLI_INT("--spp-per-frame", "N", O, spp_per_frame, 1, 1 << 16,
+            "reference samples added per frame in split view (default 1)"),
+    CLI_INT("--seed", "S", O, seed, 0, UINT32_MAX, "the reference's seed (default 0)"),
+    CLI_FLAG("--split", O, split, "start in split view"),
+    CLI_CUSTOM("--refine", "sir", O, refine, cli_parse_refine,
+               "smart image refinement while the camera stands; the\n"
+               "planes add error.combined (heat map) and refine.mask"),
+    CLI_INT("--budget", "N", O, refine_budget, 1, 1L << 30,
+            "SIR samples a frame (default 16384; docs/sir.md)"),
+    CLI_NUMBER("--exposure", "STOPS", O, exposure, -64.0, 64.0, "display exposure (default 0)"),
+    CLI_FLAG("--no-overlay", O, no_overlay, "start without the text overlay"),
+    CLI_CUSTOM("--press", "KEY,KEY,...", O, press, parse_press,
+               "apply view keys before the first frame, by their names\n"
+               "(shadows, next-buffer, split, help, ...: docs/viewer.md)"),
+    CLI_INT("--frames", "N", O, frames, 1, 1L << 30,
+            "render N frames, then exit (default: until closed)"),
+    CLI_STRING("--screenshot", "FILE.png", O, screenshot_path,
+               "after the last frame (--frames, default 1) save the\n"
+               "window's contents and print on stdout one line:\n"
+               "'wrote FILE (WxH, N frames, SOURCE): mean M, C colours'\n"
+               "(M the mean 8-bit value / 255, C the distinct RGB colours)"),
+    CLI_FLAG("--verbose", O, verbose, "more log output"),
+};
+#undef O
+
+static const cli_command view_command = {
+    .name = "view",
+    .usage = "usage: drift view [SCENE] [options]\n"
+             "\n"
+             "Opens a window on SCENE (default: the built-in Cornell box) rendered by the hybrid\n"
+             "frame renderer, with a camera you move, a technique per effect you switch, every\n"
+             "buffer of the frame, a split view against the progressive reference path tracer\n"
+             "and the milliseconds of each pass on screen.\n"
+             "\n",
+    .more_help = print_more_help,
+    .epilogue =
+        "\n"
+        "A window needs a display: without one, run it under a virtual X server\n"
+        "(xvfb-run -a drift view ...). Exit status: 0 success, 1 failure (no display, scene,\n"
+        "render), 2 usage error, 130 interrupted.\n",
+    CLI_TABLE(view_table),
+    CLI_POSITIONAL("SCENE", view_options, scene_path, 1),
+    .help_column = 27,
+};
 
 // Checks (view == NULL) or applies a comma-separated list of view key names.
 static bool parse_keys(const char *list, drift_view *view)
@@ -148,77 +168,22 @@ static bool parse_keys(const char *list, drift_view *view)
     return true;
 }
 
+// --press: checked here, applied once the view exists.
+static bool parse_press(const char *cmd, const char *flag, const char *v, void *field)
+{
+    (void)cmd;
+    (void)flag;
+    *(const char **)field = v;
+    return parse_keys(v, NULL);
+}
+
 // Returns 0 on success, 2 on a usage error (message printed), -1 after --help.
 static int parse_options(int argc, char **argv, view_options *o)
 {
-    *o = (view_options){ .spp = 4, .spp_per_frame = 1, .techniques = { -1, -1, -1, -1 } };
-    for (int i = 1; i < argc; ++i) {
-        const char *a = argv[i];
-        const char *v = NULL;
-        bool ok = true;
-#define VALUE() (v = cli_next_value("view", argc, argv, &i))
-        int effect = strcmp(a, "--shadows") == 0       ? DRIFT_EFFECT_SHADOWS
-                     : strcmp(a, "--reflections") == 0 ? DRIFT_EFFECT_REFLECTIONS
-                     : strcmp(a, "--dof") == 0         ? DRIFT_EFFECT_DOF
-                     : strcmp(a, "--indirect") == 0    ? DRIFT_EFFECT_INDIRECT
-                                                       : -1;
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            print_help();
-            return -1;
-        } else if (effect >= 0) {
-            ok = VALUE() &&
-                 cli_parse_technique("view", (drift_effect)effect, a, v, &o->techniques[effect]);
-        } else if (strcmp(a, "--width") == 0) {
-            ok = VALUE() && cli_parse_int("view", a, v, 1, 16384, &o->width);
-        } else if (strcmp(a, "--height") == 0) {
-            ok = VALUE() && cli_parse_int("view", a, v, 1, 16384, &o->height);
-        } else if (strcmp(a, "--threads") == 0) {
-            ok = VALUE() && cli_parse_int("view", a, v, 0, 256, &o->threads);
-        } else if (strcmp(a, "--spp") == 0) {
-            ok = VALUE() && cli_parse_int("view", a, v, 1, 1 << 20, &o->spp);
-        } else if (strcmp(a, "--spp-per-frame") == 0) {
-            ok = VALUE() && cli_parse_int("view", a, v, 1, 1 << 16, &o->spp_per_frame);
-        } else if (strcmp(a, "--seed") == 0) {
-            ok = VALUE() && cli_parse_int("view", a, v, 0, UINT32_MAX, &o->seed);
-        } else if (strcmp(a, "--frames") == 0) {
-            ok = VALUE() && cli_parse_int("view", a, v, 1, 1L << 30, &o->frames);
-        } else if (strcmp(a, "--exposure") == 0) {
-            ok = VALUE() && cli_parse_float("view", a, v, -64.0, 64.0, &o->exposure);
-        } else if (strcmp(a, "--screenshot") == 0) {
-            ok = VALUE() != NULL;
-            o->screenshot_path = v;
-        } else if (strcmp(a, "--press") == 0) {
-            ok = VALUE() && parse_keys(v, NULL);
-            o->press = v;
-        } else if (strcmp(a, "--split") == 0) {
-            o->split = true;
-        } else if (strcmp(a, "--refine") == 0) {
-            ok = VALUE() != NULL;
-            if (ok && strcmp(v, "sir") != 0) {
-                fprintf(stderr, "drift view: --refine expects 'sir', got '%s'\n", v);
-                ok = false;
-            }
-            o->refine = true;
-        } else if (strcmp(a, "--budget") == 0) {
-            ok = VALUE() && cli_parse_int("view", a, v, 1, 1L << 30, &o->refine_budget);
-        } else if (strcmp(a, "--no-overlay") == 0) {
-            o->no_overlay = true;
-        } else if (strcmp(a, "--verbose") == 0) {
-            o->verbose = true;
-        } else if (a[0] == '-' && a[1] != '\0') {
-            fprintf(stderr, "drift view: unknown option '%s' (see drift view --help)\n", a);
-            ok = false;
-        } else if (!o->scene_path) {
-            o->scene_path = a;
-        } else {
-            fprintf(stderr, "drift view: more than one scene given ('%s', '%s')\n", o->scene_path,
-                    a);
-            ok = false;
-        }
-#undef VALUE
-        if (!ok) {
-            return 2;
-        }
+    *o = (view_options){ .spp = 4, .spp_per_frame = 1 };
+    int status = cli_parse(&view_command, argc, argv, o, NULL);
+    if (status != CLI_PARSED) {
+        return status;
     }
     if (o->screenshot_path) {
         size_t len = strlen(o->screenshot_path);
@@ -564,28 +529,23 @@ int drift_cmd_view(int argc, char **argv)
     }
     signal(SIGINT, on_sigint);
 
-    drift_context *ctx = NULL;
-    drift_scene *scene = NULL;
-    drift_accel *accel = NULL;
     drift_view *view = NULL;
     window w = { 0 };
     int exit_code = 1;
-    ctx = cli_open_context("view", (int)o.threads, o.verbose);
-    if (!ctx) {
+    cli_session session;
+    if (!cli_session_open(&(cli_session_desc){ .cmd = "view",
+                                               .scene_path = o.scene_path,
+                                               .threads = (int)o.threads,
+                                               .verbose = o.verbose },
+                          &session)) {
         goto done;
     }
-    drift_result r = DRIFT_OK;
-    const char *scene_path = o.scene_path ? o.scene_path : cli_default_scene_path();
-    if (!cli_open_scene(ctx, "view", scene_path, &scene, &accel, NULL)) {
-        goto done;
-    }
-    drift_hybrid_params params = { .spp = (uint32_t)o.spp };
-    for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
-        if (o.techniques[e] >= 0) {
-            drift_hybrid_params_set_technique(&params, (drift_effect)e, o.techniques[e]);
-        }
-    }
-    r = drift_view_create(ctx, scene, accel,
+    drift_context *ctx = session.ctx;
+    const char *scene_path = session.scene_path;
+    drift_hybrid_params params = o.hybrid;
+    params.spp = (uint32_t)o.spp;
+    drift_result r =
+        drift_view_create(ctx, session.scene, session.accel,
                           &(drift_view_desc){ .width = (int32_t)o.width,
                                               .height = (int32_t)o.height,
                                               .hybrid = params,
@@ -617,9 +577,7 @@ int drift_cmd_view(int argc, char **argv)
 done:
     window_destroy(&w);
     drift_view_destroy(view);
-    drift_accel_destroy(accel);
-    drift_scene_destroy(scene);
-    drift_context_destroy(ctx);
+    cli_session_close(&session);
     SDL_Quit();
     return exit_code;
 }

@@ -2,12 +2,13 @@
 #ifndef DRIFT_TOOLS_RENDER_H
 #define DRIFT_TOOLS_RENDER_H
 
+#include "cli.h"
+#include "drift/hybrid.h"
+#include "drift/image.h"
+
 #include <stdatomic.h>
 #include <stdbool.h>
 #include <stddef.h>
-
-#include "drift/hybrid.h"
-#include "drift/image.h"
 
 // --refine sir and its options (hybrid mode; tools/render_refine.c, docs/sir.md).
 typedef struct render_refine_options {
@@ -26,7 +27,7 @@ typedef struct render_options {
     const char *out_path;
     const char *stats_path;
     const char *aov_path; // hybrid: every plane as layers of this EXR
-    const char *mode;
+    bool hybrid_mode;     // --mode hybrid (else reference)
     long spp, seed, threads, max_depth, width, height;
     double checkpoint_seconds;
     double exposure;
@@ -42,21 +43,29 @@ typedef struct render_options {
     render_refine_options refine;    // --refine sir (tools/render_refine.c)
 } render_options;
 
-// Parses argv[*i] when it is a hybrid-mode option (advancing *i past its value); returns
-// false when it is not one. *ok becomes false on a malformed value (message printed).
-bool render_parse_hybrid_option(int argc, char **argv, int *i, render_options *o, bool *ok);
+// Renders in hybrid mode with the session's scene; returns the process exit code.
+int render_hybrid(const render_options *o, const cli_session *session);
 
-// Renders in hybrid mode; returns the process exit code.
-int render_hybrid(const render_options *o);
+// The --stats object's first fields (scene, mode, width, height); the caller adds the rest
+// and writes it with cli_json_write.
+cJSON *render_stats_begin(const render_options *o, const cli_session *session, const char *mode,
+                          int width, int height);
 
-// Parses argv[*i] when it is a --refine option (as render_parse_hybrid_option does).
-bool render_parse_refine_option(int argc, char **argv, int *i, render_options *o, bool *ok);
 // Checks the refine options go together; prints the usage error and returns false if not.
 bool render_refine_validate(const render_options *o);
 // Refines the rendered hybrid frame and writes the outputs; returns the exit code.
 struct drift_hybrid;
-int render_refine_run(drift_context *ctx, const render_options *o, struct drift_hybrid *frame,
-                      const char *scene_path);
+int render_refine_run(const render_options *o, const cli_session *session,
+                      struct drift_hybrid *frame);
+
+// Writes `image` to --out (EXR) and its PNG beside it (--exposure, --tonemap).
+drift_result render_write_image(drift_context *ctx, const render_options *o,
+                                const drift_image *image);
+// Writes the refiner's planes (sir may be NULL), then every plane of the frame, as the
+// layers of one EXR.
+struct drift_refine;
+drift_result render_write_aov(drift_context *ctx, const char *path,
+                              const struct drift_hybrid *frame, const struct drift_refine *sir);
 
 // FILE.exr -> FILE.png
 void render_png_path(const char *exr_path, char *out, size_t size);

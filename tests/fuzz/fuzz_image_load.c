@@ -1,16 +1,15 @@
 // libFuzzer target for drift_image_load: the first byte picks the extension (.exr or .png), the
 // rest is written to a temporary file and loaded. Any result code is fine; crashes, sanitizer
 // reports and leaks are not.
+#include "drift/image.h"
+#include "drift/image_io.h"
+
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
 #include <unistd.h>
-
-#include "drift/image.h"
-#include "drift/image_io.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 

@@ -7,7 +7,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
 #include <sys/stat.h>
 
 static void capture_log(drift_log_level level, drift_result code, const char *file, int line,

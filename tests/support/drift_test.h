@@ -3,13 +3,15 @@
 #ifndef DRIFT_TEST_H
 #define DRIFT_TEST_H
 
-// cmocka needs these before its header.
+// cmocka needs these before its header (clang-format's include sorting would move it first).
+// clang-format off
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
 
 #include <cmocka.h>
+// clang-format on
 
 #include "drift/core.h"
 
@@ -44,7 +46,7 @@ float test_hash_unit(uint32_t i);
 // Adds a mesh to a test scene and returns its index; fails the test if the scene rejects it.
 struct drift_scene;
 uint32_t test_add_mesh(struct drift_scene *scene, const float *positions, uint32_t vertex_count,
-                   const uint32_t *indices, uint32_t triangle_count, uint32_t material);
+                       const uint32_t *indices, uint32_t triangle_count, uint32_t material);
 
 // DRIFT_TEST_INTENSITY (default 1) scales sample counts in statistical tests.
 double test_intensity(void);

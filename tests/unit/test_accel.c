@@ -94,7 +94,9 @@ typedef struct bf_hit {
 
 static bf_hit brute_force(const drift_scene *scene, const drift_ray *ray)
 {
-    bf_hit best = { .t = (double)INFINITY, .second_t = (double)INFINITY, .margin = (double)INFINITY };
+    bf_hit best = { .t = (double)INFINITY,
+                    .second_t = (double)INFINITY,
+                    .margin = (double)INFINITY };
     double o[3] = { (double)ray->origin.x, (double)ray->origin.y, (double)ray->origin.z };
     double d[3] = { (double)ray->dir.x, (double)ray->dir.y, (double)ray->dir.z };
     for (uint32_t m = 0; m < scene->mesh_count; ++m) {

@@ -1,9 +1,8 @@
+#include "drift/math.h"
 #include "drift_test.h"
 
 #include <stdatomic.h>
 #include <string.h>
-
-#include "drift/math.h"
 
 static void test_core_result_strings(void **state)
 {

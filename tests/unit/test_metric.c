@@ -1,12 +1,10 @@
+#include "drift/image.h"
+#include "drift/math.h"
+#include "drift/metric.h"
 #include "drift_test.h"
 
 #include <math.h>
 #include <string.h>
-
-#include "drift/image.h"
-#include "drift/math.h"
-#include "drift/metric.h"
-
 
 // Smooth-ish random texture in [0.05, 0.95]: a product of hashed values on a coarse grid and
 // per-pixel jitter, so SSIM and FLIP see structure rather than a flat field.
@@ -232,9 +230,9 @@ static void test_metric_rejects_size_mismatch_and_bad_ppd(void **state)
     assert_int_equal(cap.last_code, DRIFT_ERR_INVALID_ARGUMENT);
     double flip = 0.0;
     drift_image map = { .width = 3 };
-    assert_int_equal(drift_metric_flip(ctx, &a, &a, &(drift_metric_params){ .ppd = -1.0 },
-                                       &flip, &map),
-                     DRIFT_ERR_INVALID_ARGUMENT);
+    assert_int_equal(
+        drift_metric_flip(ctx, &a, &a, &(drift_metric_params){ .ppd = -1.0 }, &flip, &map),
+        DRIFT_ERR_INVALID_ARGUMENT);
     assert_null(map.pixels);
     assert_int_equal(map.width, 0);
     drift_metric_params p = drift_metric_params_resolve(&(drift_metric_params){ 0 });

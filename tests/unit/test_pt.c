@@ -2,15 +2,14 @@
 // a constant sky, irradiance from sphere and disk lights, thin lens vs pinhole, bit-identical
 // images for any thread count, 1/sqrt(spp) convergence, and the image split into components
 // (emission, direct, specular, diffuse) with pixel-centre, pinhole and camera overrides.
+#include "drift/accel.h"
+#include "drift/pt.h"
+#include "drift/scene.h"
 #include "drift_test.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
-
-#include "drift/accel.h"
-#include "drift/pt.h"
-#include "drift/scene.h"
 
 #define M_PI 3.14159265358979323846
 
@@ -108,8 +107,9 @@ static void test_pt_white_furnace(void **state)
         uint32_t mat;
         assert_int_equal(drift_scene_add_material(r.scene, &m, &mat), DRIFT_OK);
         add_inward_box(r.scene, 1.0f, mat);
-        r.scene->camera = drift_camera_look_at(drift_vec3_make(0, 0, 0.5f), drift_vec3_make(0.2f, 0.1f, -1),
-                                               drift_vec3_make(0, 1, 0), 1.2f, 16, 16);
+        r.scene->camera =
+            drift_camera_look_at(drift_vec3_make(0, 0, 0.5f), drift_vec3_make(0.2f, 0.1f, -1),
+                                 drift_vec3_make(0, 1, 0), 1.2f, 16, 16);
         rig_finish(&r, &variants[v]);
         drift_image img = render(&r, (uint32_t)(64 * test_intensity()));
         double mean = image_mean(&img, 1);
@@ -128,13 +128,15 @@ static void test_pt_plane_under_constant_environment(void **state)
     const float albedo = 0.6f, sky = 0.5f;
     rig r = rig_begin(2);
     uint32_t mat;
-    assert_int_equal(drift_scene_add_material(r.scene, &(drift_material){ .diffuse = drift_vec3_splat(albedo),
-                                                                          .diffuse_texture = DRIFT_INVALID_INDEX },
-                                              &mat),
-                     DRIFT_OK);
+    assert_int_equal(
+        drift_scene_add_material(r.scene,
+                                 &(drift_material){ .diffuse = drift_vec3_splat(albedo),
+                                                    .diffuse_texture = DRIFT_INVALID_INDEX },
+                                 &mat),
+        DRIFT_OK);
     add_floor(r.scene, 1e4f, mat);
-    r.scene->environment = (drift_environment){ .color = drift_vec3_splat(sky),
-                                                .texture = DRIFT_INVALID_INDEX };
+    r.scene->environment =
+        (drift_environment){ .color = drift_vec3_splat(sky), .texture = DRIFT_INVALID_INDEX };
     r.scene->camera = drift_camera_look_at(drift_vec3_make(0, 1, 0), drift_vec3_make(0, 0, -0.01f),
                                            drift_vec3_make(0, 0, -1), 0.5f, 8, 8);
     rig_finish(&r, &(drift_pt_params){ .max_depth = 4 });
@@ -155,10 +157,12 @@ static double render_point_below_light(const drift_light *light, float albedo)
 {
     rig r = rig_begin(2);
     uint32_t mat;
-    assert_int_equal(drift_scene_add_material(r.scene, &(drift_material){ .diffuse = drift_vec3_splat(albedo),
-                                                                          .diffuse_texture = DRIFT_INVALID_INDEX },
-                                              &mat),
-                     DRIFT_OK);
+    assert_int_equal(
+        drift_scene_add_material(r.scene,
+                                 &(drift_material){ .diffuse = drift_vec3_splat(albedo),
+                                                    .diffuse_texture = DRIFT_INVALID_INDEX },
+                                 &mat),
+        DRIFT_OK);
     add_floor(r.scene, 100.0f, mat);
     assert_int_equal(drift_scene_add_light(r.scene, light, NULL), DRIFT_OK);
     // Look at the origin from the side, below the light, with a 0.2 degree field of view.
@@ -195,7 +199,8 @@ static void test_pt_disk_light_irradiance(void **state)
                       .direction = { 0, -1, 0 },
                       .radius = (float)radius,
                       .color = drift_vec3_splat((float)radiance) };
-    double expected = albedo / M_PI * (M_PI * radiance * radius * radius / (height * height + radius * radius));
+    double expected =
+        albedo / M_PI * (M_PI * radiance * radius * radius / (height * height + radius * radius));
     double got = render_point_below_light(&l, (float)albedo);
     if (fabs(got - expected) > 0.01 * expected) {
         fail_msg("disk light: radiance %.5f, closed form %.5f", got, expected);
@@ -254,8 +259,9 @@ static drift_scene *small_box_scene(rig *r, float aperture)
                                                            .color = { 8, 8, 8 } },
                                            NULL),
                      DRIFT_OK);
-    r->scene->camera = drift_camera_look_at(drift_vec3_make(0, 0, 0.95f), drift_vec3_make(0, -0.2f, 0),
-                                            drift_vec3_make(0, 1, 0), 1.4f, 24, 24);
+    r->scene->camera =
+        drift_camera_look_at(drift_vec3_make(0, 0, 0.95f), drift_vec3_make(0, -0.2f, 0),
+                             drift_vec3_make(0, 1, 0), 1.4f, 24, 24);
     r->scene->camera.aperture_radius = aperture;
     return r->scene;
 }

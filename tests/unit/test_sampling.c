@@ -1,15 +1,14 @@
 // Sampling correctness: the sampler's stratification, every BSDF sampling routine against its
 // pdf (chi-square), pdf normalization, light sampling against closed-form irradiance, and the
 // environment map's importance sampling.
+#include "drift/math.h"
+#include "drift/scene.h"
 #include "drift_test.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-#include "drift/math.h"
-#include "drift/scene.h"
 
 #define M_PI 3.14159265358979323846
 
@@ -64,7 +63,7 @@ static void test_sampling_sampler_is_stratified(void **state)
 // --- CHI-SQUARE (pbrt-v3's and Mitsuba's approach) ---
 
 #define THETA_BINS 16
-#define PHI_BINS 32
+#define PHI_BINS   32
 
 // Upper quantile of the chi-square distribution (Wilson-Hilferty approximation), for
 // significance 1e-3 per test: z = 3.09.
@@ -236,8 +235,8 @@ static void test_sampling_bsdf_chi_square(void **state)
         char label[64];
         snprintf(label, sizeof(label), "phong n=300 theta_o=%.1f", (double)angles[a]);
         chi_square_check(label, bsdf_pdf_cb, bsdf_sample_cb, &sharp, n);
-        bsdf_case mixed = make_case(drift_vec3_make(0.5f, 0.3f, 0.2f), drift_vec3_splat(0.4f), 8.0f,
-                                    angles[a]);
+        bsdf_case mixed =
+            make_case(drift_vec3_make(0.5f, 0.3f, 0.2f), drift_vec3_splat(0.4f), 8.0f, angles[a]);
         chi_square_check("lambert+phong", bsdf_pdf_cb, bsdf_sample_cb, &mixed, n);
     }
 }
@@ -270,11 +269,12 @@ static void test_sampling_warps_match_their_pdfs(void **state)
 {
     (void)state;
     int n = (int)(200000 * test_intensity());
-    chi_square_check("cosine hemisphere", bsdf_pdf_cb, bsdf_sample_cb,
-                     &(bsdf_case){ .bsdf = { .diffuse = drift_vec3_splat(1),
-                                             .frame = drift_frame_from_normal(drift_vec3_make(0, 0, 1)) },
-                                   .wo = drift_vec3_make(0, 0, 1) },
-                     n);
+    chi_square_check(
+        "cosine hemisphere", bsdf_pdf_cb, bsdf_sample_cb,
+        &(bsdf_case){ .bsdf = { .diffuse = drift_vec3_splat(1),
+                                .frame = drift_frame_from_normal(drift_vec3_make(0, 0, 1)) },
+                      .wo = drift_vec3_make(0, 0, 1) },
+        n);
 }
 
 // --- ENERGY ---
@@ -285,13 +285,15 @@ static void test_sampling_bsdf_albedo_is_at_most_one(void **state)
     const float exponents[] = { 1.0f, 10.0f, 100.0f, 1000.0f };
     for (int e = 0; e < 4; ++e) {
         for (float theta = 0.0f; theta < 1.55f; theta += 0.3f) {
-            bsdf_case c = make_case(drift_vec3_splat(0.5f), drift_vec3_splat(0.5f), exponents[e], theta);
+            bsdf_case c =
+                make_case(drift_vec3_splat(0.5f), drift_vec3_splat(0.5f), exponents[e], theta);
             double albedo = 0.0;
             const int n = 20000;
             for (int i = 0; i < n; ++i) {
                 drift_sampler s = drift_sampler_make(5, 9, (uint32_t)i);
                 drift_vec2 u = drift_sampler_next2(&s);
-                drift_bsdf_sample bs = drift_bsdf_sample_wi(&c.bsdf, c.wo, drift_sampler_next1(&s), u);
+                drift_bsdf_sample bs =
+                    drift_bsdf_sample_wi(&c.bsdf, c.wo, drift_sampler_next1(&s), u);
                 if (bs.pdf > 0.0f) {
                     albedo += (double)bs.weight.x;
                 }
@@ -339,10 +341,11 @@ static void test_sampling_sphere_light_irradiance_closed_form(void **state)
     (void)state;
     drift_context *ctx = test_context(1, NULL);
     const double radius = 0.5, height = 3.0, radiance = 2.0;
-    drift_scene *scene = light_scene(ctx, &(drift_light){ .type = DRIFT_LIGHT_SPHERE,
-                                                          .position = { 0, (float)height, 0 },
-                                                          .radius = (float)radius,
-                                                          .color = drift_vec3_splat((float)radiance) });
+    drift_scene *scene =
+        light_scene(ctx, &(drift_light){ .type = DRIFT_LIGHT_SPHERE,
+                                         .position = { 0, (float)height, 0 },
+                                         .radius = (float)radius,
+                                         .color = drift_vec3_splat((float)radiance) });
     // A sphere wholly above the horizon, centred on the normal: E = pi L (r / d)^2.
     double expected = M_PI * radiance * (radius / height) * (radius / height);
     double e = estimate_irradiance(scene, drift_vec3_make(0, 0, 0), 4096);
@@ -356,11 +359,12 @@ static void test_sampling_disk_light_irradiance_closed_form(void **state)
     (void)state;
     drift_context *ctx = test_context(1, NULL);
     const double radius = 1.5, height = 2.0, radiance = 3.0;
-    drift_scene *scene = light_scene(ctx, &(drift_light){ .type = DRIFT_LIGHT_DISK,
-                                                          .position = { 0, (float)height, 0 },
-                                                          .direction = { 0, -1, 0 },
-                                                          .radius = (float)radius,
-                                                          .color = drift_vec3_splat((float)radiance) });
+    drift_scene *scene =
+        light_scene(ctx, &(drift_light){ .type = DRIFT_LIGHT_DISK,
+                                         .position = { 0, (float)height, 0 },
+                                         .direction = { 0, -1, 0 },
+                                         .radius = (float)radius,
+                                         .color = drift_vec3_splat((float)radiance) });
     // Coaxial, parallel disk: E = pi L R^2 / (h^2 + R^2).
     double expected = M_PI * radiance * radius * radius / (height * height + radius * radius);
     double e = estimate_irradiance(scene, drift_vec3_make(0, 0, 0), 4096);
@@ -378,11 +382,12 @@ static void test_sampling_quad_light_irradiance_closed_form(void **state)
     // Square of side 2a centred above the point at height h, facing down. The form factor of
     // a rectangle to a parallel point on its corner normal, summed over 4 quadrants.
     const double a = 1.0, h = 1.5, radiance = 1.0;
-    drift_scene *scene = light_scene(ctx, &(drift_light){ .type = DRIFT_LIGHT_QUAD,
-                                                          .position = { (float)-a, (float)h, (float)-a },
-                                                          .edge_u = { (float)(2 * a), 0, 0 },
-                                                          .edge_v = { 0, 0, (float)(2 * a) },
-                                                          .color = drift_vec3_splat((float)radiance) });
+    drift_scene *scene =
+        light_scene(ctx, &(drift_light){ .type = DRIFT_LIGHT_QUAD,
+                                         .position = { (float)-a, (float)h, (float)-a },
+                                         .edge_u = { (float)(2 * a), 0, 0 },
+                                         .edge_v = { 0, 0, (float)(2 * a) },
+                                         .color = drift_vec3_splat((float)radiance) });
     double x = a / h, y = a / h;
     double f = 1.0 / (2.0 * M_PI) *
                (x / sqrt(1 + x * x) * atan(y / sqrt(1 + x * x)) +
@@ -403,16 +408,27 @@ static void test_sampling_light_pdf_matches_sample(void **state)
     (void)state;
     drift_context *ctx = test_context(1, NULL);
     const drift_light lights[] = {
-        { .type = DRIFT_LIGHT_SPHERE, .position = { 0.3f, 2, 0 }, .radius = 0.7f, .color = { 1, 1, 1 } },
-        { .type = DRIFT_LIGHT_DISK, .position = { 0, 2, 0.5f }, .direction = { 0.2f, -1, 0 }, .radius = 0.5f, .color = { 1, 1, 1 } },
-        { .type = DRIFT_LIGHT_QUAD, .position = { -1, 2, -1 }, .edge_u = { 2, 0.3f, 0 }, .edge_v = { 0, 0, 2 }, .color = { 1, 1, 1 } },
+        { .type = DRIFT_LIGHT_SPHERE,
+          .position = { 0.3f, 2, 0 },
+          .radius = 0.7f,
+          .color = { 1, 1, 1 } },
+        { .type = DRIFT_LIGHT_DISK,
+          .position = { 0, 2, 0.5f },
+          .direction = { 0.2f, -1, 0 },
+          .radius = 0.5f,
+          .color = { 1, 1, 1 } },
+        { .type = DRIFT_LIGHT_QUAD,
+          .position = { -1, 2, -1 },
+          .edge_u = { 2, 0.3f, 0 },
+          .edge_v = { 0, 0, 2 },
+          .color = { 1, 1, 1 } },
     };
     for (int i = 0; i < 3; ++i) {
         drift_scene *scene = light_scene(ctx, &lights[i]);
         for (uint32_t k = 0; k < 200; ++k) {
             drift_sampler s = drift_sampler_make(4, (uint32_t)i, k);
-            drift_light_sample ls = drift_light_sample_li(scene, 0, drift_vec3_make(0, 0, 0),
-                                                          drift_sampler_next2(&s));
+            drift_light_sample ls =
+                drift_light_sample_li(scene, 0, drift_vec3_make(0, 0, 0), drift_sampler_next2(&s));
             if (!(ls.pdf > 0.0f)) {
                 continue;
             }
@@ -486,8 +502,8 @@ static void test_sampling_environment_pdf_integrates_to_one(void **state)
     for (int i = 0; i < nt; ++i) {
         for (int j = 0; j < np; ++j) {
             double ct = -1.0 + (i + 0.5) * 2.0 / nt, phi = (j + 0.5) * 2.0 * M_PI / np;
-            integral += (double)drift_environment_pdf(scene, sphere_dir(ct, phi)) *
-                        (2.0 / nt) * (2.0 * M_PI / np);
+            integral += (double)drift_environment_pdf(scene, sphere_dir(ct, phi)) * (2.0 / nt) *
+                        (2.0 * M_PI / np);
         }
     }
     if (fabs(integral - 1.0) > 0.01) {

@@ -1,0 +1,80 @@
+#!/usr/bin/env bash
+# Smoke test of every `drift bench` subcommand: each runs at a tiny size on the built-in
+# Cornell box and must exit 0 with sane JSON, answer --help, and reject an unknown option
+# with exit status 2 and a message naming it. The benchmarks are read from
+# `drift bench --help`, so a new one without a case here fails the test. Speed is not checked
+# (docs/benchmarks.md has the figures).
+set -u
+drift="$1"
+source "$(dirname "$0")/common.sh"
+box="$(cd "$(dirname "$0")/../../scenes/cornell-box" && pwd)/cornell_box.json"
+
+# check NAME PYTHON: runs PYTHON with `d`, the JSON on stdout, bound.
+check() {
+    python3 - "$tmp/out" "$2" <<'PY' || fail "bench $1: unexpected --json output: $(head -c 300 "$tmp/out")"
+import json, math, sys
+d = json.load(open(sys.argv[1]))
+exec(sys.argv[2])
+PY
+}
+
+smoke() {
+    case "$1" in
+    rays)
+        expect 0 "$drift" bench rays "$box" --width 16 --height 16 --seconds 0.02 --repeats 1 --json
+        check rays 'assert d["results_match"] is True and d["primary"]["rays"] == 256, d
+for k in ("primary", "shadow", "bounce"): assert d[k]["drift_rays_per_s"] > 0, k'
+        ;;
+    frame)
+        expect 0 "$drift" bench frame "$box" --width 16 --height 12 --frames 1 --json
+        check frame 'assert d["width"] == 16 and len(d["configs"]) >= 1, d
+for c in d["configs"]: assert c["frame_ms"] > 0 and c["passes"]["primary"] >= 0, c'
+        ;;
+    isg)
+        expect 0 "$drift" bench isg "$box" --width 16 --height 12 --qwidth 16 --qheight 12 \
+            --ref-spp 2 --json
+        check isg 'assert set(d["effects"]) == {"shadows", "reflections", "dof"}, d
+for e in d["effects"].values():
+    assert len(e["isg_ms"]) == 4 and all(len(r["search_ms"]) == 4 for r in e["isg_ms"]), e
+    assert e["quality"] and all(0 <= q["flip"] <= 1 and q["rmse"] >= 0 for q in e["quality"]), e'
+        ;;
+    aaf)
+        expect 0 "$drift" bench aaf "$box" --width 16 --height 12 --ref-spp 8 --spp 1,2 \
+            --timing-size 16x12 --timing-spp 1 --light-samples 2 --json
+        check aaf 'assert [e["effect"] for e in d["effects"]] == ["shadows"], d
+e = d["effects"][0]
+assert len(e["aaf"]) == 2 and len(e["plain_mc"]) == 2, e
+assert all(math.isfinite(p["rmse"]) and p["rmse"] >= 0 for p in e["aaf"] + e["plain_mc"]), e
+assert e["timing"]["frame_ms"] > 0, e'
+        ;;
+    sir)
+        expect 0 "$drift" bench sir "$box" --sizes 16x12 --spp 1 --budget 64 --json
+        check sir 'r = d["rows"]
+assert len(r) == 1 and r[0]["width"] == 16 and r[0]["height"] == 12, d
+assert 0 <= r[0]["flip"] <= 1 and r[0]["prt_ms"] > 0 and "shadow" in r[0]["quality"], r'
+        ;;
+    *)
+        fail "bench $1 has no smoke case in tests/cli/test_bench.sh"
+        return
+        ;;
+    esac
+    expect 0 "$drift" bench "$1" --help
+    grep -q "usage: drift bench $1" "$tmp/out" || fail "bench $1 --help prints no usage"
+    expect 2 "$drift" bench "$1" --no-such-option
+    grep -q -- "--no-such-option" "$tmp/err" || fail "bench $1: unknown option not named"
+}
+
+expect 0 "$drift" bench --help
+benches=$(sed -n '/^benchmarks:/,/^$/p' "$tmp/out" | awk 'NR > 1 && NF { print $1 }')
+[ -n "$benches" ] || fail "drift bench --help lists no benchmarks"
+for name in $benches; do
+    smoke "$name"
+done
+expect 2 "$drift" bench no-such-bench
+grep -q "no-such-bench" "$tmp/err" || fail "unknown benchmark not named"
+
+if [ "$failures" -ne 0 ]; then
+    echo "$failures failure(s)" >&2
+    exit 1
+fi
+echo "cli.bench: every benchmark ran ($(echo $benches))"

@@ -1,0 +1,314 @@
+// The option-table parser and help printer (tools/cli_options.h).
+#include "cli_options.h"
+
+#include "cli.h"
+#include "drift/hybrid.h"
+
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+// Whether `arg` is one of the ", "-separated names of `names`.
+static bool name_matches(const char *names, const char *arg)
+{
+    size_t len = strlen(arg);
+    const char *p = names;
+    while (p && *p) {
+        const char *end = strstr(p, ", ");
+        size_t n = end ? (size_t)(end - p) : strlen(p);
+        if (n == len && strncmp(p, arg, n) == 0) {
+            return true;
+        }
+        p = end ? end + 2 : NULL;
+    }
+    return false;
+}
+
+static bool store_long(void *field, cli_store store, long v)
+{
+    switch (store) {
+    case CLI_STORE_LONG:
+        *(long *)field = v;
+        return true;
+    case CLI_STORE_INT:
+        *(int *)field = (int)v;
+        return true;
+    case CLI_STORE_UINT:
+        *(unsigned *)field = (unsigned)v;
+        return true;
+    case CLI_STORE_DOUBLE:
+        *(double *)field = (double)v;
+        return true;
+    case CLI_STORE_FLOAT:
+        *(float *)field = (float)v;
+        return true;
+    case CLI_STORE_BOOL:
+        *(bool *)field = v != 0;
+        return true;
+    case CLI_STORE_NONE:
+    case CLI_STORE_STRING:
+        break;
+    }
+    return false;
+}
+
+static bool store_double(void *field, cli_store store, double v)
+{
+    switch (store) {
+    case CLI_STORE_DOUBLE:
+        *(double *)field = v;
+        return true;
+    case CLI_STORE_FLOAT:
+        *(float *)field = (float)v;
+        return true;
+    default:
+        return false;
+    }
+}
+
+// The index of `value` in "a|b|c", or -1.
+static int choice_index(const char *choices, const char *value)
+{
+    size_t len = strlen(value);
+    int index = 0;
+    for (const char *p = choices; p; ++index) {
+        const char *end = strchr(p, '|');
+        size_t n = end ? (size_t)(end - p) : strlen(p);
+        if (n == len && strncmp(p, value, n) == 0) {
+            return index;
+        }
+        p = end ? end + 1 : NULL;
+    }
+    return -1;
+}
+
+// "a, b or c"
+static void print_choices(FILE *out, const char *choices)
+{
+    for (const char *p = choices; p;) {
+        const char *end = strchr(p, '|');
+        size_t n = end ? (size_t)(end - p) : strlen(p);
+        const char *next = end ? strchr(end + 1, '|') : NULL;
+        fprintf(out, "%.*s%s", (int)n, p, !end ? "" : next ? ", " : " or ");
+        p = end ? end + 1 : NULL;
+    }
+}
+
+// Parses `value` for row `opt` into opts (the message names cmd, flag and value).
+static bool read_value(const char *cmd, const char *flag, const cli_option *opt, int effect,
+                       const char *value, void *opts)
+{
+    void *field = (char *)opts + opt->offset;
+    switch (opt->kind) {
+    case CLI_KIND_FLAG:
+        return store_long(field, opt->store, 1);
+    case CLI_KIND_INT: {
+        long v = 0;
+        return cli_parse_int(cmd, flag, value, (long)opt->lo, (long)opt->hi, &v) &&
+               store_long(field, opt->store, v);
+    }
+    case CLI_KIND_NUMBER: {
+        double v = 0.0;
+        return cli_parse_float(cmd, flag, value, opt->lo, opt->hi, &v) &&
+               store_double(field, opt->store, v);
+    }
+    case CLI_KIND_STRING:
+        *(const char **)field = value;
+        return true;
+    case CLI_KIND_CHOICE: {
+        int index = choice_index(opt->choices, value);
+        if (index < 0) {
+            fprintf(stderr, "drift %s: %s expects ", cmd, flag);
+            print_choices(stderr, opt->choices);
+            fprintf(stderr, ", got '%s'\n", value);
+            return false;
+        }
+        return store_long(field, opt->store, index);
+    }
+    case CLI_KIND_TECHNIQUES: {
+        int t = 0;
+        if (!cli_parse_technique(cmd, (drift_effect)effect, flag, value, &t)) {
+            return false;
+        }
+        drift_hybrid_params_set_technique(field, (drift_effect)effect, t);
+        return true;
+    }
+    case CLI_KIND_CUSTOM:
+        return opt->parse(cmd, flag, value, field);
+    case CLI_KIND_SECTION:
+    case CLI_KIND_NOTE:
+        break;
+    }
+    return false;
+}
+
+// The effect `arg` (--shadows, ...) names, or -1.
+static int effect_of(const char *arg)
+{
+    for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
+        if (strncmp(arg, "--", 2) == 0 &&
+            strcmp(arg + 2, drift_effect_name((drift_effect)e)) == 0) {
+            return e;
+        }
+    }
+    return -1;
+}
+
+// The row for `arg`, the groups of the section it is in and, for technique rows, the effect.
+static const cli_option *find_option(const cli_command *c, const char *arg, unsigned *groups,
+                                     int *effect)
+{
+    unsigned section = 0;
+    for (size_t k = 0; k < c->option_count; ++k) {
+        const cli_option *opt = &c->options[k];
+        *effect = opt->kind == CLI_KIND_TECHNIQUES ? effect_of(arg) : -1;
+        if (opt->kind == CLI_KIND_SECTION) {
+            section = opt->groups;
+        } else if (*effect >= 0 || (opt->name && name_matches(opt->name, arg))) {
+            *groups = section;
+            return opt;
+        }
+    }
+    return NULL;
+}
+
+int cli_parse(const cli_command *c, int argc, char **argv, void *opts,
+              const char *first_in_group[CLI_GROUP_COUNT])
+{
+    int positional_count = 0;
+    const char **positionals = (const char **)((char *)opts + c->positional_offset);
+    for (int i = 1; i < argc; ++i) {
+        const char *a = argv[i];
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            cli_print_help(c, stdout);
+            return CLI_HELP_SHOWN;
+        }
+        if (a[0] != '-' || a[1] == '\0') {
+            if (!c->positional) {
+                fprintf(stderr, "drift %s: unexpected argument '%s' (see drift %s --help)\n",
+                        c->name, a, c->name);
+                return CLI_USAGE_ERROR;
+            }
+            if (positional_count == c->positional_max) {
+                fprintf(stderr, "drift %s: at most %d %s (got '%s' too; see drift %s --help)\n",
+                        c->name, c->positional_max, c->positional, a, c->name);
+                return CLI_USAGE_ERROR;
+            }
+            positionals[positional_count++] = a;
+            continue;
+        }
+        unsigned groups = 0;
+        int effect = -1;
+        const cli_option *opt = find_option(c, a, &groups, &effect);
+        if (!opt) {
+            fprintf(stderr, "drift %s: unknown option '%s' (see drift %s --help)\n", c->name, a,
+                    c->name);
+            return CLI_USAGE_ERROR;
+        }
+        for (int g = 0; first_in_group && g < CLI_GROUP_COUNT; ++g) {
+            if ((groups & (1u << g)) && !first_in_group[g]) {
+                first_in_group[g] = a;
+            }
+        }
+        const char *value = NULL;
+        if (opt->optional_if) {
+            const char *next = i + 1 < argc ? argv[i + 1] : NULL;
+            size_t n = next ? strlen(next) : 0, m = strlen(opt->optional_if);
+            if (next && next[0] != '-' && n > m && strcmp(next + n - m, opt->optional_if) == 0) {
+                value = argv[++i];
+            }
+        } else if (opt->arg && !(value = cli_next_value(c->name, argc, argv, &i))) {
+            return CLI_USAGE_ERROR;
+        }
+        if (!read_value(c->name, a, opt, effect, value, opts)) {
+            return CLI_USAGE_ERROR;
+        }
+    }
+    return CLI_PARSED;
+}
+
+int cli_parse_exit(int status)
+{
+    return status == CLI_HELP_SHOWN ? 0 : status == CLI_PARSED ? -1 : CLI_USAGE_ERROR;
+}
+
+// Prints `text` with every line after the first indented to `column`.
+static void print_indented(FILE *out, const char *text, int column)
+{
+    for (const char *p = text; *p;) {
+        const char *end = strchr(p, '\n');
+        int n = end ? (int)(end - p) : (int)strlen(p);
+        fprintf(out, "%.*s\n", n, p);
+        if (!end) {
+            return;
+        }
+        p = end + 1;
+        fprintf(out, "%*s", column, "");
+    }
+}
+
+// "hard (default), pcf, pcss or aaf": the first technique is the zero (default) one.
+static void print_techniques(FILE *out, drift_effect effect)
+{
+    if (drift_technique_count(effect) < 1) {
+        fprintf(out, "(none)\n");
+        return;
+    }
+    int count = drift_technique_count(effect);
+    for (int t = 0; t < count; ++t) {
+        fprintf(out, "%s%s%s",
+                t == 0          ? ""
+                : t + 1 < count ? ", "
+                                : " or ",
+                drift_technique_name(effect, t), t == 0 ? " (default)" : "");
+    }
+    fprintf(out, "\n");
+}
+
+// "  --spp N" padded to `column` (or followed by two spaces when longer).
+static void print_label(FILE *out, const char *name, const char *arg, int column)
+{
+    char label[128];
+    snprintf(label, sizeof label, "%s%s%s", name, arg ? " " : "", arg ? arg : "");
+    int len = (int)strlen(label) + 2;
+    fprintf(out, "  %s%*s", label, len < column ? column - len : 2, "");
+}
+
+void cli_print_help(const cli_command *c, FILE *out)
+{
+    int column = c->help_column > 0 ? c->help_column : 24;
+    fputs(c->usage, out);
+    bool first_section = true;
+    for (size_t k = 0; k < c->option_count; ++k) {
+        const cli_option *opt = &c->options[k];
+        if (opt->kind == CLI_KIND_SECTION) {
+            fprintf(out, "%s%s\n", first_section ? "" : "\n", opt->help);
+            first_section = false;
+            continue;
+        }
+        if (opt->kind == CLI_KIND_NOTE) {
+            fprintf(out, "%*s", column, "");
+            print_indented(out, opt->help, column);
+            continue;
+        }
+        if (opt->kind == CLI_KIND_TECHNIQUES) {
+            for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
+                char name[64];
+                snprintf(name, sizeof name, "--%s", drift_effect_name((drift_effect)e));
+                print_label(out, name, opt->arg, column);
+                print_techniques(out, (drift_effect)e);
+            }
+        } else if (opt->help) { // no help: a hidden alias
+            print_label(out, opt->name, opt->arg, column);
+            print_indented(out, opt->help, column);
+        }
+    }
+    print_label(out, "-h, --help", NULL, column);
+    fprintf(out, "this text\n");
+    if (c->more_help) {
+        c->more_help(out);
+    }
+    if (c->epilogue) {
+        fputs(c->epilogue, out);
+    }
+}
