@@ -26,18 +26,22 @@
 extern "C" {
 #endif
 
-#define DRIFT_RESULT_LIST(X)                                                                       \
-    X(DRIFT_OK, "ok")                                                                              \
-    X(DRIFT_ERR_INVALID_ARGUMENT, "invalid argument")                                              \
-    X(DRIFT_ERR_OUT_OF_MEMORY, "out of memory")                                                    \
-    X(DRIFT_ERR_IO, "file could not be read or written")                                           \
-    X(DRIFT_ERR_PARSE, "malformed input")                                                          \
-    X(DRIFT_ERR_UNSUPPORTED, "unsupported feature")                                                \
-    X(DRIFT_ERR_EMBREE, "embree reported an error")                                                \
+#define DRIFT_RESULT_LIST(X)                             \
+    X(DRIFT_OK, "ok")                                    \
+    X(DRIFT_ERR_INVALID_ARGUMENT, "invalid argument")    \
+    X(DRIFT_ERR_OUT_OF_MEMORY, "out of memory")          \
+    X(DRIFT_ERR_IO, "file could not be read or written") \
+    X(DRIFT_ERR_PARSE, "malformed input")                \
+    X(DRIFT_ERR_UNSUPPORTED, "unsupported feature")      \
+    X(DRIFT_ERR_EMBREE, "embree reported an error")      \
     X(DRIFT_ERR_CANCELLED, "cancelled")
 
 #define DRIFT__RESULT_ENUM(name, text) name,
-typedef enum drift_result { DRIFT_RESULT_LIST(DRIFT__RESULT_ENUM) DRIFT_RESULT_COUNT } drift_result;
+
+typedef enum drift_result {
+    DRIFT_RESULT_LIST(DRIFT__RESULT_ENUM) DRIFT_RESULT_COUNT
+} drift_result;
+
 #undef DRIFT__RESULT_ENUM
 
 // Human text for a result; never NULL ("unknown result" when out of range).
@@ -54,8 +58,8 @@ typedef enum drift_log_level {
 
 // Receives every message of the library. `file` and `line` name the input file and line
 // where a parser reports (0 when unknown), otherwise the source location.
-typedef void (*drift_log_func)(drift_log_level level, drift_result code, const char *file,
-                               int line, const char *message, void *user);
+typedef void (*drift_log_func)(drift_log_level level, drift_result code, const char *file, int line,
+                               const char *message, void *user);
 
 typedef struct drift_logger {
     drift_log_func func; // NULL: the library prints nothing
@@ -122,11 +126,11 @@ double drift_time_now(void);
 
 // Misuse checks. DRIFT_ASSERT is compiled out with NDEBUG; DRIFT_CHECK always stays.
 void drift__check_failed(const char *expr, const char *file, int line);
-#define DRIFT_CHECK(cond)                                                                          \
-    do {                                                                                           \
-        if (!(cond)) {                                                                             \
-            drift__check_failed(#cond, __FILE__, __LINE__);                                        \
-        }                                                                                          \
+#define DRIFT_CHECK(cond)                                   \
+    do {                                                    \
+        if (!(cond)) {                                      \
+            drift__check_failed(#cond, __FILE__, __LINE__); \
+        }                                                   \
     } while (0)
 #ifdef NDEBUG
 #    define DRIFT_ASSERT(cond) ((void)0)

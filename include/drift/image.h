@@ -29,17 +29,17 @@ extern "C" {
 #define DRIFT_IMAGE_MAX_DIMENSION 32768
 
 typedef struct drift_image {
-    float *pixels;     // row-major, channels interleaved, origin top-left
+    float *pixels; // row-major, channels interleaved, origin top-left
     int32_t width;
     int32_t height;
-    int32_t channels;  // 1..4
-    ptrdiff_t stride;  // floats between the starts of two rows
+    int32_t channels; // 1..4
+    ptrdiff_t stride; // floats between the starts of two rows
 } drift_image;
 
 // Allocates a zeroed image. Errors: DRIFT_ERR_INVALID_ARGUMENT (size 0, over
 // DRIFT_IMAGE_MAX_DIMENSION, channels outside 1..4), DRIFT_ERR_OUT_OF_MEMORY.
-drift_result drift_image_create(drift_context *ctx, int32_t width, int32_t height,
-                                int32_t channels, drift_image *out_image);
+drift_result drift_image_create(drift_context *ctx, int32_t width, int32_t height, int32_t channels,
+                                drift_image *out_image);
 // Frees the pixels of an image from drift_image_create and zeroes *image. NULL-safe.
 void drift_image_destroy(drift_context *ctx, drift_image *image);
 // A non-owning view of a rectangle of `image`.
@@ -57,6 +57,7 @@ static inline drift_vec3 drift_image_get3(const drift_image *image, int32_t x, i
     const float *p = drift_image_pixel(image, x, y);
     return (drift_vec3){ p[0], p[1], p[2] };
 }
+
 static inline void drift_image_set3(const drift_image *image, int32_t x, int32_t y, drift_vec3 v)
 {
     float *p = drift_image_pixel(image, x, y);
@@ -64,6 +65,7 @@ static inline void drift_image_set3(const drift_image *image, int32_t x, int32_t
     p[1] = v.y;
     p[2] = v.z;
 }
+
 static inline bool drift_image_is_valid(const drift_image *image)
 {
     return image && image->pixels && image->width > 0 && image->height > 0 &&

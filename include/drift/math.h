@@ -23,8 +23,8 @@
 extern "C" {
 #endif
 
-#define DRIFT_PI 3.14159265358979323846f
-#define DRIFT_INV_PI 0.31830988618379067154f
+#define DRIFT_PI      3.14159265358979323846f
+#define DRIFT_INV_PI  0.31830988618379067154f
 #define DRIFT_INV_2PI 0.15915494309189533577f
 #define DRIFT_INV_4PI 0.07957747154594766788f
 // Largest float below 1: samples live in [0, 1).
@@ -188,7 +188,8 @@ static inline drift_vec3 drift_frame_to_world(const drift_frame *f, drift_vec3 v
 
 static inline drift_vec3 drift_frame_to_local(const drift_frame *f, drift_vec3 v)
 {
-    return (drift_vec3){ drift_vec3_dot(v, f->x), drift_vec3_dot(v, f->y), drift_vec3_dot(v, f->z) };
+    return (drift_vec3){ drift_vec3_dot(v, f->x), drift_vec3_dot(v, f->y),
+                         drift_vec3_dot(v, f->z) };
 }
 
 // --- BOUNDS ---

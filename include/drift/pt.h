@@ -80,10 +80,10 @@ typedef struct drift_pt_params {
     bool disable_mis;
     bool disable_nee;
     bool disable_rr;
-    uint32_t components; // bit set of drift_pt_component
-    bool pixel_centre;   // every sample through the pixel centre (no pixel jitter): the same
-                         // footprint as a one-sample-per-pixel G-buffer
-    bool pinhole;        // ignore the camera's aperture
+    uint32_t components;        // bit set of drift_pt_component
+    bool pixel_centre;          // every sample through the pixel centre (no pixel jitter): the same
+                                // footprint as a one-sample-per-pixel G-buffer
+    bool pinhole;               // ignore the camera's aperture
     const drift_camera *camera; // NULL = scene->camera; else this camera, copied at create
                                 // (moving it later does not move the pt's camera).
                                 // width/height still come from params.

@@ -98,16 +98,16 @@ drift_refine_params drift_refine_params_resolve(const drift_refine_params *param
 typedef struct drift_refine drift_refine;
 
 typedef struct drift_refine_stats {
-    uint32_t iterations;      // since the last begin
-    uint32_t sorts;           // since create
-    uint64_t error_pixels;    // pixels with non-zero combined error
-    uint64_t requested;       // pixels in the request list (error pixels, or all)
-    uint64_t refined;         // pixels of the list that have all their samples
-    uint64_t samples;         // samples traced since the last begin
-    uint64_t rays;            // rays traced since the last begin (primary, shadow, reflection)
-    double metrics_ms;        // the last begin: metrics
-    double sort_ms;           //                 combine, sort, request list
-    double trace_ms;          // since the last begin: tracing and blending
+    uint32_t iterations;   // since the last begin
+    uint32_t sorts;        // since create
+    uint64_t error_pixels; // pixels with non-zero combined error
+    uint64_t requested;    // pixels in the request list (error pixels, or all)
+    uint64_t refined;      // pixels of the list that have all their samples
+    uint64_t samples;      // samples traced since the last begin
+    uint64_t rays;         // rays traced since the last begin (primary, shadow, reflection)
+    double metrics_ms;     // the last begin: metrics
+    double sort_ms;        //                 combine, sort, request list
+    double trace_ms;       // since the last begin: tracing and blending
 } drift_refine_stats;
 
 // Errors: DRIFT_ERR_INVALID_ARGUMENT (NULL, bad parameters; logged), DRIFT_ERR_OUT_OF_MEMORY.
@@ -126,8 +126,8 @@ drift_result drift_refine_begin(drift_refine *refine);
 drift_result drift_refine_iterate(drift_refine *refine, const atomic_bool *cancel);
 bool drift_refine_done(const drift_refine *refine); // every listed pixel has its spp
 
-const drift_image *drift_refine_image(const drift_refine *refine);      // RGB, refined
-const drift_image *drift_refine_error(const drift_refine *refine);      // 1: combined error
+const drift_image *drift_refine_image(const drift_refine *refine); // RGB, refined
+const drift_image *drift_refine_error(const drift_refine *refine); // 1: combined error
 const drift_image *drift_refine_metric_image(const drift_refine *refine, drift_refine_metric m);
 drift_refine_stats drift_refine_get_stats(const drift_refine *refine);
 
@@ -164,9 +164,8 @@ double drift_refine_lambda_cost(const drift_refine_view *views, uint32_t view_co
                                 const float lambda[DRIFT_METRIC_COUNT]);
 // Random search for lambda (each in [0,1]) minimizing the cost. The averaged sum (1/n each)
 // is the first candidate, so the result never does worse than it on these views.
-void drift_refine_fit_lambda(const drift_refine_view *views, uint32_t view_count,
-                             uint32_t trials, uint32_t seed, float out_lambda[DRIFT_METRIC_COUNT],
-                             double *out_cost);
+void drift_refine_fit_lambda(const drift_refine_view *views, uint32_t view_count, uint32_t trials,
+                             uint32_t seed, float out_lambda[DRIFT_METRIC_COUNT], double *out_cost);
 // {"lambda": {"reflection1": ..., ...}} files. Errors: DRIFT_ERR_IO, DRIFT_ERR_PARSE (logged).
 drift_result drift_refine_lambda_save(drift_context *ctx, const char *path,
                                       const float lambda[DRIFT_METRIC_COUNT]);

@@ -1,12 +1,11 @@
 #include "drift/core.h"
 
+#include <pthread.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-
-#include <pthread.h>
 #include <unistd.h>
 
 // Upper bound on pool size: far above any machine we run on, keeps per-thread arrays small.
@@ -34,8 +33,8 @@ struct drift_context {
     pthread_mutex_t mutex;
     pthread_cond_t wake;
     pthread_cond_t done;
-    pool_job *job;        // current job, guarded by mutex
-    uint64_t job_serial;  // bumps once per job so sleeping workers see a new one
+    pool_job *job;       // current job, guarded by mutex
+    uint64_t job_serial; // bumps once per job so sleeping workers see a new one
     bool shutting_down;
 };
 

@@ -3,8 +3,8 @@
 #include <math.h>
 #include <string.h>
 
-drift_result drift_image_create(drift_context *ctx, int32_t width, int32_t height,
-                                int32_t channels, drift_image *out_image)
+drift_result drift_image_create(drift_context *ctx, int32_t width, int32_t height, int32_t channels,
+                                drift_image *out_image)
 {
     if (!out_image) {
         return DRIFT_ERR_INVALID_ARGUMENT;

@@ -9,11 +9,10 @@
 // message so the one error we log can carry it (the library never prints).
 #include "image_io_internal.h"
 
+#include <OpenEXR/openexr.h>
 #include <errno.h>
 #include <stdio.h>
 #include <string.h>
-
-#include <OpenEXR/openexr.h>
 
 typedef struct exr_stream {
     drift_context *ctx;
@@ -29,7 +28,8 @@ static void exr_error_handler(exr_const_context_t f, exr_result_t code, const ch
     void *user = NULL;
     if (exr_get_user_data(f, &user) == EXR_ERR_SUCCESS && user) {
         exr_stream *s = user;
-        snprintf(s->message, sizeof(s->message), "%s", msg ? msg : exr_get_error_code_as_string(code));
+        snprintf(s->message, sizeof(s->message), "%s",
+                 msg ? msg : exr_get_error_code_as_string(code));
     }
 }
 
@@ -67,7 +67,7 @@ static int64_t exr_write_temp(exr_const_context_t f, void *user, const void *buf
 
 static drift_result exr_fail(exr_stream *s, exr_result_t rv, const char *what)
 {
-    drift_result code = rv == EXR_ERR_OUT_OF_MEMORY ? DRIFT_ERR_OUT_OF_MEMORY
+    drift_result code = rv == EXR_ERR_OUT_OF_MEMORY             ? DRIFT_ERR_OUT_OF_MEMORY
                         : rv == EXR_ERR_FEATURE_NOT_IMPLEMENTED ? DRIFT_ERR_UNSUPPORTED
                         : s->temp                               ? DRIFT_ERR_IO
                                                                 : DRIFT_ERR_PARSE;
@@ -285,12 +285,13 @@ drift_result drift__image_exr_load(drift_context *ctx, const char *path, const u
         return DRIFT_ERR_UNSUPPORTED;
     }
     for (int k = 0; k < 3; ++k) {
-        const exr_attr_chlist_entry_t *e = pick.index[k] >= 0 ? &list->entries[pick.index[k]] : NULL;
+        const exr_attr_chlist_entry_t *e =
+            pick.index[k] >= 0 ? &list->entries[pick.index[k]] : NULL;
         if (e && (e->x_sampling != 1 || e->y_sampling != 1)) {
             // Log before exr_finish: the channel list belongs to the context.
             drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_UNSUPPORTED, path, 0,
-                      "channel %s is subsampled (%dx%d); not supported", e->name.str,
-                      e->x_sampling, e->y_sampling);
+                      "channel %s is subsampled (%dx%d); not supported", e->name.str, e->x_sampling,
+                      e->y_sampling);
             exr_finish(&f);
             return DRIFT_ERR_UNSUPPORTED;
         }

@@ -3,21 +3,18 @@
 //
 // The stb implementation is not compiled here: Debian's libstb (pkg-config stb, -lstb) already
 // contains stb_image and stb_image_write, so only the declarations are included.
+#include "drift/math.h"
 #include "image_io_internal.h"
 
 #include <errno.h>
-#include <limits.h>
-#include <stdio.h>
-#include <string.h>
-
 #include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
+#include <limits.h>
 #include <stb/stb_image.h>
 #include <stb/stb_image_write.h>
-
-#include "drift/math.h"
+#include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 typedef enum image_format {
     FORMAT_UNKNOWN = 0,

@@ -114,8 +114,8 @@ drift_result drift__read_file(drift_context *ctx, const char *path, bool gzip, c
     }
     const char *too_big = gzip ? "unpacks to more than" : "is larger than";
     if (!gzip && file_size > DRIFT_SCENE_MAX_FILE_BYTES) {
-        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, where, line, "'%s' %s %zu bytes",
-                  path, too_big, DRIFT_SCENE_MAX_FILE_BYTES);
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, where, line,
+                  "'%s' %s %zu bytes", path, too_big, DRIFT_SCENE_MAX_FILE_BYTES);
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
     // gzread inflates gzip data and passes anything else through unchanged, so one loop reads

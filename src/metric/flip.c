@@ -20,23 +20,22 @@
 // Every 2-D kernel here is separable (the blue-yellow CSF is a sum of two separable Gaussians),
 // so the filters run as a horizontal then a vertical pass with clamp-to-edge borders, as the
 // reference code's BORDER_REPLICATE.
+#include "drift/math.h"
 #include "metric_internal.h"
 
 #include <math.h>
 
-#include "drift/math.h"
-
 #define FLIP_PI_D 3.14159265358979323846
-#define FLIP_QC 0.7f
-#define FLIP_QF 0.5f
-#define FLIP_PC 0.4f
-#define FLIP_PT 0.95f
+#define FLIP_QC   0.7f
+#define FLIP_QF   0.5f
+#define FLIP_PC   0.4f
+#define FLIP_PT   0.95f
 // Peak-to-trough width of the human edge detection filter, in degrees (§4.2).
 #define FLIP_FEATURE_W 0.082
 
 // CSF parameters (Table 1): a1, b1, a2, b2 per channel; the achromatic and red-green CSFs are
 // single Gaussians (a2 = 0).
-#define CSF_A_B1 0.0047
+#define CSF_A_B1  0.0047
 #define CSF_RG_B1 0.0053
 #define CSF_BY_A1 34.1
 #define CSF_BY_B1 0.04
@@ -50,8 +49,8 @@ static const float rgb_to_xyz[9] = {
     1425312.0f / 73733382.0f,  8788810.0f / 73733382.0f, 70074185.0f / 73733382.0f,
 };
 static const float xyz_to_rgb[9] = {
-    3.241003275f,  -1.537398934f, -0.498615861f, -0.969224334f, 1.875930071f,
-    0.041554224f,  0.055639423f,  -0.204011202f, 1.057148933f,
+    3.241003275f, -1.537398934f, -0.498615861f, -0.969224334f, 1.875930071f,
+    0.041554224f, 0.055639423f,  -0.204011202f, 1.057148933f,
 };
 static const float white_xyz[3] = { 0.950428545f, 1.0f, 1.088900371f };
 

@@ -21,8 +21,8 @@ drift_result drift__metric_check_pair(drift_context *ctx, const drift_image *ref
                                       const drift_image *test, const char *what)
 {
     if (!drift_image_is_valid(reference) || !drift_image_is_valid(test)) {
-        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, NULL, 0,
-                  "%s: invalid image", what);
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, NULL, 0, "%s: invalid image",
+                  what);
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
     if (reference->width != test->width || reference->height != test->height) {

@@ -8,23 +8,22 @@
 // pixel; at the border the window is cut to the image and its weights renormalised, which
 // keeps images smaller than the window meaningful (Wang's MATLAB code instead drops a 5-pixel
 // border).
+#include "drift/math.h"
 #include "metric_internal.h"
 
 #include <math.h>
 
-#include "drift/math.h"
-
 #define SSIM_RADIUS 5
-#define SSIM_SIGMA 1.5
-#define SSIM_K1 0.01
-#define SSIM_K2 0.03
+#define SSIM_SIGMA  1.5
+#define SSIM_K1     0.01
+#define SSIM_K2     0.03
 
 typedef struct ssim_job {
     const drift_image *ref;
     const drift_image *test;
     int32_t width, height;
-    float *luma_a, *luma_b;                    // display luma planes
-    float *ha, *hb, *haa, *hbb, *hab;          // horizontally filtered moments
+    float *luma_a, *luma_b;           // display luma planes
+    float *ha, *hb, *haa, *hbb, *hab; // horizontally filtered moments
     double weight[2 * SSIM_RADIUS + 1];
 } ssim_job;
 
@@ -123,8 +122,9 @@ drift_result drift_metric_ssim(drift_context *ctx, const drift_image *reference,
     if (r != DRIFT_OK) {
         return r;
     }
-    ssim_job j = { .ref = reference, .test = test, .width = reference->width,
-                   .height = reference->height };
+    ssim_job j = {
+        .ref = reference, .test = test, .width = reference->width, .height = reference->height
+    };
     for (int k = -SSIM_RADIUS; k <= SSIM_RADIUS; ++k) {
         j.weight[k + SSIM_RADIUS] = exp(-(double)(k * k) / (2.0 * SSIM_SIGMA * SSIM_SIGMA));
     }

@@ -20,8 +20,8 @@ struct drift_pt {
     const drift_accel *accel;
     drift_pt_params params;
     drift_camera_frame camera; // params.camera or the scene's, pinhole when asked, per image
-    double *sums;     // SUM_CHANNELS a pixel
-    uint32_t *counts; // samples a pixel
+    double *sums;              // SUM_CHANNELS a pixel
+    uint32_t *counts;          // samples a pixel
     thread_stats *thread_stats;
     int thread_count;
     drift_image resolved[DRIFT_PT_AOV_COUNT];
@@ -243,8 +243,8 @@ static float emission_weight(const drift_pt *pt, bool prev_specular, float bsdf_
     return drift_power_heuristic(bsdf_pdf, light_pdf);
 }
 
-static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample,
-                       path_result *out, thread_stats *stats)
+static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample, path_result *out,
+                       thread_stats *stats)
 {
     const drift_scene *scene = pt->scene;
     const drift_pt_params *p = &pt->params;
@@ -270,8 +270,8 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
         if (!drift_accel_intersect(pt->accel, &ray, &hit)) {
             if (drift_scene_has_environment(scene)) {
                 drift_vec3 le = drift_environment_eval(scene, ray.dir);
-                float light_pdf = drift_scene_environment_pmf(scene) *
-                                  drift_environment_pdf(scene, ray.dir);
+                float light_pdf =
+                    drift_scene_environment_pmf(scene) * drift_environment_pdf(scene, ray.dir);
                 float w = emission_weight(pt, prev_specular, prev_bsdf_pdf, light_pdf);
                 drift_vec3 c = drift_vec3_scale(drift_vec3_mul(beta, le), w);
                 radiance = drift_vec3_add(radiance, c);
@@ -319,7 +319,8 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
         } else {
             (void)drift_sampler_next2(&sampler); // keep the dimension layout fixed
         }
-        drift_bsdf_sample bs = drift_bsdf_sample_wi(&bsdf, wo, u_choice.y, drift_sampler_next2(&sampler));
+        drift_bsdf_sample bs =
+            drift_bsdf_sample_wi(&bsdf, wo, u_choice.y, drift_sampler_next2(&sampler));
         float u_rr = drift_sampler_next1(&sampler);
         if (!(bs.pdf > 0.0f) || drift_vec3_is_zero(bs.weight)) {
             break;

@@ -8,10 +8,11 @@
 #define TILE 16
 
 // Planes in the order of drift_gbuffer, with their channel counts.
-#define GBUFFER_PLANES(X)                                                                      \
-    X(depth, 1)                                                                                \
-    X(position, 3) X(normal, 3) X(geometric_normal, 3) X(albedo, 3) X(specular, 3) X(gloss, 3) \
-        X(material_id, 1) X(emission, 3) X(motion, 2)
+// clang-format off (clang-format 14 rewraps this list differently on every run)
+#define GBUFFER_PLANES(X) \
+    X(depth, 1) X(position, 3) X(normal, 3) X(geometric_normal, 3) X(albedo, 3) \
+    X(specular, 3) X(gloss, 3) X(material_id, 1) X(emission, 3) X(motion, 2)
+// clang-format on
 
 drift_result drift_gbuffer_create(drift_context *ctx, int32_t width, int32_t height,
                                   drift_gbuffer *out)

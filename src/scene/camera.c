@@ -31,16 +31,17 @@ drift_ray drift_camera_frame_ray(const drift_camera_frame *f, float film_x, floa
     const drift_camera *camera = &f->camera;
     float sx = (2.0f * film_x / (float)f->width - 1.0f) * f->tan_half * f->aspect;
     float sy = (1.0f - 2.0f * film_y / (float)f->height) * f->tan_half;
-    drift_vec3 dir = drift_vec3_add(f->w, drift_vec3_add(drift_vec3_scale(f->u, sx), drift_vec3_scale(f->v, sy)));
+    drift_vec3 dir = drift_vec3_add(
+        f->w, drift_vec3_add(drift_vec3_scale(f->u, sx), drift_vec3_scale(f->v, sy)));
     drift_ray ray = { .origin = camera->position, .tmin = 0.0f, .tmax = INFINITY };
     if (camera->aperture_radius > 0.0f) {
         // Thin lens: every ray through the lens meets the pinhole ray on the focus plane.
         drift_vec3 focus_point = drift_vec3_fma(camera->position, dir, f->focus);
         drift_vec2 d = drift_sample_disk_concentric(lens);
-        drift_vec3 lens_point = drift_vec3_add(
-            camera->position,
-            drift_vec3_add(drift_vec3_scale(f->u, d.x * camera->aperture_radius),
-                           drift_vec3_scale(f->v, d.y * camera->aperture_radius)));
+        drift_vec3 lens_point =
+            drift_vec3_add(camera->position,
+                           drift_vec3_add(drift_vec3_scale(f->u, d.x * camera->aperture_radius),
+                                          drift_vec3_scale(f->v, d.y * camera->aperture_radius)));
         ray.origin = lens_point;
         dir = drift_vec3_sub(focus_point, lens_point);
     }

@@ -2,9 +2,9 @@
 //
 // Lat-long mapping (docs/conventions.md): theta = acos(dir.y) from +y, phi = atan2(-dir.z,
 // dir.x) in [0, 2 pi); u = phi / (2 pi), v = theta / pi with v = 0 the top image row.
-#include <math.h>
-
 #include "scene_internal.h"
+
+#include <math.h>
 
 bool drift_scene_has_environment(const drift_scene *scene)
 {
@@ -152,8 +152,8 @@ static int32_t sample_cdf(const float *cdf, int32_t n, float u, float *out_offse
         }
     }
     float width = cdf[lo + 1] - cdf[lo];
-    *out_offset = width > 0.0f ? drift_clampf((u - cdf[lo]) / width, 0.0f, DRIFT_ONE_MINUS_EPSILON)
-                               : 0.5f;
+    *out_offset =
+        width > 0.0f ? drift_clampf((u - cdf[lo]) / width, 0.0f, DRIFT_ONE_MINUS_EPSILON) : 0.5f;
     return lo;
 }
 

@@ -1,16 +1,15 @@
 // Light selection and sampling: a power-proportional pick over the scene's lights and the
 // environment, then a point (or direction) on the picked light with its solid-angle pdf.
 #include "drift/scene.h"
+#include "scene_internal.h"
 
 #include <math.h>
 
-#include "scene_internal.h"
-
 struct drift_light_table {
-    float *cdf;        // entry_count + 1 values, cdf[0] = 0, cdf[entry_count] = 1
+    float *cdf;           // entry_count + 1 values, cdf[0] = 0, cdf[entry_count] = 1
     uint32_t entry_count; // light_count, plus one for the environment when present
     bool has_environment;
-    float environment_radius; // radius of the scene's bounding sphere (for env power)
+    float environment_radius;             // radius of the scene's bounding sphere (for env power)
     drift__env_distribution *environment; // NULL for a constant environment
     // Per light, fixed after commit, so sampling does not recompute them: 1 / area (0 for
     // delta lights) and the emitting normal (unused for spheres, whose normal varies).
@@ -49,7 +48,8 @@ static float light_area(const drift_scene *scene, const drift_light *l)
     case DRIFT_LIGHT_TRIANGLE: {
         drift_vec3 a, b, c;
         drift_light_triangle_vertices(scene, l, &a, &b, &c);
-        return 0.5f * drift_vec3_length(drift_vec3_cross(drift_vec3_sub(b, a), drift_vec3_sub(c, a)));
+        return 0.5f *
+               drift_vec3_length(drift_vec3_cross(drift_vec3_sub(b, a), drift_vec3_sub(c, a)));
     }
     case DRIFT_LIGHT_POINT:
     case DRIFT_LIGHT_SPOT:
@@ -155,13 +155,15 @@ drift_result drift__light_table_build(drift_scene *scene)
     }
     if (table->has_environment) {
         float env_r = table->environment_radius;
-        total += (double)(DRIFT_PI * DRIFT_PI * env_r * env_r * 4.0f * drift__environment_average(scene));
+        total += (double)(DRIFT_PI * DRIFT_PI * env_r * env_r * 4.0f *
+                          drift__environment_average(scene));
         running[table->entry_count] = total;
     }
     for (uint32_t i = 0; i <= table->entry_count; ++i) {
         // All-black lights: fall back to a uniform pick rather than divide by zero.
-        table->cdf[i] = total > 0.0 ? (float)(running[i] / total)
-                                    : (float)i / (float)(table->entry_count ? table->entry_count : 1);
+        table->cdf[i] = total > 0.0
+                            ? (float)(running[i] / total)
+                            : (float)i / (float)(table->entry_count ? table->entry_count : 1);
     }
     if (table->entry_count > 0) {
         table->cdf[table->entry_count] = 1.0f;
@@ -314,15 +316,17 @@ drift_light_sample drift_light_sample_li(const drift_scene *scene, uint32_t ligh
         s.is_delta = true;
         return s;
     case DRIFT_LIGHT_QUAD: {
-        drift_vec3 p = drift_vec3_add(l->position, drift_vec3_add(drift_vec3_scale(l->edge_u, u.x),
-                                                                  drift_vec3_scale(l->edge_v, u.y)));
+        drift_vec3 p =
+            drift_vec3_add(l->position, drift_vec3_add(drift_vec3_scale(l->edge_u, u.x),
+                                                       drift_vec3_scale(l->edge_v, u.y)));
         return sample_area_point(scene, light, ref, p);
     }
     case DRIFT_LIGHT_DISK: {
         drift_frame f = drift_frame_from_normal(l->direction);
         drift_vec2 d = drift_sample_disk_concentric(u);
         drift_vec3 p = drift_vec3_add(
-            l->position, drift_frame_to_world(&f, drift_vec3_make(d.x * l->radius, d.y * l->radius, 0)));
+            l->position,
+            drift_frame_to_world(&f, drift_vec3_make(d.x * l->radius, d.y * l->radius, 0)));
         return sample_area_point(scene, light, ref, p);
     }
     case DRIFT_LIGHT_SPHERE: {
@@ -355,9 +359,9 @@ drift_light_sample drift_light_sample_li(const drift_scene *scene, uint32_t ligh
         drift_vec3 a, b, c;
         drift_light_triangle_vertices(scene, l, &a, &b, &c);
         drift_vec2 bary = drift_sample_triangle(u);
-        drift_vec3 p = drift_vec3_add(drift_vec3_scale(a, 1.0f - bary.x - bary.y),
-                                      drift_vec3_add(drift_vec3_scale(b, bary.x),
-                                                     drift_vec3_scale(c, bary.y)));
+        drift_vec3 p = drift_vec3_add(
+            drift_vec3_scale(a, 1.0f - bary.x - bary.y),
+            drift_vec3_add(drift_vec3_scale(b, bary.x), drift_vec3_scale(c, bary.y)));
         return sample_area_point(scene, light, ref, p);
     }
     case DRIFT_LIGHT_COUNT:

@@ -1,10 +1,10 @@
 #include "drift/scene.h"
 
+#include "scene_internal.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
-
-#include "scene_internal.h"
 
 drift_result drift_scene_create(drift_context *ctx, drift_scene **out_scene)
 {
@@ -133,8 +133,7 @@ drift_result drift_scene_add_mesh(drift_scene *scene, const drift_mesh_desc *des
     }
     if (desc->material >= scene->material_count) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, name, 0,
-                  "material %u out of range (scene has %u)", desc->material,
-                  scene->material_count);
+                  "material %u out of range (scene has %u)", desc->material, scene->material_count);
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
 
@@ -143,12 +142,12 @@ drift_result drift_scene_add_mesh(drift_scene *scene, const drift_mesh_desc *des
                         .first_light = DRIFT_INVALID_INDEX };
     snprintf(mesh.name, sizeof(mesh.name), "%s", name);
     // One padding float: Embree reads 16 bytes for the last vertex (buffer_padding.md).
-    mesh.positions = copy_array(ctx, desc->positions, (size_t)desc->vertex_count * 3,
-                                sizeof(float), sizeof(float));
+    mesh.positions = copy_array(ctx, desc->positions, (size_t)desc->vertex_count * 3, sizeof(float),
+                                sizeof(float));
     mesh.indices = copy_array(ctx, NULL, (size_t)desc->triangle_count * 3, sizeof(uint32_t), 0);
     if (desc->normals) {
-        mesh.normals = copy_array(ctx, desc->normals, (size_t)desc->vertex_count * 3,
-                                  sizeof(float), 0);
+        mesh.normals =
+            copy_array(ctx, desc->normals, (size_t)desc->vertex_count * 3, sizeof(float), 0);
     }
     if (desc->uvs) {
         mesh.uvs = copy_array(ctx, desc->uvs, (size_t)desc->vertex_count * 2, sizeof(float), 0);
@@ -194,8 +193,8 @@ drift_result drift_scene_add_mesh(drift_scene *scene, const drift_mesh_desc *des
         }
     }
     uint32_t index;
-    drift_result r = push_back(ctx, (void **)&scene->meshes, &scene->mesh_count,
-                               sizeof(drift_mesh), UINT32_MAX - 1, &index);
+    drift_result r = push_back(ctx, (void **)&scene->meshes, &scene->mesh_count, sizeof(drift_mesh),
+                               UINT32_MAX - 1, &index);
     if (r != DRIFT_OK) {
         free_mesh(ctx, &mesh);
         return r;
@@ -424,8 +423,8 @@ drift_result drift_scene_commit(drift_scene *scene)
         cam->width > DRIFT_IMAGE_MAX_DIMENSION || cam->height > DRIFT_IMAGE_MAX_DIMENSION ||
         !drift_vec3_is_finite(cam->position) || !drift_vec3_is_finite(cam->target) ||
         drift_vec3_length(drift_vec3_sub(cam->target, cam->position)) <= 0.0f ||
-        drift_vec3_length(drift_vec3_cross(drift_vec3_sub(cam->target, cam->position),
-                                           cam->up)) <= 0.0f) {
+        drift_vec3_length(drift_vec3_cross(drift_vec3_sub(cam->target, cam->position), cam->up)) <=
+            0.0f) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, NULL, 0,
                   "camera is invalid (fov in (0, pi), non-negative aperture and focus, image size "
                   "1..%d, target != position, up not parallel to the view direction)",
@@ -473,10 +472,9 @@ drift_result drift_scene_commit(drift_scene *scene)
             if (r != DRIFT_OK) {
                 return r;
             }
-            scene->lights[index] = (drift_light){ .type = DRIFT_LIGHT_TRIANGLE,
-                                                  .color = mat->emission,
-                                                  .mesh = m,
-                                                  .triangle = t };
+            scene->lights[index] = (drift_light){
+                .type = DRIFT_LIGHT_TRIANGLE, .color = mat->emission, .mesh = m, .triangle = t
+            };
         }
     }
     drift_result r = drift__light_table_build(scene);

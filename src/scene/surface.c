@@ -1,7 +1,7 @@
 // Surface reconstruction from a hit: position, normals, uv, material and emission.
-#include <math.h>
-
 #include "scene_internal.h"
+
+#include <math.h>
 
 static drift_vec3 load3(const float *a, uint32_t i)
 {
@@ -38,7 +38,8 @@ drift_surface drift_scene_surface(const drift_scene *scene, const drift_ray *ray
         drift_vec3 c = load3(mesh->positions, tri[2]);
         // Barycentric interpolation is more precise than origin + t * dir far from the origin.
         s.position = lerp3(a, b, c, hit->u, hit->v);
-        drift_vec3 ng = drift_vec3_normalize(drift_vec3_cross(drift_vec3_sub(b, a), drift_vec3_sub(c, a)));
+        drift_vec3 ng =
+            drift_vec3_normalize(drift_vec3_cross(drift_vec3_sub(b, a), drift_vec3_sub(c, a)));
         drift_vec3 ns = ng;
         if (mesh->normals) {
             drift_vec3 n = lerp3(load3(mesh->normals, tri[0]), load3(mesh->normals, tri[1]),
@@ -52,7 +53,8 @@ drift_surface drift_scene_surface(const drift_scene *scene, const drift_ray *ray
             const float *t = mesh->uvs;
             float w = 1.0f - hit->u - hit->v;
             s.uv.x = w * t[2 * tri[0]] + hit->u * t[2 * tri[1]] + hit->v * t[2 * tri[2]];
-            s.uv.y = w * t[2 * tri[0] + 1] + hit->u * t[2 * tri[1] + 1] + hit->v * t[2 * tri[2] + 1];
+            s.uv.y =
+                w * t[2 * tri[0] + 1] + hit->u * t[2 * tri[1] + 1] + hit->v * t[2 * tri[2] + 1];
         } else {
             s.uv = drift_vec2_make(hit->u, hit->v);
         }

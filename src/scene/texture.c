@@ -1,6 +1,6 @@
-#include <math.h>
-
 #include "scene_internal.h"
+
+#include <math.h>
 
 static int32_t wrap(int32_t i, int32_t n)
 {

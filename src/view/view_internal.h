@@ -43,7 +43,7 @@ struct drift_view {
     bool overlay, help;
     char *help_text;
 
-    drift_refine *sir;             // NULL unless the view refines (desc.refine)
+    drift_refine *sir;       // NULL unless the view refines (desc.refine)
     drift_camera sir_camera; // the camera of the last sort: a move (or new techniques,
     bool sir_dirty;          // sir_dirty) re-sorts, a standing view keeps refining
     bool sir_begun;

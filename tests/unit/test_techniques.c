@@ -154,6 +154,7 @@ static void test_rows_are_consistent(void **state)
 }
 
 static int freed;
+
 static void count_free(drift_context *ctx, void *data)
 {
     drift_free(ctx, data);
