@@ -8,7 +8,8 @@
 #define TILE 16
 
 // Planes in the order of drift_gbuffer, with their channel counts.
-// clang-format off (clang-format 14 rewraps this list differently on every run)
+// (clang-format 14 rewraps this list differently on every run.)
+// clang-format off
 #define GBUFFER_PLANES(X) \
     X(depth, 1) X(position, 3) X(normal, 3) X(geometric_normal, 3) X(albedo, 3) \
     X(specular, 3) X(gloss, 3) X(material_id, 1) X(emission, 3) X(motion, 2)
