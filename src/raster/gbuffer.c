@@ -13,6 +13,7 @@
 #define GBUFFER_PLANES(X) \
     X(depth, 1) X(position, 3) X(normal, 3) X(geometric_normal, 3) X(albedo, 3) \
     X(specular, 3) X(gloss, 3) X(material_id, 1) X(emission, 3) X(motion, 2)
+
 // clang-format on
 
 drift_result drift_gbuffer_create(drift_context *ctx, int32_t width, int32_t height,
