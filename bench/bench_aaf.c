@@ -201,7 +201,7 @@ static drift_hybrid_params effect_params(drift_effect effect, int technique, con
                               .spp = (uint32_t)spp,
                               .seed = 11,
                               .light_samples = (uint32_t)o->light_samples,
-                              .aaf_random = o->random };
+                              .aaf.random = o->random };
     drift_hybrid_params_set_technique(&p, effect, technique);
     return p;
 }
@@ -260,7 +260,7 @@ static drift_result measure(drift_context *ctx, const drift_scene *scene, const 
             }
             long spp = method == 0 ? o->spps[k] : o->mc_spps[k];
             p = effect_params(effect, aaf, o, spp);
-            p.aaf_uniform = p.aaf_unfiltered = method == 1;
+            p.aaf.uniform = p.aaf.unfiltered = method == 1;
             r = render(ctx, scene, accel, &p, &frame);
             if (r != DRIFT_OK) {
                 break;

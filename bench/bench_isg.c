@@ -132,8 +132,8 @@ static drift_result timing_table(const bench_ctx *b, drift_effect effect, double
     *out_base = HUGE_VAL;
     for (int g = 0; g < 4; ++g) {
         for (int s = 0; s < 4; ++s) {
-            p.isg_search = counts[s];
-            p.isg_gather = counts[g];
+            p.isg.search = counts[s];
+            p.isg.gather = counts[g];
             // The least of N frames: other processes on the machine only ever add time.
             table[g][s] = HUGE_VAL;
             for (long k = 0; k < o->frames; ++k) {
@@ -202,12 +202,12 @@ static drift_result quality(const bench_ctx *b, drift_effect effect, quality_row
         drift_hybrid_params p = effect_params(
             effect, cheap || layers ? isg_technique(effect)
                                     : drift_technique_parse(effect, names[effect][t]));
-        p.isg_layers = layers ? 2 : 1;
+        p.isg.layers = layers ? 2 : 1;
         p.width = ref.width;
         p.height = ref.height;
         p.spp = ref.spp; // the DOF runs' path-traced shadows
-        p.isg_search = cheap ? 9 : (int32_t)o->search;
-        p.isg_gather = cheap ? 9 : (int32_t)o->gather;
+        p.isg.search = cheap ? 9 : (int32_t)o->search;
+        p.isg.gather = cheap ? 9 : (int32_t)o->gather;
         drift_image test = { 0 };
         // Warm for timing (shadow maps and probes are cached), except around path tracing.
         r = render(b, p, effect != DRIFT_EFFECT_DOF, &st, &test);

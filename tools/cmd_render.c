@@ -71,11 +71,11 @@ static bool parse_probe(const char *cmd, const char *flag, const char *v, void *
 {
     drift_hybrid_params *h = field;
     if (strcmp(v, "object") == 0) {
-        h->probe_per_object = true;
+        h->envmap.per_object = true;
         return true;
     }
-    h->has_probe = true;
-    return cli_parse_vec3(cmd, flag, v, true, &h->probe);
+    h->envmap.has_probe = true;
+    return cli_parse_vec3(cmd, flag, v, true, &h->envmap.probe);
 }
 
 static bool parse_ambient(const char *cmd, const char *flag, const char *v, void *field)
@@ -157,10 +157,11 @@ static const cli_option render_table[] = {
              "pixel on average (shadows: per area light)"),
     CLI_INT("--light-samples", "N", O, hybrid.light_samples, 1, 4096,
             "samples per area light for unshadowed light (default 8)"),
-    CLI_INT("--shadow-map-size", "N", O, hybrid.shadow_map_size, 1, 8192,
+    CLI_INT("--shadow-map-size", "N", O, hybrid.shadow_map.size, 1, 8192,
             "texels a cube face (default 512)"),
-    CLI_INT("--pcf-kernel", "K", O, hybrid.pcf_kernel, 1, 63, "PCF texels across (default 3)"),
-    CLI_INT("--envmap-size", "N", O, hybrid.envmap_size, 1, 4096,
+    CLI_INT("--pcf-kernel", "K", O, hybrid.shadow_map.pcf_kernel, 1, 63,
+            "PCF texels across (default 3)"),
+    CLI_INT("--envmap-size", "N", O, hybrid.envmap.size, 1, 4096,
             "texels a cube face (default 128)"),
     CLI_CUSTOM("--probe", "X,Y,Z|object", O, hybrid, parse_probe,
                "environment-map probe: a point, or one per reflective mesh\n"
@@ -171,27 +172,27 @@ static const cli_option render_table[] = {
                "lens radius in scene units (default: the scene camera's)"),
     CLI_NUMBER("--focus-distance", "F", O, focus_distance, 1e-30, 1e30,
                "distance to the plane in focus (default: the camera's)"),
-    CLI_CUSTOM("--isg-search", "N", O, hybrid.isg_search, parse_isg_count,
+    CLI_CUSTOM("--isg-search", "N", O, hybrid.isg.search, parse_isg_count,
                "image space gathering (docs/isg.md): parameter-search"),
-    CLI_CUSTOM("--isg-gather", "M", O, hybrid.isg_gather, parse_isg_count,
+    CLI_CUSTOM("--isg-gather", "M", O, hybrid.isg.gather, parse_isg_count,
                "and gather samples, perfect squares (default 25 and 49)"),
-    CLI_NUMBER("--isg-sigma", "S", O, hybrid.isg_sigma, 1e-30, 1e30,
+    CLI_NUMBER("--isg-sigma", "S", O, hybrid.isg.sigma, 1e-30, 1e30,
                "range sigma of eq. 6 and 10, squared scene units\n"
                "(default (0.02 x scene diagonal)^2)"),
-    CLI_NUMBER("--blur-radius", "R", O, hybrid.blur_radius, 1e-30, 1024.0,
+    CLI_NUMBER("--blur-radius", "R", O, hybrid.isg.blur_radius, 1e-30, 1024.0,
                "disk radius in pixels of the blur baselines (default 4)"),
-    CLI_INT("--isg-layers", "1|2", O, hybrid.isg_layers, 1, 2,
+    CLI_INT("--isg-layers", "1|2", O, hybrid.isg.layers, 1, 2,
             "2: a second depth layer behind objects for --dof isg"),
-    CLI_CHOICE("--isg-range", "full|plane", O, hybrid.isg_range_plane, "full|plane",
+    CLI_CHOICE("--isg-range", "full|plane", O, hybrid.isg.range_plane, "full|plane",
                "l of the range functions: world distance (default, the\n"
                "paper) or distance to the centre's tangent plane"),
-    CLI_INT("--aaf-max-spp", "N", O, hybrid.aaf_max_spp, 1, 65536,
+    CLI_INT("--aaf-max-spp", "N", O, hybrid.aaf.max_spp, 1, 65536,
             "cap on AAF's adaptive samples a pixel (default 8 x spp)"),
-    CLI_CHOICE("--aaf-sampling", "M", O, hybrid.aaf_uniform, "adaptive|uniform",
+    CLI_CHOICE("--aaf-sampling", "M", O, hybrid.aaf.uniform, "adaptive|uniform",
                "adaptive (default) or uniform: spp in every pixel"),
-    CLI_CHOICE("--aaf-filter", "on|off", O, hybrid.aaf_unfiltered, "on|off",
+    CLI_CHOICE("--aaf-filter", "on|off", O, hybrid.aaf.unfiltered, "on|off",
                "off: AAF's unfiltered estimate (with uniform: plain MC)"),
-    CLI_CHOICE("--aaf-sampler", "S", O, hybrid.aaf_random, "sobol|random",
+    CLI_CHOICE("--aaf-sampler", "S", O, hybrid.aaf.random, "sobol|random",
                "sobol (default: Owen-scrambled Sobol) or random (independent\n"
                "uniform numbers, the paper's Monte Carlo)"),
 

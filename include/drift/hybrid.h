@@ -70,6 +70,63 @@ int drift_technique_parse(drift_effect effect, const char *name);
 
 // --- PARAMETERS ---
 
+// Each technique family's settings, nested in drift_hybrid_params; 0 (false) picks the default,
+// and each family resolves and checks its own (src/realtime, src/isg, src/aaf).
+
+// Shadow maps (pcf, pcss, and SIR's penumbra metric):
+//   size       = 0 -> 512 texels a cube face
+//   bias       = 0 -> 1.5 texels (the depth bias, scaled by the texel footprint)
+//   pcf_kernel = 0 -> 3 (texels across; 1 = a single tap)
+typedef struct drift_shadow_map_settings {
+    int32_t size;
+    float bias;
+    int32_t pcf_kernel;
+} drift_shadow_map_settings;
+
+// Environment-map reflections (envmap):
+//   size       = 0 -> 128 texels a cube face
+//   per_object = false: one probe at the scene centre (or `probe` when has_probe); true: one
+//                probe at the centre of every reflective mesh
+typedef struct drift_envmap_settings {
+    int32_t size;
+    bool has_probe;
+    drift_vec3 probe;
+    bool per_object;
+} drift_envmap_settings;
+
+// Image space gathering (docs/isg.md):
+//   search, gather = 0 -> 25, 49 samples (perfect squares 1..1024: 9, 25, 49, 81)
+//   sigma       = 0 -> (0.02 x scene diagonal)^2, sigma of eq. 6 and 10 in squared scene units
+//   a, b        = 0 -> 1 and 100 sigma (eq. 10: a normal difference n = 0.1 costs 1/e)
+//   blur_radius = 0 -> 4 pixels, the disk of the `blur` baselines
+//   layers      = 0 -> 1; 2 adds a second depth layer (one more ray a pixel) that ISG depth of
+//                 field reads behind foreground objects
+//   range_plane = false: l of eq. 7 and 11 is the world distance (the paper); true: the
+//                 distance to the centre's tangent plane (docs/isg.md)
+typedef struct drift_isg_settings {
+    int32_t search;
+    int32_t gather;
+    float sigma;
+    float a, b;
+    float blur_radius;
+    int32_t layers;
+    bool range_plane;
+} drift_isg_settings;
+
+// Axis-aligned filtering (docs/aaf.md):
+//   max_spp    = 0 -> 8 x spp (at most 4096): the cap on AAF's adaptive n(x)
+//   uniform    = false: AAF samples adaptively; true: every pixel takes spp samples
+//   unfiltered = false: AAF filters; true: the noisy estimate is used as it is (both true:
+//                plain Monte Carlo with AAF's sampler, the benchmark baseline)
+//   random     = false: AAF's samples are Owen-scrambled Sobol points; true: independent
+//                uniform random numbers (the paper's traditional Monte Carlo sampling)
+typedef struct drift_aaf_settings {
+    uint32_t max_spp;
+    bool uniform;
+    bool unfiltered;
+    bool random;
+} drift_aaf_settings;
+
 // How to build a frame. The default configuration is:
 //   width, height    = 0 -> the scene camera's size
 //   techniques       = hard shadows, no reflections, no depth of field, no indirect light
@@ -78,18 +135,8 @@ int drift_technique_parse(drift_effect effect, const char *name);
 //   max_depth        = 0 -> 2 for reference reflections and indirect light (pt convention:
 //                      2 = one bounce, what the sharp buffers can capture)
 //   light_samples    = 0 -> 8 samples per area light for the unshadowed light U_l
-//   shadow_map_size  = 0 -> 512 texels a cube face
-//   shadow_bias      = 0 -> 1.5 texels (the depth bias, scaled by the texel footprint)
-//   pcf_kernel       = 0 -> 3 (texels across; 1 = a single tap)
-//   envmap_size      = 0 -> 128 texels a cube face
-//   probe_per_object = false: one probe at the scene centre (or `probe` when has_probe)
 //   ambient          = used when has_ambient; otherwise the mean direct radiance of the frame
-//   aaf_max_spp      = 0 -> 8 x spp (at most 4096): the cap on AAF's adaptive n(x)
-//   aaf_uniform      = false: AAF samples adaptively; true: every pixel takes spp samples
-//   aaf_unfiltered   = false: AAF filters; true: the noisy estimate is used as it is
-//                      (both true: plain Monte Carlo with AAF's sampler, the benchmark baseline)
-//   aaf_random       = false: AAF's samples are Owen-scrambled Sobol points; true: independent
-//                      uniform random numbers (the paper's traditional Monte Carlo sampling)
+//   shadow_map, envmap, isg, aaf: each family's settings (above)
 #define DRIFT_TECHNIQUE_FIELD_(ENUM, name, type, TECHNIQUES, kind, plane) \
     drift_##type##_technique name;
 
@@ -110,35 +157,12 @@ typedef struct drift_hybrid_params {
     uint32_t spp;
     int32_t max_depth;
     uint32_t light_samples;
-    int32_t shadow_map_size;
-    float shadow_bias;
-    int32_t pcf_kernel;
-    int32_t envmap_size;
-    bool has_probe;
-    drift_vec3 probe;
-    bool probe_per_object;
     bool has_ambient;
     drift_vec3 ambient;
-    // Image space gathering (docs/isg.md); 0 picks the default:
-    //   isg_search, isg_gather = 0 -> 25, 49 samples (perfect squares 1..1024: 9, 25, 49, 81)
-    //   isg_sigma = 0 -> (0.02 x scene diagonal)^2, sigma of eq. 6 and 10 in squared scene units
-    //   isg_a, isg_b = 0 -> 1 and 100 sigma (eq. 10: a normal difference n = 0.1 costs 1/e)
-    //   blur_radius = 0 -> 4 pixels, the disk of the `blur` baselines
-    //   isg_layers = 0 -> 1; 2 adds a second depth layer (one more ray a pixel) that ISG depth
-    //                of field reads behind foreground objects
-    //   isg_range_plane = false: l of eq. 7 and 11 is the world distance (the paper); true: the
-    //                distance to the centre's tangent plane (docs/isg.md)
-    int32_t isg_search;
-    int32_t isg_gather;
-    float isg_sigma;
-    float isg_a, isg_b;
-    float blur_radius;
-    int32_t isg_layers;
-    bool isg_range_plane;
-    uint32_t aaf_max_spp;
-    bool aaf_uniform;
-    bool aaf_unfiltered;
-    bool aaf_random;
+    drift_shadow_map_settings shadow_map;
+    drift_envmap_settings envmap;
+    drift_isg_settings isg;
+    drift_aaf_settings aaf;
 } drift_hybrid_params;
 
 drift_hybrid_params drift_hybrid_params_resolve(const drift_hybrid_params *params,

@@ -147,6 +147,11 @@ drift_result drift_aaf_pass_indirect(drift_frame_state *frame, const drift_pass_
 // Fills frame->reflections (--reflections aaf, aaf_specular.c). Needs the G-buffer.
 drift_result drift_aaf_pass_specular(drift_frame_state *frame, const drift_pass_args *args);
 
+// Fills zero settings with their defaults for a frame of `spp` samples a pixel (drift/hybrid.h),
+// and says what is wrong with resolved ones (NULL: nothing).
+void drift_aaf_settings_resolve(drift_aaf_settings *settings, uint32_t spp);
+const char *drift_aaf_settings_problem(const drift_aaf_settings *settings, uint32_t spp);
+
 // The --aov planes of the AAF rows: per light (or per lobe) beta, n(x) and the unfiltered
 // estimate, listed once the buffers exist (aaf_state.c).
 void drift_aaf_shadow_planes(const drift_frame_state *frame, drift_pass_plane_fn add, void *sink);

@@ -264,8 +264,8 @@ drift_result drift_aaf_lobe_pass(drift_frame_state *f, const drift_aaf_lobe *lob
                          .sparse = drift_aaf_sparse_count(f->params.spp),
                          .shrink = drift_aaf_beta_shrink(f->params.spp, lobe->shrink_from_spp,
                                                          lobe->shrink_exponent),
-                         .uniform = f->params.aaf_uniform,
-                         .random = f->params.aaf_random,
+                         .uniform = f->params.aaf.uniform,
+                         .random = f->params.aaf.random,
                          .bounces = f->params.max_depth - 1 };
     double t = drift_time_now();
     if (job.bounces > 0) {
@@ -278,7 +278,7 @@ drift_result drift_aaf_lobe_pass(drift_frame_state *f, const drift_aaf_lobe *lob
         }
         if (!job.uniform) {
             drift_aaf_allocate(st->want, pixels, active, job.sparse, f->params.spp,
-                               f->params.aaf_max_spp, job.key, st->counts);
+                               f->params.aaf.max_spp, job.key, st->counts);
         }
         stats->rays[DRIFT_PASS_AAF_SAMPLING] += drift_pass_for_each_pixel(f, adaptive_pixel, &job);
     } else {
@@ -293,7 +293,7 @@ drift_result drift_aaf_lobe_pass(drift_frame_state *f, const drift_aaf_lobe *lob
     stats->ms[DRIFT_PASS_AAF_SAMPLING] += 1000.0 * (drift_time_now() - t);
 
     t = drift_time_now();
-    if (f->params.aaf_unfiltered) {
+    if (f->params.aaf.unfiltered) {
         drift_pass_copy_rgb(&b->radiance, &b->filtered);
     } else {
         drift_aaf_filter_desc desc = { .beta = &b->beta,

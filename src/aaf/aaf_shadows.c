@@ -289,8 +289,8 @@ drift_result drift_aaf_pass_shadows(drift_frame_state *f, const drift_pass_args 
                            .shrink =
                                drift_aaf_beta_shrink(f->params.spp, DRIFT_AAF_SHADOW_SHRINK_SPP,
                                                      DRIFT_AAF_SHADOW_SHRINK_EXP),
-                           .uniform = f->params.aaf_uniform,
-                           .random = f->params.aaf_random };
+                           .uniform = f->params.aaf.uniform,
+                           .random = f->params.aaf.random };
         job.sigma = DRIFT_AAF_LIGHT_SIGMA * sqrtf(job.area);
         double t = drift_time_now();
         bool area = job.area > 0.0f && light->type != DRIFT_LIGHT_DIRECTIONAL;
@@ -302,7 +302,7 @@ drift_result drift_aaf_pass_shadows(drift_frame_state *f, const drift_pass_args 
             drift_pass_for_each_pixel(f, rates_pixel, &job);
             if (!job.uniform) {
                 drift_aaf_allocate(st->want, pixels, active, job.sparse, f->params.spp,
-                                   f->params.aaf_max_spp, job.key, st->counts);
+                                   f->params.aaf.max_spp, job.key, st->counts);
             }
             stats->rays[DRIFT_PASS_AAF_SAMPLING] +=
                 drift_pass_for_each_pixel(f, adaptive_pixel, &job);
@@ -312,7 +312,7 @@ drift_result drift_aaf_pass_shadows(drift_frame_state *f, const drift_pass_args 
         t = drift_time_now();
         drift_aaf_light *al = &st->lights[l];
         drift_image *shadow = &f->light_buffers[l].shadow;
-        if (!area || f->params.aaf_unfiltered) {
+        if (!area || f->params.aaf.unfiltered) {
             for (int32_t y = 0; y < shadow->height; ++y) {
                 for (int32_t x = 0; x < shadow->width; ++x) {
                     drift_image_pixel(shadow, x, y)[0] =

@@ -113,6 +113,22 @@ drift_result drift_aaf_lobe_buffers_ensure(drift_context *ctx, drift_aaf_lobe_bu
     return r;
 }
 
+// --- SETTINGS ---
+
+void drift_aaf_settings_resolve(drift_aaf_settings *settings, uint32_t spp)
+{
+    if (settings->max_spp == 0) {
+        settings->max_spp = spp > 512 ? 4096 : 8 * spp;
+    }
+}
+
+const char *drift_aaf_settings_problem(const drift_aaf_settings *settings, uint32_t spp)
+{
+    return settings->max_spp < spp || settings->max_spp > 65536
+               ? "aaf max spp below spp or over 65536"
+               : NULL;
+}
+
 // --- PLANES ---
 
 static void lobe_planes(const drift_aaf_lobe_buffers *b, const char *lobe, drift_pass_plane_fn add,

@@ -64,14 +64,9 @@ drift_hybrid_params drift_hybrid_params_resolve(const drift_hybrid_params *param
     p.spp = p.spp ? p.spp : 64;
     p.max_depth = p.max_depth ? p.max_depth : 2;
     p.light_samples = p.light_samples ? p.light_samples : 8;
-    p.shadow_map_size = p.shadow_map_size ? p.shadow_map_size : 512;
-    p.shadow_bias = p.shadow_bias > 0.0f ? p.shadow_bias : 1.5f;
-    p.pcf_kernel = p.pcf_kernel ? p.pcf_kernel : 3;
-    p.envmap_size = p.envmap_size ? p.envmap_size : 128;
-    drift_isg_params_resolve(&p, scene);
-    if (p.aaf_max_spp == 0) {
-        p.aaf_max_spp = p.spp > 512 ? 4096 : 8 * p.spp;
-    }
+    drift_realtime_settings_resolve(&p.shadow_map, &p.envmap);
+    drift_isg_settings_resolve(&p.isg, scene);
+    drift_aaf_settings_resolve(&p.aaf, p.spp);
     return p;
 }
 
@@ -95,19 +90,15 @@ static bool params_valid(const drift_context *ctx, const drift_hybrid_params *p)
         problem = "unknown technique";
     } else if (p->max_depth < 1 || p->max_depth > 1024) {
         problem = "max_depth outside 1..1024";
-    } else if (p->shadow_map_size < 1 || p->shadow_map_size > 8192 || p->envmap_size < 1 ||
-               p->envmap_size > 4096) {
-        problem = "shadow map or environment map size out of range";
-    } else if (p->pcf_kernel < 1 || p->pcf_kernel > 63 || p->light_samples > 4096) {
-        problem = "pcf kernel outside 1..63 or light samples over 4096";
-    } else if (p->aaf_max_spp < p->spp || p->aaf_max_spp > 65536) {
-        problem = "aaf max spp below spp or over 65536";
-    } else if (!isfinite(p->shadow_bias) || (p->has_probe && !drift_vec3_is_finite(p->probe)) ||
-               (p->has_ambient && !drift_vec3_is_finite(p->ambient))) {
-        problem = "non-finite bias, probe or ambient";
-    } else {
-        problem = drift_isg_params_problem(p);
+    } else if (p->light_samples > 4096) {
+        problem = "light samples over 4096";
+    } else if (p->has_ambient && !drift_vec3_is_finite(p->ambient)) {
+        problem = "non-finite ambient";
     }
+    // Then each technique family's own settings.
+    problem = problem ? problem : drift_realtime_settings_problem(&p->shadow_map, &p->envmap);
+    problem = problem ? problem : drift_isg_settings_problem(&p->isg);
+    problem = problem ? problem : drift_aaf_settings_problem(&p->aaf, p->spp);
     if (problem) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, NULL, 0, "hybrid frame: %s",
                   problem);
@@ -269,13 +260,16 @@ drift_result drift_hybrid_set_params(drift_hybrid *h, const drift_hybrid_params 
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
     // Cached maps that depend on a changed setting are rebuilt on next use.
-    if (p.shadow_map_size != f->params.shadow_map_size || p.shadow_bias != f->params.shadow_bias) {
+    if (p.shadow_map.size != f->params.shadow_map.size ||
+        p.shadow_map.bias != f->params.shadow_map.bias) {
         destroy_shadow_maps(f);
     }
-    if (p.envmap_size != f->params.envmap_size || p.has_probe != f->params.has_probe ||
-        p.probe_per_object != f->params.probe_per_object || p.seed != f->params.seed ||
+    if (p.envmap.size != f->params.envmap.size ||
+        p.envmap.has_probe != f->params.envmap.has_probe ||
+        p.envmap.per_object != f->params.envmap.per_object || p.seed != f->params.seed ||
         p.light_samples != f->params.light_samples ||
-        (p.has_probe && !drift_vec3_is_zero(drift_vec3_sub(p.probe, f->params.probe)))) {
+        (p.envmap.has_probe &&
+         !drift_vec3_is_zero(drift_vec3_sub(p.envmap.probe, f->params.envmap.probe)))) {
         destroy_probes(f);
     }
     f->params = p;

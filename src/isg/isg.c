@@ -90,34 +90,34 @@ float drift_isg_gloss_alpha(float theta_max, float eye_distance, float reflected
 
 // --- PARAMETERS ---
 
-void drift_isg_params_resolve(drift_hybrid_params *p, const drift_scene *scene)
+void drift_isg_settings_resolve(drift_isg_settings *s, const drift_scene *scene)
 {
-    p->isg_search = p->isg_search ? p->isg_search : 25;
-    p->isg_gather = p->isg_gather ? p->isg_gather : 49;
-    if (!(p->isg_sigma > 0.0f)) {
+    s->search = s->search ? s->search : 25;
+    s->gather = s->gather ? s->gather : 49;
+    if (!(s->sigma > 0.0f)) {
         float diagonal = 1.0f;
         if (scene && !drift_bounds3_is_empty(scene->bounds)) {
             diagonal = drift_vec3_length(drift_vec3_sub(scene->bounds.max, scene->bounds.min));
         }
         float width = 0.02f * (diagonal > 0.0f ? diagonal : 1.0f);
-        p->isg_sigma = width * width;
+        s->sigma = width * width;
     }
-    p->isg_a = p->isg_a > 0.0f ? p->isg_a : 1.0f;
-    p->isg_b = p->isg_b > 0.0f ? p->isg_b : 100.0f * p->isg_sigma;
-    p->blur_radius = p->blur_radius > 0.0f ? p->blur_radius : 4.0f;
-    p->isg_layers = p->isg_layers ? p->isg_layers : 1;
+    s->a = s->a > 0.0f ? s->a : 1.0f;
+    s->b = s->b > 0.0f ? s->b : 100.0f * s->sigma;
+    s->blur_radius = s->blur_radius > 0.0f ? s->blur_radius : 4.0f;
+    s->layers = s->layers ? s->layers : 1;
 }
 
-const char *drift_isg_params_problem(const drift_hybrid_params *p)
+const char *drift_isg_settings_problem(const drift_isg_settings *s)
 {
-    if (!drift_isg_count_valid(p->isg_search) || !drift_isg_count_valid(p->isg_gather)) {
+    if (!drift_isg_count_valid(s->search) || !drift_isg_count_valid(s->gather)) {
         return "isg search and gather sample counts must be perfect squares in 1..1024";
     }
-    if (!isfinite(p->isg_sigma) || !isfinite(p->isg_a) || !isfinite(p->isg_b) ||
-        !isfinite(p->blur_radius) || p->blur_radius > 1024.0f) {
+    if (!isfinite(s->sigma) || !isfinite(s->a) || !isfinite(s->b) || !isfinite(s->blur_radius) ||
+        s->blur_radius > 1024.0f) {
         return "isg sigma, a, b or blur radius out of range";
     }
-    if (p->isg_layers != 1 && p->isg_layers != 2) {
+    if (s->layers != 1 && s->layers != 2) {
         return "isg layers must be 1 or 2";
     }
     return NULL;
@@ -161,10 +161,10 @@ drift_result drift_isg_prepare(drift_frame_state *f)
         }
     }
     drift_isg_state *s = f->isg;
-    drift_isg_pattern_make((uint32_t)f->params.isg_search, DRIFT_ISG_DISK, &s->search);
-    drift_isg_pattern_make((uint32_t)f->params.isg_gather, DRIFT_ISG_DISK, &s->gather);
-    drift_isg_pattern_make((uint32_t)f->params.isg_search, DRIFT_ISG_RECT, &s->search_rect);
-    drift_isg_pattern_make((uint32_t)f->params.isg_gather, DRIFT_ISG_RECT, &s->gather_rect);
+    drift_isg_pattern_make((uint32_t)f->params.isg.search, DRIFT_ISG_DISK, &s->search);
+    drift_isg_pattern_make((uint32_t)f->params.isg.gather, DRIFT_ISG_DISK, &s->gather);
+    drift_isg_pattern_make((uint32_t)f->params.isg.search, DRIFT_ISG_RECT, &s->search_rect);
+    drift_isg_pattern_make((uint32_t)f->params.isg.gather, DRIFT_ISG_RECT, &s->gather_rect);
     return DRIFT_OK;
 }
 
@@ -210,7 +210,7 @@ void drift_isg_dof_planes(const drift_frame_state *f, drift_pass_plane_fn add, v
         return;
     }
     add(sink, "isg.dof", &f->isg->dof_search);
-    if (f->params.isg_layers == 2) {
+    if (f->params.isg.layers == 2) {
         add(sink, "isg.layer2.depth", &f->isg->layer_depth);
         add(sink, "isg.layer2.colour", &f->isg->layer_colour);
     }

@@ -98,10 +98,10 @@ typedef struct drift_isg_state {
     drift_isg_pattern search, gather, search_rect, gather_rect;
 } drift_isg_state;
 
-// Fills ISG's zero fields with their defaults (hybrid.h) for this scene.
-void drift_isg_params_resolve(drift_hybrid_params *params, const drift_scene *scene);
-// What is wrong with resolved ISG parameters, or NULL.
-const char *drift_isg_params_problem(const drift_hybrid_params *params);
+// Fills ISG's zero settings with their defaults (drift/hybrid.h) for this scene.
+void drift_isg_settings_resolve(drift_isg_settings *settings, const drift_scene *scene);
+// What is wrong with resolved ISG settings, or NULL.
+const char *drift_isg_settings_problem(const drift_isg_settings *settings);
 
 // Creates the state on first use and the patterns for the current parameters.
 drift_result drift_isg_prepare(drift_frame_state *frame);

@@ -107,7 +107,7 @@ static void dof_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays
         return;
     }
     drift_isg_value_fn value = NULL;
-    if (f->params.isg_layers == 2 && rc.c0 >= 1.0f &&
+    if (f->params.isg.layers == 2 && rc.c0 >= 1.0f &&
         drift_image_pixel(&s->layer_depth, x, y)[0] > rc.z0) {
         rc.behind = drift_image_pixel(&s->layer_colour, x, y);
         rc.z_behind = drift_image_pixel(&s->layer_depth, x, y)[0];
@@ -145,7 +145,7 @@ drift_result drift_isg_pass_dof(drift_frame_state *f, const drift_pass_args *arg
             }
         }
     } else {
-        if (f->params.isg_layers == 2) {
+        if (f->params.isg.layers == 2) {
             r = drift_isg_pass_layer(f);
             if (r != DRIFT_OK) {
                 return r;

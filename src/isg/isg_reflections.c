@@ -89,17 +89,19 @@ static void reflection_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_
                      .distance = &f->reflection_distance,
                      .p0 = drift_image_get3(&g->position, x, y),
                      .n0 = drift_image_get3(&g->normal, x, y),
-                     .a_over_sigma = p->isg_a / p->isg_sigma,
-                     .b_over_sigma = p->isg_b / p->isg_sigma,
-                     .plane = p->isg_range_plane,
+                     .a_over_sigma = p->isg.a / p->isg.sigma,
+                     .b_over_sigma = p->isg.b / p->isg.sigma,
+                     .plane = p->isg.range_plane,
                      .x0 = x,
                      .y0 = y };
     uint32_t hash = drift_hash_combine(p->seed ^ DRIFT_STREAM_ISG_REFLECTIONS, (uint32_t)index);
     drift_isg_jitter jitter = drift_isg_jitter_make(hash);
     drift_vec3 gathered;
     if (p->reflections == DRIFT_REFLECTIONS_BLUR) {
-        drift_isg_kernel k = { &s->gather, jitter, drift_vec2_make(p->blur_radius, p->blur_radius),
-                               range_lobe, &rc,    NULL };
+        drift_isg_kernel k = {
+            &s->gather, jitter, drift_vec2_make(p->isg.blur_radius, p->isg.blur_radius),
+            range_lobe, &rc,    NULL
+        };
         drift_isg_filter(&k, &f->reflection_reflected, 0, 3, x, y, &gathered.x);
     } else {
         float scale_x = (float)p->width / job->fov_x, scale_y = (float)p->height / job->fov_y;

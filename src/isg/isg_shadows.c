@@ -120,8 +120,8 @@ static void shadow_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *r
                      .material_id = &g->material_id,
                      .p0 = drift_image_get3(&g->position, x, y),
                      .n0 = drift_image_get3(&g->normal, x, y),
-                     .inv_sigma = 1.0f / f->params.isg_sigma,
-                     .plane = f->params.isg_range_plane };
+                     .inv_sigma = 1.0f / f->params.isg.sigma,
+                     .plane = f->params.isg.range_plane };
     for (uint32_t l = 0; l < f->light_count; ++l) {
         drift_frame_light_buffers *b = &f->light_buffers[l];
         const float *hard = drift_image_pixel(&b->hard_shadow, x, y);
@@ -130,7 +130,7 @@ static void shadow_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *r
         rc.hard = &b->hard_shadow;
         drift_isg_jitter jitter = drift_isg_jitter_make(drift_hash_u32(hash + l));
         if (f->params.shadows == DRIFT_SHADOWS_BLUR) {
-            float r = f->params.blur_radius;
+            float r = f->params.isg.blur_radius;
             drift_isg_kernel k = { &s->gather,    jitter, drift_vec2_make(r, r),
                                    range_surface, &rc,    NULL };
             drift_isg_filter(&k, &b->hard_shadow, 0, 1, x, y, shadow);

@@ -91,7 +91,8 @@ static void shadow_filter_pixel(drift_frame_state *f, int32_t x, int32_t y, uint
         float v = 0.0f;
         if (s->material != DRIFT_INVALID_INDEX) {
             v = pcss ? drift_shadow_map_pcss(map, s->position, s->ng, drift_hash_u32(hash + l))
-                     : drift_shadow_map_pcf(map, s->position, s->ng, f->params.pcf_kernel);
+                     : drift_shadow_map_pcf(map, s->position, s->ng,
+                                            f->params.shadow_map.pcf_kernel);
         }
         drift_image_pixel(&f->light_buffers[l].shadow, x, y)[0] = v;
     }
@@ -115,8 +116,8 @@ drift_result drift_realtime_ensure_shadow_map(drift_frame_state *f, uint32_t lig
     if (f->light_buffers[light].shadow_map) {
         return DRIFT_OK; // cached: the scene has not changed
     }
-    drift_shadow_map_params params = { .size = f->params.shadow_map_size,
-                                       .bias_texels = f->params.shadow_bias };
+    drift_shadow_map_params params = { .size = f->params.shadow_map.size,
+                                       .bias_texels = f->params.shadow_map.bias };
     return drift_shadow_map_build(f->ctx, f->scene, f->accel, &f->lights[light], &params,
                                   &f->light_buffers[light].shadow_map, rays);
 }

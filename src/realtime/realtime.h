@@ -8,6 +8,15 @@
 
 #include "frame/frame.h"
 
+// --- SETTINGS (settings.c) ---
+
+// Fills zero settings with their defaults (drift/hybrid.h), and says what is wrong with
+// resolved ones (NULL: nothing).
+void drift_realtime_settings_resolve(drift_shadow_map_settings *shadow_map,
+                                     drift_envmap_settings *envmap);
+const char *drift_realtime_settings_problem(const drift_shadow_map_settings *shadow_map,
+                                            const drift_envmap_settings *envmap);
+
 // --- INPUTS OTHER TECHNIQUES READ TOO (direct.c, reflections.c) ---
 
 // U_l of every light and the ray-traced environment term for every pixel.
@@ -27,8 +36,8 @@ drift_result drift_realtime_capture_probes(drift_frame_state *frame);
 
 // --- TECHNIQUES ---
 
-// S_l by a shadow-map lookup: percentage-closer filtering over params.pcf_kernel texels, or
-// percentage-closer soft shadows (Fernando 2005: blocker search, penumbra estimate, PCF).
+// S_l by a shadow-map lookup: percentage-closer filtering over params.shadow_map.pcf_kernel texels,
+// or percentage-closer soft shadows (Fernando 2005: blocker search, penumbra estimate, PCF).
 drift_result drift_realtime_pass_pcf(drift_frame_state *frame, const drift_pass_args *args);
 drift_result drift_realtime_pass_pcss(drift_frame_state *frame, const drift_pass_args *args);
 // D = sum_l U_l S_l + environment: after any technique that writes S_l.

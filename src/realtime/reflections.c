@@ -113,7 +113,7 @@ static drift_result capture_probes(drift_frame_state *f)
     }
     const drift_scene *scene = f->scene;
     uint32_t count = 1;
-    if (f->params.probe_per_object) {
+    if (f->params.envmap.per_object) {
         count = 0;
         for (uint32_t m = 0; m < scene->mesh_count; ++m) {
             count += mesh_is_reflective(scene, m) ? 1u : 0u;
@@ -128,15 +128,15 @@ static drift_result capture_probes(drift_frame_state *f)
     }
     uint64_t *rays = &f->stats.rays[DRIFT_PASS_ENVMAP];
     uint32_t seed = drift_hash_combine(f->params.seed, DRIFT_STREAM_PROBE);
-    if (!f->params.probe_per_object) {
+    if (!f->params.envmap.per_object) {
         drift_vec3 centre =
-            f->params.has_probe
-                ? f->params.probe
+            f->params.envmap.has_probe
+                ? f->params.envmap.probe
                 : drift_vec3_scale(drift_vec3_add(scene->bounds.min, scene->bounds.max), 0.5f);
         f->probes[0].mesh = DRIFT_INVALID_INDEX;
         f->probe_count = 1;
         return drift_envmap_capture(f->ctx, &f->shading, centre, DRIFT_INVALID_INDEX,
-                                    f->params.envmap_size, seed, &f->probes[0].map, rays);
+                                    f->params.envmap.size, seed, &f->probes[0].map, rays);
     }
     for (uint32_t m = 0; m < scene->mesh_count; ++m) {
         if (!mesh_is_reflective(scene, m)) {
@@ -145,7 +145,7 @@ static drift_result capture_probes(drift_frame_state *f)
         drift_frame_probe *probe = &f->probes[f->probe_count++];
         probe->mesh = m;
         drift_result r = drift_envmap_capture(f->ctx, &f->shading, mesh_centre(scene, m), m,
-                                              f->params.envmap_size, seed, &probe->map, rays);
+                                              f->params.envmap.size, seed, &probe->map, rays);
         if (r != DRIFT_OK) {
             return r;
         }

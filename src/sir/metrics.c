@@ -50,8 +50,8 @@ static drift_vec3 probe_centre(const drift_frame_state *f, uint32_t mesh)
             return drift_envmap_probe(f->probes[i].map);
         }
     }
-    if (f->params.has_probe) {
-        return f->params.probe;
+    if (f->params.envmap.has_probe) {
+        return f->params.envmap.probe;
     }
     return drift_vec3_scale(drift_vec3_add(f->scene->bounds.min, f->scene->bounds.max), 0.5f);
 }
@@ -357,7 +357,7 @@ static void dilate(drift_image *plane, int32_t radius, float *scratch)
 // texel's worth of penumbra edge there spans more pixels than the dilation covered.
 static int32_t shadow_dilation(const drift_frame_state *f)
 {
-    double pixels_per_texel = (double)f->params.height / (double)f->params.shadow_map_size;
+    double pixels_per_texel = (double)f->params.height / (double)f->params.shadow_map.size;
     long radius = lround(2.0 * pixels_per_texel * 512.0 / 600.0);
     return radius > 2 ? (int32_t)radius : 2;
 }

@@ -97,8 +97,8 @@ static void test_shadows_converge(void **state)
         test_rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_AAF,
                                                    .spp = spps[k],
                                                    .seed = 3,
-                                                   .aaf_uniform = true,
-                                                   .aaf_unfiltered = true });
+                                                   .aaf.uniform = true,
+                                                   .aaf.unfiltered = true });
         plain[k] = test_rmse(r.ctx, drift_hybrid_image(r.frame), &truth);
     }
     print_message("shadows rmse aaf %g %g %g, plain MC %g %g %g\n", aaf[0], aaf[1], aaf[2],
@@ -372,7 +372,7 @@ static void test_indirect_converges(void **state)
         drift_hybrid_params p = { .indirect = DRIFT_INDIRECT_AAF, .spp = spps[k], .seed = 5 };
         test_rig_frame(&r, &p);
         aaf[k] = test_rmse(r.ctx, test_rig_plane(&r, "indirect"), &truth);
-        p.aaf_uniform = p.aaf_unfiltered = true;
+        p.aaf.uniform = p.aaf.unfiltered = true;
         test_rig_frame(&r, &p);
         plain[k] = test_rmse(r.ctx, test_rig_plane(&r, "indirect"), &truth);
     }

@@ -359,8 +359,8 @@ static void test_envmap_mirror_sphere_matches_ray_traced(void **state)
                              drift_vec3_make(0, 1, 0), 0.35f, 48, 48);
     test_rig_commit(&r);
     drift_hybrid_params p = { .reflections = DRIFT_REFLECTIONS_SHARP,
-                              .probe_per_object = true,
-                              .envmap_size = 256,
+                              .envmap.per_object = true,
+                              .envmap.size = 256,
                               .light_samples = 64 };
     test_rig_frame(&r, &p);
     drift_image sharp;
@@ -369,9 +369,9 @@ static void test_envmap_mirror_sphere_matches_ray_traced(void **state)
     p.reflections = DRIFT_REFLECTIONS_ENVMAP;
     double at_probe = envmap_difference(&r, &p, &sharp, mirror);
     // The same lookup from a probe far from the sphere sees the room from elsewhere.
-    p.probe_per_object = false;
-    p.has_probe = true;
-    p.probe = drift_vec3_make(6, 6, 6);
+    p.envmap.per_object = false;
+    p.envmap.has_probe = true;
+    p.envmap.probe = drift_vec3_make(6, 6, 6);
     double far_away = envmap_difference(&r, &p, &sharp, mirror);
     print_message("envmap vs sharp: relative difference %g at the probe, %g from afar\n", at_probe,
                   far_away);
@@ -421,7 +421,7 @@ static void render_room_with_threads(int threads, drift_shadow_technique shadows
                                                .reflections = DRIFT_REFLECTIONS_SHARP,
                                                .dof = DRIFT_DOF_POST,
                                                .indirect = DRIFT_INDIRECT_AMBIENT,
-                                               .shadow_map_size = 64 });
+                                               .shadow_map.size = 64 });
     memcpy(out, drift_hybrid_image(r.frame)->pixels, sizeof(float) * 3 * 24 * 24);
     test_rig_destroy(&r);
 }
@@ -538,7 +538,8 @@ static void test_rejects_bad_params(void **state)
                      DRIFT_ERR_INVALID_ARGUMENT);
     assert_null(frame);
     assert_int_equal(drift_hybrid_create(r.ctx, r.scene, r.accel,
-                                         &(drift_hybrid_params){ .pcf_kernel = 200 }, &frame),
+                                         &(drift_hybrid_params){ .shadow_map.pcf_kernel = 200 },
+                                         &frame),
                      DRIFT_ERR_INVALID_ARGUMENT);
     assert_true(capture.errors >= 2);
     assert_int_equal(drift_hybrid_create(r.ctx, r.scene, r.accel, NULL, &frame), DRIFT_OK);

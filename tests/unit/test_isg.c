@@ -126,9 +126,9 @@ static void test_contact_hardening_follows_eq8(void **state)
         // The tangent-plane range: the world distance would also weigh the floor down over
         // the penumbra (docs/isg.md); eq. 8 is what is under test.
         test_rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_ISG,
-                                                   .isg_search = 49,
-                                                   .isg_gather = 81,
-                                                   .isg_range_plane = true });
+                                                   .isg.search = 49,
+                                                   .isg.gather = 81,
+                                                   .isg.range_plane = true });
         double width = measured_penumbra(&r);
         // Eq. 8: the occluder distance d and light distance D along the ray share the ratio
         // h / H, so R_s = L h / (H - h).
@@ -341,8 +341,8 @@ static void test_dof_in_focus_foreground_does_not_bleed(void **state)
     float isg_err = 0.0f, post_err = 0.0f;
     for (int pass = 0; pass < 2; ++pass) {
         test_rig_frame(&r, &(drift_hybrid_params){ .dof = pass ? DRIFT_DOF_POST : DRIFT_DOF_ISG,
-                                                   .isg_search = 81,
-                                                   .isg_gather = 81 });
+                                                   .isg.search = 81,
+                                                   .isg.gather = 81 });
         g = drift_hybrid_gbuffer(r.frame);
         for (int x = 1; x < 64 && edge < 0; ++x) {
             if (fabsf(drift_image_pixel(&g->depth, x - 1, y)[0] -
@@ -371,7 +371,7 @@ static void test_dof_foreground_spreads(void **state)
     build_dof(&r, 0.5f);
     test_rig_commit(&r);
     test_rig_frame(
-        &r, &(drift_hybrid_params){ .dof = DRIFT_DOF_ISG, .isg_search = 81, .isg_gather = 81 });
+        &r, &(drift_hybrid_params){ .dof = DRIFT_DOF_ISG, .isg.search = 81, .isg.gather = 81 });
     const drift_image *focus = test_rig_plane(&r, "focus"), *final = test_rig_plane(&r, "final");
     const drift_image *coc = test_rig_plane(&r, "coc");
     const drift_gbuffer *g = drift_hybrid_gbuffer(r.frame);
@@ -411,7 +411,7 @@ static double bar_error(int layers, const drift_image *reference, test_rig *r)
 {
     test_rig_frame(
         r, &(drift_hybrid_params){
-               .dof = DRIFT_DOF_ISG, .isg_search = 49, .isg_gather = 81, .isg_layers = layers });
+               .dof = DRIFT_DOF_ISG, .isg.search = 49, .isg.gather = 81, .isg.layers = layers });
     const drift_gbuffer *g = drift_hybrid_gbuffer(r->frame);
     const drift_image *final = test_rig_plane(r, "final");
     double sum = 0.0;
@@ -599,7 +599,7 @@ static void test_rejects_bad_counts(void **state)
     build_occluder(&r, 1.0f, 0.5f);
     test_rig_commit(&r);
     assert_int_equal(drift_hybrid_create(r.ctx, r.scene, r.accel,
-                                         &(drift_hybrid_params){ .isg_search = 10 }, &r.frame),
+                                         &(drift_hybrid_params){ .isg.search = 10 }, &r.frame),
                      DRIFT_ERR_INVALID_ARGUMENT);
     assert_null(r.frame);
     assert_int_equal(drift_technique_parse(DRIFT_EFFECT_SHADOWS, "isg"), DRIFT_SHADOWS_ISG);

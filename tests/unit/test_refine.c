@@ -38,8 +38,8 @@ static rig rig_begin(void)
 static const drift_hybrid_params raster_params = { .shadows = DRIFT_SHADOWS_PCSS,
                                                    .reflections = DRIFT_REFLECTIONS_ENVMAP,
                                                    .dof = DRIFT_DOF_POST,
-                                                   .envmap_size = 32,
-                                                   .shadow_map_size = 256 };
+                                                   .envmap.size = 32,
+                                                   .shadow_map.size = 256 };
 
 static void rig_commit_raster(rig *r, const drift_hybrid_params *raster,
                               const drift_refine_params *params)
@@ -346,7 +346,7 @@ static double shadow_flagged_share(int32_t width, int32_t height)
     rig r = rig_begin();
     build_effects_scene(&r, width, height, drift_vec3_make(0.5f, 2.2f, -3.5f));
     drift_hybrid_params raster = raster_params;
-    raster.shadow_map_size = 64;
+    raster.shadow_map.size = 64;
     rig_commit_raster(&r, &raster, NULL);
     const drift_gbuffer *g = drift_hybrid_gbuffer(r.frame);
     const drift_image *shadow = drift_refine_metric_image(r.sir, DRIFT_METRIC_SHADOW);

@@ -69,7 +69,7 @@ static void build_scene(drift_scene *scene)
 static drift_hybrid_params cheap_params(void)
 {
     // Small maps and one sample for `reference` techniques keep every frame fast under ASan.
-    return (drift_hybrid_params){ .spp = 1, .shadow_map_size = 64, .envmap_size = 16 };
+    return (drift_hybrid_params){ .spp = 1, .shadow_map.size = 64, .envmap.size = 16 };
 }
 
 static rig rig_make(const drift_view_desc *desc)
