@@ -265,6 +265,20 @@ static void print_techniques(FILE *out, drift_effect effect)
     fprintf(out, "\n");
 }
 
+// Every technique with its one-line summary, from the technique table.
+static void print_technique_table(FILE *out)
+{
+    fprintf(out, "\ntechniques (include/drift/techniques.h):\n");
+    for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
+        for (int t = 0; t < drift_technique_count((drift_effect)e); ++t) {
+            char label[64];
+            snprintf(label, sizeof label, "%s %s", drift_effect_name((drift_effect)e),
+                     drift_technique_name((drift_effect)e, t));
+            fprintf(out, "  %-22s%s\n", label, drift_technique_summary((drift_effect)e, t));
+        }
+    }
+}
+
 // "  --spp N" padded to `column` (or followed by two spaces when longer).
 static void print_label(FILE *out, const char *name, const char *arg, int column)
 {
@@ -305,6 +319,12 @@ void cli_print_help(const cli_command *c, FILE *out)
     }
     print_label(out, "-h, --help", NULL, column);
     fprintf(out, "this text\n");
+    for (size_t k = 0; k < c->option_count; ++k) {
+        if (c->options[k].kind == CLI_KIND_TECHNIQUES) {
+            print_technique_table(out);
+            break;
+        }
+    }
     if (c->more_help) {
         c->more_help(out);
     }

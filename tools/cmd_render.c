@@ -152,9 +152,9 @@ static const cli_option render_table[] = {
 
     CLI_SECTION("hybrid mode (docs/hybrid.md):", GROUP_HYBRID),
     CLI_TECHNIQUES("T", O, hybrid),
-    CLI_NOTE("reference = that effect alone path-traced at --spp\n"
-             "aaf = axis-aligned filtering (docs/aaf.md), --spp rays a\n"
-             "pixel on average (shadows: per area light)"),
+    CLI_NOTE("each technique is listed below; reference = that effect\n"
+             "alone path-traced at --spp; aaf: --spp rays a pixel on\n"
+             "average (shadows: per area light)"),
     CLI_INT("--light-samples", "N", O, hybrid.light_samples, 1, 4096,
             "samples per area light for unshadowed light (default 8)"),
     CLI_INT("--shadow-map-size", "N", O, hybrid.shadow_map.size, 1, 8192,

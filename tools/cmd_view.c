@@ -42,9 +42,9 @@ typedef struct view_options {
 } view_options;
 
 // The key bindings, shown by the help key in the overlay (a tab separates the columns; ASCII
-// only: the overlay's font has nothing else).
-static const char help_text[] =
-    "1 2 3 4\tnext shadows / reflections / dof / indirect technique\n"
+// only: the overlay's font has nothing else). The first line, the effects' keys, is made from
+// the technique table (effect_keys_line).
+static const char other_keys_text[] =
     "Tab, Shift-Tab\tnext / previous buffer: the frame, then every plane\n"
     "Space\tsplit view: hybrid left, reference right\n"
     "[ ]\tmove the split (middle click: put it there)\n"
@@ -59,10 +59,30 @@ static const char help_text[] =
     "H, F1\tthis help on/off\n"
     "Esc\tquit";
 
+// "1 2 3 4\tnext shadows / reflections / dof / indirect technique\n" and the other keys.
+static const char *help_text(void)
+{
+    static char text[2048];
+    if (text[0]) {
+        return text;
+    }
+    size_t len = 0;
+    for (int e = 0; e < DRIFT_EFFECT_COUNT && e < 9; ++e) {
+        len += (size_t)snprintf(text + len, sizeof text - len, "%s%d", e ? " " : "", e + 1);
+    }
+    len += (size_t)snprintf(text + len, sizeof text - len, "\tnext ");
+    for (int e = 0; e < DRIFT_EFFECT_COUNT && e < 9; ++e) {
+        len += (size_t)snprintf(text + len, sizeof text - len, "%s%s", e ? " / " : "",
+                                drift_effect_name((drift_effect)e));
+    }
+    snprintf(text + len, sizeof text - len, " technique\n%s", other_keys_text);
+    return text;
+}
+
 // The key table for a terminal: the first column padded instead of tabbed.
 static void print_keys(FILE *out)
 {
-    const char *line = help_text;
+    const char *line = help_text();
     while (*line) {
         const char *end = strchr(line, '\n');
         int len = end ? (int)(end - line) : (int)strlen(line);
@@ -203,15 +223,11 @@ static int parse_options(int argc, char **argv, view_options *o)
 
 static drift_view_key key_of(SDL_Keycode sym, bool shift)
 {
+    // 1, 2, 3, ...: the next technique of each effect, in the technique table's order.
+    if (sym >= SDLK_1 && sym <= SDLK_9 && sym - SDLK_1 < DRIFT_EFFECT_COUNT) {
+        return drift_view_key_of_effect((drift_effect)(sym - SDLK_1));
+    }
     switch (sym) {
-    case SDLK_1:
-        return DRIFT_VIEW_KEY_SHADOWS;
-    case SDLK_2:
-        return DRIFT_VIEW_KEY_REFLECTIONS;
-    case SDLK_3:
-        return DRIFT_VIEW_KEY_DOF;
-    case SDLK_4:
-        return DRIFT_VIEW_KEY_INDIRECT;
     case SDLK_TAB:
         return shift ? DRIFT_VIEW_KEY_PREV_BUFFER : DRIFT_VIEW_KEY_NEXT_BUFFER;
     case SDLK_SPACE:
@@ -554,7 +570,7 @@ int drift_cmd_view(int argc, char **argv)
                                               .exposure_stops = (float)o.exposure,
                                               .split = o.split,
                                               .hide_overlay = o.no_overlay,
-                                              .help_text = help_text,
+                                              .help_text = help_text(),
                                               .refine = o.refine,
                                               .refine_budget = (uint32_t)o.refine_budget },
                           &view);

@@ -34,6 +34,11 @@ static bool write_stats(const render_options *o, const cli_session *session,
         cli_json_count(pass, "rays", s.rays[k]);
     }
     cli_json_count(root, "rays", total_rays);
+    // Each effect's chosen technique, its own work (without the inputs rows share).
+    cJSON *effects = cJSON_AddObjectToObject(root, "effect_ms");
+    for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
+        cli_json_number(effects, drift_effect_name((drift_effect)e), s.effect_ms[e], 3);
+    }
     cJSON *ms = cJSON_AddObjectToObject(root, "milliseconds");
     cli_json_number(ms, "load", 1e3 * (session->t_loaded - session->t_start), 3);
     cli_json_number(ms, "accel", 1e3 * (session->t_built - session->t_loaded), 3);

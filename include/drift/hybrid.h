@@ -65,6 +65,9 @@ const char *drift_technique_name(drift_effect effect, int technique);
 // One line describing the technique (the table's summary), for --help and the viewer; NULL
 // when technique is out of range.
 const char *drift_technique_summary(drift_effect effect, int technique);
+// Whether the technique path-traces (reference, AAF, ...): its cost grows with --spp. The
+// others are the real-time rows a frame benchmark sweeps.
+bool drift_technique_path_traced(drift_effect effect, int technique);
 // The technique called `name`, or -1.
 int drift_technique_parse(drift_effect effect, const char *name);
 

@@ -69,6 +69,12 @@ const char *drift_technique_summary(drift_effect effect, int technique)
     return row ? row->summary : NULL;
 }
 
+bool drift_technique_path_traced(drift_effect effect, int technique)
+{
+    const drift_technique_row *row = drift_technique_row_of(effect, technique);
+    return row && (row->flags & DRIFT_ROW_PATH_TRACED);
+}
+
 int drift_technique_parse(drift_effect effect, const char *name)
 {
     for (int i = 0; name && i < drift_technique_count(effect); ++i) {
