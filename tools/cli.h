@@ -17,6 +17,7 @@ int drift_cmd_info(int argc, char **argv);
 int drift_cmd_bench(int argc, char **argv);
 int drift_cmd_view(int argc, char **argv);
 int drift_cmd_refine(int argc, char **argv); // drift refine fit (tools/cmd_refine.c)
+int drift_cmd_glare(int argc, char **argv);  // temporal glare on HDR images (tools/cmd_glare.c)
 
 // Option values: print "drift <cmd>: <flag> expects ..." and return false when malformed or
 // out of [lo, hi].

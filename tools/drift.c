@@ -17,6 +17,7 @@ static const subcommand subcommands[] = {
     { "bench", drift_cmd_bench, "benchmarks (drift bench --help)" },
     { "view", drift_cmd_view, "interactive viewer: hybrid techniques against the reference" },
     { "refine", drift_cmd_refine, "smart image refinement: fit the metric weights (lambda)" },
+    { "glare", drift_cmd_glare, "temporal glare (thesis ch. 8) on an HDR image or sequence" },
 };
 
 static void print_usage(FILE *out)

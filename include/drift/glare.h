@@ -81,9 +81,9 @@ typedef enum drift_glare_diffraction {
 //   psf_size = 256 (N: the aperture and PSF are N x N; a power of two in [16, 4096])
 //   supersample = 2 (the aperture is rasterised at 2N with coverage, then box-downsampled)
 //   wavelength_count = 32 (380 nm + i (770 - 380) / n, thesis §8.4 step 3)
-//   diffraction = Fresnel, fresnel_distance_mm = 0 -> W^2 / (lambda_ref N), the shortest
-//     distance at which E is sampled without aliasing (physical 17-24 mm alias at N <= 1024;
-//     thesis-spec §6.4 "sampling caveat")
+//   diffraction = Fresnel, fresnel_distance_mm = 0 -> 2 (p_max / 2)^2 / lambda_ref = 70.4 m:
+//     a quarter wave of chirp phase at the edge of a 9 mm pupil (the physical 17-24 mm alias E
+//     at any N <= 1024 and defocus the PSF by many waves; thesis-spec §6.4 "sampling caveat")
 //   aperture_width_mm = 12 (W: physical width of the N x N aperture texture)
 //   image_fov = 0 -> one PSF pixel per image pixel (the thesis's practice); > 0: the
 //     horizontal field of view of the image in radians, and the PSF (angular pitch

@@ -139,10 +139,10 @@ drift_result drift__glare_scene_create(drift_context *ctx, const drift_glare_par
             .radius = (float)(0.010 + 0.030 * unit(seed, STREAM_LENS, (uint32_t)i, 201)),
         };
     }
-    // Fibre gratings (§8.2.3): radial fibre membranes in the cortex (outer 2.5-4.4 mm), where
-    // the lattice diffracts into the lenticular halo.
+    // Fibre gratings (§8.2.3): radial fibre membranes in the cortex (1.2-4.4 mm from the
+    // axis), where the lattice diffracts into the lenticular halo.
     for (int32_t i = 0; i < s->grating_count; ++i) {
-        double r0 = 2.5 + 1.5 * unit(seed, STREAM_GRATING, (uint32_t)i, 0);
+        double r0 = 1.2 + 2.8 * unit(seed, STREAM_GRATING, (uint32_t)i, 0);
         double len = 0.3 + 0.6 * unit(seed, STREAM_GRATING, (uint32_t)i, 1);
         s->gratings[i] = (drift__glare_grating){
             .r0 = (float)r0,

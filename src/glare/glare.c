@@ -51,11 +51,12 @@ drift_glare_params drift_glare_params_resolve(const drift_glare_params *params)
         p.diffraction = DRIFT_GLARE_DIFFRACTION_FRESNEL;
     }
     p.aperture_width_mm = p.aperture_width_mm != 0.0 ? p.aperture_width_mm : 12.0;
-    if (p.fresnel_distance_mm == 0.0 && p.psf_size > 0) {
-        // The shortest distance at which the chirp's local frequency x / (lambda d) stays
-        // below Nyquist over the texture: N > W^2 / (lambda d).
-        p.fresnel_distance_mm = p.aperture_width_mm * p.aperture_width_mm /
-                                (DRIFT_GLARE_LAMBDA_REF_NM * 1e-6 * p.psf_size);
+    if (p.fresnel_distance_mm == 0.0) {
+        // A quarter wave of chirp phase at the edge of the widest pupil: pi r^2 / (lambda d) =
+        // pi / 2 with r = p_max / 2. Physical pupil-retina distances (17-24 mm) alias E at any
+        // N <= 1024 (thesis-spec §6.4); this keeps E smooth and the PSF focused.
+        double r = 0.5 * DRIFT_GLARE_PUPIL_MAX_MM;
+        p.fresnel_distance_mm = 2.0 * r * r / (DRIFT_GLARE_LAMBDA_REF_NM * 1e-6);
     }
     if (p.pupil_model == DRIFT_GLARE_PUPIL_DEFAULT) {
         p.pupil_model = DRIFT_GLARE_PUPIL_THESIS;

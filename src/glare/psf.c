@@ -144,12 +144,18 @@ void drift__glare_psf_rgb(const float *mono, int32_t n, int32_t wavelength_count
                     }
                 }
             }
+            // A radial taper, cos^2 from 0.7 to 1.0 of the kernel's half width: the power
+            // spectrum of pixel-sized features fills the square N x N and wraps around; without
+            // the taper every bright source gets a visible square veil (seen on night.exr).
+            double rx = x - k / 2, ry = y - k / 2, rr = sqrt(rx * rx + ry * ry) / (0.5 * k);
+            double taper = rr <= 0.7 ? 1.0 : (rr >= 1.0 ? 0.0 : cos(0.5 * PI * (rr - 0.7) / 0.3));
+            taper *= taper;
             float *dst = out + ((size_t)y * (size_t)k + (size_t)x) * 3;
             for (int32_t c = 0; c < 3; ++c) {
                 // One wavelength is the monochromatic PSF itself, grey.
                 double v =
                     wc == 1 ? xyz[1] : m[c][0] * xyz[0] + m[c][1] * xyz[1] + m[c][2] * xyz[2];
-                v = v > 0.0 ? v : 0.0; // spectral colours outside the gamut
+                v = v > 0.0 ? taper * v : 0.0; // 0: spectral colours outside the gamut
                 dst[c] = (float)v;
                 sum[c] += v;
             }

@@ -544,7 +544,7 @@ static void test_glare_params_defaults_and_bad_input(void **state)
     assert_int_equal(r.wavelength_count, 32);
     assert_int_equal(r.lens_particle_count, 750);
     assert_int_equal(r.grating_count, 200);
-    assert_near(r.fresnel_distance_mm, 144.0 / (575e-6 * 256), 1e-6);
+    assert_near(r.fresnel_distance_mm, 2.0 * 4.5 * 4.5 / 575e-6, 1e-6);
     assert_int_equal(
         drift_glare_params_resolve(&(drift_glare_params){ .lash_count = -1 }).lash_count, 0);
     drift_glare *g = NULL;
