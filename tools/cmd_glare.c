@@ -429,9 +429,10 @@ int drift_cmd_glare(int argc, char **argv)
             goto done;
         }
         drift_glare_eye eye = drift_glare_eye_state(glare);
-        printf("frame %ld: %s  pupil %.3f mm (mean %.3f)  field %.4g cd/m^2  blink %.2f  "
-               "%.1f ms\n",
-               f, out_frame, eye.pupil_mm, eye.pupil_mean_mm, eye.field_luminance, eye.blink, ms);
+        printf("frame %ld: %s  t %.3f s  pupil %.4f mm (mean %.4f)  field %.4g cd/m^2  blink %.2f  "
+               "lens %+.4f mm  vitreous %+.5f %+.5f rad  %.1f ms\n",
+               f, out_frame, eye.time, eye.pupil_mm, eye.pupil_mean_mm, eye.field_luminance,
+               eye.blink, eye.accommodation, eye.vitreous_angle[0], eye.vitreous_angle[1], ms);
         drift_image_destroy(ctx, &out);
     }
     if (a.frames > 1) {
