@@ -309,6 +309,17 @@ static void test_glare_delta_psf_and_point_light(void **state)
             }
         }
     }
+    drift_image_destroy(ctx, &out);
+    // Linear, not circular: a source on the left edge sends nothing to the right edge.
+    drift_image_set3(&point, 9, 11, (drift_vec3){ 0.0f, 0.0f, 0.0f });
+    drift_image_set3(&point, 0, 11, (drift_vec3){ 2.0f, 2.0f, 2.0f });
+    assert_int_equal(drift__glare_convolve(ctx, &conv, &point, psf, k, true, &out), DRIFT_OK);
+    for (int32_t y = 0; y < point.height; ++y) {
+        for (int32_t x = point.width - k / 2; x < point.width; ++x) {
+            assert_true(fabs((double)drift_image_pixel(&out, x, y)[0]) < 1e-6);
+        }
+    }
+    assert_near(drift_image_pixel(&out, 1, 11)[0], 2.0f * psf[((k / 2) * k + k / 2 + 1) * 3], 1e-5);
     drift__glare_conv_release(ctx, &conv);
     drift_image_destroy(ctx, &out);
     drift_image_destroy(ctx, &point);
