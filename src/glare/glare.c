@@ -20,6 +20,8 @@ struct drift_glare {
     float *mono;
     float *rgb;
     int32_t k, rgb_capacity;
+    void *taps; // scratch of drift__glare_psf_rgb
+    size_t taps_bytes;
     double ratio;     // PSF pixels per image pixel
     int32_t width_px; // image width the ratio was made for (0: none yet)
     bool psf_valid, psf_changed;
@@ -159,6 +161,7 @@ void drift_glare_destroy(drift_glare *g)
     drift_free(ctx, g->aperture);
     drift_free(ctx, g->mono);
     drift_free(ctx, g->rgb);
+    drift_free(ctx, g->taps);
     drift__glare_scene_destroy(ctx, &g->scene);
     drift__glare_conv_release(ctx, &g->conv);
     drift_free(ctx, g);
@@ -270,7 +273,17 @@ static drift_result update(drift_glare *g, double luminance, double dt, int32_t 
         g->rgb = rgb;
         g->rgb_capacity = k;
     }
-    drift__glare_psf_rgb(g->mono, g->n, g->p.wavelength_count, ratio, k, g->rgb);
+    size_t taps = drift__glare_psf_rgb_scratch(k, ratio);
+    if (taps > g->taps_bytes) {
+        void *t = drift_alloc(ctx, taps);
+        if (!t) {
+            return DRIFT_ERR_OUT_OF_MEMORY;
+        }
+        drift_free(ctx, g->taps);
+        g->taps = t;
+        g->taps_bytes = taps;
+    }
+    drift__glare_psf_rgb(g->mono, g->n, g->p.wavelength_count, ratio, k, g->taps, g->rgb);
     g->k = k;
     g->ratio = ratio;
     if (width) {

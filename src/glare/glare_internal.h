@@ -160,11 +160,19 @@ void drift__glare_cie_xyz(double lambda_nm, double out_xyz[3]);
 // Bilinear lookup of an n x n image at continuous pixel coordinates (centre of pixel i is i);
 // 0 outside.
 double drift__glare_bilinear(const float *img, int32_t n, double x, double y);
+
 // The chromatic PSF (thesis §8.4 step 3) resampled to k x k pixels of `ratio` PSF pixels each
 // (1: the PSF's own grid), box-filtered when ratio > 1, tapered to 0 at radius k/2 (cos^2 from
 // 0.7 k/2), each RGB channel normalised to unit sum, centre at (k/2, k/2). out is k*k*3 floats.
+// scratch holds drift__glare_psf_rgb_scratch(k, ratio) bytes.
+typedef struct drift__glare_tap {
+    int32_t i0, i1;
+    float w0, w1;
+} drift__glare_tap;
+
+size_t drift__glare_psf_rgb_scratch(int32_t k, double ratio);
 void drift__glare_psf_rgb(const float *mono, int32_t n, int32_t wavelength_count, double ratio,
-                          int32_t k, float *out);
+                          int32_t k, void *scratch, float *out);
 
 // --- Convolution ---
 

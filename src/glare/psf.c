@@ -102,8 +102,40 @@ double drift__glare_bilinear(const float *img, int32_t n, double x, double y)
     return v;
 }
 
+// One axis of the resampling: the two taps and weights of each sample position, with weight 0
+// (and a clamped index) outside the image.
+static void axis_taps(int32_t n, int32_t k, int32_t ss, double ratio, double scale,
+                      drift__glare_tap *taps)
+{
+    double centre = n / 2;
+    for (int32_t j = 0; j < k; ++j) {
+        for (int32_t s = 0; s < ss; ++s) {
+            double u = ((j - k / 2) + (s + 0.5) / ss - 0.5) * ratio;
+            double x = centre + u * scale, fl = floor(x);
+            int32_t i0 = (int32_t)fmax(fmin(fl, 1e9), -1e9);
+            double f = x - fl;
+            drift__glare_tap t = { 0, 0, 0.0f, 0.0f };
+            if (i0 >= 0 && i0 < n) {
+                t.i0 = i0;
+                t.w0 = (float)(1.0 - f);
+            }
+            if (i0 + 1 >= 0 && i0 + 1 < n) {
+                t.i1 = i0 + 1;
+                t.w1 = (float)f;
+            }
+            taps[j * ss + s] = t;
+        }
+    }
+}
+
+size_t drift__glare_psf_rgb_scratch(int32_t k, double ratio)
+{
+    return (size_t)k * (size_t)(ratio > 1.0 ? (ratio > 8.0 ? 8 : (int32_t)ceil(ratio)) : 1) * 2 *
+           sizeof(drift__glare_tap);
+}
+
 void drift__glare_psf_rgb(const float *mono, int32_t n, int32_t wavelength_count, double ratio,
-                          int32_t k, float *out)
+                          int32_t k, void *scratch, float *out)
 {
     // Thesis §8.4 step 3: lambda_i = 380 + i (770 - 380) / n nm, F_lambda(x) = F_575(x 575 /
     // lambda) and, so that each copy keeps its energy, times (575 / lambda)^2.
@@ -125,25 +157,44 @@ void drift__glare_psf_rgb(const float *mono, int32_t n, int32_t wavelength_count
     if (ss > 8) {
         ss = 8;
     }
-    double centre = n / 2;
+    // Accumulate XYZ in `out`, one wavelength at a time: the bilinear taps of a scaled copy are
+    // separable, so each axis's taps are made once per wavelength. Box filter over the output
+    // pixel's footprint of ratio x ratio PSF pixels (ss^2 samples).
+    size_t count = (size_t)k * (size_t)k;
+    memset(out, 0, count * 3 * sizeof(float));
+    drift__glare_tap *tx = scratch, *ty = tx + (size_t)k * (size_t)ss;
+    const float inv_ss2 = 1.0f / (float)(ss * ss);
+    for (int32_t i = 0; i < wc; ++i) {
+        axis_taps(n, k, ss, ratio, scale[i], tx);
+        memcpy(ty, tx, (size_t)k * (size_t)ss * sizeof(*tx));
+        const float wx = (float)weight[i][0] * inv_ss2, wy = (float)weight[i][1] * inv_ss2;
+        const float wz = (float)weight[i][2] * inv_ss2;
+        for (int32_t y = 0; y < k; ++y) {
+            float *row = out + (size_t)y * (size_t)k * 3;
+            for (int32_t sy = 0; sy < ss; ++sy) {
+                drift__glare_tap t = ty[y * ss + sy];
+                if (t.w0 == 0.0f && t.w1 == 0.0f) {
+                    continue;
+                }
+                const float *r0 = mono + (size_t)t.i0 * (size_t)n;
+                const float *r1 = mono + (size_t)t.i1 * (size_t)n;
+                for (int32_t x = 0; x < k; ++x) {
+                    float acc = 0.0f;
+                    for (int32_t sx = 0; sx < ss; ++sx) {
+                        drift__glare_tap a = tx[x * ss + sx];
+                        acc += t.w0 * (a.w0 * r0[a.i0] + a.w1 * r0[a.i1]) +
+                               t.w1 * (a.w0 * r1[a.i0] + a.w1 * r1[a.i1]);
+                    }
+                    row[x * 3 + 0] += wx * acc;
+                    row[x * 3 + 1] += wy * acc;
+                    row[x * 3 + 2] += wz * acc;
+                }
+            }
+        }
+    }
     double sum[3] = { 0.0, 0.0, 0.0 };
     for (int32_t y = 0; y < k; ++y) {
         for (int32_t x = 0; x < k; ++x) {
-            double xyz[3] = { 0.0, 0.0, 0.0 };
-            // Box filter over the output pixel's footprint of ratio x ratio PSF pixels.
-            for (int32_t sy = 0; sy < ss; ++sy) {
-                double v = ((y - k / 2) + (sy + 0.5) / ss - 0.5) * ratio;
-                for (int32_t sx = 0; sx < ss; ++sx) {
-                    double u = ((x - k / 2) + (sx + 0.5) / ss - 0.5) * ratio;
-                    for (int32_t i = 0; i < wc; ++i) {
-                        double f = drift__glare_bilinear(mono, n, centre + u * scale[i],
-                                                         centre + v * scale[i]);
-                        xyz[0] += weight[i][0] * f;
-                        xyz[1] += weight[i][1] * f;
-                        xyz[2] += weight[i][2] * f;
-                    }
-                }
-            }
             // A radial taper, cos^2 from 0.7 to 1.0 of the kernel's half width: the power
             // spectrum of pixel-sized features fills the square N x N and wraps around; without
             // the taper every bright source gets a visible square veil (seen on night.exr).
@@ -151,6 +202,7 @@ void drift__glare_psf_rgb(const float *mono, int32_t n, int32_t wavelength_count
             double taper = rr <= 0.7 ? 1.0 : (rr >= 1.0 ? 0.0 : cos(0.5 * PI * (rr - 0.7) / 0.3));
             taper *= taper;
             float *dst = out + ((size_t)y * (size_t)k + (size_t)x) * 3;
+            double xyz[3] = { dst[0], dst[1], dst[2] };
             for (int32_t c = 0; c < 3; ++c) {
                 // One wavelength is the monochromatic PSF itself, grey.
                 double v =
@@ -161,7 +213,6 @@ void drift__glare_psf_rgb(const float *mono, int32_t n, int32_t wavelength_count
             }
         }
     }
-    size_t count = (size_t)k * (size_t)k;
     for (int32_t c = 0; c < 3; ++c) {
         double inv = sum[c] > 0.0 ? 1.0 / sum[c] : 0.0;
         for (size_t i = 0; i < count; ++i) {

@@ -191,7 +191,10 @@ static void test_glare_chromatic_scaling(void **state)
     // ratio of the channels' mean wavelengths.
     float *rgb = malloc(sizeof(float) * (size_t)n * (size_t)n * 3);
     assert_non_null(rgb);
-    drift__glare_psf_rgb(f1, n, 32, 1.0, n, rgb);
+    void *taps = malloc(drift__glare_psf_rgb_scratch(n, 1.0));
+    assert_non_null(taps);
+    drift__glare_psf_rgb(f1, n, 32, 1.0, n, taps, rgb);
+    free(taps);
     double m2[3] = { 0, 0, 0 }, sum[3] = { 0, 0, 0 };
     for (int32_t y = 0; y < n; ++y) {
         for (int32_t x = 0; x < n; ++x) {
@@ -246,7 +249,10 @@ static void test_glare_parseval_unit_sum_and_flux(void **state)
     const int32_t k = 16;
     float *rgb = malloc(sizeof(float) * (size_t)(k * k * 3));
     assert_non_null(rgb);
-    drift__glare_psf_rgb(psf, n, 32, 4.0, k, rgb);
+    void *taps = malloc(drift__glare_psf_rgb_scratch(k, 4.0));
+    assert_non_null(taps);
+    drift__glare_psf_rgb(psf, n, 32, 4.0, k, taps, rgb);
+    free(taps);
     drift_image in = make_image(ctx, 61, 47, 3, k / 2), out;
     drift__glare_conv conv = { 0 };
     assert_int_equal(drift__glare_convolve(ctx, &conv, &in, rgb, k, true, &out), DRIFT_OK);
