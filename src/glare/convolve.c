@@ -1,6 +1,6 @@
 // Convolution of the HDR frame with the RGB PSF (Ritschel 2009, thesis §8.4 step 4): per
 // channel FFT(image) FFT(PSF), then the inverse FFT, on buffers zero-padded to at least
-// W + K so that the result is the linear, not the circular, convolution.
+// W + K/2 so that the image region holds the linear, not the circular, convolution.
 #include "glare_internal.h"
 
 #include <string.h>
@@ -55,8 +55,10 @@ drift_result drift__glare_convolve(drift_context *ctx, drift__glare_conv *c, con
                                    const float *psf, int32_t k, bool psf_changed, drift_image *out)
 {
     memset(out, 0, sizeof(*out));
-    int32_t pw = drift__glare_fft_size(in->width + k);
-    int32_t ph = drift__glare_fft_size(in->height + k);
+    // With the PSF's centre at the origin, taps reach k/2 either way: spill off one edge wraps
+    // into the padding, never into the image, as long as the padded size is >= W + k/2.
+    int32_t pw = drift__glare_fft_size(in->width + k / 2);
+    int32_t ph = drift__glare_fft_size(in->height + k / 2);
     drift_result r = DRIFT_OK;
     if (pw != c->width || ph != c->height) {
         if ((r = conv_prepare(ctx, c, pw, ph)) != DRIFT_OK) {

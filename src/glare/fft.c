@@ -13,14 +13,17 @@ struct drift__glare_fft {
     kiss_fftnd_cfg cfg;
 };
 
-// Rows by kiss_fftr, columns by kiss_fft. kiss_fftndr of Debian 12's kissfft 131.1.0 cannot
-// be used: kiss_fftndr_alloc returns NULL (and a lenmem of SIZE_MAX) for 64 x 64 and most
-// other 2-D sizes, with or without caller memory.
+// Rows by kiss_fftr, columns by kiss_fft, each pass spread over the context's threads.
+// kiss_fftndr of Debian 12's kissfft 131.1.0 cannot be used: kiss_fftndr_alloc returns NULL
+// (and a lenmem of SIZE_MAX) for 64 x 64 and most other 2-D sizes, with or without caller
+// memory. A kiss_fftr plan has a scratch buffer inside, so each thread has its own; a kiss_fft
+// plan is read-only when input and output differ, so one serves all threads.
 struct drift__glare_rfft {
-    int32_t width, height;
-    kiss_fftr_cfg rows;
+    drift_context *ctx;
+    int32_t width, height, thread_count;
+    kiss_fftr_cfg *rows; // one a thread
     kiss_fft_cfg cols;
-    drift__cpx *column; // 2 * height: gathered column and its transform
+    drift__cpx *column; // 2 * height a thread: gathered column and its transform
 };
 
 drift_result drift__glare_fft_create(drift_context *ctx, int32_t width, int32_t height,
@@ -61,74 +64,112 @@ drift_result drift__glare_rfft_create(drift_context *ctx, int32_t width, int32_t
 {
     *out_fft = NULL;
     DRIFT_CHECK(width % 2 == 0);
+    int32_t threads = drift_context_thread_count(ctx);
+    threads = threads < 1 ? 1 : threads;
     size_t len_r = 0, len_c = 0;
     kiss_fftr_alloc(width, inverse ? 1 : 0, NULL, &len_r);
     kiss_fft_alloc(height, inverse ? 1 : 0, NULL, &len_c);
     drift__glare_rfft *f = drift_alloc(ctx, sizeof(*f));
-    void *mem_r = len_r ? drift_alloc(ctx, len_r) : NULL;
-    void *mem_c = len_c ? drift_alloc(ctx, len_c) : NULL;
-    drift__cpx *column = drift_alloc(ctx, 2 * (size_t)height * sizeof(drift__cpx));
-    if (!f || !mem_r || !mem_c || !column) {
-        drift_free(ctx, f);
-        drift_free(ctx, mem_r);
-        drift_free(ctx, mem_c);
-        drift_free(ctx, column);
+    if (!f) {
         return DRIFT_ERR_OUT_OF_MEMORY;
     }
+    f->ctx = ctx;
     f->width = width;
     f->height = height;
-    f->rows = kiss_fftr_alloc(width, inverse ? 1 : 0, mem_r, &len_r);
-    f->cols = kiss_fft_alloc(height, inverse ? 1 : 0, mem_c, &len_c);
-    f->column = column;
-    DRIFT_CHECK(f->rows == mem_r && f->cols == mem_c);
+    f->thread_count = threads;
+    f->rows = drift_alloc(ctx, (size_t)threads * sizeof(*f->rows));
+    f->cols = len_c ? drift_alloc(ctx, len_c) : NULL;
+    f->column = drift_alloc(ctx, (size_t)threads * 2 * (size_t)height * sizeof(drift__cpx));
+    bool ok = f->rows && f->cols && f->column;
+    for (int32_t t = 0; ok && t < threads; ++t) {
+        void *mem = drift_alloc(ctx, len_r);
+        size_t len = len_r;
+        ok = mem && kiss_fftr_alloc(width, inverse ? 1 : 0, mem, &len) == mem;
+        if (mem && !ok) {
+            drift_free(ctx, mem);
+        } else {
+            f->rows[t] = mem;
+        }
+    }
+    if (ok) {
+        size_t len = len_c;
+        ok = kiss_fft_alloc(height, inverse ? 1 : 0, f->cols, &len) == f->cols;
+    }
+    if (!ok) {
+        drift__glare_rfft_destroy(ctx, f);
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
     *out_fft = f;
     return DRIFT_OK;
 }
 
 void drift__glare_rfft_destroy(drift_context *ctx, drift__glare_rfft *fft)
 {
-    if (fft) {
-        drift_free(ctx, fft->rows);
-        drift_free(ctx, fft->cols);
-        drift_free(ctx, fft->column);
-        drift_free(ctx, fft);
+    if (!fft) {
+        return;
     }
+    for (int32_t t = 0; fft->rows && t < fft->thread_count; ++t) {
+        drift_free(ctx, fft->rows[t]);
+    }
+    drift_free(ctx, fft->rows);
+    drift_free(ctx, fft->cols);
+    drift_free(ctx, fft->column);
+    drift_free(ctx, fft);
 }
 
-// The column pass over the width / 2 + 1 spectrum columns, in place in `spectrum`.
-static void column_pass(const drift__glare_rfft *fft, drift__cpx *spectrum)
+typedef struct rfft_job {
+    const drift__glare_rfft *fft;
+    const float *real_in;
+    float *real_out;
+    drift__cpx *spectrum;
+    bool inverse;
+} rfft_job;
+
+static void column_range(size_t begin, size_t end, int thread_index, void *user)
 {
+    const rfft_job *job = user;
+    const drift__glare_rfft *fft = job->fft;
     const size_t w = (size_t)(fft->width / 2 + 1), h = (size_t)fft->height;
-    drift__cpx *in = fft->column, *out = fft->column + h;
-    for (size_t x = 0; x < w; ++x) {
+    drift__cpx *in = fft->column + (size_t)thread_index * 2 * h, *out = in + h;
+    for (size_t x = begin; x < end; ++x) {
         for (size_t y = 0; y < h; ++y) {
-            in[y] = spectrum[y * w + x];
+            in[y] = job->spectrum[y * w + x];
         }
         kiss_fft(fft->cols, (const kiss_fft_cpx *)(const void *)in, (kiss_fft_cpx *)(void *)out);
         for (size_t y = 0; y < h; ++y) {
-            spectrum[y * w + x] = out[y];
+            job->spectrum[y * w + x] = out[y];
+        }
+    }
+}
+
+static void row_range(size_t begin, size_t end, int thread_index, void *user)
+{
+    const rfft_job *job = user;
+    const drift__glare_rfft *fft = job->fft;
+    const size_t w = (size_t)(fft->width / 2 + 1), rw = (size_t)fft->width;
+    kiss_fftr_cfg cfg = fft->rows[thread_index];
+    for (size_t y = begin; y < end; ++y) {
+        kiss_fft_cpx *spec = (kiss_fft_cpx *)(void *)(job->spectrum + y * w);
+        if (job->inverse) {
+            kiss_fftri(cfg, spec, job->real_out + y * rw);
+        } else {
+            kiss_fftr(cfg, job->real_in + y * rw, spec);
         }
     }
 }
 
 void drift__glare_rfft_forward(const drift__glare_rfft *fft, const float *in, drift__cpx *out)
 {
-    const size_t w = (size_t)(fft->width / 2 + 1);
-    for (int32_t y = 0; y < fft->height; ++y) {
-        kiss_fftr(fft->rows, in + (size_t)y * (size_t)fft->width,
-                  (kiss_fft_cpx *)(void *)(out + (size_t)y * w));
-    }
-    column_pass(fft, out);
+    rfft_job job = { fft, in, NULL, out, false };
+    drift_parallel_for(fft->ctx, (size_t)fft->height, 16, row_range, &job);
+    drift_parallel_for(fft->ctx, (size_t)(fft->width / 2 + 1), 16, column_range, &job);
 }
 
 void drift__glare_rfft_inverse(const drift__glare_rfft *fft, drift__cpx *in, float *out)
 {
-    const size_t w = (size_t)(fft->width / 2 + 1);
-    column_pass(fft, in);
-    for (int32_t y = 0; y < fft->height; ++y) {
-        kiss_fftri(fft->rows, (const kiss_fft_cpx *)(const void *)(in + (size_t)y * w),
-                   out + (size_t)y * (size_t)fft->width);
-    }
+    rfft_job job = { fft, NULL, out, in, true };
+    drift_parallel_for(fft->ctx, (size_t)(fft->width / 2 + 1), 16, column_range, &job);
+    drift_parallel_for(fft->ctx, (size_t)fft->height, 16, row_range, &job);
 }
 
 int32_t drift__glare_fft_size(int32_t n)

@@ -118,6 +118,55 @@ static void test_glare_fft_matches_naive_dft_and_round_trips(void **state)
     drift_context_destroy(ctx);
 }
 
+// The real 2-D FFT (rows by kiss_fftr, columns by kiss_fft) against the complex one, and its
+// round trip, at sizes with factors 2, 3 and 5, with 1 and 3 threads.
+static void test_glare_real_fft_matches_complex_fft(void **state)
+{
+    (void)state;
+    const int32_t sizes[][2] = { { 60, 48 }, { 64, 64 }, { 90, 50 }, { 16, 30 } };
+    for (int32_t threads = 1; threads <= 3; threads += 2) {
+        drift_context *ctx = test_context(threads, NULL);
+        for (size_t s = 0; s < sizeof(sizes) / sizeof(sizes[0]); ++s) {
+            const int32_t w = sizes[s][0], h = sizes[s][1], hw = w / 2 + 1;
+            float *real = malloc(sizeof(float) * (size_t)(w * h));
+            float *back = malloc(sizeof(float) * (size_t)(w * h));
+            drift__cpx *spec = malloc(sizeof(drift__cpx) * (size_t)(hw * h));
+            drift__cpx *cin = malloc(sizeof(drift__cpx) * (size_t)(w * h));
+            drift__cpx *cout = malloc(sizeof(drift__cpx) * (size_t)(w * h));
+            for (int32_t i = 0; i < w * h; ++i) {
+                real[i] = test_hash_unit((uint32_t)i * 3u + 1u) - 0.3f;
+                cin[i] = (drift__cpx){ real[i], 0.0f };
+            }
+            drift__glare_rfft *fwd = NULL, *inv = NULL;
+            drift__glare_fft *cfft = NULL;
+            assert_int_equal(drift__glare_rfft_create(ctx, w, h, false, &fwd), DRIFT_OK);
+            assert_int_equal(drift__glare_rfft_create(ctx, w, h, true, &inv), DRIFT_OK);
+            assert_int_equal(drift__glare_fft_create(ctx, w, h, false, &cfft), DRIFT_OK);
+            drift__glare_rfft_forward(fwd, real, spec);
+            drift__glare_fft_run(cfft, cin, cout);
+            for (int32_t y = 0; y < h; ++y) {
+                for (int32_t x = 0; x < hw; ++x) {
+                    assert_near(spec[y * hw + x].re, cout[y * w + x].re, 1e-3);
+                    assert_near(spec[y * hw + x].im, cout[y * w + x].im, 1e-3);
+                }
+            }
+            drift__glare_rfft_inverse(inv, spec, back);
+            for (int32_t i = 0; i < w * h; ++i) {
+                assert_near((double)back[i] / (w * h), real[i], 1e-5);
+            }
+            drift__glare_rfft_destroy(ctx, fwd);
+            drift__glare_rfft_destroy(ctx, inv);
+            drift__glare_fft_destroy(ctx, cfft);
+            free(cout);
+            free(cin);
+            free(spec);
+            free(back);
+            free(real);
+        }
+        drift_context_destroy(ctx);
+    }
+}
+
 // --- 2. Airy ---
 
 static void test_glare_airy_rings_and_energy(void **state)
@@ -600,6 +649,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_glare_fft_matches_naive_dft_and_round_trips),
+        cmocka_unit_test(test_glare_real_fft_matches_complex_fft),
         cmocka_unit_test(test_glare_airy_rings_and_energy),
         cmocka_unit_test(test_glare_chromatic_scaling),
         cmocka_unit_test(test_glare_parseval_unit_sum_and_flux),
