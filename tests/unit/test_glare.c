@@ -553,6 +553,44 @@ static void test_glare_deterministic_and_fluid(void **state)
     drift_context_destroy(ctx);
 }
 
+// The same bits with 1 or 3 threads (the FFT passes split rows and columns over threads).
+static void test_glare_bit_identical_for_any_thread_count(void **state)
+{
+    (void)state;
+    drift_image outs[2];
+    for (int32_t t = 0; t < 2; ++t) {
+        drift_context *ctx = test_context(t ? 3 : 1, NULL);
+        drift_glare *g = NULL;
+        assert_int_equal(drift_glare_create(ctx,
+                                            &(drift_glare_params){ .mode = DRIFT_GLARE_MODE_DYNAMIC,
+                                                                   .psf_size = 64,
+                                                                   .seed = 2 },
+                                            &g),
+                         DRIFT_OK);
+        drift_image in = make_image(ctx, 70, 45, 8, 0), out;
+        for (int32_t f = 0; f < 3; ++f) {
+            assert_int_equal(drift_glare_apply(g, &in, 0.05, &out), DRIFT_OK);
+            if (f < 2) {
+                drift_image_destroy(ctx, &out);
+            }
+        }
+        // Keep the last frame in memory this test owns.
+        size_t bytes = sizeof(float) * (size_t)(out.width * out.height * 3);
+        outs[t] = out;
+        outs[t].pixels = malloc(bytes);
+        assert_non_null(outs[t].pixels);
+        memcpy(outs[t].pixels, out.pixels, bytes);
+        drift_image_destroy(ctx, &out);
+        drift_image_destroy(ctx, &in);
+        drift_glare_destroy(g);
+        drift_context_destroy(ctx);
+    }
+    assert_memory_equal(outs[0].pixels, outs[1].pixels,
+                        sizeof(float) * (size_t)(outs[0].width * outs[0].height * 3));
+    free(outs[0].pixels);
+    free(outs[1].pixels);
+}
+
 // --- 9. Supersampling ---
 
 // Variance over frames of the frame-to-frame L1 change of the PSF while one particle moves by
@@ -657,6 +695,7 @@ int main(void)
         cmocka_unit_test(test_glare_pupil_model_values_and_bounds),
         cmocka_unit_test(test_glare_symmetric_aperture_gives_point_symmetric_psf),
         cmocka_unit_test(test_glare_deterministic_and_fluid),
+        cmocka_unit_test(test_glare_bit_identical_for_any_thread_count),
         cmocka_unit_test(test_glare_supersampling_lowers_temporal_variance),
         cmocka_unit_test(test_glare_params_defaults_and_bad_input),
     };
