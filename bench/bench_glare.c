@@ -6,8 +6,8 @@
 //       XYZ and RGB), the least of --frames runs each; the thesis's "display" also drew the
 //       result, which here is the convolution, timed apart:
 //   (b) the convolution of a 1920x1080 frame with the N x N RGB PSF (zero-padded FFTs);
-//   (c) drift_glare_apply per frame, dynamic mode, PSF 256, on --sizes images (default
-//       512x512 and 1024x1024).
+//   (c) drift_glare_apply per frame, dynamic mode, PSF 256, on 640x480 (the hybrid frame's
+//       size), 512x512 and 1024x1024 images.
 // One thread: nothing in src/glare runs in parallel yet.
 #include "bench.h"
 #include "cli.h"
@@ -28,8 +28,8 @@ static void print_help(FILE *out)
                  "    2x2 supersampling, 32 wavelengths), (b) the convolution of a 1920x1080 "
                  "frame\n"
                  "    with that PSF, (c) ms a frame of drift_glare_apply (dynamic, PSF 256) on "
-                 "512^2\n"
-                 "    and 1024^2 images. One thread.\n\n"
+                 "640x480,\n"
+                 "    512^2 and 1024^2 images. One thread.\n\n"
                  "  --frames N        the least of N runs per figure (default 3)\n"
                  "  --sizes LIST      PSF sizes (default 256,512,1024)\n"
                  "  --no-convolution  skip (b) and (c)\n"
@@ -124,18 +124,19 @@ done:
     return r;
 }
 
-static drift_result time_apply(drift_context *ctx, int32_t size, int32_t frames, double *out_ms)
+static drift_result time_apply(drift_context *ctx, int32_t width, int32_t height, int32_t frames,
+                               double *out_ms)
 {
     drift_glare *g = NULL;
     drift_image in = { 0 }, out = { 0 };
     drift_result r = drift_glare_create(
         ctx, &(drift_glare_params){ .mode = DRIFT_GLARE_MODE_DYNAMIC, .seed = 1 }, &g);
     if (r == DRIFT_OK) {
-        r = drift_image_create(ctx, size, size, 3, &in);
+        r = drift_image_create(ctx, width, height, 3, &in);
     }
     *out_ms = 1e30;
     for (int32_t f = 0; f < frames + 1 && r == DRIFT_OK; ++f) {
-        drift_image_set3(&in, size / 2, size / 2, (drift_vec3){ 1e3f, 1e3f, 1e3f });
+        drift_image_set3(&in, width / 2, height / 2, (drift_vec3){ 1e3f, 1e3f, 1e3f });
         double t0 = drift_time_now();
         r = drift_glare_apply(g, &in, f ? 1.0 / 30.0 : 0.0, &out);
         if (f > 0) { // the first frame also makes the FFT plans
@@ -195,14 +196,14 @@ int drift_bench_glare(int argc, char **argv)
         return 1;
     }
     phase_ms rows[8];
-    double apply_ms[2] = { NAN, NAN };
-    const int32_t apply_sizes[2] = { 512, 1024 };
+    double apply_ms[3] = { NAN, NAN, NAN };
+    const int32_t apply_sizes[3][2] = { { 640, 480 }, { 512, 512 }, { 1024, 1024 } };
     drift_result r = DRIFT_OK;
     for (int32_t i = 0; i < size_count && r == DRIFT_OK; ++i) {
         r = time_size(ctx, sizes[i], (int32_t)frames, convolution, &rows[i]);
     }
-    for (int32_t i = 0; i < 2 && convolution && r == DRIFT_OK; ++i) {
-        r = time_apply(ctx, apply_sizes[i], (int32_t)frames, &apply_ms[i]);
+    for (int32_t i = 0; i < 3 && convolution && r == DRIFT_OK; ++i) {
+        r = time_apply(ctx, apply_sizes[i][0], apply_sizes[i][1], (int32_t)frames, &apply_ms[i]);
     }
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift bench glare: %s\n", drift_result_string(r));
@@ -223,10 +224,11 @@ int drift_bench_glare(int argc, char **argv)
                 printf("null}");
             }
         }
-        printf("], \"apply_ms\": {\"512\": ");
-        isfinite(apply_ms[0]) ? printf("%.3f", apply_ms[0]) : printf("null");
-        printf(", \"1024\": ");
-        isfinite(apply_ms[1]) ? printf("%.3f", apply_ms[1]) : printf("null");
+        printf("], \"apply_ms\": {");
+        for (int32_t i = 0; i < 3; ++i) {
+            printf("%s\"%dx%d\": ", i ? ", " : "", (int)apply_sizes[i][0], (int)apply_sizes[i][1]);
+            isfinite(apply_ms[i]) ? printf("%.3f", apply_ms[i]) : printf("null");
+        }
         printf("}}\n");
     } else {
         printf("glare, one thread, 2x2 supersampling, 32 wavelengths (least of %ld)\n", frames);
@@ -239,9 +241,9 @@ int drift_bench_glare(int argc, char **argv)
                    p->convolution);
         }
         if (convolution) {
-            printf("drift_glare_apply (dynamic, PSF 256): %.1f ms at 512x512, %.1f ms at "
-                   "1024x1024\n",
-                   apply_ms[0], apply_ms[1]);
+            printf("drift_glare_apply (dynamic, PSF 256): %.1f ms at 640x480, %.1f ms at 512x512, "
+                   "%.1f ms at 1024x1024\n",
+                   apply_ms[0], apply_ms[1], apply_ms[2]);
         }
     }
     drift_context_destroy(ctx);

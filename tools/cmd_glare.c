@@ -55,8 +55,8 @@ static const option options[] = {
     { "--seed", "S", OPT_INT, 0, 4294967295.0, NULL, AT(seed), "seed of the eye (default 0)" },
     { "--mode", "M", OPT_CHOICE, 0, 0, mode_names, AT(mode),
       "static or dynamic eye (default: static for 1 frame, dynamic for more)" },
-    { "--psf", "F.exr", OPT_STRING, 0, 0, NULL, AT(psf),
-      "write the RGB PSF (the last frame's; a %d name writes every frame's)" },
+    { "--psf", "F.exr|F.png", OPT_STRING, 0, 0, NULL, AT(psf),
+      "write the RGB PSF (last frame's; a %d name: every frame's); .png: 5 decades, log" },
     { "--aperture", "F.exr", OPT_STRING, 0, 0, NULL, AT(aperture),
       "write the aperture transmittance and F_575 as layers (last frame or %d)" },
     { "--psf-size", "N", OPT_INT, 16, 4096, NULL, AT(psf_size),
@@ -268,6 +268,37 @@ static const char *frame_name(char *buf, size_t size, const char *pattern, long 
     return n > 0 && (size_t)n < size ? buf : NULL;
 }
 
+// The PSF as a PNG that shows its five decades: 1 + log10(v / max) / 5 per channel, the
+// maximum over all channels (so colour is kept), written through the sRGB curve.
+static drift_result save_psf_png(drift_context *ctx, const char *path, const drift_image *psf)
+{
+    drift_image img;
+    drift_result r = drift_image_create(ctx, psf->width, psf->height, 3, &img);
+    if (r != DRIFT_OK) {
+        return r;
+    }
+    double mx = 0.0;
+    for (int32_t y = 0; y < psf->height; ++y) {
+        for (int32_t x = 0; x < psf->width; ++x) {
+            for (int32_t c = 0; c < 3; ++c) {
+                mx = fmax(mx, (double)drift_image_pixel(psf, x, y)[c]);
+            }
+        }
+    }
+    for (int32_t y = 0; y < psf->height; ++y) {
+        for (int32_t x = 0; x < psf->width; ++x) {
+            for (int32_t c = 0; c < 3; ++c) {
+                double v = mx > 0.0 ? (double)drift_image_pixel(psf, x, y)[c] / mx : 0.0;
+                v = v > 1e-5 ? 1.0 + log10(v) / 5.0 : 0.0;
+                drift_image_pixel(&img, x, y)[c] = drift_srgb_to_linear((float)v);
+            }
+        }
+    }
+    r = drift_image_save_png(ctx, path, &img, NULL);
+    drift_image_destroy(ctx, &img);
+    return r;
+}
+
 static drift_result save_image(drift_context *ctx, const char *path, const drift_image *img,
                                double exposure)
 {
@@ -328,10 +359,10 @@ int drift_cmd_glare(int argc, char **argv)
     }
     const char *extras[2] = { a.psf, a.aperture };
     for (int i = 0; i < 2; ++i) {
-        if (extras[i] && (!has_extension(extras[i], exr_exts) ||
+        if (extras[i] && (!has_extension(extras[i], i == 0 ? out_exts : exr_exts) ||
                           (strchr(extras[i], '%') && !is_frame_pattern(extras[i])))) {
-            fprintf(stderr, "drift glare: '%s' must be an .exr name (with at most one %%d)\n",
-                    extras[i]);
+            fprintf(stderr, "drift glare: '%s' must be an %s name (with at most one %%d)\n",
+                    extras[i], i == 0 ? ".exr or .png" : ".exr");
             return 2;
         }
     }
@@ -407,8 +438,12 @@ int drift_cmd_glare(int argc, char **argv)
         if (a.psf && (last || strchr(a.psf, '%'))) {
             drift_image psf = drift_glare_psf(glare);
             const char *name = frame_name(psf_buf, sizeof(psf_buf), a.psf, f);
-            if (!name || (r = drift_image_save_exr(ctx, name, &(drift_image_layer){ NULL, &psf },
-                                                   1)) != DRIFT_OK) {
+            if (name) {
+                r = has_extension(name, exr_exts)
+                        ? drift_image_save_exr(ctx, name, &(drift_image_layer){ NULL, &psf }, 1)
+                        : save_psf_png(ctx, name, &psf);
+            }
+            if (!name || r != DRIFT_OK) {
                 fprintf(stderr, "drift glare: cannot write PSF '%s'\n", name ? name : a.psf);
                 goto done;
             }

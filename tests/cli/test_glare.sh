@@ -44,7 +44,8 @@ grep -q "power of two" "$tmp/err" || fail "--psf-size 100 says it is not a power
 expect 2 "$drift" glare "$tmp/in.hdr" --out "$tmp/x.tiff"
 expect 2 "$drift" glare "$tmp/in.hdr" --frames 3 --out "$tmp/x.exr"
 expect 2 "$drift" glare "$tmp/in.hdr" --frames 3 --out-pattern "$tmp/f_%d_%d.exr"
-expect 2 "$drift" glare "$tmp/in.hdr" --out "$tmp/x.exr" --psf "$tmp/psf.png"
+expect 2 "$drift" glare "$tmp/in.hdr" --out "$tmp/x.exr" --psf "$tmp/psf.tif"
+expect 2 "$drift" glare "$tmp/in.hdr" --out "$tmp/x.exr" --aperture "$tmp/ap.png"
 
 # Bad input files: clear errors naming the file, exit 2, nothing written.
 expect 2 "$drift" glare "$tmp/in.png" --out "$tmp/x.exr"
