@@ -176,7 +176,7 @@ static void test_glare_airy_rings_and_energy(void **state)
     // N = 512 and a 64-pixel pupil: the first dark ring at 1.2197 N / D = 9.76 pixels.
     const int32_t n = 512;
     const double d = 64.0;
-    float *psf = disk_psf(ctx, n, d, 4, NULL);
+    float *psf = disk_psf(ctx, n, d, 2, NULL);
     double r1 = first_minimum(psf, n);
     assert_true(fabs(r1 - 1.2197 * n / d) < 1.0);
     // First side lobe at 1.635 lambda / D with I / I0 = 0.0175.
