@@ -7,7 +7,8 @@
 //       result, which here is the convolution, timed apart:
 //   (b) the convolution of a 1920x1080 frame with the N x N RGB PSF (zero-padded FFTs);
 //   (c) drift_glare_apply per frame, dynamic mode, PSF 256, on 640x480 (the hybrid frame's
-//       size), 512x512 and 1024x1024 images.
+//       size), 512x512 and 1024x1024 images of 16 lights on a dim field, and the billboard
+//       path at 640x480.
 // One thread: nothing in src/glare runs in parallel yet.
 #include "bench.h"
 #include "cli.h"
@@ -125,18 +126,28 @@ done:
 }
 
 static drift_result time_apply(drift_context *ctx, int32_t width, int32_t height, int32_t frames,
-                               double *out_ms)
+                               drift_glare_method method, double *out_ms)
 {
     drift_glare *g = NULL;
     drift_image in = { 0 }, out = { 0 };
     drift_result r = drift_glare_create(
-        ctx, &(drift_glare_params){ .mode = DRIFT_GLARE_MODE_DYNAMIC, .seed = 1 }, &g);
+        ctx, &(drift_glare_params){ .mode = DRIFT_GLARE_MODE_DYNAMIC, .seed = 1, .method = method },
+        &g);
     if (r == DRIFT_OK) {
         r = drift_image_create(ctx, width, height, 3, &in);
     }
+    // A dim frame with 16 small bright lights.
+    for (int32_t y = 0; r == DRIFT_OK && y < height; ++y) {
+        for (int32_t x = 0; x < width; ++x) {
+            drift_image_set3(&in, x, y, (drift_vec3){ 0.2f, 0.2f, 0.2f });
+        }
+    }
+    for (int32_t i = 0; r == DRIFT_OK && i < 16; ++i) {
+        drift_image_set3(&in, width * (i % 4 + 1) / 5, height * (i / 4 + 1) / 5,
+                         (drift_vec3){ 1e3f, 1e3f, 1e3f });
+    }
     *out_ms = 1e30;
     for (int32_t f = 0; f < frames + 1 && r == DRIFT_OK; ++f) {
-        drift_image_set3(&in, width / 2, height / 2, (drift_vec3){ 1e3f, 1e3f, 1e3f });
         double t0 = drift_time_now();
         r = drift_glare_apply(g, &in, f ? 1.0 / 30.0 : 0.0, &out);
         if (f > 0) { // the first frame also makes the FFT plans
@@ -196,14 +207,18 @@ int drift_bench_glare(int argc, char **argv)
         return 1;
     }
     phase_ms rows[8];
-    double apply_ms[3] = { NAN, NAN, NAN };
+    double apply_ms[3] = { NAN, NAN, NAN }, billboard_ms = NAN;
     const int32_t apply_sizes[3][2] = { { 640, 480 }, { 512, 512 }, { 1024, 1024 } };
     drift_result r = DRIFT_OK;
     for (int32_t i = 0; i < size_count && r == DRIFT_OK; ++i) {
         r = time_size(ctx, sizes[i], (int32_t)frames, convolution, &rows[i]);
     }
     for (int32_t i = 0; i < 3 && convolution && r == DRIFT_OK; ++i) {
-        r = time_apply(ctx, apply_sizes[i][0], apply_sizes[i][1], (int32_t)frames, &apply_ms[i]);
+        r = time_apply(ctx, apply_sizes[i][0], apply_sizes[i][1], (int32_t)frames,
+                       DRIFT_GLARE_METHOD_CONVOLUTION, &apply_ms[i]);
+    }
+    if (convolution && r == DRIFT_OK) {
+        r = time_apply(ctx, 640, 480, (int32_t)frames, DRIFT_GLARE_METHOD_BILLBOARD, &billboard_ms);
     }
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift bench glare: %s\n", drift_result_string(r));
@@ -229,7 +244,9 @@ int drift_bench_glare(int argc, char **argv)
             printf("%s\"%dx%d\": ", i ? ", " : "", (int)apply_sizes[i][0], (int)apply_sizes[i][1]);
             isfinite(apply_ms[i]) ? printf("%.3f", apply_ms[i]) : printf("null");
         }
-        printf("}}\n");
+        printf("}, \"billboard_640x480_ms\": ");
+        isfinite(billboard_ms) ? printf("%.3f", billboard_ms) : printf("null");
+        printf("}\n");
     } else {
         printf("glare, one thread, 2x2 supersampling, 32 wavelengths (least of %ld)\n", frames);
         printf("%6s %10s %12s %10s %10s %16s\n", "N", "aperture", "diffraction", "display",
@@ -244,6 +261,7 @@ int drift_bench_glare(int argc, char **argv)
             printf("drift_glare_apply (dynamic, PSF 256): %.1f ms at 640x480, %.1f ms at 512x512, "
                    "%.1f ms at 1024x1024\n",
                    apply_ms[0], apply_ms[1], apply_ms[2]);
+            printf("billboards (dynamic, PSF 256, 16 lights): %.1f ms at 640x480\n", billboard_ms);
         }
     }
     drift_context_destroy(ctx);

@@ -18,8 +18,8 @@ typedef struct glare_args {
     long frames, seed, psf_size, supersample, wavelengths, threads;
     long lens_particles, gratings, vitreous, lashes;
     double fps, fresnel_distance, aperture_width, fov_deg, luminance_scale, field_luminance;
-    double squint, blink_interval, hippus, exposure;
-    int mode, diffraction, pupil;
+    double squint, blink_interval, hippus, exposure, billboard_threshold;
+    int mode, diffraction, pupil, method;
     bool verbose, help;
 } glare_args;
 
@@ -34,6 +34,7 @@ typedef enum opt_kind {
 static const char *const mode_names[] = { "auto", "static", "dynamic", NULL };
 static const char *const diffraction_names[] = { "fresnel", "fraunhofer", NULL };
 static const char *const pupil_names[] = { "thesis", "moon-spencer", "watson-yellott", NULL };
+static const char *const method_names[] = { "convolution", "billboard", NULL };
 
 typedef struct option {
     const char *name;
@@ -74,6 +75,10 @@ static const option options[] = {
     { "--fov", "DEG", OPT_FLOAT, 0, 360, NULL, AT(fov_deg),
       "horizontal field of view of IN; resamples the PSF to its pitch (default 0: one PSF "
       "pixel per image pixel)" },
+    { "--method", "M", OPT_CHOICE, 0, 0, method_names, AT(method),
+      "convolve the whole image (default) or paste billboards at bright pixels" },
+    { "--billboard-threshold", "X", OPT_FLOAT, 0, 1e30, NULL, AT(billboard_threshold),
+      "luminance over which a pixel gets a billboard (default 20 x the mean)" },
     { "--pupil", "MODEL", OPT_CHOICE, 0, 0, pupil_names, AT(pupil),
       "thesis (eq. 8.2, default), moon-spencer or watson-yellott" },
     { "--luminance-scale", "X", OPT_FLOAT, 1e-12, 1e12, NULL, AT(luminance_scale),
@@ -392,6 +397,8 @@ int drift_cmd_glare(int argc, char **argv)
         .grating_count = (int32_t)a.gratings,
         .vitreous_particle_count = (int32_t)a.vitreous,
         .lash_count = (int32_t)a.lashes,
+        .method = (drift_glare_method)(a.method + 1),
+        .billboard_threshold = a.billboard_threshold,
     };
     drift_context *ctx = cli_open_context("glare", (int)a.threads, a.verbose);
     if (!ctx) {

@@ -76,6 +76,13 @@ typedef enum drift_glare_diffraction {
     DRIFT_GLARE_DIFFRACTION_COUNT
 } drift_glare_diffraction;
 
+typedef enum drift_glare_method {
+    DRIFT_GLARE_METHOD_DEFAULT = 0, // DRIFT_GLARE_METHOD_CONVOLUTION
+    DRIFT_GLARE_METHOD_CONVOLUTION, // the whole image by FFT (thesis §8.4 step 4, its results)
+    DRIFT_GLARE_METHOD_BILLBOARD,   // the PSF pasted at bright pixels only (the fast path)
+    DRIFT_GLARE_METHOD_COUNT
+} drift_glare_method;
+
 // How to make glare. Zero is the default for every field. The default configuration is:
 //   mode = static, seed = 0
 //   psf_size = 256 (N: the aperture and PSF are N x N; a power of two in [16, 4096])
@@ -100,6 +107,9 @@ typedef enum drift_glare_diffraction {
 //   blink_interval = 0 -> 4 s (mean; negative: no blinking), squint = 0 (lid closure 0..1)
 //   accommodation_scale = 0 -> 1 (scales the lens drive; negative: no accommodation)
 //   saccade_scale = 0 -> 1 (scales the vitreous forces; negative: no saccades)
+//   method = convolution; billboard: pixels whose luminance is over billboard_threshold
+//     (0 -> 20 x the frame's mean luminance; image units) are replaced by the PSF scaled by
+//     the pixel, the brightest billboard_max (0 -> 4096) of them; the rest stays sharp
 typedef struct drift_glare_params {
     drift_glare_mode mode;
     uint32_t seed;
@@ -128,6 +138,9 @@ typedef struct drift_glare_params {
     double squint;
     double accommodation_scale;
     double saccade_scale;
+    drift_glare_method method;
+    double billboard_threshold;
+    int32_t billboard_max;
 } drift_glare_params;
 
 // The params with every default filled in (negative counts and scales become 0).

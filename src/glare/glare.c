@@ -4,6 +4,7 @@
 #include "glare_internal.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #define PI 3.14159265358979323846
@@ -77,6 +78,10 @@ drift_glare_params drift_glare_params_resolve(const drift_glare_params *params)
     p.blink_interval = scale_or(p.blink_interval, 4.0);
     p.accommodation_scale = scale_or(p.accommodation_scale, 1.0);
     p.saccade_scale = scale_or(p.saccade_scale, 1.0);
+    if (p.method == DRIFT_GLARE_METHOD_DEFAULT) {
+        p.method = DRIFT_GLARE_METHOD_CONVOLUTION;
+    }
+    p.billboard_max = p.billboard_max ? p.billboard_max : 4096;
     return p;
 }
 
@@ -108,8 +113,14 @@ drift_result drift_glare_params_check(drift_context *ctx, const drift_glare_para
         FAIL("glare: wavelength count %d is outside 1..128", (int)p.wavelength_count);
     }
     if ((unsigned)p.diffraction >= DRIFT_GLARE_DIFFRACTION_COUNT ||
-        (unsigned)p.pupil_model >= DRIFT_GLARE_PUPIL_COUNT) {
-        FAIL("glare: unknown diffraction or pupil model");
+        (unsigned)p.pupil_model >= DRIFT_GLARE_PUPIL_COUNT ||
+        (unsigned)p.method >= DRIFT_GLARE_METHOD_COUNT) {
+        FAIL("glare: unknown diffraction, pupil model or method");
+    }
+    if (!in_range(p.billboard_threshold, 0.0, 1e30) || p.billboard_max < 1 ||
+        p.billboard_max > 1 << 24) {
+        FAIL("glare: billboard threshold %g or count %d out of range", p.billboard_threshold,
+             (int)p.billboard_max);
     }
     if (!in_range(p.aperture_width_mm, 0.5, 100.0)) {
         FAIL("glare: aperture width %g mm is outside [0.5, 100]", p.aperture_width_mm);
@@ -304,6 +315,85 @@ drift_result drift_glare_update(drift_glare *g, double luminance, double dt)
     return update(g, luminance * g->p.luminance_scale, dt, 0);
 }
 
+typedef struct bright_pixel {
+    float luminance;
+    int32_t index; // y * width + x
+} bright_pixel;
+
+static int brighter_first(const void *a, const void *b)
+{
+    const bright_pixel *p = a, *q = b;
+    if (p->luminance != q->luminance) {
+        return p->luminance > q->luminance ? -1 : 1;
+    }
+    return p->index < q->index ? -1 : (p->index > q->index);
+}
+
+// The billboard fast path (thesis §8.4 step 4, "dynamic textures"): the brightest pixels over
+// the threshold give their light to a copy of the PSF centred on them; every other pixel stays
+// as it is. For those pixels this is exactly the convolution; the rest is left sharp.
+static drift_result billboards(drift_glare *g, const drift_image *in, double mean_luminance,
+                               drift_image *out)
+{
+    drift_context *ctx = g->ctx;
+    drift_result r = drift_image_create(ctx, in->width, in->height, in->channels, out);
+    if (r != DRIFT_OK) {
+        return r;
+    }
+    for (int32_t y = 0; y < in->height; ++y) {
+        memcpy(drift_image_pixel(out, 0, y), drift_image_pixel(in, 0, y),
+               sizeof(float) * (size_t)in->width * (size_t)in->channels);
+    }
+    double threshold =
+        g->p.billboard_threshold > 0.0 ? g->p.billboard_threshold : 20.0 * mean_luminance;
+    size_t count = 0, pixels = (size_t)in->width * (size_t)in->height;
+    for (int32_t y = 0; y < in->height; ++y) {
+        for (int32_t x = 0; x < in->width; ++x) {
+            count += (double)drift_luminance(drift_image_get3(in, x, y)) > threshold;
+        }
+    }
+    bright_pixel *bright = drift_alloc(ctx, (count ? count : 1) * sizeof(*bright));
+    if (!bright) {
+        drift_image_destroy(ctx, out);
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    size_t n = 0;
+    for (size_t i = 0; i < pixels && n < count; ++i) {
+        int32_t x = (int32_t)(i % (size_t)in->width), y = (int32_t)(i / (size_t)in->width);
+        float l = drift_luminance(drift_image_get3(in, x, y));
+        if ((double)l > threshold) {
+            bright[n++] = (bright_pixel){ l, (int32_t)i };
+        }
+    }
+    qsort(bright, n, sizeof(*bright), brighter_first);
+    if (n > (size_t)g->p.billboard_max) {
+        n = (size_t)g->p.billboard_max;
+    }
+    const int32_t k = g->k, h = k / 2;
+    for (size_t b = 0; b < n; ++b) {
+        int32_t px = bright[b].index % in->width, py = bright[b].index / in->width;
+        drift_vec3 v = drift_image_get3(in, px, py);
+        float *o = drift_image_pixel(out, px, py);
+        o[0] -= v.x;
+        o[1] -= v.y;
+        o[2] -= v.z;
+        int32_t y0 = py - h < 0 ? h - py : 0,
+                y1 = py - h + k > in->height ? in->height - py + h : k;
+        int32_t x0 = px - h < 0 ? h - px : 0, x1 = px - h + k > in->width ? in->width - px + h : k;
+        for (int32_t v_ = y0; v_ < y1; ++v_) {
+            const float *src = g->rgb + ((size_t)v_ * (size_t)k) * 3;
+            for (int32_t u = x0; u < x1; ++u) {
+                float *d = drift_image_pixel(out, px - h + u, py - h + v_);
+                d[0] += v.x * src[u * 3 + 0];
+                d[1] += v.y * src[u * 3 + 1];
+                d[2] += v.z * src[u * 3 + 2];
+            }
+        }
+    }
+    drift_free(ctx, bright);
+    return DRIFT_OK;
+}
+
 drift_result drift_glare_apply(drift_glare *g, const drift_image *in, double dt, drift_image *out)
 {
     memset(out, 0, sizeof(*out));
@@ -343,6 +433,9 @@ drift_result drift_glare_apply(drift_glare *g, const drift_image *in, double dt,
     drift_result r = DRIFT_OK;
     if (refresh && (r = update(g, field > 0.0 ? field : 1e-6, dt, in->width)) != DRIFT_OK) {
         return r;
+    }
+    if (g->p.method == DRIFT_GLARE_METHOD_BILLBOARD) {
+        return billboards(g, in, sum / ((double)in->width * in->height), out);
     }
     r = drift__glare_convolve(ctx, &g->conv, in, g->rgb, g->k, g->psf_changed, out);
     g->psf_changed = false;

@@ -72,6 +72,11 @@ cmp -s "$tmp/a.exr" "$tmp/b.exr" || fail "same seed, same bytes"
 expect 0 "$drift" glare "$tmp/in.hdr" --out "$tmp/a.png" "${small[@]}" --diffraction fraunhofer
 [ -s "$tmp/a.png" ] || fail "PNG output written"
 
+# The billboard path.
+expect 0 "$drift" glare "$tmp/in.hdr" --out "$tmp/bb.exr" --method billboard "${small[@]}"
+[ -s "$tmp/bb.exr" ] || fail "billboard output written"
+expect 2 "$drift" glare "$tmp/in.hdr" --out "$tmp/bb.exr" --method sprites
+
 # A dynamic sequence, with per-frame PSFs.
 expect 0 "$drift" glare "$tmp/in.hdr" --frames 3 --fps 5 --out-pattern "$tmp/f_%02d.exr" \
     --psf "$tmp/p_%02d.exr" --seed 5 "${small[@]}"

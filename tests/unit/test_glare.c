@@ -634,6 +634,59 @@ static void test_glare_supersampling_lowers_temporal_variance(void **state)
     drift_context_destroy(ctx);
 }
 
+// --- Billboards ---
+
+// The billboard path is the convolution for the bright pixels and leaves the rest sharp.
+static void test_glare_billboards_match_convolution_for_bright_pixels(void **state)
+{
+    (void)state;
+    drift_context *ctx = test_context(1, NULL);
+    drift_glare_params params = { .psf_size = 32, .seed = 6 };
+    drift_glare *conv = NULL, *bill = NULL;
+    assert_int_equal(drift_glare_create(ctx, &params, &conv), DRIFT_OK);
+    params.method = DRIFT_GLARE_METHOD_BILLBOARD;
+    assert_int_equal(drift_glare_create(ctx, &params, &bill), DRIFT_OK);
+    // Bright points on black, one near a corner: identical results, spill included.
+    drift_image in, a, b;
+    assert_int_equal(drift_image_create(ctx, 50, 40, 3, &in), DRIFT_OK);
+    drift_image_set3(&in, 25, 20, (drift_vec3){ 900.0f, 800.0f, 700.0f });
+    drift_image_set3(&in, 3, 2, (drift_vec3){ 300.0f, 300.0f, 300.0f });
+    drift_image_set3(&in, 40, 33, (drift_vec3){ 50.0f, 200.0f, 100.0f });
+    assert_int_equal(drift_glare_apply(conv, &in, 0.0, &a), DRIFT_OK);
+    assert_int_equal(drift_glare_apply(bill, &in, 0.0, &b), DRIFT_OK);
+    for (int32_t i = 0; i < 50 * 40 * 3; ++i) {
+        assert_near(a.pixels[i], b.pixels[i], 1e-3);
+    }
+    drift_image_destroy(ctx, &a);
+    drift_image_destroy(ctx, &b);
+    // A dim background stays exactly as it was away from the bright pixel.
+    for (int32_t y = 0; y < 40; ++y) {
+        for (int32_t x = 0; x < 50; ++x) {
+            if (drift_luminance(drift_image_get3(&in, x, y)) == 0.0f) {
+                drift_image_set3(&in, x, y, (drift_vec3){ 0.1f, 0.2f, 0.1f });
+            }
+        }
+    }
+    assert_int_equal(drift_glare_apply(bill, &in, 0.0, &b), DRIFT_OK);
+    for (int32_t y = 0; y < 40; ++y) {
+        for (int32_t x = 0; x < 50; ++x) {
+            bool near = false;
+            const int32_t pts[3][2] = { { 25, 20 }, { 3, 2 }, { 40, 33 } };
+            for (int32_t p = 0; p < 3; ++p) {
+                near = near || (abs(x - pts[p][0]) <= 16 && abs(y - pts[p][1]) <= 16);
+            }
+            if (!near) {
+                assert_true(drift_image_pixel(&b, x, y)[1] == drift_image_pixel(&in, x, y)[1]);
+            }
+        }
+    }
+    drift_image_destroy(ctx, &b);
+    drift_image_destroy(ctx, &in);
+    drift_glare_destroy(conv);
+    drift_glare_destroy(bill);
+    drift_context_destroy(ctx);
+}
+
 // --- API and bad input ---
 
 static void test_glare_params_defaults_and_bad_input(void **state)
@@ -697,6 +750,7 @@ int main(void)
         cmocka_unit_test(test_glare_deterministic_and_fluid),
         cmocka_unit_test(test_glare_bit_identical_for_any_thread_count),
         cmocka_unit_test(test_glare_supersampling_lowers_temporal_variance),
+        cmocka_unit_test(test_glare_billboards_match_convolution_for_bright_pixels),
         cmocka_unit_test(test_glare_params_defaults_and_bad_input),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
