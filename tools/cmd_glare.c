@@ -118,13 +118,30 @@ static void print_usage(FILE *out)
         const option *o = &options[i];
         char head[64];
         snprintf(head, sizeof(head), "%s%s%s", o->name, o->arg ? " " : "", o->arg ? o->arg : "");
-        fprintf(out, "  %-28s %s", head, o->help);
+        // The help text, then the choices, wrapped at 98 columns under the help column.
+        char text[512];
+        int len = snprintf(text, sizeof(text), "%s", o->help);
         if (o->kind == OPT_CHOICE) {
-            fprintf(out, " [");
-            for (const char *const *c = o->choices; *c; ++c) {
-                fprintf(out, "%s%s", c == o->choices ? "" : "|", *c);
+            for (const char *const *c = o->choices; *c && len > 0 && (size_t)len < sizeof(text);
+                 ++c) {
+                len += snprintf(text + len, sizeof(text) - (size_t)len, "%s%s",
+                                c == o->choices ? " [" : "|", *c);
             }
-            fprintf(out, "]");
+            if (len > 0 && (size_t)len + 1 < sizeof(text)) {
+                text[len++] = ']';
+                text[len] = '\0';
+            }
+        }
+        fprintf(out, "  %-28s", head);
+        int col = 31;
+        for (char *word = strtok(text, " "); word; word = strtok(NULL, " ")) {
+            int wl = (int)strlen(word);
+            if (col + 1 + wl > 98 && col > 31) {
+                fprintf(out, "\n%30s", "");
+                col = 31;
+            }
+            fprintf(out, " %s", word);
+            col += 1 + wl;
         }
         fprintf(out, "\n");
     }
