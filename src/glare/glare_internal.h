@@ -177,8 +177,8 @@ void drift__glare_psf_rgb(const float *mono, int32_t n, int32_t wavelength_count
 // --- Convolution ---
 
 // Linear convolution of a 3- or 4-channel image (colour channels) with a k x k x 3 PSF whose
-// centre is (k/2, k/2), by FFTs zero-padded to >= (W + k/2) x (H + k/2); out has in's size and channel count (alpha
-// copied). The plans are made on demand and kept in *cache.
+// centre is (k/2, k/2), by FFTs zero-padded to >= (W + k/2) x (H + k/2); out has in's size and
+// channel count (alpha copied). The plans are made on demand and kept in *cache.
 typedef struct drift__glare_conv {
     int32_t width, height; // padded size
     drift__glare_rfft *forward, *inverse;
