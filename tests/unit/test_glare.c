@@ -634,6 +634,65 @@ static void test_glare_supersampling_lowers_temporal_variance(void **state)
     drift_context_destroy(ctx);
 }
 
+// --- Resampling to the image's pitch ---
+
+static double encircled(const drift_image *psf, int32_t channel, double radius)
+{
+    double sum = 0.0;
+    int32_t c = psf->width / 2;
+    for (int32_t y = 0; y < psf->height; ++y) {
+        for (int32_t x = 0; x < psf->width; ++x) {
+            double dx = x - c, dy = y - c;
+            if (dx * dx + dy * dy <= radius * radius) {
+                sum += (double)drift_image_pixel(psf, x, y)[channel];
+            }
+        }
+    }
+    return sum;
+}
+
+// With image_fov set, the PSF (pitch lambda / W) is box-resampled to the image's pitch fov /
+// width: at two PSF pixels an image pixel the kernel is half as wide and encloses the same
+// energy within half the radius. A clean pupil (no scatterers, no lids), Fraunhofer.
+static void test_glare_psf_resampled_to_image_pitch(void **state)
+{
+    (void)state;
+    drift_context *ctx = test_context(1, NULL);
+    const int32_t width = 64;
+    drift_glare_params params = { .psf_size = 128,
+                                  .diffraction = DRIFT_GLARE_DIFFRACTION_FRAUNHOFER,
+                                  .field_luminance = 1.0,
+                                  .lens_particle_count = -1,
+                                  .grating_count = -1,
+                                  .vitreous_particle_count = -1,
+                                  .cornea_particle_count = -1,
+                                  .retina_particle_count = -1,
+                                  .lash_count = -1 };
+    drift_glare *native = NULL, *coarse = NULL;
+    assert_int_equal(drift_glare_create(ctx, &params, &native), DRIFT_OK);
+    // fov / width = 2 lambda / W.
+    params.image_fov = 2.0 * width * DRIFT_GLARE_LAMBDA_REF_NM * 1e-6 / 12.0;
+    assert_int_equal(drift_glare_create(ctx, &params, &coarse), DRIFT_OK);
+    drift_image in = make_image(ctx, width, 48, 4, 0), a, b;
+    assert_int_equal(drift_glare_apply(native, &in, 0.0, &a), DRIFT_OK);
+    assert_int_equal(drift_glare_apply(coarse, &in, 0.0, &b), DRIFT_OK);
+    drift_image pa = drift_glare_psf(native), pb = drift_glare_psf(coarse);
+    assert_int_equal(pa.width, 128);
+    assert_int_equal(pb.width, 64);
+    assert_near(drift_glare_eye_state(native).pupil_mm, 3.760, 5e-4);
+    for (int32_t ch = 0; ch < 3; ++ch) {
+        for (double r = 3.0; r <= 12.0; r += 3.0) {
+            assert_near(encircled(&pb, ch, r), encircled(&pa, ch, 2.0 * r), 0.03);
+        }
+    }
+    drift_image_destroy(ctx, &a);
+    drift_image_destroy(ctx, &b);
+    drift_image_destroy(ctx, &in);
+    drift_glare_destroy(native);
+    drift_glare_destroy(coarse);
+    drift_context_destroy(ctx);
+}
+
 // --- Billboards ---
 
 // The billboard path is the convolution for the bright pixels and leaves the rest sharp.
@@ -750,6 +809,7 @@ int main(void)
         cmocka_unit_test(test_glare_deterministic_and_fluid),
         cmocka_unit_test(test_glare_bit_identical_for_any_thread_count),
         cmocka_unit_test(test_glare_supersampling_lowers_temporal_variance),
+        cmocka_unit_test(test_glare_psf_resampled_to_image_pitch),
         cmocka_unit_test(test_glare_billboards_match_convolution_for_bright_pixels),
         cmocka_unit_test(test_glare_params_defaults_and_bad_input),
     };
