@@ -171,6 +171,14 @@ void drift__glare_psf_rgb(const float *mono, int32_t n, int32_t wavelength_count
         const float wz = (float)weight[i][2] * inv_ss2;
         for (int32_t y = 0; y < k; ++y) {
             float *row = out + (size_t)y * (size_t)k * 3;
+            // Only the disk inside the taper's outer radius k/2 is kept; skip the corners.
+            double dy = y - k / 2, half = 0.5 * k, reach2 = half * half - dy * dy;
+            if (reach2 <= 0.0) {
+                continue;
+            }
+            double reach = sqrt(reach2);
+            int32_t xa = (int32_t)fmax(0.0, floor(k / 2 - reach));
+            int32_t xb = (int32_t)fmin((double)k, ceil(k / 2 + reach) + 1.0);
             for (int32_t sy = 0; sy < ss; ++sy) {
                 drift__glare_tap t = ty[y * ss + sy];
                 if (t.w0 == 0.0f && t.w1 == 0.0f) {
@@ -178,7 +186,7 @@ void drift__glare_psf_rgb(const float *mono, int32_t n, int32_t wavelength_count
                 }
                 const float *r0 = mono + (size_t)t.i0 * (size_t)n;
                 const float *r1 = mono + (size_t)t.i1 * (size_t)n;
-                for (int32_t x = 0; x < k; ++x) {
+                for (int32_t x = xa; x < xb; ++x) {
                     float acc = 0.0f;
                     for (int32_t sx = 0; sx < ss; ++sx) {
                         drift__glare_tap a = tx[x * ss + sx];
