@@ -97,15 +97,17 @@ static drift_result time_size(drift_context *ctx, int32_t n, int32_t frames, boo
     if (convolution) {
         drift_image frame = { 0 }, res = { 0 };
         drift__glare_conv conv = { 0 };
-        if ((r = drift_image_create(ctx, 1920, 1080, 3, &frame)) != DRIFT_OK) {
+        if ((r = drift_image_create(ctx, 1920, 1080, 3, &frame)) != DRIFT_OK ||
+            (r = drift_image_create(ctx, 1920, 1080, 3, &res)) != DRIFT_OK) {
+            drift_image_destroy(ctx, &frame);
             goto done;
         }
         for (int32_t f = 0; f < frames && r == DRIFT_OK; ++f) {
             double t0 = drift_time_now();
             r = drift__glare_convolve(ctx, &conv, &frame, rgb, n, true, &res);
             out->convolution = least(out->convolution, 1e3 * (drift_time_now() - t0));
-            drift_image_destroy(ctx, &res);
         }
+        drift_image_destroy(ctx, &res);
         drift__glare_conv_release(ctx, &conv);
         drift_image_destroy(ctx, &frame);
     } else {
@@ -136,6 +138,9 @@ static drift_result time_apply(drift_context *ctx, int32_t width, int32_t height
     if (r == DRIFT_OK) {
         r = drift_image_create(ctx, width, height, 3, &in);
     }
+    if (r == DRIFT_OK) {
+        r = drift_image_create(ctx, width, height, 3, &out);
+    }
     // A dim frame with 16 small bright lights.
     for (int32_t y = 0; r == DRIFT_OK && y < height; ++y) {
         for (int32_t x = 0; x < width; ++x) {
@@ -149,12 +154,12 @@ static drift_result time_apply(drift_context *ctx, int32_t width, int32_t height
     *out_ms = 1e30;
     for (int32_t f = 0; f < frames + 1 && r == DRIFT_OK; ++f) {
         double t0 = drift_time_now();
-        r = drift_glare_apply(g, &in, f ? 1.0 / 30.0 : 0.0, &out);
+        r = drift_glare_apply_to(g, &in, f ? 1.0 / 30.0 : 0.0, &out);
         if (f > 0) { // the first frame also makes the FFT plans
             *out_ms = least(*out_ms, 1e3 * (drift_time_now() - t0));
         }
-        drift_image_destroy(ctx, &out);
     }
+    drift_image_destroy(ctx, &out);
     drift_image_destroy(ctx, &in);
     drift_glare_destroy(g);
     return r;

@@ -189,6 +189,12 @@ void drift_glare_destroy(drift_glare *glare);
 drift_result drift_glare_apply(drift_glare *glare, const drift_image *in, double dt,
                                drift_image *out);
 
+// drift_glare_apply into an existing image `out` of in's size and channel count (no allocation
+// per frame; out may be in: the glare is applied in place). Same errors; out's pixels are
+// undefined on failure.
+drift_result drift_glare_apply_to(drift_glare *glare, const drift_image *in, double dt,
+                                  const drift_image *out);
+
 // Advances the eye by dt seconds against field luminance `luminance` (cd/m^2; <= 0 keeps the
 // current one) and redraws the PSF, without convolving. drift_glare_apply calls it.
 drift_result drift_glare_update(drift_glare *glare, double luminance, double dt);

@@ -52,9 +52,9 @@ static drift_result conv_prepare(drift_context *ctx, drift__glare_conv *c, int32
 }
 
 drift_result drift__glare_convolve(drift_context *ctx, drift__glare_conv *c, const drift_image *in,
-                                   const float *psf, int32_t k, bool psf_changed, drift_image *out)
+                                   const float *psf, int32_t k, bool psf_changed,
+                                   const drift_image *out)
 {
-    memset(out, 0, sizeof(*out));
     // With the PSF's centre at the origin, taps reach k/2 either way: spill off one edge wraps
     // into the padding, never into the image, as long as the padded size is >= W + k/2.
     int32_t pw = drift__glare_fft_size(in->width + k / 2);
@@ -84,9 +84,6 @@ drift_result drift__glare_convolve(drift_context *ctx, drift__glare_conv *c, con
         }
         c->psf_k = k;
     }
-    if ((r = drift_image_create(ctx, in->width, in->height, in->channels, out)) != DRIFT_OK) {
-        return r;
-    }
     const float norm = 1.0f / (float)real_count; // kissfft's inverse is unnormalised
     for (int32_t ch = 0; ch < 3; ++ch) {
         memset(c->real, 0, real_count * sizeof(float));
@@ -113,7 +110,7 @@ drift_result drift__glare_convolve(drift_context *ctx, drift__glare_conv *c, con
             }
         }
     }
-    if (in->channels == 4) {
+    if (in->channels == 4 && out->pixels != in->pixels) {
         for (int32_t y = 0; y < in->height; ++y) {
             for (int32_t x = 0; x < in->width; ++x) {
                 drift_image_pixel(out, x, y)[3] = drift_image_pixel(in, x, y)[3];

@@ -318,6 +318,7 @@ drift_result drift_glare_update(drift_glare *g, double luminance, double dt)
 typedef struct bright_pixel {
     float luminance;
     int32_t index; // y * width + x
+    drift_vec3 value;
 } bright_pixel;
 
 static int brighter_first(const void *a, const void *b)
@@ -333,14 +334,10 @@ static int brighter_first(const void *a, const void *b)
 // the threshold give their light to a copy of the PSF centred on them; every other pixel stays
 // as it is. For those pixels this is exactly the convolution; the rest is left sharp.
 static drift_result billboards(drift_glare *g, const drift_image *in, double mean_luminance,
-                               drift_image *out)
+                               const drift_image *out)
 {
     drift_context *ctx = g->ctx;
-    drift_result r = drift_image_create(ctx, in->width, in->height, in->channels, out);
-    if (r != DRIFT_OK) {
-        return r;
-    }
-    for (int32_t y = 0; y < in->height; ++y) {
+    for (int32_t y = 0; y < in->height && out->pixels != in->pixels; ++y) {
         memcpy(drift_image_pixel(out, 0, y), drift_image_pixel(in, 0, y),
                sizeof(float) * (size_t)in->width * (size_t)in->channels);
     }
@@ -354,7 +351,6 @@ static drift_result billboards(drift_glare *g, const drift_image *in, double mea
     }
     bright_pixel *bright = drift_alloc(ctx, (count ? count : 1) * sizeof(*bright));
     if (!bright) {
-        drift_image_destroy(ctx, out);
         return DRIFT_ERR_OUT_OF_MEMORY;
     }
     size_t n = 0;
@@ -362,7 +358,7 @@ static drift_result billboards(drift_glare *g, const drift_image *in, double mea
         int32_t x = (int32_t)(i % (size_t)in->width), y = (int32_t)(i / (size_t)in->width);
         float l = drift_luminance(drift_image_get3(in, x, y));
         if ((double)l > threshold) {
-            bright[n++] = (bright_pixel){ l, (int32_t)i };
+            bright[n++] = (bright_pixel){ l, (int32_t)i, drift_image_get3(in, x, y) };
         }
     }
     qsort(bright, n, sizeof(*bright), brighter_first);
@@ -372,7 +368,7 @@ static drift_result billboards(drift_glare *g, const drift_image *in, double mea
     const int32_t k = g->k, h = k / 2;
     for (size_t b = 0; b < n; ++b) {
         int32_t px = bright[b].index % in->width, py = bright[b].index / in->width;
-        drift_vec3 v = drift_image_get3(in, px, py);
+        drift_vec3 v = bright[b].value; // in may be out, already changed by earlier billboards
         float *o = drift_image_pixel(out, px, py);
         o[0] -= v.x;
         o[1] -= v.y;
@@ -394,13 +390,19 @@ static drift_result billboards(drift_glare *g, const drift_image *in, double mea
     return DRIFT_OK;
 }
 
-drift_result drift_glare_apply(drift_glare *g, const drift_image *in, double dt, drift_image *out)
+drift_result drift_glare_apply_to(drift_glare *g, const drift_image *in, double dt,
+                                  const drift_image *out)
 {
-    memset(out, 0, sizeof(*out));
     drift_context *ctx = g->ctx;
     if (!drift_image_is_valid(in) || in->channels < 3) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, __FILE__, __LINE__,
                   "glare: the input must be a valid 3- or 4-channel image");
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    if (!drift_image_is_valid(out) || out->width != in->width || out->height != in->height ||
+        out->channels != in->channels) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, __FILE__, __LINE__,
+                  "glare: the output must be a valid image of the input's size and channels");
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
     if (!(isfinite(dt) && dt >= 0.0)) {
@@ -439,6 +441,21 @@ drift_result drift_glare_apply(drift_glare *g, const drift_image *in, double dt,
     }
     r = drift__glare_convolve(ctx, &g->conv, in, g->rgb, g->k, g->psf_changed, out);
     g->psf_changed = false;
+    return r;
+}
+
+drift_result drift_glare_apply(drift_glare *g, const drift_image *in, double dt, drift_image *out)
+{
+    memset(out, 0, sizeof(*out));
+    if (!drift_image_is_valid(in) || in->channels < 3) {
+        drift_log(g->ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, __FILE__, __LINE__,
+                  "glare: the input must be a valid 3- or 4-channel image");
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    drift_result r = drift_image_create(g->ctx, in->width, in->height, in->channels, out);
+    if (r == DRIFT_OK && (r = drift_glare_apply_to(g, in, dt, out)) != DRIFT_OK) {
+        drift_image_destroy(g->ctx, out);
+    }
     return r;
 }
 

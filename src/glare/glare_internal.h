@@ -177,8 +177,9 @@ void drift__glare_psf_rgb(const float *mono, int32_t n, int32_t wavelength_count
 // --- Convolution ---
 
 // Linear convolution of a 3- or 4-channel image (colour channels) with a k x k x 3 PSF whose
-// centre is (k/2, k/2), by FFTs zero-padded to >= (W + k/2) x (H + k/2); out has in's size and
-// channel count (alpha copied). The plans are made on demand and kept in *cache.
+// centre is (k/2, k/2), by FFTs zero-padded to >= (W + k/2) x (H + k/2), into `out`, an
+// existing image of in's size and channel count (alpha copied; out may be in). The plans are
+// made on demand and kept in *cache.
 typedef struct drift__glare_conv {
     int32_t width, height; // padded size
     drift__glare_rfft *forward, *inverse;
@@ -190,7 +191,7 @@ typedef struct drift__glare_conv {
 
 drift_result drift__glare_convolve(drift_context *ctx, drift__glare_conv *cache,
                                    const drift_image *in, const float *psf, int32_t k,
-                                   bool psf_changed, drift_image *out);
+                                   bool psf_changed, const drift_image *out);
 void drift__glare_conv_release(drift_context *ctx, drift__glare_conv *cache);
 
 #endif

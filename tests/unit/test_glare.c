@@ -304,6 +304,7 @@ static void test_glare_parseval_unit_sum_and_flux(void **state)
     free(taps);
     drift_image in = make_image(ctx, 61, 47, 3, k / 2), out;
     drift__glare_conv conv = { 0 };
+    assert_int_equal(drift_image_create(ctx, in.width, in.height, 3, &out), DRIFT_OK);
     assert_int_equal(drift__glare_convolve(ctx, &conv, &in, rgb, k, true, &out), DRIFT_OK);
     for (int32_t ch = 0; ch < 3; ++ch) {
         double a = 0.0, b = 0.0;
@@ -336,6 +337,7 @@ static void test_glare_delta_psf_and_point_light(void **state)
     }
     drift_image in = make_image(ctx, 33, 20, 9, 0), out;
     drift__glare_conv conv = { 0 };
+    assert_int_equal(drift_image_create(ctx, in.width, in.height, 3, &out), DRIFT_OK);
     assert_int_equal(drift__glare_convolve(ctx, &conv, &in, delta, k, true, &out), DRIFT_OK);
     for (int32_t y = 0; y < in.height; ++y) {
         for (int32_t x = 0; x < in.width; ++x) {
@@ -355,6 +357,7 @@ static void test_glare_delta_psf_and_point_light(void **state)
     drift_image point;
     assert_int_equal(drift_image_create(ctx, 20, 20, 3, &point), DRIFT_OK);
     drift_image_set3(&point, 9, 11, (drift_vec3){ 2.0f, 2.0f, 2.0f });
+    assert_int_equal(drift_image_create(ctx, point.width, point.height, 3, &out), DRIFT_OK);
     assert_int_equal(drift__glare_convolve(ctx, &conv, &point, psf, k, true, &out), DRIFT_OK);
     for (int32_t v = 0; v < k; ++v) {
         for (int32_t u = 0; u < k; ++u) {
@@ -368,6 +371,7 @@ static void test_glare_delta_psf_and_point_light(void **state)
     // Linear, not circular: a source on the left edge sends nothing to the right edge.
     drift_image_set3(&point, 9, 11, (drift_vec3){ 0.0f, 0.0f, 0.0f });
     drift_image_set3(&point, 0, 11, (drift_vec3){ 2.0f, 2.0f, 2.0f });
+    assert_int_equal(drift_image_create(ctx, point.width, point.height, 3, &out), DRIFT_OK);
     assert_int_equal(drift__glare_convolve(ctx, &conv, &point, psf, k, true, &out), DRIFT_OK);
     for (int32_t y = 0; y < point.height; ++y) {
         for (int32_t x = point.width - k / 2; x < point.width; ++x) {
@@ -739,6 +743,12 @@ static void test_glare_billboards_match_convolution_for_bright_pixels(void **sta
             }
         }
     }
+    // In place, the billboards of nearby bright pixels still read the original values.
+    drift_image_set3(&in, 27, 21, (drift_vec3){ 600.0f, 600.0f, 600.0f });
+    assert_int_equal(drift_glare_apply(bill, &in, 0.0, &a), DRIFT_OK);
+    assert_int_equal(drift_glare_apply_to(bill, &in, 0.0, &in), DRIFT_OK);
+    assert_memory_equal(a.pixels, in.pixels, sizeof(float) * 50 * 40 * 3);
+    drift_image_destroy(ctx, &a);
     drift_image_destroy(ctx, &b);
     drift_image_destroy(ctx, &in);
     drift_glare_destroy(conv);
@@ -788,6 +798,17 @@ static void test_glare_params_defaults_and_bad_input(void **state)
     drift_image psf = drift_glare_psf(g);
     assert_int_equal(psf.width, 32);
     assert_int_equal(psf.channels, 3);
+    // apply_to: into a caller's image, or in place, gives the same bits as apply.
+    drift_image into, wrong;
+    assert_int_equal(drift_image_create(ctx, 16, 16, 3, &into), DRIFT_OK);
+    assert_int_equal(drift_image_create(ctx, 16, 15, 3, &wrong), DRIFT_OK);
+    assert_int_equal(drift_glare_apply_to(g, &in, 0.0, &into), DRIFT_OK);
+    assert_memory_equal(into.pixels, out.pixels, sizeof(float) * 16 * 16 * 3);
+    assert_int_equal(drift_glare_apply_to(g, &in, 0.0, &in), DRIFT_OK);
+    assert_memory_equal(in.pixels, out.pixels, sizeof(float) * 16 * 16 * 3);
+    assert_int_equal(drift_glare_apply_to(g, &in, 0.0, &wrong), DRIFT_ERR_INVALID_ARGUMENT);
+    drift_image_destroy(ctx, &wrong);
+    drift_image_destroy(ctx, &into);
     drift_image_destroy(ctx, &out);
     drift_image_destroy(ctx, &in);
     drift_glare_destroy(g);
