@@ -432,6 +432,33 @@ int drift_cmd_glare(int argc, char **argv)
     }
     char in_buf[4096], out_buf[4096], psf_buf[4096], ap_buf[4096];
     double total_ms = 0.0;
+    // A sequence of inputs is read through once first, so that a missing, corrupt or NaN frame
+    // stops the run before any frame is written.
+    for (long f = 0; in_is_pattern && f < a.frames; ++f) {
+        const char *in_name = frame_name(in_buf, sizeof(in_buf), in_path, f);
+        if (!in_name) {
+            fprintf(stderr, "drift glare: frame %ld's file name is too long\n", f);
+            status = 2;
+            goto done;
+        }
+        if ((r = drift_image_load(ctx, in_name, &in)) != DRIFT_OK) {
+            fprintf(stderr, "drift glare: cannot load '%s': %s; nothing written\n", in_name,
+                    drift_result_string(r));
+            status = 2;
+            goto done;
+        }
+        bool finite = true;
+        for (size_t i = 0; finite && i < (size_t)in.width * (size_t)in.height * 3; ++i) {
+            finite = isfinite(in.pixels[i]);
+        }
+        drift_image_destroy(ctx, &in);
+        if (!finite) {
+            fprintf(stderr, "drift glare: '%s' has NaN or infinite pixels; nothing written\n",
+                    in_name);
+            status = 2;
+            goto done;
+        }
+    }
     for (long f = 0; f < a.frames; ++f) {
         const char *in_name = frame_name(in_buf, sizeof(in_buf), in_path, f);
         const char *out_frame = frame_name(out_buf, sizeof(out_buf), out_name, f);
@@ -452,8 +479,14 @@ int drift_cmd_glare(int argc, char **argv)
         r = drift_glare_apply(glare, &in, f == 0 ? 0.0 : 1.0 / a.fps, &out);
         double ms = 1e3 * (drift_time_now() - t0);
         if (r != DRIFT_OK) {
-            fprintf(stderr, "drift glare: '%s': %s (NaN or infinite pixels?)\n", in_name,
-                    drift_result_string(r));
+            if (r == DRIFT_ERR_INVALID_ARGUMENT) {
+                fprintf(stderr,
+                        "drift glare: '%s' has NaN or infinite pixels (the first is named "
+                        "above); nothing written\n",
+                        in_name);
+            } else {
+                fprintf(stderr, "drift glare: '%s': %s\n", in_name, drift_result_string(r));
+            }
             status = r == DRIFT_ERR_INVALID_ARGUMENT ? 2 : 1;
             goto done;
         }

@@ -28,6 +28,35 @@ open(d + "/in.hdr", "wb").write(head + px)
 open(d + "/in.png", "wb").write(b"\x89PNG\r\n\x1a\n")
 open(d + "/corrupt.exr", "wb").write(b"v/1\x01" + b"\x00" * 40)
 PY
+# Uncompressed scanline EXRs written by hand: one with a NaN pixel, one valid.
+python3 - "$tmp" <<'PY'
+import struct, sys
+def attr(name, typ, data):
+    return name.encode() + b"\0" + typ.encode() + b"\0" + struct.pack("<i", len(data)) + data
+def exr(path, w, h, pixel):
+    ch = b"".join(n.encode() + b"\0" + struct.pack("<iBBBBii", 2, 0, 0, 0, 0, 1, 1) for n in "BGR")
+    hdr = b"\x76\x2f\x31\x01" + struct.pack("<i", 2) + attr("channels", "chlist", ch + b"\0")
+    hdr += attr("compression", "compression", b"\0")
+    hdr += attr("dataWindow", "box2i", struct.pack("<iiii", 0, 0, w - 1, h - 1))
+    hdr += attr("displayWindow", "box2i", struct.pack("<iiii", 0, 0, w - 1, h - 1))
+    hdr += attr("lineOrder", "lineOrder", b"\0")
+    hdr += attr("pixelAspectRatio", "float", struct.pack("<f", 1.0))
+    hdr += attr("screenWindowCenter", "v2f", struct.pack("<ff", 0, 0))
+    hdr += attr("screenWindowWidth", "float", struct.pack("<f", 1.0)) + b"\0"
+    chunks = []
+    for y in range(h):
+        data = b"".join(struct.pack("<%df" % w, *[pixel(x, y)[c] for x in range(w)])
+                        for c in (2, 1, 0))
+        chunks.append(struct.pack("<ii", y, len(data)) + data)
+    off, table = len(hdr) + 8 * h, b""
+    for c in chunks:
+        table += struct.pack("<Q", off)
+        off += len(c)
+    open(path, "wb").write(hdr + table + b"".join(chunks))
+d = sys.argv[1]
+exr(d + "/nan.exr", 8, 6, lambda x, y: (float("nan") if (x, y) == (3, 2) else 0.5, 0.5, 0.5))
+exr(d + "/ok.exr", 8, 6, lambda x, y: (0.5, 2.0 if (x, y) == (3, 2) else 0.1, 0.5))
+PY
 small=(--psf-size 32 --threads 1)
 
 # Help and usage errors.
@@ -56,6 +85,13 @@ expect 2 "$drift" glare "$tmp/corrupt.exr" --out "$tmp/x.exr" --psf "$tmp/xpsf.e
 grep -q "corrupt.exr" "$tmp/err" || fail "a corrupt input is named"
 [ -e "$tmp/x.exr" ] && fail "a refused run wrote its output"
 [ -e "$tmp/xpsf.exr" ] && fail "a refused run wrote its PSF"
+expect 2 "$drift" glare "$tmp/nan.exr" --out "$tmp/x.exr" --psf "$tmp/xpsf.exr" "${small[@]}"
+grep -q "nan.exr' has NaN or infinite pixels" "$tmp/err" || fail "a NaN input is refused by name"
+grep -q "pixel (3, 2)" "$tmp/err" || fail "the first NaN pixel is named"
+[ -e "$tmp/x.exr" ] && fail "a NaN input wrote its output"
+[ -e "$tmp/xpsf.exr" ] && fail "a NaN input wrote its PSF"
+expect 0 "$drift" glare "$tmp/ok.exr" --out "$tmp/ok_out.exr" "${small[@]}"
+[ -s "$tmp/ok_out.exr" ] || fail "an EXR input is read and glared"
 # An unwritable output fails without leaving a partial file.
 expect 1 "$drift" glare "$tmp/in.hdr" --out "$tmp/no/such/dir/x.exr" "${small[@]}"
 ls "$tmp" | grep -q "tmp-" && fail "a temporary file was left behind"
@@ -89,6 +125,12 @@ cmp -s "$tmp/p_00.exr" "$tmp/p_02.exr" && fail "the dynamic eye changes the PSF 
 # An input pattern reads one image a frame.
 expect 0 "$drift" glare "$tmp/f_%02d.exr" --frames 2 --out-pattern "$tmp/g_%d.exr" "${small[@]}"
 [ -s "$tmp/g_1.exr" ] || fail "an input pattern makes frame 1"
+# A bad frame in an input sequence stops the run before anything is written.
+cp "$tmp/ok.exr" "$tmp/s_0.exr"
+cp "$tmp/nan.exr" "$tmp/s_1.exr"
+expect 2 "$drift" glare "$tmp/s_%d.exr" --frames 2 --out-pattern "$tmp/t_%d.exr" "${small[@]}"
+grep -q "s_1.exr' has NaN" "$tmp/err" || fail "the NaN frame of a sequence is named"
+[ -e "$tmp/t_0.exr" ] && fail "a sequence with a bad frame wrote its first frame"
 
 [ "$failures" -eq 0 ] || { echo "$failures failure(s)" >&2; exit 1; }
 echo "cli glare: ok"
