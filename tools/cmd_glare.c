@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #define PI 3.14159265358979323846
 
@@ -321,6 +322,23 @@ static drift_result save_psf_png(drift_context *ctx, const char *path, const dri
     return r;
 }
 
+// Whether the folder that `path` would be written into exists and is writable.
+static bool folder_writable(const char *path)
+{
+    char dir[4096];
+    const char *slash = strrchr(path, '/');
+    if (!slash) {
+        return access(".", W_OK) == 0;
+    }
+    size_t len = (size_t)(slash - path);
+    if (len >= sizeof(dir)) {
+        return false;
+    }
+    memcpy(dir, path, len);
+    dir[len] = '\0';
+    return access(len ? dir : "/", W_OK) == 0;
+}
+
 static drift_result save_image(drift_context *ctx, const char *path, const drift_image *img,
                                double exposure)
 {
@@ -386,6 +404,14 @@ int drift_cmd_glare(int argc, char **argv)
             fprintf(stderr, "drift glare: '%s' must be an %s name (with at most one %%d)\n",
                     extras[i], i == 0 ? ".exr or .png" : ".exr");
             return 2;
+        }
+    }
+    const char *outputs[3] = { out_name, a.psf, a.aperture };
+    for (int i = 0; i < 3; ++i) {
+        if (outputs[i] && !folder_writable(outputs[i])) {
+            fprintf(stderr, "drift glare: cannot write '%s': its folder is missing or read-only\n",
+                    outputs[i]);
+            return 1;
         }
     }
     if (a.psf_size && (a.psf_size & (a.psf_size - 1)) != 0) {

@@ -94,6 +94,9 @@ expect 0 "$drift" glare "$tmp/ok.exr" --out "$tmp/ok_out.exr" "${small[@]}"
 [ -s "$tmp/ok_out.exr" ] || fail "an EXR input is read and glared"
 # An unwritable output fails without leaving a partial file.
 expect 1 "$drift" glare "$tmp/in.hdr" --out "$tmp/no/such/dir/x.exr" "${small[@]}"
+grep -q "no/such/dir/x.exr" "$tmp/err" || fail "an unwritable output is named"
+expect 1 "$drift" glare "$tmp/in.hdr" --out "$tmp/y.exr" --psf "$tmp/no/psf.exr" "${small[@]}"
+[ -e "$tmp/y.exr" ] && fail "an unwritable PSF path let the output be written"
 ls "$tmp" | grep -q "tmp-" && fail "a temporary file was left behind"
 
 # A still: output, PSF and aperture, and the same bytes for the same seed.
