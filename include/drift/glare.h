@@ -24,6 +24,7 @@
 //       ... save or show out ...
 //       drift_image_destroy(ctx, &out);
 //   }
+//   drift_glare_apply_to(glare, &frame, dt, &frame);      // or in place, no allocation
 //   const drift_image *psf = drift_glare_psf(glare);     // the last frame's RGB PSF (borrowed)
 //   drift_glare_destroy(glare);
 //
@@ -183,9 +184,11 @@ void drift_glare_destroy(drift_glare *glare);
 // Applies glare to `in` (3 or 4 channels; alpha is copied) into *out, a new image of the same
 // size the caller destroys. Dynamic mode first advances the eye by dt seconds (dt >= 0; the
 // first call's field luminance starts adapted to the first image); static mode ignores dt.
-// Errors: DRIFT_ERR_INVALID_ARGUMENT (invalid image, 1-2 channels, NaN or infinite or negative
-// pixels, dt < 0 or not finite; logged with the first bad pixel), DRIFT_ERR_OUT_OF_MEMORY.
-// *out is zeroed on failure.
+// The field luminance is the frame's mean Rec.709 luminance times luminance_scale (or the fixed
+// field_luminance). Negative pixels are convolved like any other. Errors:
+// DRIFT_ERR_INVALID_ARGUMENT (invalid image, 1-2 channels, NaN or infinite pixels, dt < 0 or
+// not finite; logged with the first bad pixel), DRIFT_ERR_OUT_OF_MEMORY. *out is zeroed on
+// failure.
 drift_result drift_glare_apply(drift_glare *glare, const drift_image *in, double dt,
                                drift_image *out);
 
