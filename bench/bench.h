@@ -14,7 +14,8 @@
     X("frame", drift_bench_frame, "hybrid frame passes vs the primary-visibility pass")        \
     X("isg", drift_bench_isg, "image space gathering: Table 1 timings, FLIP vs baselines")     \
     X("aaf", drift_bench_aaf, "axis-aligned filtering: RMSE vs spp against plain Monte Carlo") \
-    X("sir", drift_bench_sir, "smart image refinement vs pure ray tracing (Table 1)")
+    X("sir", drift_bench_sir, "smart image refinement vs pure ray tracing (Table 1)") \
+    X("glare", drift_bench_glare, "temporal glare: Table 8.2 phases, convolution, ms a frame")
 
 #include "cli.h"
 

@@ -24,7 +24,8 @@
     X("info", drift_cmd_info, "print a scene's triangle, material, light, texture counts")   \
     X("bench", drift_cmd_bench, "benchmarks (drift bench --help)")                           \
     X("view", drift_cmd_view, "interactive viewer: hybrid techniques against the reference") \
-    X("refine", drift_cmd_refine, "smart image refinement: fit the metric weights (lambda)")
+    X("refine", drift_cmd_refine, "smart image refinement: fit the metric weights (lambda)") \
+    X("glare", drift_cmd_glare, "temporal glare (thesis ch. 8) on an HDR image or sequence")
 
 #define DRIFT__COMMAND_DECLARE(name, fn, summary) int fn(int argc, char **argv);
 DRIFT_COMMAND_LIST(DRIFT__COMMAND_DECLARE)
