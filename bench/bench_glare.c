@@ -207,10 +207,13 @@ int drift_bench_glare(int argc, char **argv)
             return 2;
         }
     }
-    drift_context *ctx = cli_open_context("bench glare", 1, false);
-    if (!ctx) {
+    cli_session session;
+    if (!cli_session_open(
+            &(cli_session_desc){ .cmd = "bench glare", .threads = 1, .no_scene = true },
+            &session)) {
         return 1;
     }
+    drift_context *ctx = session.ctx;
     phase_ms rows[8];
     double apply_ms[3] = { NAN, NAN, NAN }, billboard_ms = NAN;
     const int32_t apply_sizes[3][2] = { { 640, 480 }, { 512, 512 }, { 1024, 1024 } };
@@ -227,7 +230,7 @@ int drift_bench_glare(int argc, char **argv)
     }
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift bench glare: %s\n", drift_result_string(r));
-        drift_context_destroy(ctx);
+        cli_session_close(&session);
         return 1;
     }
     if (json) {
@@ -269,6 +272,6 @@ int drift_bench_glare(int argc, char **argv)
             printf("billboards (dynamic, PSF 256, 16 lights): %.1f ms at 640x480\n", billboard_ms);
         }
     }
-    drift_context_destroy(ctx);
+    cli_session_close(&session);
     return 0;
 }

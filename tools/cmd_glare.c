@@ -443,10 +443,14 @@ int drift_cmd_glare(int argc, char **argv)
         .method = (drift_glare_method)(a.method + 1),
         .billboard_threshold = a.billboard_threshold,
     };
-    drift_context *ctx = cli_open_context("glare", (int)a.threads, a.verbose);
-    if (!ctx) {
+    cli_session session;
+    if (!cli_session_open(
+            &(cli_session_desc){
+                .cmd = "glare", .threads = (int)a.threads, .verbose = a.verbose, .no_scene = true },
+            &session)) {
         return 1;
     }
+    drift_context *ctx = session.ctx;
     int status = 1;
     drift_glare *glare = NULL;
     drift_image in = { 0 }, out = { 0 };
@@ -561,6 +565,6 @@ done:
     drift_image_destroy(ctx, &out);
     drift_image_destroy(ctx, &in);
     drift_glare_destroy(glare);
-    drift_context_destroy(ctx);
+    cli_session_close(&session);
     return status;
 }

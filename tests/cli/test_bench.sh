@@ -53,6 +53,11 @@ assert e["timing"]["frame_ms"] > 0, e'
 assert len(r) == 1 and r[0]["width"] == 16 and r[0]["height"] == 12, d
 assert 0 <= r[0]["flip"] <= 1 and r[0]["prt_ms"] > 0 and "shadow" in r[0]["quality"], r'
         ;;
+    glare)
+        expect 0 "$drift" bench glare --frames 1 --sizes 16,32 --no-convolution --json
+        check glare 'assert [r["n"] for r in d["sizes"]] == [16, 32], d
+assert all(r["overall_ms"] > 0 and r["aperture_ms"] >= 0 for r in d["sizes"]), d'
+        ;;
     *)
         fail "bench $1 has no smoke case in tests/cli/test_bench.sh"
         return
