@@ -1,0 +1,407 @@
+// Tests of src/ssdo: SSAO, GTAO and SSDO with its bounce (thesis spec §2.5, docs/ssdo.md).
+// Scenes are small and seen from straight above, where one depth layer sees everything the
+// sample points can reach.
+#include "drift/ssdo.h"
+#include "drift_test.h"
+#include "test_rig.h"
+
+#include <math.h>
+#include <string.h>
+
+#define PI 3.14159265358979323846
+
+// --- HELPERS ---
+
+typedef struct ssdo_case {
+    test_rig rig;
+    drift_ssdo_env *env;
+    drift_ssdo_output out;
+} ssdo_case;
+
+// Commits the rig's scene, renders its G-buffer and pre-filters its environment.
+static void case_begin(ssdo_case *c)
+{
+    test_rig_commit(&c->rig);
+    test_rig_frame(&c->rig, &(drift_hybrid_params){ 0 });
+    assert_int_equal(
+        drift_ssdo_env_create(c->rig.ctx, c->rig.scene,
+                              &(drift_ssdo_env_desc){ .width = 32, .source_width = 64 }, &c->env),
+        DRIFT_OK);
+    const drift_gbuffer *g = drift_hybrid_gbuffer(c->rig.frame);
+    assert_int_equal(drift_ssdo_output_create(c->rig.ctx, g->width, g->height, &c->out), DRIFT_OK);
+}
+
+static void case_render_gbuffer(ssdo_case *c, const drift_gbuffer *g, const drift_ssdo_params *p,
+                                const drift_image *extra)
+{
+    assert_int_equal(
+        drift_ssdo_render(c->rig.ctx, c->env, g, &c->rig.scene->camera, p, extra, &c->out),
+        DRIFT_OK);
+}
+
+static void case_render(ssdo_case *c, const drift_ssdo_params *p)
+{
+    case_render_gbuffer(c, drift_hybrid_gbuffer(c->rig.frame), p, NULL);
+}
+
+static void case_end(ssdo_case *c)
+{
+    drift_ssdo_output_destroy(c->rig.ctx, &c->out);
+    drift_ssdo_env_destroy(c->env);
+    test_rig_destroy(&c->rig);
+}
+
+static void look_down(drift_scene *scene, float height, float half_extent, int32_t size)
+{
+    scene->camera = drift_camera_look_at(drift_vec3_make(0.0f, height, 0.0f),
+                                         drift_vec3_splat(0.0f), drift_vec3_make(0.0f, 0.0f, 1.0f),
+                                         2.0f * atanf(half_extent / height), size, size);
+}
+
+// A box [x0, x1] x [0, h] x [-d, d] with outward-wound faces (the bottom left out).
+static void add_box(drift_scene *scene, float x0, float x1, float h, float d, uint32_t material)
+{
+    test_add_quad(scene, drift_vec3_make(x0, h, -d), drift_vec3_make(0, 0, 2 * d),
+                  drift_vec3_make(x1 - x0, 0, 0), material); // top (+y)
+    test_add_quad(scene, drift_vec3_make(x0, 0, -d), drift_vec3_make(0, 0, 2 * d),
+                  drift_vec3_make(0, h, 0), material); // -x side
+    test_add_quad(scene, drift_vec3_make(x1, 0, -d), drift_vec3_make(0, h, 0),
+                  drift_vec3_make(0, 0, 2 * d), material); // +x side
+    test_add_quad(scene, drift_vec3_make(x0, 0, -d), drift_vec3_make(0, h, 0),
+                  drift_vec3_make(x1 - x0, 0, 0), material); // -z side
+    test_add_quad(scene, drift_vec3_make(x0, 0, d), drift_vec3_make(x1 - x0, 0, 0),
+                  drift_vec3_make(0, h, 0), material); // +z side
+}
+
+static const float *pixel(const drift_image *image, int32_t x, int32_t y)
+{
+    return drift_image_pixel(image, x, y);
+}
+
+// --- WHITE FURNACE: AN UNOCCLUDED PLANE ---
+
+// Spec §2.5 test 1: under a constant environment L an open plane gives V = 1, L_dir = rho L
+// and no bounce, for every technique.
+static void test_open_plane_gives_albedo_times_environment(void **state)
+{
+    (void)state;
+    ssdo_case c = { .rig = test_rig_begin(2) };
+    uint32_t grey = test_add_material(c.rig.scene, drift_material_make(drift_vec3_splat(0.5f)));
+    test_add_floor(c.rig.scene, 50.0f, 0.0f, grey);
+    c.rig.scene->environment.color = drift_vec3_splat(1.0f);
+    look_down(c.rig.scene, 10.0f, 2.0f, 48);
+    case_begin(&c);
+    for (int t = 0; t < DRIFT_OCCLUSION_COUNT; ++t) {
+        case_render(&c, &(drift_ssdo_params){ .technique = (drift_occlusion_technique)t,
+                                              .samples = 64,
+                                              .radius = 0.5f,
+                                              .bounce = true });
+        for (int32_t y = 0; y < 48; ++y) {
+            for (int32_t x = 0; x < 48; ++x) {
+                assert_near(pixel(&c.out.visibility, x, y)[0], 1.0, 0.02);
+                for (int k = 0; k < 3; ++k) {
+                    assert_near(pixel(&c.out.radiance, x, y)[k], 0.5, 0.01);
+                    assert_true(pixel(&c.out.bounce, x, y)[k] == 0.0f);
+                }
+                assert_near(pixel(&c.out.bent_normal, x, y)[1], 1.0, 0.01);
+            }
+        }
+    }
+    case_end(&c);
+}
+
+// --- THE V-GROOVE: A CLOSED FORM ---
+
+// The groove y = |x| tan(gamma) seen from above; at its crease, with the normal along the
+// bisector, the cosine-weighted open fraction is cos(gamma) (the 2-D wedge of half-opening
+// pi/2 - gamma: sin of it). GTAO's slice integral gives the same: each slice at angle phi to
+// the cross-section sees horizons at elevation atan(|cos phi| tan gamma), and
+// (1/pi) int cos^2(elevation) dphi = 1 / sqrt(1 + tan^2 gamma). SSAO's point test is exact
+// here because the groove is star-shaped from the crease.
+static void test_groove_crease_matches_closed_form(void **state)
+{
+    (void)state;
+    const float gammas[] = { 0.5235988f, 0.7853982f, 1.0471976f };
+    for (int g = 0; g < 3; ++g) {
+        ssdo_case c = { .rig = test_rig_begin(2) };
+        uint32_t grey = test_add_material(c.rig.scene, drift_material_make(drift_vec3_splat(0.5f)));
+        float t = tanf(gammas[g]), w = 3.0f;
+        test_add_quad(c.rig.scene, drift_vec3_make(0, 0, -w), drift_vec3_make(0, 0, 2 * w),
+                      drift_vec3_make(w, w * t, 0), grey);
+        test_add_quad(c.rig.scene, drift_vec3_make(0, 0, -w), drift_vec3_make(-w, w * t, 0),
+                      drift_vec3_make(0, 0, 2 * w), grey);
+        c.rig.scene->environment.color = drift_vec3_splat(1.0f);
+        look_down(c.rig.scene, 40.0f, 1.5f, 129);
+        case_begin(&c);
+        // The crease pixel's normal is one wall's; give it the bisector (a copy of the plane).
+        const drift_gbuffer *gb = drift_hybrid_gbuffer(c.rig.frame);
+        drift_gbuffer crease = *gb;
+        assert_int_equal(drift_image_create(c.rig.ctx, 129, 129, 3, &crease.normal), DRIFT_OK);
+        memcpy(crease.normal.pixels, gb->normal.pixels, sizeof(float) * 129 * 129 * 3);
+        drift_image_set3(&crease.normal, 64, 64, drift_vec3_make(0, 1, 0));
+        assert_near(pixel(&gb->position, 64, 64)[0], 0.0, 1e-3);
+        double expected = cos((double)gammas[g]);
+        case_render_gbuffer(&c, &crease,
+                            &(drift_ssdo_params){ .technique = DRIFT_OCCLUSION_GTAO,
+                                                  .samples = 2 * 32 * 8,
+                                                  .gtao_slices = 32,
+                                                  .radius = 0.5f,
+                                                  .no_fade = true,
+                                                  .no_blur = true },
+                            NULL);
+        assert_near(pixel(&c.out.visibility, 64, 64)[0], expected, 0.02 * expected);
+        assert_near(pixel(&c.out.bent_normal, 64, 64)[1], 1.0, 1e-3);
+        for (int t2 = 0; t2 < 2; ++t2) {
+            drift_occlusion_technique tech = t2 ? DRIFT_OCCLUSION_SSDO : DRIFT_OCCLUSION_SSAO;
+            case_render_gbuffer(&c, &crease,
+                                &(drift_ssdo_params){ .technique = tech,
+                                                      .samples = 1024,
+                                                      .radius = 0.5f,
+                                                      .bias = 1e-4f,
+                                                      .no_fade = true,
+                                                      .no_blur = true },
+                                NULL);
+            assert_near(pixel(&c.out.visibility, 64, 64)[0], expected, 0.03 * expected);
+            assert_near(pixel(&c.out.direct, 64, 64)[0], 0.5 * expected, 0.03 * expected);
+        }
+        drift_image_destroy(c.rig.ctx, &crease.normal);
+        case_end(&c);
+    }
+}
+
+// --- COLOURED DIRECTIONAL SHADOWS ---
+
+// A lat-long environment, red toward +x and blue toward -x.
+static void add_red_blue_environment(drift_scene *scene)
+{
+    drift_image env;
+    assert_int_equal(drift_image_create(scene->ctx, 64, 32, 3, &env), DRIFT_OK);
+    for (int32_t y = 0; y < 32; ++y) {
+        for (int32_t x = 0; x < 64; ++x) {
+            double phi = 2.0 * PI * (x + 0.5) / 64.0;
+            bool plus_x = cos(phi) > 0.0; // dir.x = sin(theta) cos(phi)
+            drift_image_set3(&env, x, y,
+                             plus_x ? drift_vec3_make(1, 0, 0) : drift_vec3_make(0, 0, 1));
+        }
+    }
+    uint32_t index;
+    assert_int_equal(drift_scene_add_texture(scene, env, &index), DRIFT_OK);
+    scene->environment = (drift_environment){ .color = drift_vec3_splat(1.0f), .texture = index };
+}
+
+// A floor with (box) a box on the +x side of the origin under the red/blue environment, seen
+// from above or (side_view) from the -x side, where the box's -x face is on screen.
+static void build_box_scene(ssdo_case *c, bool box, drift_vec3 box_albedo, float env_scale,
+                            bool side_view)
+{
+    c->rig = test_rig_begin(2);
+    uint32_t grey = test_add_material(c->rig.scene, drift_material_make(drift_vec3_splat(0.5f)));
+    uint32_t boxm = test_add_material(c->rig.scene, drift_material_make(box_albedo));
+    test_add_floor(c->rig.scene, 20.0f, 0.0f, grey);
+    if (box) {
+        add_box(c->rig.scene, 0.3f, 1.3f, 1.0f, 2.0f, boxm);
+    }
+    add_red_blue_environment(c->rig.scene);
+    c->rig.scene->environment.color = drift_vec3_splat(env_scale);
+    look_down(c->rig.scene, 8.0f, 1.5f, 48);
+    if (side_view) {
+        c->rig.scene->camera = drift_camera_look_at(
+            drift_vec3_make(-5.0f, 4.0f, 0.0f), drift_vec3_make(0.0f, 0.3f, 0.0f),
+            drift_vec3_make(0.0f, 1.0f, 0.0f), 0.5f, 48, 48);
+    }
+    case_begin(c);
+}
+
+// Spec §2.5 test 3: with a box on the +x side, the floor beside it sees less red than blue
+// under SSDO; SSAO darkens both alike.
+static void test_directional_shadow_is_coloured(void **state)
+{
+    (void)state;
+    ssdo_case c;
+    build_box_scene(&c, true, drift_vec3_splat(0.5f), 1.0f, false);
+    drift_ssdo_params p = { .samples = 32, .radius = 2.0f };
+    int32_t x = 25, y = 24; // floor just to the -x side of the box (image right is -x)
+    assert_true(pixel(&drift_hybrid_gbuffer(c.rig.frame)->position, x, y)[0] < 0.3f);
+    p.technique = DRIFT_OCCLUSION_SSAO;
+    case_render(&c, &p);
+    const float *ao = pixel(&c.out.radiance, x, y);
+    assert_near(ao[2] / ao[0], 1.0, 0.02);
+    assert_true(pixel(&c.out.visibility, x, y)[0] < 0.9f);
+    p.technique = DRIFT_OCCLUSION_SSDO;
+    case_render(&c, &p);
+    const float *d = pixel(&c.out.radiance, x, y);
+    assert_true(d[2] / d[0] > 1.2f);
+    case_end(&c);
+}
+
+// Spec §2.5 test 2: with the fade off and the sets fixed, adding the box only lowers the
+// direct light wherever the visible surface is unchanged.
+static void test_added_geometry_only_darkens(void **state)
+{
+    (void)state;
+    ssdo_case open, boxed;
+    build_box_scene(&open, false, drift_vec3_splat(0.5f), 1.0f, false);
+    build_box_scene(&boxed, true, drift_vec3_splat(0.5f), 1.0f, false);
+    drift_ssdo_params p = { .technique = DRIFT_OCCLUSION_SSDO,
+                            .samples = 16,
+                            .radius = 1.0f,
+                            .no_fade = true,
+                            .no_blur = true };
+    case_render(&open, &p);
+    case_render(&boxed, &p);
+    const drift_gbuffer *ga = drift_hybrid_gbuffer(open.rig.frame);
+    const drift_gbuffer *gb = drift_hybrid_gbuffer(boxed.rig.frame);
+    int darker = 0;
+    for (int32_t y = 0; y < 48; ++y) {
+        for (int32_t x = 0; x < 48; ++x) {
+            if (pixel(&ga->position, x, y)[1] != pixel(&gb->position, x, y)[1]) {
+                continue; // the box covers this pixel
+            }
+            for (int k = 0; k < 3; ++k) {
+                float a = pixel(&open.out.direct, x, y)[k], b = pixel(&boxed.out.direct, x, y)[k];
+                assert_true(b <= a);
+                darker += b < a;
+            }
+        }
+    }
+    assert_true(darker > 100);
+    case_end(&open);
+    case_end(&boxed);
+}
+
+// --- THE BOUNCE ---
+
+// Spec §2.5 test 6: the bounce is non-negative, zero away from occluders, carries the
+// sender's colour times the receiver's albedo, is linear in the sender's radiance, and a
+// back-facing sender gives nothing.
+static void test_bounce_sanity(void **state)
+{
+    (void)state;
+    ssdo_case c, bright;
+    build_box_scene(&c, true, drift_vec3_make(0.8f, 0.0f, 0.0f), 1.0f, true);
+    build_box_scene(&bright, true, drift_vec3_make(0.8f, 0.0f, 0.0f), 2.0f, true);
+    drift_ssdo_params p = {
+        .technique = DRIFT_OCCLUSION_SSDO, .samples = 16, .radius = 1.0f, .bounce = true
+    };
+    case_render(&c, &p);
+    case_render(&bright, &p);
+    const drift_gbuffer *g = drift_hybrid_gbuffer(c.rig.frame);
+    double lit = 0.0;
+    for (int32_t y = 0; y < 48; ++y) {
+        for (int32_t x = 0; x < 48; ++x) {
+            const float *b = pixel(&c.out.bounce, x, y);
+            const float *b2 = pixel(&bright.out.bounce, x, y);
+            bool floor = pixel(&g->position, x, y)[1] < 1e-3f;
+            for (int k = 0; k < 3; ++k) {
+                assert_true(b[k] >= 0.0f);
+                assert_near(b2[k], 2.0f * b[k], 1e-5f + 1e-5f * b[k]);
+            }
+            if (floor) {
+                // Red sender x grey receiver: red only.
+                assert_true(b[1] == 0.0f && b[2] == 0.0f);
+                lit += (double)b[0];
+            }
+            if (floor && pixel(&g->position, x, y)[0] < 0.3f - 1.2f) {
+                assert_true(b[0] == 0.0f); // no occluder within r_max
+            }
+        }
+    }
+    assert_true(lit > 0.0);
+    // Bounded: with sender distances clamped to c r_max, N patches of area pi r_max^2 / N
+    // give at most rho_r L_s / c^2 (docs/ssdo.md); here rho_r 0.5, L_s <= 0.8 x 1.05, c 0.5.
+    for (int32_t y = 0; y < 48; ++y) {
+        for (int32_t x = 0; x < 48; ++x) {
+            assert_true(pixel(&c.out.bounce, x, y)[0] <= 0.5f * 0.84f / 0.25f);
+        }
+    }
+    // Box senders turned to face +x, away from every visible floor point, give nothing.
+    drift_gbuffer flipped = *g;
+    assert_int_equal(drift_image_create(c.rig.ctx, 48, 48, 3, &flipped.normal), DRIFT_OK);
+    for (int32_t y = 0; y < 48; ++y) {
+        for (int32_t x = 0; x < 48; ++x) {
+            bool box = pixel(&g->position, x, y)[1] > 1e-3f;
+            drift_image_set3(&flipped.normal, x, y,
+                             box ? drift_vec3_make(1, 0, 0) : drift_image_get3(&g->normal, x, y));
+        }
+    }
+    case_render_gbuffer(&c, &flipped, &p, NULL);
+    for (int32_t y = 0; y < 48; ++y) {
+        for (int32_t x = 0; x < 48; ++x) {
+            if (pixel(&g->position, x, y)[1] < 1e-3f) {
+                assert_true(pixel(&c.out.bounce, x, y)[0] == 0.0f);
+            }
+        }
+    }
+    drift_image_destroy(c.rig.ctx, &flipped.normal);
+    case_end(&c);
+    case_end(&bright);
+}
+
+// --- DETERMINISM ---
+
+// Spec §2.5 test 8: fixed sets give a bit-identical image, for any thread count.
+static void test_bit_identical_across_threads(void **state)
+{
+    (void)state;
+    ssdo_case c;
+    build_box_scene(&c, true, drift_vec3_make(0.8f, 0.2f, 0.1f), 1.0f, false);
+    drift_context *one = test_context(1, NULL);
+    for (int t = 0; t < DRIFT_OCCLUSION_COUNT; ++t) {
+        drift_ssdo_params p = { .technique = (drift_occlusion_technique)t,
+                                .samples = 16,
+                                .radius = 1.0f,
+                                .bounce = true,
+                                .seed = 3 };
+        case_render(&c, &p);
+        drift_ssdo_output first;
+        assert_int_equal(drift_ssdo_output_create(one, 48, 48, &first), DRIFT_OK);
+        assert_int_equal(drift_ssdo_render(one, c.env, drift_hybrid_gbuffer(c.rig.frame),
+                                           &c.rig.scene->camera, &p, NULL, &first),
+                         DRIFT_OK);
+        assert_memory_equal(first.radiance.pixels, c.out.radiance.pixels,
+                            sizeof(float) * 48 * 48 * 3);
+        assert_memory_equal(first.visibility.pixels, c.out.visibility.pixels,
+                            sizeof(float) * 48 * 48);
+        drift_ssdo_output_destroy(one, &first);
+    }
+    drift_context_destroy(one);
+    case_end(&c);
+}
+
+// --- ERRORS ---
+
+static void test_bad_parameters_are_rejected(void **state)
+{
+    (void)state;
+    ssdo_case c;
+    build_box_scene(&c, false, drift_vec3_splat(0.5f), 1.0f, false);
+    const drift_gbuffer *g = drift_hybrid_gbuffer(c.rig.frame);
+    const drift_ssdo_params bad[] = {
+        { .radius = -1.0f },
+        { .radius = 1.0f, .samples = -3 },
+        { .radius = 1.0f, .technique = DRIFT_OCCLUSION_COUNT },
+        { .radius = 1.0f, .gtao_thickness = 2.0f },
+    };
+    for (size_t i = 0; i < sizeof(bad) / sizeof(bad[0]); ++i) {
+        assert_int_equal(
+            drift_ssdo_render(c.rig.ctx, c.env, g, &c.rig.scene->camera, &bad[i], NULL, &c.out),
+            DRIFT_ERR_INVALID_ARGUMENT);
+    }
+    assert_int_equal(drift_occlusion_technique_parse("gtao"), DRIFT_OCCLUSION_GTAO);
+    assert_int_equal(drift_occlusion_technique_parse("hbao"), -1);
+    case_end(&c);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_open_plane_gives_albedo_times_environment),
+        cmocka_unit_test(test_groove_crease_matches_closed_form),
+        cmocka_unit_test(test_directional_shadow_is_coloured),
+        cmocka_unit_test(test_added_geometry_only_darkens),
+        cmocka_unit_test(test_bounce_sanity),
+        cmocka_unit_test(test_bit_identical_across_threads),
+        cmocka_unit_test(test_bad_parameters_are_rejected),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
