@@ -155,14 +155,16 @@ static void test_groove_crease_matches_closed_form(void **state)
             drift_occlusion_technique tech = t2 ? DRIFT_OCCLUSION_SSDO : DRIFT_OCCLUSION_SSAO;
             case_render_gbuffer(&c, &crease,
                                 &(drift_ssdo_params){ .technique = tech,
-                                                      .samples = 1024,
+                                                      .samples = 256,
                                                       .radius = 0.5f,
                                                       .bias = 1e-4f,
                                                       .no_fade = true,
                                                       .no_blur = true },
                                 NULL);
-            assert_near(pixel(&c.out.visibility, 64, 64)[0], expected, 0.03 * expected);
-            assert_near(pixel(&c.out.direct, 64, 64)[0], 0.5 * expected, 0.03 * expected);
+            // 5%: samples within a pixel footprint of the steep walls read as open (spec
+            // §2.5 test 4a); at 60 degrees they lift the estimate by 4% (2.6% at N = 1024).
+            assert_near(pixel(&c.out.visibility, 64, 64)[0], expected, 0.05 * expected);
+            assert_near(pixel(&c.out.direct, 64, 64)[0], 0.5 * expected, 0.05 * expected);
         }
         drift_image_destroy(c.rig.ctx, &crease.normal);
         case_end(&c);
@@ -337,6 +339,53 @@ static void test_bounce_sanity(void **state)
     case_end(&bright);
 }
 
+// The pre-filtered maps of the red/blue environment: around +x the cosine lobe sees red
+// alone, around +y half of each, and the narrow cone along -x blue.
+static void test_prefiltered_environment(void **state)
+{
+    (void)state;
+    ssdo_case c;
+    build_box_scene(&c, false, drift_vec3_splat(0.5f), 1.0f, false);
+    drift_vec3 e = drift_ssdo_env_irradiance(c.env, drift_vec3_make(1, 0, 0));
+    assert_near(e.x, 1.0, 0.02);
+    assert_near(e.z, 0.0, 0.02);
+    e = drift_ssdo_env_irradiance(c.env, drift_vec3_make(0, 1, 0));
+    assert_near(e.x, 0.5, 0.01);
+    assert_near(e.z, 0.5, 0.01);
+    e = drift_ssdo_env_radiance(c.env, drift_vec3_make(-1, 0, 0), 64);
+    assert_near(e.z, 1.0, 0.01);
+    assert_near(e.x, 0.0, 0.01);
+    case_end(&c);
+}
+
+// SSDO approaches the path-traced environment light with visibility as N grows, on a scene
+// that one depth layer sees whole (a box on a floor from above, r_max around all of it).
+static void test_converges_toward_reference(void **state)
+{
+    (void)state;
+    ssdo_case c;
+    build_box_scene(&c, true, drift_vec3_splat(0.5f), 1.0f, false);
+    drift_image ref;
+    assert_int_equal(drift_ssdo_reference(c.rig.ctx, c.rig.scene, c.rig.accel, &c.rig.scene->camera,
+                                          48, 48, 64, 1, false, &ref),
+                     DRIFT_OK);
+    double rmse[3];
+    const int32_t counts[3] = { 2, 8, 64 };
+    for (int i = 0; i < 3; ++i) {
+        case_render(&c, &(drift_ssdo_params){ .technique = DRIFT_OCCLUSION_SSDO,
+                                              .samples = counts[i],
+                                              .radius = 3.0f });
+        rmse[i] = test_rmse(c.rig.ctx, &ref, &c.out.radiance);
+    }
+    print_message("SSDO RMSE vs reference: N=2 %.4f, N=8 %.4f, N=64 %.4f\n", rmse[0], rmse[1],
+                  rmse[2]);
+    assert_true(rmse[1] < rmse[0]);
+    assert_true(rmse[2] < rmse[1]);
+    assert_true(rmse[2] < 0.05);
+    drift_image_destroy(c.rig.ctx, &ref);
+    case_end(&c);
+}
+
 // --- DETERMINISM ---
 
 // Spec §2.5 test 8: fixed sets give a bit-identical image, for any thread count.
@@ -400,6 +449,8 @@ int main(void)
         cmocka_unit_test(test_directional_shadow_is_coloured),
         cmocka_unit_test(test_added_geometry_only_darkens),
         cmocka_unit_test(test_bounce_sanity),
+        cmocka_unit_test(test_prefiltered_environment),
+        cmocka_unit_test(test_converges_toward_reference),
         cmocka_unit_test(test_bit_identical_across_threads),
         cmocka_unit_test(test_bad_parameters_are_rejected),
     };
