@@ -5,7 +5,8 @@
 //   (b) quality at --width x --height: FLIP and RMSE of each technique's radiance against the
 //       path-traced reference of the same term (drift_ssdo_reference: environment light with
 //       visibility plus one diffuse bounce, at --ref-spp), and of the path tracer itself at
-//       1 spp and at the spp that fits SSDO+bounce's time. --out DIR writes every image as PNG
+//       1 spp and at the spp that fits SSDO+bounce's time; ssdo+2layers adds the second depth
+//       layer (drift_ssdo_peel, its ray time included). --out DIR writes every image as PNG
 //       (the same exposure) and the FLIP maps.
 // The G-buffer comes from the hybrid frame's primary pass and is not timed: the techniques'
 // inputs are the same for all of them.
@@ -162,15 +163,17 @@ typedef struct bench_state {
 typedef struct variant {
     const char *name;
     drift_occlusion_technique technique;
-    bool bounce, multibounce;
+    bool bounce, multibounce, layers;
 } variant;
 
 static const variant variants[] = {
-    { "ssao", DRIFT_OCCLUSION_SSAO, false, false },
-    { "gtao", DRIFT_OCCLUSION_GTAO, false, false },
-    { "gtao+mb", DRIFT_OCCLUSION_GTAO, false, true },
-    { "ssdo", DRIFT_OCCLUSION_SSDO, false, false },
-    { "ssdo+bounce", DRIFT_OCCLUSION_SSDO, true, false },
+    { "ssao", DRIFT_OCCLUSION_SSAO, false, false, false },
+    { "gtao", DRIFT_OCCLUSION_GTAO, false, false, false },
+    { "gtao+mb", DRIFT_OCCLUSION_GTAO, false, true, false },
+    { "ssdo", DRIFT_OCCLUSION_SSDO, false, false, false },
+    { "ssdo+bounce", DRIFT_OCCLUSION_SSDO, true, false, false },
+    { "ssdo+2layers", DRIFT_OCCLUSION_SSDO, false, false, true },
+    { "ssdo+b+2layers", DRIFT_OCCLUSION_SSDO, true, false, true },
 };
 #define VARIANT_COUNT (sizeof(variants) / sizeof(variants[0]))
 
@@ -192,18 +195,27 @@ static drift_ssdo_params variant_params(const bench_state *b, const variant *v, 
                                 .gtao_multibounce = v->multibounce };
 }
 
-// The least total ms of --frames renders of one variant into out.
+// The least total ms of --frames renders of one variant into out; with two layers the ms
+// include peeling the second layer (into back, the G-buffer's size).
 static drift_result time_variant(const bench_state *b, const drift_gbuffer *g, const variant *v,
-                                 long samples, drift_ssdo_output *out, double *out_ms)
+                                 long samples, drift_image *back, drift_ssdo_output *out,
+                                 double *out_ms)
 {
     drift_ssdo_params p = variant_params(b, v, samples);
     *out_ms = HUGE_VAL;
     for (long k = 0; k < b->o->frames; ++k) {
-        drift_result r = drift_ssdo_render(b->timed, b->env, g, &b->scene->camera, &p, NULL, out);
+        double t0 = drift_time_now();
+        drift_result r =
+            v->layers ? drift_ssdo_peel(b->timed, b->accel, g, &b->scene->camera, back) : DRIFT_OK;
+        double peel_ms = 1e3 * (drift_time_now() - t0);
+        drift_ssdo_inputs in = { .gbuffer = g,
+                                 .camera = &b->scene->camera,
+                                 .back_depth = v->layers ? back : NULL };
+        r = r ? r : drift_ssdo_render(b->timed, b->env, &in, &p, out);
         if (r != DRIFT_OK) {
             return r;
         }
-        *out_ms = fmin(*out_ms, out->stats.total_ms);
+        *out_ms = fmin(*out_ms, out->stats.total_ms + (v->layers ? peel_ms : 0.0));
     }
     return DRIFT_OK;
 }
@@ -224,7 +236,7 @@ static drift_result run_table(const bench_state *b, double ms[3][2][4])
         for (int n = 0; r == DRIFT_OK && n < 2; ++n) {
             for (int t = 0; r == DRIFT_OK && t < 4; ++t) {
                 r = time_variant(b, drift_hybrid_gbuffer(frame), table_variants[t], n ? 16 : 8,
-                                 &out, &ms[s][n][t]);
+                                 NULL, &out, &ms[s][n][t]);
             }
         }
         drift_ssdo_output_destroy(b->ctx, &out);
@@ -282,7 +294,7 @@ static drift_result run_quality(const bench_state *b, quality_row *rows, size_t 
 {
     const ssdo_options *o = b->o;
     int32_t w = (int32_t)o->width, h = (int32_t)o->height;
-    drift_image ref_full = { 0 }, ref_direct = { 0 };
+    drift_image ref_full = { 0 }, ref_direct = { 0 }, back = { 0 };
     drift_hybrid *frame = NULL;
     drift_ssdo_output out = { 0 };
     size_t count = 0;
@@ -293,6 +305,7 @@ static drift_result run_quality(const bench_state *b, quality_row *rows, size_t 
                                  (uint32_t)o->ref_spp, 1, false, &ref_direct);
     r = r ? r : make_gbuffer(b, w, h, &frame);
     r = r ? r : drift_ssdo_output_create(b->ctx, w, h, &out);
+    r = r ? r : drift_image_create(b->ctx, w, h, 1, &back);
     if (r == DRIFT_OK) {
         save_png(b, "reference", &ref_full);
         save_png(b, "reference-direct", &ref_direct);
@@ -301,9 +314,10 @@ static drift_result run_quality(const bench_state *b, quality_row *rows, size_t 
     for (size_t v = 0; r == DRIFT_OK && v < VARIANT_COUNT; ++v) {
         quality_row *row = &rows[count++];
         snprintf(row->name, sizeof(row->name), "%s", variants[v].name);
-        r = time_variant(b, drift_hybrid_gbuffer(frame), &variants[v], o->samples, &out, &row->ms);
+        r = time_variant(b, drift_hybrid_gbuffer(frame), &variants[v], o->samples, &back, &out,
+                         &row->ms);
         r = r ? r : score(b, &ref_full, &ref_direct, &out.radiance, row);
-        if (variants[v].bounce) {
+        if (variants[v].bounce && !variants[v].layers) {
             ssdo_bounce_ms = row->ms;
         }
         if (r == DRIFT_OK && o->out_dir) {
@@ -337,6 +351,7 @@ static drift_result run_quality(const bench_state *b, quality_row *rows, size_t 
     drift_hybrid_destroy(frame);
     drift_image_destroy(b->ctx, &ref_full);
     drift_image_destroy(b->ctx, &ref_direct);
+    drift_image_destroy(b->ctx, &back);
     *out_count = count;
     return r;
 }

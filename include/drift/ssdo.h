@@ -20,7 +20,8 @@
 //   drift_ssdo_output out;
 //   drift_ssdo_output_create(ctx, gbuffer->width, gbuffer->height, &out);
 //   drift_ssdo_params params = { .technique = DRIFT_OCCLUSION_SSDO, .bounce = true };
-//   drift_ssdo_render(ctx, env, gbuffer, camera, &params, NULL, &out);   // once per frame
+//   drift_ssdo_inputs in = { .gbuffer = gbuffer, .camera = camera };
+//   drift_ssdo_render(ctx, env, &in, &params, &out);                     // once per frame
 //   ... out.radiance ...
 //   drift_ssdo_output_destroy(ctx, &out);
 //   drift_ssdo_env_destroy(env);
@@ -160,16 +161,34 @@ void drift_ssdo_output_destroy(drift_context *ctx, drift_ssdo_output *out); // N
 
 // --- RENDERING ---
 
-// Renders one technique from `gbuffer` (drift_hybrid_gbuffer) seen by `camera` (the camera
-// that made the G-buffer; its width/height are ignored). sender_extra (may be NULL) is more
-// outgoing radiance at each pixel that the bounce reflects, e.g. the frame's shadowed direct
-// light from point and area lights (3 channels, the G-buffer's size).
+// What one frame gives the techniques. gbuffer and camera are required; the rest may be NULL.
+//   gbuffer         drift_hybrid_gbuffer: reads depth, position, normal, albedo, material_id
+//   camera          the camera that made the G-buffer (its width/height are ignored)
+//   sender_radiance more outgoing radiance at each pixel that the bounce reflects, e.g. the
+//                   frame's shadowed direct light from point and area lights (3 channels)
+//   back_depth      a second depth layer (drift_ssdo_peel, 1 channel): a sample counts as an
+//                   occluder only between the first layer and this one (thesis §4.3.2)
+typedef struct drift_ssdo_inputs {
+    const drift_gbuffer *gbuffer;
+    const drift_camera *camera;
+    const drift_image *sender_radiance;
+    const drift_image *back_depth;
+} drift_ssdo_inputs;
+
+// Renders one technique into out (made by drift_ssdo_output_create at the G-buffer's size).
 // Errors: DRIFT_ERR_INVALID_ARGUMENT (sizes differ, bad parameters; logged),
 // DRIFT_ERR_OUT_OF_MEMORY.
 drift_result drift_ssdo_render(drift_context *ctx, const drift_ssdo_env *env,
-                               const drift_gbuffer *gbuffer, const drift_camera *camera,
-                               const drift_ssdo_params *params, const drift_image *sender_extra,
+                               const drift_ssdo_inputs *inputs, const drift_ssdo_params *params,
                                drift_ssdo_output *out);
+
+// Depth peeling by a second ray: for every G-buffer pixel, the view depth of the next surface
+// along its camera ray behind the first (for a closed solid, where the ray leaves it) into
+// back_depth (1 channel, the G-buffer's size, made by the caller); 0 where there is none,
+// which the occluder test reads as solid to infinity (the one-layer rule). One ray a pixel.
+drift_result drift_ssdo_peel(drift_context *ctx, const drift_accel *accel,
+                             const drift_gbuffer *gbuffer, const drift_camera *camera,
+                             drift_image *back_depth);
 
 // The path-traced reference of the same term into out (3 channels, created here and owned by
 // the caller): environment light with visibility at the first hit, plus with `bounce` the

@@ -95,6 +95,7 @@ typedef struct ssdo_job {
     const drift_ssdo_env *env;
     const drift_gbuffer *gb;
     const drift_image *sender_extra;
+    const drift_image *back_depth;
     drift_ssdo_params p;
     drift_camera_frame cam;
     int32_t width, height;
@@ -142,7 +143,8 @@ static void make_sets(ssdo_job *j)
 // --- THE OCCLUDER TEST ---
 
 // How much the point s, a sample of the pixel at p, counts as an occluder: 0 when the depth
-// buffer at its pixel lies behind it (or it falls outside the image or on a miss), else 1,
+// buffer at its pixel lies behind it (or it falls outside the image or on a miss, or with two
+// layers behind the second), else 1,
 // faded out by 1 - smoothstep(0.75 r, r, |Q - P|) unless the fade is off. *out_x, *out_y get
 // the pixel of Q.
 static float occluder(const ssdo_job *j, drift_vec3 p, drift_vec3 s, int32_t *out_x, int32_t *out_y)
@@ -164,6 +166,13 @@ static float occluder(const ssdo_job *j, drift_vec3 p, drift_vec3 s, int32_t *ou
     float zq = drift_image_pixel(&j->gb->depth, qx, qy)[0];
     if (!(zq > 0.0f) || !(zq < zs - j->p.bias * j->p.radius)) {
         return 0.0f;
+    }
+    if (j->back_depth) {
+        // Two layers: behind the solid's back face is open again (fixes "sample A").
+        float zb = drift_image_pixel(j->back_depth, qx, qy)[0];
+        if (zb > 0.0f && zs > zb) {
+            return 0.0f;
+        }
     }
     if (j->p.no_fade) {
         return 1.0f;
@@ -523,22 +532,24 @@ static bool plane_ok(const drift_image *image, int32_t w, int32_t h, int32_t cha
 }
 
 drift_result drift_ssdo_render(drift_context *ctx, const drift_ssdo_env *env,
-                               const drift_gbuffer *gbuffer, const drift_camera *camera,
-                               const drift_ssdo_params *params, const drift_image *sender_extra,
+                               const drift_ssdo_inputs *inputs, const drift_ssdo_params *params,
                                drift_ssdo_output *out)
 {
     double t0 = drift_time_now();
     drift_ssdo_params p = drift_ssdo_params_resolve(params, NULL);
-    if (!ctx || !env || !gbuffer || !camera || !out) {
+    if (!ctx || !env || !inputs || !inputs->gbuffer || !inputs->camera || !out) {
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
+    const drift_gbuffer *gbuffer = inputs->gbuffer;
+    const drift_image *sender_extra = inputs->sender_radiance;
     int32_t w = gbuffer->width, h = gbuffer->height;
     bool planes = plane_ok(&gbuffer->depth, w, h, 1) && plane_ok(&gbuffer->position, w, h, 3) &&
                   plane_ok(&gbuffer->normal, w, h, 3) && plane_ok(&gbuffer->albedo, w, h, 3) &&
                   plane_ok(&gbuffer->material_id, w, h, 1) && plane_ok(&out->radiance, w, h, 3) &&
                   plane_ok(&out->direct, w, h, 3) && plane_ok(&out->bounce, w, h, 3) &&
                   plane_ok(&out->visibility, w, h, 1) && plane_ok(&out->bent_normal, w, h, 3) &&
-                  (!sender_extra || plane_ok(sender_extra, w, h, 3));
+                  (!sender_extra || plane_ok(sender_extra, w, h, 3)) &&
+                  (!inputs->back_depth || plane_ok(inputs->back_depth, w, h, 1));
     if (!planes || (unsigned)p.technique >= DRIFT_OCCLUSION_COUNT || p.samples < 1 ||
         p.samples > MAX_SAMPLES || !(p.radius > 0.0f) || !isfinite(p.radius) ||
         !(p.bounce_area > 0.0f) || !(p.bounce_clamp > 0.0f) || !(p.bias >= 0.0f) ||
@@ -553,8 +564,9 @@ drift_result drift_ssdo_render(drift_context *ctx, const drift_ssdo_env *env,
     ssdo_job j = { .env = env,
                    .gb = gbuffer,
                    .sender_extra = sender_extra,
+                   .back_depth = inputs->back_depth,
                    .p = p,
-                   .cam = drift_camera_frame_make(camera, w, h),
+                   .cam = drift_camera_frame_make(inputs->camera, w, h),
                    .width = w,
                    .height = h };
     j.focal_px = (float)h / (2.0f * j.cam.tan_half);
