@@ -3,7 +3,8 @@
 // an irradiance map (cosine lobe, stored as E / pi) and nine cone-filtered radiance maps, one
 // per sample count N = 2^k, each with the von Mises-Fisher lobe exp(N (cos - 1)) whose solid
 // angle is about 2 pi / N: the share of the hemisphere one SSDO sample stands for. Each map is
-// normalised by the sum of its discrete weights, so a constant environment stays exact.
+// normalised by the sum of its discrete weights, so a constant environment stays exact. The
+// renders read octahedral copies (128^2, bilinear), which need no trigonometry per lookup.
 #include "ssdo_internal.h"
 
 #include <string.h>
@@ -113,6 +114,8 @@ static void convolve_rows(size_t begin, size_t end, int thread_index, void *user
     }
 }
 
+static void build_octahedral(drift_ssdo_env *env);
+
 drift_result drift_ssdo_env_create(drift_context *ctx, const drift_scene *scene,
                                    const drift_ssdo_env_desc *desc, drift_ssdo_env **out_env)
 {
@@ -141,6 +144,10 @@ drift_result drift_ssdo_env_create(drift_context *ctx, const drift_scene *scene,
     for (int k = 0; k < SSDO_ENV_LEVELS; ++k) {
         ok = ok && (env->cone[k] = drift_alloc(ctx, floats * sizeof(float))) != NULL;
     }
+    size_t oct_floats = (size_t)SSDO_OCT_SIZE * SSDO_OCT_SIZE * 3;
+    for (int k = 0; k <= SSDO_ENV_LEVELS; ++k) {
+        ok = ok && (env->oct[k] = drift_alloc(ctx, oct_floats * sizeof(float))) != NULL;
+    }
     if (!ok) {
         drift_ssdo_env_destroy(env);
         return DRIFT_ERR_OUT_OF_MEMORY;
@@ -158,6 +165,7 @@ drift_result drift_ssdo_env_create(drift_context *ctx, const drift_scene *scene,
                 memcpy(env->cone[k] + i, v, sizeof(v));
             }
         }
+        build_octahedral(env);
         *out_env = env;
         return DRIFT_OK;
     }
@@ -178,6 +186,7 @@ drift_result drift_ssdo_env_create(drift_context *ctx, const drift_scene *scene,
     drift_parallel_for(ctx, (size_t)env->height, 1, convolve_rows, &b);
     drift_free(ctx, b.source);
     drift_free(ctx, b.source_dir);
+    build_octahedral(env);
     *out_env = env;
     return DRIFT_OK;
 }
@@ -190,6 +199,9 @@ void drift_ssdo_env_destroy(drift_ssdo_env *env)
     drift_free(env->ctx, env->irradiance);
     for (int k = 0; k < SSDO_ENV_LEVELS; ++k) {
         drift_free(env->ctx, env->cone[k]);
+    }
+    for (int k = 0; k <= SSDO_ENV_LEVELS; ++k) {
+        drift_free(env->ctx, env->oct[k]);
     }
     drift_free(env->ctx, env);
 }
@@ -221,9 +233,46 @@ static drift_vec3 lookup(const drift_ssdo_env *env, const float *map, drift_vec3
     return r;
 }
 
+// Bilinear in an octahedral map, clamped at its border.
+static drift_vec3 lookup_oct(const float *map, drift_vec3 dir)
+{
+    drift_vec2 uv = ssdo_dir_to_oct(dir);
+    float fx = uv.x * SSDO_OCT_SIZE - 0.5f, fy = uv.y * SSDO_OCT_SIZE - 0.5f;
+    fx = drift_clampf(fx, 0.0f, SSDO_OCT_SIZE - 1.001f);
+    fy = drift_clampf(fy, 0.0f, SSDO_OCT_SIZE - 1.001f);
+    int32_t x0 = (int32_t)fx, y0 = (int32_t)fy;
+    float tx = fx - (float)x0, ty = fy - (float)y0;
+    const float *p00 = map + 3 * ((size_t)y0 * SSDO_OCT_SIZE + (size_t)x0);
+    const float *p10 = p00 + 3, *p01 = p00 + 3 * SSDO_OCT_SIZE, *p11 = p01 + 3;
+    float w00 = (1.0f - tx) * (1.0f - ty), w10 = tx * (1.0f - ty), w01 = (1.0f - tx) * ty,
+          w11 = tx * ty;
+    return drift_vec3_make(w00 * p00[0] + w10 * p10[0] + w01 * p01[0] + w11 * p11[0],
+                           w00 * p00[1] + w10 * p10[1] + w01 * p01[1] + w11 * p11[1],
+                           w00 * p00[2] + w10 * p10[2] + w01 * p01[2] + w11 * p11[2]);
+}
+
+// The octahedral copies, sampled from the lat-long maps at each texel's centre direction.
+static void build_octahedral(drift_ssdo_env *env)
+{
+    for (int k = 0; k <= SSDO_ENV_LEVELS; ++k) {
+        const float *src = k == 0 ? env->irradiance : env->cone[k - 1];
+        for (int32_t y = 0; y < SSDO_OCT_SIZE; ++y) {
+            for (int32_t x = 0; x < SSDO_OCT_SIZE; ++x) {
+                drift_vec3 d = ssdo_oct_to_dir(drift_vec2_make(((float)x + 0.5f) / SSDO_OCT_SIZE,
+                                                               ((float)y + 0.5f) / SSDO_OCT_SIZE));
+                drift_vec3 c = lookup(env, src, d);
+                float *dst = env->oct[k] + 3 * ((size_t)y * SSDO_OCT_SIZE + (size_t)x);
+                dst[0] = c.x;
+                dst[1] = c.y;
+                dst[2] = c.z;
+            }
+        }
+    }
+}
+
 drift_vec3 drift_ssdo_env_irradiance(const drift_ssdo_env *env, drift_vec3 n)
 {
-    return lookup(env, env->irradiance, n);
+    return lookup_oct(env->oct[0], n);
 }
 
 drift_vec3 drift_ssdo_env_radiance(const drift_ssdo_env *env, drift_vec3 dir, int32_t samples)
@@ -232,5 +281,5 @@ drift_vec3 drift_ssdo_env_radiance(const drift_ssdo_env *env, drift_vec3 dir, in
     while (k + 1 < SSDO_ENV_LEVELS && (1 << (k + 1)) <= samples) {
         ++k;
     }
-    return lookup(env, env->cone[k], dir);
+    return lookup_oct(env->oct[k + 1], dir);
 }
