@@ -5,8 +5,9 @@
 //   (b) quality at --width x --height: FLIP and RMSE of each technique's radiance against the
 //       path-traced reference of the same term (drift_ssdo_reference: environment light with
 //       visibility plus one diffuse bounce, at --ref-spp), and of the path tracer itself at
-//       1 spp and at the spp that fits SSDO+bounce's time; ssdo+2layers adds the second depth
-//       layer (drift_ssdo_peel, its ray time included). --out DIR writes every image as PNG
+//       1 spp and at the spp that fits SSDO+bounce's time, and of SSAO and GTAO at the largest N
+//       (24 .. 128) that fits that time (rows ssao-N.., gtao-N..); ssdo+2layers adds the second
+//       depth layer (drift_ssdo_peel, its ray time included). --out DIR writes every image as PNG
 //       (the same exposure) and the FLIP maps.
 // The G-buffer comes from the hybrid frame's primary pass and is not timed: the techniques'
 // inputs are the same for all of them. With --threads 1 (the default) times are the calling
@@ -222,7 +223,9 @@ static drift_ssdo_params variant_params(const bench_state *b, const variant *v, 
                                 .samples = (int32_t)samples,
                                 .radius = (float)b->o->radius,
                                 .bounce = v->bounce,
-                                .gtao_multibounce = v->multibounce };
+                                .gtao_multibounce = v->multibounce,
+                                // GTAO: 2 slices up to N = 16, then 4 steps a side and N / 8 slices
+                                .gtao_slices = samples >= 16 ? (int32_t)(samples / 8) : 2 };
 }
 
 // The least total ms of --frames renders of one variant into out; with two layers the ms
@@ -353,6 +356,30 @@ static drift_result run_quality(const bench_state *b, quality_row *rows, size_t 
             char name[64];
             snprintf(name, sizeof(name), "%s-visibility", variants[v].name);
             save_png(b, name, &out.visibility);
+        }
+    }
+    // Matched time: SSAO and GTAO at the largest N whose time stays within SSDO+bounce's.
+    static const long matched_n[] = { 24, 32, 48, 64, 96, 128 };
+    for (size_t v = 0; r == DRIFT_OK && v < 2; ++v) {
+        long best = 0;
+        double best_ms = 0.0;
+        for (size_t k = 0; r == DRIFT_OK && k < sizeof(matched_n) / sizeof(matched_n[0]); ++k) {
+            double ms;
+            r = time_variant(b, drift_hybrid_gbuffer(frame), &variants[v], matched_n[k], &back,
+                             &out, &ms);
+            if (r != DRIFT_OK || ms > ssdo_bounce_ms) {
+                break;
+            }
+            best = matched_n[k];
+            best_ms = ms;
+        }
+        if (r == DRIFT_OK && best > 0) {
+            quality_row *row = &rows[count++];
+            snprintf(row->name, sizeof(row->name), "%s-N%ld", variants[v].name, best);
+            r = time_variant(b, drift_hybrid_gbuffer(frame), &variants[v], best, &back, &out,
+                             &row->ms);
+            row->ms = fmin(row->ms, best_ms);
+            r = r ? r : score(b, &ref_full, &ref_direct, &out.radiance, row);
         }
     }
     // The path tracer at 1 spp, and at the spp that fits SSDO+bounce's time when that is more.
@@ -488,7 +515,7 @@ int drift_bench_ssdo(int argc, char **argv)
     r = r ? r : drift_ssdo_env_create(b.ctx, b.scene, NULL, &b.env);
     t_env = drift_time_now() - t_env;
     double ms[3][2][4] = { { { 0 } } };
-    quality_row rows[VARIANT_COUNT + 2];
+    quality_row rows[VARIANT_COUNT + 4];
     size_t count = 0;
     if (r == DRIFT_OK && !o.json) {
         fprintf(stderr, "pre-filtered environment in %.0f ms\n", 1e3 * t_env);
