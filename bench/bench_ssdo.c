@@ -194,17 +194,19 @@ static double elapsed_ms(const bench_state *b, run_clock c)
 typedef struct variant {
     const char *name;
     drift_occlusion_technique technique;
-    bool bounce, multibounce, layers;
+    bool bounce, multibounce, layers, plain_sum;
 } variant;
 
 static const variant variants[] = {
-    { "ssao", DRIFT_OCCLUSION_SSAO, false, false, false },
-    { "gtao", DRIFT_OCCLUSION_GTAO, false, false, false },
-    { "gtao+mb", DRIFT_OCCLUSION_GTAO, false, true, false },
-    { "ssdo", DRIFT_OCCLUSION_SSDO, false, false, false },
-    { "ssdo+bounce", DRIFT_OCCLUSION_SSDO, true, false, false },
-    { "ssdo+2layers", DRIFT_OCCLUSION_SSDO, false, false, true },
-    { "ssdo+b+2layers", DRIFT_OCCLUSION_SSDO, true, false, true },
+    { "ssao", DRIFT_OCCLUSION_SSAO, false, false, false, false },
+    { "gtao", DRIFT_OCCLUSION_GTAO, false, false, false, false },
+    { "gtao+mb", DRIFT_OCCLUSION_GTAO, false, true, false, false },
+    { "ssdo", DRIFT_OCCLUSION_SSDO, false, false, false, false },
+    { "ssdo-plain", DRIFT_OCCLUSION_SSDO, false, false, false, true },
+    { "ssdo+bounce", DRIFT_OCCLUSION_SSDO, true, false, false, false },
+    { "ssdo-plain+b", DRIFT_OCCLUSION_SSDO, true, false, false, true },
+    { "ssdo+2layers", DRIFT_OCCLUSION_SSDO, false, false, true, false },
+    { "ssdo+b+2layers", DRIFT_OCCLUSION_SSDO, true, false, true, false },
 };
 #define VARIANT_COUNT (sizeof(variants) / sizeof(variants[0]))
 
@@ -224,6 +226,7 @@ static drift_ssdo_params variant_params(const bench_state *b, const variant *v, 
                                 .radius = (float)b->o->radius,
                                 .bounce = v->bounce,
                                 .gtao_multibounce = v->multibounce,
+                                .plain_sum = v->plain_sum,
                                 // GTAO: 2 slices up to N = 16, then 4 steps a side and N / 8 slices
                                 .gtao_slices = samples >= 16 ? (int32_t)(samples / 8) : 2 };
 }
@@ -256,7 +259,7 @@ static drift_result time_variant(const bench_state *b, const drift_gbuffer *g, c
 
 static const int32_t table_sizes[3][2] = { { 1024, 768 }, { 1200, 960 }, { 1600, 1200 } };
 static const variant *const table_variants[4] = { &variants[0], &variants[1], &variants[3],
-                                                  &variants[4] };
+                                                  &variants[5] };
 
 static drift_result run_table(const bench_state *b, double ms[3][2][4])
 {
@@ -349,7 +352,7 @@ static drift_result run_quality(const bench_state *b, quality_row *rows, size_t 
         r = time_variant(b, drift_hybrid_gbuffer(frame), &variants[v], o->samples, &back, &out,
                          &row->ms);
         r = r ? r : score(b, &ref_full, &ref_direct, &out.radiance, row);
-        if (variants[v].bounce && !variants[v].layers) {
+        if (variants[v].bounce && !variants[v].layers && !variants[v].plain_sum) {
             ssdo_bounce_ms = row->ms;
         }
         if (r == DRIFT_OK && o->out_dir) {

@@ -109,6 +109,9 @@ drift_vec3 drift_ssdo_env_radiance(const drift_ssdo_env *env, drift_vec3 dir, in
 //   no_blur         = false: the geometry-aware 4x4 blur over the interleaving block
 //   blur_normal     = 0 -> 0.8: the blur skips pixels whose normals' dot is below this
 //   blur_plane      = 0 -> 0.1: ... or lie further than this x r_max off the centre's plane
+//   plain_sum       = false: SSDO's direct light is the ratio estimator E(n) x (sum of
+//                     L V cos) / (sum of L cos) per channel (docs/ssdo.md); true: the
+//                     thesis's plain sum of L V cos 2 pi / N
 //   gtao_slices     = 0 -> 2 slice directions a pixel (steps = max(1, N / (2 slices)))
 //   gtao_thickness  = 0: off; in (0, 1]: the paper's thickness heuristic, a horizon that a
 //                     sample falls below relaxes toward it by this fraction
@@ -126,6 +129,7 @@ typedef struct drift_ssdo_params {
     bool no_blur;
     float blur_normal;
     float blur_plane;
+    bool plain_sum;
     int32_t gtao_slices;
     float gtao_thickness;
     bool gtao_multibounce;

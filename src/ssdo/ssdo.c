@@ -194,6 +194,7 @@ static void occlusion_pixel(const ssdo_job *j, int32_t x, int32_t y, float *raw)
     const float *lens = j->set_len + set_index(x, y) * count;
     bool directional = j->p.technique == DRIFT_OCCLUSION_SSDO;
     drift_vec3 direct = drift_vec3_splat(0.0f), bent = drift_vec3_splat(0.0f);
+    drift_vec3 unoccluded = drift_vec3_splat(0.0f);
     float open = 0.0f, total = 0.0f;
     for (int32_t i = 0; i < count; ++i) {
         drift_vec3 w = drift_frame_to_world(&frame, dirs[i]);
@@ -204,11 +205,24 @@ static void occlusion_pixel(const ssdo_job *j, int32_t x, int32_t y, float *raw)
         open += v * c;
         total += c;
         bent = drift_vec3_fma(bent, w, v * c);
-        if (directional && v > 0.0f) {
-            // (rho / pi) L V cos (2 pi / N), rho applied after the blur.
-            direct = drift_vec3_fma(direct, drift_ssdo_env_radiance(j->env, w, count),
-                                    v * c * 2.0f / (float)count);
+        if (directional) {
+            // (rho / pi) L V cos (2 pi / N), rho applied after the blur; `unoccluded` is the
+            // same sum with V = 1, for the ratio estimator.
+            drift_vec3 l = drift_ssdo_env_radiance(j->env, w, count);
+            direct = drift_vec3_fma(direct, l, v * c * 2.0f / (float)count);
+            unoccluded = drift_vec3_fma(unoccluded, l, c * 2.0f / (float)count);
         }
+    }
+    if (directional && !j->p.plain_sum) {
+        // Ratio estimator: the exact pre-filtered irradiance times the share of it, per colour
+        // channel, that the open samples carry. Unbiased where nothing occludes (the thesis's
+        // sum has the fixed sets' quadrature error there, the same at every pixel of a plane),
+        // and as directional as the sum where something does.
+        drift_vec3 e = drift_ssdo_env_irradiance(j->env, n);
+        float a = total > 0.0f ? open / total : 1.0f;
+        direct = drift_vec3_make(unoccluded.x > 0.0f ? e.x * direct.x / unoccluded.x : e.x * a,
+                                 unoccluded.y > 0.0f ? e.y * direct.y / unoccluded.y : e.y * a,
+                                 unoccluded.z > 0.0f ? e.z * direct.z / unoccluded.z : e.z * a);
     }
     memcpy(raw + RAW_DIRECT, &direct, sizeof(float) * 3);
     raw[RAW_VIS] = total > 0.0f ? open / total : 1.0f;

@@ -341,7 +341,8 @@ static void test_bounce_sanity(void **state)
 }
 
 // The pre-filtered maps of the red/blue environment: around +x the cosine lobe sees red
-// alone, around +y half of each, and the narrow cone along -x blue.
+// alone, around +y half of each, and the narrow cone along -x blue; and SSDO's direct light
+// of the open floor under it is exactly rho E / pi.
 static void test_prefiltered_environment(void **state)
 {
     (void)state;
@@ -356,6 +357,17 @@ static void test_prefiltered_environment(void **state)
     e = drift_ssdo_env_radiance(c.env, drift_vec3_make(-1, 0, 0), 64);
     assert_near(e.z, 1.0, 0.01);
     assert_near(e.x, 0.0, 0.01);
+    // SSDO's ratio estimator is exact on the open floor under this environment: rho E(n) / pi.
+    case_render(&c, &(drift_ssdo_params){ .technique = DRIFT_OCCLUSION_SSDO,
+                                          .samples = 16,
+                                          .radius = 1.0f });
+    drift_vec3 up = drift_ssdo_env_irradiance(c.env, drift_vec3_make(0, 1, 0));
+    for (int32_t y = 0; y < 48; ++y) {
+        for (int32_t x = 0; x < 48; ++x) {
+            assert_near(pixel(&c.out.radiance, x, y)[0], 0.5 * (double)up.x, 1e-4);
+            assert_near(pixel(&c.out.radiance, x, y)[2], 0.5 * (double)up.z, 1e-4);
+        }
+    }
     case_end(&c);
 }
 
