@@ -491,9 +491,15 @@ static void log_stderr(drift_log_level level, drift_result code, const char *fil
 {
     (void)code;
     (void)user;
-    if (level >= DRIFT_LOG_WARNING) {
-        fprintf(stderr, "drift bench ssdo: %s%s%.0d%s%s\n", file ? file : "", file ? ":" : "",
-                file ? line : 0, file ? ": " : "", message);
+    if (level < DRIFT_LOG_WARNING) {
+        return;
+    }
+    if (file && line > 0) {
+        fprintf(stderr, "drift bench ssdo: %s:%d: %s\n", file, line, message);
+    } else if (file) {
+        fprintf(stderr, "drift bench ssdo: %s: %s\n", file, message);
+    } else {
+        fprintf(stderr, "drift bench ssdo: %s\n", message);
     }
 }
 
