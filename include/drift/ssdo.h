@@ -194,6 +194,17 @@ drift_result drift_ssdo_peel(drift_context *ctx, const drift_accel *accel,
                              const drift_gbuffer *gbuffer, const drift_camera *camera,
                              drift_image *back_depth);
 
+// The screen-space contact-shadow fix for shadow-map bias (thesis §4.5): for every pixel that
+// faces the light, `samples` points on the segment from P toward the light over `length`
+// scene units (the shadow map's depth bias b = p/2 tan(alpha) there, or a fixed length) are
+// tested against the depth buffer like SSDO's samples (no fade; `back_depth` honoured); any
+// occluder writes 0 to out_visible (1 channel, the G-buffer's size), else 1. The frame
+// multiplies its shadow-map visibility by it. `light` is a point light's position, or with
+// `directional` the direction its light travels.
+drift_result drift_ssdo_contact_shadows(drift_context *ctx, const drift_ssdo_inputs *inputs,
+                                        drift_vec3 light, bool directional, float length,
+                                        int32_t samples, drift_image *out_visible);
+
 // The path-traced reference of the same term into out (3 channels, created here and owned by
 // the caller): environment light with visibility at the first hit, plus with `bounce` the
 // first-bounce diffuse light, at spp samples through each pixel centre (pinhole). The scene

@@ -639,3 +639,83 @@ done:
     drift_free(ctx, j.blurred);
     return result;
 }
+
+// --- CONTACT SHADOWS (thesis §4.5) ---
+
+typedef struct contact_job {
+    ssdo_job j;
+    drift_vec3 light; // position, or for a directional light the way its light travels
+    bool directional;
+    float length; // of the march toward the light
+    int32_t samples;
+    drift_image *out;
+} contact_job;
+
+static void contact_rows(size_t begin, size_t end, int thread_index, void *user)
+{
+    (void)thread_index;
+    const contact_job *c = user;
+    const ssdo_job *j = &c->j;
+    for (int32_t y = (int32_t)begin; y < (int32_t)end; ++y) {
+        for (int32_t x = 0; x < j->width; ++x) {
+            float *dst = drift_image_pixel(c->out, x, y);
+            dst[0] = 1.0f;
+            if (!pixel_valid(j, x, y)) {
+                continue;
+            }
+            drift_vec3 p = drift_image_get3(&j->gb->position, x, y);
+            drift_vec3 n = drift_image_get3(&j->gb->normal, x, y);
+            drift_vec3 l = c->directional ? drift_vec3_neg(drift_vec3_normalize(c->light))
+                                          : drift_vec3_normalize(drift_vec3_sub(c->light, p));
+            if (!(drift_vec3_dot(n, l) > 0.0f)) {
+                continue; // facing away: the light's own shadow test decides
+            }
+            for (int32_t k = 0; k < c->samples; ++k) {
+                float t = ((float)k + 0.5f) / (float)c->samples * c->length;
+                int32_t qx, qy;
+                if (occluder(j, p, drift_vec3_fma(p, l, t), &qx, &qy) > 0.0f) {
+                    dst[0] = 0.0f;
+                    break;
+                }
+            }
+        }
+    }
+}
+
+drift_result drift_ssdo_contact_shadows(drift_context *ctx, const drift_ssdo_inputs *inputs,
+                                        drift_vec3 light, bool directional, float length,
+                                        int32_t samples, drift_image *out_visible)
+{
+    if (!ctx || !inputs || !inputs->gbuffer || !inputs->camera || !out_visible) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    const drift_gbuffer *g = inputs->gbuffer;
+    int32_t w = g->width, h = g->height;
+    if (!plane_ok(&g->depth, w, h, 1) || !plane_ok(&g->position, w, h, 3) ||
+        !plane_ok(&g->normal, w, h, 3) || !plane_ok(&g->material_id, w, h, 1) ||
+        !plane_ok(out_visible, w, h, 1) ||
+        (inputs->back_depth && !plane_ok(inputs->back_depth, w, h, 1)) || !(length > 0.0f) ||
+        !isfinite(length) || samples < 1 || samples > MAX_SAMPLES ||
+        (directional && drift_vec3_is_zero(light))) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, __FILE__, __LINE__,
+                  "ssdo contact shadows: planes of one size, length > 0 and samples 1..%d",
+                  MAX_SAMPLES);
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    // The occluder test of the sample sets with r = length, no fade: any buffer surface
+    // nearer than a sample on the segment, by more than 1% of its length, blocks it.
+    contact_job c = { .j = { .gb = g,
+                             .back_depth = inputs->back_depth,
+                             .p = drift_ssdo_params_resolve(
+                                 &(drift_ssdo_params){ .radius = length, .no_fade = true }, NULL),
+                             .cam = drift_camera_frame_make(inputs->camera, w, h),
+                             .width = w,
+                             .height = h },
+                      .light = light,
+                      .directional = directional,
+                      .length = length,
+                      .samples = samples,
+                      .out = out_visible };
+    drift_parallel_for(ctx, (size_t)h, 2, contact_rows, &c);
+    return DRIFT_OK;
+}

@@ -533,6 +533,51 @@ static void test_second_layer_opens_the_gap_behind_a_slab(void **state)
     case_end(&c);
 }
 
+// --- CONTACT SHADOWS ---
+
+// Spec §2.5 test 7, the screen-space half: a small box on a floor, a directional light 10
+// degrees above the horizon. Marching b = 0.2 toward the light marks the floor within b of the
+// box's lit-away side as shadowed and leaves the floor further out and the box's top lit.
+static void test_contact_shadows_within_the_bias(void **state)
+{
+    (void)state;
+    ssdo_case c = { .rig = test_rig_begin(2) };
+    uint32_t grey = test_add_material(c.rig.scene, drift_material_make(drift_vec3_splat(0.5f)));
+    test_add_floor(c.rig.scene, 20.0f, 0.0f, grey);
+    add_box(c.rig.scene, 0.0f, 0.5f, 0.5f, 0.25f, grey);
+    c.rig.scene->environment.color = drift_vec3_splat(1.0f);
+    look_down(c.rig.scene, 8.0f, 1.0f, 64);
+    case_begin(&c);
+    const drift_gbuffer *g = drift_hybrid_gbuffer(c.rig.frame);
+    drift_image visible;
+    assert_int_equal(drift_image_create(c.rig.ctx, 64, 64, 1, &visible), DRIFT_OK);
+    drift_vec3 travel = drift_vec3_make(-cosf(0.1745f), -sinf(0.1745f), 0.0f);
+    drift_ssdo_inputs in = { .gbuffer = g, .camera = &c.rig.scene->camera };
+    assert_int_equal(drift_ssdo_contact_shadows(c.rig.ctx, &in, travel, true, 0.2f, 8, &visible),
+                     DRIFT_OK);
+    int shadowed = 0, lit = 0;
+    for (int32_t y = 0; y < 64; ++y) {
+        for (int32_t x = 0; x < 64; ++x) {
+            const float *q = pixel(&g->position, x, y);
+            float v = pixel(&visible, x, y)[0];
+            if (q[1] > 0.49f) {
+                assert_true(v == 1.0f); // the box's top sees the light
+            } else if (q[0] > -0.15f && q[0] < -0.03f && fabsf(q[2]) < 0.2f) {
+                assert_true(v == 0.0f); // within b of the contact line
+                ++shadowed;
+            } else if (q[0] < -0.3f || q[0] > 0.6f) {
+                assert_true(v == 1.0f);
+                ++lit;
+            }
+        }
+    }
+    assert_true(shadowed > 10 && lit > 100);
+    assert_int_equal(drift_ssdo_contact_shadows(c.rig.ctx, &in, travel, true, 0.0f, 8, &visible),
+                     DRIFT_ERR_INVALID_ARGUMENT);
+    drift_image_destroy(c.rig.ctx, &visible);
+    case_end(&c);
+}
+
 // --- DETERMINISM ---
 
 // Spec §2.5 test 8: fixed sets give a bit-identical image, for any thread count.
@@ -600,6 +645,7 @@ int main(void)
         cmocka_unit_test(test_converges_toward_reference),
         cmocka_unit_test(test_heightfield_against_ray_traced_occlusion),
         cmocka_unit_test(test_second_layer_opens_the_gap_behind_a_slab),
+        cmocka_unit_test(test_contact_shadows_within_the_bias),
         cmocka_unit_test(test_bit_identical_across_threads),
         cmocka_unit_test(test_bad_parameters_are_rejected),
     };
