@@ -14,8 +14,9 @@
     X("frame", drift_bench_frame, "hybrid frame passes vs the primary-visibility pass")        \
     X("isg", drift_bench_isg, "image space gathering: Table 1 timings, FLIP vs baselines")     \
     X("aaf", drift_bench_aaf, "axis-aligned filtering: RMSE vs spp against plain Monte Carlo") \
-    X("sir", drift_bench_sir, "smart image refinement vs pure ray tracing (Table 1)") \
-    X("glare", drift_bench_glare, "temporal glare: Table 8.2 phases, convolution, ms a frame")
+    X("sir", drift_bench_sir, "smart image refinement vs pure ray tracing (Table 1)")          \
+    X("glare", drift_bench_glare, "temporal glare: Table 8.2 phases, convolution, ms a frame") \
+    X("ssdo", drift_bench_ssdo, "SSAO, GTAO, SSDO(+bounce): Table 4.1 ms, FLIP vs the path tracer")
 
 #include "cli.h"
 
