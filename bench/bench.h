@@ -14,7 +14,8 @@
     X("frame", drift_bench_frame, "hybrid frame passes vs the primary-visibility pass")      \
     X("isg", drift_bench_isg, "image space gathering: Table 1 timings, FLIP vs baselines")  \
     X("aaf", drift_bench_aaf, "axis-aligned filtering: RMSE vs spp against plain Monte Carlo") \
-    X("sir", drift_bench_sir, "smart image refinement vs pure ray tracing (Table 1)")
+    X("sir", drift_bench_sir, "smart image refinement vs pure ray tracing (Table 1)")      \
+    X("ism", drift_bench_ism, "imperfect shadow maps and instant radiosity vs the path tracer")
 
 #define DRIFT__BENCH_DECLARE(name, fn, summary) int fn(int argc, char **argv);
 DRIFT_BENCH_LIST(DRIFT__BENCH_DECLARE)
