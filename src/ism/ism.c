@@ -290,14 +290,18 @@ static void gather_rows(size_t begin, size_t end, int thread, void *user)
 {
     gather_job *job = user;
     const drift_gbuffer *gb = job->gb;
+    int32_t b = job->ism->params.block_size;
     for (size_t row = begin; row < end; ++row) {
         int32_t y = (int32_t)row;
-        for (int32_t x = 0; x < gb->width; ++x) {
-            drift_vec3 e = drift_vec3_splat(0.0f);
-            if (drift_image_pixel(&gb->material_id, x, y)[0] >= 0.0f) {
-                e = gather_pixel(job->ism, gb, x, y, &job->rays[thread % 64]);
+        // Pixels of one subset in a run, so that its VPLs and maps stay in cache.
+        for (int32_t first = 0; first < b; ++first) {
+            for (int32_t x = first; x < gb->width; x += b) {
+                drift_vec3 e = drift_vec3_splat(0.0f);
+                if (drift_image_pixel(&gb->material_id, x, y)[0] >= 0.0f) {
+                    e = gather_pixel(job->ism, gb, x, y, &job->rays[thread % 64]);
+                }
+                drift_image_set3(&job->ism->irradiance, x, y, e);
             }
-            drift_image_set3(&job->ism->irradiance, x, y, e);
         }
     }
 }
