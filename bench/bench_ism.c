@@ -31,21 +31,24 @@ typedef struct ism_options {
 
 static void print_help(FILE *out)
 {
-    fprintf(out,
-            "usage: drift bench ism [SCENE] [--size N] [--threads T] [--vpls LIST] [--spp LIST]\n"
-            "                       [--ref-spp N] [--points P] [--map N] [--block B] [--no-ir]\n"
-            "                       [--png DIR]\n\n"
-            "ism and ir (src/ism) against the path tracer on the diffuse indirect term I.\n\n"
-            "  SCENE        default scenes/cornell-box/cornell_box.json\n"
-            "  --size N     N x N pixels (default 400)\n"
-            "  --threads T  worker threads (default 2)\n"
-            "  --vpls LIST  comma-separated VPL counts (default 64,256,1024)\n"
-            "  --spp LIST   the path tracer's spp (default 1,2,4)\n"
-            "  --ref-spp N  reference samples a pixel (default 256)\n"
-            "  --points P   points per VPL (default 1024); --map N ISM side (default 64)\n"
-            "  --block B    interleaving block (default 4)\n"
-            "  --no-ir      skip the ray-traced baseline\n"
-            "  --png DIR    write each row's frame (reference terms + I) as DIR/<row>.png\n");
+    fprintf(
+        out,
+        "usage: drift bench ism [SCENE] [--size N] [--threads T] [--vpls LIST] [--spp LIST]\n"
+        "                       [--ref-spp N] [--points P] [--map N] [--block B] [--no-ir]\n"
+        "                       [--png DIR]\n\n"
+        "ism and ir (src/ism) against the path tracer on the diffuse indirect term I.\n\n"
+        "  SCENE        default scenes/cornell-box/cornell_box.json\n"
+        "  --size N     N x N pixels (default 400)\n"
+        "  --threads T  worker threads (default 2)\n"
+        "  --vpls LIST  comma-separated VPL counts (default 64,256,1024)\n"
+        "  --spp LIST   the path tracer's spp (default 1,2,4)\n"
+        "  --ref-spp N  reference samples a pixel (default 256)\n"
+        "  --points P   points per VPL (default 1024); --map N ISM side (default 64)\n"
+        "  --block B    interleaving block (default 4)\n"
+        "  --no-ir      skip the ray-traced baseline\n"
+        "  --png DIR    write each row's frame (reference terms + I) as DIR/<row>_<count>.png,\n"
+        "               I alone 3 stops up as DIR/<row>_<count>_indirect.png, and the\n"
+        "               VPLs and one ISM tile of the last ism row\n");
 }
 
 static bool parse_long(const char *s, long lo, long hi, long *out)
@@ -207,6 +210,10 @@ static void report(bench_state *b, const char *name, long count, double ms, cons
         char path[1024];
         snprintf(path, sizeof path, "%s/%s_%ld.png", b->o->png_dir, name, count);
         drift_image_save_png(b->ctx, path, &frame, &(drift_tonemap_params){ 0 });
+        // I alone, 3 stops up, where the indirect light's own artifacts show.
+        snprintf(path, sizeof path, "%s/%s_%ld_indirect.png", b->o->png_dir, name, count);
+        drift_image_save_png(b->ctx, path, indirect,
+                             &(drift_tonemap_params){ .exposure_stops = 3.0f });
     }
     drift_image_destroy(b->ctx, &frame);
 }
