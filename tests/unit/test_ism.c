@@ -330,7 +330,8 @@ static void test_pull_push_fills_holes(void **state)
 
 // The Cornell box at 32 x 32: `ir` with many VPLs, every pixel gathering every VPL, is close
 // to the path tracer's first-bounce diffuse light (max depth 2) up to the clamping bias, and
-// the visibility-free limit is brighter; ISM's error against `ir` falls as points grow.
+// the visibility-free limit is brighter; ISM's error against `ir` falls as points grow and as
+// the maps grow.
 static void test_ir_and_ism_against_path_tracer(void **state)
 {
     (void)state;
@@ -358,6 +359,19 @@ static void test_ir_and_ism_against_path_tracer(void **state)
         e_ism[i] = nrmse(&r, drift_ism_indirect(ir256), drift_ism_indirect(ism));
         drift_ism_destroy(ism);
     }
+    // And as the maps grow, at 4096 points a VPL.
+    double e_res[2];
+    int32_t sizes[2] = { 16, 64 };
+    for (int i = 0; i < 2; ++i) {
+        drift_ism *ism = render_ism(&r, &(drift_ism_params){ .vpl_count = 256,
+                                                             .block_size = 1,
+                                                             .points_per_vpl = 4096,
+                                                             .map_size = sizes[i] });
+        e_res[i] = nrmse(&r, drift_ism_indirect(ir256), drift_ism_indirect(ism));
+        drift_ism_destroy(ism);
+    }
+    printf("ism vs ir at 16^2 and 64^2 maps: %.4f %.4f\n", e_res[0], e_res[1]);
+    assert_true(e_res[1] < e_res[0]);
     drift_ism_destroy(ir256);
     printf("ir nrmse %.4f mean ratio %.4f, no visibility ratio %.4f; ism vs ir %.4f %.4f %.4f\n",
            e_ir, bias_ir, bias_none, e_ism[0], e_ism[1], e_ism[2]);
