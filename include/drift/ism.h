@@ -59,6 +59,9 @@ typedef enum drift_ism_visibility {
 //                       first land; D leaves VPLs at the first D - 1 path vertices)
 //   later_vpl_count   = 0 -> vpl_count / 4: how many of the paths go on past their first VPL
 //                       (their VPLs carry vpl_count / later_vpl_count times the flux)
+//   max_path_rounds   = 0 -> 8: light paths go in rounds of vpl_count until half as many
+//                       VPLs as paths have landed (lights that shine mostly outside the scene
+//                       in view, a sun outside a window); 1 = one round
 //   rsm_size          = 0 -> 64 texels a side of each reflective-shadow-map face
 //   map_size          = 0 -> 64: the ISM of each VPL is map_size^2 texels
 //   points_per_vpl    = 0 -> 1024 scene points splatted into each ISM
@@ -79,6 +82,7 @@ typedef struct drift_ism_params {
     uint32_t vpl_count;
     int32_t max_depth;
     uint32_t later_vpl_count;
+    int32_t max_path_rounds;
     int32_t rsm_size;
     int32_t map_size;
     uint32_t points_per_vpl;

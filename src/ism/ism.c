@@ -51,6 +51,9 @@ drift_ism_params drift_ism_params_resolve(const drift_ism_params *params, const 
     if (p.later_vpl_count > p.vpl_count) {
         p.later_vpl_count = p.vpl_count;
     }
+    if (p.max_path_rounds == 0) {
+        p.max_path_rounds = 8;
+    }
     if (p.rsm_size == 0) {
         p.rsm_size = 64;
     }
@@ -90,7 +93,8 @@ drift_ism_params drift_ism_params_resolve(const drift_ism_params *params, const 
 static bool params_valid(const drift_ism_params *p)
 {
     return p->visibility < DRIFT_ISM_VISIBILITY_COUNT && p->vpl_count <= (1u << 20) &&
-           p->max_depth >= 1 && p->max_depth <= 16 && p->rsm_size >= 1 && p->rsm_size <= 1024 &&
+           p->max_depth >= 1 && p->max_depth <= 16 && p->max_path_rounds >= 1 &&
+           p->max_path_rounds <= 64 && p->rsm_size >= 1 && p->rsm_size <= 1024 &&
            p->map_size >= 4 && p->map_size <= 1024 && p->points_per_vpl <= (1u << 20) &&
            p->splat_scale > 0.0f && p->pull_push_levels <= 7 && p->pull_push_threshold > 0.0f &&
            p->depth_bias >= 0.0f && p->clamp_distance >= 0.0f && p->block_size >= 1 &&

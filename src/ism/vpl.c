@@ -211,6 +211,7 @@ typedef struct path_job {
     drift_vpl *slots;    // paths x bounces
     drift_vec3 *emitted; // per path
     uint32_t bounces;
+    uint32_t first; // sampler index of path 0 of this round
     uint32_t key;
     drift_vec3 centre;
     float radius;
@@ -334,7 +335,7 @@ static void trace_paths(size_t begin, size_t end, int thread, void *user)
     uint32_t later = job->params->later_vpl_count;
     for (size_t i = begin; i < end; ++i) {
         drift_vpl *slots = job->slots + i * job->bounces;
-        drift_sampler s = drift_sampler_make(job->key, 0, (uint32_t)i);
+        drift_sampler s = drift_sampler_make(job->key, 0, job->first + (uint32_t)i);
         drift_ray ray;
         drift_vec3 flux;
         job->emitted[i] = drift_vec3_splat(0.0f);
@@ -377,7 +378,12 @@ uint32_t drift__ism_max_vpls(const drift_ism_params *params)
     if (bounces == 0) {
         return 0;
     }
-    return params->vpl_count + (bounces - 1) * params->later_vpl_count;
+    // One round: at most vpl_count first-bounce VPLs. More rounds stop once half of
+    // vpl_count have landed, so fewer than 1.5 vpl_count; later bounces add at most
+    // later_vpl_count a round.
+    uint32_t rounds = params->max_path_rounds > 1 ? (uint32_t)params->max_path_rounds : 1;
+    uint32_t first = rounds > 1 ? params->vpl_count + params->vpl_count / 2 : params->vpl_count;
+    return first + (bounces - 1) * params->later_vpl_count * rounds;
 }
 
 drift_result drift__ism_generate_vpls(drift_context *ctx, const drift_scene *scene,
@@ -424,32 +430,49 @@ drift_result drift__ism_generate_vpls(drift_context *ctx, const drift_scene *sce
                      .key = drift_hash_combine(params->seed, DRIFT_ISM_VPL_STREAM),
                      .centre = drift_vec3_scale(drift_vec3_add(lo, hi), 0.5f),
                      .radius = 0.5f * drift_vec3_length(drift_vec3_sub(hi, lo)) * 1.01f };
-    drift_parallel_for(ctx, paths, 16, trace_paths, &job);
-    // Compact in (bounce, path) order: the same list for any thread count.
-    uint32_t count = 0;
-    double sum[3] = { 0, 0, 0 };
-    for (uint32_t i = 0; i < paths; ++i) {
-        sum[0] += (double)emitted[i].x;
-        sum[1] += (double)emitted[i].y;
-        sum[2] += (double)emitted[i].z;
-    }
-    drift_vpl *vpls = drift_alloc(ctx, ((size_t)paths * bounces + 1) * sizeof *vpls);
+    // Rounds of `paths` light paths (Sobol samples round * paths + i) until at least half as
+    // many first-bounce VPLs as paths have landed, or max_path_rounds; every flux is then
+    // divided by the rounds traced, so the estimate stays unbiased.
+    uint32_t rounds_max = params->max_path_rounds > 0 ? (uint32_t)params->max_path_rounds : 1;
+    drift_vpl *vpls = drift_alloc(ctx, ((size_t)drift__ism_max_vpls(params) + 1) * sizeof *vpls);
     if (!vpls) {
         result = DRIFT_ERR_OUT_OF_MEMORY;
         goto done;
     }
-    for (uint32_t b = 0; b < bounces; ++b) {
+    uint32_t count = 0, landed = 0, rounds = 0;
+    double sum[3] = { 0, 0, 0 };
+    while (rounds < rounds_max && (rounds == 0 || 2 * landed < paths)) {
+        memset(slots, 0, (size_t)paths * bounces * sizeof *slots);
+        job.first = rounds * paths;
+        drift_parallel_for(ctx, paths, 16, trace_paths, &job);
+        rounds++;
         for (uint32_t i = 0; i < paths; ++i) {
-            const drift_vpl *v = &slots[(size_t)i * bounces + b];
-            if (v->bounce == b + 1) {
-                vpls[count++] = *v;
+            sum[0] += (double)emitted[i].x;
+            sum[1] += (double)emitted[i].y;
+            sum[2] += (double)emitted[i].z;
+        }
+        // Append in (bounce, path) order: the same list for any thread count.
+        for (uint32_t b = 0; b < bounces; ++b) {
+            for (uint32_t i = 0; i < paths; ++i) {
+                const drift_vpl *v = &slots[(size_t)i * bounces + b];
+                if (v->bounce == b + 1) {
+                    vpls[count++] = *v;
+                    landed += b == 0;
+                }
             }
+        }
+    }
+    if (rounds > 1) {
+        for (uint32_t j = 0; j < count; ++j) {
+            vpls[j].flux = drift_vec3_scale(vpls[j].flux, 1.0f / (float)rounds);
         }
     }
     *out_vpls = vpls;
     *out_count = count;
     if (out_emitted) {
-        *out_emitted = drift_vec3_make((float)sum[0], (float)sum[1], (float)sum[2]);
+        double inv = 1.0 / (double)rounds;
+        *out_emitted =
+            drift_vec3_make((float)(sum[0] * inv), (float)(sum[1] * inv), (float)(sum[2] * inv));
     }
 done:
     if (rsms) {
