@@ -548,6 +548,46 @@ static void test_bounces_add_shrinking_light(void **state)
     test_rig_destroy(&r);
 }
 
+// Out-of-range parameters are refused with DRIFT_ERR_INVALID_ARGUMENT and a logged reason;
+// a render has its diagnostic planes (the tile only with ISM visibility) and stats.
+static void test_parameters_and_planes(void **state)
+{
+    (void)state;
+    test_log_capture log = { 0 };
+    test_rig r = cornell_rig(1, 16);
+    drift_context *ctx = test_context(1, &log);
+    drift_ism_params bad[] = {
+        { .visibility = DRIFT_ISM_VISIBILITY_COUNT },
+        { .map_size = 2 },
+        { .block_size = -1 },
+        { .max_depth = -3 },
+        { .splat_scale = -1.0f },
+        { .max_path_rounds = 100 },
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        drift_ism *ism = (drift_ism *)&log;
+        assert_int_equal(drift_ism_create(ctx, r.scene, r.accel, &bad[i], &ism),
+                         DRIFT_ERR_INVALID_ARGUMENT);
+        assert_null(ism);
+    }
+    assert_true(log.errors >= 6);
+    drift_ism *ism = render_ism(&r, &(drift_ism_params){ .vpl_count = 32 });
+    assert_non_null(drift_ism_plane_named(ism, "ism.irradiance"));
+    assert_non_null(drift_ism_plane_named(ism, "ism.vpls"));
+    assert_non_null(drift_ism_plane_named(ism, "ism.tile"));
+    assert_null(drift_ism_plane_named(ism, "ism.nothing"));
+    drift_ism_stats st = drift_ism_get_stats(ism);
+    assert_true(st.vpl_count > 0 && st.splats > 0 && st.shadow_rays == 0);
+    drift_ism_destroy(ism);
+    ism = render_ism(
+        &r, &(drift_ism_params){ .vpl_count = 32, .visibility = DRIFT_ISM_VISIBILITY_RAYS });
+    assert_null(drift_ism_plane_named(ism, "ism.tile"));
+    assert_true(drift_ism_get_stats(ism).shadow_rays > 0);
+    drift_ism_destroy(ism);
+    drift_context_destroy(ctx);
+    test_rig_destroy(&r);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -561,6 +601,7 @@ int main(void)
         cmocka_unit_test(test_ism_is_deterministic),
         cmocka_unit_test(test_rigid_motion_leaves_the_image),
         cmocka_unit_test(test_bounces_add_shrinking_light),
+        cmocka_unit_test(test_parameters_and_planes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
