@@ -22,6 +22,8 @@ struct drift_ism {
     drift_image irradiance, indirect, vpl_plane, tile;
     drift_ism_stats stats;
     float splat_radius; // k sqrt(A_pt / pi) of the last render, world units
+    uint32_t *groups;   // group_count + 1 starts of the runs of VPLs of one bounce and round
+    uint32_t group_count;
 };
 
 static const char *const stage_names[DRIFT_ISM_STAGE_COUNT] = { "vpls",      "points", "splat",
@@ -132,7 +134,8 @@ drift_result drift_ism_create(drift_context *ctx, const drift_scene *scene,
     if (ism->max_vpls > 0) {
         size_t map = (size_t)p.map_size * (size_t)p.map_size;
         ism->frames = drift_alloc(ctx, (size_t)ism->max_vpls * sizeof *ism->frames);
-        if (!ism->frames) {
+        ism->groups = drift_alloc(ctx, ((size_t)ism->max_vpls + 1) * sizeof *ism->groups);
+        if (!ism->frames || !ism->groups) {
             r = DRIFT_ERR_OUT_OF_MEMORY;
         }
         if (r == DRIFT_OK && p.visibility == DRIFT_ISM_VISIBILITY_ISM) {
@@ -176,6 +179,7 @@ void drift_ism_destroy(drift_ism *ism)
     drift_points_destroy(ism->points);
     drift_free(ctx, ism->vpls);
     drift_free(ctx, ism->frames);
+    drift_free(ctx, ism->groups);
     drift_free(ctx, ism->atlas);
     drift_free(ctx, ism->scratch);
     drift_free(ctx, ism);
@@ -227,29 +231,17 @@ typedef struct gather_job {
     uint64_t rays[64]; // per thread
 } gather_job;
 
-// Irradiance (without albedo) at one G-buffer pixel from its interleaving subset of VPLs.
-static drift_vec3 gather_pixel(drift_ism *ism, const drift_gbuffer *gb, int32_t x, int32_t y,
-                               uint64_t *rays)
+// Adds VPLs [first, last) to e at receiver xp (normal n, geometric normal ng).
+static void gather_range(drift_ism *ism, drift_vec3 xp, drift_vec3 n, drift_vec3 ng, uint32_t first,
+                         uint32_t last, double *e, uint64_t *rays)
 {
     const drift_ism_params *p = &ism->params;
-    drift_vec3 xp = drift_image_get3(&gb->position, x, y);
-    drift_vec3 n = drift_image_get3(&gb->normal, x, y);
-    drift_vec3 ng = drift_image_get3(&gb->geometric_normal, x, y);
-    uint32_t stride = (uint32_t)p->block_size * (uint32_t)p->block_size;
-    uint32_t subset =
-        (uint32_t)(y % p->block_size) * (uint32_t)p->block_size + (uint32_t)(x % p->block_size);
-    if (subset >= ism->vpl_count) {
-        return drift_vec3_splat(0.0f);
-    }
-    uint32_t members = (ism->vpl_count - subset + stride - 1) / stride;
-    float scale = (float)ism->vpl_count / (float)members * DRIFT_INV_PI;
     float dmin2 = p->clamp_distance * p->clamp_distance;
     int32_t mn = p->map_size;
     size_t map = (size_t)mn * (size_t)mn;
     float texel = 2.0f / (float)mn;
     float splat_radius = ism->splat_radius;
-    double e[3] = { 0, 0, 0 };
-    for (uint32_t j = subset; j < ism->vpl_count; j += stride) {
+    for (uint32_t j = first; j < last; ++j) {
         const drift_vpl *v = &ism->vpls[j];
         drift_vec3 d = drift_vec3_sub(v->position, xp);
         float dist2 = drift_vec3_dot(d, d);
@@ -286,6 +278,32 @@ static drift_vec3 gather_pixel(drift_ism *ism, const drift_gbuffer *gb, int32_t 
         e[0] += (double)(v->flux.x * g);
         e[1] += (double)(v->flux.y * g);
         e[2] += (double)(v->flux.z * g);
+    }
+}
+
+// Irradiance (without albedo) at one G-buffer pixel from its interleaving subset of VPLs.
+static drift_vec3 gather_pixel(drift_ism *ism, const drift_gbuffer *gb, int32_t x, int32_t y,
+                               uint64_t *rays)
+{
+    const drift_ism_params *p = &ism->params;
+    drift_vec3 xp = drift_image_get3(&gb->position, x, y);
+    drift_vec3 n = drift_image_get3(&gb->normal, x, y);
+    drift_vec3 ng = drift_image_get3(&gb->geometric_normal, x, y);
+    // Subset k of the S = B^2 subsets takes the k-th run of each group of VPLs (one bounce of
+    // one round of light paths). Consecutive paths are consecutive Sobol samples, so each run is
+    // a stratified sample of the group (a stride of S instead would give every subset one
+    // elementary interval of the light's domain). S times the subset's sum, averaged over the
+    // S pixels of a block, is the sum over all VPLs.
+    uint64_t subsets = (uint64_t)p->block_size * (uint64_t)p->block_size;
+    uint64_t k =
+        (uint64_t)(y % p->block_size) * (uint64_t)p->block_size + (uint64_t)(x % p->block_size);
+    float scale = (float)subsets * DRIFT_INV_PI;
+    double e[3] = { 0, 0, 0 };
+    for (uint32_t g = 0; g < ism->group_count; ++g) {
+        uint64_t begin = ism->groups[g], size = (uint64_t)ism->groups[g + 1] - begin;
+        uint32_t first = (uint32_t)(begin + size * k / subsets);
+        uint32_t last = (uint32_t)(begin + size * (k + 1) / subsets);
+        gather_range(ism, xp, n, ng, first, last, e, rays);
     }
     return drift_vec3_make((float)e[0] * scale, (float)e[1] * scale, (float)e[2] * scale);
 }
@@ -433,8 +451,15 @@ drift_result drift_ism_render(drift_ism *ism, const drift_gbuffer *gbuffer,
     if (r != DRIFT_OK) {
         return r;
     }
+    ism->group_count = 0;
     for (uint32_t j = 0; j < ism->vpl_count; ++j) {
         ism->frames[j] = drift_frame_from_normal(ism->vpls[j].normal);
+        if (j == 0 || ism->vpls[j].bounce != ism->vpls[j - 1].bounce) {
+            ism->groups[ism->group_count++] = j;
+        }
+    }
+    if (ism->groups) {
+        ism->groups[ism->group_count] = ism->vpl_count;
     }
     now = drift_time_now();
     st.ms[DRIFT_ISM_STAGE_VPLS] = (now - t) * 1e3;
