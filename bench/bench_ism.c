@@ -304,11 +304,11 @@ int drift_bench_ism(int argc, char **argv)
         drift_ism_stats st = drift_ism_get_stats(ism);
         char detail[256];
         snprintf(detail, sizeof detail,
-                 "%u VPLs; vpls %.1f, splat %.1f, pull-push %.1f, gather %.1f, blur %.1f ms; "
-                 "holes %.3f",
-                 st.vpl_count, st.ms[DRIFT_ISM_STAGE_VPLS], st.ms[DRIFT_ISM_STAGE_SPLAT],
-                 st.ms[DRIFT_ISM_STAGE_PULL_PUSH], st.ms[DRIFT_ISM_STAGE_GATHER],
-                 st.ms[DRIFT_ISM_STAGE_BLUR], st.hole_fraction);
+                 "%u VPLs; vpls %.1f, points %.1f, splat %.1f, pull-push %.1f, gather %.1f, "
+                 "blur %.1f ms; holes %.3f",
+                 st.vpl_count, st.ms[DRIFT_ISM_STAGE_VPLS], st.ms[DRIFT_ISM_STAGE_POINTS],
+                 st.ms[DRIFT_ISM_STAGE_SPLAT], st.ms[DRIFT_ISM_STAGE_PULL_PUSH],
+                 st.ms[DRIFT_ISM_STAGE_GATHER], st.ms[DRIFT_ISM_STAGE_BLUR], st.hole_fraction);
         report(&b, ir ? "ir" : "ism", o.vpls[v / 2], st.total_ms, detail, drift_ism_indirect(ism));
         if (o.png_dir && !ir && v == 2 * o.vpl_count - 2) {
             char path[1024];

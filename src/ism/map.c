@@ -121,10 +121,12 @@ uint32_t drift__ism_pull_push(float *depth, int32_t n, int32_t levels, float thr
     }
     uint32_t empty = 0;
     for (int32_t y = 0; y < n; ++y) {
+        // The texel centres of this row inside the disc: |u| <= sqrt(1 - v^2).
+        float v = 2.0f * ((float)y + 0.5f) / (float)n - 1.0f;
+        float half = sqrtf(fmaxf(1.0f - v * v, 0.0f));
         for (int32_t x = 0; x < n; ++x) {
             float u = 2.0f * ((float)x + 0.5f) / (float)n - 1.0f;
-            float v = 2.0f * ((float)y + 0.5f) / (float)n - 1.0f;
-            empty += u * u + v * v <= 1.0f && !isfinite(depth[y * n + x]);
+            empty += fabsf(u) <= half && depth[y * n + x] == INFINITY;
         }
     }
     return empty;
