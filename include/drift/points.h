@@ -76,6 +76,10 @@ void drift_points_destroy(drift_points *points); // NULL-safe
 // Re-derives position, normal and area from the scene's current vertices (same meshes and
 // triangle counts as at create; DRIFT_ERR_INVALID_ARGUMENT otherwise).
 drift_result drift_points_update(drift_points *points, const drift_scene *scene);
+// The same for points [first, first + count) only (the area is always recomputed):
+// for users that read only some subsets this frame. DRIFT_ERR_INVALID_ARGUMENT past the end.
+drift_result drift_points_update_range(drift_points *points, const drift_scene *scene,
+                                       uint32_t first, uint32_t count);
 
 // Subset s is the points [begin, begin + count): consecutive, disjoint, sizes differing by at
 // most one, covering all points.

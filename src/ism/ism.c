@@ -465,7 +465,10 @@ drift_result drift_ism_render(drift_ism *ism, const drift_gbuffer *gbuffer,
     t = now;
     if (ism->params.visibility == DRIFT_ISM_VISIBILITY_ISM && ism->vpl_count > 0) {
         if (ism->points) {
-            r = drift_points_update(ism->points, ism->scene);
+            // Only the subsets of this render's VPLs are read.
+            uint32_t first, count;
+            drift_points_subset(ism->points, ism->vpl_count - 1, &first, &count);
+            r = drift_points_update_range(ism->points, ism->scene, 0, first + count);
             if (r != DRIFT_OK) {
                 return r;
             }

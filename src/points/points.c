@@ -168,13 +168,14 @@ void drift_points_destroy(drift_points *points)
 typedef struct update_job {
     drift_points *points;
     const drift_scene *scene;
+    uint32_t first;
 } update_job;
 
 static void update_range(size_t begin, size_t end, int thread, void *user)
 {
     (void)thread;
     const update_job *job = user;
-    for (size_t i = begin; i < end; ++i) {
+    for (size_t i = begin + job->first; i < end + job->first; ++i) {
         const drift_scene_point *p = &job->points->points[i];
         drift_vec3 a, b, c;
         triangle_corners(&job->scene->meshes[p->mesh], p->triangle, &a, &b, &c);
@@ -190,7 +191,18 @@ static void update_range(size_t begin, size_t end, int thread, void *user)
 
 drift_result drift_points_update(drift_points *points, const drift_scene *scene)
 {
-    for (uint32_t i = 0; i < points->count; ++i) {
+    return drift_points_update_range(points, scene, 0, points->count);
+}
+
+drift_result drift_points_update_range(drift_points *points, const drift_scene *scene,
+                                       uint32_t first, uint32_t count)
+{
+    if (first > points->count || count > points->count - first) {
+        drift_log(points->ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, __FILE__, __LINE__,
+                  "points: range %u + %u past the %u points", first, count, points->count);
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    for (uint32_t i = first; i < first + count; ++i) {
         const drift_scene_point *p = &points->points[i];
         if (p->mesh >= scene->mesh_count || p->triangle >= scene->meshes[p->mesh].triangle_count) {
             drift_log(points->ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, __FILE__, __LINE__,
@@ -208,8 +220,8 @@ drift_result drift_points_update(drift_points *points, const drift_scene *scene)
         }
     }
     points->area = area;
-    update_job job = { points, scene };
-    drift_parallel_for(points->ctx, points->count, 4096, update_range, &job);
+    update_job job = { points, scene, first };
+    drift_parallel_for(points->ctx, count, 4096, update_range, &job);
     return DRIFT_OK;
 }
 

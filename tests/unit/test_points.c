@@ -166,7 +166,8 @@ static void test_points_are_deterministic(void **state)
     test_rig_destroy(&r2);
 }
 
-// Moving a mesh's vertices and updating moves its points with it (barycentric storage).
+// Moving a mesh's vertices and updating moves its points with it (barycentric storage), a
+// range update only the points of the range.
 static void test_points_follow_a_moved_mesh(void **state)
 {
     (void)state;
@@ -181,6 +182,13 @@ static void test_points_follow_a_moved_mesh(void **state)
     for (uint32_t v = 0; v < m->vertex_count; ++v) {
         m->positions[3 * v + 1] += 2.0f;
     }
+    // A range update moves the points of the range only.
+    assert_int_equal(drift_points_update_range(pts, r.scene, 100, 50), DRIFT_OK);
+    for (uint32_t i = 0; i < pts->count; ++i) {
+        float dy = pts->points[i].mesh == 0 && i >= 100 && i < 150 ? 2.0f : 0.0f;
+        assert_near(pts->position[i].y, before[i].y + dy, 1e-5);
+    }
+    assert_int_equal(drift_points_update_range(pts, r.scene, 1990, 11), DRIFT_ERR_INVALID_ARGUMENT);
     assert_int_equal(drift_points_update(pts, r.scene), DRIFT_OK);
     for (uint32_t i = 0; i < pts->count; ++i) {
         float dy = pts->points[i].mesh == 0 ? 2.0f : 0.0f;
