@@ -16,7 +16,9 @@
     X("aaf", drift_bench_aaf, "axis-aligned filtering: RMSE vs spp against plain Monte Carlo") \
     X("sir", drift_bench_sir, "smart image refinement vs pure ray tracing (Table 1)")          \
     X("glare", drift_bench_glare, "temporal glare: Table 8.2 phases, convolution, ms a frame") \
-    X("ssdo", drift_bench_ssdo, "SSAO, GTAO, SSDO(+bounce): Table 4.1 ms, FLIP vs the path tracer")
+    X("ssdo", drift_bench_ssdo,                                                                \
+      "SSAO, GTAO, SSDO(+bounce): Table 4.1 ms, FLIP vs the path tracer")                      \
+    X("ism", drift_bench_ism, "imperfect shadow maps and instant radiosity vs the path tracer")
 
 #include "cli.h"
 

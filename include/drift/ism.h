@@ -1,0 +1,180 @@
+// drift ism: instant radiosity with imperfect shadow maps (Ritschel et al. 2008; thesis ch. 5).
+// Diffuse indirect light from many virtual point lights (VPLs), each VPL's visibility taken
+// from a tiny paraboloid depth map splatted from a sparse subset of the scene points and
+// hole-filled by pull-push.
+//
+// The passes of one drift_ism_render (docs/ism.md has the equations):
+//   1. VPLs: light paths from every light. Point and spot lights go through a reflective
+//      shadow map (a ray-traced cube, one face for a narrow spot) whose texel flux is
+//      importance-sampled through a 2-D CDF; area lights, directional lights and the
+//      environment emit their paths directly (beyond the thesis). A path leaves one VPL at
+//      each diffuse surface it reaches, for max_depth - 1 bounces (pt depth convention).
+//   2. Imperfect shadow maps: VPL j splats point subset j of drift_points into its own
+//      paraboloid map (z-test), then pull-push fills the holes; parallel over VPLs.
+//   3. Gathering: each pixel of the G-buffer sums the VPLs of its interleaving subset
+//      (block_size^2 subsets), visibility from the ISMs (or rays: the `ir` baseline), the
+//      distance clamped at d_min; a geometry-aware blur over the block; times albedo / pi.
+//
+// STEP BY STEP
+//   drift_ism *ism = NULL;
+//   drift_ism_create(ctx, scene, accel, &(drift_ism_params){ .vpl_count = 256 }, &ism);
+//   drift_ism_render(ism, gbuffer, &camera);          // per frame, after the G-buffer
+//   const drift_image *indirect = drift_ism_indirect(ism);  // RGB radiance I
+//   drift_ism_destroy(ism);
+//
+// Ownership: scene and accel are borrowed and must outlive the ism. Images and VPLs returned
+// here belong to the ism and stay valid until the next render or destroy.
+// Threads: one ism is driven from one thread; it uses the context's pool internally.
+#ifndef DRIFT_ISM_H
+#define DRIFT_ISM_H
+
+#include "drift/accel.h"
+#include "drift/core.h"
+#include "drift/hybrid.h"
+#include "drift/image.h"
+#include "drift/points.h"
+#include "drift/scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+// Sampler stream of the VPL paths: drift_sampler_make(drift_hash_combine(seed,
+// DRIFT_ISM_VPL_STREAM), 0, path index). The scene points use DRIFT_POINTS_STREAM with the
+// same seed. Gathering draws no random numbers.
+#define DRIFT_ISM_VPL_STREAM 0x76706c73u // "vpls"
+
+typedef enum drift_ism_visibility {
+    DRIFT_ISM_VISIBILITY_ISM = 0, // imperfect shadow maps (the technique)
+    DRIFT_ISM_VISIBILITY_RAYS,    // one shadow ray per pixel and VPL: instant radiosity (`ir`)
+    DRIFT_ISM_VISIBILITY_NONE,    // every VPL visible (the visibility-free limit, for tests)
+    DRIFT_ISM_VISIBILITY_COUNT
+} drift_ism_visibility;
+
+// How to render. The default configuration is:
+//   seed              = 0
+//   visibility        = ISM
+//   vpl_count         = 0 -> 256 light paths (first-bounce VPLs)
+//   max_depth         = 0 -> 2 (pt convention: 2 = one bounce, the VPLs where light paths
+//                       first land; D leaves VPLs at the first D - 1 path vertices)
+//   later_vpl_count   = 0 -> vpl_count / 4: how many of the paths go on past their first VPL
+//                       (their VPLs carry vpl_count / later_vpl_count times the flux)
+//   max_path_rounds   = 0 -> 8: light paths go in rounds of vpl_count until half as many
+//                       VPLs as paths have landed (lights that shine mostly outside the scene
+//                       in view, a sun outside a window); 1 = one round
+//   rsm_size          = 0 -> 64 texels a side of each reflective-shadow-map face
+//   map_size          = 0 -> 64: the ISM of each VPL is map_size^2 texels
+//   points_per_vpl    = 0 -> 1024 scene points splatted into each ISM
+//   splat_scale       = 0 -> 0.6: k of the splat side in texels,
+//                       s = clamp(k sqrt(A_pt / pi) n / (r (1 + v.z)), 1, 8)
+//   pull_push_levels  = 0 -> 2; negative: no hole filling
+//   pull_push_threshold = 0 -> 0.05 x scene diagonal at level 0 (times 2^l at level l)
+//   depth_bias        = 0 -> 0.01 x scene diagonal, plus one texel's footprint at the receiver
+//   clamp_distance    = 0 -> 0.05 x scene diagonal: d_min of the geometry term
+//   block_size        = 0 -> 4: interleaved sampling over 4x4 pixel blocks (1 = every pixel
+//                       gathers every VPL)
+//   no_blur           = false: the geometry-aware blur over the block runs
+//   blur_normal       = 0 -> 0.9: smallest cosine between two normals the blur mixes
+//   blur_plane        = 0 -> 0.01 x scene diagonal: largest distance to the centre's plane
+typedef struct drift_ism_params {
+    uint32_t seed;
+    drift_ism_visibility visibility;
+    uint32_t vpl_count;
+    int32_t max_depth;
+    uint32_t later_vpl_count;
+    int32_t max_path_rounds;
+    int32_t rsm_size;
+    int32_t map_size;
+    uint32_t points_per_vpl;
+    float splat_scale;
+    int32_t pull_push_levels;
+    float pull_push_threshold;
+    float depth_bias;
+    float clamp_distance;
+    int32_t block_size;
+    bool no_blur;
+    float blur_normal;
+    float blur_plane;
+} drift_ism_params;
+
+drift_ism_params drift_ism_params_resolve(const drift_ism_params *params, const drift_scene *scene);
+
+// One virtual point light: a cosine emitter of total flux `flux` on the surface at position
+// with normal `normal` (facing the side the light came from).
+typedef struct drift_vpl {
+    drift_vec3 position;
+    drift_vec3 normal;
+    drift_vec3 flux;
+    uint32_t bounce; // 1 for the first surface a light path reaches
+} drift_vpl;
+
+typedef enum drift_ism_stage {
+    DRIFT_ISM_STAGE_VPLS = 0, // reflective shadow maps, CDFs and the VPL paths
+    DRIFT_ISM_STAGE_POINTS,   // re-deriving the scene points from the meshes
+    DRIFT_ISM_STAGE_SPLAT,    // splatting the points into the ISMs
+    DRIFT_ISM_STAGE_PULL_PUSH,
+    DRIFT_ISM_STAGE_GATHER, // interleaved gathering (with the shadow rays for `ir`)
+    DRIFT_ISM_STAGE_BLUR,   // geometry-aware blur and the albedo multiply
+    DRIFT_ISM_STAGE_COUNT
+} drift_ism_stage;
+
+const char *drift_ism_stage_name(drift_ism_stage stage);
+
+typedef struct drift_ism_stats {
+    double ms[DRIFT_ISM_STAGE_COUNT];
+    double total_ms;
+    uint32_t vpl_count;   // VPLs of the last render (all bounces)
+    uint64_t shadow_rays; // `ir` visibility rays
+    uint64_t splats;      // points splatted
+    double hole_fraction; // ISM texels still empty after pull-push
+} drift_ism_stats;
+
+typedef struct drift_ism drift_ism;
+
+// Samples the scene points once (the only pre-computation). Errors:
+// DRIFT_ERR_INVALID_ARGUMENT (uncommitted scene, bad parameters; logged),
+// DRIFT_ERR_OUT_OF_MEMORY.
+drift_result drift_ism_create(drift_context *ctx, const drift_scene *scene,
+                              const drift_accel *accel, const drift_ism_params *params,
+                              drift_ism **out_ism);
+void drift_ism_destroy(drift_ism *ism); // NULL-safe
+
+// Renders the indirect light of one frame: re-derives the points from the meshes, draws the
+// VPLs, builds the maps and gathers at every G-buffer pixel. The G-buffer's position, normal,
+// geometric_normal, albedo and material_id planes are read. `camera` may be NULL (it only
+// places the "ism.vpls" plane). Errors: DRIFT_ERR_INVALID_ARGUMENT (G-buffer of another size
+// than the last call is fine; an empty one is not), DRIFT_ERR_OUT_OF_MEMORY.
+drift_result drift_ism_render(drift_ism *ism, const drift_gbuffer *gbuffer,
+                              const drift_camera *camera);
+
+// RGB radiance: the diffuse indirect light I at each pixel (0 where the G-buffer missed).
+const drift_image *drift_ism_indirect(const drift_ism *ism);
+// Diagnostic planes by name: "ism.irradiance" (RGB, before blur and albedo), "ism.vpls" (RGB,
+// the VPLs' flux splatted where they project on the camera image), "ism.tile" (1 channel,
+// the depth map of VPL 0 after pull-push, 0 where empty). NULL when the last render has none.
+const drift_image *drift_ism_plane_named(const drift_ism *ism, const char *name);
+const drift_vpl *drift_ism_vpls(const drift_ism *ism, uint32_t *out_count);
+drift_ism_stats drift_ism_get_stats(const drift_ism *ism);
+drift_ism_params drift_ism_get_params(const drift_ism *ism);
+
+// --- PARABOLOID MAPPING (Brabec et al. 2002) ---
+
+// A unit direction v with v.z >= 0 in a VPL's frame -> its map coordinate in the unit disc.
+static inline drift_vec2 drift_paraboloid_project(drift_vec3 v)
+{
+    float s = 1.0f / (1.0f + v.z);
+    return drift_vec2_make(v.x * s, v.y * s);
+}
+
+// The inverse: a point of the unit disc -> the unit direction of the hemisphere z >= 0.
+static inline drift_vec3 drift_paraboloid_unproject(drift_vec2 p)
+{
+    float r2 = p.x * p.x + p.y * p.y;
+    float s = 1.0f / (1.0f + r2);
+    return drift_vec3_make(2.0f * p.x * s, 2.0f * p.y * s, (1.0f - r2) * s);
+}
+
+#ifdef __cplusplus
+}
+#endif
+#endif // DRIFT_ISM_H

@@ -1,0 +1,48 @@
+// Internals of drift ism shared by its files and the unit tests: VPL generation, one
+// imperfect shadow map's splatting, pull-push and lookup.
+#ifndef DRIFT_ISM_INTERNAL_H
+#define DRIFT_ISM_INTERNAL_H
+
+#include "drift/ism.h"
+
+// The VPLs of all bounces, compacted in (bounce, path) order. *out_vpls is owned by the
+// caller (drift_free). out_emitted (may be NULL) gets the sum over paths of the flux that
+// left the lights (the estimate of the scene's emitted power, RGB).
+drift_result drift__ism_generate_vpls(drift_context *ctx, const drift_scene *scene,
+                                      const drift_accel *accel, const drift_ism_params *params,
+                                      drift_vpl **out_vpls, uint32_t *out_count,
+                                      drift_vec3 *out_emitted);
+
+// The most VPLs drift__ism_generate_vpls can make with these (resolved) parameters.
+uint32_t drift__ism_max_vpls(const drift_ism_params *params);
+
+// What splatting one map needs.
+typedef struct drift__ism_splat_desc {
+    int32_t n;          // the map is n x n texels
+    float point_radius; // sqrt(A_pt / pi): the radius of the disc one point stands for
+    float splat_scale;  // k
+} drift__ism_splat_desc;
+
+// Splats `count` points into the n x n depth map `depth` (filled with INFINITY first) of a
+// VPL at `origin` with frame `frame` (z = its normal), keeping the nearest distance per texel.
+void drift__ism_splat(float *depth, const drift__ism_splat_desc *desc, drift_vec3 origin,
+                      const drift_frame *frame, const drift_vec3 *positions, uint32_t count);
+
+// Pull-push hole filling of an n x n map over `levels` levels with the level-0 threshold
+// `threshold`; scratch holds at least n * n floats (levels <= 7). Returns the number of texels
+// inside the unit disc still empty.
+uint32_t drift__ism_pull_push(float *depth, int32_t n, int32_t levels, float threshold,
+                              float *scratch);
+
+// The texel of the map that direction `local` (unit, in the VPL's frame, z > 0) falls in.
+static inline int32_t drift__ism_texel(int32_t n, drift_vec3 local)
+{
+    drift_vec2 p = drift_paraboloid_project(local);
+    int32_t x = (int32_t)((p.x * 0.5f + 0.5f) * (float)n);
+    int32_t y = (int32_t)((p.y * 0.5f + 0.5f) * (float)n);
+    x = x < 0 ? 0 : (x >= n ? n - 1 : x);
+    y = y < 0 ? 0 : (y >= n ? n - 1 : y);
+    return y * n + x;
+}
+
+#endif

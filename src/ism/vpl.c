@@ -1,0 +1,487 @@
+// VPL generation (docs/ism.md, "VPLs"): light paths whose diffuse vertices become VPLs.
+//
+// A path picks a light in proportion to its power (drift_scene_pick_light; the environment is
+// the entry light_count). Point and spot lights then pick a texel of their reflective shadow
+// map (RSM) through its 2-D CDF over the texels' reflected flux and shoot a ray jittered
+// inside that texel; area lights shoot from a uniform point along a cosine direction;
+// directional lights and the environment shoot parallel rays from a disc covering the
+// scene's bounding sphere. Every path's flux is weighted by 1 / (pdf x path count), so the sum
+// over paths is an unbiased estimate of the emitted power and the sum of the VPLs' flux is the
+// reflected flux, bounce by bounce.
+#include "ism/ism_internal.h"
+
+#include <math.h>
+#include <string.h>
+
+// --- REFLECTIVE SHADOW MAPS ---
+
+// One RSM: `faces` faces of size x size texels, each a plane at distance 1 from the light
+// along `axis[f]`, spanning [-extent, extent]^2 along `u[f]`, `v[f]`. The flux of each texel
+// (luminance of the light reflected at the surface its centre ray hits) feeds the CDF over
+// rows (faces * size rows) and columns.
+typedef struct rsm {
+    int32_t size, faces;
+    float extent;
+    drift_vec3 axis[6], u[6], v[6];
+    float *flux;        // faces * size * size
+    float *marginal;    // rows + 1
+    float *conditional; // rows * (size + 1)
+    double total;
+} rsm;
+
+static float spot_falloff(const drift_light *l, drift_vec3 dir)
+{
+    if (l->type != DRIFT_LIGHT_SPOT) {
+        return 1.0f;
+    }
+    float cos_theta = drift_vec3_dot(l->direction, dir);
+    float lo = cosf(l->spot_outer), hi = cosf(l->spot_inner);
+    float t = hi > lo ? drift_clampf((cos_theta - lo) / (hi - lo), 0.0f, 1.0f)
+                      : (cos_theta >= lo ? 1.0f : 0.0f);
+    return t * t * (3.0f - 2.0f * t);
+}
+
+// Direction (unnormalised) through face coordinates (a, b) in [0, 1)^2 of face f.
+static drift_vec3 rsm_dir(const rsm *m, int32_t f, float a, float b)
+{
+    float x = (2.0f * a - 1.0f) * m->extent, y = (2.0f * b - 1.0f) * m->extent;
+    return drift_vec3_add(
+        m->axis[f], drift_vec3_add(drift_vec3_scale(m->u[f], x), drift_vec3_scale(m->v[f], y)));
+}
+
+// The diffuse albedo at the closest hit of `ray`, with the surface; false when the ray misses
+// or hits a pure emitter (a light's shape).
+static bool trace_surface(const drift_scene *scene, const drift_accel *accel, const drift_ray *ray,
+                          drift_surface *out_surface, drift_vec3 *out_kd)
+{
+    drift_hit hit;
+    if (!drift_accel_intersect(accel, ray, &hit)) {
+        return false;
+    }
+    *out_surface = drift_scene_surface(scene, ray, &hit);
+    if (out_surface->material == DRIFT_INVALID_INDEX) {
+        return false;
+    }
+    drift_bsdf bsdf = drift_bsdf_make(scene, out_surface);
+    *out_kd = bsdf.type == DRIFT_MATERIAL_MIRROR ? drift_vec3_splat(0.0f) : bsdf.diffuse;
+    return true;
+}
+
+typedef struct rsm_job {
+    rsm *map;
+    const drift_scene *scene;
+    const drift_accel *accel;
+    const drift_light *light;
+} rsm_job;
+
+static void rsm_rows(size_t begin, size_t end, int thread, void *user)
+{
+    (void)thread;
+    const rsm_job *job = user;
+    rsm *m = job->map;
+    float texel_area = (2.0f * m->extent / (float)m->size) * (2.0f * m->extent / (float)m->size);
+    for (size_t row = begin; row < end; ++row) {
+        int32_t f = (int32_t)(row / (size_t)m->size), y = (int32_t)(row % (size_t)m->size);
+        for (int32_t x = 0; x < m->size; ++x) {
+            drift_vec3 d = rsm_dir(m, f, ((float)x + 0.5f) / (float)m->size,
+                                   ((float)y + 0.5f) / (float)m->size);
+            float len = drift_vec3_length(d);
+            drift_vec3 w = drift_vec3_scale(d, 1.0f / len);
+            drift_ray ray = { job->light->position, 0.0f, w, INFINITY };
+            drift_surface s;
+            drift_vec3 kd;
+            float flux = 0.0f;
+            if (trace_surface(job->scene, job->accel, &ray, &s, &kd)) {
+                // Intensity x solid angle of the texel (dA / d^3 on the unit-distance plane).
+                float omega = texel_area / (len * len * len);
+                flux = drift_luminance(drift_vec3_mul(job->light->color, kd)) *
+                       spot_falloff(job->light, w) * omega;
+            }
+            m->flux[row * (size_t)m->size + (size_t)x] = flux;
+        }
+    }
+}
+
+static void rsm_destroy(drift_context *ctx, rsm *m)
+{
+    if (!m) {
+        return;
+    }
+    drift_free(ctx, m->flux);
+    drift_free(ctx, m->marginal);
+    drift_free(ctx, m->conditional);
+    drift_free(ctx, m);
+}
+
+static drift_result rsm_build(drift_context *ctx, const drift_scene *scene,
+                              const drift_accel *accel, const drift_light *l, int32_t size,
+                              rsm **out)
+{
+    *out = NULL;
+    rsm *m = drift_alloc(ctx, sizeof *m);
+    if (!m) {
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    m->size = size;
+    // A spot whose cone fits in one 120-degree face gets one face, anything wider a cube.
+    if (l->type == DRIFT_LIGHT_SPOT && l->spot_outer < 1.0472f) {
+        drift_frame fr = drift_frame_from_normal(l->direction);
+        m->faces = 1;
+        m->extent = tanf(l->spot_outer);
+        m->axis[0] = fr.z;
+        m->u[0] = fr.x;
+        m->v[0] = fr.y;
+    } else {
+        static const float axes[6][3][3] = {
+            { { 1, 0, 0 }, { 0, 0, -1 }, { 0, 1, 0 } }, { { -1, 0, 0 }, { 0, 0, 1 }, { 0, 1, 0 } },
+            { { 0, 1, 0 }, { 1, 0, 0 }, { 0, 0, -1 } }, { { 0, -1, 0 }, { 1, 0, 0 }, { 0, 0, 1 } },
+            { { 0, 0, 1 }, { 1, 0, 0 }, { 0, 1, 0 } },  { { 0, 0, -1 }, { -1, 0, 0 }, { 0, 1, 0 } },
+        };
+        m->faces = 6;
+        m->extent = 1.0f;
+        for (int f = 0; f < 6; ++f) {
+            m->axis[f] = drift_vec3_make(axes[f][0][0], axes[f][0][1], axes[f][0][2]);
+            m->u[f] = drift_vec3_make(axes[f][1][0], axes[f][1][1], axes[f][1][2]);
+            m->v[f] = drift_vec3_make(axes[f][2][0], axes[f][2][1], axes[f][2][2]);
+        }
+    }
+    size_t rows = (size_t)m->faces * (size_t)size;
+    m->flux = drift_alloc(ctx, rows * (size_t)size * sizeof *m->flux);
+    m->marginal = drift_alloc(ctx, (rows + 1) * sizeof *m->marginal);
+    m->conditional = drift_alloc(ctx, rows * ((size_t)size + 1) * sizeof *m->conditional);
+    if (!m->flux || !m->marginal || !m->conditional) {
+        rsm_destroy(ctx, m);
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    rsm_job job = { m, scene, accel, l };
+    drift_parallel_for(ctx, rows, 4, rsm_rows, &job);
+    // Conditional CDF of each row, then the marginal over the rows' sums (in double).
+    double total = 0.0;
+    for (size_t r = 0; r < rows; ++r) {
+        float *cdf = m->conditional + r * ((size_t)size + 1);
+        const float *flux = m->flux + r * (size_t)size;
+        double sum = 0.0;
+        cdf[0] = 0.0f;
+        for (int32_t x = 0; x < size; ++x) {
+            sum += (double)flux[x];
+            cdf[x + 1] = (float)sum;
+        }
+        for (int32_t x = 1; x <= size; ++x) {
+            cdf[x] = sum > 0.0 ? (float)((double)cdf[x] / sum) : (float)x / (float)size;
+        }
+        m->marginal[r] = (float)total;
+        total += sum;
+    }
+    m->marginal[rows] = (float)total;
+    for (size_t r = 1; r <= rows; ++r) {
+        m->marginal[r] = total > 0.0 ? (float)((double)m->marginal[r] / total) : 0.0f;
+    }
+    m->total = total;
+    *out = m;
+    return DRIFT_OK;
+}
+
+// Index i with cdf[i] <= u < cdf[i+1] over a CDF of n entries (n + 1 values), skipping empty
+// entries; *out_pmf gets cdf[i+1] - cdf[i].
+static int32_t cdf_pick(const float *cdf, int32_t n, float u, float *out_pmf)
+{
+    int32_t lo = 0, hi = n;
+    while (hi - lo > 1) {
+        int32_t mid = lo + (hi - lo) / 2;
+        if (cdf[mid] <= u) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    while (lo + 1 < n && !(cdf[lo + 1] > cdf[lo])) {
+        lo++;
+    }
+    *out_pmf = cdf[lo + 1] - cdf[lo];
+    return lo;
+}
+
+// --- LIGHT PATHS ---
+
+typedef struct path_job {
+    const drift_scene *scene;
+    const drift_accel *accel;
+    const drift_ism_params *params;
+    rsm **rsms;          // per light; NULL for lights that are not point or spot lights
+    drift_vpl *slots;    // paths x bounces
+    drift_vec3 *emitted; // per path
+    uint32_t bounces;
+    uint32_t first; // sampler index of path 0 of this round
+    uint32_t key;
+    drift_vec3 centre;
+    float radius;
+} path_job;
+
+// The first ray of path i and the flux it carries; false when the path carries nothing.
+static bool emit(const path_job *job, drift_sampler *s, drift_ray *out_ray, drift_vec3 *out_flux)
+{
+    const drift_scene *scene = job->scene;
+    float pmf;
+    uint32_t li = drift_scene_pick_light(scene, drift_sampler_next1(s), &pmf);
+    drift_vec2 u1 = drift_sampler_next2(s), u2 = drift_sampler_next2(s);
+    if (li == DRIFT_INVALID_INDEX || !(pmf > 0.0f)) {
+        return false;
+    }
+    float n = (float)job->params->vpl_count;
+    if (li == scene->light_count || scene->lights[li].type == DRIFT_LIGHT_DIRECTIONAL) {
+        // Parallel rays from a disc of radius R perpendicular to the direction of travel.
+        drift_vec3 travel;
+        drift_vec3 radiance;
+        float pdf_dir = 1.0f;
+        if (li == scene->light_count) {
+            drift_light_sample ls = drift_environment_sample(scene, u1);
+            if (!(ls.pdf > 0.0f)) {
+                return false;
+            }
+            travel = drift_vec3_neg(ls.wi);
+            radiance = ls.radiance;
+            pdf_dir = ls.pdf;
+        } else {
+            travel = scene->lights[li].direction;
+            radiance = scene->lights[li].color;
+        }
+        drift_frame f = drift_frame_from_normal(travel);
+        drift_vec2 d = drift_sample_disk_concentric(u2);
+        drift_vec3 o = drift_vec3_fma(job->centre, travel, -1.5f * job->radius);
+        o = drift_vec3_fma(o, f.x, d.x * job->radius);
+        o = drift_vec3_fma(o, f.y, d.y * job->radius);
+        *out_ray = (drift_ray){ o, 0.0f, travel, INFINITY };
+        float area = DRIFT_PI * job->radius * job->radius;
+        *out_flux = drift_vec3_scale(radiance, area / (pdf_dir * pmf * n));
+        return true;
+    }
+    const drift_light *l = &scene->lights[li];
+    if (l->type == DRIFT_LIGHT_POINT || l->type == DRIFT_LIGHT_SPOT) {
+        const rsm *m = job->rsms[li];
+        if (!m || !(m->total > 0.0)) {
+            return false;
+        }
+        float p_row, p_col;
+        int32_t rows = m->faces * m->size;
+        int32_t row = cdf_pick(m->marginal, rows, u1.y, &p_row);
+        int32_t col =
+            cdf_pick(m->conditional + (size_t)row * ((size_t)m->size + 1), m->size, u1.x, &p_col);
+        int32_t f = row / m->size, y = row % m->size;
+        drift_vec3 d =
+            rsm_dir(m, f, ((float)col + u2.x) / (float)m->size, ((float)y + u2.y) / (float)m->size);
+        float len = drift_vec3_length(d);
+        drift_vec3 w = drift_vec3_scale(d, 1.0f / len);
+        float texel_area =
+            (2.0f * m->extent / (float)m->size) * (2.0f * m->extent / (float)m->size);
+        // Solid-angle pdf: the texel's probability over its solid angle (dA / d^3).
+        float pdf_dir = p_row * p_col * len * len * len / texel_area;
+        if (!(pdf_dir > 0.0f)) {
+            return false;
+        }
+        *out_ray = (drift_ray){ l->position, 0.0f, w, INFINITY };
+        *out_flux = drift_vec3_scale(l->color, spot_falloff(l, w) / (pdf_dir * pmf * n));
+        return true;
+    }
+    // Area lights: a uniform point (density 1 / A) and a cosine direction (cos / pi) give
+    // L cos / (cos / pi / A) = pi A L per path.
+    drift_vec3 p, normal;
+    float area;
+    switch (l->type) {
+    case DRIFT_LIGHT_QUAD:
+        p = drift_vec3_fma(drift_vec3_fma(l->position, l->edge_u, u1.x), l->edge_v, u1.y);
+        normal = drift_vec3_cross(l->edge_u, l->edge_v);
+        area = drift_vec3_length(normal);
+        normal = drift_vec3_scale(normal, 1.0f / area);
+        break;
+    case DRIFT_LIGHT_DISK: {
+        drift_frame fr = drift_frame_from_normal(l->direction);
+        drift_vec2 d = drift_sample_disk_concentric(u1);
+        p = drift_vec3_fma(drift_vec3_fma(l->position, fr.x, d.x * l->radius), fr.y,
+                           d.y * l->radius);
+        normal = l->direction;
+        area = DRIFT_PI * l->radius * l->radius;
+        break;
+    }
+    case DRIFT_LIGHT_SPHERE:
+        normal = drift_sample_uniform_sphere(u1);
+        p = drift_vec3_fma(l->position, normal, l->radius);
+        area = 4.0f * DRIFT_PI * l->radius * l->radius;
+        break;
+    case DRIFT_LIGHT_TRIANGLE: {
+        drift_vec3 a, b, c;
+        drift_light_triangle_vertices(scene, l, &a, &b, &c);
+        drift_vec2 bc = drift_sample_triangle(u1);
+        p = drift_vec3_fma(drift_vec3_fma(drift_vec3_scale(a, 1.0f - bc.x - bc.y), b, bc.x), c,
+                           bc.y);
+        normal = drift_vec3_cross(drift_vec3_sub(b, a), drift_vec3_sub(c, a));
+        area = 0.5f * drift_vec3_length(normal);
+        normal = drift_vec3_normalize(normal);
+        break;
+    }
+    default:
+        return false;
+    }
+    drift_frame fr = drift_frame_from_normal(normal);
+    drift_vec3 w = drift_frame_to_world(&fr, drift_sample_cosine_hemisphere(u2));
+    *out_ray = (drift_ray){ drift_offset_origin(p, normal, w), 0.0f, w, INFINITY };
+    *out_flux = drift_vec3_scale(l->color, DRIFT_PI * area / (pmf * n));
+    return true;
+}
+
+static void trace_paths(size_t begin, size_t end, int thread, void *user)
+{
+    (void)thread;
+    const path_job *job = user;
+    uint32_t later = job->params->later_vpl_count;
+    for (size_t i = begin; i < end; ++i) {
+        drift_vpl *slots = job->slots + i * job->bounces;
+        drift_sampler s = drift_sampler_make(job->key, 0, job->first + (uint32_t)i);
+        drift_ray ray;
+        drift_vec3 flux;
+        job->emitted[i] = drift_vec3_splat(0.0f);
+        if (!emit(job, &s, &ray, &flux)) {
+            continue;
+        }
+        job->emitted[i] = flux;
+        for (uint32_t b = 0; b < job->bounces; ++b) {
+            if (b == 1) {
+                // Only the first `later` paths go on, carrying vpl_count / later times more.
+                if (i >= later) {
+                    break;
+                }
+                flux = drift_vec3_scale(flux, (float)job->params->vpl_count / (float)later);
+            }
+            drift_surface surf;
+            drift_vec3 kd;
+            if (!trace_surface(job->scene, job->accel, &ray, &surf, &kd)) {
+                break;
+            }
+            flux = drift_vec3_mul(flux, kd);
+            if (drift_vec3_is_zero(flux)) {
+                break;
+            }
+            slots[b] = (drift_vpl){ surf.position, surf.ns, flux, b + 1 };
+            drift_frame fr = drift_frame_from_normal(surf.ns);
+            drift_vec3 w =
+                drift_frame_to_world(&fr, drift_sample_cosine_hemisphere(drift_sampler_next2(&s)));
+            if (drift_vec3_dot(w, surf.ng) <= 0.0f) {
+                break;
+            }
+            ray = (drift_ray){ drift_offset_origin(surf.position, surf.ng, w), 0.0f, w, INFINITY };
+        }
+    }
+}
+
+uint32_t drift__ism_max_vpls(const drift_ism_params *params)
+{
+    uint32_t bounces = params->max_depth > 1 ? (uint32_t)(params->max_depth - 1) : 0;
+    if (bounces == 0) {
+        return 0;
+    }
+    // One round: at most vpl_count first-bounce VPLs. More rounds stop once half of
+    // vpl_count have landed, so fewer than 1.5 vpl_count; later bounces add at most
+    // later_vpl_count a round.
+    uint32_t rounds = params->max_path_rounds > 1 ? (uint32_t)params->max_path_rounds : 1;
+    uint32_t first = rounds > 1 ? params->vpl_count + params->vpl_count / 2 : params->vpl_count;
+    return first + (bounces - 1) * params->later_vpl_count * rounds;
+}
+
+drift_result drift__ism_generate_vpls(drift_context *ctx, const drift_scene *scene,
+                                      const drift_accel *accel, const drift_ism_params *params,
+                                      drift_vpl **out_vpls, uint32_t *out_count,
+                                      drift_vec3 *out_emitted)
+{
+    *out_vpls = NULL;
+    *out_count = 0;
+    if (out_emitted) {
+        *out_emitted = drift_vec3_splat(0.0f);
+    }
+    uint32_t bounces = params->max_depth > 1 ? (uint32_t)(params->max_depth - 1) : 0;
+    uint32_t paths = params->vpl_count;
+    if (bounces == 0 || paths == 0 || scene->light_count + 1 == 0) {
+        return DRIFT_OK;
+    }
+    drift_result result = DRIFT_OK;
+    rsm **rsms = drift_alloc(ctx, ((size_t)scene->light_count + 1) * sizeof *rsms);
+    drift_vpl *slots = drift_alloc(ctx, (size_t)paths * bounces * sizeof *slots);
+    drift_vec3 *emitted = drift_alloc(ctx, (size_t)paths * sizeof *emitted);
+    if (!rsms || !slots || !emitted) {
+        result = DRIFT_ERR_OUT_OF_MEMORY;
+        goto done;
+    }
+    for (uint32_t i = 0; i < scene->light_count && result == DRIFT_OK; ++i) {
+        drift_light_type t = scene->lights[i].type;
+        if ((t == DRIFT_LIGHT_POINT || t == DRIFT_LIGHT_SPOT) &&
+            drift_scene_light_pmf(scene, i) > 0.0f) {
+            result = rsm_build(ctx, scene, accel, &scene->lights[i], params->rsm_size, &rsms[i]);
+        }
+    }
+    if (result != DRIFT_OK) {
+        goto done;
+    }
+    drift_vec3 lo = scene->bounds.min, hi = scene->bounds.max;
+    path_job job = { .scene = scene,
+                     .accel = accel,
+                     .params = params,
+                     .rsms = rsms,
+                     .slots = slots,
+                     .emitted = emitted,
+                     .bounces = bounces,
+                     .key = drift_hash_combine(params->seed, DRIFT_ISM_VPL_STREAM),
+                     .centre = drift_vec3_scale(drift_vec3_add(lo, hi), 0.5f),
+                     .radius = 0.5f * drift_vec3_length(drift_vec3_sub(hi, lo)) * 1.01f };
+    // Rounds of `paths` light paths (Sobol samples round * paths + i) until at least half as
+    // many first-bounce VPLs as paths have landed, or max_path_rounds; every flux is then
+    // divided by the rounds traced, so the estimate stays unbiased.
+    uint32_t rounds_max = params->max_path_rounds > 0 ? (uint32_t)params->max_path_rounds : 1;
+    drift_vpl *vpls = drift_alloc(ctx, ((size_t)drift__ism_max_vpls(params) + 1) * sizeof *vpls);
+    if (!vpls) {
+        result = DRIFT_ERR_OUT_OF_MEMORY;
+        goto done;
+    }
+    uint32_t count = 0, landed = 0, rounds = 0;
+    double sum[3] = { 0, 0, 0 };
+    while (rounds < rounds_max && (rounds == 0 || 2 * landed < paths)) {
+        memset(slots, 0, (size_t)paths * bounces * sizeof *slots);
+        job.first = rounds * paths;
+        drift_parallel_for(ctx, paths, 16, trace_paths, &job);
+        rounds++;
+        for (uint32_t i = 0; i < paths; ++i) {
+            sum[0] += (double)emitted[i].x;
+            sum[1] += (double)emitted[i].y;
+            sum[2] += (double)emitted[i].z;
+        }
+        // Append in (bounce, path) order: the same list for any thread count.
+        for (uint32_t b = 0; b < bounces; ++b) {
+            for (uint32_t i = 0; i < paths; ++i) {
+                const drift_vpl *v = &slots[(size_t)i * bounces + b];
+                if (v->bounce == b + 1) {
+                    vpls[count++] = *v;
+                    landed += b == 0;
+                }
+            }
+        }
+    }
+    if (rounds > 1) {
+        for (uint32_t j = 0; j < count; ++j) {
+            vpls[j].flux = drift_vec3_scale(vpls[j].flux, 1.0f / (float)rounds);
+        }
+    }
+    *out_vpls = vpls;
+    *out_count = count;
+    if (out_emitted) {
+        double inv = 1.0 / (double)rounds;
+        *out_emitted =
+            drift_vec3_make((float)(sum[0] * inv), (float)(sum[1] * inv), (float)(sum[2] * inv));
+    }
+done:
+    if (rsms) {
+        for (uint32_t i = 0; i < scene->light_count; ++i) {
+            rsm_destroy(ctx, rsms[i]);
+        }
+    }
+    drift_free(ctx, rsms);
+    drift_free(ctx, slots);
+    drift_free(ctx, emitted);
+    return result;
+}
