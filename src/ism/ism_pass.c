@@ -77,10 +77,11 @@ void drift_ism_indirect_planes(const drift_frame_state *f, drift_pass_plane_fn a
     const drift_pass_args args = { .effect = DRIFT_EFFECT_INDIRECT,
                                    .technique = f->params.indirect };
     const ism_pass_state *s = drift_pass_state(f, &args);
-    static const char *const names[] = { "ism.irradiance", "ism.vpls", "ism.tile" };
+    // ism.tile (one VPL's map) is the map's size, not the frame's: not an --aov plane.
+    static const char *const names[] = { "ism.irradiance", "ism.vpls" };
     for (size_t i = 0; s && i < sizeof names / sizeof *names; ++i) {
         const drift_image *plane = drift_ism_plane_named(s->ism, names[i]);
-        if (plane) {
+        if (plane && plane->width == f->params.width && plane->height == f->params.height) {
             add(sink, names[i], plane);
         }
     }

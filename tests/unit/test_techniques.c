@@ -78,6 +78,9 @@ static void test_every_row_renders(void **state)
                 for (uint32_t k = 0; k < count; ++k) {
                     assert_string_not_equal(names[k], names[count]);
                 }
+                // --aov writes every plane as a layer of one EXR: the frame's size.
+                assert_int_equal(image->width, 20);
+                assert_int_equal(image->height, 20);
                 ++count;
             }
             drift_hybrid_stats stats = drift_hybrid_get_stats(r.frame);
