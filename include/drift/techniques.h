@@ -35,7 +35,8 @@
     X(SHADOWS, shadows, shadow, DRIFT_SHADOW_TECHNIQUES, TERM, "direct")                      \
     X(REFLECTIONS, reflections, reflection, DRIFT_REFLECTION_TECHNIQUES, TERM, "reflections") \
     X(DOF, dof, dof, DRIFT_DOF_TECHNIQUES, POST, "final")                                     \
-    X(INDIRECT, indirect, indirect, DRIFT_INDIRECT_TECHNIQUES, TERM, "indirect")
+    X(INDIRECT, indirect, indirect, DRIFT_INDIRECT_TECHNIQUES, TERM, "indirect")              \
+    X(OCCLUSION, occlusion, occlusion, DRIFT_OCCLUSION_TECHNIQUES, TERM, "occlusion")
 
 #define DRIFT_SHADOW_TECHNIQUES(X, P)                                                              \
     X(P, HARD, "hard", "ray-traced visibility of each light's centre", drift_pass_none,            \
@@ -111,5 +112,23 @@
       drift_ism_pass_indirect, 0, 0, drift_ism_indirect_planes, 0, DRIFT_PT_COMPONENT_DIFFUSE)    \
     X(P, IR, "ir", "baseline: the same VPLs with ray-traced visibility (instant radiosity)",      \
       drift_ism_pass_ir, 0, 0, drift_ism_indirect_planes, 0, DRIFT_PT_COMPONENT_DIFFUSE)
+
+// Light from the environment through the diffuse lobe, with its visibility (thesis ch. 4). Any
+// technique but none takes that light out of D (DRIFT_ROW_ENVIRONMENT_DIFFUSE).
+#define DRIFT_OCCLUSION_TECHNIQUES(X, P)                                                         \
+    X(P, NONE, "none", "the environment stays in D, ray-traced at --light-samples",              \
+      drift_pass_none, 0, DRIFT_ROW_NO_TERM, drift_planes_none, 0, DRIFT_PT_COMPONENT_DIRECT)    \
+    X(P, SSAO, "ssao", "ambient occlusion x one pre-filtered environment lookup (docs/ssdo.md)", \
+      drift_ssdo_pass_ssao, 0, DRIFT_ROW_ENVIRONMENT_DIFFUSE, drift_ssdo_planes, 0,              \
+      DRIFT_PT_COMPONENT_DIRECT)                                                                 \
+    X(P, GTAO, "gtao", "ground-truth AO with bent normals (Jimenez et al. 2016)",                \
+      drift_ssdo_pass_gtao, 0, DRIFT_ROW_ENVIRONMENT_DIFFUSE, drift_ssdo_planes, 0,              \
+      DRIFT_PT_COMPONENT_DIRECT)                                                                 \
+    X(P, SSDO, "ssdo", "screen-space directional occlusion, one bounce (thesis ch. 4)",          \
+      drift_ssdo_pass_ssdo, 0, DRIFT_ROW_ENVIRONMENT_DIFFUSE, drift_ssdo_planes, 0,              \
+      DRIFT_PT_COMPONENT_DIRECT)                                                                 \
+    X(P, REFERENCE, "reference", "the environment's diffuse light, --spp shadow rays a pixel",   \
+      drift_ssdo_pass_reference, 0, DRIFT_ROW_ENVIRONMENT_DIFFUSE | DRIFT_ROW_PATH_TRACED,       \
+      drift_planes_none, 0x55d10000, DRIFT_PT_COMPONENT_DIRECT)
 
 #endif // DRIFT_TECHNIQUES_H
