@@ -36,7 +36,8 @@
     X(REFLECTIONS, reflections, reflection, DRIFT_REFLECTION_TECHNIQUES, TERM, "reflections") \
     X(DOF, dof, dof, DRIFT_DOF_TECHNIQUES, POST, "final")                                     \
     X(INDIRECT, indirect, indirect, DRIFT_INDIRECT_TECHNIQUES, TERM, "indirect")              \
-    X(OCCLUSION, occlusion, occlusion, DRIFT_OCCLUSION_TECHNIQUES, TERM, "occlusion")
+    X(OCCLUSION, occlusion, occlusion, DRIFT_OCCLUSION_TECHNIQUES, TERM, "occlusion")         \
+    X(GLARE, glare, glare, DRIFT_GLARE_TECHNIQUES, POST, "final")
 
 #define DRIFT_SHADOW_TECHNIQUES(X, P)                                                              \
     X(P, HARD, "hard", "ray-traced visibility of each light's centre", drift_pass_none,            \
@@ -130,5 +131,14 @@
     X(P, REFERENCE, "reference", "the environment's diffuse light, --spp shadow rays a pixel",   \
       drift_ssdo_pass_reference, 0, DRIFT_ROW_ENVIRONMENT_DIFFUSE | DRIFT_ROW_PATH_TRACED,       \
       drift_planes_none, 0x55d10000, DRIFT_PT_COMPONENT_DIRECT)
+
+// The human eye's scattering of the final HDR frame (thesis ch. 8), after depth of field.
+#define DRIFT_GLARE_TECHNIQUES(X, P)                                                               \
+    X(P, NONE, "none", "no glare: the frame as a camera sees it", drift_pass_none, 0,              \
+      DRIFT_ROW_NO_TERM, drift_planes_none, 0, 0)                                                  \
+    X(P, STATIC, "static", "the eye at rest: one PSF (docs/glare.md)", drift_glare_pass_static, 0, \
+      0, drift_planes_none, 0, 0)                                                                  \
+    X(P, DYNAMIC, "dynamic", "the eye in motion: pupil, hippus, lens, blinks (docs/glare.md)",     \
+      drift_glare_pass_dynamic, 0, 0, drift_planes_none, 0, 0)
 
 #endif // DRIFT_TECHNIQUES_H

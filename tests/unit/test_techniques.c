@@ -136,6 +136,9 @@ static void test_rows_are_consistent(void **state)
                 assert_true(components == 0 || components == row->components);
                 components = row->components;
             }
+            if (row->flags & DRIFT_ROW_NO_TERM) { // adds nothing: runs nothing, needs nothing
+                assert_true(row->pass == drift_pass_none && row->inputs == 0);
+            }
             if (row->pass == drift_pass_none) { // the inputs are the term, or there is none
                 assert_true(row->inputs != 0 || (row->flags & DRIFT_ROW_NO_TERM));
             }
@@ -190,6 +193,32 @@ static void test_occlusion_counts_the_environment_once(void **state)
     test_rig_destroy(&r);
 }
 
+// Glare spreads light and makes none: the last effect changes the frame, and its mean stays
+// at most what it was (the PSF integrates to one, tests/unit/test_glare.c; the convolution is
+// zero-padded, so the light the PSF's wide halo carries past the border of this small frame
+// leaves it).
+static void test_glare_keeps_the_light(void **state)
+{
+    (void)state;
+    test_rig r = test_rig_begin(2);
+    build_scene(&r, 32);
+    test_rig_commit(&r);
+    drift_hybrid_params p = { .seed = 2 };
+    test_rig_frame(&r, &p);
+    double plain = mean_of(drift_hybrid_image(r.frame));
+    drift_image before;
+    assert_int_equal(drift_image_create(r.ctx, 32, 32, 3, &before), DRIFT_OK);
+    memcpy(before.pixels, drift_hybrid_image(r.frame)->pixels, sizeof(float) * 32 * 32 * 3);
+    p.glare = DRIFT_GLARE_STATIC;
+    test_rig_frame(&r, &p);
+    double glared = mean_of(drift_hybrid_image(r.frame));
+    print_message("mean final: no glare %g, static glare %g\n", plain, glared);
+    assert_true(test_rmse(r.ctx, &before, drift_hybrid_image(r.frame)) > 1e-4);
+    assert_true(glared <= plain * 1.001 && glared > 0.75 * plain);
+    drift_image_destroy(r.ctx, &before);
+    test_rig_destroy(&r);
+}
+
 static int freed;
 
 static void count_free(drift_context *ctx, void *data)
@@ -231,6 +260,7 @@ int main(void)
         cmocka_unit_test(test_rows_are_consistent),
         cmocka_unit_test(test_state_slots),
         cmocka_unit_test(test_occlusion_counts_the_environment_once),
+        cmocka_unit_test(test_glare_keeps_the_light),
         cmocka_unit_test(test_every_row_renders),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
