@@ -115,6 +115,18 @@ static drift_result pt_image(bench_state *b, uint32_t components, long spp, drif
     return r;
 }
 
+// out = x + y (three channels, all the same size): a frame from the reference's other terms
+// and an indirect term.
+static void add_images(drift_image *out, const drift_image *x, const drift_image *y)
+{
+    for (int32_t j = 0; j < out->height; ++j) {
+        for (int32_t i = 0; i < out->width; ++i) {
+            drift_image_set3(out, i, j,
+                             drift_vec3_add(drift_image_get3(x, i, j), drift_image_get3(y, i, j)));
+        }
+    }
+}
+
 // One row: I's RMSE against the reference, and FLIP of ref_rest + I against ref_frame, printed
 // or (--json) added to b->rows; `st`: the stages of an ism or ir row (NULL for the others).
 static void report(bench_state *b, const char *name, long count, double ms, const char *detail,
@@ -124,13 +136,7 @@ static void report(bench_state *b, const char *name, long count, double ms, cons
     if (drift_image_create(b->ctx, indirect->width, indirect->height, 3, &frame) != DRIFT_OK) {
         return;
     }
-    for (int32_t y = 0; y < frame.height; ++y) {
-        for (int32_t x = 0; x < frame.width; ++x) {
-            drift_image_set3(&frame, x, y,
-                             drift_vec3_add(drift_image_get3(&b->ref_rest, x, y),
-                                            drift_image_get3(indirect, x, y)));
-        }
-    }
+    add_images(&frame, &b->ref_rest, indirect);
     double mse = 0.0;
     drift_metric_report rep = { 0 };
     drift_metric_mse(b->ctx, &b->ref_indirect, indirect, &mse);
@@ -225,13 +231,7 @@ int drift_bench_ism(int argc, char **argv)
     if (r != DRIFT_OK) {
         goto done;
     }
-    for (int32_t y = 0; y < b.ref_frame.height; ++y) {
-        for (int32_t x = 0; x < b.ref_frame.width; ++x) {
-            drift_image_set3(&b.ref_frame, x, y,
-                             drift_vec3_add(drift_image_get3(&b.ref_rest, x, y),
-                                            drift_image_get3(&b.ref_indirect, x, y)));
-        }
-    }
+    add_images(&b.ref_frame, &b.ref_rest, &b.ref_indirect);
     drift_hybrid_stats hs = drift_hybrid_get_stats(frame);
     if (o.json) {
         root = cJSON_CreateObject();
