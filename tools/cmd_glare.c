@@ -272,15 +272,16 @@ int drift_cmd_glare(int argc, char **argv)
     }
     const char *out_name = a.out ? a.out : a.out_pattern;
     if (!has_extension(out_name, out_exts)) {
-        fprintf(stderr, "drift glare: output '%s' must end in .exr or .png\n", out_name);
+        fprintf(stderr, "drift glare: %s expects a name ending in .exr or .png, got '%s'\n",
+                a.out ? "--out" : "--out-pattern", out_name);
         return 2;
     }
     const char *extras[2] = { a.psf, a.aperture };
     for (int i = 0; i < 2; ++i) {
         if (extras[i] && (!has_extension(extras[i], i == 0 ? out_exts : exr_exts) ||
                           (strchr(extras[i], '%') && !is_frame_pattern(extras[i])))) {
-            fprintf(stderr, "drift glare: '%s' must be an %s name (with at most one %%d)\n",
-                    extras[i], i == 0 ? ".exr or .png" : ".exr");
+            fprintf(stderr, "drift glare: %s expects an %s name (with at most one %%d), got '%s'\n",
+                    i == 0 ? "--psf" : "--aperture", i == 0 ? ".exr or .png" : ".exr", extras[i]);
             return 2;
         }
     }
