@@ -161,8 +161,7 @@ static double technique_ms(drift_effect effect, const drift_hybrid_stats *s)
         return s->ms[DRIFT_PASS_REFLECTIONS] + s->ms[DRIFT_PASS_ENVMAP] + s->ms[DRIFT_PASS_ISG];
     case DRIFT_EFFECT_DOF:
         return s->ms[DRIFT_PASS_DOF] + s->ms[DRIFT_PASS_ISG];
-    case DRIFT_EFFECT_INDIRECT:
-    case DRIFT_EFFECT_COUNT:
+    default: // ISG has no technique for the other effects
         break;
     }
     return 0.0;

@@ -110,20 +110,20 @@ static double elapsed_ms(const bench_state *b, run_clock c)
 
 typedef struct variant {
     const char *name;
-    drift_occlusion_technique technique;
+    drift_ssdo_method method;
     bool bounce, multibounce, layers, plain_sum;
 } variant;
 
 static const variant variants[] = {
-    { "ssao", DRIFT_OCCLUSION_SSAO, false, false, false, false },
-    { "gtao", DRIFT_OCCLUSION_GTAO, false, false, false, false },
-    { "gtao+mb", DRIFT_OCCLUSION_GTAO, false, true, false, false },
-    { "ssdo", DRIFT_OCCLUSION_SSDO, false, false, false, false },
-    { "ssdo-plain", DRIFT_OCCLUSION_SSDO, false, false, false, true },
-    { "ssdo+bounce", DRIFT_OCCLUSION_SSDO, true, false, false, false },
-    { "ssdo-plain+b", DRIFT_OCCLUSION_SSDO, true, false, false, true },
-    { "ssdo+2layers", DRIFT_OCCLUSION_SSDO, false, false, true, false },
-    { "ssdo+b+2layers", DRIFT_OCCLUSION_SSDO, true, false, true, false },
+    { "ssao", DRIFT_SSDO_METHOD_SSAO, false, false, false, false },
+    { "gtao", DRIFT_SSDO_METHOD_GTAO, false, false, false, false },
+    { "gtao+mb", DRIFT_SSDO_METHOD_GTAO, false, true, false, false },
+    { "ssdo", DRIFT_SSDO_METHOD_SSDO, false, false, false, false },
+    { "ssdo-plain", DRIFT_SSDO_METHOD_SSDO, false, false, false, true },
+    { "ssdo+bounce", DRIFT_SSDO_METHOD_SSDO, true, false, false, false },
+    { "ssdo-plain+b", DRIFT_SSDO_METHOD_SSDO, true, false, false, true },
+    { "ssdo+2layers", DRIFT_SSDO_METHOD_SSDO, false, false, true, false },
+    { "ssdo+b+2layers", DRIFT_SSDO_METHOD_SSDO, true, false, true, false },
 };
 #define VARIANT_COUNT (sizeof(variants) / sizeof(variants[0]))
 
@@ -138,7 +138,7 @@ static drift_result make_gbuffer(const bench_state *b, int32_t w, int32_t h,
 
 static drift_ssdo_params variant_params(const bench_state *b, const variant *v, long samples)
 {
-    return (drift_ssdo_params){ .technique = v->technique,
+    return (drift_ssdo_params){ .method = v->method,
                                 .samples = (int32_t)samples,
                                 .radius = (float)b->o->radius,
                                 .bounce = v->bounce,

@@ -195,6 +195,20 @@ static const cli_option render_table[] = {
     CLI_CHOICE("--aaf-sampler", "S", O, hybrid.aaf.random, "sobol|random",
                "sobol (default: Owen-scrambled Sobol) or random (independent\n"
                "uniform numbers, the paper's Monte Carlo)"),
+    CLI_INT("--occlusion-samples", "N", O, hybrid.occlusion_settings.samples, 1, 1024,
+            "--occlusion ssao|gtao|ssdo (docs/ssdo.md): samples a pixel\n"
+            "(default 16)"),
+    CLI_NUMBER("--occlusion-radius", "R", O, hybrid.occlusion_settings.radius, 1e-30, 1e30,
+               "r_max in scene units (default 0.05 x scene diagonal)"),
+    CLI_CHOICE("--ssdo-bounce", "off|on", O, hybrid.occlusion_settings.bounce, "off|on",
+               "on: SSDO's one indirect bounce (when --indirect is none)"),
+    CLI_INT("--ism-vpls", "N", O, hybrid.ism.vpls, 1, 65536,
+            "instant radiosity (--indirect ism|ir, docs/ism.md): light\n"
+            "paths, one first-bounce VPL each (default 256)"),
+    CLI_INT("--ism-map-size", "N", O, hybrid.ism.map_size, 4, 1024,
+            "texels a side of each VPL's imperfect shadow map (default 64)"),
+    CLI_INT("--ism-points", "N", O, hybrid.ism.points_per_vpl, 16, 1 << 20,
+            "scene points splatted into each map (default 1024)"),
 
     CLI_SECTION("smart image refinement (hybrid mode; docs/sir.md):", GROUP_HYBRID | GROUP_REFINE),
     CLI_CUSTOM("--refine", "sir", O, refine.enabled, cli_parse_refine,

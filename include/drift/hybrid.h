@@ -130,6 +130,26 @@ typedef struct drift_aaf_settings {
     bool random;
 } drift_aaf_settings;
 
+// Instant radiosity (indirect ism and ir, docs/ism.md):
+//   vpls           = 0 -> 256 light paths (first-bounce VPLs)
+//   map_size       = 0 -> 64: each VPL's imperfect shadow map is map_size^2 texels
+//   points_per_vpl = 0 -> 1024 scene points splatted into each map
+typedef struct drift_ism_settings {
+    uint32_t vpls;
+    int32_t map_size;
+    uint32_t points_per_vpl;
+} drift_ism_settings;
+
+// Light from the environment in screen space (occlusion ssao, gtao, ssdo; docs/ssdo.md):
+//   samples = 0 -> 16: N sample points a pixel (GTAO: slices x steps x 2 horizon samples)
+//   radius  = 0 -> 0.05 x the scene's diagonal: r_max, the sample hemisphere's radius
+//   bounce  = false: SSDO's one indirect bounce (only when no indirect technique is chosen)
+typedef struct drift_occlusion_settings {
+    int32_t samples;
+    float radius;
+    bool bounce;
+} drift_occlusion_settings;
+
 // How to build a frame. The default configuration is:
 //   width, height    = 0 -> the scene camera's size
 //   techniques       = hard shadows, no reflections, no depth of field, no indirect light
@@ -139,7 +159,7 @@ typedef struct drift_aaf_settings {
 //                      2 = one bounce, what the sharp buffers can capture)
 //   light_samples    = 0 -> 8 samples per area light for the unshadowed light U_l
 //   ambient          = used when has_ambient; otherwise the mean direct radiance of the frame
-//   shadow_map, envmap, isg, aaf: each family's settings (above)
+//   shadow_map, envmap, isg, aaf, ism, occlusion_settings: each family's settings (above)
 #define DRIFT_TECHNIQUE_FIELD_(ENUM, name, type, TECHNIQUES, kind, plane) \
     drift_##type##_technique name;
 
@@ -166,6 +186,8 @@ typedef struct drift_hybrid_params {
     drift_envmap_settings envmap;
     drift_isg_settings isg;
     drift_aaf_settings aaf;
+    drift_ism_settings ism;
+    drift_occlusion_settings occlusion_settings;
 } drift_hybrid_params;
 
 drift_hybrid_params drift_hybrid_params_resolve(const drift_hybrid_params *params,

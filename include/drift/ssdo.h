@@ -19,7 +19,7 @@
 //   drift_ssdo_env_create(ctx, scene, &(drift_ssdo_env_desc){ 0 }, &env);
 //   drift_ssdo_output out;
 //   drift_ssdo_output_create(ctx, gbuffer->width, gbuffer->height, &out);
-//   drift_ssdo_params params = { .technique = DRIFT_OCCLUSION_SSDO, .bounce = true };
+//   drift_ssdo_params params = { .method = DRIFT_SSDO_METHOD_SSDO, .bounce = true };
 //   drift_ssdo_inputs in = { .gbuffer = gbuffer, .camera = camera };
 //   drift_ssdo_render(ctx, env, &in, &params, &out);                     // once per frame
 //   ... out.radiance ...
@@ -53,17 +53,17 @@ extern "C" {
 // Sample sets tile the image in blocks of this many pixels a side (M = 4x4 sets).
 #define DRIFT_SSDO_BLOCK 4
 
-typedef enum drift_occlusion_technique {
-    DRIFT_OCCLUSION_SSAO = 0, // AO of the SSDO sample points x one irradiance lookup along n
-    DRIFT_OCCLUSION_GTAO,     // horizon-based AO and bent normal x one irradiance lookup along b
-    DRIFT_OCCLUSION_SSDO,     // one environment lookup per open sample direction (+ bounce)
-    DRIFT_OCCLUSION_COUNT
-} drift_occlusion_technique;
+typedef enum drift_ssdo_method {
+    DRIFT_SSDO_METHOD_SSAO = 0, // AO of the SSDO sample points x one irradiance lookup along n
+    DRIFT_SSDO_METHOD_GTAO,     // horizon-based AO and bent normal x one irradiance lookup along b
+    DRIFT_SSDO_METHOD_SSDO,     // one environment lookup per open sample direction (+ bounce)
+    DRIFT_SSDO_METHOD_COUNT
+} drift_ssdo_method;
 
 // "ssao", "gtao", "ssdo"; NULL when out of range.
-const char *drift_occlusion_technique_name(drift_occlusion_technique technique);
+const char *drift_ssdo_method_name(drift_ssdo_method technique);
 // The technique called `name`, or -1.
-int drift_occlusion_technique_parse(const char *name);
+int drift_ssdo_method_parse(const char *name);
 
 // --- PRE-FILTERED ENVIRONMENT ---
 
@@ -94,7 +94,7 @@ drift_vec3 drift_ssdo_env_radiance(const drift_ssdo_env *env, drift_vec3 dir, in
 // --- PARAMETERS ---
 
 // How to render. The default configuration is:
-//   technique       = ssao
+//   method          = ssao
 //   samples         = 0 -> 16: N, sample points a pixel (SSAO, SSDO); GTAO takes
 //                     slices x steps x 2 = N horizon samples
 //   radius          = 0 -> 0.05 x the diagonal of scene bounds (drift_ssdo_params_resolve):
@@ -118,7 +118,7 @@ drift_vec3 drift_ssdo_env_radiance(const drift_ssdo_env *env, drift_vec3 dir, in
 //   gtao_multibounce= false: Jimenez et al.'s multi-bounce fit of the AO (eq. 10)
 //   seed            = 0
 typedef struct drift_ssdo_params {
-    drift_occlusion_technique technique;
+    drift_ssdo_method method;
     int32_t samples;
     float radius;
     bool bounce;

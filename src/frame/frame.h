@@ -97,6 +97,10 @@ typedef struct drift_frame_state {
     drift_image coc;                  // 1: circle-of-confusion radius, pixels
     drift_image focus;                // 3: the composed in-focus frame
 
+    // A chosen row (DRIFT_ROW_ENVIRONMENT_DIFFUSE: occlusion) renders the environment's light
+    // through the diffuse lobe, so environment_direct (and D) keeps only its glossy part.
+    bool environment_diffuse_elsewhere;
+
     drift_frame_probe *probes;
     uint32_t probe_count;
 
@@ -172,10 +176,12 @@ enum {
 
 // How the conductor treats a row: the table's `flags` column.
 enum {
-    DRIFT_ROW_NO_TERM = 1u << 0,        // the effect adds nothing to the frame
-    DRIFT_ROW_SUMS_DIRECT = 1u << 1,    // the pass writes S_l; the conductor sums D after it
-    DRIFT_ROW_PATH_TRACED = 1u << 2,    // skipped when a row replaces the frame
-    DRIFT_ROW_REPLACES_FRAME = 1u << 3, // the pass renders `final` whole (the lens reference)
+    DRIFT_ROW_NO_TERM = 1u << 0,             // the effect adds nothing to the frame
+    DRIFT_ROW_SUMS_DIRECT = 1u << 1,         // the pass writes S_l; the conductor sums D after it
+    DRIFT_ROW_PATH_TRACED = 1u << 2,         // skipped when a row replaces the frame
+    DRIFT_ROW_REPLACES_FRAME = 1u << 3,      // the pass renders `final` whole (the lens reference)
+    DRIFT_ROW_ENVIRONMENT_DIFFUSE = 1u << 4, // the term is the environment's diffuse light: D
+                                             // keeps only the glossy part of it
 };
 
 // Runs fn for every row, or every pixel, rows in parallel. `rays` is the calling thread's ray

@@ -458,11 +458,14 @@ drift_result drift_hybrid_render(drift_hybrid *h, const drift_camera *camera,
     const drift_technique_row *rows[DRIFT_EFFECT_COUNT];
     uint32_t inputs = 0;
     bool replaced = false; // a row renders the whole frame: path-traced terms are not needed
+    bool diffuse_environment = false;
     for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
         rows[e] = drift_technique_row_chosen(&f->params, (drift_effect)e);
         inputs |= rows[e]->inputs;
         replaced |= (rows[e]->flags & DRIFT_ROW_REPLACES_FRAME) != 0;
+        diffuse_environment |= (rows[e]->flags & DRIFT_ROW_ENVIRONMENT_DIFFUSE) != 0;
     }
+    f->environment_diffuse_elsewhere = diffuse_environment;
     drift_result r = prepare_inputs(f, inputs);
     // The terms in the table's order (direct light first: ambient light reads D), then the
     // composition, then the post effects (depth of field turns focus into final).

@@ -399,6 +399,31 @@ static drift_result check_layers(drift_context *ctx, const char *path,
     return DRIFT_OK;
 }
 
+// OpenEXR 3.1.5's ZIP encoder falls back to the raw chunk only when deflate's output is
+// longer than it, and keeps output of exactly the raw size. But a chunk whose data size equals
+// its uncompressed size is raw by the file format, so every reader (OpenEXRCore, the C++
+// library) would take those deflate bytes for pixels. Wrapped around the library's compressor,
+// this stores the packed (raw) chunk whenever compression does not make it smaller.
+typedef struct exr_compress_hook {
+    exr_result_t (*compress)(exr_encode_pipeline_t *encoder);
+} exr_compress_hook;
+
+static exr_result_t compress_or_store_raw(exr_encode_pipeline_t *encoder)
+{
+    const exr_compress_hook *hook = encoder->encoding_user_data;
+    exr_result_t rv = hook->compress(encoder);
+    if (rv != EXR_ERR_SUCCESS || encoder->compressed_bytes < encoder->packed_bytes ||
+        encoder->compressed_buffer == encoder->packed_buffer) {
+        return rv;
+    }
+    if (!encoder->compressed_buffer || encoder->compressed_alloc_size < encoder->packed_bytes) {
+        return EXR_ERR_CORRUPT_CHUNK; // cannot happen: the output was at least this long
+    }
+    memcpy(encoder->compressed_buffer, encoder->packed_buffer, (size_t)encoder->packed_bytes);
+    encoder->compressed_bytes = encoder->packed_bytes;
+    return EXR_ERR_SUCCESS;
+}
+
 static exr_result_t encode_all(exr_context_t f, int part, const out_channel *chans,
                                size_t chan_count, int32_t height)
 {
@@ -408,6 +433,7 @@ static exr_result_t encode_all(exr_context_t f, int part, const out_channel *cha
         rv = EXR_ERR_INVALID_ATTR;
     }
     exr_encode_pipeline_t encoder = EXR_ENCODE_PIPELINE_INITIALIZER;
+    exr_compress_hook hook = { NULL };
     bool first = true;
     for (int32_t y = 0; rv == EXR_ERR_SUCCESS && y < height; y += lines) {
         exr_chunk_info_t cinfo = { 0 };
@@ -442,6 +468,11 @@ static exr_result_t encode_all(exr_context_t f, int part, const out_channel *cha
         }
         if (rv == EXR_ERR_SUCCESS && first) {
             rv = exr_encoding_choose_default_routines(f, part, &encoder);
+            if (rv == EXR_ERR_SUCCESS && encoder.compress_fn) {
+                hook.compress = encoder.compress_fn;
+                encoder.compress_fn = compress_or_store_raw;
+                encoder.encoding_user_data = &hook;
+            }
         }
         if (rv == EXR_ERR_SUCCESS) {
             rv = exr_encoding_run(f, part, &encoder);

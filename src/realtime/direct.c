@@ -31,8 +31,14 @@ static void unshadowed_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_
                                                f->params.light_samples, &sampler);
         drift_image_set3(&f->light_buffers[l].unshadowed, x, y, u);
     }
+    // A row that renders the environment's diffuse light itself (occlusion) leaves D its
+    // glossy part only.
+    drift_bsdf env_bsdf = bsdf;
+    if (f->environment_diffuse_elsewhere) {
+        env_bsdf.diffuse = zero;
+    }
     drift_image_set3(&f->environment_direct, x, y,
-                     drift_raster_environment_direct(f->scene, f->accel, s, &bsdf, wo,
+                     drift_raster_environment_direct(f->scene, f->accel, s, &env_bsdf, wo,
                                                      f->params.light_samples, &sampler, rays));
 }
 

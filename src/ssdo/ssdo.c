@@ -26,16 +26,16 @@
 #define RAW_BENT     7
 #define RAW_CHANNELS 10
 
-const char *drift_occlusion_technique_name(drift_occlusion_technique technique)
+const char *drift_ssdo_method_name(drift_ssdo_method technique)
 {
-    static const char *const names[DRIFT_OCCLUSION_COUNT] = { "ssao", "gtao", "ssdo" };
-    return (unsigned)technique < DRIFT_OCCLUSION_COUNT ? names[technique] : NULL;
+    static const char *const names[DRIFT_SSDO_METHOD_COUNT] = { "ssao", "gtao", "ssdo" };
+    return (unsigned)technique < DRIFT_SSDO_METHOD_COUNT ? names[technique] : NULL;
 }
 
-int drift_occlusion_technique_parse(const char *name)
+int drift_ssdo_method_parse(const char *name)
 {
-    for (int t = 0; name && t < DRIFT_OCCLUSION_COUNT; ++t) {
-        if (strcmp(name, drift_occlusion_technique_name((drift_occlusion_technique)t)) == 0) {
+    for (int t = 0; name && t < DRIFT_SSDO_METHOD_COUNT; ++t) {
+        if (strcmp(name, drift_ssdo_method_name((drift_ssdo_method)t)) == 0) {
             return t;
         }
     }
@@ -192,7 +192,7 @@ static void occlusion_pixel(const ssdo_job *j, int32_t x, int32_t y, float *raw)
     int32_t count = j->p.samples;
     const drift_vec3 *dirs = j->set_dir + set_index(x, y) * count;
     const float *lens = j->set_len + set_index(x, y) * count;
-    bool directional = j->p.technique == DRIFT_OCCLUSION_SSDO;
+    bool directional = j->p.method == DRIFT_SSDO_METHOD_SSDO;
     drift_vec3 direct = drift_vec3_splat(0.0f), bent = drift_vec3_splat(0.0f);
     drift_vec3 unoccluded = drift_vec3_splat(0.0f);
     float open = 0.0f, total = 0.0f;
@@ -377,7 +377,7 @@ static void occlusion_rows(size_t begin, size_t end, int thread_index, void *use
             float *raw = j->raw + ((size_t)y * (size_t)j->width + (size_t)x) * RAW_CHANNELS;
             if (!pixel_valid(j, x, y)) {
                 memset(raw, 0, sizeof(float) * RAW_CHANNELS);
-            } else if (j->p.technique == DRIFT_OCCLUSION_GTAO) {
+            } else if (j->p.method == DRIFT_SSDO_METHOD_GTAO) {
                 gtao_pixel(j, x, y, raw);
             } else {
                 occlusion_pixel(j, x, y, raw);
@@ -534,12 +534,12 @@ static void compose_rows_out(size_t begin, size_t end, int thread_index, void *u
             bent = bl > 1e-8f ? drift_vec3_scale(bent, 1.0f / bl) : n;
             float vis = b[RAW_VIS];
             drift_vec3 direct, bounce = zero;
-            if (j->p.technique == DRIFT_OCCLUSION_SSDO) {
+            if (j->p.method == DRIFT_SSDO_METHOD_SSDO) {
                 direct = drift_vec3_mul(
                     rho, drift_vec3_make(b[RAW_DIRECT], b[RAW_DIRECT + 1], b[RAW_DIRECT + 2]));
                 bounce = drift_vec3_mul(
                     rho, drift_vec3_make(b[RAW_BOUNCE], b[RAW_BOUNCE + 1], b[RAW_BOUNCE + 2]));
-            } else if (j->p.technique == DRIFT_OCCLUSION_GTAO) {
+            } else if (j->p.method == DRIFT_SSDO_METHOD_GTAO) {
                 drift_vec3 e = drift_ssdo_env_irradiance(j->env, bent);
                 drift_vec3 ao = drift_vec3_splat(vis);
                 if (j->p.gtao_multibounce) {
@@ -587,7 +587,7 @@ drift_result drift_ssdo_render(drift_context *ctx, const drift_ssdo_env *env,
                   plane_ok(&out->visibility, w, h, 1) && plane_ok(&out->bent_normal, w, h, 3) &&
                   (!sender_extra || plane_ok(sender_extra, w, h, 3)) &&
                   (!inputs->back_depth || plane_ok(inputs->back_depth, w, h, 1));
-    if (!planes || (unsigned)p.technique >= DRIFT_OCCLUSION_COUNT || p.samples < 1 ||
+    if (!planes || (unsigned)p.method >= DRIFT_SSDO_METHOD_COUNT || p.samples < 1 ||
         p.samples > MAX_SAMPLES || !(p.radius > 0.0f) || !isfinite(p.radius) ||
         !(p.bounce_area > 0.0f) || !(p.bounce_clamp > 0.0f) || !(p.bias >= 0.0f) ||
         p.gtao_slices < 1 || p.gtao_slices > MAX_SLICES || !(p.gtao_thickness >= 0.0f) ||
@@ -620,7 +620,7 @@ drift_result drift_ssdo_render(drift_context *ctx, const drift_ssdo_env *env,
     make_sets(&j);
     drift_parallel_for(ctx, (size_t)h, 2, occlusion_rows, &j);
     double t1 = drift_time_now();
-    if (p.bounce && p.technique == DRIFT_OCCLUSION_SSDO) {
+    if (p.bounce && p.method == DRIFT_SSDO_METHOD_SSDO) {
         drift_parallel_for(ctx, (size_t)h, 2, bounce_rows, &j);
     }
     double t2 = drift_time_now();

@@ -229,6 +229,151 @@ static void test_image_io_tiled_exr_loads(void **state)
     drift_context_destroy(ctx);
 }
 
+// Writes `img` (1 to 4 channels, named as drift_image_save_exr names them, so the packed
+// chunks are byte for byte the ones drift's writer compresses) as a ZIP scanline OpenEXR file
+// with OpenEXRCore, and returns how many chunks its ZIP compressor turned into data exactly
+// as long as the raw chunk yet different from it: the data every reader takes as raw.
+static int zip_chunks_at_raw_size(const char *path, const drift_image *img)
+{
+    static const char *const names[4][4] = {
+        { "Y" }, { "Y", "A" }, { "R", "G", "B" }, { "R", "G", "B", "A" }
+    };
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    exr_context_t f = NULL;
+    int part = 0;
+    assert_int_equal(exr_start_write(&f, path, EXR_WRITE_FILE_DIRECTLY, &init), EXR_ERR_SUCCESS);
+    assert_int_equal(exr_add_part(f, NULL, EXR_STORAGE_SCANLINE, &part), EXR_ERR_SUCCESS);
+    assert_int_equal(
+        exr_initialize_required_attr_simple(f, part, img->width, img->height, EXR_COMPRESSION_ZIP),
+        EXR_ERR_SUCCESS);
+    for (int c = 0; c < img->channels; ++c) {
+        assert_int_equal(exr_add_channel(f, part, names[img->channels - 1][c], EXR_PIXEL_FLOAT,
+                                         EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1),
+                         EXR_ERR_SUCCESS);
+    }
+    assert_int_equal(exr_write_header(f), EXR_ERR_SUCCESS);
+    int32_t lines = 0;
+    assert_int_equal(exr_get_scanlines_per_chunk(f, part, &lines), EXR_ERR_SUCCESS);
+    exr_encode_pipeline_t enc = EXR_ENCODE_PIPELINE_INITIALIZER;
+    int hits = 0;
+    for (int32_t y = 0; y < img->height; y += lines) {
+        exr_chunk_info_t cinfo;
+        assert_int_equal(exr_write_scanline_chunk_info(f, part, y, &cinfo), EXR_ERR_SUCCESS);
+        assert_int_equal(y == 0 ? exr_encoding_initialize(f, part, &cinfo, &enc)
+                                : exr_encoding_update(f, part, &cinfo, &enc),
+                         EXR_ERR_SUCCESS);
+        for (int c = 0; c < enc.channel_count; ++c) {
+            int k = 0;
+            while (strcmp(names[img->channels - 1][k], enc.channels[c].channel_name) != 0) {
+                ++k;
+            }
+            enc.channels[c].encode_from_ptr = (const uint8_t *)(drift_image_pixel(img, 0, y) + k);
+            enc.channels[c].user_pixel_stride = (int32_t)((size_t)img->channels * sizeof(float));
+            enc.channels[c].user_line_stride = (int32_t)((size_t)img->stride * sizeof(float));
+            enc.channels[c].user_data_type = EXR_PIXEL_FLOAT;
+            enc.channels[c].user_bytes_per_element = 4;
+        }
+        if (y == 0) {
+            assert_int_equal(exr_encoding_choose_default_routines(f, part, &enc), EXR_ERR_SUCCESS);
+        }
+        assert_int_equal(exr_encoding_run(f, part, &enc), EXR_ERR_SUCCESS);
+        if (enc.compressed_bytes == enc.packed_bytes &&
+            enc.compressed_buffer != enc.packed_buffer &&
+            memcmp(enc.compressed_buffer, enc.packed_buffer, enc.packed_bytes) != 0) {
+            ++hits;
+        }
+    }
+    exr_encoding_destroy(f, &enc);
+    exr_finish(&f);
+    return hits;
+}
+
+// OpenEXR 3.1.5's ZIP encoder keeps its output when it is exactly as long as the raw chunk,
+// but a chunk whose size equals the uncompressed size is raw to every reader. Rows 16-31 here
+// are k random floats and then a constant; somewhere near k = all, deflate's output crosses
+// the raw size, and for some seed it lands on it exactly. drift must store that chunk raw.
+static void test_image_io_exr_chunk_compressing_to_raw_size_round_trips(void **state)
+{
+    (void)state;
+    drift_context *ctx = test_context(1, NULL);
+    char path[1024], probe[1024];
+    test_out_path(path, "io_raw_size.exr");
+    test_out_path(probe, "io_raw_size_probe.exr");
+    const int32_t w = 16, h = 32;
+    const int32_t n = w * 16 * 3; // floats in the second chunk
+    drift_image img;
+    assert_int_equal(drift_image_create(ctx, w, h, 3, &img), DRIFT_OK);
+    bool found = false;
+    for (uint32_t seed = 0; seed < 64 && !found; ++seed) {
+        for (int32_t k = n - 48; k <= n && !found; ++k) {
+            for (int32_t i = 0; i < w * h * 3; ++i) {
+                int32_t j = i - w * 16 * 3;
+                img.pixels[i] = j < 0   ? 0.25f
+                                : j < k ? test_hash_unit(seed * 100003u + (uint32_t)j)
+                                        : 0.5f;
+            }
+            found = zip_chunks_at_raw_size(probe, &img) > 0;
+        }
+    }
+    assert_true(found); // else this zlib never lands on the raw size and the test proves nothing
+    drift_image_layer layers[] = { { NULL, &img } };
+    assert_int_equal(drift_image_save_exr(ctx, path, layers, 1), DRIFT_OK);
+    drift_image loaded;
+    assert_int_equal(drift_image_load(ctx, path, &loaded), DRIFT_OK);
+    assert_rgb_equal_exact(&img, &loaded);
+    drift_image_destroy(ctx, &loaded);
+    drift_image_destroy(ctx, &img);
+    drift_context_destroy(ctx);
+}
+
+// Round trips of random images: sizes from 1x1 to over three chunks, 1 to 4 channels, rows
+// from constant to incompressible (so some chunks land near their raw size), signed zeros,
+// denormals and huge values; every value comes back bit for bit.
+static void test_image_io_exr_random_round_trips_are_exact(void **state)
+{
+    (void)state;
+    drift_context *ctx = test_context(1, NULL);
+    char path[1024];
+    test_out_path(path, "io_random.exr");
+    static const float specials[] = { -0.0f, 0.0f, 1e-40f, -1e-40f, 3e38f, -3e38f, 1.0f, 65504.0f };
+    for (uint32_t trial = 0; trial < 40; ++trial) {
+        uint32_t s = trial * 1013u;
+        int32_t w = 1 + (int32_t)(test_hash_unit(s + 1) * 70.0f);
+        int32_t h = 1 + (int32_t)(test_hash_unit(s + 2) * 56.0f);
+        int32_t channels = 1 + (int32_t)(test_hash_unit(s + 3) * 4.0f);
+        drift_image img;
+        assert_int_equal(drift_image_create(ctx, w, h, channels, &img), DRIFT_OK);
+        for (int32_t y = 0; y < h; ++y) {
+            // Per row: the share of random values, and whether they are coarse or full floats.
+            float random_share = test_hash_unit(s * 31u + (uint32_t)y * 7u + 4);
+            bool coarse = test_hash_unit(s * 31u + (uint32_t)y * 7u + 5) < 0.3f;
+            for (int32_t x = 0; x < w * channels; ++x) {
+                uint32_t i = s * 65537u + (uint32_t)(y * w * channels + x);
+                float u = test_hash_unit(i * 3u + 1);
+                float v = test_hash_unit(i * 3u + 2);
+                float value = 0.5f;
+                if (u < 0.02f) {
+                    value = specials[(int)(v * 8.0f) & 7];
+                } else if (u < random_share) {
+                    value = coarse ? floorf(v * 8.0f) / 8.0f : (v - 0.3f) * 1000.0f;
+                }
+                drift_image_pixel(&img, 0, y)[x] = value;
+            }
+        }
+        drift_image_layer layers[] = { { NULL, &img } };
+        assert_int_equal(drift_image_save_exr(ctx, path, layers, 1), DRIFT_OK);
+        drift_image loaded;
+        assert_int_equal(drift_image_load(ctx, path, &loaded), DRIFT_OK);
+        assert_rgb_equal_exact(&img, &loaded);
+        if (channels == 4) {
+            assert_int_equal(loaded.channels, 3);
+        }
+        drift_image_destroy(ctx, &loaded);
+        drift_image_destroy(ctx, &img);
+    }
+    drift_context_destroy(ctx);
+}
+
 static void test_image_io_png_round_trip_within_quantization(void **state)
 {
     (void)state;
@@ -513,6 +658,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_image_io_exr_multilayer_round_trip_is_exact),
         cmocka_unit_test(test_image_io_tiled_exr_loads),
+        cmocka_unit_test(test_image_io_exr_chunk_compressing_to_raw_size_round_trips),
+        cmocka_unit_test(test_image_io_exr_random_round_trips_are_exact),
         cmocka_unit_test(test_image_io_png_round_trip_within_quantization),
         cmocka_unit_test(test_image_io_png16_jpeg_and_hdr_load),
         cmocka_unit_test(test_image_io_errors_have_codes),

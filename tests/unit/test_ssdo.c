@@ -92,8 +92,8 @@ static void test_open_plane_gives_albedo_times_environment(void **state)
     c.rig.scene->environment.color = drift_vec3_splat(1.0f);
     look_down(c.rig.scene, 10.0f, 2.0f, 48);
     case_begin(&c);
-    for (int t = 0; t < DRIFT_OCCLUSION_COUNT; ++t) {
-        case_render(&c, &(drift_ssdo_params){ .technique = (drift_occlusion_technique)t,
+    for (int t = 0; t < DRIFT_SSDO_METHOD_COUNT; ++t) {
+        case_render(&c, &(drift_ssdo_params){ .method = (drift_ssdo_method)t,
                                               .samples = 64,
                                               .radius = 0.5f,
                                               .bounce = true });
@@ -143,7 +143,7 @@ static void test_groove_crease_matches_closed_form(void **state)
         assert_near(pixel(&gb->position, 64, 64)[0], 0.0, 1e-3);
         double expected = cos((double)gammas[g]);
         case_render_gbuffer(&c, &crease,
-                            &(drift_ssdo_params){ .technique = DRIFT_OCCLUSION_GTAO,
+                            &(drift_ssdo_params){ .method = DRIFT_SSDO_METHOD_GTAO,
                                                   .samples = 2 * 32 * 8,
                                                   .gtao_slices = 32,
                                                   .radius = 0.5f,
@@ -153,9 +153,9 @@ static void test_groove_crease_matches_closed_form(void **state)
         assert_near(pixel(&c.out.visibility, 64, 64)[0], expected, 0.02 * expected);
         assert_near(pixel(&c.out.bent_normal, 64, 64)[1], 1.0, 1e-3);
         for (int t2 = 0; t2 < 2; ++t2) {
-            drift_occlusion_technique tech = t2 ? DRIFT_OCCLUSION_SSDO : DRIFT_OCCLUSION_SSAO;
+            drift_ssdo_method tech = t2 ? DRIFT_SSDO_METHOD_SSDO : DRIFT_SSDO_METHOD_SSAO;
             case_render_gbuffer(&c, &crease,
-                                &(drift_ssdo_params){ .technique = tech,
+                                &(drift_ssdo_params){ .method = tech,
                                                       .samples = 256,
                                                       .radius = 0.5f,
                                                       .bias = 1e-4f,
@@ -225,12 +225,12 @@ static void test_directional_shadow_is_coloured(void **state)
     drift_ssdo_params p = { .samples = 32, .radius = 2.0f };
     int32_t x = 25, y = 24; // floor just to the -x side of the box (image right is -x)
     assert_true(pixel(&drift_hybrid_gbuffer(c.rig.frame)->position, x, y)[0] < 0.3f);
-    p.technique = DRIFT_OCCLUSION_SSAO;
+    p.method = DRIFT_SSDO_METHOD_SSAO;
     case_render(&c, &p);
     const float *ao = pixel(&c.out.radiance, x, y);
     assert_near(ao[2] / ao[0], 1.0, 0.02);
     assert_true(pixel(&c.out.visibility, x, y)[0] < 0.9f);
-    p.technique = DRIFT_OCCLUSION_SSDO;
+    p.method = DRIFT_SSDO_METHOD_SSDO;
     case_render(&c, &p);
     const float *d = pixel(&c.out.radiance, x, y);
     assert_true(d[2] / d[0] > 1.2f);
@@ -245,7 +245,7 @@ static void test_added_geometry_only_darkens(void **state)
     ssdo_case open, boxed;
     build_box_scene(&open, false, drift_vec3_splat(0.5f), 1.0f, false);
     build_box_scene(&boxed, true, drift_vec3_splat(0.5f), 1.0f, false);
-    drift_ssdo_params p = { .technique = DRIFT_OCCLUSION_SSDO,
+    drift_ssdo_params p = { .method = DRIFT_SSDO_METHOD_SSDO,
                             .samples = 16,
                             .radius = 1.0f,
                             .no_fade = true,
@@ -284,7 +284,7 @@ static void test_bounce_sanity(void **state)
     build_box_scene(&c, true, drift_vec3_make(0.8f, 0.0f, 0.0f), 1.0f, true);
     build_box_scene(&bright, true, drift_vec3_make(0.8f, 0.0f, 0.0f), 2.0f, true);
     drift_ssdo_params p = {
-        .technique = DRIFT_OCCLUSION_SSDO, .samples = 16, .radius = 1.0f, .bounce = true
+        .method = DRIFT_SSDO_METHOD_SSDO, .samples = 16, .radius = 1.0f, .bounce = true
     };
     case_render(&c, &p);
     case_render(&bright, &p);
@@ -359,7 +359,7 @@ static void test_prefiltered_environment(void **state)
     assert_near(e.x, 0.0, 0.01);
     // SSDO's ratio estimator is exact on the open floor under this environment: rho E(n) / pi.
     case_render(&c, &(drift_ssdo_params){
-                        .technique = DRIFT_OCCLUSION_SSDO, .samples = 16, .radius = 1.0f });
+                        .method = DRIFT_SSDO_METHOD_SSDO, .samples = 16, .radius = 1.0f });
     drift_vec3 up = drift_ssdo_env_irradiance(c.env, drift_vec3_make(0, 1, 0));
     for (int32_t y = 0; y < 48; ++y) {
         for (int32_t x = 0; x < 48; ++x) {
@@ -384,7 +384,7 @@ static void test_converges_toward_reference(void **state)
     double rmse[3];
     const int32_t counts[3] = { 2, 8, 64 };
     for (int i = 0; i < 3; ++i) {
-        case_render(&c, &(drift_ssdo_params){ .technique = DRIFT_OCCLUSION_SSDO,
+        case_render(&c, &(drift_ssdo_params){ .method = DRIFT_SSDO_METHOD_SSDO,
                                               .samples = counts[i],
                                               .radius = 3.0f });
         rmse[i] = test_rmse(c.rig.ctx, &ref, &c.out.radiance);
@@ -441,7 +441,7 @@ static void test_heightfield_against_ray_traced_occlusion(void **state)
                                           48, 48, 64, 1, false, &ref),
                      DRIFT_OK);
     case_render(&c, &(drift_ssdo_params){
-                        .technique = DRIFT_OCCLUSION_SSDO, .samples = 64, .radius = 1.0f });
+                        .method = DRIFT_SSDO_METHOD_SSDO, .samples = 64, .radius = 1.0f });
     double diff = 0.0, signed_diff = 0.0;
     for (int32_t y = 0; y < 48; ++y) {
         for (int32_t x = 0; x < 48; ++x) {
@@ -457,7 +457,7 @@ static void test_heightfield_against_ray_traced_occlusion(void **state)
     assert_true(diff < 0.2);
     // For the record: GTAO's horizons are rays, not points.
     case_render(&c, &(drift_ssdo_params){
-                        .technique = DRIFT_OCCLUSION_GTAO, .samples = 64, .radius = 1.0f });
+                        .method = DRIFT_SSDO_METHOD_GTAO, .samples = 64, .radius = 1.0f });
     double gtao = 0.0;
     for (int32_t y = 0; y < 48; ++y) {
         for (int32_t x = 0; x < 48; ++x) {
@@ -495,7 +495,7 @@ static void test_second_layer_opens_the_gap_behind_a_slab(void **state)
                      DRIFT_OK);
     assert_near(pixel(&back, 24, 24)[0], 6.1, 1e-3); // the slab's back face (camera z = -6)
     assert_true(pixel(&back, 2, 2)[0] == 0.0f);      // nothing behind the wall
-    drift_ssdo_params p = { .technique = DRIFT_OCCLUSION_SSAO,
+    drift_ssdo_params p = { .method = DRIFT_SSDO_METHOD_SSAO,
                             .samples = 32,
                             .radius = 2.5f,
                             .no_fade = true,
@@ -587,8 +587,8 @@ static void test_bit_identical_across_threads(void **state)
     ssdo_case c;
     build_box_scene(&c, true, drift_vec3_make(0.8f, 0.2f, 0.1f), 1.0f, false);
     drift_context *one = test_context(1, NULL);
-    for (int t = 0; t < DRIFT_OCCLUSION_COUNT; ++t) {
-        drift_ssdo_params p = { .technique = (drift_occlusion_technique)t,
+    for (int t = 0; t < DRIFT_SSDO_METHOD_COUNT; ++t) {
+        drift_ssdo_params p = { .method = (drift_ssdo_method)t,
                                 .samples = 16,
                                 .radius = 1.0f,
                                 .bounce = true,
@@ -620,7 +620,7 @@ static void test_bad_parameters_are_rejected(void **state)
     const drift_ssdo_params bad[] = {
         { .radius = -1.0f },
         { .radius = 1.0f, .samples = -3 },
-        { .radius = 1.0f, .technique = DRIFT_OCCLUSION_COUNT },
+        { .radius = 1.0f, .method = DRIFT_SSDO_METHOD_COUNT },
         { .radius = 1.0f, .gtao_thickness = 2.0f },
     };
     for (size_t i = 0; i < sizeof(bad) / sizeof(bad[0]); ++i) {
@@ -628,8 +628,8 @@ static void test_bad_parameters_are_rejected(void **state)
         assert_int_equal(drift_ssdo_render(c.rig.ctx, c.env, &in, &bad[i], &c.out),
                          DRIFT_ERR_INVALID_ARGUMENT);
     }
-    assert_int_equal(drift_occlusion_technique_parse("gtao"), DRIFT_OCCLUSION_GTAO);
-    assert_int_equal(drift_occlusion_technique_parse("hbao"), -1);
+    assert_int_equal(drift_ssdo_method_parse("gtao"), DRIFT_SSDO_METHOD_GTAO);
+    assert_int_equal(drift_ssdo_method_parse("hbao"), -1);
     case_end(&c);
 }
 

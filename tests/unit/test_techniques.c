@@ -32,6 +32,7 @@ static void build_scene(test_rig *r, int32_t size)
     r->scene->camera =
         drift_camera_look_at(drift_vec3_make(0, 0.5f, -3.0f), drift_vec3_make(0, -0.5f, 0.5f),
                              drift_vec3_make(0, 1, 0), 1.0f, size, size);
+    r->scene->environment.color = drift_vec3_make(0.3f, 0.35f, 0.4f); // for occlusion
     r->scene->camera.aperture_radius = 0.05f;
     r->scene->camera.focus_distance = 3.0f;
 }
@@ -78,6 +79,9 @@ static void test_every_row_renders(void **state)
                 for (uint32_t k = 0; k < count; ++k) {
                     assert_string_not_equal(names[k], names[count]);
                 }
+                // --aov writes every plane as a layer of one EXR: the frame's size.
+                assert_int_equal(image->width, 20);
+                assert_int_equal(image->height, 20);
                 ++count;
             }
             drift_hybrid_stats stats = drift_hybrid_get_stats(r.frame);
@@ -153,6 +157,39 @@ static void test_rows_are_consistent(void **state)
     assert_null(drift_technique_row_of(DRIFT_EFFECT_COUNT, 0));
 }
 
+static double mean_of(const drift_image *image)
+{
+    double sum = 0.0;
+    size_t n = (size_t)image->width * (size_t)image->height * (size_t)image->channels;
+    for (size_t i = 0; i < n; ++i) {
+        sum += (double)image->pixels[i];
+    }
+    return sum / (double)n;
+}
+
+// The environment's diffuse light is counted once: ray-traced inside D (occlusion none), or
+// as the occlusion term with D keeping only its glossy part (occlusion reference, the same
+// estimator with other samples). Both frames converge to one image; a double count would be
+// off by the whole diffuse environment term (about a third of this frame).
+static void test_occlusion_counts_the_environment_once(void **state)
+{
+    (void)state;
+    test_rig r = test_rig_begin(2);
+    build_scene(&r, 24);
+    test_rig_commit(&r);
+    drift_hybrid_params p = { .light_samples = 64, .spp = 64, .seed = 5 };
+    test_rig_frame(&r, &p);
+    double none = mean_of(drift_hybrid_image(r.frame));
+    p.occlusion = DRIFT_OCCLUSION_REFERENCE;
+    test_rig_frame(&r, &p);
+    double reference = mean_of(drift_hybrid_image(r.frame));
+    double term = mean_of(test_rig_plane(&r, "occlusion"));
+    print_message("mean final: occlusion none %g, reference %g (term %g)\n", none, reference, term);
+    assert_true(term > 0.1 * reference);
+    assert_near(reference, none, 0.02 * none);
+    test_rig_destroy(&r);
+}
+
 static int freed;
 
 static void count_free(drift_context *ctx, void *data)
@@ -193,6 +230,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_rows_are_consistent),
         cmocka_unit_test(test_state_slots),
+        cmocka_unit_test(test_occlusion_counts_the_environment_once),
         cmocka_unit_test(test_every_row_renders),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -1,0 +1,128 @@
+// The occlusion effect's rows in the hybrid frame (thesis ch. 4): O = the environment's light
+// through the diffuse lobe, with the visibility each technique estimates in screen space, and
+// SSDO's one bounce. The environment's diffuse light then leaves D (DRIFT_ROW_ENVIRONMENT_DIFFUSE),
+// so the frame counts it once: L = E + D(lights, glossy environment) + R + I + O.
+// The pre-filtered environment and the output planes live in the effect's state slot.
+#include "ssdo/ssdo_pass.h"
+
+#include "drift/ssdo.h"
+
+typedef struct ssdo_pass_state {
+    drift_ssdo_env *env;
+    drift_ssdo_output out;
+} ssdo_pass_state;
+
+static void state_destroy(drift_context *ctx, void *data)
+{
+    ssdo_pass_state *s = data;
+    drift_ssdo_env_destroy(s->env);
+    drift_ssdo_output_destroy(ctx, &s->out);
+    drift_free(ctx, s);
+}
+
+static drift_result ensure_state(drift_frame_state *f, const drift_pass_args *args,
+                                 ssdo_pass_state **out)
+{
+    *out = drift_pass_state(f, args);
+    if (*out) {
+        return DRIFT_OK;
+    }
+    ssdo_pass_state *s = drift_alloc(f->ctx, sizeof *s);
+    if (!s) {
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    drift_result r = drift_ssdo_env_create(f->ctx, f->scene, NULL, &s->env);
+    if (r == DRIFT_OK) {
+        r = drift_ssdo_output_create(f->ctx, f->params.width, f->params.height, &s->out);
+    }
+    if (r != DRIFT_OK) {
+        state_destroy(f->ctx, s);
+        return r;
+    }
+    drift_pass_set_state(f, args, s, state_destroy);
+    *out = s;
+    return DRIFT_OK;
+}
+
+static drift_result render(drift_frame_state *f, const drift_pass_args *args,
+                           drift_ssdo_method method)
+{
+    ssdo_pass_state *s = NULL;
+    drift_result r = ensure_state(f, args, &s);
+    if (r != DRIFT_OK) {
+        return r;
+    }
+    // The bounce is indirect light: when an indirect technique renders I, it already has it.
+    bool indirect_none = f->params.indirect == DRIFT_INDIRECT_NONE;
+    drift_ssdo_params params = { .method = method,
+                                 .samples = f->params.occlusion_settings.samples,
+                                 .radius = f->params.occlusion_settings.radius,
+                                 .bounce = f->params.occlusion_settings.bounce && indirect_none,
+                                 .seed = f->params.seed };
+    params = drift_ssdo_params_resolve(&params, f->scene);
+    // The bounce reflects what the senders send: their shadowed direct light D.
+    drift_ssdo_inputs in = { .gbuffer = &f->gbuffer,
+                             .camera = &f->camera,
+                             .sender_radiance = &f->direct };
+    r = drift_ssdo_render(f->ctx, s->env, &in, &params, &s->out);
+    if (r == DRIFT_OK) {
+        drift_pass_copy_rgb(&s->out.radiance, &f->terms[args->effect]);
+    }
+    return r;
+}
+
+drift_result drift_ssdo_pass_ssao(drift_frame_state *f, const drift_pass_args *args)
+{
+    return render(f, args, DRIFT_SSDO_METHOD_SSAO);
+}
+
+drift_result drift_ssdo_pass_gtao(drift_frame_state *f, const drift_pass_args *args)
+{
+    return render(f, args, DRIFT_SSDO_METHOD_GTAO);
+}
+
+drift_result drift_ssdo_pass_ssdo(drift_frame_state *f, const drift_pass_args *args)
+{
+    return render(f, args, DRIFT_SSDO_METHOD_SSDO);
+}
+
+typedef struct reference_job {
+    drift_image *out;
+    uint32_t stream;
+} reference_job;
+
+static void reference_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
+{
+    const reference_job *job = user;
+    const drift_surface *s = &f->gbuffer.surfaces[(size_t)y * (size_t)f->params.width + (size_t)x];
+    drift_vec3 o = drift_vec3_splat(0.0f);
+    if (s->material != DRIFT_INVALID_INDEX) {
+        drift_bsdf bsdf = drift_bsdf_make(f->scene, s);
+        bsdf.specular = drift_vec3_splat(0.0f); // the diffuse lobe: what O stands for
+        drift_sampler sampler = drift_pass_sampler(f, job->stream, x, y);
+        o = drift_raster_environment_direct(f->scene, f->accel, s, &bsdf, drift_pass_wo(f, x, y),
+                                            f->params.spp, &sampler, rays);
+    }
+    drift_image_set3(job->out, x, y, o);
+}
+
+drift_result drift_ssdo_pass_reference(drift_frame_state *f, const drift_pass_args *args)
+{
+    double t = drift_time_now();
+    reference_job job = { &f->terms[args->effect], args->stream };
+    f->stats.rays[DRIFT_PASS_REFERENCE] += drift_pass_for_each_pixel(f, reference_pixel, &job);
+    drift_pass_time(f, DRIFT_PASS_REFERENCE, t);
+    return DRIFT_OK;
+}
+
+void drift_ssdo_planes(const drift_frame_state *f, drift_pass_plane_fn add, void *sink)
+{
+    const drift_pass_args args = { .effect = DRIFT_EFFECT_OCCLUSION,
+                                   .technique = f->params.occlusion };
+    const ssdo_pass_state *s = drift_pass_state(f, &args);
+    if (s) {
+        add(sink, "occlusion.visibility", &s->out.visibility);
+        add(sink, "occlusion.bent_normal", &s->out.bent_normal);
+        add(sink, "occlusion.bounce", &s->out.bounce);
+    }
+}

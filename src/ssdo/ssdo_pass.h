@@ -1,0 +1,19 @@
+// The rows of the occlusion effect that src/ssdo provides (ssdo_pass.c): light from the
+// environment through the diffuse lobe, with screen-space visibility, and its reference.
+#ifndef DRIFT_SSDO_PASS_H
+#define DRIFT_SSDO_PASS_H
+
+#include "frame/frame.h"
+
+// Fill frame->terms[DRIFT_EFFECT_OCCLUSION] (O) by SSAO, GTAO or SSDO (with the one bounce
+// when params.occlusion.bounce and no indirect technique already has that light).
+drift_result drift_ssdo_pass_ssao(drift_frame_state *frame, const drift_pass_args *args);
+drift_result drift_ssdo_pass_gtao(drift_frame_state *frame, const drift_pass_args *args);
+drift_result drift_ssdo_pass_ssdo(drift_frame_state *frame, const drift_pass_args *args);
+// O ray-traced: the environment through the diffuse lobe at --spp shadow rays a pixel, exact
+// visibility (what the screen-space techniques approximate; no bounce).
+drift_result drift_ssdo_pass_reference(drift_frame_state *frame, const drift_pass_args *args);
+// occlusion.visibility, occlusion.bent_normal, occlusion.bounce of the last render.
+void drift_ssdo_planes(const drift_frame_state *frame, drift_pass_plane_fn add, void *sink);
+
+#endif // DRIFT_SSDO_PASS_H
