@@ -37,4 +37,11 @@ DRIFT_BENCH_LIST(DRIFT__BENCH_DECLARE)
 bool bench_open(cli_session *s, const char *cmd, const char *scene_path, const char *default_scene,
                 long threads);
 
+// A list option ("--vpls 64,256,1024"): 1 to `max` comma-separated integers in [lo, hi] into
+// out[0 .. *count - 1]. Otherwise prints "drift <cmd>: <flag> expects 1 to <max>
+// comma-separated integers in [lo, hi], got '<text>'", leaves *count and out as they were
+// and returns false.
+bool bench_parse_list(const char *cmd, const char *flag, const char *text, long lo, long hi,
+                      int max, long *out, int *count);
+
 #endif // DRIFT_BENCH_H

@@ -30,42 +30,28 @@ typedef struct aaf_options {
     bool random; // --sampler random: AAF and plain MC both take independent random numbers
 } aaf_options;
 
-// A comma-separated, increasing list of 2..MAX_SPPS counts into spps[0 .. *spp_count - 1].
-static bool parse_spps(const char *text, long *spps, int *spp_count)
-{
-    int count = 0;
-    const char *p = text;
-    while (*p && count < MAX_SPPS) {
-        char *end;
-        long v = strtol(p, &end, 10);
-        if (end == p || v < 1 || v > 65536 || (*end != ',' && *end != '\0') ||
-            (count > 0 && v <= spps[count - 1])) {
-            fprintf(stderr,
-                    "drift bench aaf: expected an increasing comma-separated list of "
-                    "counts in 1..65536, got '%s'\n",
-                    text);
-            return false;
-        }
-        spps[count++] = v;
-        p = *end == ',' ? end + 1 : end;
-    }
-    if (count < 2 || *p) {
-        fprintf(stderr, "drift bench aaf: a spp list needs 2..%d values, got '%s'\n", MAX_SPPS,
-                text);
-        return false;
-    }
-    *spp_count = count;
-    return true;
-}
-
-// --spp and --mc-spp: `field` is the list, followed by its count.
+// --spp and --mc-spp: an increasing list of 2..MAX_SPPS counts into that list and its count.
 static bool parse_spp_list(const char *cmd, const char *flag, const char *v, void *field)
 {
-    (void)cmd;
-    (void)flag;
     aaf_options *o = field;
-    return strcmp(flag, "--spp") == 0 ? parse_spps(v, o->spps, &o->spp_count)
-                                      : parse_spps(v, o->mc_spps, &o->mc_spp_count);
+    bool mc = strcmp(flag, "--mc-spp") == 0;
+    long spps[MAX_SPPS];
+    int count = 0;
+    if (!bench_parse_list(cmd, flag, v, 1, 65536, MAX_SPPS, spps, &count)) {
+        return false;
+    }
+    bool increasing = count >= 2;
+    for (int k = 1; increasing && k < count; ++k) {
+        increasing = spps[k] > spps[k - 1];
+    }
+    if (!increasing) {
+        fprintf(stderr, "drift %s: %s expects an increasing list of 2 or more counts, got '%s'\n",
+                cmd, flag, v);
+        return false;
+    }
+    memcpy(mc ? o->mc_spps : o->spps, spps, (size_t)count * sizeof *spps);
+    *(mc ? &o->mc_spp_count : &o->spp_count) = count;
+    return true;
 }
 
 static bool parse_size(const char *cmd, const char *flag, const char *v, void *field)
@@ -133,8 +119,9 @@ static int parse(int argc, char **argv, aaf_options *o)
                         .timing_width = 640,
                         .timing_height = 480,
                         .timing_spp = 16,
-                        .light_samples = 256 };
-    parse_spps("4,8,16,32,64", o->spps, &o->spp_count);
+                        .light_samples = 256,
+                        .spps = { 4, 8, 16, 32, 64 },
+                        .spp_count = 5 };
     int status = cli_parse(&aaf_command, argc, argv, o, NULL);
     if (status != CLI_PARSED) {
         return status;

@@ -20,22 +20,54 @@
 #include <stdlib.h>
 #include <string.h>
 
-static void print_help(FILE *out)
+#define MAX_SIZES 8
+
+typedef struct glare_options {
+    long frames;
+    long sizes[MAX_SIZES];
+    int size_count;
+    bool no_convolution, json;
+} glare_options;
+
+// --sizes: up to MAX_SIZES powers of two in [16, 4096]; `field` is the options.
+static bool parse_sizes(const char *cmd, const char *flag, const char *value, void *field)
 {
-    fprintf(out, "usage: drift bench glare [--frames N] [--sizes N,N,...] [--no-convolution]\n"
-                 "                         [--json]\n\n"
-                 "(a) aperture, diffraction and display ms per PSF size (Table 8.2 of the "
-                 "thesis;\n"
-                 "    2x2 supersampling, 32 wavelengths), (b) the convolution of a 1920x1080 "
-                 "frame\n"
-                 "    with that PSF, (c) ms a frame of drift_glare_apply (dynamic, PSF 256) on "
-                 "640x480,\n"
-                 "    512^2 and 1024^2 images. One thread.\n\n"
-                 "  --frames N        the least of N runs per figure (default 3)\n"
-                 "  --sizes LIST      PSF sizes (default 256,512,1024)\n"
-                 "  --no-convolution  skip (b) and (c)\n"
-                 "  --json            one JSON object on stdout\n");
+    glare_options *o = field, next = *o;
+    if (!bench_parse_list(cmd, flag, value, 16, 4096, MAX_SIZES, next.sizes, &next.size_count)) {
+        return false;
+    }
+    for (int i = 0; i < next.size_count; ++i) {
+        if ((next.sizes[i] & (next.sizes[i] - 1)) != 0) {
+            fprintf(stderr, "drift %s: %s expects powers of two, got %ld in '%s'\n", cmd, flag,
+                    next.sizes[i], value);
+            return false;
+        }
+    }
+    *o = next;
+    return true;
 }
+
+#define O glare_options
+static const cli_option glare_table[] = {
+    CLI_SECTION("options:", 0),
+    CLI_INT("--frames", "N", O, frames, 1, 1000, "the least of N runs per figure (default 3)"),
+    CLI_CUSTOM_ALL("--sizes", "LIST", parse_sizes,
+                   "PSF sizes, up to " CLI_STR(MAX_SIZES) " powers of two (default 256,512,1024)"),
+    CLI_FLAG("--no-convolution", O, no_convolution, "skip (b) and (c)"),
+    BENCH_OPTION_JSON(O),
+};
+#undef O
+
+static const cli_command glare_command = {
+    .name = "bench glare",
+    .usage = "usage: drift bench glare [options]\n\n"
+             "(a) aperture, diffraction and display ms per PSF size (Table 8.2 of the thesis;\n"
+             "    2x2 supersampling, 32 wavelengths), (b) the convolution of a 1920x1080 frame\n"
+             "    with that PSF, (c) ms a frame of drift_glare_apply (dynamic, PSF 256) on\n"
+             "    640x480, 512^2 and 1024^2 images. One thread.\n\n",
+    CLI_TABLE(glare_table),
+    .help_column = 20,
+};
 
 static double least(double a, double b)
 {
@@ -167,46 +199,13 @@ static drift_result time_apply(drift_context *ctx, int32_t width, int32_t height
 
 int drift_bench_glare(int argc, char **argv)
 {
-    long frames = 3;
-    bool json = false, convolution = true;
-    int32_t sizes[8] = { 256, 512, 1024 }, size_count = 3;
-    for (int i = 1; i < argc; ++i) {
-        const char *a = argv[i];
-        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
-            print_help(stdout);
-            return 0;
-        } else if (strcmp(a, "--json") == 0) {
-            json = true;
-        } else if (strcmp(a, "--no-convolution") == 0) {
-            convolution = false;
-        } else if (strcmp(a, "--frames") == 0) {
-            const char *v = cli_next_value("bench glare", argc, argv, &i);
-            if (!v || !cli_parse_int("bench glare", "--frames", v, 1, 1000, &frames)) {
-                return 2;
-            }
-        } else if (strcmp(a, "--sizes") == 0) {
-            const char *v = cli_next_value("bench glare", argc, argv, &i);
-            if (!v) {
-                return 2;
-            }
-            size_count = 0;
-            char buf[256];
-            snprintf(buf, sizeof(buf), "%s", v);
-            for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
-                long s = 0;
-                if (size_count == 8 ||
-                    !cli_parse_int("bench glare", "--sizes", tok, 16, 4096, &s) ||
-                    (s & (s - 1)) != 0) {
-                    fprintf(stderr, "drift bench glare: --sizes takes up to 8 powers of two\n");
-                    return 2;
-                }
-                sizes[size_count++] = (int32_t)s;
-            }
-        } else {
-            fprintf(stderr, "drift bench glare: unknown option '%s'\n", a);
-            return 2;
-        }
+    glare_options o = { .frames = 3, .sizes = { 256, 512, 1024 }, .size_count = 3 };
+    int status = cli_parse(&glare_command, argc, argv, &o, NULL);
+    if (status != CLI_PARSED) {
+        return cli_parse_exit(status);
     }
+    const bool convolution = !o.no_convolution;
+    const int32_t frames = (int32_t)o.frames;
     cli_session session;
     if (!cli_session_open(
             &(cli_session_desc){ .cmd = "bench glare", .threads = 1, .no_scene = true },
@@ -214,52 +213,58 @@ int drift_bench_glare(int argc, char **argv)
         return 1;
     }
     drift_context *ctx = session.ctx;
-    phase_ms rows[8];
+    phase_ms rows[MAX_SIZES];
     double apply_ms[3] = { NAN, NAN, NAN }, billboard_ms = NAN;
     const int32_t apply_sizes[3][2] = { { 640, 480 }, { 512, 512 }, { 1024, 1024 } };
     drift_result r = DRIFT_OK;
-    for (int32_t i = 0; i < size_count && r == DRIFT_OK; ++i) {
-        r = time_size(ctx, sizes[i], (int32_t)frames, convolution, &rows[i]);
+    for (int i = 0; i < o.size_count && r == DRIFT_OK; ++i) {
+        r = time_size(ctx, (int32_t)o.sizes[i], frames, convolution, &rows[i]);
     }
     for (int32_t i = 0; i < 3 && convolution && r == DRIFT_OK; ++i) {
-        r = time_apply(ctx, apply_sizes[i][0], apply_sizes[i][1], (int32_t)frames,
+        r = time_apply(ctx, apply_sizes[i][0], apply_sizes[i][1], frames,
                        DRIFT_GLARE_METHOD_CONVOLUTION, &apply_ms[i]);
     }
     if (convolution && r == DRIFT_OK) {
-        r = time_apply(ctx, 640, 480, (int32_t)frames, DRIFT_GLARE_METHOD_BILLBOARD, &billboard_ms);
+        r = time_apply(ctx, 640, 480, frames, DRIFT_GLARE_METHOD_BILLBOARD, &billboard_ms);
     }
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift bench glare: %s\n", drift_result_string(r));
         cli_session_close(&session);
         return 1;
     }
-    if (json) {
-        printf("{\"threads\": 1, \"supersample\": 2, \"wavelengths\": 32, \"sizes\": [");
-        for (int32_t i = 0; i < size_count; ++i) {
+    if (o.json) {
+        cJSON *root = cJSON_CreateObject();
+        cJSON_AddNumberToObject(root, "threads", 1);
+        cJSON_AddNumberToObject(root, "supersample", 2);
+        cJSON_AddNumberToObject(root, "wavelengths", 32);
+        cJSON *array = cJSON_AddArrayToObject(root, "sizes");
+        for (int i = 0; i < o.size_count; ++i) {
             const phase_ms *p = &rows[i];
-            printf("%s{\"n\": %d, \"aperture_ms\": %.3f, \"diffraction_ms\": %.3f, "
-                   "\"display_ms\": %.3f, \"overall_ms\": %.3f, \"convolution_1080p_ms\": ",
-                   i ? ", " : "", (int)p->n, p->aperture, p->diffraction, p->display,
-                   p->aperture + p->diffraction + p->display);
-            if (isfinite(p->convolution)) {
-                printf("%.3f}", p->convolution);
-            } else {
-                printf("null}");
-            }
+            cJSON *item = cJSON_CreateObject();
+            cJSON_AddItemToArray(array, item);
+            cJSON_AddNumberToObject(item, "n", p->n);
+            cli_json_number(item, "aperture_ms", p->aperture, 3);
+            cli_json_number(item, "diffraction_ms", p->diffraction, 3);
+            cli_json_number(item, "display_ms", p->display, 3);
+            cli_json_number(item, "overall_ms", p->aperture + p->diffraction + p->display, 3);
+            cli_json_number(item, "convolution_1080p_ms", p->convolution, 3);
         }
-        printf("], \"apply_ms\": {");
-        for (int32_t i = 0; i < 3; ++i) {
-            printf("%s\"%dx%d\": ", i ? ", " : "", (int)apply_sizes[i][0], (int)apply_sizes[i][1]);
-            isfinite(apply_ms[i]) ? printf("%.3f", apply_ms[i]) : printf("null");
+        cJSON *apply = cJSON_AddObjectToObject(root, "apply_ms");
+        for (int i = 0; i < 3; ++i) {
+            char key[32];
+            snprintf(key, sizeof key, "%dx%d", (int)apply_sizes[i][0], (int)apply_sizes[i][1]);
+            cli_json_number(apply, key, apply_ms[i], 3);
         }
-        printf("}, \"billboard_640x480_ms\": ");
-        isfinite(billboard_ms) ? printf("%.3f", billboard_ms) : printf("null");
-        printf("}\n");
+        cli_json_number(root, "billboard_640x480_ms", billboard_ms, 3);
+        if (!cli_json_write("bench glare", root, NULL)) {
+            cli_session_close(&session);
+            return 1;
+        }
     } else {
-        printf("glare, one thread, 2x2 supersampling, 32 wavelengths (least of %ld)\n", frames);
+        printf("glare, one thread, 2x2 supersampling, 32 wavelengths (least of %d)\n", (int)frames);
         printf("%6s %10s %12s %10s %10s %16s\n", "N", "aperture", "diffraction", "display",
                "overall", "conv 1920x1080");
-        for (int32_t i = 0; i < size_count; ++i) {
+        for (int i = 0; i < o.size_count; ++i) {
             const phase_ms *p = &rows[i];
             printf("%6d %8.1f ms %9.1f ms %7.1f ms %7.1f ms %13.1f ms\n", (int)p->n, p->aperture,
                    p->diffraction, p->display, p->aperture + p->diffraction + p->display,

@@ -13,7 +13,6 @@
 #include "drift/pt.h"
 #include "drift/scene_io.h"
 
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -26,118 +25,49 @@ typedef struct ism_options {
     long size, threads, ref_spp, points, map, block;
     long vpls[MAX_LIST], spps[MAX_LIST];
     int vpl_count, spp_count;
-    bool no_ir;
+    bool no_ir, json;
 } ism_options;
 
-static void print_help(FILE *out)
+// --vpls and --spp: `field` is the options.
+static bool parse_counts(const char *cmd, const char *flag, const char *value, void *field)
 {
-    fprintf(
-        out,
-        "usage: drift bench ism [SCENE] [--size N] [--threads T] [--vpls LIST] [--spp LIST]\n"
-        "                       [--ref-spp N] [--points P] [--map N] [--block B] [--no-ir]\n"
-        "                       [--png DIR]\n\n"
-        "ism and ir (src/ism) against the path tracer on the diffuse indirect term I.\n\n"
-        "  SCENE        default scenes/cornell-box/cornell_box.json\n"
-        "  --size N     N x N pixels (default 400)\n"
-        "  --threads T  worker threads (default 2)\n"
-        "  --vpls LIST  comma-separated VPL counts (default 64,256,1024)\n"
-        "  --spp LIST   the path tracer's spp (default 1,2,4)\n"
-        "  --ref-spp N  reference samples a pixel (default 256)\n"
-        "  --points P   points per VPL (default 1024); --map N ISM side (default 64)\n"
-        "  --block B    interleaving block (default 4)\n"
-        "  --no-ir      skip the ray-traced baseline\n"
-        "  --png DIR    write each row's frame (reference terms + I) as DIR/<row>_<count>.png,\n"
-        "               I alone 3 stops up as DIR/<row>_<count>_indirect.png, and the\n"
-        "               VPLs and one ISM tile of the last ism row\n");
+    ism_options *o = field;
+    bool vpls = strcmp(flag, "--vpls") == 0;
+    return bench_parse_list(cmd, flag, value, 1, 1 << 20, MAX_LIST, vpls ? o->vpls : o->spps,
+                            vpls ? &o->vpl_count : &o->spp_count);
 }
 
-static bool parse_long(const char *s, long lo, long hi, long *out)
-{
-    char *end;
-    errno = 0;
-    long v = strtol(s, &end, 10);
-    if (errno || *end || v < lo || v > hi) {
-        return false;
-    }
-    *out = v;
-    return true;
-}
+#define O ism_options
+static const cli_option ism_table[] = {
+    CLI_SECTION("options:", 0),
+    CLI_INT("--size", "N", O, size, 8, 4096, "N x N pixels (default 400)"),
+    CLI_INT("--threads", "T", O, threads, 1, 256, "worker threads (default 2)"),
+    CLI_CUSTOM_ALL("--vpls", "LIST", parse_counts,
+                   "comma-separated VPL counts (default 64,256,1024)"),
+    CLI_CUSTOM_ALL("--spp", "LIST", parse_counts, "the path tracer's spp (default 1,2,4)"),
+    CLI_INT("--ref-spp", "N", O, ref_spp, 1, 1 << 20, "reference samples a pixel (default 256)"),
+    CLI_INT("--points", "P", O, points, 1, 1 << 20, "points per VPL (default 1024)"),
+    CLI_INT("--map", "N", O, map, 4, 1024, "ISM side (default 64)"),
+    CLI_INT("--block", "B", O, block, 1, 64, "interleaving block (default 4)"),
+    CLI_FLAG("--no-ir", O, no_ir, "skip the ray-traced baseline"),
+    CLI_STRING("--png", "DIR", O, png_dir,
+               "write each row's frame (reference terms + I) as DIR/<row>_<count>.png,\n"
+               "I alone 3 stops up as DIR/<row>_<count>_indirect.png, and the\n"
+               "VPLs and one ISM tile of the last ism row"),
+    BENCH_OPTION_JSON(O),
+};
+#undef O
 
-static bool parse_list(const char *s, long *out, int *count)
-{
-    char buf[256];
-    if (strlen(s) >= sizeof buf) {
-        return false;
-    }
-    strcpy(buf, s);
-    *count = 0;
-    for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
-        if (*count >= MAX_LIST || !parse_long(tok, 1, 1 << 20, &out[*count])) {
-            return false;
-        }
-        (*count)++;
-    }
-    return *count > 0;
-}
-
-static int parse(int argc, char **argv, ism_options *o)
-{
-    *o = (ism_options){ .scene_path = DRIFT_SOURCE_DIR "/scenes/cornell-box/cornell_box.json",
-                        .size = 400,
-                        .threads = 2,
-                        .ref_spp = 256,
-                        .points = 1024,
-                        .map = 64,
-                        .block = 4,
-                        .vpls = { 64, 256, 1024 },
-                        .vpl_count = 3,
-                        .spps = { 1, 2, 4 },
-                        .spp_count = 3 };
-    for (int i = 1; i < argc; ++i) {
-        const char *a = argv[i];
-        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-        bool ok = true;
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            print_help(stdout);
-            return 0;
-        } else if (strcmp(a, "--no-ir") == 0) {
-            o->no_ir = true;
-            continue;
-        } else if (a[0] != '-') {
-            o->scene_path = a;
-            continue;
-        } else if (!v) {
-            ok = false;
-        } else if (strcmp(a, "--size") == 0) {
-            ok = parse_long(v, 8, 4096, &o->size);
-        } else if (strcmp(a, "--threads") == 0) {
-            ok = parse_long(v, 1, 256, &o->threads);
-        } else if (strcmp(a, "--ref-spp") == 0) {
-            ok = parse_long(v, 1, 1 << 20, &o->ref_spp);
-        } else if (strcmp(a, "--points") == 0) {
-            ok = parse_long(v, 1, 1 << 20, &o->points);
-        } else if (strcmp(a, "--map") == 0) {
-            ok = parse_long(v, 4, 1024, &o->map);
-        } else if (strcmp(a, "--block") == 0) {
-            ok = parse_long(v, 1, 64, &o->block);
-        } else if (strcmp(a, "--vpls") == 0) {
-            ok = parse_list(v, o->vpls, &o->vpl_count);
-        } else if (strcmp(a, "--spp") == 0) {
-            ok = parse_list(v, o->spps, &o->spp_count);
-        } else if (strcmp(a, "--png") == 0) {
-            o->png_dir = v;
-        } else {
-            ok = false;
-        }
-        if (!ok) {
-            fprintf(stderr, "drift bench ism: bad option or value: %s %s\n", a, v ? v : "");
-            print_help(stderr);
-            return 2;
-        }
-        i++;
-    }
-    return -1;
-}
+static const cli_command ism_command = {
+    .name = "bench ism",
+    .usage = "usage: drift bench ism [SCENE] [options]\n\n"
+             "ism and ir (src/ism) against the path tracer on the diffuse indirect term I: a\n"
+             "Markdown table (docs/benchmarks.md), or with --json one JSON object. SCENE\n"
+             "defaults to scenes/cornell-box/cornell_box.json.\n\n",
+    CLI_TABLE(ism_table),
+    CLI_POSITIONAL("SCENE", ism_options, scene_path, 1),
+    .help_column = 15,
+};
 
 typedef struct bench_state {
     drift_context *ctx;
@@ -145,6 +75,7 @@ typedef struct bench_state {
     drift_accel *accel;
     const ism_options *o;
     drift_image ref_indirect, ref_rest, ref_frame;
+    cJSON *rows; // --json: the rows go here instead of stdout
 } bench_state;
 
 static drift_result pt_image(bench_state *b, uint32_t components, long spp, drift_image *out,
@@ -184,28 +115,58 @@ static drift_result pt_image(bench_state *b, uint32_t components, long spp, drif
     return r;
 }
 
-// Prints one row: I's RMSE against the reference, and FLIP of ref_rest + I against ref_frame.
+// out = x + y (three channels, all the same size): a frame from the reference's other terms
+// and an indirect term.
+static void add_images(drift_image *out, const drift_image *x, const drift_image *y)
+{
+    for (int32_t j = 0; j < out->height; ++j) {
+        for (int32_t i = 0; i < out->width; ++i) {
+            drift_image_set3(out, i, j,
+                             drift_vec3_add(drift_image_get3(x, i, j), drift_image_get3(y, i, j)));
+        }
+    }
+}
+
+// One row: I's RMSE against the reference, and FLIP of ref_rest + I against ref_frame, printed
+// or (--json) added to b->rows; `st`: the stages of an ism or ir row (NULL for the others).
 static void report(bench_state *b, const char *name, long count, double ms, const char *detail,
-                   const drift_image *indirect)
+                   const drift_ism_stats *st, const drift_image *indirect)
 {
     drift_image frame;
     if (drift_image_create(b->ctx, indirect->width, indirect->height, 3, &frame) != DRIFT_OK) {
         return;
     }
-    for (int32_t y = 0; y < frame.height; ++y) {
-        for (int32_t x = 0; x < frame.width; ++x) {
-            drift_image_set3(&frame, x, y,
-                             drift_vec3_add(drift_image_get3(&b->ref_rest, x, y),
-                                            drift_image_get3(indirect, x, y)));
-        }
-    }
+    add_images(&frame, &b->ref_rest, indirect);
     double mse = 0.0;
     drift_metric_report rep = { 0 };
     drift_metric_mse(b->ctx, &b->ref_indirect, indirect, &mse);
     drift_metric_compare(b->ctx, &b->ref_frame, &frame, &(drift_metric_params){ 0 }, &rep, NULL);
-    printf("| %-4s | %5ld | %8.1f | %.4f | %.4f | %s |\n", name, count, ms, sqrt(mse), rep.flip,
-           detail);
-    fflush(stdout);
+    if (b->rows) {
+        cJSON *row = cJSON_CreateObject();
+        cJSON_AddItemToArray(b->rows, row);
+        cJSON_AddStringToObject(row, "what", name);
+        cJSON_AddNumberToObject(row, "count", (double)count);
+        cli_json_number(row, "ms", ms, 3);
+        cli_json_number(row, "rmse_indirect", sqrt(mse), 6);
+        cli_json_number(row, "flip_frame", rep.flip, 6);
+        if (st) {
+            static const char *const stages[] = { "vpls",      "points", "splat",
+                                                  "pull_push", "gather", "blur" };
+            static const int stage_index[] = { DRIFT_ISM_STAGE_VPLS,   DRIFT_ISM_STAGE_POINTS,
+                                               DRIFT_ISM_STAGE_SPLAT,  DRIFT_ISM_STAGE_PULL_PUSH,
+                                               DRIFT_ISM_STAGE_GATHER, DRIFT_ISM_STAGE_BLUR };
+            cJSON_AddNumberToObject(row, "vpls", st->vpl_count);
+            cJSON *stage_ms = cJSON_AddObjectToObject(row, "stage_ms");
+            for (size_t k = 0; k < sizeof stages / sizeof *stages; ++k) {
+                cli_json_number(stage_ms, stages[k], st->ms[stage_index[k]], 3);
+            }
+            cli_json_number(row, "holes", st->hole_fraction, 4);
+        }
+    } else {
+        printf("| %-4s | %5ld | %8.1f | %.4f | %.4f | %s |\n", name, count, ms, sqrt(mse), rep.flip,
+               detail);
+        fflush(stdout);
+    }
     if (b->o->png_dir) {
         char path[1024];
         snprintf(path, sizeof path, "%s/%s_%ld.png", b->o->png_dir, name, count);
@@ -220,21 +181,33 @@ static void report(bench_state *b, const char *name, long count, double ms, cons
 
 int drift_bench_ism(int argc, char **argv)
 {
-    ism_options o;
-    int status = parse(argc, argv, &o);
-    if (status >= 0) {
-        return status;
+    ism_options o = { .size = 400,
+                      .threads = 2,
+                      .ref_spp = 256,
+                      .points = 1024,
+                      .map = 64,
+                      .block = 4,
+                      .vpls = { 64, 256, 1024 },
+                      .vpl_count = 3,
+                      .spps = { 1, 2, 4 },
+                      .spp_count = 3 };
+    int status = cli_parse(&ism_command, argc, argv, &o, NULL);
+    if (status != CLI_PARSED) {
+        return cli_parse_exit(status);
     }
-    status = 0;
+    status = 1;
     bench_state b = { .o = &o };
-    drift_result r =
-        drift_context_create(&(drift_context_desc){ .thread_count = (int)o.threads }, &b.ctx);
-    if (r == DRIFT_OK) {
-        r = drift_scene_load(b.ctx, o.scene_path, &b.scene);
+    cli_session session;
+    cJSON *root = NULL;
+    drift_result r = DRIFT_OK;
+    if (!bench_open(&session, "bench ism", o.scene_path, "scenes/cornell-box/cornell_box.json",
+                    o.threads)) {
+        cli_session_close(&session);
+        return 1;
     }
-    if (r == DRIFT_OK) {
-        r = drift_accel_create(b.ctx, b.scene, &(drift_accel_desc){ 0 }, &b.accel);
-    }
+    b.ctx = session.ctx;
+    b.scene = session.scene;
+    b.accel = session.accel;
     drift_hybrid *frame = NULL;
     if (r == DRIFT_OK) {
         drift_hybrid_params hp = { .width = (int32_t)o.size, .height = (int32_t)o.size };
@@ -256,34 +229,37 @@ int drift_bench_ism(int argc, char **argv)
         r = drift_image_create(b.ctx, (int32_t)o.size, (int32_t)o.size, 3, &b.ref_frame);
     }
     if (r != DRIFT_OK) {
-        fprintf(stderr, "drift bench ism: %s\n", drift_result_string(r));
-        status = 1;
         goto done;
     }
-    for (int32_t y = 0; y < b.ref_frame.height; ++y) {
-        for (int32_t x = 0; x < b.ref_frame.width; ++x) {
-            drift_image_set3(&b.ref_frame, x, y,
-                             drift_vec3_add(drift_image_get3(&b.ref_rest, x, y),
-                                            drift_image_get3(&b.ref_indirect, x, y)));
-        }
-    }
+    add_images(&b.ref_frame, &b.ref_rest, &b.ref_indirect);
     drift_hybrid_stats hs = drift_hybrid_get_stats(frame);
-    printf("# %s at %ldx%ld, %ld threads; reference %ld spp; G-buffer %.1f ms (not in the rows)\n",
-           o.scene_path, o.size, o.size, o.threads, o.ref_spp, hs.ms[DRIFT_PASS_PRIMARY]);
-    printf(
-        "| what | count | ms | RMSE of I | FLIP of frame | detail |\n|---|---|---|---|---|---|\n");
-    report(&b, "ref", o.ref_spp, 0.0, "the reference against itself", &b.ref_indirect);
-    for (int i = 0; i < o.spp_count && status == 0; ++i) {
+    if (o.json) {
+        root = cJSON_CreateObject();
+        cJSON_AddStringToObject(root, "scene", session.scene_path);
+        cJSON_AddNumberToObject(root, "size", (double)o.size);
+        cJSON_AddNumberToObject(root, "threads", drift_context_thread_count(b.ctx));
+        cJSON_AddNumberToObject(root, "ref_spp", (double)o.ref_spp);
+        cli_json_number(root, "gbuffer_ms", hs.ms[DRIFT_PASS_PRIMARY], 3);
+        b.rows = cJSON_AddArrayToObject(root, "rows");
+    } else {
+        printf("# %s at %ldx%ld, %d threads; reference %ld spp; G-buffer %.1f ms (not in the "
+               "rows)\n",
+               session.scene_path, o.size, o.size, drift_context_thread_count(b.ctx), o.ref_spp,
+               hs.ms[DRIFT_PASS_PRIMARY]);
+        printf("| what | count | ms | RMSE of I | FLIP of frame | detail |\n"
+               "|---|---|---|---|---|---|\n");
+    }
+    report(&b, "ref", o.ref_spp, 0.0, "the reference against itself", NULL, &b.ref_indirect);
+    for (int i = 0; i < o.spp_count && r == DRIFT_OK; ++i) {
         drift_image img;
         double ms;
-        if (pt_image(&b, DRIFT_PT_COMPONENT_DIFFUSE, o.spps[i], &img, &ms) != DRIFT_OK) {
-            status = 1;
-            break;
+        r = pt_image(&b, DRIFT_PT_COMPONENT_DIFFUSE, o.spps[i], &img, &ms);
+        if (r == DRIFT_OK) {
+            report(&b, "pt", o.spps[i], ms, "spp, max depth 2", NULL, &img);
+            drift_image_destroy(b.ctx, &img);
         }
-        report(&b, "pt", o.spps[i], ms, "spp, max depth 2", &img);
-        drift_image_destroy(b.ctx, &img);
     }
-    for (int v = 0; v < 2 * o.vpl_count && status == 0; ++v) {
+    for (int v = 0; v < 2 * o.vpl_count && r == DRIFT_OK; ++v) {
         bool ir = v % 2 == 1;
         if (ir && o.no_ir) {
             continue;
@@ -295,10 +271,10 @@ int drift_bench_ism(int argc, char **argv)
                                 .map_size = (int32_t)o.map,
                                 .block_size = (int32_t)o.block };
         drift_ism *ism = NULL;
-        if (drift_ism_create(b.ctx, b.scene, b.accel, &ip, &ism) != DRIFT_OK ||
-            drift_ism_render(ism, drift_hybrid_gbuffer(frame), &b.scene->camera) != DRIFT_OK) {
+        r = drift_ism_create(b.ctx, b.scene, b.accel, &ip, &ism);
+        r = r ? r : drift_ism_render(ism, drift_hybrid_gbuffer(frame), &b.scene->camera);
+        if (r != DRIFT_OK) {
             drift_ism_destroy(ism);
-            status = 1;
             break;
         }
         drift_ism_stats st = drift_ism_get_stats(ism);
@@ -309,7 +285,8 @@ int drift_bench_ism(int argc, char **argv)
                  st.vpl_count, st.ms[DRIFT_ISM_STAGE_VPLS], st.ms[DRIFT_ISM_STAGE_POINTS],
                  st.ms[DRIFT_ISM_STAGE_SPLAT], st.ms[DRIFT_ISM_STAGE_PULL_PUSH],
                  st.ms[DRIFT_ISM_STAGE_GATHER], st.ms[DRIFT_ISM_STAGE_BLUR], st.hole_fraction);
-        report(&b, ir ? "ir" : "ism", o.vpls[v / 2], st.total_ms, detail, drift_ism_indirect(ism));
+        report(&b, ir ? "ir" : "ism", o.vpls[v / 2], st.total_ms, detail, &st,
+               drift_ism_indirect(ism));
         if (o.png_dir && !ir && v == 2 * o.vpl_count - 2) {
             char path[1024];
             snprintf(path, sizeof path, "%s/ism_vpls.png", o.png_dir);
@@ -335,13 +312,19 @@ int drift_bench_ism(int argc, char **argv)
         }
         drift_ism_destroy(ism);
     }
+    if (r == DRIFT_OK) {
+        status = !root || cli_json_write("bench ism", root, NULL) ? 0 : 1;
+        root = NULL; // cli_json_write destroys it
+    }
 done:
+    if (r != DRIFT_OK) {
+        fprintf(stderr, "drift bench ism: %s\n", drift_result_string(r));
+    }
+    cJSON_Delete(root);
     drift_image_destroy(b.ctx, &b.ref_indirect);
     drift_image_destroy(b.ctx, &b.ref_rest);
     drift_image_destroy(b.ctx, &b.ref_frame);
     drift_hybrid_destroy(frame);
-    drift_accel_destroy(b.accel);
-    drift_scene_destroy(b.scene);
-    drift_context_destroy(b.ctx);
+    cli_session_close(&session);
     return status;
 }

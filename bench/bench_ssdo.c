@@ -20,7 +20,6 @@
 #include "drift/scene_io.h"
 #include "drift/ssdo.h"
 
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -32,126 +31,43 @@ typedef struct ssdo_options {
     const char *out_dir;
     long width, height, samples, ref_spp, threads, frames;
     double radius, exposure;
-    bool json, table, quality;
+    bool json, table, no_quality;
 } ssdo_options;
 
-static void print_help(FILE *out)
-{
-    fprintf(
-        out,
-        "usage: drift bench ssdo [SCENE] [--width W] [--height H] [--samples N]\n"
-        "                        [--radius R] [--ref-spp N] [--threads T] [--frames N]\n"
-        "                        [--table] [--no-quality] [--out DIR] [--exposure S] [--json]\n\n"
-        "(a) --table: ms of ssao, gtao, ssdo, ssdo+bounce at 1024x768, 1200x960, 1600x1200\n"
-        "    with 8 and 16 samples (the thesis's Table 4.1), and the overhead over SSAO;\n"
-        "(b) FLIP and RMSE against the path-traced reference of the same term (environment\n"
-        "    light with visibility + one diffuse bounce) for every technique and the path\n"
-        "    tracer at matched time.\n\n"
-        "  SCENE             default scenes/ssdo-bunny/ssdo_bunny.json (lit by its\n"
-        "                    environment alone)\n"
-        "  --width, --height quality size (default 320x240)\n"
-        "  --samples N       N of the quality runs (default 16)\n"
-        "  --radius R        r_max in scene units (default 0.05 x the scene diagonal)\n"
-        "  --ref-spp N       samples per pixel of the reference (default 256)\n"
-        "  --threads T       worker threads of the timed runs (default 1)\n"
-        "  --frames N        the least of N runs per timing (default 3)\n"
-        "  --out DIR         write PNGs of every image and FLIP map there\n"
-        "  --exposure S      PNG exposure in stops (default 0)\n"
-        "  --json            one JSON object on stdout\n");
-}
+#define O ssdo_options
+static const cli_option ssdo_table[] = {
+    CLI_SECTION("options:", 0),
+    CLI_INT("--width", "W", O, width, 8, 8192, "quality size (default 320x240)"),
+    CLI_INT("--height", "H", O, height, 8, 8192, "quality size"),
+    CLI_INT("--samples", "N", O, samples, 1, 1024, "N of the quality runs (default 16)"),
+    CLI_NUMBER("--radius", "R", O, radius, 1e-9, 1e30,
+               "r_max in scene units (default 0.05 x the scene diagonal)"),
+    CLI_INT("--ref-spp", "N", O, ref_spp, 1, 1 << 20,
+            "samples per pixel of the reference (default 256)"),
+    CLI_INT("--threads", "T", O, threads, 0, 256, "worker threads of the timed runs (default 1)"),
+    CLI_INT("--frames", "N", O, frames, 1, 100, "the least of N runs per timing (default 3)"),
+    CLI_FLAG("--table", O, table, "(a): Table 4.1"),
+    CLI_FLAG("--no-quality", O, no_quality, "skip (b)"),
+    CLI_STRING("--out", "DIR", O, out_dir, "write PNGs of every image and FLIP map there"),
+    CLI_NUMBER("--exposure", "S", O, exposure, -30.0, 30.0, "PNG exposure in stops (default 0)"),
+    BENCH_OPTION_JSON(O),
+};
+#undef O
 
-static bool parse_long(const char *opt, const char *v, long lo, long hi, long *out)
-{
-    char *end = NULL;
-    errno = 0;
-    long x = v ? strtol(v, &end, 10) : 0;
-    if (!v || errno || end == v || *end || x < lo || x > hi) {
-        fprintf(stderr, "drift bench ssdo: %s needs an integer in %ld..%ld\n", opt, lo, hi);
-        return false;
-    }
-    *out = x;
-    return true;
-}
-
-static bool parse_double(const char *opt, const char *v, double lo, double hi, double *out)
-{
-    char *end = NULL;
-    errno = 0;
-    double x = v ? strtod(v, &end) : 0.0;
-    if (!v || errno || end == v || *end || !(x >= lo && x <= hi)) {
-        fprintf(stderr, "drift bench ssdo: %s needs a number in %g..%g\n", opt, lo, hi);
-        return false;
-    }
-    *out = x;
-    return true;
-}
-
-// 0 to run, -1 after --help, 2 on a usage error.
-static int parse(int argc, char **argv, ssdo_options *o)
-{
-    *o = (ssdo_options){ .scene_path = "scenes/ssdo-bunny/ssdo_bunny.json",
-                         .width = 320,
-                         .height = 240,
-                         .samples = 16,
-                         .ref_spp = 256,
-                         .threads = 1,
-                         .frames = 3,
-                         .quality = true };
-    bool scene_given = false;
-    for (int i = 1; i < argc; ++i) {
-        const char *a = argv[i];
-        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-        bool ok = true, takes = true;
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            print_help(stdout);
-            return -1;
-        } else if (strcmp(a, "--json") == 0) {
-            o->json = true;
-            takes = false;
-        } else if (strcmp(a, "--table") == 0) {
-            o->table = true;
-            takes = false;
-        } else if (strcmp(a, "--no-quality") == 0) {
-            o->quality = false;
-            takes = false;
-        } else if (strcmp(a, "--width") == 0 || strcmp(a, "--height") == 0) {
-            ok = parse_long(a, v, 8, 8192, a[2] == 'w' ? &o->width : &o->height);
-        } else if (strcmp(a, "--samples") == 0) {
-            ok = parse_long(a, v, 1, 1024, &o->samples);
-        } else if (strcmp(a, "--ref-spp") == 0) {
-            ok = parse_long(a, v, 1, 1 << 20, &o->ref_spp);
-        } else if (strcmp(a, "--threads") == 0) {
-            ok = parse_long(a, v, 0, 256, &o->threads);
-        } else if (strcmp(a, "--frames") == 0) {
-            ok = parse_long(a, v, 1, 100, &o->frames);
-        } else if (strcmp(a, "--radius") == 0) {
-            ok = parse_double(a, v, 1e-9, 1e30, &o->radius);
-        } else if (strcmp(a, "--exposure") == 0) {
-            ok = parse_double(a, v, -30.0, 30.0, &o->exposure);
-        } else if (strcmp(a, "--out") == 0) {
-            ok = v != NULL;
-            o->out_dir = v;
-            if (!ok) {
-                fprintf(stderr, "drift bench ssdo: --out needs a directory\n");
-            }
-        } else if (a[0] == '-') {
-            fprintf(stderr, "drift bench ssdo: unknown option '%s'\n", a);
-            ok = false;
-        } else if (!scene_given) {
-            o->scene_path = a;
-            scene_given = true;
-            takes = false;
-        } else {
-            fprintf(stderr, "drift bench ssdo: more than one scene given\n");
-            ok = false;
-        }
-        if (!ok) {
-            return 2;
-        }
-        i += takes ? 1 : 0;
-    }
-    return 0;
-}
+static const cli_command ssdo_command = {
+    .name = "bench ssdo",
+    .usage = "usage: drift bench ssdo [SCENE] [options]\n\n"
+             "(a) --table: ms of ssao, gtao, ssdo, ssdo+bounce at 1024x768, 1200x960, 1600x1200\n"
+             "    with 8 and 16 samples (the thesis's Table 4.1), and the overhead over SSAO;\n"
+             "(b) FLIP and RMSE against the path-traced reference of the same term (environment\n"
+             "    light with visibility + one diffuse bounce) for every technique and the path\n"
+             "    tracer at matched time.\n"
+             "SCENE defaults to scenes/ssdo-bunny/ssdo_bunny.json (lit by its environment\n"
+             "alone).\n\n",
+    CLI_TABLE(ssdo_table),
+    CLI_POSITIONAL("SCENE", ssdo_options, scene_path, 1),
+    .help_column = 19,
+};
 
 // CPU seconds of the calling thread. With --threads 1 the calling thread does all the work
 // (the pool has no workers), so this is the run's cost even on a machine that other
@@ -179,6 +95,7 @@ typedef struct bench_state {
     const ssdo_options *o;
     drift_context *ctx;   // all cores: G-buffers and references
     drift_context *timed; // --threads: the techniques
+    const char *scene_path;
     drift_scene *scene;
     drift_accel *accel;
     drift_ssdo_env *env;
@@ -417,47 +334,55 @@ static drift_result run_quality(const bench_state *b, quality_row *rows, size_t 
 
 // --- OUTPUT ---
 
-static void print_results(const bench_state *b, double ms[3][2][4], const quality_row *rows,
+// The results on stdout: a table, or with --json one JSON object (false: it could not be written).
+static bool print_results(const bench_state *b, double ms[3][2][4], const quality_row *rows,
                           size_t count)
 {
     const ssdo_options *o = b->o;
     if (o->json) {
-        printf("{\"scene\": \"%s\", \"threads\": %d, \"clock\": \"%s\", \"frames\": %ld, "
-               "\"radius\": %g",
-               o->scene_path, drift_context_thread_count(b->timed),
-               drift_context_thread_count(b->timed) == 1 ? "thread-cpu" : "wall", o->frames,
-               o->radius);
+        int threads = drift_context_thread_count(b->timed);
+        cJSON *root = cJSON_CreateObject();
+        cJSON_AddStringToObject(root, "scene", b->scene_path);
+        cJSON_AddNumberToObject(root, "threads", threads);
+        cJSON_AddStringToObject(root, "clock", threads == 1 ? "thread-cpu" : "wall");
+        cJSON_AddNumberToObject(root, "frames", (double)o->frames);
+        cli_json_float(root, "radius", (float)o->radius); // the techniques take a float
         if (o->table) {
-            printf(", \"table\": [");
+            cJSON *table = cJSON_AddArrayToObject(root, "table");
             for (int s = 0; s < 3; ++s) {
                 for (int n = 0; n < 2; ++n) {
-                    printf("%s{\"width\": %d, \"height\": %d, \"samples\": %d, \"ms\": {",
-                           s + n ? ", " : "", table_sizes[s][0], table_sizes[s][1], n ? 16 : 8);
+                    cJSON *item = cJSON_CreateObject();
+                    cJSON_AddItemToArray(table, item);
+                    cJSON_AddNumberToObject(item, "width", table_sizes[s][0]);
+                    cJSON_AddNumberToObject(item, "height", table_sizes[s][1]);
+                    cJSON_AddNumberToObject(item, "samples", n ? 16 : 8);
+                    cJSON *times = cJSON_AddObjectToObject(item, "ms");
                     for (int t = 0; t < 4; ++t) {
-                        printf("%s\"%s\": %.3f", t ? ", " : "", table_variants[t]->name,
-                               ms[s][n][t]);
+                        cli_json_number(times, table_variants[t]->name, ms[s][n][t], 3);
                     }
-                    printf("}}");
                 }
             }
-            printf("]");
         }
-        if (o->quality) {
-            printf(", \"width\": %ld, \"height\": %ld, \"samples\": %ld, \"ref_spp\": %ld, "
-                   "\"quality\": [",
-                   o->width, o->height, o->samples, o->ref_spp);
+        if (!o->no_quality) {
+            cJSON_AddNumberToObject(root, "width", (double)o->width);
+            cJSON_AddNumberToObject(root, "height", (double)o->height);
+            cJSON_AddNumberToObject(root, "samples", (double)o->samples);
+            cJSON_AddNumberToObject(root, "ref_spp", (double)o->ref_spp);
+            cJSON *quality = cJSON_AddArrayToObject(root, "quality");
             for (size_t i = 0; i < count; ++i) {
-                printf("%s{\"name\": \"%s\", \"ms\": %.3f, \"flip\": %.5f, \"rmse\": %.5f, "
-                       "\"flip_direct\": %.5f, \"rmse_direct\": %.5f}",
-                       i ? ", " : "", rows[i].name, rows[i].ms, rows[i].vs_full.flip,
-                       rows[i].vs_full.rmse, rows[i].vs_direct.flip, rows[i].vs_direct.rmse);
+                cJSON *item = cJSON_CreateObject();
+                cJSON_AddItemToArray(quality, item);
+                cJSON_AddStringToObject(item, "name", rows[i].name);
+                cli_json_number(item, "ms", rows[i].ms, 3);
+                cli_json_number(item, "flip", rows[i].vs_full.flip, 5);
+                cli_json_number(item, "rmse", rows[i].vs_full.rmse, 5);
+                cli_json_number(item, "flip_direct", rows[i].vs_direct.flip, 5);
+                cli_json_number(item, "rmse_direct", rows[i].vs_direct.rmse, 5);
             }
-            printf("]");
         }
-        printf("}\n");
-        return;
+        return cli_json_write("bench ssdo", root, NULL);
     }
-    printf("%s, %d thread(s), r_max %g\n", o->scene_path, drift_context_thread_count(b->timed),
+    printf("%s, %d thread(s), r_max %g\n", b->scene_path, drift_context_thread_count(b->timed),
            o->radius);
     if (o->table) {
         printf("\nTable 4.1 (%s ms, least of %ld):\n%-10s %3s %9s %9s %9s %9s %9s %9s %9s\n",
@@ -473,7 +398,7 @@ static void print_results(const bench_state *b, double ms[3][2][4], const qualit
             }
         }
     }
-    if (o->quality) {
+    if (!o->no_quality) {
         printf("\nquality at %ldx%ld, N = %ld, reference %ld spp (FLIP, RMSE vs direct + bounce; "
                "vs direct alone)\n%-14s %9s %8s %8s %8s %8s\n",
                o->width, o->height, o->samples, o->ref_spp, "technique", "ms", "FLIP", "RMSE",
@@ -484,39 +409,32 @@ static void print_results(const bench_state *b, double ms[3][2][4], const qualit
                    rows[i].vs_direct.rmse);
         }
     }
-}
-
-static void log_stderr(drift_log_level level, drift_result code, const char *file, int line,
-                       const char *message, void *user)
-{
-    (void)code;
-    (void)user;
-    if (level < DRIFT_LOG_WARNING) {
-        return;
-    }
-    if (file && line > 0) {
-        fprintf(stderr, "drift bench ssdo: %s:%d: %s\n", file, line, message);
-    } else if (file) {
-        fprintf(stderr, "drift bench ssdo: %s: %s\n", file, message);
-    } else {
-        fprintf(stderr, "drift bench ssdo: %s\n", message);
-    }
+    return true;
 }
 
 int drift_bench_ssdo(int argc, char **argv)
 {
-    ssdo_options o;
-    int code = parse(argc, argv, &o);
-    if (code) {
-        return code < 0 ? 0 : code;
+    ssdo_options o = {
+        .width = 320, .height = 240, .samples = 16, .ref_spp = 256, .threads = 1, .frames = 3
+    };
+    int status = cli_parse(&ssdo_command, argc, argv, &o, NULL);
+    if (status != CLI_PARSED) {
+        return cli_parse_exit(status);
     }
+    // G-buffers and references on all cores (the session); the techniques on --threads.
     bench_state b = { .o = &o };
-    drift_logger logger = { .func = log_stderr };
-    drift_result r = drift_context_create(&(drift_context_desc){ .logger = logger }, &b.ctx);
+    cli_session session;
+    bool ok =
+        bench_open(&session, "bench ssdo", o.scene_path, "scenes/ssdo-bunny/ssdo_bunny.json", 0);
+    drift_result r = ok ? DRIFT_OK : DRIFT_ERR_INVALID_ARGUMENT;
+    b.ctx = session.ctx;
+    b.scene = session.scene;
+    b.accel = session.accel;
+    b.scene_path = session.scene_path;
     r = r ? r
-          : drift_context_create(&(drift_context_desc){ .thread_count = (int)o.threads }, &b.timed);
-    r = r ? r : drift_scene_load(b.ctx, o.scene_path, &b.scene);
-    r = r ? r : drift_accel_create(b.ctx, b.scene, &(drift_accel_desc){ 0 }, &b.accel);
+          : drift_context_create(&(drift_context_desc){ .thread_count = (int)o.threads,
+                                                        .logger = cli_stderr_logger(false) },
+                                 &b.timed);
     if (r == DRIFT_OK && o.radius == 0.0) {
         o.radius = (double)drift_ssdo_params_resolve(NULL, b.scene).radius;
     }
@@ -530,16 +448,14 @@ int drift_bench_ssdo(int argc, char **argv)
         fprintf(stderr, "pre-filtered environment in %.0f ms\n", 1e3 * t_env);
     }
     r = r || !o.table ? r : run_table(&b, ms);
-    r = r || !o.quality ? r : run_quality(&b, rows, &count);
+    r = r || o.no_quality ? r : run_quality(&b, rows, &count);
     if (r == DRIFT_OK) {
-        print_results(&b, ms, rows, count);
-    } else {
+        ok = print_results(&b, ms, rows, count);
+    } else if (ok) { // (when bench_open failed, it has said why)
         fprintf(stderr, "drift bench ssdo: %s\n", drift_result_string(r));
     }
     drift_ssdo_env_destroy(b.env);
-    drift_accel_destroy(b.accel);
-    drift_scene_destroy(b.scene);
     drift_context_destroy(b.timed);
-    drift_context_destroy(b.ctx);
-    return r == DRIFT_OK ? 0 : 1;
+    cli_session_close(&session);
+    return r == DRIFT_OK && ok ? 0 : 1;
 }

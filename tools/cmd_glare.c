@@ -1,5 +1,5 @@
 // drift glare: temporal glare (Ritschel 2009, thesis ch. 8) on an HDR image or a sequence.
-// The options live in one table that both the parser and --help read.
+// The options are one cli_options table (tools/cli_options.h): the parser and --help read it.
 #include "cli.h"
 #include "drift/glare.h"
 #include "drift/image.h"
@@ -15,220 +15,101 @@
 #define PI 3.14159265358979323846
 
 typedef struct glare_args {
+    const char *in; // IN: an image or a frame pattern
     const char *out, *out_pattern, *psf, *aperture;
     long frames, seed, psf_size, supersample, wavelengths, threads;
     long lens_particles, gratings, vitreous, lashes;
     double fps, fresnel_distance, aperture_width, fov_deg, luminance_scale, field_luminance;
     double squint, blink_interval, hippus, exposure, billboard_threshold;
     int mode, diffraction, pupil, method;
-    bool verbose, help;
+    bool verbose;
 } glare_args;
 
-typedef enum opt_kind {
-    OPT_FLAG,
-    OPT_INT,
-    OPT_FLOAT,
-    OPT_STRING,
-    OPT_CHOICE
-} opt_kind;
-
-static const char *const mode_names[] = { "auto", "static", "dynamic", NULL };
-static const char *const diffraction_names[] = { "fresnel", "fraunhofer", NULL };
-static const char *const pupil_names[] = { "thesis", "moon-spencer", "watson-yellott", NULL };
-static const char *const method_names[] = { "convolution", "billboard", NULL };
-
-typedef struct option {
-    const char *name;
-    const char *arg; // NULL for flags
-    opt_kind kind;
-    double lo, hi; // OPT_INT, OPT_FLOAT
-    const char *const *choices;
-    size_t offset;
-    const char *help;
-} option;
-
-#define AT(field) offsetof(glare_args, field)
-static const option options[] = {
-    { "--out", "F.exr|F.png", OPT_STRING, 0, 0, NULL, AT(out), "output image (one frame)" },
-    { "--frames", "N", OPT_INT, 1, 100000, NULL, AT(frames), "frames to make (default 1)" },
-    { "--fps", "F", OPT_FLOAT, 0.1, 1000, NULL, AT(fps), "frame rate of a sequence (default 30)" },
-    { "--out-pattern", "P", OPT_STRING, 0, 0, NULL, AT(out_pattern),
-      "output names of a sequence, one %d (e.g. frame_%04d.exr); IN may be a pattern too" },
-    { "--seed", "S", OPT_INT, 0, 4294967295.0, NULL, AT(seed), "seed of the eye (default 0)" },
-    { "--mode", "M", OPT_CHOICE, 0, 0, mode_names, AT(mode),
-      "static or dynamic eye (default: static for 1 frame, dynamic for more)" },
-    { "--psf", "F.exr|F.png", OPT_STRING, 0, 0, NULL, AT(psf),
-      "write the RGB PSF (last frame's; a %d name: every frame's); .png: 5 decades, log" },
-    { "--aperture", "F.exr", OPT_STRING, 0, 0, NULL, AT(aperture),
-      "write the aperture transmittance and F_575 as layers (last frame or %d)" },
-    { "--psf-size", "N", OPT_INT, 16, 4096, NULL, AT(psf_size),
-      "aperture and PSF size, a power of two (default 256)" },
-    { "--supersample", "S", OPT_INT, 1, 8, NULL, AT(supersample),
-      "aperture samples per pixel per axis (default 2)" },
-    { "--wavelengths", "N", OPT_INT, 1, 128, NULL, AT(wavelengths),
-      "spectral samples over 380-770 nm (default 32)" },
-    { "--diffraction", "D", OPT_CHOICE, 0, 0, diffraction_names, AT(diffraction),
-      "fresnel (thesis eq. 8.3, default) or fraunhofer (E = 1)" },
-    { "--fresnel-distance", "MM", OPT_FLOAT, 1e-3, 1e9, NULL, AT(fresnel_distance),
-      "d of the Fresnel term E (default 70435: a quarter wave at 9 mm)" },
-    { "--aperture-width", "MM", OPT_FLOAT, 0.5, 100, NULL, AT(aperture_width),
-      "physical width W of the aperture texture (default 12)" },
-    { "--fov", "DEG", OPT_FLOAT, 0, 360, NULL, AT(fov_deg),
-      "horizontal field of view of IN; resamples the PSF to its pitch (default 0: one PSF "
-      "pixel per image pixel)" },
-    { "--method", "M", OPT_CHOICE, 0, 0, method_names, AT(method),
-      "convolve the whole image (default) or paste billboards at bright pixels" },
-    { "--billboard-threshold", "X", OPT_FLOAT, 0, 1e30, NULL, AT(billboard_threshold),
-      "luminance over which a pixel gets a billboard (default 20 x the mean)" },
-    { "--pupil", "MODEL", OPT_CHOICE, 0, 0, pupil_names, AT(pupil),
-      "thesis (eq. 8.2, default), moon-spencer or watson-yellott" },
-    { "--luminance-scale", "X", OPT_FLOAT, 1e-12, 1e12, NULL, AT(luminance_scale),
-      "cd/m^2 per image unit (default 1)" },
-    { "--field-luminance", "L", OPT_FLOAT, 1e-9, 1e12, NULL, AT(field_luminance),
-      "fixed field luminance in cd/m^2 (default: the image's mean)" },
-    { "--squint", "X", OPT_FLOAT, 0, 0.99, NULL, AT(squint), "constant lid closure (0..0.99)" },
-    { "--blink-interval", "S", OPT_FLOAT, 0, 1e6, NULL, AT(blink_interval),
-      "mean seconds between blinks (default 4; 0: none)" },
-    { "--hippus", "X", OPT_FLOAT, 0, 1, NULL, AT(hippus), "hippus noise scale (default 0.1)" },
-    { "--lens-particles", "N", OPT_INT, 0, 100000, NULL, AT(lens_particles),
-      "lens particles (default 750)" },
-    { "--gratings", "N", OPT_INT, 0, 100000, NULL, AT(gratings), "lens fibre gratings (200)" },
-    { "--vitreous", "N", OPT_INT, 0, 100000, NULL, AT(vitreous), "vitreous particles (200)" },
-    { "--lashes", "N", OPT_INT, 0, 100000, NULL, AT(lashes), "eyelashes (40)" },
-    { "--exposure", "STOPS", OPT_FLOAT, -64, 64, NULL, AT(exposure),
-      "exposure of PNG outputs (default 0)" },
-    { "--threads", "T", OPT_INT, 0, 1024, NULL, AT(threads), "worker threads (default: all)" },
-    { "--verbose", NULL, OPT_FLAG, 0, 0, NULL, AT(verbose), "more log output" },
-    { "--help", NULL, OPT_FLAG, 0, 0, NULL, AT(help), "this text" },
-};
-#undef AT
-#define OPTION_COUNT (sizeof(options) / sizeof(options[0]))
-
-static void print_usage(FILE *out)
+// A file name option: any text but the empty one.
+static bool parse_file_name(const char *cmd, const char *flag, const char *value, void *field)
 {
-    fprintf(out,
-            "usage: drift glare IN.exr --out OUT.exr [options]\n"
-            "       drift glare IN.exr --frames N --fps F --out-pattern frame_%%04d.exr\n"
-            "\n"
-            "Adds temporal glare (Ritschel et al. 2009; thesis ch. 8) to an HDR image (.exr or\n"
-            ".hdr): the eye's aperture, its Fresnel diffraction, the chromatic PSF and the\n"
-            "convolution of IN with it. docs/glare.md describes the model.\n"
-            "\n"
-            "options:\n");
-    for (size_t i = 0; i < OPTION_COUNT; ++i) {
-        const option *o = &options[i];
-        char head[64];
-        snprintf(head, sizeof(head), "%s%s%s", o->name, o->arg ? " " : "", o->arg ? o->arg : "");
-        // The help text, then the choices, wrapped at 98 columns under the help column.
-        char text[512];
-        int len = snprintf(text, sizeof(text), "%s", o->help);
-        if (o->kind == OPT_CHOICE) {
-            for (const char *const *c = o->choices; *c && len > 0 && (size_t)len < sizeof(text);
-                 ++c) {
-                len += snprintf(text + len, sizeof(text) - (size_t)len, "%s%s",
-                                c == o->choices ? " [" : "|", *c);
-            }
-            if (len > 0 && (size_t)len + 1 < sizeof(text)) {
-                text[len++] = ']';
-                text[len] = '\0';
-            }
-        }
-        fprintf(out, "  %-28s", head);
-        int col = 31;
-        for (char *word = strtok(text, " "); word; word = strtok(NULL, " ")) {
-            int wl = (int)strlen(word);
-            if (col + 1 + wl > 98 && col > 31) {
-                fprintf(out, "\n%30s", "");
-                col = 31;
-            }
-            fprintf(out, " %s", word);
-            col += 1 + wl;
-        }
-        fprintf(out, "\n");
+    if (value[0] == '\0') {
+        fprintf(stderr, "drift %s: %s expects a file name, got ''\n", cmd, flag);
+        return false;
     }
-    fprintf(out, "\nexit status: 0 ok, 1 failure, 2 usage error or bad input (nothing written)\n");
-}
-
-static const option *find_option(const char *name)
-{
-    for (size_t i = 0; i < OPTION_COUNT; ++i) {
-        if (strcmp(options[i].name, name) == 0) {
-            return &options[i];
-        }
-    }
-    return strcmp(name, "-h") == 0 ? find_option("--help")
-                                   : (strcmp(name, "-v") == 0 ? find_option("--verbose") : NULL);
-}
-
-// Parses argv into *a and the one positional argument; prints the reason and returns false on
-// any malformed input.
-static bool parse(int argc, char **argv, glare_args *a, const char **out_in)
-{
-    *out_in = NULL;
-    for (int i = 1; i < argc; ++i) {
-        const char *s = argv[i];
-        if (s[0] != '-' || s[1] == '\0') {
-            if (*out_in) {
-                fprintf(stderr, "drift glare: more than one input ('%s', '%s')\n", *out_in, s);
-                return false;
-            }
-            *out_in = s;
-            continue;
-        }
-        const option *o = find_option(s);
-        if (!o) {
-            fprintf(stderr, "drift glare: unknown option '%s' (see drift glare --help)\n", s);
-            return false;
-        }
-        char *field = (char *)a + o->offset;
-        if (o->kind == OPT_FLAG) {
-            *(bool *)(void *)field = true;
-            continue;
-        }
-        const char *v = cli_next_value("glare", argc, argv, &i);
-        if (!v) {
-            return false;
-        }
-        switch (o->kind) {
-        case OPT_INT:
-            if (!cli_parse_int("glare", o->name, v, (long)o->lo, (long)o->hi,
-                               (long *)(void *)field)) {
-                return false;
-            }
-            break;
-        case OPT_FLOAT:
-            if (!cli_parse_float("glare", o->name, v, o->lo, o->hi, (double *)(void *)field)) {
-                return false;
-            }
-            break;
-        case OPT_STRING:
-            if (v[0] == '\0') {
-                fprintf(stderr, "drift glare: %s expects a file name\n", o->name);
-                return false;
-            }
-            *(const char **)(void *)field = v;
-            break;
-        case OPT_CHOICE: {
-            int k = 0;
-            for (; o->choices[k] && strcmp(o->choices[k], v) != 0; ++k) {
-            }
-            if (!o->choices[k]) {
-                fprintf(stderr, "drift glare: %s expects one of", o->name);
-                for (int c = 0; o->choices[c]; ++c) {
-                    fprintf(stderr, "%s%s", c ? "|" : " ", o->choices[c]);
-                }
-                fprintf(stderr, ", got '%s'\n", v);
-                return false;
-            }
-            *(int *)(void *)field = k;
-            break;
-        }
-        case OPT_FLAG:
-            break;
-        }
-    }
+    *(const char **)field = value;
     return true;
 }
+
+#define O glare_args
+static const cli_option glare_table[] = {
+    CLI_SECTION("options:", 0),
+    CLI_CUSTOM("--out", "F.exr|F.png", O, out, parse_file_name, "output image (one frame)"),
+    CLI_INT("--frames", "N", O, frames, 1, 100000, "frames to make (default 1)"),
+    CLI_NUMBER("--fps", "F", O, fps, 0.1, 1000, "frame rate of a sequence (default 30)"),
+    CLI_CUSTOM("--out-pattern", "P", O, out_pattern, parse_file_name,
+               "output names of a sequence, one %d (e.g. frame_%04d.exr);\n"
+               "IN may be a pattern too"),
+    CLI_INT("--seed", "S", O, seed, 0, 4294967295.0, "seed of the eye (default 0)"),
+    CLI_CHOICE("--mode", "M", O, mode, "auto|static|dynamic",
+               "auto (default: static for 1 frame, dynamic for more), static or\n"
+               "dynamic eye"),
+    CLI_CUSTOM("--psf", "F.exr|F.png", O, psf, parse_file_name,
+               "write the RGB PSF (last frame's; a %d name: every frame's);\n"
+               ".png: 5 decades, log"),
+    CLI_CUSTOM("--aperture", "F.exr", O, aperture, parse_file_name,
+               "write the aperture transmittance and F_575 as layers (last\n"
+               "frame or %d)"),
+    CLI_INT("--psf-size", "N", O, psf_size, 16, 4096,
+            "aperture and PSF size, a power of two (default 256)"),
+    CLI_INT("--supersample", "S", O, supersample, 1, 8,
+            "aperture samples per pixel per axis (default 2)"),
+    CLI_INT("--wavelengths", "N", O, wavelengths, 1, 128,
+            "spectral samples over 380-770 nm (default 32)"),
+    CLI_CHOICE("--diffraction", "D", O, diffraction, "fresnel|fraunhofer",
+               "fresnel (thesis eq. 8.3, default) or fraunhofer (E = 1)"),
+    CLI_NUMBER("--fresnel-distance", "MM", O, fresnel_distance, 1e-3, 1e9,
+               "d of the Fresnel term E (default 70435: a quarter wave at 9 mm)"),
+    CLI_NUMBER("--aperture-width", "MM", O, aperture_width, 0.5, 100,
+               "physical width W of the aperture texture (default 12)"),
+    CLI_NUMBER("--fov", "DEG", O, fov_deg, 0, 360,
+               "horizontal field of view of IN; resamples the PSF to its pitch\n"
+               "(default 0: one PSF pixel per image pixel)"),
+    CLI_CHOICE("--method", "M", O, method, "convolution|billboard",
+               "convolution of the whole image (default) or billboard: paste\n"
+               "billboards at bright pixels"),
+    CLI_NUMBER("--billboard-threshold", "X", O, billboard_threshold, 0, 1e30,
+               "luminance over which a pixel gets a billboard (default 20 x\n"
+               "the mean)"),
+    CLI_CHOICE("--pupil", "MODEL", O, pupil, "thesis|moon-spencer|watson-yellott",
+               "thesis (eq. 8.2, default), moon-spencer or watson-yellott"),
+    CLI_NUMBER("--luminance-scale", "X", O, luminance_scale, 1e-12, 1e12,
+               "cd/m^2 per image unit (default 1)"),
+    CLI_NUMBER("--field-luminance", "L", O, field_luminance, 1e-9, 1e12,
+               "fixed field luminance in cd/m^2 (default: the image's mean)"),
+    CLI_NUMBER("--squint", "X", O, squint, 0, 0.99, "constant lid closure (0..0.99)"),
+    CLI_NUMBER("--blink-interval", "S", O, blink_interval, 0, 1e6,
+               "mean seconds between blinks (default 4; 0: none)"),
+    CLI_NUMBER("--hippus", "X", O, hippus, 0, 1, "hippus noise scale (default 0.1)"),
+    CLI_INT("--lens-particles", "N", O, lens_particles, 0, 100000, "lens particles (default 750)"),
+    CLI_INT("--gratings", "N", O, gratings, 0, 100000, "lens fibre gratings (200)"),
+    CLI_INT("--vitreous", "N", O, vitreous, 0, 100000, "vitreous particles (200)"),
+    CLI_INT("--lashes", "N", O, lashes, 0, 100000, "eyelashes (40)"),
+    CLI_NUMBER("--exposure", "STOPS", O, exposure, -64, 64, "exposure of PNG outputs (default 0)"),
+    CLI_INT("--threads", "T", O, threads, 0, 1024, "worker threads (default: all)"),
+    CLI_FLAG("-v, --verbose", O, verbose, "more log output"),
+};
+#undef O
+
+static const cli_command glare_command = {
+    .name = "glare",
+    .usage = "usage: drift glare IN.exr --out OUT.exr [options]\n"
+             "       drift glare IN.exr --frames N --fps F --out-pattern frame_%04d.exr\n"
+             "\n"
+             "Adds temporal glare (Ritschel et al. 2009; thesis ch. 8) to an HDR image (.exr or\n"
+             ".hdr): the eye's aperture, its Fresnel diffraction, the chromatic PSF and the\n"
+             "convolution of IN with it. docs/glare.md describes the model.\n"
+             "\n",
+    .epilogue = "\nexit status: 0 ok, 1 failure, 2 usage error or bad input (nothing written)\n",
+    CLI_TABLE(glare_table),
+    CLI_POSITIONAL("IN", glare_args, in, 1),
+    .help_column = 31,
+};
 
 // Whether `pattern` holds exactly one integer conversion %d or %0Nd (and only %% otherwise).
 static bool is_frame_pattern(const char *pattern)
@@ -352,17 +233,14 @@ static drift_result save_image(drift_context *ctx, const char *path, const drift
 int drift_cmd_glare(int argc, char **argv)
 {
     glare_args a = { .frames = 1, .fps = 30.0, .blink_interval = -1.0, .hippus = -1.0 };
-    const char *in_path = NULL;
-    if (!parse(argc, argv, &a, &in_path)) {
-        return 2;
-    }
-    if (a.help) {
-        print_usage(stdout);
-        return 0;
+    int parsed = cli_parse(&glare_command, argc, argv, &a, NULL);
+    if (parsed != CLI_PARSED) {
+        return cli_parse_exit(parsed);
     }
     // Check everything that can be checked before anything is read or written.
+    const char *in_path = a.in;
     if (!in_path) {
-        print_usage(stderr);
+        cli_print_help(&glare_command, stderr);
         return 2;
     }
     bool in_is_pattern = strchr(in_path, '%') != NULL;
@@ -394,15 +272,16 @@ int drift_cmd_glare(int argc, char **argv)
     }
     const char *out_name = a.out ? a.out : a.out_pattern;
     if (!has_extension(out_name, out_exts)) {
-        fprintf(stderr, "drift glare: output '%s' must end in .exr or .png\n", out_name);
+        fprintf(stderr, "drift glare: %s expects a name ending in .exr or .png, got '%s'\n",
+                a.out ? "--out" : "--out-pattern", out_name);
         return 2;
     }
     const char *extras[2] = { a.psf, a.aperture };
     for (int i = 0; i < 2; ++i) {
         if (extras[i] && (!has_extension(extras[i], i == 0 ? out_exts : exr_exts) ||
                           (strchr(extras[i], '%') && !is_frame_pattern(extras[i])))) {
-            fprintf(stderr, "drift glare: '%s' must be an %s name (with at most one %%d)\n",
-                    extras[i], i == 0 ? ".exr or .png" : ".exr");
+            fprintf(stderr, "drift glare: %s expects an %s name (with at most one %%d), got '%s'\n",
+                    i == 0 ? "--psf" : "--aperture", i == 0 ? ".exr or .png" : ".exr", extras[i]);
             return 2;
         }
     }

@@ -58,6 +58,27 @@ assert 0 <= r[0]["flip"] <= 1 and r[0]["prt_ms"] > 0 and "shadow" in r[0]["quali
         check glare 'assert [r["n"] for r in d["sizes"]] == [16, 32], d
 assert all(r["overall_ms"] > 0 and r["aperture_ms"] >= 0 for r in d["sizes"]), d'
         ;;
+    ssdo)
+        # The default scene: the Cornell box has no environment light for SSDO to occlude.
+        expect 0 "$drift" bench ssdo --width 8 --height 8 --samples 2 --ref-spp 1 --frames 1 --json
+        check ssdo 'assert d["width"] == 8 and d["samples"] == 2 and d["threads"] == 1, d
+q = {r["name"]: r for r in d["quality"]}
+assert {"ssao", "gtao", "ssdo", "ssdo+bounce", "pt-1spp"} <= set(q), d
+assert all(r["ms"] >= 0 and 0 <= r["flip"] <= 1 and r["rmse"] >= 0 and 0 <= r["flip_direct"] <= 1
+           for r in d["quality"]), d
+assert "table" not in d and d["radius"] > 0, d'
+        ;;
+    ism)
+        expect 0 "$drift" bench ism "$box" --size 16 --ref-spp 2 --vpls 8 --spp 1 --points 64 \
+            --map 8 --threads 1 --json
+        check ism 'assert d["size"] == 16 and d["ref_spp"] == 2 and d["gbuffer_ms"] >= 0, d
+assert [(r["what"], r["count"]) for r in d["rows"]] == [("ref", 2), ("pt", 1), ("ism", 8), ("ir", 8)], d
+assert all(r["ms"] >= 0 and r["rmse_indirect"] >= 0 and 0 <= r["flip_frame"] <= 1 for r in d["rows"]), d
+for r in d["rows"][2:]:
+    assert 0 < r["vpls"] <= 8 and 0 <= r["holes"] <= 1 and r["stage_ms"]["gather"] >= 0, r'
+        expect 2 "$drift" bench ism --vpls 8,,16
+        grep -q -- "--vpls expects .*got '8,,16'" "$tmp/err" || fail "bench ism: bad --vpls not named"
+        ;;
     *)
         fail "bench $1 has no smoke case in tests/cli/test_bench.sh"
         return

@@ -71,10 +71,17 @@ expect 2 "$drift" glare "$tmp/in.hdr" --out "$tmp/x.exr" --mode sideways
 expect 2 "$drift" glare "$tmp/in.hdr" --out "$tmp/x.exr" --psf-size 100
 grep -q "power of two" "$tmp/err" || fail "--psf-size 100 says it is not a power of two"
 expect 2 "$drift" glare "$tmp/in.hdr" --out "$tmp/x.tiff"
+grep -q -- "--out expects .*x.tiff'" "$tmp/err" || fail "a bad --out names the option and value"
+expect 2 "$drift" glare "$tmp/in.hdr" --out ""
+grep -q -- "--out expects a file name" "$tmp/err" || fail "an empty --out is refused by name"
+expect 2 "$drift" glare "$tmp/in.hdr" --out "$tmp/x.exr" --fps 0
+grep -q -- "--fps expects .*got '0'" "$tmp/err" || fail "--fps 0 names the option and value"
 expect 2 "$drift" glare "$tmp/in.hdr" --frames 3 --out "$tmp/x.exr"
 expect 2 "$drift" glare "$tmp/in.hdr" --frames 3 --out-pattern "$tmp/f_%d_%d.exr"
 expect 2 "$drift" glare "$tmp/in.hdr" --out "$tmp/x.exr" --psf "$tmp/psf.tif"
 expect 2 "$drift" glare "$tmp/in.hdr" --out "$tmp/x.exr" --aperture "$tmp/ap.png"
+grep -q -- "--aperture expects an .exr name" "$tmp/err" || fail "a bad --aperture is named"
+expect 2 "$drift" glare "$tmp/in.hdr" "$tmp/in2.hdr" --out "$tmp/x.exr"
 
 # Bad input files: clear errors naming the file, exit 2, nothing written.
 expect 2 "$drift" glare "$tmp/in.png" --out "$tmp/x.exr"
