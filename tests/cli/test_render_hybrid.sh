@@ -26,7 +26,11 @@ python3 - "$tmp/s.json" <<'PY' || fail "hybrid stats JSON incomplete"
 import json, sys
 s = json.load(open(sys.argv[1]))
 assert s["mode"] == "hybrid" and s["width"] == 32 and s["height"] == 24, s
-assert s["techniques"] == {"shadows": "hard", "reflections": "sharp", "dof": "post", "indirect": "none"}
+# The chosen ones, and every other effect of the table at its default (the first row).
+t = s["techniques"]
+assert (t["shadows"], t["reflections"], t["dof"], t["indirect"]) == ("hard", "sharp", "post", "none"), t
+assert t.get("occlusion") == "none" and t.get("glare") == "none", t
+assert set(s["effect_ms"]) == set(t) and all(v >= 0 for v in s["effect_ms"].values()), s["effect_ms"]
 passes = s["passes"]
 for name in ("primary", "unshadowed", "hard_shadows", "shadow_maps", "shadow_filter",
              "reflections", "envmap", "reference", "compose", "dof"):
