@@ -588,11 +588,9 @@ static void test_bit_identical_across_threads(void **state)
     build_box_scene(&c, true, drift_vec3_make(0.8f, 0.2f, 0.1f), 1.0f, false);
     drift_context *one = test_context(1, NULL);
     for (int t = 0; t < DRIFT_SSDO_METHOD_COUNT; ++t) {
-        drift_ssdo_params p = { .method = (drift_ssdo_method)t,
-                                .samples = 16,
-                                .radius = 1.0f,
-                                .bounce = true,
-                                .seed = 3 };
+        drift_ssdo_params p = {
+            .method = (drift_ssdo_method)t, .samples = 16, .radius = 1.0f, .bounce = true, .seed = 3
+        };
         case_render(&c, &p);
         drift_ssdo_output first;
         assert_int_equal(drift_ssdo_output_create(one, 48, 48, &first), DRIFT_OK);
