@@ -4,6 +4,7 @@
 // add samples in passes (progress, checkpoints, Ctrl-C), resolve and write the images.
 #include "cli.h"
 #include "drift/accel.h"
+#include "drift/glare.h"
 #include "drift/image_io.h"
 #include "drift/pt.h"
 #include "drift/scene_io.h"
@@ -251,8 +252,35 @@ static int parse_options(int argc, char **argv, render_options *o)
                            .debug_sample = -1,
                            .aperture = -1.0,
                            .focus_distance = -1.0 };
+    // --glare is the one effect that also applies to the path tracer's image (the last pass
+    // of either mode): in reference mode it is taken out here, so that every other hybrid
+    // option still says it needs --mode hybrid.
+    char *args[512];
+    int count = 0;
+    bool hybrid = false;
+    for (int i = 0; i < argc; ++i) {
+        hybrid |=
+            strcmp(argv[i], "--mode") == 0 && i + 1 < argc && strcmp(argv[i + 1], "hybrid") == 0;
+    }
+    for (int i = 0; i < argc && count < 512; ++i) {
+        if (!hybrid && strcmp(argv[i], "--glare") == 0 && i + 1 < argc) {
+            int t = drift_technique_parse(DRIFT_EFFECT_GLARE, argv[++i]);
+            if (t < 0) {
+                fprintf(stderr, "drift render: --glare expects none, static or dynamic, got '%s'\n",
+                        argv[i]);
+                return 2;
+            }
+            o->hybrid.glare = (drift_glare_technique)t;
+            continue;
+        }
+        args[count++] = argv[i];
+    }
+    if (count == 512) {
+        fprintf(stderr, "drift render: too many arguments\n");
+        return 2;
+    }
     const char *first[CLI_GROUP_COUNT] = { 0 };
-    int status = cli_parse(&render_command, argc, argv, o, first);
+    int status = cli_parse(&render_command, count, args, o, first);
     if (status != CLI_PARSED) {
         return status;
     }
@@ -281,6 +309,24 @@ void render_png_path(const char *exr_path, char *out, size_t size)
     snprintf(out, size, "%.*s.png", (int)(strlen(exr_path) - 4), exr_path);
 }
 
+// The path tracer's image through the eye into *out, a new image (--glare static|dynamic in
+// reference mode: one frame, the eye at t = 0). The pt's own image is left as it is.
+static drift_result apply_glare(drift_context *ctx, const render_options *o,
+                                const drift_image *image, drift_image *out)
+{
+    drift_glare *glare = NULL;
+    drift_glare_params params = { .mode = o->hybrid.glare == DRIFT_GLARE_DYNAMIC
+                                              ? DRIFT_GLARE_MODE_DYNAMIC
+                                              : DRIFT_GLARE_MODE_STATIC,
+                                  .seed = (uint32_t)o->seed };
+    drift_result r = drift_glare_create(ctx, &params, &glare);
+    if (r == DRIFT_OK) {
+        r = drift_glare_apply(glare, image, 0.0, out);
+    }
+    drift_glare_destroy(glare);
+    return r;
+}
+
 static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_options *o)
 {
     drift_image beauty, albedo, normal, depth;
@@ -288,12 +334,20 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
     if (r != DRIFT_OK) {
         return r;
     }
+    drift_image glared = { 0 };
+    if (o->hybrid.glare != DRIFT_GLARE_NONE) {
+        if ((r = apply_glare(ctx, o, &beauty, &glared)) != DRIFT_OK) {
+            return r;
+        }
+        beauty = glared; // the glare's copy, destroyed below
+    }
     drift_image_layer layers[4] = { { NULL, &beauty } };
     uint32_t layer_count = 1;
     if (o->aov) {
         if ((r = drift_pt_resolve(pt, DRIFT_PT_AOV_ALBEDO, &albedo)) != DRIFT_OK ||
             (r = drift_pt_resolve(pt, DRIFT_PT_AOV_NORMAL, &normal)) != DRIFT_OK ||
             (r = drift_pt_resolve(pt, DRIFT_PT_AOV_DEPTH, &depth)) != DRIFT_OK) {
+            drift_image_destroy(ctx, &glared);
             return r;
         }
         layers[1] = (drift_image_layer){ "albedo", &albedo };
@@ -302,14 +356,15 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
         layer_count = 4;
     }
     r = drift_image_save_exr(ctx, o->out_path, layers, layer_count);
-    if (r != DRIFT_OK) {
-        return r;
+    if (r == DRIFT_OK) {
+        char png[4096];
+        render_png_path(o->out_path, png, sizeof(png));
+        r = drift_image_save_png(
+            ctx, png, &beauty,
+            &(drift_tonemap_params){ .exposure_stops = (float)o->exposure, .op = o->tonemap });
     }
-    char png[4096];
-    render_png_path(o->out_path, png, sizeof(png));
-    return drift_image_save_png(
-        ctx, png, &beauty,
-        &(drift_tonemap_params){ .exposure_stops = (float)o->exposure, .op = o->tonemap });
+    drift_image_destroy(ctx, &glared); // NULL-safe on a zero image
+    return r;
 }
 
 static bool write_stats(const render_options *o, const cli_session *session, const drift_pt *pt,

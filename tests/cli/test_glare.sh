@@ -143,5 +143,19 @@ expect 2 "$drift" glare "$tmp/s_%d.exr" --frames 2 --out-pattern "$tmp/t_%d.exr"
 grep -q "s_1.exr' has NaN" "$tmp/err" || fail "the NaN frame of a sequence is named"
 [ -e "$tmp/t_0.exr" ] && fail "a sequence with a bad frame wrote its first frame"
 
+# --glare is the last pass of drift render in either mode.
+expect 0 "$drift" render --spp 2 --width 48 --height 48 --threads 2 --quiet --out "$tmp/pt.exr"
+expect 0 "$drift" render --spp 2 --width 48 --height 48 --threads 2 --quiet --glare static \
+    --out "$tmp/pt_glare.exr"
+cmp -s "$tmp/pt.exr" "$tmp/pt_glare.exr" && fail "render --glare static changes the path tracer's image"
+expect 0 "$drift" render --mode hybrid --width 48 --height 48 --threads 2 --quiet --glare dynamic \
+    --out "$tmp/hy_glare.exr"
+[ -s "$tmp/hy_glare.exr" ] || fail "render --mode hybrid --glare dynamic writes its image"
+expect 2 "$drift" render --glare sideways --out "$tmp/bad.exr"
+grep -q "glare expects none, static or dynamic" "$tmp/err" || fail "a bad --glare is named"
+expect 2 "$drift" render --glare static --shadows pcss --out "$tmp/bad.exr"
+grep -q "shadows needs --mode hybrid" "$tmp/err" || fail "other hybrid options still need hybrid mode"
+[ -e "$tmp/bad.exr" ] && fail "a refused render wrote its image"
+
 [ "$failures" -eq 0 ] || { echo "$failures failure(s)" >&2; exit 1; }
 echo "cli glare: ok"
