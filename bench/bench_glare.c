@@ -143,7 +143,7 @@ static drift_result time_size(drift_context *ctx, int32_t n, int32_t frames, boo
         drift__glare_conv_release(ctx, &conv);
         drift_image_destroy(ctx, &frame);
     } else {
-        out->convolution = NAN;
+        out->convolution = (double)NAN;
     }
 done:
     drift__glare_fft_destroy(ctx, fft);
@@ -214,7 +214,7 @@ int drift_bench_glare(int argc, char **argv)
     }
     drift_context *ctx = session.ctx;
     phase_ms rows[MAX_SIZES];
-    double apply_ms[3] = { NAN, NAN, NAN }, billboard_ms = NAN;
+    double apply_ms[3] = { (double)NAN, (double)NAN, (double)NAN }, billboard_ms = (double)NAN;
     const int32_t apply_sizes[3][2] = { { 640, 480 }, { 512, 512 }, { 1024, 1024 } };
     drift_result r = DRIFT_OK;
     for (int i = 0; i < o.size_count && r == DRIFT_OK; ++i) {

@@ -35,7 +35,7 @@ static void clip_range(const raster *r, double lo, double hi, int32_t *out_lo, i
 
 static void draw_disk(const raster *r, const drift__glare_disk *d)
 {
-    double cx = px_x(r, d->x), cy = px_y(r, d->y), rad = (double)d->radius / r->hp;
+    double cx = px_x(r, (double)d->x), cy = px_y(r, (double)d->y), rad = (double)d->radius / r->hp;
     if (rad < 0.5) {
         // Smaller than a sample: splat the disk's area bilinearly over the 4 nearest samples.
         double area = 3.14159265358979323846 * rad * rad;
@@ -72,7 +72,8 @@ static void draw_disk(const raster *r, const drift__glare_disk *d)
 
 static void draw_line(const raster *r, const drift__glare_line *l)
 {
-    double ax = px_x(r, l->ax), ay = px_y(r, l->ay), bx = px_x(r, l->bx), by = px_y(r, l->by);
+    double ax = px_x(r, (double)l->ax), ay = px_y(r, (double)l->ay), bx = px_x(r, (double)l->bx),
+           by = px_y(r, (double)l->by);
     double hw = 0.5 * (double)l->width / r->hp;
     int32_t x0, x1, y0, y1;
     clip_range(r, fmin(ax, bx) - hw, fmax(ax, bx) + hw, &x0, &x1);

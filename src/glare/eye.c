@@ -438,16 +438,16 @@ void drift__glare_scene_pose(drift__glare_scene *s, const drift__glare_eye_state
     for (int32_t i = 0; i < s->lens_count; ++i) {
         const drift__glare_lens_particle *q = &s->lens[i];
         double r, z;
-        lens_lookup(eye, q->r, q->z, &r, &z);
-        s->disks[nd++] =
-            (drift__glare_disk){ (float)(r * cos(q->phi)), (float)(r * sin(q->phi)), q->radius };
+        lens_lookup(eye, (double)q->r, (double)q->z, &r, &z);
+        s->disks[nd++] = (drift__glare_disk){ (float)(r * cos((double)q->phi)),
+                                              (float)(r * sin((double)q->phi)), q->radius };
     }
     // Vitreous: rotate the body by (yaw, pitch), project orthographically.
     double cy = cos(eye->pub.vitreous_angle[0]), sy = sin(eye->pub.vitreous_angle[0]);
     double cp = cos(eye->pub.vitreous_angle[1]), sp = sin(eye->pub.vitreous_angle[1]);
     for (int32_t i = 0; i < s->vitreous_count; ++i) {
         const float *v = s->vitreous[i];
-        double vx = v[0], vy = v[1], vz = v[2];
+        double vx = (double)v[0], vy = (double)v[1], vz = (double)v[2];
         double x = cy * vx + sy * vz, z = -sy * vx + cy * vz;
         double y = cp * vy - sp * z;
         s->disks[nd++] = (drift__glare_disk){ (float)x, (float)y, v[3] };
@@ -459,9 +459,9 @@ void drift__glare_scene_pose(drift__glare_scene *s, const drift__glare_eye_state
     for (int32_t i = 0; i < s->grating_count; ++i) {
         const drift__glare_grating *g = &s->gratings[i];
         double r0, r1, z0, z1;
-        lens_lookup(eye, g->r0, g->z, &r0, &z0);
-        lens_lookup(eye, g->r1, g->z, &r1, &z1);
-        double c = cos(g->phi), sn = sin(g->phi);
+        lens_lookup(eye, (double)g->r0, (double)g->z, &r0, &z0);
+        lens_lookup(eye, (double)g->r1, (double)g->z, &r1, &z1);
+        double c = cos((double)g->phi), sn = sin((double)g->phi);
         s->lines[nl++] = (drift__glare_line){ (float)(r0 * c), (float)(r0 * sn), (float)(r1 * c),
                                               (float)(r1 * sn), g->width };
     }
@@ -470,11 +470,11 @@ void drift__glare_scene_pose(drift__glare_scene *s, const drift__glare_eye_state
     drift__glare_lids(eye->pub.blink, &top, &bottom);
     for (int32_t i = 0; i < s->lash_count; ++i) {
         const drift__glare_lash *l = &s->lashes[i];
-        double x0 = l->x, bend = 0.02 * x0 * x0;
+        double x0 = (double)l->x, bend = 0.02 * x0 * x0;
         double y0 = l->upper ? top + bend : bottom - bend;
         double dir = l->upper ? -1.0 : 1.0;
         double len = l->upper ? (double)l->length : 0.6 * (double)l->length;
-        double x1 = x0 + len * sin(l->angle), y1 = y0 + dir * len * cos(l->angle);
+        double x1 = x0 + len * sin((double)l->angle), y1 = y0 + dir * len * cos((double)l->angle);
         s->lines[nl++] =
             (drift__glare_line){ (float)x0, (float)y0, (float)x1, (float)y1, l->width };
     }

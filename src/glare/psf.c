@@ -39,7 +39,7 @@ void drift__glare_psf_mono(const drift__glare_fft *fft, const float *aperture, c
     // |F|^2, the power spectrum (not |F|); K = 1 / (lambda d)^2 drops out in the normalisation.
     double sum = 0.0;
     for (size_t i = 0; i < count; ++i) {
-        double re = spectrum[i].re, im = spectrum[i].im;
+        double re = (double)spectrum[i].re, im = (double)spectrum[i].im;
         double p = re * re + im * im;
         sum += p;
     }
@@ -53,7 +53,7 @@ void drift__glare_psf_mono(const drift__glare_fft *fft, const float *aperture, c
         const drift__cpx *row = spectrum + (size_t)y * (size_t)n;
         float *dst = out_psf + (size_t)((y + h) % n) * (size_t)n;
         for (int32_t x = 0; x < n; ++x) {
-            double re = row[x].re, im = row[x].im;
+            double re = (double)row[x].re, im = (double)row[x].im;
             double p = re * re + im * im;
             dst[(x + h) % n] = (float)(p * inv);
         }
@@ -210,7 +210,7 @@ void drift__glare_psf_rgb(const float *mono, int32_t n, int32_t wavelength_count
             double taper = rr <= 0.7 ? 1.0 : (rr >= 1.0 ? 0.0 : cos(0.5 * PI * (rr - 0.7) / 0.3));
             taper *= taper;
             float *dst = out + ((size_t)y * (size_t)k + (size_t)x) * 3;
-            double xyz[3] = { dst[0], dst[1], dst[2] };
+            double xyz[3] = { (double)dst[0], (double)dst[1], (double)dst[2] };
             for (int32_t c = 0; c < 3; ++c) {
                 // One wavelength is the monochromatic PSF itself, grey.
                 double v =
