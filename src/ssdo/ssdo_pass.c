@@ -123,6 +123,7 @@ void drift_ssdo_planes(const drift_frame_state *f, drift_pass_plane_fn add, void
     if (s) {
         add(sink, "occlusion.visibility", &s->out.visibility);
         add(sink, "occlusion.bent_normal", &s->out.bent_normal);
+        add(sink, "occlusion.direct", &s->out.direct);
         add(sink, "occlusion.bounce", &s->out.bounce);
     }
 }

@@ -13,7 +13,7 @@ drift_result drift_ssdo_pass_ssdo(drift_frame_state *frame, const drift_pass_arg
 // O ray-traced: the environment through the diffuse lobe at --spp shadow rays a pixel, exact
 // visibility (what the screen-space techniques approximate; no bounce).
 drift_result drift_ssdo_pass_reference(drift_frame_state *frame, const drift_pass_args *args);
-// occlusion.visibility, occlusion.bent_normal, occlusion.bounce of the last render.
+// occlusion.visibility, .bent_normal, .direct and .bounce of the last render.
 void drift_ssdo_planes(const drift_frame_state *frame, drift_pass_plane_fn add, void *sink);
 
 #endif // DRIFT_SSDO_PASS_H

@@ -1,6 +1,9 @@
 // The technique table (drift/techniques.h, src/hybrid/techniques.c): every row renders, every
 // row is what the table says it is, and the frame prepares only the inputs the chosen rows ask
 // for (a technique that does not list shadow maps never gets them silently).
+#include "drift/ism.h"
+#include "drift/points.h"
+#include "drift/ssdo.h"
 #include "drift_test.h"
 #include "hybrid/techniques.h"
 #include "test_rig.h"
