@@ -311,14 +311,18 @@ void render_png_path(const char *exr_path, char *out, size_t size)
 
 // The path tracer's image through the eye into *out, a new image (--glare static|dynamic in
 // reference mode: one frame, the eye at t = 0). The pt's own image is left as it is.
-static drift_result apply_glare(drift_context *ctx, const render_options *o,
+static drift_result apply_glare(drift_context *ctx, const render_options *o, float fov_y,
                                 const drift_image *image, drift_image *out)
 {
+    // The PSF at the camera's angular pitch, as the hybrid frame's glare pass does.
+    double aspect = (double)image->width / (double)image->height;
+    double fov_x = 2.0 * atan(aspect * tan(0.5 * (double)fov_y));
     drift_glare *glare = NULL;
     drift_glare_params params = { .mode = o->hybrid.glare == DRIFT_GLARE_DYNAMIC
                                               ? DRIFT_GLARE_MODE_DYNAMIC
                                               : DRIFT_GLARE_MODE_STATIC,
-                                  .seed = (uint32_t)o->seed };
+                                  .seed = (uint32_t)o->seed,
+                                  .image_fov = fov_x };
     drift_result r = drift_glare_create(ctx, &params, &glare);
     if (r == DRIFT_OK) {
         r = drift_glare_apply(glare, image, 0.0, out);
@@ -327,7 +331,8 @@ static drift_result apply_glare(drift_context *ctx, const render_options *o,
     return r;
 }
 
-static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_options *o)
+static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_options *o,
+                                 float fov_y)
 {
     drift_image beauty, albedo, normal, depth;
     drift_result r = drift_pt_resolve(pt, DRIFT_PT_AOV_BEAUTY, &beauty);
@@ -336,7 +341,7 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
     }
     drift_image glared = { 0 };
     if (o->hybrid.glare != DRIFT_GLARE_NONE) {
-        if ((r = apply_glare(ctx, o, &beauty, &glared)) != DRIFT_OK) {
+        if ((r = apply_glare(ctx, o, fov_y, &beauty, &glared)) != DRIFT_OK) {
             return r;
         }
         beauty = glared; // the glare's copy, destroyed below
@@ -492,7 +497,7 @@ static int render_reference(const render_options *o, const cli_session *session)
         }
         if (o->checkpoint_seconds > 0.0 && now - last_checkpoint > o->checkpoint_seconds &&
             done_spp < total) {
-            if (write_images(ctx, pt, o) == DRIFT_OK && !o->quiet) {
+            if (write_images(ctx, pt, o, session->scene->camera.fov_y) == DRIFT_OK && !o->quiet) {
                 fprintf(stderr, "%sdrift render: checkpoint at %u spp written to %s\n",
                         tty ? "\n" : "", done_spp, o->out_path);
             }
@@ -505,7 +510,7 @@ static int render_reference(const render_options *o, const cli_session *session)
         fprintf(stderr, "%sdrift render: interrupted at %u spp; writing what was rendered\n",
                 tty ? "\n" : "", drift_pt_sample_count(pt));
     }
-    r = write_images(ctx, pt, o);
+    r = write_images(ctx, pt, o, session->scene->camera.fov_y);
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift render: cannot write %s: %s\n", o->out_path, drift_result_string(r));
         goto done;

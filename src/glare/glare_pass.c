@@ -5,6 +5,8 @@
 
 #include "drift/glare.h"
 
+#include <math.h>
+
 typedef struct glare_pass_state {
     drift_glare *glare;
     double last_time; // drift_time_now() of the last frame, for the dynamic eye's dt
@@ -25,7 +27,10 @@ static drift_result apply(drift_frame_state *f, const drift_pass_args *args, dri
         if (!s) {
             return DRIFT_ERR_OUT_OF_MEMORY;
         }
-        drift_glare_params params = { .mode = mode, .seed = f->params.seed };
+        // The PSF at the camera's angular pitch: the glare a viewer of this field of view sees.
+        double aspect = (double)f->params.width / (double)f->params.height;
+        double fov_x = 2.0 * atan(aspect * tan(0.5 * (double)f->camera.fov_y));
+        drift_glare_params params = { .mode = mode, .seed = f->params.seed, .image_fov = fov_x };
         drift_result r = drift_glare_create(f->ctx, &params, &s->glare);
         if (r != DRIFT_OK) {
             drift_free(f->ctx, s);
