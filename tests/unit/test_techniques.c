@@ -205,6 +205,11 @@ static void test_glare_keeps_the_light(void **state)
     (void)state;
     test_rig r = test_rig_begin(2);
     build_scene(&r, 32);
+    // A narrow view of the light's edge: at the camera's angular pitch the PSF's halo spans
+    // pixels only when a pixel is a few arcminutes (a wide 32-pixel view shows no glare).
+    r.scene->camera =
+        drift_camera_look_at(drift_vec3_make(0, 0.5f, -3.0f), drift_vec3_make(0.5f, 2.0f, 0.0f),
+                             drift_vec3_make(0, 1, 0), 0.02f, 32, 32);
     test_rig_commit(&r);
     drift_hybrid_params p = { .seed = 2 };
     test_rig_frame(&r, &p);
