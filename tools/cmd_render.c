@@ -203,6 +203,13 @@ static const cli_option render_table[] = {
                "r_max in scene units (default 0.05 x scene diagonal)"),
     CLI_CHOICE("--ssdo-bounce", "off|on", O, hybrid.occlusion_settings.bounce, "off|on",
                "on: SSDO's one indirect bounce (when --indirect is none)"),
+    CLI_INT("--occlusion-layers", "1|2", O, hybrid.occlusion_settings.layers, 1, 2,
+            "2: a second depth layer (one more ray a pixel) behind thin\n"
+            "objects (default 1)"),
+    CLI_CHOICE("--occlusion-fade", "on|off", O, hybrid.occlusion_settings.no_fade, "on|off",
+               "off: occluders near r_max count fully (default on)"),
+    CLI_CHOICE("--occlusion-blur", "on|off", O, hybrid.occlusion_settings.no_blur, "on|off",
+               "off: no geometry-aware blur of the sample sets (default on)"),
     CLI_INT("--ism-vpls", "N", O, hybrid.ism.vpls, 1, 65536,
             "instant radiosity (--indirect ism|ir, docs/ism.md): light\n"
             "paths, one first-bounce VPL each (default 256)"),

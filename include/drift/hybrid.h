@@ -144,10 +144,17 @@ typedef struct drift_ism_settings {
 //   samples = 0 -> 16: N sample points a pixel (GTAO: slices x steps x 2 horizon samples)
 //   radius  = 0 -> 0.05 x the scene's diagonal: r_max, the sample hemisphere's radius
 //   bounce  = false: SSDO's one indirect bounce (only when no indirect technique is chosen)
+//   layers  = 0 -> 1; 2: a second depth layer (one more ray a pixel) so that a sample behind a
+//             thin object is not taken for occluded (thesis §4.3.2, drift_ssdo_peel)
+//   no_fade = false: occluders at 0.75..1 r_max fade out; no_blur = false: the 4x4
+//             geometry-aware blur over the interleaved sample sets runs
 typedef struct drift_occlusion_settings {
     int32_t samples;
     float radius;
     bool bounce;
+    int32_t layers;
+    bool no_fade;
+    bool no_blur;
 } drift_occlusion_settings;
 
 // How to build a frame. The default configuration is:

@@ -10,6 +10,7 @@
 typedef struct ssdo_pass_state {
     drift_ssdo_env *env;
     drift_ssdo_output out;
+    drift_image back_depth; // 1: the second depth layer (layers = 2)
 } ssdo_pass_state;
 
 static void state_destroy(drift_context *ctx, void *data)
@@ -17,6 +18,7 @@ static void state_destroy(drift_context *ctx, void *data)
     ssdo_pass_state *s = data;
     drift_ssdo_env_destroy(s->env);
     drift_ssdo_output_destroy(ctx, &s->out);
+    drift_image_destroy(ctx, &s->back_depth);
     drift_free(ctx, s);
 }
 
@@ -34,6 +36,9 @@ static drift_result ensure_state(drift_frame_state *f, const drift_pass_args *ar
     drift_result r = drift_ssdo_env_create(f->ctx, f->scene, NULL, &s->env);
     if (r == DRIFT_OK) {
         r = drift_ssdo_output_create(f->ctx, f->params.width, f->params.height, &s->out);
+    }
+    if (r == DRIFT_OK) {
+        r = drift_image_create(f->ctx, f->params.width, f->params.height, 1, &s->back_depth);
     }
     if (r != DRIFT_OK) {
         state_destroy(f->ctx, s);
@@ -54,16 +59,26 @@ static drift_result render(drift_frame_state *f, const drift_pass_args *args,
     }
     // The bounce is indirect light: when an indirect technique renders I, it already has it.
     bool indirect_none = f->params.indirect == DRIFT_INDIRECT_NONE;
+    const drift_occlusion_settings *o = &f->params.occlusion_settings;
     drift_ssdo_params params = { .method = method,
-                                 .samples = f->params.occlusion_settings.samples,
-                                 .radius = f->params.occlusion_settings.radius,
-                                 .bounce = f->params.occlusion_settings.bounce && indirect_none,
+                                 .samples = o->samples,
+                                 .radius = o->radius,
+                                 .bounce = o->bounce && indirect_none,
+                                 .no_fade = o->no_fade,
+                                 .no_blur = o->no_blur,
                                  .seed = f->params.seed };
     params = drift_ssdo_params_resolve(&params, f->scene);
     // The bounce reflects what the senders send: their shadowed direct light D.
     drift_ssdo_inputs in = { .gbuffer = &f->gbuffer,
                              .camera = &f->camera,
                              .sender_radiance = &f->direct };
+    if (o->layers == 2) { // one more ray a pixel: where the first layer's surface ends
+        r = drift_ssdo_peel(f->ctx, f->accel, &f->gbuffer, &f->camera, &s->back_depth);
+        if (r != DRIFT_OK) {
+            return r;
+        }
+        in.back_depth = &s->back_depth;
+    }
     r = drift_ssdo_render(f->ctx, s->env, &in, &params, &s->out);
     if (r == DRIFT_OK) {
         drift_pass_copy_rgb(&s->out.radiance, &f->terms[args->effect]);
@@ -124,6 +139,9 @@ void drift_ssdo_planes(const drift_frame_state *f, drift_pass_plane_fn add, void
         add(sink, "occlusion.visibility", &s->out.visibility);
         add(sink, "occlusion.bent_normal", &s->out.bent_normal);
         add(sink, "occlusion.direct", &s->out.direct);
+        if (f->params.occlusion_settings.layers == 2) {
+            add(sink, "occlusion.back_depth", &s->back_depth);
+        }
         add(sink, "occlusion.bounce", &s->out.bounce);
     }
 }
