@@ -156,6 +156,10 @@ static const cli_option render_table[] = {
     CLI_NOTE("each technique is listed below; reference = that effect\n"
              "alone path-traced at --spp; aaf: --spp rays a pixel on\n"
              "average (shadows: per area light)"),
+    CLI_INT("--frames", "N", O, frames, 1, 100000,
+            "render N frames of the view and write the last: its stats\n"
+            "are a frame with warm caches (default 1; first_frame_ms in\n"
+            "--stats has the first)"),
     CLI_INT("--light-samples", "N", O, hybrid.light_samples, 1, 4096,
             "samples per area light for unshadowed light (default 8)"),
     CLI_INT("--shadow-map-size", "N", O, hybrid.shadow_map.size, 1, 8192,
@@ -252,6 +256,7 @@ static const cli_command render_command = {
 static int parse_options(int argc, char **argv, render_options *o)
 {
     *o = (render_options){ .out_path = "out/render.exr",
+                           .frames = 1,
                            .spp = 64,
                            .checkpoint_seconds = 60.0,
                            .debug_x = -1,

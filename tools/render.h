@@ -28,6 +28,7 @@ typedef struct render_options {
     const char *stats_path;
     const char *aov_path; // hybrid: every plane as layers of this EXR
     bool hybrid_mode;     // --mode hybrid (else reference)
+    long frames;          // hybrid: frames rendered of the one view (the last is written)
     long spp, seed, threads, max_depth, width, height;
     double checkpoint_seconds;
     double exposure;

@@ -66,4 +66,15 @@ expect 2 "$drift" render --aov "$tmp/x-aov.exr" --out "$tmp/x.exr"
 expect 0 "$drift" render --help
 grep -q -- "--reflections" "$tmp/out" || fail "--help does not list --reflections"
 
+# --frames N renders the one view N times: the same image (the frame is deterministic), the
+# last frame's stats with the first one's milliseconds beside them.
+expect 0 "$drift" render --mode hybrid "${small[@]}" --indirect ism --ism-vpls 8 --out "$tmp/f1.exr"
+expect 0 "$drift" render --mode hybrid "${small[@]}" --indirect ism --ism-vpls 8 --frames 3 \
+    --out "$tmp/f3.exr" --stats "$tmp/f3.json"
+cmp -s "$tmp/f1.exr" "$tmp/f3.exr" || fail "--frames 3 wrote another image than one frame"
+python3 -c "import json,sys; d=json.load(open(sys.argv[1])); m=d['milliseconds']
+assert d['frames'] == 3 and m['first_frame'] > 0 and m['frame'] > 0, d" "$tmp/f3.json" \
+    || fail "--frames stats"
+expect 2 "$drift" render --mode hybrid "${small[@]}" --frames 0 --out "$tmp/f0.exr"
+
 exit $((failures > 0))
