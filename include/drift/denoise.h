@@ -20,8 +20,12 @@
 // and multiplies the result back (Zimmer et al. 2015, SVGF §4): texture detail is kept and
 // only the lighting is smoothed. Any guide may be NULL (its weight is then 1).
 //
-// Defaults (params zeroed): iterations 5, sigma_color 4, sigma_normal 128, sigma_depth 0.1,
-// albedo demodulation on when albedo is given.
+//   albedo  exp(-|a_p - a_q|^2 / sigma_albedo^2): keeps texture and material edges
+// Defaults (params zeroed): iterations 5, sigma_color 1, sigma_normal 128, sigma_depth 0.1,
+// sigma_albedo 0.1, albedo demodulation on when albedo is given. sigma_color 1 is the best
+// ꟻLIP of {0.5, 1, 4, 16, no colour weight} on the Cornell box at 2 spp (docs/frontier.md):
+// without a variance estimate (SVGF's temporal part), a looser colour weight lets the
+// emitter bleed into the ceiling (the path tracer's albedo AOV does not tell them apart).
 //
 // Every output pixel is a gather over the previous pass alone, so the result is bit-identical
 // for any thread count. A constant image (with constant guides) comes back unchanged up to
@@ -47,9 +51,11 @@ extern "C" {
 
 typedef struct drift_denoise_params {
     int32_t iterations; // 0 -> 5 (kernel footprint 2^(n+1)+1 pixels); at most 10
-    float sigma_color;  // 0 -> 4: relative colour distance, halved in variance each pass
+    float sigma_color;  // 0 -> 1: relative colour distance, halved in variance each pass
     float sigma_normal; // 0 -> 128: exponent of the normal dot product
-    float sigma_depth;  // 0 -> 0.1: relative depth difference per tap step
+    float sigma_depth;
+    float sigma_albedo; // 0 -> 0.1: albedo difference (keeps emitters and texture edges)  // 0 ->
+                        // 0.1: relative depth difference per tap step
     bool no_demodulate; // true: filter the colour as it is even when albedo is given
     bool disable_color; // true: no colour weight (a guide-only cross-bilateral filter)
 } drift_denoise_params;

@@ -14,10 +14,13 @@ drift_denoise_params drift_denoise_params_resolve(const drift_denoise_params *pa
         p.iterations = 5;
     }
     if (p.sigma_color == 0.0f) {
-        p.sigma_color = 4.0f;
+        p.sigma_color = 1.0f;
     }
     if (p.sigma_normal == 0.0f) {
         p.sigma_normal = 128.0f;
+    }
+    if (p.sigma_albedo == 0.0f) {
+        p.sigma_albedo = 0.1f;
     }
     if (p.sigma_depth == 0.0f) {
         p.sigma_depth = 0.1f;
@@ -28,12 +31,13 @@ drift_denoise_params drift_denoise_params_resolve(const drift_denoise_params *pa
 typedef struct atrous_job {
     const float *in; // packed 3-channel, width * height
     float *out;
-    const drift_image *normal, *depth;
+    const drift_image *albedo, *normal, *depth;
     int32_t width, height;
     int32_t step;
     float inv_color; // 1 / (sigma_color^2 2^-i); 0: no colour weight
     float sigma_normal;
-    float inv_depth; // 1 / (sigma_depth 2^i)
+    float inv_depth;  // 1 / (sigma_depth 2^i)
+    float inv_albedo; // 1 / sigma_albedo^2
 } atrous_job;
 
 static const float b3[5] = { 1.0f / 16.0f, 1.0f / 4.0f, 3.0f / 8.0f, 1.0f / 4.0f, 1.0f / 16.0f };
@@ -61,6 +65,7 @@ static void atrous_rows(size_t begin, size_t end, int thread_index, void *user)
         for (int32_t x = 0; x < w; ++x) {
             const float *cp = j->in + 3 * ((size_t)y * (size_t)w + (size_t)x);
             const float *np = j->normal ? drift_image_pixel(j->normal, x, y) : NULL;
+            const float *ap = j->albedo ? drift_image_pixel(j->albedo, x, y) : NULL;
             float zp = j->depth ? drift_image_pixel(j->depth, x, y)[0] : 0.0f;
             float lum_p = luminance(cp);
             float sum[3] = { 0.0f, 0.0f, 0.0f }, wsum = 0.0f;
@@ -85,6 +90,11 @@ static void atrous_rows(size_t begin, size_t end, int thread_index, void *user)
                             if (zp > 0.0f) {
                                 wk *= expf(-fabsf(zp - zq) * j->inv_depth / zp);
                             }
+                        }
+                        if (ap) {
+                            const float *aq = drift_image_pixel(j->albedo, qx, qy);
+                            float d0 = ap[0] - aq[0], d1 = ap[1] - aq[1], d2 = ap[2] - aq[2];
+                            wk *= expf(-(d0 * d0 + d1 * d1 + d2 * d2) * j->inv_albedo);
                         }
                         if (np) {
                             wk *= normal_weight(np, drift_image_pixel(j->normal, qx, qy),
@@ -154,8 +164,9 @@ drift_result drift_denoise_atrous(drift_context *ctx, const drift_image *color,
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
     if (p.iterations < 1 || p.iterations > 10 || !(p.sigma_color > 0.0f) ||
-        !(p.sigma_normal >= 0.0f) || !(p.sigma_depth > 0.0f) || !isfinite(p.sigma_color) ||
-        !isfinite(p.sigma_normal) || !isfinite(p.sigma_depth)) {
+        !(p.sigma_normal >= 0.0f) || !(p.sigma_depth > 0.0f) || !(p.sigma_albedo > 0.0f) ||
+        !isfinite(p.sigma_albedo) || !isfinite(p.sigma_color) || !isfinite(p.sigma_normal) ||
+        !isfinite(p.sigma_depth)) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, NULL, 0,
                   "drift_denoise_atrous: iterations must be in [1, 10] and the sigmas positive");
         return DRIFT_ERR_INVALID_ARGUMENT;
