@@ -6,6 +6,7 @@
 
 #define DENOISE_ALBEDO_MIN 1e-3f
 #define DENOISE_LUM_EPS    1e-2f
+#define DENOISE_EXP_CUTOFF 30.0f // exp(-30) ~ 1e-13: the tap adds nothing
 
 drift_denoise_params drift_denoise_params_resolve(const drift_denoise_params *params)
 {
@@ -38,17 +39,32 @@ typedef struct atrous_job {
     float sigma_normal;
     float inv_depth;  // 1 / (sigma_depth 2^i)
     float inv_albedo; // 1 / sigma_albedo^2
+    int normal_pow;   // sigma_normal when it is a whole number up to 4096, else -1
 } atrous_job;
 
 static const float b3[5] = { 1.0f / 16.0f, 1.0f / 4.0f, 3.0f / 8.0f, 1.0f / 4.0f, 1.0f / 16.0f };
 
-static float normal_weight(const float *np, const float *nq, float sigma)
+// max(0, n_p . n_q)^sigma; by squaring when sigma is a whole number (`pow`, else -1).
+static float normal_weight(const float *np, const float *nq, float sigma, int pow)
 {
     float d = np[0] * nq[0] + np[1] * nq[1] + np[2] * nq[2];
     if (d <= 0.0f) {
         return 0.0f;
     }
-    return d >= 1.0f ? 1.0f : powf(d, sigma);
+    if (d >= 1.0f) {
+        return 1.0f;
+    }
+    if (pow < 0) {
+        return powf(d, sigma);
+    }
+    float result = 1.0f;
+    for (; pow; pow >>= 1) {
+        if (pow & 1) {
+            result *= d;
+        }
+        d *= d;
+    }
+    return result;
 }
 
 static float luminance(const float *c)
@@ -68,6 +84,7 @@ static void atrous_rows(size_t begin, size_t end, int thread_index, void *user)
             const float *ap = j->albedo ? drift_image_pixel(j->albedo, x, y) : NULL;
             float zp = j->depth ? drift_image_pixel(j->depth, x, y)[0] : 0.0f;
             float lum_p = luminance(cp);
+            float inv_depth_p = zp > 0.0f ? j->inv_depth / zp : 0.0f;
             float sum[3] = { 0.0f, 0.0f, 0.0f }, wsum = 0.0f;
             for (int dy = -2; dy <= 2; ++dy) {
                 int32_t qy = y + dy * j->step;
@@ -82,30 +99,35 @@ static void atrous_rows(size_t begin, size_t end, int thread_index, void *user)
                     const float *cq = j->in + 3 * ((size_t)qy * (size_t)w + (size_t)qx);
                     float wk = b3[dx + 2] * b3[dy + 2];
                     if (dx != 0 || dy != 0) {
+                        // One exponential for the depth, albedo and colour weights.
+                        float e = 0.0f;
                         if (j->depth) {
                             float zq = drift_image_pixel(j->depth, qx, qy)[0];
                             if ((zp > 0.0f) != (zq > 0.0f)) {
                                 continue;
                             }
                             if (zp > 0.0f) {
-                                wk *= expf(-fabsf(zp - zq) * j->inv_depth / zp);
+                                e += fabsf(zp - zq) * inv_depth_p;
                             }
                         }
                         if (ap) {
                             const float *aq = drift_image_pixel(j->albedo, qx, qy);
                             float d0 = ap[0] - aq[0], d1 = ap[1] - aq[1], d2 = ap[2] - aq[2];
-                            wk *= expf(-(d0 * d0 + d1 * d1 + d2 * d2) * j->inv_albedo);
-                        }
-                        if (np) {
-                            wk *= normal_weight(np, drift_image_pixel(j->normal, qx, qy),
-                                                j->sigma_normal);
+                            e += (d0 * d0 + d1 * d1 + d2 * d2) * j->inv_albedo;
                         }
                         if (j->inv_color > 0.0f) {
                             float d0 = cp[0] - cq[0], d1 = cp[1] - cq[1], d2 = cp[2] - cq[2];
                             float mean = 0.5f * (lum_p + luminance(cq)) + DENOISE_LUM_EPS;
-                            wk *=
-                                expf(-(d0 * d0 + d1 * d1 + d2 * d2) * j->inv_color / (mean * mean));
+                            e += (d0 * d0 + d1 * d1 + d2 * d2) * j->inv_color / (mean * mean);
                         }
+                        if (e > DENOISE_EXP_CUTOFF) {
+                            continue;
+                        }
+                        if (np) {
+                            wk *= normal_weight(np, drift_image_pixel(j->normal, qx, qy),
+                                                j->sigma_normal, j->normal_pow);
+                        }
+                        wk *= expf(-e);
                     }
                     sum[0] += wk * cq[0];
                     sum[1] += wk * cq[1];
