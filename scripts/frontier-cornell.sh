@@ -7,8 +7,9 @@ set -u
 bin=${BIN:-drift}
 [ -f ref512.exr ] || "$bin" render --spp 512 --width 400 --height 400 --threads 2 --quiet \
   --checkpoint 0 --out ref512.exr >/dev/null
-row() { # name, args...
+row() { # name, args... (hybrid rows render 3 frames: the warm frame's ms, as a viewer sees it)
   local name=$1; shift
+  case " $* " in *" --mode hybrid "*) set -- "$@" --frames 3 ;; esac
   "$bin" render --width 400 --height 400 --threads 2 --quiet --checkpoint 0 "$@" --out "$name.exr" --stats "$name.json" >/dev/null 2>&1 || { echo "$name FAILED"; return; }
   local ms=$(python3 -c "import json;d=json.load(open('$name.json'));m=d.get('milliseconds',{});print(m.get('frame', m.get('render', 0)))")
   local flip=$("$bin" diff ref512.exr "$name.exr" | awk '/^flip/{print $2}')

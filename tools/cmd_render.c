@@ -4,6 +4,7 @@
 // add samples in passes (progress, checkpoints, Ctrl-C), resolve and write the images.
 #include "cli.h"
 #include "drift/accel.h"
+#include "drift/denoise.h"
 #include "drift/glare.h"
 #include "drift/image_io.h"
 #include "drift/pt.h"
@@ -132,6 +133,9 @@ static const cli_option render_table[] = {
             "image size (default: the scene camera's)"),
     CLI_STRING("--out", "FILE.exr", O, out_path,
                "output (default out/render.exr); FILE.png is written too"),
+    CLI_CHOICE("--denoise", "none|atrous", O, denoise, "none|atrous",
+               "reference: the edge-avoiding a-trous filter guided by the\n"
+               "albedo, normal and depth AOVs over the image written (docs/frontier.md)"),
     { .name = "--aov",
       .arg = "[FILE.exr]",
       .help = "reference: add albedo, normal and depth layers to the EXR;\n"
@@ -351,9 +355,20 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
     if (r != DRIFT_OK) {
         return r;
     }
-    drift_image glared = { 0 };
+    drift_image denoised = { 0 }, glared = { 0 };
+    if (o->denoise) { // --denoise atrous, before glare (the last pass)
+        if ((r = drift_pt_resolve(pt, DRIFT_PT_AOV_ALBEDO, &albedo)) != DRIFT_OK ||
+            (r = drift_pt_resolve(pt, DRIFT_PT_AOV_NORMAL, &normal)) != DRIFT_OK ||
+            (r = drift_pt_resolve(pt, DRIFT_PT_AOV_DEPTH, &depth)) != DRIFT_OK ||
+            (r = drift_denoise_atrous(ctx, &beauty, &albedo, &normal, &depth, NULL, &denoised)) !=
+                DRIFT_OK) {
+            return r;
+        }
+        beauty = denoised; // destroyed below
+    }
     if (o->hybrid.glare != DRIFT_GLARE_NONE) {
         if ((r = apply_glare(ctx, o, fov_y, &beauty, &glared)) != DRIFT_OK) {
+            drift_image_destroy(ctx, &denoised);
             return r;
         }
         beauty = glared; // the glare's copy, destroyed below
@@ -365,6 +380,7 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
             (r = drift_pt_resolve(pt, DRIFT_PT_AOV_NORMAL, &normal)) != DRIFT_OK ||
             (r = drift_pt_resolve(pt, DRIFT_PT_AOV_DEPTH, &depth)) != DRIFT_OK) {
             drift_image_destroy(ctx, &glared);
+            drift_image_destroy(ctx, &denoised);
             return r;
         }
         layers[1] = (drift_image_layer){ "albedo", &albedo };
@@ -381,6 +397,7 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
             &(drift_tonemap_params){ .exposure_stops = (float)o->exposure, .op = o->tonemap });
     }
     drift_image_destroy(ctx, &glared); // NULL-safe on a zero image
+    drift_image_destroy(ctx, &denoised);
     return r;
 }
 

@@ -34,6 +34,7 @@ typedef struct render_options {
     double exposure;
     drift_tonemap_operator tonemap;
     bool aov;
+    bool denoise; // --denoise atrous (reference mode)
     bool quiet;
     bool verbose;
     long debug_x, debug_y, debug_sample; // -1: not replaying a sample

@@ -79,6 +79,32 @@ for r in d["rows"][2:]:
         expect 2 "$drift" bench ism --vpls 8,,16
         grep -q -- "--vpls expects .*got '8,,16'" "$tmp/err" || fail "bench ism: bad --vpls not named"
         ;;
+    frontier)
+        # Twice: the second run must reuse the cached reference and give the same FLIP values.
+        for run in 1 2; do
+            expect 0 "$drift" bench frontier "$box" --size 12 --ref-spp 4 --runs 1 --max-spp 2 \
+                --vpls 8 --aaf-spp 1 --budgets 1,20,1000 --cache "$tmp/cache" --threads 1 \
+                --csv "$tmp/frontier.csv" --json
+            cp "$tmp/out" "$tmp/frontier$run.json"
+        done
+        check frontier 'first = json.load(open(sys.argv[1][:-3] + "frontier1.json"))
+assert first["reference_cached"] is False and d["reference_cached"] is True, (first, d)
+assert [r["flip"] for r in first["rows"] if r["family"] != "hybrid"] == \
+    [r["flip"] for r in d["rows"] if r["family"] != "hybrid"], d
+fam = [r["family"] for r in d["rows"]]
+assert fam.count("pt") == 2 and fam.count("pt+atrous") == 2 and fam.count("hybrid") >= 10, fam
+assert all(r["ms"] > 0 and 0 <= r["flip"] <= 1 and r["rmse"] >= 0 for r in d["rows"]), d
+prev = 2.0
+for f in d["front"]:
+    best = f["best"]
+    if best is None:
+        continue
+    assert best["ms"] <= f["budget_ms"] and best["flip"] <= prev, d["front"]
+    prev = best["flip"]
+    for k in ("pt", "pt_atrous", "hybrid"):
+        assert f[k] is None or (f[k]["ms"] <= f["budget_ms"] and f[k]["flip"] >= best["flip"]), f'
+        [ "$(wc -l < "$tmp/frontier.csv")" -ge 15 ] || fail "bench frontier: --csv has too few rows"
+        ;;
     *)
         fail "bench $1 has no smoke case in tests/cli/test_bench.sh"
         return

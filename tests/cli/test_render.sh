@@ -72,6 +72,25 @@ grep -q "interrupted" "$tmp/err" || fail "interrupted render did not say so"
 python3 -c "import json; s=json.load(open('$tmp/int.json')); assert 0 < s['spp'] < 100000, s" \
     || fail "interrupted stats do not show a partial spp"
 
+# --denoise atrous writes the filtered image: smoother than the plain one of the same seed,
+# closer to a converged render; a bad value is a usage error.
+for d in none atrous; do
+    expect 0 "$drift" render --spp 2 --width 32 --height 32 --threads 2 --checkpoint 0 --quiet \
+        --denoise "$d" --out "$tmp/dn-$d.exr"
+done
+expect 0 "$drift" render --spp 128 --width 32 --height 32 --threads 2 --checkpoint 0 --quiet \
+    --out "$tmp/dn-ref.exr"
+expect 0 "$drift" diff "$tmp/dn-ref.exr" "$tmp/dn-none.exr" --json
+cp "$tmp/out" "$tmp/dn-none.json"
+expect 0 "$drift" diff "$tmp/dn-ref.exr" "$tmp/dn-atrous.exr" --json
+python3 - "$tmp/dn-none.json" "$tmp/out" <<'PY' || fail "--denoise atrous does not bring the image closer"
+import json, sys
+plain, filtered = (json.load(open(p)) for p in sys.argv[1:3])
+assert filtered["flip"] < plain["flip"], (plain, filtered)
+PY
+expect 2 "$drift" render --denoise oidn --out "$tmp/never.exr"
+grep -q -- "--denoise" "$tmp/err" || fail "a bad --denoise value is not named"
+
 if [ "$failures" -ne 0 ]; then
     echo "$failures render CLI check(s) failed"
     exit 1

@@ -1,0 +1,559 @@
+// drift bench frontier: the equal-time frontier (issue 21). Every row renders the whole frame
+// and is compared with one converged path-traced image of the whole frame (all effects, max
+// depth 8, the path tracer's pixel filter): the path tracer at 1, 2, 4, ... spp, the same
+// images through the edge-avoiding a-trous filter (drift/denoise.h), and hybrid frames built
+// from the technique table (shadows x indirect, VPL counts and AAF spp swept, max depth 8).
+// Each row's milliseconds are the median of --runs renders; then, per budget, the row with
+// the lowest FLIP within it (the Pareto front) and whether a hybrid row beats both the plain
+// and the denoised path tracer there. The reference is cached as an EXR keyed by scene, size,
+// spp and max depth, so reruns reuse it. docs/frontier.md has the measured table.
+#include "bench.h"
+#include "drift/accel.h"
+#include "drift/denoise.h"
+#include "drift/hybrid.h"
+#include "drift/image_io.h"
+#include "drift/metric.h"
+#include "drift/pt.h"
+#include "drift/scene_io.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#define MAX_BUDGETS    16
+#define MAX_ROWS       256
+#define FRONTIER_DEPTH 8
+#define REF_SEED       0x5eedu
+
+typedef struct frontier_options {
+    const char *scene_path, *csv_path, *cache_dir;
+    long size, threads, ref_spp, runs, max_spp;
+    long budgets[MAX_BUDGETS], vpls[MAX_BUDGETS], aaf_spps[MAX_BUDGETS];
+    int budget_count, vpl_count, aaf_spp_count;
+    bool json;
+} frontier_options;
+
+static bool parse_budgets(const char *cmd, const char *flag, const char *value, void *field)
+{
+    frontier_options *o = field;
+    if (strcmp(flag, "--vpls") == 0) {
+        return bench_parse_list(cmd, flag, value, 1, 1 << 16, MAX_BUDGETS, o->vpls, &o->vpl_count);
+    }
+    if (strcmp(flag, "--aaf-spp") == 0) {
+        return bench_parse_list(cmd, flag, value, 1, 1024, MAX_BUDGETS, o->aaf_spps,
+                                &o->aaf_spp_count);
+    }
+    return bench_parse_list(cmd, flag, value, 1, 1000000, MAX_BUDGETS, o->budgets,
+                            &o->budget_count);
+}
+
+#define O frontier_options
+static const cli_option frontier_table[] = {
+    CLI_SECTION("options:", 0),
+    CLI_CUSTOM_ALL("--budgets", "LIST", parse_budgets,
+                   "frame budgets in ms (default 50,100,250,500,1000,2000)"),
+    CLI_CUSTOM_ALL("--vpls", "LIST", parse_budgets,
+                   "VPL counts of the ism and ir rows (default 16,64,256,1024)"),
+    CLI_CUSTOM_ALL("--aaf-spp", "LIST", parse_budgets, "spp of the AAF rows (default 1,2,4)"),
+    CLI_INT("--size", "N", O, size, 4, 4096, "N x N pixels (default 400)"),
+    CLI_INT("--threads", "T", O, threads, 0, 256, "worker threads (default 2)"),
+    CLI_INT("--ref-spp", "N", O, ref_spp, 1, 1 << 20, "reference samples a pixel (default 512)"),
+    CLI_INT("--runs", "N", O, runs, 1, 100, "renders a row, the median is its ms (default 3)"),
+    CLI_INT("--max-spp", "N", O, max_spp, 1, 1 << 16,
+            "the path tracer's largest spp (default: until a render exceeds the\n"
+            "largest budget)"),
+    CLI_STRING("--cache", "DIR", O, cache_dir, "where the reference is cached (default out)"),
+    CLI_STRING("--csv", "FILE", O, csv_path, "every row as CSV"),
+    BENCH_OPTION_JSON(O),
+};
+#undef O
+
+static const cli_command frontier_command = {
+    .name = "bench frontier",
+    .usage = "usage: drift bench frontier [SCENE] [options]\n\n"
+             "The equal-time frontier: the path tracer, the path tracer + a-trous and hybrid\n"
+             "technique combinations against one converged path-traced image of the whole\n"
+             "frame; every row's median ms, FLIP and RMSE, then per budget the lowest FLIP\n"
+             "within it. SCENE defaults to scenes/cornell-box/cornell_box.json.\n\n",
+    CLI_TABLE(frontier_table),
+    CLI_POSITIONAL("SCENE", frontier_options, scene_path, 1),
+    .help_column = 15,
+};
+
+typedef enum row_family {
+    FAMILY_PT = 0,
+    FAMILY_PT_ATROUS,
+    FAMILY_HYBRID,
+    FAMILY_COUNT
+} row_family;
+
+static const char *const family_names[FAMILY_COUNT] = { "pt", "pt+atrous", "hybrid" };
+
+typedef struct frontier_row {
+    char name[96];
+    row_family family;
+    double ms, flip, rmse;
+} frontier_row;
+
+typedef struct frontier_state {
+    drift_context *ctx;
+    const drift_scene *scene;
+    const drift_accel *accel;
+    const frontier_options *o;
+    drift_image reference;
+    frontier_row rows[MAX_ROWS];
+    int row_count;
+} frontier_state;
+
+static int compare_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median(double *v, long n)
+{
+    qsort(v, (size_t)n, sizeof *v, compare_double);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+static int compare_long(const void *a, const void *b)
+{
+    long x = *(const long *)a, y = *(const long *)b;
+    return (x > y) - (x < y);
+}
+
+static drift_pt_params pt_params(const frontier_options *o, uint32_t seed)
+{
+    return (drift_pt_params){ .width = (int32_t)o->size,
+                              .height = (int32_t)o->size,
+                              .seed = seed,
+                              .max_depth = FRONTIER_DEPTH };
+}
+
+// A copy of the first three channels of `src` into a new image.
+static drift_result copy_rgb(drift_context *ctx, const drift_image *src, drift_image *out)
+{
+    drift_result r = drift_image_create(ctx, src->width, src->height, 3, out);
+    for (int32_t y = 0; r == DRIFT_OK && y < src->height; ++y) {
+        for (int32_t x = 0; x < src->width; ++x) {
+            drift_image_set3(out, x, y, drift_image_get3(src, x, y));
+        }
+    }
+    return r;
+}
+
+// FNV-1a of the scene path: the cache key's scene part.
+static uint32_t hash_text(const char *s)
+{
+    uint32_t h = 2166136261u;
+    for (; *s; ++s) {
+        h = (h ^ (uint8_t)*s) * 16777619u;
+    }
+    return h;
+}
+
+// Loads the cached reference or renders and caches it; *cached says which.
+static drift_result reference_image(frontier_state *b, const char *scene_path, bool *cached,
+                                    char *path, size_t path_size)
+{
+    const frontier_options *o = b->o;
+    const char *base = strrchr(scene_path, '/');
+    base = base ? base + 1 : scene_path;
+    snprintf(path, path_size, "%s/frontier-ref-%.40s-%08x-%ld-%ldspp-d%d.exr", o->cache_dir, base,
+             hash_text(scene_path), o->size, o->ref_spp, FRONTIER_DEPTH);
+    drift_image loaded;
+    struct stat st;
+    if (stat(path, &st) == 0 && drift_image_load(b->ctx, path, &loaded) == DRIFT_OK) {
+        bool fits = loaded.width == o->size && loaded.height == o->size && loaded.channels >= 3;
+        drift_result r = fits ? copy_rgb(b->ctx, &loaded, &b->reference) : DRIFT_OK;
+        drift_image_destroy(b->ctx, &loaded);
+        if (fits && r == DRIFT_OK) {
+            *cached = true;
+            return DRIFT_OK;
+        }
+        drift_image_destroy(b->ctx, &b->reference);
+    }
+    *cached = false;
+    drift_pt_params params = pt_params(o, REF_SEED);
+    drift_pt *pt = NULL;
+    drift_result r = drift_pt_create(b->ctx, b->scene, b->accel, &params, &pt);
+    r = r ? r : drift_pt_render_samples(pt, (uint32_t)o->ref_spp, NULL);
+    drift_image beauty;
+    r = r ? r : drift_pt_resolve(pt, DRIFT_PT_AOV_BEAUTY, &beauty);
+    r = r ? r : copy_rgb(b->ctx, &beauty, &b->reference);
+    drift_pt_destroy(pt);
+    if (r == DRIFT_OK) {
+        if (mkdir(o->cache_dir, 0777) != 0 && errno != EEXIST) {
+            fprintf(stderr, "drift bench frontier: cannot create %s (reference not cached)\n",
+                    o->cache_dir);
+            return DRIFT_OK;
+        }
+        drift_image_layer layer = { NULL, &b->reference };
+        if (drift_image_save_exr(b->ctx, path, &layer, 1) != DRIFT_OK) {
+            fprintf(stderr, "drift bench frontier: cannot write %s (reference not cached)\n", path);
+        }
+    }
+    return r;
+}
+
+static drift_result add_row(frontier_state *b, row_family family, const char *name, double ms,
+                            const drift_image *image)
+{
+    if (b->row_count >= MAX_ROWS) {
+        return DRIFT_OK;
+    }
+    drift_metric_report rep = { 0 };
+    drift_result r =
+        drift_metric_compare(b->ctx, &b->reference, image, &(drift_metric_params){ 0 }, &rep, NULL);
+    if (r != DRIFT_OK) {
+        return r;
+    }
+    frontier_row *row = &b->rows[b->row_count++];
+    snprintf(row->name, sizeof row->name, "%s", name);
+    row->family = family;
+    row->ms = ms;
+    row->flip = rep.flip;
+    row->rmse = rep.rmse;
+    if (!b->o->json) {
+        fprintf(stderr, "  %-10s %-40s %9.1f ms  FLIP %.4f  RMSE %.4f\n", family_names[family],
+                name, ms, rep.flip, rep.rmse);
+    }
+    return DRIFT_OK;
+}
+
+// The path tracer at `spp` (median of --runs fresh renders), then the same image through the
+// a-trous filter (its ms: the render's plus the filter's median). *out_ms: the render's.
+static drift_result pt_rows(frontier_state *b, long spp, double *out_ms)
+{
+    const frontier_options *o = b->o;
+    double render_ms[100], filter_ms[100];
+    drift_result r = DRIFT_OK;
+    drift_image plain = { 0 }, denoised = { 0 };
+    for (long k = 0; k < o->runs && r == DRIFT_OK; ++k) {
+        drift_pt_params params = pt_params(o, 1u);
+        drift_pt *pt = NULL;
+        r = drift_pt_create(b->ctx, b->scene, b->accel, &params, &pt);
+        double t0 = drift_time_now();
+        r = r ? r : drift_pt_render_samples(pt, (uint32_t)spp, NULL);
+        render_ms[k] = (drift_time_now() - t0) * 1e3;
+        drift_image beauty, albedo, normal, depth;
+        r = r ? r : drift_pt_resolve(pt, DRIFT_PT_AOV_BEAUTY, &beauty);
+        r = r ? r : drift_pt_resolve(pt, DRIFT_PT_AOV_ALBEDO, &albedo);
+        r = r ? r : drift_pt_resolve(pt, DRIFT_PT_AOV_NORMAL, &normal);
+        r = r ? r : drift_pt_resolve(pt, DRIFT_PT_AOV_DEPTH, &depth);
+        drift_image_destroy(b->ctx, &denoised);
+        t0 = drift_time_now();
+        r = r ? r
+              : drift_denoise_atrous(b->ctx, &beauty, &albedo, &normal, &depth, NULL, &denoised);
+        filter_ms[k] = (drift_time_now() - t0) * 1e3;
+        drift_image_destroy(b->ctx, &plain);
+        r = r ? r : copy_rgb(b->ctx, &beauty, &plain);
+        drift_pt_destroy(pt);
+    }
+    if (r == DRIFT_OK) {
+        double ms = median(render_ms, o->runs), fms = median(filter_ms, o->runs);
+        char name[64];
+        snprintf(name, sizeof name, "%ld spp", spp);
+        r = add_row(b, FAMILY_PT, name, ms, &plain);
+        r = r ? r : add_row(b, FAMILY_PT_ATROUS, name, ms + fms, &denoised);
+        *out_ms = ms;
+    }
+    drift_image_destroy(b->ctx, &plain);
+    drift_image_destroy(b->ctx, &denoised);
+    return r;
+}
+
+static int technique_index(drift_effect effect, const char *name)
+{
+    for (int t = 0; t < drift_technique_count(effect); ++t) {
+        if (strcmp(drift_technique_name(effect, t), name) == 0) {
+            return t;
+        }
+    }
+    return -1;
+}
+
+// One hybrid frame: a warm-up render (it builds what the frame caches across frames), then
+// the median frame ms of --runs renders. *out_ms: that median (or the warm-up's when it is
+// already over twice the largest budget, and the row is then not measured further).
+static drift_result hybrid_row(frontier_state *b, const char *name,
+                               const drift_hybrid_params *params, double limit_ms)
+{
+    const frontier_options *o = b->o;
+    drift_hybrid *frame = NULL;
+    drift_result r = drift_hybrid_create(b->ctx, b->scene, b->accel, params, &frame);
+    double ms[101];
+    long n = 0;
+    r = r ? r : drift_hybrid_render(frame, &b->scene->camera, NULL);
+    if (r == DRIFT_OK && drift_hybrid_get_stats(frame).frame_ms > limit_ms) {
+        ms[n++] = drift_hybrid_get_stats(frame).frame_ms;
+    }
+    for (long k = 0; r == DRIFT_OK && n == 0 && k < o->runs; ++k) {
+        r = drift_hybrid_render(frame, &b->scene->camera, NULL);
+        ms[k] = drift_hybrid_get_stats(frame).frame_ms;
+        if (k + 1 == o->runs) {
+            n = o->runs;
+        }
+    }
+    if (r == DRIFT_OK) {
+        r = add_row(b, FAMILY_HYBRID, name, median(ms, n), drift_hybrid_image(frame));
+    }
+    drift_hybrid_destroy(frame);
+    return r;
+}
+
+// The hybrid combinations: shadows hard, pcss, aaf x indirect none, ambient, ism and ir at
+// 16..1024 VPLs, aaf; AAF rows at 1, 2 and 4 spp; max depth 8. The other effects keep the
+// technique that matches the reference: reflections none on a scene without glossy or mirror
+// materials (else aaf), depth of field none for a pinhole camera (else reference), occlusion
+// none, glare none.
+static drift_result hybrid_rows(frontier_state *b, double limit_ms)
+{
+    static const char *const shadows[] = { "hard", "pcss", "aaf" };
+    static const char *const indirect[] = { "none", "ambient", "ism", "ir", "aaf" };
+    const long *vpls = b->o->vpls, *spps = b->o->aaf_spps;
+    bool glossy = false;
+    for (uint32_t m = 0; m < b->scene->material_count; ++m) {
+        const drift_material *mat = &b->scene->materials[m];
+        glossy = glossy || !drift_vec3_is_zero(mat->specular);
+    }
+    const bool lens = b->scene->camera.aperture_radius > 0.0f;
+    drift_result r = DRIFT_OK;
+    for (size_t s = 0; s < sizeof shadows / sizeof *shadows && r == DRIFT_OK; ++s) {
+        for (size_t i = 0; i < sizeof indirect / sizeof *indirect && r == DRIFT_OK; ++i) {
+            bool vpl = strcmp(indirect[i], "ism") == 0 || strcmp(indirect[i], "ir") == 0;
+            bool aaf = strcmp(shadows[s], "aaf") == 0 || strcmp(indirect[i], "aaf") == 0;
+            size_t vpl_count = vpl ? (size_t)b->o->vpl_count : 1;
+            size_t spp_count = aaf ? (size_t)b->o->aaf_spp_count : 1;
+            for (size_t v = 0; v < vpl_count && r == DRIFT_OK; ++v) {
+                for (size_t k = 0; k < spp_count && r == DRIFT_OK; ++k) {
+                    drift_hybrid_params p = { .width = (int32_t)b->o->size,
+                                              .height = (int32_t)b->o->size,
+                                              .max_depth = FRONTIER_DEPTH,
+                                              .spp = aaf ? (uint32_t)spps[k] : 1 };
+                    drift_hybrid_params_set_technique(
+                        &p, DRIFT_EFFECT_SHADOWS,
+                        technique_index(DRIFT_EFFECT_SHADOWS, shadows[s]));
+                    drift_hybrid_params_set_technique(
+                        &p, DRIFT_EFFECT_INDIRECT,
+                        technique_index(DRIFT_EFFECT_INDIRECT, indirect[i]));
+                    if (glossy) {
+                        drift_hybrid_params_set_technique(
+                            &p, DRIFT_EFFECT_REFLECTIONS,
+                            technique_index(DRIFT_EFFECT_REFLECTIONS, "aaf"));
+                    }
+                    if (lens) {
+                        drift_hybrid_params_set_technique(
+                            &p, DRIFT_EFFECT_DOF, technique_index(DRIFT_EFFECT_DOF, "reference"));
+                    }
+                    char name[96];
+                    int len = snprintf(name, sizeof name, "%s + %s", shadows[s], indirect[i]);
+                    if (vpl) {
+                        p.ism.vpls = (uint32_t)vpls[v];
+                        len +=
+                            snprintf(name + len, sizeof name - (size_t)len, " %ld VPLs", vpls[v]);
+                    }
+                    if (aaf) {
+                        snprintf(name + len, sizeof name - (size_t)len, " %ld spp", spps[k]);
+                    }
+                    r = hybrid_row(b, name, &p, limit_ms);
+                }
+            }
+        }
+    }
+    return r;
+}
+
+// The row with the lowest FLIP among `family` (-1: any) within `budget` ms; -1 if none.
+static int best_within(const frontier_state *b, int family, double budget)
+{
+    int best = -1;
+    for (int i = 0; i < b->row_count; ++i) {
+        const frontier_row *row = &b->rows[i];
+        if (row->ms <= budget && (family < 0 || (int)row->family == family) &&
+            (best < 0 || row->flip < b->rows[best].flip)) {
+            best = i;
+        }
+    }
+    return best;
+}
+
+static void add_best(cJSON *item, const char *key, const frontier_state *b, int i)
+{
+    if (i < 0) {
+        cJSON_AddNullToObject(item, key);
+        return;
+    }
+    cJSON *o = cJSON_AddObjectToObject(item, key);
+    cJSON_AddStringToObject(o, "family", family_names[b->rows[i].family]);
+    cJSON_AddStringToObject(o, "name", b->rows[i].name);
+    cli_json_number(o, "ms", b->rows[i].ms, 2);
+    cli_json_number(o, "flip", b->rows[i].flip, 5);
+}
+
+static void print_best(const frontier_state *b, int i)
+{
+    if (i < 0) {
+        printf(" — |");
+    } else {
+        printf(" %s %s (%.0f ms, %.3f) |", family_names[b->rows[i].family], b->rows[i].name,
+               b->rows[i].ms, b->rows[i].flip);
+    }
+}
+
+// Whether the best hybrid row within the budget has a lower FLIP than the best plain and the
+// best denoised path-tracer rows within it (a family with no row there counts as beaten).
+static bool hybrid_wins(const frontier_state *b, int h, int pt, int dn)
+{
+    return h >= 0 && (pt < 0 || b->rows[h].flip < b->rows[pt].flip) &&
+           (dn < 0 || b->rows[h].flip < b->rows[dn].flip);
+}
+
+static bool write_csv(const frontier_state *b, const char *path)
+{
+    FILE *f = fopen(path, "w");
+    if (!f) {
+        fprintf(stderr, "drift bench frontier: cannot write %s\n", path);
+        return false;
+    }
+    fprintf(f, "family,name,ms,flip,rmse\n");
+    for (int i = 0; i < b->row_count; ++i) {
+        const frontier_row *row = &b->rows[i];
+        fprintf(f, "%s,%s,%.3f,%.6f,%.6f\n", family_names[row->family], row->name, row->ms,
+                row->flip, row->rmse);
+    }
+    return fclose(f) == 0;
+}
+
+int drift_bench_frontier(int argc, char **argv)
+{
+    frontier_options o = { .size = 400,
+                           .threads = 2,
+                           .ref_spp = 512,
+                           .runs = 3,
+                           .cache_dir = "out",
+                           .budgets = { 50, 100, 250, 500, 1000, 2000 },
+                           .budget_count = 6,
+                           .vpls = { 16, 64, 256, 1024 },
+                           .vpl_count = 4,
+                           .aaf_spps = { 1, 2, 4 },
+                           .aaf_spp_count = 3 };
+    int status = cli_parse(&frontier_command, argc, argv, &o, NULL);
+    if (status != CLI_PARSED) {
+        return cli_parse_exit(status);
+    }
+    qsort(o.budgets, (size_t)o.budget_count, sizeof *o.budgets, compare_long);
+    status = 1;
+    frontier_state *b = calloc(1, sizeof *b);
+    cli_session session;
+    if (!b || !bench_open(&session, "bench frontier", o.scene_path,
+                          "scenes/cornell-box/cornell_box.json", o.threads)) {
+        free(b);
+        cli_session_close(&session);
+        return 1;
+    }
+    b->ctx = session.ctx;
+    b->scene = session.scene;
+    b->accel = session.accel;
+    b->o = &o;
+    const double max_budget = (double)o.budgets[o.budget_count - 1];
+    bool cached = false;
+    char ref_path[4096];
+    double t0 = drift_time_now();
+    drift_result r = reference_image(b, session.scene_path, &cached, ref_path, sizeof ref_path);
+    double ref_s = drift_time_now() - t0;
+    if (r == DRIFT_OK && !o.json) {
+        fprintf(stderr, "drift bench frontier: reference %s (%s, %.1f s)\n", ref_path,
+                cached ? "cached" : "rendered", ref_s);
+    }
+    // The path tracer at 1, 2, 4, ... spp until a render is over the largest budget.
+    for (long spp = 1; r == DRIFT_OK; spp *= 2) {
+        double ms = 0.0;
+        r = pt_rows(b, spp, &ms);
+        if ((o.max_spp > 0 && spp * 2 > o.max_spp) || (o.max_spp == 0 && ms > max_budget) ||
+            spp >= (1 << 16)) {
+            break;
+        }
+    }
+    r = r ? r : hybrid_rows(b, 2.0 * max_budget);
+    if (r != DRIFT_OK) {
+        fprintf(stderr, "drift bench frontier: %s\n", drift_result_string(r));
+        goto done;
+    }
+    if (o.csv_path && !write_csv(b, o.csv_path)) {
+        goto done;
+    }
+    if (o.json) {
+        cJSON *root = cJSON_CreateObject();
+        cJSON_AddStringToObject(root, "scene", session.scene_path);
+        cJSON_AddNumberToObject(root, "size", (double)o.size);
+        cJSON_AddNumberToObject(root, "threads", drift_context_thread_count(b->ctx));
+        cJSON_AddNumberToObject(root, "ref_spp", (double)o.ref_spp);
+        cJSON_AddNumberToObject(root, "max_depth", FRONTIER_DEPTH);
+        cJSON_AddNumberToObject(root, "runs", (double)o.runs);
+        cJSON_AddStringToObject(root, "reference", ref_path);
+        cJSON_AddBoolToObject(root, "reference_cached", cached);
+        cJSON *rows = cJSON_AddArrayToObject(root, "rows");
+        for (int i = 0; i < b->row_count; ++i) {
+            cJSON *row = cJSON_CreateObject();
+            cJSON_AddItemToArray(rows, row);
+            cJSON_AddStringToObject(row, "family", family_names[b->rows[i].family]);
+            cJSON_AddStringToObject(row, "name", b->rows[i].name);
+            cli_json_number(row, "ms", b->rows[i].ms, 3);
+            cli_json_number(row, "flip", b->rows[i].flip, 6);
+            cli_json_number(row, "rmse", b->rows[i].rmse, 6);
+        }
+        cJSON *front = cJSON_AddArrayToObject(root, "front");
+        for (int k = 0; k < o.budget_count; ++k) {
+            double budget = (double)o.budgets[k];
+            int best = best_within(b, -1, budget), pt = best_within(b, FAMILY_PT, budget),
+                dn = best_within(b, FAMILY_PT_ATROUS, budget),
+                h = best_within(b, FAMILY_HYBRID, budget);
+            cJSON *item = cJSON_CreateObject();
+            cJSON_AddItemToArray(front, item);
+            cJSON_AddNumberToObject(item, "budget_ms", budget);
+            add_best(item, "best", b, best);
+            add_best(item, "pt", b, pt);
+            add_best(item, "pt_atrous", b, dn);
+            add_best(item, "hybrid", b, h);
+            cJSON_AddBoolToObject(item, "hybrid_beats_both", hybrid_wins(b, h, pt, dn));
+        }
+        if (!cli_json_write("bench frontier", root, NULL)) {
+            goto done;
+        }
+    } else {
+        printf("# %s at %ldx%ld, %d threads; reference %ld spp, max depth %d; median of %ld "
+               "runs\n\n",
+               session.scene_path, o.size, o.size, drift_context_thread_count(b->ctx), o.ref_spp,
+               FRONTIER_DEPTH, o.runs);
+        printf("| family | row | ms | FLIP | RMSE |\n|---|---|---|---|---|\n");
+        for (int i = 0; i < b->row_count; ++i) {
+            printf("| %s | %s | %.1f | %.4f | %.4f |\n", family_names[b->rows[i].family],
+                   b->rows[i].name, b->rows[i].ms, b->rows[i].flip, b->rows[i].rmse);
+        }
+        printf("\n| budget ms | front (lowest FLIP) | best pt | best pt+atrous | best hybrid | "
+               "hybrid beats both |\n|---|---|---|---|---|---|\n");
+        for (int k = 0; k < o.budget_count; ++k) {
+            double budget = (double)o.budgets[k];
+            int pt = best_within(b, FAMILY_PT, budget),
+                dn = best_within(b, FAMILY_PT_ATROUS, budget),
+                h = best_within(b, FAMILY_HYBRID, budget);
+            printf("| %ld |", o.budgets[k]);
+            print_best(b, best_within(b, -1, budget));
+            print_best(b, pt);
+            print_best(b, dn);
+            print_best(b, h);
+            printf(" %s |\n", hybrid_wins(b, h, pt, dn) ? "yes" : "no");
+        }
+    }
+    status = 0;
+done:
+    drift_image_destroy(b->ctx, &b->reference);
+    free(b);
+    cli_session_close(&session);
+    return status;
+}

@@ -1,0 +1,76 @@
+// drift denoise: the edge-avoiding a-trous wavelet filter (Dammertz, Sewtz, Hanika & Lensch
+// 2010, "Edge-Avoiding A-Trous Wavelet Transform for fast Global Illumination Filtering", HPG
+// 2010; the spatial filter of SVGF, Schied et al. 2017) over a noisy path-traced image, guided
+// by the first hit's albedo, normal and depth (drift_pt_resolve's AOVs).
+//
+// Each of `iterations` passes convolves with the 5x5 B3-spline kernel (1/16, 1/4, 3/8, 1/4,
+// 1/16) whose taps are 2^i pixels apart in pass i ("holes"), and multiplies each tap's kernel
+// weight by three edge-stopping weights (taps outside the image are dropped and the weights
+// renormalised):
+//   colour  exp(-|c_p - c_q|^2 / (sigma_color^2 2^-i)) on the current pass's colours (the
+//           demodulated ones when albedo is given), as Dammertz's sigma_rt halved each pass;
+//           the distance is taken relative to the pair's mean luminance, |c_p - c_q|^2 /
+//           ((lum_p + lum_q) / 2 + 1e-2)^2, so that one sigma fits dim and bright regions
+//           alike (and a black noisy pixel still mixes with its bright neighbours)
+//   normal  max(0, n_p . n_q)^sigma_normal (SVGF's form)
+//   depth   exp(-|z_p - z_q| / (sigma_depth 2^i z_p)): a relative depth difference, scaled
+//           with the tap distance so that slanted planes stay connected; a pixel whose ray
+//           missed (z = 0) only mixes with other misses
+// With albedo, the filter works on c / albedo (per channel; albedo below 1e-3 is taken as 1)
+// and multiplies the result back (Zimmer et al. 2015, SVGF §4): texture detail is kept and
+// only the lighting is smoothed. Any guide may be NULL (its weight is then 1).
+//
+//   albedo  exp(-|a_p - a_q|^2 / sigma_albedo^2): keeps texture and material edges
+// Defaults (params zeroed): iterations 5, sigma_color 1, sigma_normal 128, sigma_depth 0.1,
+// sigma_albedo 0.1, albedo demodulation on when albedo is given. sigma_color 1 is the best
+// ꟻLIP of {0.5, 1, 4, 16, no colour weight} on the Cornell box at 2 spp (docs/frontier.md):
+// without a variance estimate (SVGF's temporal part), a looser colour weight lets the
+// emitter bleed into the ceiling (the path tracer's albedo AOV does not tell them apart).
+//
+// Every output pixel is a gather over the previous pass alone, so the result is bit-identical
+// for any thread count. A constant image (with constant guides) comes back unchanged up to
+// float rounding.
+//
+// STEP BY STEP
+//   drift_image out;                                           // made by the call
+//   drift_denoise_atrous(ctx, &beauty, &albedo, &normal, &depth, NULL, &out);
+//   ... drift_image_save_exr ... drift_image_destroy(ctx, &out);
+//
+// Errors: DRIFT_ERR_INVALID_ARGUMENT (invalid colour, a guide of another size, bad params;
+// logged), DRIFT_ERR_OUT_OF_MEMORY. *out is zeroed on failure.
+// Threads: uses drift_parallel_for, so not re-entrant from inside a worker.
+#ifndef DRIFT_DENOISE_H
+#define DRIFT_DENOISE_H
+
+#include "drift/core.h"
+#include "drift/image.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct drift_denoise_params {
+    int32_t iterations; // 0 -> 5 (kernel footprint 2^(n+1)+1 pixels); at most 10
+    float sigma_color;  // 0 -> 1: relative colour distance, halved in variance each pass
+    float sigma_normal; // 0 -> 128: exponent of the normal dot product
+    float sigma_depth;
+    float sigma_albedo; // 0 -> 0.1: albedo difference (keeps emitters and texture edges)  // 0 ->
+                        // 0.1: relative depth difference per tap step
+    bool no_demodulate; // true: filter the colour as it is even when albedo is given
+    bool disable_color; // true: no colour weight (a guide-only cross-bilateral filter)
+} drift_denoise_params;
+
+drift_denoise_params drift_denoise_params_resolve(const drift_denoise_params *params);
+
+// Filters the first three channels of `color` into *out, a new 3-channel image of the same
+// size (the caller destroys it). albedo and normal are read as RGB, depth as its first channel.
+drift_result drift_denoise_atrous(drift_context *ctx, const drift_image *color,
+                                  const drift_image *albedo, const drift_image *normal,
+                                  const drift_image *depth, const drift_denoise_params *params,
+                                  drift_image *out);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif // DRIFT_DENOISE_H
