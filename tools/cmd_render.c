@@ -306,6 +306,11 @@ static int parse_options(int argc, char **argv, render_options *o)
         fprintf(stderr, "drift render: %s needs --mode hybrid\n", o->hybrid_option);
         return 2;
     }
+    if (o->hybrid_mode && o->denoise) {
+        fprintf(stderr, "drift render: --denoise atrous filters the path tracer's image; the "
+                        "hybrid frame has its own techniques (drop --mode hybrid or --denoise)\n");
+        return 2;
+    }
     if (!o->hybrid_mode && o->aov_path) {
         fprintf(stderr, "drift render: --aov FILE needs --mode hybrid (reference mode: --aov "
                         "adds layers to --out)\n");

@@ -90,6 +90,9 @@ assert filtered["flip"] < plain["flip"], (plain, filtered)
 PY
 expect 2 "$drift" render --denoise oidn --out "$tmp/never.exr"
 grep -q -- "--denoise" "$tmp/err" || fail "a bad --denoise value is not named"
+expect 2 "$drift" render --mode hybrid --denoise atrous --out "$tmp/never.exr"
+grep -q "filters the path tracer" "$tmp/err" || fail "--denoise in hybrid mode is not refused"
+[ -e "$tmp/never.exr" ] && fail "a refused render wrote its image"
 
 if [ "$failures" -ne 0 ]; then
     echo "$failures render CLI check(s) failed"
