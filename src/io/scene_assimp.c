@@ -531,6 +531,9 @@ drift_result drift__scene_import_mesh_file(drift_scene *scene, const drift__impo
 {
     drift_context *ctx = scene->ctx;
     *out_info = (drift__import_info){ 0 };
+    if (params->textures && params->textures->on_input) {
+        params->textures->on_input(params->path, params->textures->user);
+    }
     import_state s = { .scene = scene,
                        .ctx = ctx,
                        .params = params,
