@@ -546,14 +546,27 @@ int drift_cmd_render(int argc, char **argv)
     if (o.hybrid_mode && !render_refine_validate(&o)) {
         return 2;
     }
+    char png[4096];
+    render_png_path(o.out_path, png, sizeof png);
+    const cli_file outputs[] = { { "--out", o.out_path },
+                                 { "--out's PNG", png },
+                                 { "--stats", o.stats_path },
+                                 { "--aov", o.aov_path } };
+    const cli_file inputs[] = { { "--lambda", o.refine.lambda_path } };
     cli_session session;
     int exit_code = 1;
     if (cli_session_open(&(cli_session_desc){ .cmd = "render",
                                               .scene_path = o.scene_path,
                                               .threads = (int)o.threads,
-                                              .verbose = o.verbose },
+                                              .verbose = o.verbose,
+                                              .outputs = outputs,
+                                              .output_count = 4,
+                                              .inputs = inputs,
+                                              .input_count = 1 },
                          &session)) {
         exit_code = o.hybrid_mode ? render_hybrid(&o, &session) : render_reference(&o, &session);
+    } else if (session.refused) {
+        exit_code = 2;
     }
     cli_session_close(&session);
     return exit_code;
