@@ -80,7 +80,8 @@ drift_result drift__image_read_file(drift_context *ctx, const char *path, uint8_
     *out_data = NULL;
     *out_size = 0;
     char why[128];
-    int fd = open(path, O_RDONLY);
+    // O_NONBLOCK: opening a FIFO would otherwise wait for a writer; it is refused below.
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY);
     if (fd < 0) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, path, 0, "cannot open image: %s",
                   drift__errno_text(errno, why, sizeof(why)));
