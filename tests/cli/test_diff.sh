@@ -133,6 +133,16 @@ assert all(v is None or math.isfinite(v) for v in d.values()), d
 PY
 grep -q "over the 41 finite pixels" "$tmp/err" || fail "--ignore-nonfinite says what was measured"
 
+# A FIFO or a device is refused at once, as info and render do (it used to hang).
+mkfifo "$tmp/fifo.png"
+expect 1 timeout 10 "$drift" diff "$tmp/fifo.png" "$tmp/ref.png"
+grep -q "fifo.png.*not a regular file" "$tmp/err" || fail "a FIFO reference is refused by name"
+expect 1 timeout 10 "$drift" diff "$tmp/ref.png" "$tmp/fifo.png"
+grep -q "fifo.png" "$tmp/err" || fail "a FIFO test image is refused by name"
+ln -s /dev/zero "$tmp/zero.png"
+expect 1 timeout 10 "$drift" diff "$tmp/ref.png" "$tmp/zero.png"
+grep -q "not a regular file" "$tmp/err" || fail "a device is refused"
+
 if [ "$failures" -ne 0 ]; then
     echo "$failures failure(s)" >&2
     exit 1
