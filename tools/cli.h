@@ -86,6 +86,11 @@ typedef struct cli_file {
 bool cli_check_outputs(const char *cmd, const cli_file *inputs, size_t input_count,
                        const cli_file *outputs, size_t output_count);
 
+// Checks before any work that each output can be made: its folder exists and is writable
+// and the name is not a folder. Prints "drift <cmd>: cannot write <flag> 'path': <the OS
+// reason>; nothing written" for the first that cannot and returns false (exit status 1).
+bool cli_check_writable(const char *cmd, const cli_file *outputs, size_t output_count);
+
 // What a command opens: a context, and unless told otherwise the scene and its ray-tracing
 // structure. Zero is the default: all cores, the built-in Cornell box, scene and accel.
 typedef struct cli_session_desc {
@@ -98,7 +103,8 @@ typedef struct cli_session_desc {
     bool no_accel;             // the scene without its ray-tracing structure
     // The files the command will write and the other files it reads (--lambda): once the
     // scene is loaded, cli_check_outputs refuses outputs that name the scene, its mesh files
-    // or textures, an input or each other (the session then has `refused` set: exit 2).
+    // or textures, an input or each other (the session then has `refused` set: exit 2), and
+    // cli_check_writable those that cannot be made (exit 1), before the accel is built.
     const cli_file *outputs;
     size_t output_count;
     const cli_file *inputs;

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 bool cli_parse_int(const char *cmd, const char *flag, const char *text, long lo, long hi, long *out)
 {
@@ -196,6 +197,37 @@ bool cli_check_outputs(const char *cmd, const cli_file *inputs, size_t input_cou
     return true;
 }
 
+bool cli_check_writable(const char *cmd, const cli_file *outputs, size_t output_count)
+{
+    for (size_t i = 0; i < output_count; ++i) {
+        const char *path = outputs[i].path;
+        if (!path) {
+            continue;
+        }
+        const char *slash = strrchr(path, '/');
+        char dir[4096];
+        snprintf(dir, sizeof dir, "%.*s", slash ? (slash == path ? 1 : (int)(slash - path)) : 1,
+                 slash ? path : ".");
+        struct stat st;
+        const char *why = NULL;
+        if (stat(dir, &st) != 0) {
+            why = strerror(errno);
+        } else if (!S_ISDIR(st.st_mode)) {
+            why = strerror(ENOTDIR);
+        } else if (access(dir, W_OK) != 0) {
+            why = strerror(errno);
+        } else if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
+            why = strerror(EISDIR);
+        }
+        if (why) {
+            fprintf(stderr, "drift %s: cannot write %s '%s': %s; nothing written\n", cmd,
+                    outputs[i].flag, path, why);
+            return false;
+        }
+    }
+    return true;
+}
+
 static void note_scene_input(const char *path, void *user)
 {
     cli_session *s = user;
@@ -240,7 +272,7 @@ static bool check_session_outputs(const cli_session_desc *desc, cli_session *s)
     bool ok = cli_check_outputs(desc->cmd, inputs, count, desc->outputs, desc->output_count);
     free(inputs);
     s->refused = !ok;
-    return ok;
+    return ok && cli_check_writable(desc->cmd, desc->outputs, desc->output_count);
 }
 
 static drift_context *open_context(const char *cmd, int threads, bool verbose)

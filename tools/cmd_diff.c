@@ -111,8 +111,12 @@ int drift_cmd_diff(int argc, char **argv)
     const char *paths[2] = { o.paths[0], o.paths[1] };
     const char *heatmap_path = o.heatmap_path;
     const cli_file inputs[2] = { { "REF", paths[0] }, { "TEST", paths[1] } };
-    if (!cli_check_outputs("diff", inputs, 2, &(cli_file){ "--heatmap", heatmap_path }, 1)) {
+    const cli_file heatmap = { "--heatmap", heatmap_path };
+    if (!cli_check_outputs("diff", inputs, 2, &heatmap, 1)) {
         return 2;
+    }
+    if (!cli_check_writable("diff", &heatmap, 1)) {
+        return 1;
     }
     cli_session session;
     if (!cli_session_open(

@@ -560,7 +560,7 @@ int drift_cmd_render(int argc, char **argv)
                                               .threads = (int)o.threads,
                                               .verbose = o.verbose,
                                               .outputs = outputs,
-                                              .output_count = 4,
+                                              .output_count = o.debug_sample >= 0 ? 0 : 4,
                                               .inputs = inputs,
                                               .input_count = 1 },
                          &session)) {
