@@ -143,6 +143,30 @@ ln -s /dev/zero "$tmp/zero.png"
 expect 1 timeout 10 "$drift" diff "$tmp/ref.png" "$tmp/zero.png"
 grep -q "not a regular file" "$tmp/err" || fail "a device is refused"
 
+# A truncated .hdr is an error naming the file (stb_image decoded it without one, or looped).
+python3 - "$tmp" <<'PY'
+import sys
+def hdr(path, w, h, rle, cut=0):
+    out = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n" + ("-Y %d +X %d\n" % (h, w)).encode()
+    for y in range(h):
+        if rle:
+            out += bytes([2, 2, w >> 8, w & 255]) + bytes([128 + w, 128] * 3 + [128 + w, 129])
+        else:
+            out += bytes([128, 128, 128, 129]) * w
+    open(path, "wb").write(out[:len(out) - cut])
+d = sys.argv[1]
+hdr(d + "/flat.hdr", 4, 4, False)
+hdr(d + "/flat_cut.hdr", 4, 4, False, 5)
+hdr(d + "/rle.hdr", 16, 4, True)
+hdr(d + "/rle_cut.hdr", 16, 4, True, 3)
+PY
+expect 0 timeout 20 "$drift" diff "$tmp/flat.hdr" "$tmp/flat.hdr"
+expect 0 timeout 20 "$drift" diff "$tmp/rle.hdr" "$tmp/rle.hdr"
+for cut in flat_cut rle_cut; do
+    expect 1 timeout 20 "$drift" diff "$tmp/$cut.hdr" "$tmp/$cut.hdr"
+    grep -q "$cut.hdr.*truncated" "$tmp/err" || fail "truncated $cut.hdr is named"
+done
+
 if [ "$failures" -ne 0 ]; then
     echo "$failures failure(s)" >&2
     exit 1
