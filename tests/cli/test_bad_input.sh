@@ -121,6 +121,11 @@ expect_line cut_gz.obj.gz 7
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n# no newline' >"$dir/no_newline.obj"
 "$drift" info "$dir/no_newline.obj" >/dev/null 2>&1 || fail "an OBJ ending in a comment loads"
 
+# A FIFO named as a scene is refused at once, not read forever.
+mkfifo "$dir/fifo.json"
+timeout 10 "$drift" info "$dir/fifo.json" >"$dir/out" 2>"$dir/err"
+[ $? -eq 1 ] && grep -q "fifo.json" "$dir/err" || fail "a FIFO scene is refused at once by name"
+
 if [ "$failures" -ne 0 ]; then
     echo "$failures failure(s)" >&2
     exit 1
