@@ -71,6 +71,26 @@ drift_logger cli_stderr_logger(bool verbose);
 // Directory of the built-in default scene (the repository's scenes/ folder).
 const char *cli_default_scene_path(void);
 
+// A file a command reads or writes, and the option (or argument) that named it.
+typedef struct cli_file {
+    const char *flag; // "--stats", "SCENE", "the scene's texture"
+    const char *path;
+} cli_file;
+
+// Refuses to write over an input: fails unless every output is a different file from every
+// input and from every other output. Files are compared by identity, not by spelling: the
+// device and inode of a file that exists (hard links, symbolic links and "./x" are the same
+// file), else those of the folder it would be made in plus its name. Prints "drift <cmd>:
+// <flag> 'path' is <flag> 'path'; nothing written" for the first clash and returns false
+// (the caller exits with status 2). NULL paths are skipped.
+bool cli_check_outputs(const char *cmd, const cli_file *inputs, size_t input_count,
+                       const cli_file *outputs, size_t output_count);
+
+// Checks before any work that each output can be made: its folder exists and is writable
+// and the name is not a folder. Prints "drift <cmd>: cannot write <flag> 'path': <the OS
+// reason>; nothing written" for the first that cannot and returns false (exit status 1).
+bool cli_check_writable(const char *cmd, const cli_file *outputs, size_t output_count);
+
 // What a command opens: a context, and unless told otherwise the scene and its ray-tracing
 // structure. Zero is the default: all cores, the built-in Cornell box, scene and accel.
 typedef struct cli_session_desc {
@@ -81,6 +101,14 @@ typedef struct cli_session_desc {
     bool verbose;              // info-level log messages too
     bool no_scene;             // the context only (load scenes later with cli_session_load)
     bool no_accel;             // the scene without its ray-tracing structure
+    // The files the command will write and the other files it reads (--lambda): once the
+    // scene is loaded, cli_check_outputs refuses outputs that name the scene, its mesh files
+    // or textures, an input or each other (the session then has `refused` set: exit 2), and
+    // cli_check_writable those that cannot be made (exit 1), before the accel is built.
+    const cli_file *outputs;
+    size_t output_count;
+    const cli_file *inputs;
+    size_t input_count;
 } cli_session_desc;
 
 struct drift_scene;
@@ -94,6 +122,9 @@ typedef struct cli_session {
     double t_start;         // drift_time_now() at open, after loading and after the accel:
     double t_loaded;        // for phase timings
     double t_built;
+    bool refused;        // an output names an input (cli_session_desc's outputs): exit status 2
+    char **scene_inputs; // the files the scene load read (drift_scene_load_inputs)
+    size_t scene_input_count;
     char path[4096];
 } cli_session;
 

@@ -7,6 +7,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 bool cli_parse_int(const char *cmd, const char *flag, const char *text, long lo, long hi, long *out)
 {
@@ -123,6 +125,156 @@ const char *cli_default_scene_path(void)
     return env && *env ? env : DRIFT_SOURCE_DIR "/scenes/cornell-box/cornell_box.json";
 }
 
+// A file's identity: its device and inode when it exists; else the folder's it would be
+// made in and its name. `known` is false when neither can be found (the path is compared as
+// text then).
+typedef struct file_key {
+    bool known, exists;
+    dev_t dev;
+    ino_t ino;
+    const char *name; // !exists: the name in the folder
+} file_key;
+
+static file_key file_key_of(const char *path)
+{
+    file_key k = { 0 };
+    struct stat st;
+    if (stat(path, &st) == 0) {
+        return (file_key){ .known = true, .exists = true, .dev = st.st_dev, .ino = st.st_ino };
+    }
+    const char *slash = strrchr(path, '/');
+    char dir[4096];
+    if (!slash) {
+        snprintf(dir, sizeof dir, ".");
+    } else {
+        snprintf(dir, sizeof dir, "%.*s", slash == path ? 1 : (int)(slash - path), path);
+    }
+    if (stat(dir, &st) == 0) {
+        k = (file_key){ .known = true, .dev = st.st_dev, .ino = st.st_ino };
+        k.name = slash ? slash + 1 : path;
+    }
+    return k;
+}
+
+static bool same_file(const char *a, const char *b)
+{
+    file_key ka = file_key_of(a), kb = file_key_of(b);
+    if (!ka.known || !kb.known) {
+        return strcmp(a, b) == 0;
+    }
+    if (ka.exists != kb.exists || ka.dev != kb.dev || ka.ino != kb.ino) {
+        return false;
+    }
+    return ka.exists || strcmp(ka.name, kb.name) == 0;
+}
+
+bool cli_check_outputs(const char *cmd, const cli_file *inputs, size_t input_count,
+                       const cli_file *outputs, size_t output_count)
+{
+    for (size_t i = 0; i < output_count; ++i) {
+        const cli_file *out = &outputs[i];
+        if (!out->path) {
+            continue;
+        }
+        for (size_t j = 0; j < input_count; ++j) {
+            if (inputs[j].path && same_file(out->path, inputs[j].path)) {
+                fprintf(stderr,
+                        "drift %s: %s '%s' is the input %s '%s'; refusing to overwrite it, "
+                        "nothing written\n",
+                        cmd, out->flag, out->path, inputs[j].flag, inputs[j].path);
+                return false;
+            }
+        }
+        for (size_t j = 0; j < i; ++j) {
+            if (outputs[j].path && same_file(out->path, outputs[j].path)) {
+                fprintf(stderr,
+                        "drift %s: %s '%s' and %s '%s' are the same file; nothing written\n", cmd,
+                        outputs[j].flag, outputs[j].path, out->flag, out->path);
+                return false;
+            }
+        }
+    }
+    return true;
+}
+
+bool cli_check_writable(const char *cmd, const cli_file *outputs, size_t output_count)
+{
+    for (size_t i = 0; i < output_count; ++i) {
+        const char *path = outputs[i].path;
+        if (!path) {
+            continue;
+        }
+        const char *slash = strrchr(path, '/');
+        char dir[4096];
+        snprintf(dir, sizeof dir, "%.*s", slash ? (slash == path ? 1 : (int)(slash - path)) : 1,
+                 slash ? path : ".");
+        struct stat st;
+        const char *why = NULL;
+        if (stat(dir, &st) != 0) {
+            why = strerror(errno);
+        } else if (!S_ISDIR(st.st_mode)) {
+            why = strerror(ENOTDIR);
+        } else if (access(dir, W_OK) != 0) {
+            why = strerror(errno);
+        } else if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
+            why = strerror(EISDIR);
+        }
+        if (why) {
+            fprintf(stderr, "drift %s: cannot write %s '%s': %s; nothing written\n", cmd,
+                    outputs[i].flag, path, why);
+            return false;
+        }
+    }
+    return true;
+}
+
+static void note_scene_input(const char *path, void *user)
+{
+    cli_session *s = user;
+    char **grown = realloc(s->scene_inputs, (s->scene_input_count + 1) * sizeof *grown);
+    char *copy = strdup(path);
+    if (!grown || !copy) {
+        free(copy);
+        if (grown) {
+            s->scene_inputs = grown;
+        }
+        return;
+    }
+    s->scene_inputs = grown;
+    s->scene_inputs[s->scene_input_count++] = copy;
+}
+
+static void free_scene_inputs(cli_session *s)
+{
+    for (size_t i = 0; i < s->scene_input_count; ++i) {
+        free(s->scene_inputs[i]);
+    }
+    free(s->scene_inputs);
+    s->scene_inputs = NULL;
+    s->scene_input_count = 0;
+}
+
+// The session's outputs against the scene's files and the other inputs (cli_session_desc).
+static bool check_session_outputs(const cli_session_desc *desc, cli_session *s)
+{
+    size_t count = s->scene_input_count + desc->input_count;
+    cli_file *inputs = calloc(count ? count : 1, sizeof *inputs);
+    if (!inputs) {
+        fprintf(stderr, "drift %s: out of memory\n", desc->cmd);
+        return false;
+    }
+    for (size_t i = 0; i < s->scene_input_count; ++i) {
+        inputs[i] = (cli_file){ i == 0 ? "SCENE" : "file the scene reads", s->scene_inputs[i] };
+    }
+    for (size_t i = 0; i < desc->input_count; ++i) {
+        inputs[s->scene_input_count + i] = desc->inputs[i];
+    }
+    bool ok = cli_check_outputs(desc->cmd, inputs, count, desc->outputs, desc->output_count);
+    free(inputs);
+    s->refused = !ok;
+    return ok && cli_check_writable(desc->cmd, desc->outputs, desc->output_count);
+}
+
 static drift_context *open_context(const char *cmd, int threads, bool verbose)
 {
     drift_context *ctx = NULL;
@@ -136,6 +288,18 @@ static drift_context *open_context(const char *cmd, int threads, bool verbose)
     return ctx;
 }
 
+static bool build_accel(cli_session *s, const char *cmd)
+{
+    drift_result r = drift_accel_create(s->ctx, s->scene, &(drift_accel_desc){ 0 }, &s->accel);
+    if (r != DRIFT_OK) {
+        fprintf(stderr, "drift %s: cannot build the ray-tracing structure: %s\n", cmd,
+                drift_result_string(r));
+        return false;
+    }
+    s->t_built = drift_time_now();
+    return true;
+}
+
 bool cli_session_load(cli_session *s, const char *cmd, const char *path, bool no_accel)
 {
     drift_accel_destroy(s->accel);
@@ -144,23 +308,15 @@ bool cli_session_load(cli_session *s, const char *cmd, const char *path, bool no
     s->scene = NULL;
     snprintf(s->path, sizeof s->path, "%s", path);
     s->scene_path = s->path;
-    drift_result r = drift_scene_load(s->ctx, s->path, &s->scene);
+    free_scene_inputs(s);
+    drift_result r = drift_scene_load_inputs(s->ctx, s->path, note_scene_input, s, &s->scene);
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift %s: cannot load scene %s: %s\n", cmd, s->path,
                 drift_result_string(r));
         return false;
     }
     s->t_loaded = drift_time_now();
-    if (!no_accel) {
-        r = drift_accel_create(s->ctx, s->scene, &(drift_accel_desc){ 0 }, &s->accel);
-        if (r != DRIFT_OK) {
-            fprintf(stderr, "drift %s: cannot build the ray-tracing structure: %s\n", cmd,
-                    drift_result_string(r));
-            return false;
-        }
-    }
-    s->t_built = drift_time_now();
-    return true;
+    return no_accel ? (s->t_built = drift_time_now(), true) : build_accel(s, cmd);
 }
 
 bool cli_session_open(const cli_session_desc *desc, cli_session *s)
@@ -176,6 +332,11 @@ bool cli_session_open(const cli_session_desc *desc, cli_session *s)
     const char *path = desc->scene_path      ? desc->scene_path
                        : desc->default_scene ? desc->default_scene
                                              : cli_default_scene_path();
+    if (desc->output_count > 0 || desc->input_count > 0) {
+        // The files are known once the scene is read; the accel waits for the check.
+        return cli_session_load(s, desc->cmd, path, true) && check_session_outputs(desc, s) &&
+               (desc->no_accel || build_accel(s, desc->cmd));
+    }
     return cli_session_load(s, desc->cmd, path, desc->no_accel);
 }
 
@@ -184,6 +345,7 @@ void cli_session_close(cli_session *s)
     drift_accel_destroy(s->accel);
     drift_scene_destroy(s->scene);
     drift_context_destroy(s->ctx);
+    free_scene_inputs(s);
     *s = (cli_session){ 0 };
 }
 

@@ -1,6 +1,7 @@
 // The JSON writer of the drift CLI (tools/cli_json.h).
 #include "cli_json.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -93,22 +94,32 @@ static bool print_item(FILE *out, const cJSON *item, int indent, int depth)
 bool cli_json_write(const char *cmd, cJSON *root, const char *path)
 {
     bool ok = root != NULL;
+    int error = 0;
     if (ok && !path) {
         ok = print_item(stdout, root, -1, 0) && fputc('\n', stdout) != EOF && fflush(stdout) == 0;
     } else if (ok) {
         char tmp[4096];
         snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid());
+        errno = 0;
         FILE *f = fopen(tmp, "w");
-        ok = f && print_item(f, root, 2, 0) && fputc('\n', f) != EOF;
-        ok = (f && fclose(f) == 0) && ok;
-        if (!ok || rename(tmp, path) != 0) {
-            remove(tmp);
+        ok = f && print_item(f, root, 2, 0) && fputc('\n', f) != EOF && fflush(f) == 0;
+        error = ok ? 0 : errno;
+        if (f && fclose(f) != 0 && ok) {
             ok = false;
+            error = errno;
+        }
+        if (ok && rename(tmp, path) != 0) {
+            ok = false;
+            error = errno;
+        }
+        if (!ok) {
+            remove(tmp);
         }
     }
     cJSON_Delete(root);
     if (!ok) {
-        fprintf(stderr, "drift %s: cannot write %s\n", cmd, path ? path : "JSON to stdout");
+        fprintf(stderr, "drift %s: cannot write %s%s%s\n", cmd, path ? path : "JSON to stdout",
+                error ? ": " : "", error ? strerror(error) : "");
     }
     return ok;
 }

@@ -12,7 +12,7 @@
 typedef struct diff_options {
     const char *paths[2]; // REF TEST
     const char *heatmap_path;
-    bool json, verbose;
+    bool json, verbose, ignore_nonfinite;
     double difftol; // < 0: none
     double ppd;     // 0: DRIFT_METRIC_DEFAULT_PPD
 } diff_options;
@@ -24,7 +24,11 @@ static const cli_option diff_table[] = {
                "write the per-pixel FLIP error as a magma heat map"),
     CLI_FLAG("--json", O, json,
              "print {\"mse\":..,\"rmse\":..,\"relmse\":..,\"psnr\":..,\n"
-             "\"ssim\":..,\"flip\":..}; psnr is null for identical images"),
+             "\"ssim\":..,\"flip\":..,\"nonfinite\":..}; psnr is null for identical\n"
+             "images"),
+    CLI_FLAG("--ignore-nonfinite", O, ignore_nonfinite,
+             "accept NaN or infinite pixels (exit 0): the metrics are over the\n"
+             "finite pixels (without it such pixels make the exit status 1)"),
     CLI_NUMBER("--difftol", "X", O, difftol, 0.0, 1.0, "exit with status 1 when FLIP > X"),
     CLI_NUMBER("--ppd", "P", O, ppd, 1.0, 2000.0,
                "FLIP pixels per degree (default " CLI_STR(DRIFT_METRIC_DEFAULT_PPD) ")"),
@@ -37,9 +41,12 @@ static const cli_command diff_command = {
     .usage = "usage: drift diff REF TEST [options]\n"
              "\n"
              "Compares TEST against the reference REF (.exr, .png, .jpg, .jpeg, .hdr; same size)\n"
-             "and prints one line per metric: mse, rmse, relmse, psnr (dB, peak 1.0), ssim, flip.\n"
+             "and prints one line per metric: mse, rmse, relmse, psnr (dB, peak 1.0), ssim, flip,\n"
+             "and nonfinite: the pixels that are NaN or infinite in either image.\n"
              "\n",
-    .epilogue = "\nexit status: 0 ok, 1 error or FLIP over --difftol, 2 usage error\n",
+    .epilogue =
+        "\nexit status: 0 ok, 1 error, FLIP over --difftol or NaN/infinite pixels (without\n"
+        "--ignore-nonfinite), 2 usage error\n",
     CLI_TABLE(diff_table),
     CLI_POSITIONAL("REF TEST", diff_options, paths, 2),
     .help_column = 22,
@@ -52,6 +59,42 @@ static void print_number(const char *key, double v)
     } else {
         printf("%-7s %.9g\n", key, v);
     }
+}
+
+static bool pixel_finite(const drift_image *img, int32_t x, int32_t y)
+{
+    const float *p = drift_image_pixel(img, x, y);
+    for (int32_t c = 0; c < img->channels; ++c) {
+        if (!isfinite(p[c])) {
+            return false;
+        }
+    }
+    return true;
+}
+
+static void pixel_zero(drift_image *img, int32_t x, int32_t y)
+{
+    float *p = drift_image_pixel(img, x, y);
+    for (int32_t c = 0; c < img->channels; ++c) {
+        p[c] = 0.0f;
+    }
+}
+
+// Sets the pixels that are NaN or infinite in either image to 0 in both (they then add no
+// error) and returns how many there were.
+static size_t mask_nonfinite(drift_image *a, drift_image *b)
+{
+    size_t count = 0;
+    for (int32_t y = 0; y < a->height; ++y) {
+        for (int32_t x = 0; x < a->width; ++x) {
+            if (!pixel_finite(a, x, y) || !pixel_finite(b, x, y)) {
+                pixel_zero(a, x, y);
+                pixel_zero(b, x, y);
+                ++count;
+            }
+        }
+    }
+    return count;
 }
 
 int drift_cmd_diff(int argc, char **argv)
@@ -67,6 +110,14 @@ int drift_cmd_diff(int argc, char **argv)
     }
     const char *paths[2] = { o.paths[0], o.paths[1] };
     const char *heatmap_path = o.heatmap_path;
+    const cli_file inputs[2] = { { "REF", paths[0] }, { "TEST", paths[1] } };
+    const cli_file heatmap = { "--heatmap", heatmap_path };
+    if (!cli_check_outputs("diff", inputs, 2, &heatmap, 1)) {
+        return 2;
+    }
+    if (!cli_check_writable("diff", &heatmap, 1)) {
+        return 1;
+    }
     cli_session session;
     if (!cli_session_open(
             &(cli_session_desc){ .cmd = "diff", .verbose = o.verbose, .no_scene = true },
@@ -94,11 +145,32 @@ int drift_cmd_diff(int argc, char **argv)
                 ref.width, ref.height, paths[1], test.width, test.height);
         goto done;
     }
+    size_t pixels = (size_t)ref.width * (size_t)ref.height;
+    size_t nonfinite = mask_nonfinite(&ref, &test);
+    if (nonfinite == pixels) {
+        fprintf(stderr, "drift diff: every pixel of '%s' or '%s' is NaN or infinite\n", paths[0],
+                paths[1]);
+        goto done;
+    }
     r = drift_metric_compare(ctx, &ref, &test, &(drift_metric_params){ .ppd = o.ppd }, &rep,
                              heatmap_path ? &flip_map : NULL);
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift diff: %s\n", drift_result_string(r));
         goto done;
+    }
+    if (nonfinite > 0) {
+        // The masked pixels added no error: MSE and relMSE are means over the finite ones.
+        double scale = (double)pixels / (double)(pixels - nonfinite);
+        rep.mse *= scale;
+        rep.relmse *= scale;
+        rep.rmse = sqrt(rep.mse);
+        rep.psnr = rep.mse > 0.0 ? 10.0 * log10(1.0 / rep.mse) : HUGE_VAL;
+        fprintf(stderr,
+                "drift diff: %zu of %zu pixels are NaN or infinite in '%s' or '%s'; the metrics "
+                "are over the %zu finite pixels (ssim and flip with the others set to 0 in "
+                "both)%s\n",
+                nonfinite, pixels, paths[0], paths[1], pixels - nonfinite,
+                o.ignore_nonfinite ? "" : "; exit status 1 (--ignore-nonfinite accepts them)");
     }
     if (heatmap_path) {
         r = drift_metric_flip_heatmap(ctx, &flip_map, &heat);
@@ -121,11 +193,16 @@ int drift_cmd_diff(int argc, char **argv)
             print_number(keys[k], values[k]);
         }
     }
+    if (root) {
+        cli_json_count(root, "nonfinite", nonfinite);
+    } else {
+        printf("%-7s %zu\n", "nonfinite", nonfinite);
+    }
     if (root && !cli_json_write("diff", root, NULL)) {
         goto done;
     }
-    status = 0;
-    if (o.difftol >= 0.0 && rep.flip > o.difftol) {
+    status = nonfinite > 0 && !o.ignore_nonfinite ? 1 : 0;
+    if (status == 0 && o.difftol >= 0.0 && rep.flip > o.difftol) {
         fprintf(stderr, "drift diff: FLIP %.6f exceeds --difftol %g\n", rep.flip, o.difftol);
         status = 1;
     }

@@ -220,6 +220,28 @@ static bool folder_writable(const char *path)
     return access(len ? dir : "/", W_OK) == 0;
 }
 
+// Every frame's outputs against its input and each other (cli_check_outputs).
+static bool check_frame_outputs(const glare_args *a, const char *out_name)
+{
+    char bufs[4][4096];
+    bool patterned = strchr(a->in, '%') || strchr(out_name, '%') ||
+                     (a->psf && strchr(a->psf, '%')) || (a->aperture && strchr(a->aperture, '%'));
+    for (long f = 0; f < (patterned ? a->frames : 1); ++f) {
+        const cli_file in = { "IN", frame_name(bufs[0], sizeof bufs[0], a->in, f) };
+        const cli_file outs[3] = {
+            { a->out ? "--out" : "--out-pattern",
+              frame_name(bufs[1], sizeof bufs[1], out_name, f) },
+            { "--psf", a->psf ? frame_name(bufs[2], sizeof bufs[2], a->psf, f) : NULL },
+            { "--aperture",
+              a->aperture ? frame_name(bufs[3], sizeof bufs[3], a->aperture, f) : NULL },
+        };
+        if (!cli_check_outputs("glare", &in, 1, outs, 3)) {
+            return false;
+        }
+    }
+    return true;
+}
+
 static drift_result save_image(drift_context *ctx, const char *path, const drift_image *img,
                                double exposure)
 {
@@ -286,6 +308,9 @@ int drift_cmd_glare(int argc, char **argv)
         }
     }
     const char *outputs[3] = { out_name, a.psf, a.aperture };
+    if (!check_frame_outputs(&a, out_name)) {
+        return 2;
+    }
     for (int i = 0; i < 3; ++i) {
         if (outputs[i] && !folder_writable(outputs[i])) {
             fprintf(stderr, "drift glare: cannot write '%s': its folder is missing or read-only\n",

@@ -18,19 +18,26 @@
 #include <string.h>
 #include <unistd.h>
 
-// Set from the SIGINT handler; the render loop polls it between tiles.
+// Set from the SIGINT and SIGTERM handler; the render loop polls it between tiles.
 static atomic_bool interrupted;
+static volatile sig_atomic_t interrupt_signal;
 
 static void on_sigint(int sig)
 {
-    (void)sig;
+    interrupt_signal = sig;
     atomic_store(&interrupted, true);
 }
 
 const atomic_bool *render_catch_sigint(void)
 {
     signal(SIGINT, on_sigint);
+    signal(SIGTERM, on_sigint); // schedulers and mpirun stop jobs with SIGTERM
     return &interrupted;
+}
+
+int render_interrupt_status(void)
+{
+    return 128 + (interrupt_signal ? (int)interrupt_signal : SIGINT);
 }
 
 // --- OPTIONS ---
@@ -251,7 +258,8 @@ static const cli_command render_command = {
         "Renders SCENE (a drift .json scene, or .obj/.gltf/.glb/.ply[.gz]); without SCENE, the\n"
         "built-in Cornell box. Writes a linear EXR and a tone-mapped sRGB PNG beside it.\n"
         "\n",
-    .epilogue = "\nCtrl-C stops the render and writes what it has.\n",
+    .epilogue = "\nCtrl-C (or SIGTERM) stops the render and writes what it has: exit status 130\n"
+                "(143 after SIGTERM).\n",
     CLI_TABLE(render_table),
     CLI_POSITIONAL("SCENE", render_options, scene_path, 1),
 };
@@ -563,7 +571,7 @@ static int render_reference(const render_options *o, const cli_session *session)
     printf("wrote %s and %s (%u spp, %dx%d) in %.2f s (render %.2f s)\n", o->out_path, png,
            drift_pt_sample_count(pt), params.width, params.height, t_written - session->t_start,
            t_rendered - t_render);
-    exit_code = cancelled ? 130 : 0;
+    exit_code = cancelled ? render_interrupt_status() : 0;
 
 done:
     drift_pt_destroy(pt);
@@ -580,14 +588,27 @@ int drift_cmd_render(int argc, char **argv)
     if (o.hybrid_mode && !render_refine_validate(&o)) {
         return 2;
     }
+    char png[4096];
+    render_png_path(o.out_path, png, sizeof png);
+    const cli_file outputs[] = { { "--out", o.out_path },
+                                 { "--out's PNG", png },
+                                 { "--stats", o.stats_path },
+                                 { "--aov", o.aov_path } };
+    const cli_file inputs[] = { { "--lambda", o.refine.lambda_path } };
     cli_session session;
     int exit_code = 1;
     if (cli_session_open(&(cli_session_desc){ .cmd = "render",
                                               .scene_path = o.scene_path,
                                               .threads = (int)o.threads,
-                                              .verbose = o.verbose },
+                                              .verbose = o.verbose,
+                                              .outputs = outputs,
+                                              .output_count = o.debug_sample >= 0 ? 0 : 4,
+                                              .inputs = inputs,
+                                              .input_count = 1 },
                          &session)) {
         exit_code = o.hybrid_mode ? render_hybrid(&o, &session) : render_reference(&o, &session);
+    } else if (session.refused) {
+        exit_code = 2;
     }
     cli_session_close(&session);
     return exit_code;

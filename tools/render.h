@@ -72,7 +72,9 @@ drift_result render_write_aov(drift_context *ctx, const char *path,
 // FILE.exr -> FILE.png
 void render_png_path(const char *exr_path, char *out, size_t size);
 
-// Installs the Ctrl-C handler; the flag it returns becomes true on SIGINT.
+// Installs the Ctrl-C handler; the flag it returns becomes true on SIGINT or SIGTERM.
 const atomic_bool *render_catch_sigint(void);
+// The exit status of an interrupted run: 128 + the signal (130 SIGINT, 143 SIGTERM).
+int render_interrupt_status(void);
 
 #endif

@@ -160,7 +160,7 @@ int render_hybrid(const render_options *o, const cli_session *session)
     if (r == DRIFT_ERR_CANCELLED) {
         fprintf(stderr, "drift render: interrupted; a hybrid frame is all or nothing, nothing "
                         "written\n");
-        exit_code = 130;
+        exit_code = render_interrupt_status();
         goto done;
     }
     if (r != DRIFT_OK) {

@@ -124,7 +124,7 @@ int render_refine_run(const render_options *o, const cli_session *session, drift
            (unsigned long long)s.refined, (unsigned long long)s.requested, s.iterations,
            (unsigned long long)s.samples, (unsigned long long)s.rays,
            drift_hybrid_get_stats(frame).frame_ms, refine_ms);
-    exit_code = r == DRIFT_ERR_CANCELLED ? 130 : 0;
+    exit_code = r == DRIFT_ERR_CANCELLED ? render_interrupt_status() : 0;
 done:
     drift_refine_destroy(sir);
     return exit_code;

@@ -46,6 +46,16 @@ extern "C" {
 // .gltf, .glb, .ply, or one of those followed by .gz. Returns a committed scene.
 drift_result drift_scene_load(drift_context *ctx, const char *path, drift_scene **out_scene);
 
+// A file a scene load reads: the scene file, then each mesh file and texture it names, once
+// a path, as the loader opens them (drift render refuses outputs that name one of them).
+typedef void (*drift_scene_input_fn)(const char *path, void *user);
+
+// drift_scene_load that also calls on_input(path, user) for each file it reads (on_input may
+// be NULL). Paths are as the loader opened them (joined to the scene file's folder).
+drift_result drift_scene_load_inputs(drift_context *ctx, const char *path,
+                                     drift_scene_input_fn on_input, void *user,
+                                     drift_scene **out_scene);
+
 // Parses a drift scene file from memory. `text` need not be NUL-terminated. Paths in the
 // file are relative to `base_dir` (NULL: the current directory). `name_for_messages` names
 // the text in log messages (NULL: "<memory>"). Returns a committed scene.

@@ -80,7 +80,8 @@ drift_result drift__image_read_file(drift_context *ctx, const char *path, uint8_
     *out_data = NULL;
     *out_size = 0;
     char why[128];
-    int fd = open(path, O_RDONLY);
+    // O_NONBLOCK: opening a FIFO would otherwise wait for a writer; it is refused below.
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY);
     if (fd < 0) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, path, 0, "cannot open image: %s",
                   drift__errno_text(errno, why, sizeof(why)));
@@ -200,6 +201,69 @@ drift_result drift__image_temp_close(drift_context *ctx, drift__image_temp *t, d
 
 // --- STB BACK END (PNG, JPEG, HDR) ---
 
+// Whether a Radiance HDR file holds all the scanlines its header promises: stb_image decodes
+// a cut file without complaint (the rest comes out black). Walks the header (lines up to an
+// empty one), the resolution line and each scanline, flat (4 bytes a pixel) or new-style
+// RLE (2, 2, width; then per channel runs of a repeated byte (count > 128) or literals).
+static bool hdr_is_complete(const uint8_t *data, size_t size, int width)
+{
+    size_t at = 0;
+    int height = 0, w = 0;
+    bool blank = false;
+    while (!blank) { // header lines
+        size_t start = at;
+        while (at < size && data[at] != '\n') {
+            ++at;
+        }
+        if (at++ >= size) {
+            return false;
+        }
+        blank = at - start == 1;
+    }
+    char res[64];
+    size_t n = 0;
+    while (at < size && data[at] != '\n' && n + 1 < sizeof res) {
+        res[n++] = (char)data[at++];
+    }
+    res[n] = '\0';
+    if (at++ >= size || sscanf(res, "-Y %d +X %d", &height, &w) != 2 || w != width) {
+        return true; // a layout stb_image reads otherwise: leave it to the decoder
+    }
+    for (int y = 0; y < height; ++y) {
+        bool rle = width >= 8 && width < 32768 && at + 4 <= size && data[at] == 2 &&
+                   data[at + 1] == 2 && !(data[at + 2] & 0x80) &&
+                   ((int)data[at + 2] << 8 | data[at + 3]) == width;
+        if (!rle) {
+            if (size - at < (size_t)width * 4) {
+                return false;
+            }
+            at += (size_t)width * 4;
+            continue;
+        }
+        at += 4;
+        for (int c = 0; c < 4; ++c) {
+            for (int x = 0; x < width;) {
+                if (at >= size) {
+                    return false;
+                }
+                int count = data[at++];
+                bool run = count > 128;
+                count = run ? count - 128 : count;
+                if (count == 0 || x + count > width) {
+                    return true; // corrupt: stb_image says so itself
+                }
+                size_t bytes = run ? 1 : (size_t)count;
+                if (size - at < bytes) {
+                    return false;
+                }
+                at += bytes;
+                x += count;
+            }
+        }
+    }
+    return true;
+}
+
 // stb stops at the last IDAT it needs and never looks at the end of the file, so a PNG cut
 // inside its final chunk would load. A complete file ends its chunk list with IEND (length 0,
 // type, CRC); trailing bytes after it are tolerated.
@@ -251,6 +315,11 @@ static drift_result stb_load(drift_context *ctx, const char *path, image_format 
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, path, 0,
                   "content does not match the extension (%s data)",
                   is_hdr ? "Radiance HDR" : "8/16-bit");
+        return DRIFT_ERR_PARSE;
+    }
+    if (is_hdr && !hdr_is_complete(data, size, width)) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, path, 0,
+                  "truncated Radiance HDR: the file ends before its %d scanlines do", height);
         return DRIFT_ERR_PARSE;
     }
     if (format == FORMAT_PNG) {

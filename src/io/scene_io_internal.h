@@ -21,6 +21,8 @@ typedef struct drift__texture_cache {
     uint32_t *indices;
     uint32_t count;
     uint32_t capacity;
+    drift_scene_input_fn on_input; // told of each texture and mesh file read (may be NULL)
+    void *user;
 } drift__texture_cache;
 
 // Returns the scene texture index for the image at `path`, loading it on first use.
@@ -58,6 +60,12 @@ typedef struct drift__import_info {
 // Imports meshes, materials, lights and the first camera of a mesh file through assimp.
 drift_result drift__scene_import_mesh_file(drift_scene *scene, const drift__import_params *params,
                                            drift__import_info *out_info);
+
+// drift_scene_load_json_text that tells on_input of each file read (see drift_scene_load_inputs).
+drift_result drift__scene_load_json_text(drift_context *ctx, const char *text, size_t length,
+                                         const char *base_dir, const char *name_for_messages,
+                                         drift_scene_input_fn on_input, void *user,
+                                         drift_scene **out_scene);
 
 // Fails with DRIFT_ERR_IO unless path names a readable regular file (not a directory or a
 // device); *out_size gets its size in bytes.

@@ -1084,6 +1084,15 @@ drift_result drift_scene_load_json_text(drift_context *ctx, const char *text, si
                                         const char *base_dir, const char *name_for_messages,
                                         drift_scene **out_scene)
 {
+    return drift__scene_load_json_text(ctx, text, length, base_dir, name_for_messages, NULL, NULL,
+                                       out_scene);
+}
+
+drift_result drift__scene_load_json_text(drift_context *ctx, const char *text, size_t length,
+                                         const char *base_dir, const char *name_for_messages,
+                                         drift_scene_input_fn on_input, void *user,
+                                         drift_scene **out_scene)
+{
     if (!out_scene) {
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
@@ -1093,7 +1102,8 @@ drift_result drift_scene_load_json_text(drift_context *ctx, const char *text, si
     }
     json_reader r = { .ctx = ctx,
                       .file = name_for_messages ? name_for_messages : "<memory>",
-                      .base_dir = base_dir };
+                      .base_dir = base_dir,
+                      .textures = { .on_input = on_input, .user = user } };
     char *copy;
     cJSON *root;
     drift_result res = parse_document(&r, text, length, DRIFT_SCENE_MAX_FILE_BYTES, &copy, &root);

@@ -211,6 +211,9 @@ drift_result drift__texture_cache_get(drift_scene *scene, drift__texture_cache *
         drift_log(ctx, DRIFT_LOG_ERROR, r, where, line, "cannot load texture '%s'", path);
         return r;
     }
+    if (cache->on_input) {
+        cache->on_input(path, cache->user);
+    }
     uint32_t index;
     r = drift_scene_add_texture(scene, image, &index); // owns the pixels, even on failure
     if (r != DRIFT_OK) {
@@ -308,14 +311,16 @@ bool drift__is_mesh_extension(const char *ext)
            strcmp(ext, "ply") == 0;
 }
 
-static drift_result load_mesh_scene(drift_context *ctx, const char *path, drift_scene **out_scene)
+static drift_result load_mesh_scene(drift_context *ctx, const char *path,
+                                    drift_scene_input_fn on_input, void *user,
+                                    drift_scene **out_scene)
 {
     drift_scene *scene = NULL;
     drift_result r = drift_scene_create(ctx, &scene);
     if (r != DRIFT_OK) {
         return r;
     }
-    drift__texture_cache textures = { 0 };
+    drift__texture_cache textures = { .on_input = on_input, .user = user };
     drift__import_info info = { 0 };
     drift__import_params params = {
         .path = path, .where = path, .material_override = DRIFT_INVALID_INDEX, .textures = &textures
@@ -357,6 +362,13 @@ static void dirname_of(const char *path, char *out, size_t out_size)
 
 drift_result drift_scene_load(drift_context *ctx, const char *path, drift_scene **out_scene)
 {
+    return drift_scene_load_inputs(ctx, path, NULL, NULL, out_scene);
+}
+
+drift_result drift_scene_load_inputs(drift_context *ctx, const char *path,
+                                     drift_scene_input_fn on_input, void *user,
+                                     drift_scene **out_scene)
+{
     if (!out_scene) {
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
@@ -380,14 +392,17 @@ drift_result drift_scene_load(drift_context *ctx, const char *path, drift_scene 
         if (r != DRIFT_OK) {
             return r;
         }
+        if (on_input) {
+            on_input(path, user);
+        }
         char base_dir[DRIFT__PATH_MAX];
         dirname_of(path, base_dir, sizeof(base_dir));
-        r = drift_scene_load_json_text(ctx, text, size, base_dir, path, out_scene);
+        r = drift__scene_load_json_text(ctx, text, size, base_dir, path, on_input, user, out_scene);
         drift_free(ctx, text);
         return r;
     }
     if (drift__is_mesh_extension(ext)) {
-        return load_mesh_scene(ctx, path, out_scene);
+        return load_mesh_scene(ctx, path, on_input, user, out_scene);
     }
     drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_UNSUPPORTED, path, 0,
               "unsupported scene file extension '%s' (drift reads .json, .obj, .gltf, .glb, "

@@ -106,6 +106,26 @@ assert info["lights"]["triangle"] == 2, info
 EOF
 fi
 
+# An OBJ cut mid-line (issue 18) is an error naming the file and the line, not a quiet
+# load of the triangles before the cut; a file that ends without a newline after a comment
+# still loads.
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\nf 1 2 3' >"$dir/cut_face.obj"
+expect_failure cut_face.obj
+expect_line cut_face.obj 7
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nv 1 1' >"$dir/cut_vertex.obj"
+expect_failure cut_vertex.obj
+expect_line cut_vertex.obj 5
+gzip -c "$dir/cut_face.obj" >"$dir/cut_gz.obj.gz"
+expect_failure cut_gz.obj.gz
+expect_line cut_gz.obj.gz 7
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n# no newline' >"$dir/no_newline.obj"
+"$drift" info "$dir/no_newline.obj" >/dev/null 2>&1 || fail "an OBJ ending in a comment loads"
+
+# A FIFO named as a scene is refused at once, not read forever.
+mkfifo "$dir/fifo.json"
+timeout 10 "$drift" info "$dir/fifo.json" >"$dir/out" 2>"$dir/err"
+[ $? -eq 1 ] && grep -q "fifo.json" "$dir/err" || fail "a FIFO scene is refused at once by name"
+
 if [ "$failures" -ne 0 ]; then
     echo "$failures failure(s)" >&2
     exit 1

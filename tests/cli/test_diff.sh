@@ -43,7 +43,8 @@ expect 0 "$drift" diff "$tmp/ref.png" "$tmp/ref.png" --json
 python3 - "$tmp/out" <<'PY' || fail "--json of identical images"
 import json, sys
 d = json.load(open(sys.argv[1]))
-assert sorted(d) == sorted(["mse", "rmse", "relmse", "psnr", "ssim", "flip"]), d
+assert sorted(d) == sorted(["mse", "rmse", "relmse", "psnr", "ssim", "flip", "nonfinite"]), d
+assert d["nonfinite"] == 0, d
 assert d["mse"] == 0 and d["flip"] == 0 and d["ssim"] == 1 and d["psnr"] is None, d
 PY
 
@@ -52,7 +53,8 @@ expect 0 "$drift" diff "$tmp/ref.png" "$tmp/test.png" --json --ppd 40
 python3 - "$tmp/out" <<'PY' || fail "--json of different images"
 import json, sys
 d = json.load(open(sys.argv[1]))
-assert sorted(d) == sorted(["mse", "rmse", "relmse", "psnr", "ssim", "flip"]), d
+assert sorted(d) == sorted(["mse", "rmse", "relmse", "psnr", "ssim", "flip", "nonfinite"]), d
+assert d.pop("nonfinite") == 0, d
 assert all(isinstance(v, float) for v in d.values()), d
 assert d["mse"] > 0 and 0 < d["flip"] < 1 and d["ssim"] < 1 and d["psnr"] > 0, d
 assert abs(d["rmse"] ** 2 - d["mse"]) < 1e-12, d
@@ -79,6 +81,91 @@ grep -q "garbage.exr" "$tmp/err" || fail "corrupt EXR is named"
 expect 1 "$drift" diff "$tmp/ref.png" "$tmp/ref.bmp"
 expect 1 "$drift" diff "$tmp/ref.png" "$tmp/small.png"
 grep -q "sizes differ" "$tmp/err" || fail "size mismatch is explained"
+
+# NaN and infinite pixels (issue 18): counted, reported, exit 1 unless --ignore-nonfinite,
+# and then the metrics are over the finite pixels. EXRs written by hand (uncompressed).
+python3 - "$tmp" <<'PY'
+import struct, sys
+def attr(name, typ, data):
+    return name.encode() + b"\0" + typ.encode() + b"\0" + struct.pack("<i", len(data)) + data
+def exr(path, w, h, pixel):
+    ch = b"".join(n.encode() + b"\0" + struct.pack("<iBBBBii", 2, 0, 0, 0, 0, 1, 1) for n in "BGR")
+    hdr = b"\x76\x2f\x31\x01" + struct.pack("<i", 2) + attr("channels", "chlist", ch + b"\0")
+    hdr += attr("compression", "compression", b"\0")
+    hdr += attr("dataWindow", "box2i", struct.pack("<iiii", 0, 0, w - 1, h - 1))
+    hdr += attr("displayWindow", "box2i", struct.pack("<iiii", 0, 0, w - 1, h - 1))
+    hdr += attr("lineOrder", "lineOrder", b"\0")
+    hdr += attr("pixelAspectRatio", "float", struct.pack("<f", 1.0))
+    hdr += attr("screenWindowCenter", "v2f", struct.pack("<ff", 0, 0))
+    hdr += attr("screenWindowWidth", "float", struct.pack("<f", 1.0)) + b"\0"
+    chunks = []
+    for y in range(h):
+        data = b"".join(struct.pack("<%df" % w, *[pixel(x, y)[c] for x in range(w)])
+                        for c in (2, 1, 0))
+        chunks.append(struct.pack("<ii", y, len(data)) + data)
+    off, table = len(hdr) + 8 * h, b""
+    for c in chunks:
+        table += struct.pack("<Q", off)
+        off += len(c)
+    open(path, "wb").write(hdr + table + b"".join(chunks))
+d = sys.argv[1]
+exr(d + "/flat.exr", 8, 6, lambda x, y: (0.5, 0.5, 0.5))
+exr(d + "/nan.exr", 8, 6, lambda x, y: (float("nan") if (x, y) == (3, 2) else 0.5, 0.5, 0.5))
+exr(d + "/inf.exr", 8, 6, lambda x, y: (0.5, float("inf") if x == 0 else 0.5, 0.5))
+PY
+expect 1 "$drift" diff "$tmp/flat.exr" "$tmp/nan.exr"
+grep -q "^nonfinite *1$" "$tmp/out" || fail "the NaN pixel is counted in plain output"
+grep -q "1 of 48 pixels are NaN or infinite" "$tmp/err" || fail "the NaN pixel is reported"
+grep -q "^mse *0$" "$tmp/out" || fail "mse is over the finite pixels, not nan"
+expect 1 "$drift" diff "$tmp/inf.exr" "$tmp/flat.exr" --json
+python3 - "$tmp/out" <<'PY' || fail "--json counts infinite pixels"
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["nonfinite"] == 6 and d["mse"] == 0, d
+PY
+expect 1 "$drift" diff "$tmp/nan.exr" "$tmp/inf.exr" --difftol 1
+expect 0 "$drift" diff "$tmp/nan.exr" "$tmp/inf.exr" --ignore-nonfinite --json
+python3 - "$tmp/out" <<'PY' || fail "--ignore-nonfinite: metrics over the finite pixels"
+import json, math, sys
+d = json.load(open(sys.argv[1]))
+assert d["nonfinite"] == 7 and d["mse"] == 0 and d["psnr"] is None, d
+assert all(v is None or math.isfinite(v) for v in d.values()), d
+PY
+grep -q "over the 41 finite pixels" "$tmp/err" || fail "--ignore-nonfinite says what was measured"
+
+# A FIFO or a device is refused at once, as info and render do (it used to hang).
+mkfifo "$tmp/fifo.png"
+expect 1 timeout 10 "$drift" diff "$tmp/fifo.png" "$tmp/ref.png"
+grep -q "fifo.png.*not a regular file" "$tmp/err" || fail "a FIFO reference is refused by name"
+expect 1 timeout 10 "$drift" diff "$tmp/ref.png" "$tmp/fifo.png"
+grep -q "fifo.png" "$tmp/err" || fail "a FIFO test image is refused by name"
+ln -s /dev/zero "$tmp/zero.png"
+expect 1 timeout 10 "$drift" diff "$tmp/ref.png" "$tmp/zero.png"
+grep -q "not a regular file" "$tmp/err" || fail "a device is refused"
+
+# A truncated .hdr is an error naming the file (stb_image decoded it without one, or looped).
+python3 - "$tmp" <<'PY'
+import sys
+def hdr(path, w, h, rle, cut=0):
+    out = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n" + ("-Y %d +X %d\n" % (h, w)).encode()
+    for y in range(h):
+        if rle:
+            out += bytes([2, 2, w >> 8, w & 255]) + bytes([128 + w, 128] * 3 + [128 + w, 129])
+        else:
+            out += bytes([128, 128, 128, 129]) * w
+    open(path, "wb").write(out[:len(out) - cut])
+d = sys.argv[1]
+hdr(d + "/flat.hdr", 4, 4, False)
+hdr(d + "/flat_cut.hdr", 4, 4, False, 5)
+hdr(d + "/rle.hdr", 16, 4, True)
+hdr(d + "/rle_cut.hdr", 16, 4, True, 3)
+PY
+expect 0 timeout 20 "$drift" diff "$tmp/flat.hdr" "$tmp/flat.hdr"
+expect 0 timeout 20 "$drift" diff "$tmp/rle.hdr" "$tmp/rle.hdr"
+for cut in flat_cut rle_cut; do
+    expect 1 timeout 20 "$drift" diff "$tmp/$cut.hdr" "$tmp/$cut.hdr"
+    grep -q "$cut.hdr.*truncated" "$tmp/err" || fail "truncated $cut.hdr is named"
+done
 
 if [ "$failures" -ne 0 ]; then
     echo "$failures failure(s)" >&2
