@@ -29,30 +29,9 @@ open(d + "/in.png", "wb").write(b"\x89PNG\r\n\x1a\n")
 open(d + "/corrupt.exr", "wb").write(b"v/1\x01" + b"\x00" * 40)
 PY
 # Uncompressed scanline EXRs written by hand: one with a NaN pixel, one valid.
-python3 - "$tmp" <<'PY'
-import struct, sys
-def attr(name, typ, data):
-    return name.encode() + b"\0" + typ.encode() + b"\0" + struct.pack("<i", len(data)) + data
-def exr(path, w, h, pixel):
-    ch = b"".join(n.encode() + b"\0" + struct.pack("<iBBBBii", 2, 0, 0, 0, 0, 1, 1) for n in "BGR")
-    hdr = b"\x76\x2f\x31\x01" + struct.pack("<i", 2) + attr("channels", "chlist", ch + b"\0")
-    hdr += attr("compression", "compression", b"\0")
-    hdr += attr("dataWindow", "box2i", struct.pack("<iiii", 0, 0, w - 1, h - 1))
-    hdr += attr("displayWindow", "box2i", struct.pack("<iiii", 0, 0, w - 1, h - 1))
-    hdr += attr("lineOrder", "lineOrder", b"\0")
-    hdr += attr("pixelAspectRatio", "float", struct.pack("<f", 1.0))
-    hdr += attr("screenWindowCenter", "v2f", struct.pack("<ff", 0, 0))
-    hdr += attr("screenWindowWidth", "float", struct.pack("<f", 1.0)) + b"\0"
-    chunks = []
-    for y in range(h):
-        data = b"".join(struct.pack("<%df" % w, *[pixel(x, y)[c] for x in range(w)])
-                        for c in (2, 1, 0))
-        chunks.append(struct.pack("<ii", y, len(data)) + data)
-    off, table = len(hdr) + 8 * h, b""
-    for c in chunks:
-        table += struct.pack("<Q", off)
-        off += len(c)
-    open(path, "wb").write(hdr + table + b"".join(chunks))
+PYTHONPATH="$(dirname "$0")" python3 - "$tmp" <<'PY'
+import sys
+from make_exr import exr
 d = sys.argv[1]
 exr(d + "/nan.exr", 8, 6, lambda x, y: (float("nan") if (x, y) == (3, 2) else 0.5, 0.5, 0.5))
 exr(d + "/ok.exr", 8, 6, lambda x, y: (0.5, 2.0 if (x, y) == (3, 2) else 0.1, 0.5))

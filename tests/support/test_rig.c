@@ -145,3 +145,20 @@ double test_rmse(drift_context *ctx, const drift_image *a, const drift_image *b)
     assert_int_equal(drift_metric_mse(ctx, a, b, &mse), DRIFT_OK);
     return sqrt(mse);
 }
+
+drift_image test_rig_render_pt(test_rig *r, uint32_t components, int32_t max_depth, uint32_t spp,
+                               uint32_t seed, drift_pt **pt)
+{
+    drift_pt_params params = { .width = r->scene->camera.width,
+                               .height = r->scene->camera.height,
+                               .seed = seed,
+                               .max_depth = max_depth,
+                               .components = components,
+                               .pixel_centre = true,
+                               .pinhole = true };
+    assert_int_equal(drift_pt_create(r->ctx, r->scene, r->accel, &params, pt), DRIFT_OK);
+    assert_int_equal(drift_pt_render_samples(*pt, spp, NULL), DRIFT_OK);
+    drift_image img;
+    assert_int_equal(drift_pt_resolve(*pt, DRIFT_PT_AOV_BEAUTY, &img), DRIFT_OK);
+    return img;
+}

@@ -5,6 +5,7 @@
 
 #include "drift/accel.h"
 #include "drift/hybrid.h"
+#include "drift/pt.h"
 #include "drift/scene.h"
 
 typedef struct test_rig {
@@ -37,6 +38,13 @@ void test_add_floor(drift_scene *scene, float half, float height, uint32_t mater
 // UV sphere with smooth normals and outward winding; returns its mesh index.
 uint32_t test_add_sphere(drift_scene *scene, drift_vec3 centre, float radius, uint32_t slices,
                          uint32_t stacks, uint32_t material);
+
+// The path tracer's image of the rig's scene camera through the pixel centres, pinhole, with
+// only `components` (DRIFT_PT_COMPONENT_*) up to max_depth, at spp samples: the truth a
+// hybrid term is compared with. *pt owns the image; destroy it after use.
+struct drift_image;
+drift_image test_rig_render_pt(test_rig *r, uint32_t components, int32_t max_depth, uint32_t spp,
+                               uint32_t seed, struct drift_pt **pt);
 
 // RMSE over the three colour channels of two images of one size (drift_metric_mse).
 double test_rmse(drift_context *ctx, const drift_image *a, const drift_image *b);

@@ -41,21 +41,11 @@ static test_rig cornell_rig(int threads, int32_t w)
     return r;
 }
 
+// The path tracer's truth of a term (seed 99).
 static drift_image render_pt(test_rig *r, uint32_t components, int32_t max_depth, uint32_t spp,
                              drift_pt **pt)
 {
-    drift_pt_params params = { .width = r->scene->camera.width,
-                               .height = r->scene->camera.height,
-                               .seed = 99,
-                               .max_depth = max_depth,
-                               .components = components,
-                               .pixel_centre = true,
-                               .pinhole = true };
-    assert_int_equal(drift_pt_create(r->ctx, r->scene, r->accel, &params, pt), DRIFT_OK);
-    assert_int_equal(drift_pt_render_samples(*pt, spp, NULL), DRIFT_OK);
-    drift_image img;
-    assert_int_equal(drift_pt_resolve(*pt, DRIFT_PT_AOV_BEAUTY, &img), DRIFT_OK);
-    return img;
+    return test_rig_render_pt(r, components, max_depth, spp, 99, pt);
 }
 
 // Renders the rig's G-buffer with `params`; the ism is returned for its planes.
