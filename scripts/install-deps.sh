@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages drift needs to build, test, check formatting and fuzz (SDL2
+# Installs the Debian 12 packages drift needs to build, test (python3 for the CLI tests), check
+# formatting and fuzz (SDL2
 # for `drift view`; Xvfb and xauth for its window test under xvfb-run). Idempotent: when everything is present
 # it does nothing (no apt-get update), so repeated runs are fast.
 set -euo pipefail
@@ -7,7 +8,7 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config clang libclang-rt-14-dev
   libembree-dev libassimp-dev libcjson-dev libopenexr-dev libstb-dev zlib1g-dev libkissfft-dev
-  libcmocka-dev valgrind clang-format git
+  libcmocka-dev valgrind clang-format git python3
   libsdl2-dev xvfb xauth
 )
 
