@@ -128,6 +128,22 @@ void drift_pass_copy_rgb(const drift_image *from, drift_image *to)
     }
 }
 
+void drift_pass_pixels(drift_frame_state *frame, drift_hybrid_pass pass, drift_pass_pixel_fn fn,
+                       void *user)
+{
+    double t = drift_time_now();
+    frame->stats.rays[pass] += drift_pass_for_each_pixel(frame, fn, user);
+    drift_pass_time(frame, pass, t);
+}
+
+void drift_pass_rows(drift_frame_state *frame, drift_hybrid_pass pass, drift_pass_row_fn fn,
+                     void *user)
+{
+    double t = drift_time_now();
+    frame->stats.rays[pass] += drift_pass_for_each_row(frame, fn, user);
+    drift_pass_time(frame, pass, t);
+}
+
 // --- PATH-TRACED COMPONENTS ---
 
 drift_result drift_pass_reference_render(drift_frame_state *f, uint32_t components,

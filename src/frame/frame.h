@@ -198,6 +198,13 @@ static inline void drift_pass_time(drift_frame_state *frame, drift_hybrid_pass p
     frame->stats.ms[pass] += 1000.0 * (drift_time_now() - start);
 }
 
+// fn for every pixel (or row) of the frame, booked to `pass`: its rays and its milliseconds
+// added to the frame's stats.
+void drift_pass_pixels(drift_frame_state *frame, drift_hybrid_pass pass, drift_pass_pixel_fn fn,
+                       void *user);
+void drift_pass_rows(drift_frame_state *frame, drift_hybrid_pass pass, drift_pass_row_fn fn,
+                     void *user);
+
 // Renders `components` of the pt (DRIFT_PT_COMPONENT_*) at the frame's spp through the pixel
 // centres, pinhole unless `lens`, into the RGB image `out`.
 drift_result drift_pass_reference_render(drift_frame_state *frame, uint32_t components,

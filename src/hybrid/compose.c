@@ -39,15 +39,13 @@ static bool adds_term(const drift_frame_state *f, drift_effect effect)
 
 drift_result drift_hybrid_pass_compose(drift_frame_state *f)
 {
-    double t = drift_time_now();
     compose_job job = { .count = 0 };
     for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
         if (adds_term(f, (drift_effect)e)) {
             job.terms[job.count++] = e;
         }
     }
-    drift_pass_for_each_pixel(f, compose_pixel, &job);
-    drift_pass_time(f, DRIFT_PASS_COMPOSE, t);
+    drift_pass_pixels(f, DRIFT_PASS_COMPOSE, compose_pixel, &job);
     return DRIFT_OK;
 }
 

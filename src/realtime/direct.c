@@ -141,25 +141,19 @@ drift_result drift_realtime_build_shadow_maps(drift_frame_state *f)
 
 drift_result drift_realtime_pass_unshadowed(drift_frame_state *f)
 {
-    double t = drift_time_now();
-    f->stats.rays[DRIFT_PASS_UNSHADOWED] += drift_pass_for_each_pixel(f, unshadowed_pixel, NULL);
-    drift_pass_time(f, DRIFT_PASS_UNSHADOWED, t);
+    drift_pass_pixels(f, DRIFT_PASS_UNSHADOWED, unshadowed_pixel, NULL);
     return DRIFT_OK;
 }
 
 drift_result drift_realtime_pass_hard_shadows(drift_frame_state *f)
 {
-    double t = drift_time_now();
-    f->stats.rays[DRIFT_PASS_HARD_SHADOWS] += drift_pass_for_each_row(f, hard_shadow_row, NULL);
-    drift_pass_time(f, DRIFT_PASS_HARD_SHADOWS, t);
+    drift_pass_rows(f, DRIFT_PASS_HARD_SHADOWS, hard_shadow_row, NULL);
     return DRIFT_OK;
 }
 
 static drift_result shadow_filter(drift_frame_state *f, bool pcss)
 {
-    double t = drift_time_now();
-    drift_pass_for_each_pixel(f, shadow_filter_pixel, &pcss);
-    drift_pass_time(f, DRIFT_PASS_SHADOW_FILTER, t);
+    drift_pass_pixels(f, DRIFT_PASS_SHADOW_FILTER, shadow_filter_pixel, &pcss);
     return DRIFT_OK;
 }
 
@@ -177,8 +171,6 @@ drift_result drift_realtime_pass_pcss(drift_frame_state *f, const drift_pass_arg
 
 drift_result drift_realtime_pass_sum_direct(drift_frame_state *f)
 {
-    double t = drift_time_now(); // summing is part of composition
-    drift_pass_for_each_pixel(f, sum_direct_pixel, NULL);
-    drift_pass_time(f, DRIFT_PASS_COMPOSE, t);
+    drift_pass_pixels(f, DRIFT_PASS_COMPOSE, sum_direct_pixel, NULL); // part of composition
     return DRIFT_OK;
 }

@@ -155,9 +155,7 @@ static drift_result capture_probes(drift_frame_state *f)
 
 drift_result drift_realtime_pass_sharp_reflections(drift_frame_state *f)
 {
-    double t = drift_time_now();
-    f->stats.rays[DRIFT_PASS_REFLECTIONS] += drift_pass_for_each_pixel(f, sharp_pixel, NULL);
-    drift_pass_time(f, DRIFT_PASS_REFLECTIONS, t);
+    drift_pass_pixels(f, DRIFT_PASS_REFLECTIONS, sharp_pixel, NULL);
     return DRIFT_OK;
 }
 
@@ -173,8 +171,6 @@ drift_result drift_realtime_pass_envmap_reflections(drift_frame_state *f,
                                                     const drift_pass_args *args)
 {
     (void)args;
-    double t = drift_time_now();
-    drift_pass_for_each_pixel(f, envmap_pixel, NULL);
-    drift_pass_time(f, DRIFT_PASS_ENVMAP, t);
+    drift_pass_pixels(f, DRIFT_PASS_ENVMAP, envmap_pixel, NULL);
     return DRIFT_OK;
 }

@@ -123,10 +123,8 @@ static void reference_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t
 
 drift_result drift_ssdo_pass_reference(drift_frame_state *f, const drift_pass_args *args)
 {
-    double t = drift_time_now();
     reference_job job = { &f->terms[args->effect], args->stream };
-    f->stats.rays[DRIFT_PASS_REFERENCE] += drift_pass_for_each_pixel(f, reference_pixel, &job);
-    drift_pass_time(f, DRIFT_PASS_REFERENCE, t);
+    drift_pass_pixels(f, DRIFT_PASS_REFERENCE, reference_pixel, &job);
     return DRIFT_OK;
 }
 
