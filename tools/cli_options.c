@@ -154,6 +154,34 @@ static int effect_of(const char *arg)
     return -1;
 }
 
+// Whether a CLI_TECHNIQUE row of the command names the effect `e` on its own.
+static bool effect_has_own_row(const cli_command *c, int e)
+{
+    char name[64];
+    snprintf(name, sizeof name, "--%s", drift_effect_name((drift_effect)e));
+    for (size_t k = 0; k < c->option_count; ++k) {
+        const cli_option *opt = &c->options[k];
+        if (opt->kind == CLI_KIND_TECHNIQUES && opt->name && strcmp(opt->name, name) == 0) {
+            return true;
+        }
+    }
+    return false;
+}
+
+// The effect a technique row takes `arg` for, or -1: its own effect (CLI_TECHNIQUE), or any
+// effect without a row of its own (CLI_TECHNIQUES).
+static int technique_row_effect(const cli_command *c, const cli_option *opt, const char *arg)
+{
+    int e = effect_of(arg);
+    if (e < 0 || opt->kind != CLI_KIND_TECHNIQUES) {
+        return -1;
+    }
+    if (opt->name) {
+        return strcmp(opt->name, arg) == 0 ? e : -1;
+    }
+    return effect_has_own_row(c, e) ? -1 : e;
+}
+
 // The row for `arg`, the groups of the section it is in and, for technique rows, the effect.
 static const cli_option *find_option(const cli_command *c, const char *arg, unsigned *groups,
                                      int *effect)
@@ -161,10 +189,11 @@ static const cli_option *find_option(const cli_command *c, const char *arg, unsi
     unsigned section = 0;
     for (size_t k = 0; k < c->option_count; ++k) {
         const cli_option *opt = &c->options[k];
-        *effect = opt->kind == CLI_KIND_TECHNIQUES ? effect_of(arg) : -1;
+        *effect = technique_row_effect(c, opt, arg);
         if (opt->kind == CLI_KIND_SECTION) {
             section = opt->groups;
-        } else if (*effect >= 0 || (opt->name && name_matches(opt->name, arg))) {
+        } else if (*effect >= 0 || (opt->kind != CLI_KIND_TECHNIQUES && opt->name &&
+                                    name_matches(opt->name, arg))) {
             *groups = section;
             return opt;
         }
@@ -305,8 +334,18 @@ void cli_print_help(const cli_command *c, FILE *out)
             print_indented(out, opt->help, column);
             continue;
         }
-        if (opt->kind == CLI_KIND_TECHNIQUES) {
+        if (opt->kind == CLI_KIND_TECHNIQUES && opt->name) {
+            print_label(out, opt->name, opt->arg, column);
+            print_techniques(out, (drift_effect)effect_of(opt->name));
+            if (opt->help) {
+                fprintf(out, "%*s", column, "");
+                print_indented(out, opt->help, column);
+            }
+        } else if (opt->kind == CLI_KIND_TECHNIQUES) {
             for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
+                if (effect_has_own_row(c, e)) {
+                    continue; // printed at its own row
+                }
                 char name[64];
                 snprintf(name, sizeof name, "--%s", drift_effect_name((drift_effect)e));
                 print_label(out, name, opt->arg, column);

@@ -118,6 +118,13 @@ typedef struct cli_option {
     {                                                                     \
         .arg = (a), .kind = CLI_KIND_TECHNIQUES, .offset = offsetof(T, f) \
     }
+// One effect's --name T row on its own (in another section than CLI_TECHNIQUES, e.g. an
+// effect both of drift render's modes take); CLI_TECHNIQUES then leaves that effect out.
+#define CLI_TECHNIQUE(n, a, T, f, h)                                       \
+    {                                                                      \
+        .name = (n), .arg = (a), .help = (h), .kind = CLI_KIND_TECHNIQUES, \
+        .offset = offsetof(T, f)                                           \
+    }
 #define CLI_CUSTOM(n, a, T, f, fn, h)                                                 \
     {                                                                                 \
         .name = (n), .arg = (a), .help = (h), .kind = CLI_KIND_CUSTOM, .parse = (fn), \

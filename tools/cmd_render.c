@@ -143,6 +143,9 @@ static const cli_option render_table[] = {
     CLI_CHOICE("--denoise", "none|atrous", O, denoise, "none|atrous",
                "reference: the edge-avoiding a-trous filter guided by the\n"
                "albedo, normal and depth AOVs over the image written (docs/frontier.md)"),
+    CLI_TECHNIQUE("--glare", "T", O, hybrid,
+                  "the last pass of either mode, at the camera's angular pitch\n"
+                  "(docs/glare.md)"),
     { .name = "--aov",
       .arg = "[FILE.exr]",
       .help = "reference: add albedo, normal and depth layers to the EXR;\n"
@@ -276,35 +279,8 @@ static int parse_options(int argc, char **argv, render_options *o)
                            .debug_sample = -1,
                            .aperture = -1.0,
                            .focus_distance = -1.0 };
-    // --glare is the one effect that also applies to the path tracer's image (the last pass
-    // of either mode): in reference mode it is taken out here, so that every other hybrid
-    // option still says it needs --mode hybrid.
-    char *args[512];
-    int count = 0;
-    bool hybrid = false;
-    for (int i = 0; i < argc; ++i) {
-        hybrid |=
-            strcmp(argv[i], "--mode") == 0 && i + 1 < argc && strcmp(argv[i + 1], "hybrid") == 0;
-    }
-    for (int i = 0; i < argc && count < 512; ++i) {
-        if (!hybrid && strcmp(argv[i], "--glare") == 0 && i + 1 < argc) {
-            int t = drift_technique_parse(DRIFT_EFFECT_GLARE, argv[++i]);
-            if (t < 0) {
-                fprintf(stderr, "drift render: --glare expects none, static or dynamic, got '%s'\n",
-                        argv[i]);
-                return 2;
-            }
-            o->hybrid.glare = (drift_glare_technique)t;
-            continue;
-        }
-        args[count++] = argv[i];
-    }
-    if (count == 512) {
-        fprintf(stderr, "drift render: too many arguments\n");
-        return 2;
-    }
     const char *first[CLI_GROUP_COUNT] = { 0 };
-    int status = cli_parse(&render_command, count, args, o, first);
+    int status = cli_parse(&render_command, argc, argv, o, first);
     if (status != CLI_PARSED) {
         return status;
     }

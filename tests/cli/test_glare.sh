@@ -131,7 +131,7 @@ expect 0 "$drift" render --mode hybrid --width 48 --height 48 --threads 2 --quie
     --out "$tmp/hy_glare.exr"
 [ -s "$tmp/hy_glare.exr" ] || fail "render --mode hybrid --glare dynamic writes its image"
 expect 2 "$drift" render --glare sideways --out "$tmp/bad.exr"
-grep -q "glare expects none, static or dynamic" "$tmp/err" || fail "a bad --glare is named"
+grep -q "\-\-glare expects one of none, static, dynamic, got .sideways." "$tmp/err" || fail "a bad --glare is named"
 expect 2 "$drift" render --glare static --shadows pcss --out "$tmp/bad.exr"
 grep -q "shadows needs --mode hybrid" "$tmp/err" || fail "other hybrid options still need hybrid mode"
 [ -e "$tmp/bad.exr" ] && fail "a refused render wrote its image"
