@@ -271,6 +271,25 @@ float drift_sampler_next1(drift_sampler *s);
 // judged (error ~ 1/sqrt(N) where Sobol's falls nearly as 1/N on smooth integrands).
 drift_vec2 drift_sampler_next2_random(drift_sampler *s);
 
+// --- DISCRETE DISTRIBUTIONS ---
+
+// The entry i of a CDF over n entries (n + 1 values, cdf[0] = 0, ascending) whose interval
+// [cdf[i], cdf[i+1]) holds u, by binary search; n - 1 when u is at or past cdf[n - 1]'s end.
+// Zero-width entries are never returned for a u inside [0, cdf[n]).
+static inline uint32_t drift_cdf_find(const float *cdf, uint32_t n, float u)
+{
+    uint32_t lo = 0, hi = n;
+    while (hi - lo > 1) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (cdf[mid] <= u) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    return lo;
+}
+
 // --- WARPS ([0,1)^2 -> shapes and directions; each with its pdf) ---
 
 // Shirley & Chiu 1997 concentric map to the unit disk (area-preserving, low distortion).

@@ -185,15 +185,7 @@ static drift_result rsm_build(drift_context *ctx, const drift_scene *scene,
 // entries; *out_pmf gets cdf[i+1] - cdf[i].
 static int32_t cdf_pick(const float *cdf, int32_t n, float u, float *out_pmf)
 {
-    int32_t lo = 0, hi = n;
-    while (hi - lo > 1) {
-        int32_t mid = lo + (hi - lo) / 2;
-        if (cdf[mid] <= u) {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
+    int32_t lo = (int32_t)drift_cdf_find(cdf, (uint32_t)n, u);
     while (lo + 1 < n && !(cdf[lo + 1] > cdf[lo])) {
         lo++;
     }

@@ -142,15 +142,7 @@ float drift__environment_average(const drift_scene *scene)
 // Finds i with cdf[i] <= u < cdf[i+1] among n intervals and the offset within it.
 static int32_t sample_cdf(const float *cdf, int32_t n, float u, float *out_offset)
 {
-    int32_t lo = 0, hi = n;
-    while (hi - lo > 1) {
-        int32_t mid = lo + (hi - lo) / 2;
-        if (cdf[mid] <= u) {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
+    int32_t lo = (int32_t)drift_cdf_find(cdf, (uint32_t)n, u);
     float width = cdf[lo + 1] - cdf[lo];
     *out_offset =
         width > 0.0f ? drift_clampf((u - cdf[lo]) / width, 0.0f, DRIFT_ONE_MINUS_EPSILON) : 0.5f;

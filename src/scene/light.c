@@ -192,15 +192,7 @@ static float entry_pmf(const drift_light_table *t, uint32_t i)
 // Index of the entry whose [cdf[i], cdf[i+1]) holds u, skipping zero-width entries.
 static uint32_t table_pick(const drift_light_table *t, float u)
 {
-    uint32_t lo = 0, hi = t->entry_count;
-    while (hi - lo > 1) {
-        uint32_t mid = lo + (hi - lo) / 2;
-        if (t->cdf[mid] <= u) {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
+    uint32_t lo = drift_cdf_find(t->cdf, t->entry_count, u);
     while (lo + 1 < t->entry_count && entry_pmf(t, lo) <= 0.0f) {
         lo++;
     }
