@@ -64,6 +64,15 @@ bool cli_parse_refine(const char *cmd, const char *flag, const char *value, void
 // Returns argv[*i + 1] and advances *i, or prints a usage error and returns NULL.
 const char *cli_next_value(const char *cmd, int argc, char **argv, int *i);
 
+// drift diff's comparison of TEST against REF (same size): the pixels NaN or infinite in
+// either are set to 0 in both (*nonfinite counts them) and MSE and relMSE are means over
+// the others; then drift_metric_compare. DRIFT_ERR_INVALID_ARGUMENT when the sizes differ or
+// every pixel is masked. `drift report` uses it so that its numbers equal drift diff's.
+struct drift_metric_report;
+drift_result cli_compare_images(drift_context *ctx, drift_image *ref, drift_image *test, double ppd,
+                                struct drift_metric_report *rep, drift_image *flip_map,
+                                size_t *nonfinite);
+
 // A logger that prints warnings and errors (and info with verbose) as
 // "drift: FILE:LINE: level: message" on stderr.
 drift_logger cli_stderr_logger(bool verbose);
