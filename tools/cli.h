@@ -25,7 +25,8 @@
     X("bench", drift_cmd_bench, "benchmarks (drift bench --help)")                           \
     X("view", drift_cmd_view, "interactive viewer: hybrid techniques against the reference") \
     X("refine", drift_cmd_refine, "smart image refinement: fit the metric weights (lambda)") \
-    X("glare", drift_cmd_glare, "temporal glare (thesis ch. 8) on an HDR image or sequence")
+    X("glare", drift_cmd_glare, "temporal glare (thesis ch. 8) on an HDR image or sequence") \
+    X("report", drift_cmd_report, "one HTML page: every technique against the reference")
 
 #define DRIFT__COMMAND_DECLARE(name, fn, summary) int fn(int argc, char **argv);
 DRIFT_COMMAND_LIST(DRIFT__COMMAND_DECLARE)
