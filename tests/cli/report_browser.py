@@ -262,7 +262,11 @@ def check_page(browser, drift, folder, expect_errors, screenshot, numbers):
     browser.send("Page.navigate", {"url": "file://" + folder + "/index.html"})
     browser.wait_event("Page.loadEventFired")
     if browser.evaluate("document.body.dataset.ready") != "1":
-        fail("the page's script did not finish building the page")
+        thrown = [e["params"]["exceptionDetails"] for e in browser.events
+                  if e.get("method") == "Runtime.exceptionThrown"]
+        fail("the page's script did not finish building the page: %s"
+             % [t.get("exception", {}).get("description", t.get("text")) for t in thrown])
+        return
 
     referenced = browser.evaluate("window.driftReport.images()")
     missing = [p for p in referenced if not os.path.isfile(os.path.join(folder, p))]
