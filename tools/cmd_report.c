@@ -197,8 +197,9 @@ static double job_units(const report_job *j)
 }
 
 // The frame of `effect` at `technique`: every other effect at its first row (hard shadows,
-// nothing else), except that a POST effect (depth of field) sees path-traced shadows, the
-// light its reference takes through the lens, so that its error is its own.
+// nothing else), except that a POST effect (depth of field) sees every term path-traced,
+// the light its reference takes through the lens, so that its error is its own
+// (docs/hybrid.md).
 static report_job make_job(const report_options *o, const drift_scene *scene, drift_effect effect,
                            int technique, uint32_t spp, bool truth)
 {
@@ -212,8 +213,11 @@ static report_job make_job(const report_options *o, const drift_scene *scene, dr
         j.params.height = 1;
     }
     j.params.techniques[effect] = technique;
-    if (effect_kind[effect] == REPORT_POST) {
-        j.params.shadows = DRIFT_SHADOWS_REFERENCE;
+    for (int e = 0; e < DRIFT_EFFECT_COUNT && effect_kind[effect] == REPORT_POST; ++e) {
+        int reference = drift_technique_parse((drift_effect)e, "reference");
+        if (effect_kind[e] == REPORT_TERM && reference >= 0) {
+            j.params.techniques[e] = reference;
+        }
     }
     bool pt = frame_path_traced(&j.params);
     j.spp = pt ? spp : 1;
