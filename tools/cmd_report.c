@@ -704,6 +704,8 @@ int drift_cmd_report(int argc, char **argv)
     if (!o.scenes[0]) {
         o.scenes[0] = cli_default_scene_path();
     }
+    // Before anything is written, so that Ctrl-C from here on writes the page.
+    const atomic_bool *cancel = render_catch_sigint();
     if (!make_dir(o.out_dir)) {
         fprintf(stderr, "drift report: cannot create --out '%s': %s\n", o.out_dir, strerror(errno));
         return 1;
@@ -720,7 +722,7 @@ int drift_cmd_report(int argc, char **argv)
     report_run run = { .o = &o, .ctx = session.ctx, .t_start = drift_time_now() };
     snprintf(run.manifest_path, sizeof run.manifest_path, "%s/manifest.json", o.out_dir);
     load_manifest(&run);
-    run.cancel = render_catch_sigint();
+    run.cancel = cancel;
     int scene_count = 0;
     while (scene_count < REPORT_MAX_SCENES && o.scenes[scene_count]) {
         ++scene_count;

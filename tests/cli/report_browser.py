@@ -49,8 +49,8 @@ class Browser:
             os.dup2(write_end, 4)
 
         args = [binary, "--headless=new", "--remote-debugging-pipe", "--no-sandbox",
-                "--disable-gpu", "--no-first-run", "--no-default-browser-check",
-                "--disable-extensions", "--disable-background-networking",
+                "--disable-gpu", "--disable-dev-shm-usage", "--no-first-run",
+                "--no-default-browser-check", "--disable-extensions", "--disable-background-networking",
                 "--disable-component-update", "--disable-sync", "--mute-audio",
                 "--user-data-dir=" + self.profile, "about:blank"]
         log = None if os.environ.get("DRIFT_REPORT_BROWSER_LOG") else subprocess.DEVNULL
