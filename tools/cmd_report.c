@@ -255,13 +255,14 @@ static int plan_effect(const report_options *o, const drift_scene *scene, drift_
 #define MAX_JOBS 256
 
 // The key of a render: the scene's content, the effect it is for (its ms are that effect's),
-// the frame's size, techniques and spp (all that make_job sets) and drift's version.
-static void job_key(const report_job *j, uint64_t scene, char *out, size_t size)
+// the frame's size, techniques and spp (all that make_job sets), the threads (its ms depend
+// on them) and drift's version.
+static void job_key(const report_job *j, uint64_t scene, int threads, char *out, size_t size)
 {
     char text[512];
-    int n =
-        snprintf(text, sizeof text, "%016" PRIx64 " %s %dx%d %u spp", scene,
-                 drift_effect_name(j->effect), j->params.width, j->params.height, j->params.spp);
+    int n = snprintf(text, sizeof text, "%016" PRIx64 " %s %dx%d %u spp %d threads", scene,
+                     drift_effect_name(j->effect), j->params.width, j->params.height, j->params.spp,
+                     threads);
     for (int e = 0; e < DRIFT_EFFECT_COUNT && n < (int)sizeof text; ++e) {
         n += snprintf(text + n, sizeof text - (size_t)n, " %s",
                       drift_technique_name((drift_effect)e, j->params.techniques[e]));
@@ -360,7 +361,7 @@ static const cJSON *render_job(report_run *run, const cli_session *s, const char
                                const char **why)
 {
     char key[32], name[256], base[4096], exr[4200];
-    job_key(j, hash, key, sizeof key);
+    job_key(j, hash, drift_context_thread_count(run->ctx), key, sizeof key);
     job_name(j, key, name, sizeof name);
     snprintf(base, sizeof base, "%s/%s", dir, name);
     snprintf(exr, sizeof exr, "%s.exr", base);
