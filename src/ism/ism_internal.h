@@ -16,6 +16,12 @@ drift_result drift__ism_generate_vpls(drift_context *ctx, const drift_scene *sce
 // The most VPLs drift__ism_generate_vpls can make with these (resolved) parameters.
 uint32_t drift__ism_max_vpls(const drift_ism_params *params);
 
+// Sizes the atlas and the scene points for at least `vpls` maps (at most the max above);
+// a render calls it with its VPL count. Growing re-samples the points, with the same result.
+drift_result drift__ism_reserve(drift_ism *ism, uint32_t vpls);
+// How many maps the atlas and the points hold now.
+uint32_t drift__ism_map_capacity(const drift_ism *ism);
+
 // What splatting one map needs.
 typedef struct drift__ism_splat_desc {
     int32_t n;          // the map is n x n texels
