@@ -84,7 +84,7 @@ for r in d["rows"][2:]:
         for run in 1 2; do
             expect 0 "$drift" bench frontier "$box" --size 12 --ref-spp 4 --runs 1 --max-spp 2 \
                 --vpls 8 --aaf-spp 1 --budgets 1,20,1000 --cache "$tmp/cache" --threads 1 \
-                --csv "$tmp/frontier.csv" --json
+                --csv "$tmp/frontier.csv" --svg "$tmp/frontier.svg" --json
             cp "$tmp/out" "$tmp/frontier$run.json"
         done
         check frontier 'first = json.load(open(sys.argv[1][:-3] + "frontier1.json"))
@@ -102,8 +102,30 @@ for f in d["front"]:
     assert best["ms"] <= f["budget_ms"] and best["flip"] <= prev, d["front"]
     prev = best["flip"]
     for k in ("pt", "pt_atrous", "hybrid"):
-        assert f[k] is None or (f[k]["ms"] <= f["budget_ms"] and f[k]["flip"] >= best["flip"]), f'
+        assert f[k] is None or (f[k]["ms"] <= f["budget_ms"] and f[k]["flip"] >= best["flip"]), f
+budgets = [f["budget_ms"] for f in d["front"]]
+for r in d["rows"]:
+    # The band: the smallest budget over the row ms, above the one before it (null: over all).
+    band = next((x for x in budgets if r["ms"] <= x), None)
+    assert r["budget_ms"] == band, r
+    if band is not None:
+        below = [x for x in budgets if x < band]
+        assert not below or r["ms"] > below[-1], r
+    # On the front: no row at most as slow is strictly closer (up to the JSON rounding).
+    beaten = [q for q in d["rows"] if q is not r and q["ms"] <= r["ms"] + 1e-3 and q["flip"] <= r["flip"] + 1e-6]
+    assert (not r["pareto"] or all(q["ms"] > r["ms"] - 1e-3 or q["flip"] >= r["flip"] - 1e-6 for q in beaten)) \
+        and (r["pareto"] or beaten), r
+front = sorted((r for r in d["rows"] if r["pareto"]), key=lambda r: r["ms"])
+assert front and all(a["flip"] >= b["flip"] for a, b in zip(front, front[1:])), front
+for f in d["front"]:
+    if f["best"] is not None:
+        assert any(r["pareto"] and r["name"] == f["best"]["name"] and r["family"] == f["best"]["family"]
+                   for r in d["rows"]), f'
         [ "$(wc -l < "$tmp/frontier.csv")" -ge 15 ] || fail "bench frontier: --csv has too few rows"
+        python3 -c 'import sys, xml.etree.ElementTree as E; t = E.parse(sys.argv[1]).getroot()
+ns = "{http://www.w3.org/2000/svg}"
+assert t.tag == ns + "svg" and len(t.findall(ns + "circle")) > 15 and t.findall(ns + "polyline"), t' \
+            "$tmp/frontier.svg" || fail "bench frontier: --svg is not a plot of the rows"
         ;;
     *)
         fail "bench $1 has no smoke case in tests/cli/test_bench.sh"
