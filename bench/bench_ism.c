@@ -12,6 +12,7 @@
 #include "drift/metric.h"
 #include "drift/pt.h"
 #include "drift/scene_io.h"
+#include "ism/ism_internal.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -22,10 +23,10 @@
 
 typedef struct ism_options {
     const char *scene_path, *png_dir;
-    long size, threads, ref_spp, points, map, block;
+    long size, height, threads, ref_spp, points, map, block;
     long vpls[MAX_LIST], spps[MAX_LIST];
     int vpl_count, spp_count;
-    bool no_ir, json;
+    bool no_ir, classic, json;
 } ism_options;
 
 // --vpls and --spp: `field` is the options.
@@ -41,6 +42,8 @@ static bool parse_counts(const char *cmd, const char *flag, const char *value, v
 static const cli_option ism_table[] = {
     CLI_SECTION("options:", 0),
     CLI_INT("--size", "N", O, size, 8, 4096, "N x N pixels (default 400)"),
+    CLI_INT("--height", "H", O, height, 8, 4096,
+            "N x H pixels instead (e.g. --size 640 --height 480)"),
     CLI_INT("--threads", "T", O, threads, 1, 256, "worker threads (default 2)"),
     CLI_CUSTOM_ALL("--vpls", "LIST", parse_counts,
                    "comma-separated VPL counts (default 64,256,1024)"),
@@ -50,6 +53,9 @@ static const cli_option ism_table[] = {
     CLI_INT("--map", "N", O, map, 4, 1024, "ISM side (default 64)"),
     CLI_INT("--block", "B", O, block, 1, 64, "interleaving block (default 4)"),
     CLI_FLAG("--no-ir", O, no_ir, "skip the ray-traced baseline"),
+    CLI_FLAG("--classic", O, classic,
+             "after each ism row, time exact (ray-cast) paraboloid maps for the\n"
+             "same VPLs: the classic shadow maps ISMs replace (row sm)"),
     CLI_STRING("--png", "DIR", O, png_dir,
                "write each row's frame (reference terms + I) as DIR/<row>_<count>.png,\n"
                "I alone 3 stops up as DIR/<row>_<count>_indirect.png, and the\n"
@@ -83,7 +89,7 @@ static drift_result pt_image(bench_state *b, uint32_t components, long spp, drif
 {
     drift_pt *pt = NULL;
     drift_pt_params params = { .width = (int32_t)b->o->size,
-                               .height = (int32_t)b->o->size,
+                               .height = (int32_t)b->o->height,
                                .seed = (uint32_t)spp * 7u + components,
                                .max_depth = 2,
                                .components = components,
@@ -179,6 +185,51 @@ static void report(bench_state *b, const char *name, long count, double ms, cons
     drift_image_destroy(b->ctx, &frame);
 }
 
+typedef struct classic_job {
+    const drift_accel *accel;
+    const drift_vpl *vpls;
+    int32_t n;
+    float *maps; // one n x n map per thread: only the build is timed
+} classic_job;
+
+static void classic_maps(size_t begin, size_t end, int thread, void *user)
+{
+    classic_job *job = user;
+    float *depth = job->maps + (size_t)thread * (size_t)job->n * (size_t)job->n;
+    for (size_t j = begin; j < end; ++j) {
+        drift_frame frame = drift_frame_from_normal(job->vpls[j].normal);
+        drift__ism_exact_map(depth, job->n, job->accel, job->vpls[j].position, &frame);
+    }
+}
+
+// Row sm: exact paraboloid maps for the ism row's VPLs, one Embree ray a texel (the CPU's
+// classic shadow maps; the thesis rasterises the scene into each), timed against the ISM
+// build (splat + pull-push). Its image is the ism row's: only the build differs.
+static void classic_row(bench_state *b, const drift_ism *ism, const drift_ism_stats *st,
+                        const drift_image *indirect, long count)
+{
+    uint32_t vpl_count = 0;
+    const drift_vpl *vpls = drift_ism_vpls(ism, &vpl_count);
+    int32_t n = (int32_t)b->o->map;
+    classic_job job = { .accel = b->accel, .vpls = vpls, .n = n };
+    job.maps =
+        malloc((size_t)drift_context_thread_count(b->ctx) * (size_t)n * (size_t)n * sizeof(float));
+    if (!job.maps) {
+        return;
+    }
+    double t0 = drift_time_now();
+    drift_parallel_for(b->ctx, vpl_count, 1, classic_maps, &job);
+    double ms = (drift_time_now() - t0) * 1e3;
+    free(job.maps);
+    double ism_ms = st->ms[DRIFT_ISM_STAGE_SPLAT] + st->ms[DRIFT_ISM_STAGE_PULL_PUSH];
+    char detail[256];
+    snprintf(detail, sizeof detail,
+             "%u exact %dx%d maps, %.0f rays; %.1fx the ISM build (splat + pull-push %.1f ms)",
+             vpl_count, n, n, (double)vpl_count * (double)n * (double)n * (double)DRIFT_PI / 4.0,
+             ism_ms > 0.0 ? ms / ism_ms : 0.0, ism_ms);
+    report(b, "sm", count, ms, detail, NULL, indirect);
+}
+
 int drift_bench_ism(int argc, char **argv)
 {
     ism_options o = { .size = 400,
@@ -195,6 +246,7 @@ int drift_bench_ism(int argc, char **argv)
     if (status != CLI_PARSED) {
         return cli_parse_exit(status);
     }
+    o.height = o.height ? o.height : o.size;
     status = 1;
     bench_state b = { .o = &o };
     cli_session session;
@@ -210,7 +262,7 @@ int drift_bench_ism(int argc, char **argv)
     b.accel = session.accel;
     drift_hybrid *frame = NULL;
     if (r == DRIFT_OK) {
-        drift_hybrid_params hp = { .width = (int32_t)o.size, .height = (int32_t)o.size };
+        drift_hybrid_params hp = { .width = (int32_t)o.size, .height = (int32_t)o.height };
         r = drift_hybrid_create(b.ctx, b.scene, b.accel, &hp, &frame);
     }
     if (r == DRIFT_OK) {
@@ -226,7 +278,7 @@ int drift_bench_ism(int argc, char **argv)
                      o.ref_spp, &b.ref_rest, NULL);
     }
     if (r == DRIFT_OK) {
-        r = drift_image_create(b.ctx, (int32_t)o.size, (int32_t)o.size, 3, &b.ref_frame);
+        r = drift_image_create(b.ctx, (int32_t)o.size, (int32_t)o.height, 3, &b.ref_frame);
     }
     if (r != DRIFT_OK) {
         goto done;
@@ -237,6 +289,7 @@ int drift_bench_ism(int argc, char **argv)
         root = cJSON_CreateObject();
         cJSON_AddStringToObject(root, "scene", session.scene_path);
         cJSON_AddNumberToObject(root, "size", (double)o.size);
+        cJSON_AddNumberToObject(root, "height", (double)o.height);
         cJSON_AddNumberToObject(root, "threads", drift_context_thread_count(b.ctx));
         cJSON_AddNumberToObject(root, "ref_spp", (double)o.ref_spp);
         cli_json_number(root, "gbuffer_ms", hs.ms[DRIFT_PASS_PRIMARY], 3);
@@ -244,7 +297,7 @@ int drift_bench_ism(int argc, char **argv)
     } else {
         printf("# %s at %ldx%ld, %d threads; reference %ld spp; G-buffer %.1f ms (not in the "
                "rows)\n",
-               session.scene_path, o.size, o.size, drift_context_thread_count(b.ctx), o.ref_spp,
+               session.scene_path, o.size, o.height, drift_context_thread_count(b.ctx), o.ref_spp,
                hs.ms[DRIFT_PASS_PRIMARY]);
         printf("| what | count | ms | RMSE of I | FLIP of frame | detail |\n"
                "|---|---|---|---|---|---|\n");
@@ -287,6 +340,9 @@ int drift_bench_ism(int argc, char **argv)
                  st.ms[DRIFT_ISM_STAGE_GATHER], st.ms[DRIFT_ISM_STAGE_BLUR], st.hole_fraction);
         report(&b, ir ? "ir" : "ism", o.vpls[v / 2], st.total_ms, detail, &st,
                drift_ism_indirect(ism));
+        if (o.classic && !ir) {
+            classic_row(&b, ism, &st, drift_ism_indirect(ism), o.vpls[v / 2]);
+        }
         if (o.png_dir && !ir && v == 2 * o.vpl_count - 2) {
             char path[1024];
             snprintf(path, sizeof path, "%s/ism_vpls.png", o.png_dir);

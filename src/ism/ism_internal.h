@@ -34,6 +34,12 @@ typedef struct drift__ism_splat_desc {
 void drift__ism_splat(float *depth, const drift__ism_splat_desc *desc, drift_vec3 origin,
                       const drift_frame *frame, const drift_vec3 *positions, uint32_t count);
 
+// The exact n x n paraboloid depth map of a VPL at `origin` (frame z = its normal): one ray
+// through each texel centre inside the disc, the nearest hit's distance (INFINITY: a miss or
+// outside the disc). The CPU's classic shadow map, against which ISMs are timed.
+void drift__ism_exact_map(float *depth, int32_t n, const drift_accel *accel, drift_vec3 origin,
+                          const drift_frame *frame);
+
 // Pull-push hole filling of an n x n map over `levels` levels with the level-0 threshold
 // `threshold`; scratch holds at least n * n floats (levels <= 7). Returns the number of texels
 // inside the unit disc still empty.

@@ -69,12 +69,13 @@ assert all(r["ms"] >= 0 and 0 <= r["flip"] <= 1 and r["rmse"] >= 0 and 0 <= r["f
 assert "table" not in d and d["radius"] > 0, d'
         ;;
     ism)
-        expect 0 "$drift" bench ism "$box" --size 16 --ref-spp 2 --vpls 8 --spp 1 --points 64 \
-            --map 8 --threads 1 --json
-        check ism 'assert d["size"] == 16 and d["ref_spp"] == 2 and d["gbuffer_ms"] >= 0, d
-assert [(r["what"], r["count"]) for r in d["rows"]] == [("ref", 2), ("pt", 1), ("ism", 8), ("ir", 8)], d
+        expect 0 "$drift" bench ism "$box" --size 16 --height 12 --ref-spp 2 --vpls 8 --spp 1 \
+            --points 64 --map 8 --threads 1 --classic --json
+        check ism 'assert d["size"] == 16 and d["height"] == 12 and d["ref_spp"] == 2 and d["gbuffer_ms"] >= 0, d
+assert [(r["what"], r["count"]) for r in d["rows"]] == [("ref", 2), ("pt", 1), ("ism", 8), ("sm", 8), ("ir", 8)], d
 assert all(r["ms"] >= 0 and r["rmse_indirect"] >= 0 and 0 <= r["flip_frame"] <= 1 for r in d["rows"]), d
-for r in d["rows"][2:]:
+assert d["rows"][3]["ms"] > 0 and d["rows"][3]["flip_frame"] == d["rows"][2]["flip_frame"], d
+for r in (d["rows"][2], d["rows"][4]):
     assert 0 < r["vpls"] <= 8 and 0 <= r["holes"] <= 1 and r["stage_ms"]["gather"] >= 0, r'
         expect 2 "$drift" bench ism --vpls 8,,16
         grep -q -- "--vpls expects .*got '8,,16'" "$tmp/err" || fail "bench ism: bad --vpls not named"
