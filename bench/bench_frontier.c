@@ -312,7 +312,8 @@ static drift_result hybrid_row(frontier_state *b, const char *name,
 // The hybrid combinations: shadows hard, pcss, isg, aaf x indirect none, ambient, ism and ir at
 // 16..1024 VPLs, aaf; AAF rows at 1, 2 and 4 spp; max depth 8. The other effects keep the
 // technique that matches the reference: reflections none on a scene without glossy or mirror
-// materials (else aaf), depth of field none for a pinhole camera (else reference), occlusion
+// materials (else aaf), depth of field none for a pinhole camera (else post: reference would
+// path-trace the whole frame through the lens, replacing every other row's output), occlusion
 // none, glare none.
 static drift_result hybrid_rows(frontier_state *b, double limit_ms)
 {
@@ -351,7 +352,7 @@ static drift_result hybrid_rows(frontier_state *b, double limit_ms)
                     }
                     if (lens) {
                         drift_hybrid_params_set_technique(
-                            &p, DRIFT_EFFECT_DOF, technique_index(DRIFT_EFFECT_DOF, "reference"));
+                            &p, DRIFT_EFFECT_DOF, technique_index(DRIFT_EFFECT_DOF, "post"));
                     }
                     char name[96];
                     int len = snprintf(name, sizeof name, "%s + %s", shadows[s], indirect[i]);
