@@ -81,7 +81,9 @@ typedef struct bench_state {
     drift_accel *accel;
     const ism_options *o;
     drift_image ref_indirect, ref_rest, ref_frame;
-    cJSON *rows; // --json: the rows go here instead of stdout
+    drift_image last_ism; // the last ism row's I, for the ir row of the same VPLs
+    double nrmse_vs_ism;  // the next row's NRMSE of the ism I against it (< 0: none)
+    cJSON *rows;          // --json: the rows go here instead of stdout
 } bench_state;
 
 static drift_result pt_image(bench_state *b, uint32_t components, long spp, drift_image *out,
@@ -133,6 +135,21 @@ static void add_images(drift_image *out, const drift_image *x, const drift_image
     }
 }
 
+// RMSE of `test` against `ref` over ref's mean (all channels); 0 for a black reference.
+static double nrmse(drift_context *ctx, const drift_image *ref, const drift_image *test)
+{
+    double mse = 0.0, sum = 0.0;
+    drift_metric_mse(ctx, ref, test, &mse);
+    for (int32_t y = 0; y < ref->height; ++y) {
+        for (int32_t x = 0; x < ref->width; ++x) {
+            drift_vec3 c = drift_image_get3(ref, x, y);
+            sum += (double)(c.x + c.y + c.z) / 3.0;
+        }
+    }
+    double mean = sum / ((double)ref->width * (double)ref->height);
+    return mean > 0.0 ? sqrt(mse) / mean : 0.0;
+}
+
 // One row: I's RMSE against the reference, and FLIP of ref_rest + I against ref_frame, printed
 // or (--json) added to b->rows; `st`: the stages of an ism or ir row (NULL for the others).
 static void report(bench_state *b, const char *name, long count, double ms, const char *detail,
@@ -155,6 +172,9 @@ static void report(bench_state *b, const char *name, long count, double ms, cons
         cli_json_number(row, "ms", ms, 3);
         cli_json_number(row, "rmse_indirect", sqrt(mse), 6);
         cli_json_number(row, "flip_frame", rep.flip, 6);
+        if (b->nrmse_vs_ism >= 0.0) {
+            cli_json_number(row, "nrmse_ism_vs_ir", b->nrmse_vs_ism, 6);
+        }
         if (st) {
             static const char *const stages[] = { "vpls",      "points", "splat",
                                                   "pull_push", "gather", "blur" };
@@ -169,8 +189,12 @@ static void report(bench_state *b, const char *name, long count, double ms, cons
             cli_json_number(row, "holes", st->hole_fraction, 4);
         }
     } else {
-        printf("| %-4s | %5ld | %8.1f | %.4f | %.4f | %s |\n", name, count, ms, sqrt(mse), rep.flip,
+        printf("| %-4s | %5ld | %8.1f | %.4f | %.4f | %s", name, count, ms, sqrt(mse), rep.flip,
                detail);
+        if (b->nrmse_vs_ism >= 0.0) {
+            printf("; ism's NRMSE against it %.4f", b->nrmse_vs_ism);
+        }
+        printf(" |\n");
         fflush(stdout);
     }
     if (b->o->png_dir) {
@@ -248,7 +272,7 @@ int drift_bench_ism(int argc, char **argv)
     }
     o.height = o.height ? o.height : o.size;
     status = 1;
-    bench_state b = { .o = &o };
+    bench_state b = { .o = &o, .nrmse_vs_ism = -1.0 };
     cli_session session;
     cJSON *root = NULL;
     drift_result r = DRIFT_OK;
@@ -338,8 +362,20 @@ int drift_bench_ism(int argc, char **argv)
                  st.vpl_count, st.ms[DRIFT_ISM_STAGE_VPLS], st.ms[DRIFT_ISM_STAGE_POINTS],
                  st.ms[DRIFT_ISM_STAGE_SPLAT], st.ms[DRIFT_ISM_STAGE_PULL_PUSH],
                  st.ms[DRIFT_ISM_STAGE_GATHER], st.ms[DRIFT_ISM_STAGE_BLUR], st.hole_fraction);
+        // Fig. 5.8's error: the ism I against the ir I of the same VPLs (exact visibility),
+        // RMSE over ir's mean.
+        b.nrmse_vs_ism =
+            ir && b.last_ism.pixels ? nrmse(b.ctx, drift_ism_indirect(ism), &b.last_ism) : -1.0;
         report(&b, ir ? "ir" : "ism", o.vpls[v / 2], st.total_ms, detail, &st,
                drift_ism_indirect(ism));
+        b.nrmse_vs_ism = -1.0;
+        if (!ir) {
+            drift_image_destroy(b.ctx, &b.last_ism);
+            const drift_image *img = drift_ism_indirect(ism);
+            if (drift_image_create(b.ctx, img->width, img->height, 3, &b.last_ism) == DRIFT_OK) {
+                add_images(&b.last_ism, img, &b.last_ism); // a copy: the new image is zero
+            }
+        }
         if (o.classic && !ir) {
             classic_row(&b, ism, &st, drift_ism_indirect(ism), o.vpls[v / 2]);
         }
@@ -380,6 +416,7 @@ done:
     drift_image_destroy(b.ctx, &b.ref_indirect);
     drift_image_destroy(b.ctx, &b.ref_rest);
     drift_image_destroy(b.ctx, &b.ref_frame);
+    drift_image_destroy(b.ctx, &b.last_ism);
     drift_hybrid_destroy(frame);
     cli_session_close(&session);
     return status;

@@ -75,6 +75,7 @@ assert "table" not in d and d["radius"] > 0, d'
 assert [(r["what"], r["count"]) for r in d["rows"]] == [("ref", 2), ("pt", 1), ("ism", 8), ("sm", 8), ("ir", 8)], d
 assert all(r["ms"] >= 0 and r["rmse_indirect"] >= 0 and 0 <= r["flip_frame"] <= 1 for r in d["rows"]), d
 assert d["rows"][3]["ms"] > 0 and d["rows"][3]["flip_frame"] == d["rows"][2]["flip_frame"], d
+assert d["rows"][4]["nrmse_ism_vs_ir"] >= 0 and "nrmse_ism_vs_ir" not in d["rows"][2], d
 for r in (d["rows"][2], d["rows"][4]):
     assert 0 < r["vpls"] <= 8 and 0 <= r["holes"] <= 1 and r["stage_ms"]["gather"] >= 0, r'
         expect 2 "$drift" bench ism --vpls 8,,16
