@@ -101,8 +101,9 @@ uint32_t drift_aaf_shadow_sparse_count(uint32_t spp);
 // samples; < 0 for pixels outside the budget) into counts[i] >= sparse, at most max_spp, whose
 // mean over the `active` pixels (those with want >= 0) is spp: the rates are scaled by one
 // factor found by bisection, then rounded up or down by a per-pixel hash so the expected total
-// is the budget. Flat pixels keep `sparse`, plus an even share of what the adaptive pixels
-// cannot take under max_spp; pixels outside the budget keep `sparse`.
+// is the budget. When the adaptive pixels cannot spend it under max_spp, the cap doubles until
+// they can (at most to 8 max_spp). Flat pixels keep `sparse`, plus an even share of what the
+// adaptive pixels still cannot take; pixels outside the budget keep `sparse`.
 void drift_aaf_allocate(const float *want, size_t count, size_t active, uint32_t sparse,
                         uint32_t spp, uint32_t max_spp, uint32_t seed, uint32_t *counts);
 
