@@ -94,8 +94,8 @@ static void reflection_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_
                      .plane = p->isg.range_plane,
                      .x0 = x,
                      .y0 = y };
-    uint32_t hash = drift_hash_combine(p->seed ^ DRIFT_STREAM_ISG_REFLECTIONS, (uint32_t)index);
-    drift_isg_jitter jitter = drift_isg_jitter_make(hash);
+    drift_isg_jitter jitter =
+        drift_isg_jitter_at(drift_hash_u32(p->seed ^ DRIFT_STREAM_ISG_REFLECTIONS), x, y);
     drift_vec3 gathered;
     if (p->reflections == DRIFT_REFLECTIONS_BLUR) {
         drift_isg_kernel k = {

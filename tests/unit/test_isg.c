@@ -571,6 +571,76 @@ static double gather_variance(const drift_image *image, uint32_t count)
     return sum2 / trials - mean * mean;
 }
 
+// The noise of the gather over a shadow edge (its value less its mean over rotations), seen
+// through a 3 x 3 box (what the eye integrates): the per-pixel rotation's stipple.
+// Interleaved rotations (neighbours take evenly spread angles) leave less of it than white
+// ones at the same cost.
+static double stipple(const drift_image *image, bool interleaved)
+{
+    static drift_isg_pattern pattern;
+    drift_isg_pattern_make(9, DRIFT_ISG_DISK, &pattern);
+
+    enum {
+        N = 40,
+        ANGLES = 64
+    };
+
+    static float error[N][N];
+    for (int32_t y = 0; y < N; ++y) {
+        for (int32_t x = 0; x < N; ++x) {
+            uint32_t pixel = (uint32_t)(y * N + x);
+            drift_isg_jitter jitter = interleaved ? drift_isg_jitter_at(99, x, y)
+                                                  : drift_isg_jitter_make(drift_hash_u32(pixel));
+            drift_isg_kernel kernel = { &pattern,   jitter, drift_vec2_make(6.0f, 6.0f),
+                                        range_unit, NULL,   NULL };
+            float a, mean = 0.0f;
+            drift_isg_filter(&kernel, image, 0, 1, x + 12, y + 12, &a);
+            for (int k = 0; k < ANGLES; ++k) {
+                float angle = 2.0f * 3.14159265f * ((float)k + 0.5f) / ANGLES, b;
+                kernel.jitter.cos_a = cosf(angle);
+                kernel.jitter.sin_a = sinf(angle);
+                drift_isg_filter(&kernel, image, 0, 1, x + 12, y + 12, &b);
+                mean += b / ANGLES;
+            }
+            error[y][x] = a - mean;
+        }
+    }
+    double sum2 = 0.0;
+    int count = 0;
+    for (int32_t y = 1; y + 1 < N; ++y) {
+        for (int32_t x = 1; x + 1 < N; ++x) {
+            float box = 0.0f;
+            for (int32_t j = -1; j <= 1; ++j) {
+                for (int32_t i = -1; i <= 1; ++i) {
+                    box += error[y + j][x + i] / 9.0f;
+                }
+            }
+            sum2 += (double)box * (double)box;
+            ++count;
+        }
+    }
+    return sqrt(sum2 / count);
+}
+
+static void test_interleaved_rotation_less_stipple(void **state)
+{
+    (void)state;
+    drift_context *ctx = test_context(1, NULL);
+    drift_image image;
+    assert_int_equal(drift_image_create(ctx, 64, 64, 1, &image), DRIFT_OK);
+    for (int32_t y = 0; y < 64; ++y) {
+        for (int32_t x = 0; x < 64; ++x) {
+            // A diagonal shadow edge: every gather near it straddles it.
+            drift_image_pixel(&image, x, y)[0] = (float)((x + y / 2) % 16 < 8);
+        }
+    }
+    double white = stipple(&image, false), interleaved = stipple(&image, true);
+    print_message("stipple after a 3x3 box: white %g, interleaved %g\n", white, interleaved);
+    assert_true(interleaved < 0.85 * white); // 0.78x measured
+    drift_image_destroy(ctx, &image);
+    drift_context_destroy(ctx);
+}
+
 static void test_more_gather_samples_lower_variance(void **state)
 {
     (void)state;
@@ -624,6 +694,7 @@ int main(void)
         cmocka_unit_test(test_constant_image_stays_constant),
         cmocka_unit_test(test_all_rejected_falls_back_to_centre),
         cmocka_unit_test(test_more_gather_samples_lower_variance),
+        cmocka_unit_test(test_interleaved_rotation_less_stipple),
         cmocka_unit_test(test_rejects_bad_counts),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
