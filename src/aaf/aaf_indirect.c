@@ -2,8 +2,9 @@
 // bounce: the diffuse lobe here (--indirect aaf, the frame's I term) and the glossy lobe in
 // aaf_specular.c (--reflections aaf, R), each in its own buffers, filtered apart (sec. 4.3),
 // path-traced per pixel and filtered in world space:
-//   1. sparse: a few rays sampled from the lobe; their hit distances give z_min and z_max,
-//      which set beta (eq. 4.4, with the lobe's Omega_h^max of eq. 4.5) and n(x) (eq. 4.6);
+//   1. sparse: a few rays sampled from the lobe; the hit distances of the neighbours' rays
+//      give z_min and z_max (escaped rays count as infinitely far), which set beta (eq. 4.4,
+//      with the lobe's Omega_h^max of eq. 4.5) and n(x) (eq. 4.6);
 //   2. adaptive: the --spp budget spread in proportion to n(x), capped at aaf_max_spp;
 //   3. the separable filter on the estimate divided by the lobe's albedo (so texture is not
 //      blurred), then multiplied back by the albedo.
