@@ -33,6 +33,7 @@ typedef struct sir_options {
     const char *figures_dir;
     bool json;
     bool noise_floor;
+    bool paper_metrics;
     bool has_target;
     drift_vec3 target; // --target: look here instead of the scene camera's target
     double fov;        // --fov: vertical field of view, degrees (0: the camera's)
@@ -90,11 +91,15 @@ static const cli_option sir_table[] = {
     CLI_STRING("--lambda", "FILE", O, lambda_path, "also measure the fitted combination"),
     CLI_STRING("--figures", "DIR", O, figures_dir,
                "PNGs per row: raster, pure, sir, combined error, and the\n"
-               "recall map (white: real error flagged, red: missed, blue: flagged only)"),
+               "recall map (white: real error flagged, red: missed, blue: flagged only),\n"
+               "and the raster's error 4x (red: brighter than PRT, green: darker)"),
     CLI_FLAG("--noise-floor", O, noise_floor,
              "also the FLIP between two pure images of different seeds (how\n"
              "close two equally good images are), and a real error must exceed\n"
              "the threshold plus the two pure images' difference at the pixel"),
+    CLI_FLAG("--paper-metrics", O, paper_metrics,
+             "the paper's metrics alone: reflection metrics unweighted by the raster's\n"
+             "expected error, penumbrae ungated, no leak metric (the before of issue 17)"),
     CLI_CUSTOM_ALL("--target", "X,Y,Z", parse_target,
                    "look at this point instead of the camera's target (other views,\n"
                    "as the paper's rows are views with more or fewer error pixels)"),
@@ -174,6 +179,7 @@ typedef struct sir_row {
     double noise_flip; // FLIP between two pure images of different seeds (-1: not measured)
     double reached_ms; // SIR's time to FLIP <= FLIP_TARGET against PRT (-1: not reached)
     uint64_t sir_rays, prt_rays;
+    uint64_t raster_rays, metrics_rays; // the raster frame's, the metrics'
     uint32_t iterations;
     quality q[QUALITY_ROWS]; // the metrics, the averaged sum, lambda (when given)
 } sir_row;
@@ -212,6 +218,17 @@ static void save_figures(drift_context *ctx, const sir_options *o, const char *s
         }
     }
     save_png(ctx, o, scene, w, h, "recall", &map);
+    // The sign of the raster's error, 4x: red where the raster is brighter (a leak), green
+    // where it is darker.
+    for (int32_t y = 0; y < h; ++y) {
+        for (int32_t x = 0; x < w; ++x) {
+            const float *a = drift_image_pixel(raster, x, y), *b = drift_image_pixel(pure, x, y);
+            float d = 4.0f * ((a[0] + a[1] + a[2]) - (b[0] + b[1] + b[2])) / 3.0f;
+            drift_image_set3(&map, x, y,
+                             drift_vec3_make(d > 0.0f ? d : 0.0f, d < 0.0f ? -d : 0.0f, 0));
+        }
+    }
+    save_png(ctx, o, scene, w, h, "sign", &map);
     drift_image_destroy(ctx, &map);
 }
 
@@ -236,7 +253,12 @@ static drift_result run_one(drift_context *ctx, const drift_scene *scene, const 
     if (r == DRIFT_OK) {
         r = drift_refine_create(
             ctx, frame,
-            &(drift_refine_params){ .spp = (uint32_t)o->spp, .budget = (uint32_t)o->budget }, &sir);
+            &(drift_refine_params){ .spp = (uint32_t)o->spp,
+                                    .budget = (uint32_t)o->budget,
+                                    .reflection_tolerance = o->paper_metrics ? -1.0f : 0.0f,
+                                    .leak_tolerance = o->paper_metrics ? -1.0f : 0.0f,
+                                    .shadow_tolerance = o->paper_metrics ? -1.0f : 0.0f },
+            &sir);
     }
     if (r == DRIFT_OK) {
         r = drift_image_create(ctx, w, h, 3, &pure);
@@ -253,7 +275,11 @@ static drift_result run_one(drift_context *ctx, const drift_scene *scene, const 
     if (r != DRIFT_OK) {
         goto done;
     }
-    row->raster_ms = drift_hybrid_get_stats(frame).frame_ms;
+    drift_hybrid_stats raster_stats = drift_hybrid_get_stats(frame);
+    row->raster_ms = raster_stats.frame_ms;
+    for (int p = 0; p < DRIFT_PASS_COUNT; ++p) {
+        row->raster_rays += raster_stats.rays[p];
+    }
     double t = drift_time_now();
     r = drift_refine_render_pure(sir, (uint32_t)o->spp, &pure, &row->prt_rays, NULL);
     row->prt_ms = 1000.0 * (drift_time_now() - t);
@@ -294,6 +320,7 @@ static drift_result run_one(drift_context *ctx, const drift_scene *scene, const 
     row->error_pixels = s.error_pixels;
     row->error_percent = 100.0 * (double)s.error_pixels / ((double)w * (double)h);
     row->metrics_ms = s.metrics_ms;
+    row->metrics_rays = s.metrics_rays;
     row->sort_ms = s.sort_ms;
     row->trace_ms = s.trace_ms;
     row->sir_ms = row->raster_ms + refine_ms;
@@ -411,6 +438,16 @@ static void add_json_row(cJSON *rows, const sir_row *row, bool lambda)
     cli_json_count(r, "iterations", row->iterations);
     cli_json_count(r, "sir_rays", row->sir_rays);
     cli_json_count(r, "prt_rays", row->prt_rays);
+    cli_json_count(r, "raster_rays", row->raster_rays);
+    cli_json_count(r, "metrics_rays", row->metrics_rays);
+    // What refining cannot save: the raster and the metrics, against pure ray tracing.
+    cli_json_number(r, "raster_metrics_time_share",
+                    (row->raster_ms + row->metrics_ms) / row->prt_ms, 4);
+    cli_json_number(r, "raster_metrics_ray_share",
+                    row->prt_rays
+                        ? (double)(row->raster_rays + row->metrics_rays) / (double)row->prt_rays
+                        : 0.0,
+                    4);
     cJSON *by_metric = cJSON_AddObjectToObject(r, "quality");
     int count = lambda ? QUALITY_ROWS : QUALITY_ROWS - 1;
     for (int k = 0; k < count; ++k) {
@@ -433,6 +470,14 @@ static void print_text_row(const sir_row *row, bool lambda)
     } else {
         printf("    FLIP <= %.2f not reached\n", FLIP_TARGET);
     }
+    printf("    raster + metrics: %.1f%% of PRT's time, %.1f%% of its rays (%llu + %llu of "
+           "%llu)\n",
+           100.0 * (row->raster_ms + row->metrics_ms) / row->prt_ms,
+           row->prt_rays
+               ? 100.0 * (double)(row->raster_rays + row->metrics_rays) / (double)row->prt_rays
+               : 0.0,
+           (unsigned long long)row->raster_rays, (unsigned long long)row->metrics_rays,
+           (unsigned long long)row->prt_rays);
     printf("    raster %.1f + metrics %.1f + sort %.1f + trace %.1f ms, %u iterations; real error "
            "pixels %.2f%%; pure vs pure FLIP %.5f\n    recall/precision:",
            row->raster_ms, row->metrics_ms, row->sort_ms, row->trace_ms, row->iterations,
