@@ -51,7 +51,11 @@ assert e["timing"]["frame_ms"] > 0, e'
         expect 0 "$drift" bench sir "$box" --sizes 16x12 --spp 1 --budget 64 --json
         check sir 'r = d["rows"]
 assert len(r) == 1 and r[0]["width"] == 16 and r[0]["height"] == 12, d
-assert 0 <= r[0]["flip"] <= 1 and r[0]["prt_ms"] > 0 and "shadow" in r[0]["quality"], r'
+assert 0 <= r[0]["flip"] <= 1 and r[0]["prt_ms"] > 0 and "shadow" in r[0]["quality"], r
+assert "leak" in r[0]["quality"] and r[0]["raster_metrics_time_share"] > 0, r
+assert 0 < r[0]["raster_metrics_ray_share"] and r[0]["metrics_rays"] >= 0, r'
+        expect 0 "$drift" bench sir "$box" --sizes 16x12 --spp 1 --budget 64 --paper-metrics --json
+        check sir 'assert d["rows"][0]["quality"]["leak"]["flagged"] == 0, d'
         ;;
     glare)
         expect 0 "$drift" bench glare --frames 1 --sizes 16,32 --no-convolution --json
