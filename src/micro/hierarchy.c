@@ -84,8 +84,10 @@ drift_result drift__micro_tree_create(drift_context *ctx, const drift_points *po
     tree->albedo = drift_alloc(ctx, m * sizeof *tree->albedo);
     tree->front = drift_alloc(ctx, m * sizeof *tree->front);
     tree->back = drift_alloc(ctx, m * sizeof *tree->back);
+    tree->cube = drift_alloc(ctx, 6 * m * sizeof *tree->cube);
+    tree->cube_weight = drift_alloc(ctx, 6 * m * sizeof *tree->cube_weight);
     if (!tree->point_of || !tree->center || !tree->radius || !tree->axis || !tree->cone_cos ||
-        !tree->albedo || !tree->front || !tree->back) {
+        !tree->albedo || !tree->front || !tree->back || !tree->cube || !tree->cube_weight) {
         drift__micro_tree_destroy(ctx, tree);
         return DRIFT_ERR_OUT_OF_MEMORY;
     }
@@ -96,6 +98,8 @@ drift_result drift__micro_tree_create(drift_context *ctx, const drift_points *po
     memset(tree->albedo, 0, m * sizeof *tree->albedo);
     memset(tree->front, 0, m * sizeof *tree->front);
     memset(tree->back, 0, m * sizeof *tree->back);
+    memset(tree->cube, 0, 6 * m * sizeof *tree->cube);
+    memset(tree->cube_weight, 0, 6 * m * sizeof *tree->cube_weight);
     drift__micro_tree_refit(tree, points);
     return DRIFT_OK;
 }
@@ -110,6 +114,8 @@ void drift__micro_tree_destroy(drift_context *ctx, drift__micro_tree *tree)
     drift_free(ctx, tree->albedo);
     drift_free(ctx, tree->front);
     drift_free(ctx, tree->back);
+    drift_free(ctx, tree->cube);
+    drift_free(ctx, tree->cube_weight);
     memset(tree, 0, sizeof *tree);
 }
 
@@ -191,9 +197,31 @@ void drift__micro_tree_refit(drift__micro_tree *tree, const drift_points *points
     }
 }
 
+// The weights of direction m on the six axes +x, -x, +y, -y, +z, -z: its squared
+// components on the axes it points along (they sum to 1 for a unit m).
+static void cube_weights(drift_vec3 m, float w[6])
+{
+    float c[3] = { m.x, m.y, m.z };
+    for (int a = 0; a < 3; ++a) {
+        w[2 * a] = c[a] > 0.0f ? c[a] * c[a] : 0.0f;
+        w[2 * a + 1] = c[a] < 0.0f ? c[a] * c[a] : 0.0f;
+    }
+}
+
 void drift__micro_tree_pull(drift__micro_tree *tree)
 {
     uint32_t n = tree->leaf_count;
+    for (uint32_t j = 0; j < n; ++j) {
+        uint32_t node = n - 1 + j;
+        float wf[6], wb[6];
+        cube_weights(tree->axis[node], wf);
+        cube_weights(drift_vec3_neg(tree->axis[node]), wb);
+        for (int k = 0; k < 6; ++k) {
+            tree->cube[6 * node + k] = drift_vec3_add(drift_vec3_scale(tree->front[node], wf[k]),
+                                                      drift_vec3_scale(tree->back[node], wb[k]));
+            tree->cube_weight[6 * node + k] = wf[k] + wb[k];
+        }
+    }
     for (uint32_t i = n - 1; i-- > 0;) {
         drift_vec3 front = drift_vec3_splat(0.0f), back = front, albedo = front;
         for (uint32_t c = 2 * i + 1; c <= 2 * i + 2; ++c) {
@@ -205,7 +233,33 @@ void drift__micro_tree_pull(drift__micro_tree *tree)
         tree->front[i] = drift_vec3_scale(front, 0.5f);
         tree->back[i] = drift_vec3_scale(back, 0.5f);
         tree->albedo[i] = drift_vec3_scale(albedo, 0.5f);
+        for (int k = 0; k < 6; ++k) {
+            tree->cube[6 * i + k] =
+                drift_vec3_add(tree->cube[6 * (2 * i + 1) + k], tree->cube[6 * (2 * i + 2) + k]);
+            tree->cube_weight[6 * i + k] =
+                tree->cube_weight[6 * (2 * i + 1) + k] + tree->cube_weight[6 * (2 * i + 2) + k];
+        }
     }
+}
+
+drift_vec3 drift__micro_tree_radiance(const drift__micro_tree *tree, uint32_t i, drift_vec3 toward)
+{
+    float len = drift_vec3_length(toward);
+    float c[6];
+    cube_weights(len > 0.0f ? drift_vec3_scale(toward, 1.0f / len) : tree->axis[i], c);
+    drift_vec3 sum = drift_vec3_splat(0.0f), all = sum;
+    float weight = 0.0f, all_weight = 0.0f;
+    for (int k = 0; k < 6; ++k) {
+        sum = drift_vec3_fma(sum, tree->cube[6 * i + k], c[k]);
+        weight += c[k] * tree->cube_weight[6 * i + k];
+        all = drift_vec3_add(all, tree->cube[6 * i + k]);
+        all_weight += tree->cube_weight[6 * i + k];
+    }
+    // Seen exactly edge-on no leaf faces the viewer: the node's mean over all of them.
+    if (weight > 1e-6f * all_weight) {
+        return drift_vec3_scale(sum, 1.0f / weight);
+    }
+    return all_weight > 0.0f ? drift_vec3_scale(all, 1.0f / all_weight) : all;
 }
 
 // --- NEAREST LEAF ---

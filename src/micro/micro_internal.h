@@ -12,7 +12,11 @@
 // children 2i + 1 and 2i + 2; the leaves are the last leaf_count nodes, leaf j = node
 // leaf_count - 1 + j standing for scene point point_of[j]. Each node is a bounding sphere
 // (center, radius), a cone of normals (axis, cos of its half angle; -1: every direction) and
-// the radiance its two sides reflect (front: the side its axis points to).
+// the radiance it reflects. A leaf's is that of its disc's two sides (front: the side its
+// axis points to); every node's is also kept as an "ambient cube" (six directions +x, -x,
+// +y, -y, +z, -z, each side of each leaf weighted by the square of its normal's component
+// along them) so that a node is seen with the radiance of the leaves that face the viewer:
+// a single mean would show a box's lit top to a point below it (docs/micro.md).
 typedef struct drift__micro_tree {
     uint32_t leaf_count, node_count;
     uint32_t *point_of; // leaf_count: the drift_points index of each leaf
@@ -21,8 +25,10 @@ typedef struct drift__micro_tree {
     drift_vec3 *axis;
     float *cone_cos;
     drift_vec3 *albedo; // area-weighted mean diffuse reflectance kd
-    drift_vec3 *front;  // outgoing radiance of the front side
+    drift_vec3 *front;  // outgoing radiance of the front side (set at the leaves)
     drift_vec3 *back;   // of the back side
+    drift_vec3 *cube;   // 6 a node: the radiance-weighted sums along +x, -x, +y, -y, +z, -z
+    float *cube_weight; // 6 a node: the weights' sums
     float leaf_radius;  // r = sqrt(A / (pi n)): the disc one point stands for
 } drift__micro_tree;
 
@@ -34,9 +40,12 @@ void drift__micro_tree_destroy(drift_context *ctx, drift__micro_tree *tree);
 // Leaves from the points' current positions and normals (radius from their current area),
 // then every interior sphere and cone from its children's, bottom-up.
 void drift__micro_tree_refit(drift__micro_tree *tree, const drift_points *points);
-// Interior albedo and radiance as the mean of the children (equal areas: a complete tree over
-// equal-area points); a child's side that faces its parent's front counts toward the front.
+// Interior albedo and radiance from the leaves' (equal areas: a complete tree over equal-area
+// points): albedo, front and back the children's means (a child's side that faces its
+// parent's front counts toward the front), the ambient cubes their sums.
 void drift__micro_tree_pull(drift__micro_tree *tree);
+// The radiance node i sends toward `toward` (any length; from the node to the viewer).
+drift_vec3 drift__micro_tree_radiance(const drift__micro_tree *tree, uint32_t i, drift_vec3 toward);
 // The leaf nearest to x (branch and bound over the spheres).
 uint32_t drift__micro_tree_nearest_leaf(const drift__micro_tree *tree, drift_vec3 x);
 

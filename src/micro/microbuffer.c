@@ -39,6 +39,12 @@ drift_vec3 drift__micro_gather(const drift__micro_gather_desc *desc, drift_vec3 
         }
         bool leaf = i >= n - 1;
         float dist = drift_vec3_length(d);
+        // A flat node whose plane holds p is seen edge-on from it (the floor around a gather
+        // point on the floor): it covers no pixel, and refining it would reach every leaf.
+        if (tree->cone_cos[i] >= 0.99995f &&
+            fabsf(drift_vec3_dot(tree->axis[i], d)) <= 1e-3f * (dist + r)) {
+            continue;
+        }
         float omega_node = dist > r ? DRIFT_PI * r * r / (dist * dist) : INFINITY;
         int32_t pix = -1;
         if (local.z > 0.0f && dist > r) {
@@ -64,35 +70,35 @@ drift_vec3 drift__micro_gather(const drift__micro_gather_desc *desc, drift_vec3 
         if (splat_ok && omega_node > desc->cut_scale * pixels->omega[pix]) {
             *splat_ok = false;
         }
-        // The splat: its own pixel, and every pixel whose centre direction the node's disc
-        // covers (a node near its pixel's size otherwise leaves gaps that far nodes leak
-        // through).
-        // Depth-tested at the node's centre: nodes of the cut differ in size, and a big far
-        // one's sphere front would win over a small near one's.
-        float front = dist;
-        if (front < depth[pix]) {
-            depth[pix] = front;
-            node[pix] = (int32_t)i;
-            stats->splats++;
+        // The splat: every pixel whose centre direction the node's disc covers, its own and
+        // its neighbours' (coverage point-sampled at the pixel centres, as rays would: a
+        // node merely falling into a pixel at a silhouette would fill it whole and brighten
+        // the mean). Pixels no node covers are left to the rays. Depth-tested at the node's
+        // centre: nodes of the cut differ in size, and a big far one's sphere front would
+        // win over a small near one's.
+        // The disc of the node's own area (its leaves' discs), foreshortened when the node
+        // is flat: the bounding sphere would dilate every surface into the background.
+        uint32_t leaves = n >> (31 - __builtin_clz(i + 1));
+        float area_r = sqrtf((float)leaves) * tree->leaf_radius;
+        if (tree->cone_cos[i] > 0.9f) {
+            area_r *= sqrtf(fmaxf(fabsf(drift_vec3_dot(tree->axis[i], d)) / dist, 0.05f));
         }
-        float sin_a = r / dist, pixel_a = sqrtf(pixels->omega[pix]);
-        if (sin_a > 0.5f * pixel_a) {
-            drift_vec3 w = drift_vec3_scale(local, 1.0f / dist);
-            float cos_a = sqrtf(fmaxf(1.0f - sin_a * sin_a, 0.0f));
-            int32_t span = (int32_t)ceilf(sin_a / pixel_a) + 1;
-            span = span > k / 2 ? k / 2 : span;
-            int32_t px = pix % k, py = pix / k;
-            for (int32_t qy = py - span; qy <= py + span; ++qy) {
-                for (int32_t qx = px - span; qx <= px + span; ++qx) {
-                    if (qx < 0 || qy < 0 || qx >= k || qy >= k) {
-                        continue;
-                    }
-                    int32_t q = qy * k + qx;
-                    if (front < depth[q] && drift_vec3_dot(pixels->dir[q], w) >= cos_a) {
-                        depth[q] = front;
-                        node[q] = (int32_t)i;
-                        stats->splats++;
-                    }
+        float sin_a = fminf(r, area_r) / dist, pixel_a = sqrtf(pixels->omega[pix]);
+        drift_vec3 w = drift_vec3_scale(local, 1.0f / dist);
+        float cos_a = sqrtf(fmaxf(1.0f - sin_a * sin_a, 0.0f));
+        int32_t span = (int32_t)ceilf(sin_a / pixel_a) + 1;
+        span = span > k / 2 ? k / 2 : span;
+        int32_t px = pix % k, py = pix / k;
+        for (int32_t qy = py - span; qy <= py + span; ++qy) {
+            for (int32_t qx = px - span; qx <= px + span; ++qx) {
+                if (qx < 0 || qy < 0 || qx >= k || qy >= k) {
+                    continue;
+                }
+                int32_t q = qy * k + qx;
+                if (dist < depth[q] && drift_vec3_dot(pixels->dir[q], w) >= cos_a) {
+                    depth[q] = dist;
+                    node[q] = (int32_t)i;
+                    stats->splats++;
                 }
             }
         }
@@ -150,8 +156,8 @@ drift_vec3 drift__micro_gather(const drift__micro_gather_desc *desc, drift_vec3 
         if (i == BLOCKED) {
             continue;
         }
-        bool front = drift_vec3_dot(tree->axis[i], drift_vec3_sub(p, tree->center[i])) >= 0.0f;
-        sum = drift_vec3_add(sum, front ? tree->front[i] : tree->back[i]);
+        sum = drift_vec3_add(
+            sum, drift__micro_tree_radiance(tree, (uint32_t)i, drift_vec3_sub(p, tree->center[i])));
     }
     return drift_vec3_scale(sum, 1.0f / (float)k2);
 }
