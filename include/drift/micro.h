@@ -93,7 +93,7 @@ const char *drift_micro_stage_name(drift_micro_stage stage);
 typedef struct drift_micro_stats {
     double ms[DRIFT_MICRO_STAGE_COUNT];
     double total_ms;
-    uint64_t gathers;       // gather points of the last render (fallbacks included)
+    uint64_t gathers;       // micro-buffers rendered (fallbacks included; not on misses)
     uint64_t nodes_visited; // nodes the traversals touched
     uint64_t splats;        // nodes written into a micro-buffer pixel
     uint64_t post_leaves;   // leaves put on post-traversal lists

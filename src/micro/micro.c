@@ -287,7 +287,7 @@ static void upsample_rows(size_t begin, size_t end, int thread, void *user)
                         trusted += bil;
                     }
                 }
-                if (d == 1 || trusted > 0.01f) {
+                if (total > 0.0f && (d == 1 || trusted > 0.01f)) {
                     in = drift_vec3_scale(sum_in, 1.0f / total);
                     out = drift_vec3_scale(sum_out, 1.0f / total);
                     if (job->lobe == DRIFT_MICRO_LOBE_DIFFUSE) {
@@ -381,6 +381,7 @@ drift_result drift_micro_render(drift_micro *micro, const drift_gbuffer *gbuffer
     double t4 = drift_time_now();
     for (int i = 0; i < 64; ++i) {
         const drift__micro_gather_stats *s = &job->stats[i];
+        m->stats.gathers += s->gathers;
         m->stats.nodes_visited += s->visited;
         m->stats.splats += s->splats;
         m->stats.post_leaves += s->post_leaves;
@@ -389,7 +390,6 @@ drift_result drift_micro_render(drift_micro *micro, const drift_gbuffer *gbuffer
         m->stats.cast_gathers += s->cast;
         m->stats.fallbacks += job->fallbacks[i];
     }
-    m->stats.gathers = (uint64_t)gw * (uint64_t)gh + m->stats.fallbacks;
     drift_free(m->ctx, job);
     m->stats.ms[DRIFT_MICRO_STAGE_HIERARCHY] = (t1 - t0) * 1e3;
     m->stats.ms[DRIFT_MICRO_STAGE_LIGHTING] = (t2 - t1) * 1e3;

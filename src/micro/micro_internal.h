@@ -109,7 +109,7 @@ typedef struct drift__micro_gather_desc {
 
 // What one gather did.
 typedef struct drift__micro_gather_stats {
-    uint64_t visited, splats, post_leaves, rays, empty, cast;
+    uint64_t gathers, visited, splats, post_leaves, rays, empty, cast;
 } drift__micro_gather_stats;
 
 // The micro-buffer of the gather point p with local frame `frame` (z: the normal the

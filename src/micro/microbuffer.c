@@ -25,6 +25,7 @@ drift_vec3 drift__micro_gather(const drift__micro_gather_desc *desc, drift_vec3 
         node[i] = NO_NODE;
     }
     uint32_t post = 0;
+    stats->gathers++;
     uint32_t stack[96];
     int top = 0;
     stack[top++] = 0;
