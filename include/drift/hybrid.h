@@ -140,6 +140,16 @@ typedef struct drift_ism_settings {
     uint32_t points_per_vpl;
 } drift_ism_settings;
 
+// Micro-rendering (indirect micro and reflections micro, docs/micro.md):
+//   points      = 0 -> 65536 scene points in the hierarchy (rounded up to a power of two)
+//   buffer_size = 0 -> 16: K, each gather's micro-buffer is K x K pixels
+//   density     = 0 -> 1: a gather every pixel; 2: 1/4 of them, 4: 1/16 (bilateral upsampling)
+typedef struct drift_micro_settings {
+    uint32_t points;
+    int32_t buffer_size;
+    int32_t density;
+} drift_micro_settings;
+
 // Light from the environment in screen space (occlusion ssao, gtao, ssdo; docs/ssdo.md):
 //   samples = 0 -> 16: N sample points a pixel (GTAO: slices x steps x 2 horizon samples)
 //   radius  = 0 -> 0.05 x the scene's diagonal: r_max, the sample hemisphere's radius
@@ -166,7 +176,7 @@ typedef struct drift_occlusion_settings {
 //                      2 = one bounce, what the sharp buffers can capture)
 //   light_samples    = 0 -> 8 samples per area light for the unshadowed light U_l
 //   ambient          = used when has_ambient; otherwise the mean direct radiance of the frame
-//   shadow_map, envmap, isg, aaf, ism, occlusion_settings: each family's settings (above)
+//   shadow_map, envmap, isg, aaf, ism, micro, occlusion_settings: each family's settings (above)
 #define DRIFT_TECHNIQUE_FIELD_(ENUM, name, type, TECHNIQUES, kind, plane) \
     drift_##type##_technique name;
 
@@ -194,6 +204,7 @@ typedef struct drift_hybrid_params {
     drift_isg_settings isg;
     drift_aaf_settings aaf;
     drift_ism_settings ism;
+    drift_micro_settings micro;
     drift_occlusion_settings occlusion_settings;
 } drift_hybrid_params;
 

@@ -85,6 +85,19 @@ for r in (d["rows"][2], d["rows"][4]):
         expect 2 "$drift" bench ism --vpls 8,,16
         grep -q -- "--vpls expects .*got '8,,16'" "$tmp/err" || fail "bench ism: bad --vpls not named"
         ;;
+    micro)
+        expect 0 "$drift" bench micro "$box" --size 12 --ref-spp 2 --points 256 --sizes 4,8 \
+            --densities 1,16 --scaling 8,9 --csv "$tmp/micro.csv" --json
+        check micro 'assert d["size"] == 12 and d["ref_spp"] == 2 and d["threads"] == 1, d
+assert [(r["sweep"], r["k"], r["density"], r["points"]) for r in d["rows"]] == [
+    ("size", 4, 1, 256), ("size", 8, 1, 256), ("density", 16, 1, 256), ("density", 16, 16, 256),
+    ("points", 16, 16, 256), ("points", 16, 16, 512)], d
+assert all(r["ms"] >= 0 and r["gathers"] > 0 and r["nodes_visited"] > 0 and r["nrms"] >= 0 and
+           set(r["stage_ms"]) == {"hierarchy", "lighting", "gather", "upsample"} for r in d["rows"]), d'
+        [ "$(wc -l < "$tmp/micro.csv")" -eq 3 ] || fail "bench micro: --csv should hold 2 rows"
+        expect 2 "$drift" bench micro --densities 3
+        grep -q -- "--densities expects 1, 4 or 16" "$tmp/err" || fail "bench micro: bad --densities not named"
+        ;;
     frontier)
         # Twice: the second run must reuse the cached reference and give the same FLIP values.
         for run in 1 2; do
