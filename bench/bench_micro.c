@@ -90,17 +90,6 @@ static const cli_command micro_command = {
     .help_column = 17,
 };
 
-static double mean_luminance(const drift_image *img)
-{
-    double sum = 0.0;
-    for (int32_t y = 0; y < img->height; ++y) {
-        for (int32_t x = 0; x < img->width; ++x) {
-            sum += (double)drift_luminance(drift_image_get3(img, x, y));
-        }
-    }
-    return sum / ((double)img->width * (double)img->height);
-}
-
 typedef struct row {
     const char *sweep;
     long value;
@@ -131,7 +120,7 @@ static drift_result run_row(cli_session *s, const micro_options *o, drift_hybrid
     drift_micro_stats st = drift_micro_get_stats(m);
     double mse = 0.0;
     drift_metric_mse(s->ctx, ref, drift_micro_result(m), &mse);
-    double rmse = sqrt(mse), nrms = rmse / mean_luminance(ref);
+    double rmse = sqrt(mse), nrms = rmse / drift_image_mean_luminance(ref);
     double gather_ms = st.ms[DRIFT_MICRO_STAGE_GATHER];
     double gathers_per_s = gather_ms > 0.0 ? (double)st.gathers * 1e3 / gather_ms : 0.0;
     double samples_per_s = gathers_per_s * (double)w->k * (double)w->k;

@@ -45,6 +45,8 @@ void drift_image_destroy(drift_context *ctx, drift_image *image);
 // A non-owning view of a rectangle of `image`.
 drift_image drift_image_view(const drift_image *image, int32_t x, int32_t y, int32_t width,
                              int32_t height);
+// The mean luminance (drift_luminance) over every pixel of an RGB image.
+double drift_image_mean_luminance(const drift_image *image);
 
 static inline float *drift_image_pixel(const drift_image *image, int32_t x, int32_t y)
 {

@@ -51,6 +51,17 @@ drift_image drift_image_view(const drift_image *image, int32_t x, int32_t y, int
                           .stride = image->stride };
 }
 
+double drift_image_mean_luminance(const drift_image *image)
+{
+    double sum = 0.0;
+    for (int32_t y = 0; y < image->height; ++y) {
+        for (int32_t x = 0; x < image->width; ++x) {
+            sum += (double)drift_luminance(drift_image_get3(image, x, y));
+        }
+    }
+    return sum / ((double)image->width * (double)image->height);
+}
+
 float drift_srgb_to_linear(float v)
 {
     return v <= 0.04045f ? v / 12.92f : powf((v + 0.055f) / 1.055f, 2.4f);

@@ -146,6 +146,11 @@ double test_rmse(drift_context *ctx, const drift_image *a, const drift_image *b)
     return sqrt(mse);
 }
 
+double test_nrmse(drift_context *ctx, const drift_image *a, const drift_image *b)
+{
+    return test_rmse(ctx, a, b) / drift_image_mean_luminance(a);
+}
+
 drift_image test_rig_render_pt(test_rig *r, uint32_t components, int32_t max_depth, uint32_t spp,
                                uint32_t seed, drift_pt **pt)
 {

@@ -48,5 +48,7 @@ drift_image test_rig_render_pt(test_rig *r, uint32_t components, int32_t max_dep
 
 // RMSE over the three colour channels of two images of one size (drift_metric_mse).
 double test_rmse(drift_context *ctx, const drift_image *a, const drift_image *b);
+// test_rmse of b against a over a's mean luminance (drift_image_mean_luminance).
+double test_nrmse(drift_context *ctx, const drift_image *a, const drift_image *b);
 
 #endif

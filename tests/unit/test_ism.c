@@ -58,23 +58,6 @@ static drift_ism *render_ism(test_rig *r, const drift_ism_params *params)
     return ism;
 }
 
-static double mean_luminance(const drift_image *img)
-{
-    double sum = 0.0;
-    for (int32_t y = 0; y < img->height; ++y) {
-        for (int32_t x = 0; x < img->width; ++x) {
-            sum += (double)drift_luminance(drift_image_get3(img, x, y));
-        }
-    }
-    return sum / ((double)img->width * (double)img->height);
-}
-
-// RMSE of b against a, over a's mean luminance.
-static double nrmse(test_rig *r, const drift_image *a, const drift_image *b)
-{
-    return test_rmse(r->ctx, a, b) / mean_luminance(a);
-}
-
 // --- TESTS ---
 
 // A grid over the hemisphere maps to the disc and back within 1e-5, and the texels whose
@@ -331,12 +314,14 @@ static void test_ir_and_ism_against_path_tracer(void **state)
     drift_ism *ir = render_ism(&r, &(drift_ism_params){ .visibility = DRIFT_ISM_VISIBILITY_RAYS,
                                                         .vpl_count = 2048,
                                                         .block_size = 1 });
-    double e_ir = nrmse(&r, &ref, drift_ism_indirect(ir));
-    double bias_ir = mean_luminance(drift_ism_indirect(ir)) / mean_luminance(&ref);
+    double e_ir = test_nrmse(r.ctx, &ref, drift_ism_indirect(ir));
+    double bias_ir =
+        drift_image_mean_luminance(drift_ism_indirect(ir)) / drift_image_mean_luminance(&ref);
     drift_ism *none = render_ism(&r, &(drift_ism_params){ .visibility = DRIFT_ISM_VISIBILITY_NONE,
                                                           .vpl_count = 2048,
                                                           .block_size = 1 });
-    double bias_none = mean_luminance(drift_ism_indirect(none)) / mean_luminance(&ref);
+    double bias_none =
+        drift_image_mean_luminance(drift_ism_indirect(none)) / drift_image_mean_luminance(&ref);
     // ISM against `ir` with the same 256 VPLs as the points per VPL grow.
     drift_ism *ir256 = render_ism(&r, &(drift_ism_params){ .visibility = DRIFT_ISM_VISIBILITY_RAYS,
                                                            .vpl_count = 256,
@@ -346,7 +331,7 @@ static void test_ir_and_ism_against_path_tracer(void **state)
     for (int i = 0; i < 3; ++i) {
         drift_ism *ism = render_ism(
             &r, &(drift_ism_params){ .vpl_count = 256, .block_size = 1, .points_per_vpl = pts[i] });
-        e_ism[i] = nrmse(&r, drift_ism_indirect(ir256), drift_ism_indirect(ism));
+        e_ism[i] = test_nrmse(r.ctx, drift_ism_indirect(ir256), drift_ism_indirect(ism));
         drift_ism_destroy(ism);
     }
     // And as the maps grow, at 4096 points a VPL.
@@ -357,7 +342,7 @@ static void test_ir_and_ism_against_path_tracer(void **state)
                                                              .block_size = 1,
                                                              .points_per_vpl = 4096,
                                                              .map_size = sizes[i] });
-        e_res[i] = nrmse(&r, drift_ism_indirect(ir256), drift_ism_indirect(ism));
+        e_res[i] = test_nrmse(r.ctx, drift_ism_indirect(ir256), drift_ism_indirect(ism));
         drift_ism_destroy(ism);
     }
     printf("ism vs ir at 16^2 and 64^2 maps: %.4f %.4f\n", e_res[0], e_res[1]);
@@ -536,7 +521,7 @@ static void test_rigid_motion_leaves_the_image(void **state)
     build_shifted_scene(&b, drift_vec3_make(0.75f, -0.5f, 0.25f));
     drift_ism_params p = { .vpl_count = 128, .block_size = 2 };
     drift_ism *ia = render_ism(&a, &p), *ib = render_ism(&b, &p);
-    double e = nrmse(&a, drift_ism_indirect(ia), drift_ism_indirect(ib));
+    double e = test_nrmse(a.ctx, drift_ism_indirect(ia), drift_ism_indirect(ib));
     assert_true(e < 0.02);
     drift_ism_destroy(ia);
     drift_ism_destroy(ib);
@@ -555,7 +540,7 @@ static void test_bounces_add_shrinking_light(void **state)
         drift_ism *ism = render_ism(
             &r,
             &(drift_ism_params){ .vpl_count = 512, .later_vpl_count = 512, .max_depth = 2 + d });
-        mean[d] = mean_luminance(drift_ism_indirect(ism));
+        mean[d] = drift_image_mean_luminance(drift_ism_indirect(ism));
         drift_ism_destroy(ism);
     }
     assert_true(mean[1] > mean[0] && mean[2] > mean[1]);

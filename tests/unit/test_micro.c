@@ -52,23 +52,6 @@ static drift_micro *render_micro(test_rig *r, const drift_micro_params *params,
     return m;
 }
 
-static double mean_luminance(const drift_image *img)
-{
-    double sum = 0.0;
-    for (int32_t y = 0; y < img->height; ++y) {
-        for (int32_t x = 0; x < img->width; ++x) {
-            sum += (double)drift_luminance(drift_image_get3(img, x, y));
-        }
-    }
-    return sum / ((double)img->width * (double)img->height);
-}
-
-// RMSE of b against a, over a's mean luminance.
-static double nrmse(test_rig *r, const drift_image *a, const drift_image *b)
-{
-    return test_rmse(r->ctx, a, b) / mean_luminance(a);
-}
-
 // --- TESTS ---
 
 typedef struct phong_slice {
@@ -400,15 +383,17 @@ static void test_against_path_tracer(void **state)
         drift_micro *m =
             render_micro(&r, &(drift_micro_params){ .point_count = 16384, .buffer_size = sizes[i] },
                          DRIFT_MICRO_LOBE_DIFFUSE);
-        e[i] = nrmse(&r, &ref, drift_micro_result(m));
+        e[i] = test_nrmse(r.ctx, &ref, drift_micro_result(m));
         drift_micro_stats st = drift_micro_get_stats(m);
         printf("K = %d: nrmse %.4f mean ratio %.4f; %.0f visited, %.1f post-list leaves, %.1f "
                "empty pixels a gather; %.1f ms\n",
-               sizes[i], e[i], mean_luminance(drift_micro_result(m)) / mean_luminance(&ref),
+               sizes[i], e[i],
+               drift_image_mean_luminance(drift_micro_result(m)) / drift_image_mean_luminance(&ref),
                (double)st.nodes_visited / (double)st.gathers,
                (double)st.post_leaves / (double)st.gathers,
                (double)st.empty_pixels / (double)st.gathers, st.total_ms);
-        bias[i] = mean_luminance(drift_micro_result(m)) / mean_luminance(&ref);
+        bias[i] =
+            drift_image_mean_luminance(drift_micro_result(m)) / drift_image_mean_luminance(&ref);
         drift_micro_destroy(m);
     }
     // 8 -> 16 shrinks the error; 24 does not shrink it further at 2^14 points (it reaches the
@@ -424,8 +409,8 @@ static void test_against_path_tracer(void **state)
         render_micro(&r, &(drift_micro_params){ .point_count = 16384 }, DRIFT_MICRO_LOBE_DIFFUSE);
     drift_micro *quarter = render_micro(
         &r, &(drift_micro_params){ .point_count = 16384, .density = 2 }, DRIFT_MICRO_LOBE_DIFFUSE);
-    double e_full = nrmse(&r, &ref, drift_micro_result(full));
-    double e_quarter = nrmse(&r, &ref, drift_micro_result(quarter));
+    double e_full = test_nrmse(r.ctx, &ref, drift_micro_result(full));
+    double e_quarter = test_nrmse(r.ctx, &ref, drift_micro_result(quarter));
     drift_micro_stats sq = drift_micro_get_stats(quarter);
     printf("every pixel %.4f, 1/4 upsampled %.4f (%llu gathers, %llu fallbacks)\n", e_full,
            e_quarter, (unsigned long long)sq.gathers, (unsigned long long)sq.fallbacks);
