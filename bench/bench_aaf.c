@@ -203,19 +203,6 @@ static drift_result render(drift_context *ctx, const drift_scene *scene, const d
     return r == DRIFT_OK ? drift_hybrid_render(*frame, &scene->camera, NULL) : r;
 }
 
-// Mean of an image over its pixels and 3 channels.
-static double image_mean(const drift_image *image)
-{
-    double sum = 0.0;
-    for (int32_t y = 0; y < image->height; ++y) {
-        for (int32_t x = 0; x < image->width; ++x) {
-            const float *v = drift_image_pixel(image, x, y);
-            sum += (double)v[0] + (double)v[1] + (double)v[2];
-        }
-    }
-    return sum / (3.0 * (double)image->width * (double)image->height);
-}
-
 // log spp at which the plain curve reaches `error`, linear in log-log between its points
 // (extrapolated from the nearest two outside them).
 static double equal_error_spp(const point *plain, int count, double error, bool *extrapolated)
@@ -275,11 +262,12 @@ static drift_result measure(drift_context *ctx, const drift_scene *scene, const 
             }
             drift_hybrid_stats s = drift_hybrid_get_stats(frame);
             point *pt = method == 0 ? &out->aaf[k] : &out->plain[k];
-            double truth_mean = image_mean(truth);
+            double truth_mean = drift_image_mean_rgb(truth);
             *pt = (point){ .spp = (double)spp,
                            .actual_spp = actual_spp(frame, effect),
                            .rmse = sqrt(mse),
-                           .mean_ratio = truth_mean > 0.0 ? image_mean(test) / truth_mean : 1.0,
+                           .mean_ratio =
+                               truth_mean > 0.0 ? drift_image_mean_rgb(test) / truth_mean : 1.0,
                            .sampling_ms = s.ms[DRIFT_PASS_AAF_SAMPLING],
                            .filter_ms = s.ms[DRIFT_PASS_AAF_FILTER] };
             if (!(pt->actual_spp > 0.0)) {

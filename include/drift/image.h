@@ -47,6 +47,8 @@ drift_image drift_image_view(const drift_image *image, int32_t x, int32_t y, int
                              int32_t height);
 // The mean luminance (drift_luminance) over every pixel of an RGB image.
 double drift_image_mean_luminance(const drift_image *image);
+// The mean of the first three channels over every pixel of an RGB image.
+double drift_image_mean_rgb(const drift_image *image);
 
 static inline float *drift_image_pixel(const drift_image *image, int32_t x, int32_t y)
 {

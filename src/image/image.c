@@ -62,6 +62,18 @@ double drift_image_mean_luminance(const drift_image *image)
     return sum / ((double)image->width * (double)image->height);
 }
 
+double drift_image_mean_rgb(const drift_image *image)
+{
+    double sum = 0.0;
+    for (int32_t y = 0; y < image->height; ++y) {
+        for (int32_t x = 0; x < image->width; ++x) {
+            const float *v = drift_image_pixel(image, x, y);
+            sum += (double)v[0] + (double)v[1] + (double)v[2];
+        }
+    }
+    return sum / (3.0 * (double)image->width * (double)image->height);
+}
+
 float drift_srgb_to_linear(float v)
 {
     return v <= 0.04045f ? v / 12.92f : powf((v + 0.055f) / 1.055f, 2.4f);
