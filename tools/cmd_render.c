@@ -162,6 +162,9 @@ static const cli_option render_table[] = {
                "reference: continue the render a checkpoint holds (default:\n"
                "FILE.ckpt beside --out when there is one); the end image is\n"
                "the same bits as an uninterrupted render's"),
+    CLI_NUMBER("--rank-timeout", "SECONDS", O, rank_timeout, 0.1, 1e9,
+               "under mpirun: a rank that sends nothing for SECONDS is taken\n"
+               "as hung and the job stops, keeping its work (default 300)"),
     CLI_NUMBER("--exposure", "STOPS", O, exposure, -64.0, 64.0, "PNG exposure (default 0)"),
     CLI_CUSTOM("--tonemap", "OP", O, tonemap, parse_tonemap,
                "PNG operator: clamp (default) or reinhard"),
@@ -274,13 +277,13 @@ static const cli_command render_command = {
     CLI_POSITIONAL("SCENE", render_options, scene_path, 1),
 };
 
-// Returns 0 on success, 2 on a usage error (message printed), -1 after --help.
-static int parse_options(int argc, char **argv, render_options *o)
+int render_parse_options(int argc, char **argv, render_options *o)
 {
     *o = (render_options){ .out_path = "out/render.exr",
                            .frames = 1,
                            .spp = 64,
                            .checkpoint_seconds = 60.0,
+                           .rank_timeout = 300.0,
                            .debug_x = -1,
                            .debug_y = -1,
                            .debug_sample = -1,
@@ -642,6 +645,9 @@ static int render_reference(const render_options *o, const cli_session *session)
 {
     drift_context *ctx = session->ctx;
     render_reference_run run = { .o = o, .session = session };
+    if (o->debug_sample < 0) {
+        render_catch_sigint(); // before the checkpoint is read: a signal then still counts
+    }
     int exit_code = render_reference_begin(&run);
     if (exit_code != 0) {
         goto done;
@@ -667,7 +673,6 @@ static int render_reference(const render_options *o, const cli_session *session)
     // Passes grow until one takes about a second: responsive progress, checkpoints and
     // Ctrl-C, without per-pass overhead dominating small images. Each pass brings every tile
     // `pass` samples nearer the total (tiles of a resumed render start where they were).
-    render_catch_sigint();
     bool tty = isatty(STDERR_FILENO) != 0;
     uint32_t total = (uint32_t)o->spp, done_spp = run.resumed_spp, pass = 1;
     run.t_render = drift_time_now();
@@ -710,40 +715,52 @@ done:
     return exit_code;
 }
 
+int render_open_session(const render_options *o, bool outputs_here, cli_session *session)
+{
+    char png[4096];
+    render_png_path(o->out_path, png, sizeof png);
+    char checkpoint[4096];
+    render_checkpoint_path(o->out_path, checkpoint, sizeof checkpoint);
+    const cli_file outputs[] = { { "--out", o->out_path },
+                                 { "--out's PNG", png },
+                                 { "--stats", o->stats_path },
+                                 { "--aov", o->aov_path },
+                                 { "--out's checkpoint", o->hybrid_mode ? NULL : checkpoint } };
+    const cli_file inputs[] = { { "--lambda", o->refine.lambda_path } };
+    bool writes = outputs_here && o->debug_sample < 0;
+    if (cli_session_open(&(cli_session_desc){ .cmd = "render",
+                                              .scene_path = o->scene_path,
+                                              .threads = (int)o->threads,
+                                              .verbose = o->verbose,
+                                              .outputs = outputs,
+                                              .output_count = writes ? 5 : 0,
+                                              .inputs = inputs,
+                                              .input_count = 1 },
+                         session)) {
+        return 0;
+    }
+    return session->refused ? 2 : 1;
+}
+
 int drift_cmd_render(int argc, char **argv)
 {
+#ifdef DRIFT_MPI
+    if (render_mpi_launched()) { // mpirun -n N drift render ...: tools/distributed
+        return render_mpi(argc, argv);
+    }
+#endif
     render_options o;
-    int status = parse_options(argc, argv, &o);
+    int status = render_parse_options(argc, argv, &o);
     if (status != 0) {
         return status < 0 ? 0 : status;
     }
     if (o.hybrid_mode && !render_refine_validate(&o)) {
         return 2;
     }
-    char png[4096];
-    render_png_path(o.out_path, png, sizeof png);
-    char checkpoint[4096];
-    render_checkpoint_path(o.out_path, checkpoint, sizeof checkpoint);
-    const cli_file outputs[] = { { "--out", o.out_path },
-                                 { "--out's PNG", png },
-                                 { "--stats", o.stats_path },
-                                 { "--aov", o.aov_path },
-                                 { "--out's checkpoint", o.hybrid_mode ? NULL : checkpoint } };
-    const cli_file inputs[] = { { "--lambda", o.refine.lambda_path } };
     cli_session session;
-    int exit_code = 1;
-    if (cli_session_open(&(cli_session_desc){ .cmd = "render",
-                                              .scene_path = o.scene_path,
-                                              .threads = (int)o.threads,
-                                              .verbose = o.verbose,
-                                              .outputs = outputs,
-                                              .output_count = o.debug_sample >= 0 ? 0 : 5,
-                                              .inputs = inputs,
-                                              .input_count = 1 },
-                         &session)) {
+    int exit_code = render_open_session(&o, true, &session);
+    if (exit_code == 0) {
         exit_code = o.hybrid_mode ? render_hybrid(&o, &session) : render_reference(&o, &session);
-    } else if (session.refused) {
-        exit_code = 2;
     }
     cli_session_close(&session);
     return exit_code;

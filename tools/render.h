@@ -32,6 +32,7 @@ typedef struct render_options {
     long frames;             // hybrid: frames rendered of the one view (the last is written)
     long spp, seed, threads, max_depth, width, height;
     double checkpoint_seconds;
+    double rank_timeout; // mpirun: seconds a rank may send nothing before it counts as hung
     double exposure;
     drift_tonemap_operator tonemap;
     bool aov;
@@ -45,6 +46,19 @@ typedef struct render_options {
     double aperture, focus_distance; // < 0: the scene camera's
     render_refine_options refine;    // --refine sir (tools/render_refine.c)
 } render_options;
+
+// drift render's options from argv: 0, 2 after a usage error (message printed), -1 after
+// --help.
+int render_parse_options(int argc, char **argv, render_options *o);
+// Opens the context, scene and accel; with outputs_here, refuses outputs that name an input
+// and checks each can be written. Returns 0, or the exit status (message printed); close the
+// session in both cases.
+int render_open_session(const render_options *o, bool outputs_here, cli_session *session);
+
+// mpirun -n N drift render (tools/distributed/render_mpi.c, built with -DDRIFT_MPI=ON):
+// whether this process was started by mpirun, and the distributed render.
+bool render_mpi_launched(void);
+int render_mpi(int argc, char **argv);
 
 // Renders in hybrid mode with the session's scene; returns the process exit code.
 int render_hybrid(const render_options *o, const cli_session *session);

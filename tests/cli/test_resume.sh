@@ -20,7 +20,7 @@ interrupt() {
         grep -q "spp, depth" "$tmp/err" && break
         sleep 0.1
     done
-    sleep 1
+    sleep 0.3
     kill -TERM "$pid"
     wait "$pid"
     local status=$?
@@ -52,7 +52,8 @@ fi
 most=$(python3 -c "import json; s=json.load(open('$tmp/i.json')); print(s.get('spp_max', s['spp']))")
 total=$((most + 8))
 
-# A checkpoint of other options, or a damaged one, is refused: exit 2, nothing written.
+# A checkpoint of other options, or a damaged one, is refused: exit 2, nothing written
+# (--resume FILE resuming to the same bytes: distributed.mpi).
 cp "$tmp/i.ckpt" "$tmp/keep.ckpt"
 expect 2 "$drift" render "${base[@]}" --seed 4 --spp "$total" --quiet --out "$tmp/x.exr" \
     --resume "$tmp/i.ckpt"
@@ -67,9 +68,6 @@ head -c 5000 "$tmp/i.ckpt" >"$tmp/cut.ckpt"
 expect 2 "$drift" render "${base[@]}" --spp "$total" --quiet --out "$tmp/x.exr" \
     --resume "$tmp/cut.ckpt"
 grep -q "cut short or damaged" "$tmp/err" || fail "a cut checkpoint is not refused"
-expect 2 "$drift" render "${base[@]}" --spp "$total" --quiet --out "$tmp/x.exr" \
-    --resume "$tmp/i.exr"
-grep -q "not a drift checkpoint" "$tmp/err" || fail "an EXR given as a checkpoint is not refused"
 ls "$tmp" | grep -q '^x\.' && fail "a refused resume wrote output: $(ls "$tmp")"
 cmp -s "$tmp/i.ckpt" "$tmp/keep.ckpt" || fail "a refused resume changed the checkpoint"
 
@@ -80,10 +78,6 @@ grep -q "resuming from $tmp/i.ckpt" "$tmp/err" || fail "the same command did not
 [ -e "$tmp/i.ckpt" ] && fail "the finished render left its checkpoint"
 expect 0 "$drift" render "${base[@]}" --spp "$total" --aov --quiet --out "$tmp/full.exr"
 cmp -s "$tmp/i.exr" "$tmp/full.exr" || fail "the resumed render differs from an uninterrupted one"
-# --resume FILE from elsewhere, to another --out, also ends identical.
-expect 0 "$drift" render "${base[@]}" --spp "$total" --aov --quiet --out "$tmp/r.exr" \
-    --resume "$tmp/keep.ckpt"
-cmp -s "$tmp/r.exr" "$tmp/full.exr" || fail "--resume FILE differs from an uninterrupted render"
 python3 -c "import json; s=json.load(open('$tmp/i.json')); assert s['spp'] == $total and 0 < s['resumed_from_spp'] < $total, s" ||
     fail "the resumed stats do not say where they resumed from"
 
