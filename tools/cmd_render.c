@@ -171,7 +171,15 @@ static const cli_option render_table[] = {
     CLI_STRING("--stats", "FILE.json", O, stats_path,
                "spp, rays traced and milliseconds per phase"),
     CLI_NUMBER("--checkpoint", "SECONDS", O, checkpoint_seconds, 0.0, 1e9,
-               "write the image so far every SECONDS (default 60; 0 = never)"),
+               "write the image so far and FILE.ckpt beside --out every\n"
+               "SECONDS (default 60; 0 = never); Ctrl-C writes FILE.ckpt too"),
+    CLI_STRING("--resume", "FILE.ckpt", O, resume_path,
+               "reference: continue the render a checkpoint holds (default:\n"
+               "FILE.ckpt beside --out when there is one); the end image is\n"
+               "the same bits as an uninterrupted render's"),
+    CLI_NUMBER("--rank-timeout", "SECONDS", O, rank_timeout, 0.1, 1e9,
+               "under mpirun: a rank that sends nothing for SECONDS is taken\n"
+               "as hung and the job stops, keeping its work (default 300)"),
     CLI_NUMBER("--exposure", "STOPS", O, exposure, -64.0, 64.0, "PNG exposure (default 0)"),
     CLI_CUSTOM("--tonemap", "OP", O, tonemap, parse_tonemap,
                "PNG operator: clamp (default) or reinhard"),
@@ -285,19 +293,21 @@ static const cli_command render_command = {
         "Renders SCENE (a drift .json scene, or .obj/.gltf/.glb/.ply[.gz]); without SCENE, the\n"
         "built-in Cornell box. Writes a linear EXR and a tone-mapped sRGB PNG beside it.\n"
         "\n",
-    .epilogue = "\nCtrl-C (or SIGTERM) stops the render and writes what it has: exit status 130\n"
-                "(143 after SIGTERM).\n",
+    .epilogue =
+        "\nCtrl-C (or SIGTERM) stops the render and writes what it has, and the checkpoint\n"
+        "FILE.ckpt beside --out: exit status 130 (143 after SIGTERM). Running the same\n"
+        "command again resumes from it (docs/reliability.md).\n",
     CLI_TABLE(render_table),
     CLI_POSITIONAL("SCENE", render_options, scene_path, 1),
 };
 
-// Returns 0 on success, 2 on a usage error (message printed), -1 after --help.
-static int parse_options(int argc, char **argv, render_options *o)
+int render_parse_options(int argc, char **argv, render_options *o)
 {
     *o = (render_options){ .out_path = "out/render.exr",
                            .frames = 1,
                            .spp = 64,
                            .checkpoint_seconds = 60.0,
+                           .rank_timeout = 300.0,
                            .debug_x = -1,
                            .debug_y = -1,
                            .debug_sample = -1,
@@ -317,6 +327,11 @@ static int parse_options(int argc, char **argv, render_options *o)
     if (o->hybrid_mode && o->denoise) {
         fprintf(stderr, "drift render: --denoise atrous filters the path tracer's image; the "
                         "hybrid frame has its own techniques (drop --mode hybrid or --denoise)\n");
+        return 2;
+    }
+    if (o->hybrid_mode && o->resume_path) {
+        fprintf(stderr, "drift render: --resume continues a reference render (drop --mode "
+                        "hybrid)\n");
         return 2;
     }
     if (!o->hybrid_mode && o->aov_path) {
@@ -360,15 +375,29 @@ static drift_result apply_glare(drift_context *ctx, const render_options *o, flo
     return r;
 }
 
+// The lowest and highest sample count of the pt's tiles (they differ after an interruption).
+void render_spp_range(const drift_pt *pt, uint32_t *lowest, uint32_t *highest)
+{
+    *lowest = UINT32_MAX;
+    *highest = 0;
+    for (uint32_t t = 0; t < drift_pt_tile_count(pt); ++t) {
+        uint32_t n = drift_pt_tile_sample_count(pt, t);
+        *lowest = n < *lowest ? n : *lowest;
+        *highest = n > *highest ? n : *highest;
+    }
+}
+
+// The EXR (beauty, --aov layers; an "spp" layer of each pixel's sample count when the tiles
+// hold different counts) and the PNG beside it, to the paths given (staged by the caller).
 static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_options *o,
-                                 float fov_y)
+                                 float fov_y, const char *exr_path, const char *png_path)
 {
     drift_image beauty, albedo, normal, depth;
     drift_result r = drift_pt_resolve(pt, DRIFT_PT_AOV_BEAUTY, &beauty);
     if (r != DRIFT_OK) {
         return r;
     }
-    drift_image denoised = { 0 }, glared = { 0 };
+    drift_image denoised = { 0 }, glared = { 0 }, spp = { 0 };
     if (o->denoise) { // --denoise atrous, before glare (the last pass)
         if ((r = drift_pt_resolve(pt, DRIFT_PT_AOV_ALBEDO, &albedo)) != DRIFT_OK ||
             (r = drift_pt_resolve(pt, DRIFT_PT_AOV_NORMAL, &normal)) != DRIFT_OK ||
@@ -386,7 +415,7 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
         }
         beauty = glared; // the glare's copy, destroyed below
     }
-    drift_image_layer layers[4] = { { NULL, &beauty } };
+    drift_image_layer layers[5] = { { NULL, &beauty } };
     uint32_t layer_count = 1;
     if (o->aov) {
         if ((r = drift_pt_resolve(pt, DRIFT_PT_AOV_ALBEDO, &albedo)) != DRIFT_OK ||
@@ -401,29 +430,72 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
         layers[3] = (drift_image_layer){ "depth", &depth };
         layer_count = 4;
     }
-    r = drift_image_save_exr(ctx, o->out_path, layers, layer_count);
+    uint32_t lowest, highest;
+    render_spp_range(pt, &lowest, &highest);
+    char spp_text[64], note[256];
+    drift_image_attribute attributes[2] = { { "drift.spp", spp_text }, { "drift.spp_note", note } };
+    uint32_t attribute_count = 1;
+    snprintf(spp_text, sizeof spp_text, "%u", lowest);
+    if (lowest != highest && r == DRIFT_OK) {
+        snprintf(spp_text, sizeof spp_text, "%u..%u", lowest, highest);
+        snprintf(note, sizeof note,
+                 "interrupted: tiles of %dx%d pixels hold %u to %u samples; the spp layer has "
+                 "each pixel's count",
+                 DRIFT_PT_TILE_SIZE, DRIFT_PT_TILE_SIZE, lowest, highest);
+        attribute_count = 2;
+        r = drift_image_create(ctx, beauty.width, beauty.height, 1, &spp);
+        for (uint32_t t = 0; r == DRIFT_OK && t < drift_pt_tile_count(pt); ++t) {
+            drift_pt_tile rect = drift_pt_tile_rect(pt, t);
+            float n = (float)drift_pt_tile_sample_count(pt, t);
+            for (int32_t y = rect.y0; y < rect.y1; ++y) {
+                for (int32_t x = rect.x0; x < rect.x1; ++x) {
+                    *drift_image_pixel(&spp, x, y) = n;
+                }
+            }
+        }
+        layers[layer_count++] = (drift_image_layer){ "spp", &spp };
+    }
     if (r == DRIFT_OK) {
-        char png[4096];
-        render_png_path(o->out_path, png, sizeof(png));
+        r = drift_image_save_exr_attributes(ctx, exr_path, layers, layer_count, attributes,
+                                            attribute_count);
+    }
+    if (r == DRIFT_OK) {
         r = drift_image_save_png(
-            ctx, png, &beauty,
+            ctx, png_path, &beauty,
             &(drift_tonemap_params){ .exposure_stops = (float)o->exposure, .op = o->tonemap });
     }
+    drift_image_destroy(ctx, &spp);
     drift_image_destroy(ctx, &glared); // NULL-safe on a zero image
     drift_image_destroy(ctx, &denoised);
     return r;
 }
 
-static bool write_stats(const render_options *o, const cli_session *session, const drift_pt *pt,
-                        double t_render, double t_rendered, double t_written)
+static cJSON *reference_stats(const render_reference_run *run, double t_rendered, double t_written)
 {
+    const render_options *o = run->o;
+    const cli_session *session = run->session;
+    const drift_pt *pt = run->pt;
     drift_pt_stats s = drift_pt_get_stats(pt);
     drift_pt_params p = drift_pt_get_params(pt);
     cJSON *root = render_stats_begin(o, session, "reference", p.width, p.height);
-    cli_json_count(root, "spp", drift_pt_sample_count(pt));
+    uint32_t lowest, highest;
+    render_spp_range(pt, &lowest, &highest);
+    cli_json_count(root, "spp", lowest);
+    if (lowest != highest) { // interrupted: say each tile's count
+        cli_json_count(root, "spp_max", highest);
+        cJSON_AddNumberToObject(root, "tile_size", DRIFT_PT_TILE_SIZE);
+        cJSON *tiles = cJSON_AddArrayToObject(root, "tile_spp");
+        for (uint32_t t = 0; t < drift_pt_tile_count(pt); ++t) {
+            cJSON_AddItemToArray(tiles, cJSON_CreateNumber(drift_pt_tile_sample_count(pt, t)));
+        }
+    }
+    cli_json_count(root, "resumed_from_spp", run->resumed_spp);
     cli_json_count(root, "seed", p.seed);
     cJSON_AddNumberToObject(root, "max_depth", p.max_depth);
     cJSON_AddNumberToObject(root, "threads", drift_context_thread_count(session->ctx));
+    if (run->ranks > 0) {
+        cJSON_AddNumberToObject(root, "ranks", run->ranks);
+    }
     cli_json_count(root, "nan_samples", s.nan_samples);
     cJSON *rays = cJSON_AddObjectToObject(root, "rays");
     cli_json_count(rays, "camera", s.camera_rays);
@@ -433,10 +505,10 @@ static bool write_stats(const render_options *o, const cli_session *session, con
     cJSON *ms = cJSON_AddObjectToObject(root, "milliseconds");
     cli_json_number(ms, "load", 1e3 * (session->t_loaded - session->t_start), 3);
     cli_json_number(ms, "accel", 1e3 * (session->t_built - session->t_loaded), 3);
-    cli_json_number(ms, "render", 1e3 * (t_rendered - t_render), 3);
+    cli_json_number(ms, "render", 1e3 * (t_rendered - run->t_render), 3);
     cli_json_number(ms, "write", 1e3 * (t_written - t_rendered), 3);
     cli_json_number(ms, "total", 1e3 * (t_written - session->t_start), 3);
-    return cli_json_write("render", root, o->stats_path);
+    return root;
 }
 
 cJSON *render_stats_begin(const render_options *o, const cli_session *session, const char *mode,
@@ -451,10 +523,12 @@ cJSON *render_stats_begin(const render_options *o, const cli_session *session, c
     return root;
 }
 
-static void print_progress(bool tty, uint32_t done, uint32_t total, double elapsed, bool final)
+void render_progress(bool tty, uint32_t first, uint32_t done, uint32_t total, double elapsed,
+                     bool final)
 {
     double fraction = total ? (double)done / (double)total : 1.0;
-    double eta = fraction > 0.0 ? elapsed * (1.0 - fraction) / fraction : 0.0;
+    double run = total > first ? (double)(done - first) / (double)(total - first) : 1.0;
+    double eta = run > 0.0 ? elapsed * (1.0 - run) / run : 0.0;
     if (tty) {
         char bar[41];
         int filled = (int)(fraction * 40.0);
@@ -474,24 +548,136 @@ static void print_progress(bool tty, uint32_t done, uint32_t total, double elaps
     fflush(stderr);
 }
 
-// The reference path tracer: passes of samples with progress, checkpoints and Ctrl-C.
-static int render_reference(const render_options *o, const cli_session *session)
+int render_reference_begin(render_reference_run *run)
 {
-    drift_context *ctx = session->ctx;
-    const char *scene_path = session->scene_path;
-    drift_pt *pt = NULL;
-    drift_result r = DRIFT_OK;
-    int exit_code = 1;
+    const render_options *o = run->o;
+    const cli_session *session = run->session;
     drift_pt_params params = { .width = (int32_t)o->width,
                                .height = (int32_t)o->height,
                                .seed = (uint32_t)o->seed,
                                .max_depth = (int32_t)o->max_depth };
-    r = drift_pt_create(ctx, session->scene, session->accel, &params, &pt);
+    drift_result r =
+        drift_pt_create(session->ctx, session->scene, session->accel, &params, &run->pt);
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift render: %s\n", drift_result_string(r));
+        return 1;
+    }
+    render_checkpoint_path(o->out_path, run->checkpoint_path, sizeof run->checkpoint_path);
+    if (o->debug_sample >= 0) {
+        return 0;
+    }
+    if (!render_checkpoint_key(session, run->pt, run->key, sizeof run->key)) {
+        return 1;
+    }
+    // --resume FILE, or the checkpoint beside --out when there is one.
+    const char *resume = o->resume_path;
+    if (!resume && access(run->checkpoint_path, F_OK) == 0) {
+        resume = run->checkpoint_path;
+    }
+    if (resume) {
+        int status = render_checkpoint_read(resume, run->key, run->pt, (uint32_t)o->spp);
+        if (status != 0) {
+            return status;
+        }
+        uint32_t highest;
+        render_spp_range(run->pt, &run->resumed_spp, &highest);
+        if (!o->quiet) {
+            fprintf(stderr, "drift render: resuming from %s (tiles at %u to %u spp)\n", resume,
+                    run->resumed_spp, highest);
+        }
+    }
+    return 0;
+}
+
+// --out, its PNG and --stats (final) or the first two (checkpoint), all or none.
+static bool write_outputs(render_reference_run *run, bool final, double t_rendered)
+{
+    const render_options *o = run->o;
+    char png[4096];
+    render_png_path(o->out_path, png, sizeof png);
+    render_stage stage = { 0 };
+    const char *exr_temp = render_stage_add(&stage, o->out_path);
+    const char *png_temp = render_stage_add(&stage, png);
+    drift_result r = write_images(run->session->ctx, run->pt, o, run->session->scene->camera.fov_y,
+                                  exr_temp, png_temp);
+    if (r != DRIFT_OK) {
+        fprintf(stderr, "drift render: cannot write %s: %s; nothing written\n", o->out_path,
+                drift_result_string(r));
+        render_stage_abort(&stage);
+        return false;
+    }
+    if (final && o->stats_path) {
+        const char *stats_temp = render_stage_add(&stage, o->stats_path);
+        if (!cli_json_write("render", reference_stats(run, t_rendered, drift_time_now()),
+                            stats_temp)) {
+            fprintf(stderr, "drift render: nothing written\n");
+            render_stage_abort(&stage);
+            return false;
+        }
+    }
+    return render_stage_commit(&stage);
+}
+
+bool render_reference_checkpoint(render_reference_run *run)
+{
+    bool ok = render_checkpoint_write(run->checkpoint_path, run->key, run->pt);
+    return write_outputs(run, false, 0.0) && ok;
+}
+
+int render_reference_finish(render_reference_run *run, bool cancelled, double t_rendered)
+{
+    const render_options *o = run->o;
+    bool tty = isatty(STDERR_FILENO) != 0;
+    uint32_t lowest, highest;
+    render_spp_range(run->pt, &lowest, &highest);
+    bool complete = lowest >= (uint32_t)o->spp;
+    if (!complete) {
+        bool saved = render_checkpoint_write(run->checkpoint_path, run->key, run->pt);
+        fprintf(stderr, "%sdrift render: %s at %u spp%s; writing what was rendered%s%s%s\n",
+                tty && !o->quiet ? "\n" : "", cancelled ? "interrupted" : "stopped", lowest,
+                lowest != highest ? " (tiles hold different counts, up to the most; the EXR's "
+                                    "spp layer has each pixel's)"
+                                  : "",
+                saved ? "; run the same command to resume from " : "",
+                saved ? run->checkpoint_path : "", saved ? "" : "");
+    }
+    if (!write_outputs(run, true, t_rendered)) {
+        return 1;
+    }
+    if (complete && access(run->checkpoint_path, F_OK) == 0 && unlink(run->checkpoint_path) != 0) {
+        fprintf(stderr, "drift render: warning: cannot remove the finished checkpoint %s\n",
+                run->checkpoint_path);
+    }
+    drift_pt_stats stats = drift_pt_get_stats(run->pt);
+    if (stats.nan_samples > 0) {
+        fprintf(stderr, "drift render: warning: %llu samples were not finite and were dropped\n",
+                (unsigned long long)stats.nan_samples);
+    }
+    char png[4096];
+    render_png_path(o->out_path, png, sizeof png);
+    drift_pt_params params = drift_pt_get_params(run->pt);
+    char spp[64];
+    snprintf(spp, sizeof spp, lowest == highest ? "%u spp" : "%u..%u spp", lowest, highest);
+    printf("wrote %s and %s (%s, %dx%d) in %.2f s (render %.2f s)\n", o->out_path, png, spp,
+           params.width, params.height, drift_time_now() - run->session->t_start,
+           t_rendered - run->t_render);
+    return cancelled ? render_interrupt_status() : complete ? 0 : 1;
+}
+
+// The reference path tracer: passes of samples with progress, checkpoints and Ctrl-C.
+static int render_reference(const render_options *o, const cli_session *session)
+{
+    drift_context *ctx = session->ctx;
+    render_reference_run run = { .o = o, .session = session };
+    if (o->debug_sample < 0) {
+        render_catch_sigint(); // before the checkpoint is read: a signal then still counts
+    }
+    int exit_code = render_reference_begin(&run);
+    if (exit_code != 0) {
         goto done;
     }
-    params = drift_pt_get_params(pt);
+    drift_pt *pt = run.pt;
+    drift_pt_params params = drift_pt_get_params(pt);
 
     if (o->debug_sample >= 0) {
         if (o->debug_x >= params.width || o->debug_y >= params.height || o->debug_x < 0 ||
@@ -505,110 +691,100 @@ static int render_reference(const render_options *o, const cli_session *session)
                                              (uint32_t)o->debug_sample);
         printf("pixel (%ld, %ld) sample %ld seed %ld: radiance %.9g %.9g %.9g\n", o->debug_x,
                o->debug_y, o->debug_sample, o->seed, (double)L.x, (double)L.y, (double)L.z);
-        exit_code = 0;
         goto done;
     }
 
     // Passes grow until one takes about a second: responsive progress, checkpoints and
-    // Ctrl-C, without per-pass overhead dominating small images.
-    render_catch_sigint();
+    // Ctrl-C, without per-pass overhead dominating small images. Each pass brings every tile
+    // `pass` samples nearer the total (tiles of a resumed render start where they were).
     bool tty = isatty(STDERR_FILENO) != 0;
-    uint32_t total = (uint32_t)o->spp, done_spp = 0, pass = 1;
-    double t_render = drift_time_now(), last_checkpoint = t_render, last_report = 0.0;
+    uint32_t total = (uint32_t)o->spp, done_spp = run.resumed_spp, pass = 1;
+    run.t_render = drift_time_now();
+    double last_checkpoint = run.t_render, last_report = 0.0;
     if (!o->quiet) {
-        fprintf(stderr, "drift render: %s, %dx%d, %u spp, depth %d, %d threads\n", scene_path,
-                params.width, params.height, total, params.max_depth,
+        fprintf(stderr, "drift render: %s, %dx%d, %u spp, depth %d, %d threads\n",
+                session->scene_path, params.width, params.height, total, params.max_depth,
                 drift_context_thread_count(ctx));
     }
     while (done_spp < total) {
-        uint32_t count = pass < total - done_spp ? pass : total - done_spp;
         double t0 = drift_time_now();
-        r = drift_pt_render_samples(pt, count, &interrupted);
+        drift_result r = drift_pt_render_tiles(pt, NULL, 0, pass, total, &interrupted);
         double dt = drift_time_now() - t0;
         if (r == DRIFT_ERR_CANCELLED) {
             break;
         }
-        done_spp += count;
+        done_spp = drift_pt_sample_count(pt);
         if (dt < 0.5 && pass < (1u << 20)) {
             pass *= 2;
         }
         double now = drift_time_now();
         if (!o->quiet && (tty || now - last_report > 5.0 || done_spp == total)) {
-            print_progress(tty, done_spp, total, now - t_render, done_spp == total);
+            render_progress(tty, run.resumed_spp, done_spp, total, now - run.t_render,
+                            done_spp == total);
             last_report = now;
         }
         if (o->checkpoint_seconds > 0.0 && now - last_checkpoint > o->checkpoint_seconds &&
             done_spp < total) {
-            if (write_images(ctx, pt, o, session->scene->camera.fov_y) == DRIFT_OK && !o->quiet) {
-                fprintf(stderr, "%sdrift render: checkpoint at %u spp written to %s\n",
-                        tty ? "\n" : "", done_spp, o->out_path);
+            if (render_reference_checkpoint(&run) && !o->quiet) {
+                fprintf(stderr, "%sdrift render: checkpoint at %u spp written to %s and %s\n",
+                        tty ? "\n" : "", done_spp, o->out_path, run.checkpoint_path);
             }
             last_checkpoint = now;
         }
     }
-    double t_rendered = drift_time_now();
-    bool cancelled = atomic_load(&interrupted);
-    if (cancelled) {
-        fprintf(stderr, "%sdrift render: interrupted at %u spp; writing what was rendered\n",
-                tty ? "\n" : "", drift_pt_sample_count(pt));
-    }
-    r = write_images(ctx, pt, o, session->scene->camera.fov_y);
-    if (r != DRIFT_OK) {
-        fprintf(stderr, "drift render: cannot write %s: %s\n", o->out_path, drift_result_string(r));
-        goto done;
-    }
-    double t_written = drift_time_now();
-    if (o->stats_path && !write_stats(o, session, pt, t_render, t_rendered, t_written)) {
-        goto done;
-    }
-    drift_pt_stats stats = drift_pt_get_stats(pt);
-    if (stats.nan_samples > 0) {
-        fprintf(stderr, "drift render: warning: %llu samples were not finite and were dropped\n",
-                (unsigned long long)stats.nan_samples);
-    }
-    char png[4096];
-    render_png_path(o->out_path, png, sizeof(png));
-    printf("wrote %s and %s (%u spp, %dx%d) in %.2f s (render %.2f s)\n", o->out_path, png,
-           drift_pt_sample_count(pt), params.width, params.height, t_written - session->t_start,
-           t_rendered - t_render);
-    exit_code = cancelled ? render_interrupt_status() : 0;
+    exit_code = render_reference_finish(&run, atomic_load(&interrupted), drift_time_now());
 
 done:
-    drift_pt_destroy(pt);
+    drift_pt_destroy(run.pt);
     return exit_code;
+}
+
+int render_open_session(const render_options *o, bool outputs_here, cli_session *session)
+{
+    char png[4096];
+    render_png_path(o->out_path, png, sizeof png);
+    char checkpoint[4096];
+    render_checkpoint_path(o->out_path, checkpoint, sizeof checkpoint);
+    const cli_file outputs[] = { { "--out", o->out_path },
+                                 { "--out's PNG", png },
+                                 { "--stats", o->stats_path },
+                                 { "--aov", o->aov_path },
+                                 { "--out's checkpoint", o->hybrid_mode ? NULL : checkpoint } };
+    const cli_file inputs[] = { { "--lambda", o->refine.lambda_path } };
+    bool writes = outputs_here && o->debug_sample < 0;
+    if (cli_session_open(&(cli_session_desc){ .cmd = "render",
+                                              .scene_path = o->scene_path,
+                                              .threads = (int)o->threads,
+                                              .verbose = o->verbose,
+                                              .outputs = outputs,
+                                              .output_count = writes ? 5 : 0,
+                                              .inputs = inputs,
+                                              .input_count = 1 },
+                         session)) {
+        return 0;
+    }
+    return session->refused ? 2 : 1;
 }
 
 int drift_cmd_render(int argc, char **argv)
 {
+#ifdef DRIFT_MPI
+    if (render_mpi_launched()) { // mpirun -n N drift render ...: tools/distributed
+        return render_mpi(argc, argv);
+    }
+#endif
     render_options o;
-    int status = parse_options(argc, argv, &o);
+    int status = render_parse_options(argc, argv, &o);
     if (status != 0) {
         return status < 0 ? 0 : status;
     }
     if (o.hybrid_mode && !render_refine_validate(&o)) {
         return 2;
     }
-    char png[4096];
-    render_png_path(o.out_path, png, sizeof png);
-    const cli_file outputs[] = { { "--out", o.out_path },
-                                 { "--out's PNG", png },
-                                 { "--stats", o.stats_path },
-                                 { "--aov", o.aov_path } };
-    const cli_file inputs[] = { { "--lambda", o.refine.lambda_path } };
     cli_session session;
-    int exit_code = 1;
-    if (cli_session_open(&(cli_session_desc){ .cmd = "render",
-                                              .scene_path = o.scene_path,
-                                              .threads = (int)o.threads,
-                                              .verbose = o.verbose,
-                                              .outputs = outputs,
-                                              .output_count = o.debug_sample >= 0 ? 0 : 4,
-                                              .inputs = inputs,
-                                              .input_count = 1 },
-                         &session)) {
+    int exit_code = render_open_session(&o, true, &session);
+    if (exit_code == 0) {
         exit_code = o.hybrid_mode ? render_hybrid(&o, &session) : render_reference(&o, &session);
-    } else if (session.refused) {
-        exit_code = 2;
     }
     cli_session_close(&session);
     return exit_code;

@@ -26,11 +26,13 @@ typedef struct render_options {
     const char *scene_path;
     const char *out_path;
     const char *stats_path;
-    const char *aov_path; // hybrid: every plane as layers of this EXR
-    bool hybrid_mode;     // --mode hybrid (else reference)
-    long frames;          // hybrid: frames rendered of the one view (the last is written)
+    const char *aov_path;    // hybrid: every plane as layers of this EXR
+    const char *resume_path; // reference: --resume FILE.ckpt
+    bool hybrid_mode;        // --mode hybrid (else reference)
+    long frames;             // hybrid: frames rendered of the one view (the last is written)
     long spp, seed, threads, max_depth, width, height;
     double checkpoint_seconds;
+    double rank_timeout; // mpirun: seconds a rank may send nothing before it counts as hung
     double exposure;
     drift_tonemap_operator tonemap;
     bool aov;
@@ -44,6 +46,19 @@ typedef struct render_options {
     double aperture, focus_distance; // < 0: the scene camera's
     render_refine_options refine;    // --refine sir (tools/render_refine.c)
 } render_options;
+
+// drift render's options from argv: 0, 2 after a usage error (message printed), -1 after
+// --help.
+int render_parse_options(int argc, char **argv, render_options *o);
+// Opens the context, scene and accel; with outputs_here, refuses outputs that name an input
+// and checks each can be written. Returns 0, or the exit status (message printed); close the
+// session in both cases.
+int render_open_session(const render_options *o, bool outputs_here, cli_session *session);
+
+// mpirun -n N drift render (tools/distributed/render_mpi.c, built with -DDRIFT_MPI=ON):
+// whether this process was started by mpirun, and the distributed render.
+bool render_mpi_launched(void);
+int render_mpi(int argc, char **argv);
 
 // Renders in hybrid mode with the session's scene; returns the process exit code.
 int render_hybrid(const render_options *o, const cli_session *session);
@@ -71,6 +86,67 @@ drift_result render_write_aov(drift_context *ctx, const char *path,
 
 // FILE.exr -> FILE.png
 void render_png_path(const char *exr_path, char *out, size_t size);
+
+// --- REFERENCE RENDERS (tools/cmd_render.c; tools/distributed drives the same steps) ---
+
+typedef struct render_reference_run {
+    const render_options *o;
+    const cli_session *session;
+    struct drift_pt *pt;
+    uint32_t resumed_spp; // the lowest tile count the checkpoint held (0: a fresh render)
+    int ranks;            // processes that rendered (0: not distributed)
+    double t_render;      // drift_time_now() when rendering began
+    char key[1024];       // render_checkpoint_key
+    char checkpoint_path[4096];
+} render_reference_run;
+
+// Creates the pt and loads the checkpoint to resume (--resume, or FILE.ckpt beside --out);
+// returns 0 or the exit status (message printed).
+int render_reference_begin(render_reference_run *run);
+// Writes FILE.ckpt and the images so far (all or none); false after a message.
+bool render_reference_checkpoint(render_reference_run *run);
+// Writes the outputs (all or none) and, when tiles are short of --spp, the checkpoint, and
+// says so; removes the checkpoint of a finished render. Returns the exit status.
+int render_reference_finish(render_reference_run *run, bool cancelled, double t_rendered);
+// The lowest and highest sample count of the pt's tiles.
+void render_spp_range(const struct drift_pt *pt, uint32_t *lowest, uint32_t *highest);
+// One progress line (a bar on a terminal): done of total spp, `first` where this run began.
+void render_progress(bool tty, uint32_t first, uint32_t done, uint32_t total, double elapsed,
+                     bool final);
+
+// --- REFERENCE RENDERS: CHECKPOINTS, RESUME, STAGED OUTPUTS (tools/render_checkpoint.c) ---
+
+struct drift_pt;
+// FILE.exr -> FILE.ckpt, the checkpoint beside --out.
+void render_checkpoint_path(const char *exr_path, char *out, size_t size);
+// The key a checkpoint must match to be resumed: drift's version, the scene's content (every
+// file it read), image size, seed, depth, tile size; "name value" lines. False (message
+// printed) when a scene file cannot be read.
+bool render_checkpoint_key(const cli_session *session, const struct drift_pt *pt, char *key,
+                           size_t size);
+// Writes every tile's state to `path` (temp file, then rename). Prints the reason on failure.
+bool render_checkpoint_write(const char *path, const char *key, const struct drift_pt *pt);
+// Loads a checkpoint into the pt: 0 on success; 2 (message printed, pt unchanged or partly
+// loaded) when the file cannot be read, is not a checkpoint, is cut short, belongs to
+// another render (the first differing key line is named) or holds more than `spp` samples.
+int render_checkpoint_read(const char *path, const char *key, struct drift_pt *pt, uint32_t spp);
+
+// A run's outputs, written to "<path>.stage-PID" first and renamed over their targets
+// together once every one was written (render_stage_commit), or all removed.
+typedef struct render_staged_file {
+    const char *path;
+    char temp[4096];
+} render_staged_file;
+
+typedef struct render_stage {
+    size_t count;
+    render_staged_file files[8];
+} render_stage;
+
+// Returns the temporary path to write `path` to (NULL stays NULL).
+const char *render_stage_add(render_stage *s, const char *path);
+bool render_stage_commit(render_stage *s);
+void render_stage_abort(render_stage *s);
 
 // Installs the Ctrl-C handler; the flag it returns becomes true on SIGINT or SIGTERM.
 const atomic_bool *render_catch_sigint(void);

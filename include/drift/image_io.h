@@ -66,6 +66,19 @@ typedef struct drift_image_layer {
 drift_result drift_image_save_exr(drift_context *ctx, const char *path,
                                   const drift_image_layer *layers, uint32_t layer_count);
 
+// A string attribute in an EXR header (name and value borrowed for the call).
+typedef struct drift_image_attribute {
+    const char *name;
+    const char *value;
+} drift_image_attribute;
+
+// drift_image_save_exr plus string attributes in the header ("drift.spp": how the image was
+// made). Names must be unique and not those the EXR format itself defines.
+drift_result drift_image_save_exr_attributes(drift_context *ctx, const char *path,
+                                             const drift_image_layer *layers, uint32_t layer_count,
+                                             const drift_image_attribute *attributes,
+                                             uint32_t attribute_count);
+
 // Writes an 8-bit RGB PNG of the image tone-mapped by drift_image_tonemap (tonemap may be NULL:
 // defaults). 1-channel images are written grey in RGB; alpha is dropped. Errors:
 // DRIFT_ERR_INVALID_ARGUMENT, DRIFT_ERR_IO, DRIFT_ERR_OUT_OF_MEMORY.

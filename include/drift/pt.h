@@ -120,6 +120,40 @@ void drift_pt_destroy(drift_pt *pt); // NULL-safe
 // divided by its own sample count at resolve.
 drift_result drift_pt_render_samples(drift_pt *pt, uint32_t count, const atomic_bool *cancel);
 
+// --- TILES ---
+// The image is cut into DRIFT_PT_TILE_SIZE squares (smaller at the right and bottom edges),
+// numbered row by row. Every render call works tile by tile and polls `cancel` between
+// tiles, so after a cancelled call tiles can hold different sample counts; each pixel still
+// holds whole samples 0..n-1. A tile's state (its pixels' sums and counts) can be copied out
+// and back in: checkpoints, resuming, and other processes rendering some of the tiles
+// (tools/distributed) give the same bits as one uninterrupted render, because a pixel's
+// samples are summed one by one in index order whoever renders them.
+#define DRIFT_PT_TILE_SIZE 16
+
+typedef struct drift_pt_tile {
+    int32_t x0, y0, x1, y1; // pixels [x0, x1) x [y0, y1)
+} drift_pt_tile;
+
+uint32_t drift_pt_tile_count(const drift_pt *pt);
+drift_pt_tile drift_pt_tile_rect(const drift_pt *pt, uint32_t tile);
+// The samples every pixel of the tile holds (the lowest of its pixels).
+uint32_t drift_pt_tile_sample_count(const drift_pt *pt, uint32_t tile);
+
+// Renders the listed tiles (NULL: all of them, tile_count ignored): each pixel gets the
+// samples from its own count n up to min(n + add, until). Tiles already at `until` are left
+// as they are. Errors: DRIFT_ERR_INVALID_ARGUMENT (a tile out of range), DRIFT_ERR_CANCELLED.
+drift_result drift_pt_render_tiles(drift_pt *pt, const uint32_t *tiles, uint32_t tile_count,
+                                   uint32_t add, uint32_t until, const atomic_bool *cancel);
+
+// Bytes of one tile's state; get copies it to `out` (that many bytes), set replaces the
+// tile's sums and counts by it. The layout is the pt's own: only for a pt of the same
+// size (and the same params, for the bits to mean the same render).
+size_t drift_pt_tile_state_size(const drift_pt *pt, uint32_t tile);
+void drift_pt_tile_get_state(const drift_pt *pt, uint32_t tile, void *out);
+void drift_pt_tile_set_state(drift_pt *pt, uint32_t tile, const void *state);
+// Adds another renderer's counters (rays of tiles rendered elsewhere) to this pt's stats.
+void drift_pt_add_stats(drift_pt *pt, const drift_pt_stats *stats);
+
 // Completed samples per pixel (the minimum over pixels).
 uint32_t drift_pt_sample_count(const drift_pt *pt);
 drift_pt_stats drift_pt_get_stats(const drift_pt *pt);

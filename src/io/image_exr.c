@@ -486,6 +486,14 @@ static exr_result_t encode_all(exr_context_t f, int part, const out_channel *cha
 drift_result drift_image_save_exr(drift_context *ctx, const char *path,
                                   const drift_image_layer *layers, uint32_t layer_count)
 {
+    return drift_image_save_exr_attributes(ctx, path, layers, layer_count, NULL, 0);
+}
+
+drift_result drift_image_save_exr_attributes(drift_context *ctx, const char *path,
+                                             const drift_image_layer *layers, uint32_t layer_count,
+                                             const drift_image_attribute *attributes,
+                                             uint32_t attribute_count)
+{
     size_t chan_count = 0;
     drift_result r = check_layers(ctx, path, layers, layer_count, &chan_count);
     if (r != DRIFT_OK) {
@@ -549,6 +557,9 @@ drift_result drift_image_save_exr(drift_context *ctx, const char *path,
     for (size_t i = 0; rv == EXR_ERR_SUCCESS && i < chan_count; ++i) {
         rv = exr_add_channel(f, part, chans[i].name, EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LOGARITHMIC,
                              1, 1);
+    }
+    for (uint32_t i = 0; rv == EXR_ERR_SUCCESS && i < attribute_count; ++i) {
+        rv = exr_attr_set_string(f, part, attributes[i].name, attributes[i].value);
     }
     if (rv == EXR_ERR_SUCCESS) {
         rv = exr_write_header(f);

@@ -4,7 +4,7 @@
 #include <math.h>
 #include <string.h>
 
-#define TILE_SIZE 16
+#define TILE_SIZE DRIFT_PT_TILE_SIZE
 // Channels accumulated per pixel: beauty RGB, albedo RGB, normal XYZ, depth.
 #define SUM_CHANNELS 10
 
@@ -363,33 +363,55 @@ drift_vec3 drift_pt_trace_sample(const drift_pt *pt, int32_t x, int32_t y, uint3
 
 // --- RENDER LOOP ---
 
+// Each listed pixel continues from its own sample count: sample indices [first, end) with
+// end = min(first + add, until). Samples are summed one by one in index order, so a pixel's
+// sums do not depend on how its samples were split into calls, tiles or processes.
 typedef struct render_job {
     drift_pt *pt;
-    uint32_t sample_count;
-    int32_t tiles_x;
+    const uint32_t *tiles; // NULL: tile i is the i-th
+    uint32_t add, until;
     const atomic_bool *cancel;
 } render_job;
+
+drift_pt_tile drift_pt_tile_rect(const drift_pt *pt, uint32_t tile)
+{
+    int32_t width = pt->params.width, height = pt->params.height;
+    int32_t tiles_x = (width + TILE_SIZE - 1) / TILE_SIZE;
+    drift_pt_tile t = { .x0 = (int32_t)(tile % (uint32_t)tiles_x) * TILE_SIZE,
+                        .y0 = (int32_t)(tile / (uint32_t)tiles_x) * TILE_SIZE };
+    t.x1 = t.x0 + TILE_SIZE < width ? t.x0 + TILE_SIZE : width;
+    t.y1 = t.y0 + TILE_SIZE < height ? t.y0 + TILE_SIZE : height;
+    return t;
+}
+
+uint32_t drift_pt_tile_count(const drift_pt *pt)
+{
+    uint32_t tiles_x = (uint32_t)(pt->params.width + TILE_SIZE - 1) / TILE_SIZE;
+    uint32_t tiles_y = (uint32_t)(pt->params.height + TILE_SIZE - 1) / TILE_SIZE;
+    return tiles_x * tiles_y;
+}
 
 static void render_tiles(size_t begin, size_t end, int thread_index, void *user)
 {
     render_job *job = user;
     drift_pt *pt = job->pt;
     thread_stats *stats = &pt->thread_stats[thread_index];
-    int32_t width = pt->params.width, height = pt->params.height;
-    for (size_t tile = begin; tile < end; ++tile) {
+    int32_t width = pt->params.width;
+    for (size_t i = begin; i < end; ++i) {
         if (job->cancel && atomic_load(job->cancel)) {
             return;
         }
-        int32_t x0 = (int32_t)(tile % (size_t)job->tiles_x) * TILE_SIZE;
-        int32_t y0 = (int32_t)(tile / (size_t)job->tiles_x) * TILE_SIZE;
-        int32_t x1 = x0 + TILE_SIZE < width ? x0 + TILE_SIZE : width;
-        int32_t y1 = y0 + TILE_SIZE < height ? y0 + TILE_SIZE : height;
-        for (int32_t y = y0; y < y1; ++y) {
-            for (int32_t x = x0; x < x1; ++x) {
+        drift_pt_tile t = drift_pt_tile_rect(pt, job->tiles ? job->tiles[i] : (uint32_t)i);
+        for (int32_t y = t.y0; y < t.y1; ++y) {
+            for (int32_t x = t.x0; x < t.x1; ++x) {
                 size_t pixel = (size_t)y * (size_t)width + (size_t)x;
                 double *sum = pt->sums + pixel * SUM_CHANNELS;
                 uint32_t first = pt->counts[pixel];
-                for (uint32_t s = first; s < first + job->sample_count; ++s) {
+                uint32_t last = job->until - first < job->add ? job->until : first + job->add;
+                if (first >= job->until) {
+                    continue;
+                }
+                for (uint32_t s = first; s < last; ++s) {
                     path_result r;
                     trace_path(pt, x, y, s, &r, stats);
                     if (!drift_vec3_is_finite(r.radiance)) {
@@ -404,26 +426,93 @@ static void render_tiles(size_t begin, size_t end, int thread_index, void *user)
                         sum[c] += (double)v[c];
                     }
                 }
-                pt->counts[pixel] = first + job->sample_count;
+                pt->counts[pixel] = last;
             }
         }
     }
 }
 
-drift_result drift_pt_render_samples(drift_pt *pt, uint32_t count, const atomic_bool *cancel)
+drift_result drift_pt_render_tiles(drift_pt *pt, const uint32_t *tiles, uint32_t tile_count,
+                                   uint32_t add, uint32_t until, const atomic_bool *cancel)
 {
     if (!pt) {
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
+    uint32_t all = drift_pt_tile_count(pt);
+    for (uint32_t i = 0; tiles && i < tile_count; ++i) {
+        if (tiles[i] >= all) {
+            return DRIFT_ERR_INVALID_ARGUMENT;
+        }
+    }
     double start = drift_time_now();
-    render_job job = { .pt = pt,
-                       .sample_count = count,
-                       .tiles_x = (pt->params.width + TILE_SIZE - 1) / TILE_SIZE,
-                       .cancel = cancel };
-    int32_t tiles_y = (pt->params.height + TILE_SIZE - 1) / TILE_SIZE;
-    drift_parallel_for(pt->ctx, (size_t)job.tiles_x * (size_t)tiles_y, 1, render_tiles, &job);
+    render_job job = { .pt = pt, .tiles = tiles, .add = add, .until = until, .cancel = cancel };
+    drift_parallel_for(pt->ctx, tiles ? tile_count : all, 1, render_tiles, &job);
     pt->render_seconds += drift_time_now() - start;
     return cancel && atomic_load(cancel) ? DRIFT_ERR_CANCELLED : DRIFT_OK;
+}
+
+drift_result drift_pt_render_samples(drift_pt *pt, uint32_t count, const atomic_bool *cancel)
+{
+    return drift_pt_render_tiles(pt, NULL, 0, count, UINT32_MAX, cancel);
+}
+
+uint32_t drift_pt_tile_sample_count(const drift_pt *pt, uint32_t tile)
+{
+    drift_pt_tile t = drift_pt_tile_rect(pt, tile);
+    uint32_t lowest = UINT32_MAX;
+    for (int32_t y = t.y0; y < t.y1; ++y) {
+        for (int32_t x = t.x0; x < t.x1; ++x) {
+            uint32_t n = pt->counts[(size_t)y * (size_t)pt->params.width + (size_t)x];
+            lowest = n < lowest ? n : lowest;
+        }
+    }
+    return lowest;
+}
+
+// A tile's state: its pixels' sums (SUM_CHANNELS doubles each, row by row), then their
+// sample counts (uint32 each).
+size_t drift_pt_tile_state_size(const drift_pt *pt, uint32_t tile)
+{
+    drift_pt_tile t = drift_pt_tile_rect(pt, tile);
+    size_t pixels = (size_t)(t.x1 - t.x0) * (size_t)(t.y1 - t.y0);
+    return pixels * (SUM_CHANNELS * sizeof(double) + sizeof(uint32_t));
+}
+
+void drift_pt_tile_get_state(const drift_pt *pt, uint32_t tile, void *out)
+{
+    drift_pt_tile t = drift_pt_tile_rect(pt, tile);
+    size_t row = (size_t)(t.x1 - t.x0), rows = (size_t)(t.y1 - t.y0);
+    uint8_t *sums = out, *counts = sums + row * rows * SUM_CHANNELS * sizeof(double);
+    for (int32_t y = t.y0; y < t.y1; ++y) {
+        size_t pixel = (size_t)y * (size_t)pt->params.width + (size_t)t.x0;
+        memcpy(sums, pt->sums + pixel * SUM_CHANNELS, row * SUM_CHANNELS * sizeof(double));
+        memcpy(counts, pt->counts + pixel, row * sizeof(uint32_t));
+        sums += row * SUM_CHANNELS * sizeof(double);
+        counts += row * sizeof(uint32_t);
+    }
+}
+
+void drift_pt_tile_set_state(drift_pt *pt, uint32_t tile, const void *state)
+{
+    drift_pt_tile t = drift_pt_tile_rect(pt, tile);
+    size_t row = (size_t)(t.x1 - t.x0), rows = (size_t)(t.y1 - t.y0);
+    const uint8_t *sums = state, *counts = sums + row * rows * SUM_CHANNELS * sizeof(double);
+    for (int32_t y = t.y0; y < t.y1; ++y) {
+        size_t pixel = (size_t)y * (size_t)pt->params.width + (size_t)t.x0;
+        memcpy(pt->sums + pixel * SUM_CHANNELS, sums, row * SUM_CHANNELS * sizeof(double));
+        memcpy(pt->counts + pixel, counts, row * sizeof(uint32_t));
+        sums += row * SUM_CHANNELS * sizeof(double);
+        counts += row * sizeof(uint32_t);
+    }
+}
+
+void drift_pt_add_stats(drift_pt *pt, const drift_pt_stats *stats)
+{
+    thread_stats *s = &pt->thread_stats[0];
+    s->camera_rays += stats->camera_rays;
+    s->shadow_rays += stats->shadow_rays;
+    s->bounce_rays += stats->bounce_rays;
+    s->nan_samples += stats->nan_samples;
 }
 
 uint32_t drift_pt_sample_count(const drift_pt *pt)

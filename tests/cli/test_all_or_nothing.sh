@@ -34,6 +34,24 @@ no_outputs "--stats a folder" "Is a directory"
 expect 1 "$drift" diff s.json s.json --heatmap nodir/h.png
 no_outputs "diff --heatmap nodir/h.png" "No such file or directory"
 
+# A write that fails after the images were made (here: --stats' folder removed during the
+# render) leaves none of the outputs: they are staged and renamed together at the end. The
+# checkpoint beside --out keeps the work.
+mkdir sub
+"$drift" render s.json --spp 16000000 --threads 1 --out o.exr --stats sub/s.json >out 2>err &
+pid=$!
+for i in $(seq 100); do
+    grep -q "spp, depth" err && break
+    sleep 0.1
+done
+rm -r sub
+kill -INT "$pid"
+wait "$pid"
+status=$?
+[ "$status" -eq 1 ] || fail "a failed --stats write after rendering exited $status, expected 1"
+rm -f o.ckpt
+no_outputs "--stats folder removed mid-run" "No such file or directory"
+
 # The stats JSON is escaped (cJSON): a scene path with a quote and a backslash.
 cp s.json 'q"uote\.json'
 expect 0 "$drift" render 'q"uote\.json' "${fast[@]}" --out o.exr --stats o.json

@@ -8,7 +8,11 @@ source "$(dirname "$0")/common.sh"
 "$drift" render --spp 100000 --width 64 --height 64 --threads 1 --checkpoint 0 \
     --out "$tmp/term.exr" --stats "$tmp/term.json" >"$tmp/out" 2>"$tmp/err" &
 pid=$!
-sleep 3
+for i in $(seq 300); do # until it renders (a loaded machine can take seconds to get there)
+    grep -q "spp, depth" "$tmp/err" && break
+    sleep 0.1
+done
+sleep 1
 kill -TERM "$pid"
 wait "$pid"
 status=$?

@@ -324,6 +324,49 @@ static void test_pt_bit_identical_for_any_thread_count(void **state)
     test_free(first);
 }
 
+// Tiles rendered one at a time, in reverse order, in uneven pieces, their state moved to a
+// second pt and back (what a checkpoint and an MPI rank do), give the bits of one render.
+static void test_pt_tiles_moved_between_pts_are_bit_identical(void **state)
+{
+    (void)state;
+    const drift_pt_params params = { .seed = 5, .width = 40, .height = 24 };
+    rig whole = rig_begin(2);
+    small_box_scene(&whole, 0.02f);
+    rig_finish(&whole, &params);
+    drift_image expected = render(&whole, 6);
+
+    rig r = rig_begin(1), other = rig_begin(3);
+    small_box_scene(&r, 0.02f);
+    small_box_scene(&other, 0.02f);
+    rig_finish(&r, &params);
+    rig_finish(&other, &params);
+    uint32_t tiles = drift_pt_tile_count(r.pt);
+    assert_int_equal(tiles, 6); // 3 x 2, the right and bottom ones cut
+    drift_pt_tile last = drift_pt_tile_rect(r.pt, tiles - 1);
+    assert_true(last.x1 == 40 && last.y1 == 24 && last.x1 - last.x0 == 8);
+    uint8_t *scratch = test_malloc(drift_pt_tile_state_size(r.pt, 0));
+    for (uint32_t t = tiles; t-- > 0;) {
+        assert_int_equal(drift_pt_render_tiles(r.pt, &t, 1, 1 + t % 3, 6, NULL), DRIFT_OK);
+        assert_int_equal(drift_pt_tile_sample_count(r.pt, t), 1 + t % 3);
+        drift_pt_tile_get_state(r.pt, t, scratch);
+        drift_pt_tile_set_state(other.pt, t, scratch);
+        assert_int_equal(drift_pt_render_tiles(other.pt, &t, 1, 100, 6, NULL), DRIFT_OK);
+        drift_pt_tile_get_state(other.pt, t, scratch);
+        drift_pt_tile_set_state(r.pt, t, scratch);
+    }
+    assert_int_equal(drift_pt_sample_count(r.pt), 6);
+    drift_image got;
+    assert_int_equal(drift_pt_resolve(r.pt, DRIFT_PT_AOV_BEAUTY, &got), DRIFT_OK);
+    assert_memory_equal(expected.pixels, got.pixels, 40 * 24 * 3 * sizeof(float));
+    uint32_t outside = tiles;
+    assert_int_equal(drift_pt_render_tiles(r.pt, &outside, 1, 1, 7, NULL),
+                     DRIFT_ERR_INVALID_ARGUMENT);
+    test_free(scratch);
+    rig_destroy(&other);
+    rig_destroy(&r);
+    rig_destroy(&whole);
+}
+
 static double rmse(const drift_image *a, const drift_image *b)
 {
     double sum = 0.0;
@@ -722,6 +765,7 @@ int main(void)
         cmocka_unit_test(test_pt_thin_lens_focuses_on_the_focus_plane),
         cmocka_unit_test(test_pt_zero_aperture_equals_pinhole),
         cmocka_unit_test(test_pt_bit_identical_for_any_thread_count),
+        cmocka_unit_test(test_pt_tiles_moved_between_pts_are_bit_identical),
         cmocka_unit_test(test_pt_converges_as_inverse_sqrt_spp),
         cmocka_unit_test(test_pt_cancel_flag_stops_and_reports),
         cmocka_unit_test(test_pt_components_sum_to_the_full_image),

@@ -1,0 +1,92 @@
+#!/usr/bin/env bash
+# mpirun -n N drift render (issue 19, docs/distributed.md): 1 to 4 ranks give the same bytes
+# as one process (beauty and AOV layers); a rank killed mid-render ends the job non-zero with
+# the checkpoint of every merged tile, which resumes to the same bytes; a hung rank is named
+# and its job ends the same way; bad input fails once, on every rank, writing nothing.
+# $1: drift (built with -DDRIFT_MPI=ON), $2: mpirun.
+set -u
+drift="$1"
+mpirun=("$2" --oversubscribe --allow-run-as-root)
+source "$(dirname "$0")/../cli/common.sh"
+export ASAN_OPTIONS="${ASAN_OPTIONS:-}:detect_leaks=0" # Open MPI's own allocations at exit
+
+# 48x48: 9 tiles, more than 4 ranks x 2 jobs queued.
+base=(--width 48 --height 48 --threads 1 --seed 2 --checkpoint 0 --aov)
+small=(--width 48 --height 16 --threads 1 --seed 2 --checkpoint 0 --aov)
+
+expect 0 "$drift" render "${base[@]}" --spp 3 --quiet --out "$tmp/one.exr"
+for n in 1 2 3 4; do
+    expect 0 "${mpirun[@]}" -n "$n" "$drift" render "${base[@]}" --spp 3 --quiet \
+        --out "$tmp/n$n.exr"
+    cmp -s "$tmp/one.exr" "$tmp/n$n.exr" || fail "$n ranks: not the bytes of one process"
+done
+
+# rank_pid MPIRUN_PID RANK: the pid of that rank (mpirun's child with its rank in the env).
+rank_pid() {
+    local c
+    for c in $(pgrep -P "$1"); do
+        if tr '\0' '\n' <"/proc/$c/environ" 2>/dev/null | grep -qx "OMPI_COMM_WORLD_RANK=$2"; then
+            echo "$c"
+        fi
+    done
+}
+
+# start_long OUT: a long 3-rank render of 48x16 (3 tiles) in the background; sets $job once
+# it renders.
+start_long() {
+    "${mpirun[@]}" -n 3 "$drift" render "${small[@]}" --spp 1000000 --out "$1" \
+        --stats "${1%.exr}.json" "${@:2}" \
+        >"$tmp/out" 2>"$tmp/err" &
+    job=$!
+    local i
+    for i in $(seq 200); do
+        grep -q "ranks (" "$tmp/err" && break
+        sleep 0.1
+    done
+    sleep 0.5
+}
+
+# A killed rank: rank 0 writes the checkpoint and the partial image, the job ends non-zero
+# and mpirun names the rank.
+start_long "$tmp/k.exr"
+victim=$(rank_pid "$job" 1)
+[ -n "$victim" ] || fail "no rank 1 found under mpirun"
+kill -KILL $victim
+wait "$job"
+status=$?
+[ "$status" -ne 0 ] || fail "a job with a killed rank exited 0"
+grep -q "rank 1" "$tmp/err" || fail "the killed rank is not named: $(cat "$tmp/err")"
+[ -s "$tmp/k.ckpt" ] || fail "no checkpoint after a rank died"
+grep -q "interrupted at" "$tmp/err" || fail "rank 0 did not say what it kept"
+# Resuming it (on 2 ranks) gives the bytes of an uninterrupted one-process render.
+most=$(python3 -c "import json; s=json.load(open('$tmp/k.json')); print(s.get('spp_max', s['spp']))" \
+    2>/dev/null || echo 0)
+expect 0 "${mpirun[@]}" -n 2 "$drift" render "${small[@]}" --spp $((most + 2)) --quiet \
+    --out "$tmp/k.exr" --resume "$tmp/k.ckpt"
+expect 0 "$drift" render "${small[@]}" --spp $((most + 2)) --quiet --out "$tmp/k1.exr"
+cmp -s "$tmp/k.exr" "$tmp/k1.exr" || fail "the resumed job differs from an uninterrupted render"
+
+# A hung rank (stopped): rank 0 names it after --rank-timeout, keeps its work, exits non-zero.
+start_long "$tmp/h.exr" --rank-timeout 6
+kill -STOP $(rank_pid "$job" 2)
+wait "$job"
+status=$?
+[ "$status" -ne 0 ] || fail "a job with a hung rank exited 0"
+grep -q "rank 2 sent nothing for 6 s" "$tmp/err" || fail "the hung rank is not named: $(cat "$tmp/err")"
+[ -s "$tmp/h.ckpt" ] && [ -s "$tmp/h.exr" ] || fail "the hung job kept no checkpoint or image"
+
+# Bad input: one message whatever the rank count, nothing written.
+expect 2 "${mpirun[@]}" -n 3 "$drift" render --spp zero --out "$tmp/bad.exr"
+[ "$(grep -c "expects an integer" "$tmp/err")" -eq 1 ] ||
+    fail "a bad option is not reported exactly once: $(cat "$tmp/err")"
+expect 1 "${mpirun[@]}" -n 1 "$drift" render "${small[@]}" --spp 1 --out "$tmp/bad.exr" : \
+    -n 1 "$drift" render "$tmp/missing.json" "${small[@]}" --spp 1 --out "$tmp/bad.exr"
+[ "$(grep -c "rank 1: drift render: cannot load scene" "$tmp/err")" -eq 1 ] ||
+    fail "a scene missing on rank 1 is not reported once, naming the rank: $(cat "$tmp/err")"
+ls "$tmp" | grep -q '^bad\.' && fail "bad input wrote output: $(ls "$tmp")"
+
+if [ "$failures" -ne 0 ]; then
+    echo "$failures failure(s)" >&2
+    exit 1
+fi
+echo "distributed.mpi: all checks passed"
