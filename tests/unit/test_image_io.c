@@ -382,6 +382,53 @@ static int zip_chunks_at_raw_size(const char *path, const drift_image *img)
 // but a chunk whose size equals the uncompressed size is raw to every reader. Rows 16-31 here
 // are k random floats and then a constant; somewhere near k = all, deflate's output crosses
 // the raw size, and for some seed it lands on it exactly. drift must store that chunk raw.
+// Auto exposure brings the geometric mean of the lit pixels to 0.18 and ignores unlit ones;
+// EV100 follows its closed forms (sunny 16: f/16, 1/100 s, ISO 100 is EV100 14.64); the
+// filmic curve is Narkowicz's ACES fit, monotonic, 0 at 0 and white far above 1.
+static void test_image_io_exposure_and_filmic(void **state)
+{
+    (void)state;
+    drift_context *ctx = test_context(1, NULL);
+    drift_image img;
+    assert_int_equal(drift_image_create(ctx, 4, 2, 3, &img), DRIFT_OK);
+    // Row 0 grey 0.5 and 8 (geometric mean 2), row 1 black.
+    for (int32_t x = 0; x < 4; ++x) {
+        float v = x % 2 ? 8.0f : 0.5f;
+        for (int c = 0; c < 3; ++c) {
+            drift_image_pixel(&img, x, 0)[c] = v;
+        }
+    }
+    float expected = (float)(log2(0.18) - 0.5 * (log2(0.5 + 1e-4) + log2(8.0 + 1e-4)));
+    assert_float_equal(drift_image_auto_exposure(&img), expected, 1e-5f);
+    drift_image_pixel(&img, 0, 1)[1] = NAN; // not finite: ignored too
+    assert_float_equal(drift_image_auto_exposure(&img), expected, 1e-5f);
+    drift_image_destroy(ctx, &img);
+    assert_int_equal(drift_image_create(ctx, 2, 2, 3, &img), DRIFT_OK);
+    assert_float_equal(drift_image_auto_exposure(&img), 0.0f, 0.0f); // no light
+    drift_image_destroy(ctx, &img);
+
+    assert_float_equal(drift_ev100_from_camera(16.0f, 0.01f, 100.0f), log2f(25600.0f), 1e-4f);
+    assert_float_equal(drift_ev100_from_camera(16.0f, 0.01f, 200.0f), log2f(12800.0f), 1e-4f);
+    // A radiance of 1.2 · 2^EV100 / 683 W/(m² sr) (1.2 · 2^EV100 cd/m²) just saturates.
+    float ev = 9.0f;
+    float saturating = 1.2f * exp2f(ev) / 683.0f;
+    assert_float_equal(saturating * exp2f(drift_exposure_from_ev100(ev)), 1.0f, 1e-5f);
+
+    drift_tonemap_params filmic = { .op = DRIFT_TONEMAP_FILMIC };
+    assert_float_equal(drift_tonemap_value(0.0f, &filmic), 0.0f, 0.0f);
+    float x = 0.18f;
+    float aces = (x * (2.51f * x + 0.03f)) / (x * (2.43f * x + 0.59f) + 0.14f);
+    assert_float_equal(drift_tonemap_value(x, &filmic), drift_linear_to_srgb(aces), 1e-6f);
+    assert_float_equal(drift_tonemap_value(100.0f, &filmic), 1.0f, 0.0f);
+    float last = 0.0f;
+    for (int i = 1; i <= 200; ++i) {
+        float v = drift_tonemap_value(0.05f * (float)i, &filmic);
+        assert_true(v >= last);
+        last = v;
+    }
+    drift_context_destroy(ctx);
+}
+
 static void test_image_io_exr_chunk_compressing_to_raw_size_round_trips(void **state)
 {
     (void)state;
@@ -750,6 +797,7 @@ int main(void)
         cmocka_unit_test(test_image_io_tiled_exr_loads),
         cmocka_unit_test(test_image_io_piz_multipart_exr_loads),
         cmocka_unit_test(test_image_io_dwab_panoramas_equal_zip_copies),
+        cmocka_unit_test(test_image_io_exposure_and_filmic),
         cmocka_unit_test(test_image_io_exr_chunk_compressing_to_raw_size_round_trips),
         cmocka_unit_test(test_image_io_exr_random_round_trips_are_exact),
         cmocka_unit_test(test_image_io_png_round_trip_within_quantization),
