@@ -95,6 +95,12 @@ bool drift__gltf_get_material(const drift__gltf *g, unsigned index, drift__gltf_
 // The index in `cameras` of the camera named `selector`, or numbered by it; -1 if none.
 int drift__gltf_camera_index(const drift__gltf *g, const char *selector);
 
+// Loads a Mitsuba 0.5/0.6 scene file (.xml) with expat (scene_mitsuba.c); on_input as for
+// drift_scene_load_inputs.
+drift_result drift__scene_load_mitsuba(drift_context *ctx, const char *path,
+                                       drift_scene_input_fn on_input, void *user,
+                                       drift_scene **out_scene);
+
 // drift_scene_load_json_text that tells on_input of each file read (see drift_scene_load_inputs).
 drift_result drift__scene_load_json_text(drift_context *ctx, const char *text, size_t length,
                                          const char *base_dir, const char *name_for_messages,

@@ -842,6 +842,128 @@ static void test_scene_io_gltf_extensions_and_cameras(void **state)
     drift_context_destroy(ctx);
 }
 
+// A Mitsuba scene with every supported element (the line numbers of the warnings are checked,
+// so keep its lines as they are).
+static const char mitsuba_text[] =
+    "<?xml version='1.0'?>\n"                                                        // 1
+    "<scene version=\"0.5.0\">\n"                                                    // 2
+    " <sensor type=\"perspective\"><float name=\"fov\" value=\"60\"/>\n"             // 3
+    "  <transform name=\"toWorld\"><lookat origin=\"0,1,5\" target=\"0,1,0\""        //
+    " up=\"0,1,0\"/></transform>\n"                                                  // 4
+    "  <film type=\"hdrfilm\"><integer name=\"width\" value=\"64\"/>"                //
+    "<integer name=\"height\" value=\"48\"/></film></sensor>\n"                      // 5
+    " <bsdf type=\"twosided\" id=\"wall\"><bsdf type=\"diffuse\">"                   //
+    "<rgb name=\"reflectance\" value=\"0.2, 0.4, 0.6\"/></bsdf></bsdf>\n"            // 6
+    " <bsdf type=\"roughplastic\" id=\"coat\"><float name=\"alpha\" value=\"0.3\"/>" //
+    "<spectrum name=\"diffuseReflectance\" value=\"0.5\"/></bsdf>\n"                 // 7
+    " <bsdf type=\"conductor\" id=\"mirror\"/>\n"                                    // 8
+    " <bsdf type=\"dielectric\" id=\"glass\"/>\n"                                    // 9
+    " <medium type=\"homogeneous\" id=\"fog\"/>\n"                                   // 10
+    " <shape type=\"rectangle\"><transform name=\"toWorld\"><scale value=\"2\"/>"    //
+    "<translate z=\"-1\"/></transform><ref id=\"wall\"/></shape>\n"                  // 11
+    " <shape type=\"cube\"><bsdf type=\"roughconductor\"><float name=\"alpha\""      //
+    " value=\"0.1\"/></bsdf><transform name=\"toWorld\"><scale value=\"0.5\"/>"      //
+    "</transform></shape>\n"                                                         // 12
+    " <shape type=\"sphere\"><point name=\"center\" x=\"3\" y=\"0\" z=\"0\"/>"       //
+    "<float name=\"radius\" value=\"0.25\"/><emitter type=\"area\">"                 //
+    "<rgb name=\"radiance\" value=\"10, 10, 10\"/></emitter></shape>\n"              // 13
+    " <shape type=\"sphere\"><ref id=\"glass\"/></shape>\n"                          // 14
+    " <emitter type=\"point\"><point name=\"position\" x=\"0\" y=\"4\" z=\"0\"/>"    //
+    "<spectrum name=\"intensity\" value=\"5\"/></emitter>\n"                         // 15
+    " <emitter type=\"spot\"><float name=\"cutoffAngle\" value=\"30\"/>"             //
+    "<transform name=\"toWorld\"><lookat origin=\"0,4,0\" target=\"0,0,0\""          //
+    " up=\"0,0,1\"/></transform></emitter>\n"                                        // 16
+    " <emitter type=\"constant\"><rgb name=\"radiance\" value=\"0.1,0.2,0.3\"/></emitter>\n"
+    " <emitter type=\"sunsky\"/>\n" // 18
+    "</scene>\n";
+
+static const drift_light *light_of_type(const drift_scene *scene, drift_light_type type)
+{
+    for (uint32_t i = 0; i < scene->light_count; ++i) {
+        if (scene->lights[i].type == type) {
+            return &scene->lights[i];
+        }
+    }
+    fail_msg("no light of type %d", (int)type);
+    return NULL;
+}
+
+static void test_scene_io_mitsuba_subset(void **state)
+{
+    (void)state;
+    char path[1024];
+    test_out_path(path, "scene_io_mitsuba.xml");
+    write_file(path, mitsuba_text);
+    located_log log;
+    drift_context *ctx = located_context(&log);
+    drift_scene *scene = NULL;
+    assert_int_equal(drift_scene_load(ctx, path, &scene), DRIFT_OK);
+    assert_int_equal(log.errors, 0);
+    // fovAxis x (the default): 60° across 64 pixels is 2 atan(tan 30° · 48/64) vertically.
+    assert_float_equal(scene->camera.fov_y, 2.0f * atanf(tanf(DRIFT_PI / 6.0f) * 0.75f), 1e-5f);
+    assert_int_equal(scene->camera.width, 64);
+    assert_float_equal(scene->camera.position.z, 5.0f, 1e-5f);
+    assert_float_equal(scene->camera.target.y, 1.0f, 1e-5f);
+    const drift_material *wall = material_named(scene, "wall");
+    assert_float_equal(wall->diffuse.y, 0.4f, 1e-6f);
+    const drift_material *coat = material_named(scene, "coat");
+    assert_float_equal(coat->diffuse.x, 0.48f, 1e-6f);
+    assert_float_equal(coat->specular.x, 0.04f, 1e-6f);
+    assert_float_equal(coat->exponent, 0.25f * (2.0f / 0.09f - 2.0f), 1e-3f);
+    assert_int_equal(material_named(scene, "mirror")->type, DRIFT_MATERIAL_MIRROR);
+    // The rectangle, scaled by 2 then moved to z = -1: corners at ±2.
+    assert_float_equal(scene->bounds.min.z, -1.0f, 1e-5f);
+    assert_float_equal(scene->bounds.min.x, -2.0f, 1e-5f);
+    const drift_light *sun = light_of_type(scene, DRIFT_LIGHT_SPHERE);
+    assert_float_equal(sun->radius, 0.25f, 1e-6f);
+    assert_float_equal(sun->position.x, 3.0f, 1e-6f);
+    assert_float_equal(light_of_type(scene, DRIFT_LIGHT_POINT)->color.x, 5.0f, 0.0f);
+    const drift_light *spot = light_of_type(scene, DRIFT_LIGHT_SPOT);
+    assert_float_equal(spot->spot_outer, DRIFT_PI / 6.0f, 1e-6f);
+    assert_float_equal(spot->direction.y, -1.0f, 1e-5f);
+    assert_float_equal(scene->environment.color.z, 0.3f, 1e-6f);
+    // Warnings name the element and its line: the dielectric (9), the medium (10), sunsky (18).
+    assert_non_null(strstr(log.text, "no refraction"));
+    assert_non_null(strstr(log.text, "<medium type=homogeneous> is not supported"));
+    assert_non_null(strstr(log.text, "<emitter type=sunsky> is not a supported emitter"));
+    assert_int_equal(log.min_warning_line, 9);
+    drift_scene_destroy(scene);
+
+    // Errors name the file and the line.
+    static const struct {
+        const char *text, *message;
+        int line;
+    } bad[] = {
+        { "<scene>\n <shape type=\"hair\"/>\n</scene>\n", "unknown shape type", 2 },
+        { "<scene>\n\n <shape type=\"cube\"><ref id=\"nope\"/></shape>\n</scene>\n",
+          "unknown bsdf id", 3 },
+        { "<scene>\n <shape type=\"cube\">\n</scene>\n", "malformed Mitsuba XML", 3 },
+        { "<scene>\n <shape type=\"obj\"><string name=\"filename\" value=\"none.obj\"/>"
+          "</shape>\n</scene>\n",
+          "none.obj", 2 },
+        { "<scene>\n <shape type=\"rectangle\"><transform name=\"toWorld\">"
+          "<matrix value=\"1 2 3\"/></transform></shape>\n</scene>\n",
+          "16 numbers", 2 },
+        { "<scene>\n <sensor type=\"perspective\"><float name=\"fov\" value=\"wide\"/>"
+          "</sensor>\n</scene>\n",
+          "expected a number", 2 },
+        { "<scene/>\n", "no shapes", 1 },
+    };
+
+    for (size_t i = 0; i < sizeof(bad) / sizeof(bad[0]); ++i) {
+        write_file(path, bad[i].text);
+        log = (located_log){ 0 };
+        assert_int_not_equal(drift_scene_load(ctx, path, &scene), DRIFT_OK);
+        assert_null(scene);
+        if (!strstr(log.text, bad[i].message) || log.first_error_line != bad[i].line ||
+            !strstr(log.located_error_file, "scene_io_mitsuba.xml")) {
+            fail_msg("case %zu: line %d, file '%s': %s", i, log.first_error_line,
+                     log.located_error_file, log.text);
+        }
+    }
+    drift_context_destroy(ctx);
+}
+
 static void test_scene_io_textures_are_shared(void **state)
 {
     (void)state;
@@ -984,6 +1106,7 @@ int main(void)
         cmocka_unit_test(test_scene_io_gltf_camera_lights_emission),
         cmocka_unit_test(test_scene_io_gltf_photometry_and_materials),
         cmocka_unit_test(test_scene_io_gltf_extensions_and_cameras),
+        cmocka_unit_test(test_scene_io_mitsuba_subset),
         cmocka_unit_test(test_scene_io_textures_are_shared),
         cmocka_unit_test(test_scene_io_camera_views),
     };
