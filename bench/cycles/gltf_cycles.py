@@ -26,6 +26,9 @@ def parse_args():
     p.add_argument("--threads", type=int, default=2)
     p.add_argument("--max-bounces", type=int, default=8)
     p.add_argument("--out", required=True)
+    p.add_argument("--lambert", action="store_true",
+                   help="replace each Principled BSDF by a Diffuse BSDF of its base colour "
+                        "(emission kept): separates the material model from the light units")
     return p.parse_args(argv)
 
 
@@ -40,6 +43,20 @@ def main():
         bpy.data.objects.remove(ob, do_unlink=True)
     bpy.ops.import_scene.gltf(filepath=args.gltf)
     scene = bpy.context.scene
+    if args.lambert:
+        for mat in bpy.data.materials:
+            nodes = mat.node_tree.nodes if mat.use_nodes else []
+            for node in [n for n in nodes if n.type == "BSDF_PRINCIPLED"]:
+                diffuse = nodes.new("ShaderNodeBsdfDiffuse")
+                diffuse.inputs["Color"].default_value = node.inputs["Base Color"].default_value
+                emission = nodes.new("ShaderNodeEmission")
+                emission.inputs["Color"].default_value = node.inputs["Emission"].default_value
+                emission.inputs["Strength"].default_value = node.inputs["Emission Strength"].default_value
+                add = nodes.new("ShaderNodeAddShader")
+                mat.node_tree.links.new(diffuse.outputs[0], add.inputs[0])
+                mat.node_tree.links.new(emission.outputs[0], add.inputs[1])
+                for link in list(node.outputs[0].links):
+                    mat.node_tree.links.new(add.outputs[0], link.to_socket)
     cameras = [ob for ob in scene.objects if ob.type == "CAMERA"]
     if not cameras:
         raise SystemExit("gltf_cycles.py: the file has no camera")
