@@ -22,8 +22,9 @@ cmake --build build/release -j"$jobs"
 
 echo "== fuzz smoke (libFuzzer, ${DRIFT_FUZZ_SECONDS:-20} s per target)"
 # fuzzer-no-link instruments the library too, so libFuzzer sees coverage inside drift.
-CC=clang cmake -S . -B build/fuzz -DCMAKE_BUILD_TYPE=Debug -DDRIFT_BUILD_FUZZERS=ON \
-  -DCMAKE_C_FLAGS=-fsanitize=fuzzer-no-link \
+# CXX too: the library's one C++ file (src/io/image_exr_dwa.cpp) makes its links C++ links.
+CC=clang CXX=clang++ cmake -S . -B build/fuzz -DCMAKE_BUILD_TYPE=Debug -DDRIFT_BUILD_FUZZERS=ON \
+  -DCMAKE_C_FLAGS=-fsanitize=fuzzer-no-link -DCMAKE_CXX_FLAGS=-fsanitize=fuzzer-no-link \
   -DDRIFT_BUILD_TESTS=OFF -DDRIFT_SANITIZE=address,undefined -DDRIFT_WERROR=ON >/dev/null
 cmake --build build/fuzz -j"$jobs"
 for fuzzer in build/fuzz/fuzz_*; do

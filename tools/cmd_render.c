@@ -46,12 +46,84 @@ int render_interrupt_status(void)
 static bool parse_tonemap(const char *cmd, const char *flag, const char *v, void *field)
 {
     drift_tonemap_operator *op = field;
-    if (strcmp(v, "clamp") == 0 || strcmp(v, "reinhard") == 0) {
-        *op = strcmp(v, "clamp") == 0 ? DRIFT_TONEMAP_CLAMP : DRIFT_TONEMAP_REINHARD;
-        return true;
+
+    static const struct {
+        const char *name;
+        drift_tonemap_operator op;
+    } ops[] = { { "clamp", DRIFT_TONEMAP_CLAMP },
+                { "reinhard", DRIFT_TONEMAP_REINHARD },
+                { "filmic", DRIFT_TONEMAP_FILMIC } };
+
+    for (size_t i = 0; i < sizeof(ops) / sizeof(ops[0]); ++i) {
+        if (strcmp(v, ops[i].name) == 0) {
+            *op = ops[i].op;
+            return true;
+        }
     }
-    fprintf(stderr, "drift %s: %s expects clamp or reinhard, got '%s'\n", cmd, flag, v);
+    fprintf(stderr, "drift %s: %s expects clamp, reinhard or filmic, got '%s'\n", cmd, flag, v);
     return false;
+}
+
+// --exposure, --ev100 and --camera-exposure each choose the PNG's exposure: one at most.
+static bool set_exposure_mode(const char *cmd, const char *flag, render_options *o,
+                              render_exposure_mode mode)
+{
+    if (o->exposure_given) {
+        fprintf(stderr,
+                "drift %s: %s: give one of --exposure, --ev100 and --camera-exposure, not two\n",
+                cmd, flag);
+        return false;
+    }
+    o->exposure_given = true;
+    o->exposure_mode = mode;
+    return true;
+}
+
+static bool parse_exposure(const char *cmd, const char *flag, const char *v, void *field)
+{
+    render_options *o = field;
+    if (strcmp(v, "auto") == 0) {
+        return set_exposure_mode(cmd, flag, o, RENDER_EXPOSURE_AUTO);
+    }
+    char *end = NULL;
+    double stops = strtod(v, &end);
+    if (end == v || *end != '\0' || !(stops >= -64.0 && stops <= 64.0)) {
+        fprintf(stderr, "drift %s: %s expects auto or stops in [-64, 64], got '%s'\n", cmd, flag,
+                v);
+        return false;
+    }
+    o->exposure = stops;
+    return set_exposure_mode(cmd, flag, o, RENDER_EXPOSURE_STOPS);
+}
+
+static bool parse_ev100(const char *cmd, const char *flag, const char *v, void *field)
+{
+    render_options *o = field;
+    char *end = NULL;
+    double ev = strtod(v, &end);
+    if (end == v || *end != '\0' || !(ev >= -20.0 && ev <= 30.0)) {
+        fprintf(stderr, "drift %s: %s expects an EV100 in [-20, 30], got '%s'\n", cmd, flag, v);
+        return false;
+    }
+    o->ev100 = ev;
+    return set_exposure_mode(cmd, flag, o, RENDER_EXPOSURE_EV100);
+}
+
+static bool parse_camera_exposure(const char *cmd, const char *flag, const char *v, void *field)
+{
+    render_options *o = field;
+    double n, t, iso;
+    char tail;
+    if (sscanf(v, "%lf,%lf,%lf%c", &n, &t, &iso, &tail) != 3 || !(n > 0.0 && n < 1e3) ||
+        !(t > 0.0 && t < 1e5) || !(iso > 0.0 && iso < 1e7)) {
+        fprintf(stderr,
+                "drift %s: %s expects F-NUMBER,SHUTTER-SECONDS,ISO (all > 0, e.g. 16,0.01,100), "
+                "got '%s'\n",
+                cmd, flag, v);
+        return false;
+    }
+    o->ev100 = drift_ev100_from_camera((float)n, (float)t, (float)iso);
+    return set_exposure_mode(cmd, flag, o, RENDER_EXPOSURE_EV100);
 }
 
 static bool parse_debug_sample(const char *cmd, const char *flag, const char *v, void *field)
@@ -180,9 +252,15 @@ static const cli_option render_table[] = {
     CLI_NUMBER("--rank-timeout", "SECONDS", O, rank_timeout, 0.1, 1e9,
                "under mpirun: a rank that sends nothing for SECONDS is taken\n"
                "as hung and the job stops, keeping its work (default 300)"),
-    CLI_NUMBER("--exposure", "STOPS", O, exposure, -64.0, 64.0, "PNG exposure (default 0)"),
+    CLI_CUSTOM_ALL("--exposure", "STOPS|auto", parse_exposure,
+                   "PNG exposure in stops (default 0), or auto: the mean log\n"
+                   "luminance to middle grey (docs/reference-renderer.md)"),
+    CLI_CUSTOM_ALL("--ev100", "EV", parse_ev100,
+                   "PNG exposure of a camera at EV100 EV (radiance x 683 as cd/m2)"),
+    CLI_CUSTOM_ALL("--camera-exposure", "N,T,ISO", parse_camera_exposure,
+                   "PNG exposure of f-number N, shutter T seconds, ISO (EV100 from them)"),
     CLI_CUSTOM("--tonemap", "OP", O, tonemap, parse_tonemap,
-               "PNG operator: clamp (default) or reinhard"),
+               "PNG operator: clamp (default), reinhard or filmic (ACES fit)"),
     CLI_CUSTOM_ALL("--debug-sample", "X,Y,S", parse_debug_sample,
                    "trace one sample of one pixel and print its radiance"),
     CLI_FLAG("--quiet", O, quiet, "no progress output"),
@@ -347,6 +425,21 @@ int render_parse_options(int argc, char **argv, render_options *o)
     return 0;
 }
 
+drift_tonemap_params render_png_tonemap(const render_options *o, const drift_image *image)
+{
+    float stops = (float)o->exposure;
+    if (o->exposure_mode == RENDER_EXPOSURE_AUTO) {
+        stops = drift_image_auto_exposure(image);
+    } else if (o->exposure_mode == RENDER_EXPOSURE_EV100) {
+        stops = drift_exposure_from_ev100((float)o->ev100);
+    }
+    if (o->exposure_mode != RENDER_EXPOSURE_STOPS && !o->quiet) {
+        fprintf(stderr, "drift render: PNG exposure %+.2f stops (%s)\n", (double)stops,
+                o->exposure_mode == RENDER_EXPOSURE_AUTO ? "auto" : "EV100");
+    }
+    return (drift_tonemap_params){ .exposure_stops = stops, .op = o->tonemap };
+}
+
 // FILE.exr -> FILE.png
 void render_png_path(const char *exr_path, char *out, size_t size)
 {
@@ -460,9 +553,8 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
                                             attribute_count);
     }
     if (r == DRIFT_OK) {
-        r = drift_image_save_png(
-            ctx, png_path, &beauty,
-            &(drift_tonemap_params){ .exposure_stops = (float)o->exposure, .op = o->tonemap });
+        drift_tonemap_params tonemap = render_png_tonemap(o, &beauty);
+        r = drift_image_save_png(ctx, png_path, &beauty, &tonemap);
     }
     drift_image_destroy(ctx, &spp);
     drift_image_destroy(ctx, &glared); // NULL-safe on a zero image

@@ -22,6 +22,13 @@ typedef struct render_refine_options {
     const char *lambda_path;  // --lambda FILE: the fitted linear combination
 } render_refine_options;
 
+// How the PNG's exposure is chosen (one of --exposure, --ev100, --camera-exposure).
+typedef enum render_exposure_mode {
+    RENDER_EXPOSURE_STOPS = 0, // --exposure STOPS (default 0)
+    RENDER_EXPOSURE_AUTO,      // --exposure auto: mean log luminance to middle grey
+    RENDER_EXPOSURE_EV100,     // --ev100 EV or --camera-exposure N,T,ISO
+} render_exposure_mode;
+
 typedef struct render_options {
     const char *scene_path;
     const char *out_path;
@@ -33,7 +40,10 @@ typedef struct render_options {
     long spp, seed, threads, max_depth, width, height;
     double checkpoint_seconds;
     double rank_timeout; // mpirun: seconds a rank may send nothing before it counts as hung
-    double exposure;
+    double exposure; // PNG stops (--exposure STOPS)
+    render_exposure_mode exposure_mode;
+    bool exposure_given; // one of the three exposure options was seen
+    double ev100;        // --ev100, or from --camera-exposure
     drift_tonemap_operator tonemap;
     bool aov;
     bool denoise; // --denoise atrous (reference mode)
@@ -75,6 +85,8 @@ struct drift_hybrid;
 int render_refine_run(const render_options *o, const cli_session *session,
                       struct drift_hybrid *frame);
 
+// The PNG's tone mapping for `image` (--exposure, --ev100, --camera-exposure, --tonemap).
+drift_tonemap_params render_png_tonemap(const render_options *o, const drift_image *image);
 // Writes `image` to --out (EXR) and its PNG beside it (--exposure, --tonemap).
 drift_result render_write_image(drift_context *ctx, const render_options *o,
                                 const drift_image *image);

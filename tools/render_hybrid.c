@@ -84,9 +84,8 @@ drift_result render_write_image(drift_context *ctx, const render_options *o,
     if (r == DRIFT_OK) {
         char png[4096];
         render_png_path(o->out_path, png, sizeof png);
-        r = drift_image_save_png(
-            ctx, png, image,
-            &(drift_tonemap_params){ .exposure_stops = (float)o->exposure, .op = o->tonemap });
+        drift_tonemap_params tonemap = render_png_tonemap(o, image);
+        r = drift_image_save_png(ctx, png, image, &tonemap);
     }
     return r;
 }

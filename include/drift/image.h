@@ -80,6 +80,7 @@ typedef enum drift_tonemap_operator {
     DRIFT_TONEMAP_DEFAULT = 0, // DRIFT_TONEMAP_CLAMP
     DRIFT_TONEMAP_CLAMP,       // exposure, then clamp to [0,1]
     DRIFT_TONEMAP_REINHARD,    // exposure, then x / (1 + x) per channel (Reinhard 2002, eq. 3)
+    DRIFT_TONEMAP_FILMIC,      // exposure, then the ACES filmic curve fit of Narkowicz (2015)
     DRIFT_TONEMAP_COUNT
 } drift_tonemap_operator;
 
@@ -92,6 +93,18 @@ typedef struct drift_tonemap_params {
 
 // Linear -> display value in [0,1] (exposure, operator, sRGB OETF).
 float drift_tonemap_value(float linear, const drift_tonemap_params *params);
+// Automatic exposure, as a camera's averaging meter: the stops that bring the image's mean log
+// luminance (Rec. 709 Y; the geometric mean of 1e-4 + Y over the finite pixels with Y > 0, as
+// Reinhard et al. 2002, eq. 1) to middle grey, 0.18. 0 for an image with no light.
+float drift_image_auto_exposure(const drift_image *image);
+// Photographic exposure: the stops for a camera at EV100 `ev100` (Lagarde & de Rousiers 2014,
+// "Moving Frostbite to PBR", §5.1: a luminance of 1.2 · 2^EV100 cd/m² saturates the sensor).
+// drift's radiance is W/(m² sr); times 683 lm/W it is taken as cd/m², so the stops are
+// log2(683 / 1.2) − EV100.
+float drift_exposure_from_ev100(float ev100);
+// EV100 of a camera with f-number N, shutter time t seconds and sensitivity ISO S:
+// log2(N² / t · 100 / S).
+float drift_ev100_from_camera(float f_number, float shutter_seconds, float iso);
 // sRGB electro-optical transfer function pair (IEC 61966-2-1).
 float drift_srgb_to_linear(float v);
 float drift_linear_to_srgb(float v);

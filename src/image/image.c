@@ -93,8 +93,46 @@ float drift_tonemap_value(float linear, const drift_tonemap_params *params)
     }
     if (p.op == DRIFT_TONEMAP_REINHARD) {
         x = x / (1.0f + x);
+    } else if (p.op == DRIFT_TONEMAP_FILMIC) {
+        // Narkowicz's fit of the ACES reference rendering transform: a toe that keeps the
+        // shadows' contrast and a shoulder that rolls highlights off to white.
+        x = (x * (2.51f * x + 0.03f)) / (x * (2.43f * x + 0.59f) + 0.14f);
     }
     return drift_linear_to_srgb(fminf(x, 1.0f));
+}
+
+float drift_image_auto_exposure(const drift_image *image)
+{
+    double log_sum = 0.0;
+    size_t count = 0;
+    for (int32_t y = 0; y < image->height; ++y) {
+        for (int32_t x = 0; x < image->width; ++x) {
+            const float *p = drift_image_pixel(image, x, y);
+            float lum =
+                image->channels >= 3 ? 0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2] : p[0];
+            // Pixels with no light (an empty background) say nothing about the exposure,
+            // and would pull the geometric mean towards the floor.
+            if (isfinite(lum) && lum > 0.0f) {
+                log_sum += log(1e-4 + (double)lum);
+                count++;
+            }
+        }
+    }
+    if (count == 0) {
+        return 0.0f;
+    }
+    double mean_log = log_sum / (double)count;
+    return (float)(log2(0.18) - mean_log / log(2.0));
+}
+
+float drift_exposure_from_ev100(float ev100)
+{
+    return log2f(683.0f / 1.2f) - ev100;
+}
+
+float drift_ev100_from_camera(float f_number, float shutter_seconds, float iso)
+{
+    return log2f(f_number * f_number / shutter_seconds * 100.0f / iso);
 }
 
 void drift_image_tonemap(const drift_image *image, const drift_tonemap_params *params,

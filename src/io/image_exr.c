@@ -5,8 +5,12 @@
 // exercises exactly the code the loader runs. Writing goes through a custom write function
 // into the temp file of drift__image_temp, which is renamed over the target on success.
 //
+// DWAA/DWAB parts go to image_exr_dwa.cpp (OpenEXRCore 3.1 has no DWA decoder); the part and
+// channel choice and every limit below stay here, so both codecs follow the same rules.
+//
 // OpenEXRCore prints to stderr unless an error handler is installed; ours keeps the last
 // message so the one error we log can carry it (the library never prints).
+#include "image_exr_dwa.h"
 #include "image_io_internal.h"
 
 #include <OpenEXR/openexr.h>
@@ -332,7 +336,26 @@ drift_result drift__image_exr_load(drift_context *ctx, const char *path, const u
         exr_finish(&f);
         return r;
     }
-    rv = decode_part(f, part, storage, &dw, &pick, &img);
+    exr_compression_t compression = EXR_COMPRESSION_NONE;
+    rv = exr_get_compression(f, part, &compression);
+    if (rv == EXR_ERR_SUCCESS &&
+        (compression == EXR_COMPRESSION_DWAA || compression == EXR_COMPRESSION_DWAB)) {
+        const char *names[3] = { NULL, NULL, NULL };
+        for (int k = 0; k < 3; ++k) {
+            names[k] = pick.index[k] >= 0 ? list->entries[pick.index[k]].name.str : NULL;
+        }
+        if (drift__exr_dwa_decode(path, data, size, part, names, img.pixels, img.stride, img.width,
+                                  img.height, stream.message, sizeof(stream.message)) != 0) {
+            exr_finish(&f);
+            drift_image_destroy(ctx, &img);
+            drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, path, 0,
+                      "corrupt %s-compressed OpenEXR pixel data: %s",
+                      compression == EXR_COMPRESSION_DWAA ? "DWAA" : "DWAB", stream.message);
+            return DRIFT_ERR_PARSE;
+        }
+    } else if (rv == EXR_ERR_SUCCESS) {
+        rv = decode_part(f, part, storage, &dw, &pick, &img);
+    }
     if (rv != EXR_ERR_SUCCESS) {
         r = exr_fail(&stream, rv, "corrupt OpenEXR pixel data");
         exr_finish(&f);

@@ -90,6 +90,9 @@ typedef struct import_state {
     const char *base_name;     // file name without folder, for unnamed meshes and materials
     uint32_t *material_map;    // assimp material -> drift material
     bool *light_placed;        // assimp light already added through its node
+    int *material_uv_set;      // assimp material -> UV set of its diffuse texture
+    drift__gltf *gltf;         // the glTF JSON (glTF files only)
+    unsigned camera;           // assimp camera to use (glTF: chosen by params->camera)
     drift__import_info *info;
 } import_state;
 
@@ -156,6 +159,37 @@ static void material_texture(import_state *s, const struct aiMaterial *mat, drif
     }
 }
 
+// A glTF material by the metallic-roughness rule of scene_gltf.c, with a warning for each
+// part drift's material cannot hold.
+static void gltf_material(import_state *s, const drift__gltf_material *gm, drift_material *m)
+{
+    m->diffuse = gm->diffuse;
+    m->specular = gm->specular;
+    m->exponent = gm->exponent;
+    m->emission = gm->emission;
+
+    const struct {
+        bool present;
+        const char *what;
+    } ignored[] = {
+        { gm->has_metallic_roughness_texture, "metallic-roughness texture (its factors are used)" },
+        { gm->has_normal_texture, "normal texture" },
+        { gm->has_emissive_texture, "emissive texture (its factor is used)" },
+        { gm->has_occlusion_texture, "occlusion texture" },
+        { gm->alpha_blended, "alpha mode (drawn opaque)" },
+        { !gm->base_color_sampler_supported,
+          "base colour sampler (clamp/mirror wrap or nearest filter; drift repeats and filters "
+          "bilinearly)" },
+    };
+
+    for (size_t k = 0; k < sizeof(ignored) / sizeof(ignored[0]); ++k) {
+        if (ignored[k].present) {
+            drift_log(s->ctx, DRIFT_LOG_WARNING, DRIFT_ERR_UNSUPPORTED, s->where, s->line,
+                      "'%s': material '%s': %s ignored", s->params->path, m->name, ignored[k].what);
+        }
+    }
+}
+
 static drift_result convert_materials(import_state *s)
 {
     const struct aiScene *ai = s->ai;
@@ -197,6 +231,12 @@ static drift_result convert_materials(import_state *s)
             AI_SUCCESS) {
             m.emission = drift_vec3_scale(m.emission, strength);
         }
+        s->material_uv_set[i] = 0;
+        drift__gltf_material gm;
+        if (drift__gltf_get_material(s->gltf, i, &gm)) {
+            gltf_material(s, &gm, &m);
+            s->material_uv_set[i] = gm.base_color_uv_set;
+        }
         material_texture(s, mat, &m);
         uint32_t index;
         drift_result r = drift_scene_add_material(s->scene, &m, &index);
@@ -229,13 +269,21 @@ static drift_result add_mesh(import_state *s, const struct aiMesh *mesh, const d
         return DRIFT_OK;
     }
     size_t nv = mesh->mNumVertices;
+    unsigned uv_set = 0;
+    if (s->params->material_override == DRIFT_INVALID_INDEX &&
+        mesh->mMaterialIndex < s->ai->mNumMaterials) {
+        uv_set = (unsigned)s->material_uv_set[mesh->mMaterialIndex];
+    }
+    if (uv_set >= AI_MAX_NUMBER_OF_TEXTURECOORDS || !mesh->mTextureCoords[uv_set]) {
+        uv_set = 0;
+    }
+    const struct aiVector3D *uv_source = mesh->mTextureCoords[uv_set];
     float *positions = drift_alloc(ctx, nv * 3 * sizeof(float));
     float *normals = mesh->mNormals ? drift_alloc(ctx, nv * 3 * sizeof(float)) : NULL;
-    float *uvs = mesh->mTextureCoords[0] ? drift_alloc(ctx, nv * 2 * sizeof(float)) : NULL;
+    float *uvs = uv_source ? drift_alloc(ctx, nv * 2 * sizeof(float)) : NULL;
     uint32_t *indices = drift_alloc(ctx, (size_t)tri_count * 3 * sizeof(uint32_t));
     drift_result r = DRIFT_OK;
-    if (!positions || !indices || (mesh->mNormals && !normals) ||
-        (mesh->mTextureCoords[0] && !uvs)) {
+    if (!positions || !indices || (mesh->mNormals && !normals) || (uv_source && !uvs)) {
         r = DRIFT_ERR_OUT_OF_MEMORY;
         goto done;
     }
@@ -258,8 +306,8 @@ static drift_result add_mesh(import_state *s, const struct aiMesh *mesh, const d
             }
         }
         if (uvs) {
-            uvs[2 * v] = mesh->mTextureCoords[0][v].x;
-            uvs[2 * v + 1] = mesh->mTextureCoords[0][v].y;
+            uvs[2 * v] = uv_source[v].x;
+            uvs[2 * v + 1] = uv_source[v].y;
         }
     }
     // A mirroring transform reverses the winding; swap two corners to keep faces facing out.
@@ -314,8 +362,9 @@ done:
     return r;
 }
 
-static drift_result add_light(import_state *s, const struct aiLight *l, const drift__mat4 *world)
+static drift_result add_light(import_state *s, unsigned index, const drift__mat4 *world)
 {
+    const struct aiLight *l = s->ai->mLights[index];
     drift_light light = { 0 };
     drift_vec3 position =
         transform_point(world, drift_vec3_make(l->mPosition.x, l->mPosition.y, l->mPosition.z));
@@ -351,6 +400,24 @@ static drift_result add_light(import_state *s, const struct aiLight *l, const dr
         drift_log(s->ctx, DRIFT_LOG_WARNING, DRIFT_ERR_UNSUPPORTED, s->where, s->line,
                   "'%s': light '%s' has an unsupported type; ignored", s->params->path, name);
         return DRIFT_OK;
+    }
+    drift__gltf_light gl;
+    if (drift__gltf_get_light(s->gltf, index, &gl)) {
+        // assimp multiplies the intensity into the colour without its unit; take both from
+        // the JSON, converted to W/sr or W/m².
+        light.color = gl.color;
+        if (light.type == DRIFT_LIGHT_SPOT) {
+            light.spot_outer = gl.outer_angle > 0.0f && gl.outer_angle <= DRIFT_PI / 2.0f
+                                   ? gl.outer_angle
+                                   : DRIFT_PI / 4.0f;
+            light.spot_inner = drift_clampf(gl.inner_angle, 0.0f, light.spot_outer);
+        }
+        if (gl.has_range) {
+            drift_log(s->ctx, DRIFT_LOG_WARNING, DRIFT_ERR_UNSUPPORTED, s->where, s->line,
+                      "'%s': light '%s': range ignored (drift lights fall off as 1/d² without "
+                      "a cut-off)",
+                      s->params->path, name);
+        }
     }
     drift_result r = drift_scene_add_light(s->scene, &light, NULL);
     if (r != DRIFT_OK) {
@@ -418,15 +485,15 @@ static drift_result walk_nodes(import_state *s, const struct aiNode *node,
         }
     }
     // Cameras and lights are tied to the node of the same name.
-    if (!s->info->has_camera && s->ai->mNumCameras > 0 &&
-        strcmp(s->ai->mCameras[0]->mName.data, node->mName.data) == 0) {
-        set_camera(s, s->ai->mCameras[0], &world);
+    if (!s->info->has_camera && s->camera < s->ai->mNumCameras &&
+        strcmp(s->ai->mCameras[s->camera]->mName.data, node->mName.data) == 0) {
+        set_camera(s, s->ai->mCameras[s->camera], &world);
     }
     for (unsigned i = 0; i < s->ai->mNumLights; ++i) {
         const struct aiLight *l = s->ai->mLights[i];
         if (!s->light_placed[i] && strcmp(l->mName.data, node->mName.data) == 0) {
             s->light_placed[i] = true;
-            drift_result r = add_light(s, l, &world);
+            drift_result r = add_light(s, i, &world);
             if (r != DRIFT_OK) {
                 return r;
             }
@@ -449,7 +516,8 @@ static drift_result import_scene(import_state *s)
     drift_result r = DRIFT_OK;
     s->material_map = drift_alloc(ctx, ((size_t)ai->mNumMaterials + 1) * sizeof(uint32_t));
     s->light_placed = drift_alloc(ctx, ((size_t)ai->mNumLights + 1) * sizeof(bool));
-    if (!s->material_map || !s->light_placed) {
+    s->material_uv_set = drift_alloc(ctx, ((size_t)ai->mNumMaterials + 1) * sizeof(int));
+    if (!s->material_map || !s->light_placed || !s->material_uv_set) {
         r = DRIFT_ERR_OUT_OF_MEMORY;
     }
     if (r == DRIFT_OK) {
@@ -461,7 +529,7 @@ static drift_result import_scene(import_state *s)
     // Lights no node names are in world space already.
     for (unsigned i = 0; r == DRIFT_OK && i < ai->mNumLights; ++i) {
         if (!s->light_placed[i]) {
-            r = add_light(s, ai->mLights[i], &root);
+            r = add_light(s, i, &root);
         }
     }
     if (r == DRIFT_OK && s->info->mesh_count == 0) {
@@ -471,6 +539,7 @@ static drift_result import_scene(import_state *s)
     }
     drift_free(ctx, s->material_map);
     drift_free(ctx, s->light_placed);
+    drift_free(ctx, s->material_uv_set);
     return r;
 }
 
@@ -665,7 +734,23 @@ drift_result drift__scene_import_mesh_file(drift_scene *scene, const drift__impo
         return DRIFT_ERR_PARSE;
     }
     s.ai = ai;
-    r = import_scene(&s);
+    if (s.is_gltf) {
+        r = drift__gltf_open(ctx, params->path, gz, s.where, s.line, &s.gltf);
+    }
+    if (r == DRIFT_OK && params->camera) {
+        int camera = s.gltf ? drift__gltf_camera_index(s.gltf, params->camera) : -1;
+        if (camera < 0 || (unsigned)camera >= ai->mNumCameras) {
+            drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, s.where, s.line,
+                      "'%s' has no camera named or numbered '%s' (it has %u)", params->path,
+                      params->camera, ai->mNumCameras);
+            r = DRIFT_ERR_INVALID_ARGUMENT;
+        }
+        s.camera = (unsigned)camera;
+    }
+    if (r == DRIFT_OK) {
+        r = import_scene(&s);
+    }
+    drift__gltf_close(ctx, s.gltf);
     aiReleaseImport(ai);
     return r;
 }

@@ -48,6 +48,7 @@ typedef struct drift__import_params {
     const drift__mat4 *transform; // applied after the file's own; NULL: identity
     uint32_t material_override;   // DRIFT_INVALID_INDEX: the file's materials
     drift__texture_cache *textures;
+    const char *camera; // glTF: the camera to use, by name or index; NULL: the first
 } drift__import_params;
 
 // What the import found besides geometry.
@@ -60,6 +61,45 @@ typedef struct drift__import_info {
 // Imports meshes, materials, lights and the first camera of a mesh file through assimp.
 drift_result drift__scene_import_mesh_file(drift_scene *scene, const drift__import_params *params,
                                            drift__import_info *out_info);
+
+// --- glTF JSON (scene_gltf.c): what assimp 5.2 drops ---
+
+typedef struct drift__gltf drift__gltf;
+
+// A KHR_lights_punctual light in drift's units.
+typedef struct drift__gltf_light {
+    drift_vec3 color;               // W/sr (point, spot) or W/m² (directional): cd or lux / 683
+    float inner_angle, outer_angle; // spot cone half angles, radians (defaults 0, π/4)
+    bool has_range;                 // a `range` is given (drift ignores it)
+} drift__gltf_light;
+
+// A glTF metallic-roughness material as drift's diffuse + glossy (docs/scene-format.md).
+typedef struct drift__gltf_material {
+    drift_vec3 diffuse, specular, emission; // emission includes KHR_materials_emissive_strength
+    float exponent;
+    int base_color_uv_set;             // baseColorTexture.texCoord
+    bool base_color_sampler_supported; // repeat wrap, linear magnification (or no sampler)
+    bool has_metallic_roughness_texture, has_normal_texture, has_emissive_texture,
+        has_occlusion_texture, alpha_blended;
+} drift__gltf_material;
+
+// Reads the JSON of a .gltf or .glb (gunzipped when gz), warns once for each extension in
+// extensionsUsed that drift ignores. Errors (logged against where/line, naming path):
+// DRIFT_ERR_IO, DRIFT_ERR_PARSE (bad .glb header, malformed JSON).
+drift_result drift__gltf_open(drift_context *ctx, const char *path, bool gz, const char *where,
+                              int line, drift__gltf **out);
+void drift__gltf_close(drift_context *ctx, drift__gltf *g);
+// Entry `index` of the file's lights / materials; false when the file has no such entry.
+bool drift__gltf_get_light(const drift__gltf *g, unsigned index, drift__gltf_light *out);
+bool drift__gltf_get_material(const drift__gltf *g, unsigned index, drift__gltf_material *out);
+// The index in `cameras` of the camera named `selector`, or numbered by it; -1 if none.
+int drift__gltf_camera_index(const drift__gltf *g, const char *selector);
+
+// Loads a Mitsuba 0.5/0.6 scene file (.xml) with expat (scene_mitsuba.c); on_input as for
+// drift_scene_load_inputs.
+drift_result drift__scene_load_mitsuba(drift_context *ctx, const char *path,
+                                       drift_scene_input_fn on_input, void *user,
+                                       drift_scene **out_scene);
 
 // drift_scene_load_json_text that tells on_input of each file read (see drift_scene_load_inputs).
 drift_result drift__scene_load_json_text(drift_context *ctx, const char *text, size_t length,

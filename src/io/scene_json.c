@@ -699,12 +699,13 @@ static drift_result read_mesh(json_reader *r, const cJSON *item, const char *pat
     if (res != DRIFT_OK) {
         return res;
     }
-    if ((res = CHECK_KEYS(r, item, path, "path", "transform", "material")) != DRIFT_OK) {
+    if ((res = CHECK_KEYS(r, item, path, "path", "transform", "material", "camera")) != DRIFT_OK) {
         return res;
     }
-    const char *rel = NULL, *material_name = NULL;
+    const char *rel = NULL, *material_name = NULL, *camera = NULL;
     if ((res = read_string(r, item, path, "path", true, &rel)) != DRIFT_OK ||
-        (res = read_string(r, item, path, "material", false, &material_name)) != DRIFT_OK) {
+        (res = read_string(r, item, path, "material", false, &material_name)) != DRIFT_OK ||
+        (res = read_string(r, item, path, "camera", false, &camera)) != DRIFT_OK) {
         return res;
     }
     const cJSON *path_item = cJSON_GetObjectItemCaseSensitive(item, "path");
@@ -736,7 +737,8 @@ static drift_result read_mesh(json_reader *r, const cJSON *item, const char *pat
                                     .line = line_of(r, path_item),
                                     .transform = &transform,
                                     .material_override = material,
-                                    .textures = &r->textures };
+                                    .textures = &r->textures,
+                                    .camera = camera };
     res = drift__scene_import_mesh_file(r->scene, &params, &info);
     if (res != DRIFT_OK) {
         return res;

@@ -404,9 +404,12 @@ drift_result drift_scene_load_inputs(drift_context *ctx, const char *path,
     if (drift__is_mesh_extension(ext)) {
         return load_mesh_scene(ctx, path, on_input, user, out_scene);
     }
+    if (strcmp(ext, "xml") == 0 && !gz) {
+        return drift__scene_load_mitsuba(ctx, path, on_input, user, out_scene);
+    }
     drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_UNSUPPORTED, path, 0,
               "unsupported scene file extension '%s' (drift reads .json, .obj, .gltf, .glb, "
-              ".ply, and those with .gz)",
+              ".ply, those with .gz, and Mitsuba .xml)",
               ext);
     return DRIFT_ERR_UNSUPPORTED;
 }

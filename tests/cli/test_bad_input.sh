@@ -126,6 +126,29 @@ mkfifo "$dir/fifo.json"
 timeout 10 "$drift" info "$dir/fifo.json" >"$dir/out" 2>"$dir/err"
 [ $? -eq 1 ] && grep -q "fifo.json" "$dir/err" || fail "a FIFO scene is refused at once by name"
 
+# Bad glTF: wrong types, a missing buffer, out-of-range accessors and indices, a light without
+# its spot, a .glb cut short, malformed JSON: each an error naming the file.
+python3 - "$DRIFT_SOURCE_DIR/tests/data/gltf/blender_scene.gltf" "$dir" <<'PY'
+import copy, json, sys
+base, out = json.load(open(sys.argv[1])), sys.argv[2]
+def write(name, change):
+    d = copy.deepcopy(base)
+    change(d)
+    open(out + "/" + name, "w").write(json.dumps(d))
+write("missing_buffer.gltf", lambda d: d["buffers"][0].update(uri="nothere.bin"))
+write("long_accessor.gltf", lambda d: d["accessors"][0].update(count=100000))
+write("meshes_number.gltf", lambda d: d.update(meshes=5))
+write("bad_indices.gltf", lambda d: d["meshes"][0]["primitives"][0].update(indices=999))
+write("spot_without_cone.gltf",
+      lambda d: d["extensions"]["KHR_lights_punctual"]["lights"][1].pop("spot"))
+open(out + "/cut.glb", "wb").write(b"glTF\x02\x00\x00\x00\x10\x00\x00\x00JSON")
+open(out + "/braces.gltf", "w").write(json.dumps(base)[:-40])
+PY
+for name in missing_buffer.gltf long_accessor.gltf meshes_number.gltf bad_indices.gltf \
+    spot_without_cone.gltf cut.glb braces.gltf; do
+    expect_failure "$name"
+done
+
 if [ "$failures" -ne 0 ]; then
     echo "$failures failure(s)" >&2
     exit 1

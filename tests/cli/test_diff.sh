@@ -122,6 +122,20 @@ ln -s /dev/zero "$tmp/zero.png"
 expect 1 timeout 10 "$drift" diff "$tmp/ref.png" "$tmp/zero.png"
 grep -q "not a regular file" "$tmp/err" || fail "a device is refused"
 
+# A DWAB panorama as shipped and its ZIP re-encoding are the same image (the C++ shim decodes
+# DWA); a truncated DWAB file is an error naming the file and the codec.
+hdri="$DRIFT_SOURCE_DIR/../shared/scenes/hdri"
+if [ -f "$hdri/dwab/studio.exr" ]; then
+    expect 0 "$drift" diff "$hdri/dwab/studio.exr" "$hdri/studio.exr" --json
+    python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); assert d["mse"] == 0 and d["flip"] == 0, d' \
+        "$tmp/out" || fail "DWAB and ZIP studio.exr differ"
+    head -c 60000 "$hdri/dwab/studio.exr" >"$tmp/cut_dwab.exr"
+    expect 1 "$drift" diff "$tmp/cut_dwab.exr" "$hdri/studio.exr"
+    grep -q "cut_dwab.exr.*DWAB" "$tmp/err" || fail "truncated DWAB file is named with its codec"
+else
+    echo "cli.diff: skipped the DWAB checks: $hdri/dwab is absent"
+fi
+
 # A truncated .hdr is an error naming the file (stb_image decoded it without one, or looped).
 python3 - "$tmp" <<'PY'
 import sys

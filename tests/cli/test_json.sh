@@ -40,8 +40,8 @@ expect 2 "$drift" render --spp many --out "$tmp/x.exr"
 grep -q -- "--spp .*'many'" "$tmp/err" || fail "bad --spp value not named"
 expect 2 "$drift" render --mode hybrid --dof blurry --out "$tmp/x.exr"
 grep -q -- "--dof .*'blurry'" "$tmp/err" || fail "bad --dof value not named"
-expect 2 "$drift" render --tonemap filmic --out "$tmp/x.exr"
-grep -q -- "--tonemap .*'filmic'" "$tmp/err" || fail "bad --tonemap value not named"
+expect 2 "$drift" render --tonemap hable --out "$tmp/x.exr"
+grep -q -- "--tonemap .*'hable'" "$tmp/err" || fail "bad --tonemap value not named"
 expect 2 "$drift" view --shadows soft
 grep -q -- "--shadows .*'soft'" "$tmp/err" || fail "bad view --shadows value not named"
 expect 2 "$drift" bench frame --frames 0

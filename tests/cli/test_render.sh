@@ -94,6 +94,28 @@ expect 2 "$drift" render --mode hybrid --denoise atrous --out "$tmp/never.exr"
 grep -q "filters the path tracer" "$tmp/err" || fail "--denoise in hybrid mode is not refused"
 [ -e "$tmp/never.exr" ] && fail "a refused render wrote its image"
 
+# Exposure: --exposure auto, --ev100 and --camera-exposure change the PNG only (the EXR stays
+# linear and unscaled), say the stops they chose, and refuse each other and bad values.
+expect 0 "$drift" render --spp 2 --width 16 --height 16 --threads 1 --checkpoint 0 --seed 3 \
+    --out "$tmp/x0.exr"
+expect 0 "$drift" render --spp 2 --width 16 --height 16 --threads 1 --checkpoint 0 --seed 3 \
+    --exposure auto --tonemap filmic --out "$tmp/x1.exr"
+grep -q "PNG exposure .* stops (auto)" "$tmp/err" || fail "--exposure auto reports its stops"
+expect 0 "$drift" diff "$tmp/x0.exr" "$tmp/x1.exr" --json
+python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); assert d["mse"] == 0, d' "$tmp/out" \
+    || fail "--exposure auto changed the EXR"
+cmp -s "$tmp/x0.png" "$tmp/x1.png" && fail "--exposure auto --tonemap filmic left the PNG as is"
+expect 0 "$drift" render --spp 1 --width 8 --height 8 --checkpoint 0 --camera-exposure 16,0.01,100 \
+    --out "$tmp/x2.exr"
+grep -q "PNG exposure .* stops (EV100)" "$tmp/err" || fail "--camera-exposure reports its stops"
+expect 2 "$drift" render --exposure auto --ev100 9 --out "$tmp/never.exr"
+grep -q "one of --exposure, --ev100 and --camera-exposure" "$tmp/err" || fail "two exposures refused"
+expect 2 "$drift" render --exposure bright --out "$tmp/never.exr"
+expect 2 "$drift" render --ev100 99 --out "$tmp/never.exr"
+expect 2 "$drift" render --camera-exposure 16,0,100 --out "$tmp/never.exr"
+expect 2 "$drift" render --tonemap aces --out "$tmp/never.exr"
+grep -q "\-\-tonemap expects clamp, reinhard or filmic" "$tmp/err" || fail "--tonemap names its values"
+
 if [ "$failures" -ne 0 ]; then
     echo "$failures render CLI check(s) failed"
     exit 1

@@ -158,27 +158,10 @@ static void test_image_io_exr_multilayer_round_trip_is_exact(void **state)
     drift_context_destroy(ctx);
 }
 
-// Writes `img` (3 channels) as a tiled OpenEXR file (8x8 tiles, ZIP, float) with OpenEXRCore.
-static void write_tiled_exr(const char *path, const drift_image *img)
+// Encodes `img` into part `part` as 8x8 tiles; channels R, G, B take their component, any
+// other channel (a depth Z) takes B.
+static void encode_tiles(exr_context_t f, int part, const drift_image *img)
 {
-    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-    exr_context_t f = NULL;
-    int part = 0;
-    assert_int_equal(exr_start_write(&f, path, EXR_WRITE_FILE_DIRECTLY, &init), EXR_ERR_SUCCESS);
-    assert_int_equal(exr_add_part(f, "tiled", EXR_STORAGE_TILED, &part), EXR_ERR_SUCCESS);
-    assert_int_equal(
-        exr_initialize_required_attr_simple(f, part, img->width, img->height, EXR_COMPRESSION_ZIP),
-        EXR_ERR_SUCCESS);
-    assert_int_equal(
-        exr_set_tile_descriptor(f, part, 8, 8, EXR_TILE_ONE_LEVEL, EXR_TILE_ROUND_DOWN),
-        EXR_ERR_SUCCESS);
-    const char *names[3] = { "B", "G", "R" };
-    for (int c = 0; c < 3; ++c) {
-        assert_int_equal(
-            exr_add_channel(f, part, names[c], EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1),
-            EXR_ERR_SUCCESS);
-    }
-    assert_int_equal(exr_write_header(f), EXR_ERR_SUCCESS);
     exr_encode_pipeline_t enc = EXR_ENCODE_PIPELINE_INITIALIZER;
     bool first = true;
     for (int ty = 0; ty * 8 < img->height; ++ty) {
@@ -209,6 +192,40 @@ static void write_tiled_exr(const char *path, const drift_image *img)
         }
     }
     exr_encoding_destroy(f, &enc);
+}
+
+// Writes `img` (3 channels) as a tiled OpenEXR file (8x8 tiles, float) with OpenEXRCore.
+// With `depth_first`, the file is multi-part and its first part holds only a Z channel, so a
+// reader must find the colour in part 1.
+static void write_tiled_exr(const char *path, const drift_image *img, exr_compression_t compression,
+                            bool depth_first)
+{
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    exr_context_t f = NULL;
+    assert_int_equal(exr_start_write(&f, path, EXR_WRITE_FILE_DIRECTLY, &init), EXR_ERR_SUCCESS);
+    int parts[2] = { 0, 0 };
+    int part_count = depth_first ? 2 : 1;
+    for (int p = 0; p < part_count; ++p) {
+        bool depth = depth_first && p == 0;
+        assert_int_equal(exr_add_part(f, depth ? "depth" : "beauty", EXR_STORAGE_TILED, &parts[p]),
+                         EXR_ERR_SUCCESS);
+        assert_int_equal(
+            exr_initialize_required_attr_simple(f, parts[p], img->width, img->height, compression),
+            EXR_ERR_SUCCESS);
+        assert_int_equal(
+            exr_set_tile_descriptor(f, parts[p], 8, 8, EXR_TILE_ONE_LEVEL, EXR_TILE_ROUND_DOWN),
+            EXR_ERR_SUCCESS);
+        const char *names[3] = { "B", "G", "R" };
+        for (int c = 0; c < (depth ? 1 : 3); ++c) {
+            assert_int_equal(exr_add_channel(f, parts[p], depth ? "Z" : names[c], EXR_PIXEL_FLOAT,
+                                             EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1),
+                             EXR_ERR_SUCCESS);
+        }
+    }
+    assert_int_equal(exr_write_header(f), EXR_ERR_SUCCESS);
+    for (int p = 0; p < part_count; ++p) {
+        encode_tiles(f, parts[p], img);
+    }
     assert_int_equal(exr_finish(&f), EXR_ERR_SUCCESS);
 }
 
@@ -220,12 +237,85 @@ static void test_image_io_tiled_exr_loads(void **state)
     drift_image img = make_random(ctx, 21, 13, 3, 21, 0.0f, 8.0f);
     char path[1024];
     test_out_path(path, "io_tiled.exr");
-    write_tiled_exr(path, &img);
+    write_tiled_exr(path, &img, EXR_COMPRESSION_ZIP, false);
     drift_image loaded;
     assert_int_equal(drift_image_load(ctx, path, &loaded), DRIFT_OK);
     assert_rgb_equal_exact(&img, &loaded);
     drift_image_destroy(ctx, &loaded);
     drift_image_destroy(ctx, &img);
+    drift_context_destroy(ctx);
+}
+
+// PIZ (lossless for float) and multi-part: the colour sits in part 1, behind a depth part.
+static void test_image_io_piz_multipart_exr_loads(void **state)
+{
+    (void)state;
+    drift_context *ctx = test_context(1, NULL);
+    drift_image img = make_random(ctx, 19, 11, 3, 23, 0.0f, 64.0f);
+    char path[1024];
+    test_out_path(path, "io_piz_multipart.exr");
+    write_tiled_exr(path, &img, EXR_COMPRESSION_PIZ, true);
+    drift_image loaded;
+    assert_int_equal(drift_image_load(ctx, path, &loaded), DRIFT_OK);
+    assert_rgb_equal_exact(&img, &loaded);
+    drift_image_destroy(ctx, &loaded);
+    drift_image_destroy(ctx, &img);
+    drift_context_destroy(ctx);
+}
+
+// Components of a and b (same size) whose values differ; NaN equals NaN, and -0 equals +0
+// (DWA's decoder and the ZIP re-encoding disagree on the sign of 18 zeros of city.exr).
+static size_t rgb_value_differences(const drift_image *a, const drift_image *b)
+{
+    size_t count = 0;
+    for (int32_t y = 0; y < a->height; ++y) {
+        for (int32_t x = 0; x < a->width; ++x) {
+            for (int c = 0; c < 3; ++c) {
+                float va = drift_image_pixel(a, x, y)[c], vb = drift_image_pixel(b, x, y)[c];
+                count += !(va == vb || (isnan(va) && isnan(vb)));
+            }
+        }
+    }
+    return count;
+}
+
+// Every DWAB panorama of ../shared/scenes/hdri/dwab (as Blender ships them) decodes to exactly
+// the pixel values of its ZIP re-encoding one folder up. OpenEXRCore 3.1 cannot decode DWAB; the
+// C++ shim (src/io/image_exr_dwa.cpp) does.
+static void test_image_io_dwab_panoramas_equal_zip_copies(void **state)
+{
+    (void)state;
+    char dir[1024];
+    struct stat st;
+    if (stat(test_shared_path(dir, "scenes/hdri/dwab"), &st) != 0) {
+        fprintf(stderr, "skipped: %s is absent\n", dir);
+        skip();
+    }
+    static const char *const names[] = { "city",  "courtyard", "forest",  "interior",
+                                         "night", "studio",    "sunrise", "sunset" };
+    drift_context *ctx = test_context(1, NULL);
+    for (size_t i = 0; i < sizeof(names) / sizeof(names[0]); ++i) {
+        char dwab_rel[256], zip_rel[256], dwab_path[1024], zip_path[1024];
+        snprintf(dwab_rel, sizeof(dwab_rel), "scenes/hdri/dwab/%s.exr", names[i]);
+        snprintf(zip_rel, sizeof(zip_rel), "scenes/hdri/%s.exr", names[i]);
+        drift_image dwab, zip;
+        assert_int_equal(drift_image_load(ctx, test_shared_path(dwab_path, dwab_rel), &dwab),
+                         DRIFT_OK);
+        assert_int_equal(drift_image_load(ctx, test_shared_path(zip_path, zip_rel), &zip),
+                         DRIFT_OK);
+        assert_int_equal(dwab.width, 1024);
+        assert_int_equal(dwab.height, 512);
+        assert_int_equal(zip.width, 1024);
+        assert_int_equal(zip.height, 512);
+        size_t differences = rgb_value_differences(&dwab, &zip);
+        if (differences != 0) {
+            fprintf(stderr, "%s: %zu DWAB components differ from the ZIP copy\n", names[i],
+                    differences);
+        }
+        assert_int_equal(differences, 0);
+        drift_image_destroy(ctx, &dwab);
+        drift_image_destroy(ctx, &zip);
+    }
     drift_context_destroy(ctx);
 }
 
@@ -292,6 +382,53 @@ static int zip_chunks_at_raw_size(const char *path, const drift_image *img)
 // but a chunk whose size equals the uncompressed size is raw to every reader. Rows 16-31 here
 // are k random floats and then a constant; somewhere near k = all, deflate's output crosses
 // the raw size, and for some seed it lands on it exactly. drift must store that chunk raw.
+// Auto exposure brings the geometric mean of the lit pixels to 0.18 and ignores unlit ones;
+// EV100 follows its closed forms (sunny 16: f/16, 1/100 s, ISO 100 is EV100 14.64); the
+// filmic curve is Narkowicz's ACES fit, monotonic, 0 at 0 and white far above 1.
+static void test_image_io_exposure_and_filmic(void **state)
+{
+    (void)state;
+    drift_context *ctx = test_context(1, NULL);
+    drift_image img;
+    assert_int_equal(drift_image_create(ctx, 4, 2, 3, &img), DRIFT_OK);
+    // Row 0 grey 0.5 and 8 (geometric mean 2), row 1 black.
+    for (int32_t x = 0; x < 4; ++x) {
+        float v = x % 2 ? 8.0f : 0.5f;
+        for (int c = 0; c < 3; ++c) {
+            drift_image_pixel(&img, x, 0)[c] = v;
+        }
+    }
+    float expected = (float)(log2(0.18) - 0.5 * (log2(0.5 + 1e-4) + log2(8.0 + 1e-4)));
+    assert_float_equal(drift_image_auto_exposure(&img), expected, 1e-5f);
+    drift_image_pixel(&img, 0, 1)[1] = NAN; // not finite: ignored too
+    assert_float_equal(drift_image_auto_exposure(&img), expected, 1e-5f);
+    drift_image_destroy(ctx, &img);
+    assert_int_equal(drift_image_create(ctx, 2, 2, 3, &img), DRIFT_OK);
+    assert_float_equal(drift_image_auto_exposure(&img), 0.0f, 0.0f); // no light
+    drift_image_destroy(ctx, &img);
+
+    assert_float_equal(drift_ev100_from_camera(16.0f, 0.01f, 100.0f), log2f(25600.0f), 1e-4f);
+    assert_float_equal(drift_ev100_from_camera(16.0f, 0.01f, 200.0f), log2f(12800.0f), 1e-4f);
+    // A radiance of 1.2 · 2^EV100 / 683 W/(m² sr) (1.2 · 2^EV100 cd/m²) just saturates.
+    float ev = 9.0f;
+    float saturating = 1.2f * exp2f(ev) / 683.0f;
+    assert_float_equal(saturating * exp2f(drift_exposure_from_ev100(ev)), 1.0f, 1e-5f);
+
+    drift_tonemap_params filmic = { .op = DRIFT_TONEMAP_FILMIC };
+    assert_float_equal(drift_tonemap_value(0.0f, &filmic), 0.0f, 0.0f);
+    float x = 0.18f;
+    float aces = (x * (2.51f * x + 0.03f)) / (x * (2.43f * x + 0.59f) + 0.14f);
+    assert_float_equal(drift_tonemap_value(x, &filmic), drift_linear_to_srgb(aces), 1e-6f);
+    assert_float_equal(drift_tonemap_value(100.0f, &filmic), 1.0f, 0.0f);
+    float last = 0.0f;
+    for (int i = 1; i <= 200; ++i) {
+        float v = drift_tonemap_value(0.05f * (float)i, &filmic);
+        assert_true(v >= last);
+        last = v;
+    }
+    drift_context_destroy(ctx);
+}
+
 static void test_image_io_exr_chunk_compressing_to_raw_size_round_trips(void **state)
 {
     (void)state;
@@ -658,6 +795,9 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_image_io_exr_multilayer_round_trip_is_exact),
         cmocka_unit_test(test_image_io_tiled_exr_loads),
+        cmocka_unit_test(test_image_io_piz_multipart_exr_loads),
+        cmocka_unit_test(test_image_io_dwab_panoramas_equal_zip_copies),
+        cmocka_unit_test(test_image_io_exposure_and_filmic),
         cmocka_unit_test(test_image_io_exr_chunk_compressing_to_raw_size_round_trips),
         cmocka_unit_test(test_image_io_exr_random_round_trips_are_exact),
         cmocka_unit_test(test_image_io_png_round_trip_within_quantization),

@@ -21,6 +21,7 @@ typedef struct located_log {
     int min_warning_line;
     char first_error_file[1024];   // file of the first error
     char located_error_file[1024]; // file of the first error with a line
+    char text[8192];               // every warning and error message, one a line
 } located_log;
 
 static void located_log_func(drift_log_level level, drift_result code, const char *file, int line,
@@ -29,6 +30,10 @@ static void located_log_func(drift_log_level level, drift_result code, const cha
     located_log *log = user;
     if (getenv("DRIFT_TEST_VERBOSE")) {
         fprintf(stderr, "[log %d] %s:%d: %s\n", (int)level, file ? file : "-", line, message);
+    }
+    if (level >= DRIFT_LOG_WARNING) {
+        size_t used = strlen(log->text);
+        snprintf(log->text + used, sizeof(log->text) - used, "%s\n", message);
     }
     if (level == DRIFT_LOG_WARNING) {
         if (log->warnings++ == 0 || line < log->min_warning_line) {
@@ -678,7 +683,7 @@ static void test_scene_io_gltf_camera_lights_emission(void **state)
         if (l->type == DRIFT_LIGHT_POINT) {
             point++;
             assert_float_equal(l->position.y, 2.0f, 1e-5f);
-            assert_float_equal(l->color.y, 5.0f, 1e-5f);
+            assert_float_equal(l->color.y, 5.0f / 683.0f, 1e-7f); // 10 cd × 0.5 → W/sr
         } else if (l->type == DRIFT_LIGHT_SPOT) {
             spot++;
             assert_float_equal(l->direction.y, -1.0f, 1e-5f);
@@ -692,6 +697,270 @@ static void test_scene_io_gltf_camera_lights_emission(void **state)
     assert_int_equal(spot, 1);
     assert_int_equal(triangle, 1); // the emissive material
     drift_scene_destroy(scene);
+    drift_context_destroy(ctx);
+}
+
+static const drift_material *material_named(const drift_scene *scene, const char *name)
+{
+    for (uint32_t i = 0; i < scene->material_count; ++i) {
+        if (strcmp(scene->materials[i].name, name) == 0) {
+            return &scene->materials[i];
+        }
+    }
+    fail_msg("no material '%s'", name);
+    return NULL;
+}
+
+// tests/data/gltf/blender_scene.gltf (Blender's exporter conventions): Blender's watts come
+// back as radiant intensity (the exporter's cd = W·683/4π, so W/sr = W/4π), the spot cone is
+// Blender's half spot size, the metallic-roughness rule gives the documented diffuse, F0 and
+// exponent, and KHR_materials_emissive_strength scales the emission.
+static void test_scene_io_gltf_photometry_and_materials(void **state)
+{
+    (void)state;
+    char path[1024];
+    test_repo_path(path, "tests/data/gltf/blender_scene.gltf");
+    located_log log;
+    drift_context *ctx = located_context(&log);
+    drift_scene *scene = NULL;
+    assert_int_equal(drift_scene_load(ctx, path, &scene), DRIFT_OK);
+    assert_int_equal(log.errors, 0);
+    uint32_t point = 0, spot = 0;
+    for (uint32_t i = 0; i < scene->light_count; ++i) {
+        const drift_light *l = &scene->lights[i];
+        if (l->type == DRIFT_LIGHT_POINT) {
+            point++;
+            assert_float_equal(l->color.x, 1000.0f / (4.0f * DRIFT_PI), 1e-3f);
+            assert_float_equal(l->position.y, 4.0f, 1e-5f);
+        } else if (l->type == DRIFT_LIGHT_SPOT) {
+            spot++;
+            assert_float_equal(l->color.x, 800.0f / (4.0f * DRIFT_PI), 1e-3f);
+            assert_float_equal(l->color.z, 0.9f * 800.0f / (4.0f * DRIFT_PI), 1e-3f);
+            assert_float_equal(l->spot_outer, 30.0f * DRIFT_PI / 180.0f, 1e-5f);
+            assert_float_equal(l->spot_inner, 0.85f * 30.0f * DRIFT_PI / 180.0f, 1e-5f);
+            // Aimed from (-3, 5, 0) at the origin.
+            assert_float_equal(l->direction.x, 3.0f / sqrtf(34.0f), 1e-4f);
+            assert_float_equal(l->direction.y, -5.0f / sqrtf(34.0f), 1e-4f);
+        }
+    }
+    assert_int_equal(point, 1);
+    assert_int_equal(spot, 1);
+    // Red: base (0.8, 0.05, 0.05), metallic 0, roughness 0.3: diffuse = 0.96 base, F0 = 0.04,
+    // n = (2/α² − 2)/4 with α = 0.09.
+    const drift_material *red = material_named(scene, "Red");
+    assert_float_equal(red->diffuse.x, 0.96f * 0.8f, 1e-6f);
+    assert_float_equal(red->diffuse.y, 0.96f * 0.05f, 1e-6f);
+    assert_float_equal(red->specular.x, 0.04f, 1e-6f);
+    float alpha = 0.3f * 0.3f;
+    assert_float_equal(red->exponent, 0.25f * (2.0f / (alpha * alpha) - 2.0f), 1e-2f);
+    const drift_material *panel = material_named(scene, "Panel");
+    assert_float_equal(panel->emission.x, 4.0f, 1e-6f);
+    assert_float_equal(panel->emission.z, 2.8f, 1e-6f);
+    drift_scene_destroy(scene);
+    drift_context_destroy(ctx);
+}
+
+// gltf_text with a metal that has a normal texture, extensions drift ignores, a light range
+// and a second camera ("side", on a node at x = 7).
+static const char gltf_cameras_text[] =
+    "{\"asset\": {\"version\": \"2.0\"}, \"extensionsUsed\": [\"KHR_lights_punctual\","
+    "  \"KHR_materials_clearcoat\", \"KHR_texture_transform\"],"
+    " \"extensions\": {\"KHR_lights_punctual\": {\"lights\": ["
+    "  {\"type\": \"point\", \"color\": [1, 1, 1], \"intensity\": 683, \"range\": 3}]}},"
+    " \"scene\": 0, \"scenes\": [{\"nodes\": [0, 1, 2, 3]}],"
+    " \"nodes\": [{\"mesh\": 0, \"name\": \"tri\"},"
+    "  {\"camera\": 0, \"translation\": [0, 0, 5], \"name\": \"cam\"},"
+    "  {\"camera\": 1, \"translation\": [7, 0, 0], \"name\": \"sidenode\"},"
+    "  {\"translation\": [1, 2, 3], \"name\": \"lampnode\","
+    "   \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}],"
+    " \"cameras\": [{\"type\": \"perspective\", \"name\": \"front\","
+    "  \"perspective\": {\"yfov\": 0.8, \"aspectRatio\": 1.5, \"znear\": 0.1}},"
+    "  {\"type\": \"perspective\", \"name\": \"side\","
+    "  \"perspective\": {\"yfov\": 0.5, \"aspectRatio\": 1, \"znear\": 0.1}}],"
+    " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"indices\": 1,"
+    "  \"material\": 0}]}],"
+    " \"materials\": [{\"name\": \"metal\", \"normalTexture\": {\"index\": 0},"
+    "  \"pbrMetallicRoughness\": {\"baseColorFactor\": [0.2, 0.4, 0.6, 1],"
+    "  \"metallicFactor\": 1, \"roughnessFactor\": 0}}],"
+    " \"textures\": [{\"source\": 0}], \"images\": [{\"uri\": \"normal.png\"}],"
+    " \"buffers\": [{\"byteLength\": 44, \"uri\": \"data:application/octet-stream;base64,"
+    "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIAAAA=\"}],"
+    " \"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 36},"
+    "  {\"buffer\": 0, \"byteOffset\": 36, \"byteLength\": 6}],"
+    " \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 3, \"type\": "
+    "\"VEC3\", \"min\": [0, 0, 0], \"max\": [1, 1, 0]},"
+    "  {\"bufferView\": 1, \"componentType\": 5123, \"count\": 3, \"type\": \"SCALAR\"}]}";
+
+// One warning per ignored extension and feature; cameras chosen by name or index through a
+// scene file; an unknown camera is an error naming the file.
+static void test_scene_io_gltf_extensions_and_cameras(void **state)
+{
+    (void)state;
+    char gltf_path[1024], json_path[1024];
+    test_out_path(gltf_path, "scene_io_cameras.gltf");
+    write_file(gltf_path, gltf_cameras_text);
+    located_log log;
+    drift_context *ctx = located_context(&log);
+    drift_scene *scene = NULL;
+    assert_int_equal(drift_scene_load(ctx, gltf_path, &scene), DRIFT_OK);
+    assert_int_equal(log.errors, 0);
+    assert_non_null(strstr(log.text, "KHR_materials_clearcoat is not supported"));
+    assert_non_null(strstr(log.text, "KHR_texture_transform is not supported"));
+    assert_non_null(strstr(log.text, "normal texture ignored"));
+    assert_non_null(strstr(log.text, "range ignored"));
+    assert_float_equal(scene->camera.position.z, 5.0f, 1e-5f); // the first camera
+    assert_int_equal(scene->lights[0].type, DRIFT_LIGHT_POINT);
+    assert_float_equal(scene->lights[0].color.x, 1.0f, 1e-6f); // 683 cd = 1 W/sr
+    // The metal reflects its base colour as a sharp lobe and has no diffuse part.
+    const drift_material *m = &scene->materials[0];
+    assert_float_equal(m->specular.y, 0.4f, 1e-6f);
+    assert_float_equal(m->diffuse.y, 0.0f, 0.0f);
+    assert_float_equal(m->exponent, 10000.0f, 0.0f);
+    drift_scene_destroy(scene);
+
+    const char *selectors[] = { "side", "1", "front", "0" };
+    const float eye_x[] = { 7.0f, 7.0f, 0.0f, 0.0f };
+    for (int i = 0; i < 4; ++i) {
+        char json[1024];
+        snprintf(json, sizeof(json),
+                 "{\"version\": 1, \"meshes\": [{\"path\": \"scene_io_cameras.gltf\","
+                 " \"camera\": \"%s\"}]}",
+                 selectors[i]);
+        test_out_path(json_path, "scene_io_cameras.json");
+        write_file(json_path, json);
+        assert_int_equal(drift_scene_load(ctx, json_path, &scene), DRIFT_OK);
+        assert_float_equal(scene->camera.position.x, eye_x[i], 1e-5f);
+        drift_scene_destroy(scene);
+    }
+    log = (located_log){ 0 };
+    write_file(json_path, "{\"version\": 1, \"meshes\": [{\"path\": \"scene_io_cameras.gltf\","
+                          " \"camera\": \"top\"}]}");
+    assert_int_equal(drift_scene_load(ctx, json_path, &scene), DRIFT_ERR_INVALID_ARGUMENT);
+    assert_null(scene);
+    assert_non_null(strstr(log.text, "no camera named or numbered 'top'"));
+    assert_non_null(strstr(log.text, "scene_io_cameras.gltf"));
+    drift_context_destroy(ctx);
+}
+
+// A Mitsuba scene with every supported element (the line numbers of the warnings are checked,
+// so keep its lines as they are).
+static const char mitsuba_text[] =
+    "<?xml version='1.0'?>\n"                                                        // 1
+    "<scene version=\"0.5.0\">\n"                                                    // 2
+    " <sensor type=\"perspective\"><float name=\"fov\" value=\"60\"/>\n"             // 3
+    "  <transform name=\"toWorld\"><lookat origin=\"0,1,5\" target=\"0,1,0\""        //
+    " up=\"0,1,0\"/></transform>\n"                                                  // 4
+    "  <film type=\"hdrfilm\"><integer name=\"width\" value=\"64\"/>"                //
+    "<integer name=\"height\" value=\"48\"/></film></sensor>\n"                      // 5
+    " <bsdf type=\"twosided\" id=\"wall\"><bsdf type=\"diffuse\">"                   //
+    "<rgb name=\"reflectance\" value=\"0.2, 0.4, 0.6\"/></bsdf></bsdf>\n"            // 6
+    " <bsdf type=\"roughplastic\" id=\"coat\"><float name=\"alpha\" value=\"0.3\"/>" //
+    "<spectrum name=\"diffuseReflectance\" value=\"0.5\"/></bsdf>\n"                 // 7
+    " <bsdf type=\"conductor\" id=\"mirror\"/>\n"                                    // 8
+    " <bsdf type=\"dielectric\" id=\"glass\"/>\n"                                    // 9
+    " <medium type=\"homogeneous\" id=\"fog\"/>\n"                                   // 10
+    " <shape type=\"rectangle\"><transform name=\"toWorld\"><scale value=\"2\"/>"    //
+    "<translate z=\"-1\"/></transform><ref id=\"wall\"/></shape>\n"                  // 11
+    " <shape type=\"cube\"><bsdf type=\"roughconductor\"><float name=\"alpha\""      //
+    " value=\"0.1\"/></bsdf><transform name=\"toWorld\"><scale value=\"0.5\"/>"      //
+    "</transform></shape>\n"                                                         // 12
+    " <shape type=\"sphere\"><point name=\"center\" x=\"3\" y=\"0\" z=\"0\"/>"       //
+    "<float name=\"radius\" value=\"0.25\"/><emitter type=\"area\">"                 //
+    "<rgb name=\"radiance\" value=\"10, 10, 10\"/></emitter></shape>\n"              // 13
+    " <shape type=\"sphere\"><ref id=\"glass\"/></shape>\n"                          // 14
+    " <emitter type=\"point\"><point name=\"position\" x=\"0\" y=\"4\" z=\"0\"/>"    //
+    "<spectrum name=\"intensity\" value=\"5\"/></emitter>\n"                         // 15
+    " <emitter type=\"spot\"><float name=\"cutoffAngle\" value=\"30\"/>"             //
+    "<transform name=\"toWorld\"><lookat origin=\"0,4,0\" target=\"0,0,0\""          //
+    " up=\"0,0,1\"/></transform></emitter>\n"                                        // 16
+    " <emitter type=\"constant\"><rgb name=\"radiance\" value=\"0.1,0.2,0.3\"/></emitter>\n"
+    " <emitter type=\"sunsky\"/>\n" // 18
+    "</scene>\n";
+
+static const drift_light *light_of_type(const drift_scene *scene, drift_light_type type)
+{
+    for (uint32_t i = 0; i < scene->light_count; ++i) {
+        if (scene->lights[i].type == type) {
+            return &scene->lights[i];
+        }
+    }
+    fail_msg("no light of type %d", (int)type);
+    return NULL;
+}
+
+static void test_scene_io_mitsuba_subset(void **state)
+{
+    (void)state;
+    char path[1024];
+    test_out_path(path, "scene_io_mitsuba.xml");
+    write_file(path, mitsuba_text);
+    located_log log;
+    drift_context *ctx = located_context(&log);
+    drift_scene *scene = NULL;
+    assert_int_equal(drift_scene_load(ctx, path, &scene), DRIFT_OK);
+    assert_int_equal(log.errors, 0);
+    // fovAxis x (the default): 60° across 64 pixels is 2 atan(tan 30° · 48/64) vertically.
+    assert_float_equal(scene->camera.fov_y, 2.0f * atanf(tanf(DRIFT_PI / 6.0f) * 0.75f), 1e-5f);
+    assert_int_equal(scene->camera.width, 64);
+    assert_float_equal(scene->camera.position.z, 5.0f, 1e-5f);
+    assert_float_equal(scene->camera.target.y, 1.0f, 1e-5f);
+    const drift_material *wall = material_named(scene, "wall");
+    assert_float_equal(wall->diffuse.y, 0.4f, 1e-6f);
+    const drift_material *coat = material_named(scene, "coat");
+    assert_float_equal(coat->diffuse.x, 0.48f, 1e-6f);
+    assert_float_equal(coat->specular.x, 0.04f, 1e-6f);
+    assert_float_equal(coat->exponent, 0.25f * (2.0f / 0.09f - 2.0f), 1e-3f);
+    assert_int_equal(material_named(scene, "mirror")->type, DRIFT_MATERIAL_MIRROR);
+    // The rectangle, scaled by 2 then moved to z = -1: corners at ±2.
+    assert_float_equal(scene->bounds.min.z, -1.0f, 1e-5f);
+    assert_float_equal(scene->bounds.min.x, -2.0f, 1e-5f);
+    const drift_light *sun = light_of_type(scene, DRIFT_LIGHT_SPHERE);
+    assert_float_equal(sun->radius, 0.25f, 1e-6f);
+    assert_float_equal(sun->position.x, 3.0f, 1e-6f);
+    assert_float_equal(light_of_type(scene, DRIFT_LIGHT_POINT)->color.x, 5.0f, 0.0f);
+    const drift_light *spot = light_of_type(scene, DRIFT_LIGHT_SPOT);
+    assert_float_equal(spot->spot_outer, DRIFT_PI / 6.0f, 1e-6f);
+    assert_float_equal(spot->direction.y, -1.0f, 1e-5f);
+    assert_float_equal(scene->environment.color.z, 0.3f, 1e-6f);
+    // Warnings name the element and its line: the dielectric (9), the medium (10), sunsky (18).
+    assert_non_null(strstr(log.text, "no refraction"));
+    assert_non_null(strstr(log.text, "<medium type=homogeneous> is not supported"));
+    assert_non_null(strstr(log.text, "<emitter type=sunsky> is not a supported emitter"));
+    assert_int_equal(log.min_warning_line, 9);
+    drift_scene_destroy(scene);
+
+    // Errors name the file and the line.
+    static const struct {
+        const char *text, *message;
+        int line;
+    } bad[] = {
+        { "<scene>\n <shape type=\"hair\"/>\n</scene>\n", "unknown shape type", 2 },
+        { "<scene>\n\n <shape type=\"cube\"><ref id=\"nope\"/></shape>\n</scene>\n",
+          "unknown bsdf id", 3 },
+        { "<scene>\n <shape type=\"cube\">\n</scene>\n", "malformed Mitsuba XML", 3 },
+        { "<scene>\n <shape type=\"obj\"><string name=\"filename\" value=\"none.obj\"/>"
+          "</shape>\n</scene>\n",
+          "none.obj", 2 },
+        { "<scene>\n <shape type=\"rectangle\"><transform name=\"toWorld\">"
+          "<matrix value=\"1 2 3\"/></transform></shape>\n</scene>\n",
+          "16 numbers", 2 },
+        { "<scene>\n <sensor type=\"perspective\"><float name=\"fov\" value=\"wide\"/>"
+          "</sensor>\n</scene>\n",
+          "expected a number", 2 },
+        { "<scene/>\n", "no shapes", 1 },
+    };
+
+    for (size_t i = 0; i < sizeof(bad) / sizeof(bad[0]); ++i) {
+        write_file(path, bad[i].text);
+        log = (located_log){ 0 };
+        assert_int_not_equal(drift_scene_load(ctx, path, &scene), DRIFT_OK);
+        assert_null(scene);
+        if (!strstr(log.text, bad[i].message) || log.first_error_line != bad[i].line ||
+            !strstr(log.located_error_file, "scene_io_mitsuba.xml")) {
+            fail_msg("case %zu: line %d, file '%s': %s", i, log.first_error_line,
+                     log.located_error_file, log.text);
+        }
+    }
     drift_context_destroy(ctx);
 }
 
@@ -835,6 +1104,9 @@ int main(void)
         cmocka_unit_test(test_scene_io_transforms_and_overrides),
         cmocka_unit_test(test_scene_io_every_light_type),
         cmocka_unit_test(test_scene_io_gltf_camera_lights_emission),
+        cmocka_unit_test(test_scene_io_gltf_photometry_and_materials),
+        cmocka_unit_test(test_scene_io_gltf_extensions_and_cameras),
+        cmocka_unit_test(test_scene_io_mitsuba_subset),
         cmocka_unit_test(test_scene_io_textures_are_shared),
         cmocka_unit_test(test_scene_io_camera_views),
     };

@@ -1,0 +1,289 @@
+// What assimp 5.2 does not tell about a glTF 2.0 file, read from its JSON with cJSON.
+//
+// assimp gives drift the geometry, the node graph, textures and cameras, but it multiplies
+// KHR_lights_punctual intensities into the colour without their units, drops
+// KHR_materials_emissive_strength and keeps no list of the extensions it ignored. This file
+// parses the same file's JSON (a .gltf, or the JSON chunk of a .glb) for those fields only:
+// the light units (candela, lux) become drift's radiometric W/sr and W/m² through the
+// 683 lm/W luminous efficacy the glTF specification uses, and the metallic-roughness
+// material becomes drift's diffuse + glossy material by the rule in docs/scene-format.md.
+//
+// Index correspondence: assimp 5.2's glTF importer keeps the order of `materials` (adding
+// its default material after them) and of the KHR_lights_punctual `lights`, so entry i of
+// each assimp array is entry i of the JSON array.
+#include "scene_io_internal.h"
+
+#include <cjson/cJSON.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+// Luminous efficacy of the glTF specification (KHR_lights_punctual): 683 lm/W.
+#define GLTF_LUMENS_PER_WATT 683.0f
+
+// Dielectric reflectance at normal incidence of the metallic-roughness model (IOR 1.5).
+#define GLTF_DIELECTRIC_F0 0.04f
+
+struct drift__gltf {
+    cJSON *root;
+    const cJSON *lights;    // extensions.KHR_lights_punctual.lights, or NULL
+    const cJSON *materials; // materials, or NULL
+};
+
+// The extensions this file turns into drift's quantities; any other in extensionsUsed is
+// named in a warning.
+static const char *const handled_extensions[] = { "KHR_lights_punctual",
+                                                  "KHR_materials_emissive_strength" };
+
+static uint32_t read_u32(const uint8_t *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+// The JSON text of a .glb (binary glTF): the 12-byte header, then the first chunk, which the
+// specification requires to be the JSON chunk.
+static bool glb_json(const char *data, size_t size, const char **out_json, size_t *out_length)
+{
+    const uint8_t *p = (const uint8_t *)data;
+    if (size < 20 || memcmp(p, "glTF", 4) != 0 || read_u32(p + 4) != 2) {
+        return false;
+    }
+    uint32_t length = read_u32(p + 12);
+    if (memcmp(p + 16, "JSON", 4) != 0 || length > size - 20) {
+        return false;
+    }
+    *out_json = data + 20;
+    *out_length = length;
+    return true;
+}
+
+drift_result drift__gltf_open(drift_context *ctx, const char *path, bool gz, const char *where,
+                              int line, drift__gltf **out)
+{
+    *out = NULL;
+    char *data = NULL;
+    size_t size = 0;
+    drift_result r = drift__read_file(ctx, path, gz, where, line, &data, &size);
+    if (r != DRIFT_OK) {
+        return r;
+    }
+    const char *json = data;
+    size_t length = size;
+    if (size >= 4 && memcmp(data, "glTF", 4) == 0 && !glb_json(data, size, &json, &length)) {
+        drift_free(ctx, data);
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, where, line,
+                  "'%s': not a glTF 2.0 binary (.glb): bad header or no JSON chunk", path);
+        return DRIFT_ERR_PARSE;
+    }
+    cJSON *root = cJSON_ParseWithLength(json, length);
+    drift_free(ctx, data);
+    if (!cJSON_IsObject(root)) {
+        cJSON_Delete(root);
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, where, line,
+                  "'%s': not a glTF 2.0 file: its JSON is malformed or not an object", path);
+        return DRIFT_ERR_PARSE;
+    }
+    drift__gltf *g = drift_alloc(ctx, sizeof(*g));
+    if (!g) {
+        cJSON_Delete(root);
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    g->root = root;
+    g->materials = cJSON_GetObjectItemCaseSensitive(root, "materials");
+    const cJSON *ext = cJSON_GetObjectItemCaseSensitive(root, "extensions");
+    const cJSON *punctual = cJSON_GetObjectItemCaseSensitive(ext, "KHR_lights_punctual");
+    g->lights = cJSON_GetObjectItemCaseSensitive(punctual, "lights");
+    if (!cJSON_IsArray(g->materials)) {
+        g->materials = NULL;
+    }
+    if (!cJSON_IsArray(g->lights)) {
+        g->lights = NULL;
+    }
+    // Ignored extensions: one warning each. Required ones the file cannot be shown without
+    // are still loaded (assimp decides what it can read); the warning says so.
+    const cJSON *used = cJSON_GetObjectItemCaseSensitive(root, "extensionsUsed");
+    const cJSON *required = cJSON_GetObjectItemCaseSensitive(root, "extensionsRequired");
+    used = cJSON_IsArray(used) ? used : NULL;
+    required = cJSON_IsArray(required) ? required : NULL;
+    const cJSON *name;
+    cJSON_ArrayForEach(name, used)
+    {
+        if (!cJSON_IsString(name)) {
+            continue;
+        }
+        bool handled = false;
+        for (size_t i = 0; i < sizeof(handled_extensions) / sizeof(handled_extensions[0]); ++i) {
+            handled = handled || strcmp(name->valuestring, handled_extensions[i]) == 0;
+        }
+        bool is_required = false;
+        const cJSON *req;
+        cJSON_ArrayForEach(req, required)
+        {
+            is_required = is_required ||
+                          (cJSON_IsString(req) && strcmp(req->valuestring, name->valuestring) == 0);
+        }
+        if (!handled) {
+            drift_log(ctx, DRIFT_LOG_WARNING, DRIFT_ERR_UNSUPPORTED, where, line,
+                      "'%s': glTF extension %s is not supported by drift; ignored%s", path,
+                      name->valuestring, is_required ? " (the file marks it required)" : "");
+        }
+    }
+    *out = g;
+    return DRIFT_OK;
+}
+
+void drift__gltf_close(drift_context *ctx, drift__gltf *g)
+{
+    if (g) {
+        cJSON_Delete(g->root);
+        drift_free(ctx, g);
+    }
+}
+
+// A finite number member of `object`, or `fallback` when absent or not a number.
+static float number_or(const cJSON *object, const char *key, float fallback)
+{
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(object, key);
+    return cJSON_IsNumber(v) && isfinite(v->valuedouble) ? (float)v->valuedouble : fallback;
+}
+
+// An array member of `object` of `n` numbers, into out (left as is when absent or malformed).
+static bool numbers(const cJSON *object, const char *key, float *out, int n)
+{
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(object, key);
+    if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) < n) {
+        return false;
+    }
+    float tmp[4];
+    for (int i = 0; i < n; ++i) {
+        const cJSON *e = cJSON_GetArrayItem(v, i);
+        if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble)) {
+            return false;
+        }
+        tmp[i] = (float)e->valuedouble;
+    }
+    memcpy(out, tmp, sizeof(float) * (size_t)n);
+    return true;
+}
+
+bool drift__gltf_get_light(const drift__gltf *g, unsigned index, drift__gltf_light *out)
+{
+    const cJSON *l = g && g->lights ? cJSON_GetArrayItem(g->lights, (int)index) : NULL;
+    if (!cJSON_IsObject(l)) {
+        return false;
+    }
+    float color[3] = { 1.0f, 1.0f, 1.0f };
+    numbers(l, "color", color, 3);
+    // candela (lm/sr) for point and spot lights, lux (lm/m²) for directional ones; divided by
+    // 683 lm/W they are W/sr and W/m², drift's units for those lights.
+    float scale = number_or(l, "intensity", 1.0f) / GLTF_LUMENS_PER_WATT;
+    out->color = drift_vec3_make(color[0] * scale, color[1] * scale, color[2] * scale);
+    const cJSON *spot = cJSON_GetObjectItemCaseSensitive(l, "spot");
+    out->outer_angle = number_or(spot, "outerConeAngle", DRIFT_PI / 4.0f);
+    out->inner_angle = number_or(spot, "innerConeAngle", 0.0f);
+    out->has_range = cJSON_GetObjectItemCaseSensitive(l, "range") != NULL;
+    return true;
+}
+
+// Glossy exponent of drift's normalized Phong lobe for a glTF roughness (see
+// docs/scene-format.md): α = roughness², the Beckmann/Blinn-Phong equivalence n_b = 2/α² − 2
+// (Walter et al. 2007), and a quarter of it for a lobe about the mirror direction instead of
+// the half vector; kept within [1, 10000].
+static float roughness_to_exponent(float roughness)
+{
+    float alpha = drift_clampf(roughness, 0.0f, 1.0f);
+    alpha *= alpha;
+    if (alpha < 1e-4f) {
+        return 10000.0f;
+    }
+    float n = 0.25f * (2.0f / (alpha * alpha) - 2.0f);
+    return drift_clampf(n, 1.0f, 10000.0f);
+}
+
+// array[index] for a JSON number index, or NULL when it is not an integer in range.
+static const cJSON *item_at(const cJSON *array, const cJSON *index)
+{
+    if (!cJSON_IsArray(array) || !cJSON_IsNumber(index) || !(index->valuedouble >= 0.0) ||
+        index->valuedouble >= (double)cJSON_GetArraySize(array)) {
+        return NULL;
+    }
+    return cJSON_GetArrayItem(array, (int)index->valuedouble);
+}
+
+// Whether the sampler of a texture reference is what drift's textures do: repeat in u and v
+// (10497, the default) and bilinear magnification (9729 LINEAR, or unset).
+static bool sampler_supported(const drift__gltf *g, const cJSON *texture_ref)
+{
+    const cJSON *textures = cJSON_GetObjectItemCaseSensitive(g->root, "textures");
+    const cJSON *samplers = cJSON_GetObjectItemCaseSensitive(g->root, "samplers");
+    const cJSON *index = cJSON_GetObjectItemCaseSensitive(texture_ref, "index");
+    const cJSON *texture = item_at(textures, index);
+    const cJSON *sampler = item_at(samplers, cJSON_GetObjectItemCaseSensitive(texture, "sampler"));
+    if (!sampler) {
+        return true;
+    }
+    return number_or(sampler, "wrapS", 10497.0f) == 10497.0f &&
+           number_or(sampler, "wrapT", 10497.0f) == 10497.0f &&
+           number_or(sampler, "magFilter", 9729.0f) == 9729.0f;
+}
+
+bool drift__gltf_get_material(const drift__gltf *g, unsigned index, drift__gltf_material *out)
+{
+    const cJSON *m = g && g->materials ? cJSON_GetArrayItem(g->materials, (int)index) : NULL;
+    if (!cJSON_IsObject(m)) {
+        return false;
+    }
+    const cJSON *pbr = cJSON_GetObjectItemCaseSensitive(m, "pbrMetallicRoughness");
+    float base[4] = { 1.0f, 1.0f, 1.0f, 1.0f };
+    numbers(pbr, "baseColorFactor", base, 4);
+    float metallic = drift_clampf(number_or(pbr, "metallicFactor", 1.0f), 0.0f, 1.0f);
+    float roughness = drift_clampf(number_or(pbr, "roughnessFactor", 1.0f), 0.0f, 1.0f);
+    drift_vec3 base_color =
+        drift_vec3_make(drift_clampf(base[0], 0.0f, 1.0f), drift_clampf(base[1], 0.0f, 1.0f),
+                        drift_clampf(base[2], 0.0f, 1.0f));
+    // Metals reflect their base colour; dielectrics reflect 4% and pass the rest to the
+    // diffuse base, which is what remains after that reflection.
+    out->diffuse = drift_vec3_scale(base_color, (1.0f - metallic) * (1.0f - GLTF_DIELECTRIC_F0));
+    out->specular = drift_vec3_add(drift_vec3_splat(GLTF_DIELECTRIC_F0 * (1.0f - metallic)),
+                                   drift_vec3_scale(base_color, metallic));
+    out->exponent = roughness_to_exponent(roughness);
+    float emissive[3] = { 0.0f, 0.0f, 0.0f };
+    numbers(m, "emissiveFactor", emissive, 3);
+    const cJSON *ext = cJSON_GetObjectItemCaseSensitive(m, "extensions");
+    const cJSON *es = cJSON_GetObjectItemCaseSensitive(ext, "KHR_materials_emissive_strength");
+    float strength = fmaxf(number_or(es, "emissiveStrength", 1.0f), 0.0f);
+    out->emission =
+        drift_vec3_make(fmaxf(emissive[0], 0.0f) * strength, fmaxf(emissive[1], 0.0f) * strength,
+                        fmaxf(emissive[2], 0.0f) * strength);
+    const cJSON *base_tex = cJSON_GetObjectItemCaseSensitive(pbr, "baseColorTexture");
+    out->base_color_uv_set = (int)drift_clampf(number_or(base_tex, "texCoord", 0.0f), 0.0f, 7.0f);
+    out->base_color_sampler_supported = sampler_supported(g, base_tex);
+    out->has_metallic_roughness_texture =
+        cJSON_GetObjectItemCaseSensitive(pbr, "metallicRoughnessTexture") != NULL;
+    out->has_normal_texture = cJSON_GetObjectItemCaseSensitive(m, "normalTexture") != NULL;
+    out->has_emissive_texture = cJSON_GetObjectItemCaseSensitive(m, "emissiveTexture") != NULL;
+    out->has_occlusion_texture = cJSON_GetObjectItemCaseSensitive(m, "occlusionTexture") != NULL;
+    const cJSON *alpha_mode = cJSON_GetObjectItemCaseSensitive(m, "alphaMode");
+    out->alpha_blended = cJSON_IsString(alpha_mode) && strcmp(alpha_mode->valuestring, "OPAQUE");
+    return true;
+}
+
+int drift__gltf_camera_index(const drift__gltf *g, const char *selector)
+{
+    const cJSON *cameras = g ? cJSON_GetObjectItemCaseSensitive(g->root, "cameras") : NULL;
+    int count = cJSON_IsArray(cameras) ? cJSON_GetArraySize(cameras) : 0;
+    char *end = NULL;
+    long index = strtol(selector, &end, 10);
+    if (end != selector && *end == '\0') {
+        return index >= 0 && index < count ? (int)index : -1;
+    }
+    for (int i = 0; i < count; ++i) {
+        const cJSON *name =
+            cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(cameras, i), "name");
+        if (cJSON_IsString(name) && strcmp(name->valuestring, selector) == 0) {
+            return i;
+        }
+    }
+    return -1;
+}
