@@ -8,6 +8,7 @@
 #include "drift/glare.h"
 #include "drift/image_io.h"
 #include "drift/pt.h"
+#include "drift/reflect_edit.h"
 #include "drift/scene_io.h"
 #include "render.h"
 
@@ -162,6 +163,9 @@ static const cli_option render_table[] = {
                "PNG operator: clamp (default) or reinhard"),
     CLI_CUSTOM_ALL("--debug-sample", "X,Y,S", parse_debug_sample,
                    "trace one sample of one pixel and print its radiance"),
+    CLI_STRING("--reflection-edits", "FILE.json", O, edits_path,
+               "edit the reflections: sharp, envmap and ISG reflections and the path\n"
+               "tracer's first specular bounce follow e(q) (docs/reflection-editing.md)"),
     CLI_FLAG("--quiet", O, quiet, "no progress output"),
     CLI_FLAG("--verbose", O, verbose, "more log output"),
 
@@ -461,7 +465,8 @@ static int render_reference(const render_options *o, const cli_session *session)
     drift_pt_params params = { .width = (int32_t)o->width,
                                .height = (int32_t)o->height,
                                .seed = (uint32_t)o->seed,
-                               .max_depth = (int32_t)o->max_depth };
+                               .max_depth = (int32_t)o->max_depth,
+                               .reflection_edits = o->hybrid.reflection_edits };
     r = drift_pt_create(ctx, session->scene, session->accel, &params, &pt);
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift render: %s\n", drift_result_string(r));
@@ -570,7 +575,8 @@ int drift_cmd_render(int argc, char **argv)
                                  { "--out's PNG", png },
                                  { "--stats", o.stats_path },
                                  { "--aov", o.aov_path } };
-    const cli_file inputs[] = { { "--lambda", o.refine.lambda_path } };
+    const cli_file inputs[] = { { "--lambda", o.refine.lambda_path },
+                                { "--reflection-edits", o.edits_path } };
     cli_session session;
     int exit_code = 1;
     if (cli_session_open(&(cli_session_desc){ .cmd = "render",
@@ -580,9 +586,19 @@ int drift_cmd_render(int argc, char **argv)
                                               .outputs = outputs,
                                               .output_count = o.debug_sample >= 0 ? 0 : 4,
                                               .inputs = inputs,
-                                              .input_count = 1 },
+                                              .input_count = 2 },
                          &session)) {
-        exit_code = o.hybrid_mode ? render_hybrid(&o, &session) : render_reference(&o, &session);
+        drift_reflection_edits *edits = NULL;
+        if (o.edits_path && drift_reflection_edits_load(session.ctx, session.scene, session.accel,
+                                                        o.edits_path, &edits) != DRIFT_OK) {
+            fprintf(stderr, "drift render: cannot apply --reflection-edits %s\n", o.edits_path);
+            exit_code = 2;
+        } else {
+            o.hybrid.reflection_edits = edits;
+            exit_code =
+                o.hybrid_mode ? render_hybrid(&o, &session) : render_reference(&o, &session);
+        }
+        drift_reflection_edits_destroy(edits);
     } else if (session.refused) {
         exit_code = 2;
     }

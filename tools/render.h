@@ -43,6 +43,7 @@ typedef struct render_options {
     drift_hybrid_params hybrid;
     double aperture, focus_distance; // < 0: the scene camera's
     render_refine_options refine;    // --refine sir (tools/render_refine.c)
+    const char *edits_path;          // --reflection-edits FILE.json (docs/reflection-editing.md)
 } render_options;
 
 // Renders in hybrid mode with the session's scene; returns the process exit code.
