@@ -467,7 +467,7 @@ drift_result drift_reflection_edits_load(drift_context *ctx, const drift_scene *
 
 static cJSON *vec3_json(drift_vec3 v)
 {
-    const double values[3] = { v.x, v.y, v.z };
+    const double values[3] = { (double)v.x, (double)v.y, (double)v.z };
     return cJSON_CreateDoubleArray(values, 3);
 }
 
@@ -518,9 +518,9 @@ drift_result drift_reflection_edits_save(const drift_reflection_edits *edits, co
             }
         } else {
             cJSON_AddItemToObject(o, "centre", vec3_json(g->centre));
-            cJSON_AddNumberToObject(o, "radius", g->radius);
+            cJSON_AddNumberToObject(o, "radius", (double)g->radius);
         }
-        cJSON_AddNumberToObject(o, "border", g->border);
+        cJSON_AddNumberToObject(o, "border", (double)g->border);
         cJSON_AddItemToArray(regions, o);
     }
     char *text = cJSON_Print(root);

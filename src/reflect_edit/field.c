@@ -437,8 +437,9 @@ static drift_mat3 constrained_fit(const drift__constraint *c, double others[3][3
     double cs = cos(phi), sn = sin(phi);
     // Rot = r r^T + cos (x x^T + y y^T) + sin (y x^T - x y^T), then R0 Rot.
     double rot[3][3];
-    const double x[3] = { f.x.x, f.x.y, f.x.z }, y[3] = { f.y.x, f.y.y, f.y.z },
-                 z[3] = { f.z.x, f.z.y, f.z.z };
+    const double x[3] = { (double)f.x.x, (double)f.x.y, (double)f.x.z },
+                 y[3] = { (double)f.y.x, (double)f.y.y, (double)f.y.z },
+                 z[3] = { (double)f.z.x, (double)f.z.y, (double)f.z.z };
     for (int i = 0; i < 3; ++i) {
         for (int j = 0; j < 3; ++j) {
             rot[i][j] =
@@ -495,7 +496,8 @@ static bool region_rotation(const drift_reflection_edits *edits, int region,
         }
         const drift__constraint *c = &edits->constraints[n];
         double wn = w[n] * scale;
-        const double e[3] = { c->e.x, c->e.y, c->e.z }, r[3] = { c->r.x, c->r.y, c->r.z };
+        const double e[3] = { (double)c->e.x, (double)c->e.y, (double)c->e.z },
+                     r[3] = { (double)c->r.x, (double)c->r.y, (double)c->r.z };
         for (int i = 0; i < 3; ++i) {
             for (int j = 0; j < 3; ++j) {
                 m[i][j] += wn * e[i] * r[j];
@@ -524,7 +526,7 @@ void drift_reflection_edits_rotation(const drift_reflection_edits *edits, const 
     // Regions are independent: each fits its own constraints; where they overlap their
     // rotations blend by a_k(q) and are re-orthonormalised.
     double blend[3][3] = { { 0.0 } };
-    float a_sum = 0.0f, a_max = 0.0f;
+    float a_max = 0.0f;
     int contributors = 0;
     drift_mat3 last = drift_mat3_identity();
     for (uint32_t k = 0; k < edits->region_count; ++k) {
@@ -538,7 +540,6 @@ void drift_reflection_edits_rotation(const drift_reflection_edits *edits, const 
                 blend[i][j] += (double)a * (double)rk.m[i][j];
             }
         }
-        a_sum += a;
         a_max = fmaxf(a_max, a);
         contributors++;
         last = rk;
@@ -560,7 +561,7 @@ drift_vec3 drift_reflection_edits_apply(const drift_mat3 *rotation, float influe
     }
     // R_a = ortho(a R + (1 - a) r r^T) (eq. 7.7).
     double m[3][3];
-    const double rv[3] = { r.x, r.y, r.z };
+    const double rv[3] = { (double)r.x, (double)r.y, (double)r.z };
     for (int i = 0; i < 3; ++i) {
         for (int j = 0; j < 3; ++j) {
             m[i][j] = (double)influence * (double)rotation->m[i][j] +

@@ -71,7 +71,8 @@ static double normalize3(double v[3])
 
 drift_mat3 drift_mat3_rotation_between(drift_vec3 a, drift_vec3 b)
 {
-    double x[3] = { a.x, a.y, a.z }, y[3] = { b.x, b.y, b.z };
+    double x[3] = { (double)a.x, (double)a.y, (double)a.z },
+           y[3] = { (double)b.x, (double)b.y, (double)b.z };
     normalize3(x);
     normalize3(y);
     double c = x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
@@ -79,7 +80,7 @@ drift_mat3 drift_mat3_rotation_between(drift_vec3 a, drift_vec3 b)
     if (c < -1.0 + 1e-12) {
         // A half turn about an axis k normal to a: 2 k k^T - I.
         drift_frame f = drift_frame_from_normal(drift_vec3_normalize(a));
-        double k[3] = { f.x.x, f.x.y, f.x.z };
+        double k[3] = { (double)f.x.x, (double)f.x.y, (double)f.x.z };
         for (int i = 0; i < 3; ++i) {
             for (int j = 0; j < 3; ++j) {
                 out[i][j] = 2.0 * k[i] * k[j] - (i == j ? 1.0 : 0.0);
