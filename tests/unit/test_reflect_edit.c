@@ -566,6 +566,17 @@ static void test_renderers_follow_the_edit(void **state)
         drift_vec3 seen = drift_image_get3(test_rig_plane(&r, "reflections"), 32, 32);
         assert_near(seen.x, expected.x, 0.05 * (double)expected.x + 1e-3);
         assert_near(seen.y, expected.y, 0.05 * (double)expected.y + 1e-3);
+        // The environment map, captured at the sphere's centre, is looked up along e too
+        // (a cube map's texels blur the quad's edge: only the bulk of its light is asked for).
+        hp.reflections = DRIFT_REFLECTIONS_ENVMAP;
+        hp.envmap.size = 32;
+        test_rig_frame(&r, &hp);
+        seen = drift_image_get3(test_rig_plane(&r, "reflections"), 32, 32);
+        if (edited) {
+            assert_true(seen.x > 0.5f * expected.x && seen.x < 1.5f * expected.x);
+        } else {
+            assert_true(seen.x < 0.05f);
+        }
     }
     drift_reflection_edits_destroy(edits);
     test_rig_destroy(&r);
