@@ -7,6 +7,7 @@
 #include "drift/hybrid.h"
 #include "drift/pt.h"
 #include "drift/reflect_edit.h"
+#include "drift/view.h"
 #include "drift_test.h"
 #include "test_rig.h"
 
@@ -680,6 +681,79 @@ static void test_bad_edit_files_name_file_and_line(void **state)
     test_rig_destroy(&r);
 }
 
+// The viewer's editing: pick a point (no change yet), drag the green handle (e_n changes),
+// add a region, undo back step by step, save and load the file.
+static void test_view_edits_pick_drag_undo_save(void **state)
+{
+    (void)state;
+    uint32_t mesh;
+    test_rig r = test_rig_begin(2);
+    drift_material mirror = drift_material_make(drift_vec3_splat(0.0f));
+    mirror.type = DRIFT_MATERIAL_MIRROR;
+    mirror.specular = drift_vec3_splat(0.9f);
+    mesh = test_add_sphere(r.scene, drift_vec3_make(0, 0, 0), 1.0f, 48, 24,
+                           test_add_material(r.scene, mirror));
+    test_add_floor(r.scene, 10.0f, -1.0f,
+                   test_add_material(r.scene, drift_material_make(drift_vec3_splat(0.5f))));
+    r.scene->camera = drift_camera_look_at(eye, drift_vec3_make(0, -0.3f, 0),
+                                           drift_vec3_make(0, 1, 0), 0.7f, VIEW_W, VIEW_H);
+    test_rig_commit(&r);
+    char path[1024];
+    test_out_path(path, "view.edit.json");
+    remove(path);
+    drift_view *view = NULL;
+    assert_int_equal(drift_view_create(r.ctx, r.scene, r.accel,
+                                       &(drift_view_desc){ .reflection_edits_path = path }, &view),
+                     DRIFT_OK);
+    const drift_reflection_edits *edits = drift_view_reflection_edits(view);
+    assert_int_equal(drift_reflection_edits_constraint_count(edits), 0);
+    // A click on the floor is no constraint; on the sphere it is.
+    assert_false(drift_view_handle_event(
+        view, &(drift_view_event){ .type = DRIFT_VIEW_EVENT_EDIT_PICK, .x = 32.5f, .y = 62.5f }));
+    assert_true(drift_view_handle_event(
+        view, &(drift_view_event){ .type = DRIFT_VIEW_EVENT_EDIT_PICK, .x = 30.5f, .y = 30.5f }));
+    edits = drift_view_reflection_edits(view);
+    assert_int_equal(drift_reflection_edits_constraint_count(edits), 1);
+    assert_int_equal(drift_view_selected_constraint(view), 0);
+    assert_int_equal(drift_reflection_edits_constraint(edits, 0)->mesh, mesh);
+    drift_vec3 rn, en;
+    drift_reflection_edits_constraint_rays(edits, 0, &rn, &en);
+    assert_true(angle_between(rn, en) < 1e-3f); // the green handle starts where it reflects
+    // The green handle onto the floor seen at the bottom of the image.
+    assert_true(drift_view_handle_event(
+        view, &(drift_view_event){ .type = DRIFT_VIEW_EVENT_EDIT_GREEN, .x = 10.5f, .y = 60.5f }));
+    edits = drift_view_reflection_edits(view);
+    drift_reflection_edits_constraint_rays(edits, 0, &rn, &en);
+    assert_true(angle_between(rn, en) > 0.1f);
+    assert_true(en.y < 0.0f); // toward the floor
+    assert_true(
+        drift_view_handle_event(view, &(drift_view_event){ .type = DRIFT_VIEW_EVENT_KEY,
+                                                           .key = DRIFT_VIEW_KEY_EDIT_REGION }));
+    assert_int_equal(drift_reflection_edits_region_count(drift_view_reflection_edits(view)), 1);
+    assert_int_equal(drift_view_frame(view, NULL), DRIFT_OK); // the frame renders with them
+    assert_false(
+        drift_view_handle_event(view, &(drift_view_event){ .type = DRIFT_VIEW_EVENT_KEY,
+                                                           .key = DRIFT_VIEW_KEY_EDIT_SAVE }));
+    // Undo: the region, then the drag (e_n = r_n again), then the pick.
+    const drift_view_event undo = { .type = DRIFT_VIEW_EVENT_KEY, .key = DRIFT_VIEW_KEY_EDIT_UNDO };
+    assert_true(drift_view_handle_event(view, &undo));
+    assert_int_equal(drift_reflection_edits_region_count(drift_view_reflection_edits(view)), 0);
+    assert_true(drift_view_handle_event(view, &undo));
+    drift_reflection_edits_constraint_rays(drift_view_reflection_edits(view), 0, &rn, &en);
+    assert_true(angle_between(rn, en) < 1e-3f);
+    assert_true(drift_view_handle_event(view, &undo));
+    assert_int_equal(drift_reflection_edits_constraint_count(drift_view_reflection_edits(view)), 0);
+    assert_false(drift_view_handle_event(view, &undo)); // nothing left
+    drift_view_destroy(view);
+    // The saved file holds the state at the save.
+    drift_reflection_edits *loaded = NULL;
+    assert_int_equal(drift_reflection_edits_load(r.ctx, r.scene, r.accel, path, &loaded), DRIFT_OK);
+    assert_int_equal(drift_reflection_edits_constraint_count(loaded), 1);
+    assert_int_equal(drift_reflection_edits_region_count(loaded), 1);
+    drift_reflection_edits_destroy(loaded);
+    test_rig_destroy(&r);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -693,6 +767,7 @@ int main(void)
         cmocka_unit_test(test_cost_grows_mildly_with_constraints),
         cmocka_unit_test(test_renderers_follow_the_edit),
         cmocka_unit_test(test_bad_edit_files_name_file_and_line),
+        cmocka_unit_test(test_view_edits_pick_drag_undo_save),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
