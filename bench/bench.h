@@ -20,7 +20,8 @@
       "SSAO, GTAO, SSDO(+bounce): Table 4.1 ms, FLIP vs the path tracer")                       \
     X("ism", drift_bench_ism, "imperfect shadow maps and instant radiosity vs the path tracer") \
     X("frontier", drift_bench_frontier,                                                         \
-      "equal-time frontier: pt, pt + a-trous, hybrid rows vs a whole-frame reference")
+      "equal-time frontier: pt, pt + a-trous, hybrid rows vs a whole-frame reference")          \
+    X("redit", drift_bench_redit, "reflection editing: edit-field Mpixel/s vs constraints")
 
 #include "cli.h"
 

@@ -105,6 +105,12 @@ for f in d["front"]:
         assert f[k] is None or (f[k]["ms"] <= f["budget_ms"] and f[k]["flip"] >= best["flip"]), f'
         [ "$(wc -l < "$tmp/frontier.csv")" -ge 15 ] || fail "bench frontier: --csv has too few rows"
         ;;
+    redit)
+        expect 0 "$drift" bench redit --width 32 --height 24 --constraints 1,4 --frames 1 --json
+        check redit 'assert [r["constraints"] for r in d["field"]] == [1, 4], d
+assert d["reflective_pixels"] > 0 and all(r["mpixel_per_s"] > 0 for r in d["field"]), d
+assert d["frame_ms_unedited"] > 0 and d["frame_ms_edited"] > 0, d'
+        ;;
     *)
         fail "bench $1 has no smoke case in tests/cli/test_bench.sh"
         return
