@@ -310,7 +310,7 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
             break;
         }
         drift_bsdf bsdf = drift_bsdf_make(scene, &surf);
-        if (depth == 0 && p->reflection_edits) {
+        if (depth == 0 && p->reflection_edits && !drift_vec3_is_zero(bsdf.specular)) {
             // The first specular bounce follows the edit: its lobes centre on e(q).
             drift_edit_point q = drift_edit_point_from_surface(&surf);
             bsdf.edited_mirror = drift_reflection_edits_direction(
