@@ -9,18 +9,19 @@
 #define DRIFT_BENCH_H
 
 // X(name, function, one-line summary)
-#define DRIFT_BENCH_LIST(X)                                                                     \
-    X("rays", drift_bench_rays, "rays/s through drift's accel vs raw Embree, one thread")       \
-    X("frame", drift_bench_frame, "hybrid frame passes vs the primary-visibility pass")         \
-    X("isg", drift_bench_isg, "image space gathering: Table 1 timings, FLIP vs baselines")      \
-    X("aaf", drift_bench_aaf, "axis-aligned filtering: RMSE vs spp against plain Monte Carlo")  \
-    X("sir", drift_bench_sir, "smart image refinement vs pure ray tracing (Table 1)")           \
-    X("glare", drift_bench_glare, "temporal glare: Table 8.2 phases, convolution, ms a frame")  \
-    X("ssdo", drift_bench_ssdo,                                                                 \
-      "SSAO, GTAO, SSDO(+bounce): Table 4.1 ms, FLIP vs the path tracer")                       \
-    X("ism", drift_bench_ism, "imperfect shadow maps and instant radiosity vs the path tracer") \
-    X("frontier", drift_bench_frontier,                                                         \
-      "equal-time frontier: pt, pt + a-trous, hybrid rows vs a whole-frame reference")          \
+#define DRIFT_BENCH_LIST(X)                                                                      \
+    X("rays", drift_bench_rays, "rays/s through drift's accel vs raw Embree, one thread")        \
+    X("frame", drift_bench_frame, "hybrid frame passes vs the primary-visibility pass")          \
+    X("isg", drift_bench_isg, "image space gathering: Table 1 timings, FLIP vs baselines")       \
+    X("aaf", drift_bench_aaf, "axis-aligned filtering: RMSE vs spp against plain Monte Carlo")   \
+    X("sir", drift_bench_sir, "smart image refinement vs pure ray tracing (Table 1)")            \
+    X("glare", drift_bench_glare, "temporal glare: Table 8.2 phases, convolution, ms a frame")   \
+    X("ssdo", drift_bench_ssdo,                                                                  \
+      "SSAO, GTAO, SSDO(+bounce): Table 4.1 ms, FLIP vs the path tracer")                        \
+    X("ism", drift_bench_ism, "imperfect shadow maps and instant radiosity vs the path tracer")  \
+    X("micro", drift_bench_micro, "micro-rendering: rate vs K, density, points; NRMS vs the pt") \
+    X("frontier", drift_bench_frontier,                                                          \
+      "equal-time frontier: pt, pt + a-trous, hybrid rows vs a whole-frame reference")           \
     X("redit", drift_bench_redit, "reflection editing: edit-field Mpixel/s vs constraints")
 
 #include "cli.h"

@@ -140,6 +140,7 @@ static int parse(int argc, char **argv, aaf_options *o)
 
 typedef struct point {
     double spp, actual_spp, rmse, sampling_ms, filter_ms;
+    double mean_ratio; // the term's mean over the image against the reference's
 } point;
 
 typedef struct curve {
@@ -202,6 +203,19 @@ static drift_result render(drift_context *ctx, const drift_scene *scene, const d
     return r == DRIFT_OK ? drift_hybrid_render(*frame, &scene->camera, NULL) : r;
 }
 
+// Mean of an image over its pixels and 3 channels.
+static double image_mean(const drift_image *image)
+{
+    double sum = 0.0;
+    for (int32_t y = 0; y < image->height; ++y) {
+        for (int32_t x = 0; x < image->width; ++x) {
+            const float *v = drift_image_pixel(image, x, y);
+            sum += (double)v[0] + (double)v[1] + (double)v[2];
+        }
+    }
+    return sum / (3.0 * (double)image->width * (double)image->height);
+}
+
 // log spp at which the plain curve reaches `error`, linear in log-log between its points
 // (extrapolated from the nearest two outside them).
 static double equal_error_spp(const point *plain, int count, double error, bool *extrapolated)
@@ -261,9 +275,11 @@ static drift_result measure(drift_context *ctx, const drift_scene *scene, const 
             }
             drift_hybrid_stats s = drift_hybrid_get_stats(frame);
             point *pt = method == 0 ? &out->aaf[k] : &out->plain[k];
+            double truth_mean = image_mean(truth);
             *pt = (point){ .spp = (double)spp,
                            .actual_spp = actual_spp(frame, effect),
                            .rmse = sqrt(mse),
+                           .mean_ratio = truth_mean > 0.0 ? image_mean(test) / truth_mean : 1.0,
                            .sampling_ms = s.ms[DRIFT_PASS_AAF_SAMPLING],
                            .filter_ms = s.ms[DRIFT_PASS_AAF_FILTER] };
             if (!(pt->actual_spp > 0.0)) {
@@ -440,6 +456,7 @@ static bool print_json(const aaf_options *o, const char *scene_path, int threads
             cli_json_number(item, "actual_spp", cv->aaf[k].actual_spp, 3);
             cli_json_number(item, "rmse", cv->aaf[k].rmse, -1);
             cli_json_number(item, "equal_error_ratio", cv->ratio[k], 3);
+            cli_json_number(item, "mean_ratio", cv->aaf[k].mean_ratio, 4);
             cJSON_AddBoolToObject(item, "extrapolated", cv->extrapolated[k]);
         }
         cJSON *plain = cJSON_AddArrayToObject(effect, "plain_mc");
@@ -448,6 +465,7 @@ static bool print_json(const aaf_options *o, const char *scene_path, int threads
             cJSON_AddItemToArray(plain, item);
             cli_json_number(item, "spp", cv->plain[k].spp, 0);
             cli_json_number(item, "rmse", cv->plain[k].rmse, -1);
+            cli_json_number(item, "mean_ratio", cv->plain[k].mean_ratio, 4);
         }
         cJSON *timing = cJSON_AddObjectToObject(effect, "timing");
         cJSON_AddNumberToObject(timing, "width", (double)o->timing_width);
@@ -468,16 +486,17 @@ static void print_text(const aaf_options *o, const char *scene_path, int threads
            o->height, o->ref_spp, threads, o->random ? "random" : "sobol");
     for (int c = 0; c < count; ++c) {
         const curve *cv = &curves[c];
-        printf("\n%s\n%8s %10s %12s %10s\n", drift_effect_name(cv->effect), "spp", "aaf spp",
-               "aaf rmse", "ratio");
+        printf("\n%s\n%8s %10s %12s %10s %9s\n", drift_effect_name(cv->effect), "spp", "aaf spp",
+               "aaf rmse", "ratio", "mean/ref");
         for (int k = 0; k < cv->count; ++k) {
-            printf("%8.0f %10.2f %12.4g %9.2fx%s\n", cv->aaf[k].spp, cv->aaf[k].actual_spp,
-                   cv->aaf[k].rmse, cv->ratio[k], cv->extrapolated[k] ? " (extrapolated)" : "");
+            printf("%8.0f %10.2f %12.4g %9.2fx %9.4f%s\n", cv->aaf[k].spp, cv->aaf[k].actual_spp,
+                   cv->aaf[k].rmse, cv->ratio[k], cv->aaf[k].mean_ratio,
+                   cv->extrapolated[k] ? " (extrapolated)" : "");
         }
-        printf("plain MC:");
+        printf("plain MC (rmse, mean/ref):");
         for (int k = 0; k < cv->plain_count; ++k) {
-            printf(" %.0f spp %.4g%s", cv->plain[k].spp, cv->plain[k].rmse,
-                   k + 1 < cv->plain_count ? "," : "\n");
+            printf(" %.0f spp %.4g %.4f%s", cv->plain[k].spp, cv->plain[k].rmse,
+                   cv->plain[k].mean_ratio, k + 1 < cv->plain_count ? "," : "\n");
         }
         printf("timing %ldx%ld at %ld spp: sampling %.1f ms, filter %.1f ms, frame %.1f ms "
                "(filter %.1f%% of the frame)\n",

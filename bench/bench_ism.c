@@ -12,6 +12,7 @@
 #include "drift/metric.h"
 #include "drift/pt.h"
 #include "drift/scene_io.h"
+#include "ism/ism_internal.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -22,10 +23,10 @@
 
 typedef struct ism_options {
     const char *scene_path, *png_dir;
-    long size, threads, ref_spp, points, map, block;
+    long size, height, threads, ref_spp, points, map, block;
     long vpls[MAX_LIST], spps[MAX_LIST];
     int vpl_count, spp_count;
-    bool no_ir, json;
+    bool no_ir, classic, json;
 } ism_options;
 
 // --vpls and --spp: `field` is the options.
@@ -41,6 +42,8 @@ static bool parse_counts(const char *cmd, const char *flag, const char *value, v
 static const cli_option ism_table[] = {
     CLI_SECTION("options:", 0),
     CLI_INT("--size", "N", O, size, 8, 4096, "N x N pixels (default 400)"),
+    CLI_INT("--height", "H", O, height, 8, 4096,
+            "N x H pixels instead (e.g. --size 640 --height 480)"),
     CLI_INT("--threads", "T", O, threads, 1, 256, "worker threads (default 2)"),
     CLI_CUSTOM_ALL("--vpls", "LIST", parse_counts,
                    "comma-separated VPL counts (default 64,256,1024)"),
@@ -50,6 +53,9 @@ static const cli_option ism_table[] = {
     CLI_INT("--map", "N", O, map, 4, 1024, "ISM side (default 64)"),
     CLI_INT("--block", "B", O, block, 1, 64, "interleaving block (default 4)"),
     CLI_FLAG("--no-ir", O, no_ir, "skip the ray-traced baseline"),
+    CLI_FLAG("--classic", O, classic,
+             "after each ism row, time exact (ray-cast) paraboloid maps for the\n"
+             "same VPLs: the classic shadow maps ISMs replace (row sm)"),
     CLI_STRING("--png", "DIR", O, png_dir,
                "write each row's frame (reference terms + I) as DIR/<row>_<count>.png,\n"
                "I alone 3 stops up as DIR/<row>_<count>_indirect.png, and the\n"
@@ -75,7 +81,9 @@ typedef struct bench_state {
     drift_accel *accel;
     const ism_options *o;
     drift_image ref_indirect, ref_rest, ref_frame;
-    cJSON *rows; // --json: the rows go here instead of stdout
+    drift_image last_ism; // the last ism row's I, for the ir row of the same VPLs
+    double nrmse_vs_ism;  // the next row's NRMSE of the ism I against it (< 0: none)
+    cJSON *rows;          // --json: the rows go here instead of stdout
 } bench_state;
 
 static drift_result pt_image(bench_state *b, uint32_t components, long spp, drift_image *out,
@@ -83,7 +91,7 @@ static drift_result pt_image(bench_state *b, uint32_t components, long spp, drif
 {
     drift_pt *pt = NULL;
     drift_pt_params params = { .width = (int32_t)b->o->size,
-                               .height = (int32_t)b->o->size,
+                               .height = (int32_t)b->o->height,
                                .seed = (uint32_t)spp * 7u + components,
                                .max_depth = 2,
                                .components = components,
@@ -127,6 +135,21 @@ static void add_images(drift_image *out, const drift_image *x, const drift_image
     }
 }
 
+// RMSE of `test` against `ref` over ref's mean (all channels); 0 for a black reference.
+static double nrmse(drift_context *ctx, const drift_image *ref, const drift_image *test)
+{
+    double mse = 0.0, sum = 0.0;
+    drift_metric_mse(ctx, ref, test, &mse);
+    for (int32_t y = 0; y < ref->height; ++y) {
+        for (int32_t x = 0; x < ref->width; ++x) {
+            drift_vec3 c = drift_image_get3(ref, x, y);
+            sum += (double)(c.x + c.y + c.z) / 3.0;
+        }
+    }
+    double mean = sum / ((double)ref->width * (double)ref->height);
+    return mean > 0.0 ? sqrt(mse) / mean : 0.0;
+}
+
 // One row: I's RMSE against the reference, and FLIP of ref_rest + I against ref_frame, printed
 // or (--json) added to b->rows; `st`: the stages of an ism or ir row (NULL for the others).
 static void report(bench_state *b, const char *name, long count, double ms, const char *detail,
@@ -149,6 +172,9 @@ static void report(bench_state *b, const char *name, long count, double ms, cons
         cli_json_number(row, "ms", ms, 3);
         cli_json_number(row, "rmse_indirect", sqrt(mse), 6);
         cli_json_number(row, "flip_frame", rep.flip, 6);
+        if (b->nrmse_vs_ism >= 0.0) {
+            cli_json_number(row, "nrmse_ism_vs_ir", b->nrmse_vs_ism, 6);
+        }
         if (st) {
             static const char *const stages[] = { "vpls",      "points", "splat",
                                                   "pull_push", "gather", "blur" };
@@ -163,8 +189,12 @@ static void report(bench_state *b, const char *name, long count, double ms, cons
             cli_json_number(row, "holes", st->hole_fraction, 4);
         }
     } else {
-        printf("| %-4s | %5ld | %8.1f | %.4f | %.4f | %s |\n", name, count, ms, sqrt(mse), rep.flip,
+        printf("| %-4s | %5ld | %8.1f | %.4f | %.4f | %s", name, count, ms, sqrt(mse), rep.flip,
                detail);
+        if (b->nrmse_vs_ism >= 0.0) {
+            printf("; ism's NRMSE against it %.4f", b->nrmse_vs_ism);
+        }
+        printf(" |\n");
         fflush(stdout);
     }
     if (b->o->png_dir) {
@@ -177,6 +207,51 @@ static void report(bench_state *b, const char *name, long count, double ms, cons
                              &(drift_tonemap_params){ .exposure_stops = 3.0f });
     }
     drift_image_destroy(b->ctx, &frame);
+}
+
+typedef struct classic_job {
+    const drift_accel *accel;
+    const drift_vpl *vpls;
+    int32_t n;
+    float *maps; // one n x n map per thread: only the build is timed
+} classic_job;
+
+static void classic_maps(size_t begin, size_t end, int thread, void *user)
+{
+    classic_job *job = user;
+    float *depth = job->maps + (size_t)thread * (size_t)job->n * (size_t)job->n;
+    for (size_t j = begin; j < end; ++j) {
+        drift_frame frame = drift_frame_from_normal(job->vpls[j].normal);
+        drift__ism_exact_map(depth, job->n, job->accel, job->vpls[j].position, &frame);
+    }
+}
+
+// Row sm: exact paraboloid maps for the ism row's VPLs, one Embree ray a texel (the CPU's
+// classic shadow maps; the thesis rasterises the scene into each), timed against the ISM
+// build (splat + pull-push). Its image is the ism row's: only the build differs.
+static void classic_row(bench_state *b, const drift_ism *ism, const drift_ism_stats *st,
+                        const drift_image *indirect, long count)
+{
+    uint32_t vpl_count = 0;
+    const drift_vpl *vpls = drift_ism_vpls(ism, &vpl_count);
+    int32_t n = (int32_t)b->o->map;
+    classic_job job = { .accel = b->accel, .vpls = vpls, .n = n };
+    job.maps =
+        malloc((size_t)drift_context_thread_count(b->ctx) * (size_t)n * (size_t)n * sizeof(float));
+    if (!job.maps) {
+        return;
+    }
+    double t0 = drift_time_now();
+    drift_parallel_for(b->ctx, vpl_count, 1, classic_maps, &job);
+    double ms = (drift_time_now() - t0) * 1e3;
+    free(job.maps);
+    double ism_ms = st->ms[DRIFT_ISM_STAGE_SPLAT] + st->ms[DRIFT_ISM_STAGE_PULL_PUSH];
+    char detail[256];
+    snprintf(detail, sizeof detail,
+             "%u exact %dx%d maps, %.0f rays; %.1fx the ISM build (splat + pull-push %.1f ms)",
+             vpl_count, n, n, (double)vpl_count * (double)n * (double)n * (double)DRIFT_PI / 4.0,
+             ism_ms > 0.0 ? ms / ism_ms : 0.0, ism_ms);
+    report(b, "sm", count, ms, detail, NULL, indirect);
 }
 
 int drift_bench_ism(int argc, char **argv)
@@ -195,8 +270,9 @@ int drift_bench_ism(int argc, char **argv)
     if (status != CLI_PARSED) {
         return cli_parse_exit(status);
     }
+    o.height = o.height ? o.height : o.size;
     status = 1;
-    bench_state b = { .o = &o };
+    bench_state b = { .o = &o, .nrmse_vs_ism = -1.0 };
     cli_session session;
     cJSON *root = NULL;
     drift_result r = DRIFT_OK;
@@ -210,7 +286,7 @@ int drift_bench_ism(int argc, char **argv)
     b.accel = session.accel;
     drift_hybrid *frame = NULL;
     if (r == DRIFT_OK) {
-        drift_hybrid_params hp = { .width = (int32_t)o.size, .height = (int32_t)o.size };
+        drift_hybrid_params hp = { .width = (int32_t)o.size, .height = (int32_t)o.height };
         r = drift_hybrid_create(b.ctx, b.scene, b.accel, &hp, &frame);
     }
     if (r == DRIFT_OK) {
@@ -226,7 +302,7 @@ int drift_bench_ism(int argc, char **argv)
                      o.ref_spp, &b.ref_rest, NULL);
     }
     if (r == DRIFT_OK) {
-        r = drift_image_create(b.ctx, (int32_t)o.size, (int32_t)o.size, 3, &b.ref_frame);
+        r = drift_image_create(b.ctx, (int32_t)o.size, (int32_t)o.height, 3, &b.ref_frame);
     }
     if (r != DRIFT_OK) {
         goto done;
@@ -237,6 +313,7 @@ int drift_bench_ism(int argc, char **argv)
         root = cJSON_CreateObject();
         cJSON_AddStringToObject(root, "scene", session.scene_path);
         cJSON_AddNumberToObject(root, "size", (double)o.size);
+        cJSON_AddNumberToObject(root, "height", (double)o.height);
         cJSON_AddNumberToObject(root, "threads", drift_context_thread_count(b.ctx));
         cJSON_AddNumberToObject(root, "ref_spp", (double)o.ref_spp);
         cli_json_number(root, "gbuffer_ms", hs.ms[DRIFT_PASS_PRIMARY], 3);
@@ -244,7 +321,7 @@ int drift_bench_ism(int argc, char **argv)
     } else {
         printf("# %s at %ldx%ld, %d threads; reference %ld spp; G-buffer %.1f ms (not in the "
                "rows)\n",
-               session.scene_path, o.size, o.size, drift_context_thread_count(b.ctx), o.ref_spp,
+               session.scene_path, o.size, o.height, drift_context_thread_count(b.ctx), o.ref_spp,
                hs.ms[DRIFT_PASS_PRIMARY]);
         printf("| what | count | ms | RMSE of I | FLIP of frame | detail |\n"
                "|---|---|---|---|---|---|\n");
@@ -285,8 +362,23 @@ int drift_bench_ism(int argc, char **argv)
                  st.vpl_count, st.ms[DRIFT_ISM_STAGE_VPLS], st.ms[DRIFT_ISM_STAGE_POINTS],
                  st.ms[DRIFT_ISM_STAGE_SPLAT], st.ms[DRIFT_ISM_STAGE_PULL_PUSH],
                  st.ms[DRIFT_ISM_STAGE_GATHER], st.ms[DRIFT_ISM_STAGE_BLUR], st.hole_fraction);
+        // Fig. 5.8's error: the ism I against the ir I of the same VPLs (exact visibility),
+        // RMSE over ir's mean.
+        b.nrmse_vs_ism =
+            ir && b.last_ism.pixels ? nrmse(b.ctx, drift_ism_indirect(ism), &b.last_ism) : -1.0;
         report(&b, ir ? "ir" : "ism", o.vpls[v / 2], st.total_ms, detail, &st,
                drift_ism_indirect(ism));
+        b.nrmse_vs_ism = -1.0;
+        if (!ir) {
+            drift_image_destroy(b.ctx, &b.last_ism);
+            const drift_image *img = drift_ism_indirect(ism);
+            if (drift_image_create(b.ctx, img->width, img->height, 3, &b.last_ism) == DRIFT_OK) {
+                add_images(&b.last_ism, img, &b.last_ism); // a copy: the new image is zero
+            }
+        }
+        if (o.classic && !ir) {
+            classic_row(&b, ism, &st, drift_ism_indirect(ism), o.vpls[v / 2]);
+        }
         if (o.png_dir && !ir && v == 2 * o.vpl_count - 2) {
             char path[1024];
             snprintf(path, sizeof path, "%s/ism_vpls.png", o.png_dir);
@@ -324,6 +416,7 @@ done:
     drift_image_destroy(b.ctx, &b.ref_indirect);
     drift_image_destroy(b.ctx, &b.ref_rest);
     drift_image_destroy(b.ctx, &b.ref_frame);
+    drift_image_destroy(b.ctx, &b.last_ism);
     drift_hybrid_destroy(frame);
     cli_session_close(&session);
     return status;

@@ -33,6 +33,7 @@ typedef struct sir_options {
     const char *figures_dir;
     bool json;
     bool noise_floor;
+    bool paper_metrics;
     bool has_target;
     drift_vec3 target; // --target: look here instead of the scene camera's target
     double fov;        // --fov: vertical field of view, degrees (0: the camera's)
@@ -90,11 +91,15 @@ static const cli_option sir_table[] = {
     CLI_STRING("--lambda", "FILE", O, lambda_path, "also measure the fitted combination"),
     CLI_STRING("--figures", "DIR", O, figures_dir,
                "PNGs per row: raster, pure, sir, combined error, and the\n"
-               "recall map (white: real error flagged, red: missed, blue: flagged only)"),
+               "recall map (white: real error flagged, red: missed, blue: flagged only),\n"
+               "and the raster's error 4x (red: brighter than PRT, green: darker)"),
     CLI_FLAG("--noise-floor", O, noise_floor,
              "also the FLIP between two pure images of different seeds (how\n"
              "close two equally good images are), and a real error must exceed\n"
              "the threshold plus the two pure images' difference at the pixel"),
+    CLI_FLAG("--paper-metrics", O, paper_metrics,
+             "the paper's metrics alone: reflection metrics unweighted by the raster's\n"
+             "expected error, penumbrae ungated, no leak metric (the before of issue 17)"),
     CLI_CUSTOM_ALL("--target", "X,Y,Z", parse_target,
                    "look at this point instead of the camera's target (other views,\n"
                    "as the paper's rows are views with more or fewer error pixels)"),
@@ -162,6 +167,47 @@ static quality measure_quality(const drift_image *flag, const drift_image *real)
                       flagged ? (double)hit / (double)flagged : 1.0, (double)flagged / (double)n };
 }
 
+typedef struct ranked_pixel {
+    float error;
+    bool real;
+} ranked_pixel;
+
+static int by_error_descending(const void *a, const void *b)
+{
+    float ea = ((const ranked_pixel *)a)->error, eb = ((const ranked_pixel *)b)->error;
+    return (ea < eb) - (ea > eb);
+}
+
+// Precision at recall `recall` along SIR's own order (descending combined error: the pixels
+// it refines first): the share of real error among the first pixels that hold that much of
+// it. -1 when the flagged pixels never reach it; -2 without memory.
+static double precision_at_recall(const drift_image *error, const drift_image *real, double recall)
+{
+    size_t n = (size_t)error->width * (size_t)error->height, flagged = 0, truth = 0;
+    ranked_pixel *ranked = malloc(sizeof *ranked * (n ? n : 1));
+    if (!ranked) {
+        return -2.0;
+    }
+    for (size_t i = 0; i < n; ++i) {
+        truth += real->pixels[i] > 0.0f;
+        if (error->pixels[i] > 0.0f) {
+            ranked[flagged++] = (ranked_pixel){ error->pixels[i], real->pixels[i] > 0.0f };
+        }
+    }
+    qsort(ranked, flagged, sizeof *ranked, by_error_descending);
+    double result = -1.0;
+    size_t hits = 0;
+    for (size_t k = 0; k < flagged && truth > 0; ++k) {
+        hits += ranked[k].real;
+        if ((double)hits >= recall * (double)truth) {
+            result = (double)hits / (double)(k + 1);
+            break;
+        }
+    }
+    free(ranked);
+    return truth == 0 ? 1.0 : result;
+}
+
 #define QUALITY_ROWS (DRIFT_METRIC_COUNT + 2)
 
 typedef struct sir_row {
@@ -174,8 +220,10 @@ typedef struct sir_row {
     double noise_flip; // FLIP between two pure images of different seeds (-1: not measured)
     double reached_ms; // SIR's time to FLIP <= FLIP_TARGET against PRT (-1: not reached)
     uint64_t sir_rays, prt_rays;
+    uint64_t raster_rays, metrics_rays; // the raster frame's, the metrics'
     uint32_t iterations;
     quality q[QUALITY_ROWS]; // the metrics, the averaged sum, lambda (when given)
+    double precision_at_90;  // the combined error's precision at recall 0.9, in its order
 } sir_row;
 
 static void save_png(drift_context *ctx, const sir_options *o, const char *scene, int32_t w,
@@ -212,6 +260,17 @@ static void save_figures(drift_context *ctx, const sir_options *o, const char *s
         }
     }
     save_png(ctx, o, scene, w, h, "recall", &map);
+    // The sign of the raster's error, 4x: red where the raster is brighter (a leak), green
+    // where it is darker.
+    for (int32_t y = 0; y < h; ++y) {
+        for (int32_t x = 0; x < w; ++x) {
+            const float *a = drift_image_pixel(raster, x, y), *b = drift_image_pixel(pure, x, y);
+            float d = 4.0f * ((a[0] + a[1] + a[2]) - (b[0] + b[1] + b[2])) / 3.0f;
+            drift_image_set3(&map, x, y,
+                             drift_vec3_make(d > 0.0f ? d : 0.0f, d < 0.0f ? -d : 0.0f, 0));
+        }
+    }
+    save_png(ctx, o, scene, w, h, "sign", &map);
     drift_image_destroy(ctx, &map);
 }
 
@@ -236,7 +295,12 @@ static drift_result run_one(drift_context *ctx, const drift_scene *scene, const 
     if (r == DRIFT_OK) {
         r = drift_refine_create(
             ctx, frame,
-            &(drift_refine_params){ .spp = (uint32_t)o->spp, .budget = (uint32_t)o->budget }, &sir);
+            &(drift_refine_params){ .spp = (uint32_t)o->spp,
+                                    .budget = (uint32_t)o->budget,
+                                    .reflection_tolerance = o->paper_metrics ? -1.0f : 0.0f,
+                                    .leak_tolerance = o->paper_metrics ? -1.0f : 0.0f,
+                                    .shadow_tolerance = o->paper_metrics ? -1.0f : 0.0f },
+            &sir);
     }
     if (r == DRIFT_OK) {
         r = drift_image_create(ctx, w, h, 3, &pure);
@@ -253,7 +317,11 @@ static drift_result run_one(drift_context *ctx, const drift_scene *scene, const 
     if (r != DRIFT_OK) {
         goto done;
     }
-    row->raster_ms = drift_hybrid_get_stats(frame).frame_ms;
+    drift_hybrid_stats raster_stats = drift_hybrid_get_stats(frame);
+    row->raster_ms = raster_stats.frame_ms;
+    for (int p = 0; p < DRIFT_PASS_COUNT; ++p) {
+        row->raster_rays += raster_stats.rays[p];
+    }
     double t = drift_time_now();
     r = drift_refine_render_pure(sir, (uint32_t)o->spp, &pure, &row->prt_rays, NULL);
     row->prt_ms = 1000.0 * (drift_time_now() - t);
@@ -294,6 +362,7 @@ static drift_result run_one(drift_context *ctx, const drift_scene *scene, const 
     row->error_pixels = s.error_pixels;
     row->error_percent = 100.0 * (double)s.error_pixels / ((double)w * (double)h);
     row->metrics_ms = s.metrics_ms;
+    row->metrics_rays = s.metrics_rays;
     row->sort_ms = s.sort_ms;
     row->trace_ms = s.trace_ms;
     row->sir_ms = row->raster_ms + refine_ms;
@@ -338,6 +407,7 @@ static drift_result run_one(drift_context *ctx, const drift_scene *scene, const 
         row->q[m] = measure_quality(drift_refine_metric_image(sir, (drift_refine_metric)m), &real);
     }
     row->q[DRIFT_METRIC_COUNT] = measure_quality(drift_refine_error(sir), &real);
+    row->precision_at_90 = precision_at_recall(drift_refine_error(sir), &real, 0.9);
     if (o->figures_dir) {
         char label[160];
         snprintf(label, sizeof label, "%s%s%s", row->scene, o->view_count ? "_" : "",
@@ -408,9 +478,20 @@ static void add_json_row(cJSON *rows, const sir_row *row, bool lambda)
     cli_json_number(r, "speedup_to_flip",
                     row->reached_ms > 0.0 ? row->prt_ms / row->reached_ms : 0.0, 3);
     cJSON_AddBoolToObject(r, "same_image", row->flip <= FLIP_TARGET);
+    cli_json_number(r, "precision_at_recall_0_9", row->precision_at_90, 4);
     cli_json_count(r, "iterations", row->iterations);
     cli_json_count(r, "sir_rays", row->sir_rays);
     cli_json_count(r, "prt_rays", row->prt_rays);
+    cli_json_count(r, "raster_rays", row->raster_rays);
+    cli_json_count(r, "metrics_rays", row->metrics_rays);
+    // What refining cannot save: the raster and the metrics, against pure ray tracing.
+    cli_json_number(r, "raster_metrics_time_share",
+                    (row->raster_ms + row->metrics_ms) / row->prt_ms, 4);
+    cli_json_number(r, "raster_metrics_ray_share",
+                    row->prt_rays
+                        ? (double)(row->raster_rays + row->metrics_rays) / (double)row->prt_rays
+                        : 0.0,
+                    4);
     cJSON *by_metric = cJSON_AddObjectToObject(r, "quality");
     int count = lambda ? QUALITY_ROWS : QUALITY_ROWS - 1;
     for (int k = 0; k < count; ++k) {
@@ -433,6 +514,14 @@ static void print_text_row(const sir_row *row, bool lambda)
     } else {
         printf("    FLIP <= %.2f not reached\n", FLIP_TARGET);
     }
+    printf("    raster + metrics: %.1f%% of PRT's time, %.1f%% of its rays (%llu + %llu of "
+           "%llu)\n",
+           100.0 * (row->raster_ms + row->metrics_ms) / row->prt_ms,
+           row->prt_rays
+               ? 100.0 * (double)(row->raster_rays + row->metrics_rays) / (double)row->prt_rays
+               : 0.0,
+           (unsigned long long)row->raster_rays, (unsigned long long)row->metrics_rays,
+           (unsigned long long)row->prt_rays);
     printf("    raster %.1f + metrics %.1f + sort %.1f + trace %.1f ms, %u iterations; real error "
            "pixels %.2f%%; pure vs pure FLIP %.5f\n    recall/precision:",
            row->raster_ms, row->metrics_ms, row->sort_ms, row->trace_ms, row->iterations,
@@ -441,7 +530,12 @@ static void print_text_row(const sir_row *row, bool lambda)
     for (int k = 0; k < rows; ++k) {
         printf(" %s %.3f/%.3f", quality_name(k), row->q[k].recall, row->q[k].precision);
     }
-    printf("\n");
+    printf("\n    precision at recall 0.9 in SIR's order: ");
+    if (row->precision_at_90 >= 0.0) {
+        printf("%.3f\n", row->precision_at_90);
+    } else {
+        printf("not reached\n");
+    }
 }
 
 static const char *short_name(const char *path)

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages drift needs to build, test (python3 for the CLI tests), check
 # formatting and fuzz (SDL2 for `drift view`; Xvfb and xauth for its window test under
-# xvfb-run). Idempotent: when everything is present it does nothing (no apt-get update), so
-# repeated runs are fast.
+# xvfb-run; chromium for the `drift report` page test). Idempotent: when everything is
+# present it does nothing (no apt-get update), so repeated runs are fast.
 set -euo pipefail
 
 packages=(
@@ -10,6 +10,7 @@ packages=(
   libembree-dev libassimp-dev libcjson-dev libopenexr-dev libstb-dev zlib1g-dev libkissfft-dev
   libcmocka-dev valgrind clang-format git python3
   libsdl2-dev xvfb xauth
+  chromium
 )
 
 missing=()

@@ -25,7 +25,8 @@
     X("bench", drift_cmd_bench, "benchmarks (drift bench --help)")                           \
     X("view", drift_cmd_view, "interactive viewer: hybrid techniques against the reference") \
     X("refine", drift_cmd_refine, "smart image refinement: fit the metric weights (lambda)") \
-    X("glare", drift_cmd_glare, "temporal glare (thesis ch. 8) on an HDR image or sequence")
+    X("glare", drift_cmd_glare, "temporal glare (thesis ch. 8) on an HDR image or sequence") \
+    X("report", drift_cmd_report, "one HTML page: every technique against the reference")
 
 #define DRIFT__COMMAND_DECLARE(name, fn, summary) int fn(int argc, char **argv);
 DRIFT_COMMAND_LIST(DRIFT__COMMAND_DECLARE)
@@ -63,6 +64,15 @@ bool cli_parse_vec3(const char *cmd, const char *flag, const char *text, bool sc
 bool cli_parse_refine(const char *cmd, const char *flag, const char *value, void *field);
 // Returns argv[*i + 1] and advances *i, or prints a usage error and returns NULL.
 const char *cli_next_value(const char *cmd, int argc, char **argv, int *i);
+
+// drift diff's comparison of TEST against REF (same size): the pixels NaN or infinite in
+// either are set to 0 in both (*nonfinite counts them) and MSE and relMSE are means over
+// the others; then drift_metric_compare. DRIFT_ERR_INVALID_ARGUMENT when the sizes differ or
+// every pixel is masked. `drift report` uses it so that its numbers equal drift diff's.
+struct drift_metric_report;
+drift_result cli_compare_images(drift_context *ctx, drift_image *ref, drift_image *test, double ppd,
+                                struct drift_metric_report *rep, drift_image *flip_map,
+                                size_t *nonfinite);
 
 // A logger that prints warnings and errors (and info with verbose) as
 // "drift: FILE:LINE: level: message" on stderr.

@@ -61,42 +61,6 @@ static void print_number(const char *key, double v)
     }
 }
 
-static bool pixel_finite(const drift_image *img, int32_t x, int32_t y)
-{
-    const float *p = drift_image_pixel(img, x, y);
-    for (int32_t c = 0; c < img->channels; ++c) {
-        if (!isfinite(p[c])) {
-            return false;
-        }
-    }
-    return true;
-}
-
-static void pixel_zero(drift_image *img, int32_t x, int32_t y)
-{
-    float *p = drift_image_pixel(img, x, y);
-    for (int32_t c = 0; c < img->channels; ++c) {
-        p[c] = 0.0f;
-    }
-}
-
-// Sets the pixels that are NaN or infinite in either image to 0 in both (they then add no
-// error) and returns how many there were.
-static size_t mask_nonfinite(drift_image *a, drift_image *b)
-{
-    size_t count = 0;
-    for (int32_t y = 0; y < a->height; ++y) {
-        for (int32_t x = 0; x < a->width; ++x) {
-            if (!pixel_finite(a, x, y) || !pixel_finite(b, x, y)) {
-                pixel_zero(a, x, y);
-                pixel_zero(b, x, y);
-                ++count;
-            }
-        }
-    }
-    return count;
-}
-
 int drift_cmd_diff(int argc, char **argv)
 {
     diff_options o = { .difftol = -1.0 };
@@ -145,26 +109,19 @@ int drift_cmd_diff(int argc, char **argv)
                 ref.width, ref.height, paths[1], test.width, test.height);
         goto done;
     }
-    size_t pixels = (size_t)ref.width * (size_t)ref.height;
-    size_t nonfinite = mask_nonfinite(&ref, &test);
-    if (nonfinite == pixels) {
+    size_t pixels = (size_t)ref.width * (size_t)ref.height, nonfinite = 0;
+    r = cli_compare_images(ctx, &ref, &test, o.ppd, &rep, heatmap_path ? &flip_map : NULL,
+                           &nonfinite);
+    if (r != DRIFT_OK && nonfinite == pixels) {
         fprintf(stderr, "drift diff: every pixel of '%s' or '%s' is NaN or infinite\n", paths[0],
                 paths[1]);
         goto done;
     }
-    r = drift_metric_compare(ctx, &ref, &test, &(drift_metric_params){ .ppd = o.ppd }, &rep,
-                             heatmap_path ? &flip_map : NULL);
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift diff: %s\n", drift_result_string(r));
         goto done;
     }
     if (nonfinite > 0) {
-        // The masked pixels added no error: MSE and relMSE are means over the finite ones.
-        double scale = (double)pixels / (double)(pixels - nonfinite);
-        rep.mse *= scale;
-        rep.relmse *= scale;
-        rep.rmse = sqrt(rep.mse);
-        rep.psnr = rep.mse > 0.0 ? 10.0 * log10(1.0 / rep.mse) : HUGE_VAL;
         fprintf(stderr,
                 "drift diff: %zu of %zu pixels are NaN or infinite in '%s' or '%s'; the metrics "
                 "are over the %zu finite pixels (ssim and flip with the others set to 0 in "

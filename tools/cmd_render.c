@@ -115,6 +115,21 @@ static bool parse_isg_count(const char *cmd, const char *flag, const char *v, vo
     return true;
 }
 
+// --micro-density: the share of pixels that gather, as 1, 1/4 or 1/16 (the grid's spacing).
+static bool parse_micro_density(const char *cmd, const char *flag, const char *v, void *field)
+{
+    static const char *const names[] = { "1", "1/4", "1/16" };
+    static const int32_t spacing[] = { 1, 2, 4 };
+    for (int i = 0; i < 3; ++i) {
+        if (strcmp(v, names[i]) == 0) {
+            *(int32_t *)field = spacing[i];
+            return true;
+        }
+    }
+    fprintf(stderr, "drift %s: %s expects 1, 1/4 or 1/16, got '%s'\n", cmd, flag, v);
+    return false;
+}
+
 // Groups of options (cli_parse's first_in_group): hybrid-only, and refinement-only.
 enum {
     GROUP_HYBRID = 1u << 0,
@@ -239,6 +254,15 @@ static const cli_option render_table[] = {
             "texels a side of each VPL's imperfect shadow map (default 64)"),
     CLI_INT("--ism-points", "N", O, hybrid.ism.points_per_vpl, 16, 1 << 20,
             "scene points splatted into each map (default 1024)"),
+    CLI_INT("--micro-points", "N", O, hybrid.micro.points, 2, 1 << 22,
+            "micro-rendering (--indirect micro, --reflections micro,\n"
+            "docs/micro.md): scene points in the hierarchy, rounded up to\n"
+            "a power of two (default 65536)"),
+    CLI_INT("--micro-size", "K", O, hybrid.micro.buffer_size, 4, 32,
+            "each gather's micro-buffer is K x K pixels (default 16)"),
+    CLI_CUSTOM("--micro-density", "1|1/4|1/16", O, hybrid.micro.density, parse_micro_density,
+               "gather at every pixel, 1/4 or 1/16 of them and upsample\n"
+               "bilaterally (default 1)"),
 
     CLI_SECTION("smart image refinement (hybrid mode; docs/sir.md):", GROUP_HYBRID | GROUP_REFINE),
     CLI_CUSTOM("--refine", "sir", O, refine.enabled, cli_parse_refine,

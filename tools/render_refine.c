@@ -48,6 +48,7 @@ static bool write_stats(const render_options *o, const cli_session *session,
     cli_json_count(root, "iterations", s.iterations);
     cli_json_count(root, "samples", s.samples);
     cli_json_count(root, "rays", s.rays);
+    cli_json_count(root, "metrics_rays", s.metrics_rays);
     cJSON *ms = cJSON_AddObjectToObject(root, "milliseconds");
     cli_json_number(ms, "metrics", s.metrics_ms, 3);
     cli_json_number(ms, "sort", s.sort_ms, 3);

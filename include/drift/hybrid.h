@@ -141,6 +141,16 @@ typedef struct drift_ism_settings {
     uint32_t points_per_vpl;
 } drift_ism_settings;
 
+// Micro-rendering (indirect micro and reflections micro, docs/micro.md):
+//   points      = 0 -> 65536 scene points in the hierarchy (rounded up to a power of two)
+//   buffer_size = 0 -> 16: K, each gather's micro-buffer is K x K pixels
+//   density     = 0 -> 1: a gather every pixel; 2: 1/4 of them, 4: 1/16 (bilateral upsampling)
+typedef struct drift_micro_settings {
+    uint32_t points;
+    int32_t buffer_size;
+    int32_t density;
+} drift_micro_settings;
+
 // Light from the environment in screen space (occlusion ssao, gtao, ssdo; docs/ssdo.md):
 //   samples = 0 -> 16: N sample points a pixel (GTAO: slices x steps x 2 horizon samples)
 //   radius  = 0 -> 0.05 x the scene's diagonal: r_max, the sample hemisphere's radius
@@ -167,7 +177,7 @@ typedef struct drift_occlusion_settings {
 //                      2 = one bounce, what the sharp buffers can capture)
 //   light_samples    = 0 -> 8 samples per area light for the unshadowed light U_l
 //   ambient          = used when has_ambient; otherwise the mean direct radiance of the frame
-//   shadow_map, envmap, isg, aaf, ism, occlusion_settings: each family's settings (above)
+//   shadow_map, envmap, isg, aaf, ism, micro, occlusion_settings: each family's settings (above)
 //   reflection_edits = NULL: physical reflections. Otherwise the sharp and environment-map
 //                      reflections (and so ISG's glossy gather over the sharp buffer) and the
 //                      reference's first specular bounce follow e(q) (drift/reflect_edit.h).
@@ -199,6 +209,7 @@ typedef struct drift_hybrid_params {
     drift_isg_settings isg;
     drift_aaf_settings aaf;
     drift_ism_settings ism;
+    drift_micro_settings micro;
     drift_occlusion_settings occlusion_settings;
     const drift_reflection_edits *reflection_edits;
 } drift_hybrid_params;

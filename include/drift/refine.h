@@ -47,6 +47,8 @@ typedef enum drift_refine_metric {
     DRIFT_METRIC_REFLECTION5,     // ambient occlusion k_a: a self-reflection estimate
     DRIFT_METRIC_DOF,             // Sobel depth edges dilated by C_max(p)
     DRIFT_METRIC_SHADOW,          // conservative penumbra estimate of area lights
+    DRIFT_METRIC_LEAK,            // the raster's shadow wrong outside every penumbra (contacts,
+                                  // seams), by one shadow ray to each light's centre
     DRIFT_METRIC_COUNT
 } drift_refine_metric;
 
@@ -75,6 +77,15 @@ typedef enum drift_refine_combine {
 //   edge_threshold    = 0 -> 0.05: relative depth step per pixel that counts as an edge
 //   ao_radius         = 0 -> 5% of the scene's bounding diagonal
 //   ao_samples        = 0 -> 8 occlusion rays a reflective pixel
+//   reflection_tolerance = 0 -> 0.01: a reflective pixel whose raster reflection is expected
+//                       to be off by less (display values) gets no reflection error; < 0:
+//                       the paper's unweighted reflection metrics
+//   lobe_samples      = 0 -> 4 rays from a glossy lobe for that expectation (a mirror: 1)
+//   leak_tolerance    = 0 -> 0.01: the leak metric flags a raster shadow wrong by more;
+//                       < 0: no leak metric (and no rays for it)
+//   shadow_tolerance  = 0 -> 0.01: a penumbra pixel stays flagged only where the raster's
+//                       shadow, checked by lobe_samples shadow rays averaged over 5 x 5
+//                       pixels, is off by more; < 0: the paper's ungated penumbra estimate
 //   seed              = 0
 typedef struct drift_refine_params {
     uint32_t budget;
@@ -87,6 +98,10 @@ typedef struct drift_refine_params {
     float edge_threshold;
     float ao_radius;
     uint32_t ao_samples;
+    float reflection_tolerance;
+    uint32_t lobe_samples;
+    float leak_tolerance;
+    float shadow_tolerance;
     uint32_t seed;
 } drift_refine_params;
 
@@ -105,6 +120,7 @@ typedef struct drift_refine_stats {
     uint64_t refined;      // pixels of the list that have all their samples
     uint64_t samples;      // samples traced since the last begin
     uint64_t rays;         // rays traced since the last begin (primary, shadow, reflection)
+    uint64_t metrics_rays; // the last begin: rays the metrics cast (AO, lobe, shadow checks)
     double metrics_ms;     // the last begin: metrics
     double sort_ms;        //                 combine, sort, request list
     double trace_ms;       // since the last begin: tracing and blending

@@ -83,7 +83,10 @@
       DRIFT_STREAM_ISG_REFLECTIONS, DRIFT_PT_COMPONENT_SPECULAR)                                   \
     X(P, AAF, "aaf", "glossy light path-traced, adaptively sampled and filtered (docs/aaf.md)",    \
       drift_aaf_pass_specular, 0, DRIFT_ROW_PATH_TRACED, drift_aaf_specular_planes,                \
-      DRIFT_STREAM_AAF_SPECULAR, DRIFT_PT_COMPONENT_SPECULAR)
+      DRIFT_STREAM_AAF_SPECULAR, DRIFT_PT_COMPONENT_SPECULAR)                                      \
+    X(P, MICRO, "micro", "glossy final gather into micro-buffers (thesis ch. 6, docs/micro.md)",   \
+      drift_micro_pass_reflections, 0, 0, drift_micro_reflection_planes, 0,                        \
+      DRIFT_PT_COMPONENT_SPECULAR)
 
 #define DRIFT_DOF_TECHNIQUES(X, P)                                                           \
     X(P, NONE, "none", "pinhole: everything in focus", drift_hybrid_pass_pinhole, 0, 0,      \
@@ -112,7 +115,9 @@
     X(P, ISM, "ism", "virtual point lights, imperfect shadow maps (thesis ch. 5, docs/ism.md)",   \
       drift_ism_pass_indirect, 0, 0, drift_ism_indirect_planes, 0, DRIFT_PT_COMPONENT_DIFFUSE)    \
     X(P, IR, "ir", "baseline: the same VPLs with ray-traced visibility (instant radiosity)",      \
-      drift_ism_pass_ir, 0, 0, drift_ism_indirect_planes, 0, DRIFT_PT_COMPONENT_DIFFUSE)
+      drift_ism_pass_ir, 0, 0, drift_ism_indirect_planes, 0, DRIFT_PT_COMPONENT_DIFFUSE)          \
+    X(P, MICRO, "micro", "final gather into point-hierarchy micro-buffers (thesis ch. 6)",        \
+      drift_micro_pass_indirect, 0, 0, drift_micro_indirect_planes, 0, DRIFT_PT_COMPONENT_DIFFUSE)
 
 // Light from the environment through the diffuse lobe, with its visibility (thesis ch. 4). Any
 // technique but none takes that light out of D (DRIFT_ROW_ENVIRONMENT_DIFFUSE).

@@ -93,11 +93,17 @@ float drift_aaf_pixel_footprint(const drift_camera *camera, int32_t image_height
 // Sparse samples per pixel for an average target of `spp`: a quarter of it, at least
 // DRIFT_AAF_SPARSE_MIN (never more than spp).
 uint32_t drift_aaf_sparse_count(uint32_t spp);
+// The soft-shadow pass's: the same from 8 spp on, half of spp (at least 2) below, so that 4 spp
+// keeps an adaptive pass (aaf_shadows.c).
+uint32_t drift_aaf_shadow_sparse_count(uint32_t spp);
 
-// Turns the desired rates want[i] (eq. 3.5 or 4.6; 0 for pixels that get no adaptive samples)
-// into counts[i] >= sparse, at most max_spp, whose mean over `active` pixels is about spp: the
-// rates are scaled by one factor found by bisection, then rounded up or down by a per-pixel
-// hash so the expected total is the budget. Pixels with want 0 keep `sparse`.
+// Turns the desired rates want[i] (eq. 3.5 or 4.6; 0 for flat pixels, which get no adaptive
+// samples; < 0 for pixels outside the budget) into counts[i] >= sparse, at most max_spp, whose
+// mean over the `active` pixels (those with want >= 0) is spp: the rates are scaled by one
+// factor found by bisection, then rounded up or down by a per-pixel hash so the expected total
+// is the budget. When the adaptive pixels cannot spend it under max_spp, the cap doubles until
+// they can (at most to 8 max_spp). Flat pixels keep `sparse`, plus an even share of what the
+// adaptive pixels still cannot take; pixels outside the budget keep `sparse`.
 void drift_aaf_allocate(const float *want, size_t count, size_t active, uint32_t sparse,
                         uint32_t spp, uint32_t max_spp, uint32_t seed, uint32_t *counts);
 

@@ -42,9 +42,10 @@ static double allocated(const float *want, size_t count, double scale, double lo
 void drift_aaf_allocate(const float *want, size_t count, size_t active, uint32_t sparse,
                         uint32_t spp, uint32_t max_spp, uint32_t seed, uint32_t *counts)
 {
-    size_t adaptive = 0;
+    size_t adaptive = 0, flat = 0;
     for (size_t i = 0; i < count; ++i) {
         adaptive += want[i] > 0.0f;
+        flat += want[i] == 0.0f;
     }
     // Pixels that get adaptive samples take at least half the target: eq. 3.5 and 4.6 peak
     // steeply (as 1/s2^4 near contact), and without a floor a few contact pixels took the
@@ -54,6 +55,12 @@ void drift_aaf_allocate(const float *want, size_t count, size_t active, uint32_t
     double hi = fmax((double)max_spp, lo);
     // What the adaptive pixels may spend: the whole budget less the sparse-only pixels.
     double budget = (double)spp * (double)active - (double)sparse * (double)(active - adaptive);
+    // When the adaptive pixels cannot spend the budget under the cap (few pixels in penumbra,
+    // a small light), the cap doubles until they can, up to 8 times: samples at contact edges
+    // lower the error, samples in flat pixels (exactly 0 or 1 already) hardly do.
+    for (int k = 0; k < 3 && adaptive > 0 && hi * (double)adaptive < budget; ++k) {
+        hi *= 2.0;
+    }
     double scale = 0.0;
     if (adaptive > 0 && budget <= lo * (double)adaptive) {
         lo = budget / (double)adaptive; // the floor is all there is: spread the budget evenly
@@ -72,15 +79,19 @@ void drift_aaf_allocate(const float *want, size_t count, size_t active, uint32_t
         }
         scale = b;
     }
+    // What the adaptive pixels cannot take even so (none, or very few, in penumbra) goes to the
+    // flat ones, evenly, so the mean stays the budget.
+    double left = budget - (adaptive > 0 ? allocated(want, count, scale, lo, hi) : 0.0);
+    double extra = flat > 0 && left > 0.0 ? left / (double)flat : 0.0;
     for (size_t i = 0; i < count; ++i) {
+        // Randomised rounding keeps the expected total on budget.
+        double u = (double)drift_u32_to_unit(drift_hash_combine(seed, (uint32_t)i));
         if (!(want[i] > 0.0f)) {
-            counts[i] = sparse;
+            counts[i] = sparse + (want[i] == 0.0f ? (uint32_t)floor(extra + u) : 0u);
             continue;
         }
         double n = scale * (double)want[i];
         n = n < lo ? lo : (n > hi ? hi : n);
-        // Randomised rounding keeps the expected total on budget.
-        double u = (double)drift_u32_to_unit(drift_hash_combine(seed, (uint32_t)i));
         counts[i] = (uint32_t)floor(n + u);
         counts[i] = counts[i] > (uint32_t)hi ? (uint32_t)hi : counts[i];
         counts[i] = counts[i] < sparse ? sparse : counts[i];

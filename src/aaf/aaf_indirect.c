@@ -2,8 +2,9 @@
 // bounce: the diffuse lobe here (--indirect aaf, the frame's I term) and the glossy lobe in
 // aaf_specular.c (--reflections aaf, R), each in its own buffers, filtered apart (sec. 4.3),
 // path-traced per pixel and filtered in world space:
-//   1. sparse: a few rays sampled from the lobe; their hit distances give z_min and z_max,
-//      which set beta (eq. 4.4, with the lobe's Omega_h^max of eq. 4.5) and n(x) (eq. 4.6);
+//   1. sparse: a few rays sampled from the lobe; the hit distances of the neighbours' rays
+//      give z_min and z_max (escaped rays count as infinitely far), which set beta (eq. 4.4,
+//      with the lobe's Omega_h^max of eq. 4.5) and n(x) (eq. 4.6);
 //   2. adaptive: the --spp budget spread in proportion to n(x), capped at aaf_max_spp;
 //   3. the separable filter on the estimate divided by the lobe's albedo (so texture is not
 //      blurred), then multiplied back by the albedo.
@@ -193,25 +194,91 @@ static void sparse_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *r
     *sums = (indirect_sums){ INFINITY, 0.0f, 0.0f, 0.0f };
     drift_image_set3(&b->radiance, x, y, drift_vec3_splat(0.0f));
     drift_image_pixel(&b->beta, x, y)[0] = 0.0f;
-    st->want[i] = 0.0f;
+    st->want[i] = -1.0f; // outside the budget
     drift_vec3 albedo;
     float omega;
     if (!lobe_at(f, job, x, y, &albedo, &omega)) {
         return;
     }
+    st->want[i] = 0.0f; // set by rates_pixel; a mirror keeps its sparse samples
     sums->has_lobe = 1.0f;
     add_samples(f, job, x, y, 0, job->uniform ? f->params.spp : job->sparse, rays);
-    if (!isfinite(sums->z_min) || !(omega > 0.0f)) {
-        return; // open to the sky, or a mirror: nothing to filter
+}
+
+// z_min and z_max of the pixel for eq. 4.4 and 4.6: the means of its neighbours' (on the same
+// surface, within DRIFT_AAF_DILATE pixels; the pixel's own left out). Taking a pixel's own
+// sparse distances made beta and n(x) functions of the very samples they filter: in an open
+// scene a pixel whose few rays all escaped (an estimate of 0) got no filter and no adaptive
+// samples, one whose rays met the near plant got more, and the frame came out 23-28% dark
+// (issue 17). From the neighbours, beta and n(x) hardly depend on the pixel's own estimate,
+// so the adaptive pass and the filter stay unbiased. Escaped rays count as infinitely far:
+// returns false when no neighbour's ray hit anything (the pixel is open to the sky, whose
+// light, the environment, reaches this term only through next-event estimation later on:
+// low frequency, filtered at the widest width).
+static bool neighbour_distances(const drift_frame_state *f, int32_t x, int32_t y, float *z_min,
+                                float *z_max)
+{
+    const drift_aaf_state *st = f->aaf;
+    const drift_gbuffer *g = &f->gbuffer;
+    float depth = drift_image_pixel(&g->depth, x, y)[0];
+    drift_vec3 normal = drift_image_get3(&g->normal, x, y);
+    float sum_min = 0.0f, sum_max = 0.0f;
+    int32_t count = 0;
+    for (int32_t ny = y - DRIFT_AAF_DILATE; ny <= y + DRIFT_AAF_DILATE; ++ny) {
+        for (int32_t nx = x - DRIFT_AAF_DILATE; nx <= x + DRIFT_AAF_DILATE; ++nx) {
+            if (nx < 0 || ny < 0 || nx >= f->params.width || ny >= f->params.height ||
+                (nx == x && ny == y)) {
+                continue;
+            }
+            const indirect_sums *n =
+                (const indirect_sums *)&st->aux[DRIFT_AAF_AUX * pixel_index(f, nx, ny)];
+            if (!(n->has_lobe > 0.0f) || !isfinite(n->z_min) ||
+                fabsf(drift_image_pixel(&g->depth, nx, ny)[0] - depth) >
+                    DRIFT_AAF_DEPTH_TOLERANCE * depth ||
+                drift_vec3_dot(drift_image_get3(&g->normal, nx, ny), normal) <
+                    DRIFT_AAF_NORMAL_COS) {
+                continue;
+            }
+            sum_min += n->z_min;
+            sum_max += n->z_max;
+            ++count;
+        }
     }
-    float z_min = fmaxf(sums->z_min, 1e-4f), z_max = fmaxf(sums->z_max, z_min);
+    if (count == 0) {
+        return false;
+    }
+    *z_min = fmaxf(sum_min / (float)count, 1e-4f);
+    *z_max = fmaxf(sum_max / (float)count, *z_min);
+    return true;
+}
+
+// beta (eq. 4.4) and n(x) (eq. 4.6) from the neighbours' sparse distances.
+static void rates_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
+{
+    (void)rays;
+    const indirect_job *job = user;
+    drift_aaf_state *st = f->aaf;
+    size_t i = pixel_index(f, x, y);
+    drift_vec3 albedo;
+    float omega;
+    if (!(((const indirect_sums *)&st->aux[DRIFT_AAF_AUX * i])->has_lobe > 0.0f) ||
+        !lobe_at(f, job, x, y, &albedo, &omega) || !(omega > 0.0f)) {
+        return; // no lobe, or a mirror: nothing to filter
+    }
     float d = drift_image_pixel(&st->footprint, x, y)[0];
-    drift_image_pixel(&b->beta, x, y)[0] =
-        drift_aaf_indirect_beta(z_min, d, omega, job->lobe->pixel_width) * job->shrink;
-    // eq. 4.6 with sqrt(A_p) = d.
-    float a = 0.9f * omega * d / z_min + 0.3f;
-    float c = 1.0f + 0.9f * z_max / z_min;
-    st->want[i] = fmaxf(0.4f * a * a * omega * omega * c * c, 1e-3f);
+    float z_min, z_max, beta;
+    if (neighbour_distances(f, x, y, &z_min, &z_max)) {
+        beta = drift_aaf_indirect_beta(z_min, d, omega, job->lobe->pixel_width);
+        // eq. 4.6 with sqrt(A_p) = d.
+        float a = 0.9f * omega * d / z_min + 0.3f;
+        float c = 1.0f + 0.9f * z_max / z_min;
+        st->want[i] = fmaxf(0.4f * a * a * omega * omega * c * c, 1e-3f);
+    } else {
+        // Open: eq. 4.4 as z_min grows without bound, held to the filter's widest reach.
+        beta = fmaxf(job->lobe->pixel_width, (float)DRIFT_AAF_MAX_RADIUS / 3.0f) * d;
+        st->want[i] = 1e-3f;
+    }
+    drift_image_pixel(&job->lobe->buffers->beta, x, y)[0] = beta * job->shrink;
 }
 
 static void adaptive_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
@@ -270,6 +337,7 @@ drift_result drift_aaf_lobe_pass(drift_frame_state *f, const drift_aaf_lobe *lob
     double t = drift_time_now();
     if (job.bounces > 0) {
         stats->rays[DRIFT_PASS_AAF_SAMPLING] += drift_pass_for_each_pixel(f, sparse_pixel, &job);
+        drift_pass_for_each_pixel(f, rates_pixel, &job);
         // The average --spp is over the pixels that have the lobe: a glossy floor in a diffuse
         // room must not receive the budget of every diffuse pixel.
         size_t active = 0;

@@ -27,6 +27,7 @@ typedef enum drift_stream {
     DRIFT_STREAM_ISG_DOF = 13,         // isg/isg_dof.c
     DRIFT_STREAM_ISG_LAYER = 14,       // isg/isg_layers.c
     DRIFT_STREAM_SIR_AO = 0x5150,      // SIR's ambient-occlusion metric (sir/metrics.c)
+    DRIFT_STREAM_SIR_LOBE = 0x5151,    // SIR's expected reflection error (sir/metrics.c)
     DRIFT_STREAM_SIR_TRACE = 0x51f0,   // SIR's ray tracer (sir/raytrace.c)
     DRIFT_STREAM_AAF_SHADOWS = 0x5aaf0001,  // + light index (aaf/aaf_shadows.c)
     DRIFT_STREAM_AAF_INDIRECT = 0x5aaf1000, // aaf/aaf_indirect.c

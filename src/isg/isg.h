@@ -41,7 +41,11 @@ typedef struct drift_isg_jitter {
     drift_vec2 shift;
 } drift_isg_jitter;
 
-drift_isg_jitter drift_isg_jitter_make(uint32_t hash);
+drift_isg_jitter drift_isg_jitter_make(uint32_t hash); // white: independent per pixel
+// Interleaved over the image (what the passes use): the nine pixels of every 3 x 3 window
+// take the nine strata of the rotation (quarter turn) and of the shift, placed by the hash,
+// so neighbouring errors cancel (less stipple than white noise at the same cost).
+drift_isg_jitter drift_isg_jitter_at(uint32_t hash, int32_t x, int32_t y);
 
 // Offset in pixels of sample i of the pattern for a kernel of half extents `radius`.
 drift_vec2 drift_isg_offset(const drift_isg_pattern *pattern, const drift_isg_jitter *jitter,

@@ -91,9 +91,8 @@ static void dof_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays
                      .y0 = y,
                      .z0 = depth_at(&f->gbuffer.depth, x, y),
                      .c0 = drift_image_pixel(&f->coc, x, y)[0] };
-    uint32_t pixel = (uint32_t)y * (uint32_t)f->params.width + (uint32_t)x;
     drift_isg_jitter jitter =
-        drift_isg_jitter_make(drift_hash_combine(f->params.seed ^ DRIFT_STREAM_ISG_DOF, pixel));
+        drift_isg_jitter_at(drift_hash_u32(f->params.seed ^ DRIFT_STREAM_ISG_DOF), x, y);
     drift_isg_kernel search = {
         &s->search,   jitter, drift_vec2_make(job->search_radius, job->search_radius),
         range_search, &rc,    NULL

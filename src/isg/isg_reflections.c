@@ -6,7 +6,7 @@
 //           centre's tangent plane with isg_range_plane), n = 1 - N_i . N_0
 //           (eq. 12) -> E, their average (misses rejected; none found: E = infinity)
 //   support tan alpha = E tan theta_max / (e + E) (eq. 13), e the eye distance; alpha / fov
-//           per axis, times cos(theta_incident) (eq. 14)
+//           per axis (eq. 14's cos(theta_incident) is for half-vector lobes: not applied)
 //   gather  over the reflected radiance with range eq. 10 and a spatial weight shaped like
 //           the Phong lobe across the cone, 0.1^(rho^2) at fraction rho of the support (the
 //           search's weight is constant, as in the paper)
@@ -94,8 +94,8 @@ static void reflection_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_
                      .plane = p->isg.range_plane,
                      .x0 = x,
                      .y0 = y };
-    uint32_t hash = drift_hash_combine(p->seed ^ DRIFT_STREAM_ISG_REFLECTIONS, (uint32_t)index);
-    drift_isg_jitter jitter = drift_isg_jitter_make(hash);
+    drift_isg_jitter jitter =
+        drift_isg_jitter_at(drift_hash_u32(p->seed ^ DRIFT_STREAM_ISG_REFLECTIONS), x, y);
     drift_vec3 gathered;
     if (p->reflections == DRIFT_REFLECTIONS_BLUR) {
         drift_isg_kernel k = {
@@ -117,9 +117,12 @@ static void reflection_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_
         }
         float eye_distance = drift_vec3_length(drift_vec3_sub(f->camera.position, rc.p0));
         float alpha = drift_isg_gloss_alpha(theta, eye_distance, reflected_distance);
-        float cos_incident = fmaxf(0.0f, drift_vec3_dot(rc.n0, wo));
-        drift_vec2 gather_radius =
-            drift_vec2_make(alpha * scale_x * cos_incident, alpha * scale_y * cos_incident);
+        // No eq. 14: its cos(theta_incident) tightens a half-vector (Blinn-Phong) lobe at
+        // grazing angles, but drift's Phong lobe is a cone about the mirror direction at any
+        // angle, and a flat reflector shows the virtual image undistorted, so the cone stays
+        // alpha wide on screen. With the cosine, a Phong-100 floor seen at grazing view blurred
+        // 3-5x too little (a ghost of the dragon in the open glossy room, issue 17).
+        drift_vec2 gather_radius = drift_vec2_make(alpha * scale_x, alpha * scale_y);
         search_out[0] = reflected_distance;
         search_out[1] = fmaxf(gather_radius.x, gather_radius.y);
         if (search_out[1] < 0.5f) {

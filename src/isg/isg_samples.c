@@ -41,6 +41,29 @@ drift_isg_jitter drift_isg_jitter_make(uint32_t hash)
                                                    drift_u32_to_unit(drift_hash_u32(h2)) - 0.5f) };
 }
 
+// Interleaved sampling (Keller and Heidrich 2001) over 3 x 3 pixel tiles: the nine pixels of
+// a tile take the nine strata of the rotation (and of the shift), so every 3 x 3 window of
+// the image, aligned or not, holds each stratum once and its errors nearly cancel there,
+// where independent per-pixel rotations leave white noise (stipple). The order within the
+// tile is a knight's-move permutation, so that neighbours take strata far apart.
+static const uint8_t interleave_order[9] = { 0, 5, 7, 3, 8, 1, 6, 2, 4 };
+
+drift_isg_jitter drift_isg_jitter_at(uint32_t hash, int32_t x, int32_t y)
+{
+    uint32_t i = (uint32_t)(x % 3 + 3) % 3, j = (uint32_t)(y % 3 + 3) % 3;
+    uint32_t h2 = drift_hash_u32(hash);
+    // The hash places the strata's points (one offset per seed and light): the strata stay.
+    float a = ((float)interleave_order[3 * j + i] + drift_u32_to_unit(hash)) / 9.0f;
+    // The grid's disk has the square's four-fold symmetry: angles a quarter turn apart give
+    // one pattern, so the strata cover a quarter turn.
+    float angle = 0.5f * DRIFT_PI * a;
+    float sx = ((float)i + drift_u32_to_unit(h2)) / 3.0f;
+    float sy = ((float)j + drift_u32_to_unit(drift_hash_u32(h2))) / 3.0f;
+    return (drift_isg_jitter){ .cos_a = cosf(angle),
+                               .sin_a = sinf(angle),
+                               .shift = drift_vec2_make(sx - 0.5f, sy - 0.5f) };
+}
+
 // Wraps v into [-1, 1).
 static float wrap_unit(float v)
 {

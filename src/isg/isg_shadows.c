@@ -113,8 +113,7 @@ static void shadow_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *r
         }
         return; // direct.c has set S_l = 0 on misses
     }
-    uint32_t pixel = (uint32_t)y * (uint32_t)f->params.width + (uint32_t)x;
-    uint32_t hash = drift_hash_combine(f->params.seed ^ DRIFT_STREAM_ISG_SHADOWS, pixel);
+    uint32_t hash = drift_hash_u32(f->params.seed ^ DRIFT_STREAM_ISG_SHADOWS);
     float z = drift_image_pixel(&g->depth, x, y)[0];
     range_ctx rc = { .position = &g->position,
                      .material_id = &g->material_id,
@@ -128,7 +127,7 @@ static void shadow_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *r
         float *shadow = drift_image_pixel(&b->shadow, x, y);
         float *search_out = drift_image_pixel(&s->light_search[l], x, y);
         rc.hard = &b->hard_shadow;
-        drift_isg_jitter jitter = drift_isg_jitter_make(drift_hash_u32(hash + l));
+        drift_isg_jitter jitter = drift_isg_jitter_at(drift_hash_u32(hash + l), x, y);
         if (f->params.shadows == DRIFT_SHADOWS_BLUR) {
             float r = f->params.isg.blur_radius;
             drift_isg_kernel k = { &s->gather,    jitter, drift_vec2_make(r, r),

@@ -16,6 +16,12 @@ drift_result drift__ism_generate_vpls(drift_context *ctx, const drift_scene *sce
 // The most VPLs drift__ism_generate_vpls can make with these (resolved) parameters.
 uint32_t drift__ism_max_vpls(const drift_ism_params *params);
 
+// Sizes the atlas and the scene points for at least `vpls` maps (at most the max above);
+// a render calls it with its VPL count. Growing re-samples the points, with the same result.
+drift_result drift__ism_reserve(drift_ism *ism, uint32_t vpls);
+// How many maps the atlas and the points hold now.
+uint32_t drift__ism_map_capacity(const drift_ism *ism);
+
 // What splatting one map needs.
 typedef struct drift__ism_splat_desc {
     int32_t n;          // the map is n x n texels
@@ -27,6 +33,12 @@ typedef struct drift__ism_splat_desc {
 // VPL at `origin` with frame `frame` (z = its normal), keeping the nearest distance per texel.
 void drift__ism_splat(float *depth, const drift__ism_splat_desc *desc, drift_vec3 origin,
                       const drift_frame *frame, const drift_vec3 *positions, uint32_t count);
+
+// The exact n x n paraboloid depth map of a VPL at `origin` (frame z = its normal): one ray
+// through each texel centre inside the disc, the nearest hit's distance (INFINITY: a miss or
+// outside the disc). The CPU's classic shadow map, against which ISMs are timed.
+void drift__ism_exact_map(float *depth, int32_t n, const drift_accel *accel, drift_vec3 origin,
+                          const drift_frame *frame);
 
 // Pull-push hole filling of an n x n map over `levels` levels with the level-0 threshold
 // `threshold`; scratch holds at least n * n floats (levels <= 7). Returns the number of texels

@@ -1,5 +1,6 @@
 // One imperfect shadow map: paraboloid point splatting with a z-test, and pull-push hole
 // filling (Ritschel et al. 2008, §5.2.2; docs/ism.md, "Maps").
+#include "drift/accel.h"
 #include "ism/ism_internal.h"
 
 #include <math.h>
@@ -130,4 +131,23 @@ uint32_t drift__ism_pull_push(float *depth, int32_t n, int32_t levels, float thr
         }
     }
     return empty;
+}
+
+void drift__ism_exact_map(float *depth, int32_t n, const drift_accel *accel, drift_vec3 origin,
+                          const drift_frame *frame)
+{
+    for (int32_t y = 0; y < n; ++y) {
+        for (int32_t x = 0; x < n; ++x) {
+            drift_vec2 p = { 2.0f * ((float)x + 0.5f) / (float)n - 1.0f,
+                             2.0f * ((float)y + 0.5f) / (float)n - 1.0f };
+            float d = INFINITY;
+            if (p.x * p.x + p.y * p.y <= 1.0f) {
+                drift_vec3 dir = drift_frame_to_world(frame, drift_paraboloid_unproject(p));
+                drift_ray ray = { origin, 0.0f, dir, INFINITY };
+                drift_hit hit;
+                d = drift_accel_intersect(accel, &ray, &hit) ? hit.t : INFINITY;
+            }
+            depth[y * n + x] = d;
+        }
+    }
 }

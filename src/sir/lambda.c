@@ -121,7 +121,9 @@ drift_result drift_refine_lambda_load(drift_context *ctx, const char *path,
     for (int m = 0; r == DRIFT_OK && m < DRIFT_METRIC_COUNT; ++m) {
         const cJSON *v = cJSON_GetObjectItemCaseSensitive(
             weights, drift_refine_metric_name((drift_refine_metric)m));
-        if (!cJSON_IsNumber(v) || !(v->valuedouble >= 0.0) || !isfinite(v->valuedouble)) {
+        if (!v && m == DRIFT_METRIC_LEAK) {
+            out_lambda[m] = 1.0f / DRIFT_METRIC_COUNT; // files fitted before the leak metric
+        } else if (!cJSON_IsNumber(v) || !(v->valuedouble >= 0.0) || !isfinite(v->valuedouble)) {
             r = DRIFT_ERR_PARSE;
         } else {
             out_lambda[m] = (float)v->valuedouble;
@@ -131,7 +133,7 @@ drift_result drift_refine_lambda_load(drift_context *ctx, const char *path,
     if (r != DRIFT_OK) {
         drift_log(ctx, DRIFT_LOG_ERROR, r, path, 0,
                   "lambda file: expected {\"lambda\": {\"reflection1\": number >= 0, ... "
-                  "\"shadow\": ...}}");
+                  "\"shadow\": ..., \"leak\": ...}}");
     }
     return r;
 }

@@ -17,6 +17,12 @@
 // vertices): the shadow metric bounds the light by them instead of its bounding sphere.
 #define MAX_CORNERS 64
 
+// A metric's value is its expected display-value error over this (the lambda fit's scale of
+// the real error), so it orders pixels as the error does.
+#define REAL_ERROR_SCALE 0.1f
+// The square over which the expected reflection error is averaged: 5 x 5 pixels.
+#define EXPECTED_RADIUS 2
+
 typedef struct light_shape {
     uint32_t count; // 0: use the bounding sphere
     bool planar;    // one-sided and every part faces `direction`: nothing lights its back
@@ -29,6 +35,8 @@ typedef struct metric_job {
     float ao_radius;
     uint64_t ao_rays;
     light_shape *shapes; // one a frame light, or NULL: bounding spheres
+    float *expected;     // a pixel's expected reflection error (-1: not reflective), or NULL
+    float *shadow_delta; // 3 a pixel: the raster's estimated shadow error in a penumbra
 } metric_job;
 
 static bool is_reflective(const drift_frame_state *f, const drift_surface *s)
@@ -87,9 +95,159 @@ static float ambient_occlusion(const drift_frame_state *f, const drift_surface *
     return samples ? (float)hits / (float)samples : 0.0f;
 }
 
+static float display(float v)
+{
+    return powf(drift_clampf(v, 0.0f, 1.0f), 1.0f / 2.2f);
+}
+
+// How far the displayed pixel `base` moves when `delta` is added (largest channel, display
+// values: clamp to [0,1], gamma 1/2.2, as the real error is measured).
+static float display_change(drift_vec3 base, drift_vec3 delta)
+{
+    drift_vec3 moved = drift_vec3_add(base, delta);
+    return fmaxf(
+        fmaxf(fabsf(display(moved.x) - display(base.x)), fabsf(display(moved.y) - display(base.y))),
+        fabsf(display(moved.z) - display(base.z)));
+}
+
+static const drift_envmap *probe_map(const drift_frame_state *f, uint32_t mesh)
+{
+    for (uint32_t i = 0; i < f->probe_count; ++i) {
+        if (f->probes[i].mesh == mesh || f->probes[i].mesh == DRIFT_INVALID_INDEX) {
+            return f->probes[i].map;
+        }
+    }
+    return NULL;
+}
+
+static drift_vec3 seen_in_map(const drift_envmap *map, drift_vec3 dir, float cone, bool mirror)
+{
+    drift_raster_radiance l = drift_envmap_lookup(map, dir, cone);
+    return mirror ? drift_vec3_add(l.emitted, l.reflected) : l.reflected;
+}
+
+// The raster's own expected reflection error at a reflective pixel, in display values: R
+// looks the map up along the mirror direction r as if the pixel sat at the probe c. The mirror
+// ray finds where the reflection really lands (q), and rays drawn from the lobe the share of
+// it that escapes the scene; the map seen from c toward q, blurred over the lobe's cone as R
+// is (parallax-corrected, as local cube maps are), is what R would hold there. The change of
+// the pixel when R takes that value, weighted by the lobe's albedo as R is, is the expected
+// error. A q hidden from c is unknown to the map: the raster cannot be trusted there (error
+// 1). Without a map (another reflection technique) the error is unknown too.
+static float expected_reflection_error(drift_frame_state *f, size_t index, const drift_surface *s,
+                                       drift_vec3 wo, uint32_t samples, drift_sampler *sampler,
+                                       uint64_t *rays)
+{
+    const drift_envmap *map = probe_map(f, f->gbuffer.mesh_index[index]);
+    if (!map || f->params.reflections != DRIFT_REFLECTIONS_ENVMAP) {
+        return 1.0f;
+    }
+    drift_bsdf bsdf = drift_bsdf_make(f->scene, s);
+    bool mirror = bsdf.type == DRIFT_MATERIAL_MIRROR;
+    float cone = mirror ? 0.0f : drift_gloss_theta_max(&f->scene->materials[s->material]);
+    drift_vec3 c = drift_envmap_probe(map);
+    drift_vec3 r = drift_vec3_reflect(wo, s->ns);
+    drift_vec3 escaped = drift_vec3_splat(0.0f);
+    uint32_t hits = 0, used = 0;
+    drift_vec3 q = s->position;
+    bool found = false;
+    for (uint32_t k = 0; k <= (mirror ? 0u : samples); ++k) { // k = 0: the mirror ray
+        drift_vec3 dir =
+            k == 0 ? r : drift_bsdf_sample_glossy_lobe(&bsdf, wo, drift_sampler_next2(sampler));
+        if (drift_vec3_dot(dir, s->ng) <= 0.0f) {
+            continue; // below the surface: the ray tracer gives it no weight either
+        }
+        drift_ray ray = { .origin = drift_offset_origin(s->position, s->ng, dir),
+                          .dir = dir,
+                          .tmin = 0.0f,
+                          .tmax = INFINITY };
+        drift_hit hit;
+        ++*rays;
+        ++used;
+        if (drift_accel_intersect(f->accel, &ray, &hit)) {
+            ++hits;
+            if (k == 0) {
+                q = drift_vec3_fma(ray.origin, dir, hit.t);
+                found = true;
+            }
+        } else if (mirror && drift_scene_has_environment(f->scene)) {
+            escaped = drift_vec3_add(escaped, drift_environment_eval(f->scene, dir));
+        } // a glossy lobe's escaped rays see the environment in D, not R
+    }
+    if (used == 0) {
+        return 0.0f;
+    }
+    drift_vec3 expected = escaped;
+    if (hits > 0) {
+        // The lobe's hits see what the mirror ray's q shows in the map (or, when the mirror ray
+        // escaped, what the map shows along r itself).
+        drift_vec3 to_q = found ? drift_vec3_sub(q, c) : r;
+        float distance = drift_vec3_length(to_q);
+        if (!(distance > 0.0f)) {
+            return 1.0f;
+        }
+        drift_ray from_probe = { .origin = c,
+                                 .dir = drift_vec3_scale(to_q, 1.0f / distance),
+                                 .tmin = 0.0f,
+                                 .tmax = 0.99f * distance };
+        ++*rays;
+        if (found && drift_accel_occluded(f->accel, &from_probe)) {
+            return 1.0f;
+        }
+        expected = drift_vec3_fma(expected, seen_in_map(map, to_q, cone, mirror), (float)hits);
+    }
+    expected = drift_vec3_scale(expected, 1.0f / (float)used);
+    drift_vec3 weight = drift_raster_reflection_weight(&bsdf, wo);
+    drift_vec3 delta =
+        drift_vec3_mul(weight, drift_vec3_sub(expected, seen_in_map(map, r, cone, mirror)));
+    return display_change(drift_image_get3(&f->final, (int32_t)(index % (size_t)f->params.width),
+                                           (int32_t)(index / (size_t)f->params.width)),
+                          delta);
+}
+
+// First pass: the expected error of each reflective pixel (-1 elsewhere), into job->expected.
+static void expected_error_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays,
+                                 void *user)
+{
+    metric_job *job = user;
+    size_t index = (size_t)y * (size_t)f->params.width + (size_t)x;
+    const drift_surface *s = &f->gbuffer.surfaces[index];
+    float expected = -1.0f;
+    if (is_reflective(f, s)) {
+        drift_sampler sampler =
+            drift_pass_sampler(f, DRIFT_STREAM_SIR_LOBE ^ job->params->seed, x, y);
+        expected = expected_reflection_error(f, index, s, drift_pass_wo(f, x, y),
+                                             job->params->lobe_samples, &sampler, rays);
+    }
+    job->expected[index] = expected;
+}
+
+// A few lobe rays a pixel make a noisy estimate; its mean over the reflective pixels of a
+// (2 radius + 1)^2 square is steadier (the error it estimates varies smoothly, but for
+// contacts, which an unknown q marks 1 and the mean spreads).
+static void smooth_expected(const float *in, int32_t w, int32_t h, int32_t radius, float *out)
+{
+    for (int32_t y = 0; y < h; ++y) {
+        for (int32_t x = 0; x < w; ++x) {
+            size_t index = (size_t)y * (size_t)w + (size_t)x;
+            float sum = 0.0f;
+            int count = 0;
+            for (int32_t v = y - radius; in[index] >= 0.0f && v <= y + radius; ++v) {
+                for (int32_t u = x - radius; v >= 0 && v < h && u <= x + radius; ++u) {
+                    float e = u >= 0 && u < w ? in[(size_t)v * (size_t)w + (size_t)u] : -1.0f;
+                    sum += e >= 0.0f ? e : 0.0f;
+                    count += e >= 0.0f;
+                }
+            }
+            out[index] = count ? sum / (float)count : in[index];
+        }
+    }
+}
+
 static void reflection_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
 {
     metric_job *job = user;
+    const drift_refine_metric_params *params = job->params;
     size_t index = (size_t)y * (size_t)f->params.width + (size_t)x;
     const drift_surface *s = &f->gbuffer.surfaces[index];
     float e[5] = { 0 };
@@ -98,13 +256,28 @@ static void reflection_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_
         drift_vec3 r = drift_vec3_reflect(wo, s->ns);
         drift_vec3 c = probe_centre(f, f->gbuffer.mesh_index[index]);
         float far = max_distance(f->scene, c);
-        e[0] = 1.0f;
-        e[1] = far > 0.0f ? drift_vec3_length(drift_vec3_sub(s->position, c)) / far : 0.0f;
-        e[2] = drift_vec3_dot(wo, r);
-        e[3] = drift_vec3_dot(wo, s->ns);
-        drift_sampler sampler =
-            drift_pass_sampler(f, DRIFT_STREAM_SIR_AO ^ job->params->seed, x, y);
-        e[4] = ambient_occlusion(f, s, job->ao_radius, job->params->ao_samples, &sampler, rays);
+        // The paper's metrics say where an environment map may be wrong; weigh them by how
+        // wrong this one is expected to be here, so a glossy surface whose raster reflection
+        // is already right is not flagged (0 below the tolerance).
+        float expected = job->expected ? job->expected[index] : 1.0f;
+        float weight = expected >= params->reflection_tolerance
+                           ? drift_clampf(expected / REAL_ERROR_SCALE, 0.0f, 1.0f)
+                           : 0.0f;
+        weight = job->expected ? weight : 1.0f;
+        if (weight > 0.0f) {
+            e[0] = 1.0f;
+            e[1] = far > 0.0f ? drift_vec3_length(drift_vec3_sub(s->position, c)) / far : 0.0f;
+            // <-i, r> = 2 <-i, n>^2 - 1 runs from 1 head-on to -1 at grazing view: mapped
+            // onto [0,1] growing toward grazing view, where the map's parallax is largest
+            // (clamped as printed, it was 0 wherever the view is more than 45 degrees off).
+            e[2] = 0.5f * (1.0f - drift_vec3_dot(wo, r));
+            e[3] = drift_vec3_dot(wo, s->ns);
+            drift_sampler sampler = drift_pass_sampler(f, DRIFT_STREAM_SIR_AO ^ params->seed, x, y);
+            e[4] = ambient_occlusion(f, s, job->ao_radius, params->ao_samples, &sampler, rays);
+            for (int m = 0; m < 5; ++m) {
+                e[m] *= weight;
+            }
+        }
     }
     for (int m = 0; m < 5; ++m) {
         drift_image_pixel(&job->out[DRIFT_METRIC_REFLECTION1 + m], x, y)[0] =
@@ -178,13 +351,107 @@ static float light_size_from(const drift_raster_light *light, const light_shape 
     return fminf(1.01f * size, light->radius);
 }
 
+// Where the penumbra estimate finds p outside every penumbra of light l, one shadow ray to
+// the light's centre says whether all of it is seen (1) or none (0); the raster's shadow S_l
+// should say the same. Returns U_l (v - S_l): what the raster's direct light lacks (or has too
+// much of) there. The shadow map's mistakes at contacts and seams (its bias and texels of the
+// neighbouring surface) are exactly such pixels, which the penumbra estimate does not flag.
+static drift_vec3 shadow_map_mistake(drift_frame_state *f, uint32_t l, int32_t x, int32_t y,
+                                     const drift_surface *s, uint64_t *rays)
+{
+    const drift_frame_light_buffers *b = &f->light_buffers[l];
+    drift_vec3 unshadowed = drift_image_get3(&b->unshadowed, x, y);
+    if (drift_vec3_is_zero(unshadowed)) {
+        return drift_vec3_splat(0.0f);
+    }
+    const drift_raster_light *light = &f->lights[l];
+    drift_vec3 to_light = drift_vec3_sub(light->centre, s->position);
+    float distance = drift_vec3_length(to_light);
+    if (!(distance > 0.0f)) {
+        return drift_vec3_splat(0.0f);
+    }
+    drift_vec3 dir = drift_vec3_scale(to_light, 1.0f / distance);
+    drift_ray ray = { .origin = drift_offset_origin(s->position, s->ng, dir),
+                      .dir = dir,
+                      .tmin = 0.0f,
+                      .tmax = distance * (1.0f - 1e-4f) };
+    drift_hit hit;
+    ++*rays;
+    bool seen =
+        !drift_accel_intersect(f->accel, &ray, &hit) || drift_raster_light_owns(light, hit.light);
+    float raster = drift_image_pixel(&b->shadow, x, y)[0];
+    return drift_vec3_scale(unshadowed, (seen ? 1.0f : 0.0f) - raster);
+}
+
+// In a penumbra of light l, what the raster's shadow S_l gets wrong, estimated with `samples`
+// shadow rays to stratified points of the light: U_l (v - S_l), v the rays' visible share.
+// Noisy alone (a quarter of U_l at 4 rays); smooth_shadow_mistakes averages it over a square
+// of penumbra pixels, where the raster's error varies slowly and the noise cancels.
+static drift_vec3 penumbra_mistake(drift_frame_state *f, uint32_t l, int32_t x, int32_t y,
+                                   const drift_surface *s, uint32_t samples, uint64_t *rays)
+{
+    const drift_frame_light_buffers *b = &f->light_buffers[l];
+    drift_vec3 unshadowed = drift_image_get3(&b->unshadowed, x, y);
+    if (drift_vec3_is_zero(unshadowed)) {
+        return drift_vec3_splat(0.0f);
+    }
+    const drift_raster_light *light = &f->lights[l];
+    drift_sampler sampler = drift_pass_sampler(f, DRIFT_STREAM_SIR_LOBE + 1u + l, x, y);
+    uint32_t side = 1;
+    while (side * side < samples) {
+        ++side;
+    }
+    uint32_t seen = 0, cast = 0;
+    for (uint32_t k = 0; k < side * side; ++k) {
+        drift_vec2 u = drift_sampler_next2(&sampler);
+        u = drift_vec2_make(((float)(k % side) + u.x) / (float)side,
+                            ((float)(k / side) + u.y) / (float)side);
+        drift_light_sample ls = drift_raster_light_sample(f->scene, light, s->position,
+                                                          drift_sampler_next1(&sampler), u);
+        if (!(ls.pdf > 0.0f)) {
+            continue;
+        }
+        drift_ray ray = { .origin = drift_offset_origin(s->position, s->ng, ls.wi),
+                          .dir = ls.wi,
+                          .tmin = 0.0f,
+                          .tmax = isfinite(ls.distance) ? ls.distance * (1.0f - 1e-4f) : INFINITY };
+        ++*rays;
+        ++cast;
+        seen += drift_accel_occluded(f->accel, &ray) ? 0u : 1u;
+    }
+    float raster = drift_image_pixel(&b->shadow, x, y)[0];
+    float visible = cast ? (float)seen / (float)cast : raster;
+    return drift_vec3_scale(unshadowed, visible - raster);
+}
+
+// Second pass over the (dilated) penumbra estimate: the raster's shadow error there, summed
+// over the area lights, into job->shadow_delta.
+static void penumbra_check_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays,
+                                 void *user)
+{
+    metric_job *job = user;
+    size_t index = (size_t)y * (size_t)f->params.width + (size_t)x;
+    const drift_surface *s = &f->gbuffer.surfaces[index];
+    drift_vec3 delta = drift_vec3_splat(0.0f);
+    if (drift_image_pixel(&job->out[DRIFT_METRIC_SHADOW], x, y)[0] > 0.0f &&
+        s->material != DRIFT_INVALID_INDEX) {
+        for (uint32_t l = 0; l < f->light_count; ++l) {
+            if (f->light_buffers[l].shadow_map && f->lights[l].radius > 0.0f) {
+                delta = drift_vec3_add(
+                    delta, penumbra_mistake(f, l, x, y, s, job->params->lobe_samples, rays));
+            }
+        }
+    }
+    memcpy(&job->shadow_delta[3 * index], &delta, sizeof(float) * 3);
+}
+
 static void shadow_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
 {
-    (void)rays;
     metric_job *job = user;
     size_t index = (size_t)y * (size_t)f->params.width + (size_t)x;
     const drift_surface *s = &f->gbuffer.surfaces[index];
     float e = 0.0f;
+    drift_vec3 leak = drift_vec3_splat(0.0f);
     for (uint32_t l = 0; e == 0.0f && s->material != DRIFT_INVALID_INDEX && l < f->light_count;
          ++l) {
         const drift_raster_light *light = &f->lights[l];
@@ -232,8 +499,22 @@ static void shadow_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *r
             .light_size = shape ? light_size_from(light, shape, s->position) : 0.0f
         };
         e = drift_shadow_map_penumbra_query(map, s->position, s->ng, &query);
+        if (e == 0.0f && job->params->leak_tolerance > 0.0f) {
+            leak = drift_vec3_add(leak, shadow_map_mistake(f, l, x, y, s, rays));
+        }
     }
     drift_image_pixel(&job->out[DRIFT_METRIC_SHADOW], x, y)[0] = e;
+    // Outside every penumbra the light is wholly seen or wholly hidden; where the raster's
+    // shadow says otherwise by more than the tolerance (light leaking through a contact or a
+    // seam, or a seam darkened by the map's own surfaces), its error is known.
+    float leaked = 0.0f;
+    if (e == 0.0f && !drift_vec3_is_zero(leak)) {
+        float change = display_change(drift_image_get3(&f->final, x, y), leak);
+        leaked = change >= job->params->leak_tolerance
+                     ? drift_clampf(change / REAL_ERROR_SCALE, 0.0f, 1.0f)
+                     : 0.0f;
+    }
+    drift_image_pixel(&job->out[DRIFT_METRIC_LEAK], x, y)[0] = leaked;
 }
 
 // Shadow maps of area lights, built (and left in the frame's cache) when the frame's shadow
@@ -362,30 +643,90 @@ static int32_t shadow_dilation(const drift_frame_state *f)
     return radius > 2 ? (int32_t)radius : 2;
 }
 
-void drift_refine_compute_metrics(drift_frame_state *f, const drift_refine_metric_params *params,
-                                  drift_image out[DRIFT_METRIC_COUNT])
+// Keeps a penumbra pixel flagged only where the raster's shadow error, its estimate averaged
+// (signed, so the rays' noise cancels) over the penumbra pixels of a 5 x 5 square, moves the
+// displayed pixel by the tolerance or more: PCSS is right in much of a broad penumbra. (Kept
+// at 1, as the paper's estimate: valued by the change, precision at recall 0.9 fell from 0.56
+// to 0.51 on scenes/open-glossy, penumbrae sorting below the floor's reflections.)
+static void gate_penumbra(drift_frame_state *f, drift_image *shadow, const float *delta,
+                          float tolerance, float *scratch)
 {
+    int32_t w = shadow->width, h = shadow->height;
+    for (int32_t y = 0; y < h; ++y) {
+        for (int32_t x = 0; x < w; ++x) {
+            drift_vec3 sum = drift_vec3_splat(0.0f);
+            int count = 0;
+            for (int32_t v = y - EXPECTED_RADIUS; v <= y + EXPECTED_RADIUS; ++v) {
+                for (int32_t u = x - EXPECTED_RADIUS; v >= 0 && v < h && u <= x + EXPECTED_RADIUS;
+                     ++u) {
+                    if (u < 0 || u >= w || drift_image_pixel(shadow, u, v)[0] <= 0.0f) {
+                        continue;
+                    }
+                    const float *d = &delta[3 * ((size_t)v * (size_t)w + (size_t)u)];
+                    sum = drift_vec3_add(sum, drift_vec3_make(d[0], d[1], d[2]));
+                    ++count;
+                }
+            }
+            float change = count ? display_change(drift_image_get3(&f->final, x, y),
+                                                  drift_vec3_scale(sum, 1.0f / (float)count))
+                                 : 0.0f;
+            scratch[(size_t)y * (size_t)w + (size_t)x] =
+                drift_image_pixel(shadow, x, y)[0] > 0.0f && change >= tolerance ? 1.0f : 0.0f;
+        }
+    }
+    memcpy(shadow->pixels, scratch, sizeof(float) * (size_t)w * (size_t)h);
+}
+
+uint64_t drift_refine_compute_metrics(drift_frame_state *f,
+                                      const drift_refine_metric_params *params,
+                                      drift_image out[DRIFT_METRIC_COUNT])
+{
+    uint64_t rays = 0;
     drift_bounds3 b = f->scene->bounds;
     float diagonal = drift_vec3_length(drift_vec3_sub(b.max, b.min));
     metric_job job = { .params = params,
                        .out = out,
                        .ao_radius =
                            params->ao_radius > 0.0f ? params->ao_radius : 0.05f * diagonal };
-    drift_pass_for_each_pixel(f, reflection_pixel, &job);
+    size_t pixels = (size_t)f->params.width * (size_t)f->params.height;
+    float *raw = NULL;
+    if (params->reflection_tolerance > 0.0f) { // without memory: the unweighted metrics
+        raw = drift_alloc(f->ctx, sizeof(float) * pixels);
+        job.expected = raw ? drift_alloc(f->ctx, sizeof(float) * pixels) : NULL;
+    }
+    if (job.expected) {
+        float *smooth = job.expected;
+        job.expected = raw;
+        rays += drift_pass_for_each_pixel(f, expected_error_pixel, &job);
+        smooth_expected(raw, f->params.width, f->params.height, EXPECTED_RADIUS, smooth);
+        job.expected = smooth;
+    }
+    rays += drift_pass_for_each_pixel(f, reflection_pixel, &job);
+    drift_free(f->ctx, job.expected);
+    drift_free(f->ctx, raw);
     ensure_shadow_maps(f);
     job.shapes = f->light_count ? drift_alloc(f->ctx, sizeof(light_shape) * f->light_count) : NULL;
     for (uint32_t l = 0; job.shapes && l < f->light_count; ++l) {
         light_corners(f->scene, &f->lights[l], &job.shapes[l]);
     }
-    drift_pass_for_each_pixel(f, shadow_pixel, &job); // without memory: bounding spheres
+    rays += drift_pass_for_each_pixel(f, shadow_pixel, &job); // without memory: spheres
     drift_free(f->ctx, job.shapes);
-    float *scratch =
-        drift_alloc(f->ctx, sizeof(float) * (size_t)f->params.width * (size_t)f->params.height);
+    float *scratch = drift_alloc(f->ctx, sizeof(float) * pixels);
     if (scratch) { // without memory the estimate stays undilated
         dilate(&out[DRIFT_METRIC_SHADOW], shadow_dilation(f), scratch);
-        drift_free(f->ctx, scratch);
     }
+    if (scratch && params->shadow_tolerance > 0.0f) { // without memory: the estimate ungated
+        job.shadow_delta = drift_alloc(f->ctx, 3 * sizeof(float) * pixels);
+    }
+    if (job.shadow_delta) {
+        rays += drift_pass_for_each_pixel(f, penumbra_check_pixel, &job);
+        gate_penumbra(f, &out[DRIFT_METRIC_SHADOW], job.shadow_delta, params->shadow_tolerance,
+                      scratch);
+        drift_free(f->ctx, job.shadow_delta);
+    }
+    drift_free(f->ctx, scratch);
     dof_metric(f, params->edge_threshold, &out[DRIFT_METRIC_DOF]);
+    return rays;
 }
 
 void drift_refine_combine_metrics(const drift_image metrics[DRIFT_METRIC_COUNT],

@@ -10,10 +10,13 @@
 #define DEFAULT_DEPTH      3
 #define DEFAULT_EDGE       0.05f
 #define DEFAULT_AO_SAMPLES 8
+// Display-value error a metric lets pass: half the bench's real-error threshold (0.02).
+#define DEFAULT_TOLERANCE    0.01f
+#define DEFAULT_LOBE_SAMPLES 4
 
 static const char *const metric_names[] = { "reflection1", "reflection2", "reflection3",
                                             "reflection4", "reflection5", "dof",
-                                            "shadow" };
+                                            "shadow",      "leak" };
 _Static_assert(sizeof metric_names / sizeof *metric_names == DRIFT_METRIC_COUNT, "names");
 
 const char *drift_refine_metric_name(drift_refine_metric metric)
@@ -80,6 +83,11 @@ drift_refine_params drift_refine_params_resolve(const drift_refine_params *param
     p.max_depth = p.max_depth ? p.max_depth : DEFAULT_DEPTH;
     p.edge_threshold = p.edge_threshold > 0.0f ? p.edge_threshold : DEFAULT_EDGE;
     p.ao_samples = p.ao_samples ? p.ao_samples : DEFAULT_AO_SAMPLES;
+    p.reflection_tolerance =
+        p.reflection_tolerance != 0.0f ? p.reflection_tolerance : DEFAULT_TOLERANCE;
+    p.lobe_samples = p.lobe_samples ? p.lobe_samples : DEFAULT_LOBE_SAMPLES;
+    p.leak_tolerance = p.leak_tolerance != 0.0f ? p.leak_tolerance : DEFAULT_TOLERANCE;
+    p.shadow_tolerance = p.shadow_tolerance != 0.0f ? p.shadow_tolerance : DEFAULT_TOLERANCE;
     return p;
 }
 
@@ -90,8 +98,10 @@ static bool params_valid(drift_context *ctx, const drift_refine_params *p)
         problem = "max_depth outside 0..64";
     } else if ((unsigned)p->combine >= DRIFT_COMBINE_COUNT) {
         problem = "unknown combination";
-    } else if (!isfinite(p->edge_threshold) || !isfinite(p->ao_radius) || p->ao_radius < 0.0f) {
-        problem = "non-finite edge threshold or AO radius";
+    } else if (!isfinite(p->edge_threshold) || !isfinite(p->ao_radius) || p->ao_radius < 0.0f ||
+               !isfinite(p->reflection_tolerance) || !isfinite(p->leak_tolerance) ||
+               !isfinite(p->shadow_tolerance)) {
+        problem = "non-finite edge threshold, AO radius or tolerance";
     }
     for (int m = 0; !problem && m < DRIFT_METRIC_COUNT; ++m) {
         if (!(p->lambda[m] >= 0.0f) || !isfinite(p->lambda[m])) {
@@ -219,8 +229,12 @@ drift_result drift_refine_begin(drift_refine *r)
     drift_refine_metric_params mp = { .edge_threshold = r->params.edge_threshold,
                                       .ao_radius = r->params.ao_radius,
                                       .ao_samples = r->params.ao_samples,
+                                      .reflection_tolerance = r->params.reflection_tolerance,
+                                      .lobe_samples = r->params.lobe_samples,
+                                      .leak_tolerance = r->params.leak_tolerance,
+                                      .shadow_tolerance = r->params.shadow_tolerance,
                                       .seed = r->params.seed };
-    drift_refine_compute_metrics(drift_hybrid_frame(r->frame), &mp, r->metrics);
+    st->metrics_rays = drift_refine_compute_metrics(drift_hybrid_frame(r->frame), &mp, r->metrics);
     st->metrics_ms = 1000.0 * (drift_time_now() - t);
 
     t = drift_time_now();
@@ -381,7 +395,7 @@ bool drift_refine_plane(const drift_refine *r, uint32_t index, const char **out_
     static const char *const metric_planes[] = { "error.reflection1", "error.reflection2",
                                                  "error.reflection3", "error.reflection4",
                                                  "error.reflection5", "error.dof",
-                                                 "error.shadow" };
+                                                 "error.shadow",      "error.leak" };
     _Static_assert(sizeof metric_planes / sizeof *metric_planes == DRIFT_METRIC_COUNT, "planes");
     const drift_image *fixed_images[] = { &r->refined, &r->combined, &r->mask, &r->samples_plane };
     if (index < 4) {

@@ -58,13 +58,18 @@ typedef struct drift_refine_metric_params {
     float edge_threshold;
     float ao_radius;
     uint32_t ao_samples;
+    float reflection_tolerance; // <= 0: unweighted reflection metrics
+    uint32_t lobe_samples;
+    float leak_tolerance;   // <= 0: no leak metric
+    float shadow_tolerance; // <= 0: the penumbra estimate ungated
     uint32_t seed;
 } drift_refine_metric_params;
 
 // Fills out[m] (1 channel, the frame's size) for every metric from the frame's last render.
-void drift_refine_compute_metrics(drift_frame_state *frame,
-                                  const drift_refine_metric_params *params,
-                                  drift_image out[DRIFT_METRIC_COUNT]);
+// Returns the rays the metrics cast (not counting shadow maps they had to build).
+uint64_t drift_refine_compute_metrics(drift_frame_state *frame,
+                                      const drift_refine_metric_params *params,
+                                      drift_image out[DRIFT_METRIC_COUNT]);
 // E = average or min(1, sum lambda_i E_i); written to `combined` (1 channel).
 void drift_refine_combine_metrics(const drift_image metrics[DRIFT_METRIC_COUNT],
                                   drift_refine_combine combine,

@@ -51,7 +51,11 @@ assert e["timing"]["frame_ms"] > 0, e'
         expect 0 "$drift" bench sir "$box" --sizes 16x12 --spp 1 --budget 64 --json
         check sir 'r = d["rows"]
 assert len(r) == 1 and r[0]["width"] == 16 and r[0]["height"] == 12, d
-assert 0 <= r[0]["flip"] <= 1 and r[0]["prt_ms"] > 0 and "shadow" in r[0]["quality"], r'
+assert 0 <= r[0]["flip"] <= 1 and r[0]["prt_ms"] > 0 and "shadow" in r[0]["quality"], r
+assert "leak" in r[0]["quality"] and r[0]["raster_metrics_time_share"] > 0, r
+assert 0 < r[0]["raster_metrics_ray_share"] and r[0]["metrics_rays"] >= 0, r'
+        expect 0 "$drift" bench sir "$box" --sizes 16x12 --spp 1 --budget 64 --paper-metrics --json
+        check sir 'assert d["rows"][0]["quality"]["leak"]["flagged"] == 0, d'
         ;;
     glare)
         expect 0 "$drift" bench glare --frames 1 --sizes 16,32 --no-convolution --json
@@ -69,22 +73,37 @@ assert all(r["ms"] >= 0 and 0 <= r["flip"] <= 1 and r["rmse"] >= 0 and 0 <= r["f
 assert "table" not in d and d["radius"] > 0, d'
         ;;
     ism)
-        expect 0 "$drift" bench ism "$box" --size 16 --ref-spp 2 --vpls 8 --spp 1 --points 64 \
-            --map 8 --threads 1 --json
-        check ism 'assert d["size"] == 16 and d["ref_spp"] == 2 and d["gbuffer_ms"] >= 0, d
-assert [(r["what"], r["count"]) for r in d["rows"]] == [("ref", 2), ("pt", 1), ("ism", 8), ("ir", 8)], d
+        expect 0 "$drift" bench ism "$box" --size 16 --height 12 --ref-spp 2 --vpls 8 --spp 1 \
+            --points 64 --map 8 --threads 1 --classic --json
+        check ism 'assert d["size"] == 16 and d["height"] == 12 and d["ref_spp"] == 2 and d["gbuffer_ms"] >= 0, d
+assert [(r["what"], r["count"]) for r in d["rows"]] == [("ref", 2), ("pt", 1), ("ism", 8), ("sm", 8), ("ir", 8)], d
 assert all(r["ms"] >= 0 and r["rmse_indirect"] >= 0 and 0 <= r["flip_frame"] <= 1 for r in d["rows"]), d
-for r in d["rows"][2:]:
+assert d["rows"][3]["ms"] > 0 and d["rows"][3]["flip_frame"] == d["rows"][2]["flip_frame"], d
+assert d["rows"][4]["nrmse_ism_vs_ir"] >= 0 and "nrmse_ism_vs_ir" not in d["rows"][2], d
+for r in (d["rows"][2], d["rows"][4]):
     assert 0 < r["vpls"] <= 8 and 0 <= r["holes"] <= 1 and r["stage_ms"]["gather"] >= 0, r'
         expect 2 "$drift" bench ism --vpls 8,,16
         grep -q -- "--vpls expects .*got '8,,16'" "$tmp/err" || fail "bench ism: bad --vpls not named"
+        ;;
+    micro)
+        expect 0 "$drift" bench micro "$box" --size 12 --ref-spp 2 --points 256 --sizes 4,8 \
+            --densities 1,16 --scaling 8,9 --csv "$tmp/micro.csv" --json
+        check micro 'assert d["size"] == 12 and d["ref_spp"] == 2 and d["threads"] == 1, d
+assert [(r["sweep"], r["k"], r["density"], r["points"]) for r in d["rows"]] == [
+    ("size", 4, 1, 256), ("size", 8, 1, 256), ("density", 16, 1, 256), ("density", 16, 16, 256),
+    ("points", 16, 16, 256), ("points", 16, 16, 512)], d
+assert all(r["ms"] >= 0 and r["gathers"] > 0 and r["nodes_visited"] > 0 and r["nrms"] >= 0 and
+           set(r["stage_ms"]) == {"hierarchy", "lighting", "gather", "upsample"} for r in d["rows"]), d'
+        [ "$(wc -l < "$tmp/micro.csv")" -eq 3 ] || fail "bench micro: --csv should hold 2 rows"
+        expect 2 "$drift" bench micro --densities 3
+        grep -q -- "--densities expects 1, 4 or 16" "$tmp/err" || fail "bench micro: bad --densities not named"
         ;;
     frontier)
         # Twice: the second run must reuse the cached reference and give the same FLIP values.
         for run in 1 2; do
             expect 0 "$drift" bench frontier "$box" --size 12 --ref-spp 4 --runs 1 --max-spp 2 \
                 --vpls 8 --aaf-spp 1 --budgets 1,20,1000 --cache "$tmp/cache" --threads 1 \
-                --csv "$tmp/frontier.csv" --json
+                --csv "$tmp/frontier.csv" --svg "$tmp/frontier.svg" --json
             cp "$tmp/out" "$tmp/frontier$run.json"
         done
         check frontier 'first = json.load(open(sys.argv[1][:-3] + "frontier1.json"))
@@ -102,8 +121,30 @@ for f in d["front"]:
     assert best["ms"] <= f["budget_ms"] and best["flip"] <= prev, d["front"]
     prev = best["flip"]
     for k in ("pt", "pt_atrous", "hybrid"):
-        assert f[k] is None or (f[k]["ms"] <= f["budget_ms"] and f[k]["flip"] >= best["flip"]), f'
+        assert f[k] is None or (f[k]["ms"] <= f["budget_ms"] and f[k]["flip"] >= best["flip"]), f
+budgets = [f["budget_ms"] for f in d["front"]]
+for r in d["rows"]:
+    # The band: the smallest budget over the row ms, above the one before it (null: over all).
+    band = next((x for x in budgets if r["ms"] <= x), None)
+    assert r["budget_ms"] == band, r
+    if band is not None:
+        below = [x for x in budgets if x < band]
+        assert not below or r["ms"] > below[-1], r
+    # On the front: no row at most as slow is strictly closer (up to the JSON rounding).
+    beaten = [q for q in d["rows"] if q is not r and q["ms"] <= r["ms"] + 1e-3 and q["flip"] <= r["flip"] + 1e-6]
+    assert (not r["pareto"] or all(q["ms"] > r["ms"] - 1e-3 or q["flip"] >= r["flip"] - 1e-6 for q in beaten)) \
+        and (r["pareto"] or beaten), r
+front = sorted((r for r in d["rows"] if r["pareto"]), key=lambda r: r["ms"])
+assert front and all(a["flip"] >= b["flip"] for a, b in zip(front, front[1:])), front
+for f in d["front"]:
+    if f["best"] is not None:
+        assert any(r["pareto"] and r["name"] == f["best"]["name"] and r["family"] == f["best"]["family"]
+                   for r in d["rows"]), f'
         [ "$(wc -l < "$tmp/frontier.csv")" -ge 15 ] || fail "bench frontier: --csv has too few rows"
+        python3 -c 'import sys, xml.etree.ElementTree as E; t = E.parse(sys.argv[1]).getroot()
+ns = "{http://www.w3.org/2000/svg}"
+assert t.tag == ns + "svg" and len(t.findall(ns + "circle")) > 15 and t.findall(ns + "polyline"), t' \
+            "$tmp/frontier.svg" || fail "bench frontier: --svg is not a plot of the rows"
         ;;
     redit)
         expect 0 "$drift" bench redit --width 32 --height 24 --constraints 1,4 --frames 1 --json

@@ -15,7 +15,7 @@ expect 0 "$drift" render "${small[@]}" --refine sir --budget 100 --refine-spp 2 
     --out "$tmp/r.exr" --aov "$tmp/r-aov.exr" --stats "$tmp/r.json"
 [ -s "$tmp/r.exr" ] && [ -s "$tmp/r.png" ] || fail "--refine sir wrote no image"
 for layer in refined.R error.combined.Y refine.mask.Y refine.samples.Y error.reflection1.Y \
-             error.reflection5.Y error.dof.Y error.shadow.Y final.R depth.Y; do
+             error.reflection5.Y error.dof.Y error.shadow.Y error.leak.Y final.R depth.Y; do
     grep -aq "$layer" "$tmp/r-aov.exr" || fail "AOV file lacks $layer"
 done
 python3 - "$tmp/r.json" <<'PY' || fail "refine stats JSON incomplete or not refined"
@@ -48,7 +48,7 @@ python3 -c "import json,sys; d=json.load(open('$tmp/out')); sys.exit(0 if d['mse
 # Fit lambda on the built-in Cornell box, then refine with it.
 expect 0 "$drift" refine fit --out "$tmp/lambda.json" --views 2 --width 24 --height 18 --spp 1 \
     --trials 50 --threads 2
-python3 -c "import json; l=json.load(open('$tmp/lambda.json'))['lambda']; assert len(l)==7 and all(v>=0 for v in l.values())" \
+python3 -c "import json; l=json.load(open('$tmp/lambda.json'))['lambda']; assert len(l)==8 and all(v>=0 for v in l.values())" \
     || fail "refine fit wrote no lambda file"
 expect 0 "$drift" render "${small[@]}" --refine sir --lambda "$tmp/lambda.json" --out "$tmp/l.exr"
 

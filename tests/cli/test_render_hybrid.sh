@@ -77,4 +77,23 @@ assert d['frames'] == 3 and m['first_frame'] > 0 and m['frame'] > 0, d" "$tmp/f3
     || fail "--frames stats"
 expect 2 "$drift" render --mode hybrid "${small[@]}" --frames 0 --out "$tmp/f0.exr"
 
+# Micro-rendering (docs/micro.md): both rows, with their planes, at the three densities; bad
+# values of its options exit 2 naming the option.
+for density in 1 1/4 1/16; do
+    expect 0 "$drift" render --mode hybrid "${small[@]}" --indirect micro --reflections micro \
+        --micro-points 1024 --micro-size 8 --micro-density "$density" --out "$tmp/micro.exr" \
+        --aov "$tmp/micro-aov.exr"
+    [ -s "$tmp/micro.exr" ] || fail "--indirect micro --micro-density $density wrote no image"
+done
+for layer in micro.incident.R micro.gathers.Y micro.glossy_incident.R; do
+    grep -aq "$layer" "$tmp/micro-aov.exr" || fail "micro AOV file lacks $layer"
+done
+expect 2 "$drift" render --mode hybrid --indirect micro --micro-density 1/3 --out "$tmp/x.exr"
+grep -q -- "--micro-density expects 1, 1/4 or 1/16, got '1/3'" "$tmp/err" \
+    || fail "bad --micro-density not named"
+expect 2 "$drift" render --mode hybrid --indirect micro --micro-size 64 --out "$tmp/x.exr"
+grep -q -- "--micro-size" "$tmp/err" || fail "bad --micro-size not named"
+expect 2 "$drift" render --mode hybrid --indirect micro --micro-points 0 --out "$tmp/x.exr"
+[ -e "$tmp/x.exr" ] && fail "an output was written after a micro usage error"
+
 exit $((failures > 0))

@@ -475,6 +475,31 @@ static void test_ism_is_deterministic(void **state)
     test_rig_destroy(&r2);
 }
 
+// The atlas and the scene points start at one round of paths, not at the bound over eight
+// rounds (which sampled 14M points at 1024 VPLs, depth 8), and growing them changes no pixel:
+// point i is the same Sobol sample whatever the count.
+static void test_maps_grow_without_changing_the_image(void **state)
+{
+    (void)state;
+    test_rig r = cornell_rig(2, 24);
+    drift_ism_params p = { .vpl_count = 64, .max_depth = 4, .seed = 5 };
+    drift_ism *lazy = render_ism(&r, &p), *big = NULL;
+    drift_ism_params resolved = drift_ism_params_resolve(&p, r.scene);
+    uint32_t one_round = 64 + 2 * resolved.later_vpl_count;
+    assert_true(drift__ism_map_capacity(lazy) <= one_round);
+    assert_true(drift__ism_max_vpls(&resolved) > 2 * one_round);
+    assert_int_equal(drift_ism_create(r.ctx, r.scene, r.accel, &p, &big), DRIFT_OK);
+    assert_int_equal(drift__ism_reserve(big, drift__ism_max_vpls(&resolved)), DRIFT_OK);
+    assert_int_equal(drift__ism_map_capacity(big), drift__ism_max_vpls(&resolved));
+    assert_int_equal(drift_ism_render(big, drift_hybrid_gbuffer(r.frame), &r.scene->camera),
+                     DRIFT_OK);
+    const drift_image *a = drift_ism_indirect(lazy), *b = drift_ism_indirect(big);
+    assert_memory_equal(a->pixels, b->pixels, 24 * 24 * 3 * sizeof(float));
+    drift_ism_destroy(lazy);
+    drift_ism_destroy(big);
+    test_rig_destroy(&r);
+}
+
 // A closed box with a block inside and a point light, all shifted by `shift`, seen by a camera
 // shifted alike.
 static void build_shifted_scene(test_rig *r, drift_vec3 shift)
@@ -589,6 +614,7 @@ int main(void)
         cmocka_unit_test(test_environment_vpls_carry_its_power),
         cmocka_unit_test(test_gather_equals_the_formula),
         cmocka_unit_test(test_ism_is_deterministic),
+        cmocka_unit_test(test_maps_grow_without_changing_the_image),
         cmocka_unit_test(test_rigid_motion_leaves_the_image),
         cmocka_unit_test(test_bounces_add_shrinking_light),
         cmocka_unit_test(test_parameters_and_planes),

@@ -283,14 +283,14 @@ static void test_metrics_see_effects(void **state)
 
 // The penumbra estimate is conservative: every pixel from which the quad light is partly
 // hidden (by ray-traced visibility of an 8 x 8 grid of its points) is flagged, up to 5%, by the
-// shadow map's estimate itself (before the metric's dilation) and by the metric.
+// shadow map's estimate itself (before the metric's dilation) and by the ungated metric.
 static void test_shadow_metric_conservative(void **state)
 {
     (void)state;
     rig r = rig_begin();
     const int32_t w = 64, h = 48;
     build_effects_scene(&r, w, h, drift_vec3_make(0.5f, 2.2f, -3.5f));
-    rig_commit(&r, NULL);
+    rig_commit(&r, &(drift_refine_params){ .shadow_tolerance = -1.0f }); // the estimate ungated
     const drift_gbuffer *g = drift_hybrid_gbuffer(r.frame);
     const drift_image *shadow = drift_refine_metric_image(r.sir, DRIFT_METRIC_SHADOW);
     uint32_t partial = 0, flagged = 0, estimated = 0, umbra = 0, lit_unflagged = 0;
@@ -512,6 +512,178 @@ static void test_hierarchical_search_matches_exhaustive(void **state)
     print_message("penumbra: %u seen points flagged (3 lights), %u by the texel levels alone\n",
                   extra[1], extra[0]);
     assert_true(extra[0] * 20u < extra[1]);
+    rig_destroy(&r);
+}
+
+// --- ISSUE 17: METRICS THAT WEIGH THE RASTER'S OWN ERROR ---
+
+static float display_value(float v)
+{
+    return powf(fminf(fmaxf(v, 0.0f), 1.0f), 1.0f / 2.2f);
+}
+
+// A glossy floor (Phong 100) seen at a grazing angle, reflecting a far, evenly lit wall: the
+// environment map at a probe above the floor sees the same wall in every direction the floor
+// reflects, so the raster's reflection is right (checked against the pure ray tracer) and the
+// metrics must not flag the floor. The paper's metrics flag all of it (E_reflection1 = 1 on
+// every reflective pixel). Unweighted, E_reflection3 is not zero at grazing view (printed,
+// <-i, r> < 0 there and was clamped to 0).
+static void test_glossy_plane_not_flagged(void **state)
+{
+    (void)state;
+    rig r = rig_begin();
+    const int32_t w = 48, h = 36;
+    uint32_t glossy =
+        test_add_material(r.scene, (drift_material){ .type = DRIFT_MATERIAL_DEFAULT,
+                                                     .diffuse = { 0.3f, 0.28f, 0.25f },
+                                                     .specular = { 0.5f, 0.5f, 0.5f },
+                                                     .exponent = 100.0f,
+                                                     .diffuse_texture = DRIFT_INVALID_INDEX });
+    uint32_t white = test_add_material(r.scene, drift_material_make(drift_vec3_splat(0.7f)));
+    test_add_floor(r.scene, 4.0f, 0.0f, glossy);
+    test_add_quad(r.scene, drift_vec3_make(-80.0f, -1.0f, 40.0f), drift_vec3_make(160.0f, 0, 0),
+                  drift_vec3_make(0, 80.0f, 0), white);
+    assert_int_equal(drift_scene_add_light(r.scene,
+                                           &(drift_light){ .type = DRIFT_LIGHT_DIRECTIONAL,
+                                                           .direction = { 0.0f, -0.6f, 0.8f },
+                                                           .color = { 2, 2, 2 } },
+                                           NULL),
+                     DRIFT_OK);
+    r.scene->camera =
+        drift_camera_look_at(drift_vec3_make(0.0f, 1.0f, -3.8f), drift_vec3_make(0.0f, 0.0f, 1.0f),
+                             drift_vec3_make(0, 1, 0), 0.8f, w, h);
+    drift_hybrid_params raster = raster_params;
+    raster.envmap.has_probe = true;
+    raster.envmap.probe = drift_vec3_make(0.0f, 0.5f, 0.0f);
+    rig_commit_raster(&r, &raster, &(drift_refine_params){ .spp = 4 });
+    drift_image pure;
+    assert_int_equal(drift_image_create(r.ctx, w, h, 3, &pure), DRIFT_OK);
+    assert_int_equal(drift_refine_render_pure(r.sir, test_spp(), &pure, NULL, NULL), DRIFT_OK);
+    const drift_gbuffer *g = drift_hybrid_gbuffer(r.frame);
+    const drift_image *raster_image = drift_hybrid_image(r.frame);
+    const drift_image *error = drift_refine_error(r.sir);
+    uint32_t floor = 0, flagged = 0, wrong = 0;
+    for (int32_t y = 0; y < h; ++y) {
+        for (int32_t x = 0; x < w; ++x) {
+            const drift_surface *s = &g->surfaces[(size_t)y * (size_t)w + (size_t)x];
+            if (s->material != glossy) {
+                continue;
+            }
+            ++floor;
+            flagged += drift_image_pixel(error, x, y)[0] > 0.0f;
+            float d = 0.0f;
+            for (int c = 0; c < 3; ++c) {
+                d = fmaxf(d, fabsf(display_value(drift_image_pixel(raster_image, x, y)[c]) -
+                                   display_value(drift_image_pixel(&pure, x, y)[c])));
+            }
+            wrong += d > 0.02f;
+        }
+    }
+    print_message("glossy plane: %u floor pixels, %u wrong in the raster, %u flagged\n", floor,
+                  wrong, flagged);
+    assert_true(floor > (uint32_t)(w * h) / 3);
+    assert_true(wrong <= floor / 20); // the raster's reflection is right: nothing to flag
+    if (flagged > floor / 20) {
+        fail_msg("%u of %u floor pixels flagged where the raster is right", flagged, floor);
+    }
+    // The paper's metrics, unweighted: everything flagged, and E_reflection3 at grazing view.
+    assert_int_equal(drift_refine_set_params(
+                         r.sir, &(drift_refine_params){ .spp = 4, .reflection_tolerance = -1.0f }),
+                     DRIFT_OK);
+    assert_int_equal(drift_refine_begin(r.sir), DRIFT_OK);
+    const drift_image *e3 = drift_refine_metric_image(r.sir, DRIFT_METRIC_REFLECTION3);
+    uint32_t grazing = 0, grazing_zero = 0;
+    for (int32_t y = 0; y < h; ++y) {
+        for (int32_t x = 0; x < w; ++x) {
+            const drift_surface *s = &g->surfaces[(size_t)y * (size_t)w + (size_t)x];
+            drift_vec3 wo =
+                drift_vec3_normalize(drift_vec3_sub(r.scene->camera.position, s->position));
+            if (s->material == glossy && drift_vec3_dot(wo, s->ns) < 0.5f) {
+                ++grazing;
+                grazing_zero += drift_image_pixel(e3, x, y)[0] <= 0.0f;
+            }
+        }
+    }
+    assert_true(grazing > 20);
+    assert_int_equal(grazing_zero, 0);
+    drift_image_destroy(r.ctx, &pure);
+    rig_destroy(&r);
+}
+
+// Where a floor meets a wall, the shadow map's texels of the neighbouring surface and its bias
+// make the raster's shadow wrong outside any penumbra (the seams of issue 17's open room). The
+// leak metric flags nearly every pixel outside the penumbra estimate whose raster shadow is
+// off (against 8 x 8 ray-traced points of the light) by enough to move the display by 0.03,
+// and flags little where the raster's shadow is right.
+static void test_leak_metric_finds_seams(void **state)
+{
+    (void)state;
+    rig r = rig_begin();
+    const int32_t w = 64, h = 48;
+    uint32_t white = test_add_material(r.scene, drift_material_make(drift_vec3_splat(0.7f)));
+    test_add_floor(r.scene, 3.0f, 0.0f, white);
+    test_add_quad(r.scene, drift_vec3_make(-3.0f, 0.0f, 3.0f), drift_vec3_make(6.0f, 0, 0),
+                  drift_vec3_make(0, 3.0f, 0), white); // back wall
+    test_add_quad(r.scene, drift_vec3_make(-3.0f, 0.0f, -3.0f), drift_vec3_make(0, 0, 6.0f),
+                  drift_vec3_make(0, 3.0f, 0), white); // left wall
+    const drift_vec3 corner = { -0.5f, 3.6f, -0.5f };
+    assert_int_equal(drift_scene_add_light(r.scene,
+                                           &(drift_light){ .type = DRIFT_LIGHT_QUAD,
+                                                           .position = corner,
+                                                           .edge_u = { 1, 0, 0 },
+                                                           .edge_v = { 0, 0, 1 },
+                                                           .color = { 40, 40, 40 } },
+                                           NULL),
+                     DRIFT_OK);
+    r.scene->camera =
+        drift_camera_look_at(drift_vec3_make(1.0f, 1.5f, -4.5f), drift_vec3_make(-1.5f, 0.8f, 2.0f),
+                             drift_vec3_make(0, 1, 0), 0.9f, w, h);
+    rig_commit(&r, NULL);
+    const drift_frame_state *f = drift_hybrid_frame(r.frame);
+    const drift_image *leak = drift_refine_metric_image(r.sir, DRIFT_METRIC_LEAK);
+    const drift_image *shadow = drift_refine_metric_image(r.sir, DRIFT_METRIC_SHADOW);
+    uint32_t wrong = 0, found = 0, right = 0, false_flags = 0;
+    for (int32_t y = 0; y < h; ++y) {
+        for (int32_t x = 0; x < w; ++x) {
+            const drift_surface *s = &f->gbuffer.surfaces[(size_t)y * (size_t)w + (size_t)x];
+            if (s->material == DRIFT_INVALID_INDEX || drift_image_pixel(shadow, x, y)[0] > 0.0f) {
+                continue;
+            }
+            int visible = 0;
+            for (int k = 0; k < 64; ++k) {
+                drift_vec3 q = drift_vec3_make(corner.x + ((float)(k % 8) + 0.5f) / 8.0f, corner.y,
+                                               corner.z + ((float)(k / 8) + 0.5f) / 8.0f);
+                drift_vec3 d = drift_vec3_sub(q, s->position);
+                float len = drift_vec3_length(d);
+                d = drift_vec3_scale(d, 1.0f / len);
+                drift_ray ray = { .origin = drift_offset_origin(s->position, s->ng, d),
+                                  .dir = d,
+                                  .tmin = 0.0f,
+                                  .tmax = len * 0.999f };
+                visible += !drift_accel_occluded(r.accel, &ray);
+            }
+            float v = (float)visible / 64.0f;
+            float raster = drift_image_pixel(&f->light_buffers[0].shadow, x, y)[0];
+            drift_vec3 u = drift_image_get3(&f->light_buffers[0].unshadowed, x, y);
+            drift_vec3 base = drift_image_get3(&f->final, x, y);
+            float moved = fabsf(display_value(base.x + u.x * (v - raster)) - display_value(base.x));
+            bool flagged = drift_image_pixel(leak, x, y)[0] > 0.0f;
+            if (moved > 0.03f) {
+                ++wrong;
+                found += flagged;
+            } else if (moved < 0.005f) {
+                ++right;
+                false_flags += flagged;
+            }
+        }
+    }
+    print_message("seams: %u pixels with a wrong raster shadow, %u flagged; %u right, %u flagged\n",
+                  wrong, found, right, false_flags);
+    assert_true(wrong >= 10); // the scene shows what the metric is for
+    if ((double)found < 0.85 * (double)wrong || (double)false_flags > 0.05 * (double)right) {
+        fail_msg("leak metric: %u of %u wrong pixels flagged, %u of %u right ones", found, wrong,
+                 false_flags, right);
+    }
     rig_destroy(&r);
 }
 
@@ -758,6 +930,8 @@ int main(void)
         cmocka_unit_test(test_hierarchical_search_matches_exhaustive),
         cmocka_unit_test(test_shadow_metric_skips_unlit),
         cmocka_unit_test(test_shadow_dilation_follows_resolution),
+        cmocka_unit_test(test_glossy_plane_not_flagged),
+        cmocka_unit_test(test_leak_metric_finds_seams),
         cmocka_unit_test(test_radix_sort_stable_and_complete),
         cmocka_unit_test(test_refines_errors_first),
         cmocka_unit_test(test_lambda_fit_not_worse_than_average),

@@ -64,7 +64,7 @@ static void test_every_row_renders(void **state)
     for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
         for (int t = 0; t < drift_technique_count((drift_effect)e); ++t) {
             const drift_technique_row *row = drift_technique_row_of((drift_effect)e, t);
-            drift_hybrid_params p = { .spp = 2, .seed = 3 };
+            drift_hybrid_params p = { .spp = 2, .seed = 3, .micro = { .points = 1024 } };
             drift_hybrid_params_set_technique(&p, (drift_effect)e, t);
             print_message("%s %s\n", drift_effect_name((drift_effect)e), row->name);
             test_rig_frame(&r, &p);

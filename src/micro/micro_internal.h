@@ -1,0 +1,124 @@
+// Internals of drift micro shared by its files and the unit tests: the point hierarchy
+// (hierarchy.c), its lighting (lighting.c), the BRDF warp (warp.c) and one gather into a
+// micro-buffer (microbuffer.c).
+#ifndef DRIFT_MICRO_INTERNAL_H
+#define DRIFT_MICRO_INTERNAL_H
+
+#include "drift/micro.h"
+
+// --- HIERARCHY (thesis §6.2.1) ---
+
+// A complete binary tree over leaf_count = 2^k scene points, stored as arrays: node i has the
+// children 2i + 1 and 2i + 2; the leaves are the last leaf_count nodes, leaf j = node
+// leaf_count - 1 + j standing for scene point point_of[j]. Each node is a bounding sphere
+// (center, radius), a cone of normals (axis, cos of its half angle; -1: every direction) and
+// the radiance it reflects. A leaf's is that of its disc's two sides (front: the side its
+// axis points to); every node's is also kept as an "ambient cube" (six directions +x, -x,
+// +y, -y, +z, -z, each side of each leaf weighted by the square of its normal's component
+// along them) so that a node is seen with the radiance of the leaves that face the viewer:
+// a single mean would show a box's lit top to a point below it (docs/micro.md).
+typedef struct drift__micro_tree {
+    uint32_t leaf_count, node_count;
+    uint32_t *point_of; // leaf_count: the drift_points index of each leaf
+    drift_vec3 *center;
+    float *radius;
+    drift_vec3 *axis;
+    float *cone_cos;
+    drift_vec3 *albedo; // area-weighted mean diffuse reflectance kd
+    drift_vec3 *front;  // outgoing radiance of the front side (set at the leaves)
+    drift_vec3 *back;   // of the back side
+    drift_vec3 *cube;   // 6 a node: the radiance-weighted sums along +x, -x, +y, -y, +z, -z
+    float *cube_weight; // 6 a node: the weights' sums
+    float leaf_radius;  // r = sqrt(A / (pi n)): the disc one point stands for
+} drift__micro_tree;
+
+// Orders the points by a median-split BSP along the largest extent (O(n log n)) and allocates
+// the nodes; leaf_count must be points->count, a power of two. Then drift__micro_tree_refit.
+drift_result drift__micro_tree_create(drift_context *ctx, const drift_points *points,
+                                      drift__micro_tree *tree);
+void drift__micro_tree_destroy(drift_context *ctx, drift__micro_tree *tree);
+// Leaves from the points' current positions and normals (radius from their current area),
+// then every interior sphere and cone from its children's, bottom-up.
+void drift__micro_tree_refit(drift__micro_tree *tree, const drift_points *points);
+// Interior albedo and radiance from the leaves' (equal areas: a complete tree over equal-area
+// points): albedo, front and back the children's means (a child's side that faces its
+// parent's front counts toward the front), the ambient cubes their sums.
+void drift__micro_tree_pull(drift__micro_tree *tree);
+// The radiance node i sends toward `toward` (any length; from the node to the viewer).
+drift_vec3 drift__micro_tree_radiance(const drift__micro_tree *tree, uint32_t i, drift_vec3 toward);
+// The leaf nearest to x (branch and bound over the spheres).
+uint32_t drift__micro_tree_nearest_leaf(const drift__micro_tree *tree, drift_vec3 x);
+
+// --- LIGHTING (§6.4, one bounce) ---
+
+// Direct light reflected by the leaves' diffuse lobe (kd / pi E) on both sides, `samples` light
+// samples a side, ray-traced visibility; and the leaves' albedo. Returns the shadow rays cast.
+uint64_t drift__micro_light_leaves(drift_context *ctx, const drift_scene *scene,
+                                   const drift_accel *accel, const drift_points *points,
+                                   drift__micro_tree *tree, int32_t samples, uint32_t seed);
+
+// --- WARP (§6.2.3) ---
+
+// A BRDF slice tabulated over the unit disc of projected directions (omega_x, omega_y),
+// parametrised by (u, t) in [-1, 1]^2 with omega_x = u, omega_y = t sqrt(1 - u^2) so that the
+// table has no cells outside the disc; density f_r(omega) sqrt(1 - u^2) (f_r cos d omega =
+// f_r d omega_x d omega_y). The marginal CDF runs over u, the conditional ones over t.
+#define DRIFT_MICRO_MAX_WARP 128
+
+typedef struct drift__micro_warp {
+    int32_t n;                                // table cells a side
+    float marginal[DRIFT_MICRO_MAX_WARP + 1]; // over the n columns of u, unnormalised
+    float conditional[DRIFT_MICRO_MAX_WARP * (DRIFT_MICRO_MAX_WARP + 1)]; // per column, over t
+    float rho; // integral of the slice: its directional albedo
+} drift__micro_warp;
+
+// Tabulates the slice `lobe(omega, user)` (omega unit, local, z >= 0) and its CDFs.
+typedef float (*drift__micro_lobe_fn)(drift_vec3 omega, const void *user);
+void drift__micro_warp_build(drift__micro_warp *warp, int32_t n, drift__micro_lobe_fn lobe,
+                             const void *user);
+// The cosine lobe 1/pi (the Nusselt map).
+void drift__micro_warp_build_diffuse(drift__micro_warp *warp, int32_t n);
+// Phi: a point of [0, 1]^2 -> a unit local direction; *out_pdf gets p_omega = f_r cos / rho
+// there (solid angle measure).
+drift_vec3 drift__micro_warp_forward(const drift__micro_warp *warp, drift_vec2 xy, float *out_pdf);
+// Phi^-1: a unit local direction with z >= 0 -> its point of [0, 1]^2.
+drift_vec2 drift__micro_warp_inverse(const drift__micro_warp *warp, drift_vec3 omega);
+
+// --- MICRO-BUFFER (§6.2.2) ---
+
+#define DRIFT_MICRO_MAX_K 32
+
+// A K x K micro-buffer's pixels through one warp: direction (local) and solid angle of each.
+typedef struct drift__micro_pixels {
+    int32_t k;
+    drift_vec3 dir[DRIFT_MICRO_MAX_K * DRIFT_MICRO_MAX_K];
+    float omega[DRIFT_MICRO_MAX_K * DRIFT_MICRO_MAX_K];
+} drift__micro_pixels;
+
+void drift__micro_pixels_make(drift__micro_pixels *pixels, const drift__micro_warp *warp,
+                              int32_t k);
+
+// What one gather reads.
+typedef struct drift__micro_gather_desc {
+    const drift__micro_tree *tree;
+    const drift_accel *accel; // NULL: no ray casting
+    const drift__micro_warp *warp;
+    const drift__micro_pixels *pixels;
+    float cut_scale;
+} drift__micro_gather_desc;
+
+// What one gather did.
+typedef struct drift__micro_gather_stats {
+    uint64_t gathers, visited, splats, post_leaves, rays, empty, cast;
+} drift__micro_gather_stats;
+
+// The micro-buffer of the gather point p with local frame `frame` (z: the normal the
+// hemisphere is over) and geometric normal ng (for ray origins): node of each pixel (-1:
+// none; out_node may be NULL) and the mean radiance over the K^2 pixels (empty ones are 0).
+// Optional checks for the tests: when `splat_ok` is given it is cleared if a splatted node
+// was bigger than cut_scale x its pixel's solid angle, or a post-list leaf was not.
+drift_vec3 drift__micro_gather(const drift__micro_gather_desc *desc, drift_vec3 p,
+                               const drift_frame *frame, drift_vec3 ng, int32_t *out_node,
+                               drift__micro_gather_stats *stats, bool *splat_ok);
+
+#endif // DRIFT_MICRO_INTERNAL_H

@@ -1,0 +1,164 @@
+// One gather into a micro-buffer (thesis §6.2.2): a depth-first cut of the point hierarchy
+// by solid angle, each node of the cut splatted into the pixel its direction warps to
+// (nearest first), the leaves bigger than their pixel kept on a post-traversal list; then
+// ray casting against the scene's triangles (Embree) over the pixels those leaves may cover,
+// and over the pixels left empty, so that the buffer is watertight; then the mean.
+#include "micro/micro_internal.h"
+
+#include <math.h>
+
+#define NO_NODE (-1)
+#define BLOCKED (-2) // a ray hit geometry without points (a light's shape): radiance 0
+
+drift_vec3 drift__micro_gather(const drift__micro_gather_desc *desc, drift_vec3 p,
+                               const drift_frame *frame, drift_vec3 ng, int32_t *out_node,
+                               drift__micro_gather_stats *stats, bool *splat_ok)
+{
+    const drift__micro_tree *tree = desc->tree;
+    const drift__micro_pixels *pixels = desc->pixels;
+    const int32_t k = pixels->k, k2 = k * k;
+    const uint32_t n = tree->leaf_count;
+    float depth[DRIFT_MICRO_MAX_K * DRIFT_MICRO_MAX_K];
+    int32_t node[DRIFT_MICRO_MAX_K * DRIFT_MICRO_MAX_K];
+    for (int32_t i = 0; i < k2; ++i) {
+        depth[i] = INFINITY;
+        node[i] = NO_NODE;
+    }
+    uint32_t post = 0;
+    stats->gathers++;
+    uint32_t stack[96];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        uint32_t i = stack[--top];
+        stats->visited++;
+        drift_vec3 d = drift_vec3_sub(tree->center[i], p);
+        drift_vec3 local = drift_frame_to_local(frame, d);
+        float r = tree->radius[i];
+        if (local.z < -r) {
+            continue; // entirely below the tangent plane
+        }
+        bool leaf = i >= n - 1;
+        float dist = drift_vec3_length(d);
+        // A flat node whose plane holds p is seen edge-on from it (the floor around a gather
+        // point on the floor): it covers no pixel, and refining it would reach every leaf.
+        if (tree->cone_cos[i] >= 0.99995f &&
+            fabsf(drift_vec3_dot(tree->axis[i], d)) <= 1e-3f * (dist + r)) {
+            continue;
+        }
+        float omega_node = dist > r ? DRIFT_PI * r * r / (dist * dist) : INFINITY;
+        int32_t pix = -1;
+        if (local.z > 0.0f && dist > r) {
+            drift_vec2 xy =
+                drift__micro_warp_inverse(desc->warp, drift_vec3_scale(local, 1.0f / dist));
+            int32_t px = (int32_t)drift_clampf(floorf(xy.x * (float)k), 0.0f, (float)(k - 1));
+            int32_t py = (int32_t)drift_clampf(floorf(xy.y * (float)k), 0.0f, (float)(k - 1));
+            pix = py * k + px;
+        }
+        if (pix < 0 || omega_node > desc->cut_scale * pixels->omega[pix]) {
+            // Bigger than its pixel (or straddling the plane): refine, or leave to the rays.
+            if (!leaf) {
+                stack[top++] = 2 * i + 2;
+                stack[top++] = 2 * i + 1;
+            } else if (local.z > -r) {
+                post++;
+                if (splat_ok && pix >= 0 && !(omega_node > desc->cut_scale * pixels->omega[pix])) {
+                    *splat_ok = false;
+                }
+            }
+            continue;
+        }
+        if (splat_ok && omega_node > desc->cut_scale * pixels->omega[pix]) {
+            *splat_ok = false;
+        }
+        // The splat: every pixel whose centre direction the node's disc covers, its own and
+        // its neighbours' (coverage point-sampled at the pixel centres, as rays would: a
+        // node merely falling into a pixel at a silhouette would fill it whole and brighten
+        // the mean). Pixels no node covers are left to the rays. Depth-tested at the node's
+        // centre: nodes of the cut differ in size, and a big far one's sphere front would
+        // win over a small near one's.
+        // The disc of the node's own area (its leaves' discs), foreshortened when the node
+        // is flat: the bounding sphere would dilate every surface into the background.
+        uint32_t leaves = n >> (31 - __builtin_clz(i + 1));
+        float area_r = sqrtf((float)leaves) * tree->leaf_radius;
+        if (tree->cone_cos[i] > 0.9f) {
+            area_r *= sqrtf(fmaxf(fabsf(drift_vec3_dot(tree->axis[i], d)) / dist, 0.05f));
+        }
+        float sin_a = fminf(r, area_r) / dist, pixel_a = sqrtf(pixels->omega[pix]);
+        drift_vec3 w = drift_vec3_scale(local, 1.0f / dist);
+        float cos_a = sqrtf(fmaxf(1.0f - sin_a * sin_a, 0.0f));
+        int32_t span = (int32_t)ceilf(sin_a / pixel_a) + 1;
+        span = span > k / 2 ? k / 2 : span;
+        int32_t px = pix % k, py = pix / k;
+        for (int32_t qy = py - span; qy <= py + span; ++qy) {
+            for (int32_t qx = px - span; qx <= px + span; ++qx) {
+                if (qx < 0 || qy < 0 || qx >= k || qy >= k) {
+                    continue;
+                }
+                int32_t q = qy * k + qx;
+                if (dist < depth[q] && drift_vec3_dot(pixels->dir[q], w) >= cos_a) {
+                    depth[q] = dist;
+                    node[q] = (int32_t)i;
+                    stats->splats++;
+                }
+            }
+        }
+    }
+    stats->post_leaves += post;
+    if (desc->accel) {
+        // With near leaves every pixel may be theirs; otherwise only the empty ones need rays.
+        bool all = post > 0;
+        bool cast = false;
+        for (int32_t pix = 0; pix < k2; ++pix) {
+            if (!all && node[pix] != NO_NODE) {
+                continue;
+            }
+            cast = true;
+            drift_vec3 dir = drift_frame_to_world(frame, pixels->dir[pix]);
+            drift_ray ray = { drift_offset_origin(p, ng, dir), 0.0f, dir, INFINITY };
+            drift_hit hit;
+            stats->rays++;
+            float stored = node[pix] >= 0 ? depth[pix] - tree->radius[node[pix]] : depth[pix];
+            if (!drift_accel_intersect(desc->accel, &ray, &hit) || !(hit.t < stored)) {
+                continue;
+            }
+            depth[pix] = hit.t;
+            if (hit.mesh == DRIFT_INVALID_INDEX) {
+                node[pix] = BLOCKED;
+                continue;
+            }
+            // The nearest leaf to the hit, then its largest ancestor that still fits the
+            // pixel: the radiance at the pixel's own scale, not one leaf's.
+            drift_vec3 x = drift_vec3_fma(ray.origin, dir, hit.t);
+            uint32_t i = drift__micro_tree_nearest_leaf(tree, x);
+            float limit = desc->cut_scale * pixels->omega[pix] * hit.t * hit.t * DRIFT_INV_PI;
+            while (i > 0) {
+                uint32_t up = (i - 1) / 2;
+                float r = tree->radius[up];
+                if (r * r > limit || drift_vec3_length(drift_vec3_sub(tree->center[up], x)) > r) {
+                    break;
+                }
+                i = up;
+            }
+            node[pix] = (int32_t)i;
+        }
+        stats->cast += cast ? 1 : 0;
+    }
+    drift_vec3 sum = drift_vec3_splat(0.0f);
+    for (int32_t pix = 0; pix < k2; ++pix) {
+        int32_t i = node[pix];
+        if (out_node) {
+            out_node[pix] = i;
+        }
+        if (i == NO_NODE) {
+            stats->empty++;
+            continue;
+        }
+        if (i == BLOCKED) {
+            continue;
+        }
+        sum = drift_vec3_add(
+            sum, drift__micro_tree_radiance(tree, (uint32_t)i, drift_vec3_sub(p, tree->center[i])));
+    }
+    return drift_vec3_scale(sum, 1.0f / (float)k2);
+}

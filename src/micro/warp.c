@@ -1,0 +1,146 @@
+// BRDF importance warping (thesis §6.2.3): the micro-buffer's pixels redistributed over the
+// hemisphere so that each one carries the same share of f_r cos, through a tabulated 2-D CDF
+// over projected-disc coordinates (marginal over omega_x, conditional over omega_y). The
+// thesis always tabulates, even where an analytic inverse exists; so does this.
+#include "micro/micro_internal.h"
+
+#include <math.h>
+
+// Mean of sqrt(1 - u^2) over [a, b]: the disc's height over a column of the table, exactly.
+static float column_height(float a, float b)
+{
+    double da = fmax(fmin((double)a, 1.0), -1.0), db = fmax(fmin((double)b, 1.0), -1.0);
+    double fa = 0.5 * (da * sqrt(fmax(1.0 - da * da, 0.0)) + asin(da));
+    double fb = 0.5 * (db * sqrt(fmax(1.0 - db * db, 0.0)) + asin(db));
+    return (float)((fb - fa) / (db - da));
+}
+
+static drift_vec3 direction_of(float u, float t)
+{
+    float s = sqrtf(fmaxf(1.0f - u * u, 0.0f));
+    return drift_vec3_make(u, t * s, s * sqrtf(fmaxf(1.0f - t * t, 0.0f)));
+}
+
+void drift__micro_warp_build(drift__micro_warp *warp, int32_t n, drift__micro_lobe_fn lobe,
+                             const void *user)
+{
+    n = n < 2 ? 2 : (n > DRIFT_MICRO_MAX_WARP ? DRIFT_MICRO_MAX_WARP : n);
+    warp->n = n;
+    float cell = 2.0f / (float)n;
+    warp->marginal[0] = 0.0f;
+    for (int32_t c = 0; c < n; ++c) {
+        float u0 = -1.0f + (float)c * cell, u = u0 + 0.5f * cell;
+        float height = column_height(u0, u0 + cell);
+        float *cond = warp->conditional + (size_t)c * (size_t)(n + 1);
+        cond[0] = 0.0f;
+        for (int32_t r = 0; r < n; ++r) {
+            float t = -1.0f + ((float)r + 0.5f) * cell;
+            float f = lobe(direction_of(u, t), user);
+            cond[r + 1] = cond[r] + fmaxf(f, 0.0f) * height * cell;
+        }
+        warp->marginal[c + 1] = warp->marginal[c] + cond[n] * cell;
+    }
+    warp->rho = warp->marginal[n];
+}
+
+static float diffuse_lobe(drift_vec3 omega, const void *user)
+{
+    (void)omega;
+    (void)user;
+    return DRIFT_INV_PI;
+}
+
+void drift__micro_warp_build_diffuse(drift__micro_warp *warp, int32_t n)
+{
+    drift__micro_warp_build(warp, n, diffuse_lobe, NULL);
+}
+
+// Where `v` falls in the CDF `cdf` of n cells over [-1, 1]: the coordinate, linear in a cell.
+static float invert_cdf(const float *cdf, int32_t n, float v, float *out_mass)
+{
+    uint32_t i = drift_cdf_find(cdf, (uint32_t)n, v);
+    float w = cdf[i + 1] - cdf[i];
+    float frac = w > 0.0f ? drift_clampf((v - cdf[i]) / w, 0.0f, 1.0f) : 0.5f;
+    *out_mass = w;
+    return -1.0f + ((float)i + frac) * 2.0f / (float)n;
+}
+
+drift_vec3 drift__micro_warp_forward(const drift__micro_warp *warp, drift_vec2 xy, float *out_pdf)
+{
+    int32_t n = warp->n;
+    float total = warp->marginal[n];
+    if (!(total > 0.0f)) {
+        *out_pdf = 0.0f;
+        return drift_vec3_make(0.0f, 0.0f, 1.0f);
+    }
+    float column_mass;
+    float u = invert_cdf(warp->marginal, n, xy.x * total, &column_mass);
+    int32_t c = (int32_t)drift_clampf(floorf((u + 1.0f) * 0.5f * (float)n), 0.0f, (float)(n - 1));
+    const float *cond = warp->conditional + (size_t)c * (size_t)(n + 1);
+    float cell_mass;
+    float t = invert_cdf(cond, n, xy.y * cond[n], &cell_mass);
+    // Density over (u, t): the cell's mass over its area; over (omega_x, omega_y) divided by
+    // sqrt(1 - u^2); over solid angle times omega_z = sqrt(1 - u^2) sqrt(1 - t^2).
+    float cell = 2.0f / (float)n;
+    float p_ut = cell_mass / (cell * total);
+    (void)column_mass;
+    *out_pdf = p_ut * sqrtf(fmaxf(1.0f - t * t, 0.0f));
+    return direction_of(u, t);
+}
+
+// The fraction of a CDF of n cells over [-1, 1] below coordinate a.
+static float cdf_at(const float *cdf, int32_t n, float a)
+{
+    float f = (a + 1.0f) * 0.5f * (float)n;
+    int32_t i = (int32_t)drift_clampf(floorf(f), 0.0f, (float)(n - 1));
+    float frac = drift_clampf(f - (float)i, 0.0f, 1.0f);
+    return cdf[n] > 0.0f ? (cdf[i] + frac * (cdf[i + 1] - cdf[i])) / cdf[n] : 0.5f;
+}
+
+drift_vec2 drift__micro_warp_inverse(const drift__micro_warp *warp, drift_vec3 omega)
+{
+    int32_t n = warp->n;
+    float u = drift_clampf(omega.x, -1.0f, 1.0f);
+    float s = sqrtf(fmaxf(1.0f - u * u, 0.0f));
+    float t = s > 1e-7f ? drift_clampf(omega.y / s, -1.0f, 1.0f) : 0.0f;
+    float x = cdf_at(warp->marginal, n, u);
+    int32_t c = (int32_t)drift_clampf(floorf((u + 1.0f) * 0.5f * (float)n), 0.0f, (float)(n - 1));
+    float y = cdf_at(warp->conditional + (size_t)c * (size_t)(n + 1), n, t);
+    return drift_vec2_make(x, y);
+}
+
+// Solid angle of the spherical triangle a, b, c (Van Oosterom and Strackee 1983).
+static float triangle_solid_angle(drift_vec3 a, drift_vec3 b, drift_vec3 c)
+{
+    float num = fabsf(drift_vec3_dot(a, drift_vec3_cross(b, c)));
+    float den = 1.0f + drift_vec3_dot(a, b) + drift_vec3_dot(b, c) + drift_vec3_dot(c, a);
+    return 2.0f * atan2f(num, den);
+}
+
+void drift__micro_pixels_make(drift__micro_pixels *pixels, const drift__micro_warp *warp, int32_t k)
+{
+    pixels->k = k;
+    float inv = 1.0f / (float)k;
+    // Omega(x, y): the spherical quad of the pixel's warped corners, so that the pixels tile
+    // the hemisphere (the first-order 1 / (K^2 p_omega) undercounts near the horizon).
+    drift_vec3 corner[(DRIFT_MICRO_MAX_K + 1) * (DRIFT_MICRO_MAX_K + 1)];
+    for (int32_t j = 0; j <= k; ++j) {
+        for (int32_t i = 0; i <= k; ++i) {
+            float pdf;
+            corner[j * (k + 1) + i] = drift__micro_warp_forward(
+                warp, drift_vec2_make((float)i * inv, (float)j * inv), &pdf);
+        }
+    }
+    for (int32_t j = 0; j < k; ++j) {
+        for (int32_t i = 0; i < k; ++i) {
+            float pdf;
+            drift_vec3 d = drift__micro_warp_forward(
+                warp, drift_vec2_make(((float)i + 0.5f) * inv, ((float)j + 0.5f) * inv), &pdf);
+            pixels->dir[j * k + i] = d;
+            drift_vec3 c00 = corner[j * (k + 1) + i], c10 = corner[j * (k + 1) + i + 1];
+            drift_vec3 c01 = corner[(j + 1) * (k + 1) + i], c11 = corner[(j + 1) * (k + 1) + i + 1];
+            float omega = triangle_solid_angle(c00, c10, c11) + triangle_solid_angle(c00, c11, c01);
+            pixels->omega[j * k + i] = omega > 0.0f ? omega : (pdf > 0.0f ? inv * inv / pdf : 0.0f);
+        }
+    }
+}
