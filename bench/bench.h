@@ -21,7 +21,8 @@
     X("ism", drift_bench_ism, "imperfect shadow maps and instant radiosity vs the path tracer")  \
     X("micro", drift_bench_micro, "micro-rendering: rate vs K, density, points; NRMS vs the pt") \
     X("frontier", drift_bench_frontier,                                                          \
-      "equal-time frontier: pt, pt + a-trous, hybrid rows vs a whole-frame reference")
+      "equal-time frontier: pt, pt + a-trous, hybrid rows vs a whole-frame reference")           \
+    X("redit", drift_bench_redit, "reflection editing: edit-field Mpixel/s vs constraints")
 
 #include "cli.h"
 

@@ -146,4 +146,12 @@ bool cli_session_load(cli_session *s, const char *cmd, const char *path, bool no
 // Destroys the accel, the scene and the context (each may be NULL); *s becomes zero.
 void cli_session_close(cli_session *s);
 
+// FNV-1a, the content hash of checkpoints and report caches (not cryptographic: it tells an
+// edited file from the one a result was made from).
+#define CLI_FNV_BASIS 0xcbf29ce484222325ull
+uint64_t cli_fnv1a(uint64_t h, const void *data, size_t size);
+// cli_fnv1a of the files' contents in order, a NUL between files; false (errno set) when one
+// cannot be read. NULL paths are skipped.
+bool cli_hash_files(const char *const *paths, size_t count, uint64_t *out);
+
 #endif

@@ -340,6 +340,42 @@ bool cli_session_open(const cli_session_desc *desc, cli_session *s)
     return cli_session_load(s, desc->cmd, path, desc->no_accel);
 }
 
+uint64_t cli_fnv1a(uint64_t h, const void *data, size_t size)
+{
+    const uint8_t *p = data;
+    for (size_t i = 0; i < size; ++i) {
+        h = (h ^ p[i]) * 0x100000001b3ull;
+    }
+    return h;
+}
+
+bool cli_hash_files(const char *const *paths, size_t count, uint64_t *out)
+{
+    uint64_t h = CLI_FNV_BASIS;
+    for (size_t i = 0; i < count; ++i) {
+        if (!paths[i]) {
+            continue;
+        }
+        FILE *f = fopen(paths[i], "rb");
+        if (!f) {
+            return false;
+        }
+        uint8_t buf[1 << 16];
+        size_t n;
+        while ((n = fread(buf, 1, sizeof buf, f)) > 0) {
+            h = cli_fnv1a(h, buf, n);
+        }
+        bool ok = !ferror(f);
+        fclose(f);
+        if (!ok) {
+            return false;
+        }
+        h = cli_fnv1a(h, "\0", 1); // file boundaries count
+    }
+    *out = h;
+    return true;
+}
+
 void cli_session_close(cli_session *s)
 {
     drift_accel_destroy(s->accel);

@@ -8,6 +8,7 @@
 #include "drift/glare.h"
 #include "drift/image_io.h"
 #include "drift/pt.h"
+#include "drift/reflect_edit.h"
 #include "drift/scene_io.h"
 #include "render.h"
 
@@ -263,6 +264,9 @@ static const cli_option render_table[] = {
                "PNG operator: clamp (default), reinhard or filmic (ACES fit)"),
     CLI_CUSTOM_ALL("--debug-sample", "X,Y,S", parse_debug_sample,
                    "trace one sample of one pixel and print its radiance"),
+    CLI_STRING("--reflection-edits", "FILE.json", O, edits_path,
+               "edit the reflections: sharp, envmap and ISG reflections and the path\n"
+               "tracer's first specular bounce follow e(q) (docs/reflection-editing.md)"),
     CLI_FLAG("--quiet", O, quiet, "no progress output"),
     CLI_FLAG("--verbose", O, verbose, "more log output"),
 
@@ -647,7 +651,8 @@ int render_reference_begin(render_reference_run *run)
     drift_pt_params params = { .width = (int32_t)o->width,
                                .height = (int32_t)o->height,
                                .seed = (uint32_t)o->seed,
-                               .max_depth = (int32_t)o->max_depth };
+                               .max_depth = (int32_t)o->max_depth,
+                               .reflection_edits = o->hybrid.reflection_edits };
     drift_result r =
         drift_pt_create(session->ctx, session->scene, session->accel, &params, &run->pt);
     if (r != DRIFT_OK) {
@@ -658,7 +663,7 @@ int render_reference_begin(render_reference_run *run)
     if (o->debug_sample >= 0) {
         return 0;
     }
-    if (!render_checkpoint_key(session, run->pt, run->key, sizeof run->key)) {
+    if (!render_checkpoint_key(session, run->pt, run->o->edits_path, run->key, sizeof run->key)) {
         return 1;
     }
     // --resume FILE, or the checkpoint beside --out when there is one.
@@ -831,7 +836,7 @@ done:
     return exit_code;
 }
 
-int render_open_session(const render_options *o, bool outputs_here, cli_session *session)
+int render_open_session(render_options *o, bool outputs_here, cli_session *session)
 {
     char png[4096];
     render_png_path(o->out_path, png, sizeof png);
@@ -842,8 +847,11 @@ int render_open_session(const render_options *o, bool outputs_here, cli_session 
                                  { "--stats", o->stats_path },
                                  { "--aov", o->aov_path },
                                  { "--out's checkpoint", o->hybrid_mode ? NULL : checkpoint } };
-    const cli_file inputs[] = { { "--lambda", o->refine.lambda_path } };
+    const cli_file inputs[] = { { "--lambda", o->refine.lambda_path },
+                                { "--reflection-edits", o->edits_path } };
     bool writes = outputs_here && o->debug_sample < 0;
+    o->edits = NULL;
+    o->hybrid.reflection_edits = NULL;
     if (cli_session_open(&(cli_session_desc){ .cmd = "render",
                                               .scene_path = o->scene_path,
                                               .threads = (int)o->threads,
@@ -851,11 +859,25 @@ int render_open_session(const render_options *o, bool outputs_here, cli_session 
                                               .outputs = outputs,
                                               .output_count = writes ? 5 : 0,
                                               .inputs = inputs,
-                                              .input_count = 1 },
+                                              .input_count = 2 },
                          session)) {
-        return 0;
+        return session->refused ? 2 : 1;
     }
-    return session->refused ? 2 : 1;
+    if (o->edits_path && drift_reflection_edits_load(session->ctx, session->scene, session->accel,
+                                                     o->edits_path, &o->edits) != DRIFT_OK) {
+        fprintf(stderr, "drift render: cannot apply --reflection-edits %s\n", o->edits_path);
+        return 2;
+    }
+    o->hybrid.reflection_edits = o->edits;
+    return 0;
+}
+
+void render_close_session(render_options *o, cli_session *session)
+{
+    drift_reflection_edits_destroy(o->edits);
+    o->edits = NULL;
+    o->hybrid.reflection_edits = NULL;
+    cli_session_close(session);
 }
 
 int drift_cmd_render(int argc, char **argv)
@@ -878,6 +900,6 @@ int drift_cmd_render(int argc, char **argv)
     if (exit_code == 0) {
         exit_code = o.hybrid_mode ? render_hybrid(&o, &session) : render_reference(&o, &session);
     }
-    cli_session_close(&session);
+    render_close_session(&o, &session);
     return exit_code;
 }

@@ -123,33 +123,11 @@ static const cli_command report_command = {
 
 // --- hashing: the cache key ---
 
-static uint64_t fnv1a(uint64_t h, const void *data, size_t size)
-{
-    const uint8_t *p = data;
-    for (size_t i = 0; i < size; ++i) {
-        h = (h ^ p[i]) * 1099511628211u;
-    }
-    return h;
-}
-
-#define FNV_OFFSET 14695981039346656037u
-
 // The scene's content: every file its load read (the scene file first), byte for byte.
 static uint64_t scene_hash(const cli_session *s)
 {
-    uint64_t h = FNV_OFFSET;
-    for (size_t i = 0; i < s->scene_input_count; ++i) {
-        FILE *f = fopen(s->scene_inputs[i], "rb");
-        char buffer[65536];
-        size_t n;
-        while (f && (n = fread(buffer, 1, sizeof buffer, f)) > 0) {
-            h = fnv1a(h, buffer, n);
-        }
-        if (f) {
-            fclose(f);
-        }
-        h = fnv1a(h, "\n", 1);
-    }
+    uint64_t h = 0; // a file that vanished after the load: the key still differs from a good run's
+    cli_hash_files((const char *const *)s->scene_inputs, s->scene_input_count, &h);
     return h;
 }
 
@@ -268,7 +246,8 @@ static void job_key(const report_job *j, uint64_t scene, int threads, char *out,
                       drift_technique_name((drift_effect)e, j->params.techniques[e]));
     }
     snprintf(out, size, "%016" PRIx64,
-             fnv1a(fnv1a(FNV_OFFSET, text, strlen(text)), REPORT_VERSION, sizeof REPORT_VERSION));
+             cli_fnv1a(cli_fnv1a(CLI_FNV_BASIS, text, strlen(text)), REPORT_VERSION,
+                       sizeof REPORT_VERSION));
 }
 
 // "shadows-pcss-1spp-0123abcd" under the scene's folder.

@@ -37,8 +37,9 @@ typedef struct view_options {
     double exposure;
     drift_hybrid_params hybrid; // the techniques given (zero: the defaults)
     bool split, no_overlay, verbose;
-    bool refine;        // --refine sir
-    long refine_budget; // --budget: SIR samples a frame (0: the default)
+    bool refine;            // --refine sir
+    long refine_budget;     // --budget: SIR samples a frame (0: the default)
+    const char *edits_path; // --reflection-edits: loaded if it exists, saved by the save key
 } view_options;
 
 // The key bindings, shown by the help key in the overlay (a tab separates the columns; ASCII
@@ -57,6 +58,12 @@ static const char other_keys_text[] =
     "R, Home\treset the camera\n"
     "O\toverlay on/off\n"
     "H, F1\tthis help on/off\n"
+    "Ctrl-click\tedit: a constraint at a reflective point\n"
+    "Ctrl-left drag\tits red handle (slide the reflection)\n"
+    "Ctrl-right drag\tits green handle (what it reflects)\n"
+    "G, Shift-G\tadd a region around it / remove the last\n"
+    "U, Ctrl-Z\tundo the last edit\n"
+    "P, Ctrl-S\tsave the edit file (--reflection-edits)\n"
     "Esc\tquit";
 
 // "1 2 3 4\tnext shadows / reflections / dof / indirect technique\n" and the other keys.
@@ -125,7 +132,11 @@ static const cli_option view_table[] = {
     CLI_FLAG("--no-overlay", O, no_overlay, "start without the text overlay"),
     CLI_CUSTOM("--press", "KEY,KEY,...", O, press, parse_press,
                "apply view keys before the first frame, by their names\n"
-               "(shadows, next-buffer, split, help, ...: docs/viewer.md)"),
+               "(shadows, next-buffer, split, help, ...: docs/viewer.md;\n"
+               "pick@X:Y red@X:Y green@X:Y edit reflections at pixel X, Y)"),
+    CLI_STRING("--reflection-edits", "FILE.json", O, edits_path,
+               "edit reflections: loaded when it exists, written by P\n"
+               "(pick@X:Y, red@X:Y, green@X:Y in --press; docs/reflection-editing.md)"),
     CLI_INT("--frames", "N", O, frames, 1, 1L << 30,
             "render N frames, then exit (default: until closed)"),
     CLI_STRING("--screenshot", "FILE.png", O, screenshot_path,
@@ -163,6 +174,38 @@ static bool parse_keys(const char *list, drift_view *view)
     const char *p = list;
     while (*p) {
         size_t len = strcspn(p, ",");
+        // pick@X:Y, red@X:Y, green@X:Y: the editing mouse events at pixel (X, Y).
+        static const char *const edit_events[3] = { "pick@", "red@", "green@" };
+        static const drift_view_event_type edit_types[3] = { DRIFT_VIEW_EVENT_EDIT_PICK,
+                                                             DRIFT_VIEW_EVENT_EDIT_RED,
+                                                             DRIFT_VIEW_EVENT_EDIT_GREEN };
+        bool edit = false;
+        for (int k = 0; k < 3 && !edit; ++k) {
+            size_t n = strlen(edit_events[k]);
+            if (len > n && strncmp(p, edit_events[k], n) == 0) {
+                char at[64] = "";
+                snprintf(at, sizeof at, "%.*s", (int)(len - n), p + n);
+                double x, y;
+                char tail;
+                if (sscanf(at, "%lf:%lf%c", &x, &y, &tail) != 2 || !(x >= 0.0) || !(y >= 0.0) ||
+                    x > 1e6 || y > 1e6) {
+                    fprintf(stderr, "drift view: --press: '%.*s' expects %sX:Y in pixels\n",
+                            (int)len, p, edit_events[k]);
+                    return false;
+                }
+                if (view) {
+                    drift_view_handle_event(view, &(drift_view_event){ .type = edit_types[k],
+                                                                       .x = (float)x + 0.5f,
+                                                                       .y = (float)y + 0.5f });
+                }
+                edit = true;
+            }
+        }
+        if (edit) {
+            p += len;
+            p += *p == ',';
+            continue;
+        }
         drift_view_key key = DRIFT_VIEW_KEY_NONE;
         for (int k = 1; k < DRIFT_VIEW_KEY_COUNT; ++k) {
             const char *name = drift_view_key_name((drift_view_key)k);
@@ -269,6 +312,13 @@ static drift_view_key key_of(SDL_Keycode sym, bool shift)
     case SDLK_h:
     case SDLK_F1:
         return DRIFT_VIEW_KEY_HELP;
+    case SDLK_g:
+        return shift ? DRIFT_VIEW_KEY_EDIT_UNREGION : DRIFT_VIEW_KEY_EDIT_REGION;
+    case SDLK_u:
+    case SDLK_z:
+        return DRIFT_VIEW_KEY_EDIT_UNDO;
+    case SDLK_p:
+        return DRIFT_VIEW_KEY_EDIT_SAVE;
     default:
         return DRIFT_VIEW_KEY_NONE;
     }
@@ -303,6 +353,15 @@ static bool handle_sdl_event(drift_view *view, const SDL_Event *e, bool *quit)
         break;
     }
     case SDL_MOUSEMOTION:
+        if ((SDL_GetModState() & KMOD_CTRL) &&
+            (e->motion.state & (SDL_BUTTON_LMASK | SDL_BUTTON_RMASK))) {
+            ev = (drift_view_event){ .type = (e->motion.state & SDL_BUTTON_LMASK)
+                                                 ? DRIFT_VIEW_EVENT_EDIT_RED
+                                                 : DRIFT_VIEW_EVENT_EDIT_GREEN,
+                                     .x = (float)e->motion.x + 0.5f,
+                                     .y = (float)e->motion.y + 0.5f };
+            break;
+        }
         if (e->motion.state & SDL_BUTTON_LMASK) {
             ev.type = DRIFT_VIEW_EVENT_ORBIT;
         } else if (e->motion.state & SDL_BUTTON_RMASK) {
@@ -317,6 +376,12 @@ static bool handle_sdl_event(drift_view *view, const SDL_Event *e, bool *quit)
         ev.dy = (float)e->motion.yrel;
         break;
     case SDL_MOUSEBUTTONDOWN:
+        if (e->button.button == SDL_BUTTON_LEFT && (SDL_GetModState() & KMOD_CTRL)) {
+            ev = (drift_view_event){ .type = DRIFT_VIEW_EVENT_EDIT_PICK,
+                                     .x = (float)e->button.x + 0.5f,
+                                     .y = (float)e->button.y + 0.5f };
+            break;
+        }
         if (e->button.button != SDL_BUTTON_MIDDLE) {
             return false;
         }
@@ -572,7 +637,8 @@ int drift_cmd_view(int argc, char **argv)
                                               .hide_overlay = o.no_overlay,
                                               .help_text = help_text(),
                                               .refine = o.refine,
-                                              .refine_budget = (uint32_t)o.refine_budget },
+                                              .refine_budget = (uint32_t)o.refine_budget,
+                                              .reflection_edits_path = o.edits_path },
                           &view);
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift view: %s\n", drift_result_string(r));

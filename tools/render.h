@@ -33,14 +33,15 @@ typedef struct render_options {
     const char *scene_path;
     const char *out_path;
     const char *stats_path;
-    const char *aov_path;    // hybrid: every plane as layers of this EXR
-    const char *resume_path; // reference: --resume FILE.ckpt
-    bool hybrid_mode;        // --mode hybrid (else reference)
-    long frames;             // hybrid: frames rendered of the one view (the last is written)
+    const char *aov_path;                 // hybrid: every plane as layers of this EXR
+    const char *resume_path;              // reference: --resume FILE.ckpt
+    struct drift_reflection_edits *edits; // --reflection-edits, loaded by render_open_session
+    bool hybrid_mode;                     // --mode hybrid (else reference)
+    long frames; // hybrid: frames rendered of the one view (the last is written)
     long spp, seed, threads, max_depth, width, height;
     double checkpoint_seconds;
     double rank_timeout; // mpirun: seconds a rank may send nothing before it counts as hung
-    double exposure; // PNG stops (--exposure STOPS)
+    double exposure;     // PNG stops (--exposure STOPS)
     render_exposure_mode exposure_mode;
     bool exposure_given; // one of the three exposure options was seen
     double ev100;        // --ev100, or from --camera-exposure
@@ -55,15 +56,17 @@ typedef struct render_options {
     drift_hybrid_params hybrid;
     double aperture, focus_distance; // < 0: the scene camera's
     render_refine_options refine;    // --refine sir (tools/render_refine.c)
+    const char *edits_path;          // --reflection-edits FILE.json (docs/reflection-editing.md)
 } render_options;
 
 // drift render's options from argv: 0, 2 after a usage error (message printed), -1 after
 // --help.
 int render_parse_options(int argc, char **argv, render_options *o);
-// Opens the context, scene and accel; with outputs_here, refuses outputs that name an input
-// and checks each can be written. Returns 0, or the exit status (message printed); close the
-// session in both cases.
-int render_open_session(const render_options *o, bool outputs_here, cli_session *session);
+// Opens the context, scene and accel and loads --reflection-edits into o->hybrid; with
+// outputs_here, refuses outputs that name an input and checks each can be written. Returns 0,
+// or the exit status (message printed); render_close_session in both cases.
+int render_open_session(render_options *o, bool outputs_here, cli_session *session);
+void render_close_session(render_options *o, cli_session *session);
 
 // mpirun -n N drift render (tools/distributed/render_mpi.c, built with -DDRIFT_MPI=ON):
 // whether this process was started by mpirun, and the distributed render.
@@ -134,8 +137,8 @@ void render_checkpoint_path(const char *exr_path, char *out, size_t size);
 // The key a checkpoint must match to be resumed: drift's version, the scene's content (every
 // file it read), image size, seed, depth, tile size; "name value" lines. False (message
 // printed) when a scene file cannot be read.
-bool render_checkpoint_key(const cli_session *session, const struct drift_pt *pt, char *key,
-                           size_t size);
+bool render_checkpoint_key(const cli_session *session, const struct drift_pt *pt,
+                           const char *edits_path, char *key, size_t size);
 // Writes every tile's state to `path` (temp file, then rename). Prints the reason on failure.
 bool render_checkpoint_write(const char *path, const char *key, const struct drift_pt *pt);
 // Loads a checkpoint into the pt: 0 on success; 2 (message printed, pt unchanged or partly

@@ -26,61 +26,29 @@
 
 static const char checkpoint_magic[] = "drift checkpoint 1\n";
 
-static uint64_t fnv1a(uint64_t h, const void *data, size_t size)
-{
-    const uint8_t *p = data;
-    for (size_t i = 0; i < size; ++i) {
-        h = (h ^ p[i]) * 0x100000001b3ull;
-    }
-    return h;
-}
-
-static const uint64_t fnv_basis = 0xcbf29ce484222325ull;
-
-// FNV-1a of the files' contents in order; false (errno set) when one cannot be read.
-static bool hash_files(char *const *paths, size_t count, uint64_t *out)
-{
-    uint64_t h = fnv_basis;
-    for (size_t i = 0; i < count; ++i) {
-        FILE *f = fopen(paths[i], "rb");
-        if (!f) {
-            return false;
-        }
-        uint8_t buf[1 << 16];
-        size_t n;
-        while ((n = fread(buf, 1, sizeof buf, f)) > 0) {
-            h = fnv1a(h, buf, n);
-        }
-        bool ok = !ferror(f);
-        fclose(f);
-        if (!ok) {
-            return false;
-        }
-        h = fnv1a(h, "\0", 1); // file boundaries count
-    }
-    *out = h;
-    return true;
-}
-
 void render_checkpoint_path(const char *exr_path, char *out, size_t size)
 {
     snprintf(out, size, "%.*s.ckpt", (int)(strlen(exr_path) - 4), exr_path);
 }
 
-bool render_checkpoint_key(const cli_session *session, const drift_pt *pt, char *key, size_t size)
+bool render_checkpoint_key(const cli_session *session, const drift_pt *pt, const char *edits_path,
+                           char *key, size_t size)
 {
-    uint64_t scene = 0;
-    if (!hash_files(session->scene_inputs, session->scene_input_count, &scene)) {
+    uint64_t scene = 0, edits = 0;
+    if (!cli_hash_files((const char *const *)session->scene_inputs, session->scene_input_count,
+                        &scene) ||
+        !cli_hash_files(&edits_path, 1, &edits)) {
         fprintf(stderr, "drift render: cannot read the scene's files for the checkpoint: %s\n",
                 strerror(errno));
         return false;
     }
     drift_pt_params p = drift_pt_get_params(pt);
     snprintf(key, size,
-             "drift %s\nscene-content %016llx\nsize %dx%d\nseed %u\nmax-depth %d\n"
+             "drift %s\nscene-content %016llx\nreflection-edits %016llx\nsize %dx%d\nseed "
+             "%u\nmax-depth %d\n"
              "tile-size %d\n",
-             DRIFT_VERSION " " DRIFT_COMMIT, (unsigned long long)scene, p.width, p.height, p.seed, p.max_depth,
-             DRIFT_PT_TILE_SIZE);
+             DRIFT_VERSION " " DRIFT_COMMIT, (unsigned long long)scene, (unsigned long long)edits,
+             p.width, p.height, p.seed, p.max_depth, DRIFT_PT_TILE_SIZE);
     return true;
 }
 
@@ -90,14 +58,14 @@ bool render_checkpoint_write(const char *path, const char *key, const drift_pt *
     snprintf(tmp, sizeof tmp, "%s.tmp-%ld", path, (long)getpid());
     FILE *f = fopen(tmp, "wb");
     bool ok = f != NULL;
-    uint64_t h = fnv_basis;
+    uint64_t h = CLI_FNV_BASIS;
     uint8_t *state = NULL;
     uint32_t tiles = drift_pt_tile_count(pt);
     if (ok) {
-        h = fnv1a(h, checkpoint_magic, strlen(checkpoint_magic));
-        h = fnv1a(h, key, strlen(key));
-        h = fnv1a(h, "\n", 1);
-        h = fnv1a(h, &tiles, sizeof tiles);
+        h = cli_fnv1a(h, checkpoint_magic, strlen(checkpoint_magic));
+        h = cli_fnv1a(h, key, strlen(key));
+        h = cli_fnv1a(h, "\n", 1);
+        h = cli_fnv1a(h, &tiles, sizeof tiles);
         ok = fputs(checkpoint_magic, f) >= 0 && fputs(key, f) >= 0 && fputc('\n', f) != EOF &&
              fwrite(&tiles, sizeof tiles, 1, f) == 1;
         state = malloc(drift_pt_tile_state_size(pt, 0));
@@ -106,7 +74,7 @@ bool render_checkpoint_write(const char *path, const char *key, const drift_pt *
     for (uint32_t t = 0; ok && t < tiles; ++t) {
         size_t n = drift_pt_tile_state_size(pt, t);
         drift_pt_tile_get_state(pt, t, state);
-        h = fnv1a(h, state, n);
+        h = cli_fnv1a(h, state, n);
         ok = fwrite(state, 1, n, f) == n;
     }
     free(state);
@@ -226,7 +194,7 @@ int render_checkpoint_read(const char *path, const char *key, drift_pt *pt, uint
         }
         if (body && at + sizeof tiles + body + sizeof h == size) {
             memcpy(&h, data + size - sizeof h, sizeof h);
-            if (fnv1a(fnv_basis, data, size - sizeof h) == h) {
+            if (cli_fnv1a(CLI_FNV_BASIS, data, size - sizeof h) == h) {
                 uint32_t most = 0;
                 const uint8_t *state = data + at + sizeof tiles;
                 for (uint32_t t = 0; t < tiles; ++t) {

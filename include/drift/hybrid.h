@@ -34,6 +34,7 @@
 #include "drift/accel.h"
 #include "drift/core.h"
 #include "drift/image.h"
+#include "drift/reflect_edit.h"
 #include "drift/scene.h"
 #include "drift/techniques.h"
 
@@ -177,6 +178,10 @@ typedef struct drift_occlusion_settings {
 //   light_samples    = 0 -> 8 samples per area light for the unshadowed light U_l
 //   ambient          = used when has_ambient; otherwise the mean direct radiance of the frame
 //   shadow_map, envmap, isg, aaf, ism, micro, occlusion_settings: each family's settings (above)
+//   reflection_edits = NULL: physical reflections. Otherwise the sharp and environment-map
+//                      reflections (and so ISG's glossy gather over the sharp buffer) and the
+//                      reference's first specular bounce follow e(q) (drift/reflect_edit.h).
+//                      Borrowed: it must outlive the frame.
 #define DRIFT_TECHNIQUE_FIELD_(ENUM, name, type, TECHNIQUES, kind, plane) \
     drift_##type##_technique name;
 
@@ -206,6 +211,7 @@ typedef struct drift_hybrid_params {
     drift_ism_settings ism;
     drift_micro_settings micro;
     drift_occlusion_settings occlusion_settings;
+    const drift_reflection_edits *reflection_edits;
 } drift_hybrid_params;
 
 drift_hybrid_params drift_hybrid_params_resolve(const drift_hybrid_params *params,

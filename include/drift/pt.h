@@ -28,6 +28,7 @@
 #include "drift/accel.h"
 #include "drift/core.h"
 #include "drift/image.h"
+#include "drift/reflect_edit.h"
 #include "drift/scene.h"
 
 #ifdef __cplusplus
@@ -72,6 +73,10 @@ typedef enum drift_pt_component {
 //                   jitter), the footprint of a one-sample-per-pixel G-buffer
 //   pinhole       = false: with true, the camera's aperture is ignored (no depth of field)
 //   camera        = NULL -> scene->camera
+//   reflection_edits = NULL: physical reflection. Otherwise the glossy and mirror lobes of the
+//                   first vertex centre on the edited direction e(q) (drift/reflect_edit.h)
+//                   instead of the mirror direction, the reference of an edited image;
+//                   diffuse light and later bounces do not change. Borrowed.
 typedef struct drift_pt_params {
     int32_t width, height;
     uint32_t seed;
@@ -87,6 +92,7 @@ typedef struct drift_pt_params {
     const drift_camera *camera; // NULL = scene->camera; else this camera, copied at create
                                 // (moving it later does not move the pt's camera).
                                 // width/height still come from params.
+    const drift_reflection_edits *reflection_edits;
 } drift_pt_params;
 
 drift_pt_params drift_pt_params_resolve(const drift_pt_params *params, const drift_scene *scene);

@@ -249,6 +249,9 @@ typedef struct drift_surface {
     uint32_t light;      // area light at this point, or DRIFT_INVALID_INDEX
     drift_vec3 emission; // radiance emitted toward the incoming ray's origin
     bool front_face;     // the ray hit the side the geometric normal points to
+    uint32_t mesh;       // the mesh hit, or DRIFT_INVALID_INDEX (a light's shape, nothing)
+    uint32_t triangle;   // its triangle, and the barycentrics of vertices 1 and 2 there
+    drift_vec2 barycentric;
 } drift_surface;
 
 drift_surface drift_scene_surface(const drift_scene *scene, const drift_ray *ray,
@@ -266,6 +269,10 @@ typedef struct drift_bsdf {
     drift_vec3 diffuse, specular;
     float exponent;
     drift_frame frame; // z = shading normal
+    // Zero: the lobes centre on the mirror direction of wo. Otherwise the unit direction they
+    // centre on instead, for the one wo it was made for: an edited reflection e(q)
+    // (drift/reflect_edit.h). The diffuse lobe does not change.
+    drift_vec3 edited_mirror;
 } drift_bsdf;
 
 drift_bsdf drift_bsdf_make(const drift_scene *scene, const drift_surface *surface);

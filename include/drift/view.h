@@ -61,6 +61,11 @@ typedef enum drift_view_key {
     DRIFT_VIEW_KEY_RESET_CAMERA,  // back to the scene's camera
     DRIFT_VIEW_KEY_OVERLAY,       // text overlay on/off
     DRIFT_VIEW_KEY_HELP,          // key list in the overlay on/off
+    // Reflection editing (docs/reflection-editing.md): on the selected constraint
+    DRIFT_VIEW_KEY_EDIT_REGION,   // add a Euclidean region around its red handle
+    DRIFT_VIEW_KEY_EDIT_UNREGION, // remove the last region
+    DRIFT_VIEW_KEY_EDIT_UNDO,     // undo the last edit
+    DRIFT_VIEW_KEY_EDIT_SAVE,     // write the edit file (desc.reflection_edits_path)
     DRIFT_VIEW_KEY_COUNT
 } drift_view_key;
 
@@ -75,6 +80,12 @@ typedef enum drift_view_event_type {
     DRIFT_VIEW_EVENT_LOOK,     // drag by (dx, dy) pixels: turn the camera about its position
     DRIFT_VIEW_EVENT_DOLLY,    // wheel by dy notches: toward the target (dy > 0) or away
     DRIFT_VIEW_EVENT_SPLIT_AT, // put the split line at column x (and turn the split on)
+    // Reflection editing at pixel (x, y):
+    DRIFT_VIEW_EVENT_EDIT_PICK,  // a new constraint at the reflective point seen there (its
+                                 // green handle where it reflects now: no change yet)
+    DRIFT_VIEW_EVENT_EDIT_RED,   // the selected constraint's red handle to the point seen there
+                                 // (slides the reflection; this view becomes its view)
+    DRIFT_VIEW_EVENT_EDIT_GREEN, // its green handle to the point seen there (what it reflects)
     DRIFT_VIEW_EVENT_COUNT
 } drift_view_event_type;
 
@@ -82,7 +93,8 @@ typedef struct drift_view_event {
     drift_view_event_type type;
     drift_view_key key; // DRIFT_VIEW_EVENT_KEY
     float dx, dy;       // ORBIT, LOOK: pixels, right and down positive; DOLLY: dy notches
-    float x;            // SPLIT_AT: the column
+    float x;            // SPLIT_AT: the column; EDIT_*: the pixel's column
+    float y;            // EDIT_*: the pixel's row
 } drift_view_event;
 
 // How to create a view. The default configuration is:
@@ -94,6 +106,8 @@ typedef struct drift_view_event {
 //   exposure_stops  = 0
 //   split           = false; split_position = 0 -> 0.5 (fraction of the width)
 //   hide_overlay    = false
+//   reflection_edits_path = NULL: edits live in memory only (the save key refuses); else
+//                     loaded from it at create when it exists, and written by the save key
 //   help_text       = NULL: what the help key shows in the overlay (the window knows its key
 //                     bindings; copied, lines of printable ASCII)
 typedef struct drift_view_desc {
@@ -111,6 +125,7 @@ typedef struct drift_view_desc {
     // planes gain error.combined (a heat map), refine.mask and the metrics.
     bool refine;
     uint32_t refine_budget;
+    const char *reflection_edits_path;
 } drift_view_desc;
 
 // What the view shows now.
@@ -159,6 +174,11 @@ void drift_view_set_camera(drift_view *view, const drift_camera *camera);
 // (NULL until the first frame with the split on).
 const drift_hybrid *drift_view_hybrid(const drift_view *view);
 drift_pt *drift_view_reference(drift_view *view);
+
+// The view's reflection edits (never NULL after create) and the selected constraint (-1:
+// none).
+const drift_reflection_edits *drift_view_reflection_edits(const drift_view *view);
+int32_t drift_view_selected_constraint(const drift_view *view);
 
 // "shadows", ..., "help": the stable name of a key (NULL out of range), for docs and logs.
 const char *drift_view_key_name(drift_view_key key);

@@ -157,7 +157,8 @@ drift_result drift_pass_reference_render(drift_frame_state *f, uint32_t componen
                                .components = components,
                                .pixel_centre = true,
                                .pinhole = !lens,
-                               .camera = &f->camera };
+                               .camera = &f->camera,
+                               .reflection_edits = f->params.reflection_edits };
     drift_pt *pt = NULL;
     drift_result r = drift_pt_create(f->ctx, f->scene, f->accel, &params, &pt);
     if (r == DRIFT_OK) {

@@ -70,7 +70,10 @@ static void write_pixel(const gbuffer_job *job, int32_t x, int32_t y, const drif
     g->mesh_index[index] = hit->mesh;
     drift_vec3 zero = drift_vec3_splat(0.0f);
     if (hit->mesh == DRIFT_INVALID_INDEX && hit->light == DRIFT_INVALID_INDEX) {
-        *surface = (drift_surface){ .material = DRIFT_INVALID_INDEX, .light = DRIFT_INVALID_INDEX };
+        *surface = (drift_surface){ .material = DRIFT_INVALID_INDEX,
+                                    .light = DRIFT_INVALID_INDEX,
+                                    .mesh = DRIFT_INVALID_INDEX,
+                                    .triangle = DRIFT_INVALID_INDEX };
         if (drift_scene_has_environment(scene)) {
             surface->emission = drift_environment_eval(scene, ray->dir);
         }

@@ -2,8 +2,9 @@
 // `sharp` traces one mirror ray per glossy or mirror pixel and shades its hit with direct
 // light and hard shadows; `envmap` looks the mirror direction up in a cube map captured at a
 // probe (blurred over the lobe's cone for glossy pixels). Both weight the radiance by the
-// lobe's directional albedo (drift_raster_reflection_weight). Emission seen in the mirror direction
-// belongs to R only for mirrors: for glossy lobes the direct pass already has it.
+// lobe's directional albedo (drift_raster_reflection_weight). Under reflection edits both
+// look along the edited direction e(q) instead (drift/reflect_edit.h). Emission seen in the mirror
+// direction belongs to R only for mirrors: for glossy lobes the direct pass already has it.
 #include "realtime/realtime.h"
 
 #include <math.h>
@@ -21,6 +22,18 @@ static bool has_reflection(const drift_frame_state *f, const drift_surface *s, d
     *out_bsdf = drift_bsdf_make(f->scene, s);
     return !drift_vec3_is_zero(out_bsdf->specular) &&
            (out_bsdf->type == DRIFT_MATERIAL_MIRROR || out_bsdf->exponent > 0.0f);
+}
+
+// The direction a reflection looks along: the mirror direction of wo, or e(q) under edits.
+static drift_vec3 reflection_direction(const drift_frame_state *f, const drift_surface *s,
+                                       drift_vec3 wo)
+{
+    drift_vec3 r = drift_vec3_reflect(wo, s->ns);
+    if (!f->params.reflection_edits) {
+        return r;
+    }
+    drift_edit_point q = drift_edit_point_from_surface(s);
+    return drift_reflection_edits_direction(f->params.reflection_edits, &q, r);
 }
 
 static drift_vec3 combine(const drift_bsdf *bsdf, drift_vec3 wo, drift_raster_radiance l)
@@ -44,7 +57,7 @@ static void sharp_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *ra
         return;
     }
     drift_vec3 wo = drift_pass_wo(f, x, y);
-    drift_vec3 dir = drift_vec3_reflect(wo, s->ns);
+    drift_vec3 dir = reflection_direction(f, s, wo);
     drift_ray ray = { .origin = drift_offset_origin(s->position, s->ng, dir),
                       .dir = dir,
                       .tmin = 0.0f,
@@ -85,7 +98,7 @@ static void envmap_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *r
         return;
     }
     drift_vec3 wo = drift_pass_wo(f, x, y);
-    drift_vec3 dir = drift_vec3_reflect(wo, s->ns);
+    drift_vec3 dir = reflection_direction(f, s, wo);
     float cone = bsdf.type == DRIFT_MATERIAL_MIRROR
                      ? 0.0f
                      : drift_gloss_theta_max(&f->scene->materials[s->material]);

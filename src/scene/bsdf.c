@@ -32,10 +32,17 @@ static float glossy_probability(const drift_bsdf *b)
     return ld + ls > 0.0f ? ls / (ld + ls) : 0.0f;
 }
 
-// cos^n(alpha) and cos(alpha), alpha between wi and the mirror direction of wo.
+// The direction the lobes centre on: the mirror direction of wo, or the edited one.
+static drift_vec3 lobe_axis(const drift_bsdf *b, drift_vec3 wo)
+{
+    return drift_vec3_is_zero(b->edited_mirror) ? drift_vec3_reflect(wo, b->frame.z)
+                                                : b->edited_mirror;
+}
+
+// cos(alpha), alpha between wi and the lobe's axis (0 past a right angle).
 static float phong_cos_alpha(const drift_bsdf *b, drift_vec3 wo, drift_vec3 wi)
 {
-    drift_vec3 r = drift_vec3_reflect(wo, b->frame.z);
+    drift_vec3 r = lobe_axis(b, wo);
     return fmaxf(0.0f, drift_vec3_dot(r, wi));
 }
 
@@ -80,7 +87,7 @@ float drift_bsdf_pdf(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec3 wi)
 
 drift_vec3 drift_bsdf_sample_glossy_lobe(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec2 u)
 {
-    drift_frame f = drift_frame_from_normal(drift_vec3_reflect(wo, bsdf->frame.z));
+    drift_frame f = drift_frame_from_normal(lobe_axis(bsdf, wo));
     float cos_a = powf(u.x, 1.0f / (bsdf->exponent + 1.0f));
     float sin_a = sqrtf(fmaxf(0.0f, 1.0f - cos_a * cos_a));
     float phi = 2.0f * DRIFT_PI * u.y;
@@ -96,7 +103,7 @@ drift_bsdf_sample drift_bsdf_sample_wi(const drift_bsdf *bsdf, drift_vec3 wo, fl
         return s;
     }
     if (bsdf->type == DRIFT_MATERIAL_MIRROR) {
-        s.wi = drift_vec3_reflect(wo, bsdf->frame.z);
+        s.wi = lobe_axis(bsdf, wo);
         s.weight = bsdf->specular;
         s.pdf = 1.0f;
         s.is_delta = true;

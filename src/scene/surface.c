@@ -28,7 +28,10 @@ static void orient(drift_surface *s, drift_vec3 ng_geometric, drift_vec3 ns, dri
 drift_surface drift_scene_surface(const drift_scene *scene, const drift_ray *ray,
                                   const drift_hit *hit)
 {
-    drift_surface s = { .material = DRIFT_INVALID_INDEX, .light = hit->light };
+    drift_surface s = { .material = DRIFT_INVALID_INDEX,
+                        .light = hit->light,
+                        .mesh = DRIFT_INVALID_INDEX,
+                        .triangle = DRIFT_INVALID_INDEX };
     drift_vec3 dir = drift_vec3_normalize(ray->dir);
     if (hit->mesh != DRIFT_INVALID_INDEX) {
         const drift_mesh *mesh = &scene->meshes[hit->mesh];
@@ -60,6 +63,9 @@ drift_surface drift_scene_surface(const drift_scene *scene, const drift_ray *ray
         }
         orient(&s, ng, ns, dir);
         s.material = mesh->material;
+        s.mesh = hit->mesh;
+        s.triangle = hit->prim;
+        s.barycentric = drift_vec2_make(hit->u, hit->v);
         const drift_material *m = &scene->materials[mesh->material];
         if (s.front_face && !drift_vec3_is_zero(m->emission)) {
             s.emission = m->emission;

@@ -17,9 +17,10 @@
 
 // The keys after the effects' (those are named after their effects).
 static const char *const key_names[DRIFT_VIEW_KEY_COUNT - DRIFT_VIEW_KEY_NEXT_BUFFER] = {
-    "next-buffer",   "prev-buffer",  "split",   "split-left", "split-right", "forward",
-    "back",          "left",         "right",   "up",         "down",        "exposure-up",
-    "exposure-down", "reset-camera", "overlay", "help",
+    "next-buffer", "prev-buffer", "split",         "split-left",   "split-right",
+    "forward",     "back",        "left",          "right",        "up",
+    "down",        "exposure-up", "exposure-down", "reset-camera", "overlay",
+    "help",        "edit-region", "edit-unregion", "undo",         "save-edits",
 };
 
 drift_view_key drift_view_key_of_effect(drift_effect effect)
@@ -136,7 +137,8 @@ static drift_pt_params reference_params(const drift_view *view)
     return (drift_pt_params){ .width = view->width,
                               .height = view->height,
                               .seed = view->seed,
-                              .camera = &view->reference_camera };
+                              .camera = &view->reference_camera,
+                              .reflection_edits = view->edits };
 }
 
 // Called only without a reference (drift_view_frame drops it when the camera moves).
@@ -214,9 +216,14 @@ drift_result drift_view_create(drift_context *ctx, const drift_scene *scene,
         r = DRIFT_ERR_OUT_OF_MEMORY;
         goto fail;
     }
+    r = drift_view_edit_begin(view, d.reflection_edits_path);
+    if (r != DRIFT_OK) {
+        goto fail;
+    }
     view->params = d.hybrid;
     view->params.width = width;
     view->params.height = height;
+    view->params.reflection_edits = view->edits;
     r = drift_hybrid_create(ctx, scene, accel, &view->params, &view->hybrid);
     if (r != DRIFT_OK) {
         goto fail;
@@ -248,6 +255,7 @@ void drift_view_destroy(drift_view *view)
     drift_refine_destroy(view->sir);
     drift_hybrid_destroy(view->hybrid);
     drift_pt_destroy(view->reference);
+    drift_view_edit_end(view);
     drift_free(ctx, view->pixels);
     drift_free(ctx, view->text_vertices);
     drift_free(ctx, view->help_text);
@@ -319,6 +327,11 @@ static bool handle_key(drift_view *view, drift_view_key key)
         view->help = !view->help;
         view->overlay = view->overlay || view->help;
         return true;
+    case DRIFT_VIEW_KEY_EDIT_REGION:
+    case DRIFT_VIEW_KEY_EDIT_UNREGION:
+    case DRIFT_VIEW_KEY_EDIT_UNDO:
+    case DRIFT_VIEW_KEY_EDIT_SAVE:
+        return drift_view_edit_key(view, key);
     default:
         return false;
     }
@@ -339,6 +352,10 @@ bool drift_view_handle_event(drift_view *view, const drift_view_event *event)
     case DRIFT_VIEW_EVENT_DOLLY:
         return note_camera_move(view,
                                 drift_view_camera_dolly(&view->camera, event->dy, view->move_step));
+    case DRIFT_VIEW_EVENT_EDIT_PICK:
+    case DRIFT_VIEW_EVENT_EDIT_RED:
+    case DRIFT_VIEW_EVENT_EDIT_GREEN:
+        return drift_view_edit_event(view, event);
     case DRIFT_VIEW_EVENT_SPLIT_AT:
         if (!isfinite(event->x)) {
             return false;
@@ -444,6 +461,7 @@ drift_result drift_view_frame(drift_view *view, const atomic_bool *cancel)
     int32_t split_x = view->split ? split_column(view) : view->width;
     drift_view_show(view, shown, plane_name, &reference, split_x);
     if (view->overlay) {
+        drift_view_draw_edits(view);
         drift_view_draw_overlay(view);
     }
     view->frame_count += 1;

@@ -8,6 +8,7 @@
 #include "drift/image.h"
 #include "drift/math.h"
 #include "drift/refine.h"
+#include "drift/reflect_edit.h"
 #include "drift/view.h"
 
 #define VIEW_BUFFER_NAME_MAX 128
@@ -48,6 +49,13 @@ struct drift_view {
     bool sir_dirty;          // sir_dirty) re-sorts, a standing view keeps refining
     bool sir_begun;
 
+    // Reflection editing (view_edit.c).
+    drift_reflection_edits *edits;
+    int32_t selected;                   // the constraint the handles move, -1: none
+    struct view_edit_snapshot *history; // undo states, oldest first
+    uint32_t history_count;
+    char *edits_path; // NULL: no file to save to
+
     uint8_t *pixels;
     void *text_vertices; // VIEW_TEXT_VERTEX_BYTES for the overlay's glyph quads
     uint64_t frame_count;
@@ -87,6 +95,17 @@ void drift_view_blend_rect(drift_view *view, int32_t x0, int32_t y0, int32_t x1,
 // view's size; `reference` is read only where split_x < width.
 void drift_view_show(drift_view *view, const drift_image *shown, const char *plane_name,
                      const drift_image *reference, int32_t split_x);
+
+// --- REFLECTION EDITING (view_edit.c) ---
+
+// Creates the view's edit set (loaded from desc's path when the file exists).
+drift_result drift_view_edit_begin(drift_view *view, const char *path);
+void drift_view_edit_end(drift_view *view);
+// The EDIT_* events and keys; true when the image changes (the reference restarts).
+bool drift_view_edit_event(drift_view *view, const drift_view_event *event);
+bool drift_view_edit_key(drift_view *view, drift_view_key key);
+// The handles (red: on the mirror, green: the target) and the regions over the framebuffer.
+void drift_view_draw_edits(drift_view *view);
 
 // --- THE OVERLAY (view_overlay.c) ---
 

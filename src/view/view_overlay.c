@@ -154,6 +154,12 @@ void drift_view_draw_overlay(drift_view *view)
         }
         append(text, &len, "buffer\t%s\n", view->buffer_name);
         append(text, &len, "exposure\t%+.1f stops\n", (double)view->exposure_stops);
+        if (drift_reflection_edits_constraint_count(view->edits) > 0 ||
+            drift_reflection_edits_region_count(view->edits) > 0) {
+            append(text, &len, "edits\t%u constraints, %u regions\n",
+                   drift_reflection_edits_constraint_count(view->edits),
+                   drift_reflection_edits_region_count(view->edits));
+        }
         if (view->split) {
             append(text, &len, "pt reference\t%u spp\n",
                    view->reference ? drift_pt_sample_count(view->reference) : 0u);

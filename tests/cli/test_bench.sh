@@ -146,6 +146,12 @@ ns = "{http://www.w3.org/2000/svg}"
 assert t.tag == ns + "svg" and len(t.findall(ns + "circle")) > 15 and t.findall(ns + "polyline"), t' \
             "$tmp/frontier.svg" || fail "bench frontier: --svg is not a plot of the rows"
         ;;
+    redit)
+        expect 0 "$drift" bench redit --width 32 --height 24 --constraints 1,4 --frames 1 --json
+        check redit 'assert [r["constraints"] for r in d["field"]] == [1, 4], d
+assert d["reflective_pixels"] > 0 and all(r["mpixel_per_s"] > 0 for r in d["field"]), d
+assert d["frame_ms_unedited"] > 0 and d["frame_ms_edited"] > 0, d'
+        ;;
     *)
         fail "bench $1 has no smoke case in tests/cli/test_bench.sh"
         return

@@ -525,10 +525,12 @@ int render_mpi(int argc, char **argv)
             drift_pt_params params = { .width = (int32_t)o.width,
                                        .height = (int32_t)o.height,
                                        .seed = (uint32_t)o.seed,
-                                       .max_depth = (int32_t)o.max_depth };
+                                       .max_depth = (int32_t)o.max_depth,
+                                       .reflection_edits = o.hybrid.reflection_edits };
             status = drift_pt_create(session.ctx, session.scene, session.accel, &params, &run.pt) ==
                                  DRIFT_OK &&
-                             render_checkpoint_key(&session, run.pt, run.key, sizeof run.key)
+                             render_checkpoint_key(&session, run.pt, o.edits_path, run.key,
+                                                   sizeof run.key)
                          ? 0
                          : 1;
         }
@@ -553,7 +555,7 @@ int render_mpi(int argc, char **argv)
     }
     drift_pt_destroy(run.pt);
     if (opened) {
-        cli_session_close(&session);
+        render_close_session(&o, &session);
     }
     MPI_Finalize();
     return rank == 0 ? status : (status == 0 ? 0 : status);
