@@ -852,15 +852,15 @@ int render_open_session(render_options *o, bool outputs_here, cli_session *sessi
     bool writes = outputs_here && o->debug_sample < 0;
     o->edits = NULL;
     o->hybrid.reflection_edits = NULL;
-    if (cli_session_open(&(cli_session_desc){ .cmd = "render",
-                                              .scene_path = o->scene_path,
-                                              .threads = (int)o->threads,
-                                              .verbose = o->verbose,
-                                              .outputs = outputs,
-                                              .output_count = writes ? 5 : 0,
-                                              .inputs = inputs,
-                                              .input_count = 2 },
-                         session)) {
+    if (!cli_session_open(&(cli_session_desc){ .cmd = "render",
+                                               .scene_path = o->scene_path,
+                                               .threads = (int)o->threads,
+                                               .verbose = o->verbose,
+                                               .outputs = outputs,
+                                               .output_count = writes ? 5 : 0,
+                                               .inputs = inputs,
+                                               .input_count = 2 },
+                          session)) {
         return session->refused ? 2 : 1;
     }
     if (o->edits_path && drift_reflection_edits_load(session->ctx, session->scene, session->accel,
