@@ -138,7 +138,7 @@ static double time_field(const cli_session *s, const drift_reflection_edits *edi
                          const reflective_pixels *px, long frames, float *sink)
 {
     field_job job = { edits, px, sink };
-    double best = INFINITY;
+    double best = HUGE_VAL;
     for (long f = 0; f < frames; ++f) {
         double t = drift_time_now();
         drift_parallel_for(s->ctx, px->count, 1024, field_range, &job);
@@ -156,7 +156,7 @@ static drift_result time_frame(const cli_session *s, int32_t width, int32_t heig
                                    .reflection_edits = edits };
     drift_hybrid *frame = NULL;
     drift_result r = drift_hybrid_create(s->ctx, s->scene, s->accel, &params, &frame);
-    *out_ms = INFINITY;
+    *out_ms = HUGE_VAL;
     for (long f = 0; f <= frames && r == DRIFT_OK; ++f) {
         r = drift_hybrid_render(frame, &s->scene->camera, NULL);
         if (f > 0) { // the first frame warms the caches

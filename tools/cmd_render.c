@@ -123,7 +123,7 @@ static bool parse_camera_exposure(const char *cmd, const char *flag, const char 
                 cmd, flag, v);
         return false;
     }
-    o->ev100 = drift_ev100_from_camera((float)n, (float)t, (float)iso);
+    o->ev100 = (double)drift_ev100_from_camera((float)n, (float)t, (float)iso);
     return set_exposure_mode(cmd, flag, o, RENDER_EXPOSURE_EV100);
 }
 
