@@ -90,14 +90,18 @@ int render_refine_run(const render_options *o, const cli_session *session,
 
 // The PNG's tone mapping for `image` (--exposure, --ev100, --camera-exposure, --tonemap).
 drift_tonemap_params render_png_tonemap(const render_options *o, const drift_image *image);
-// Writes `image` to --out (EXR) and its PNG beside it (--exposure, --tonemap).
-drift_result render_write_image(drift_context *ctx, const render_options *o,
-                                const drift_image *image);
 // Writes the refiner's planes (sir may be NULL), then every plane of the frame, as the
 // layers of one EXR.
 struct drift_refine;
 drift_result render_write_aov(drift_context *ctx, const char *path,
                               const struct drift_hybrid *frame, const struct drift_refine *sir);
+struct render_stage;
+// Stages `image` as --out (EXR) and its PNG (--exposure, --tonemap), and with --aov the planes
+// (render_write_aov). On failure says so, removes what was staged and returns false; on
+// success the caller stages --stats and commits.
+bool render_stage_hybrid_images(drift_context *ctx, const render_options *o,
+                                const drift_image *image, const struct drift_hybrid *frame,
+                                const struct drift_refine *sir, struct render_stage *stage);
 
 // FILE.exr -> FILE.png
 void render_png_path(const char *exr_path, char *out, size_t size);
@@ -149,7 +153,7 @@ int render_checkpoint_read(const char *path, const char *key, struct drift_pt *p
 // A run's outputs, written to "<path>.stage-PID" first and renamed over their targets
 // together once every one was written (render_stage_commit), or all removed.
 typedef struct render_staged_file {
-    const char *path;
+    char path[4096]; // a copy: the caller's string need not outlive the stage
     char temp[4096];
 } render_staged_file;
 

@@ -229,7 +229,7 @@ const char *render_stage_add(render_stage *s, const char *path)
         return path;
     }
     render_staged_file *f = &s->files[s->count++];
-    f->path = path;
+    snprintf(f->path, sizeof f->path, "%s", path);
     snprintf(f->temp, sizeof f->temp, "%s.stage-%ld", path, (long)getpid());
     return f->temp;
 }

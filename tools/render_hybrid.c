@@ -10,7 +10,8 @@
 #include <string.h>
 
 static bool write_stats(const render_options *o, const cli_session *session,
-                        const drift_hybrid *frame, double first_frame_ms, double t_done)
+                        const drift_hybrid *frame, double first_frame_ms, double t_done,
+                        const char *path)
 {
     drift_hybrid_params p = drift_hybrid_get_params(frame);
     drift_hybrid_stats s = drift_hybrid_get_stats(frame);
@@ -46,7 +47,7 @@ static bool write_stats(const render_options *o, const cli_session *session,
     cli_json_number(ms, "first_frame", first_frame_ms, 3);
     cJSON_AddNumberToObject(root, "frames", (double)o->frames);
     cli_json_number(ms, "total", 1e3 * (t_done - session->t_start), 3);
-    return cli_json_write("render", root, o->stats_path);
+    return cli_json_write("render", root, path);
 }
 
 drift_result render_write_aov(drift_context *ctx, const char *path, const drift_hybrid *frame,
@@ -77,30 +78,30 @@ drift_result render_write_aov(drift_context *ctx, const char *path, const drift_
     return r;
 }
 
-drift_result render_write_image(drift_context *ctx, const render_options *o,
-                                const drift_image *image)
+bool render_stage_hybrid_images(drift_context *ctx, const render_options *o,
+                                const drift_image *image, const drift_hybrid *frame,
+                                const drift_refine *sir, render_stage *stage)
 {
-    drift_result r = drift_image_save_exr(ctx, o->out_path, &(drift_image_layer){ NULL, image }, 1);
+    char png[4096];
+    render_png_path(o->out_path, png, sizeof png);
+    const char *exr_temp = render_stage_add(stage, o->out_path);
+    const char *png_temp = render_stage_add(stage, png);
+    const char *aov_temp = render_stage_add(stage, o->aov_path);
+    drift_result r = drift_image_save_exr(ctx, exr_temp, &(drift_image_layer){ NULL, image }, 1);
     if (r == DRIFT_OK) {
-        char png[4096];
-        render_png_path(o->out_path, png, sizeof png);
         drift_tonemap_params tonemap = render_png_tonemap(o, image);
-        r = drift_image_save_png(ctx, png, image, &tonemap);
+        r = drift_image_save_png(ctx, png_temp, image, &tonemap);
     }
-    return r;
-}
-
-static drift_result write_outputs(drift_context *ctx, const render_options *o,
-                                  const drift_hybrid *frame)
-{
-    drift_result r = render_write_image(ctx, o, drift_hybrid_image(frame));
-    if (r == DRIFT_OK && o->aov_path) {
-        r = render_write_aov(ctx, o->aov_path, frame, NULL);
+    if (r == DRIFT_OK && aov_temp) {
+        r = render_write_aov(ctx, aov_temp, frame, sir);
     }
     if (r != DRIFT_OK) {
-        fprintf(stderr, "drift render: cannot write the images: %s\n", drift_result_string(r));
+        fprintf(stderr, "drift render: cannot write the images: %s; nothing written\n",
+                drift_result_string(r));
+        render_stage_abort(stage);
+        return false;
     }
-    return r;
+    return true;
 }
 
 int render_hybrid(const render_options *o, const cli_session *session)
@@ -170,11 +171,19 @@ int render_hybrid(const render_options *o, const cli_session *session)
         exit_code = render_refine_run(o, session, frame);
         goto done;
     }
-    if (write_outputs(ctx, o, frame) != DRIFT_OK) {
+    // --out, its PNG, --aov and --stats: all written, or none.
+    render_stage stage = { 0 };
+    if (!render_stage_hybrid_images(ctx, o, drift_hybrid_image(frame), frame, NULL, &stage)) {
         goto done;
     }
     double t_done = drift_time_now();
-    if (o->stats_path && !write_stats(o, session, frame, first_frame_ms, t_done)) {
+    if (o->stats_path && !write_stats(o, session, frame, first_frame_ms, t_done,
+                                      render_stage_add(&stage, o->stats_path))) {
+        fprintf(stderr, "drift render: nothing written\n");
+        render_stage_abort(&stage);
+        goto done;
+    }
+    if (!render_stage_commit(&stage)) {
         goto done;
     }
     if (!o->quiet) {

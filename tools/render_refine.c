@@ -32,7 +32,8 @@ bool render_refine_validate(const render_options *o)
 }
 
 static bool write_stats(const render_options *o, const cli_session *session,
-                        const drift_hybrid *frame, const drift_refine *sir, double refine_ms)
+                        const drift_hybrid *frame, const drift_refine *sir, double refine_ms,
+                        const char *path)
 {
     drift_hybrid_params p = drift_hybrid_get_params(frame);
     drift_refine_stats s = drift_refine_get_stats(sir);
@@ -54,7 +55,7 @@ static bool write_stats(const render_options *o, const cli_session *session,
     cli_json_number(ms, "sort", s.sort_ms, 3);
     cli_json_number(ms, "trace", s.trace_ms, 3);
     cli_json_number(ms, "refine", refine_ms, 3);
-    return cli_json_write("render", root, o->stats_path);
+    return cli_json_write("render", root, path);
 }
 
 int render_refine_run(const render_options *o, const cli_session *session, drift_hybrid *frame)
@@ -103,15 +104,18 @@ int render_refine_run(const render_options *o, const cli_session *session, drift
         fprintf(stderr, "drift render: refinement failed: %s\n", drift_result_string(r));
         goto done;
     }
-    drift_result w = render_write_image(ctx, o, drift_refine_image(sir));
-    if (w == DRIFT_OK && o->aov_path) {
-        w = render_write_aov(ctx, o->aov_path, frame, sir);
-    }
-    if (w != DRIFT_OK) {
-        fprintf(stderr, "drift render: cannot write the outputs: %s\n", drift_result_string(w));
+    // --out, its PNG, --aov and --stats: all written, or none.
+    render_stage stage = { 0 };
+    if (!render_stage_hybrid_images(ctx, o, drift_refine_image(sir), frame, sir, &stage)) {
         goto done;
     }
-    if (o->stats_path && !write_stats(o, session, frame, sir, refine_ms)) {
+    if (o->stats_path &&
+        !write_stats(o, session, frame, sir, refine_ms, render_stage_add(&stage, o->stats_path))) {
+        fprintf(stderr, "drift render: nothing written\n");
+        render_stage_abort(&stage);
+        goto done;
+    }
+    if (!render_stage_commit(&stage)) {
         goto done;
     }
     char png[4096];

@@ -703,6 +703,18 @@ drift_result drift__scene_import_mesh_file(drift_scene *scene, const drift__impo
     if (strcmp(ext, "ply") == 0) {
         r = gz ? check_ply_header(&s, data, size < 8192 ? size : 8192, size)
                : check_ply_file(&s, size);
+        // Then every element, naming the line or byte where assimp would name none.
+        char *text = data;
+        size_t text_size = size;
+        if (r == DRIFT_OK && !gz) {
+            r = drift__read_file(ctx, params->path, false, s.where, s.line, &text, &text_size);
+        }
+        if (r == DRIFT_OK) {
+            r = drift__ply_check(ctx, params->path, text, text_size);
+        }
+        if (text != data) {
+            drift_free(ctx, text);
+        }
         if (r != DRIFT_OK) {
             drift_free(ctx, data);
             return r;
@@ -714,6 +726,14 @@ drift_result drift__scene_import_mesh_file(drift_scene *scene, const drift__impo
             obj_tail_feed(&t, data, size);
         }
         r = gz ? obj_tail_check(&s, &t) : check_obj_file(&s);
+        if (r != DRIFT_OK) {
+            drift_free(ctx, data);
+            return r;
+        }
+    }
+    // glTF's own JSON first: a syntax error is named by line, where assimp names none.
+    if (s.is_gltf) {
+        r = drift__gltf_open(ctx, params->path, gz, s.where, s.line, &s.gltf);
         if (r != DRIFT_OK) {
             drift_free(ctx, data);
             return r;
@@ -731,12 +751,10 @@ drift_result drift__scene_import_mesh_file(drift_scene *scene, const drift__impo
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, s.where, s.line, "cannot read '%s': %s",
                   params->path, ai ? "no scene" : aiGetErrorString());
         aiReleaseImport(ai);
+        drift__gltf_close(ctx, s.gltf);
         return DRIFT_ERR_PARSE;
     }
     s.ai = ai;
-    if (s.is_gltf) {
-        r = drift__gltf_open(ctx, params->path, gz, s.where, s.line, &s.gltf);
-    }
     if (r == DRIFT_OK && params->camera) {
         int camera = s.gltf ? drift__gltf_camera_index(s.gltf, params->camera) : -1;
         if (camera < 0 || (unsigned)camera >= ai->mNumCameras) {

@@ -76,7 +76,33 @@ drift_result drift__gltf_open(drift_context *ctx, const char *path, bool gz, con
                   "'%s': not a glTF 2.0 binary (.glb): bad header or no JSON chunk", path);
         return DRIFT_ERR_PARSE;
     }
-    cJSON *root = cJSON_ParseWithLength(json, length);
+    const char *error_at = NULL;
+    cJSON *root = cJSON_ParseWithLengthOpts(json, length, &error_at, false);
+    if (!root) {
+        // Where cJSON stopped (its cJSON_GetErrorPtr, without the global state), as a line.
+        size_t offset = error_at && error_at >= json ? (size_t)(error_at - json) : 0;
+        offset = offset < length ? offset : length;
+        int json_line = 1;
+        size_t line_start = 0;
+        for (size_t i = 0; i < offset; ++i) {
+            if (json[i] == '\n') {
+                ++json_line;
+                line_start = i + 1;
+            }
+        }
+        int column = (int)(offset - line_start) + 1;
+        if (json == data) {
+            drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, path, json_line,
+                      "malformed glTF JSON at column %d%s", column,
+                      offset == length ? " (the file ends early: cut short?)" : "");
+        } else {
+            drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, where, line,
+                      "'%s': the JSON chunk of this .glb is malformed at its line %d, column %d",
+                      path, json_line, column);
+        }
+        drift_free(ctx, data);
+        return DRIFT_ERR_PARSE;
+    }
     drift_free(ctx, data);
     if (!cJSON_IsObject(root)) {
         cJSON_Delete(root);

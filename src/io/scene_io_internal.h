@@ -117,6 +117,11 @@ drift_result drift__check_file(drift_context *ctx, const char *path, const char 
 drift_result drift__read_file(drift_context *ctx, const char *path, bool gzip, const char *where,
                               int line, char **out_data, size_t *out_size);
 
+// Checks a PLY file's header and that its data holds every element the header declares,
+// each with its values (scene_ply.c): errors name path and line (ASCII) or byte offset
+// (binary). A header with more elements or properties than any mesh needs is left to assimp.
+drift_result drift__ply_check(drift_context *ctx, const char *path, const char *data, size_t size);
+
 // Lower-case extension of path without the dot ("" when none). A trailing ".gz" is looked
 // through: "x.obj.gz" gives "obj" and sets *out_gz (false for any other name).
 void drift__path_extension(const char *path, char *out, size_t out_size, bool *out_gz);

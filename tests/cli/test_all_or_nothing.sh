@@ -52,6 +52,25 @@ status=$?
 rm -f o.ckpt
 no_outputs "--stats folder removed mid-run" "No such file or directory"
 
+# The same in hybrid mode, plain and refined: --out, its PNG and --aov are staged with
+# --stats, so --stats' folder removed while the frames render leaves none of them.
+for refine in "" "--refine sir"; do
+    mkdir sub
+    # shellcheck disable=SC2086 # $refine is two words or none
+    "$drift" render s.json --mode hybrid $refine --frames 8000 --out h.exr --aov a.exr \
+        --stats sub/s.json >out 2>err &
+    pid=$!
+    for i in $(seq 100); do
+        grep -q "hybrid frame of" err && break
+        sleep 0.1
+    done
+    rm -r sub
+    wait "$pid"
+    status=$?
+    [ "$status" -eq 1 ] || fail "hybrid $refine: a failed --stats write exited $status, expected 1"
+    no_outputs "hybrid $refine: --stats folder removed mid-run" "No such file or directory"
+done
+
 # The stats JSON is escaped (cJSON): a scene path with a quote and a backslash.
 cp s.json 'q"uote\.json'
 expect 0 "$drift" render 'q"uote\.json' "${fast[@]}" --out o.exr --stats o.json

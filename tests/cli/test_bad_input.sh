@@ -121,6 +121,46 @@ expect_line cut_gz.obj.gz 7
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n# no newline' >"$dir/no_newline.obj"
 "$drift" info "$dir/no_newline.obj" >/dev/null 2>&1 || fail "an OBJ ending in a comment loads"
 
+# PLY errors name the line (ASCII) or the byte and element (binary); assimp names neither
+# and loads a file cut short without a word.
+ply_head='ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n'
+printf "${ply_head}0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n" >"$dir/good.ply"
+"$drift" info "$dir/good.ply" >/dev/null 2>"$dir/err" || fail "a small ASCII PLY loads: $(cat "$dir/err")"
+printf "${ply_head}0 0 0\n1 0 0\n0 1" >"$dir/cut_mid_line.ply"
+expect_failure cut_mid_line.ply
+expect_line cut_mid_line.ply 12
+printf "${ply_head}0 0 0\n1 0 0\n0 1 0\n" >"$dir/cut_before_face.ply"
+expect_failure cut_before_face.ply
+expect_line cut_before_face.ply 13
+printf "${ply_head}0 0 0\n1 0 0 7\n0 1 0\n3 0 1 2\n" >"$dir/extra_value.ply"
+expect_failure extra_value.ply
+expect_line extra_value.ply 11
+printf "${ply_head}0 0 0\n1 0 0\n0 1 0\n3 0 1\n" >"$dir/short_face.ply"
+expect_failure short_face.ply
+expect_line short_face.ply 13
+printf "${ply_head}0 0 0\n1 x 0\n0 1 0\n3 0 1 2\n" >"$dir/not_number.ply"
+expect_failure not_number.ply
+expect_line not_number.ply 11
+printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty floot x\nend_header\n0\n0\n0\n' >"$dir/bad_type.ply"
+expect_failure bad_type.ply
+expect_line bad_type.ply 4
+python3 - "$dir/cut_binary.ply" <<'PY'
+import struct, sys
+head = (b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
+        b"property float y\nproperty float z\nelement face 1\n"
+        b"property list uchar int vertex_indices\nend_header\n")
+body = struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, 1, 0) + struct.pack("<B3i", 3, 0, 1, 2)
+open(sys.argv[1], "wb").write(head + body[:-6])
+PY
+expect_failure cut_binary.ply
+grep -q "byte .*'face' element 1 of 1" "$dir/err" || fail "cut_binary.ply: no byte and element: $(cat "$dir/err")"
+
+# Malformed glTF JSON names its line (cJSON's error position).
+printf '{\n  "asset": { "version": "2.0" },\n  "scenes": [ { "nodes": [0] } \n  "nodes": []\n}\n' \
+    >"$dir/syntax.gltf"
+expect_failure syntax.gltf
+expect_line syntax.gltf 4
+
 # A FIFO named as a scene is refused at once, not read forever.
 mkfifo "$dir/fifo.json"
 timeout 10 "$drift" info "$dir/fifo.json" >"$dir/out" 2>"$dir/err"
