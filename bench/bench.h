@@ -48,4 +48,15 @@ bool bench_open(cli_session *s, const char *cmd, const char *scene_path, const c
 bool bench_parse_list(const char *cmd, const char *flag, const char *text, long lo, long hi,
                       int max, long *out, int *count);
 
+// The frontier's whole-frame path tracer (drift bench frontier, drift report's sir cell): every
+// effect, max depth 8, `spp` samples a pixel from `seed`; its RGB into a new *out, its rays
+// (camera, shadow, bounce) into *rays when not NULL. The reference: the same at a fixed seed.
+drift_result bench_frontier_path_trace(drift_context *ctx, const drift_scene *scene,
+                                       const drift_accel *accel, int32_t width, int32_t height,
+                                       uint32_t spp, uint32_t seed, const atomic_bool *cancel,
+                                       drift_image *out, uint64_t *rays);
+drift_result bench_frontier_reference(drift_context *ctx, const drift_scene *scene,
+                                      const drift_accel *accel, int32_t width, int32_t height,
+                                      uint32_t spp, drift_image *out);
+
 #endif // DRIFT_BENCH_H

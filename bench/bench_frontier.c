@@ -159,6 +159,36 @@ static uint32_t hash_text(const char *s)
     return h;
 }
 
+drift_result bench_frontier_path_trace(drift_context *ctx, const drift_scene *scene,
+                                       const drift_accel *accel, int32_t width, int32_t height,
+                                       uint32_t spp, uint32_t seed, const atomic_bool *cancel,
+                                       drift_image *out, uint64_t *rays)
+{
+    drift_pt_params params = {
+        .width = width, .height = height, .seed = seed, .max_depth = FRONTIER_DEPTH
+    };
+    drift_pt *pt = NULL;
+    drift_result r = drift_pt_create(ctx, scene, accel, &params, &pt);
+    r = r ? r : drift_pt_render_samples(pt, spp, cancel);
+    drift_image beauty;
+    r = r ? r : drift_pt_resolve(pt, DRIFT_PT_AOV_BEAUTY, &beauty);
+    r = r ? r : copy_rgb(ctx, &beauty, out);
+    if (r == DRIFT_OK && rays) {
+        drift_pt_stats st = drift_pt_get_stats(pt);
+        *rays = st.camera_rays + st.shadow_rays + st.bounce_rays;
+    }
+    drift_pt_destroy(pt);
+    return r;
+}
+
+drift_result bench_frontier_reference(drift_context *ctx, const drift_scene *scene,
+                                      const drift_accel *accel, int32_t width, int32_t height,
+                                      uint32_t spp, drift_image *out)
+{
+    return bench_frontier_path_trace(ctx, scene, accel, width, height, spp, REF_SEED, NULL, out,
+                                     NULL);
+}
+
 // Loads the cached reference or renders and caches it; *cached says which.
 static drift_result reference_image(frontier_state *b, const char *scene_path, bool *cached,
                                     char *path, size_t path_size)
@@ -181,14 +211,9 @@ static drift_result reference_image(frontier_state *b, const char *scene_path, b
         drift_image_destroy(b->ctx, &b->reference);
     }
     *cached = false;
-    drift_pt_params params = pt_params(o, REF_SEED);
-    drift_pt *pt = NULL;
-    drift_result r = drift_pt_create(b->ctx, b->scene, b->accel, &params, &pt);
-    r = r ? r : drift_pt_render_samples(pt, (uint32_t)o->ref_spp, NULL);
-    drift_image beauty;
-    r = r ? r : drift_pt_resolve(pt, DRIFT_PT_AOV_BEAUTY, &beauty);
-    r = r ? r : copy_rgb(b->ctx, &beauty, &b->reference);
-    drift_pt_destroy(pt);
+    drift_result r =
+        bench_frontier_reference(b->ctx, b->scene, b->accel, (int32_t)o->size, (int32_t)o->size,
+                                 (uint32_t)o->ref_spp, &b->reference);
     if (r == DRIFT_OK) {
         if (mkdir(o->cache_dir, 0777) != 0 && errno != EEXIST) {
             fprintf(stderr, "drift bench frontier: cannot create %s (reference not cached)\n",

@@ -8,10 +8,13 @@
 // tools/report/page.html with the data as JSON, beside the images (EXR, PNGs at several
 // exposures, FLIP heat maps). Renders are cached in DIR/manifest.json keyed by the scene's
 // content, the frame's parameters and drift's version, so a rerun renders only what is
-// missing and Ctrl-C keeps what is finished.
+// missing and Ctrl-C keeps what is finished. The `sir` cell is the whole frame refined by
+// smart image refinement, against drift bench frontier's whole-frame path-traced truth.
+#include "bench.h"
 #include "cli.h"
 #include "drift/image_io.h"
 #include "drift/metric.h"
+#include "drift/refine.h"
 #include "drift/scene.h"
 #include "render.h"
 
@@ -29,6 +32,8 @@
 #define REPORT_MAX_SCENES 16
 #define REPORT_EXPOSURES  3
 #define REPORT_VERSION    DRIFT_VERSION " " DRIFT_COMMIT
+#define REPORT_MAX_SIR    8
+#define REPORT_SIR_NAME   "sir" // --effects name of the whole-frame SIR cell
 
 extern const char drift_report_page[]; // tools/report/page.html (cmake/embed_text.cmake)
 
@@ -49,8 +54,10 @@ typedef struct report_options {
     const char *scenes[REPORT_MAX_SCENES];
     const char *out_dir;
     bool effects[DRIFT_EFFECT_COUNT];
-    bool effects_given;
-    long size, ref_spp, sweep_spp, threads;
+    bool effects_given, sir;
+    long sir_iterations[REPORT_MAX_SIR];
+    int sir_iteration_count;
+    long size, ref_spp, sweep_spp, sir_budget, threads;
     double time_budget; // seconds; 0: none
     bool verbose;
 } report_options;
@@ -60,6 +67,7 @@ static bool parse_effects(const char *cmd, const char *flag, const char *value, 
     report_options *o = field;
     memset(o->effects, 0, sizeof o->effects);
     o->effects_given = true;
+    o->sir = false;
     const char *p = value;
     while (*p) {
         size_t n = strcspn(p, ",");
@@ -70,16 +78,38 @@ static bool parse_effects(const char *cmd, const char *flag, const char *value, 
                 found = e;
             }
         }
-        if (found < 0) {
+        bool sir = strlen(REPORT_SIR_NAME) == n && strncmp(REPORT_SIR_NAME, p, n) == 0;
+        if (found < 0 && !sir) {
             fprintf(stderr, "drift %s: %s expects effects from", cmd, flag);
             for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
                 fprintf(stderr, "%s%s", e ? ", " : " ", drift_effect_name((drift_effect)e));
             }
-            fprintf(stderr, " separated by commas, got '%s'\n", value);
+            fprintf(stderr, ", " REPORT_SIR_NAME " separated by commas, got '%s'\n", value);
             return false;
         }
-        o->effects[found] = true;
+        if (sir) {
+            o->sir = true;
+        } else {
+            o->effects[found] = true;
+        }
         p += n + (p[n] == ',');
+    }
+    return true;
+}
+
+static bool parse_sir_iterations(const char *cmd, const char *flag, const char *value, void *field)
+{
+    report_options *o = field;
+    if (!bench_parse_list(cmd, flag, value, 1, 1 << 20, REPORT_MAX_SIR, o->sir_iterations,
+                          &o->sir_iteration_count)) {
+        return false;
+    }
+    for (int i = 1; i < o->sir_iteration_count; ++i) { // ascending: one refinement gives all
+        for (int k = i; k > 0 && o->sir_iterations[k - 1] > o->sir_iterations[k]; --k) {
+            long t = o->sir_iterations[k];
+            o->sir_iterations[k] = o->sir_iterations[k - 1];
+            o->sir_iterations[k - 1] = t;
+        }
     }
     return true;
 }
@@ -89,15 +119,20 @@ static const cli_option report_table[] = {
     CLI_SECTION("options:", 0),
     CLI_STRING("--out", "DIR", O, out_dir,
                "the report's folder: index.html, images, cache (required)"),
-    CLI_CUSTOM_ALL("--effects", "LIST", parse_effects,
-                   "effects to show, e.g. shadows,dof (default: every effect with a\n"
-                   "path-traced reference)"),
+    CLI_CUSTOM_ALL(
+        "--effects", "LIST", parse_effects,
+        "effects to show, e.g. shadows,dof; " REPORT_SIR_NAME ": the whole frame refined by\n"
+        "SIR (default: every effect with a path-traced reference, and " REPORT_SIR_NAME ")"),
     CLI_INT("--size", "N", O, size, 8, 4096,
             "frame width in pixels; the height follows the camera (default 256)"),
     CLI_INT("--ref-spp", "N", O, ref_spp, 1, 4096,
             "samples a pixel of the references (default 256)"),
     CLI_INT("--sweep-spp", "N", O, sweep_spp, 1, 1 << 16,
             "path-traced techniques at 1, 2, 4, ... N spp (default 16)"),
+    CLI_CUSTOM_ALL("--sir-iterations", "LIST", parse_sir_iterations,
+                   "the " REPORT_SIR_NAME " cell refines for these iterations (default 1,2,4,8)"),
+    CLI_INT("--sir-budget", "N", O, sir_budget, 0, 1L << 30,
+            "samples a SIR iteration (default 0: one a pixel)"),
     CLI_NUMBER("--time-budget", "S", O, time_budget, 0.0, 1e9,
                "start no render after S seconds (0: no limit); a rerun goes on"),
     CLI_INT("--threads", "T", O, threads, 0, 256, "worker threads (default: one a core)"),
@@ -267,14 +302,19 @@ static void format_seconds(double s, char *out, size_t size)
     }
 }
 
-static void progress(report_run *run, const char *scene, const report_job *j, const char *what)
+static void eta_text(const report_run *run, char *eta, size_t size)
 {
-    char eta[32] = "?";
+    snprintf(eta, size, "?");
     if (run->units_done > 0.0 && run->render_seconds > 0.0) {
         double left = run->units_total - run->units_done;
-        format_seconds(left > 0.0 ? left * run->render_seconds / run->units_done : 0.0, eta,
-                       sizeof eta);
+        format_seconds(left > 0.0 ? left * run->render_seconds / run->units_done : 0.0, eta, size);
     }
+}
+
+static void progress(report_run *run, const char *scene, const report_job *j, const char *what)
+{
+    char eta[32];
+    eta_text(run, eta, sizeof eta);
     char spp[32] = "";
     if (frame_path_traced(&j->params)) {
         snprintf(spp, sizeof spp, " %u spp", j->spp);
@@ -524,6 +564,351 @@ static cJSON *report_effect(report_run *run, const cli_session *s, const char *l
     return out;
 }
 
+// --- the sir cell: the whole frame, refined ---
+
+// The frame SIR refines (drift render --mode hybrid --shadows pcss --reflections envmap --dof
+// post --refine sir, docs/sir.md), at the report's size.
+static drift_hybrid_params sir_frame_params(const report_options *o, const drift_scene *scene)
+{
+    drift_hybrid_params p = make_job(o, scene, DRIFT_EFFECT_SHADOWS, 0, 1, false).params;
+    p.shadows = DRIFT_SHADOWS_PCSS;
+    p.reflections = DRIFT_REFLECTIONS_ENVMAP;
+    p.dof = DRIFT_DOF_POST;
+    return p;
+}
+
+// The whole-frame path tracer's sweep beside SIR's curve: 1, 2, 4, ... --sweep-spp below
+// --ref-spp.
+static int pt_sweep_count(const report_options *o)
+{
+    int n = 0;
+    for (long spp = 1; spp <= o->sweep_spp && spp < o->ref_spp; spp *= 2) {
+        ++n;
+    }
+    return n;
+}
+
+// iterations -1: the whole-frame truth; < -1: the whole-frame path tracer at -1 - iterations
+// spp.
+static void sir_key(const report_options *o, const drift_hybrid_params *p, uint64_t scene,
+                    int threads, long iterations, char *out, size_t size)
+{
+    char text[256];
+    if (iterations < -1) {
+        snprintf(text, sizeof text, "%016" PRIx64 " whole-frame pt %dx%d %ld spp %d threads", scene,
+                 p->width, p->height, -1 - iterations, threads);
+    } else if (iterations < 0) { // the whole-frame truth
+        snprintf(text, sizeof text, "%016" PRIx64 " whole-frame truth %dx%d %ld spp", scene,
+                 p->width, p->height, o->ref_spp);
+    } else {
+        snprintf(text, sizeof text, "%016" PRIx64 " sir %dx%d budget %ld %ld iterations %d threads",
+                 scene, p->width, p->height, o->sir_budget, iterations, threads);
+    }
+    snprintf(out, size, "%016" PRIx64,
+             cli_fnv1a(cli_fnv1a(CLI_FNV_BASIS, text, strlen(text)), REPORT_VERSION,
+                       sizeof REPORT_VERSION));
+}
+
+// Writes `image` as DIR/NAME.exr and its PNGs and records it in the manifest under `key`.
+static cJSON *store_render(report_run *run, const char *dir, const char *key, const char *name,
+                           const drift_image *image, double ms, uint64_t rays)
+{
+    char base[4096], exr[4200];
+    snprintf(base, sizeof base, "%.3800s/%.256s", dir, name);
+    snprintf(exr, sizeof exr, "%s.exr", base);
+    drift_image_layer layer = { NULL, image };
+    drift_result r = drift_image_save_exr(run->ctx, exr, &layer, 1);
+    r = r ? r : save_pngs(run->ctx, base, image);
+    if (r != DRIFT_OK) {
+        fprintf(stderr, "drift report: cannot write %s: %s\n", exr, drift_result_string(r));
+        return NULL;
+    }
+    cJSON *item = cJSON_CreateObject();
+    cJSON_AddStringToObject(item, "file", name);
+    cli_json_number(item, "ms", ms, 3);
+    cli_json_number(item, "frame_ms", ms, 3);
+    cli_json_count(item, "rays", rays);
+    cJSON_DeleteItemFromObjectCaseSensitive(run->renders, key);
+    cJSON_AddItemToObject(run->renders, key, item);
+    return write_manifest(run) ? item : NULL;
+}
+
+static const cJSON *cached_render(report_run *run, const char *dir, const char *key)
+{
+    const cJSON *entry = cJSON_GetObjectItemCaseSensitive(run->renders, key);
+    const char *file = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(entry, "file"));
+    char exr[4200];
+    snprintf(exr, sizeof exr, "%.3800s/%.256s.exr", dir, file ? file : "");
+    return file && file_exists(exr) ? entry : NULL;
+}
+
+static void sir_progress(report_run *run, const char *scene, const char *what, const char *how)
+{
+    char eta[32];
+    eta_text(run, eta, sizeof eta);
+    fprintf(stderr, "drift report: [%d/%d] %s " REPORT_SIR_NAME " %s: %s, ETA %s\n", run->jobs_done,
+            run->jobs_total, scene, what, how, eta);
+}
+
+static bool run_stopped(report_run *run)
+{
+    if (!run->interrupted && !run->budget_spent && run->o->time_budget > 0.0 &&
+        drift_time_now() - run->t_start > run->o->time_budget) {
+        run->budget_spent = true;
+        fprintf(stderr, "drift report: --time-budget %g s spent; a rerun goes on from here\n",
+                run->o->time_budget);
+    }
+    return run->interrupted || run->budget_spent;
+}
+
+// The whole-frame truth: drift bench frontier's (the path tracer at --ref-spp, every effect).
+static const cJSON *sir_truth(report_run *run, const cli_session *s, const char *label,
+                              const char *dir, uint64_t hash, const drift_hybrid_params *p)
+{
+    char key[32], name[256];
+    sir_key(run->o, p, hash, drift_context_thread_count(run->ctx), -1, key, sizeof key);
+    snprintf(name, sizeof name, "sir-truth-%ldspp-%.8s", run->o->ref_spp, key);
+    ++run->jobs_done;
+    const cJSON *entry = cached_render(run, dir, key);
+    if (entry) {
+        run->units_total -= (double)run->o->ref_spp;
+    }
+    if (entry || run_stopped(run)) {
+        sir_progress(run, label, "whole-frame truth", entry ? "cached" : "not rendered");
+        return entry;
+    }
+    drift_image truth = { 0 };
+    double t0 = drift_time_now();
+    drift_result r = bench_frontier_reference(run->ctx, s->scene, s->accel, p->width, p->height,
+                                              (uint32_t)run->o->ref_spp, &truth);
+    double ms = 1e3 * (drift_time_now() - t0);
+    run->render_seconds += ms / 1e3;
+    run->units_done += (double)run->o->ref_spp;
+    entry = r == DRIFT_OK ? store_render(run, dir, key, name, &truth, ms, 0) : NULL;
+    drift_image_destroy(run->ctx, &truth);
+    char took[64];
+    snprintf(took, sizeof took, "%.2f s", ms / 1e3);
+    sir_progress(run, label, "whole-frame truth", entry ? took : drift_result_string(r));
+    return entry;
+}
+
+// The whole frame path-traced at `spp` from another seed than the truth's (as the frontier's
+// pt rows): the convergence SIR's curve is measured against.
+static const cJSON *sir_pt(report_run *run, const cli_session *s, const char *label,
+                           const char *dir, uint64_t hash, const drift_hybrid_params *p, long spp,
+                           const char **why)
+{
+    char key[32], name[256], what[64];
+    sir_key(run->o, p, hash, drift_context_thread_count(run->ctx), -1 - spp, key, sizeof key);
+    snprintf(name, sizeof name, "sir-pt-%ldspp-%.8s", spp, key);
+    snprintf(what, sizeof what, "whole-frame pt %ld spp", spp);
+    ++run->jobs_done;
+    const cJSON *entry = cached_render(run, dir, key);
+    if (entry) {
+        run->units_total -= (double)spp;
+        sir_progress(run, label, what, "cached");
+        return entry;
+    }
+    if (run_stopped(run)) {
+        *why = run->interrupted ? "not rendered: interrupted (rerun to finish)"
+                                : "not rendered: --time-budget spent (rerun to go on)";
+        return NULL;
+    }
+    drift_image image = { 0 };
+    uint64_t rays = 0;
+    double t0 = drift_time_now();
+    drift_result r = bench_frontier_path_trace(run->ctx, s->scene, s->accel, p->width, p->height,
+                                               (uint32_t)spp, 1u, run->cancel, &image, &rays);
+    double ms = 1e3 * (drift_time_now() - t0);
+    run->render_seconds += ms / 1e3;
+    run->units_done += (double)spp;
+    entry = r == DRIFT_OK ? store_render(run, dir, key, name, &image, ms, rays) : NULL;
+    drift_image_destroy(run->ctx, &image);
+    if (r == DRIFT_ERR_CANCELLED) {
+        run->interrupted = true;
+        fprintf(stderr, "drift report: interrupted; writing the page with what is finished\n");
+    }
+    *why = r == DRIFT_ERR_CANCELLED ? "not rendered: interrupted (rerun to finish)"
+                                    : "render failed (see the log)";
+    char took[64];
+    snprintf(took, sizeof took, "%.2f s", ms / 1e3);
+    sir_progress(run, label, what, entry ? took : drift_result_string(r));
+    run_stopped(run);
+    return entry;
+}
+
+// The raster frame (0 iterations) and the refined frame after each of --sir-iterations,
+// from one refinement: a row's ms are the raster frame's and the refinement's so far (its
+// metrics, sort and tracing), its rays the frame's, the metrics' and the tracer's. All the
+// rows come from one run, so a missing one renders them all again.
+static void sir_rows(report_run *run, const cli_session *s, const char *label, const char *dir,
+                     uint64_t hash, const drift_hybrid_params *p, const cJSON **entries,
+                     const char **why)
+{
+    const report_options *o = run->o;
+    int n = o->sir_iteration_count + 1, threads = drift_context_thread_count(run->ctx);
+    char keys[REPORT_MAX_SIR + 1][32];
+    bool all = true;
+    for (int k = 0; k < n; ++k) {
+        sir_key(o, p, hash, threads, k ? o->sir_iterations[k - 1] : 0, keys[k], sizeof keys[k]);
+        entries[k] = cached_render(run, dir, keys[k]);
+        all = all && entries[k];
+    }
+    run->jobs_done += n;
+    if (all) {
+        run->units_total -= n;
+        sir_progress(run, label, "iterations", "cached");
+        return;
+    }
+    if (run_stopped(run)) {
+        *why = run->interrupted ? "not rendered: interrupted (rerun to finish)"
+                                : "not rendered: --time-budget spent (rerun to go on)";
+        return;
+    }
+    memset(entries, 0, sizeof *entries * (size_t)n);
+    *why = "render failed (see the log)";
+    drift_hybrid *frame = NULL;
+    drift_refine *sir = NULL;
+    double t0 = drift_time_now();
+    drift_result r = drift_hybrid_create(run->ctx, s->scene, s->accel, p, &frame);
+    r = r ? r : drift_hybrid_render(frame, &s->scene->camera, run->cancel);
+    r = r ? r : drift_hybrid_render(frame, &s->scene->camera, run->cancel); // warm, as above
+    double raster_ms = 0.0;
+    uint64_t raster_rays = 0;
+    char name[256];
+    if (r == DRIFT_OK) {
+        drift_hybrid_stats st = drift_hybrid_get_stats(frame);
+        raster_ms = st.frame_ms;
+        for (int k = 0; k < DRIFT_PASS_COUNT; ++k) {
+            raster_rays += st.rays[k];
+        }
+        snprintf(name, sizeof name, "sir-0it-%.8s", keys[0]);
+        entries[0] = store_render(run, dir, keys[0], name, drift_hybrid_image(frame), raster_ms,
+                                  raster_rays);
+        r = entries[0] ? DRIFT_OK : DRIFT_ERR_IO;
+    }
+    drift_refine_params rp = { .budget = (uint32_t)o->sir_budget };
+    r = r ? r : drift_refine_create(run->ctx, frame, &rp, &sir);
+    double start = drift_time_now();
+    r = r ? r : drift_refine_begin(sir);
+    for (int k = 1; k < n && r == DRIFT_OK; ++k) {
+        while (r == DRIFT_OK && !drift_refine_done(sir) &&
+               drift_refine_get_stats(sir).iterations < (uint32_t)o->sir_iterations[k - 1]) {
+            r = drift_refine_iterate(sir, run->cancel);
+        }
+        if (r != DRIFT_OK) {
+            break;
+        }
+        double now = drift_time_now(), ms = raster_ms + 1e3 * (now - start);
+        drift_refine_stats st = drift_refine_get_stats(sir);
+        snprintf(name, sizeof name, "sir-%ldit-%.8s", o->sir_iterations[k - 1], keys[k]);
+        cJSON *item = store_render(run, dir, keys[k], name, drift_refine_image(sir), ms,
+                                   raster_rays + st.metrics_rays + st.rays);
+        if (item) { // fewer than asked when every error pixel was refined before
+            cli_json_count(item, "iterations_run", st.iterations);
+            cli_json_count(item, "refined", st.refined);
+            cli_json_count(item, "requested", st.requested);
+            entries[k] = item;
+        }
+        r = item && write_manifest(run) ? DRIFT_OK : DRIFT_ERR_IO;
+        start += drift_time_now() - now; // writing the files is not the refinement's time
+    }
+    if (r == DRIFT_ERR_CANCELLED) {
+        run->interrupted = true;
+        *why = "not rendered: interrupted (rerun to finish)";
+        fprintf(stderr, "drift report: interrupted; writing the page with what is finished\n");
+    } else if (r != DRIFT_OK) {
+        fprintf(stderr, "drift report: %s " REPORT_SIR_NAME ": %s\n", label,
+                drift_result_string(r));
+    }
+    run->render_seconds += drift_time_now() - t0;
+    run->units_done += n;
+    char took[64];
+    snprintf(took, sizeof took, "%.2f s", drift_time_now() - t0);
+    sir_progress(run, label, "iterations", r == DRIFT_OK ? took : drift_result_string(r));
+    run_stopped(run);
+    drift_refine_destroy(sir);
+    drift_hybrid_destroy(frame);
+}
+
+// The sir cell: the whole frame, raster and refined, against the whole-frame truth.
+static cJSON *report_sir(report_run *run, const cli_session *s, const char *label, const char *slug,
+                         const char *dir, uint64_t hash)
+{
+    const report_options *o = run->o;
+    drift_hybrid_params p = sir_frame_params(o, s->scene);
+    cJSON *out = cJSON_CreateObject();
+    cJSON_AddStringToObject(out, "effect", REPORT_SIR_NAME);
+    cJSON_AddBoolToObject(out, "whole_frame", true);
+    cJSON *rows = cJSON_AddArrayToObject(out, "rows");
+    const cJSON *truth = sir_truth(run, s, label, dir, hash, &p);
+    if (!truth) {
+        cJSON_AddStringToObject(out, "error",
+                                run->interrupted ? "not rendered: interrupted (rerun to finish)"
+                                : run->budget_spent
+                                    ? "not rendered: --time-budget spent (rerun to go on)"
+                                    : "the whole-frame reference failed");
+        run->failed = run->failed || !(run->interrupted || run->budget_spent);
+        run->jobs_done += o->sir_iteration_count + 1 + pt_sweep_count(o);
+        return out;
+    }
+    cJSON *reference = cJSON_AddObjectToObject(out, "reference");
+    copy_render(reference, truth, slug);
+    cJSON_AddNumberToObject(reference, "spp", (double)o->ref_spp);
+    const char *truth_name = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(truth, "file"));
+    const cJSON *entries[REPORT_MAX_SIR + 1] = { 0 };
+    const char *why = NULL;
+    sir_rows(run, s, label, dir, hash, &p, entries, &why);
+    for (int k = 0; k <= o->sir_iteration_count; ++k) {
+        cJSON *row = cJSON_CreateObject();
+        cJSON_AddItemToArray(rows, row);
+        cJSON_AddStringToObject(row, "technique", REPORT_SIR_NAME);
+        cJSON_AddNumberToObject(row, "iterations", k ? (double)o->sir_iterations[k - 1] : 0.0);
+        cJSON_AddNumberToObject(row, "spp", 1);
+        cJSON_AddBoolToObject(row, "path_traced", false);
+        if (!entries[k]) {
+            cJSON_AddStringToObject(row, "error", why ? why : "render failed");
+            run->failed = run->failed || !(run->interrupted || run->budget_spent);
+            continue;
+        }
+        copy_render(row, entries[k], slug);
+        const char *const counts[3] = { "iterations_run", "refined", "requested" };
+        for (int c = 0; c < 3; ++c) {
+            const cJSON *v = cJSON_GetObjectItemCaseSensitive(entries[k], counts[c]);
+            if (cJSON_IsNumber(v)) {
+                cJSON_AddNumberToObject(row, counts[c], v->valuedouble);
+            }
+        }
+        const char *name =
+            cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(entries[k], "file"));
+        if (add_metrics(run, dir, truth_name, name, row) != DRIFT_OK) {
+            cJSON_AddStringToObject(row, "error", "cannot compare with the reference");
+            run->failed = true;
+        }
+    }
+    for (long spp = 1; spp <= o->sweep_spp && spp < o->ref_spp; spp *= 2) {
+        cJSON *row = cJSON_CreateObject();
+        cJSON_AddItemToArray(rows, row);
+        cJSON_AddStringToObject(row, "technique", "pt");
+        cJSON_AddNumberToObject(row, "spp", (double)spp);
+        cJSON_AddBoolToObject(row, "path_traced", true);
+        why = NULL;
+        const cJSON *entry = sir_pt(run, s, label, dir, hash, &p, spp, &why);
+        if (!entry) {
+            cJSON_AddStringToObject(row, "error", why ? why : "render failed");
+            run->failed = run->failed || !(run->interrupted || run->budget_spent);
+            continue;
+        }
+        copy_render(row, entry, slug);
+        const char *name = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(entry, "file"));
+        if (add_metrics(run, dir, truth_name, name, row) != DRIFT_OK) {
+            cJSON_AddStringToObject(row, "error", "cannot compare with the reference");
+            run->failed = true;
+        }
+    }
+    return out;
+}
+
 static void add_facts(cJSON *scene_json, const cli_session *s, uint64_t hash)
 {
     const drift_scene *scene = s->scene;
@@ -572,6 +957,8 @@ static cJSON *report_scene(report_run *run, cli_session *session, const char *pa
             run->jobs_done +=
                 run->o->effects[e] ? plan_effect(run->o, NULL, (drift_effect)e, jobs, MAX_JOBS) : 0;
         }
+        run->jobs_done +=
+            run->o->sir ? run->o->sir_iteration_count + 2 + pt_sweep_count(run->o) : 0;
         return out;
     }
     uint64_t hash = scene_hash(session);
@@ -592,6 +979,9 @@ static cJSON *report_scene(report_run *run, cli_session *session, const char *pa
             cJSON_AddItemToArray(
                 list, report_effect(run, session, slug, slug, dir, hash, (drift_effect)e));
         }
+    }
+    if (run->o->sir) {
+        cJSON_AddItemToArray(list, report_sir(run, session, slug, slug, dir, hash));
     }
     return out;
 }
@@ -667,7 +1057,12 @@ static void load_manifest(report_run *run)
 
 int drift_cmd_report(int argc, char **argv)
 {
-    report_options o = { .size = 256, .ref_spp = 256, .sweep_spp = 16 };
+    report_options o = { .size = 256,
+                         .ref_spp = 256,
+                         .sweep_spp = 16,
+                         .sir = true,
+                         .sir_iterations = { 1, 2, 4, 8 },
+                         .sir_iteration_count = 4 };
     int status = cli_parse(&report_command, argc, argv, &o, NULL);
     if (status != CLI_PARSED) {
         return cli_parse_exit(status);
@@ -715,6 +1110,14 @@ int drift_cmd_report(int argc, char **argv)
             for (int k = 0; k < n; ++k) {
                 run.units_total += scene_count * job_units(&jobs[k]);
             }
+        }
+    }
+
+    if (o.sir) { // the truth, the raster frame, one row an iteration count, the pt sweep
+        run.jobs_total += scene_count * (o.sir_iteration_count + 2 + pt_sweep_count(&o));
+        run.units_total += scene_count * ((double)o.ref_spp + o.sir_iteration_count + 1);
+        for (long spp = 1; spp <= o.sweep_spp && spp < o.ref_spp; spp *= 2) {
+            run.units_total += scene_count * (double)spp;
         }
     }
 

@@ -6,12 +6,14 @@ messages ending in NUL on file descriptors 3 and 4), with the standard library o
 the page loads with no console error or exception and no request other than file: and data:
 URLs; every image it references exists and every image it shows decodes; the comparison
 slider follows a synthetic pointer; each plot holds one mark per table row with numbers; a
-screenshot is not blank; each row's numbers equal `drift diff --json` on the same files.
+screenshot is not blank; each row's numbers equal `drift diff --json` on the same files (the
+sir cell's rows against its whole-frame truth too).
 
 usage: report_browser.py DRIFT DIR [--expect-error TEXT]... [--screenshot FILE.png]
-                         [--no-numbers] [DIR ...]
+                         [--no-numbers] [--sir-marks N] [DIR ...]
 (each DIR a report folder, checked in one browser; --expect-error: a cell of that page must
-hold TEXT, and without it no cell may report an error; --no-numbers: skip the drift diff runs)
+hold TEXT, and without it no cell may report an error; --no-numbers: skip the drift diff runs;
+--sir-marks N: the page's sir plot holds N SIR marks joined as one curve)
 exit status 0 when every check passes, 1 otherwise (each failure printed as FAIL: ...).
 """
 import base64
@@ -226,7 +228,11 @@ PLOT_MARKS = """
   effect: s.dataset.effect,
   marks: [...s.querySelectorAll("svg.plot circle.mark")].map(c => +c.dataset.row).sort((a, b) => a - b),
   rows: [...s.querySelectorAll("table.metrics tbody tr")].filter(tr => tr.querySelector("td[data-key=flip]").dataset.value !== undefined).map(tr => +tr.dataset.row).sort((a, b) => a - b),
-  pareto: s.querySelectorAll("svg.plot circle.mark.pareto").length
+  pareto: s.querySelectorAll("svg.plot circle.mark.pareto").length,
+  sir: [...s.querySelectorAll("svg.plot circle.mark")].filter(c => window.driftReport.data.scenes
+    .find(x => x.path === s.closest("section.scene").dataset.scene).effects
+    .find(e => e.effect === s.dataset.effect).rows[+c.dataset.row].technique === "sir").length,
+  curves: [...s.querySelectorAll("svg.plot polyline.sweep")].map(p => p.getAttribute("points").trim().split(/\s+/).length)
 }))
 """
 
@@ -257,7 +263,7 @@ def check_slider(browser):
         fail("the technique image is not clipped at the split: clip-path %r" % clip)
 
 
-def check_page(browser, drift, folder, expect_errors, screenshot, numbers):
+def check_page(browser, drift, folder, expect_errors, screenshot, numbers, sir_marks):
     browser.events.clear()
     browser.send("Page.navigate", {"url": "file://" + folder + "/index.html"})
     browser.wait_event("Page.loadEventFired")
@@ -277,7 +283,16 @@ def check_page(browser, drift, folder, expect_errors, screenshot, numbers):
             fail("the image %s does not load" % src)
 
     check_slider(browser)
-    for plot in browser.evaluate(PLOT_MARKS):
+    plots = browser.evaluate(PLOT_MARKS)
+    if sir_marks is not None:
+        sir = [p for p in plots if p["effect"] == "sir"]
+        if not sir or sir[0]["sir"] != sir_marks:
+            fail("the sir plot holds %s SIR marks, expected %d (the raster frame and each"
+                 " iteration count)" % (sir[0]["sir"] if sir else "no", sir_marks))
+        elif sir_marks > 1 and sir_marks not in sir[0]["curves"]:
+            fail("the SIR marks are not joined as one curve: polylines of %s points"
+                 % sir[0]["curves"])
+    for plot in plots:
         if not plot["rows"] or plot["marks"] != plot["rows"]:
             fail("%s: the plot's marks %s are not the table's rows %s"
                  % (plot["effect"], plot["marks"], plot["rows"]))
@@ -338,8 +353,11 @@ def main():
         elif args[i] == "--no-numbers":
             pages[-1][3] = False
             i += 1
+        elif args[i] == "--sir-marks":
+            pages[-1][4] = int(args[i + 1])
+            i += 2
         else:
-            pages.append([os.path.abspath(args[i]), [], None, True])
+            pages.append([os.path.abspath(args[i]), [], None, True, None])
             i += 1
     binary = shutil.which("chromium") or shutil.which("chromium-browser")
     browser = Browser(binary)
@@ -351,8 +369,8 @@ def main():
             browser.send(domain + ".enable")
         browser.send("Emulation.setDeviceMetricsOverride", {
             "width": 1200, "height": 900, "deviceScaleFactor": 1, "mobile": False})
-        for folder, expect_errors, screenshot, numbers in pages:
-            check_page(browser, drift, folder, expect_errors, screenshot, numbers)
+        for folder, expect_errors, screenshot, numbers, sir_marks in pages:
+            check_page(browser, drift, folder, expect_errors, screenshot, numbers, sir_marks)
     finally:
         browser.close()
     return 1 if failures else 0

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # CLI tests for `drift report` (issue 20): usage errors; a tiny report of the built-in Cornell
 # box opened in headless Chromium (tests/cli/report_browser.py: no console error, no network,
-# images exist, slider, plot marks, screenshot, numbers equal drift diff's); the cache (a
-# rerun renders nothing, --time-budget keeps what is finished and a rerun goes on); Ctrl-C;
+# images exist, slider, plot marks (the sir cell: raster + 2 iteration counts, one curve),
+# screenshot, numbers equal drift diff's); the cache (a rerun renders nothing, --time-budget
+# keeps what is finished and a rerun goes on); Ctrl-C;
 # a scene that fails to load and an effect without reference get cells saying so and a
 # non-zero exit. Exits 77 (skipped) without chromium. $1 is the drift binary.
 set -u
@@ -35,15 +36,17 @@ finished=$(python3 -c "import json; print(len(json.load(open('$tmp/r/manifest.js
 grep -q "not rendered: --time-budget spent" "$tmp/r/index.html" ||
     fail "--time-budget: the page does not say what was not rendered"
 
-# The full report renders only what is missing, then the page passes the browser checks.
-expect 0 "$drift" report --out "$tmp/r" --effects shadows,indirect "${small[@]}"
+# The full report renders only what is missing (and the sir cell: the raster frame and 2
+# iteration counts against the whole-frame truth), then the page passes the browser checks.
+with_sir=(--effects shadows,indirect,sir --sir-iterations 2,1)
+expect 0 "$drift" report --out "$tmp/r" "${with_sir[@]}" "${small[@]}"
 cached=$(grep -c ": cached, ETA" "$tmp/err")
 [ "$cached" -eq "$finished" ] || fail "rerun: $cached renders reused, expected $finished"
 grep -q "wrote $tmp/r/index.html (complete)" "$tmp/out" || fail "report does not say where"
 cp -r "$tmp/r" "$tmp/good"
 
 # A rerun with the same options renders nothing.
-expect 0 "$drift" report --out "$tmp/r" --effects shadows,indirect "${small[@]}"
+expect 0 "$drift" report --out "$tmp/r" "${with_sir[@]}" "${small[@]}"
 if grep -q " s, ETA" "$tmp/err"; then fail "an unchanged rerun rendered again"; fi
 
 # A missing scene and an effect with no reference: cells say so, the rest renders, exit 1.
@@ -51,7 +54,7 @@ expect 1 "$drift" report "$DRIFT_SOURCE_DIR/scenes/cornell-box/cornell_box.json"
     "$tmp/no-such-scene.json" --out "$tmp/r" --effects shadows,glare "${small[@]}"
 grep -q "shadows-hard" "$tmp/r/index.html" || fail "the failing report lost the scene that loads"
 # Both pages in one browser (it takes seconds to start).
-browser "$tmp/good" "$tmp/r" --expect-error "no-such-scene.json: the scene failed to load" \
+browser "$tmp/good" --sir-marks 3 "$tmp/r" --expect-error "no-such-scene.json: the scene failed to load" \
     --expect-error "glare: glare has no path-traced reference" --no-numbers || fail "the browser checks failed"
 
 # Ctrl-C during a long reference: exit 130 and a page that says it was interrupted.
