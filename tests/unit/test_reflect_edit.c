@@ -772,7 +772,7 @@ static void test_bad_edit_files_name_file_and_line(void **state)
 }
 
 // The viewer's editing: pick a point (no change yet), drag the green handle (e_n changes),
-// add a region, undo back step by step, save and load the file.
+// add a geodesic and a Euclidean region, undo back step by step, save and load the file.
 static void test_view_edits_pick_drag_undo_save(void **state)
 {
     (void)state;
@@ -816,16 +816,38 @@ static void test_view_edits_pick_drag_undo_save(void **state)
     drift_reflection_edits_constraint_rays(edits, 0, &rn, &en);
     assert_true(angle_between(rn, en) > 0.1f);
     assert_true(en.y < 0.0f); // toward the floor
+    // A geodesic region first: along the red handle's mesh, so the floor just below the
+    // handle (Euclidean distance 1, inside radius + border) stays outside it.
+    assert_true(drift_view_handle_event(
+        view, &(drift_view_event){ .type = DRIFT_VIEW_EVENT_KEY,
+                                   .key = DRIFT_VIEW_KEY_EDIT_GEODESIC_REGION }));
+    edits = drift_view_reflection_edits(view);
+    assert_int_equal(drift_reflection_edits_region_count(edits), 1);
+    const drift_reflection_region *geodesic = drift_reflection_edits_region(edits, 0);
+    assert_int_equal(geodesic->type, DRIFT_EDIT_REGION_GEODESIC);
+    assert_int_equal(geodesic->mesh, mesh);
+    assert_true(geodesic->radius + geodesic->border > 1.5f);
+    drift_vec3 rq;
+    drift_edit_point on_handle = pixel_point(&r, 30, 30, &rq);
+    assert_true(drift_reflection_edits_influence(edits, &on_handle) > 0.99f);
+    drift_vec3 hp = drift_reflection_edits_constraint(edits, 0)->point;
+    drift_edit_point floor_below = { .position = drift_vec3_make(hp.x, -1.0f, hp.z),
+                                     .mesh = DRIFT_INVALID_INDEX };
+    assert_true(drift_reflection_edits_influence(edits, &floor_below) == 0.0f);
     assert_true(
         drift_view_handle_event(view, &(drift_view_event){ .type = DRIFT_VIEW_EVENT_KEY,
                                                            .key = DRIFT_VIEW_KEY_EDIT_REGION }));
-    assert_int_equal(drift_reflection_edits_region_count(drift_view_reflection_edits(view)), 1);
+    edits = drift_view_reflection_edits(view);
+    assert_int_equal(drift_reflection_edits_region_count(edits), 2);
+    assert_true(drift_reflection_edits_influence(edits, &floor_below) > 0.0f); // Euclidean
     assert_int_equal(drift_view_frame(view, NULL), DRIFT_OK); // the frame renders with them
     assert_false(
         drift_view_handle_event(view, &(drift_view_event){ .type = DRIFT_VIEW_EVENT_KEY,
                                                            .key = DRIFT_VIEW_KEY_EDIT_SAVE }));
-    // Undo: the region, then the drag (e_n = r_n again), then the pick.
+    // Undo: the regions, then the drag (e_n = r_n again), then the pick.
     const drift_view_event undo = { .type = DRIFT_VIEW_EVENT_KEY, .key = DRIFT_VIEW_KEY_EDIT_UNDO };
+    assert_true(drift_view_handle_event(view, &undo));
+    assert_int_equal(drift_reflection_edits_region_count(drift_view_reflection_edits(view)), 1);
     assert_true(drift_view_handle_event(view, &undo));
     assert_int_equal(drift_reflection_edits_region_count(drift_view_reflection_edits(view)), 0);
     assert_true(drift_view_handle_event(view, &undo));
@@ -839,7 +861,8 @@ static void test_view_edits_pick_drag_undo_save(void **state)
     drift_reflection_edits *loaded = NULL;
     assert_int_equal(drift_reflection_edits_load(r.ctx, r.scene, r.accel, path, &loaded), DRIFT_OK);
     assert_int_equal(drift_reflection_edits_constraint_count(loaded), 1);
-    assert_int_equal(drift_reflection_edits_region_count(loaded), 1);
+    assert_int_equal(drift_reflection_edits_region_count(loaded), 2);
+    assert_int_equal(drift_reflection_edits_region(loaded, 0)->type, DRIFT_EDIT_REGION_GEODESIC);
     drift_reflection_edits_destroy(loaded);
     test_rig_destroy(&r);
 }
