@@ -62,6 +62,7 @@ static const char other_keys_text[] =
     "Ctrl-left drag\tits red handle (slide the reflection)\n"
     "Ctrl-right drag\tits green handle (what it reflects)\n"
     "G, Shift-G\tadd a region around it / remove the last\n"
+    "J\tadd a geodesic region around it (along its mesh)\n"
     "U, Ctrl-Z\tundo the last edit\n"
     "P, Ctrl-S\tsave the edit file (--reflection-edits)\n"
     "Esc\tquit";
@@ -314,6 +315,8 @@ static drift_view_key key_of(SDL_Keycode sym, bool shift)
         return DRIFT_VIEW_KEY_HELP;
     case SDLK_g:
         return shift ? DRIFT_VIEW_KEY_EDIT_UNREGION : DRIFT_VIEW_KEY_EDIT_REGION;
+    case SDLK_j:
+        return DRIFT_VIEW_KEY_EDIT_GEODESIC_REGION;
     case SDLK_u:
     case SDLK_z:
         return DRIFT_VIEW_KEY_EDIT_UNDO;

@@ -36,6 +36,7 @@
 #include "drift/hybrid.h"
 #include "drift/image.h"
 #include "drift/points.h"
+#include "drift/reflect_edit.h"
 #include "drift/scene.h"
 
 #ifdef __cplusplus
@@ -76,6 +77,9 @@ typedef struct drift_micro_params {
     float cut_scale;
     bool no_ray_casting;
     bool no_jitter;
+    // NULL: physical reflections. Otherwise the glossy lobe of each gather point centres on
+    // the edited direction e(q) (drift/reflect_edit.h); borrowed, it must outlive the renders.
+    const drift_reflection_edits *reflection_edits;
 } drift_micro_params;
 
 drift_micro_params drift_micro_params_resolve(const drift_micro_params *params);

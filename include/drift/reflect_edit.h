@@ -160,6 +160,11 @@ drift_vec3 drift_reflection_edits_apply(const drift_mat3 *rotation, float influe
 // e(q) for the physical reflection r(q): _rotation then _apply.
 drift_vec3 drift_reflection_edits_direction(const drift_reflection_edits *edits,
                                             const drift_edit_point *q, drift_vec3 r);
+// Aims the glossy and mirror lobes of `bsdf`, made at `surface` and seen along wo, at e(q)
+// (drift_bsdf.edited_mirror): the one call every renderer makes at its first specular bounce.
+// Nothing changes when edits is NULL or the bsdf has no specular lobe.
+void drift_reflection_edits_aim_bsdf(const drift_reflection_edits *edits,
+                                     const drift_surface *surface, drift_vec3 wo, drift_bsdf *bsdf);
 // The normalised weight w_n / sum_m w_m of constraint n at q among the constraints that reach
 // it (0 when n does not).
 float drift_reflection_edits_weight(const drift_reflection_edits *edits, const drift_edit_point *q,

@@ -297,6 +297,9 @@ typedef struct drift_bsdf_sample {
 // Samples wi. u_lobe picks the lobe, u the direction. pdf == 0 means no sample.
 drift_bsdf_sample drift_bsdf_sample_wi(const drift_bsdf *bsdf, drift_vec3 wo, float u_lobe,
                                        drift_vec2 u);
+// The direction the glossy and mirror lobes centre on: the mirror direction of wo about the
+// shading normal, or edited_mirror when set (the one ray a mirror reflects).
+drift_vec3 drift_bsdf_mirror_direction(const drift_bsdf *bsdf, drift_vec3 wo);
 // A direction from the glossy lobe's cos^n(alpha) distribution around the mirror direction of
 // wo (cos alpha = u.x^(1/(n+1)), phi = 2 pi u.y): the one place the Phong lobe is sampled
 // (the path tracer, AAF's specular buffer and SIR's ray tracer). It may point below the surface.

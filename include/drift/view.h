@@ -62,10 +62,11 @@ typedef enum drift_view_key {
     DRIFT_VIEW_KEY_OVERLAY,       // text overlay on/off
     DRIFT_VIEW_KEY_HELP,          // key list in the overlay on/off
     // Reflection editing (docs/reflection-editing.md): on the selected constraint
-    DRIFT_VIEW_KEY_EDIT_REGION,   // add a Euclidean region around its red handle
-    DRIFT_VIEW_KEY_EDIT_UNREGION, // remove the last region
-    DRIFT_VIEW_KEY_EDIT_UNDO,     // undo the last edit
-    DRIFT_VIEW_KEY_EDIT_SAVE,     // write the edit file (desc.reflection_edits_path)
+    DRIFT_VIEW_KEY_EDIT_REGION,          // add a Euclidean region around its red handle
+    DRIFT_VIEW_KEY_EDIT_UNREGION,        // remove the last region
+    DRIFT_VIEW_KEY_EDIT_UNDO,            // undo the last edit
+    DRIFT_VIEW_KEY_EDIT_SAVE,            // write the edit file (desc.reflection_edits_path)
+    DRIFT_VIEW_KEY_EDIT_GEODESIC_REGION, // add a geodesic region around it, along its mesh
     DRIFT_VIEW_KEY_COUNT
 } drift_view_key;
 

@@ -154,6 +154,8 @@ static void add_samples(drift_frame_state *f, const indirect_job *job, int32_t x
     const drift_surface *s = &f->gbuffer.surfaces[i];
     drift_bsdf bsdf = drift_bsdf_make(f->scene, s);
     drift_vec3 wo = drift_pass_wo(f, x, y);
+    // Reflection edits re-aim the glossy and mirror lobes (the diffuse one does not change).
+    drift_reflection_edits_aim_bsdf(f->params.reflection_edits, s, wo, &bsdf);
     indirect_sums *sums = (indirect_sums *)&f->aaf->aux[DRIFT_AAF_AUX * i];
     float *radiance = drift_image_pixel(&job->lobe->buffers->radiance, x, y);
     drift_vec3 sum =

@@ -26,7 +26,7 @@ static void specular_sample(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec2 u,
 {
     *emission = bsdf->type == DRIFT_MATERIAL_MIRROR;
     if (*emission) {
-        *wi = drift_vec3_reflect(wo, bsdf->frame.z);
+        *wi = drift_bsdf_mirror_direction(bsdf, wo); // e(q) under reflection edits
         *weight = 1.0f;
         return;
     }

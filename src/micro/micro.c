@@ -203,7 +203,10 @@ static drift_vec3 gather_pixel(const gather_job *job, int32_t x, int32_t y,
     if (!(ks > 0.0f) || drift_bsdf_is_delta(&bsdf)) {
         return drift_vec3_splat(0.0f); // no glossy lobe, or a mirror (not a micro-buffer's)
     }
-    glossy_slice slice = { &bsdf, &frame, drift_vec3_normalize(drift_vec3_sub(job->eye, p)) };
+    drift_vec3 wo = drift_vec3_normalize(drift_vec3_sub(job->eye, p));
+    // Under reflection edits the lobe the warp is built from centres on e(q).
+    drift_reflection_edits_aim_bsdf(m->params.reflection_edits, surf, wo, &bsdf);
+    glossy_slice slice = { &bsdf, &frame, wo };
     drift__micro_warp warp;
     drift__micro_pixels pixels;
     drift__micro_warp_build(&warp, m->params.warp_size, glossy_lobe, &slice);

@@ -27,13 +27,15 @@ static drift_micro_params params_of(const drift_frame_state *f)
         .point_count = f->params.micro.points,
         .buffer_size = f->params.micro.buffer_size,
         .density = f->params.micro.density,
+        .reflection_edits = f->params.reflection_edits,
     });
 }
 
 static bool same_params(const drift_micro_params *a, const drift_micro_params *b)
 {
     return a->seed == b->seed && a->point_count == b->point_count &&
-           a->buffer_size == b->buffer_size && a->density == b->density;
+           a->buffer_size == b->buffer_size && a->density == b->density &&
+           a->reflection_edits == b->reflection_edits;
 }
 
 static drift_result render(drift_frame_state *f, const drift_pass_args *args, drift_micro_lobe lobe)

@@ -310,11 +310,9 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
             break;
         }
         drift_bsdf bsdf = drift_bsdf_make(scene, &surf);
-        if (depth == 0 && p->reflection_edits && !drift_vec3_is_zero(bsdf.specular)) {
+        if (depth == 0) {
             // The first specular bounce follows the edit: its lobes centre on e(q).
-            drift_edit_point q = drift_edit_point_from_surface(&surf);
-            bsdf.edited_mirror = drift_reflection_edits_direction(
-                p->reflection_edits, &q, drift_vec3_reflect(wo, bsdf.frame.z));
+            drift_reflection_edits_aim_bsdf(p->reflection_edits, &surf, wo, &bsdf);
         }
         drift_vec2 u_choice = drift_sampler_next2(&sampler); // x: light pick, y: lobe pick
         if (!p->disable_nee && !drift_bsdf_is_delta(&bsdf)) {

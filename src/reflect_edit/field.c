@@ -19,6 +19,17 @@ drift_edit_point drift_edit_point_from_surface(const drift_surface *s)
                                .barycentric = s->barycentric };
 }
 
+void drift_reflection_edits_aim_bsdf(const drift_reflection_edits *edits,
+                                     const drift_surface *surface, drift_vec3 wo, drift_bsdf *bsdf)
+{
+    if (!edits || drift_vec3_is_zero(bsdf->specular)) {
+        return;
+    }
+    drift_edit_point q = drift_edit_point_from_surface(surface);
+    bsdf->edited_mirror =
+        drift_reflection_edits_direction(edits, &q, drift_vec3_reflect(wo, bsdf->frame.z));
+}
+
 // --- LIFETIME AND EDITING ---
 
 drift_result drift_reflection_edits_create(drift_context *ctx, const drift_scene *scene,

@@ -39,6 +39,11 @@ static drift_vec3 lobe_axis(const drift_bsdf *b, drift_vec3 wo)
                                                 : b->edited_mirror;
 }
 
+drift_vec3 drift_bsdf_mirror_direction(const drift_bsdf *bsdf, drift_vec3 wo)
+{
+    return lobe_axis(bsdf, wo);
+}
+
 // cos(alpha), alpha between wi and the lobe's axis (0 past a right angle).
 static float phong_cos_alpha(const drift_bsdf *b, drift_vec3 wo, drift_vec3 wi)
 {

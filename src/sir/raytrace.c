@@ -23,7 +23,8 @@ drift_refine_tracer drift_refine_tracer_make(const drift_frame_state *frame, uin
                                       &frame->camera, frame->params.width, frame->params.height),
                                   .seed = drift_hash_combine(seed, DRIFT_STREAM_SIR_TRACE),
                                   .max_depth = max_depth,
-                                  .light_samples = frame->params.light_samples };
+                                  .light_samples = frame->params.light_samples,
+                                  .reflection_edits = frame->params.reflection_edits };
 }
 
 // light_samples sampled points on each light, each with a shadow ray: an unbiased estimate of
@@ -112,9 +113,14 @@ static drift_vec3 radiance(const drift_refine_tracer *t, drift_ray ray, int32_t 
     if (!reflective || depth >= t->max_depth) {
         return l;
     }
+    if (depth == 0) {
+        // The camera ray's reflection follows the edit, as the hybrid frame's sharp ray does;
+        // its direct term above stays physical, as the frame's direct pass.
+        drift_reflection_edits_aim_bsdf(t->reflection_edits, &s, wo, &bsdf);
+    }
     drift_vec3 dir, weight;
     if (mirror) {
-        dir = drift_vec3_reflect(wo, s.ns);
+        dir = drift_bsdf_mirror_direction(&bsdf, wo);
         weight = bsdf.specular;
     } else {
         weight = sample_glossy(&bsdf, wo, s.ng, u, &dir);

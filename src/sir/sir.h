@@ -22,6 +22,7 @@ typedef struct drift_refine_tracer {
     int32_t max_depth;      // reflection bounces
     uint32_t light_samples; // shadow rays a light (and toward the environment) at each hit:
                             // the frame's light_samples, the raster's count for U_l
+    const drift_reflection_edits *reflection_edits; // the frame's: the first bounce follows e(q)
 } drift_refine_tracer;
 
 drift_refine_tracer drift_refine_tracer_make(const drift_frame_state *frame, uint32_t seed,

@@ -17,10 +17,27 @@
 
 // The keys after the effects' (those are named after their effects).
 static const char *const key_names[DRIFT_VIEW_KEY_COUNT - DRIFT_VIEW_KEY_NEXT_BUFFER] = {
-    "next-buffer", "prev-buffer", "split",         "split-left",   "split-right",
-    "forward",     "back",        "left",          "right",        "up",
-    "down",        "exposure-up", "exposure-down", "reset-camera", "overlay",
-    "help",        "edit-region", "edit-unregion", "undo",         "save-edits",
+    "next-buffer",
+    "prev-buffer",
+    "split",
+    "split-left",
+    "split-right",
+    "forward",
+    "back",
+    "left",
+    "right",
+    "up",
+    "down",
+    "exposure-up",
+    "exposure-down",
+    "reset-camera",
+    "overlay",
+    "help",
+    "edit-region",
+    "edit-unregion",
+    "undo",
+    "save-edits",
+    "edit-geodesic-region",
 };
 
 drift_view_key drift_view_key_of_effect(drift_effect effect)
@@ -331,6 +348,7 @@ static bool handle_key(drift_view *view, drift_view_key key)
     case DRIFT_VIEW_KEY_EDIT_UNREGION:
     case DRIFT_VIEW_KEY_EDIT_UNDO:
     case DRIFT_VIEW_KEY_EDIT_SAVE:
+    case DRIFT_VIEW_KEY_EDIT_GEODESIC_REGION:
         return drift_view_edit_key(view, key);
     default:
         return false;

@@ -269,14 +269,20 @@ bool drift_view_edit_key(drift_view *view, drift_view_key key)
         return false;
     }
     bool changed = false;
-    if (key == DRIFT_VIEW_KEY_EDIT_REGION && view->selected >= 0 &&
-        next->region_count < DRIFT_EDIT_MAX_REGIONS) {
+    bool add = key == DRIFT_VIEW_KEY_EDIT_REGION || key == DRIFT_VIEW_KEY_EDIT_GEODESIC_REGION;
+    if (add && view->selected >= 0 && next->region_count < DRIFT_EDIT_MAX_REGIONS) {
+        // Around the red handle; a geodesic region measures along the handle's own mesh, so
+        // it does not reach across a gap to another part of the object.
+        const drift_reflection_constraint *c = &next->constraints[view->selected];
         float size = 0.05f * scene_size(view->scene);
         next->regions[next->region_count++] =
-            (drift_reflection_region){ .type = DRIFT_EDIT_REGION_EUCLIDEAN,
-                                       .centre = next->constraints[view->selected].point,
+            (drift_reflection_region){ .type = key == DRIFT_VIEW_KEY_EDIT_REGION
+                                                   ? DRIFT_EDIT_REGION_EUCLIDEAN
+                                                   : DRIFT_EDIT_REGION_GEODESIC,
+                                       .centre = c->point,
                                        .radius = size,
-                                       .border = size };
+                                       .border = size,
+                                       .mesh = c->mesh };
         changed = true;
     } else if (key == DRIFT_VIEW_KEY_EDIT_UNREGION && next->region_count > 0) {
         next->region_count--;

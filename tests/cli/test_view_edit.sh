@@ -21,10 +21,11 @@ view=(view "$scene" --width 160 --height 120 --threads 2 --frames 1 --reflection
 expect 0 xvfb-run -a "$drift" "${view[@]}" --no-overlay --screenshot "$tmp/before.png"
 # The teapot's body at (80, 78); the red left wall at (3, 70).
 expect 0 xvfb-run -a "$drift" "${view[@]}" --no-overlay --reflection-edits "$tmp/v.edit.json" \
-    --press pick@80:78,green@3:70,edit-region,save-edits --screenshot "$tmp/after.png"
+    --press pick@80:78,green@3:70,edit-region,edit-geodesic-region,save-edits --screenshot "$tmp/after.png"
 [ -s "$tmp/v.edit.json" ] || fail "the edit file was not saved"
 grep -q '"defaultobject"' "$tmp/v.edit.json" || fail "no constraint on the teapot in the saved file"
 grep -q '"euclidean"' "$tmp/v.edit.json" || fail "no region in the saved file"
+grep -q '"geodesic"' "$tmp/v.edit.json" || fail "no geodesic region in the saved file"
 expect 0 "$drift" diff "$tmp/before.png" "$tmp/after.png" --json
 python3 -c "import json,sys; d=json.load(open('$tmp/out')); sys.exit(0 if d['mse'] > 0 else 1)" \
     || fail "the edited view looks the same as the unedited one"

@@ -6,6 +6,7 @@
 // tracer and the sharp reflections see what the edit aims at; edit files fail with file:line.
 #include "drift/hybrid.h"
 #include "drift/pt.h"
+#include "drift/refine.h"
 #include "drift/reflect_edit.h"
 #include "drift/view.h"
 #include "drift_test.h"
@@ -578,6 +579,95 @@ static void test_renderers_follow_the_edit(void **state)
         } else {
             assert_true(seen.x < 0.05f);
         }
+        // AAF's specular buffer keeps a mirror's one sharp ray: along e, unfiltered.
+        hp.reflections = DRIFT_REFLECTIONS_AAF;
+        hp.spp = 1;
+        test_rig_frame(&r, &hp);
+        seen = drift_image_get3(test_rig_plane(&r, "reflections"), 32, 32);
+        assert_near(seen.x, expected.x, 0.05 * (double)expected.x + 1e-3);
+        assert_near(seen.y, expected.y, 0.05 * (double)expected.y + 1e-3);
+        // SIR's pure ray tracer (what --refine sir blends in) reflects its camera rays along e.
+        drift_refine *sir = NULL;
+        assert_int_equal(drift_refine_create(r.ctx, r.frame, &(drift_refine_params){ 0 }, &sir),
+                         DRIFT_OK);
+        drift_image pure;
+        assert_int_equal(drift_image_create(r.ctx, VIEW_W, VIEW_H, 3, &pure), DRIFT_OK);
+        assert_int_equal(drift_refine_render_pure(sir, 1, &pure, NULL, NULL), DRIFT_OK);
+        seen = drift_image_get3(&pure, 32, 32);
+        assert_near(seen.x, expected.x, 0.05 * (double)expected.x + 1e-3);
+        assert_near(seen.y, expected.y, 0.05 * (double)expected.y + 1e-3);
+        drift_image_destroy(r.ctx, &pure);
+        drift_refine_destroy(sir);
+    }
+    drift_reflection_edits_destroy(edits);
+    test_rig_destroy(&r);
+}
+
+// `--reflections micro` (the glossy lobe gathered from lit scene points) follows e: a Phong
+// sphere (n = 100) edited at its centre pixel to look at a diffuse quad lit by a point light
+// shows the quad there as the edited path tracer does, where unedited it sees the black sky.
+// (At n = 1000 micro reads a third of it: its 32^2 warp is coarser than such a lobe.)
+static void test_micro_reflections_follow_the_edit(void **state)
+{
+    (void)state;
+    test_rig r = test_rig_begin(2);
+    drift_material phong = drift_material_make(drift_vec3_splat(0.0f));
+    phong.specular = drift_vec3_splat(0.5f);
+    phong.exponent = 100.0f;
+    uint32_t mesh = test_add_sphere(r.scene, drift_vec3_make(0, 0, 0), 1.0f, 96, 48,
+                                    test_add_material(r.scene, phong));
+    // A diffuse quad at x = 4, z in [1, 3], facing -x, lit head-on from 1.5 away.
+    test_add_quad(r.scene, drift_vec3_make(4, -1, 1), drift_vec3_make(0, 0, 2),
+                  drift_vec3_make(0, 2, 0),
+                  test_add_material(r.scene, drift_material_make(drift_vec3_splat(0.8f))));
+    drift_light light = { .type = DRIFT_LIGHT_POINT,
+                          .position = drift_vec3_make(2.5f, 0.0f, 2.0f),
+                          .color = drift_vec3_splat(10.0f) };
+    assert_int_equal(drift_scene_add_light(r.scene, &light, NULL), DRIFT_OK);
+    r.scene->camera = drift_camera_look_at(eye, drift_vec3_make(0, 0, 0), drift_vec3_make(0, 1, 0),
+                                           0.5f, VIEW_W, VIEW_H);
+    test_rig_commit(&r);
+    drift_vec3 rq;
+    drift_edit_point p = pixel_point(&r, 32, 32, &rq);
+    drift_reflection_edits *edits = NULL;
+    assert_int_equal(drift_reflection_edits_create(r.ctx, r.scene, r.accel, &edits), DRIFT_OK);
+    drift_reflection_constraint c = {
+        .mesh = mesh, .point = p.position, .target = drift_vec3_make(4, 0, 2), .view = eye
+    };
+    assert_int_equal(drift_reflection_edits_add_constraint(edits, &c), DRIFT_OK);
+    assert_int_equal(drift_reflection_edits_commit(edits), DRIFT_OK);
+    // The truth: the path tracer's edited glossy light at that pixel (it follows e, above).
+    drift_pt *pt = NULL;
+    drift_pt_params params = { .pixel_centre = true,
+                               .components = DRIFT_PT_COMPONENT_SPECULAR,
+                               .max_depth = 2,
+                               .reflection_edits = edits };
+    assert_int_equal(drift_pt_create(r.ctx, r.scene, r.accel, &params, &pt), DRIFT_OK);
+    double sum = 0.0;
+    for (uint32_t k = 0; k < 1024; ++k) {
+        sum += (double)drift_pt_trace_sample(pt, 32, 32, k).x;
+    }
+    drift_pt_destroy(pt);
+    float expected = (float)(sum / 1024.0);
+    // The closed form at the lobe's axis, ks (n+2)/(n+1) cos(theta_i) kd I / (pi d^2), bounds
+    // it from above (the lobe spreads over dimmer parts of the quad).
+    drift_vec3 to_target = drift_vec3_normalize(drift_vec3_sub(c.target, p.position));
+    float cos_i = drift_vec3_dot(to_target, drift_vec3_normalize(p.position));
+    float axis = 0.5f * (102.0f / 101.0f) * cos_i * 0.8f * 10.0f / (DRIFT_PI * 2.25f);
+    assert_true(expected > 0.6f * axis && expected < 1.05f * axis);
+    for (int edited = 0; edited < 2; ++edited) {
+        drift_hybrid_params hp = { .reflections = DRIFT_REFLECTIONS_MICRO,
+                                   .reflection_edits = edited ? edits : NULL };
+        hp.micro.points = 16384;
+        test_rig_frame(&r, &hp);
+        drift_vec3 seen = drift_image_get3(test_rig_plane(&r, "reflections"), 32, 32);
+        print_message("micro reflection at the edit, %s: %.4f (path tracer, edited: %.4f)\n",
+                      edited ? "edited" : "unedited", (double)seen.x, (double)expected);
+        if (edited) {
+            assert_true(seen.x > 0.7f * expected && seen.x < 1.3f * expected);
+        } else {
+            assert_true(seen.x < 0.02f * expected);
+        }
     }
     drift_reflection_edits_destroy(edits);
     test_rig_destroy(&r);
@@ -682,7 +772,7 @@ static void test_bad_edit_files_name_file_and_line(void **state)
 }
 
 // The viewer's editing: pick a point (no change yet), drag the green handle (e_n changes),
-// add a region, undo back step by step, save and load the file.
+// add a geodesic and a Euclidean region, undo back step by step, save and load the file.
 static void test_view_edits_pick_drag_undo_save(void **state)
 {
     (void)state;
@@ -726,16 +816,38 @@ static void test_view_edits_pick_drag_undo_save(void **state)
     drift_reflection_edits_constraint_rays(edits, 0, &rn, &en);
     assert_true(angle_between(rn, en) > 0.1f);
     assert_true(en.y < 0.0f); // toward the floor
+    // A geodesic region first: along the red handle's mesh, so the floor just below the
+    // handle (Euclidean distance 1, inside radius + border) stays outside it.
+    assert_true(drift_view_handle_event(
+        view, &(drift_view_event){ .type = DRIFT_VIEW_EVENT_KEY,
+                                   .key = DRIFT_VIEW_KEY_EDIT_GEODESIC_REGION }));
+    edits = drift_view_reflection_edits(view);
+    assert_int_equal(drift_reflection_edits_region_count(edits), 1);
+    const drift_reflection_region *geodesic = drift_reflection_edits_region(edits, 0);
+    assert_int_equal(geodesic->type, DRIFT_EDIT_REGION_GEODESIC);
+    assert_int_equal(geodesic->mesh, mesh);
+    assert_true(geodesic->radius + geodesic->border > 1.5f);
+    drift_vec3 rq;
+    drift_edit_point on_handle = pixel_point(&r, 30, 30, &rq);
+    assert_true(drift_reflection_edits_influence(edits, &on_handle) > 0.99f);
+    drift_vec3 hp = drift_reflection_edits_constraint(edits, 0)->point;
+    drift_edit_point floor_below = { .position = drift_vec3_make(hp.x, -1.0f, hp.z),
+                                     .mesh = DRIFT_INVALID_INDEX };
+    assert_true(drift_reflection_edits_influence(edits, &floor_below) == 0.0f);
     assert_true(
         drift_view_handle_event(view, &(drift_view_event){ .type = DRIFT_VIEW_EVENT_KEY,
                                                            .key = DRIFT_VIEW_KEY_EDIT_REGION }));
-    assert_int_equal(drift_reflection_edits_region_count(drift_view_reflection_edits(view)), 1);
+    edits = drift_view_reflection_edits(view);
+    assert_int_equal(drift_reflection_edits_region_count(edits), 2);
+    assert_true(drift_reflection_edits_influence(edits, &floor_below) > 0.0f); // Euclidean
     assert_int_equal(drift_view_frame(view, NULL), DRIFT_OK); // the frame renders with them
     assert_false(
         drift_view_handle_event(view, &(drift_view_event){ .type = DRIFT_VIEW_EVENT_KEY,
                                                            .key = DRIFT_VIEW_KEY_EDIT_SAVE }));
-    // Undo: the region, then the drag (e_n = r_n again), then the pick.
+    // Undo: the regions, then the drag (e_n = r_n again), then the pick.
     const drift_view_event undo = { .type = DRIFT_VIEW_EVENT_KEY, .key = DRIFT_VIEW_KEY_EDIT_UNDO };
+    assert_true(drift_view_handle_event(view, &undo));
+    assert_int_equal(drift_reflection_edits_region_count(drift_view_reflection_edits(view)), 1);
     assert_true(drift_view_handle_event(view, &undo));
     assert_int_equal(drift_reflection_edits_region_count(drift_view_reflection_edits(view)), 0);
     assert_true(drift_view_handle_event(view, &undo));
@@ -749,7 +861,8 @@ static void test_view_edits_pick_drag_undo_save(void **state)
     drift_reflection_edits *loaded = NULL;
     assert_int_equal(drift_reflection_edits_load(r.ctx, r.scene, r.accel, path, &loaded), DRIFT_OK);
     assert_int_equal(drift_reflection_edits_constraint_count(loaded), 1);
-    assert_int_equal(drift_reflection_edits_region_count(loaded), 1);
+    assert_int_equal(drift_reflection_edits_region_count(loaded), 2);
+    assert_int_equal(drift_reflection_edits_region(loaded, 0)->type, DRIFT_EDIT_REGION_GEODESIC);
     drift_reflection_edits_destroy(loaded);
     test_rig_destroy(&r);
 }
@@ -766,6 +879,7 @@ int main(void)
         cmocka_unit_test(test_weight_tends_to_one_at_constraint),
         cmocka_unit_test(test_cost_grows_mildly_with_constraints),
         cmocka_unit_test(test_renderers_follow_the_edit),
+        cmocka_unit_test(test_micro_reflections_follow_the_edit),
         cmocka_unit_test(test_bad_edit_files_name_file_and_line),
         cmocka_unit_test(test_view_edits_pick_drag_undo_save),
     };
