@@ -4,6 +4,7 @@
 // where every JSON value starts. Values appear in the text in the same order as a pre-order
 // walk of cJSON's tree, which pairs each cJSON node with its line. Messages can then name
 // "file:line" for any key the reader complains about.
+#include "io/json_lines.h"
 #include "scene_io_internal.h"
 
 #include <cjson/cJSON.h>
@@ -19,18 +20,12 @@
 #define MAX_JSON_MATERIALS 65536
 #define KEY_PATH_MAX       256
 
-typedef struct node_line {
-    const cJSON *node;
-    int line;
-} node_line;
-
 typedef struct json_reader {
     drift_context *ctx;
     drift_scene *scene;
-    const char *file;     // name in messages
-    const char *base_dir; // paths in the file are relative to this
-    node_line *lines;     // sorted by node address
-    size_t line_count;
+    const char *file;        // name in messages
+    const char *base_dir;    // paths in the file are relative to this
+    drift__json_lines lines; // every node's line
     uint32_t material_count; // the file's materials: scene materials 0 .. material_count - 1
     drift__texture_cache textures;
     bool file_camera_found;
@@ -39,128 +34,9 @@ typedef struct json_reader {
 
 // --- SOURCE POSITIONS ---
 
-static bool is_json_space(unsigned char c)
-{
-    return c <= 32; // what cJSON skips
-}
-
-static bool is_json_delimiter(unsigned char c)
-{
-    return is_json_space(c) || c == ',' || c == ':' || c == '[' || c == ']' || c == '{' ||
-           c == '}' || c == '"';
-}
-
-// Records (when starts != NULL) the offset of every JSON value in text order; returns how
-// many there are. Only run on text cJSON accepted, but bounds-checked for any input.
-static size_t scan_value_starts(const char *text, size_t length, size_t *starts, size_t cap)
-{
-    size_t i = 0, n = 0;
-    if (length >= 3 && memcmp(text, "\xEF\xBB\xBF", 3) == 0) {
-        i = 3;
-    }
-    while (i < length) {
-        unsigned char c = (unsigned char)text[i];
-        if (is_json_space(c) || c == ',' || c == ':' || c == ']' || c == '}') {
-            i++;
-            continue;
-        }
-        size_t start = i;
-        if (c == '{' || c == '[') {
-            i++;
-        } else if (c == '"') {
-            for (i++; i < length && text[i] != '"'; ++i) {
-                if (text[i] == '\\') {
-                    i++;
-                }
-            }
-            i++;
-            size_t j = i;
-            while (j < length && is_json_space((unsigned char)text[j])) {
-                j++;
-            }
-            if (j < length && text[j] == ':') {
-                continue; // an object key, not a value
-            }
-        } else {
-            while (i < length && !is_json_delimiter((unsigned char)text[i])) {
-                i++;
-            }
-        }
-        if (starts && n < cap) {
-            starts[n] = start;
-        }
-        n++;
-    }
-    return n;
-}
-
-static size_t count_nodes(const cJSON *item)
-{
-    size_t n = 1;
-    for (const cJSON *c = item->child; c; c = c->next) {
-        n += count_nodes(c);
-    }
-    return n;
-}
-
-static void collect_nodes(const cJSON *item, node_line *out, size_t *n)
-{
-    out[(*n)++].node = item;
-    for (const cJSON *c = item->child; c; c = c->next) {
-        collect_nodes(c, out, n);
-    }
-}
-
-static int compare_node_line(const void *a, const void *b)
-{
-    uintptr_t x = (uintptr_t)((const node_line *)a)->node;
-    uintptr_t y = (uintptr_t)((const node_line *)b)->node;
-    return x < y ? -1 : (x > y ? 1 : 0);
-}
-
-// Builds r->lines. Leaves it empty (every line reads 0) if the scan and the tree disagree.
-static drift_result index_lines(json_reader *r, const cJSON *root, const char *text, size_t length)
-{
-    size_t node_count = count_nodes(root);
-    size_t value_count = scan_value_starts(text, length, NULL, 0);
-    if (value_count != node_count) {
-        return DRIFT_OK;
-    }
-    size_t *starts = drift_alloc(r->ctx, value_count * sizeof(size_t));
-    node_line *lines = drift_alloc(r->ctx, node_count * sizeof(node_line));
-    if (!starts || !lines) {
-        drift_free(r->ctx, starts);
-        drift_free(r->ctx, lines);
-        return DRIFT_ERR_OUT_OF_MEMORY;
-    }
-    scan_value_starts(text, length, starts, value_count);
-    size_t n = 0;
-    collect_nodes(root, lines, &n);
-    // Starts increase, so one pass over the text numbers them all.
-    int line = 1;
-    size_t pos = 0;
-    for (size_t k = 0; k < n; ++k) {
-        for (; pos < starts[k]; ++pos) {
-            line += text[pos] == '\n';
-        }
-        lines[k].line = line;
-    }
-    drift_free(r->ctx, starts);
-    qsort(lines, n, sizeof(node_line), compare_node_line);
-    r->lines = lines;
-    r->line_count = n;
-    return DRIFT_OK;
-}
-
 static int line_of(const json_reader *r, const cJSON *node)
 {
-    if (!node || !r->lines) {
-        return 0;
-    }
-    node_line key = { .node = node };
-    const node_line *hit =
-        bsearch(&key, r->lines, r->line_count, sizeof(node_line), compare_node_line);
-    return hit ? hit->line : 0;
+    return drift__json_lines_find(&r->lines, node);
 }
 
 // --- MESSAGES ---
@@ -1071,7 +947,7 @@ static drift_result parse_document(json_reader *r, const char *text, size_t leng
         drift_free(r->ctx, copy);
         return res;
     }
-    drift_result res = index_lines(r, root, copy, length);
+    drift_result res = drift__json_lines_build(r->ctx, root, copy, length, &r->lines);
     if (res != DRIFT_OK) {
         cJSON_Delete(root);
         drift_free(r->ctx, copy);
@@ -1117,7 +993,7 @@ drift_result drift__scene_load_json_text(drift_context *ctx, const char *text, s
     }
     cJSON_Delete(root);
     drift_free(ctx, copy);
-    drift_free(ctx, r.lines);
+    drift__json_lines_free(ctx, &r.lines);
     drift__texture_cache_clear(ctx, &r.textures);
     if (res != DRIFT_OK) {
         drift_scene_destroy(r.scene);
@@ -1206,7 +1082,7 @@ drift_result drift_camera_views_load_json_text(drift_context *ctx, const char *t
     }
     cJSON_Delete(root);
     drift_free(ctx, copy);
-    drift_free(ctx, r.lines);
+    drift__json_lines_free(ctx, &r.lines);
     return res;
 }
 

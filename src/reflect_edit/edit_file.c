@@ -1,6 +1,7 @@
 // Edit files (.edit.json; format in docs/reflection-editing.md), read with cJSON. As for
-// scene files (src/io/scene_json.c), a scan of the text pairs every cJSON node with the line
-// its value starts on, so each complaint names "file:line".
+// scene files, src/io/json_lines.c pairs every cJSON node with the line its value starts on,
+// so each complaint names "file:line".
+#include "io/json_lines.h"
 #include "reflect_edit/reflect_edit_internal.h"
 
 #include <cjson/cJSON.h>
@@ -15,127 +16,18 @@
 #define MAX_EDIT_FILE_BYTES (16u << 20)
 #define MAX_MASK_VERTICES   (1u << 24)
 
-typedef struct node_line {
-    const cJSON *node;
-    int line;
-} node_line;
-
 typedef struct reader {
     drift_context *ctx;
     const drift_scene *scene;
     const char *file;
-    node_line *lines; // in pre-order (the text order of the values)
-    size_t line_count;
+    drift__json_lines lines; // every node's line
 } reader;
 
 // --- SOURCE POSITIONS ---
 
-static bool is_space(unsigned char c)
-{
-    return c <= 32;
-}
-
-static bool is_delimiter(unsigned char c)
-{
-    return is_space(c) || c == ',' || c == ':' || c == '[' || c == ']' || c == '{' || c == '}' ||
-           c == '"';
-}
-
-// The line of every JSON value, in text order (keys skipped); returns how many values.
-static size_t scan_value_lines(const char *text, size_t length, int *lines, size_t cap)
-{
-    size_t i = 0, n = 0;
-    int line = 1;
-    while (i < length) {
-        unsigned char c = (unsigned char)text[i];
-        if (c == '\n') {
-            line++;
-        }
-        if (is_space(c) || c == ',' || c == ':' || c == ']' || c == '}') {
-            i++;
-            continue;
-        }
-        int start_line = line;
-        if (c == '{' || c == '[') {
-            i++;
-        } else if (c == '"') {
-            for (i++; i < length && text[i] != '"'; ++i) {
-                if (text[i] == '\\') {
-                    i++;
-                }
-            }
-            i++;
-            size_t j = i;
-            while (j < length && is_space((unsigned char)text[j])) {
-                line += text[j] == '\n';
-                j++;
-            }
-            i = j;
-            if (j < length && text[j] == ':') {
-                continue; // a key
-            }
-        } else {
-            while (i < length && !is_delimiter((unsigned char)text[i])) {
-                i++;
-            }
-        }
-        if (lines && n < cap) {
-            lines[n] = start_line;
-        }
-        n++;
-    }
-    return n;
-}
-
-static size_t count_nodes(const cJSON *item)
-{
-    size_t n = 1;
-    for (const cJSON *c = item->child; c; c = c->next) {
-        n += count_nodes(c);
-    }
-    return n;
-}
-
-static void collect_nodes(const cJSON *item, node_line *out, size_t *n)
-{
-    out[(*n)++].node = item;
-    for (const cJSON *c = item->child; c; c = c->next) {
-        collect_nodes(c, out, n);
-    }
-}
-
-static void index_lines(reader *r, const cJSON *root, const char *text, size_t length)
-{
-    size_t nodes = count_nodes(root);
-    if (scan_value_lines(text, length, NULL, 0) != nodes) {
-        return; // the scan and the tree disagree: lines read 0
-    }
-    int *lines = drift_alloc(r->ctx, nodes * sizeof(int));
-    r->lines = drift_alloc(r->ctx, nodes * sizeof(node_line));
-    if (!lines || !r->lines) {
-        drift_free(r->ctx, lines);
-        drift_free(r->ctx, r->lines);
-        r->lines = NULL;
-        return;
-    }
-    scan_value_lines(text, length, lines, nodes);
-    size_t n = 0;
-    collect_nodes(root, r->lines, &n);
-    for (size_t k = 0; k < n; ++k) {
-        r->lines[k].line = lines[k];
-    }
-    r->line_count = n;
-    drift_free(r->ctx, lines);
-}
-
 static int line_of(const reader *r, const cJSON *node)
 {
-    for (size_t k = 0; node && k < r->line_count; ++k) {
-        if (r->lines[k].node == node) {
-            return r->lines[k].line;
-        }
-    }
-    return 0;
+    return drift__json_lines_find(&r->lines, node);
 }
 
 #if defined(__GNUC__)
@@ -402,7 +294,7 @@ drift_result drift_reflection_edits_parse(drift_context *ctx, const drift_scene 
                   "not valid JSON (NaN and infinities are not JSON numbers)");
         return DRIFT_ERR_PARSE;
     }
-    index_lines(&r, root, text, length);
+    drift__json_lines_build(ctx, root, text, length, &r.lines); // no map: lines read 0
     drift_reflection_edits *edits = NULL;
     drift_result res = drift_reflection_edits_create(ctx, scene, accel, &edits);
     if (res == DRIFT_OK) {
@@ -421,7 +313,7 @@ drift_result drift_reflection_edits_parse(drift_context *ctx, const drift_scene 
                       edits->failed_constraint);
         }
     }
-    drift_free(ctx, r.lines);
+    drift__json_lines_free(ctx, &r.lines);
     cJSON_Delete(root);
     if (res != DRIFT_OK) {
         drift_reflection_edits_destroy(edits);
