@@ -2,6 +2,7 @@
 // --reflection-edits) applied to a fixed scene (a square mirror named "mirror" in z = 0, seen
 // from +z). Any result code is fine; crashes, sanitizer reports and leaks are not, a failed
 // parse must leave no edit set, and a successful one must give unit edited directions.
+#define _DEFAULT_SOURCE // mkstemps (fuzz_context.h)
 #include "drift/accel.h"
 #include "drift/reflect_edit.h"
 #include "drift/scene.h"

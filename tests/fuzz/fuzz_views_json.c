@@ -1,6 +1,7 @@
 // libFuzzer target for drift_camera_views_load_json_text: the input is a views file (drift
 // bench sir --views). Any result code is fine; crashes, sanitizer reports and leaks are not,
 // and a successful load must hold 1 to capacity named views.
+#define _DEFAULT_SOURCE // mkstemps (fuzz_context.h)
 #include "drift/scene_io.h"
 #include "fuzz_context.h"
 
