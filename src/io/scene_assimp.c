@@ -40,7 +40,7 @@ static drift__mat4 mat4_from_ai(const struct aiMatrix4x4 *a)
                             a->c3, a->c4, a->d1, a->d2, a->d3, a->d4 } };
 }
 
-static drift_vec3 transform_point(const drift__mat4 *t, drift_vec3 p)
+drift_vec3 drift__mat4_point(const drift__mat4 *t, drift_vec3 p)
 {
     const float *m = t->m;
     return drift_vec3_make(m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3],
@@ -48,7 +48,7 @@ static drift_vec3 transform_point(const drift__mat4 *t, drift_vec3 p)
                            m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]);
 }
 
-static drift_vec3 transform_vector(const drift__mat4 *t, drift_vec3 v)
+drift_vec3 drift__mat4_vector(const drift__mat4 *t, drift_vec3 v)
 {
     const float *m = t->m;
     return drift_vec3_make(m[0] * v.x + m[1] * v.y + m[2] * v.z,
@@ -293,7 +293,7 @@ static drift_result add_mesh(import_state *s, const struct aiMesh *mesh, const d
     float normal_sign = det < 0.0f ? -1.0f : 1.0f;
     for (size_t v = 0; v < nv; ++v) {
         const struct aiVector3D *p = &mesh->mVertices[v];
-        drift_vec3 q = transform_point(world, drift_vec3_make(p->x, p->y, p->z));
+        drift_vec3 q = drift__mat4_point(world, drift_vec3_make(p->x, p->y, p->z));
         positions[3 * v] = q.x;
         positions[3 * v + 1] = q.y;
         positions[3 * v + 2] = q.z;
@@ -367,8 +367,8 @@ static drift_result add_light(import_state *s, unsigned index, const drift__mat4
     const struct aiLight *l = s->ai->mLights[index];
     drift_light light = { 0 };
     drift_vec3 position =
-        transform_point(world, drift_vec3_make(l->mPosition.x, l->mPosition.y, l->mPosition.z));
-    drift_vec3 direction = drift_vec3_normalize(transform_vector(
+        drift__mat4_point(world, drift_vec3_make(l->mPosition.x, l->mPosition.y, l->mPosition.z));
+    drift_vec3 direction = drift_vec3_normalize(drift__mat4_vector(
         world, drift_vec3_make(l->mDirection.x, l->mDirection.y, l->mDirection.z)));
     light.color = drift_vec3_make(l->mColorDiffuse.r, l->mColorDiffuse.g, l->mColorDiffuse.b);
     char name[DRIFT_NAME_MAX];
@@ -451,9 +451,9 @@ static void set_camera(import_state *s, const struct aiCamera *cam, const drift_
     if (!(fov_y > 0.0f && fov_y < DRIFT_PI)) {
         fov_y = 45.0f * DRIFT_PI / 180.0f;
     }
-    drift_vec3 eye = transform_point(world, local_eye);
-    drift_vec3 look = drift_vec3_normalize(transform_vector(world, local_look));
-    drift_vec3 up = drift_vec3_normalize(transform_vector(world, local_up));
+    drift_vec3 eye = drift__mat4_point(world, local_eye);
+    drift_vec3 look = drift_vec3_normalize(drift__mat4_vector(world, local_look));
+    drift_vec3 up = drift_vec3_normalize(drift__mat4_vector(world, local_up));
     int32_t height = 512;
     int32_t width = (int32_t)lroundf(drift_clampf(512.0f * aspect, 1.0f, 8192.0f));
     s->info->camera =

@@ -39,6 +39,9 @@ typedef struct drift__mat4 {
 
 drift__mat4 drift__mat4_identity(void);
 drift__mat4 drift__mat4_mul(const drift__mat4 *a, const drift__mat4 *b);
+// t applied to a point (with the translation) and to a direction (without it).
+drift_vec3 drift__mat4_point(const drift__mat4 *t, drift_vec3 p);
+drift_vec3 drift__mat4_vector(const drift__mat4 *t, drift_vec3 v);
 
 // How to bring one mesh file into a scene.
 typedef struct drift__import_params {

@@ -237,22 +237,6 @@ static drift_result read_color(mitsuba_state *s, const xml_node *n, const char *
     return DRIFT_OK;
 }
 
-static drift_vec3 xform_point(const drift__mat4 *t, drift_vec3 p)
-{
-    const float *m = t->m;
-    return drift_vec3_make(m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3],
-                           m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7],
-                           m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]);
-}
-
-static drift_vec3 xform_vector(const drift__mat4 *t, drift_vec3 v)
-{
-    const float *m = t->m;
-    return drift_vec3_make(m[0] * v.x + m[1] * v.y + m[2] * v.z,
-                           m[4] * v.x + m[5] * v.y + m[6] * v.z,
-                           m[8] * v.x + m[9] * v.y + m[10] * v.z);
-}
-
 static drift_result read_vec3_attrs(mitsuba_state *s, const xml_node *n, const char *key,
                                     drift_vec3 *out)
 {
@@ -508,8 +492,8 @@ static drift_result add_triangles(mitsuba_state *s, const xml_node *n, const cha
         return DRIFT_ERR_OUT_OF_MEMORY;
     }
     for (uint32_t v = 0; v < vertex_count; ++v) {
-        drift_vec3 p =
-            xform_point(world, drift_vec3_make(local[3 * v], local[3 * v + 1], local[3 * v + 2]));
+        drift_vec3 p = drift__mat4_point(
+            world, drift_vec3_make(local[3 * v], local[3 * v + 1], local[3 * v + 2]));
         positions[3 * v] = p.x;
         positions[3 * v + 1] = p.y;
         positions[3 * v + 2] = p.z;
@@ -639,8 +623,8 @@ static drift_result read_shape(mitsuba_state *s, const xml_node *n)
         if ((r = read_float(s, n, "radius", 1.0f, &radius)) != DRIFT_OK) {
             return r;
         }
-        center = xform_point(&world, center);
-        drift_vec3 scaled = xform_vector(&world, drift_vec3_make(radius, 0.0f, 0.0f));
+        center = drift__mat4_point(&world, center);
+        drift_vec3 scaled = drift__mat4_vector(&world, drift_vec3_make(radius, 0.0f, 0.0f));
         radius = drift_vec3_length(scaled);
         if (emitter) {
             drift_light light = {
@@ -738,14 +722,14 @@ static drift_result read_emitter(mitsuba_state *s, const xml_node *n)
             }
             pos = drift_vec3_make(xyz[0], xyz[1], xyz[2]);
         }
-        light.position = xform_point(&world, pos);
+        light.position = drift__mat4_point(&world, pos);
         r = read_color(s, n, "intensity", drift_vec3_splat(1.0f), &light.color, NULL);
     } else if (strcmp(type, "spot") == 0) {
         float cutoff, beam;
         light.type = DRIFT_LIGHT_SPOT;
-        light.position = xform_point(&world, drift_vec3_splat(0.0f));
+        light.position = drift__mat4_point(&world, drift_vec3_splat(0.0f));
         light.direction =
-            drift_vec3_normalize(xform_vector(&world, drift_vec3_make(0.0f, 0.0f, 1.0f)));
+            drift_vec3_normalize(drift__mat4_vector(&world, drift_vec3_make(0.0f, 0.0f, 1.0f)));
         if ((r = read_color(s, n, "intensity", drift_vec3_splat(1.0f), &light.color, NULL)) ==
                 DRIFT_OK &&
             (r = read_float(s, n, "cutoffAngle", 20.0f, &cutoff)) == DRIFT_OK &&
@@ -756,7 +740,7 @@ static drift_result read_emitter(mitsuba_state *s, const xml_node *n)
     } else if (strcmp(type, "directional") == 0) {
         light.type = DRIFT_LIGHT_DIRECTIONAL;
         light.direction =
-            drift_vec3_normalize(xform_vector(&world, drift_vec3_make(0.0f, 0.0f, 1.0f)));
+            drift_vec3_normalize(drift__mat4_vector(&world, drift_vec3_make(0.0f, 0.0f, 1.0f)));
         const xml_node *d = property(n, "direction");
         if (d) {
             float xyz[3] = { 0, 0, 1 };
@@ -816,9 +800,9 @@ static drift_result read_sensor(mitsuba_state *s, const xml_node *n)
                       (strcmp(axis, "larger") == 0 && width >= height);
     float half = 0.5f * fov * DRIFT_PI / 180.0f;
     float fov_y = horizontal ? 2.0f * atanf(tanf(half) * height / width) : 2.0f * half;
-    drift_vec3 eye = xform_point(&world, drift_vec3_splat(0.0f));
-    drift_vec3 forward = xform_vector(&world, drift_vec3_make(0.0f, 0.0f, 1.0f));
-    drift_vec3 up = xform_vector(&world, drift_vec3_make(0.0f, 1.0f, 0.0f));
+    drift_vec3 eye = drift__mat4_point(&world, drift_vec3_splat(0.0f));
+    drift_vec3 forward = drift__mat4_vector(&world, drift_vec3_make(0.0f, 0.0f, 1.0f));
+    drift_vec3 up = drift__mat4_vector(&world, drift_vec3_make(0.0f, 1.0f, 0.0f));
     s->scene->camera = drift_camera_look_at(eye, drift_vec3_add(eye, forward), up, fov_y,
                                             (int32_t)width, (int32_t)height);
     s->has_camera = true;
