@@ -2,6 +2,7 @@
 #include "test_rig.h"
 
 #include "drift/metric.h"
+#include "drift/scene_io.h"
 #include "drift_test.h"
 
 #include <math.h>
@@ -12,6 +13,19 @@ test_rig test_rig_begin(int threads)
 {
     test_rig r = { .ctx = test_context(threads, NULL) };
     assert_int_equal(drift_scene_create(r.ctx, &r.scene), DRIFT_OK);
+    return r;
+}
+
+test_rig test_rig_load(int threads, const char *repo_path, int32_t w)
+{
+    test_rig r = { .ctx = test_context(threads, NULL) };
+    char path[1024];
+    assert_int_equal(drift_scene_load(r.ctx, test_repo_path(path, repo_path), &r.scene), DRIFT_OK);
+    r.scene->camera.width = w;
+    r.scene->camera.height = w;
+    assert_int_equal(drift_accel_create(r.ctx, r.scene, &(drift_accel_desc){ 0 }, &r.accel),
+                     DRIFT_OK);
+    test_rig_frame(&r, &(drift_hybrid_params){ .width = w, .height = w });
     return r;
 }
 

@@ -17,6 +17,9 @@ typedef struct test_rig {
 
 // A context with `threads` threads and an empty scene.
 test_rig test_rig_begin(int threads);
+// A context with `threads` threads, the repository's scene `repo_path` at w x w pixels, its
+// accelerator, and a first frame (drift_hybrid_params' defaults) rendered from its camera.
+test_rig test_rig_load(int threads, const char *repo_path, int32_t w);
 // Commits the scene and builds its accelerator.
 void test_rig_commit(test_rig *r);
 // Replaces the rig's frame by one made with `params` and renders it from the scene camera.

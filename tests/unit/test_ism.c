@@ -27,18 +27,7 @@
 // The Cornell box at w x w, committed with its accel, and a G-buffer frame.
 static test_rig cornell_rig(int threads, int32_t w)
 {
-    test_rig r = { .ctx = test_context(threads, NULL) };
-    char path[1024];
-    assert_int_equal(drift_scene_load(r.ctx,
-                                      test_repo_path(path, "scenes/cornell-box/cornell_box.json"),
-                                      &r.scene),
-                     DRIFT_OK);
-    r.scene->camera.width = w;
-    r.scene->camera.height = w;
-    assert_int_equal(drift_accel_create(r.ctx, r.scene, &(drift_accel_desc){ 0 }, &r.accel),
-                     DRIFT_OK);
-    test_rig_frame(&r, &(drift_hybrid_params){ .width = w, .height = w });
-    return r;
+    return test_rig_load(threads, "scenes/cornell-box/cornell_box.json", w);
 }
 
 // The path tracer's truth of a term (seed 99).
