@@ -160,10 +160,15 @@ drift_result drift__micro_light_points(drift_context *ctx, const drift_scene *sc
     double t1 = drift_time_now();
     drift_result r = DRIFT_OK;
     if (params->bounces > 1 && params->lighting == DRIFT_MICRO_LIGHTING_RADIOSITY) {
+        // Elements of 32 leaves up to 2^14 points, then as many elements as at 2^14 (their
+        // gathers cost what the final gather does, whatever the points).
+        uint32_t element_leaves = tree->leaf_count / 512 > DRIFT_MICRO_RADIOSITY_LEAVES
+                                      ? tree->leaf_count / 512
+                                      : DRIFT_MICRO_RADIOSITY_LEAVES;
         drift__micro_radiosity_desc desc = { .accel = accel,
                                              .iterations = params->bounces - 1,
                                              .buffer_size = params->radiosity_size,
-                                             .element_leaves = DRIFT_MICRO_RADIOSITY_LEAVES };
+                                             .element_leaves = element_leaves };
         r = drift__micro_radiosity(ctx, tree, points, &desc, NULL, &stats->rays);
     } else if (params->bounces > 1 && params->lighting == DRIFT_MICRO_LIGHTING_PHOTONS) {
         drift__micro_photon_map map;

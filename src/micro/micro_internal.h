@@ -61,7 +61,7 @@ uint64_t drift__micro_light_leaves(drift_context *ctx, const drift_scene *scene,
 
 #define DRIFT_MICRO_MAX_BOUNCES      8
 #define DRIFT_MICRO_MAX_PHOTON_K     256
-#define DRIFT_MICRO_RADIOSITY_LEAVES 32 // the most leaves one radiosity element holds
+#define DRIFT_MICRO_RADIOSITY_LEAVES 32 // leaves an element holds at most (up to 2^14 points)
 
 // The defaults and the checks of the lighting fields of drift_micro_params.
 void drift__micro_lighting_resolve(drift_micro_params *p);
