@@ -4,8 +4,9 @@
 // closed furnace, the total the geometric series' partial sum); a photon map estimates the
 // closed-form irradiance of a plane under a point light and the caustic a mirror throws; the
 // photons' flux is unbiased (the emitted power, rho and rho^2 of it at the next bounces of a
-// closed sphere); and micro-rendering with 2 bounces matches the path tracer's max depth 3 on
-// the Cornell box where one bounce falls short.
+// closed sphere); the increments on the Cornell box shrink by at least its largest albedo; and
+// micro-rendering with 2 bounces matches the path tracer's max depth 3 on the Cornell box
+// where one bounce falls short.
 #include "drift/accel.h"
 #include "drift/hybrid.h"
 #include "drift/micro.h"
@@ -252,6 +253,44 @@ static void test_two_bounces_against_path_tracer(void **state)
     test_rig_destroy(&r);
 }
 
+// On the Cornell box, lit by its light: each radiosity increment is positive and at most the
+// largest albedo times the last (equal-area leaves: what an enclosure gathers is at most what
+// it holds), so the series converges.
+static void test_radiosity_increments_shrink_on_cornell_box(void **state)
+{
+    (void)state;
+    test_rig r = test_rig_load(2, "scenes/cornell-box/cornell_box.json", 8);
+    drift_points *points;
+    drift__micro_tree tree;
+    make_tree(&r, 4096, &points, &tree);
+    drift__micro_light_leaves(r.ctx, r.scene, r.accel, points, &tree, 4, 0);
+    uint32_t n = tree.leaf_count;
+    float kd_max = 0.0f;
+    for (uint32_t j = 0; j < n; ++j) {
+        drift_vec3 kd = tree.albedo[n - 1 + j];
+        kd_max = fmaxf(kd_max, fmaxf(kd.x, fmaxf(kd.y, kd.z)));
+    }
+
+    enum {
+        ITER = 3
+    };
+
+    double inc[ITER + 1];
+    drift__micro_radiosity_desc desc = {
+        .accel = r.accel, .iterations = ITER, .buffer_size = 8, .element_leaves = 32
+    };
+    assert_int_equal(drift__micro_radiosity(r.ctx, &tree, points, &desc, inc, NULL), DRIFT_OK);
+    for (int k = 1; k <= ITER; ++k) {
+        printf("increment %d: %.5f (ratio %.4f; largest albedo %.3f)\n", k, inc[k],
+               inc[k] / inc[k - 1], (double)kd_max);
+        assert_true(inc[k] > 0.0);
+        assert_true(inc[k] <= 1.02 * (double)kd_max * inc[k - 1]);
+    }
+    drift__micro_tree_destroy(r.ctx, &tree);
+    drift_points_destroy(points);
+    test_rig_destroy(&r);
+}
+
 // Bad lighting parameters are refused: direct light with 2 bounces, 0 or 9 bounces.
 static void test_bad_lighting_parameters(void **state)
 {
@@ -276,6 +315,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_radiosity_energy_bound_and_monotone),
+        cmocka_unit_test(test_radiosity_increments_shrink_on_cornell_box),
         cmocka_unit_test(test_photon_irradiance_under_point_light),
         cmocka_unit_test(test_photon_caustic_of_a_mirror),
         cmocka_unit_test(test_photon_flux_is_unbiased),
