@@ -257,6 +257,7 @@ static void build(drift__micro_photon *ph, uint8_t *axis, uint32_t lo, uint32_t 
 typedef struct knn {
     const drift__micro_photon_map *map;
     drift_vec3 x, n;
+    bool both_sides; // accept photons facing n or -n (each within 60 degrees)
     int32_t k, count;
     float max_d2; // the search radius squared: the k-th's once k are found
     float d2[DRIFT_MICRO_MAX_PHOTON_K];
@@ -313,7 +314,8 @@ static void knn_search(knn *q, uint32_t lo, uint32_t hi)
         drift_vec3 d = drift_vec3_sub(p->position, q->x);
         float d2 = drift_vec3_dot(d, d);
         // Only photons that arrived on a surface facing the query's side.
-        if (d2 < q->max_d2 && drift_vec3_dot(p->normal, q->n) > 0.5f) {
+        float c = drift_vec3_dot(p->normal, q->n);
+        if (d2 < q->max_d2 && (c > 0.5f || (q->both_sides && c < -0.5f))) {
             knn_insert(q, d2, mid);
         }
         int a = q->map->axis[mid];
@@ -329,33 +331,51 @@ static void knn_search(knn *q, uint32_t lo, uint32_t hi)
     }
 }
 
-drift_vec3 drift__micro_photons_irradiance(const drift__micro_photon_map *map, drift_vec3 x,
-                                           drift_vec3 n, int32_t k, float max_radius)
+// The k nearest photons around x on a surface facing n (or, both_sides, n or -n): their
+// flux over pi r^2 split by the side they arrived on.
+static void estimate(const drift__micro_photon_map *map, drift_vec3 x, drift_vec3 n, int32_t k,
+                     float max_radius, bool both_sides, drift_vec3 *out_front, drift_vec3 *out_back)
 {
+    *out_front = *out_back = drift_vec3_splat(0.0f);
     if (map->count == 0) {
-        return drift_vec3_splat(0.0f);
+        return;
     }
     knn q;
     q.map = map;
     q.x = x;
     q.n = n;
+    q.both_sides = both_sides;
     q.k = k < 1 ? 1 : (k > DRIFT_MICRO_MAX_PHOTON_K ? DRIFT_MICRO_MAX_PHOTON_K : k);
     q.count = 0;
     q.max_d2 = isfinite(max_radius) ? max_radius * max_radius : INFINITY;
     knn_search(&q, 0, map->count);
     if (q.count == 0) {
-        return drift_vec3_splat(0.0f);
-    }
-    drift_vec3 sum = drift_vec3_splat(0.0f);
-    for (int32_t i = 0; i < q.count; ++i) {
-        sum = drift_vec3_add(sum, map->photons[q.idx[i]].power);
+        return;
     }
     // The k-th's distance; with fewer, the search radius (or, unbounded, the farthest found).
     float r2 = q.count == q.k || isfinite(q.max_d2) ? q.max_d2 : q.d2[0];
     if (!(r2 > 0.0f) || !isfinite(r2)) {
-        return drift_vec3_splat(0.0f);
+        return;
     }
-    return drift_vec3_scale(sum, 1.0f / (DRIFT_PI * r2));
+    drift_vec3 front = drift_vec3_splat(0.0f), back = front;
+    for (int32_t i = 0; i < q.count; ++i) {
+        const drift__micro_photon *p = &map->photons[q.idx[i]];
+        if (drift_vec3_dot(p->normal, n) > 0.0f) {
+            front = drift_vec3_add(front, p->power);
+        } else {
+            back = drift_vec3_add(back, p->power);
+        }
+    }
+    *out_front = drift_vec3_scale(front, 1.0f / (DRIFT_PI * r2));
+    *out_back = drift_vec3_scale(back, 1.0f / (DRIFT_PI * r2));
+}
+
+drift_vec3 drift__micro_photons_irradiance(const drift__micro_photon_map *map, drift_vec3 x,
+                                           drift_vec3 n, int32_t k, float max_radius)
+{
+    drift_vec3 front, back;
+    estimate(map, x, n, k, max_radius, false, &front, &back);
+    return front;
 }
 
 drift_result drift__micro_photons_trace(drift_context *ctx, const drift_scene *scene,
@@ -458,10 +478,11 @@ static void light_range(size_t begin, size_t end, int thread, void *user)
         if (drift_vec3_is_zero(kd)) {
             continue;
         }
-        drift_vec3 x = tree->center[node], axis = tree->axis[node];
-        drift_vec3 ef = drift__micro_photons_irradiance(job->map, x, axis, job->k, job->max_radius);
-        drift_vec3 eb = drift__micro_photons_irradiance(job->map, x, drift_vec3_neg(axis), job->k,
-                                                        job->max_radius);
+        // One search for both sides: a wall's dark outside costs nothing extra, and a thin
+        // surface lit on both sides splits the k nearest by the side they arrived on.
+        drift_vec3 ef, eb;
+        estimate(job->map, tree->center[node], tree->axis[node], job->k, job->max_radius, true, &ef,
+                 &eb);
         tree->front[node] = drift_vec3_fma(tree->front[node], drift_vec3_mul(kd, ef), DRIFT_INV_PI);
         tree->back[node] = drift_vec3_fma(tree->back[node], drift_vec3_mul(kd, eb), DRIFT_INV_PI);
     }
