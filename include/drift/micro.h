@@ -8,7 +8,9 @@
 //      bounding sphere, a cone of normals, an albedo and its outgoing radiance. The topology is
 //      fixed at create; each render re-derives the leaves and refits the nodes bottom-up.
 //   2. Lighting (lighting.c): the direct light reflected by each leaf, both sides of its disc,
-//      ray-traced; pulled up the tree as area-weighted means (one bounce).
+//      ray-traced; with bounces > 1 the further bounces from a radiosity (Jacobi) iteration
+//      over the tree (radiosity.c) or a photon map (photons.c, caustics included); pulled up
+//      the tree as area-weighted means.
 //   3. Gathering (microbuffer.c, warp.c): per gather point a depth-first cut of the tree by
 //      solid angle, each node of the cut splatted into the pixel of the micro-buffer its
 //      direction warps to (depth-tested); then ray casting (Embree) of the pixels a leaf
@@ -150,8 +152,8 @@ void drift_micro_destroy(drift_micro *micro); // NULL-safe
 drift_result drift_micro_render(drift_micro *micro, const drift_gbuffer *gbuffer,
                                 const drift_camera *camera, drift_micro_lobe lobe);
 
-// RGB radiance of the last render: the lobe's one-bounce light toward the camera (0 where the
-// G-buffer missed, and for the glossy lobe on mirrors).
+// RGB radiance of the last render: the lobe's indirect light (of `bounces` bounces) toward the
+// camera (0 where the G-buffer missed, and for the glossy lobe on mirrors).
 const drift_image *drift_micro_result(const drift_micro *micro);
 // "micro.incident" (RGB, the micro-buffers' mean radiance before rho, at full resolution
 // after upsampling) and "micro.gathers" (1 channel: 1 where a gather ran). NULL before a render.
