@@ -354,9 +354,10 @@ static const cli_option render_table[] = {
             "direct light plus N - 1 bounces (default 1)"),
     CLI_CHOICE("--micro-lighting", "MODE", O, hybrid.micro.lighting,
                "auto|direct|radiosity|photons",
-               "how the points get bounces 2..N: radiosity (Jacobi gathers\n"
-               "over the hierarchy) or a photon map (caustics included);\n"
-               "auto: direct for one bounce, else radiosity"),
+               "auto, direct, radiosity or photons: how the points get\n"
+               "bounces 2..N, by Jacobi gathers over the hierarchy or a\n"
+               "photon map (caustics included); direct is one bounce; auto\n"
+               "(default): direct for one bounce, else radiosity"),
 
     CLI_SECTION("smart image refinement (hybrid mode; docs/sir.md):", GROUP_HYBRID | GROUP_REFINE),
     CLI_CUSTOM("--refine", "sir", O, refine.enabled, cli_parse_refine,
