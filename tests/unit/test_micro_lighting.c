@@ -76,7 +76,7 @@ static void test_radiosity_energy_bound_and_monotone(void **state)
         printf("%d iterations: inside mean %.4f, partial sum %.4f, bound %.4f\n", iterations,
                inside, partial, (double)L / (1.0 - (double)rho));
         // Never above the series (no energy made), at most 3% below it after 4 bounces (the
-        // ambient cubes of curved nodes mix in their dark outsides: docs/micro.md).
+        // near nodes of a curved wall are partly seen with their dark outsides: docs/micro.md).
         assert_true(inside <= partial * 1.001 && inside >= 0.97 * partial);
         assert_true(inside < (double)L / (1.0 - (double)rho));
     }
