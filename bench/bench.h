@@ -20,6 +20,8 @@
       "SSAO, GTAO, SSDO(+bounce): Table 4.1 ms, FLIP vs the path tracer")                        \
     X("ism", drift_bench_ism, "imperfect shadow maps and instant radiosity vs the path tracer")  \
     X("micro", drift_bench_micro, "micro-rendering: rate vs K, density, points; NRMS vs the pt") \
+    X("micro-bounces", drift_bench_micro_bounces,                                                \
+      "micro-rendering's points lit by radiosity or photons: NRMS, FLIP vs the pt, 1-3 bounces") \
     X("frontier", drift_bench_frontier,                                                          \
       "equal-time frontier: pt, pt + a-trous, hybrid rows vs a whole-frame reference")           \
     X("redit", drift_bench_redit, "reflection editing: edit-field Mpixel/s vs constraints")

@@ -349,6 +349,15 @@ static const cli_option render_table[] = {
     CLI_CUSTOM("--micro-density", "1|1/4|1/16", O, hybrid.micro.density, parse_micro_density,
                "gather at every pixel, 1/4 or 1/16 of them and upsample\n"
                "bilaterally (default 1)"),
+    CLI_INT("--micro-bounces", "N", O, hybrid.micro.bounces, 1, 8,
+            "light bounces the micro-buffers gather: the points hold\n"
+            "direct light plus N - 1 bounces (default 1)"),
+    CLI_CHOICE("--micro-lighting", "MODE", O, hybrid.micro.lighting,
+               "auto|direct|radiosity|photons",
+               "auto, direct, radiosity or photons: how the points get\n"
+               "bounces 2..N, by Jacobi gathers over the hierarchy or a\n"
+               "photon map (caustics included); direct is one bounce; auto\n"
+               "(default): direct for one bounce, else radiosity"),
 
     CLI_SECTION("smart image refinement (hybrid mode; docs/sir.md):", GROUP_HYBRID | GROUP_REFINE),
     CLI_CUSTOM("--refine", "sir", O, refine.enabled, cli_parse_refine,
@@ -414,6 +423,13 @@ int render_parse_options(int argc, char **argv, render_options *o)
     if (o->hybrid_mode && o->resume_path) {
         fprintf(stderr, "drift render: --resume continues a reference render (drop --mode "
                         "hybrid)\n");
+        return 2;
+    }
+    if (o->hybrid.micro.lighting == 1 && o->hybrid.micro.bounces > 1) {
+        fprintf(stderr,
+                "drift render: --micro-lighting direct is one bounce; --micro-bounces %d "
+                "needs radiosity or photons\n",
+                o->hybrid.micro.bounces);
         return 2;
     }
     if (!o->hybrid_mode && o->aov_path) {

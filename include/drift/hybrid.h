@@ -145,10 +145,13 @@ typedef struct drift_ism_settings {
 //   points      = 0 -> 65536 scene points in the hierarchy (rounded up to a power of two)
 //   buffer_size = 0 -> 16: K, each gather's micro-buffer is K x K pixels
 //   density     = 0 -> 1: a gather every pixel; 2: 1/4 of them, 4: 1/16 (bilateral upsampling)
+//   bounces     = 0 -> 1: light bounces at the points; lighting: a drift_micro_lighting (0: auto)
 typedef struct drift_micro_settings {
     uint32_t points;
     int32_t buffer_size;
     int32_t density;
+    int32_t bounces;
+    int32_t lighting;
 } drift_micro_settings;
 
 // Light from the environment in screen space (occlusion ssao, gtao, ssdo; docs/ssdo.md):

@@ -8,7 +8,9 @@
 //      bounding sphere, a cone of normals, an albedo and its outgoing radiance. The topology is
 //      fixed at create; each render re-derives the leaves and refits the nodes bottom-up.
 //   2. Lighting (lighting.c): the direct light reflected by each leaf, both sides of its disc,
-//      ray-traced; pulled up the tree as area-weighted means (one bounce).
+//      ray-traced; with bounces > 1 the further bounces from a radiosity (Jacobi) iteration
+//      over the tree (radiosity.c) or a photon map (photons.c, caustics included); pulled up
+//      the tree as area-weighted means.
 //   3. Gathering (microbuffer.c, warp.c): per gather point a depth-first cut of the tree by
 //      solid angle, each node of the cut splatted into the pixel of the micro-buffer its
 //      direction warps to (depth-tested); then ray casting (Embree) of the pixels a leaf
@@ -56,6 +58,17 @@ typedef enum drift_micro_lobe {
     DRIFT_MICRO_LOBE_COUNT
 } drift_micro_lobe;
 
+// How the points are lit (thesis §6.4; docs/micro.md "Lighting the points").
+typedef enum drift_micro_lighting {
+    DRIFT_MICRO_LIGHTING_AUTO = 0,  // direct when bounces = 1, radiosity above
+    DRIFT_MICRO_LIGHTING_DIRECT,    // ray-traced direct light only (one bounce)
+    DRIFT_MICRO_LIGHTING_RADIOSITY, // direct, then bounces - 1 Jacobi gathers over the tree
+    DRIFT_MICRO_LIGHTING_PHOTONS,   // direct, plus a photon map's light of bounces 2..bounces
+    DRIFT_MICRO_LIGHTING_COUNT
+} drift_micro_lighting;
+
+const char *drift_micro_lighting_name(drift_micro_lighting lighting);
+
 // How to render. The default configuration is:
 //   seed          = 0
 //   point_count   = 0 -> 65536 scene points (rounded up to a power of two; at most 2^22)
@@ -77,6 +90,16 @@ typedef struct drift_micro_params {
     float cut_scale;
     bool no_ray_casting;
     bool no_jitter;
+    // Lighting the points (lighting.c, radiosity.c, photons.c):
+    //   lighting       = AUTO (direct for one bounce, radiosity above)
+    //   bounces        = 0 -> 1: light bounces the gather sees (the path tracer's max depth - 1)
+    //   radiosity_size = 0 -> 8: K of the radiosity gathers' micro-buffers (4..32)
+    //   photon_count   = 0 -> 2^18 photon paths; photon_k = 0 -> 64 nearest photons a leaf
+    drift_micro_lighting lighting;
+    int32_t bounces;
+    int32_t radiosity_size;
+    uint32_t photon_count;
+    int32_t photon_k;
     // NULL: physical reflections. Otherwise the glossy lobe of each gather point centres on
     // the edited direction e(q) (drift/reflect_edit.h); borrowed, it must outlive the renders.
     const drift_reflection_edits *reflection_edits;
@@ -105,6 +128,10 @@ typedef struct drift_micro_stats {
     uint64_t rays;          // post-traversal and light rays
     uint64_t empty_pixels;  // micro-buffer pixels left without a node (holes and misses)
     uint64_t fallbacks;     // full-resolution gathers where the upsampling had no weight
+    // Lighting the points, inside DRIFT_MICRO_STAGE_LIGHTING: the direct light, the radiosity
+    // iterations or the photon map (tracing, kd-tree and the density estimates) and the pulls.
+    double direct_ms, bounces_ms;
+    uint64_t photons; // photons stored (the photon map's size)
 } drift_micro_stats;
 
 typedef struct drift_micro drift_micro;
@@ -125,8 +152,8 @@ void drift_micro_destroy(drift_micro *micro); // NULL-safe
 drift_result drift_micro_render(drift_micro *micro, const drift_gbuffer *gbuffer,
                                 const drift_camera *camera, drift_micro_lobe lobe);
 
-// RGB radiance of the last render: the lobe's one-bounce light toward the camera (0 where the
-// G-buffer missed, and for the glossy lobe on mirrors).
+// RGB radiance of the last render: the lobe's indirect light (of `bounces` bounces) toward the
+// camera (0 where the G-buffer missed, and for the glossy lobe on mirrors).
 const drift_image *drift_micro_result(const drift_micro *micro);
 // "micro.incident" (RGB, the micro-buffers' mean radiance before rho, at full resolution
 // after upsampling) and "micro.gathers" (1 channel: 1 where a gather ran). NULL before a render.

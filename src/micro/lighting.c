@@ -1,10 +1,12 @@
-// Lighting the points for one bounce (thesis §6.4): the direct light each leaf's disc reflects
-// through its diffuse lobe, on both sides (drift's surfaces are two-sided), with ray-traced
-// visibility where the thesis used shadow maps. Light picks follow the path tracer's
-// power-proportional distribution (the environment included).
+// Lighting the points (thesis §6.4). The first bounce: the direct light each leaf's disc
+// reflects through its diffuse lobe, on both sides (drift's surfaces are two-sided), with
+// ray-traced visibility where the thesis used shadow maps. Light picks follow the path
+// tracer's power-proportional distribution (the environment included). More bounces come from
+// a radiosity (Jacobi) iteration over the tree (radiosity.c) or a photon map (photons.c).
 #include "micro/micro_internal.h"
 
 #include <math.h>
+#include <string.h>
 
 typedef struct light_job {
     const drift_scene *scene;
@@ -106,4 +108,85 @@ uint64_t drift__micro_light_leaves(drift_context *ctx, const drift_scene *scene,
         rays += job.rays[i];
     }
     return rays;
+}
+
+// --- THE LIGHTING MODES ---
+
+const char *drift_micro_lighting_name(drift_micro_lighting lighting)
+{
+    static const char *const names[DRIFT_MICRO_LIGHTING_COUNT] = { "auto", "direct", "radiosity",
+                                                                   "photons" };
+    return (unsigned)lighting < DRIFT_MICRO_LIGHTING_COUNT ? names[lighting] : "?";
+}
+
+void drift__micro_lighting_resolve(drift_micro_params *p)
+{
+    if (p->bounces == 0) {
+        p->bounces = 1;
+    }
+    if (p->lighting == DRIFT_MICRO_LIGHTING_AUTO) {
+        p->lighting = p->bounces > 1 ? DRIFT_MICRO_LIGHTING_RADIOSITY : DRIFT_MICRO_LIGHTING_DIRECT;
+    }
+    if (p->radiosity_size == 0) {
+        p->radiosity_size = 8;
+    }
+    if (p->photon_count == 0) {
+        p->photon_count = 1u << 18;
+    }
+    if (p->photon_k == 0) {
+        p->photon_k = 64;
+    }
+}
+
+bool drift__micro_lighting_valid(const drift_micro_params *p)
+{
+    // Direct light is one bounce: more with it would silently be ignored.
+    return (unsigned)p->lighting < DRIFT_MICRO_LIGHTING_COUNT && p->bounces >= 1 &&
+           p->bounces <= DRIFT_MICRO_MAX_BOUNCES &&
+           (p->lighting != DRIFT_MICRO_LIGHTING_DIRECT || p->bounces == 1) &&
+           p->radiosity_size >= 4 && p->radiosity_size <= DRIFT_MICRO_MAX_K &&
+           p->photon_count >= 1 && p->photon_count <= (1u << 24) && p->photon_k >= 1 &&
+           p->photon_k <= DRIFT_MICRO_MAX_PHOTON_K;
+}
+
+drift_result drift__micro_light_points(drift_context *ctx, const drift_scene *scene,
+                                       const drift_accel *accel, const drift_points *points,
+                                       drift__micro_tree *tree, const drift_micro_params *params,
+                                       drift_micro_stats *stats)
+{
+    double t0 = drift_time_now();
+    stats->rays += drift__micro_light_leaves(ctx, scene, accel, points, tree, params->light_samples,
+                                             params->seed);
+    double t1 = drift_time_now();
+    drift_result r = DRIFT_OK;
+    if (params->bounces > 1 && params->lighting == DRIFT_MICRO_LIGHTING_RADIOSITY) {
+        // Elements of 32 leaves up to 2^14 points, then as many elements as at 2^14 (their
+        // gathers cost what the final gather does, whatever the points).
+        uint32_t element_leaves = tree->leaf_count / 512 > DRIFT_MICRO_RADIOSITY_LEAVES
+                                      ? tree->leaf_count / 512
+                                      : DRIFT_MICRO_RADIOSITY_LEAVES;
+        drift__micro_radiosity_desc desc = { .accel = accel,
+                                             .iterations = params->bounces - 1,
+                                             .buffer_size = params->radiosity_size,
+                                             .element_leaves = element_leaves };
+        r = drift__micro_radiosity(ctx, tree, points, &desc, NULL, &stats->rays);
+    } else if (params->bounces > 1 && params->lighting == DRIFT_MICRO_LIGHTING_PHOTONS) {
+        drift__micro_photon_map map;
+        drift__micro_photon_desc desc = { .paths = params->photon_count,
+                                          .min_scatter = 1,
+                                          .max_scatter = params->bounces - 1,
+                                          .seed = params->seed };
+        r = drift__micro_photons_trace(ctx, scene, accel, &desc, &map);
+        if (r == DRIFT_OK) {
+            stats->photons = map.count;
+            stats->rays += map.rays;
+            drift__micro_photons_light_leaves(ctx, &map, points, tree, params->photon_k);
+            drift__micro_photons_destroy(ctx, &map);
+        }
+    }
+    drift__micro_tree_pull(tree);
+    double t2 = drift_time_now();
+    stats->direct_ms = (t1 - t0) * 1e3;
+    stats->bounces_ms = (t2 - t1) * 1e3;
+    return r;
 }

@@ -54,6 +54,7 @@ drift_micro_params drift_micro_params_resolve(const drift_micro_params *params)
     if (p.cut_scale == 0.0f) {
         p.cut_scale = 1.0f;
     }
+    drift__micro_lighting_resolve(&p);
     return p;
 }
 
@@ -63,7 +64,7 @@ static bool params_valid(const drift_micro_params *p)
            p->buffer_size <= DRIFT_MICRO_MAX_K &&
            (p->density == 1 || p->density == 2 || p->density == 4) && p->light_samples >= 1 &&
            p->light_samples <= 1024 && p->warp_size >= 8 && p->warp_size <= DRIFT_MICRO_MAX_WARP &&
-           p->cut_scale > 0.0f && p->cut_scale <= 64.0f;
+           p->cut_scale > 0.0f && p->cut_scale <= 64.0f && drift__micro_lighting_valid(p);
 }
 
 drift_result drift_micro_create(drift_context *ctx, const drift_scene *scene,
@@ -360,10 +361,12 @@ drift_result drift_micro_render(drift_micro *micro, const drift_gbuffer *gbuffer
     }
     drift__micro_tree_refit(&m->tree, m->points);
     double t1 = drift_time_now();
-    // 2. One bounce: direct light at the leaves, pulled up the tree.
-    m->stats.rays += drift__micro_light_leaves(m->ctx, m->scene, m->accel, m->points, &m->tree,
-                                               m->params.light_samples, m->params.seed);
-    drift__micro_tree_pull(&m->tree);
+    // 2. Lighting the leaves (direct light and the further bounces), pulled up the tree.
+    r = drift__micro_light_points(m->ctx, m->scene, m->accel, m->points, &m->tree, &m->params,
+                                  &m->stats);
+    if (r != DRIFT_OK) {
+        return r;
+    }
     double t2 = drift_time_now();
     // 3. The gathers.
     gather_job *job = drift_alloc(m->ctx, sizeof *job);

@@ -57,6 +57,83 @@ uint64_t drift__micro_light_leaves(drift_context *ctx, const drift_scene *scene,
                                    const drift_accel *accel, const drift_points *points,
                                    drift__micro_tree *tree, int32_t samples, uint32_t seed);
 
+// --- LIGHTING MODES (§6.4: lighting.c, radiosity.c, photons.c) ---
+
+#define DRIFT_MICRO_MAX_BOUNCES      8
+#define DRIFT_MICRO_MAX_PHOTON_K     256
+#define DRIFT_MICRO_RADIOSITY_LEAVES 32 // leaves an element holds at most (up to 2^14 points)
+
+// The defaults and the checks of the lighting fields of drift_micro_params.
+void drift__micro_lighting_resolve(drift_micro_params *p);
+bool drift__micro_lighting_valid(const drift_micro_params *p);
+
+// Lights the leaves (direct light, then the bounces of params->lighting) and pulls the tree;
+// adds to stats->rays, sets stats->direct_ms, bounces_ms and photons.
+drift_result drift__micro_light_points(drift_context *ctx, const drift_scene *scene,
+                                       const drift_accel *accel, const drift_points *points,
+                                       drift__micro_tree *tree, const drift_micro_params *params,
+                                       drift_micro_stats *stats);
+
+// Radiosity (Jacobi) over the hierarchy. The tree is cut into elements: the largest nodes
+// with at most element_leaves leaves whose normal cone is within 30 degrees (a leaf always
+// is one). Each iteration pulls the last increment of radiance up the tree and gathers it at
+// every element, on both sides of its cone's axis, with a diffuse micro-buffer of K =
+// buffer_size (the frame unrotated); each leaf of the element gets kd times the side it faces
+// as the next increment. Increments are non-negative, so the total only grows; with albedo
+// below 1 they shrink geometrically.
+typedef struct drift__micro_radiosity_desc {
+    const drift_accel *accel; // the post-traversal ray casting (NULL: none)
+    int32_t iterations;       // bounces added beyond the leaves' current radiance
+    int32_t buffer_size;
+    uint32_t element_leaves;
+} drift__micro_radiosity_desc;
+
+// On entry the leaves hold their first bounce (front and back); on return that plus the
+// `iterations` increments, not pulled. out_increments (may be NULL; iterations + 1 entries)
+// gets the mean over leaves of the luminance of front + back of each: [0] the entry's.
+drift_result drift__micro_radiosity(drift_context *ctx, drift__micro_tree *tree,
+                                    const drift_points *points,
+                                    const drift__micro_radiosity_desc *desc, double *out_increments,
+                                    uint64_t *out_rays);
+
+// A photon map (Jensen 1996, the thesis's Fig. 6.9): light paths traced from the lights with
+// drift's accel, scattered by the BSDF (mirror and glossy lobes included: caustics), stored
+// where they land on a surface with a diffuse lobe after min_scatter..max_scatter scatterings.
+typedef struct drift__micro_photon {
+    drift_vec3 position;
+    drift_vec3 normal; // the geometric normal on the side the photon arrived from
+    drift_vec3 power;  // flux (W) arriving
+} drift__micro_photon;
+
+typedef struct drift__micro_photon_desc {
+    uint32_t paths;
+    int32_t min_scatter, max_scatter; // 0: the light's own first hits
+    uint32_t seed;
+} drift__micro_photon_desc;
+
+typedef struct drift__micro_photon_map {
+    drift__micro_photon *photons; // in kd-tree order: the median of a range splits it
+    uint8_t *axis;                // split axis of each range's median
+    uint32_t count;
+    drift_vec3 emitted; // the flux that left the lights, summed over the paths
+    uint64_t rays;
+} drift__micro_photon_map;
+
+drift_result drift__micro_photons_trace(drift_context *ctx, const drift_scene *scene,
+                                        const drift_accel *accel,
+                                        const drift__micro_photon_desc *desc,
+                                        drift__micro_photon_map *out_map);
+void drift__micro_photons_destroy(drift_context *ctx, drift__micro_photon_map *map);
+// Irradiance at x on the side of the unit normal n: the k nearest photons that arrived on
+// a surface facing n (normals within 60 degrees), their flux over pi r^2, r the k-th's distance;
+// at most max_radius away (INFINITY: no bound), fewer than k within it over pi max_radius^2.
+drift_vec3 drift__micro_photons_irradiance(const drift__micro_photon_map *map, drift_vec3 x,
+                                           drift_vec3 n, int32_t k, float max_radius);
+// Adds kd / pi E of both sides to every leaf's front and back (not pulled).
+void drift__micro_photons_light_leaves(drift_context *ctx, const drift__micro_photon_map *map,
+                                       const drift_points *points, drift__micro_tree *tree,
+                                       int32_t k);
+
 // --- WARP (§6.2.3) ---
 
 // A BRDF slice tabulated over the unit disc of projected directions (omega_x, omega_y),

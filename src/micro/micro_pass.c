@@ -27,6 +27,8 @@ static drift_micro_params params_of(const drift_frame_state *f)
         .point_count = f->params.micro.points,
         .buffer_size = f->params.micro.buffer_size,
         .density = f->params.micro.density,
+        .bounces = f->params.micro.bounces,
+        .lighting = (drift_micro_lighting)f->params.micro.lighting,
         .reflection_edits = f->params.reflection_edits,
     });
 }
@@ -35,17 +37,19 @@ static bool same_params(const drift_micro_params *a, const drift_micro_params *b
 {
     return a->seed == b->seed && a->point_count == b->point_count &&
            a->buffer_size == b->buffer_size && a->density == b->density &&
-           a->reflection_edits == b->reflection_edits;
+           a->reflection_edits == b->reflection_edits && a->bounces == b->bounces &&
+           a->lighting == b->lighting;
 }
 
 static drift_result render(drift_frame_state *f, const drift_pass_args *args, drift_micro_lobe lobe)
 {
-    if (f->params.max_depth > 2) {
-        drift_log(f->ctx, DRIFT_LOG_WARNING, DRIFT_OK, __FILE__, __LINE__,
-                  "micro: one bounce only (--max-depth %d is rendered as 2; docs/micro.md)",
-                  f->params.max_depth);
-    }
     drift_micro_params want = params_of(f);
+    if (f->params.max_depth > want.bounces + 1) {
+        drift_log(f->ctx, DRIFT_LOG_WARNING, DRIFT_OK, __FILE__, __LINE__,
+                  "micro: %d bounce(s) (--max-depth %d is rendered as %d; --micro-bounces, "
+                  "docs/micro.md)",
+                  want.bounces, f->params.max_depth, want.bounces + 1);
+    }
     micro_pass_state *s = drift_pass_state(f, args);
     if (!s || !same_params(&s->params, &want)) {
         micro_pass_state *made = drift_alloc(f->ctx, sizeof *made);

@@ -98,6 +98,18 @@ assert all(r["ms"] >= 0 and r["gathers"] > 0 and r["nodes_visited"] > 0 and r["n
         expect 2 "$drift" bench micro --densities 3
         grep -q -- "--densities expects 1, 4 or 16" "$tmp/err" || fail "bench micro: bad --densities not named"
         ;;
+    micro-bounces)
+        expect 0 "$drift" bench micro-bounces "$box" --size 8 --ref-spp 2 --points 256 \
+            --micro-size 4 --photons 256 --bounces 1,2 --json
+        check micro-bounces 'assert d["size"] == 8 and d["points"] == 256, d
+assert [(r["reference_bounces"], r["lighting"], r["bounces"]) for r in d["rows"]] == [
+    (1, "direct", 1), (2, "direct", 1), (2, "radiosity", 2), (2, "photons", 2)], d
+assert all(r["ms"] >= 0 and r["nrms"] >= 0 and 0 <= r["flip"] <= 1 and r["bounces_ms"] >= 0
+           for r in d["rows"]), d
+assert d["rows"][3]["photons"] > 0 and d["rows"][2]["photons"] == 0, d'
+        expect 2 "$drift" bench micro-bounces --bounces 0
+        grep -q -- "--bounces expects" "$tmp/err" || fail "bench micro-bounces: bad --bounces not named"
+        ;;
     frontier)
         # Twice: the second run must reuse the cached reference and give the same FLIP values.
         for run in 1 2; do

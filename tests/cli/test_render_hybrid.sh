@@ -95,5 +95,21 @@ expect 2 "$drift" render --mode hybrid --indirect micro --micro-size 64 --out "$
 grep -q -- "--micro-size" "$tmp/err" || fail "bad --micro-size not named"
 expect 2 "$drift" render --mode hybrid --indirect micro --micro-points 0 --out "$tmp/x.exr"
 [ -e "$tmp/x.exr" ] && fail "an output was written after a micro usage error"
+# More bounces at the points (radiosity, photons), with reflections micro and --max-depth 3;
+# direct light with 2 bounces, 0 bounces and an unknown lighting exit 2 naming the option.
+for lighting in radiosity photons; do
+    expect 0 "$drift" render --mode hybrid "${small[@]}" --indirect micro --reflections micro \
+        --micro-points 512 --micro-size 4 --micro-bounces 2 --micro-lighting "$lighting" \
+        --max-depth 3 --out "$tmp/micro-b2.exr"
+    [ -s "$tmp/micro-b2.exr" ] || fail "--micro-lighting $lighting wrote no image"
+    grep -q "micro:" "$tmp/err" && fail "--micro-bounces 2 --max-depth 3 warned: $(cat "$tmp/err")"
+done
+expect 2 "$drift" render --mode hybrid --indirect micro --micro-lighting direct --micro-bounces 2 \
+    --out "$tmp/x.exr"
+grep -q -- "--micro-lighting direct is one bounce" "$tmp/err" || fail "direct + 2 bounces not named"
+expect 2 "$drift" render --mode hybrid --indirect micro --micro-bounces 0 --out "$tmp/x.exr"
+grep -q -- "--micro-bounces" "$tmp/err" || fail "bad --micro-bounces not named"
+expect 2 "$drift" render --mode hybrid --indirect micro --micro-lighting vpl --out "$tmp/x.exr"
+grep -q -- "--micro-lighting" "$tmp/err" || fail "bad --micro-lighting not named"
 
 exit $((failures > 0))

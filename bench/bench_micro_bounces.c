@@ -1,0 +1,204 @@
+// drift bench micro-bounces: micro-rendering's points lit for more than one bounce (src/micro
+// radiosity.c, photons.c) against the path tracer's diffuse indirect term with as many bounces
+// (DRIFT_PT_COMPONENT_DIFFUSE at max depth bounces + 1). One row a (bounces, lighting): the
+// milliseconds by stage (the lighting split into the direct light and the further bounces),
+// photons stored, NRMS, LDR-FLIP and the mean's ratio to the reference. The one-bounce
+// `direct` row is repeated against each reference: what the extra bounces add.
+#include "bench.h"
+#include "drift/accel.h"
+#include "drift/hybrid.h"
+#include "drift/metric.h"
+#include "drift/micro.h"
+#include "drift/pt.h"
+#include "drift/scene_io.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define MAX_LIST 8
+
+typedef struct bounces_options {
+    const char *scene_path;
+    long size, threads, ref_spp, points, k, density, photons;
+    long bounces[MAX_LIST];
+    int bounce_count;
+    bool json;
+} bounces_options;
+
+static bool parse_bounces(const char *cmd, const char *flag, const char *value, void *field)
+{
+    bounces_options *o = field;
+    return bench_parse_list(cmd, flag, value, 1, 8, MAX_LIST, o->bounces, &o->bounce_count);
+}
+
+#define O bounces_options
+static const cli_option bounces_table[] = {
+    CLI_SECTION("options:", 0),
+    CLI_INT("--size", "N", O, size, 8, 4096, "N x N pixels (default 64)"),
+    BENCH_OPTION_THREADS(O),
+    CLI_INT("--ref-spp", "N", O, ref_spp, 1, 1 << 20, "reference samples a pixel (default 1024)"),
+    CLI_INT("--points", "P", O, points, 2, 1 << 22, "scene points (default 16384)"),
+    CLI_INT("--micro-size", "K", O, k, 4, 32, "the final gather's K (default 16)"),
+    CLI_INT("--density", "D", O, density, 1, 4, "one gather a D x D block (1, 2 or 4; default 1)"),
+    CLI_INT("--photons", "N", O, photons, 1, 1 << 24, "photon paths (default 262144)"),
+    CLI_CUSTOM_ALL("--bounces", "LIST", parse_bounces, "bounce counts (default 1,2,3)"),
+    BENCH_OPTION_JSON(O),
+};
+#undef O
+
+static const cli_command bounces_command = {
+    .name = "bench micro-bounces",
+    .usage = "usage: drift bench micro-bounces [SCENE] [options]\n\n"
+             "micro-rendering with the points lit by direct light, radiosity or a photon map,\n"
+             "against the path tracer's diffuse indirect light of as many bounces: a Markdown\n"
+             "table (docs/benchmarks.md), or with --json one JSON object. SCENE defaults to\n"
+             "scenes/cornell-box/cornell_box.json.\n\n",
+    CLI_TABLE(bounces_table),
+    CLI_POSITIONAL("SCENE", bounces_options, scene_path, 1),
+    .help_column = 17,
+};
+
+static drift_result run_row(cli_session *s, const bounces_options *o, drift_hybrid *frame,
+                            const drift_image *ref, int32_t bounces, int32_t ref_bounces,
+                            drift_micro_lighting lighting, cJSON *rows)
+{
+    drift_micro *m = NULL;
+    drift_micro_params mp = { .point_count = (uint32_t)o->points,
+                              .buffer_size = (int32_t)o->k,
+                              .density = (int32_t)o->density,
+                              .lighting = lighting,
+                              .bounces = bounces,
+                              .photon_count = (uint32_t)o->photons };
+    drift_result r = drift_micro_create(s->ctx, s->scene, s->accel, &mp, &m);
+    if (r == DRIFT_OK) {
+        r = drift_micro_render(m, drift_hybrid_gbuffer(frame), &s->scene->camera,
+                               DRIFT_MICRO_LOBE_DIFFUSE);
+    }
+    drift_metric_report rep = { 0 };
+    if (r == DRIFT_OK) {
+        r = drift_metric_compare(s->ctx, ref, drift_micro_result(m), &(drift_metric_params){ 0 },
+                                 &rep, NULL);
+    }
+    if (r != DRIFT_OK) {
+        drift_micro_destroy(m);
+        return r;
+    }
+    drift_micro_stats st = drift_micro_get_stats(m);
+    double mean = drift_image_mean_luminance(ref);
+    double nrms = rep.rmse / mean;
+    double ratio = drift_image_mean_luminance(drift_micro_result(m)) / mean;
+    if (rows) {
+        cJSON *j = cJSON_CreateObject();
+        cJSON_AddItemToArray(rows, j);
+        cJSON_AddNumberToObject(j, "reference_bounces", ref_bounces);
+        cJSON_AddNumberToObject(j, "bounces", bounces);
+        cJSON_AddStringToObject(j, "lighting", drift_micro_lighting_name(lighting));
+        cli_json_number(j, "ms", st.total_ms, 3);
+        cJSON *stage_ms = cJSON_AddObjectToObject(j, "stage_ms");
+        for (int k = 0; k < DRIFT_MICRO_STAGE_COUNT; ++k) {
+            cli_json_number(stage_ms, drift_micro_stage_name((drift_micro_stage)k), st.ms[k], 3);
+        }
+        cli_json_number(j, "direct_ms", st.direct_ms, 3);
+        cli_json_number(j, "bounces_ms", st.bounces_ms, 3);
+        cJSON_AddNumberToObject(j, "photons", (double)st.photons);
+        cli_json_number(j, "nrms", nrms, 6);
+        cli_json_number(j, "flip", rep.flip, 6);
+        cli_json_number(j, "mean_ratio", ratio, 4);
+    } else {
+        printf("| %d | %-9s | %d | %8.1f | %6.1f / %6.1f / %8.1f / %8.1f / %5.1f | %7llu | %.4f | "
+               "%.4f | %.3f |\n",
+               ref_bounces, drift_micro_lighting_name(lighting), bounces, st.total_ms,
+               st.ms[DRIFT_MICRO_STAGE_HIERARCHY], st.direct_ms, st.bounces_ms,
+               st.ms[DRIFT_MICRO_STAGE_GATHER], st.ms[DRIFT_MICRO_STAGE_UPSAMPLE],
+               (unsigned long long)st.photons, nrms, rep.flip, ratio);
+        fflush(stdout);
+    }
+    drift_micro_destroy(m);
+    return DRIFT_OK;
+}
+
+int drift_bench_micro_bounces(int argc, char **argv)
+{
+    bounces_options o = { .size = 64,
+                          .threads = 1,
+                          .ref_spp = 1024,
+                          .points = 16384,
+                          .k = 16,
+                          .density = 1,
+                          .photons = 262144,
+                          .bounces = { 1, 2, 3 },
+                          .bounce_count = 3 };
+    int status = cli_parse(&bounces_command, argc, argv, &o, NULL);
+    if (status != CLI_PARSED) {
+        return cli_parse_exit(status);
+    }
+    if (o.density == 3) {
+        fprintf(stderr, "drift bench micro-bounces: --density expects 1, 2 or 4, got 3\n");
+        return 2;
+    }
+    status = 1;
+    cli_session s;
+    if (!bench_open(&s, "bench micro-bounces", o.scene_path, "scenes/cornell-box/cornell_box.json",
+                    o.threads)) {
+        cli_session_close(&s);
+        return 1;
+    }
+    drift_hybrid *frame = NULL;
+    cJSON *root = NULL, *rows = NULL;
+    drift_hybrid_params hp = { .width = (int32_t)o.size, .height = (int32_t)o.size };
+    drift_result r = drift_hybrid_create(s.ctx, s.scene, s.accel, &hp, &frame);
+    r = r ? r : drift_hybrid_render(frame, &s.scene->camera, NULL);
+    if (r == DRIFT_OK) {
+        if (o.json) {
+            root = cJSON_CreateObject();
+            cJSON_AddStringToObject(root, "scene", s.scene_path);
+            cJSON_AddNumberToObject(root, "size", (double)o.size);
+            cJSON_AddNumberToObject(root, "threads", drift_context_thread_count(s.ctx));
+            cJSON_AddNumberToObject(root, "ref_spp", (double)o.ref_spp);
+            cJSON_AddNumberToObject(root, "points", (double)o.points);
+            cJSON_AddNumberToObject(root, "k", (double)o.k);
+            rows = cJSON_AddArrayToObject(root, "rows");
+        } else {
+            printf("# %s at %ldx%ld, %d threads; references %ld spp (DIFFUSE, max depth "
+                   "bounces + 1); %ld points, K = %ld, 1/%ld density, %ld photon paths\n",
+                   s.scene_path, o.size, o.size, drift_context_thread_count(s.ctx), o.ref_spp,
+                   o.points, o.k, o.density * o.density, o.photons);
+            printf("| reference bounces | lighting | bounces | ms | hierarchy / direct / bounces / "
+                   "gather / upsample ms | photons | NRMS | FLIP | mean / reference |\n"
+                   "|---|---|---|---|---|---|---|---|---|\n");
+        }
+    }
+    for (int i = 0; i < o.bounce_count && r == DRIFT_OK; ++i) {
+        int32_t b = (int32_t)o.bounces[i];
+        drift_pt *pt = NULL;
+        drift_image ref = { 0 }; // owned by the pt
+        drift_pt_params pp = { .width = (int32_t)o.size,
+                               .height = (int32_t)o.size,
+                               .seed = 99,
+                               .max_depth = b + 1,
+                               .components = DRIFT_PT_COMPONENT_DIFFUSE,
+                               .pixel_centre = true,
+                               .pinhole = true };
+        r = drift_pt_create(s.ctx, s.scene, s.accel, &pp, &pt);
+        r = r ? r : drift_pt_render_samples(pt, (uint32_t)o.ref_spp, NULL);
+        r = r ? r : drift_pt_resolve(pt, DRIFT_PT_AOV_BEAUTY, &ref);
+        r = r ? r : run_row(&s, &o, frame, &ref, 1, b, DRIFT_MICRO_LIGHTING_DIRECT, rows);
+        if (b > 1) {
+            r = r ? r : run_row(&s, &o, frame, &ref, b, b, DRIFT_MICRO_LIGHTING_RADIOSITY, rows);
+            r = r ? r : run_row(&s, &o, frame, &ref, b, b, DRIFT_MICRO_LIGHTING_PHOTONS, rows);
+        }
+        drift_pt_destroy(pt);
+    }
+    if (r == DRIFT_OK) {
+        status = !root || cli_json_write("bench micro-bounces", root, NULL) ? 0 : 1;
+        root = NULL; // cli_json_write destroys it
+    } else {
+        fprintf(stderr, "drift bench micro-bounces: %s\n", drift_result_string(r));
+    }
+    cJSON_Delete(root);
+    drift_hybrid_destroy(frame);
+    cli_session_close(&s);
+    return status;
+}
