@@ -167,6 +167,8 @@ static void gltf_material(import_state *s, const drift__gltf_material *gm, drift
     m->specular = gm->specular;
     m->exponent = gm->exponent;
     m->emission = gm->emission;
+    m->diffuse_model = DRIFT_DIFFUSE_BURLEY;
+    m->diffuse_roughness = gm->roughness;
 
     const struct {
         bool present;

@@ -80,6 +80,7 @@ typedef struct drift__gltf_light {
 typedef struct drift__gltf_material {
     drift_vec3 diffuse, specular, emission; // emission includes KHR_materials_emissive_strength
     float exponent;
+    float roughness;                   // the Burley diffuse's (the clamped roughnessFactor)
     int base_color_uv_set;             // baseColorTexture.texCoord
     bool base_color_sampler_supported; // repeat wrap, linear magnification (or no sampler)
     bool has_metallic_roughness_texture, has_normal_texture, has_emissive_texture,

@@ -745,11 +745,13 @@ static void test_scene_io_gltf_photometry_and_materials(void **state)
     }
     assert_int_equal(point, 1);
     assert_int_equal(spot, 1);
-    // Red: base (0.8, 0.05, 0.05), metallic 0, roughness 0.3: diffuse = 0.96 base, F0 = 0.04,
-    // n = (2/α² − 2)/4 with α = 0.09.
+    // Red: base (0.8, 0.05, 0.05), metallic 0, roughness 0.3: a Burley diffuse of the base
+    // and roughness 0.3, F0 = 0.04 on top, n = (2/α² − 2)/4 with α = 0.09.
     const drift_material *red = material_named(scene, "Red");
-    assert_float_equal(red->diffuse.x, 0.96f * 0.8f, 1e-6f);
-    assert_float_equal(red->diffuse.y, 0.96f * 0.05f, 1e-6f);
+    assert_float_equal(red->diffuse.x, 0.8f, 1e-6f);
+    assert_float_equal(red->diffuse.y, 0.05f, 1e-6f);
+    assert_int_equal(red->diffuse_model, DRIFT_DIFFUSE_BURLEY);
+    assert_float_equal(red->diffuse_roughness, 0.3f, 1e-6f);
     assert_float_equal(red->specular.x, 0.04f, 1e-6f);
     float alpha = 0.3f * 0.3f;
     assert_float_equal(red->exponent, 0.25f * (2.0f / (alpha * alpha) - 2.0f), 1e-2f);
