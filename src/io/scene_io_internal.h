@@ -52,6 +52,7 @@ typedef struct drift__import_params {
     uint32_t material_override;   // DRIFT_INVALID_INDEX: the file's materials
     drift__texture_cache *textures;
     const char *camera; // glTF: the camera to use, by name or index; NULL: the first
+    bool face_normals;  // drop the file's normals: flat shading (Mitsuba's faceNormals)
 } drift__import_params;
 
 // What the import found besides geometry.

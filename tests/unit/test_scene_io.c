@@ -966,6 +966,34 @@ static void test_scene_io_mitsuba_subset(void **state)
     drift_context_destroy(ctx);
 }
 
+// Mitsuba's faceNormals shades a mesh flat: the OBJ's vertex normals are dropped for the
+// shape that sets it and kept for the one that does not.
+static void test_scene_io_mitsuba_face_normals(void **state)
+{
+    (void)state;
+    char obj[1024], xml[1024];
+    test_out_path(obj, "scene_io_face_normals.obj");
+    write_file(obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0.6 0 0.8\nf 1//1 2//1 3//1\n");
+    test_out_path(xml, "scene_io_face_normals.xml");
+    write_file(xml, "<scene version=\"0.5.0\">\n"
+                    " <shape type=\"obj\"><string name=\"filename\""
+                    " value=\"scene_io_face_normals.obj\"/>"
+                    "<boolean name=\"faceNormals\" value=\"true\"/></shape>\n"
+                    " <shape type=\"obj\"><string name=\"filename\""
+                    " value=\"scene_io_face_normals.obj\"/></shape>\n"
+                    " <emitter type=\"constant\"/>\n"
+                    "</scene>\n");
+    located_log log;
+    drift_context *ctx = located_context(&log);
+    drift_scene *scene = NULL;
+    assert_int_equal(drift_scene_load(ctx, xml, &scene), DRIFT_OK);
+    assert_int_equal(scene->mesh_count, 2);
+    assert_null(scene->meshes[0].normals);
+    assert_non_null(scene->meshes[1].normals);
+    drift_scene_destroy(scene);
+    drift_context_destroy(ctx);
+}
+
 static void test_scene_io_textures_are_shared(void **state)
 {
     (void)state;
@@ -1109,6 +1137,7 @@ int main(void)
         cmocka_unit_test(test_scene_io_gltf_photometry_and_materials),
         cmocka_unit_test(test_scene_io_gltf_extensions_and_cameras),
         cmocka_unit_test(test_scene_io_mitsuba_subset),
+        cmocka_unit_test(test_scene_io_mitsuba_face_normals),
         cmocka_unit_test(test_scene_io_textures_are_shared),
         cmocka_unit_test(test_scene_io_camera_views),
     };
