@@ -268,6 +268,13 @@ static void test_scene_io_bad_json_reports_code_and_line(void **state)
         { "negative colour",
           "{\n \"materials\": {\n  \"m\": { \"diffuse\": [0.5, -0.1, 0.5] }\n }\n}\n",
           DRIFT_ERR_INVALID_ARGUMENT, 3 },
+        { "diffuse roughness over 1",
+          "{\n \"materials\": {\n  \"m\": {\n \"diffuse_roughness\": 1.5 }\n }\n}\n",
+          DRIFT_ERR_INVALID_ARGUMENT, 4 },
+        { "diffuse roughness on a mirror",
+          "{\n \"materials\": {\n  \"m\": { \"type\": \"mirror\",\n"
+          "   \"diffuse_roughness\": 0.5 }\n }\n}\n",
+          DRIFT_ERR_INVALID_ARGUMENT, 4 },
         { "absurd width",
           "{\n \"camera\": { \"position\": [0,0,1], \"target\": [0,0,0],\n"
           "   \"width\": 1000000000 }\n}\n",
@@ -1010,7 +1017,7 @@ static void test_scene_io_textures_are_shared(void **state)
     drift_image_destroy(ctx, &img);
     char text[4096];
     snprintf(text, sizeof(text),
-             "{\"materials\": {\"a\": {\"diffuse_texture\": \"%s\"},\n"
+             "{\"materials\": {\"a\": {\"diffuse_texture\": \"%s\", \"diffuse_roughness\": 0.25},\n"
              "               \"b\": {\"type\": \"glossy\", \"specular\": 0.2, \"exponent\": 50,"
              " \"diffuse_texture\": \"%s\"}},\n"
              " \"environment\": {\"map\": \"%s\", \"multiplier\": 2}}",
@@ -1021,6 +1028,10 @@ static void test_scene_io_textures_are_shared(void **state)
     assert_int_equal(scene->texture_count, 1);
     assert_int_equal(scene->materials[0].diffuse_texture, 0);
     assert_int_equal(scene->materials[1].diffuse_texture, 0);
+    // diffuse_roughness asks for Burley's diffuse; without it the diffuse stays Lambertian.
+    assert_int_equal(scene->materials[0].diffuse_model, DRIFT_DIFFUSE_BURLEY);
+    assert_float_equal(scene->materials[0].diffuse_roughness, 0.25f, 0.0f);
+    assert_int_equal(scene->materials[1].diffuse_model, DRIFT_DIFFUSE_LAMBERT);
     assert_int_equal(scene->environment.texture, 0);
     assert_float_equal(scene->environment.color.x, 2.0f, 1e-6f);
     assert_int_equal(scene->textures[0].width, 4);
