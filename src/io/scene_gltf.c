@@ -274,9 +274,9 @@ bool drift__gltf_get_material(const drift__gltf *g, unsigned index, drift__gltf_
     out->specular = drift_vec3_add(drift_vec3_splat(GLTF_DIELECTRIC_F0 * (1.0f - metallic)),
                                    drift_vec3_scale(base_color, metallic));
     drift_vec3 d = drift_vec3_scale(base_color, 1.0f - metallic);
-    out->diffuse = drift_vec3_make(fminf(d.x, 1.0f - out->specular.x),
-                                   fminf(d.y, 1.0f - out->specular.y),
-                                   fminf(d.z, 1.0f - out->specular.z));
+    out->diffuse =
+        drift_vec3_make(fminf(d.x, 1.0f - out->specular.x), fminf(d.y, 1.0f - out->specular.y),
+                        fminf(d.z, 1.0f - out->specular.z));
     out->exponent = roughness_to_exponent(roughness);
     out->roughness = roughness;
     float emissive[3] = { 0.0f, 0.0f, 0.0f };
