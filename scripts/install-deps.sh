@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages drift needs to build, test (python3 for the CLI tests), check
 # formatting and fuzz (SDL2 for `drift view`; Xvfb and xauth for its window test under
-# xvfb-run; chromium for the `drift report` page test; Open MPI for `mpirun -n N drift render`).
+# xvfb-run; chromium for the `drift report` page test; Open MPI for `mpirun -n N drift render`;
+# Blender for the Cycles comparison of a Blender-exported glTF).
 # Idempotent: when everything is present it does nothing (no apt-get update), so repeated runs
 # are fast.
 set -euo pipefail
@@ -13,6 +14,9 @@ packages=(
   libsdl2-dev xvfb xauth
   chromium
   libopenmpi-dev openmpi-bin
+  # Blender 3.4 (Cycles, its glTF exporter and importer; numpy for the importer): the
+  # cli.blender_gltf test (issue 22). ~70 MB download, ~600 MB installed.
+  blender python3-numpy
 )
 
 missing=()

@@ -26,6 +26,7 @@ def parse_args():
     p.add_argument("--threads", type=int, default=2)
     p.add_argument("--max-bounces", type=int, default=8)
     p.add_argument("--out", required=True)
+    p.add_argument("--seed", type=int, default=0, help="Cycles' sampling seed")
     p.add_argument("--lambert", action="store_true",
                    help="replace each Principled BSDF by a Diffuse BSDF of its base colour "
                         "(emission kept): separates the material model from the light units")
@@ -88,6 +89,7 @@ def main():
     c = scene.cycles
     c.device = "CPU"
     c.samples = args.spp
+    c.seed = args.seed
     c.use_adaptive_sampling = False
     c.use_denoising = False
     c.max_bounces = c.diffuse_bounces = c.glossy_bounces = args.max_bounces

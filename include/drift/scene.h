@@ -97,14 +97,22 @@ typedef enum drift_material_type {
     DRIFT_MATERIAL_COUNT
 } drift_material_type;
 
+// The diffuse lobe's shape (docs/materials.md).
+typedef enum drift_diffuse_model {
+    DRIFT_DIFFUSE_LAMBERT = 0, // kd / pi
+    DRIFT_DIFFUSE_BURLEY,      // Burley's (Disney's) diffuse of roughness `diffuse_roughness`
+} drift_diffuse_model;
+
 typedef struct drift_material {
     char name[DRIFT_NAME_MAX];
     drift_material_type type;
-    drift_vec3 diffuse;       // Lambertian albedo kd
+    drift_vec3 diffuse;       // diffuse albedo kd (at normal incidence for Burley)
     drift_vec3 specular;      // glossy or mirror reflectance ks
     float exponent;           // Phong exponent n of the glossy lobe (> 0 when specular > 0)
     drift_vec3 emission;      // emitted radiance from the front face (0 = not emissive)
     uint32_t diffuse_texture; // texture index modulating `diffuse`, or DRIFT_INVALID_INDEX
+    drift_diffuse_model diffuse_model;
+    float diffuse_roughness; // Burley only: in [0, 1] (glTF's perceptual roughness)
 } drift_material;
 
 // A material with no texture: the value to start from when filling one in.
@@ -268,6 +276,8 @@ typedef struct drift_bsdf {
     drift_material_type type;
     drift_vec3 diffuse, specular;
     float exponent;
+    drift_diffuse_model diffuse_model;
+    float diffuse_roughness;
     drift_frame frame; // z = shading normal
     // Zero: the lobes centre on the mirror direction of wo. Otherwise the unit direction they
     // centre on instead, for the one wo it was made for: an edited reflection e(q)

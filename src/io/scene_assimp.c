@@ -167,6 +167,8 @@ static void gltf_material(import_state *s, const drift__gltf_material *gm, drift
     m->specular = gm->specular;
     m->exponent = gm->exponent;
     m->emission = gm->emission;
+    m->diffuse_model = DRIFT_DIFFUSE_BURLEY;
+    m->diffuse_roughness = gm->roughness;
 
     const struct {
         bool present;
@@ -279,11 +281,12 @@ static drift_result add_mesh(import_state *s, const struct aiMesh *mesh, const d
     }
     const struct aiVector3D *uv_source = mesh->mTextureCoords[uv_set];
     float *positions = drift_alloc(ctx, nv * 3 * sizeof(float));
-    float *normals = mesh->mNormals ? drift_alloc(ctx, nv * 3 * sizeof(float)) : NULL;
+    bool keep_normals = mesh->mNormals && !s->params->face_normals;
+    float *normals = keep_normals ? drift_alloc(ctx, nv * 3 * sizeof(float)) : NULL;
     float *uvs = uv_source ? drift_alloc(ctx, nv * 2 * sizeof(float)) : NULL;
     uint32_t *indices = drift_alloc(ctx, (size_t)tri_count * 3 * sizeof(uint32_t));
     drift_result r = DRIFT_OK;
-    if (!positions || !indices || (mesh->mNormals && !normals) || (uv_source && !uvs)) {
+    if (!positions || !indices || (keep_normals && !normals) || (uv_source && !uvs)) {
         r = DRIFT_ERR_OUT_OF_MEMORY;
         goto done;
     }

@@ -268,12 +268,17 @@ bool drift__gltf_get_material(const drift__gltf *g, unsigned index, drift__gltf_
     drift_vec3 base_color =
         drift_vec3_make(drift_clampf(base[0], 0.0f, 1.0f), drift_clampf(base[1], 0.0f, 1.0f),
                         drift_clampf(base[2], 0.0f, 1.0f));
-    // Metals reflect their base colour; dielectrics reflect 4% and pass the rest to the
-    // diffuse base, which is what remains after that reflection.
-    out->diffuse = drift_vec3_scale(base_color, (1.0f - metallic) * (1.0f - GLTF_DIELECTRIC_F0));
+    // Metals reflect their base colour; dielectrics reflect 4% at normal incidence on top of
+    // an undimmed diffuse base, as Blender's Principled BSDF does (the base is cut only where
+    // base + 4% would pass 1, drift's bound on kd + ks).
     out->specular = drift_vec3_add(drift_vec3_splat(GLTF_DIELECTRIC_F0 * (1.0f - metallic)),
                                    drift_vec3_scale(base_color, metallic));
+    drift_vec3 d = drift_vec3_scale(base_color, 1.0f - metallic);
+    out->diffuse =
+        drift_vec3_make(fminf(d.x, 1.0f - out->specular.x), fminf(d.y, 1.0f - out->specular.y),
+                        fminf(d.z, 1.0f - out->specular.z));
     out->exponent = roughness_to_exponent(roughness);
+    out->roughness = roughness;
     float emissive[3] = { 0.0f, 0.0f, 0.0f };
     numbers(m, "emissiveFactor", emissive, 3);
     const cJSON *ext = cJSON_GetObjectItemCaseSensitive(m, "extensions");

@@ -52,6 +52,7 @@ typedef struct drift__import_params {
     uint32_t material_override;   // DRIFT_INVALID_INDEX: the file's materials
     drift__texture_cache *textures;
     const char *camera; // glTF: the camera to use, by name or index; NULL: the first
+    bool face_normals;  // drop the file's normals: flat shading (Mitsuba's faceNormals)
 } drift__import_params;
 
 // What the import found besides geometry.
@@ -80,6 +81,7 @@ typedef struct drift__gltf_light {
 typedef struct drift__gltf_material {
     drift_vec3 diffuse, specular, emission; // emission includes KHR_materials_emissive_strength
     float exponent;
+    float roughness;                   // the Burley diffuse's (the clamped roughnessFactor)
     int base_color_uv_set;             // baseColorTexture.texCoord
     bool base_color_sampler_supported; // repeat wrap, linear magnification (or no sampler)
     bool has_metallic_roughness_texture, has_normal_texture, has_emissive_texture,

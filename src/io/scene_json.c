@@ -351,7 +351,7 @@ static drift_result read_material(json_reader *r, const cJSON *item)
         return res;
     }
     res = CHECK_KEYS(r, item, path, "type", "diffuse", "specular", "exponent", "emission",
-                     "diffuse_texture");
+                     "diffuse_texture", "diffuse_roughness");
     if (res != DRIFT_OK) {
         return res;
     }
@@ -383,6 +383,8 @@ static drift_result read_material(json_reader *r, const cJSON *item)
         unused = "diffuse";
     } else if (is_mirror && cJSON_HasObjectItem(item, "diffuse_texture")) {
         unused = "diffuse_texture";
+    } else if (is_mirror && cJSON_HasObjectItem(item, "diffuse_roughness")) {
+        unused = "diffuse_roughness";
     }
     if (unused) {
         return FAIL(r, cJSON_GetObjectItemCaseSensitive(item, unused), DRIFT_ERR_INVALID_ARGUMENT,
@@ -400,8 +402,14 @@ static drift_result read_material(json_reader *r, const cJSON *item)
         (res = read_float(r, item, path, "exponent", is_glossy, 1e-3, 1e7, &m.exponent)) !=
             DRIFT_OK ||
         (res = read_vec3(r, item, path, "emission", false, VEC3_COLOR, &m.emission)) != DRIFT_OK ||
-        (res = load_texture(r, item, path, "diffuse_texture", &m.diffuse_texture)) != DRIFT_OK) {
+        (res = load_texture(r, item, path, "diffuse_texture", &m.diffuse_texture)) != DRIFT_OK ||
+        (res = read_float(r, item, path, "diffuse_roughness", false, 0.0, 1.0,
+                          &m.diffuse_roughness)) != DRIFT_OK) {
         return res;
+    }
+    // A diffuse roughness asks for Burley's diffuse (what glTF and Blender materials use).
+    if (cJSON_HasObjectItem(item, "diffuse_roughness")) {
+        m.diffuse_model = DRIFT_DIFFUSE_BURLEY;
     }
     res = drift_scene_add_material(r->scene, &m, NULL);
     if (res != DRIFT_OK) {

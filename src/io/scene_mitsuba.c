@@ -579,12 +579,17 @@ static drift_result read_shape(mitsuba_state *s, const xml_node *n)
         if (!rel || !drift__path_join(s->dir, rel, full, sizeof(full))) {
             return fail(s, n, DRIFT_ERR_PARSE, "<shape> needs a filename", type);
         }
+        // faceNormals: Mitsuba shades the mesh flat, ignoring the file's normals.
+        const xml_node *face = property(n, "faceNormals");
+        const char *face_value = face ? attr(face, "value") : NULL;
         drift__import_params params = { .path = full,
                                         .where = s->path,
                                         .line = n->line,
                                         .transform = &world,
                                         .material_override = material,
-                                        .textures = s->textures };
+                                        .textures = s->textures,
+                                        .face_normals =
+                                            face_value && strcmp(face_value, "true") == 0 };
         drift__import_info info;
         return drift__scene_import_mesh_file(s->scene, &params, &info);
     }

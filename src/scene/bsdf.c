@@ -1,6 +1,8 @@
 // Lambertian diffuse plus a normalized modified-Phong glossy lobe (Lafortune & Willems 1994,
 // "Using the Modified Phong Reflectance Model for Physically Based Rendering"), and a perfect
-// mirror. Directions are world space; the lobe frame's z is the shading normal.
+// mirror; or, for materials from Blender and glTF, Burley's diffuse ("Physically-Based Shading
+// at Disney", 2012, section 5.3) in place of the Lambertian one. Directions are world space;
+// the lobe frame's z is the shading normal.
 #include "scene_internal.h"
 
 #include <math.h>
@@ -12,6 +14,8 @@ drift_bsdf drift_bsdf_make(const drift_scene *scene, const drift_surface *surfac
                      .diffuse = m->diffuse,
                      .specular = m->specular,
                      .exponent = m->exponent,
+                     .diffuse_model = m->diffuse_model,
+                     .diffuse_roughness = m->diffuse_roughness,
                      .frame = drift_frame_from_normal(surface->ns) };
     if (m->diffuse_texture != DRIFT_INVALID_INDEX) {
         b.diffuse = drift_vec3_mul(
@@ -51,6 +55,19 @@ static float phong_cos_alpha(const drift_bsdf *b, drift_vec3 wo, drift_vec3 wi)
     return fmaxf(0.0f, drift_vec3_dot(r, wi));
 }
 
+// Burley's diffuse over Lambert's: (1 + (F_D90 − 1)(1 − cos θl)^5)(1 + (F_D90 − 1)(1 − cos θv)^5)
+// with F_D90 = 0.5 + 2 roughness cos² θd, θd the angle between wi and the half vector
+// (2 cos² θd = 1 + wi·wo). Darker than Lambert at grazing angles when smooth, brighter
+// (retro-reflection) when rough; 1 at normal incidence. Cycles' Principled BSDF (Blender 3.4)
+// evaluates the same expression.
+static float burley_factor(float roughness, float cos_o, float cos_i, float cos_oi)
+{
+    float fd90_minus_1 = roughness * (1.0f + cos_oi) - 0.5f;
+    float fo = 1.0f - cos_o, fi = 1.0f - cos_i;
+    float fo5 = (fo * fo) * (fo * fo) * fo, fi5 = (fi * fi) * (fi * fi) * fi;
+    return (1.0f + fd90_minus_1 * fi5) * (1.0f + fd90_minus_1 * fo5);
+}
+
 void drift_bsdf_eval_lobes(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec3 wi,
                            drift_vec3 *out_diffuse, drift_vec3 *out_glossy)
 {
@@ -60,7 +77,11 @@ void drift_bsdf_eval_lobes(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec3 wi,
     if (bsdf->type == DRIFT_MATERIAL_MIRROR || cos_o <= 0.0f || cos_i <= 0.0f) {
         return;
     }
-    *out_diffuse = drift_vec3_scale(bsdf->diffuse, DRIFT_INV_PI);
+    float diffuse = DRIFT_INV_PI;
+    if (bsdf->diffuse_model == DRIFT_DIFFUSE_BURLEY) {
+        diffuse *= burley_factor(bsdf->diffuse_roughness, cos_o, cos_i, drift_vec3_dot(wo, wi));
+    }
+    *out_diffuse = drift_vec3_scale(bsdf->diffuse, diffuse);
     if (!drift_vec3_is_zero(bsdf->specular)) {
         float n = bsdf->exponent;
         float lobe = (n + 2.0f) * DRIFT_INV_2PI * powf(phong_cos_alpha(bsdf, wo, wi), n);

@@ -227,9 +227,11 @@ drift_result drift_scene_add_material(drift_scene *scene, const drift_material *
     m.name[DRIFT_NAME_MAX - 1] = '\0';
     if (!vec3_is_nonnegative_finite(m.diffuse) || !vec3_is_nonnegative_finite(m.specular) ||
         !vec3_is_nonnegative_finite(m.emission) || !isfinite(m.exponent) || m.exponent < 0.0f ||
-        (unsigned)m.type >= DRIFT_MATERIAL_COUNT) {
+        (unsigned)m.type >= DRIFT_MATERIAL_COUNT ||
+        (unsigned)m.diffuse_model > DRIFT_DIFFUSE_BURLEY ||
+        !(m.diffuse_roughness >= 0.0f && m.diffuse_roughness <= 1.0f)) {
         drift_log(scene->ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, m.name, 0,
-                  "material has a negative or non-finite value");
+                  "material has a negative, non-finite or out-of-range value");
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
     uint32_t index;

@@ -311,6 +311,47 @@ static void test_sampling_bsdf_albedo_is_at_most_one(void **state)
     }
 }
 
+// Burley's diffuse (glTF and Blender materials) seen at normal incidence: its directional
+// albedo has the closed form 2∫ [1 + (r(1 + μ) − 1/2)(1 − μ)^5] μ dμ = 1 + (r − 1/2)/21 + r/84
+// (∫(1−μ)^5 μ = 1/42, ∫(1−μ)^5 μ² = 1/168): 0.976 when smooth (darker than Lambert), 1.036
+// at roughness 1 (the retro-reflection). The sampled weights f cos / pdf must average to it;
+// wo = wi = n gives exactly Lambert's kd / π, and swapping wo and wi changes nothing.
+static void test_sampling_burley_albedo_closed_form(void **state)
+{
+    (void)state;
+    const float roughness[] = { 0.0f, 0.3f, 1.0f };
+    const int n = (int)(200000 * test_intensity()) + 1000;
+    for (int k = 0; k < 3; ++k) {
+        bsdf_case c = make_case(drift_vec3_splat(1.0f), drift_vec3_splat(0), 0, 0.0f);
+        c.bsdf.diffuse_model = DRIFT_DIFFUSE_BURLEY;
+        c.bsdf.diffuse_roughness = roughness[k];
+        double albedo = 0.0, albedo2 = 0.0;
+        for (int i = 0; i < n; ++i) {
+            drift_sampler s = drift_sampler_make(11, 3, (uint32_t)i);
+            drift_vec2 u = drift_sampler_next2(&s);
+            drift_bsdf_sample bs = drift_bsdf_sample_wi(&c.bsdf, c.wo, drift_sampler_next1(&s), u);
+            double w = bs.pdf > 0.0f ? (double)bs.weight.x : 0.0;
+            albedo += w;
+            albedo2 += w * w;
+        }
+        albedo /= n;
+        double sigma = sqrt(fmax(albedo2 / n - albedo * albedo, 0.0) / n);
+        double r = (double)roughness[k];
+        double expected = 1.0 + (r - 0.5) / 21.0 + r / 84.0;
+        if (fabs(albedo - expected) > 4.0 * sigma + 1e-4) {
+            fail_msg("Burley r=%g: albedo %.5f, closed form %.5f (sigma %.5f)", r, albedo, expected,
+                     sigma);
+        }
+        drift_vec3 normal = c.bsdf.frame.z;
+        drift_vec3 f = drift_bsdf_eval(&c.bsdf, normal, normal);
+        assert_float_equal(f.x, DRIFT_INV_PI, 1e-6f);
+        drift_vec3 a = drift_vec3_normalize(drift_vec3_make(0.7f, 0.2f, 0.3f));
+        drift_vec3 b = drift_vec3_normalize(drift_vec3_make(-0.1f, -0.5f, 0.6f));
+        assert_float_equal(drift_bsdf_eval(&c.bsdf, a, b).x, drift_bsdf_eval(&c.bsdf, b, a).x,
+                           1e-6f);
+    }
+}
+
 // --- LIGHTS ---
 
 static drift_scene *light_scene(drift_context *ctx, const drift_light *light)
@@ -538,6 +579,7 @@ int main(void)
         cmocka_unit_test(test_sampling_chi_square_detects_a_wrong_pdf),
         cmocka_unit_test(test_sampling_bsdf_chi_square),
         cmocka_unit_test(test_sampling_bsdf_albedo_is_at_most_one),
+        cmocka_unit_test(test_sampling_burley_albedo_closed_form),
         cmocka_unit_test(test_sampling_sphere_light_irradiance_closed_form),
         cmocka_unit_test(test_sampling_disk_light_irradiance_closed_form),
         cmocka_unit_test(test_sampling_quad_light_irradiance_closed_form),

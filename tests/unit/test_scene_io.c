@@ -268,6 +268,13 @@ static void test_scene_io_bad_json_reports_code_and_line(void **state)
         { "negative colour",
           "{\n \"materials\": {\n  \"m\": { \"diffuse\": [0.5, -0.1, 0.5] }\n }\n}\n",
           DRIFT_ERR_INVALID_ARGUMENT, 3 },
+        { "diffuse roughness over 1",
+          "{\n \"materials\": {\n  \"m\": {\n \"diffuse_roughness\": 1.5 }\n }\n}\n",
+          DRIFT_ERR_INVALID_ARGUMENT, 4 },
+        { "diffuse roughness on a mirror",
+          "{\n \"materials\": {\n  \"m\": { \"type\": \"mirror\",\n"
+          "   \"diffuse_roughness\": 0.5 }\n }\n}\n",
+          DRIFT_ERR_INVALID_ARGUMENT, 4 },
         { "absurd width",
           "{\n \"camera\": { \"position\": [0,0,1], \"target\": [0,0,0],\n"
           "   \"width\": 1000000000 }\n}\n",
@@ -745,11 +752,13 @@ static void test_scene_io_gltf_photometry_and_materials(void **state)
     }
     assert_int_equal(point, 1);
     assert_int_equal(spot, 1);
-    // Red: base (0.8, 0.05, 0.05), metallic 0, roughness 0.3: diffuse = 0.96 base, F0 = 0.04,
-    // n = (2/α² − 2)/4 with α = 0.09.
+    // Red: base (0.8, 0.05, 0.05), metallic 0, roughness 0.3: a Burley diffuse of the base
+    // and roughness 0.3, F0 = 0.04 on top, n = (2/α² − 2)/4 with α = 0.09.
     const drift_material *red = material_named(scene, "Red");
-    assert_float_equal(red->diffuse.x, 0.96f * 0.8f, 1e-6f);
-    assert_float_equal(red->diffuse.y, 0.96f * 0.05f, 1e-6f);
+    assert_float_equal(red->diffuse.x, 0.8f, 1e-6f);
+    assert_float_equal(red->diffuse.y, 0.05f, 1e-6f);
+    assert_int_equal(red->diffuse_model, DRIFT_DIFFUSE_BURLEY);
+    assert_float_equal(red->diffuse_roughness, 0.3f, 1e-6f);
     assert_float_equal(red->specular.x, 0.04f, 1e-6f);
     float alpha = 0.3f * 0.3f;
     assert_float_equal(red->exponent, 0.25f * (2.0f / (alpha * alpha) - 2.0f), 1e-2f);
@@ -964,6 +973,34 @@ static void test_scene_io_mitsuba_subset(void **state)
     drift_context_destroy(ctx);
 }
 
+// Mitsuba's faceNormals shades a mesh flat: the OBJ's vertex normals are dropped for the
+// shape that sets it and kept for the one that does not.
+static void test_scene_io_mitsuba_face_normals(void **state)
+{
+    (void)state;
+    char obj[1024], xml[1024];
+    test_out_path(obj, "scene_io_face_normals.obj");
+    write_file(obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0.6 0 0.8\nf 1//1 2//1 3//1\n");
+    test_out_path(xml, "scene_io_face_normals.xml");
+    write_file(xml, "<scene version=\"0.5.0\">\n"
+                    " <shape type=\"obj\"><string name=\"filename\""
+                    " value=\"scene_io_face_normals.obj\"/>"
+                    "<boolean name=\"faceNormals\" value=\"true\"/></shape>\n"
+                    " <shape type=\"obj\"><string name=\"filename\""
+                    " value=\"scene_io_face_normals.obj\"/></shape>\n"
+                    " <emitter type=\"constant\"/>\n"
+                    "</scene>\n");
+    located_log log;
+    drift_context *ctx = located_context(&log);
+    drift_scene *scene = NULL;
+    assert_int_equal(drift_scene_load(ctx, xml, &scene), DRIFT_OK);
+    assert_int_equal(scene->mesh_count, 2);
+    assert_null(scene->meshes[0].normals);
+    assert_non_null(scene->meshes[1].normals);
+    drift_scene_destroy(scene);
+    drift_context_destroy(ctx);
+}
+
 static void test_scene_io_textures_are_shared(void **state)
 {
     (void)state;
@@ -980,7 +1017,7 @@ static void test_scene_io_textures_are_shared(void **state)
     drift_image_destroy(ctx, &img);
     char text[4096];
     snprintf(text, sizeof(text),
-             "{\"materials\": {\"a\": {\"diffuse_texture\": \"%s\"},\n"
+             "{\"materials\": {\"a\": {\"diffuse_texture\": \"%s\", \"diffuse_roughness\": 0.25},\n"
              "               \"b\": {\"type\": \"glossy\", \"specular\": 0.2, \"exponent\": 50,"
              " \"diffuse_texture\": \"%s\"}},\n"
              " \"environment\": {\"map\": \"%s\", \"multiplier\": 2}}",
@@ -991,6 +1028,10 @@ static void test_scene_io_textures_are_shared(void **state)
     assert_int_equal(scene->texture_count, 1);
     assert_int_equal(scene->materials[0].diffuse_texture, 0);
     assert_int_equal(scene->materials[1].diffuse_texture, 0);
+    // diffuse_roughness asks for Burley's diffuse; without it the diffuse stays Lambertian.
+    assert_int_equal(scene->materials[0].diffuse_model, DRIFT_DIFFUSE_BURLEY);
+    assert_float_equal(scene->materials[0].diffuse_roughness, 0.25f, 0.0f);
+    assert_int_equal(scene->materials[1].diffuse_model, DRIFT_DIFFUSE_LAMBERT);
     assert_int_equal(scene->environment.texture, 0);
     assert_float_equal(scene->environment.color.x, 2.0f, 1e-6f);
     assert_int_equal(scene->textures[0].width, 4);
@@ -1107,6 +1148,7 @@ int main(void)
         cmocka_unit_test(test_scene_io_gltf_photometry_and_materials),
         cmocka_unit_test(test_scene_io_gltf_extensions_and_cameras),
         cmocka_unit_test(test_scene_io_mitsuba_subset),
+        cmocka_unit_test(test_scene_io_mitsuba_face_normals),
         cmocka_unit_test(test_scene_io_textures_are_shared),
         cmocka_unit_test(test_scene_io_camera_views),
     };
