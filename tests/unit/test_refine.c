@@ -610,6 +610,43 @@ static void test_glossy_plane_not_flagged(void **state)
     rig_destroy(&r);
 }
 
+// The penumbra search at half resolution (one search a 2 x 2 block on one surface, then the
+// dilation) flags what the search at every pixel flags: at least 95% of its pixels, and not
+// more than 5% others, on the effects scene's penumbrae.
+static void test_half_res_penumbra_keeps_flags(void **state)
+{
+    (void)state;
+    rig r = rig_begin();
+    const int32_t w = 64, h = 48;
+    build_effects_scene(&r, w, h, drift_vec3_make(0.5f, 2.2f, -3.5f));
+    rig_commit(&r, &(drift_refine_params){ .spp = 1 });
+    const drift_image *shadow = drift_refine_metric_image(r.sir, DRIFT_METRIC_SHADOW);
+    uint8_t half[64 * 48];
+    for (int32_t i = 0; i < w * h; ++i) {
+        half[i] = shadow->pixels[i] > 0.0f;
+    }
+    assert_int_equal(drift_refine_set_params(
+                         r.sir, &(drift_refine_params){ .spp = 1, .full_res_penumbra = true }),
+                     DRIFT_OK);
+    assert_int_equal(drift_refine_begin(r.sir), DRIFT_OK);
+    shadow = drift_refine_metric_image(r.sir, DRIFT_METRIC_SHADOW);
+    uint32_t full = 0, kept = 0, extra = 0;
+    for (int32_t i = 0; i < w * h; ++i) {
+        bool f = shadow->pixels[i] > 0.0f;
+        full += f;
+        kept += f && half[i];
+        extra += !f && half[i];
+    }
+    print_message("penumbra: %u pixels flagged at full resolution, %u of them at half, %u "
+                  "others\n",
+                  full, kept, extra);
+    assert_true(full >= 50); // the scene has penumbrae
+    if ((double)kept < 0.95 * (double)full || (double)extra > 0.05 * (double)full) {
+        fail_msg("half resolution kept %u of %u penumbra pixels, added %u", kept, full, extra);
+    }
+    rig_destroy(&r);
+}
+
 // Precision at recall 0.9 along SIR's order (descending combined error, ties in scanline
 // order, as the radix sort): of the pixels refined before 90% of the real error is, the share
 // that has real error. -1 when the error pixels never reach that recall.
@@ -1029,6 +1066,7 @@ int main(void)
         cmocka_unit_test(test_shadow_dilation_follows_resolution),
         cmocka_unit_test(test_glossy_plane_not_flagged),
         cmocka_unit_test(test_glossy_room_refined_in_error_order),
+        cmocka_unit_test(test_half_res_penumbra_keeps_flags),
         cmocka_unit_test(test_leak_metric_finds_seams),
         cmocka_unit_test(test_radix_sort_stable_and_complete),
         cmocka_unit_test(test_refines_errors_first),
