@@ -520,8 +520,11 @@ static void penumbra_coarse_pixel(drift_frame_state *f, int32_t x, int32_t y, ui
         const drift_raster_light *light = &f->lights[l];
         const drift_shadow_map *map = f->light_buffers[l].shadow_map;
         float e = -1.0f;
-        if (map && light->radius > 0.0f && s->material != DRIFT_INVALID_INDEX) {
-            const light_shape *shape = job->shapes ? &job->shapes[l] : NULL;
+        const light_shape *shape = job->shapes ? &job->shapes[l] : NULL;
+        bool behind =
+            shape && shape->planar &&
+            drift_vec3_dot(light->direction, drift_vec3_sub(s->position, light->centre)) <= 0.0f;
+        if (map && light->radius > 0.0f && s->material != DRIFT_INVALID_INDEX && !behind) {
             drift_penumbra_query query = {
                 .light_size = shape ? light_size_from(light, shape, s->position) : 0.0f
             };
