@@ -29,11 +29,13 @@ typedef struct sir_options {
     int size_count;
     long spp, budget, threads, light_samples;
     double threshold;
+    double tolerance; // the metrics' tolerances (0: the refiner's default)
     const char *lambda_path;
     const char *figures_dir;
     bool json;
     bool noise_floor;
     bool paper_metrics;
+    bool full_res_penumbra;
     bool has_target;
     drift_vec3 target; // --target: look here instead of the scene camera's target
     double fov;        // --fov: vertical field of view, degrees (0: the camera's)
@@ -88,6 +90,9 @@ static const cli_option sir_table[] = {
             "(default 8, the hybrid frame's)"),
     CLI_NUMBER("--threshold", "T", O, threshold, 1e-6, 1.0,
                "real error: largest display-value channel difference > T (0.02)"),
+    CLI_NUMBER("--tolerance", "T", O, tolerance, 1e-4, 1.0,
+               "the metrics' tolerances: a pixel whose raster is expected off by less\n"
+               "(display values) is not flagged (default 0.01)"),
     CLI_STRING("--lambda", "FILE", O, lambda_path, "also measure the fitted combination"),
     CLI_STRING("--figures", "DIR", O, figures_dir,
                "PNGs per row: raster, pure, sir, combined error, and the\n"
@@ -100,6 +105,8 @@ static const cli_option sir_table[] = {
     CLI_FLAG("--paper-metrics", O, paper_metrics,
              "the paper's metrics alone: reflection metrics unweighted by the raster's\n"
              "expected error, penumbrae ungated, no leak metric (the before of issue 17)"),
+    CLI_FLAG("--full-res-penumbra", O, full_res_penumbra,
+             "search the penumbra estimate at every pixel, not once a 2 x 2 block"),
     CLI_CUSTOM_ALL("--target", "X,Y,Z", parse_target,
                    "look at this point instead of the camera's target (other views,\n"
                    "as the paper's rows are views with more or fewer error pixels)"),
@@ -287,20 +294,21 @@ static drift_result run_one(drift_context *ctx, const drift_scene *scene, const 
     drift_hybrid *frame = NULL;
     drift_refine *sir = NULL;
     drift_image pure = { 0 }, real = { 0 }, combined = { 0 }, pure_other = { 0 };
+    float tolerance = o->paper_metrics ? -1.0f : (float)o->tolerance;
     drift_result r = drift_hybrid_create(ctx, scene, accel, &hp, &frame);
     // Two frames: the first builds the shadow maps and captures the environment maps.
     for (int k = 0; r == DRIFT_OK && k < 2; ++k) {
         r = drift_hybrid_render(frame, &scene->camera, NULL);
     }
     if (r == DRIFT_OK) {
-        r = drift_refine_create(
-            ctx, frame,
-            &(drift_refine_params){ .spp = (uint32_t)o->spp,
-                                    .budget = (uint32_t)o->budget,
-                                    .reflection_tolerance = o->paper_metrics ? -1.0f : 0.0f,
-                                    .leak_tolerance = o->paper_metrics ? -1.0f : 0.0f,
-                                    .shadow_tolerance = o->paper_metrics ? -1.0f : 0.0f },
-            &sir);
+        r = drift_refine_create(ctx, frame,
+                                &(drift_refine_params){ .spp = (uint32_t)o->spp,
+                                                        .budget = (uint32_t)o->budget,
+                                                        .reflection_tolerance = tolerance,
+                                                        .leak_tolerance = tolerance,
+                                                        .shadow_tolerance = tolerance,
+                                                        .full_res_penumbra = o->full_res_penumbra },
+                                &sir);
     }
     if (r == DRIFT_OK) {
         r = drift_image_create(ctx, w, h, 3, &pure);

@@ -57,8 +57,10 @@ const char *drift_refine_metric_name(drift_refine_metric metric);
 int drift_refine_metric_parse(const char *name); // -1 when unknown
 
 typedef enum drift_refine_combine {
-    DRIFT_COMBINE_AVERAGE = 0, // E = sum_i E_i / n
+    DRIFT_COMBINE_DEFAULT = 0, // MAX with the weighted metrics, AVERAGE with the paper's
+    DRIFT_COMBINE_AVERAGE,     // E = sum_i E_i / n
     DRIFT_COMBINE_LAMBDA,      // E = min(1, sum_i lambda_i E_i)
+    DRIFT_COMBINE_MAX,         // E = max_i E_i: each metric is its expected error / 0.1
     DRIFT_COMBINE_COUNT
 } drift_refine_combine;
 
@@ -71,7 +73,11 @@ typedef enum drift_refine_combine {
 //   visit_spp         = 0 -> spp: the most samples one visit of the request buffer gives a
 //                       pixel (ceil(visit_spp * error), at least 1)
 //   max_depth         = 0 -> 3 reflection bounces
-//   combine           = DRIFT_COMBINE_AVERAGE; DRIFT_COMBINE_LAMBDA uses `lambda`
+//   combine           = DRIFT_COMBINE_DEFAULT -> DRIFT_COMBINE_MAX when the metrics are weighted
+//                       by the raster's expected error (they are that error, so the largest
+//                       orders pixels as the error does), DRIFT_COMBINE_AVERAGE with the
+//                       paper's metrics (reflection_tolerance < 0); DRIFT_COMBINE_LAMBDA uses
+//                       `lambda`
 //   refine_zero_error = false: pixels with zero error are never traced; true: they follow
 //                       every non-zero one (the whole image converges to the pure one)
 //   edge_threshold    = 0 -> 0.05: relative depth step per pixel that counts as an edge
@@ -86,6 +92,9 @@ typedef enum drift_refine_combine {
 //   shadow_tolerance  = 0 -> 0.01: a penumbra pixel stays flagged only where the raster's
 //                       shadow, checked by lobe_samples shadow rays averaged over 5 x 5
 //                       pixels, is off by more; < 0: the paper's ungated penumbra estimate
+//   full_res_penumbra = false: with the gate (shadow_tolerance > 0) the penumbra estimate is
+//                       searched at one pixel of each 2 x 2 block on one surface; true: at
+//                       every pixel (always so without the gate)
 //   seed              = 0
 typedef struct drift_refine_params {
     uint32_t budget;
@@ -102,6 +111,7 @@ typedef struct drift_refine_params {
     uint32_t lobe_samples;
     float leak_tolerance;
     float shadow_tolerance;
+    bool full_res_penumbra;
     uint32_t seed;
 } drift_refine_params;
 

@@ -37,6 +37,7 @@ typedef struct metric_job {
     light_shape *shapes; // one a frame light, or NULL: bounding spheres
     float *expected;     // a pixel's expected reflection error (-1: not reflective), or NULL
     float *shadow_delta; // 3 a pixel: the raster's estimated shadow error in a penumbra
+    float *coarse;       // the penumbra estimate at each 2 x 2 block's corner pixel, a light
 } metric_job;
 
 static bool is_reflective(const drift_frame_state *f, const drift_surface *s)
@@ -126,14 +127,51 @@ static drift_vec3 seen_in_map(const drift_envmap *map, drift_vec3 dir, float con
     return mirror ? drift_vec3_add(l.emitted, l.reflected) : l.reflected;
 }
 
+// The most lobe rays a pixel's expected reflection error keeps for shading.
+#define MAX_LOBE_RAYS 16
+// Shadow rays a light for each lobe ray's hit when shading what a hidden q shows.
+#define HIDDEN_LIGHT_SAMPLES 2
+
+// The expected reflection error where the map cannot see q: the lobe rays' hits shaded by the
+// pure ray tracer's direct light (one bounce), as it estimates R: each sample of the Phong lobe
+// weighs ks (n + 2) / (n + 1) cos theta_i (a mirror: ks), escaped and below-surface samples
+// count zero. Against the raster's R, in display values.
+static float hidden_reflection_error(drift_frame_state *f, size_t index, const drift_bsdf *bsdf,
+                                     const drift_ray *lobe, uint32_t lobe_count, uint32_t samples,
+                                     drift_vec3 raster, drift_sampler *sampler, uint64_t *rays)
+{
+    bool mirror = bsdf->type == DRIFT_MATERIAL_MIRROR;
+    drift_refine_tracer tracer = drift_refine_tracer_make(f, 0, 1);
+    tracer.light_samples = HIDDEN_LIGHT_SAMPLES;
+    drift_vec3 sum = drift_vec3_splat(0.0f);
+    for (uint32_t k = 0; k < lobe_count; ++k) {
+        float cos_i = drift_vec3_dot(lobe[k].dir, bsdf->frame.z);
+        if (!mirror && cos_i <= 0.0f) {
+            continue;
+        }
+        drift_vec3 w = mirror
+                           ? bsdf->specular
+                           : drift_vec3_scale(bsdf->specular, (bsdf->exponent + 2.0f) /
+                                                                  (bsdf->exponent + 1.0f) * cos_i);
+        sum = drift_vec3_fma(
+            sum, drift_vec3_mul(w, drift_refine_trace_ray(&tracer, lobe[k], mirror, sampler, rays)),
+            1.0f);
+    }
+    drift_vec3 traced = drift_vec3_scale(sum, 1.0f / (float)(samples ? samples : 1));
+    return display_change(drift_image_get3(&f->final, (int32_t)(index % (size_t)f->params.width),
+                                           (int32_t)(index / (size_t)f->params.width)),
+                          drift_vec3_sub(traced, raster));
+}
+
 // The raster's own expected reflection error at a reflective pixel, in display values: R
 // looks the map up along the mirror direction r as if the pixel sat at the probe c. The mirror
 // ray finds where the reflection really lands (q), and rays drawn from the lobe the share of
 // it that escapes the scene; the map seen from c toward q, blurred over the lobe's cone as R
 // is (parallax-corrected, as local cube maps are), is what R would hold there. The change of
 // the pixel when R takes that value, weighted by the lobe's albedo as R is, is the expected
-// error. A q hidden from c is unknown to the map: the raster cannot be trusted there (error
-// 1). Without a map (another reflection technique) the error is unknown too.
+// error. A q hidden from c is unknown to the map: there the lobe rays' hits are shaded as the
+// ray tracer would (hidden_reflection_error). Without a map (another reflection technique)
+// the error is unknown: 1.
 static float expected_reflection_error(drift_frame_state *f, size_t index, const drift_surface *s,
                                        drift_vec3 wo, uint32_t samples, drift_sampler *sampler,
                                        uint64_t *rays)
@@ -151,6 +189,8 @@ static float expected_reflection_error(drift_frame_state *f, size_t index, const
     uint32_t hits = 0, used = 0;
     drift_vec3 q = s->position;
     bool found = false;
+    drift_ray lobe[MAX_LOBE_RAYS];
+    uint32_t lobe_count = 0;
     for (uint32_t k = 0; k <= (mirror ? 0u : samples); ++k) { // k = 0: the mirror ray
         drift_vec3 dir =
             k == 0 ? r : drift_bsdf_sample_glossy_lobe(&bsdf, wo, drift_sampler_next2(sampler));
@@ -170,6 +210,9 @@ static float expected_reflection_error(drift_frame_state *f, size_t index, const
                 q = drift_vec3_fma(ray.origin, dir, hit.t);
                 found = true;
             }
+            if ((k > 0 || mirror) && lobe_count < MAX_LOBE_RAYS) {
+                lobe[lobe_count++] = ray;
+            }
         } else if (mirror && drift_scene_has_environment(f->scene)) {
             escaped = drift_vec3_add(escaped, drift_environment_eval(f->scene, dir));
         } // a glossy lobe's escaped rays see the environment in D, not R
@@ -178,6 +221,8 @@ static float expected_reflection_error(drift_frame_state *f, size_t index, const
         return 0.0f;
     }
     drift_vec3 expected = escaped;
+    drift_vec3 weight = drift_raster_reflection_weight(&bsdf, wo);
+    drift_vec3 raster = drift_vec3_mul(weight, seen_in_map(map, r, cone, mirror));
     if (hits > 0) {
         // The lobe's hits see what the mirror ray's q shows in the map (or, when the mirror ray
         // escaped, what the map shows along r itself).
@@ -192,14 +237,16 @@ static float expected_reflection_error(drift_frame_state *f, size_t index, const
                                  .tmax = 0.99f * distance };
         ++*rays;
         if (found && drift_accel_occluded(f->accel, &from_probe)) {
-            return 1.0f;
+            // A q the map cannot see (a contact, the underside of an object in the floor):
+            // what the lobe's rays see there, shaded by the tracer's direct light (a few
+            // shadow rays), is the reflection the ray tracer will find.
+            return hidden_reflection_error(f, index, &bsdf, lobe, lobe_count, mirror ? 1u : samples,
+                                           raster, sampler, rays);
         }
         expected = drift_vec3_fma(expected, seen_in_map(map, to_q, cone, mirror), (float)hits);
     }
     expected = drift_vec3_scale(expected, 1.0f / (float)used);
-    drift_vec3 weight = drift_raster_reflection_weight(&bsdf, wo);
-    drift_vec3 delta =
-        drift_vec3_mul(weight, drift_vec3_sub(expected, seen_in_map(map, r, cone, mirror)));
+    drift_vec3 delta = drift_vec3_sub(drift_vec3_mul(weight, expected), raster);
     return display_change(drift_image_get3(&f->final, (int32_t)(index % (size_t)f->params.width),
                                            (int32_t)(index / (size_t)f->params.width)),
                           delta);
@@ -445,6 +492,65 @@ static void penumbra_check_pixel(drift_frame_state *f, int32_t x, int32_t y, uin
     memcpy(&job->shadow_delta[3 * index], &delta, sizeof(float) * 3);
 }
 
+// Whether pixel b's shadow error says something about pixel a's: the same mesh, facing about
+// the same way (a thin part of an object in front of the floor is not averaged with it).
+static bool same_surface(const drift_frame_state *f, size_t a, size_t b)
+{
+    return f->gbuffer.mesh_index[a] == f->gbuffer.mesh_index[b] &&
+           drift_vec3_dot(f->gbuffer.surfaces[a].ns, f->gbuffer.surfaces[b].ns) > 0.9f;
+}
+
+// The penumbra estimate (the metrics' largest cost: the blocker search's shadow-map taps) is
+// evaluated at half resolution: at the corner pixel of each 2 x 2 block, for every light; the
+// block's other pixels take it when they lie on the same surface (same mesh, normals within
+// 25 degrees, depth within 2%), else search themselves. The estimate is dilated by at least
+// 2 pixels afterwards, which covers the block.
+static void penumbra_coarse_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays,
+                                  void *user)
+{
+    (void)rays;
+    metric_job *job = user;
+    if ((x | y) & 1) {
+        return;
+    }
+    size_t index = (size_t)y * (size_t)f->params.width + (size_t)x;
+    size_t block = (size_t)(y / 2) * (size_t)((f->params.width + 1) / 2) + (size_t)(x / 2);
+    const drift_surface *s = &f->gbuffer.surfaces[index];
+    for (uint32_t l = 0; l < f->light_count; ++l) {
+        const drift_raster_light *light = &f->lights[l];
+        const drift_shadow_map *map = f->light_buffers[l].shadow_map;
+        float e = -1.0f;
+        const light_shape *shape = job->shapes ? &job->shapes[l] : NULL;
+        bool behind =
+            shape && shape->planar &&
+            drift_vec3_dot(light->direction, drift_vec3_sub(s->position, light->centre)) <= 0.0f;
+        if (map && light->radius > 0.0f && s->material != DRIFT_INVALID_INDEX && !behind) {
+            drift_penumbra_query query = {
+                .light_size = shape ? light_size_from(light, shape, s->position) : 0.0f
+            };
+            e = drift_shadow_map_penumbra_query(map, s->position, s->ng, &query);
+        }
+        job->coarse[block * f->light_count + l] = e;
+    }
+}
+
+static float coarse_estimate(const drift_frame_state *f, const metric_job *job, int32_t x,
+                             int32_t y, uint32_t l)
+{
+    int32_t w = f->params.width;
+    size_t index = (size_t)y * (size_t)w + (size_t)x;
+    size_t corner = (size_t)(y & ~1) * (size_t)w + (size_t)(x & ~1);
+    if (corner != index) {
+        float za = drift_image_pixel(&f->gbuffer.depth, x, y)[0];
+        float zb = drift_image_pixel(&f->gbuffer.depth, x & ~1, y & ~1)[0];
+        if (!same_surface(f, index, corner) || !(fabsf(za - zb) <= 0.02f * za)) {
+            return -1.0f;
+        }
+    }
+    size_t block = (size_t)(y / 2) * (size_t)((w + 1) / 2) + (size_t)(x / 2);
+    return job->coarse[block * f->light_count + l];
+}
+
 static void shadow_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
 {
     metric_job *job = user;
@@ -495,10 +601,15 @@ static void shadow_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *r
                 break;
             }
         }
-        drift_penumbra_query query = {
-            .light_size = shape ? light_size_from(light, shape, s->position) : 0.0f
-        };
-        e = drift_shadow_map_penumbra_query(map, s->position, s->ng, &query);
+        float known = job->coarse ? coarse_estimate(f, job, x, y, l) : -1.0f;
+        if (known >= 0.0f) {
+            e = known;
+        } else {
+            drift_penumbra_query query = {
+                .light_size = shape ? light_size_from(light, shape, s->position) : 0.0f
+            };
+            e = drift_shadow_map_penumbra_query(map, s->position, s->ng, &query);
+        }
         if (e == 0.0f && job->params->leak_tolerance > 0.0f) {
             leak = drift_vec3_add(leak, shadow_map_mistake(f, l, x, y, s, rays));
         }
@@ -644,10 +755,10 @@ static int32_t shadow_dilation(const drift_frame_state *f)
 }
 
 // Keeps a penumbra pixel flagged only where the raster's shadow error, its estimate averaged
-// (signed, so the rays' noise cancels) over the penumbra pixels of a 5 x 5 square, moves the
-// displayed pixel by the tolerance or more: PCSS is right in much of a broad penumbra. (Kept
-// at 1, as the paper's estimate: valued by the change, precision at recall 0.9 fell from 0.56
-// to 0.51 on scenes/open-glossy, penumbrae sorting below the floor's reflections.)
+// (signed, so the rays' noise cancels) over the penumbra pixels of the same surface in a 5 x 5
+// square, moves the displayed pixel by the tolerance or more: PCSS is right in much of a broad
+// penumbra. Valued by that change / 0.1, as the other weighted metrics, so that their largest
+// (DRIFT_COMBINE_MAX) orders pixels by the expected error.
 static void gate_penumbra(drift_frame_state *f, drift_image *shadow, const float *delta,
                           float tolerance, float *scratch)
 {
@@ -659,7 +770,9 @@ static void gate_penumbra(drift_frame_state *f, drift_image *shadow, const float
             for (int32_t v = y - EXPECTED_RADIUS; v <= y + EXPECTED_RADIUS; ++v) {
                 for (int32_t u = x - EXPECTED_RADIUS; v >= 0 && v < h && u <= x + EXPECTED_RADIUS;
                      ++u) {
-                    if (u < 0 || u >= w || drift_image_pixel(shadow, u, v)[0] <= 0.0f) {
+                    if (u < 0 || u >= w || drift_image_pixel(shadow, u, v)[0] <= 0.0f ||
+                        !same_surface(f, (size_t)y * (size_t)w + (size_t)x,
+                                      (size_t)v * (size_t)w + (size_t)u)) {
                         continue;
                     }
                     const float *d = &delta[3 * ((size_t)v * (size_t)w + (size_t)u)];
@@ -671,7 +784,9 @@ static void gate_penumbra(drift_frame_state *f, drift_image *shadow, const float
                                                   drift_vec3_scale(sum, 1.0f / (float)count))
                                  : 0.0f;
             scratch[(size_t)y * (size_t)w + (size_t)x] =
-                drift_image_pixel(shadow, x, y)[0] > 0.0f && change >= tolerance ? 1.0f : 0.0f;
+                drift_image_pixel(shadow, x, y)[0] > 0.0f && change >= tolerance
+                    ? drift_clampf(change / REAL_ERROR_SCALE, 0.0f, 1.0f)
+                    : 0.0f;
         }
     }
     memcpy(shadow->pixels, scratch, sizeof(float) * (size_t)w * (size_t)h);
@@ -709,7 +824,16 @@ uint64_t drift_refine_compute_metrics(drift_frame_state *f,
     for (uint32_t l = 0; job.shapes && l < f->light_count; ++l) {
         light_corners(f->scene, &f->lights[l], &job.shapes[l]);
     }
+    size_t blocks = (size_t)((f->params.width + 1) / 2) * (size_t)((f->params.height + 1) / 2);
+    job.coarse = f->light_count && params->half_res_penumbra
+                     ? drift_alloc(f->ctx, sizeof(float) * blocks * f->light_count)
+                     : NULL;
+    if (job.coarse) { // without memory: every pixel searches
+        rays += drift_pass_for_each_pixel(f, penumbra_coarse_pixel, &job);
+    }
     rays += drift_pass_for_each_pixel(f, shadow_pixel, &job); // without memory: spheres
+    drift_free(f->ctx, job.coarse);
+    job.coarse = NULL;
     drift_free(f->ctx, job.shapes);
     float *scratch = drift_alloc(f->ctx, sizeof(float) * pixels);
     if (scratch) { // without memory the estimate stays undilated
@@ -738,7 +862,8 @@ void drift_refine_combine_metrics(const drift_image metrics[DRIFT_METRIC_COUNT],
         float sum = 0.0f;
         for (int m = 0; m < DRIFT_METRIC_COUNT; ++m) {
             float weight = combine == DRIFT_COMBINE_LAMBDA ? lambda[m] : 1.0f / DRIFT_METRIC_COUNT;
-            sum += weight * metrics[m].pixels[i];
+            sum = combine == DRIFT_COMBINE_MAX ? fmaxf(sum, metrics[m].pixels[i])
+                                               : sum + weight * metrics[m].pixels[i];
         }
         combined->pixels[i] = drift_clampf(sum, 0.0f, 1.0f);
     }

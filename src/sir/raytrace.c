@@ -136,6 +136,13 @@ static drift_vec3 radiance(const drift_refine_tracer *t, drift_ray ray, int32_t 
     return drift_vec3_add(l, drift_vec3_mul(weight, seen));
 }
 
+drift_vec3 drift_refine_trace_ray(const drift_refine_tracer *t, drift_ray ray, bool see_emission,
+                                  drift_sampler *sampler, uint64_t *rays)
+{
+    drift_vec3 l = radiance(t, ray, 1, see_emission, sampler, rays);
+    return drift_vec3_is_finite(l) ? l : drift_vec3_splat(0.0f);
+}
+
 drift_vec3 drift_refine_trace_sample(const drift_refine_tracer *t, int32_t x, int32_t y,
                                      uint32_t sample, uint64_t *rays)
 {

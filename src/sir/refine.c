@@ -88,6 +88,9 @@ drift_refine_params drift_refine_params_resolve(const drift_refine_params *param
     p.lobe_samples = p.lobe_samples ? p.lobe_samples : DEFAULT_LOBE_SAMPLES;
     p.leak_tolerance = p.leak_tolerance != 0.0f ? p.leak_tolerance : DEFAULT_TOLERANCE;
     p.shadow_tolerance = p.shadow_tolerance != 0.0f ? p.shadow_tolerance : DEFAULT_TOLERANCE;
+    if (p.combine == DRIFT_COMBINE_DEFAULT) {
+        p.combine = p.reflection_tolerance < 0.0f ? DRIFT_COMBINE_AVERAGE : DRIFT_COMBINE_MAX;
+    }
     return p;
 }
 
@@ -233,6 +236,8 @@ drift_result drift_refine_begin(drift_refine *r)
                                       .lobe_samples = r->params.lobe_samples,
                                       .leak_tolerance = r->params.leak_tolerance,
                                       .shadow_tolerance = r->params.shadow_tolerance,
+                                      .half_res_penumbra = !r->params.full_res_penumbra &&
+                                                           r->params.shadow_tolerance > 0.0f,
                                       .seed = r->params.seed };
     st->metrics_rays = drift_refine_compute_metrics(drift_hybrid_frame(r->frame), &mp, r->metrics);
     st->metrics_ms = 1000.0 * (drift_time_now() - t);

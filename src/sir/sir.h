@@ -31,6 +31,10 @@ drift_refine_tracer drift_refine_tracer_make(const drift_frame_state *frame, uin
 // image), adding the rays it traced to *rays.
 drift_vec3 drift_refine_trace_sample(const drift_refine_tracer *tracer, int32_t x, int32_t y,
                                      uint32_t sample, uint64_t *rays);
+// Radiance back along one ray, as a reflection ray of the tracer sees it (see_emission: a
+// mirror's ray; a glossy ray leaves emitters to the direct term), up to max_depth bounces.
+drift_vec3 drift_refine_trace_ray(const drift_refine_tracer *tracer, drift_ray ray,
+                                  bool see_emission, drift_sampler *sampler, uint64_t *rays);
 
 // --- PENUMBRA ESTIMATE (penumbra.c) ---
 
@@ -63,6 +67,7 @@ typedef struct drift_refine_metric_params {
     uint32_t lobe_samples;
     float leak_tolerance;   // <= 0: no leak metric
     float shadow_tolerance; // <= 0: the penumbra estimate ungated
+    bool half_res_penumbra; // the penumbra estimate at each 2 x 2 block's corner (same surface)
     uint32_t seed;
 } drift_refine_metric_params;
 
