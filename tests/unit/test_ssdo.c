@@ -578,6 +578,65 @@ static void test_contact_shadows_within_the_bias(void **state)
     case_end(&c);
 }
 
+// Spec §2.5 test 7 against the frame: a small box (0.1 thick, 0.5 high) on a floor lit by a
+// point light 10 degrees above the horizon, its shadow map coarse and biased (b about 0.37).
+// The ray-traced hard shadow is the truth. Without the fix the map's bias erases the contact
+// shadow: the floor within 0.1 of the box's far side, truly shadowed, is lit. With --contact-shadows every such pixel is
+// shadowed again, and (almost) no truly lit pixel is darkened.
+static void test_contact_shadows_fix_the_frames_shadow_map(void **state)
+{
+    (void)state;
+    test_rig r = test_rig_begin(2);
+    uint32_t grey = test_add_material(r.scene, drift_material_make(drift_vec3_splat(0.5f)));
+    test_add_floor(r.scene, 20.0f, 0.0f, grey);
+    add_box(r.scene, -0.05f, 0.05f, 0.5f, 0.25f, grey);
+    drift_vec3 light = drift_vec3_make(-6.0f * cosf(0.1745f), 6.0f * sinf(0.1745f), 0.0f);
+    assert_int_equal(drift_scene_add_light(r.scene,
+                                           &(drift_light){ .type = DRIFT_LIGHT_POINT,
+                                                           .color = drift_vec3_splat(30.0f),
+                                                           .position = light },
+                                           NULL),
+                     DRIFT_OK);
+    look_down(r.scene, 6.0f, 1.0f, 64);
+    test_rig_commit(&r);
+    enum { N = 64 * 64 };
+    static float truth[N], biased[N], fixed[N];
+    float *out[3] = { truth, biased, fixed };
+    for (int run = 0; run < 3; ++run) {
+        drift_hybrid_params p = { .shadows = run == 0 ? DRIFT_SHADOWS_HARD : DRIFT_SHADOWS_PCF,
+                                  .shadow_map = { .size = 128,
+                                                  .bias = 3.0f,
+                                                  .pcf_kernel = 1,
+                                                  .contact_shadows = run == 2,
+                                                  .contact_samples = 16 } };
+        test_rig_frame(&r, &p);
+        const drift_image *s = test_rig_plane(&r, "light0.shadow");
+        for (int32_t i = 0; i < N; ++i) {
+            out[run][i] = pixel(s, i % 64, i / 64)[0];
+        }
+    }
+    const drift_gbuffer *g = drift_hybrid_gbuffer(r.frame);
+    int contact = 0, lit = 0, darkened = 0;
+    for (int32_t i = 0; i < N; ++i) {
+        const float *q = pixel(&g->position, i % 64, i / 64);
+        bool floor = q[1] < 1e-3f;
+        if (floor && truth[i] == 0.0f && q[0] > 0.06f && q[0] < 0.15f && fabsf(q[2]) < 0.2f) {
+            assert_true(biased[i] == 1.0f); // the bias erased it
+            assert_true(fixed[i] == 0.0f);  // the march restores it
+            ++contact;
+        }
+        if (truth[i] == 1.0f && biased[i] == 1.0f) {
+            ++lit;
+            darkened += fixed[i] == 0.0f;
+        }
+    }
+    print_message("contact pixels %d; truly lit %d, of them darkened by the fix %d\n", contact, lit,
+                  darkened);
+    assert_true(contact >= 6);
+    assert_true(darkened * 100 <= lit);
+    test_rig_destroy(&r);
+}
+
 // --- DETERMINISM ---
 
 // Spec §2.5 test 8: fixed sets give a bit-identical image, for any thread count.
@@ -644,6 +703,7 @@ int main(void)
         cmocka_unit_test(test_heightfield_against_ray_traced_occlusion),
         cmocka_unit_test(test_second_layer_opens_the_gap_behind_a_slab),
         cmocka_unit_test(test_contact_shadows_within_the_bias),
+        cmocka_unit_test(test_contact_shadows_fix_the_frames_shadow_map),
         cmocka_unit_test(test_bit_identical_across_threads),
         cmocka_unit_test(test_bad_parameters_are_rejected),
     };
