@@ -175,15 +175,16 @@ void drift_ssdo_output_destroy(drift_context *ctx, drift_ssdo_output *out); // N
 // Additional cameras (thesis §4.3.3): depth-only views of the scene, so that a sample outside
 // the viewer's image can still meet an occluder. Made by drift_ssdo_views_render.
 #define DRIFT_SSDO_MAX_VIEWS 5
+
 typedef struct drift_ssdo_view {
     drift_camera camera; // pinhole
     drift_image depth;   // 1 channel: view depth along the camera's axis, 0 where nothing
 } drift_ssdo_view;
 
 // views, view_count: 0..DRIFT_SSDO_MAX_VIEWS additional cameras. A sample outside the
-// viewer's image is an occluder when at least one of them sees it and every one that sees it
-// has it behind a surface. They add occluders only (no sender pixels for the bounce), and only
-// to SSAO, SSDO and the contact shadows (GTAO marches the viewer's image).
+// viewer's image is an occluder when some of them see it and all that do have it behind a
+// surface (one that has it in front proves it free). They add occluders only (no sender pixels for
+// the bounce), and only to SSAO, SSDO and the contact shadows (GTAO marches the viewer's image).
 typedef struct drift_ssdo_inputs {
     const drift_gbuffer *gbuffer;
     const drift_camera *camera;
@@ -223,10 +224,9 @@ drift_result drift_ssdo_contact_shadows(drift_context *ctx, const drift_ssdo_inp
 // G-buffer's size; <= 0: not marched, visible): the frame's shadow maps give each pixel its
 // own b (drift_shadow_map_blind_length).
 drift_result drift_ssdo_contact_shadows_per_pixel(drift_context *ctx,
-                                                  const drift_ssdo_inputs *inputs,
-                                                  drift_vec3 light, bool directional,
-                                                  const drift_image *lengths, int32_t samples,
-                                                  drift_image *out_visible);
+                                                  const drift_ssdo_inputs *inputs, drift_vec3 light,
+                                                  bool directional, const drift_image *lengths,
+                                                  int32_t samples, drift_image *out_visible);
 
 // Renders `count` (1..DRIFT_SSDO_MAX_VIEWS) additional cameras for `camera` by one ray a
 // texel into views[0..count) (their depth images created here, width x height each; free

@@ -171,9 +171,9 @@ static bool view_lookup(const drift_camera_frame *cam, const drift_image *depth,
 // buffer at its pixel lies behind it (or it falls on a miss, or with two layers behind the
 // second), else 1, faded out by 1 - smoothstep(0.75 r, r, |Q - P|) unless the fade is off. A
 // sample outside the image is open, unless additional cameras see it: then it is an occluder
-// when every camera whose image holds it has it behind a surface (by `margin` plus one of its
-// texels), with Q on the camera's ray. `margin` is the depth margin in scene units. *out_x,
-// *out_y get the viewer's pixel of Q (-1 when an additional camera found it).
+// when every camera whose image holds it has it behind a surface by `margin` (any one in
+// front proves free space), with Q on the first one's ray. `margin` is the depth margin in scene
+// units. *out_x, *out_y get the viewer's pixel of Q (-1 when an additional camera found it).
 static float occluder(const ssdo_job *j, drift_vec3 p, drift_vec3 s, float margin, int32_t *out_x,
                       int32_t *out_y)
 {
@@ -207,8 +207,7 @@ static float occluder(const ssdo_job *j, drift_vec3 p, drift_vec3 s, float margi
             if (!view_lookup(cam, j->view_depth[k], s, &zk, &zqk, &vx, &vy)) {
                 continue;
             }
-            float texel = 2.0f * cam->tan_half / (float)cam->height * zk;
-            if (!(zqk > 0.0f) || !(zqk < zk - margin - texel)) {
+            if (!(zqk > 0.0f) || !(zqk < zk - margin)) {
                 return 0.0f; // this camera sees free space there
             }
             if (!seen) {
@@ -720,8 +719,8 @@ typedef struct contact_job {
     ssdo_job j;
     drift_vec3 light; // position, or for a directional light the way its light travels
     bool directional;
-    float length;                // of the march toward the light
-    const drift_image *lengths;  // or one length a pixel (<= 0: no march)
+    float length;               // of the march toward the light
+    const drift_image *lengths; // or one length a pixel (<= 0: no march)
     int32_t samples;
     drift_image *out;
 } contact_job;
@@ -810,10 +809,9 @@ drift_result drift_ssdo_contact_shadows(drift_context *ctx, const drift_ssdo_inp
 }
 
 drift_result drift_ssdo_contact_shadows_per_pixel(drift_context *ctx,
-                                                  const drift_ssdo_inputs *inputs,
-                                                  drift_vec3 light, bool directional,
-                                                  const drift_image *lengths, int32_t samples,
-                                                  drift_image *out_visible)
+                                                  const drift_ssdo_inputs *inputs, drift_vec3 light,
+                                                  bool directional, const drift_image *lengths,
+                                                  int32_t samples, drift_image *out_visible)
 {
     if (!lengths) {
         return DRIFT_ERR_INVALID_ARGUMENT;

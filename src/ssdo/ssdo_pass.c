@@ -70,8 +70,8 @@ static drift_result prepare_layers(drift_frame_state *f, drift_image *back_depth
     if (o->cameras > 0) { // the camera moves every frame: so do its views
         int32_t w = f->params.width / 2 > 0 ? f->params.width / 2 : 1;
         int32_t h = f->params.height / 2 > 0 ? f->params.height / 2 : 1;
-        drift_result r = drift_ssdo_views_render(f->ctx, f->scene, f->accel, &f->camera,
-                                                 o->cameras, w, h, views);
+        drift_result r = drift_ssdo_views_render(f->ctx, f->scene, f->accel, &f->camera, o->cameras,
+                                                 w, h, views);
         if (r != DRIFT_OK) {
             return r;
         }
@@ -199,17 +199,16 @@ drift_result drift_ssdo_pass_contact_shadows(drift_frame_state *f)
         for (int32_t y = 0; y < h; ++y) {
             for (int32_t x = 0; x < w; ++x) {
                 const drift_surface *s = &f->gbuffer.surfaces[(size_t)y * (size_t)w + (size_t)x];
-                bool lit = s->material != DRIFT_INVALID_INDEX &&
-                           drift_image_pixel(shadow, x, y)[0] > 0.0f;
+                bool lit =
+                    s->material != DRIFT_INVALID_INDEX && drift_image_pixel(shadow, x, y)[0] > 0.0f;
                 drift_image_pixel(&lengths, x, y)[0] =
                     lit ? drift_shadow_map_blind_length(map, s->position, s->ng) : 0.0f;
             }
         }
         bool directional = light->type == DRIFT_LIGHT_DIRECTIONAL;
-        r = drift_ssdo_contact_shadows_per_pixel(ctx, &in,
-                                                 directional ? light->direction : light->centre,
-                                                 directional, &lengths,
-                                                 f->params.shadow_map.contact_samples, &mask);
+        r = drift_ssdo_contact_shadows_per_pixel(
+            ctx, &in, directional ? light->direction : light->centre, directional, &lengths,
+            f->params.shadow_map.contact_samples, &mask);
         for (int32_t y = 0; r == DRIFT_OK && y < h; ++y) {
             for (int32_t x = 0; x < w; ++x) {
                 drift_image_pixel(shadow, x, y)[0] *= drift_image_pixel(&mask, x, y)[0];

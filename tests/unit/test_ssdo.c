@@ -533,6 +533,76 @@ static void test_second_layer_opens_the_gap_behind_a_slab(void **state)
     case_end(&c);
 }
 
+// --- ADDITIONAL CAMERAS ---
+
+// Thesis §4.3.3: a wall just outside the image on the right (x 1.1..1.3, seen from above, the
+// image covers x -1..1) darkens the floor at the border only when an additional camera sees
+// it; floor pixels whose samples stay on screen are unchanged, and without the wall the extra
+// cameras invent no occluder.
+static void test_additional_cameras_find_an_off_screen_blocker(void **state)
+{
+    (void)state;
+    for (int wall = 0; wall < 2; ++wall) {
+        ssdo_case c = { .rig = test_rig_begin(2) };
+        uint32_t grey = test_add_material(c.rig.scene, drift_material_make(drift_vec3_splat(0.5f)));
+        test_add_floor(c.rig.scene, 20.0f, 0.0f, grey);
+        if (wall) {
+            add_box(c.rig.scene, 1.1f, 1.3f, 1.0f, 3.0f, grey);
+        }
+        c.rig.scene->environment.color = drift_vec3_splat(1.0f);
+        look_down(c.rig.scene, 8.0f, 1.0f, 48);
+        case_begin(&c);
+        const drift_gbuffer *g = drift_hybrid_gbuffer(c.rig.frame);
+        drift_ssdo_params p = { .method = DRIFT_SSDO_METHOD_SSAO,
+                                .samples = 32,
+                                .radius = 0.5f,
+                                .no_fade = true,
+                                .no_blur = true };
+        case_render(&c, &p);
+        static float one[48 * 48];
+        for (int32_t i = 0; i < 48 * 48; ++i) {
+            one[i] = pixel(&c.out.visibility, i % 48, i / 48)[0];
+        }
+        for (int32_t count = 1; count <= DRIFT_SSDO_MAX_VIEWS; count += 4) {
+            drift_ssdo_view views[DRIFT_SSDO_MAX_VIEWS];
+            assert_int_equal(drift_ssdo_views_render(c.rig.ctx, c.rig.scene, c.rig.accel,
+                                                     &c.rig.scene->camera, count, 24, 24, views),
+                             DRIFT_OK);
+            drift_ssdo_inputs in = {
+                .gbuffer = g, .camera = &c.rig.scene->camera, .views = views, .view_count = count
+            };
+            assert_int_equal(drift_ssdo_render(c.rig.ctx, c.env, &in, &p, &c.out), DRIFT_OK);
+            double border_one = 0.0, border_views = 0.0;
+            int n = 0;
+            for (int32_t y = 0; y < 48; ++y) {
+                for (int32_t x = 0; x < 48; ++x) {
+                    float px = pixel(&g->position, x, y)[0];
+                    float v = pixel(&c.out.visibility, x, y)[0];
+                    if (px < 0.4f && fabsf(pixel(&g->position, x, y)[2]) < 0.4f) {
+                        assert_true(v == one[y * 48 + x]); // its samples stay on screen
+                    } else if (px > 0.85f && fabsf(pixel(&g->position, x, y)[2]) < 0.5f) {
+                        border_one += (double)one[y * 48 + x];
+                        border_views += (double)v;
+                        ++n;
+                    }
+                }
+            }
+            border_one /= n;
+            border_views /= n;
+            print_message("wall %d, %d cameras: border visibility %.3f, %.3f with the cameras\n",
+                          wall, count, border_one, border_views);
+            assert_true(border_one > 0.99);
+            if (wall) {
+                assert_true(border_views < 0.95);
+            } else {
+                assert_true(border_views > 0.99);
+            }
+            drift_ssdo_views_destroy(c.rig.ctx, views, count);
+        }
+        case_end(&c);
+    }
+}
+
 // --- CONTACT SHADOWS ---
 
 // Spec §2.5 test 7, the screen-space half: a small box on a floor, a directional light 10
@@ -581,8 +651,9 @@ static void test_contact_shadows_within_the_bias(void **state)
 // Spec §2.5 test 7 against the frame: a small box (0.1 thick, 0.5 high) on a floor lit by a
 // point light 10 degrees above the horizon, its shadow map coarse and biased (b about 0.37).
 // The ray-traced hard shadow is the truth. Without the fix the map's bias erases the contact
-// shadow: the floor within 0.1 of the box's far side, truly shadowed, is lit. With --contact-shadows every such pixel is
-// shadowed again, and (almost) no truly lit pixel is darkened.
+// shadow: the floor within 0.1 of the box's far side, truly shadowed, is lit. With
+// --contact-shadows every such pixel is shadowed again, and (almost) no truly lit pixel is
+// darkened.
 static void test_contact_shadows_fix_the_frames_shadow_map(void **state)
 {
     (void)state;
@@ -599,7 +670,11 @@ static void test_contact_shadows_fix_the_frames_shadow_map(void **state)
                      DRIFT_OK);
     look_down(r.scene, 6.0f, 1.0f, 64);
     test_rig_commit(&r);
-    enum { N = 64 * 64 };
+
+    enum {
+        N = 64 * 64
+    };
+
     static float truth[N], biased[N], fixed[N];
     float *out[3] = { truth, biased, fixed };
     for (int run = 0; run < 3; ++run) {
@@ -702,6 +777,7 @@ int main(void)
         cmocka_unit_test(test_converges_toward_reference),
         cmocka_unit_test(test_heightfield_against_ray_traced_occlusion),
         cmocka_unit_test(test_second_layer_opens_the_gap_behind_a_slab),
+        cmocka_unit_test(test_additional_cameras_find_an_off_screen_blocker),
         cmocka_unit_test(test_contact_shadows_within_the_bias),
         cmocka_unit_test(test_contact_shadows_fix_the_frames_shadow_map),
         cmocka_unit_test(test_bit_identical_across_threads),
