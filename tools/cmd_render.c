@@ -338,6 +338,9 @@ static const cli_option render_table[] = {
     CLI_INT("--occlusion-cameras", "N", O, hybrid.occlusion_settings.cameras, 0, 5,
             "additional depth-only cameras at half size that find occluders\n"
             "outside the image (ssao, ssdo, contact shadows; default 0)"),
+    CLI_INT("--occlusion-steps", "K", O, hybrid.occlusion_settings.steps, 1, 64,
+            "points on each ssao/ssdo sample direction: 1 the thesis's\n"
+            "point test (default), more a march to r_max (a ray test)"),
     CLI_CHOICE("--contact-shadows", "off|on", O, hybrid.shadow_map.contact_shadows, "off|on",
                "on: --shadows pcf|pcss march each lit pixel's shadow-map bias\n"
                "toward the light in screen space (thesis §4.5; default off)"),

@@ -167,6 +167,8 @@ typedef struct drift_micro_settings {
 //             geometry-aware blur over the interleaved sample sets runs
 //   cameras = 0: additional depth-only cameras (0..5, thesis §4.3.3, drift_ssdo_views_render)
 //             at half the frame's size that find occluders outside the image (ssao, ssdo)
+//   steps   = 0 -> 1: points on each ssao/ssdo sample direction; more march it to r_max (a ray
+//             test instead of the thesis's point test; drift_ssdo_params.steps)
 typedef struct drift_occlusion_settings {
     int32_t samples;
     float radius;
@@ -175,6 +177,7 @@ typedef struct drift_occlusion_settings {
     bool no_fade;
     bool no_blur;
     int32_t cameras;
+    int32_t steps;
 } drift_occlusion_settings;
 
 // How to build a frame. The default configuration is:

@@ -134,6 +134,11 @@ typedef struct drift_ssdo_params {
     float gtao_thickness;
     bool gtao_multibounce;
     uint32_t seed;
+    // 0 -> 1: points tested along each SSAO/SSDO sample direction. 1: the thesis's point at
+    // lambda_i; more: a march to r_max through (k + lambda_i / r) r / steps, k = 0..steps-1,
+    // the direction blocked by its strongest occluder (a ray test, like GTAO's horizons and
+    // the path tracer, instead of a point test that reads the air behind a ridge as open)
+    int32_t steps;
 } drift_ssdo_params;
 
 // Fills the defaults (scene may be NULL: then radius 0 stays 0 and is invalid).

@@ -56,6 +56,7 @@ drift_ssdo_params drift_ssdo_params_resolve(const drift_ssdo_params *params,
     p.blur_normal = p.blur_normal != 0.0f ? p.blur_normal : 0.8f;
     p.blur_plane = p.blur_plane != 0.0f ? p.blur_plane : 0.1f;
     p.gtao_slices = p.gtao_slices ? p.gtao_slices : 2;
+    p.steps = p.steps ? p.steps : 1;
     return p;
 }
 
@@ -239,14 +240,21 @@ static void occlusion_pixel(const ssdo_job *j, int32_t x, int32_t y, float *raw)
     const float *lens = j->set_len + set_index(x, y) * count;
     bool directional = j->p.method == DRIFT_SSDO_METHOD_SSDO;
     float margin = j->p.bias * j->p.radius;
+    int32_t steps = j->p.steps;
     drift_vec3 direct = drift_vec3_splat(0.0f), bent = drift_vec3_splat(0.0f);
     drift_vec3 unoccluded = drift_vec3_splat(0.0f);
     float open = 0.0f, total = 0.0f;
     for (int32_t i = 0; i < count; ++i) {
         drift_vec3 w = drift_frame_to_world(&frame, dirs[i]);
-        drift_vec3 s = drift_vec3_fma(p, w, lens[i]);
         int32_t qx, qy;
-        float v = 1.0f - occluder(j, p, s, margin, &qx, &qy);
+        // steps = 1: the thesis's point at lambda_i. More: a march to r_max through the points
+        // (k + lambda_i / r) r / steps, blocked by the strongest occluder among them.
+        float occ = 0.0f;
+        for (int32_t k = 0; k < steps && occ < 1.0f; ++k) {
+            float t = ((float)k * j->p.radius + lens[i]) / (float)steps;
+            occ = fmaxf(occ, occluder(j, p, drift_vec3_fma(p, w, t), margin, &qx, &qy));
+        }
+        float v = 1.0f - occ;
         float c = dirs[i].z;
         open += v * c;
         total += c;
@@ -662,8 +670,8 @@ drift_result drift_ssdo_render(drift_context *ctx, const drift_ssdo_env *env,
     if (!planes || (unsigned)p.method >= DRIFT_SSDO_METHOD_COUNT || p.samples < 1 ||
         p.samples > MAX_SAMPLES || !(p.radius > 0.0f) || !isfinite(p.radius) ||
         !(p.bounce_area > 0.0f) || !(p.bounce_clamp > 0.0f) || !(p.bias >= 0.0f) ||
-        p.gtao_slices < 1 || p.gtao_slices > MAX_SLICES || !(p.gtao_thickness >= 0.0f) ||
-        !(p.gtao_thickness <= 1.0f) || !(p.blur_plane > 0.0f)) {
+        p.gtao_slices < 1 || p.gtao_slices > MAX_SLICES || p.steps < 1 || p.steps > 64 ||
+        !(p.gtao_thickness >= 0.0f) || !(p.gtao_thickness <= 1.0f) || !(p.blur_plane > 0.0f)) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, __FILE__, __LINE__,
                   "ssdo: G-buffer and output planes of one size, samples 1..%d, radius > 0, "
                   "slices 1..%d and thickness in [0, 1] are required",

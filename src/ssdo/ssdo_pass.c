@@ -99,6 +99,7 @@ static drift_result render(drift_frame_state *f, const drift_pass_args *args,
                                  .bounce = o->bounce && indirect_none,
                                  .no_fade = o->no_fade,
                                  .no_blur = o->no_blur,
+                                 .steps = o->steps,
                                  .seed = f->params.seed };
     params = drift_ssdo_params_resolve(&params, f->scene);
     // The bounce reflects what the senders send: their shadowed direct light D.
