@@ -759,7 +759,16 @@ static void contact_rows(size_t begin, size_t end, int thread_index, void *user)
             for (int32_t k = 0; k < c->samples; ++k) {
                 float t = ((float)k + 0.5f) / (float)c->samples * length;
                 int32_t qx, qy;
-                if (occluder(j, p, drift_vec3_fma(p, l, t), 0.01f * length, &qx, &qy) > 0.0f) {
+                float margin = 0.01f * length;
+                if (!(occluder(j, p, drift_vec3_fma(p, l, t), margin, &qx, &qy) > 0.0f)) {
+                    continue;
+                }
+                // A blocker rises above the receiver's tangent plane. The same surface seen at
+                // a grazing angle does not: its next pixel's stored point is nearer only because
+                // depth changes fast across a pixel there (self-shadowing acne otherwise).
+                if (qx < 0 ||
+                    drift_vec3_dot(n, drift_vec3_sub(drift_image_get3(&j->gb->position, qx, qy),
+                                                     p)) > margin) {
                     dst[0] = 0.0f;
                     break;
                 }
