@@ -112,18 +112,25 @@ typedef struct variant {
     const char *name;
     drift_ssdo_method method;
     bool bounce, multibounce, layers, plain_sum;
+    int32_t steps, divide; // --occlusion-steps, and N / divide directions (equal points at 4/4)
 } variant;
 
 static const variant variants[] = {
-    { "ssao", DRIFT_SSDO_METHOD_SSAO, false, false, false, false },
-    { "gtao", DRIFT_SSDO_METHOD_GTAO, false, false, false, false },
-    { "gtao+mb", DRIFT_SSDO_METHOD_GTAO, false, true, false, false },
-    { "ssdo", DRIFT_SSDO_METHOD_SSDO, false, false, false, false },
-    { "ssdo-plain", DRIFT_SSDO_METHOD_SSDO, false, false, false, true },
-    { "ssdo+bounce", DRIFT_SSDO_METHOD_SSDO, true, false, false, false },
-    { "ssdo-plain+b", DRIFT_SSDO_METHOD_SSDO, true, false, false, true },
-    { "ssdo+2layers", DRIFT_SSDO_METHOD_SSDO, false, false, true, false },
-    { "ssdo+b+2layers", DRIFT_SSDO_METHOD_SSDO, true, false, true, false },
+    { "ssao", DRIFT_SSDO_METHOD_SSAO, false, false, false, false, 1, 1 },
+    { "gtao", DRIFT_SSDO_METHOD_GTAO, false, false, false, false, 1, 1 },
+    { "gtao+mb", DRIFT_SSDO_METHOD_GTAO, false, true, false, false, 1, 1 },
+    { "ssdo", DRIFT_SSDO_METHOD_SSDO, false, false, false, false, 1, 1 },
+    { "ssdo-plain", DRIFT_SSDO_METHOD_SSDO, false, false, false, true, 1, 1 },
+    { "ssdo+bounce", DRIFT_SSDO_METHOD_SSDO, true, false, false, false, 1, 1 },
+    { "ssdo-plain+b", DRIFT_SSDO_METHOD_SSDO, true, false, false, true, 1, 1 },
+    { "ssdo+2layers", DRIFT_SSDO_METHOD_SSDO, false, false, true, false, 1, 1 },
+    { "ssdo+b+2layers", DRIFT_SSDO_METHOD_SSDO, true, false, true, false, 1, 1 },
+    // The march to r_max: N/4 directions x 4 steps (as many depth reads as N points), N/2 x 2,
+    // and N x 4.
+    { "ssdo-s4/4", DRIFT_SSDO_METHOD_SSDO, false, false, false, false, 4, 4 },
+    { "ssdo-s4/4+b", DRIFT_SSDO_METHOD_SSDO, true, false, false, false, 4, 4 },
+    { "ssdo-s2/2", DRIFT_SSDO_METHOD_SSDO, false, false, false, false, 2, 2 },
+    { "ssdo-s4", DRIFT_SSDO_METHOD_SSDO, false, false, false, false, 4, 1 },
 };
 #define VARIANT_COUNT (sizeof(variants) / sizeof(variants[0]))
 
@@ -138,8 +145,10 @@ static drift_result make_gbuffer(const bench_state *b, int32_t w, int32_t h,
 
 static drift_ssdo_params variant_params(const bench_state *b, const variant *v, long samples)
 {
+    long n = v->divide > 1 ? (samples / v->divide > 0 ? samples / v->divide : 1) : samples;
     return (drift_ssdo_params){ .method = v->method,
-                                .samples = (int32_t)samples,
+                                .samples = (int32_t)n,
+                                .steps = v->steps,
                                 .radius = (float)b->o->radius,
                                 .bounce = v->bounce,
                                 .gtao_multibounce = v->multibounce,

@@ -283,6 +283,8 @@ static const cli_option render_table[] = {
             "samples per area light for unshadowed light (default 8)"),
     CLI_INT("--shadow-map-size", "N", O, hybrid.shadow_map.size, 1, 8192,
             "texels a cube face (default 512)"),
+    CLI_NUMBER("--shadow-bias", "B", O, hybrid.shadow_map.bias, 1e-3, 1e3,
+               "shadow-map depth bias in texel footprints (default 1.5)"),
     CLI_INT("--pcf-kernel", "K", O, hybrid.shadow_map.pcf_kernel, 1, 63,
             "PCF texels across (default 3)"),
     CLI_INT("--envmap-size", "N", O, hybrid.envmap.size, 1, 4096,
@@ -333,6 +335,17 @@ static const cli_option render_table[] = {
                "off: occluders near r_max count fully (default on)"),
     CLI_CHOICE("--occlusion-blur", "on|off", O, hybrid.occlusion_settings.no_blur, "on|off",
                "off: no geometry-aware blur of the sample sets (default on)"),
+    CLI_INT("--occlusion-cameras", "N", O, hybrid.occlusion_settings.cameras, 0, 5,
+            "additional depth-only cameras at half size that find occluders\n"
+            "outside the image (ssao, ssdo, contact shadows; default 0)"),
+    CLI_INT("--occlusion-steps", "K", O, hybrid.occlusion_settings.steps, 1, 64,
+            "points on each ssao/ssdo sample direction: 1 the thesis's\n"
+            "point test (default), more a march to r_max (a ray test)"),
+    CLI_CHOICE("--contact-shadows", "off|on", O, hybrid.shadow_map.contact_shadows, "off|on",
+               "on: --shadows pcf|pcss march each lit pixel's shadow-map bias\n"
+               "toward the light in screen space (thesis §4.5; default off)"),
+    CLI_INT("--contact-samples", "N", O, hybrid.shadow_map.contact_samples, 1, 1024,
+            "points on each contact-shadow march (default 8)"),
     CLI_INT("--ism-vpls", "N", O, hybrid.ism.vpls, 1, 65536,
             "instant radiosity (--indirect ism|ir, docs/ism.md): light\n"
             "paths, one first-bounce VPL each (default 256)"),

@@ -81,10 +81,16 @@ int drift_technique_parse(drift_effect effect, const char *name);
 //   size       = 0 -> 512 texels a cube face
 //   bias       = 0 -> 1.5 texels (the depth bias, scaled by the texel footprint)
 //   pcf_kernel = 0 -> 3 (texels across; 1 = a single tap)
+//   contact_shadows = false: true marches each lit pixel's blind length toward the light in
+//              screen space and shadows it on an occluder (thesis §4.5, docs/ssdo.md), with
+//              contact_samples = 0 -> 8 points; the occlusion settings' layers and cameras
+//              apply to it too
 typedef struct drift_shadow_map_settings {
     int32_t size;
     float bias;
     int32_t pcf_kernel;
+    bool contact_shadows;
+    int32_t contact_samples;
 } drift_shadow_map_settings;
 
 // Environment-map reflections (envmap):
@@ -162,6 +168,10 @@ typedef struct drift_micro_settings {
 //             thin object is not taken for occluded (thesis §4.3.2, drift_ssdo_peel)
 //   no_fade = false: occluders at 0.75..1 r_max fade out; no_blur = false: the 4x4
 //             geometry-aware blur over the interleaved sample sets runs
+//   cameras = 0: additional depth-only cameras (0..5, thesis §4.3.3, drift_ssdo_views_render)
+//             at half the frame's size that find occluders outside the image (ssao, ssdo)
+//   steps   = 0 -> 1: points on each ssao/ssdo sample direction; more march it to r_max (a ray
+//             test instead of the thesis's point test; drift_ssdo_params.steps)
 typedef struct drift_occlusion_settings {
     int32_t samples;
     float radius;
@@ -169,6 +179,8 @@ typedef struct drift_occlusion_settings {
     int32_t layers;
     bool no_fade;
     bool no_blur;
+    int32_t cameras;
+    int32_t steps;
 } drift_occlusion_settings;
 
 // How to build a frame. The default configuration is:

@@ -134,6 +134,11 @@ typedef struct drift_ssdo_params {
     float gtao_thickness;
     bool gtao_multibounce;
     uint32_t seed;
+    // 0 -> 1: points tested along each SSAO/SSDO sample direction. 1: the thesis's point at
+    // lambda_i; more: a march to r_max through (k + lambda_i / r) r / steps, k = 0..steps-1,
+    // the direction blocked by its strongest occluder (a ray test, like GTAO's horizons and
+    // the path tracer, instead of a point test that reads the air behind a ridge as open)
+    int32_t steps;
 } drift_ssdo_params;
 
 // Fills the defaults (scene may be NULL: then radius 0 stays 0 and is invalid).
@@ -172,11 +177,26 @@ void drift_ssdo_output_destroy(drift_context *ctx, drift_ssdo_output *out); // N
 //                   frame's shadowed direct light from point and area lights (3 channels)
 //   back_depth      a second depth layer (drift_ssdo_peel, 1 channel): a sample counts as an
 //                   occluder only between the first layer and this one (thesis §4.3.2)
+// Additional cameras (thesis §4.3.3): depth-only views of the scene, so that a sample outside
+// the viewer's image can still meet an occluder. Made by drift_ssdo_views_render.
+#define DRIFT_SSDO_MAX_VIEWS 5
+
+typedef struct drift_ssdo_view {
+    drift_camera camera; // pinhole
+    drift_image depth;   // 1 channel: view depth along the camera's axis, 0 where nothing
+} drift_ssdo_view;
+
+// views, view_count: 0..DRIFT_SSDO_MAX_VIEWS additional cameras. A sample outside the
+// viewer's image is an occluder when some of them see it and all that do have it behind a
+// surface (one that has it in front proves it free). They add occluders only (no sender pixels for
+// the bounce), and only to SSAO, SSDO and the contact shadows (GTAO marches the viewer's image).
 typedef struct drift_ssdo_inputs {
     const drift_gbuffer *gbuffer;
     const drift_camera *camera;
     const drift_image *sender_radiance;
     const drift_image *back_depth;
+    const drift_ssdo_view *views;
+    int32_t view_count;
 } drift_ssdo_inputs;
 
 // Renders one technique into out (made by drift_ssdo_output_create at the G-buffer's size).
@@ -204,6 +224,26 @@ drift_result drift_ssdo_peel(drift_context *ctx, const drift_accel *accel,
 drift_result drift_ssdo_contact_shadows(drift_context *ctx, const drift_ssdo_inputs *inputs,
                                         drift_vec3 light, bool directional, float length,
                                         int32_t samples, drift_image *out_visible);
+
+// As drift_ssdo_contact_shadows with one march length a pixel (`lengths`, 1 channel, the
+// G-buffer's size; <= 0: not marched, visible): the frame's shadow maps give each pixel its
+// own b (drift_shadow_map_blind_length).
+drift_result drift_ssdo_contact_shadows_per_pixel(drift_context *ctx,
+                                                  const drift_ssdo_inputs *inputs, drift_vec3 light,
+                                                  bool directional, const drift_image *lengths,
+                                                  int32_t samples, drift_image *out_visible);
+
+// Renders `count` (1..DRIFT_SSDO_MAX_VIEWS) additional cameras for `camera` by one ray a
+// texel into views[0..count) (their depth images created here, width x height each; free
+// with drift_ssdo_views_destroy). All look at the viewer's centre of interest (its centre
+// ray's first hit) with twice the viewer's tan(fov/2): view 0 from the viewer's eye (a guard
+// band), views 1-4 from the eye moved by 0.25 x the scene's bounding-sphere radius along the
+// image's +x, -x, +y, -y, pulled back to free space when the move would cross a surface.
+drift_result drift_ssdo_views_render(drift_context *ctx, const drift_scene *scene,
+                                     const drift_accel *accel, const drift_camera *camera,
+                                     int32_t count, int32_t width, int32_t height,
+                                     drift_ssdo_view *views);
+void drift_ssdo_views_destroy(drift_context *ctx, drift_ssdo_view *views, int32_t count);
 
 // The path-traced reference of the same term into out (3 channels, created here and owned by
 // the caller): environment light with visibility at the first hit, plus with `bounce` the

@@ -7,6 +7,7 @@
 #include "hybrid/techniques.h"
 #include "isg/isg.h"
 #include "realtime/realtime.h"
+#include "ssdo/ssdo_pass.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -429,6 +430,10 @@ static drift_result run_row(drift_frame_state *f, const drift_technique_row *row
                              .cancel = cancel };
     double t = drift_time_now();
     drift_result r = row->pass(f, &args);
+    if (r == DRIFT_OK && row->effect == DRIFT_EFFECT_SHADOWS &&
+        (row->inputs & DRIFT_INPUT_SHADOW_MAPS) && f->params.shadow_map.contact_shadows) {
+        r = drift_ssdo_pass_contact_shadows(f); // the shadow maps' bias, fixed in screen space
+    }
     if (r == DRIFT_OK && (row->flags & DRIFT_ROW_SUMS_DIRECT)) {
         r = drift_realtime_pass_sum_direct(f);
     }

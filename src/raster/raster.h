@@ -154,6 +154,10 @@ float drift_shadow_map_hard(const drift_shadow_map *map, drift_vec3 p, drift_vec
 float drift_shadow_map_pcf(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n, int32_t kernel);
 float drift_shadow_map_pcss(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n,
                             uint32_t rotation_hash);
+// How far toward the light from p (normal n) the map cannot see blockers, scene units: the
+// depth bias plus the normal offset of the lookups (thesis §4.5's b; the screen-space
+// contact-shadow fix marches this far, ssdo/ssdo_pass.c).
+float drift_shadow_map_blind_length(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n);
 // --- ENVIRONMENT MAP (envmap.c) ---
 
 // A cube map of the radiance seen from a probe point, emitted and reflected parts apart,

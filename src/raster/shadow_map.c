@@ -557,6 +557,13 @@ static float hard_lookup(const drift_shadow_map *map, const drift_shadow_receive
     return drift_shadow_map_tap_lit(rec, drift_shadow_map_tap(map, rec, 0.0f, 0.0f)) ? 1.0f : 0.0f;
 }
 
+float drift_shadow_map_blind_length(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n)
+{
+    drift_shadow_receiver rec = drift_shadow_map_receiver(map, p, n);
+    // The lookup moved p NORMAL_OFFSET_TEXELS footprints along n, then compared with the bias.
+    return rec.bias + NORMAL_OFFSET_TEXELS * rec.texel * (map->directional ? 1.0f : rec.depth);
+}
+
 float drift_shadow_map_hard(const drift_shadow_map *map, drift_vec3 p, drift_vec3 n)
 {
     drift_shadow_receiver rec = drift_shadow_map_receiver(map, p, n);

@@ -10,6 +10,7 @@ void drift_realtime_settings_resolve(drift_shadow_map_settings *shadow_map,
     shadow_map->size = shadow_map->size ? shadow_map->size : 512;
     shadow_map->bias = shadow_map->bias > 0.0f ? shadow_map->bias : 1.5f;
     shadow_map->pcf_kernel = shadow_map->pcf_kernel ? shadow_map->pcf_kernel : 3;
+    shadow_map->contact_samples = shadow_map->contact_samples ? shadow_map->contact_samples : 8;
     envmap->size = envmap->size ? envmap->size : 128;
 }
 
@@ -22,6 +23,9 @@ const char *drift_realtime_settings_problem(const drift_shadow_map_settings *sha
     }
     if (shadow_map->pcf_kernel < 1 || shadow_map->pcf_kernel > 63) {
         return "pcf kernel outside 1..63";
+    }
+    if (shadow_map->contact_samples < 1 || shadow_map->contact_samples > 1024) {
+        return "contact-shadow samples outside 1..1024";
     }
     if (!isfinite(shadow_map->bias) ||
         (envmap->has_probe && !drift_vec3_is_finite(envmap->probe))) {

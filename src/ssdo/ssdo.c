@@ -56,6 +56,7 @@ drift_ssdo_params drift_ssdo_params_resolve(const drift_ssdo_params *params,
     p.blur_normal = p.blur_normal != 0.0f ? p.blur_normal : 0.8f;
     p.blur_plane = p.blur_plane != 0.0f ? p.blur_plane : 0.1f;
     p.gtao_slices = p.gtao_slices ? p.gtao_slices : 2;
+    p.steps = p.steps ? p.steps : 1;
     return p;
 }
 
@@ -98,6 +99,9 @@ typedef struct ssdo_job {
     const drift_image *back_depth;
     drift_ssdo_params p;
     drift_camera_frame cam;
+    int32_t view_count; // additional cameras (thesis §4.3.3)
+    drift_camera_frame view_cam[DRIFT_SSDO_MAX_VIEWS];
+    const drift_image *view_depth[DRIFT_SSDO_MAX_VIEWS];
     int32_t width, height;
     float focal_px;            // pixels per unit of tan: height / (2 tan(fov / 2))
     drift_vec3 *set_dir;       // SETS x N unit directions in the local frame (z = normal)
@@ -142,42 +146,84 @@ static void make_sets(ssdo_job *j)
 
 // --- THE OCCLUDER TEST ---
 
-// How much the point s, a sample of the pixel at p, counts as an occluder: 0 when the depth
-// buffer at its pixel lies behind it (or it falls outside the image or on a miss, or with two
-// layers behind the second), else 1,
-// faded out by 1 - smoothstep(0.75 r, r, |Q - P|) unless the fade is off. *out_x, *out_y get
-// the pixel of Q.
-static float occluder(const ssdo_job *j, drift_vec3 p, drift_vec3 s, int32_t *out_x, int32_t *out_y)
+// Where point s falls in one view: false when it is behind the camera or outside the image;
+// else its pixel, its view depth *zs and the depth stored there *zq.
+static bool view_lookup(const drift_camera_frame *cam, const drift_image *depth, drift_vec3 s,
+                        float *zs, float *zq, int32_t *qx, int32_t *qy)
 {
-    drift_vec3 d = drift_vec3_sub(s, j->cam.camera.position);
-    float zs = drift_vec3_dot(d, j->cam.w);
-    if (!(zs > 0.0f)) {
-        return 0.0f;
+    drift_vec3 d = drift_vec3_sub(s, cam->camera.position);
+    *zs = drift_vec3_dot(d, cam->w);
+    if (!(*zs > 0.0f)) {
+        return false;
     }
-    float sx = drift_vec3_dot(d, j->cam.u) / (zs * j->cam.tan_half * j->cam.aspect);
-    float sy = drift_vec3_dot(d, j->cam.v) / (zs * j->cam.tan_half);
-    float fx = 0.5f * (sx + 1.0f) * (float)j->width, fy = 0.5f * (1.0f - sy) * (float)j->height;
-    if (!(fx >= 0.0f && fy >= 0.0f && fx < (float)j->width && fy < (float)j->height)) {
-        return 0.0f;
+    float sx = drift_vec3_dot(d, cam->u) / (*zs * cam->tan_half * cam->aspect);
+    float sy = drift_vec3_dot(d, cam->v) / (*zs * cam->tan_half);
+    float fx = 0.5f * (sx + 1.0f) * (float)cam->width, fy = 0.5f * (1.0f - sy) * (float)cam->height;
+    if (!(fx >= 0.0f && fy >= 0.0f && fx < (float)cam->width && fy < (float)cam->height)) {
+        return false;
     }
-    int32_t qx = (int32_t)fx, qy = (int32_t)fy;
-    *out_x = qx;
-    *out_y = qy;
-    float zq = drift_image_pixel(&j->gb->depth, qx, qy)[0];
-    if (!(zq > 0.0f) || !(zq < zs - j->p.bias * j->p.radius)) {
-        return 0.0f;
-    }
-    if (j->back_depth) {
-        // Two layers: behind the solid's back face is open again (fixes "sample A").
-        float zb = drift_image_pixel(j->back_depth, qx, qy)[0];
-        if (zb > 0.0f && zs > zb) {
+    *qx = (int32_t)fx;
+    *qy = (int32_t)fy;
+    *zq = drift_image_pixel(depth, *qx, *qy)[0];
+    return true;
+}
+
+// How much the point s, a sample of the pixel at p, counts as an occluder: 0 when the depth
+// buffer at its pixel lies behind it (or it falls on a miss, or with two layers behind the
+// second), else 1, faded out by 1 - smoothstep(0.75 r, r, |Q - P|) unless the fade is off. A
+// sample outside the image is open, unless additional cameras see it: then it is an occluder
+// when every camera whose image holds it has it behind a surface by `margin` (any one in
+// front proves free space), with Q on the first one's ray. `margin` is the depth margin in scene
+// units. *out_x, *out_y get the viewer's pixel of Q (-1 when an additional camera found it).
+static float occluder(const ssdo_job *j, drift_vec3 p, drift_vec3 s, float margin, int32_t *out_x,
+                      int32_t *out_y)
+{
+    float zs, zq;
+    int32_t qx, qy;
+    drift_vec3 q = p;
+    *out_x = *out_y = -1;
+    if (view_lookup(&j->cam, &j->gb->depth, s, &zs, &zq, &qx, &qy)) {
+        *out_x = qx;
+        *out_y = qy;
+        if (!(zq > 0.0f) || !(zq < zs - margin)) {
             return 0.0f;
         }
+        if (j->back_depth) {
+            // Two layers: behind the solid's back face is open again (fixes "sample A").
+            float zb = drift_image_pixel(j->back_depth, qx, qy)[0];
+            if (zb > 0.0f && zs > zb) {
+                return 0.0f;
+            }
+        }
+        if (j->p.no_fade) {
+            return 1.0f;
+        }
+        q = drift_image_get3(&j->gb->position, qx, qy);
+    } else {
+        bool seen = false;
+        for (int32_t k = 0; k < j->view_count; ++k) {
+            const drift_camera_frame *cam = &j->view_cam[k];
+            float zk, zqk;
+            int32_t vx, vy;
+            if (!view_lookup(cam, j->view_depth[k], s, &zk, &zqk, &vx, &vy)) {
+                continue;
+            }
+            if (!(zqk > 0.0f) || !(zqk < zk - margin)) {
+                return 0.0f; // this camera sees free space there
+            }
+            if (!seen) {
+                drift_vec3 eye = cam->camera.position;
+                q = drift_vec3_fma(eye, drift_vec3_sub(s, eye), zqk / zk);
+            }
+            seen = true;
+        }
+        if (!seen) {
+            return 0.0f;
+        }
+        if (j->p.no_fade) {
+            return 1.0f;
+        }
     }
-    if (j->p.no_fade) {
-        return 1.0f;
-    }
-    drift_vec3 q = drift_image_get3(&j->gb->position, qx, qy);
     float dist = drift_vec3_length(drift_vec3_sub(q, p));
     return 1.0f - ssdo_smoothstep(0.75f * j->p.radius, j->p.radius, dist);
 }
@@ -193,14 +239,22 @@ static void occlusion_pixel(const ssdo_job *j, int32_t x, int32_t y, float *raw)
     const drift_vec3 *dirs = j->set_dir + set_index(x, y) * count;
     const float *lens = j->set_len + set_index(x, y) * count;
     bool directional = j->p.method == DRIFT_SSDO_METHOD_SSDO;
+    float margin = j->p.bias * j->p.radius;
+    int32_t steps = j->p.steps;
     drift_vec3 direct = drift_vec3_splat(0.0f), bent = drift_vec3_splat(0.0f);
     drift_vec3 unoccluded = drift_vec3_splat(0.0f);
     float open = 0.0f, total = 0.0f;
     for (int32_t i = 0; i < count; ++i) {
         drift_vec3 w = drift_frame_to_world(&frame, dirs[i]);
-        drift_vec3 s = drift_vec3_fma(p, w, lens[i]);
         int32_t qx, qy;
-        float v = 1.0f - occluder(j, p, s, &qx, &qy);
+        // steps = 1: the thesis's point at lambda_i. More: a march to r_max through the points
+        // (k + lambda_i / r) r / steps, blocked by the strongest occluder among them.
+        float occ = 0.0f;
+        for (int32_t k = 0; k < steps && occ < 1.0f; ++k) {
+            float t = ((float)k * j->p.radius + lens[i]) / (float)steps;
+            occ = fmaxf(occ, occluder(j, p, drift_vec3_fma(p, w, t), margin, &qx, &qy));
+        }
+        float v = 1.0f - occ;
         float c = dirs[i].z;
         open += v * c;
         total += c;
@@ -403,9 +457,9 @@ static void bounce_pixel(const ssdo_job *j, int32_t x, int32_t y, float *raw)
     for (int32_t i = 0; i < count; ++i) {
         drift_vec3 s = drift_vec3_fma(p, drift_frame_to_world(&frame, dirs[i]), lens[i]);
         int32_t qx, qy;
-        float occ = occluder(j, p, s, &qx, &qy);
-        if (!(occ > 0.0f) || !pixel_valid(j, qx, qy)) {
-            continue;
+        float occ = occluder(j, p, s, j->p.bias * r, &qx, &qy);
+        if (!(occ > 0.0f) || qx < 0 || !pixel_valid(j, qx, qy)) {
+            continue; // open, or found by an additional camera only: no sender pixel
         }
         drift_vec3 q = drift_image_get3(&j->gb->position, qx, qy);
         drift_vec3 nq = drift_image_get3(&j->gb->normal, qx, qy);
@@ -568,6 +622,31 @@ static bool plane_ok(const drift_image *image, int32_t w, int32_t h, int32_t cha
            image->channels >= channels;
 }
 
+static bool views_ok(const drift_ssdo_inputs *in)
+{
+    if (in->view_count < 0 || in->view_count > DRIFT_SSDO_MAX_VIEWS ||
+        (in->view_count > 0 && !in->views)) {
+        return false;
+    }
+    for (int32_t k = 0; k < in->view_count; ++k) {
+        const drift_image *d = &in->views[k].depth;
+        if (!drift_image_is_valid(d) || d->channels < 1) {
+            return false;
+        }
+    }
+    return true;
+}
+
+static void set_views(ssdo_job *j, const drift_ssdo_inputs *in)
+{
+    j->view_count = in->view_count;
+    for (int32_t k = 0; k < in->view_count; ++k) {
+        const drift_image *d = &in->views[k].depth;
+        j->view_cam[k] = drift_camera_frame_make(&in->views[k].camera, d->width, d->height);
+        j->view_depth[k] = d;
+    }
+}
+
 drift_result drift_ssdo_render(drift_context *ctx, const drift_ssdo_env *env,
                                const drift_ssdo_inputs *inputs, const drift_ssdo_params *params,
                                drift_ssdo_output *out)
@@ -586,12 +665,13 @@ drift_result drift_ssdo_render(drift_context *ctx, const drift_ssdo_env *env,
                   plane_ok(&out->direct, w, h, 3) && plane_ok(&out->bounce, w, h, 3) &&
                   plane_ok(&out->visibility, w, h, 1) && plane_ok(&out->bent_normal, w, h, 3) &&
                   (!sender_extra || plane_ok(sender_extra, w, h, 3)) &&
-                  (!inputs->back_depth || plane_ok(inputs->back_depth, w, h, 1));
+                  (!inputs->back_depth || plane_ok(inputs->back_depth, w, h, 1)) &&
+                  views_ok(inputs);
     if (!planes || (unsigned)p.method >= DRIFT_SSDO_METHOD_COUNT || p.samples < 1 ||
         p.samples > MAX_SAMPLES || !(p.radius > 0.0f) || !isfinite(p.radius) ||
         !(p.bounce_area > 0.0f) || !(p.bounce_clamp > 0.0f) || !(p.bias >= 0.0f) ||
-        p.gtao_slices < 1 || p.gtao_slices > MAX_SLICES || !(p.gtao_thickness >= 0.0f) ||
-        !(p.gtao_thickness <= 1.0f) || !(p.blur_plane > 0.0f)) {
+        p.gtao_slices < 1 || p.gtao_slices > MAX_SLICES || p.steps < 1 || p.steps > 64 ||
+        !(p.gtao_thickness >= 0.0f) || !(p.gtao_thickness <= 1.0f) || !(p.blur_plane > 0.0f)) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, __FILE__, __LINE__,
                   "ssdo: G-buffer and output planes of one size, samples 1..%d, radius > 0, "
                   "slices 1..%d and thickness in [0, 1] are required",
@@ -607,6 +687,7 @@ drift_result drift_ssdo_render(drift_context *ctx, const drift_ssdo_env *env,
                    .width = w,
                    .height = h };
     j.focal_px = (float)h / (2.0f * j.cam.tan_half);
+    set_views(&j, inputs);
     size_t pixels = (size_t)w * (size_t)h;
     j.set_dir = drift_alloc(ctx, sizeof(drift_vec3) * SETS * (size_t)p.samples);
     j.set_len = drift_alloc(ctx, sizeof(float) * SETS * (size_t)p.samples);
@@ -646,7 +727,8 @@ typedef struct contact_job {
     ssdo_job j;
     drift_vec3 light; // position, or for a directional light the way its light travels
     bool directional;
-    float length; // of the march toward the light
+    float length;               // of the march toward the light
+    const drift_image *lengths; // or one length a pixel (<= 0: no march)
     int32_t samples;
     drift_image *out;
 } contact_job;
@@ -663,6 +745,10 @@ static void contact_rows(size_t begin, size_t end, int thread_index, void *user)
             if (!pixel_valid(j, x, y)) {
                 continue;
             }
+            float length = c->lengths ? drift_image_pixel(c->lengths, x, y)[0] : c->length;
+            if (!(length > 0.0f)) {
+                continue;
+            }
             drift_vec3 p = drift_image_get3(&j->gb->position, x, y);
             drift_vec3 n = drift_image_get3(&j->gb->normal, x, y);
             drift_vec3 l = c->directional ? drift_vec3_neg(drift_vec3_normalize(c->light))
@@ -671,9 +757,18 @@ static void contact_rows(size_t begin, size_t end, int thread_index, void *user)
                 continue; // facing away: the light's own shadow test decides
             }
             for (int32_t k = 0; k < c->samples; ++k) {
-                float t = ((float)k + 0.5f) / (float)c->samples * c->length;
+                float t = ((float)k + 0.5f) / (float)c->samples * length;
                 int32_t qx, qy;
-                if (occluder(j, p, drift_vec3_fma(p, l, t), &qx, &qy) > 0.0f) {
+                float margin = 0.01f * length;
+                if (!(occluder(j, p, drift_vec3_fma(p, l, t), margin, &qx, &qy) > 0.0f)) {
+                    continue;
+                }
+                // A blocker rises above the receiver's tangent plane. The same surface seen at
+                // a grazing angle does not: its next pixel's stored point is nearer only because
+                // depth changes fast across a pixel there (self-shadowing acne otherwise).
+                if (qx < 0 ||
+                    drift_vec3_dot(n, drift_vec3_sub(drift_image_get3(&j->gb->position, qx, qy),
+                                                     p)) > margin) {
                     dst[0] = 0.0f;
                     break;
                 }
@@ -682,9 +777,10 @@ static void contact_rows(size_t begin, size_t end, int thread_index, void *user)
     }
 }
 
-drift_result drift_ssdo_contact_shadows(drift_context *ctx, const drift_ssdo_inputs *inputs,
-                                        drift_vec3 light, bool directional, float length,
-                                        int32_t samples, drift_image *out_visible)
+static drift_result contact_shadows(drift_context *ctx, const drift_ssdo_inputs *inputs,
+                                    drift_vec3 light, bool directional, float length,
+                                    const drift_image *lengths, int32_t samples,
+                                    drift_image *out_visible)
 {
     if (!ctx || !inputs || !inputs->gbuffer || !inputs->camera || !out_visible) {
         return DRIFT_ERR_INVALID_ARGUMENT;
@@ -694,28 +790,48 @@ drift_result drift_ssdo_contact_shadows(drift_context *ctx, const drift_ssdo_inp
     if (!plane_ok(&g->depth, w, h, 1) || !plane_ok(&g->position, w, h, 3) ||
         !plane_ok(&g->normal, w, h, 3) || !plane_ok(&g->material_id, w, h, 1) ||
         !plane_ok(out_visible, w, h, 1) ||
-        (inputs->back_depth && !plane_ok(inputs->back_depth, w, h, 1)) || !(length > 0.0f) ||
-        !isfinite(length) || samples < 1 || samples > MAX_SAMPLES ||
-        (directional && drift_vec3_is_zero(light))) {
+        (inputs->back_depth && !plane_ok(inputs->back_depth, w, h, 1)) || !views_ok(inputs) ||
+        (lengths ? !plane_ok(lengths, w, h, 1) : !(length > 0.0f) || !isfinite(length)) ||
+        samples < 1 || samples > MAX_SAMPLES || (directional && drift_vec3_is_zero(light))) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, __FILE__, __LINE__,
                   "ssdo contact shadows: planes of one size, length > 0 and samples 1..%d",
                   MAX_SAMPLES);
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
-    // The occluder test of the sample sets with r = length, no fade: any buffer surface
-    // nearer than a sample on the segment, by more than 1% of its length, blocks it.
+    // The occluder test of the sample sets with no fade: any buffer surface nearer than a
+    // sample on the segment, by more than 1% of its length, blocks it.
     contact_job c = { .j = { .gb = g,
                              .back_depth = inputs->back_depth,
                              .p = drift_ssdo_params_resolve(
-                                 &(drift_ssdo_params){ .radius = length, .no_fade = true }, NULL),
+                                 &(drift_ssdo_params){ .radius = 1.0f, .no_fade = true }, NULL),
                              .cam = drift_camera_frame_make(inputs->camera, w, h),
                              .width = w,
                              .height = h },
                       .light = light,
                       .directional = directional,
                       .length = length,
+                      .lengths = lengths,
                       .samples = samples,
                       .out = out_visible };
+    set_views(&c.j, inputs);
     drift_parallel_for(ctx, (size_t)h, 2, contact_rows, &c);
     return DRIFT_OK;
+}
+
+drift_result drift_ssdo_contact_shadows(drift_context *ctx, const drift_ssdo_inputs *inputs,
+                                        drift_vec3 light, bool directional, float length,
+                                        int32_t samples, drift_image *out_visible)
+{
+    return contact_shadows(ctx, inputs, light, directional, length, NULL, samples, out_visible);
+}
+
+drift_result drift_ssdo_contact_shadows_per_pixel(drift_context *ctx,
+                                                  const drift_ssdo_inputs *inputs, drift_vec3 light,
+                                                  bool directional, const drift_image *lengths,
+                                                  int32_t samples, drift_image *out_visible)
+{
+    if (!lengths) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    return contact_shadows(ctx, inputs, light, directional, 0.0f, lengths, samples, out_visible);
 }

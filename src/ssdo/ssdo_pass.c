@@ -11,6 +11,8 @@ typedef struct ssdo_pass_state {
     drift_ssdo_env *env;
     drift_ssdo_output out;
     drift_image back_depth; // 1: the second depth layer (layers = 2)
+    drift_ssdo_view views[DRIFT_SSDO_MAX_VIEWS];
+    int32_t view_count; // rendered this frame (cameras > 0)
 } ssdo_pass_state;
 
 static void state_destroy(drift_context *ctx, void *data)
@@ -19,6 +21,7 @@ static void state_destroy(drift_context *ctx, void *data)
     drift_ssdo_env_destroy(s->env);
     drift_ssdo_output_destroy(ctx, &s->out);
     drift_image_destroy(ctx, &s->back_depth);
+    drift_ssdo_views_destroy(ctx, s->views, s->view_count);
     drift_free(ctx, s);
 }
 
@@ -49,6 +52,36 @@ static drift_result ensure_state(drift_frame_state *f, const drift_pass_args *ar
     return DRIFT_OK;
 }
 
+// The second depth layer (layers = 2) and the additional cameras (cameras > 0) into `in`.
+static drift_result prepare_layers(drift_frame_state *f, drift_image *back_depth,
+                                   drift_ssdo_view *views, int32_t *view_count,
+                                   drift_ssdo_inputs *in)
+{
+    const drift_occlusion_settings *o = &f->params.occlusion_settings;
+    if (o->layers == 2) { // one more ray a pixel: where the first layer's surface ends
+        drift_result r = drift_ssdo_peel(f->ctx, f->accel, &f->gbuffer, &f->camera, back_depth);
+        if (r != DRIFT_OK) {
+            return r;
+        }
+        in->back_depth = back_depth;
+    }
+    drift_ssdo_views_destroy(f->ctx, views, *view_count);
+    *view_count = 0;
+    if (o->cameras > 0) { // the camera moves every frame: so do its views
+        int32_t w = f->params.width / 2 > 0 ? f->params.width / 2 : 1;
+        int32_t h = f->params.height / 2 > 0 ? f->params.height / 2 : 1;
+        drift_result r = drift_ssdo_views_render(f->ctx, f->scene, f->accel, &f->camera, o->cameras,
+                                                 w, h, views);
+        if (r != DRIFT_OK) {
+            return r;
+        }
+        *view_count = o->cameras;
+        in->views = views;
+        in->view_count = o->cameras;
+    }
+    return DRIFT_OK;
+}
+
 static drift_result render(drift_frame_state *f, const drift_pass_args *args,
                            drift_ssdo_method method)
 {
@@ -66,18 +99,16 @@ static drift_result render(drift_frame_state *f, const drift_pass_args *args,
                                  .bounce = o->bounce && indirect_none,
                                  .no_fade = o->no_fade,
                                  .no_blur = o->no_blur,
+                                 .steps = o->steps,
                                  .seed = f->params.seed };
     params = drift_ssdo_params_resolve(&params, f->scene);
     // The bounce reflects what the senders send: their shadowed direct light D.
     drift_ssdo_inputs in = { .gbuffer = &f->gbuffer,
                              .camera = &f->camera,
                              .sender_radiance = &f->direct };
-    if (o->layers == 2) { // one more ray a pixel: where the first layer's surface ends
-        r = drift_ssdo_peel(f->ctx, f->accel, &f->gbuffer, &f->camera, &s->back_depth);
-        if (r != DRIFT_OK) {
-            return r;
-        }
-        in.back_depth = &s->back_depth;
+    r = prepare_layers(f, &s->back_depth, s->views, &s->view_count, &in);
+    if (r != DRIFT_OK) {
+        return r;
     }
     r = drift_ssdo_render(f->ctx, s->env, &in, &params, &s->out);
     if (r == DRIFT_OK) {
@@ -142,4 +173,52 @@ void drift_ssdo_planes(const drift_frame_state *f, drift_pass_plane_fn add, void
         }
         add(sink, "occlusion.bounce", &s->out.bounce);
     }
+}
+
+// The contact-shadow fix (thesis §4.5) for the shadow-mapped lights: every pixel the map lets
+// through marches its blind length b (the map's depth bias plus its normal offset there)
+// toward the light through the depth buffer; an occluder on the way shadows it. S_l *= mask.
+drift_result drift_ssdo_pass_contact_shadows(drift_frame_state *f)
+{
+    drift_context *ctx = f->ctx;
+    int32_t w = f->params.width, h = f->params.height;
+    drift_image lengths = { 0 }, mask = { 0 }, back = { 0 };
+    drift_ssdo_view views[DRIFT_SSDO_MAX_VIEWS];
+    int32_t view_count = 0;
+    drift_ssdo_inputs in = { .gbuffer = &f->gbuffer, .camera = &f->camera };
+    drift_result r = drift_image_create(ctx, w, h, 1, &lengths);
+    r = r ? r : drift_image_create(ctx, w, h, 1, &mask);
+    r = r ? r : drift_image_create(ctx, w, h, 1, &back);
+    r = r ? r : prepare_layers(f, &back, views, &view_count, &in);
+    for (uint32_t l = 0; r == DRIFT_OK && l < f->light_count; ++l) {
+        const drift_raster_light *light = &f->lights[l];
+        const drift_shadow_map *map = f->light_buffers[l].shadow_map;
+        drift_image *shadow = &f->light_buffers[l].shadow;
+        if (!map) {
+            continue;
+        }
+        for (int32_t y = 0; y < h; ++y) {
+            for (int32_t x = 0; x < w; ++x) {
+                const drift_surface *s = &f->gbuffer.surfaces[(size_t)y * (size_t)w + (size_t)x];
+                bool lit =
+                    s->material != DRIFT_INVALID_INDEX && drift_image_pixel(shadow, x, y)[0] > 0.0f;
+                drift_image_pixel(&lengths, x, y)[0] =
+                    lit ? drift_shadow_map_blind_length(map, s->position, s->ng) : 0.0f;
+            }
+        }
+        bool directional = light->type == DRIFT_LIGHT_DIRECTIONAL;
+        r = drift_ssdo_contact_shadows_per_pixel(
+            ctx, &in, directional ? light->direction : light->centre, directional, &lengths,
+            f->params.shadow_map.contact_samples, &mask);
+        for (int32_t y = 0; r == DRIFT_OK && y < h; ++y) {
+            for (int32_t x = 0; x < w; ++x) {
+                drift_image_pixel(shadow, x, y)[0] *= drift_image_pixel(&mask, x, y)[0];
+            }
+        }
+    }
+    drift_ssdo_views_destroy(ctx, views, view_count);
+    drift_image_destroy(ctx, &lengths);
+    drift_image_destroy(ctx, &mask);
+    drift_image_destroy(ctx, &back);
+    return r;
 }

@@ -13,6 +13,9 @@ drift_result drift_ssdo_pass_ssdo(drift_frame_state *frame, const drift_pass_arg
 // O ray-traced: the environment through the diffuse lobe at --spp shadow rays a pixel, exact
 // visibility (what the screen-space techniques approximate; no bounce).
 drift_result drift_ssdo_pass_reference(drift_frame_state *frame, const drift_pass_args *args);
+// The contact-shadow fix for shadow-map bias in the frame's S_l (--contact-shadows on): runs
+// after the pcf or pcss row, before D is summed (src/hybrid/frame.c).
+drift_result drift_ssdo_pass_contact_shadows(drift_frame_state *frame);
 // occlusion.visibility, .bent_normal, .direct and .bounce of the last render.
 void drift_ssdo_planes(const drift_frame_state *frame, drift_pass_plane_fn add, void *sink);
 
