@@ -101,8 +101,8 @@ typedef struct drift_micro_stats {
     uint64_t nodes_visited; // nodes the traversals touched
     uint64_t splats;        // nodes written into a micro-buffer pixel
     uint64_t post_leaves;   // leaves put on post-traversal lists
-    uint64_t cast_gathers;  // gathers that cast rays (a post list or empty pixels)
-    uint64_t rays;          // post-traversal and light rays
+    uint64_t cast_gathers;  // gathers that cast rays (every one unless no_ray_casting)
+    uint64_t rays;          // gather rays (one a micro-buffer pixel) and light rays
     uint64_t empty_pixels;  // micro-buffer pixels left without a node (holes and misses)
     uint64_t fallbacks;     // full-resolution gathers where the upsampling had no weight
 } drift_micro_stats;

@@ -266,7 +266,14 @@ drift_vec3 drift__micro_tree_radiance(const drift__micro_tree *tree, uint32_t i,
 
 uint32_t drift__micro_tree_nearest_leaf(const drift__micro_tree *tree, drift_vec3 x)
 {
-    uint32_t n = tree->leaf_count, best = n - 1;
+    return drift__micro_tree_nearest_leaf_seen(tree, x, NULL, drift_vec3_splat(0.0f),
+                                               drift_vec3_splat(0.0f));
+}
+
+uint32_t drift__micro_tree_nearest_leaf_seen(const drift__micro_tree *tree, drift_vec3 x,
+                                             const drift_vec3 *p, drift_vec3 n, drift_vec3 ng)
+{
+    uint32_t leaves = tree->leaf_count, best = leaves - 1;
     float best_d2 = INFINITY;
     uint32_t stack[64];
     int top = 0;
@@ -277,9 +284,16 @@ uint32_t drift__micro_tree_nearest_leaf(const drift__micro_tree *tree, drift_vec
         if (d > 0.0f && d * d >= best_d2) {
             continue;
         }
-        if (i >= n - 1) {
+        if (i >= leaves - 1) {
             drift_vec3 v = drift_vec3_sub(tree->center[i], x);
             float d2 = drift_vec3_dot(v, v);
+            // A leaf behind the gather point's tangent plane, or on a surface turned away
+            // from the hit's, is not what the ray sees: at a contact (a box on the floor)
+            // the nearest leaf may lie under the box, in its shadow.
+            if (p && (drift_vec3_dot(drift_vec3_sub(tree->center[i], *p), n) <= 0.0f ||
+                      fabsf(drift_vec3_dot(tree->axis[i], ng)) < 0.5f)) {
+                continue;
+            }
             if (d2 < best_d2) {
                 best_d2 = d2;
                 best = i;

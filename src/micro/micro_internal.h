@@ -48,6 +48,11 @@ void drift__micro_tree_pull(drift__micro_tree *tree);
 drift_vec3 drift__micro_tree_radiance(const drift__micro_tree *tree, uint32_t i, drift_vec3 toward);
 // The leaf nearest to x (branch and bound over the spheres).
 uint32_t drift__micro_tree_nearest_leaf(const drift__micro_tree *tree, drift_vec3 x);
+// The same among the leaves a gather point p (normal n) can see at a ray's hit x of geometric
+// normal ng: in front of p's tangent plane and on a surface turned like the hit's (|axis . ng|
+// >= 0.5). p NULL: every leaf. Falls back to the last leaf when none qualifies: check.
+uint32_t drift__micro_tree_nearest_leaf_seen(const drift__micro_tree *tree, drift_vec3 x,
+                                             const drift_vec3 *p, drift_vec3 n, drift_vec3 ng);
 
 // --- LIGHTING (§6.4, one bounce) ---
 

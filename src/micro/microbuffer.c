@@ -1,8 +1,8 @@
 // One gather into a micro-buffer (thesis §6.2.2): a depth-first cut of the point hierarchy
-// by solid angle, each node of the cut splatted into the pixel its direction warps to
-// (nearest first), the leaves bigger than their pixel kept on a post-traversal list; then
-// ray casting against the scene's triangles (Embree) over the pixels those leaves may cover,
-// and over the pixels left empty, so that the buffer is watertight; then the mean.
+// by solid angle, each node of the cut splatted into the pixels its disc covers (nearest
+// first), the leaves bigger than their pixel kept on a post-traversal list; then one ray a
+// pixel against the scene's triangles (Embree), which decides what each pixel sees, so that
+// the buffer is watertight and free of the splats' silhouette errors; then the mean.
 #include "micro/micro_internal.h"
 
 #include <math.h>
@@ -106,20 +106,26 @@ drift_vec3 drift__micro_gather(const drift__micro_gather_desc *desc, drift_vec3 
     }
     stats->post_leaves += post;
     if (desc->accel) {
-        // With near leaves every pixel may be theirs; otherwise only the empty ones need rays.
-        bool all = post > 0;
-        bool cast = false;
+        // Every pixel's ray is cast, not only those a near leaf may cover or no splat did:
+        // the splats alone were biased (docs/micro.md: on the Cornell box's ceiling, which
+        // gathers without near leaves, 10% dark at K = 24), because a splat's disc is only
+        // its node's area in a circle around its centre and at silhouettes (the boxes'
+        // edges, the open front, the light's quad seen edge-on) it covers pixel centres
+        // that see past it. So the ray decides what the pixel's centre sees, and a splat
+        // stays only when the surface hit lies within its node.
+        stats->cast++;
         for (int32_t pix = 0; pix < k2; ++pix) {
-            if (!all && node[pix] != NO_NODE) {
-                continue;
-            }
-            cast = true;
             drift_vec3 dir = drift_frame_to_world(frame, pixels->dir[pix]);
             drift_ray ray = { drift_offset_origin(p, ng, dir), 0.0f, dir, INFINITY };
             drift_hit hit;
             stats->rays++;
-            float stored = node[pix] >= 0 ? depth[pix] - tree->radius[node[pix]] : depth[pix];
-            if (!drift_accel_intersect(desc->accel, &ray, &hit) || !(hit.t < stored)) {
+            if (!drift_accel_intersect(desc->accel, &ray, &hit)) {
+                node[pix] = NO_NODE; // the open scene: nothing there
+                continue;
+            }
+            drift_vec3 x = drift_vec3_fma(ray.origin, dir, hit.t);
+            if (node[pix] >= 0 && drift_vec3_length(drift_vec3_sub(tree->center[node[pix]], x)) <=
+                                      tree->radius[node[pix]]) {
                 continue;
             }
             depth[pix] = hit.t;
@@ -129,8 +135,8 @@ drift_vec3 drift__micro_gather(const drift__micro_gather_desc *desc, drift_vec3 
             }
             // The nearest leaf to the hit, then its largest ancestor that still fits the
             // pixel: the radiance at the pixel's own scale, not one leaf's.
-            drift_vec3 x = drift_vec3_fma(ray.origin, dir, hit.t);
-            uint32_t i = drift__micro_tree_nearest_leaf(tree, x);
+            uint32_t i = drift__micro_tree_nearest_leaf_seen(tree, x, &p, frame->z,
+                                                             drift_vec3_normalize(hit.ng));
             float limit = desc->cut_scale * pixels->omega[pix] * hit.t * hit.t * DRIFT_INV_PI;
             while (i > 0) {
                 uint32_t up = (i - 1) / 2;
@@ -142,7 +148,6 @@ drift_vec3 drift__micro_gather(const drift__micro_gather_desc *desc, drift_vec3 
             }
             node[pix] = (int32_t)i;
         }
-        stats->cast += cast ? 1 : 0;
     }
     drift_vec3 sum = drift_vec3_splat(0.0f);
     for (int32_t pix = 0; pix < k2; ++pix) {

@@ -6,7 +6,7 @@
 // deformation and refit; the cut splats only nodes within their pixel's solid angle and
 // visits grow sub-linearly with the points; every-pixel gathering matches the path tracer's
 // first-bounce diffuse light on the Cornell box (upsampled within 2x of that); no pixel
-// exceeds rho max L; the error shrinks from K = 8 to 16.
+// exceeds rho max L; the error shrinks from K = 8 to 16 to 24.
 #include "drift/accel.h"
 #include "drift/hybrid.h"
 #include "drift/metric.h"
@@ -357,7 +357,7 @@ static void test_cut_is_correct_and_sublinear(void **state)
 
 // Spec §4.5 tests 5 to 7 on the Cornell box at 16 x 16 against the path tracer's first-bounce
 // diffuse light (max depth 2): every-pixel gathers are close to it (NRMS, mean within 10%);
-// the error shrinks from K = 8 to 16; 1/4-density upsampled stays within 2x of the
+// the error shrinks from K = 8 to 16 to 24; 1/4-density upsampled stays within 2x of the
 // every-pixel error; no pixel exceeds kd x the brightest leaf (one bounce: a mean of node
 // radiances times rho).
 static void test_against_path_tracer(void **state)
@@ -385,11 +385,11 @@ static void test_against_path_tracer(void **state)
             drift_image_mean_luminance(drift_micro_result(m)) / drift_image_mean_luminance(&ref);
         drift_micro_destroy(m);
     }
-    // 8 -> 16 shrinks the error; 24 does not shrink it further at 2^14 points (it reaches the
-    // leaves, docs/micro.md); the spec's 5% is not met at this size (the reference's own noise
-    // is about 3%).
+    // The error shrinks 8 -> 16 -> 24 (Fig. 6.17), and at K = 24 it is within 7% (measured
+    // 5.2%, of which the 2048-spp reference's own noise is about 3%; docs/micro.md).
     assert_true(e[1] < 0.8 * e[0]);
-    assert_true(fmin(e[1], e[2]) < 0.2);
+    assert_true(e[2] < 0.85 * e[1]);
+    assert_true(e[2] < 0.07);
     for (int i = 0; i < 3; ++i) {
         assert_true(bias[i] > 0.9 && bias[i] < 1.1);
     }
