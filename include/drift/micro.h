@@ -45,9 +45,11 @@ extern "C" {
 
 // Sampler streams: the light samples of leaf i, drift_sampler_make(drift_hash_combine(seed,
 // DRIFT_MICRO_LIGHT_STREAM), 0, i); the frame rotation of gather pixel (x, y) hashes the same
-// seed with DRIFT_MICRO_JITTER_STREAM. The scene points use DRIFT_POINTS_STREAM.
+// seed with DRIFT_MICRO_JITTER_STREAM, and the light samples of its rays' glossy hits with
+// DRIFT_MICRO_GLOSSY_STREAM. The scene points use DRIFT_POINTS_STREAM.
 #define DRIFT_MICRO_LIGHT_STREAM  0x6d6c6974u // "mlit"
 #define DRIFT_MICRO_JITTER_STREAM 0x6d6a6974u // "mjit"
+#define DRIFT_MICRO_GLOSSY_STREAM 0x6d676c73u // "mgls"
 
 // Which lobe of the gather point's BSDF the micro-buffer integrates.
 typedef enum drift_micro_lobe {

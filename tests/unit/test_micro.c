@@ -63,13 +63,18 @@ static void test_warp_round_trip_and_solid_angles(void **state)
     (void)state;
     drift__micro_warp *warp = malloc(sizeof *warp);
     drift__micro_pixels *pixels = malloc(sizeof *pixels);
-    for (int lobe = 0; lobe < 2; ++lobe) {
-        phong_slice slice = { 5.0f, drift_vec3_make(0.0f, 0.0f, 1.0f) };
+    for (int lobe = 0; lobe < 3; ++lobe) {
+        phong_slice slice = { lobe == 2 ? 200.0f : 5.0f,
+                              lobe == 2 ? drift_vec3_normalize(drift_vec3_make(0.3f, -0.2f, 0.9f))
+                                        : drift_vec3_make(0.0f, 0.0f, 1.0f) };
         if (lobe == 0) {
             drift__micro_warp_build_diffuse(warp, 32);
             assert_float_equal(warp->rho, 1.0f, 1e-4f);
-        } else {
+        } else if (lobe == 1) {
             drift__micro_warp_build(warp, 32, phong_lobe, &slice);
+        } else {
+            drift__micro_warp_build_cap(warp, 32, slice.mirror, drift__micro_phong_cap(200.0f),
+                                        phong_lobe, &slice);
         }
         double worst = 0.0;
         for (int j = 0; j < 64; ++j) {
@@ -92,35 +97,41 @@ static void test_warp_round_trip_and_solid_angles(void **state)
         for (int q = 0; q < 24 * 24; ++q) {
             sum += (double)pixels->omega[q];
         }
-        printf("lobe %d: pixels' solid angles sum to %.4f (2 pi = %.4f)\n", lobe, sum,
-               2.0 * (double)DRIFT_PI);
-        assert_true(fabs(sum - 2.0 * (double)DRIFT_PI) <
-                    (lobe == 0 ? 0.02 : 0.1) * 2.0 * (double)DRIFT_PI);
+        // The hemisphere's 2 pi, or the cap's 2 pi (1 - cos).
+        double whole = 2.0 * (double)DRIFT_PI *
+                       (1.0 - sqrt(fmax(1.0 - (double)warp->scale * (double)warp->scale, 0.0)));
+        printf("lobe %d: pixels' solid angles sum to %.4f (expected %.4f)\n", lobe, sum, whole);
+        assert_true(fabs(sum - whole) < (lobe == 0 ? 0.02 : 0.1) * whole);
     }
     free(warp);
     free(pixels);
 }
 
-// Expected share of f_r cos / rho in each of B x B bins of (cos theta, phi), by fine
-// quadrature of the exact lobe; observed: a 128^2 grid through Phi. Their L1 distance is small
-// and rho matches the quadrature's.
+// Expected share of f_r cos / rho in each of B x B bins of (cos theta, phi) about the warp's
+// axis (the normal, or a cap's axis), by fine quadrature of the exact lobe; observed: a 128^2
+// grid through Phi. Their L1 distance is small and rho matches the quadrature's. scale < 1:
+// the warp over the cap of that sine around slice->mirror.
 #define BINS 8
 
-static void check_warp_distribution(drift__micro_lobe_fn lobe, const void *user, const char *what)
+static void check_warp_distribution(drift__micro_lobe_fn lobe, const void *user, float scale,
+                                    drift_vec3 axis, const char *what)
 {
     drift__micro_warp *warp = malloc(sizeof *warp);
-    drift__micro_warp_build(warp, 64, lobe, user);
+    drift__micro_warp_build_cap(warp, 64, axis, scale, lobe, user);
+    float cap_cos = sqrtf(fmaxf(1.0f - warp->scale * warp->scale, 0.0f));
     double expected[BINS * BINS] = { 0 }, observed[BINS * BINS] = { 0 }, rho = 0.0;
     const int fine = 512;
     for (int j = 0; j < fine; ++j) {
         for (int i = 0; i < fine; ++i) {
-            // Uniform in (cos theta, phi): d omega = d cos d phi.
-            float ct = ((float)j + 0.5f) / (float)fine,
+            // Uniform in (cos theta, phi) about the axis: d omega = d cos d phi.
+            float ct = cap_cos + (1.0f - cap_cos) * ((float)j + 0.5f) / (float)fine,
                   phi = 2.0f * DRIFT_PI * ((float)i + 0.5f) / (float)fine;
             float st = sqrtf(1.0f - ct * ct);
-            drift_vec3 w = drift_vec3_make(st * cosf(phi), st * sinf(phi), ct);
-            double f =
-                (double)lobe(w, user) * (double)ct * 2.0 * (double)DRIFT_PI / ((double)fine * fine);
+            drift_vec3 w = drift_frame_to_world(
+                &warp->cap, drift_vec3_make(st * cosf(phi), st * sinf(phi), ct));
+            double f = w.z > 0.0f ? (double)lobe(w, user) * (double)w.z * 2.0 * (double)DRIFT_PI *
+                                        (double)(1.0f - cap_cos) / ((double)fine * fine)
+                                  : 0.0;
             rho += f;
             expected[(j * BINS / fine) * BINS + i * BINS / fine] += f;
         }
@@ -129,14 +140,17 @@ static void check_warp_distribution(drift__micro_lobe_fn lobe, const void *user,
     for (int j = 0; j < grid; ++j) {
         for (int i = 0; i < grid; ++i) {
             float pdf;
-            drift_vec3 w = drift__micro_warp_forward(
-                warp,
-                drift_vec2_make(((float)i + 0.5f) / (float)grid, ((float)j + 0.5f) / (float)grid),
-                &pdf);
+            drift_vec3 w = drift_frame_to_local(
+                &warp->cap,
+                drift__micro_warp_forward(warp,
+                                          drift_vec2_make(((float)i + 0.5f) / (float)grid,
+                                                          ((float)j + 0.5f) / (float)grid),
+                                          &pdf));
             float phi = atan2f(w.y, w.x);
             phi = phi < 0.0f ? phi + 2.0f * DRIFT_PI : phi;
-            int bt = (int)(w.z * BINS), bp = (int)(phi / (2.0f * DRIFT_PI) * BINS);
-            bt = bt >= BINS ? BINS - 1 : bt;
+            int bt = (int)((w.z - cap_cos) / (1.0f - cap_cos) * BINS),
+                bp = (int)(phi / (2.0f * DRIFT_PI) * BINS);
+            bt = bt >= BINS ? BINS - 1 : (bt < 0 ? 0 : bt);
             bp = bp >= BINS ? BINS - 1 : bp;
             observed[bt * BINS + bp] += 1.0 / (grid * grid);
         }
@@ -168,14 +182,27 @@ static float diffuse_lobe(drift_vec3 omega, const void *user)
 static void test_warp_is_distribution_correct(void **state)
 {
     (void)state;
-    check_warp_distribution(diffuse_lobe, NULL, "diffuse");
+    drift_vec3 z = drift_vec3_make(0.0f, 0.0f, 1.0f);
+    check_warp_distribution(diffuse_lobe, NULL, 1.0f, z, "diffuse");
     float exponents[3] = { 1.0f, 5.0f, 20.0f };
     for (int i = 0; i < 3; ++i) {
         phong_slice slice = { exponents[i],
                               drift_vec3_normalize(drift_vec3_make(0.4f, 0.2f, 0.9f)) };
         char what[32];
         snprintf(what, sizeof what, "phong %g", (double)exponents[i]);
-        check_warp_distribution(phong_lobe, &slice, what);
+        check_warp_distribution(phong_lobe, &slice, 1.0f, z, what);
+    }
+    // The sharp lobes of the glossy scenes (60-200) through the cap around the lobe's axis,
+    // one of them grazing (the cap cut by the horizon).
+    float sharp[3] = { 20.0f, 60.0f, 200.0f };
+    for (int i = 0; i < 3; ++i) {
+        phong_slice slice = { sharp[i], drift_vec3_normalize(
+                                            drift_vec3_make(0.4f, 0.2f, i == 1 ? 0.1f : 0.9f)) };
+        char what[32];
+        snprintf(what, sizeof what, "phong %g, cap", (double)sharp[i]);
+        assert_true(drift__micro_phong_cap(sharp[i]) < 1.0f);
+        check_warp_distribution(phong_lobe, &slice, drift__micro_phong_cap(sharp[i]), slice.mirror,
+                                what);
     }
 }
 
@@ -209,13 +236,17 @@ static void test_white_furnace(void **state)
     drift__micro_warp *warp = malloc(sizeof *warp);
     drift__micro_pixels *pixels = malloc(sizeof *pixels);
     int32_t nodes[DRIFT_MICRO_MAX_K * DRIFT_MICRO_MAX_K];
-    for (int lobe = 0; lobe < 3; ++lobe) {
-        phong_slice slice = { lobe == 1 ? 5.0f : 20.0f,
+    for (int lobe = 0; lobe < 4; ++lobe) {
+        phong_slice slice = { lobe == 1 ? 5.0f : (lobe == 2 ? 20.0f : 200.0f),
                               drift_vec3_normalize(drift_vec3_make(0.4f, 0.2f, 0.9f)) };
         if (lobe == 0) {
             drift__micro_warp_build_diffuse(warp, 32);
-        } else {
+        } else if (lobe < 3) {
             drift__micro_warp_build(warp, 32, phong_lobe, &slice);
+        } else {
+            // Phong 200 through the cap around its axis (the glossy gathers' warp).
+            drift__micro_warp_build_cap(warp, 32, slice.mirror, drift__micro_phong_cap(200.0f),
+                                        phong_lobe, &slice);
         }
         drift__micro_pixels_make(pixels, warp, 16);
         // At the centre, and near the bottom looking up (near leaves bigger than their pixel).
@@ -225,8 +256,9 @@ static void test_white_furnace(void **state)
                 where ? drift_vec3_make(0.0f, 1.0f, 0.0f)
                       : drift_vec3_normalize(drift_vec3_make(0.2f, 1.0f, 0.1f)));
             for (int cast = 0; cast < 2; ++cast) {
-                drift__micro_gather_desc desc = { &tree, cast ? r.accel : NULL, warp, pixels,
-                                                  1.0f };
+                drift__micro_gather_desc desc = {
+                    &tree, cast ? r.accel : NULL, warp, pixels, 1.0f, NULL, 0
+                };
                 drift__micro_gather_stats st = { 0 };
                 drift_vec3 mean = drift__micro_gather(&desc, p, &frame, frame.z, nodes, &st, NULL);
                 int empty = 0;
@@ -240,7 +272,7 @@ static void test_white_furnace(void **state)
                 if (cast) {
                     assert_int_equal(empty, 0);
                     assert_float_equal(mean.y, 2.0f, 0.02f);
-                } else {
+                } else if (lobe < 3) {
                     assert_true(empty > 0);
                     assert_true(mean.y < 1.9f);
                 }
@@ -326,7 +358,7 @@ static void test_cut_is_correct_and_sublinear(void **state)
         drift_points *points;
         drift__micro_tree tree;
         make_tree(&r, counts[c], &points, &tree);
-        drift__micro_gather_desc desc = { &tree, NULL, warp, pixels, 1.0f };
+        drift__micro_gather_desc desc = { &tree, NULL, warp, pixels, 1.0f, NULL, 0 };
         drift__micro_gather_stats st = { 0 };
         bool ok = true;
         int gathers = 0;
