@@ -86,7 +86,7 @@ drift_result drift__micro_tree_create(drift_context *ctx, const drift_points *po
     tree->back = drift_alloc(ctx, m * sizeof *tree->back);
     tree->cube = drift_alloc(ctx, 6 * m * sizeof *tree->cube);
     tree->cube_weight = drift_alloc(ctx, 6 * m * sizeof *tree->cube_weight);
-    tree->covered = drift_alloc(ctx, n * sizeof *tree->covered);
+    tree->covered = drift_alloc(ctx, m * sizeof *tree->covered);
     if (!tree->point_of || !tree->center || !tree->radius || !tree->axis || !tree->cone_cos ||
         !tree->albedo || !tree->front || !tree->back || !tree->cube || !tree->cube_weight ||
         !tree->covered) {
@@ -102,7 +102,7 @@ drift_result drift__micro_tree_create(drift_context *ctx, const drift_points *po
     memset(tree->back, 0, m * sizeof *tree->back);
     memset(tree->cube, 0, 6 * m * sizeof *tree->cube);
     memset(tree->cube_weight, 0, 6 * m * sizeof *tree->cube_weight);
-    memset(tree->covered, 0, n * sizeof *tree->covered);
+    memset(tree->covered, 0, m * sizeof *tree->covered);
     drift__micro_tree_refit(tree, points);
     return DRIFT_OK;
 }
@@ -236,7 +236,7 @@ static void cover_range(size_t begin, size_t end, int thread, void *user)
                 bits |= (uint8_t)(1u << side);
             }
         }
-        tree->covered[j] = bits;
+        tree->covered[node] = bits == 3u ? 7u : bits;
     }
 }
 
@@ -244,6 +244,9 @@ void drift__micro_tree_cover(drift_context *ctx, drift__micro_tree *tree, const 
 {
     cover_job job = { tree, accel };
     drift_parallel_for(ctx, tree->leaf_count, 1024, cover_range, &job);
+    for (uint32_t i = tree->leaf_count - 1; i-- > 0;) {
+        tree->covered[i] = (uint8_t)(tree->covered[2 * i + 1] & tree->covered[2 * i + 2] & 4u);
+    }
 }
 
 void drift__micro_tree_pull(drift__micro_tree *tree)
@@ -256,8 +259,8 @@ void drift__micro_tree_pull(drift__micro_tree *tree)
         cube_weights(drift_vec3_neg(tree->axis[node]), wb);
         // A covered side is seen by nothing: it takes no part in what its ancestors show.
         for (int k = 0; k < 6; ++k) {
-            wf[k] = (tree->covered[j] & 1u) ? 0.0f : wf[k];
-            wb[k] = (tree->covered[j] & 2u) ? 0.0f : wb[k];
+            wf[k] = (tree->covered[node] & 1u) ? 0.0f : wf[k];
+            wb[k] = (tree->covered[node] & 2u) ? 0.0f : wb[k];
         }
         for (int k = 0; k < 6; ++k) {
             tree->cube[6 * node + k] = drift_vec3_add(drift_vec3_scale(tree->front[node], wf[k]),
@@ -305,6 +308,22 @@ drift_vec3 drift__micro_tree_radiance(const drift__micro_tree *tree, uint32_t i,
     return all_weight > 0.0f ? drift_vec3_scale(all, 1.0f / all_weight) : all;
 }
 
+bool drift__micro_tree_seen(const drift__micro_tree *tree, uint32_t i, drift_vec3 toward)
+{
+    float len = drift_vec3_length(toward);
+    if (!(len > 0.0f)) {
+        return true;
+    }
+    float c[6];
+    cube_weights(drift_vec3_scale(toward, 1.0f / len), c);
+    const float *w = tree->cube_weight + 6 * (size_t)i;
+    float all = w[0] + w[1] + w[2] + w[3] + w[4] + w[5], seen = 0.0f;
+    for (int k = 0; k < 6; ++k) {
+        seen += c[k] * w[k];
+    }
+    return all <= 0.0f || seen > 1e-6f * all;
+}
+
 // --- NEAREST LEAF ---
 
 uint32_t drift__micro_tree_nearest_leaf(const drift__micro_tree *tree, drift_vec3 x)
@@ -337,7 +356,7 @@ uint32_t drift__micro_tree_nearest_leaf_seen(const drift__micro_tree *tree, drif
                 p ? drift_vec3_dot(tree->axis[i], drift_vec3_sub(*p, tree->center[i])) : 0.0f;
             if (p && (drift_vec3_dot(drift_vec3_sub(tree->center[i], *p), n) <= 0.0f ||
                       fabsf(drift_vec3_dot(tree->axis[i], ng)) < 0.5f ||
-                      (tree->covered[i - (leaves - 1)] & (facing >= 0.0f ? 1u : 2u)))) {
+                      (tree->covered[i] & (facing >= 0.0f ? 1u : 2u)))) {
                 continue;
             }
             if (d2 < best_d2) {

@@ -30,8 +30,9 @@ typedef struct drift__micro_tree {
     drift_vec3 *cube;   // 6 a node: the radiance-weighted sums along +x, -x, +y, -y, +z, -z
     float *cube_weight; // 6 a node: the weights' sums
     float leaf_radius;  // r = sqrt(A / (pi n)): the disc one point stands for
-    uint8_t *covered;   // leaf_count: bit 0 the front side, bit 1 the back lies under
-                        // another surface (a floor laid over a floor): left out of the pull
+    uint8_t *covered;   // per node: bit 0 (leaves) the front side, bit 1 the back lies under
+                        // another surface (a floor laid over a floor), left out of the pull;
+                        // bit 2 every side of the node's leaves does (the gathers cull it)
 } drift__micro_tree;
 
 // Orders the points by a median-split BSP along the largest extent (O(n log n)) and allocates
@@ -53,6 +54,9 @@ void drift__micro_tree_cover(drift_context *ctx, drift__micro_tree *tree, const 
 void drift__micro_tree_pull(drift__micro_tree *tree);
 // The radiance node i sends toward `toward` (any length; from the node to the viewer).
 drift_vec3 drift__micro_tree_radiance(const drift__micro_tree *tree, uint32_t i, drift_vec3 toward);
+// Whether node i shows any leaf side toward `toward` (from the node to the viewer): false
+// when all that faces that way is covered. A node never pulled (no weights) counts as seen.
+bool drift__micro_tree_seen(const drift__micro_tree *tree, uint32_t i, drift_vec3 toward);
 // The leaf nearest to x (branch and bound over the spheres).
 uint32_t drift__micro_tree_nearest_leaf(const drift__micro_tree *tree, drift_vec3 x);
 // The same among the leaves a gather point p (normal n) can see at a ray's hit x of geometric

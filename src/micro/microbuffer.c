@@ -87,6 +87,9 @@ drift_vec3 drift__micro_gather(const drift__micro_gather_desc *desc, drift_vec3 
         if (local.z < -r) {
             continue; // entirely below the tangent plane
         }
+        if (tree->covered[i] & 4u) {
+            continue; // every side of its leaves lies under another surface
+        }
         bool leaf = i >= n - 1;
         float dist = drift_vec3_length(d);
         float cos_c = capped && dist > 0.0f ? drift_vec3_dot(local, warp->cap.z) / dist : 1.0f;
@@ -127,6 +130,9 @@ drift_vec3 drift__micro_gather(const drift__micro_gather_desc *desc, drift_vec3 
         }
         if (splat_ok && omega_node > desc->cut_scale * pixels->omega[pix]) {
             *splat_ok = false;
+        }
+        if (!drift__micro_tree_seen(tree, i, drift_vec3_neg(d))) {
+            continue; // what it turns toward p lies under another surface
         }
         // The splat: every pixel whose centre direction the node's disc covers, its own and
         // its neighbours' (coverage point-sampled at the pixel centres, as rays would: a
