@@ -11,10 +11,11 @@
 //      ray-traced; pulled up the tree as area-weighted means (one bounce).
 //   3. Gathering (microbuffer.c, warp.c): per gather point a depth-first cut of the tree by
 //      solid angle, each node of the cut splatted into the pixel of the micro-buffer its
-//      direction warps to (depth-tested); then ray casting (Embree) of the pixels a leaf
-//      bigger than its pixel may cover, and of the pixels left empty; the reflected radiance
-//      is rho times the mean of the micro-buffer, with the pixels importance-warped by
-//      f_r cos / rho through tabulated 2-D CDFs (the diffuse lobe's warp is the Nusselt map).
+//      direction warps to (depth-tested); then one ray a pixel (Embree), which decides what
+//      the pixel sees (a splat stays where the ray hits inside its node); the reflected
+//      radiance is rho times the mean of the micro-buffer, with the pixels importance-warped
+//      by f_r cos / rho through tabulated 2-D CDFs (the diffuse lobe's warp is the Nusselt
+//      map; a sharp glossy lobe's covers only the cap around its axis).
 //   4. Upsampling (micro.c): gathers at every pixel, 1/4 or 1/16 of them; a bilateral
 //      (depth- and normal-aware) upsampling fills the rest.
 //
