@@ -18,6 +18,7 @@ struct drift_micro {
     drift_image result, incident, gathers;
     drift_image coarse_in, coarse_out; // at the gather points: mean radiance, and times rho
     drift_micro_stats stats;
+    bool any_glossy; // a material with a non-delta glossy lobe: the hits' on-the-fly light
 };
 
 static const char *const stage_names[DRIFT_MICRO_STAGE_COUNT] = { "hierarchy", "lighting", "gather",
@@ -91,6 +92,10 @@ drift_result drift_micro_create(drift_context *ctx, const drift_scene *scene,
     m->scene = scene;
     m->accel = accel;
     m->params = p;
+    for (uint32_t i = 0; i < scene->material_count; ++i) {
+        const drift_material *mat = &scene->materials[i];
+        m->any_glossy |= mat->type != DRIFT_MATERIAL_MIRROR && !drift_vec3_is_zero(mat->specular);
+    }
     drift__micro_warp_build_diffuse(&m->diffuse_warp, p.warp_size);
     drift__micro_pixels_make(&m->diffuse_pixels, &m->diffuse_warp, p.buffer_size);
     drift_points_desc pd = { .count = p.point_count, .seed = p.seed };
@@ -186,7 +191,7 @@ static drift_vec3 gather_pixel(const gather_job *job, int32_t x, int32_t y,
         .warp = &m->diffuse_warp,
         .pixels = &m->diffuse_pixels,
         .cut_scale = m->params.cut_scale,
-        .scene = m->scene,
+        .scene = m->any_glossy ? m->scene : NULL,
         .seed = drift_hash_combine(
             drift_hash_combine(drift_hash_combine(m->params.seed, DRIFT_MICRO_GLOSSY_STREAM),
                                (uint32_t)x),
