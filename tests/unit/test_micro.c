@@ -507,6 +507,31 @@ static void test_against_path_tracer(void **state)
     test_rig_destroy(&r);
 }
 
+// Spec §4.5 test 5 for the Phong lobe: on the glossy Cornell box (floor Phong 200, bunny 60,
+// dragon 120; the glossy floor laid 0.5 mm over the box's own) every-pixel glossy gathers
+// with the default 2^16 points match the path tracer's first-bounce glossy light (SPECULAR
+// at max depth 2) in the mean within 8% and per pixel within NRMS 0.8 (measured 0.64 and
+// 0.943 here, 0.55-0.8 over four seeds, against a 2048-spp reference whose own noise is
+// about 0.25; 0.95 and 0.891 without the covered floor's points left out, docs/micro.md).
+static void test_glossy_against_path_tracer(void **state)
+{
+    (void)state;
+    test_rig r = test_rig_load(2, "scenes/cornell-glossy/cornell_glossy.json", 16);
+    drift_pt *pt = NULL;
+    drift_image ref = test_rig_render_pt(&r, DRIFT_PT_COMPONENT_SPECULAR, 2, 2048, 99, &pt);
+    drift_micro *m =
+        render_micro(&r, &(drift_micro_params){ .point_count = 65536 }, DRIFT_MICRO_LOBE_GLOSSY);
+    double e = test_nrmse(r.ctx, &ref, drift_micro_result(m));
+    double ratio =
+        drift_image_mean_luminance(drift_micro_result(m)) / drift_image_mean_luminance(&ref);
+    printf("glossy: nrmse %.4f, mean ratio %.4f\n", e, ratio);
+    assert_true(ratio > 0.92 && ratio < 1.08);
+    assert_true(e < 0.8);
+    drift_micro_destroy(m);
+    drift_pt_destroy(pt);
+    test_rig_destroy(&r);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -517,6 +542,7 @@ int main(void)
         cmocka_unit_test(test_covered_leaves_left_out),
         cmocka_unit_test(test_cut_is_correct_and_sublinear),
         cmocka_unit_test(test_against_path_tracer),
+        cmocka_unit_test(test_glossy_against_path_tracer),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
