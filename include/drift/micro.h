@@ -13,10 +13,11 @@
 //      the tree as area-weighted means.
 //   3. Gathering (microbuffer.c, warp.c): per gather point a depth-first cut of the tree by
 //      solid angle, each node of the cut splatted into the pixel of the micro-buffer its
-//      direction warps to (depth-tested); then ray casting (Embree) of the pixels a leaf
-//      bigger than its pixel may cover, and of the pixels left empty; the reflected radiance
-//      is rho times the mean of the micro-buffer, with the pixels importance-warped by
-//      f_r cos / rho through tabulated 2-D CDFs (the diffuse lobe's warp is the Nusselt map).
+//      direction warps to (depth-tested); then one ray a pixel (Embree), which decides what
+//      the pixel sees (a splat stays where the ray hits inside its node); the reflected
+//      radiance is rho times the mean of the micro-buffer, with the pixels importance-warped
+//      by f_r cos / rho through tabulated 2-D CDFs (the diffuse lobe's warp is the Nusselt
+//      map; a sharp glossy lobe's covers only the cap around its axis).
 //   4. Upsampling (micro.c): gathers at every pixel, 1/4 or 1/16 of them; a bilateral
 //      (depth- and normal-aware) upsampling fills the rest.
 //
@@ -47,9 +48,11 @@ extern "C" {
 
 // Sampler streams: the light samples of leaf i, drift_sampler_make(drift_hash_combine(seed,
 // DRIFT_MICRO_LIGHT_STREAM), 0, i); the frame rotation of gather pixel (x, y) hashes the same
-// seed with DRIFT_MICRO_JITTER_STREAM. The scene points use DRIFT_POINTS_STREAM.
+// seed with DRIFT_MICRO_JITTER_STREAM, and the light samples of its rays' glossy hits with
+// DRIFT_MICRO_GLOSSY_STREAM. The scene points use DRIFT_POINTS_STREAM.
 #define DRIFT_MICRO_LIGHT_STREAM  0x6d6c6974u // "mlit"
 #define DRIFT_MICRO_JITTER_STREAM 0x6d6a6974u // "mjit"
+#define DRIFT_MICRO_GLOSSY_STREAM 0x6d676c73u // "mgls"
 
 // Which lobe of the gather point's BSDF the micro-buffer integrates.
 typedef enum drift_micro_lobe {
@@ -124,8 +127,8 @@ typedef struct drift_micro_stats {
     uint64_t nodes_visited; // nodes the traversals touched
     uint64_t splats;        // nodes written into a micro-buffer pixel
     uint64_t post_leaves;   // leaves put on post-traversal lists
-    uint64_t cast_gathers;  // gathers that cast rays (a post list or empty pixels)
-    uint64_t rays;          // post-traversal and light rays
+    uint64_t cast_gathers;  // gathers that cast rays (every one unless no_ray_casting)
+    uint64_t rays;          // gather rays (one a micro-buffer pixel) and light rays
     uint64_t empty_pixels;  // micro-buffer pixels left without a node (holes and misses)
     uint64_t fallbacks;     // full-resolution gathers where the upsampling had no weight
     // Lighting the points, inside DRIFT_MICRO_STAGE_LIGHTING: the direct light, the radiosity

@@ -86,8 +86,10 @@ drift_result drift__micro_tree_create(drift_context *ctx, const drift_points *po
     tree->back = drift_alloc(ctx, m * sizeof *tree->back);
     tree->cube = drift_alloc(ctx, 6 * m * sizeof *tree->cube);
     tree->cube_weight = drift_alloc(ctx, 6 * m * sizeof *tree->cube_weight);
+    tree->covered = drift_alloc(ctx, m * sizeof *tree->covered);
     if (!tree->point_of || !tree->center || !tree->radius || !tree->axis || !tree->cone_cos ||
-        !tree->albedo || !tree->front || !tree->back || !tree->cube || !tree->cube_weight) {
+        !tree->albedo || !tree->front || !tree->back || !tree->cube || !tree->cube_weight ||
+        !tree->covered) {
         drift__micro_tree_destroy(ctx, tree);
         return DRIFT_ERR_OUT_OF_MEMORY;
     }
@@ -100,6 +102,7 @@ drift_result drift__micro_tree_create(drift_context *ctx, const drift_points *po
     memset(tree->back, 0, m * sizeof *tree->back);
     memset(tree->cube, 0, 6 * m * sizeof *tree->cube);
     memset(tree->cube_weight, 0, 6 * m * sizeof *tree->cube_weight);
+    memset(tree->covered, 0, m * sizeof *tree->covered);
     drift__micro_tree_refit(tree, points);
     return DRIFT_OK;
 }
@@ -116,6 +119,7 @@ void drift__micro_tree_destroy(drift_context *ctx, drift__micro_tree *tree)
     drift_free(ctx, tree->back);
     drift_free(ctx, tree->cube);
     drift_free(ctx, tree->cube_weight);
+    drift_free(ctx, tree->covered);
     memset(tree, 0, sizeof *tree);
 }
 
@@ -208,6 +212,43 @@ static void cube_weights(drift_vec3 m, float w[6])
     }
 }
 
+// --- COVERED SIDES ---
+
+typedef struct cover_job {
+    drift__micro_tree *tree;
+    const drift_accel *accel;
+} cover_job;
+
+static void cover_range(size_t begin, size_t end, int thread, void *user)
+{
+    (void)thread;
+    cover_job *job = user;
+    drift__micro_tree *tree = job->tree;
+    uint32_t n = tree->leaf_count;
+    float reach = 0.5f * tree->leaf_radius;
+    for (size_t j = begin; j < end; ++j) {
+        uint32_t node = n - 1 + (uint32_t)j;
+        uint8_t bits = 0;
+        for (int side = 0; side < 2; ++side) {
+            drift_vec3 dir = side ? drift_vec3_neg(tree->axis[node]) : tree->axis[node];
+            drift_ray ray = { drift_offset_origin(tree->center[node], dir, dir), 0.0f, dir, reach };
+            if (drift_accel_occluded(job->accel, &ray)) {
+                bits |= (uint8_t)(1u << side);
+            }
+        }
+        tree->covered[node] = bits == 3u ? 7u : bits;
+    }
+}
+
+void drift__micro_tree_cover(drift_context *ctx, drift__micro_tree *tree, const drift_accel *accel)
+{
+    cover_job job = { tree, accel };
+    drift_parallel_for(ctx, tree->leaf_count, 1024, cover_range, &job);
+    for (uint32_t i = tree->leaf_count - 1; i-- > 0;) {
+        tree->covered[i] = (uint8_t)(tree->covered[2 * i + 1] & tree->covered[2 * i + 2] & 4u);
+    }
+}
+
 void drift__micro_tree_pull(drift__micro_tree *tree)
 {
     uint32_t n = tree->leaf_count;
@@ -216,6 +257,11 @@ void drift__micro_tree_pull(drift__micro_tree *tree)
         float wf[6], wb[6];
         cube_weights(tree->axis[node], wf);
         cube_weights(drift_vec3_neg(tree->axis[node]), wb);
+        // A covered side is seen by nothing: it takes no part in what its ancestors show.
+        for (int k = 0; k < 6; ++k) {
+            wf[k] = (tree->covered[node] & 1u) ? 0.0f : wf[k];
+            wb[k] = (tree->covered[node] & 2u) ? 0.0f : wb[k];
+        }
         for (int k = 0; k < 6; ++k) {
             tree->cube[6 * node + k] = drift_vec3_add(drift_vec3_scale(tree->front[node], wf[k]),
                                                       drift_vec3_scale(tree->back[node], wb[k]));
@@ -262,11 +308,34 @@ drift_vec3 drift__micro_tree_radiance(const drift__micro_tree *tree, uint32_t i,
     return all_weight > 0.0f ? drift_vec3_scale(all, 1.0f / all_weight) : all;
 }
 
+bool drift__micro_tree_seen(const drift__micro_tree *tree, uint32_t i, drift_vec3 toward)
+{
+    float len = drift_vec3_length(toward);
+    if (!(len > 0.0f)) {
+        return true;
+    }
+    float c[6];
+    cube_weights(drift_vec3_scale(toward, 1.0f / len), c);
+    const float *w = tree->cube_weight + 6 * (size_t)i;
+    float all = w[0] + w[1] + w[2] + w[3] + w[4] + w[5], seen = 0.0f;
+    for (int k = 0; k < 6; ++k) {
+        seen += c[k] * w[k];
+    }
+    return all <= 0.0f || seen > 1e-6f * all;
+}
+
 // --- NEAREST LEAF ---
 
 uint32_t drift__micro_tree_nearest_leaf(const drift__micro_tree *tree, drift_vec3 x)
 {
-    uint32_t n = tree->leaf_count, best = n - 1;
+    return drift__micro_tree_nearest_leaf_seen(tree, x, NULL, drift_vec3_splat(0.0f),
+                                               drift_vec3_splat(0.0f));
+}
+
+uint32_t drift__micro_tree_nearest_leaf_seen(const drift__micro_tree *tree, drift_vec3 x,
+                                             const drift_vec3 *p, drift_vec3 n, drift_vec3 ng)
+{
+    uint32_t leaves = tree->leaf_count, best = leaves - 1;
     float best_d2 = INFINITY;
     uint32_t stack[64];
     int top = 0;
@@ -277,9 +346,19 @@ uint32_t drift__micro_tree_nearest_leaf(const drift__micro_tree *tree, drift_vec
         if (d > 0.0f && d * d >= best_d2) {
             continue;
         }
-        if (i >= n - 1) {
+        if (i >= leaves - 1) {
             drift_vec3 v = drift_vec3_sub(tree->center[i], x);
             float d2 = drift_vec3_dot(v, v);
+            // A leaf behind the gather point's tangent plane, or on a surface turned away
+            // from the hit's, is not what the ray sees: at a contact (a box on the floor)
+            // the nearest leaf may lie under the box, in its shadow.
+            float facing =
+                p ? drift_vec3_dot(tree->axis[i], drift_vec3_sub(*p, tree->center[i])) : 0.0f;
+            if (p && (drift_vec3_dot(drift_vec3_sub(tree->center[i], *p), n) <= 0.0f ||
+                      fabsf(drift_vec3_dot(tree->axis[i], ng)) < 0.5f ||
+                      (tree->covered[i] & (facing >= 0.0f ? 1u : 2u)))) {
+                continue;
+            }
             if (d2 < best_d2) {
                 best_d2 = d2;
                 best = i;

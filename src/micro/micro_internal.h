@@ -30,6 +30,9 @@ typedef struct drift__micro_tree {
     drift_vec3 *cube;   // 6 a node: the radiance-weighted sums along +x, -x, +y, -y, +z, -z
     float *cube_weight; // 6 a node: the weights' sums
     float leaf_radius;  // r = sqrt(A / (pi n)): the disc one point stands for
+    uint8_t *covered;   // per node: bit 0 (leaves) the front side, bit 1 the back lies under
+                        // another surface (a floor laid over a floor), left out of the pull;
+                        // bit 2 every side of the node's leaves does (the gathers cull it)
 } drift__micro_tree;
 
 // Orders the points by a median-split BSP along the largest extent (O(n log n)) and allocates
@@ -40,14 +43,27 @@ void drift__micro_tree_destroy(drift_context *ctx, drift__micro_tree *tree);
 // Leaves from the points' current positions and normals (radius from their current area),
 // then every interior sphere and cone from its children's, bottom-up.
 void drift__micro_tree_refit(drift__micro_tree *tree, const drift_points *points);
+// Marks the leaf sides that another surface covers within half a leaf radius along their
+// normal (drift__micro_tree.covered): such a side is seen by nothing, and a node mixing it
+// with the cover would show the cover's light diluted by its darkness (on cornell-glossy the
+// glossy floor 0.5 mm above the box's own halved the floor's radiance).
+void drift__micro_tree_cover(drift_context *ctx, drift__micro_tree *tree, const drift_accel *accel);
 // Interior albedo and radiance from the leaves' (equal areas: a complete tree over equal-area
 // points): albedo, front and back the children's means (a child's side that faces its
 // parent's front counts toward the front), the ambient cubes their sums.
 void drift__micro_tree_pull(drift__micro_tree *tree);
 // The radiance node i sends toward `toward` (any length; from the node to the viewer).
 drift_vec3 drift__micro_tree_radiance(const drift__micro_tree *tree, uint32_t i, drift_vec3 toward);
+// Whether node i shows any leaf side toward `toward` (from the node to the viewer): false
+// when all that faces that way is covered. A node never pulled (no weights) counts as seen.
+bool drift__micro_tree_seen(const drift__micro_tree *tree, uint32_t i, drift_vec3 toward);
 // The leaf nearest to x (branch and bound over the spheres).
 uint32_t drift__micro_tree_nearest_leaf(const drift__micro_tree *tree, drift_vec3 x);
+// The same among the leaves a gather point p (normal n) can see at a ray's hit x of geometric
+// normal ng: in front of p's tangent plane and on a surface turned like the hit's (|axis . ng|
+// >= 0.5). p NULL: every leaf. Falls back to the last leaf when none qualifies: check.
+uint32_t drift__micro_tree_nearest_leaf_seen(const drift__micro_tree *tree, drift_vec3 x,
+                                             const drift_vec3 *p, drift_vec3 n, drift_vec3 ng);
 
 // --- LIGHTING (§6.4, one bounce) ---
 
@@ -140,19 +156,33 @@ void drift__micro_photons_light_leaves(drift_context *ctx, const drift__micro_ph
 // parametrised by (u, t) in [-1, 1]^2 with omega_x = u, omega_y = t sqrt(1 - u^2) so that the
 // table has no cells outside the disc; density f_r(omega) sqrt(1 - u^2) (f_r cos d omega =
 // f_r d omega_x d omega_y). The marginal CDF runs over u, the conditional ones over t.
+// A sharp lobe would cover a few cells of the disc: its table may instead cover only a cap
+// of directions around the lobe's axis (cap.z, local), the disc scaled by `scale` = sin of
+// the cap's half angle (omega_x = scale u, ... in the cap's frame), density f_r cos dω over
+// (u, t).
 #define DRIFT_MICRO_MAX_WARP 128
 
 typedef struct drift__micro_warp {
     int32_t n;                                // table cells a side
     float marginal[DRIFT_MICRO_MAX_WARP + 1]; // over the n columns of u, unnormalised
     float conditional[DRIFT_MICRO_MAX_WARP * (DRIFT_MICRO_MAX_WARP + 1)]; // per column, over t
-    float rho; // integral of the slice: its directional albedo
+    float rho;       // integral of the slice: its directional albedo
+    float scale;     // 1: the whole hemisphere; < 1: the cap of half angle asin(scale)
+    drift_frame cap; // the cap's frame in local coordinates (identity for the hemisphere)
 } drift__micro_warp;
 
-// Tabulates the slice `lobe(omega, user)` (omega unit, local, z >= 0) and its CDFs.
+// Tabulates the slice `lobe(omega, user)` (omega unit, local, z >= 0; f_r without the
+// cosine) and its CDFs over the hemisphere.
 typedef float (*drift__micro_lobe_fn)(drift_vec3 omega, const void *user);
 void drift__micro_warp_build(drift__micro_warp *warp, int32_t n, drift__micro_lobe_fn lobe,
                              const void *user);
+// The same over the cap of directions within asin(scale) of `axis` (unit, local, z > 0):
+// for a lobe with (almost) all of f_r cos there. scale >= 1 is the hemisphere.
+void drift__micro_warp_build_cap(drift__micro_warp *warp, int32_t n, drift_vec3 axis, float scale,
+                                 drift__micro_lobe_fn lobe, const void *user);
+// The half angle's sine of the cap around a Phong lobe of exponent `exponent` that holds all
+// but 10^-3 of its integral (cos^(n+1) of the angle), or 1 (the hemisphere) past 70 degrees.
+float drift__micro_phong_cap(float exponent);
 // The cosine lobe 1/pi (the Nusselt map).
 void drift__micro_warp_build_diffuse(drift__micro_warp *warp, int32_t n);
 // Phi: a point of [0, 1]^2 -> a unit local direction; *out_pdf gets p_omega = f_r cos / rho
@@ -182,6 +212,11 @@ typedef struct drift__micro_gather_desc {
     const drift__micro_warp *warp;
     const drift__micro_pixels *pixels;
     float cut_scale;
+    // Non-NULL: the glossy lobes of the surfaces the rays hit reflect the direct light toward
+    // p on the fly (one light sample a pixel, sampler key `seed`), the thesis's on-the-fly
+    // radiance for non-diffuse nodes; the nodes carry only the diffuse lobe's.
+    const drift_scene *scene;
+    uint32_t seed;
 } drift__micro_gather_desc;
 
 // What one gather did.

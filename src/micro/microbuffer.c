@@ -1,14 +1,58 @@
 // One gather into a micro-buffer (thesis §6.2.2): a depth-first cut of the point hierarchy
-// by solid angle, each node of the cut splatted into the pixel its direction warps to
-// (nearest first), the leaves bigger than their pixel kept on a post-traversal list; then
-// ray casting against the scene's triangles (Embree) over the pixels those leaves may cover,
-// and over the pixels left empty, so that the buffer is watertight; then the mean.
+// by solid angle, each node of the cut splatted into the pixels its disc covers (nearest
+// first), the leaves bigger than their pixel kept on a post-traversal list; then one ray a
+// pixel against the scene's triangles (Embree), which decides what each pixel sees, so that
+// the buffer is watertight and free of the splats' silhouette errors; then the mean.
 #include "micro/micro_internal.h"
 
 #include <math.h>
 
 #define NO_NODE (-1)
 #define BLOCKED (-2) // a ray hit geometry without points (a light's shape): radiance 0
+
+// The direct light the glossy lobe of the surface a ray hit reflects back along it (toward
+// the gather point), from one power-proportional light sample with a shadow ray; 0 for a
+// surface without a glossy lobe or a mirror (a delta lobe: the light's image, not gathered).
+static drift_vec3 glossy_direct(const drift__micro_gather_desc *desc, const drift_ray *ray,
+                                const drift_hit *hit, drift_sampler *s, uint64_t *rays)
+{
+    const drift_scene *scene = desc->scene;
+    drift_surface surf = drift_scene_surface(scene, ray, hit);
+    drift_vec3 zero = drift_vec3_splat(0.0f);
+    if (surf.material == DRIFT_INVALID_INDEX) {
+        return zero;
+    }
+    drift_bsdf bsdf = drift_bsdf_make(scene, &surf);
+    if (drift_vec3_is_zero(bsdf.specular) || drift_bsdf_is_delta(&bsdf)) {
+        return zero;
+    }
+    float u_pick = drift_sampler_next1(s);
+    drift_vec2 u = drift_sampler_next2(s);
+    float pmf = 0.0f;
+    uint32_t light = drift_scene_pick_light(scene, u_pick, &pmf);
+    if (light == DRIFT_INVALID_INDEX || !(pmf > 0.0f)) {
+        return zero;
+    }
+    drift_light_sample ls = drift_light_sample_li(scene, light, surf.position, u);
+    float cos_i = drift_vec3_dot(ls.wi, surf.ns);
+    if (!(ls.pdf > 0.0f) || cos_i <= 0.0f || drift_vec3_is_zero(ls.radiance)) {
+        return zero;
+    }
+    drift_vec3 diffuse, glossy;
+    drift_bsdf_eval_lobes(&bsdf, drift_vec3_neg(ray->dir), ls.wi, &diffuse, &glossy);
+    if (drift_vec3_is_zero(glossy)) {
+        return zero;
+    }
+    drift_ray shadow = { .origin = drift_offset_origin(surf.position, surf.ng, ls.wi),
+                         .dir = ls.wi,
+                         .tmin = 0.0f,
+                         .tmax = isfinite(ls.distance) ? ls.distance * (1.0f - 1e-4f) : INFINITY };
+    (*rays)++;
+    if (drift_accel_occluded(desc->accel, &shadow)) {
+        return zero;
+    }
+    return drift_vec3_scale(drift_vec3_mul(glossy, ls.radiance), cos_i / (pmf * ls.pdf));
+}
 
 drift_vec3 drift__micro_gather(const drift__micro_gather_desc *desc, drift_vec3 p,
                                const drift_frame *frame, drift_vec3 ng, int32_t *out_node,
@@ -26,6 +70,11 @@ drift_vec3 drift__micro_gather(const drift__micro_gather_desc *desc, drift_vec3 
     }
     uint32_t post = 0;
     stats->gathers++;
+    // A warp over a cap (a sharp glossy lobe): nodes wholly outside it are culled, and only
+    // those whose centre lies in it have a pixel.
+    const drift__micro_warp *warp = desc->warp;
+    bool capped = warp->scale < 1.0f;
+    float cap_cos = sqrtf(fmaxf(1.0f - warp->scale * warp->scale, 0.0f));
     uint32_t stack[96];
     int top = 0;
     stack[top++] = 0;
@@ -38,8 +87,19 @@ drift_vec3 drift__micro_gather(const drift__micro_gather_desc *desc, drift_vec3 
         if (local.z < -r) {
             continue; // entirely below the tangent plane
         }
+        if (tree->covered[i] & 4u) {
+            continue; // every side of its leaves lies under another surface
+        }
         bool leaf = i >= n - 1;
         float dist = drift_vec3_length(d);
+        float cos_c = capped && dist > 0.0f ? drift_vec3_dot(local, warp->cap.z) / dist : 1.0f;
+        if (capped && dist > r) {
+            float sin_r = r / dist, cos_r = sqrtf(fmaxf(1.0f - sin_r * sin_r, 0.0f));
+            float sin_c = sqrtf(fmaxf(1.0f - cos_c * cos_c, 0.0f));
+            if (cos_c < cos_r && cos_c * cos_r + sin_c * sin_r < cap_cos) {
+                continue; // its nearest direction to the axis is outside the cap
+            }
+        }
         // A flat node whose plane holds p is seen edge-on from it (the floor around a gather
         // point on the floor): it covers no pixel, and refining it would reach every leaf.
         if (tree->cone_cos[i] >= 0.99995f &&
@@ -48,7 +108,7 @@ drift_vec3 drift__micro_gather(const drift__micro_gather_desc *desc, drift_vec3 
         }
         float omega_node = dist > r ? DRIFT_PI * r * r / (dist * dist) : INFINITY;
         int32_t pix = -1;
-        if (local.z > 0.0f && dist > r) {
+        if (local.z > 0.0f && dist > r && cos_c >= cap_cos) {
             drift_vec2 xy =
                 drift__micro_warp_inverse(desc->warp, drift_vec3_scale(local, 1.0f / dist));
             int32_t px = (int32_t)drift_clampf(floorf(xy.x * (float)k), 0.0f, (float)(k - 1));
@@ -70,6 +130,9 @@ drift_vec3 drift__micro_gather(const drift__micro_gather_desc *desc, drift_vec3 
         }
         if (splat_ok && omega_node > desc->cut_scale * pixels->omega[pix]) {
             *splat_ok = false;
+        }
+        if (!drift__micro_tree_seen(tree, i, drift_vec3_neg(d))) {
+            continue; // what it turns toward p lies under another surface
         }
         // The splat: every pixel whose centre direction the node's disc covers, its own and
         // its neighbours' (coverage point-sampled at the pixel centres, as rays would: a
@@ -105,21 +168,33 @@ drift_vec3 drift__micro_gather(const drift__micro_gather_desc *desc, drift_vec3 
         }
     }
     stats->post_leaves += post;
+    drift_vec3 on_the_fly = drift_vec3_splat(0.0f);
     if (desc->accel) {
-        // With near leaves every pixel may be theirs; otherwise only the empty ones need rays.
-        bool all = post > 0;
-        bool cast = false;
+        drift_sampler sampler = drift_sampler_make(desc->seed, 0, 0);
+        // Every pixel's ray is cast, not only those a near leaf may cover or no splat did:
+        // the splats alone were biased (docs/micro.md: on the Cornell box's ceiling, which
+        // gathers without near leaves, 10% dark at K = 24), because a splat's disc is only
+        // its node's area in a circle around its centre and at silhouettes (the boxes'
+        // edges, the open front, the light's quad seen edge-on) it covers pixel centres
+        // that see past it. So the ray decides what the pixel's centre sees, and a splat
+        // stays only when the surface hit lies within its node.
+        stats->cast++;
         for (int32_t pix = 0; pix < k2; ++pix) {
-            if (!all && node[pix] != NO_NODE) {
-                continue;
-            }
-            cast = true;
             drift_vec3 dir = drift_frame_to_world(frame, pixels->dir[pix]);
             drift_ray ray = { drift_offset_origin(p, ng, dir), 0.0f, dir, INFINITY };
             drift_hit hit;
             stats->rays++;
-            float stored = node[pix] >= 0 ? depth[pix] - tree->radius[node[pix]] : depth[pix];
-            if (!drift_accel_intersect(desc->accel, &ray, &hit) || !(hit.t < stored)) {
+            if (!drift_accel_intersect(desc->accel, &ray, &hit)) {
+                node[pix] = NO_NODE; // the open scene: nothing there
+                continue;
+            }
+            drift_vec3 x = drift_vec3_fma(ray.origin, dir, hit.t);
+            if (desc->scene && hit.mesh != DRIFT_INVALID_INDEX) {
+                on_the_fly = drift_vec3_add(
+                    on_the_fly, glossy_direct(desc, &ray, &hit, &sampler, &stats->rays));
+            }
+            if (node[pix] >= 0 && drift_vec3_length(drift_vec3_sub(tree->center[node[pix]], x)) <=
+                                      tree->radius[node[pix]]) {
                 continue;
             }
             depth[pix] = hit.t;
@@ -129,8 +204,8 @@ drift_vec3 drift__micro_gather(const drift__micro_gather_desc *desc, drift_vec3 
             }
             // The nearest leaf to the hit, then its largest ancestor that still fits the
             // pixel: the radiance at the pixel's own scale, not one leaf's.
-            drift_vec3 x = drift_vec3_fma(ray.origin, dir, hit.t);
-            uint32_t i = drift__micro_tree_nearest_leaf(tree, x);
+            uint32_t i = drift__micro_tree_nearest_leaf_seen(tree, x, &p, frame->z,
+                                                             drift_vec3_normalize(hit.ng));
             float limit = desc->cut_scale * pixels->omega[pix] * hit.t * hit.t * DRIFT_INV_PI;
             while (i > 0) {
                 uint32_t up = (i - 1) / 2;
@@ -142,7 +217,6 @@ drift_vec3 drift__micro_gather(const drift__micro_gather_desc *desc, drift_vec3 
             }
             node[pix] = (int32_t)i;
         }
-        stats->cast += cast ? 1 : 0;
     }
     drift_vec3 sum = drift_vec3_splat(0.0f);
     for (int32_t pix = 0; pix < k2; ++pix) {
@@ -160,5 +234,5 @@ drift_vec3 drift__micro_gather(const drift__micro_gather_desc *desc, drift_vec3 
         sum = drift_vec3_add(
             sum, drift__micro_tree_radiance(tree, (uint32_t)i, drift_vec3_sub(p, tree->center[i])));
     }
-    return drift_vec3_scale(sum, 1.0f / (float)k2);
+    return drift_vec3_scale(drift_vec3_add(sum, on_the_fly), 1.0f / (float)k2);
 }

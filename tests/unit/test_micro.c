@@ -6,7 +6,7 @@
 // deformation and refit; the cut splats only nodes within their pixel's solid angle and
 // visits grow sub-linearly with the points; every-pixel gathering matches the path tracer's
 // first-bounce diffuse light on the Cornell box (upsampled within 2x of that); no pixel
-// exceeds rho max L; the error shrinks from K = 8 to 16.
+// exceeds rho max L; the error shrinks from K = 8 to 16 to 24.
 #include "drift/accel.h"
 #include "drift/hybrid.h"
 #include "drift/metric.h"
@@ -63,13 +63,18 @@ static void test_warp_round_trip_and_solid_angles(void **state)
     (void)state;
     drift__micro_warp *warp = malloc(sizeof *warp);
     drift__micro_pixels *pixels = malloc(sizeof *pixels);
-    for (int lobe = 0; lobe < 2; ++lobe) {
-        phong_slice slice = { 5.0f, drift_vec3_make(0.0f, 0.0f, 1.0f) };
+    for (int lobe = 0; lobe < 3; ++lobe) {
+        phong_slice slice = { lobe == 2 ? 200.0f : 5.0f,
+                              lobe == 2 ? drift_vec3_normalize(drift_vec3_make(0.3f, -0.2f, 0.9f))
+                                        : drift_vec3_make(0.0f, 0.0f, 1.0f) };
         if (lobe == 0) {
             drift__micro_warp_build_diffuse(warp, 32);
             assert_float_equal(warp->rho, 1.0f, 1e-4f);
-        } else {
+        } else if (lobe == 1) {
             drift__micro_warp_build(warp, 32, phong_lobe, &slice);
+        } else {
+            drift__micro_warp_build_cap(warp, 32, slice.mirror, drift__micro_phong_cap(200.0f),
+                                        phong_lobe, &slice);
         }
         double worst = 0.0;
         for (int j = 0; j < 64; ++j) {
@@ -92,35 +97,41 @@ static void test_warp_round_trip_and_solid_angles(void **state)
         for (int q = 0; q < 24 * 24; ++q) {
             sum += (double)pixels->omega[q];
         }
-        printf("lobe %d: pixels' solid angles sum to %.4f (2 pi = %.4f)\n", lobe, sum,
-               2.0 * (double)DRIFT_PI);
-        assert_true(fabs(sum - 2.0 * (double)DRIFT_PI) <
-                    (lobe == 0 ? 0.02 : 0.1) * 2.0 * (double)DRIFT_PI);
+        // The hemisphere's 2 pi, or the cap's 2 pi (1 - cos).
+        double whole = 2.0 * (double)DRIFT_PI *
+                       (1.0 - sqrt(fmax(1.0 - (double)warp->scale * (double)warp->scale, 0.0)));
+        printf("lobe %d: pixels' solid angles sum to %.4f (expected %.4f)\n", lobe, sum, whole);
+        assert_true(fabs(sum - whole) < (lobe == 0 ? 0.02 : 0.1) * whole);
     }
     free(warp);
     free(pixels);
 }
 
-// Expected share of f_r cos / rho in each of B x B bins of (cos theta, phi), by fine
-// quadrature of the exact lobe; observed: a 128^2 grid through Phi. Their L1 distance is small
-// and rho matches the quadrature's.
+// Expected share of f_r cos / rho in each of B x B bins of (cos theta, phi) about the warp's
+// axis (the normal, or a cap's axis), by fine quadrature of the exact lobe; observed: a 128^2
+// grid through Phi. Their L1 distance is small and rho matches the quadrature's. scale < 1:
+// the warp over the cap of that sine around slice->mirror.
 #define BINS 8
 
-static void check_warp_distribution(drift__micro_lobe_fn lobe, const void *user, const char *what)
+static void check_warp_distribution(drift__micro_lobe_fn lobe, const void *user, float scale,
+                                    drift_vec3 axis, const char *what)
 {
     drift__micro_warp *warp = malloc(sizeof *warp);
-    drift__micro_warp_build(warp, 64, lobe, user);
+    drift__micro_warp_build_cap(warp, 64, axis, scale, lobe, user);
+    float cap_cos = sqrtf(fmaxf(1.0f - warp->scale * warp->scale, 0.0f));
     double expected[BINS * BINS] = { 0 }, observed[BINS * BINS] = { 0 }, rho = 0.0;
     const int fine = 512;
     for (int j = 0; j < fine; ++j) {
         for (int i = 0; i < fine; ++i) {
-            // Uniform in (cos theta, phi): d omega = d cos d phi.
-            float ct = ((float)j + 0.5f) / (float)fine,
+            // Uniform in (cos theta, phi) about the axis: d omega = d cos d phi.
+            float ct = cap_cos + (1.0f - cap_cos) * ((float)j + 0.5f) / (float)fine,
                   phi = 2.0f * DRIFT_PI * ((float)i + 0.5f) / (float)fine;
             float st = sqrtf(1.0f - ct * ct);
-            drift_vec3 w = drift_vec3_make(st * cosf(phi), st * sinf(phi), ct);
-            double f =
-                (double)lobe(w, user) * (double)ct * 2.0 * (double)DRIFT_PI / ((double)fine * fine);
+            drift_vec3 w = drift_frame_to_world(
+                &warp->cap, drift_vec3_make(st * cosf(phi), st * sinf(phi), ct));
+            double f = w.z > 0.0f ? (double)lobe(w, user) * (double)w.z * 2.0 * (double)DRIFT_PI *
+                                        (double)(1.0f - cap_cos) / ((double)fine * fine)
+                                  : 0.0;
             rho += f;
             expected[(j * BINS / fine) * BINS + i * BINS / fine] += f;
         }
@@ -129,14 +140,17 @@ static void check_warp_distribution(drift__micro_lobe_fn lobe, const void *user,
     for (int j = 0; j < grid; ++j) {
         for (int i = 0; i < grid; ++i) {
             float pdf;
-            drift_vec3 w = drift__micro_warp_forward(
-                warp,
-                drift_vec2_make(((float)i + 0.5f) / (float)grid, ((float)j + 0.5f) / (float)grid),
-                &pdf);
+            drift_vec3 w = drift_frame_to_local(
+                &warp->cap,
+                drift__micro_warp_forward(warp,
+                                          drift_vec2_make(((float)i + 0.5f) / (float)grid,
+                                                          ((float)j + 0.5f) / (float)grid),
+                                          &pdf));
             float phi = atan2f(w.y, w.x);
             phi = phi < 0.0f ? phi + 2.0f * DRIFT_PI : phi;
-            int bt = (int)(w.z * BINS), bp = (int)(phi / (2.0f * DRIFT_PI) * BINS);
-            bt = bt >= BINS ? BINS - 1 : bt;
+            int bt = (int)((w.z - cap_cos) / (1.0f - cap_cos) * BINS),
+                bp = (int)(phi / (2.0f * DRIFT_PI) * BINS);
+            bt = bt >= BINS ? BINS - 1 : (bt < 0 ? 0 : bt);
             bp = bp >= BINS ? BINS - 1 : bp;
             observed[bt * BINS + bp] += 1.0 / (grid * grid);
         }
@@ -168,14 +182,27 @@ static float diffuse_lobe(drift_vec3 omega, const void *user)
 static void test_warp_is_distribution_correct(void **state)
 {
     (void)state;
-    check_warp_distribution(diffuse_lobe, NULL, "diffuse");
+    drift_vec3 z = drift_vec3_make(0.0f, 0.0f, 1.0f);
+    check_warp_distribution(diffuse_lobe, NULL, 1.0f, z, "diffuse");
     float exponents[3] = { 1.0f, 5.0f, 20.0f };
     for (int i = 0; i < 3; ++i) {
         phong_slice slice = { exponents[i],
                               drift_vec3_normalize(drift_vec3_make(0.4f, 0.2f, 0.9f)) };
         char what[32];
         snprintf(what, sizeof what, "phong %g", (double)exponents[i]);
-        check_warp_distribution(phong_lobe, &slice, what);
+        check_warp_distribution(phong_lobe, &slice, 1.0f, z, what);
+    }
+    // The sharp lobes of the glossy scenes (60-200) through the cap around the lobe's axis,
+    // one of them grazing (the cap cut by the horizon).
+    float sharp[3] = { 20.0f, 60.0f, 200.0f };
+    for (int i = 0; i < 3; ++i) {
+        phong_slice slice = { sharp[i], drift_vec3_normalize(
+                                            drift_vec3_make(0.4f, 0.2f, i == 1 ? 0.1f : 0.9f)) };
+        char what[32];
+        snprintf(what, sizeof what, "phong %g, cap", (double)sharp[i]);
+        assert_true(drift__micro_phong_cap(sharp[i]) < 1.0f);
+        check_warp_distribution(phong_lobe, &slice, drift__micro_phong_cap(sharp[i]), slice.mirror,
+                                what);
     }
 }
 
@@ -209,13 +236,17 @@ static void test_white_furnace(void **state)
     drift__micro_warp *warp = malloc(sizeof *warp);
     drift__micro_pixels *pixels = malloc(sizeof *pixels);
     int32_t nodes[DRIFT_MICRO_MAX_K * DRIFT_MICRO_MAX_K];
-    for (int lobe = 0; lobe < 3; ++lobe) {
-        phong_slice slice = { lobe == 1 ? 5.0f : 20.0f,
+    for (int lobe = 0; lobe < 4; ++lobe) {
+        phong_slice slice = { lobe == 1 ? 5.0f : (lobe == 2 ? 20.0f : 200.0f),
                               drift_vec3_normalize(drift_vec3_make(0.4f, 0.2f, 0.9f)) };
         if (lobe == 0) {
             drift__micro_warp_build_diffuse(warp, 32);
-        } else {
+        } else if (lobe < 3) {
             drift__micro_warp_build(warp, 32, phong_lobe, &slice);
+        } else {
+            // Phong 200 through the cap around its axis (the glossy gathers' warp).
+            drift__micro_warp_build_cap(warp, 32, slice.mirror, drift__micro_phong_cap(200.0f),
+                                        phong_lobe, &slice);
         }
         drift__micro_pixels_make(pixels, warp, 16);
         // At the centre, and near the bottom looking up (near leaves bigger than their pixel).
@@ -225,8 +256,9 @@ static void test_white_furnace(void **state)
                 where ? drift_vec3_make(0.0f, 1.0f, 0.0f)
                       : drift_vec3_normalize(drift_vec3_make(0.2f, 1.0f, 0.1f)));
             for (int cast = 0; cast < 2; ++cast) {
-                drift__micro_gather_desc desc = { &tree, cast ? r.accel : NULL, warp, pixels,
-                                                  1.0f };
+                drift__micro_gather_desc desc = {
+                    &tree, cast ? r.accel : NULL, warp, pixels, 1.0f, NULL, 0
+                };
                 drift__micro_gather_stats st = { 0 };
                 drift_vec3 mean = drift__micro_gather(&desc, p, &frame, frame.z, nodes, &st, NULL);
                 int empty = 0;
@@ -240,7 +272,7 @@ static void test_white_furnace(void **state)
                 if (cast) {
                     assert_int_equal(empty, 0);
                     assert_float_equal(mean.y, 2.0f, 0.02f);
-                } else {
+                } else if (lobe < 3) {
                     assert_true(empty > 0);
                     assert_true(mean.y < 1.9f);
                 }
@@ -249,6 +281,48 @@ static void test_white_furnace(void **state)
     }
     free(warp);
     free(pixels);
+    drift__micro_tree_destroy(r.ctx, &tree);
+    drift_points_destroy(points);
+    test_rig_destroy(&r);
+}
+
+// A floor laid 0.005 over another (cornell-glossy's glossy floor over the box's own): the
+// lower floor's leaves lie in the dark under the cover, and a node that mixes them with the
+// cover's must still show the cover's light from above. Leaf radiance 1 on the cover, 0 under
+// it: every node seen from above gives exactly 1 once the covered sides are marked (0.5
+// without).
+static void test_covered_leaves_left_out(void **state)
+{
+    (void)state;
+    test_rig r = test_rig_begin(2);
+    uint32_t mat = test_add_material(r.scene, drift_material_make(drift_vec3_splat(0.5f)));
+    test_add_floor(r.scene, 1.0f, 0.0f, mat);
+    test_add_floor(r.scene, 1.0f, 0.005f, mat);
+    test_rig_commit(&r);
+    drift_points *points;
+    drift__micro_tree tree;
+    make_tree(&r, 4096, &points, &tree);
+    uint32_t n = tree.leaf_count;
+    for (uint32_t j = 0; j < n; ++j) {
+        bool cover = tree.center[n - 1 + j].y > 0.0025f;
+        tree.front[n - 1 + j] = drift_vec3_splat(cover ? 1.0f : 0.0f);
+        tree.back[n - 1 + j] = drift_vec3_splat(0.0f);
+    }
+    drift__micro_tree_cover(r.ctx, &tree, r.accel);
+    drift__micro_tree_pull(&tree);
+    float lo = INFINITY, hi = -INFINITY;
+    for (uint32_t i = 0; i < n - 1; ++i) {
+        if (!drift__micro_tree_seen(&tree, i, drift_vec3_make(0.0f, 1.0f, 0.0f))) {
+            continue; // under the cover only: the gathers do not show it from above
+        }
+        float v = drift__micro_tree_radiance(&tree, i, drift_vec3_make(0.0f, 1.0f, 0.0f)).y;
+        lo = fminf(lo, v);
+        hi = fmaxf(hi, v);
+    }
+    printf("nodes seen from above: radiance %.4f .. %.4f (the cover's 1)\n", (double)lo,
+           (double)hi);
+    assert_float_equal(lo, 1.0f, 1e-4f);
+    assert_float_equal(hi, 1.0f, 1e-4f);
     drift__micro_tree_destroy(r.ctx, &tree);
     drift_points_destroy(points);
     test_rig_destroy(&r);
@@ -326,7 +400,7 @@ static void test_cut_is_correct_and_sublinear(void **state)
         drift_points *points;
         drift__micro_tree tree;
         make_tree(&r, counts[c], &points, &tree);
-        drift__micro_gather_desc desc = { &tree, NULL, warp, pixels, 1.0f };
+        drift__micro_gather_desc desc = { &tree, NULL, warp, pixels, 1.0f, NULL, 0 };
         drift__micro_gather_stats st = { 0 };
         bool ok = true;
         int gathers = 0;
@@ -357,7 +431,7 @@ static void test_cut_is_correct_and_sublinear(void **state)
 
 // Spec §4.5 tests 5 to 7 on the Cornell box at 16 x 16 against the path tracer's first-bounce
 // diffuse light (max depth 2): every-pixel gathers are close to it (NRMS, mean within 10%);
-// the error shrinks from K = 8 to 16; 1/4-density upsampled stays within 2x of the
+// the error shrinks from K = 8 to 16 to 24; 1/4-density upsampled stays within 2x of the
 // every-pixel error; no pixel exceeds kd x the brightest leaf (one bounce: a mean of node
 // radiances times rho).
 static void test_against_path_tracer(void **state)
@@ -385,11 +459,11 @@ static void test_against_path_tracer(void **state)
             drift_image_mean_luminance(drift_micro_result(m)) / drift_image_mean_luminance(&ref);
         drift_micro_destroy(m);
     }
-    // 8 -> 16 shrinks the error; 24 does not shrink it further at 2^14 points (it reaches the
-    // leaves, docs/micro.md); the spec's 5% is not met at this size (the reference's own noise
-    // is about 3%).
+    // The error shrinks 8 -> 16 -> 24 (Fig. 6.17), and at K = 24 it is within 7% (measured
+    // 5.2%, of which the 2048-spp reference's own noise is about 3%; docs/micro.md).
     assert_true(e[1] < 0.8 * e[0]);
-    assert_true(fmin(e[1], e[2]) < 0.2);
+    assert_true(e[2] < 0.85 * e[1]);
+    assert_true(e[2] < 0.07);
     for (int i = 0; i < 3; ++i) {
         assert_true(bias[i] > 0.9 && bias[i] < 1.1);
     }
@@ -433,6 +507,31 @@ static void test_against_path_tracer(void **state)
     test_rig_destroy(&r);
 }
 
+// Spec §4.5 test 5 for the Phong lobe: on the glossy Cornell box (floor Phong 200, bunny 60,
+// dragon 120; the glossy floor laid 0.5 mm over the box's own) every-pixel glossy gathers
+// with the default 2^16 points match the path tracer's first-bounce glossy light (SPECULAR
+// at max depth 2) in the mean within 8% and per pixel within NRMS 0.8 (measured 0.64 and
+// 0.943 here, 0.55-0.8 over four seeds, against a 2048-spp reference whose own noise is
+// about 0.25; 0.95 and 0.891 without the covered floor's points left out, docs/micro.md).
+static void test_glossy_against_path_tracer(void **state)
+{
+    (void)state;
+    test_rig r = test_rig_load(2, "scenes/cornell-glossy/cornell_glossy.json", 16);
+    drift_pt *pt = NULL;
+    drift_image ref = test_rig_render_pt(&r, DRIFT_PT_COMPONENT_SPECULAR, 2, 2048, 99, &pt);
+    drift_micro *m =
+        render_micro(&r, &(drift_micro_params){ .point_count = 65536 }, DRIFT_MICRO_LOBE_GLOSSY);
+    double e = test_nrmse(r.ctx, &ref, drift_micro_result(m));
+    double ratio =
+        drift_image_mean_luminance(drift_micro_result(m)) / drift_image_mean_luminance(&ref);
+    printf("glossy: nrmse %.4f, mean ratio %.4f\n", e, ratio);
+    assert_true(ratio > 0.92 && ratio < 1.08);
+    assert_true(e < 0.8);
+    drift_micro_destroy(m);
+    drift_pt_destroy(pt);
+    test_rig_destroy(&r);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -440,8 +539,10 @@ int main(void)
         cmocka_unit_test(test_warp_is_distribution_correct),
         cmocka_unit_test(test_white_furnace),
         cmocka_unit_test(test_hierarchy_invariants_after_refit),
+        cmocka_unit_test(test_covered_leaves_left_out),
         cmocka_unit_test(test_cut_is_correct_and_sublinear),
         cmocka_unit_test(test_against_path_tracer),
+        cmocka_unit_test(test_glossy_against_path_tracer),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
