@@ -7,6 +7,7 @@
 // against the sampling's at 640x480 (Tables 3.1 and 4.1). Writes CSV and an SVG plot.
 #include "bench.h"
 #include "cli.h"
+#include "distributed/sweep.h"
 #include "drift/accel.h"
 #include "drift/hybrid.h"
 #include "drift/metric.h"
@@ -221,8 +222,12 @@ static double equal_error_spp(const point *plain, int count, double error, bool 
     return exp(x0 + (y - y0) * (x1 - x0) / (y1 - y0));
 }
 
+// The effect's curve. Its items (AAF's points, plain MC's, the timing frame) are numbered from
+// `first` (*next: the number after them) and spread over the ranks under mpirun (sweep.h):
+// each rank renders the reference when it has points to compare, rank 0 gathers them all.
 static drift_result measure(drift_context *ctx, const drift_scene *scene, const drift_accel *accel,
-                            const aaf_options *o, drift_effect effect, curve *out)
+                            const aaf_options *o, drift_effect effect, int first, int *next,
+                            curve *out)
 {
     const char *term = effect == DRIFT_EFFECT_SHADOWS    ? "direct"
                        : effect == DRIFT_EFFECT_INDIRECT ? "indirect"
@@ -233,17 +238,23 @@ static drift_result measure(drift_context *ctx, const drift_scene *scene, const 
     int reference = effect == DRIFT_EFFECT_SHADOWS    ? DRIFT_SHADOWS_REFERENCE
                     : effect == DRIFT_EFFECT_INDIRECT ? DRIFT_INDIRECT_REFERENCE
                                                       : DRIFT_REFLECTIONS_REFERENCE;
-    out->effect = effect;
-    out->count = o->spp_count;
-    out->plain_count = o->mc_spp_count;
+    *out = (curve){ .effect = effect, .count = o->spp_count, .plain_count = o->mc_spp_count };
+    int most = o->spp_count > o->mc_spp_count ? o->spp_count : o->mc_spp_count;
+    int first_plain = first + most, timing_item = first + 2 * most;
+    *next = timing_item + 1;
+    bool compares = false; // this rank has points to compare against the reference
+    for (int k = 0; k < most; ++k) {
+        compares |= (k < o->spp_count && sweep_mine(first + k)) ||
+                    (k < o->mc_spp_count && sweep_mine(first_plain + k));
+    }
     drift_hybrid *ref = NULL, *frame = NULL;
     drift_hybrid_params p = effect_params(effect, reference, o, o->ref_spp);
-    drift_result r = render(ctx, scene, accel, &p, &ref);
-    const drift_image *truth = r == DRIFT_OK ? drift_hybrid_plane_named(ref, term) : NULL;
-    int most = o->spp_count > o->mc_spp_count ? o->spp_count : o->mc_spp_count;
+    drift_result r = compares ? render(ctx, scene, accel, &p, &ref) : DRIFT_OK;
+    const drift_image *truth = r == DRIFT_OK && ref ? drift_hybrid_plane_named(ref, term) : NULL;
     for (int k = 0; r == DRIFT_OK && k < most; ++k) {
         for (int method = 0; r == DRIFT_OK && method < 2; ++method) {
-            if (k >= (method == 0 ? o->spp_count : o->mc_spp_count)) {
+            if (k >= (method == 0 ? o->spp_count : o->mc_spp_count) ||
+                !sweep_mine((method == 0 ? first : first_plain) + k)) {
                 continue;
             }
             long spp = method == 0 ? o->spps[k] : o->mc_spps[k];
@@ -275,26 +286,36 @@ static drift_result measure(drift_context *ctx, const drift_scene *scene, const 
             }
         }
     }
-    for (int k = 0; r == DRIFT_OK && k < o->spp_count; ++k) {
-        double spp =
-            equal_error_spp(out->plain, o->mc_spp_count, out->aaf[k].rmse, &out->extrapolated[k]);
-        out->ratio[k] = spp / out->aaf[k].actual_spp;
-    }
-    if (r == DRIFT_OK) {
+    double timing[3] = { 0 }; // sampling, filter, frame ms
+    if (r == DRIFT_OK && sweep_mine(timing_item)) {
         p = effect_params(effect, aaf, o, o->timing_spp);
         p.width = (int32_t)o->timing_width;
         p.height = (int32_t)o->timing_height;
         r = render(ctx, scene, accel, &p, &frame);
         if (r == DRIFT_OK) {
             drift_hybrid_stats s = drift_hybrid_get_stats(frame);
-            out->timing_sampling_ms = s.ms[DRIFT_PASS_AAF_SAMPLING];
-            out->timing_filter_ms = s.ms[DRIFT_PASS_AAF_FILTER];
-            out->timing_frame_ms = s.frame_ms;
+            timing[0] = s.ms[DRIFT_PASS_AAF_SAMPLING];
+            timing[1] = s.ms[DRIFT_PASS_AAF_FILTER];
+            timing[2] = s.frame_ms;
         }
     }
     drift_hybrid_destroy(ref);
     drift_hybrid_destroy(frame);
-    return r;
+    bool ok = sweep_gather(out->aaf, sizeof *out->aaf, first, o->spp_count, r == DRIFT_OK);
+    ok = sweep_gather(out->plain, sizeof *out->plain, first_plain, o->mc_spp_count, ok) && ok;
+    ok = sweep_gather(timing, sizeof timing, timing_item, 1, ok) && ok;
+    if (!ok) {
+        return r != DRIFT_OK ? r : DRIFT_ERR_CANCELLED; // another rank failed (named by rank 0)
+    }
+    out->timing_sampling_ms = timing[0];
+    out->timing_filter_ms = timing[1];
+    out->timing_frame_ms = timing[2];
+    for (int k = 0; sweep_rank() == 0 && k < o->spp_count; ++k) {
+        double spp =
+            equal_error_spp(out->plain, o->mc_spp_count, out->aaf[k].rmse, &out->extrapolated[k]);
+        out->ratio[k] = spp / out->aaf[k].actual_spp;
+    }
+    return DRIFT_OK;
 }
 
 // --- OUTPUT ---
@@ -503,7 +524,9 @@ int drift_bench_aaf(int argc, char **argv)
     }
     int exit_code = 1;
     cli_session session;
-    if (!bench_open(&session, "bench aaf", o.scene_path, "scenes/grids/grids.json", o.threads)) {
+    bool opened =
+        bench_open(&session, "bench aaf", o.scene_path, "scenes/grids/grids.json", o.threads);
+    if (!sweep_gather(NULL, 0, 0, 0, opened)) { // under mpirun: every rank, or none, goes on
         goto done;
     }
     drift_context *ctx = session.ctx;
@@ -514,11 +537,11 @@ int drift_bench_aaf(int argc, char **argv)
     drift_effect effects[3] = { DRIFT_EFFECT_SHADOWS, DRIFT_EFFECT_INDIRECT,
                                 DRIFT_EFFECT_REFLECTIONS };
     bool wanted[3] = { o.shadows, o.indirect, o.reflections };
-    for (int e = 0; e < 3; ++e) {
+    for (int e = 0, item = 0; e < 3; ++e) {
         if (!wanted[e]) {
             continue;
         }
-        r = measure(ctx, session.scene, session.accel, &o, effects[e], &curves[count]);
+        r = measure(ctx, session.scene, session.accel, &o, effects[e], item, &item, &curves[count]);
         if (r != DRIFT_OK) {
             fprintf(stderr, "drift bench aaf: %s failed: %s\n", drift_effect_name(effects[e]),
                     drift_result_string(r));
@@ -527,6 +550,10 @@ int drift_bench_aaf(int argc, char **argv)
         ++count;
     }
     int threads = drift_context_thread_count(ctx);
+    if (sweep_rank() != 0) { // rank 0 prints and writes the figures it gathered
+        exit_code = 0;
+        goto done;
+    }
     if (o.json) {
         if (!print_json(&o, scene_path, threads, curves, count)) {
             goto done;

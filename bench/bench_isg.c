@@ -15,6 +15,7 @@
 //                      shadows so that only depth of field differs from the lens reference
 #include "bench.h"
 #include "cli.h"
+#include "distributed/sweep.h"
 #include "drift/accel.h"
 #include "drift/hybrid.h"
 #include "drift/metric.h"
@@ -118,9 +119,10 @@ static int isg_technique(drift_effect effect)
     return drift_technique_parse(effect, "isg");
 }
 
-// (a) The paper's Table 1 for one effect: rows gather, columns search.
-static drift_result timing_table(const bench_ctx *b, drift_effect effect, double table[4][4],
-                                 double *out_base)
+// (a) The paper's Table 1 for one effect: rows gather, columns search. Its 16 cells are sweep
+// items first .. first + 15, over the ranks under mpirun (sweep.h).
+static drift_result timing_table(const bench_ctx *b, drift_effect effect, int first,
+                                 double table[4][4], double *out_base)
 {
     const isg_options *o = b->o;
     drift_hybrid_params p = effect_params(effect, isg_technique(effect));
@@ -129,23 +131,32 @@ static drift_result timing_table(const bench_ctx *b, drift_effect effect, double
     }
     p.width = (int32_t)o->width;
     p.height = (int32_t)o->height;
-    *out_base = HUGE_VAL;
-    for (int g = 0; g < 4; ++g) {
-        for (int s = 0; s < 4; ++s) {
-            p.isg.search = counts[s];
-            p.isg.gather = counts[g];
-            // The least of N frames: other processes on the machine only ever add time.
-            table[g][s] = HUGE_VAL;
-            for (long k = 0; k < o->frames; ++k) {
-                drift_hybrid_stats st;
-                drift_result r = render(b, p, false, &st, NULL);
-                if (r != DRIFT_OK) {
-                    return r;
-                }
-                table[g][s] = fmin(table[g][s], st.ms[DRIFT_PASS_ISG]);
-                *out_base = fmin(*out_base, st.frame_ms - st.ms[DRIFT_PASS_ISG]);
+    double cells[16][2]; // the ISG pass's ms, the rest of the frame's
+    drift_result r = DRIFT_OK;
+    for (int c = 0; c < 16 && r == DRIFT_OK; ++c) {
+        if (!sweep_mine(first + c)) {
+            continue;
+        }
+        p.isg.search = counts[c % 4];
+        p.isg.gather = counts[c / 4];
+        // The least of N frames: other processes on the machine only ever add time.
+        cells[c][0] = cells[c][1] = HUGE_VAL;
+        for (long k = 0; k < o->frames && r == DRIFT_OK; ++k) {
+            drift_hybrid_stats st;
+            r = render(b, p, false, &st, NULL);
+            if (r == DRIFT_OK) {
+                cells[c][0] = fmin(cells[c][0], st.ms[DRIFT_PASS_ISG]);
+                cells[c][1] = fmin(cells[c][1], st.frame_ms - st.ms[DRIFT_PASS_ISG]);
             }
         }
+    }
+    if (!sweep_gather(cells, sizeof cells[0], first, 16, r == DRIFT_OK)) {
+        return r != DRIFT_OK ? r : DRIFT_ERR_CANCELLED; // another rank failed (named by rank 0)
+    }
+    *out_base = HUGE_VAL;
+    for (int c = 0; c < 16; ++c) {
+        table[c / 4][c % 4] = cells[c][0];
+        *out_base = fmin(*out_base, cells[c][1]);
     }
     return DRIFT_OK;
 }
@@ -174,8 +185,9 @@ typedef struct quality_row {
 
 #define MAX_ROWS 5
 
-// (b) for one effect: the reference, then every technique against it.
-static drift_result quality(const bench_ctx *b, drift_effect effect, quality_row *rows,
+// (b) for one effect: the reference, then every technique against it. Its rows are sweep items
+// first .. first + MAX_ROWS - 1; a rank renders the reference when it has rows to compare.
+static drift_result quality(const bench_ctx *b, drift_effect effect, int first, quality_row *rows,
                             int *out_count)
 {
     const isg_options *o = b->o;
@@ -185,15 +197,22 @@ static drift_result quality(const bench_ctx *b, drift_effect effect, quality_row
         { "none", "post", "isg", "isg-9x9", "isg-2layers" },
         { NULL },
     };
+    int count = 0;
+    bool compares = false;
+    while (count < MAX_ROWS && names[effect][count]) {
+        compares |= sweep_mine(first + count++);
+    }
     drift_hybrid_params ref = effect_params(effect, drift_technique_parse(effect, "reference"));
     ref.width = (int32_t)o->qwidth;
     ref.height = (int32_t)o->qheight;
     ref.spp = (uint32_t)o->ref_spp;
     drift_image reference = { 0 };
     drift_hybrid_stats st;
-    drift_result r = render(b, ref, false, &st, &reference);
-    *out_count = 0;
-    for (int t = 0; r == DRIFT_OK && t < MAX_ROWS && names[effect][t]; ++t) {
+    drift_result r = compares ? render(b, ref, false, &st, &reference) : DRIFT_OK;
+    for (int t = 0; r == DRIFT_OK && t < count; ++t) {
+        if (!sweep_mine(first + t)) {
+            continue;
+        }
         // "isg-9x9" is ISG at its cheapest sample counts: the time-matched variant.
         // "isg-2layers" adds the second depth layer.
         bool cheap = strcmp(names[effect][t], "isg-9x9") == 0;
@@ -216,13 +235,20 @@ static drift_result quality(const bench_ctx *b, drift_effect effect, quality_row
                                      NULL);
         }
         if (r == DRIFT_OK) {
-            rows[(*out_count)++] =
-                (quality_row){ names[effect][t], rep.flip, rep.rmse, technique_ms(effect, &st) };
+            rows[t] = (quality_row){ NULL, rep.flip, rep.rmse, technique_ms(effect, &st) };
         }
         drift_image_destroy(b->ctx, &test);
     }
     drift_image_destroy(b->ctx, &reference);
-    return r;
+    *out_count = 0;
+    if (!sweep_gather(rows, sizeof *rows, first, count, r == DRIFT_OK)) {
+        return r != DRIFT_OK ? r : DRIFT_ERR_CANCELLED; // another rank failed (named by rank 0)
+    }
+    for (int t = 0; t < count; ++t) { // names here: a pointer from another rank means nothing
+        rows[t].technique = names[effect][t];
+    }
+    *out_count = count;
+    return DRIFT_OK;
 }
 
 static const drift_effect effects[3] = { DRIFT_EFFECT_SHADOWS, DRIFT_EFFECT_REFLECTIONS,
@@ -321,8 +347,9 @@ int drift_bench_isg(int argc, char **argv)
     }
     int exit_code = 1;
     cli_session session;
-    if (!bench_open(&session, "bench isg", o.scene_path,
-                    "scenes/cornell-glossy/cornell_glossy.json", o.threads)) {
+    bool opened = bench_open(&session, "bench isg", o.scene_path,
+                             "scenes/cornell-glossy/cornell_glossy.json", o.threads);
+    if (!sweep_gather(NULL, 0, 0, 0, opened)) { // under mpirun: every rank, or none, goes on
         goto done;
     }
     drift_context *ctx = session.ctx;
@@ -351,11 +378,13 @@ int drift_bench_isg(int argc, char **argv)
     double base[3] = { 0.0, 0.0, 0.0 };
     static quality_row rows[3][MAX_ROWS];
     int row_count[3] = { 0, 0, 0 };
-    for (int e = 0; e < 3; ++e) {
-        if (!o.skip_table && (r = timing_table(&b, effects[e], tables[e], &base[e])) != DRIFT_OK) {
+    for (int e = 0, item = 0; e < 3; ++e, item += 16 + MAX_ROWS) { // the sweep's items
+        if (!o.skip_table &&
+            (r = timing_table(&b, effects[e], item, tables[e], &base[e])) != DRIFT_OK) {
             break;
         }
-        if (!o.skip_quality && (r = quality(&b, effects[e], rows[e], &row_count[e])) != DRIFT_OK) {
+        if (!o.skip_quality &&
+            (r = quality(&b, effects[e], item + 16, rows[e], &row_count[e])) != DRIFT_OK) {
             break;
         }
     }
@@ -363,7 +392,9 @@ int drift_bench_isg(int argc, char **argv)
         fprintf(stderr, "drift bench isg: %s\n", drift_result_string(r));
         goto done;
     }
-    if (o.json) {
+    if (sweep_rank() != 0) { // rank 0 prints the figures it gathered
+        exit_code = 0;
+    } else if (o.json) {
         exit_code = print_json(&b, tables, base, rows, row_count, scene_path) ? 0 : 1;
     } else {
         print_text(&b, tables, base, rows, row_count, scene_path);

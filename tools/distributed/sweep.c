@@ -1,0 +1,133 @@
+// The sweep helper of sweep.h: MPI in the MPI build when started by mpirun, one rank otherwise.
+#include "distributed/sweep.h"
+
+#include "render.h"
+
+#include <stdint.h>
+#include <stdio.h>
+
+#ifdef DRIFT_MPI
+#    include <mpi.h>
+
+enum {
+    TAG_ITEM = 100
+};
+
+static int rank_here = 0, rank_count = 1;
+static bool joined = false;
+
+void sweep_begin(void)
+{
+    if (!render_mpi_launched()) {
+        return;
+    }
+    MPI_Init(NULL, NULL);
+    joined = true;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank_here);
+    MPI_Comm_size(MPI_COMM_WORLD, &rank_count);
+    if (rank_here != 0) { // rank 0 prints every figure and message once
+        fflush(NULL);
+        if (!freopen("/dev/null", "w", stdout) || !freopen("/dev/null", "w", stderr)) {
+            MPI_Abort(MPI_COMM_WORLD, 1);
+        }
+    }
+}
+
+int sweep_end(int status)
+{
+    if (!joined) {
+        return status;
+    }
+    int worst = status;
+    MPI_Allreduce(&status, &worst, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    MPI_Finalize();
+    joined = false;
+    return worst;
+}
+
+int sweep_rank(void)
+{
+    return rank_here;
+}
+
+int sweep_ranks(void)
+{
+    return rank_count;
+}
+
+bool sweep_mine(int item)
+{
+    return item % rank_count == rank_here;
+}
+
+bool sweep_gather(void *items, size_t size, int first, int count, bool ok)
+{
+    if (rank_count == 1) {
+        return ok;
+    }
+    int mine = ok ? 1 : 0, all = 0;
+    MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+    if (!all) { // every rank's message but rank 0's is discarded: name the rank
+        int failed = ok ? rank_count : rank_here, lowest = 0;
+        MPI_Reduce(&failed, &lowest, 1, MPI_INT, MPI_MIN, 0, MPI_COMM_WORLD);
+        if (rank_here == 0 && lowest != 0) {
+            fprintf(stderr,
+                    "drift bench: rank %d failed (run the command without mpirun to see "
+                    "why)\n",
+                    lowest);
+        }
+        return false;
+    }
+    uint8_t *bytes = items;
+    for (int k = 0; k < count; ++k) {
+        int owner = (first + k) % rank_count;
+        if (owner == 0) {
+            continue;
+        }
+        if (rank_here == 0) {
+            MPI_Recv(bytes + (size_t)k * size, (int)size, MPI_BYTE, owner, TAG_ITEM, MPI_COMM_WORLD,
+                     MPI_STATUS_IGNORE);
+        } else if (owner == rank_here) {
+            MPI_Send(bytes + (size_t)k * size, (int)size, MPI_BYTE, 0, TAG_ITEM, MPI_COMM_WORLD);
+        }
+    }
+    return true;
+}
+
+#else // the plain build: one rank
+
+void sweep_begin(void)
+{
+}
+
+int sweep_end(int status)
+{
+    return status;
+}
+
+int sweep_rank(void)
+{
+    return 0;
+}
+
+int sweep_ranks(void)
+{
+    return 1;
+}
+
+bool sweep_mine(int item)
+{
+    (void)item;
+    return true;
+}
+
+bool sweep_gather(void *items, size_t size, int first, int count, bool ok)
+{
+    (void)items;
+    (void)size;
+    (void)first;
+    (void)count;
+    return ok;
+}
+
+#endif
