@@ -45,7 +45,9 @@ for r in $(seq "$rounds"); do
     done
     printf "%-6s %10.0f" "$r" "$p"
     for n in "${ranks[@]}"; do printf " %10.0f" "${t[$n]}"; done
-    line=$(python3 -c "import sys; v=[float(x) for x in sys.argv[1:]]; print(' '.join('%.3f' % (v[1] / x) for x in [v[0]] + v[2:]))" "$p" "${t[@]}")
+    vals=("$p")
+    for n in "${ranks[@]}"; do vals+=("${t[$n]}"); done # in rank order (t's keys are not)
+    line=$(python3 -c "import sys; v=[float(x) for x in sys.argv[1:]]; print(' '.join('%.3f' % (v[1] / x) for x in [v[0]] + v[2:]))" "${vals[@]}")
     echo "$line" >>"$dir/ratios"
     for x in $line; do printf " %10s" "$x"; done
     echo

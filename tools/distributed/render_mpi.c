@@ -30,6 +30,8 @@ enum {
 // Jobs kept at each rank: one it renders and three waiting, so it never waits for rank 0
 // (a job of a small pass is milliseconds, about a time slice of a loaded machine).
 #define JOBS_QUEUED 4
+// Sends rank 0 holds a rank: a job's send may still be completing when its result is in.
+#define SENDS_HELD (2 * JOBS_QUEUED)
 
 bool render_mpi_launched(void)
 {
@@ -296,13 +298,14 @@ typedef struct coordinator {
     uint32_t tile_count;
     uint32_t *queue; // tiles waiting for a job, a ring of tile_count
     uint32_t head, queued;
-    uint32_t pass;                  // samples a job adds (doubles while a round of jobs is quick)
-    uint32_t handed;                // jobs' tiles handed out since the pass last changed
-    double round_start;             // when that began
-    int *outstanding;               // jobs at each rank
-    double *last_heard;             // when each rank last sent a result (or got its first job)
-    int *threads;                   // each rank's worker threads: tiles a job
-    pending_message *sends, *recvs; // at most JOBS_QUEUED a rank each
+    uint32_t pass;          // samples a job adds (doubles while a round of jobs is quick)
+    uint32_t handed;        // jobs' tiles handed out since the pass last changed
+    double round_start;     // when that began
+    int *outstanding;       // jobs at each rank
+    double *last_heard;     // when each rank last sent a result (or got its first job)
+    int *threads;           // each rank's worker threads: tiles a job
+    pending_message *sends; // at most SENDS_HELD a rank
+    pending_message *recvs; // at most JOBS_QUEUED a rank (one a job out)
     int sends_pending, recvs_pending;
     uint32_t *scratch; // tile indices of a job being packed or merged
     uint64_t bytes_sent, bytes_received, tiles_merged;
@@ -458,7 +461,8 @@ static void serve(coordinator *c)
     complete_sends(c);
     int most = c->queued >= (uint32_t)(JOBS_QUEUED * c->ranks) ? JOBS_QUEUED : 1;
     for (int r = 1; r < c->ranks; ++r) {
-        while (c->outstanding[r] < most && c->queued > 0 && !c->stuck_on) {
+        while (c->outstanding[r] < most && c->queued > 0 && !c->stuck_on &&
+               c->sends_pending < SENDS_HELD * c->ranks) {
             send_job(c, r);
         }
     }
@@ -549,7 +553,7 @@ static int render_rank0(render_reference_run *run, int ranks, const int *threads
                       .outstanding = calloc((size_t)ranks, sizeof(int)),
                       .last_heard = calloc((size_t)ranks, sizeof(double)),
                       .threads = (int *)threads,
-                      .sends = calloc((size_t)ranks * JOBS_QUEUED, sizeof(pending_message)),
+                      .sends = calloc((size_t)ranks * SENDS_HELD, sizeof(pending_message)),
                       .recvs = calloc((size_t)ranks * JOBS_QUEUED, sizeof(pending_message)),
                       .cancel = cancel };
     c.queue = malloc(c.tile_count * sizeof *c.queue);
