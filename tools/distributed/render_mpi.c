@@ -184,29 +184,35 @@ static size_t take_tiles(drift_pt *pt, const uint8_t *at, uint32_t n, uint32_t *
     return (size_t)(p - at);
 }
 
-// Lets MPI move the messages under way (a large message needs both sides to enter MPI);
-// called between samples, so that no rank's message waits for another's render.
+// How often a rank lets MPI move messages while it renders (between samples): often enough
+// that no message waits long, rarely enough that it costs nothing next to the samples.
+#define SERVE_SECONDS 2e-4
+
+// Lets MPI move the messages under way (a large message needs both sides to enter MPI):
+// one test of a pending request runs MPI's progress engine for all of them.
 static void progress(MPI_Request *requests, int count)
 {
     for (int i = 0; i < count; ++i) {
-        int done = 0;
         if (requests[i] != MPI_REQUEST_NULL) {
+            int done = 0;
             MPI_Request_get_status(requests[i], &done, MPI_STATUS_IGNORE);
+            return;
         }
     }
 }
 
 // Waits for a request sleeping between tests, not spinning as MPI_Wait does: a rank waiting
-// for a job leaves its core to the others (more ranks than cores, or a loaded machine).
+// for a job leaves its core to the others (more ranks than cores, or a loaded machine); the
+// naps grow, so that a long wait (the end of the render) costs few wake-ups.
 static void wait_politely(MPI_Request *request, MPI_Status *status)
 {
-    for (;;) {
+    for (long nap = 20000;; nap = nap < 640000 ? 2 * nap : nap) { // 20 us, doubling to 0.64 ms
         int done = 0;
         MPI_Test(request, &done, status);
         if (done) {
             return;
         }
-        nanosleep(&(struct timespec){ .tv_nsec = 50000 }, NULL);
+        nanosleep(&(struct timespec){ .tv_nsec = nap }, NULL);
     }
 }
 
@@ -243,9 +249,13 @@ static void serve_jobs(drift_pt *pt, const atomic_bool *cancel, int threads)
         MPI_Irecv(in[which], (int)job_size, MPI_BYTE, 0, MPI_ANY_TAG, MPI_COMM_WORLD,
                   &requests[which]);
         bool stopped = false;
+        double served = drift_time_now();
         for (uint32_t s = 0; s < head[0] && !stopped; ++s) {
             stopped = drift_pt_render_tiles(pt, tiles, head[2], 1, head[1], cancel) != DRIFT_OK;
-            progress(requests, 2 * JOBS_QUEUED);
+            if (drift_time_now() - served > SERVE_SECONDS) {
+                progress(requests, 2 * JOBS_QUEUED);
+                served = drift_time_now();
+            }
         }
         if (stopped) {
             break; // SIGTERM: mpirun is stopping the job; rank 0 keeps what it merged
@@ -311,6 +321,7 @@ typedef struct coordinator {
     uint64_t bytes_sent, bytes_received, tiles_merged;
     double merge_seconds;  // rank 0's time unpacking results
     double serve_seconds;  // rank 0's time in MPI and job handling, merges included
+    double served;         // when it last served
     double render_seconds; // rank 0's time rendering its own jobs
     double idle_seconds;   // rank 0 with nothing to render, waiting for the last results
     double workers_waited; // the other ranks' time waiting for a job, summed
@@ -459,6 +470,7 @@ static void serve(coordinator *c)
     double t0 = drift_time_now();
     merge_results(c);
     complete_sends(c);
+    c->served = t0;
     int most = c->queued >= (uint32_t)(JOBS_QUEUED * c->ranks) ? JOBS_QUEUED : 1;
     for (int r = 1; r < c->ranks; ++r) {
         while (c->outstanding[r] < most && c->queued > 0 && !c->stuck_on &&
@@ -501,7 +513,7 @@ static int coordinate(coordinator *c, const atomic_bool *cancel)
                 double t0 = drift_time_now();
                 drift_pt_render_tiles(pt, own, n, step, (uint32_t)o->spp, cancel);
                 c->render_seconds += drift_time_now() - t0;
-                if (c->ranks > 1) {
+                if (c->ranks > 1 && drift_time_now() - c->served > SERVE_SECONDS) {
                     serve(c);
                 }
             }
