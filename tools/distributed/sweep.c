@@ -5,6 +5,7 @@
 
 #include <stdint.h>
 #include <stdio.h>
+#include <time.h>
 
 #ifdef DRIFT_MPI
 #    include <mpi.h>
@@ -15,6 +16,23 @@ enum {
 
 static int rank_here = 0, rank_count = 1;
 static bool joined = false;
+
+// MPI_Allreduce of one int, waiting by sleeping: a rank that finished its items early (or
+// has none) leaves its core to the ranks still rendering instead of spinning in MPI.
+static int agree(int value, MPI_Op op)
+{
+    int result = value;
+    MPI_Request request;
+    MPI_Iallreduce(&value, &result, 1, MPI_INT, op, MPI_COMM_WORLD, &request);
+    for (long nap = 20000;; nap = nap < 5000000 ? 2 * nap : nap) { // 20 us, doubling to 5 ms
+        int done = 0;
+        MPI_Test(&request, &done, MPI_STATUS_IGNORE);
+        if (done) {
+            return result;
+        }
+        nanosleep(&(struct timespec){ .tv_nsec = nap }, NULL);
+    }
+}
 
 void sweep_begin(void)
 {
@@ -38,8 +56,7 @@ int sweep_end(int status)
     if (!joined) {
         return status;
     }
-    int worst = status;
-    MPI_Allreduce(&status, &worst, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    int worst = agree(status, MPI_MAX);
     MPI_Finalize();
     joined = false;
     return worst;
@@ -65,9 +82,8 @@ bool sweep_gather(void *items, size_t size, int first, int count, bool ok)
     if (rank_count == 1) {
         return ok;
     }
-    int mine = ok ? 1 : 0, all = 0;
-    MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
-    if (!all) { // every rank's message but rank 0's is discarded: name the rank
+    if (!agree(ok ? 1 : 0,
+               MPI_MIN)) { // every rank's message but rank 0's is discarded: name the rank
         int failed = ok ? rank_count : rank_here, lowest = 0;
         MPI_Reduce(&failed, &lowest, 1, MPI_INT, MPI_MIN, 0, MPI_COMM_WORLD);
         if (rank_here == 0 && lowest != 0) {
