@@ -2,14 +2,15 @@
 // docs/distributed.md). Built only with -DDRIFT_MPI=ON; nothing else in drift sees MPI.
 //
 // Every rank opens the same scene and makes the same path tracer. Rank 0 hands out jobs (a
-// few tiles and a number of samples to add) from a queue, keeps two jobs queued at each
-// other rank so none waits for it (its sends never block: they complete while it renders),
-// renders jobs of its own one sample at a time, answering between samples, and merges what
-// comes back into its pt. A job carries the tiles' sums and counts from rank 0 and brings them back
-// with the samples added; a pixel's samples are still summed one by one in index order, so
-// the image is the same bits as one process's for any number of ranks and any hand-out
-// order. Rank 0 alone writes: progress, checkpoints (FILE.ckpt holds every merged tile),
-// the images and the stats, through the same steps as a one-process render (render.h).
+// few tiles and a number of samples to add) from a queue, keeps JOBS_QUEUED jobs at each
+// other rank so none waits for it (its sends and receives never block: they complete while
+// it renders), renders jobs of its own a sample at a time, serving in between, and merges
+// what comes back into its pt. A job carries the tiles' sums and counts from rank 0 and
+// brings them back with the samples added; a pixel's samples are still summed one by one in
+// index order, so the image is the same bits as one process's for any number of ranks and
+// any hand-out order. Rank 0 alone writes: progress, checkpoints (FILE.ckpt holds every
+// merged tile), the images and the stats, through the same steps as a one-process render
+// (render.h). Also here: sweep.c, the benchmark sweeps over ranks (sweep.h).
 #include "drift/pt.h"
 #include "render.h"
 
