@@ -24,4 +24,13 @@ bool sweep_mine(int item);
 // rank, whether all ranks' items succeeded (rank 0 names a rank that failed).
 bool sweep_gather(void *items, size_t size, int first, int count, bool ok);
 
+// The same with each item's rank given: owners[k] computed item k.
+bool sweep_gather_owned(void *items, size_t size, int count, const int *owners, bool ok);
+// The rank of the index-th item of a group whose first rank is busy with something larger
+// (a reference): the other ranks in turn, or rank 0 alone when there is one rank.
+int sweep_owner_besides(int busy, int index);
+// `size` bytes at data from rank `owner` to every rank (every rank calls it). ok: this
+// rank's part went well; returns whether every rank's did.
+bool sweep_share(void *data, size_t size, int owner, bool ok);
+
 #endif // DRIFT_TOOLS_DISTRIBUTED_SWEEP_H
