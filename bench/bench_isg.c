@@ -120,9 +120,10 @@ static int isg_technique(drift_effect effect)
 }
 
 // (a) The paper's Table 1 for one effect: rows gather, columns search. Its 16 cells are sweep
-// items first .. first + 15, over the ranks under mpirun (sweep.h).
-static drift_result timing_table(const bench_ctx *b, drift_effect effect, int first,
-                                 double table[4][4], double *out_base)
+// items first .. first + 15, over the ranks under mpirun (sweep.h): this rank's cells into
+// cells (the ISG pass's ms, the rest of the frame's), gathered by timing_collect.
+static drift_result timing_render(const bench_ctx *b, drift_effect effect, int first,
+                                  double cells[16][2])
 {
     const isg_options *o = b->o;
     drift_hybrid_params p = effect_params(effect, isg_technique(effect));
@@ -131,7 +132,6 @@ static drift_result timing_table(const bench_ctx *b, drift_effect effect, int fi
     }
     p.width = (int32_t)o->width;
     p.height = (int32_t)o->height;
-    double cells[16][2]; // the ISG pass's ms, the rest of the frame's
     drift_result r = DRIFT_OK;
     for (int c = 0; c < 16 && r == DRIFT_OK; ++c) {
         if (!sweep_mine(first + c)) {
@@ -150,15 +150,21 @@ static drift_result timing_table(const bench_ctx *b, drift_effect effect, int fi
             }
         }
     }
-    if (!sweep_gather(cells, sizeof cells[0], first, 16, r == DRIFT_OK)) {
-        return r != DRIFT_OK ? r : DRIFT_ERR_CANCELLED; // another rank failed (named by rank 0)
+    return r;
+}
+
+static bool timing_collect(int first, double cells[16][2], bool ok, double table[4][4],
+                           double *out_base)
+{
+    if (!sweep_gather(cells, sizeof cells[0], first, 16, ok)) {
+        return false;
     }
     *out_base = HUGE_VAL;
     for (int c = 0; c < 16; ++c) {
         table[c / 4][c % 4] = cells[c][0];
         *out_base = fmin(*out_base, cells[c][1]);
     }
-    return DRIFT_OK;
+    return true;
 }
 
 // The milliseconds a technique of an effect adds to the frame.
@@ -185,70 +191,100 @@ typedef struct quality_row {
 
 #define MAX_ROWS 5
 
-// (b) for one effect: the reference, then every technique against it. Its rows are sweep items
-// first .. first + MAX_ROWS - 1; a rank renders the reference when it has rows to compare.
-static drift_result quality(const bench_ctx *b, drift_effect effect, int first, quality_row *rows,
-                            int *out_count)
+// (b) for one effect: the reference, then every technique against it. Under mpirun the
+// reference is rendered by one rank (effect ordinal mod N) while the others render the
+// techniques' frames (quality_render); quality_compare then shares the reference with every
+// rank, each compares its own frames, and rank 0 gathers the rows.
+typedef struct quality_run {
+    int ref_owner, count;
+    int owners[MAX_ROWS];
+    drift_image reference, tests[MAX_ROWS];
+    double ms[MAX_ROWS];
+} quality_run;
+
+static const char *const quality_names[DRIFT_EFFECT_COUNT][MAX_ROWS] = {
+    { "hard", "pcss", "blur", "isg", "isg-9x9" },
+    { "sharp", "envmap", "blur", "isg", "isg-9x9" },
+    { "none", "post", "isg", "isg-9x9", "isg-2layers" },
+    { NULL },
+};
+
+static drift_result quality_render(const bench_ctx *b, drift_effect effect, int ordinal,
+                                   quality_run *q)
 {
     const isg_options *o = b->o;
-    static const char *const names[DRIFT_EFFECT_COUNT][MAX_ROWS] = {
-        { "hard", "pcss", "blur", "isg", "isg-9x9" },
-        { "sharp", "envmap", "blur", "isg", "isg-9x9" },
-        { "none", "post", "isg", "isg-9x9", "isg-2layers" },
-        { NULL },
-    };
-    int count = 0;
-    bool compares = false;
-    while (count < MAX_ROWS && names[effect][count]) {
-        compares |= sweep_mine(first + count++);
+    const char *const *names = quality_names[effect];
+    q->ref_owner = ordinal % sweep_ranks();
+    q->count = 0;
+    while (q->count < MAX_ROWS && names[q->count]) {
+        q->owners[q->count] = sweep_owner_besides(q->ref_owner, q->count);
+        q->count++;
     }
     drift_hybrid_params ref = effect_params(effect, drift_technique_parse(effect, "reference"));
     ref.width = (int32_t)o->qwidth;
     ref.height = (int32_t)o->qheight;
     ref.spp = (uint32_t)o->ref_spp;
-    drift_image reference = { 0 };
-    drift_hybrid_stats st;
-    drift_result r = compares ? render(b, ref, false, &st, &reference) : DRIFT_OK;
-    for (int t = 0; r == DRIFT_OK && t < count; ++t) {
-        if (!sweep_mine(first + t)) {
+    drift_hybrid_stats st = { 0 };
+    drift_result r = DRIFT_OK;
+    if (q->ref_owner == sweep_rank()) {
+        r = render(b, ref, false, &st, &q->reference);
+    }
+    for (int t = 0; r == DRIFT_OK && t < q->count; ++t) {
+        if (q->owners[t] != sweep_rank()) {
             continue;
         }
         // "isg-9x9" is ISG at its cheapest sample counts: the time-matched variant.
         // "isg-2layers" adds the second depth layer.
-        bool cheap = strcmp(names[effect][t], "isg-9x9") == 0;
-        bool layers = strcmp(names[effect][t], "isg-2layers") == 0;
-        drift_hybrid_params p = effect_params(
-            effect, cheap || layers ? isg_technique(effect)
-                                    : drift_technique_parse(effect, names[effect][t]));
+        bool cheap = strcmp(names[t], "isg-9x9") == 0;
+        bool layers = strcmp(names[t], "isg-2layers") == 0;
+        drift_hybrid_params p =
+            effect_params(effect, cheap || layers ? isg_technique(effect)
+                                                  : drift_technique_parse(effect, names[t]));
         p.isg.layers = layers ? 2 : 1;
         p.width = ref.width;
         p.height = ref.height;
         p.spp = ref.spp; // the DOF runs' path-traced shadows
         p.isg.search = cheap ? 9 : (int32_t)o->search;
         p.isg.gather = cheap ? 9 : (int32_t)o->gather;
-        drift_image test = { 0 };
         // Warm for timing (shadow maps and probes are cached), except around path tracing.
-        r = render(b, p, effect != DRIFT_EFFECT_DOF, &st, &test);
+        r = render(b, p, effect != DRIFT_EFFECT_DOF, &st, &q->tests[t]);
+        q->ms[t] = r == DRIFT_OK ? technique_ms(effect, &st) : 0.0;
+    }
+    return r;
+}
+
+static bool quality_compare(const bench_ctx *b, drift_effect effect, quality_run *q, bool ok,
+                            quality_row *rows, int *out_count)
+{
+    int32_t dims[3] = { q->reference.width, q->reference.height, q->reference.channels };
+    ok = sweep_share(dims, sizeof dims, q->ref_owner, ok);
+    if (ok && q->ref_owner != sweep_rank()) {
+        ok = drift_image_create(b->ctx, dims[0], dims[1], dims[2], &q->reference) == DRIFT_OK;
+    }
+    size_t bytes = sizeof(float) * (size_t)dims[0] * (size_t)dims[1] * (size_t)dims[2];
+    ok = sweep_share(q->reference.pixels, ok ? bytes : 0, q->ref_owner, ok);
+    for (int t = 0; ok && t < q->count; ++t) {
+        if (q->owners[t] != sweep_rank()) {
+            continue;
+        }
         drift_metric_report rep;
-        if (r == DRIFT_OK) {
-            r = drift_metric_compare(b->ctx, &reference, &test, &(drift_metric_params){ 0 }, &rep,
-                                     NULL);
-        }
-        if (r == DRIFT_OK) {
-            rows[t] = (quality_row){ NULL, rep.flip, rep.rmse, technique_ms(effect, &st) };
-        }
-        drift_image_destroy(b->ctx, &test);
+        ok = drift_metric_compare(b->ctx, &q->reference, &q->tests[t], &(drift_metric_params){ 0 },
+                                  &rep, NULL) == DRIFT_OK;
+        rows[t] = (quality_row){ NULL, rep.flip, rep.rmse, q->ms[t] };
     }
-    drift_image_destroy(b->ctx, &reference);
+    drift_image_destroy(b->ctx, &q->reference);
+    for (int t = 0; t < MAX_ROWS; ++t) {
+        drift_image_destroy(b->ctx, &q->tests[t]);
+    }
     *out_count = 0;
-    if (!sweep_gather(rows, sizeof *rows, first, count, r == DRIFT_OK)) {
-        return r != DRIFT_OK ? r : DRIFT_ERR_CANCELLED; // another rank failed (named by rank 0)
+    if (!sweep_gather_owned(rows, sizeof *rows, q->count, q->owners, ok)) {
+        return false;
     }
-    for (int t = 0; t < count; ++t) { // names here: a pointer from another rank means nothing
-        rows[t].technique = names[effect][t];
+    for (int t = 0; t < q->count; ++t) { // names here: a pointer from another rank means nothing
+        rows[t].technique = quality_names[effect][t];
     }
-    *out_count = count;
-    return DRIFT_OK;
+    *out_count = q->count;
+    return true;
 }
 
 static const drift_effect effects[3] = { DRIFT_EFFECT_SHADOWS, DRIFT_EFFECT_REFLECTIONS,
@@ -378,15 +414,29 @@ int drift_bench_isg(int argc, char **argv)
     double base[3] = { 0.0, 0.0, 0.0 };
     static quality_row rows[3][MAX_ROWS];
     int row_count[3] = { 0, 0, 0 };
-    for (int e = 0, item = 0; e < 3; ++e, item += 16 + MAX_ROWS) { // the sweep's items
-        if (!o.skip_table &&
-            (r = timing_table(&b, effects[e], item, tables[e], &base[e])) != DRIFT_OK) {
-            break;
+    // Every rank's renders first (timing cells, references, technique frames), then the
+    // comparisons and gathers, so that no rank waits for another's reference before its own.
+    static double cells[3][16][2];
+    static quality_run runs[3];
+    for (int e = 0; e < 3 && r == DRIFT_OK; ++e) {
+        if (!o.skip_table) {
+            r = timing_render(&b, effects[e], 16 * e, cells[e]);
         }
-        if (!o.skip_quality &&
-            (r = quality(&b, effects[e], item + 16, rows[e], &row_count[e])) != DRIFT_OK) {
-            break;
+        if (!o.skip_quality && r == DRIFT_OK) {
+            r = quality_render(&b, effects[e], e, &runs[e]);
         }
+    }
+    bool ok = r == DRIFT_OK;
+    for (int e = 0; e < 3; ++e) {
+        if (!o.skip_table) {
+            ok = timing_collect(16 * e, cells[e], ok, tables[e], &base[e]) && ok;
+        }
+        if (!o.skip_quality) {
+            ok = quality_compare(&b, effects[e], &runs[e], ok, rows[e], &row_count[e]) && ok;
+        }
+    }
+    if (r == DRIFT_OK && !ok) {
+        r = DRIFT_ERR_CANCELLED; // on another rank, named by rank 0
     }
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift bench isg: %s\n", drift_result_string(r));
