@@ -7,6 +7,7 @@
 // against the sampling's at 640x480 (Tables 3.1 and 4.1). Writes CSV and an SVG plot.
 #include "bench.h"
 #include "cli.h"
+#include "distributed/sweep.h"
 #include "drift/accel.h"
 #include "drift/hybrid.h"
 #include "drift/metric.h"
@@ -221,53 +222,87 @@ static double equal_error_spp(const point *plain, int count, double error, bool 
     return exp(x0 + (y - y0) * (x1 - x0) / (y1 - y0));
 }
 
-static drift_result measure(drift_context *ctx, const drift_scene *scene, const drift_accel *accel,
-                            const aaf_options *o, drift_effect effect, curve *out)
+// One effect's sweep under mpirun (sweep.h): its reference is rendered by one rank (effect
+// ordinal mod N) while the other ranks render AAF's and plain MC's points and the timing
+// frame in turn; the reference's term is then shared with every rank, each compares its own
+// points, and rank 0 gathers them. One process renders everything itself.
+typedef struct effect_run {
+    drift_effect effect;
+    const char *term;
+    int aaf;
+    int ref_owner;                  // the rank rendering the reference
+    drift_hybrid *ref;              // there
+    drift_image truth;              // the reference's term, on every rank after sharing
+    drift_image tests[2][MAX_SPPS]; // this rank's points' term (0: AAF, 1: plain MC)
+    int owners[2][MAX_SPPS];        // each point's rank
+    int timing_owner;
+    double timing[3]; // sampling, filter, frame ms
+} effect_run;
+
+static drift_result copy_plane(drift_context *ctx, const drift_image *plane, drift_image *out)
 {
-    const char *term = effect == DRIFT_EFFECT_SHADOWS    ? "direct"
-                       : effect == DRIFT_EFFECT_INDIRECT ? "indirect"
-                                                         : "reflections";
-    int aaf = effect == DRIFT_EFFECT_SHADOWS    ? DRIFT_SHADOWS_AAF
-              : effect == DRIFT_EFFECT_INDIRECT ? DRIFT_INDIRECT_AAF
-                                                : DRIFT_REFLECTIONS_AAF;
+    if (!plane) {
+        return DRIFT_ERR_INVALID_ARGUMENT; // the term's plane is missing
+    }
+    drift_result r = drift_image_create(ctx, plane->width, plane->height, plane->channels, out);
+    if (r == DRIFT_OK) {
+        memcpy(out->pixels, plane->pixels,
+               sizeof(float) * (size_t)plane->channels * (size_t)plane->width *
+                   (size_t)plane->height);
+    }
+    return r;
+}
+
+// Phase 1: this rank's renders of the effect (the reference, or its points and timing).
+static drift_result measure_render(drift_context *ctx, const drift_scene *scene,
+                                   const drift_accel *accel, const aaf_options *o, int ordinal,
+                                   effect_run *e, curve *out)
+{
+    drift_effect effect = e->effect;
+    e->term = effect == DRIFT_EFFECT_SHADOWS    ? "direct"
+              : effect == DRIFT_EFFECT_INDIRECT ? "indirect"
+                                                : "reflections";
+    e->aaf = effect == DRIFT_EFFECT_SHADOWS    ? DRIFT_SHADOWS_AAF
+             : effect == DRIFT_EFFECT_INDIRECT ? DRIFT_INDIRECT_AAF
+                                               : DRIFT_REFLECTIONS_AAF;
     int reference = effect == DRIFT_EFFECT_SHADOWS    ? DRIFT_SHADOWS_REFERENCE
                     : effect == DRIFT_EFFECT_INDIRECT ? DRIFT_INDIRECT_REFERENCE
                                                       : DRIFT_REFLECTIONS_REFERENCE;
-    out->effect = effect;
-    out->count = o->spp_count;
-    out->plain_count = o->mc_spp_count;
-    drift_hybrid *ref = NULL, *frame = NULL;
-    drift_hybrid_params p = effect_params(effect, reference, o, o->ref_spp);
-    drift_result r = render(ctx, scene, accel, &p, &ref);
-    const drift_image *truth = r == DRIFT_OK ? drift_hybrid_plane_named(ref, term) : NULL;
+    *out = (curve){ .effect = effect, .count = o->spp_count, .plain_count = o->mc_spp_count };
+    e->ref_owner = ordinal % sweep_ranks();
     int most = o->spp_count > o->mc_spp_count ? o->spp_count : o->mc_spp_count;
+    for (int k = 0; k < most; ++k) { // AAF's and plain MC's points in turn, by spp
+        e->owners[0][k] = sweep_owner_besides(e->ref_owner, 2 * k);
+        e->owners[1][k] = sweep_owner_besides(e->ref_owner, 2 * k + 1);
+    }
+    e->timing_owner = sweep_owner_besides(e->ref_owner, 2 * most);
+    int me = sweep_rank();
+    drift_result r = DRIFT_OK;
+    drift_hybrid *frame = NULL;
+    drift_hybrid_params p;
+    if (e->ref_owner == me) {
+        p = effect_params(effect, reference, o, o->ref_spp);
+        r = render(ctx, scene, accel, &p, &e->ref);
+    }
     for (int k = 0; r == DRIFT_OK && k < most; ++k) {
         for (int method = 0; r == DRIFT_OK && method < 2; ++method) {
-            if (k >= (method == 0 ? o->spp_count : o->mc_spp_count)) {
+            if (k >= (method == 0 ? o->spp_count : o->mc_spp_count) || e->owners[method][k] != me) {
                 continue;
             }
             long spp = method == 0 ? o->spps[k] : o->mc_spps[k];
-            p = effect_params(effect, aaf, o, spp);
+            p = effect_params(effect, e->aaf, o, spp);
             p.aaf.uniform = p.aaf.unfiltered = method == 1;
             r = render(ctx, scene, accel, &p, &frame);
-            if (r != DRIFT_OK) {
-                break;
+            if (r == DRIFT_OK) {
+                r = copy_plane(ctx, drift_hybrid_plane_named(frame, e->term), &e->tests[method][k]);
             }
-            const drift_image *test = drift_hybrid_plane_named(frame, term);
-            double mse = 0.0;
-            r = test && truth ? drift_metric_mse(ctx, truth, test, &mse)
-                              : DRIFT_ERR_INVALID_ARGUMENT; // the term's plane is missing
             if (r != DRIFT_OK) {
                 break;
             }
             drift_hybrid_stats s = drift_hybrid_get_stats(frame);
             point *pt = method == 0 ? &out->aaf[k] : &out->plain[k];
-            double truth_mean = drift_image_mean_rgb(truth);
             *pt = (point){ .spp = (double)spp,
                            .actual_spp = actual_spp(frame, effect),
-                           .rmse = sqrt(mse),
-                           .mean_ratio =
-                               truth_mean > 0.0 ? drift_image_mean_rgb(test) / truth_mean : 1.0,
                            .sampling_ms = s.ms[DRIFT_PASS_AAF_SAMPLING],
                            .filter_ms = s.ms[DRIFT_PASS_AAF_FILTER] };
             if (!(pt->actual_spp > 0.0)) {
@@ -275,26 +310,85 @@ static drift_result measure(drift_context *ctx, const drift_scene *scene, const 
             }
         }
     }
-    for (int k = 0; r == DRIFT_OK && k < o->spp_count; ++k) {
-        double spp =
-            equal_error_spp(out->plain, o->mc_spp_count, out->aaf[k].rmse, &out->extrapolated[k]);
-        out->ratio[k] = spp / out->aaf[k].actual_spp;
-    }
-    if (r == DRIFT_OK) {
-        p = effect_params(effect, aaf, o, o->timing_spp);
+    if (r == DRIFT_OK && e->timing_owner == me) {
+        p = effect_params(effect, e->aaf, o, o->timing_spp);
         p.width = (int32_t)o->timing_width;
         p.height = (int32_t)o->timing_height;
         r = render(ctx, scene, accel, &p, &frame);
         if (r == DRIFT_OK) {
             drift_hybrid_stats s = drift_hybrid_get_stats(frame);
-            out->timing_sampling_ms = s.ms[DRIFT_PASS_AAF_SAMPLING];
-            out->timing_filter_ms = s.ms[DRIFT_PASS_AAF_FILTER];
-            out->timing_frame_ms = s.frame_ms;
+            e->timing[0] = s.ms[DRIFT_PASS_AAF_SAMPLING];
+            e->timing[1] = s.ms[DRIFT_PASS_AAF_FILTER];
+            e->timing[2] = s.frame_ms;
         }
     }
-    drift_hybrid_destroy(ref);
     drift_hybrid_destroy(frame);
     return r;
+}
+
+// Phase 2 (every rank, after every effect's phase 1): the reference's term to every rank,
+// the errors of this rank's points, everything to rank 0; the equal-error ratios there.
+static drift_result measure_compare(drift_context *ctx, const aaf_options *o, effect_run *e,
+                                    bool ok, curve *out)
+{
+    int me = sweep_rank();
+    int32_t dims[3] = { 0, 0, 0 };
+    if (ok && e->ref_owner == me) {
+        drift_result r = copy_plane(ctx, drift_hybrid_plane_named(e->ref, e->term), &e->truth);
+        ok = r == DRIFT_OK;
+        if (ok) {
+            dims[0] = e->truth.width;
+            dims[1] = e->truth.height;
+            dims[2] = e->truth.channels;
+        }
+    }
+    ok = sweep_share(dims, sizeof dims, e->ref_owner, ok);
+    if (ok && e->ref_owner != me) {
+        ok = drift_image_create(ctx, dims[0], dims[1], dims[2], &e->truth) == DRIFT_OK;
+    }
+    size_t floats = (size_t)dims[0] * (size_t)dims[1] * (size_t)dims[2];
+    ok = sweep_share(e->truth.pixels, ok ? floats * sizeof(float) : 0, e->ref_owner, ok);
+    double truth_mean = ok ? drift_image_mean_rgb(&e->truth) : 0.0;
+    for (int k = 0; ok && k < MAX_SPPS; ++k) {
+        for (int method = 0; ok && method < 2; ++method) {
+            if (k >= (method == 0 ? o->spp_count : o->mc_spp_count) || e->owners[method][k] != me) {
+                continue;
+            }
+            const drift_image *test = &e->tests[method][k];
+            point *pt = method == 0 ? &out->aaf[k] : &out->plain[k];
+            double mse = 0.0;
+            ok = drift_metric_mse(ctx, &e->truth, test, &mse) == DRIFT_OK;
+            pt->rmse = sqrt(mse);
+            pt->mean_ratio = truth_mean > 0.0 ? drift_image_mean_rgb(test) / truth_mean : 1.0;
+        }
+    }
+    ok = sweep_gather_owned(out->aaf, sizeof *out->aaf, o->spp_count, e->owners[0], ok);
+    ok =
+        sweep_gather_owned(out->plain, sizeof *out->plain, o->mc_spp_count, e->owners[1], ok) && ok;
+    ok = sweep_gather_owned(e->timing, sizeof e->timing, 1, &e->timing_owner, ok) && ok;
+    if (!ok) {
+        return DRIFT_ERR_INVALID_ARGUMENT; // here or on another rank (named by rank 0)
+    }
+    out->timing_sampling_ms = e->timing[0];
+    out->timing_filter_ms = e->timing[1];
+    out->timing_frame_ms = e->timing[2];
+    for (int k = 0; me == 0 && k < o->spp_count; ++k) {
+        double spp =
+            equal_error_spp(out->plain, o->mc_spp_count, out->aaf[k].rmse, &out->extrapolated[k]);
+        out->ratio[k] = spp / out->aaf[k].actual_spp;
+    }
+    return DRIFT_OK;
+}
+
+static void effect_run_free(drift_context *ctx, effect_run *e)
+{
+    drift_hybrid_destroy(e->ref);
+    drift_image_destroy(ctx, &e->truth);
+    for (int m = 0; m < 2; ++m) {
+        for (int k = 0; k < MAX_SPPS; ++k) {
+            drift_image_destroy(ctx, &e->tests[m][k]);
+        }
+    }
 }
 
 // --- OUTPUT ---
@@ -503,30 +597,50 @@ int drift_bench_aaf(int argc, char **argv)
     }
     int exit_code = 1;
     cli_session session;
-    if (!bench_open(&session, "bench aaf", o.scene_path, "scenes/grids/grids.json", o.threads)) {
+    bool opened =
+        bench_open(&session, "bench aaf", o.scene_path, "scenes/grids/grids.json", o.threads);
+    if (!sweep_gather(NULL, 0, 0, 0, opened)) { // under mpirun: every rank, or none, goes on
         goto done;
     }
     drift_context *ctx = session.ctx;
     const char *scene_path = session.scene_path;
     drift_result r = DRIFT_OK;
     curve curves[3];
+    static effect_run runs[3];
     int count = 0;
     drift_effect effects[3] = { DRIFT_EFFECT_SHADOWS, DRIFT_EFFECT_INDIRECT,
                                 DRIFT_EFFECT_REFLECTIONS };
     bool wanted[3] = { o.shadows, o.indirect, o.reflections };
-    for (int e = 0; e < 3; ++e) {
-        if (!wanted[e]) {
-            continue;
+    for (int e = 0; e < 3; ++e) { // every rank's renders first, then the comparisons
+        if (wanted[e]) {
+            runs[count].effect = effects[e];
+            if (r == DRIFT_OK) {
+                r = measure_render(ctx, session.scene, session.accel, &o, count, &runs[count],
+                                   &curves[count]);
+            }
+            ++count;
         }
-        r = measure(ctx, session.scene, session.accel, &o, effects[e], &curves[count]);
-        if (r != DRIFT_OK) {
-            fprintf(stderr, "drift bench aaf: %s failed: %s\n", drift_effect_name(effects[e]),
-                    drift_result_string(r));
-            goto done;
+    }
+    for (int c = 0; c < count; ++c) {
+        drift_result compared = measure_compare(ctx, &o, &runs[c], r == DRIFT_OK, &curves[c]);
+        if (r == DRIFT_OK && compared != DRIFT_OK) {
+            r = DRIFT_ERR_CANCELLED; // another rank failed: rank 0 named it
         }
-        ++count;
+    }
+    for (int c = 0; c < count; ++c) {
+        effect_run_free(ctx, &runs[c]);
+    }
+    if (r != DRIFT_OK) {
+        if (r != DRIFT_ERR_CANCELLED) {
+            fprintf(stderr, "drift bench aaf: %s\n", drift_result_string(r));
+        }
+        goto done;
     }
     int threads = drift_context_thread_count(ctx);
+    if (sweep_rank() != 0) { // rank 0 prints and writes the figures it gathered
+        exit_code = 0;
+        goto done;
+    }
     if (o.json) {
         if (!print_json(&o, scene_path, threads, curves, count)) {
             goto done;

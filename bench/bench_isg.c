@@ -15,6 +15,7 @@
 //                      shadows so that only depth of field differs from the lens reference
 #include "bench.h"
 #include "cli.h"
+#include "distributed/sweep.h"
 #include "drift/accel.h"
 #include "drift/hybrid.h"
 #include "drift/metric.h"
@@ -118,9 +119,11 @@ static int isg_technique(drift_effect effect)
     return drift_technique_parse(effect, "isg");
 }
 
-// (a) The paper's Table 1 for one effect: rows gather, columns search.
-static drift_result timing_table(const bench_ctx *b, drift_effect effect, double table[4][4],
-                                 double *out_base)
+// (a) The paper's Table 1 for one effect: rows gather, columns search. Its 16 cells are sweep
+// items first .. first + 15, over the ranks under mpirun (sweep.h): this rank's cells into
+// cells (the ISG pass's ms, the rest of the frame's), gathered by timing_collect.
+static drift_result timing_render(const bench_ctx *b, drift_effect effect, int first,
+                                  double cells[16][2])
 {
     const isg_options *o = b->o;
     drift_hybrid_params p = effect_params(effect, isg_technique(effect));
@@ -129,25 +132,39 @@ static drift_result timing_table(const bench_ctx *b, drift_effect effect, double
     }
     p.width = (int32_t)o->width;
     p.height = (int32_t)o->height;
-    *out_base = HUGE_VAL;
-    for (int g = 0; g < 4; ++g) {
-        for (int s = 0; s < 4; ++s) {
-            p.isg.search = counts[s];
-            p.isg.gather = counts[g];
-            // The least of N frames: other processes on the machine only ever add time.
-            table[g][s] = HUGE_VAL;
-            for (long k = 0; k < o->frames; ++k) {
-                drift_hybrid_stats st;
-                drift_result r = render(b, p, false, &st, NULL);
-                if (r != DRIFT_OK) {
-                    return r;
-                }
-                table[g][s] = fmin(table[g][s], st.ms[DRIFT_PASS_ISG]);
-                *out_base = fmin(*out_base, st.frame_ms - st.ms[DRIFT_PASS_ISG]);
+    drift_result r = DRIFT_OK;
+    for (int c = 0; c < 16 && r == DRIFT_OK; ++c) {
+        if (!sweep_mine(first + c)) {
+            continue;
+        }
+        p.isg.search = counts[c % 4];
+        p.isg.gather = counts[c / 4];
+        // The least of N frames: other processes on the machine only ever add time.
+        cells[c][0] = cells[c][1] = HUGE_VAL;
+        for (long k = 0; k < o->frames && r == DRIFT_OK; ++k) {
+            drift_hybrid_stats st;
+            r = render(b, p, false, &st, NULL);
+            if (r == DRIFT_OK) {
+                cells[c][0] = fmin(cells[c][0], st.ms[DRIFT_PASS_ISG]);
+                cells[c][1] = fmin(cells[c][1], st.frame_ms - st.ms[DRIFT_PASS_ISG]);
             }
         }
     }
-    return DRIFT_OK;
+    return r;
+}
+
+static bool timing_collect(int first, double cells[16][2], bool ok, double table[4][4],
+                           double *out_base)
+{
+    if (!sweep_gather(cells, sizeof cells[0], first, 16, ok)) {
+        return false;
+    }
+    *out_base = HUGE_VAL;
+    for (int c = 0; c < 16; ++c) {
+        table[c / 4][c % 4] = cells[c][0];
+        *out_base = fmin(*out_base, cells[c][1]);
+    }
+    return true;
 }
 
 // The milliseconds a technique of an effect adds to the frame.
@@ -174,55 +191,100 @@ typedef struct quality_row {
 
 #define MAX_ROWS 5
 
-// (b) for one effect: the reference, then every technique against it.
-static drift_result quality(const bench_ctx *b, drift_effect effect, quality_row *rows,
-                            int *out_count)
+// (b) for one effect: the reference, then every technique against it. Under mpirun the
+// reference is rendered by one rank (effect ordinal mod N) while the others render the
+// techniques' frames (quality_render); quality_compare then shares the reference with every
+// rank, each compares its own frames, and rank 0 gathers the rows.
+typedef struct quality_run {
+    int ref_owner, count;
+    int owners[MAX_ROWS];
+    drift_image reference, tests[MAX_ROWS];
+    double ms[MAX_ROWS];
+} quality_run;
+
+static const char *const quality_names[DRIFT_EFFECT_COUNT][MAX_ROWS] = {
+    { "hard", "pcss", "blur", "isg", "isg-9x9" },
+    { "sharp", "envmap", "blur", "isg", "isg-9x9" },
+    { "none", "post", "isg", "isg-9x9", "isg-2layers" },
+    { NULL },
+};
+
+static drift_result quality_render(const bench_ctx *b, drift_effect effect, int ordinal,
+                                   quality_run *q)
 {
     const isg_options *o = b->o;
-    static const char *const names[DRIFT_EFFECT_COUNT][MAX_ROWS] = {
-        { "hard", "pcss", "blur", "isg", "isg-9x9" },
-        { "sharp", "envmap", "blur", "isg", "isg-9x9" },
-        { "none", "post", "isg", "isg-9x9", "isg-2layers" },
-        { NULL },
-    };
+    const char *const *names = quality_names[effect];
+    q->ref_owner = ordinal % sweep_ranks();
+    q->count = 0;
+    while (q->count < MAX_ROWS && names[q->count]) {
+        q->owners[q->count] = sweep_owner_besides(q->ref_owner, q->count);
+        q->count++;
+    }
     drift_hybrid_params ref = effect_params(effect, drift_technique_parse(effect, "reference"));
     ref.width = (int32_t)o->qwidth;
     ref.height = (int32_t)o->qheight;
     ref.spp = (uint32_t)o->ref_spp;
-    drift_image reference = { 0 };
-    drift_hybrid_stats st;
-    drift_result r = render(b, ref, false, &st, &reference);
-    *out_count = 0;
-    for (int t = 0; r == DRIFT_OK && t < MAX_ROWS && names[effect][t]; ++t) {
+    drift_hybrid_stats st = { 0 };
+    drift_result r = DRIFT_OK;
+    if (q->ref_owner == sweep_rank()) {
+        r = render(b, ref, false, &st, &q->reference);
+    }
+    for (int t = 0; r == DRIFT_OK && t < q->count; ++t) {
+        if (q->owners[t] != sweep_rank()) {
+            continue;
+        }
         // "isg-9x9" is ISG at its cheapest sample counts: the time-matched variant.
         // "isg-2layers" adds the second depth layer.
-        bool cheap = strcmp(names[effect][t], "isg-9x9") == 0;
-        bool layers = strcmp(names[effect][t], "isg-2layers") == 0;
-        drift_hybrid_params p = effect_params(
-            effect, cheap || layers ? isg_technique(effect)
-                                    : drift_technique_parse(effect, names[effect][t]));
+        bool cheap = strcmp(names[t], "isg-9x9") == 0;
+        bool layers = strcmp(names[t], "isg-2layers") == 0;
+        drift_hybrid_params p =
+            effect_params(effect, cheap || layers ? isg_technique(effect)
+                                                  : drift_technique_parse(effect, names[t]));
         p.isg.layers = layers ? 2 : 1;
         p.width = ref.width;
         p.height = ref.height;
         p.spp = ref.spp; // the DOF runs' path-traced shadows
         p.isg.search = cheap ? 9 : (int32_t)o->search;
         p.isg.gather = cheap ? 9 : (int32_t)o->gather;
-        drift_image test = { 0 };
         // Warm for timing (shadow maps and probes are cached), except around path tracing.
-        r = render(b, p, effect != DRIFT_EFFECT_DOF, &st, &test);
-        drift_metric_report rep;
-        if (r == DRIFT_OK) {
-            r = drift_metric_compare(b->ctx, &reference, &test, &(drift_metric_params){ 0 }, &rep,
-                                     NULL);
-        }
-        if (r == DRIFT_OK) {
-            rows[(*out_count)++] =
-                (quality_row){ names[effect][t], rep.flip, rep.rmse, technique_ms(effect, &st) };
-        }
-        drift_image_destroy(b->ctx, &test);
+        r = render(b, p, effect != DRIFT_EFFECT_DOF, &st, &q->tests[t]);
+        q->ms[t] = r == DRIFT_OK ? technique_ms(effect, &st) : 0.0;
     }
-    drift_image_destroy(b->ctx, &reference);
     return r;
+}
+
+static bool quality_compare(const bench_ctx *b, drift_effect effect, quality_run *q, bool ok,
+                            quality_row *rows, int *out_count)
+{
+    int32_t dims[3] = { q->reference.width, q->reference.height, q->reference.channels };
+    ok = sweep_share(dims, sizeof dims, q->ref_owner, ok);
+    if (ok && q->ref_owner != sweep_rank()) {
+        ok = drift_image_create(b->ctx, dims[0], dims[1], dims[2], &q->reference) == DRIFT_OK;
+    }
+    size_t bytes = sizeof(float) * (size_t)dims[0] * (size_t)dims[1] * (size_t)dims[2];
+    ok = sweep_share(q->reference.pixels, ok ? bytes : 0, q->ref_owner, ok);
+    for (int t = 0; ok && t < q->count; ++t) {
+        if (q->owners[t] != sweep_rank()) {
+            continue;
+        }
+        drift_metric_report rep;
+        ok = drift_metric_compare(b->ctx, &q->reference, &q->tests[t], &(drift_metric_params){ 0 },
+                                  &rep, NULL) == DRIFT_OK;
+        rows[t] = (quality_row){ NULL, rep.flip, rep.rmse, q->ms[t] };
+    }
+    drift_image_destroy(b->ctx, &q->reference);
+    for (int t = 0; t < MAX_ROWS; ++t) {
+        drift_image_destroy(b->ctx, &q->tests[t]);
+    }
+    *out_count = 0;
+    if (!sweep_gather_owned(rows, sizeof *rows, q->count, q->owners, ok)) {
+        return false;
+    }
+    for (int t = 0; t < q->count; ++t) { // names here: a pointer from another rank means nothing
+        rows[t].technique = quality_names[effect][t];
+    }
+    *out_count = q->count;
+    return true;
 }
 
 static const drift_effect effects[3] = { DRIFT_EFFECT_SHADOWS, DRIFT_EFFECT_REFLECTIONS,
@@ -321,8 +383,9 @@ int drift_bench_isg(int argc, char **argv)
     }
     int exit_code = 1;
     cli_session session;
-    if (!bench_open(&session, "bench isg", o.scene_path,
-                    "scenes/cornell-glossy/cornell_glossy.json", o.threads)) {
+    bool opened = bench_open(&session, "bench isg", o.scene_path,
+                             "scenes/cornell-glossy/cornell_glossy.json", o.threads);
+    if (!sweep_gather(NULL, 0, 0, 0, opened)) { // under mpirun: every rank, or none, goes on
         goto done;
     }
     drift_context *ctx = session.ctx;
@@ -351,19 +414,37 @@ int drift_bench_isg(int argc, char **argv)
     double base[3] = { 0.0, 0.0, 0.0 };
     static quality_row rows[3][MAX_ROWS];
     int row_count[3] = { 0, 0, 0 };
+    // Every rank's renders first (timing cells, references, technique frames), then the
+    // comparisons and gathers, so that no rank waits for another's reference before its own.
+    static double cells[3][16][2];
+    static quality_run runs[3];
+    for (int e = 0; e < 3 && r == DRIFT_OK; ++e) {
+        if (!o.skip_table) {
+            r = timing_render(&b, effects[e], 16 * e, cells[e]);
+        }
+        if (!o.skip_quality && r == DRIFT_OK) {
+            r = quality_render(&b, effects[e], e, &runs[e]);
+        }
+    }
+    bool ok = r == DRIFT_OK;
     for (int e = 0; e < 3; ++e) {
-        if (!o.skip_table && (r = timing_table(&b, effects[e], tables[e], &base[e])) != DRIFT_OK) {
-            break;
+        if (!o.skip_table) {
+            ok = timing_collect(16 * e, cells[e], ok, tables[e], &base[e]) && ok;
         }
-        if (!o.skip_quality && (r = quality(&b, effects[e], rows[e], &row_count[e])) != DRIFT_OK) {
-            break;
+        if (!o.skip_quality) {
+            ok = quality_compare(&b, effects[e], &runs[e], ok, rows[e], &row_count[e]) && ok;
         }
+    }
+    if (r == DRIFT_OK && !ok) {
+        r = DRIFT_ERR_CANCELLED; // on another rank, named by rank 0
     }
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift bench isg: %s\n", drift_result_string(r));
         goto done;
     }
-    if (o.json) {
+    if (sweep_rank() != 0) { // rank 0 prints the figures it gathered
+        exit_code = 0;
+    } else if (o.json) {
         exit_code = print_json(&b, tables, base, rows, row_count, scene_path) ? 0 : 1;
     } else {
         print_text(&b, tables, base, rows, row_count, scene_path);

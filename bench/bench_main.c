@@ -1,6 +1,7 @@
 // drift bench <name> ...: dispatches to the benchmarks listed in bench.h (DRIFT_BENCH_LIST).
 #include "bench.h"
 #include "cli.h"
+#include "distributed/sweep.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -55,8 +56,15 @@ bool bench_parse_list(const char *cmd, const char *flag, const char *text, long 
 
 int drift_cmd_bench(int argc, char **argv)
 {
-    return cli_dispatch("bench", "benchmarks",
-                        "'drift bench <name> --help' describes each one; docs/benchmarks.md has "
-                        "recorded figures.\n",
-                        benches, sizeof benches / sizeof *benches, argc, argv);
+    sweep_begin(); // mpirun -n N drift bench ...: the sweeps' renders over the ranks
+    bool spreads = argc >= 2 && (strcmp(argv[1], "aaf") == 0 || strcmp(argv[1], "isg") == 0 ||
+                                 strcmp(argv[1], "sir") == 0);
+    if (!spreads && sweep_rank() != 0) {
+        return sweep_end(0); // a bench that does not spread runs on rank 0 alone
+    }
+    int status = cli_dispatch("bench", "benchmarks",
+                              "'drift bench <name> --help' describes each one; docs/benchmarks.md "
+                              "has recorded figures.\n",
+                              benches, sizeof benches / sizeof *benches, argc, argv);
+    return sweep_end(status);
 }

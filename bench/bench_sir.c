@@ -5,6 +5,7 @@
 // and precision against the real error |raster - ray traced| > threshold.
 #include "bench.h"
 #include "cli.h"
+#include "distributed/sweep.h"
 #include "drift/accel.h"
 #include "drift/hybrid.h"
 #include "drift/image_io.h"
@@ -596,8 +597,12 @@ int drift_bench_sir(int argc, char **argv)
         printf("%-16s %-10s %-11s %20s %9s %9s %8s %8s %s\n", "scene", "view", "size",
                "error pixels", "PRT ms", "SIR ms", "speedup", "FLIP", "same");
     }
-    for (int s = 0; s < o.scene_count && exit_code == 0; ++s) {
-        if (!cli_session_load(&session, "bench sir", o.scenes[s], false)) {
+    // Each (scene, view, size) row is a sweep item; under mpirun they spread over the ranks
+    // (sweep.h) and rank 0 prints each scene's rows once it has gathered them.
+    bool spread = sweep_ranks() > 1;
+    for (int s = 0, item = 0; s < o.scene_count && exit_code == 0; ++s) {
+        bool loaded = cli_session_load(&session, "bench sir", o.scenes[s], false);
+        if (!sweep_gather(NULL, 0, 0, 0, loaded)) {
             exit_code = 1;
             break;
         }
@@ -609,33 +614,53 @@ int drift_bench_sir(int argc, char **argv)
             scene->camera.fov_y = (float)(o.fov * 3.14159265358979323846 / 180.0);
         }
         const drift_camera camera = scene->camera;
-        for (uint32_t v = 0; v < (o.view_count ? o.view_count : 1) && exit_code == 0; ++v) {
+        int views = (int)(o.view_count ? o.view_count : 1), count = views * o.size_count;
+        sir_row *scene_rows = calloc((size_t)count, sizeof *scene_rows);
+        bool ok = scene_rows != NULL;
+        for (int i = 0; ok && i < count; ++i) {
+            int v = i / o.size_count, k = i % o.size_count;
             const drift_camera_view *view = o.view_count ? &o.views[v] : NULL;
+            if (!sweep_mine(item + i)) {
+                continue;
+            }
             scene->camera = camera;
             if (view) {
                 drift_camera_view_apply(view, &scene->camera);
             }
-            for (int k = 0; k < o.size_count; ++k) {
-                sir_row row = { .scene = short_name(o.scenes[s]),
-                                .view = view ? view->name : "camera" };
-                r = run_one(ctx, scene, session.accel, &o, o.widths[k], o.heights[k],
-                            o.lambda_path ? lambda : NULL, &row);
-                if (r != DRIFT_OK) {
-                    fprintf(stderr, "drift bench sir: %s failed: %s\n", o.scenes[s],
-                            drift_result_string(r));
-                    exit_code = 1;
-                    break;
-                }
+            sir_row *row = &scene_rows[i];
+            r = run_one(ctx, scene, session.accel, &o, o.widths[k], o.heights[k],
+                        o.lambda_path ? lambda : NULL, row);
+            if (r != DRIFT_OK) {
+                fprintf(stderr, "drift bench sir: %s failed: %s\n", o.scenes[s],
+                        drift_result_string(r));
+                ok = false;
+            } else if (!spread) { // one process: each row as soon as it is measured
+                row->scene = short_name(o.scenes[s]);
+                row->view = view ? view->name : "camera";
                 if (rows) {
-                    add_json_row(rows, &row, o.lambda_path != NULL);
+                    add_json_row(rows, row, o.lambda_path != NULL);
                 } else {
-                    print_text_row(&row, o.lambda_path != NULL);
+                    print_text_row(row, o.lambda_path != NULL);
                     fflush(stdout);
                 }
             }
         }
+        ok = sweep_gather(scene_rows, sizeof *scene_rows, item, count, ok);
+        for (int i = 0; ok && spread && sweep_rank() == 0 && i < count; ++i) {
+            sir_row *row = &scene_rows[i]; // its names: another rank's pointers mean nothing
+            row->scene = short_name(o.scenes[s]);
+            row->view = o.view_count ? o.views[i / o.size_count].name : "camera";
+            if (rows) {
+                add_json_row(rows, row, o.lambda_path != NULL);
+            } else {
+                print_text_row(row, o.lambda_path != NULL);
+            }
+        }
+        free(scene_rows);
+        item += count;
+        exit_code = ok ? 0 : 1;
     }
-    if (root && exit_code != 0) {
+    if (root && (exit_code != 0 || sweep_rank() != 0)) {
         cJSON_Delete(root);
     } else if (root && !cli_json_write("bench sir", root, NULL)) {
         exit_code = 1;

@@ -85,6 +85,31 @@ expect 1 "${mpirun[@]}" -n 1 "$drift" render "${small[@]}" --spp 1 --out "$tmp/b
     fail "a scene missing on rank 1 is not reported once, naming the rank: $(cat "$tmp/err")"
 ls "$tmp" | grep -q '^bad\.' && fail "bad input wrote output: $(ls "$tmp")"
 
+# mpirun -n N drift bench aaf|isg|sir: the sweep's renders spread over the ranks, the same
+# figures as one process (timings aside), printed once by rank 0.
+same_figures() { python3 "$(dirname "$0")/same_figures.py" "$@" >/dev/null || fail "$3: $(python3 "$(dirname "$0")/same_figures.py" "$1" "$2")"; }
+scenes="$(dirname "$0")/../../scenes"
+bench_aaf=(bench aaf --effect both --spp 1,2 --ref-spp 4 --width 16 --height 12 --timing-size 16x12
+    --timing-spp 1 --light-samples 4 --json)
+bench_isg=(bench isg --no-table --qwidth 16 --qheight 12 --ref-spp 2 --json)
+bench_sir=(bench sir "$scenes/cornell-box/cornell_box.json" --sizes 24x16,16x16 --spp 1 --budget 64
+    --json)
+for b in aaf isg sir; do
+    declare -n cmd="bench_$b"
+    "$drift" "${cmd[@]}" >"$tmp/$b.json" 2>"$tmp/err" || fail "bench $b failed: $(cat "$tmp/err")"
+    ranks=(2)
+    [ "$b" = aaf ] && ranks=(2 3) # 3 ranks: items not a multiple of the ranks
+    for n in "${ranks[@]}"; do
+        "${mpirun[@]}" -n "$n" "$drift" "${cmd[@]}" >"$tmp/$b$n.json" 2>"$tmp/err" ||
+            fail "bench $b on $n ranks failed: $(cat "$tmp/err")"
+        same_figures "$tmp/$b.json" "$tmp/$b$n.json" "bench $b on $n ranks"
+    done
+done
+# A bad option: one message, whatever the rank count.
+expect 2 "${mpirun[@]}" -n 2 "$drift" bench aaf --spp 4,2
+[ "$(grep -c "increasing list" "$tmp/err")" -eq 1 ] ||
+    fail "a bad bench option is not reported exactly once: $(cat "$tmp/err")"
+
 if [ "$failures" -ne 0 ]; then
     echo "$failures failure(s)" >&2
     exit 1

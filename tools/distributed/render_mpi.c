@@ -2,13 +2,15 @@
 // docs/distributed.md). Built only with -DDRIFT_MPI=ON; nothing else in drift sees MPI.
 //
 // Every rank opens the same scene and makes the same path tracer. Rank 0 hands out jobs (a
-// few tiles and a number of samples to add) from a queue, keeps two jobs queued at each
-// other rank so none waits for it, renders jobs of its own in between, and merges what comes
-// back into its pt. A job carries the tiles' sums and counts from rank 0 and brings them back
-// with the samples added; a pixel's samples are still summed one by one in index order, so
-// the image is the same bits as one process's for any number of ranks and any hand-out
-// order. Rank 0 alone writes: progress, checkpoints (FILE.ckpt holds every merged tile),
-// the images and the stats, through the same steps as a one-process render (render.h).
+// few tiles and a number of samples to add) from a queue, keeps JOBS_QUEUED jobs at each
+// other rank so none waits for it (its sends and receives never block: they complete while
+// it renders), renders jobs of its own a sample at a time, serving in between, and merges
+// what comes back into its pt. A job carries the tiles' sums and counts from rank 0 and
+// brings them back with the samples added; a pixel's samples are still summed one by one in
+// index order, so the image is the same bits as one process's for any number of ranks and
+// any hand-out order. Rank 0 alone writes: progress, checkpoints (FILE.ckpt holds every
+// merged tile), the images and the stats, through the same steps as a one-process render
+// (render.h). Also here: sweep.c, the benchmark sweeps over ranks (sweep.h).
 #include "drift/pt.h"
 #include "render.h"
 
@@ -26,8 +28,11 @@ enum {
     TAG_STOP       // 0 -> rank: no more jobs
 };
 
-// Jobs kept at each rank: one it renders, one waiting, so it never waits for rank 0.
-#define JOBS_QUEUED 2
+// Jobs kept at each rank: one it renders and three waiting, so it never waits for rank 0
+// (a job of a small pass is milliseconds, about a time slice of a loaded machine).
+#define JOBS_QUEUED 4
+// Sends rank 0 holds a rank: a job's send may still be completing when its result is in.
+#define SENDS_HELD (2 * JOBS_QUEUED)
 
 bool render_mpi_launched(void)
 {
@@ -126,7 +131,8 @@ static int agree_on_setup(int rank, int ranks, int status, const char *text, con
 // --- JOBS ---
 
 // A job: uint32 add, until, tile count n, the n tiles, then each tile's state (pt.h). The
-// result: uint32 n, the ray counters (4 x uint64), the n tiles, their states.
+// result: uint32 n, the ray counters (4 x uint64), the seconds the rank waited for this job
+// (a double), the n tiles, their states.
 typedef struct byte_buffer {
     uint8_t *data;
     size_t size, cap;
@@ -179,55 +185,80 @@ static size_t take_tiles(drift_pt *pt, const uint8_t *at, uint32_t n, uint32_t *
     return (size_t)(p - at);
 }
 
-// Waits for a request rank 0 made; false when the job is being stopped (a signal: mpirun
-// stops every rank when one dies, and a dead rank's message never completes) or `rank`
-// (>= 0) has kept it waiting longer than timeout seconds.
-static bool finish_request(MPI_Request *request, const atomic_bool *cancel, double timeout)
+// How often a rank lets MPI move messages while it renders (between samples): often enough
+// that no message waits long, rarely enough that it costs nothing next to the samples.
+#define SERVE_SECONDS 2e-4
+
+// Lets MPI move the messages under way (a large message needs both sides to enter MPI):
+// one test of a pending request runs MPI's progress engine for all of them.
+static void progress(MPI_Request *requests, int count)
 {
-    double start = drift_time_now();
-    for (;;) {
-        int done = 0;
-        MPI_Test(request, &done, MPI_STATUS_IGNORE);
-        if (done) {
-            return true;
+    for (int i = 0; i < count; ++i) {
+        if (requests[i] != MPI_REQUEST_NULL) {
+            int done = 0;
+            MPI_Request_get_status(requests[i], &done, MPI_STATUS_IGNORE);
+            return;
         }
-        if (atomic_load(cancel) || drift_time_now() - start > timeout) {
-            return false; // left pending: the job ends without waiting for it
-        }
-        nanosleep(&(struct timespec){ .tv_nsec = 100000 }, NULL);
     }
 }
 
-static byte_buffer receive(int source, int tag, MPI_Status *status)
+// Waits for a request sleeping between tests, not spinning as MPI_Wait does: a rank waiting
+// for a job leaves its core to the others (more ranks than cores, or a loaded machine); the
+// naps grow, so that a long wait (the end of the render) costs few wake-ups.
+static void wait_politely(MPI_Request *request, MPI_Status *status)
 {
-    MPI_Probe(source, tag, MPI_COMM_WORLD, status);
-    int count = 0;
-    MPI_Get_count(status, MPI_BYTE, &count);
-    byte_buffer b = { .data = malloc(count ? (size_t)count : 1), .size = (size_t)count };
-    MPI_Recv(b.data, count, MPI_BYTE, status->MPI_SOURCE, status->MPI_TAG, MPI_COMM_WORLD,
-             MPI_STATUS_IGNORE);
-    return b;
+    for (long nap = 20000;; nap = nap < 640000 ? 2 * nap : nap) { // 20 us, doubling to 0.64 ms
+        int done = 0;
+        MPI_Test(request, &done, status);
+        if (done) {
+            return;
+        }
+        nanosleep(&(struct timespec){ .tv_nsec = nap }, NULL);
+    }
 }
 
-// Ranks other than 0: render each job, send it back (while the next one renders).
-static void serve_jobs(drift_pt *pt, const atomic_bool *cancel)
+// Ranks other than 0: JOBS_QUEUED receives stay posted for the next jobs, so that a job rank
+// 0 sent arrives while this rank renders the one before; each job is rendered a sample at a
+// time, letting MPI move messages in between, and sent back while the next one renders.
+static void serve_jobs(drift_pt *pt, const atomic_bool *cancel, int threads)
 {
-    byte_buffer out[2] = { { 0 } };
-    MPI_Request sent[2] = { MPI_REQUEST_NULL, MPI_REQUEST_NULL };
+    size_t job_size = 3 * sizeof(uint32_t) +
+                      (size_t)threads * (sizeof(uint32_t) + drift_pt_tile_state_size(pt, 0));
+    uint8_t *in[JOBS_QUEUED];
+    byte_buffer out[JOBS_QUEUED] = { { 0 } };
+    // [0, JOBS_QUEUED): the receives of the next jobs, matched in that order (a ring);
+    // then the results being sent.
+    MPI_Request requests[2 * JOBS_QUEUED];
+    for (int i = 0; i < JOBS_QUEUED; ++i) {
+        in[i] = malloc(job_size);
+        MPI_Irecv(in[i], (int)job_size, MPI_BYTE, 0, MPI_ANY_TAG, MPI_COMM_WORLD, &requests[i]);
+        requests[JOBS_QUEUED + i] = MPI_REQUEST_NULL;
+    }
     uint32_t *tiles = malloc(drift_pt_tile_count(pt) * sizeof *tiles);
     drift_pt_stats before = { 0 };
-    for (int which = 0;; which ^= 1) {
+    for (int which = 0, first = 1;; which = (which + 1) % JOBS_QUEUED, first = 0) {
         MPI_Status status;
-        byte_buffer job = receive(0, MPI_ANY_TAG, &status);
+        double asked = drift_time_now();
+        wait_politely(&requests[which], &status);
+        double waited = first ? 0.0 : drift_time_now() - asked; // the first: setup's end
         if (status.MPI_TAG != TAG_JOB) {
-            free(job.data);
             break;
         }
         uint32_t head[3];
-        memcpy(head, job.data, sizeof head);
-        take_tiles(pt, job.data + sizeof head, head[2], tiles);
-        free(job.data);
-        if (drift_pt_render_tiles(pt, tiles, head[2], head[0], head[1], cancel) != DRIFT_OK) {
+        memcpy(head, in[which], sizeof head);
+        take_tiles(pt, in[which] + sizeof head, head[2], tiles);
+        MPI_Irecv(in[which], (int)job_size, MPI_BYTE, 0, MPI_ANY_TAG, MPI_COMM_WORLD,
+                  &requests[which]);
+        bool stopped = false;
+        double served = drift_time_now();
+        for (uint32_t s = 0; s < head[0] && !stopped; ++s) {
+            stopped = drift_pt_render_tiles(pt, tiles, head[2], 1, head[1], cancel) != DRIFT_OK;
+            if (drift_time_now() - served > SERVE_SECONDS) {
+                progress(requests, 2 * JOBS_QUEUED);
+                served = drift_time_now();
+            }
+        }
+        if (stopped) {
             break; // SIGTERM: mpirun is stopping the job; rank 0 keeps what it merged
         }
         drift_pt_stats now = drift_pt_get_stats(pt);
@@ -236,21 +267,41 @@ static void serve_jobs(drift_pt *pt, const atomic_bool *cancel)
                              now.bounce_rays - before.bounce_rays,
                              now.nan_samples - before.nan_samples };
         before = now;
-        MPI_Wait(&sent[which], MPI_STATUS_IGNORE);
+        MPI_Request *sent = &requests[JOBS_QUEUED + which];
+        MPI_Wait(sent, MPI_STATUS_IGNORE);
         out[which].size = 0;
         buffer_put(&out[which], &head[2], sizeof head[2]);
         buffer_put(&out[which], rays, sizeof rays);
+        buffer_put(&out[which], &waited, sizeof waited);
         put_tiles(&out[which], pt, tiles, head[2]);
         MPI_Isend(out[which].data, (int)out[which].size, MPI_BYTE, 0, TAG_RESULT, MPI_COMM_WORLD,
-                  &sent[which]);
+                  sent);
     }
-    MPI_Waitall(2, sent, MPI_STATUSES_IGNORE);
-    free(out[0].data);
-    free(out[1].data);
+    for (int i = 0; i < JOBS_QUEUED; ++i) { // the receives left posted
+        if (requests[i] != MPI_REQUEST_NULL) {
+            MPI_Cancel(&requests[i]);
+            MPI_Wait(&requests[i], MPI_STATUS_IGNORE);
+        }
+        free(in[i]);
+    }
+    MPI_Waitall(JOBS_QUEUED, requests + JOBS_QUEUED, MPI_STATUSES_IGNORE);
+    for (int i = 0; i < JOBS_QUEUED; ++i) {
+        free(out[i].data);
+    }
     free(tiles);
 }
 
 // --- RANK 0 ---
+
+// A job sent and not yet taken in by its rank, or a result being received: its bytes stay
+// until the message completes.
+typedef struct pending_message {
+    MPI_Request request;
+    uint8_t *data;
+    size_t size;
+    int rank;
+    double since;
+} pending_message;
 
 typedef struct coordinator {
     render_reference_run *run;
@@ -258,14 +309,23 @@ typedef struct coordinator {
     uint32_t tile_count;
     uint32_t *queue; // tiles waiting for a job, a ring of tile_count
     uint32_t head, queued;
-    uint32_t pass;      // samples a job adds (doubles while a round of jobs is quick)
-    uint32_t handed;    // jobs' tiles handed out since the pass last changed
-    double round_start; // when that began
-    int *outstanding;   // jobs at each rank
-    double *last_heard; // when each rank last sent a result (or got its first job)
-    int *threads;       // each rank's worker threads: tiles a job
+    uint32_t pass;          // samples a job adds (doubles while a round of jobs is quick)
+    uint32_t handed;        // jobs' tiles handed out since the pass last changed
+    double round_start;     // when that began
+    int *outstanding;       // jobs at each rank
+    double *last_heard;     // when each rank last sent a result (or got its first job)
+    int *threads;           // each rank's worker threads: tiles a job
+    pending_message *sends; // at most SENDS_HELD a rank
+    pending_message *recvs; // at most JOBS_QUEUED a rank (one a job out)
+    int sends_pending, recvs_pending;
+    uint32_t *scratch; // tile indices of a job being packed or merged
     uint64_t bytes_sent, bytes_received, tiles_merged;
-    double merge_seconds; // rank 0's time unpacking results
+    double merge_seconds;  // rank 0's time unpacking results
+    double serve_seconds;  // rank 0's time in MPI and job handling, merges included
+    double served;         // when it last served
+    double render_seconds; // rank 0's time rendering its own jobs
+    double idle_seconds;   // rank 0 with nothing to render, waiting for the last results
+    double workers_waited; // the other ranks' time waiting for a job, summed
     const atomic_bool *cancel;
     int stuck_on; // a rank whose message did not complete (hung or dead, or a signal came)
 } coordinator;
@@ -298,70 +358,128 @@ static void requeue(coordinator *c, uint32_t tile)
     }
 }
 
-static void send_job(coordinator *c, int rank, uint32_t *scratch)
+// Sends a job without waiting for it to arrive: the rank takes it when it next asks, and
+// rank 0 goes on rendering meanwhile.
+static void send_job(coordinator *c, int rank)
 {
-    uint32_t n = take_queued(c, scratch, (uint32_t)c->threads[rank]);
+    uint32_t n = take_queued(c, c->scratch, (uint32_t)c->threads[rank]);
     if (n == 0) {
         return;
     }
     uint32_t head[3] = { c->pass, (uint32_t)c->run->o->spp, n };
     byte_buffer b = { 0 };
     buffer_put(&b, head, sizeof head);
-    put_tiles(&b, c->run->pt, scratch, n);
-    MPI_Request request;
-    MPI_Isend(b.data, (int)b.size, MPI_BYTE, rank, TAG_JOB, MPI_COMM_WORLD, &request);
-    if (!finish_request(&request, c->cancel, c->run->o->rank_timeout)) {
-        c->stuck_on = rank;
-        return; // b.data stays with the pending request
-    }
+    put_tiles(&b, c->run->pt, c->scratch, n);
+    pending_message *s = &c->sends[c->sends_pending++];
+    *s = (pending_message){ .data = b.data, .rank = rank, .since = drift_time_now() };
+    MPI_Isend(b.data, (int)b.size, MPI_BYTE, rank, TAG_JOB, MPI_COMM_WORLD, &s->request);
     c->bytes_sent += b.size;
-    free(b.data);
     if (c->outstanding[rank]++ == 0) {
-        c->last_heard[rank] = drift_time_now();
+        c->last_heard[rank] = s->since;
     }
 }
 
-// Merges every result that has arrived; returns how many.
-static int merge_results(coordinator *c, uint32_t *scratch)
+// Frees the jobs that have arrived; a job that its rank has not taken for --rank-timeout
+// seconds marks that rank as stuck.
+static void complete_sends(coordinator *c)
 {
-    int merged = 0;
+    double now = drift_time_now();
+    for (int i = 0; i < c->sends_pending;) {
+        int done = 0;
+        MPI_Test(&c->sends[i].request, &done, MPI_STATUS_IGNORE);
+        if (done) {
+            free(c->sends[i].data);
+            c->sends[i] = c->sends[--c->sends_pending];
+            continue;
+        }
+        if (now - c->sends[i].since > c->run->o->rank_timeout && !c->stuck_on) {
+            c->stuck_on = c->sends[i].rank; // its data stays with the pending request
+        }
+        ++i;
+    }
+}
+
+// Takes in one result: its tiles' state into rank 0's pt, its counters into the stats.
+static void take_result(coordinator *c, int rank, const uint8_t *p, size_t size)
+{
+    double t0 = drift_time_now();
+    uint32_t n;
+    uint64_t rays[4];
+    double waited;
+    memcpy(&n, p, sizeof n);
+    memcpy(rays, p += sizeof n, sizeof rays);
+    memcpy(&waited, p += sizeof rays, sizeof waited);
+    take_tiles(c->run->pt, p + sizeof waited, n, c->scratch);
+    drift_pt_add_stats(c->run->pt, &(drift_pt_stats){ .camera_rays = rays[0],
+                                                      .shadow_rays = rays[1],
+                                                      .bounce_rays = rays[2],
+                                                      .nan_samples = rays[3] });
+    for (uint32_t i = 0; i < n; ++i) {
+        requeue(c, c->scratch[i]);
+    }
+    c->merge_seconds += drift_time_now() - t0;
+    c->workers_waited += waited;
+    c->bytes_received += size;
+    c->tiles_merged += n;
+    c->outstanding[rank]--;
+    c->last_heard[rank] = drift_time_now();
+}
+
+// Starts receiving every result that has arrived and takes in those received, never waiting:
+// a receive that has not completed for --rank-timeout seconds marks its rank as stuck.
+static void merge_results(coordinator *c)
+{
     for (;;) {
         int ready = 0;
         MPI_Status status;
         MPI_Iprobe(MPI_ANY_SOURCE, TAG_RESULT, MPI_COMM_WORLD, &ready, &status);
         if (!ready) {
-            return merged;
+            break;
         }
         int count = 0;
         MPI_Get_count(&status, MPI_BYTE, &count);
-        byte_buffer b = { .data = malloc(count ? (size_t)count : 1), .size = (size_t)count };
-        MPI_Request request;
-        MPI_Irecv(b.data, count, MPI_BYTE, status.MPI_SOURCE, TAG_RESULT, MPI_COMM_WORLD, &request);
-        if (!finish_request(&request, c->cancel, c->run->o->rank_timeout)) {
-            c->stuck_on = status.MPI_SOURCE; // its tiles keep the state merged before
-            return merged;                   // (b.data stays with the pending request)
-        }
-        double t0 = drift_time_now();
-        uint32_t n;
-        uint64_t rays[4];
-        memcpy(&n, b.data, sizeof n);
-        memcpy(rays, b.data + sizeof n, sizeof rays);
-        take_tiles(c->run->pt, b.data + sizeof n + sizeof rays, n, scratch);
-        drift_pt_add_stats(c->run->pt, &(drift_pt_stats){ .camera_rays = rays[0],
-                                                          .shadow_rays = rays[1],
-                                                          .bounce_rays = rays[2],
-                                                          .nan_samples = rays[3] });
-        for (uint32_t i = 0; i < n; ++i) {
-            requeue(c, scratch[i]);
-        }
-        c->merge_seconds += drift_time_now() - t0;
-        c->bytes_received += b.size;
-        c->tiles_merged += n;
-        free(b.data);
-        c->outstanding[status.MPI_SOURCE]--;
-        c->last_heard[status.MPI_SOURCE] = drift_time_now();
-        merged++;
+        pending_message *m = &c->recvs[c->recvs_pending++];
+        *m = (pending_message){ .data = malloc(count ? (size_t)count : 1),
+                                .size = (size_t)count,
+                                .rank = status.MPI_SOURCE,
+                                .since = drift_time_now() };
+        MPI_Irecv(m->data, count, MPI_BYTE, m->rank, TAG_RESULT, MPI_COMM_WORLD, &m->request);
     }
+    double now = drift_time_now();
+    for (int i = 0; i < c->recvs_pending;) {
+        pending_message *m = &c->recvs[i];
+        int done = 0;
+        MPI_Test(&m->request, &done, MPI_STATUS_IGNORE);
+        if (done) {
+            take_result(c, m->rank, m->data, m->size);
+            free(m->data);
+            *m = c->recvs[--c->recvs_pending];
+            continue;
+        }
+        if (now - m->since > c->run->o->rank_timeout && !c->stuck_on) {
+            c->stuck_on = m->rank; // its tiles keep the state merged before
+        }
+        ++i;
+    }
+}
+
+// Rank 0's answer to the others, between its own samples: merge what came back, free the
+// jobs that arrived, top every rank up to JOBS_QUEUED jobs (one near the end, so that the
+// last tiles go to whoever is free first, rank 0 included).
+static void serve(coordinator *c)
+{
+    double t0 = drift_time_now();
+    merge_results(c);
+    complete_sends(c);
+    c->served = t0;
+    int most = c->queued >= (uint32_t)(JOBS_QUEUED * c->ranks) ? JOBS_QUEUED : 1;
+    for (int r = 1; r < c->ranks; ++r) {
+        while (c->outstanding[r] < most && c->queued > 0 && !c->stuck_on &&
+               c->sends_pending < SENDS_HELD * c->ranks) {
+            send_job(c, r);
+        }
+    }
+    c->serve_seconds += drift_time_now() - t0;
 }
 
 // Rank 0's loop; returns the rank found hung (0: none).
@@ -369,18 +487,13 @@ static int coordinate(coordinator *c, const atomic_bool *cancel)
 {
     const render_options *o = c->run->o;
     drift_pt *pt = c->run->pt;
-    uint32_t *scratch = malloc(c->tile_count * sizeof *scratch);
+    uint32_t *own = malloc(c->tile_count * sizeof *own);
     bool tty = isatty(STDERR_FILENO) != 0;
     double last_report = 0.0, last_checkpoint = c->run->t_render;
     uint32_t shown = UINT32_MAX;
     int hung = 0;
     while (!atomic_load(cancel)) {
-        merge_results(c, scratch);
-        for (int r = 1; r < c->ranks; ++r) {
-            while (c->outstanding[r] < JOBS_QUEUED && c->queued > 0 && !c->stuck_on) {
-                send_job(c, r, scratch);
-            }
-        }
+        serve(c);
         int in_flight = 0;
         for (int r = 1; r < c->ranks; ++r) {
             in_flight += c->outstanding[r];
@@ -394,16 +507,26 @@ static int coordinate(coordinator *c, const atomic_bool *cancel)
         if (hung) {
             break;
         }
-        if (c->queued > 0) { // rank 0 renders a job too
-            uint32_t n = take_queued(c, scratch, (uint32_t)c->threads[0]);
-            drift_pt_render_tiles(pt, scratch, n, c->pass, (uint32_t)o->spp, cancel);
+        if (c->queued > 0) { // rank 0 renders a job too, a sample at a time when it serves
+            uint32_t add = c->pass, n = take_queued(c, own, (uint32_t)c->threads[0]);
+            uint32_t step = c->ranks > 1 ? 1 : add;
+            for (uint32_t s = 0; s < add && !atomic_load(cancel) && !c->stuck_on; s += step) {
+                double t0 = drift_time_now();
+                drift_pt_render_tiles(pt, own, n, step, (uint32_t)o->spp, cancel);
+                c->render_seconds += drift_time_now() - t0;
+                if (c->ranks > 1 && drift_time_now() - c->served > SERVE_SECONDS) {
+                    serve(c);
+                }
+            }
             for (uint32_t i = 0; i < n; ++i) {
-                requeue(c, scratch[i]);
+                requeue(c, own[i]);
             }
         } else if (in_flight == 0) {
             break; // every tile has its samples
         } else {
-            nanosleep(&(struct timespec){ .tv_nsec = 1000000 }, NULL);
+            double t0 = drift_time_now();
+            nanosleep(&(struct timespec){ .tv_nsec = 100000 }, NULL);
+            c->idle_seconds += drift_time_now() - t0;
         }
         uint32_t done = drift_pt_sample_count(pt);
         double now = drift_time_now();
@@ -428,7 +551,7 @@ static int coordinate(coordinator *c, const atomic_bool *cancel)
         render_progress(tty, c->run->resumed_spp, done, done, drift_time_now() - c->run->t_render,
                         true);
     }
-    free(scratch);
+    free(own);
     return hung;
 }
 
@@ -443,8 +566,11 @@ static int render_rank0(render_reference_run *run, int ranks, const int *threads
                       .outstanding = calloc((size_t)ranks, sizeof(int)),
                       .last_heard = calloc((size_t)ranks, sizeof(double)),
                       .threads = (int *)threads,
+                      .sends = calloc((size_t)ranks * SENDS_HELD, sizeof(pending_message)),
+                      .recvs = calloc((size_t)ranks * JOBS_QUEUED, sizeof(pending_message)),
                       .cancel = cancel };
     c.queue = malloc(c.tile_count * sizeof *c.queue);
+    c.scratch = malloc(c.tile_count * sizeof *c.scratch);
     for (uint32_t t = 0; t < c.tile_count; ++t) {
         requeue(&c, t);
     }
@@ -464,13 +590,20 @@ static int render_rank0(render_reference_run *run, int ranks, const int *threads
                 hung, o->rank_timeout);
     }
     if (o->verbose) {
+        double wall = t_rendered - run->t_render;
         fprintf(stderr,
                 "drift render: rank 0 sent %.0f and received %.0f bytes, merged %llu tiles in "
-                "%.3f ms (%.0f bytes and %.2f us a tile)\n",
+                "%.3f ms (%.0f bytes and %.2f us a tile)\n"
+                "drift render: of %.3f s, rank 0 rendered %.1f%%, served the others %.2f%%, "
+                "waited for the last results %.2f%%; the others waited for jobs %.2f%% of "
+                "their time\n",
                 (double)c.bytes_sent, (double)c.bytes_received, (unsigned long long)c.tiles_merged,
                 1e3 * c.merge_seconds,
                 c.tiles_merged ? (double)c.bytes_received / (double)c.tiles_merged : 0.0,
-                c.tiles_merged ? 1e6 * c.merge_seconds / (double)c.tiles_merged : 0.0);
+                c.tiles_merged ? 1e6 * c.merge_seconds / (double)c.tiles_merged : 0.0, wall,
+                100.0 * c.render_seconds / wall, 100.0 * c.serve_seconds / wall,
+                100.0 * c.idle_seconds / wall,
+                ranks > 1 ? 100.0 * c.workers_waited / (wall * (ranks - 1)) : 0.0);
     }
     run->ranks = ranks;
     int status = render_reference_finish(run, atomic_load(cancel), t_rendered);
@@ -480,10 +613,18 @@ static int render_rank0(render_reference_run *run, int ranks, const int *threads
         fflush(NULL);
         MPI_Abort(MPI_COMM_WORLD, status ? status : 1);
     }
+    // Every job came back, so every send has completed (or completes now).
+    for (int i = 0; i < c.sends_pending; ++i) {
+        MPI_Wait(&c.sends[i].request, MPI_STATUS_IGNORE);
+        free(c.sends[i].data);
+    }
     for (int r = 1; r < ranks; ++r) {
         MPI_Send(NULL, 0, MPI_BYTE, r, TAG_STOP, MPI_COMM_WORLD);
     }
     free(c.queue);
+    free(c.scratch);
+    free(c.sends);
+    free(c.recvs);
     free(c.outstanding);
     free(c.last_heard);
     return status;
@@ -492,6 +633,10 @@ static int render_rank0(render_reference_run *run, int ranks, const int *threads
 int render_mpi(int argc, char **argv)
 {
     int provided = 0, rank = 0, ranks = 1;
+    // With more ranks than cores Open MPI yields the core in every MPI call, which costs rank
+    // 0 a time slice each time it serves between samples; ranks here wait by sleeping
+    // instead (unless the user set it).
+    setenv("OMPI_MCA_mpi_yield_when_idle", "0", 0);
     MPI_Init_thread(NULL, NULL, MPI_THREAD_FUNNELED, &provided);
     MPI_Comm_rank(MPI_COMM_WORLD, &rank);
     MPI_Comm_size(MPI_COMM_WORLD, &ranks);
@@ -549,7 +694,7 @@ int render_mpi(int argc, char **argv)
         if (rank == 0) {
             status = render_rank0(&run, ranks, threads, cancel);
         } else {
-            serve_jobs(run.pt, cancel);
+            serve_jobs(run.pt, cancel, mine);
         }
         free(threads);
     }
