@@ -281,6 +281,10 @@ static const cli_option render_table[] = {
             "--stats has the first)"),
     CLI_INT("--light-samples", "N", O, hybrid.light_samples, 1, 4096,
             "samples per area light for unshadowed light (default 8)"),
+    CLI_INT("--aa", "N", O, hybrid.aa, 1, 4096,
+            "anti-aliasing: the whole frame N times, each through a\n"
+            "stratified sub-pixel offset with its own seed, averaged (the\n"
+            "path tracer's box pixel filter; default 1 = pixel centres)"),
     CLI_INT("--shadow-map-size", "N", O, hybrid.shadow_map.size, 1, 8192,
             "texels a cube face (default 512)"),
     CLI_INT("--pcf-kernel", "K", O, hybrid.shadow_map.pcf_kernel, 1, 63,

@@ -24,6 +24,7 @@ static bool write_stats(const render_options *o, const cli_session *session,
     }
     cli_json_count(root, "spp", p.spp);
     cli_json_count(root, "seed", p.seed);
+    cli_json_count(root, "aa", p.aa ? p.aa : 1);
     cJSON_AddNumberToObject(root, "max_depth", p.max_depth);
     cJSON_AddNumberToObject(root, "threads", drift_context_thread_count(session->ctx));
     uint64_t total_rays = 0;
