@@ -476,9 +476,8 @@ static drift_result render_pass(drift_frame_state *f, const atomic_bool *cancel,
     // The previous camera shifted like this pass's: the jitter is not motion.
     prev.film_shift_x = f->camera.film_shift_x;
     prev.film_shift_y = f->camera.film_shift_y;
-    drift_gbuffer_render(f->ctx, f->scene, f->accel, &f->camera,
-                         f->has_prev_camera ? &prev : NULL, &f->gbuffer,
-                         &f->stats.rays[DRIFT_PASS_PRIMARY]);
+    drift_gbuffer_render(f->ctx, f->scene, f->accel, &f->camera, f->has_prev_camera ? &prev : NULL,
+                         &f->gbuffer, &f->stats.rays[DRIFT_PASS_PRIMARY]);
     drift_pass_time(f, DRIFT_PASS_PRIMARY, t);
 
     const drift_technique_row *rows[DRIFT_EFFECT_COUNT];
