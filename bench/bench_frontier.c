@@ -25,15 +25,15 @@
 #include <sys/stat.h>
 
 #define MAX_BUDGETS    16
-#define MAX_ROWS       256
+#define MAX_ROWS       512
 #define FRONTIER_DEPTH 8
 #define REF_SEED       0x5eedu
 
 typedef struct frontier_options {
     const char *scene_path, *csv_path, *svg_path, *cache_dir;
     long size, threads, ref_spp, runs, max_spp;
-    long budgets[MAX_BUDGETS], vpls[MAX_BUDGETS], aaf_spps[MAX_BUDGETS];
-    int budget_count, vpl_count, aaf_spp_count;
+    long budgets[MAX_BUDGETS], vpls[MAX_BUDGETS], aaf_spps[MAX_BUDGETS], aa[MAX_BUDGETS];
+    int budget_count, vpl_count, aaf_spp_count, aa_count;
     bool json;
 } frontier_options;
 
@@ -42,6 +42,9 @@ static bool parse_budgets(const char *cmd, const char *flag, const char *value, 
     frontier_options *o = field;
     if (strcmp(flag, "--vpls") == 0) {
         return bench_parse_list(cmd, flag, value, 1, 1 << 16, MAX_BUDGETS, o->vpls, &o->vpl_count);
+    }
+    if (strcmp(flag, "--aa") == 0) {
+        return bench_parse_list(cmd, flag, value, 1, 4096, MAX_BUDGETS, o->aa, &o->aa_count);
     }
     if (strcmp(flag, "--aaf-spp") == 0) {
         return bench_parse_list(cmd, flag, value, 1, 1024, MAX_BUDGETS, o->aaf_spps,
@@ -59,6 +62,8 @@ static const cli_option frontier_table[] = {
     CLI_CUSTOM_ALL("--vpls", "LIST", parse_budgets,
                    "VPL counts of the ism and ir rows (default 16,64,256,1024)"),
     CLI_CUSTOM_ALL("--aaf-spp", "LIST", parse_budgets, "spp of the AAF rows (default 1,2,4)"),
+    CLI_CUSTOM_ALL("--aa", "LIST", parse_budgets,
+                   "anti-aliasing passes of every hybrid row (default 1,4)"),
     CLI_INT("--size", "N", O, size, 4, 4096, "N x N pixels (default 400)"),
     CLI_INT("--threads", "T", O, threads, 0, 256, "worker threads (default 2)"),
     CLI_INT("--ref-spp", "N", O, ref_spp, 1, 1 << 20, "reference samples a pixel (default 512)"),
@@ -331,7 +336,8 @@ static drift_result hybrid_row(frontier_state *b, const char *name,
 }
 
 // The hybrid combinations: shadows hard, pcss, isg, aaf x indirect none, ambient, ism and ir at
-// 16..1024 VPLs, aaf; AAF rows at 1, 2 and 4 spp; max depth 8. The other effects keep the
+// 16..1024 VPLs, aaf; AAF rows at 1, 2 and 4 spp; each at --aa 1 and 4 anti-aliasing passes;
+// max depth 8. The other effects keep the
 // technique that matches the reference: reflections none on a scene without glossy or mirror
 // materials (else aaf), depth of field none for a pinhole camera (else post: reference would
 // path-trace the whole frame through the lens, replacing every other row's output), occlusion
@@ -355,11 +361,13 @@ static drift_result hybrid_rows(frontier_state *b, double limit_ms)
             size_t vpl_count = vpl ? (size_t)b->o->vpl_count : 1;
             size_t spp_count = aaf ? (size_t)b->o->aaf_spp_count : 1;
             for (size_t v = 0; v < vpl_count && r == DRIFT_OK; ++v) {
-                for (size_t k = 0; k < spp_count && r == DRIFT_OK; ++k) {
+                for (size_t k = 0; k < spp_count * (size_t)b->o->aa_count && r == DRIFT_OK; ++k) {
+                    long aa_passes = b->o->aa[k / spp_count];
                     drift_hybrid_params p = { .width = (int32_t)b->o->size,
                                               .height = (int32_t)b->o->size,
                                               .max_depth = FRONTIER_DEPTH,
-                                              .spp = aaf ? (uint32_t)spps[k] : 1 };
+                                              .spp = aaf ? (uint32_t)spps[k % spp_count] : 1,
+                                              .aa = (uint32_t)aa_passes };
                     drift_hybrid_params_set_technique(
                         &p, DRIFT_EFFECT_SHADOWS,
                         technique_index(DRIFT_EFFECT_SHADOWS, shadows[s]));
@@ -383,7 +391,11 @@ static drift_result hybrid_rows(frontier_state *b, double limit_ms)
                             snprintf(name + len, sizeof name - (size_t)len, " %ld VPLs", vpls[v]);
                     }
                     if (aaf) {
-                        snprintf(name + len, sizeof name - (size_t)len, " %ld spp", spps[k]);
+                        len += snprintf(name + len, sizeof name - (size_t)len, " %ld spp",
+                                        spps[k % spp_count]);
+                    }
+                    if (aa_passes > 1) {
+                        snprintf(name + len, sizeof name - (size_t)len, " aa %ld", aa_passes);
                     }
                     r = hybrid_row(b, name, &p, limit_ms);
                 }
@@ -618,7 +630,9 @@ int drift_bench_frontier(int argc, char **argv)
                            .vpls = { 16, 64, 256, 1024 },
                            .vpl_count = 4,
                            .aaf_spps = { 1, 2, 4 },
-                           .aaf_spp_count = 3 };
+                           .aaf_spp_count = 3,
+                           .aa = { 1, 4 },
+                           .aa_count = 2 };
     int status = cli_parse(&frontier_command, argc, argv, &o, NULL);
     if (status != CLI_PARSED) {
         return cli_parse_exit(status);

@@ -221,7 +221,7 @@ static const cli_option render_table[] = {
     CLI_INT("--max-depth", "D", O, max_depth, 1, 1024,
             "scattering vertices per path, pbrt's convention: 1 = direct\n"
             "light only (default 8; hybrid: depth of reference reflections\n"
-            "and indirect, default 2)"),
+            "and indirect, default 8)"),
     CLI_INT("--width", "W", O, width, 1, DRIFT_IMAGE_MAX_DIMENSION,
             "image size (default: the scene camera's)"),
     CLI_INT("--height", "H", O, height, 1, DRIFT_IMAGE_MAX_DIMENSION,
@@ -390,6 +390,7 @@ static const cli_command render_command = {
 int render_parse_options(int argc, char **argv, render_options *o)
 {
     *o = (render_options){ .out_path = "out/render.exr",
+                           .hybrid = drift_hybrid_params_recommended(),
                            .frames = 1,
                            .spp = 64,
                            .checkpoint_seconds = 60.0,

@@ -124,7 +124,9 @@ int render_hybrid(const render_options *o, const cli_session *session)
     params.height = (int32_t)o->height;
     params.seed = (uint32_t)o->seed;
     params.spp = (uint32_t)o->spp;
-    params.max_depth = (int32_t)o->max_depth;
+    if (o->max_depth > 0) {
+        params.max_depth = (int32_t)o->max_depth;
+    }
     r = drift_hybrid_create(ctx, scene, session->accel, &params, &frame);
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift render: %s\n", drift_result_string(r));

@@ -71,6 +71,14 @@ drift_hybrid_params drift_hybrid_params_resolve(const drift_hybrid_params *param
     return p;
 }
 
+drift_hybrid_params drift_hybrid_params_recommended(void)
+{
+    return (drift_hybrid_params){ .shadows = DRIFT_SHADOWS_HARD,
+                                  .indirect = DRIFT_INDIRECT_ISM,
+                                  .max_depth = 8,
+                                  .ism = { .vpls = 256 } };
+}
+
 static bool techniques_valid(const drift_hybrid_params *p)
 {
     for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
