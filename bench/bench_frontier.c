@@ -15,6 +15,7 @@
 #include "drift/image_io.h"
 #include "drift/metric.h"
 #include "drift/pt.h"
+#include "drift/refine.h"
 #include "drift/scene_io.h"
 
 #include <errno.h>
@@ -32,8 +33,9 @@
 typedef struct frontier_options {
     const char *scene_path, *csv_path, *svg_path, *cache_dir;
     long size, threads, ref_spp, runs, max_spp;
-    long budgets[MAX_BUDGETS], vpls[MAX_BUDGETS], aaf_spps[MAX_BUDGETS], aa[MAX_BUDGETS];
-    int budget_count, vpl_count, aaf_spp_count, aa_count;
+    long budgets[MAX_BUDGETS], vpls[MAX_BUDGETS], aaf_spps[MAX_BUDGETS], aa[MAX_BUDGETS],
+        sir[MAX_BUDGETS];
+    int budget_count, vpl_count, aaf_spp_count, aa_count, sir_count;
     bool json;
 } frontier_options;
 
@@ -42,6 +44,9 @@ static bool parse_budgets(const char *cmd, const char *flag, const char *value, 
     frontier_options *o = field;
     if (strcmp(flag, "--vpls") == 0) {
         return bench_parse_list(cmd, flag, value, 1, 1 << 16, MAX_BUDGETS, o->vpls, &o->vpl_count);
+    }
+    if (strcmp(flag, "--sir-iterations") == 0) {
+        return bench_parse_list(cmd, flag, value, 1, 1 << 20, MAX_BUDGETS, o->sir, &o->sir_count);
     }
     if (strcmp(flag, "--aa") == 0) {
         return bench_parse_list(cmd, flag, value, 1, 4096, MAX_BUDGETS, o->aa, &o->aa_count);
@@ -62,6 +67,8 @@ static const cli_option frontier_table[] = {
     CLI_CUSTOM_ALL("--vpls", "LIST", parse_budgets,
                    "VPL counts of the ism and ir rows (default 16,64,256,1024)"),
     CLI_CUSTOM_ALL("--aaf-spp", "LIST", parse_budgets, "spp of the AAF rows (default 1,2,4)"),
+    CLI_CUSTOM_ALL("--sir-iterations", "LIST", parse_budgets,
+                   "SIR rows refine for these iterations (default 1,4,16)"),
     CLI_CUSTOM_ALL("--aa", "LIST", parse_budgets,
                    "anti-aliasing passes of every hybrid row (default 1,4)"),
     CLI_INT("--size", "N", O, size, 4, 4096, "N x N pixels (default 400)"),
@@ -95,10 +102,15 @@ typedef enum row_family {
     FAMILY_PT = 0,
     FAMILY_PT_ATROUS,
     FAMILY_HYBRID,
+    FAMILY_SIR,
     FAMILY_COUNT
 } row_family;
 
-static const char *const family_names[FAMILY_COUNT] = { "pt", "pt+atrous", "hybrid" };
+// best_within's family for a drift technique of either kind: a hybrid frame, or one refined
+// by SIR.
+#define FAMILY_DRIFT (-2)
+
+static const char *const family_names[FAMILY_COUNT] = { "pt", "pt+atrous", "hybrid", "sir" };
 
 typedef struct frontier_row {
     char name[96];
@@ -405,13 +417,78 @@ static drift_result hybrid_rows(frontier_state *b, double limit_ms)
     return r;
 }
 
+// Smart image refinement (docs/sir.md) of the frame it is made for: shadows pcss, reflections
+// envmap on a glossy scene (else none), depth of field post with a lens, indirect none (SIR's
+// Whitted-style tracer has no indirect light, so a refined pixel would lose the raster's).
+// One refinement per --sir-iterations count (one sample budget a pixel an iteration, SIR's
+// default): a row's ms are the warm raster frame's plus the refinement's (metrics, sort,
+// tracing), as drift report's sir cell counts them; the median of --runs refinements.
+static drift_result sir_rows(frontier_state *b, double limit_ms)
+{
+    const frontier_options *o = b->o;
+    bool glossy = false;
+    for (uint32_t m = 0; m < b->scene->material_count; ++m) {
+        glossy = glossy || !drift_vec3_is_zero(b->scene->materials[m].specular);
+    }
+    drift_hybrid_params p = {
+        .width = (int32_t)o->size,
+        .height = (int32_t)o->size,
+        .max_depth = FRONTIER_DEPTH,
+        .shadows = DRIFT_SHADOWS_PCSS,
+        .reflections = glossy ? DRIFT_REFLECTIONS_ENVMAP : DRIFT_REFLECTIONS_NONE,
+        .dof = b->scene->camera.aperture_radius > 0.0f ? DRIFT_DOF_POST : DRIFT_DOF_NONE
+    };
+    drift_hybrid *frame = NULL;
+    drift_result r = drift_hybrid_create(b->ctx, b->scene, b->accel, &p, &frame);
+    r = r ? r : drift_hybrid_render(frame, &b->scene->camera, NULL); // warm-up
+    double raster[100];
+    long n = 0;
+    while (r == DRIFT_OK && n < o->runs) {
+        r = drift_hybrid_render(frame, &b->scene->camera, NULL);
+        raster[n++] = drift_hybrid_get_stats(frame).frame_ms;
+    }
+    double raster_ms = r == DRIFT_OK ? median(raster, n) : 0.0;
+    for (int k = 0; k < o->sir_count && r == DRIFT_OK; ++k) {
+        double ms[100];
+        drift_refine *sir = NULL;
+        for (long run = 0; run < o->runs && r == DRIFT_OK; ++run) {
+            drift_refine_destroy(sir);
+            sir = NULL;
+            r = drift_refine_create(b->ctx, frame, &(drift_refine_params){ 0 }, &sir);
+            double t = drift_time_now();
+            r = r ? r : drift_refine_begin(sir);
+            while (r == DRIFT_OK && !drift_refine_done(sir) &&
+                   drift_refine_get_stats(sir).iterations < (uint32_t)o->sir[k]) {
+                r = drift_refine_iterate(sir, NULL);
+            }
+            ms[run] = raster_ms + 1e3 * (drift_time_now() - t);
+        }
+        if (r == DRIFT_OK) {
+            char name[96];
+            snprintf(name, sizeof name, "pcss%s + none, %ld iterations", glossy ? " + envmap" : "",
+                     o->sir[k]);
+            r = add_row(b, FAMILY_SIR, name, median(ms, o->runs), drift_refine_image(sir));
+        }
+        bool over = r == DRIFT_OK && b->rows[b->row_count - 1].ms > limit_ms;
+        bool done = sir && drift_refine_done(sir); // every error pixel refined: no more to show
+        drift_refine_destroy(sir);
+        if (over || done) {
+            break;
+        }
+    }
+    drift_hybrid_destroy(frame);
+    return r;
+}
+
 // The row with the lowest FLIP among `family` (-1: any) within `budget` ms; -1 if none.
 static int best_within(const frontier_state *b, int family, double budget)
 {
     int best = -1;
     for (int i = 0; i < b->row_count; ++i) {
         const frontier_row *row = &b->rows[i];
-        if (row->ms <= budget && (family < 0 || (int)row->family == family) &&
+        bool drift = row->family == FAMILY_HYBRID || row->family == FAMILY_SIR;
+        if (row->ms <= budget &&
+            (family == -1 || (int)row->family == family || (family == FAMILY_DRIFT && drift)) &&
             (best < 0 || row->flip < b->rows[best].flip)) {
             best = i;
         }
@@ -563,7 +640,7 @@ static bool write_svg(const frontier_state *b, const char *path, const char *sce
         fprintf(f, "%.1f,%.1f ", PX(row->ms), PY(row->flip));
     }
     fprintf(f, "\"/>\n");
-    static const char *const colours[FAMILY_COUNT] = { "#c62f1f", "#e08a1e", "#1f63c6" };
+    static const char *const colours[FAMILY_COUNT] = { "#c62f1f", "#e08a1e", "#1f63c6", "#2f9e44" };
     for (int i = 0; i < b->row_count; ++i) {
         const frontier_row *row = &b->rows[i];
         fprintf(f,
@@ -632,7 +709,9 @@ int drift_bench_frontier(int argc, char **argv)
                            .aaf_spps = { 1, 2, 4 },
                            .aaf_spp_count = 3,
                            .aa = { 1, 4 },
-                           .aa_count = 2 };
+                           .aa_count = 2,
+                           .sir = { 1, 4, 16 },
+                           .sir_count = 3 };
     int status = cli_parse(&frontier_command, argc, argv, &o, NULL);
     if (status != CLI_PARSED) {
         return cli_parse_exit(status);
@@ -671,6 +750,7 @@ int drift_bench_frontier(int argc, char **argv)
         }
     }
     r = r ? r : hybrid_rows(b, 2.0 * max_budget);
+    r = r ? r : sir_rows(b, 2.0 * max_budget);
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift bench frontier: %s\n", drift_result_string(r));
         goto done;
@@ -711,7 +791,7 @@ int drift_bench_frontier(int argc, char **argv)
             double budget = (double)o.budgets[k];
             int best = best_within(b, -1, budget), pt = best_within(b, FAMILY_PT, budget),
                 dn = best_within(b, FAMILY_PT_ATROUS, budget),
-                h = best_within(b, FAMILY_HYBRID, budget);
+                h = best_within(b, FAMILY_DRIFT, budget);
             cJSON *item = cJSON_CreateObject();
             cJSON_AddItemToArray(front, item);
             cJSON_AddNumberToObject(item, "budget_ms", budget);
@@ -748,7 +828,7 @@ int drift_bench_frontier(int argc, char **argv)
             double budget = (double)o.budgets[k];
             int pt = best_within(b, FAMILY_PT, budget),
                 dn = best_within(b, FAMILY_PT_ATROUS, budget),
-                h = best_within(b, FAMILY_HYBRID, budget);
+                h = best_within(b, FAMILY_DRIFT, budget);
             printf("| %ld |", o.budgets[k]);
             print_best(b, best_within(b, -1, budget));
             print_best(b, pt);
