@@ -401,9 +401,16 @@ int render_parse_options(int argc, char **argv, render_options *o)
                            .aperture = -1.0,
                            .focus_distance = -1.0 };
     const char *first[CLI_GROUP_COUNT] = { 0 };
+    // Whether --indirect is given decides its default (see --refine below).
+    o->hybrid.techniques[DRIFT_EFFECT_INDIRECT] = CLI_TECHNIQUE_UNSET;
     int status = cli_parse(&render_command, argc, argv, o, first);
     if (status != CLI_PARSED) {
         return status;
+    }
+    // SIR's tracer has no indirect light (docs/sir.md): a refined frame starts from none.
+    if (o->hybrid.techniques[DRIFT_EFFECT_INDIRECT] == CLI_TECHNIQUE_UNSET) {
+        o->hybrid.indirect =
+            o->refine.enabled ? DRIFT_INDIRECT_NONE : drift_hybrid_params_recommended().indirect;
     }
     o->hybrid_option = first[0];
     o->refine.first_option = first[1];

@@ -246,9 +246,16 @@ static int parse_options(int argc, char **argv, view_options *o)
 {
     *o =
         (view_options){ .spp = 4, .spp_per_frame = 1, .hybrid = drift_hybrid_params_recommended() };
+    // Whether --indirect is given decides its default (see --refine below).
+    o->hybrid.techniques[DRIFT_EFFECT_INDIRECT] = CLI_TECHNIQUE_UNSET;
     int status = cli_parse(&view_command, argc, argv, o, NULL);
     if (status != CLI_PARSED) {
         return status;
+    }
+    // SIR's tracer has no indirect light (docs/sir.md): a refined view starts from none.
+    if (o->hybrid.techniques[DRIFT_EFFECT_INDIRECT] == CLI_TECHNIQUE_UNSET) {
+        o->hybrid.indirect =
+            o->refine ? DRIFT_INDIRECT_NONE : drift_hybrid_params_recommended().indirect;
     }
     if (o->screenshot_path) {
         size_t len = strlen(o->screenshot_path);
