@@ -822,7 +822,8 @@ int drift_bench_frontier(int argc, char **argv)
             }
             printf(" | %s |\n", on_front(b, i) ? "yes" : "");
         }
-        printf("\n| budget ms | front (lowest FLIP) | best pt | best pt+atrous | best drift (hybrid or sir) | "
+        printf("\n| budget ms | front (lowest FLIP) | best pt | best pt+atrous | best drift "
+               "(hybrid or sir) | "
                "drift beats both |\n|---|---|---|---|---|---|\n");
         for (int k = 0; k < o.budget_count; ++k) {
             double budget = (double)o.budgets[k];
