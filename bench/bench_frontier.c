@@ -15,6 +15,7 @@
 #include "drift/image_io.h"
 #include "drift/metric.h"
 #include "drift/pt.h"
+#include "drift/refine.h"
 #include "drift/scene_io.h"
 
 #include <errno.h>
@@ -25,15 +26,16 @@
 #include <sys/stat.h>
 
 #define MAX_BUDGETS    16
-#define MAX_ROWS       256
+#define MAX_ROWS       512
 #define FRONTIER_DEPTH 8
 #define REF_SEED       0x5eedu
 
 typedef struct frontier_options {
     const char *scene_path, *csv_path, *svg_path, *cache_dir;
     long size, threads, ref_spp, runs, max_spp;
-    long budgets[MAX_BUDGETS], vpls[MAX_BUDGETS], aaf_spps[MAX_BUDGETS];
-    int budget_count, vpl_count, aaf_spp_count;
+    long budgets[MAX_BUDGETS], vpls[MAX_BUDGETS], aaf_spps[MAX_BUDGETS], aa[MAX_BUDGETS],
+        sir[MAX_BUDGETS];
+    int budget_count, vpl_count, aaf_spp_count, aa_count, sir_count;
     bool json;
 } frontier_options;
 
@@ -42,6 +44,12 @@ static bool parse_budgets(const char *cmd, const char *flag, const char *value, 
     frontier_options *o = field;
     if (strcmp(flag, "--vpls") == 0) {
         return bench_parse_list(cmd, flag, value, 1, 1 << 16, MAX_BUDGETS, o->vpls, &o->vpl_count);
+    }
+    if (strcmp(flag, "--sir-iterations") == 0) {
+        return bench_parse_list(cmd, flag, value, 1, 1 << 20, MAX_BUDGETS, o->sir, &o->sir_count);
+    }
+    if (strcmp(flag, "--aa") == 0) {
+        return bench_parse_list(cmd, flag, value, 1, 4096, MAX_BUDGETS, o->aa, &o->aa_count);
     }
     if (strcmp(flag, "--aaf-spp") == 0) {
         return bench_parse_list(cmd, flag, value, 1, 1024, MAX_BUDGETS, o->aaf_spps,
@@ -59,6 +67,10 @@ static const cli_option frontier_table[] = {
     CLI_CUSTOM_ALL("--vpls", "LIST", parse_budgets,
                    "VPL counts of the ism and ir rows (default 16,64,256,1024)"),
     CLI_CUSTOM_ALL("--aaf-spp", "LIST", parse_budgets, "spp of the AAF rows (default 1,2,4)"),
+    CLI_CUSTOM_ALL("--sir-iterations", "LIST", parse_budgets,
+                   "SIR rows refine for these iterations (default 1,4,16)"),
+    CLI_CUSTOM_ALL("--aa", "LIST", parse_budgets,
+                   "anti-aliasing passes of every hybrid row (default 1,4)"),
     CLI_INT("--size", "N", O, size, 4, 4096, "N x N pixels (default 400)"),
     CLI_INT("--threads", "T", O, threads, 0, 256, "worker threads (default 2)"),
     CLI_INT("--ref-spp", "N", O, ref_spp, 1, 1 << 20, "reference samples a pixel (default 512)"),
@@ -90,10 +102,15 @@ typedef enum row_family {
     FAMILY_PT = 0,
     FAMILY_PT_ATROUS,
     FAMILY_HYBRID,
+    FAMILY_SIR,
     FAMILY_COUNT
 } row_family;
 
-static const char *const family_names[FAMILY_COUNT] = { "pt", "pt+atrous", "hybrid" };
+// best_within's family for a drift technique of either kind: a hybrid frame, or one refined
+// by SIR.
+#define FAMILY_DRIFT (-2)
+
+static const char *const family_names[FAMILY_COUNT] = { "pt", "pt+atrous", "hybrid", "sir" };
 
 typedef struct frontier_row {
     char name[96];
@@ -331,7 +348,8 @@ static drift_result hybrid_row(frontier_state *b, const char *name,
 }
 
 // The hybrid combinations: shadows hard, pcss, isg, aaf x indirect none, ambient, ism and ir at
-// 16..1024 VPLs, aaf; AAF rows at 1, 2 and 4 spp; max depth 8. The other effects keep the
+// 16..1024 VPLs, aaf; AAF rows at 1, 2 and 4 spp; each at --aa 1 and 4 anti-aliasing passes;
+// max depth 8. The other effects keep the
 // technique that matches the reference: reflections none on a scene without glossy or mirror
 // materials (else aaf), depth of field none for a pinhole camera (else post: reference would
 // path-trace the whole frame through the lens, replacing every other row's output), occlusion
@@ -355,11 +373,13 @@ static drift_result hybrid_rows(frontier_state *b, double limit_ms)
             size_t vpl_count = vpl ? (size_t)b->o->vpl_count : 1;
             size_t spp_count = aaf ? (size_t)b->o->aaf_spp_count : 1;
             for (size_t v = 0; v < vpl_count && r == DRIFT_OK; ++v) {
-                for (size_t k = 0; k < spp_count && r == DRIFT_OK; ++k) {
+                for (size_t k = 0; k < spp_count * (size_t)b->o->aa_count && r == DRIFT_OK; ++k) {
+                    long aa_passes = b->o->aa[k / spp_count];
                     drift_hybrid_params p = { .width = (int32_t)b->o->size,
                                               .height = (int32_t)b->o->size,
                                               .max_depth = FRONTIER_DEPTH,
-                                              .spp = aaf ? (uint32_t)spps[k] : 1 };
+                                              .spp = aaf ? (uint32_t)spps[k % spp_count] : 1,
+                                              .aa = (uint32_t)aa_passes };
                     drift_hybrid_params_set_technique(
                         &p, DRIFT_EFFECT_SHADOWS,
                         technique_index(DRIFT_EFFECT_SHADOWS, shadows[s]));
@@ -383,7 +403,11 @@ static drift_result hybrid_rows(frontier_state *b, double limit_ms)
                             snprintf(name + len, sizeof name - (size_t)len, " %ld VPLs", vpls[v]);
                     }
                     if (aaf) {
-                        snprintf(name + len, sizeof name - (size_t)len, " %ld spp", spps[k]);
+                        len += snprintf(name + len, sizeof name - (size_t)len, " %ld spp",
+                                        spps[k % spp_count]);
+                    }
+                    if (aa_passes > 1) {
+                        snprintf(name + len, sizeof name - (size_t)len, " aa %ld", aa_passes);
                     }
                     r = hybrid_row(b, name, &p, limit_ms);
                 }
@@ -393,13 +417,78 @@ static drift_result hybrid_rows(frontier_state *b, double limit_ms)
     return r;
 }
 
+// Smart image refinement (docs/sir.md) of the frame it is made for: shadows pcss, reflections
+// envmap on a glossy scene (else none), depth of field post with a lens, indirect none (SIR's
+// Whitted-style tracer has no indirect light, so a refined pixel would lose the raster's).
+// One refinement per --sir-iterations count (one sample budget a pixel an iteration, SIR's
+// default): a row's ms are the warm raster frame's plus the refinement's (metrics, sort,
+// tracing), as drift report's sir cell counts them; the median of --runs refinements.
+static drift_result sir_rows(frontier_state *b, double limit_ms)
+{
+    const frontier_options *o = b->o;
+    bool glossy = false;
+    for (uint32_t m = 0; m < b->scene->material_count; ++m) {
+        glossy = glossy || !drift_vec3_is_zero(b->scene->materials[m].specular);
+    }
+    drift_hybrid_params p = {
+        .width = (int32_t)o->size,
+        .height = (int32_t)o->size,
+        .max_depth = FRONTIER_DEPTH,
+        .shadows = DRIFT_SHADOWS_PCSS,
+        .reflections = glossy ? DRIFT_REFLECTIONS_ENVMAP : DRIFT_REFLECTIONS_NONE,
+        .dof = b->scene->camera.aperture_radius > 0.0f ? DRIFT_DOF_POST : DRIFT_DOF_NONE
+    };
+    drift_hybrid *frame = NULL;
+    drift_result r = drift_hybrid_create(b->ctx, b->scene, b->accel, &p, &frame);
+    r = r ? r : drift_hybrid_render(frame, &b->scene->camera, NULL); // warm-up
+    double raster[100];
+    long n = 0;
+    while (r == DRIFT_OK && n < o->runs) {
+        r = drift_hybrid_render(frame, &b->scene->camera, NULL);
+        raster[n++] = drift_hybrid_get_stats(frame).frame_ms;
+    }
+    double raster_ms = r == DRIFT_OK ? median(raster, n) : 0.0;
+    for (int k = 0; k < o->sir_count && r == DRIFT_OK; ++k) {
+        double ms[100];
+        drift_refine *sir = NULL;
+        for (long run = 0; run < o->runs && r == DRIFT_OK; ++run) {
+            drift_refine_destroy(sir);
+            sir = NULL;
+            r = drift_refine_create(b->ctx, frame, &(drift_refine_params){ 0 }, &sir);
+            double t = drift_time_now();
+            r = r ? r : drift_refine_begin(sir);
+            while (r == DRIFT_OK && !drift_refine_done(sir) &&
+                   drift_refine_get_stats(sir).iterations < (uint32_t)o->sir[k]) {
+                r = drift_refine_iterate(sir, NULL);
+            }
+            ms[run] = raster_ms + 1e3 * (drift_time_now() - t);
+        }
+        if (r == DRIFT_OK) {
+            char name[96];
+            snprintf(name, sizeof name, "pcss%s + none, %ld iterations", glossy ? " + envmap" : "",
+                     o->sir[k]);
+            r = add_row(b, FAMILY_SIR, name, median(ms, o->runs), drift_refine_image(sir));
+        }
+        bool over = r == DRIFT_OK && b->rows[b->row_count - 1].ms > limit_ms;
+        bool done = sir && drift_refine_done(sir); // every error pixel refined: no more to show
+        drift_refine_destroy(sir);
+        if (over || done) {
+            break;
+        }
+    }
+    drift_hybrid_destroy(frame);
+    return r;
+}
+
 // The row with the lowest FLIP among `family` (-1: any) within `budget` ms; -1 if none.
 static int best_within(const frontier_state *b, int family, double budget)
 {
     int best = -1;
     for (int i = 0; i < b->row_count; ++i) {
         const frontier_row *row = &b->rows[i];
-        if (row->ms <= budget && (family < 0 || (int)row->family == family) &&
+        bool drift = row->family == FAMILY_HYBRID || row->family == FAMILY_SIR;
+        if (row->ms <= budget &&
+            (family == -1 || (int)row->family == family || (family == FAMILY_DRIFT && drift)) &&
             (best < 0 || row->flip < b->rows[best].flip)) {
             best = i;
         }
@@ -551,7 +640,7 @@ static bool write_svg(const frontier_state *b, const char *path, const char *sce
         fprintf(f, "%.1f,%.1f ", PX(row->ms), PY(row->flip));
     }
     fprintf(f, "\"/>\n");
-    static const char *const colours[FAMILY_COUNT] = { "#c62f1f", "#e08a1e", "#1f63c6" };
+    static const char *const colours[FAMILY_COUNT] = { "#c62f1f", "#e08a1e", "#1f63c6", "#2f9e44" };
     for (int i = 0; i < b->row_count; ++i) {
         const frontier_row *row = &b->rows[i];
         fprintf(f,
@@ -618,7 +707,11 @@ int drift_bench_frontier(int argc, char **argv)
                            .vpls = { 16, 64, 256, 1024 },
                            .vpl_count = 4,
                            .aaf_spps = { 1, 2, 4 },
-                           .aaf_spp_count = 3 };
+                           .aaf_spp_count = 3,
+                           .aa = { 1, 4 },
+                           .aa_count = 2,
+                           .sir = { 1, 4, 16 },
+                           .sir_count = 3 };
     int status = cli_parse(&frontier_command, argc, argv, &o, NULL);
     if (status != CLI_PARSED) {
         return cli_parse_exit(status);
@@ -657,6 +750,7 @@ int drift_bench_frontier(int argc, char **argv)
         }
     }
     r = r ? r : hybrid_rows(b, 2.0 * max_budget);
+    r = r ? r : sir_rows(b, 2.0 * max_budget);
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift bench frontier: %s\n", drift_result_string(r));
         goto done;
@@ -697,7 +791,7 @@ int drift_bench_frontier(int argc, char **argv)
             double budget = (double)o.budgets[k];
             int best = best_within(b, -1, budget), pt = best_within(b, FAMILY_PT, budget),
                 dn = best_within(b, FAMILY_PT_ATROUS, budget),
-                h = best_within(b, FAMILY_HYBRID, budget);
+                h = best_within(b, FAMILY_DRIFT, budget);
             cJSON *item = cJSON_CreateObject();
             cJSON_AddItemToArray(front, item);
             cJSON_AddNumberToObject(item, "budget_ms", budget);
@@ -728,13 +822,14 @@ int drift_bench_frontier(int argc, char **argv)
             }
             printf(" | %s |\n", on_front(b, i) ? "yes" : "");
         }
-        printf("\n| budget ms | front (lowest FLIP) | best pt | best pt+atrous | best hybrid | "
-               "hybrid beats both |\n|---|---|---|---|---|---|\n");
+        printf("\n| budget ms | front (lowest FLIP) | best pt | best pt+atrous | best drift "
+               "(hybrid or sir) | "
+               "drift beats both |\n|---|---|---|---|---|---|\n");
         for (int k = 0; k < o.budget_count; ++k) {
             double budget = (double)o.budgets[k];
             int pt = best_within(b, FAMILY_PT, budget),
                 dn = best_within(b, FAMILY_PT_ATROUS, budget),
-                h = best_within(b, FAMILY_HYBRID, budget);
+                h = best_within(b, FAMILY_DRIFT, budget);
             printf("| %ld |", o.budgets[k]);
             print_best(b, best_within(b, -1, budget));
             print_best(b, pt);

@@ -148,6 +148,10 @@ void cli_session_close(cli_session *s);
 
 // FNV-1a, the content hash of checkpoints and report caches (not cryptographic: it tells an
 // edited file from the one a result was made from).
+// A technique no option chose yet: set before cli_parse where a default depends on other
+// options (--refine sir starts from --indirect none).
+#define CLI_TECHNIQUE_UNSET (-1)
+
 #define CLI_FNV_BASIS 0xcbf29ce484222325ull
 uint64_t cli_fnv1a(uint64_t h, const void *data, size_t size);
 // cli_fnv1a of the files' contents in order, a NUL between files; false (errno set) when one

@@ -221,7 +221,7 @@ static const cli_option render_table[] = {
     CLI_INT("--max-depth", "D", O, max_depth, 1, 1024,
             "scattering vertices per path, pbrt's convention: 1 = direct\n"
             "light only (default 8; hybrid: depth of reference reflections\n"
-            "and indirect, default 2)"),
+            "and indirect, default 8)"),
     CLI_INT("--width", "W", O, width, 1, DRIFT_IMAGE_MAX_DIMENSION,
             "image size (default: the scene camera's)"),
     CLI_INT("--height", "H", O, height, 1, DRIFT_IMAGE_MAX_DIMENSION,
@@ -281,6 +281,10 @@ static const cli_option render_table[] = {
             "--stats has the first)"),
     CLI_INT("--light-samples", "N", O, hybrid.light_samples, 1, 4096,
             "samples per area light for unshadowed light (default 8)"),
+    CLI_INT("--aa", "N", O, hybrid.aa, 1, 4096,
+            "anti-aliasing: the whole frame N times, each through a\n"
+            "stratified sub-pixel offset with its own seed, averaged (the\n"
+            "path tracer's box pixel filter; default 1 = pixel centres)"),
     CLI_INT("--shadow-map-size", "N", O, hybrid.shadow_map.size, 1, 8192,
             "texels a cube face (default 512)"),
     CLI_NUMBER("--shadow-bias", "B", O, hybrid.shadow_map.bias, 1e-3, 1e3,
@@ -408,6 +412,7 @@ static const cli_command render_command = {
 int render_parse_options(int argc, char **argv, render_options *o)
 {
     *o = (render_options){ .out_path = "out/render.exr",
+                           .hybrid = drift_hybrid_params_recommended(),
                            .frames = 1,
                            .spp = 64,
                            .checkpoint_seconds = 60.0,
@@ -418,9 +423,16 @@ int render_parse_options(int argc, char **argv, render_options *o)
                            .aperture = -1.0,
                            .focus_distance = -1.0 };
     const char *first[CLI_GROUP_COUNT] = { 0 };
+    // Whether --indirect is given decides its default (see --refine below).
+    o->hybrid.techniques[DRIFT_EFFECT_INDIRECT] = CLI_TECHNIQUE_UNSET;
     int status = cli_parse(&render_command, argc, argv, o, first);
     if (status != CLI_PARSED) {
         return status;
+    }
+    // SIR's tracer has no indirect light (docs/sir.md): a refined frame starts from none.
+    if (o->hybrid.techniques[DRIFT_EFFECT_INDIRECT] == CLI_TECHNIQUE_UNSET) {
+        o->hybrid.indirect =
+            o->refine.enabled ? DRIFT_INDIRECT_NONE : drift_hybrid_params_recommended().indirect;
     }
     o->hybrid_option = first[0];
     o->refine.first_option = first[1];

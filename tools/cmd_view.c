@@ -35,7 +35,7 @@ typedef struct view_options {
     const char *press; // --press: view keys applied before the first frame
     long width, height, threads, spp_per_frame, spp, seed, frames;
     double exposure;
-    drift_hybrid_params hybrid; // the techniques given (zero: the defaults)
+    drift_hybrid_params hybrid; // the techniques given (drift_hybrid_params_recommended else)
     bool split, no_overlay, verbose;
     bool refine;            // --refine sir
     long refine_budget;     // --budget: SIR samples a frame (0: the default)
@@ -244,10 +244,18 @@ static bool parse_press(const char *cmd, const char *flag, const char *v, void *
 // Returns 0 on success, 2 on a usage error (message printed), -1 after --help.
 static int parse_options(int argc, char **argv, view_options *o)
 {
-    *o = (view_options){ .spp = 4, .spp_per_frame = 1 };
+    *o =
+        (view_options){ .spp = 4, .spp_per_frame = 1, .hybrid = drift_hybrid_params_recommended() };
+    // Whether --indirect is given decides its default (see --refine below).
+    o->hybrid.techniques[DRIFT_EFFECT_INDIRECT] = CLI_TECHNIQUE_UNSET;
     int status = cli_parse(&view_command, argc, argv, o, NULL);
     if (status != CLI_PARSED) {
         return status;
+    }
+    // SIR's tracer has no indirect light (docs/sir.md): a refined view starts from none.
+    if (o->hybrid.techniques[DRIFT_EFFECT_INDIRECT] == CLI_TECHNIQUE_UNSET) {
+        o->hybrid.indirect =
+            o->refine ? DRIFT_INDIRECT_NONE : drift_hybrid_params_recommended().indirect;
     }
     if (o->screenshot_path) {
         size_t len = strlen(o->screenshot_path);

@@ -24,6 +24,7 @@ static bool write_stats(const render_options *o, const cli_session *session,
     }
     cli_json_count(root, "spp", p.spp);
     cli_json_count(root, "seed", p.seed);
+    cli_json_count(root, "aa", p.aa ? p.aa : 1);
     cJSON_AddNumberToObject(root, "max_depth", p.max_depth);
     cJSON_AddNumberToObject(root, "threads", drift_context_thread_count(session->ctx));
     uint64_t total_rays = 0;
@@ -123,7 +124,9 @@ int render_hybrid(const render_options *o, const cli_session *session)
     params.height = (int32_t)o->height;
     params.seed = (uint32_t)o->seed;
     params.spp = (uint32_t)o->spp;
-    params.max_depth = (int32_t)o->max_depth;
+    if (o->max_depth > 0) {
+        params.max_depth = (int32_t)o->max_depth;
+    }
     r = drift_hybrid_create(ctx, scene, session->accel, &params, &frame);
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift render: %s\n", drift_result_string(r));

@@ -191,6 +191,11 @@ typedef struct drift_occlusion_settings {
 //   max_depth        = 0 -> 2 for reference reflections and indirect light (pt convention:
 //                      2 = one bounce, what the sharp buffers can capture)
 //   light_samples    = 0 -> 8 samples per area light for the unshadowed light U_l
+//   aa               = 0 -> 1: anti-aliasing passes. N > 1 renders the whole frame N times,
+//                      each pass with the camera's film shifted by a stratified sub-pixel
+//                      offset (the path tracer's box pixel filter) and its own seed, and
+//                      averages them: edges converge to the path tracer's pixel filter. 1 is
+//                      one sample through each pixel centre. Costs N frames.
 //   ambient          = used when has_ambient; otherwise the mean direct radiance of the frame
 //   shadow_map, envmap, isg, aaf, ism, micro, occlusion_settings: each family's settings (above)
 //   reflection_edits = NULL: physical reflections. Otherwise the sharp and environment-map
@@ -217,6 +222,7 @@ typedef struct drift_hybrid_params {
     uint32_t spp;
     int32_t max_depth;
     uint32_t light_samples;
+    uint32_t aa;
     bool has_ambient;
     drift_vec3 ambient;
     drift_shadow_map_settings shadow_map;
@@ -231,6 +237,12 @@ typedef struct drift_hybrid_params {
 
 drift_hybrid_params drift_hybrid_params_resolve(const drift_hybrid_params *params,
                                                 const drift_scene *scene);
+// What `drift render --mode hybrid` and `drift view` start from: the lowest-FLIP combination
+// of the equal-time frontier within ~100 ms on the built-in Cornell box at 400x400, 2 threads
+// (docs/frontier.md): hard shadows, instant radiosity from imperfect shadow maps (256 VPLs)
+// and max depth 8 (multiple bounces). A zeroed drift_hybrid_params stays hard shadows, no
+// indirect light, max depth 2: the library's and the tests' neutral frame.
+drift_hybrid_params drift_hybrid_params_recommended(void);
 // The technique `params` chooses for `effect` (-1 for an invalid effect), and setting it: one
 // int per effect for code that walks the effects (the viewer's keys and overlay, the CLI).
 int drift_hybrid_params_technique(const drift_hybrid_params *params, drift_effect effect);

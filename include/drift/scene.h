@@ -56,6 +56,9 @@ typedef struct drift_camera {
     float aperture_radius; // lens radius in scene units; 0 = pinhole
     float focus_distance;  // distance to the plane in focus; 0 = |target - position|
     int32_t width, height; // default image size in pixels
+    // Pixels added to every film position (rays and projections): the sub-pixel jitter of
+    // the hybrid frame's anti-aliasing passes (drift_hybrid_params.aa). Zero for a camera.
+    float film_shift_x, film_shift_y;
 } drift_camera;
 
 drift_camera drift_camera_look_at(drift_vec3 position, drift_vec3 target, drift_vec3 up,

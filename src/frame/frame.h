@@ -68,6 +68,10 @@ typedef struct drift_frame_state {
     const drift_scene *scene;
     const drift_accel *accel;
     drift_hybrid_params params;
+    // The seed the frame's params were set with. params.seed is this anti-aliasing pass's
+    // (each pass mixes its index in); state kept across passes (ISM's VPLs, micro-rendering's
+    // points) keys on this one so that a pass does not rebuild it.
+    uint32_t base_seed;
     drift_camera camera, prev_camera;
     bool has_prev_camera;
 

@@ -23,6 +23,7 @@ struct drift_hybrid {
     plane_ref *planes;       // the last frame's planes, in a stable order
     uint32_t plane_count, plane_capacity;
     bool planes_out_of_memory;
+    drift_image aa_sum; // the anti-aliasing passes' running sum (made on first use)
 };
 
 static const char *const pass_names[] = { "primary",     "unshadowed",    "hard_shadows",
@@ -71,6 +72,14 @@ drift_hybrid_params drift_hybrid_params_resolve(const drift_hybrid_params *param
     return p;
 }
 
+drift_hybrid_params drift_hybrid_params_recommended(void)
+{
+    return (drift_hybrid_params){ .shadows = DRIFT_SHADOWS_HARD,
+                                  .indirect = DRIFT_INDIRECT_ISM,
+                                  .max_depth = 8,
+                                  .ism = { .vpls = 256 } };
+}
+
 static bool techniques_valid(const drift_hybrid_params *p)
 {
     for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
@@ -93,6 +102,8 @@ static bool params_valid(const drift_context *ctx, const drift_hybrid_params *p)
         problem = "max_depth outside 1..1024";
     } else if (p->light_samples > 4096) {
         problem = "light samples over 4096";
+    } else if (p->aa > 4096) {
+        problem = "anti-aliasing passes over 4096";
     } else if (p->has_ambient && !drift_vec3_is_finite(p->ambient)) {
         problem = "non-finite ambient";
     }
@@ -243,6 +254,7 @@ void drift_hybrid_destroy(drift_hybrid *h)
     drift_raster_lights_destroy(ctx, f->lights, f->light_count);
     drift_free(ctx, f->light_buffers);
     drift_free(ctx, f->counters);
+    drift_image_destroy(ctx, &h->aa_sum);
     drift_free(ctx, h->planes);
     drift_free(ctx, h);
 }
@@ -420,6 +432,32 @@ static drift_result prepare_inputs(drift_frame_state *f, uint32_t inputs)
     return r;
 }
 
+// Adds pass k's final image to the sum; after the last of n passes, final is their mean.
+static drift_result accumulate(drift_hybrid *h, uint32_t k, uint32_t n)
+{
+    drift_frame_state *f = &h->frame;
+    if (!h->aa_sum.pixels) {
+        drift_result r = drift_image_create(f->ctx, f->final.width, f->final.height,
+                                            f->final.channels, &h->aa_sum);
+        if (r != DRIFT_OK) {
+            return r;
+        }
+    }
+    size_t row = (size_t)f->final.width * (size_t)f->final.channels;
+    float scale = 1.0f / (float)n;
+    for (int32_t y = 0; y < f->final.height; ++y) {
+        float *sum = h->aa_sum.pixels + (ptrdiff_t)y * h->aa_sum.stride;
+        float *final = f->final.pixels + (ptrdiff_t)y * f->final.stride;
+        for (size_t i = 0; i < row; ++i) {
+            sum[i] = k == 0 ? final[i] : sum[i] + final[i];
+            if (k + 1 == n) {
+                final[i] = sum[i] * scale;
+            }
+        }
+    }
+    return DRIFT_OK;
+}
+
 static drift_result run_row(drift_frame_state *f, const drift_technique_row *row,
                             const atomic_bool *cancel)
 {
@@ -441,23 +479,18 @@ static drift_result run_row(drift_frame_state *f, const drift_technique_row *row
     return r;
 }
 
-drift_result drift_hybrid_render(drift_hybrid *h, const drift_camera *camera,
-                                 const atomic_bool *cancel)
+// One pass of the frame: the G-buffer through f->camera, every chosen row, the composition
+// and the post effects, into f->final. *out_inputs: the inputs the rows asked for.
+static drift_result render_pass(drift_frame_state *f, const atomic_bool *cancel,
+                                uint32_t *out_inputs)
 {
-    if (!h || !camera) {
-        return DRIFT_ERR_INVALID_ARGUMENT;
-    }
-    drift_frame_state *f = &h->frame;
-    double start = drift_time_now();
-    f->stats = (drift_hybrid_stats){ 0 };
-    f->camera = *camera;
-    f->camera.width = f->params.width;
-    f->camera.height = f->params.height;
-
     double t = drift_time_now();
-    drift_gbuffer_render(f->ctx, f->scene, f->accel, &f->camera,
-                         f->has_prev_camera ? &f->prev_camera : NULL, &f->gbuffer,
-                         &f->stats.rays[DRIFT_PASS_PRIMARY]);
+    drift_camera prev = f->prev_camera;
+    // The previous camera shifted like this pass's: the jitter is not motion.
+    prev.film_shift_x = f->camera.film_shift_x;
+    prev.film_shift_y = f->camera.film_shift_y;
+    drift_gbuffer_render(f->ctx, f->scene, f->accel, &f->camera, f->has_prev_camera ? &prev : NULL,
+                         &f->gbuffer, &f->stats.rays[DRIFT_PASS_PRIMARY]);
     drift_pass_time(f, DRIFT_PASS_PRIMARY, t);
 
     const drift_technique_row *rows[DRIFT_EFFECT_COUNT];
@@ -470,6 +503,7 @@ drift_result drift_hybrid_render(drift_hybrid *h, const drift_camera *camera,
         replaced |= (rows[e]->flags & DRIFT_ROW_REPLACES_FRAME) != 0;
         diffuse_environment |= (rows[e]->flags & DRIFT_ROW_ENVIRONMENT_DIFFUSE) != 0;
     }
+    *out_inputs = inputs;
     f->environment_diffuse_elsewhere = diffuse_environment;
     drift_result r = prepare_inputs(f, inputs);
     // The terms in the table's order (direct light first: ambient light reads D), then the
@@ -490,6 +524,65 @@ drift_result drift_hybrid_render(drift_hybrid *h, const drift_camera *camera,
             r = run_row(f, rows[e], cancel);
         }
     }
+    return r;
+}
+
+static float radical_inverse2(uint32_t i)
+{
+    i = (i << 16) | (i >> 16);
+    i = ((i & 0x00ff00ffu) << 8) | ((i & 0xff00ff00u) >> 8);
+    i = ((i & 0x0f0f0f0fu) << 4) | ((i & 0xf0f0f0f0u) >> 4);
+    i = ((i & 0x33333333u) << 2) | ((i & 0xccccccccu) >> 2);
+    i = ((i & 0x55555555u) << 1) | ((i & 0xaaaaaaaau) >> 1);
+    return (float)i * 0x1p-32f;
+}
+
+// Pass k of n's film offset from the pixel centre: the Hammersley point set, shifted so that
+// one pass is the centre. n points stratify the pixel in x and (for n a power of two) in y,
+// so their mean converges to the path tracer's box pixel filter (its film sample is uniform
+// over the pixel).
+static void aa_offset(uint32_t k, uint32_t n, float *dx, float *dy)
+{
+    float x = ((float)k + 0.5f) / (float)n;
+    float y = radical_inverse2(k) + 0.5f / (float)n;
+    *dx = x - 0.5f;
+    *dy = (y >= 1.0f ? y - 1.0f : y) - 0.5f;
+}
+
+drift_result drift_hybrid_render(drift_hybrid *h, const drift_camera *camera,
+                                 const atomic_bool *cancel)
+{
+    if (!h || !camera) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    drift_frame_state *f = &h->frame;
+    double start = drift_time_now();
+    f->stats = (drift_hybrid_stats){ 0 };
+    uint32_t seed = f->params.seed, passes = f->params.aa ? f->params.aa : 1;
+    f->base_seed = seed;
+    uint32_t inputs = 0;
+    drift_result r = DRIFT_OK;
+    for (uint32_t k = 0; r == DRIFT_OK && k < passes; ++k) {
+        f->camera = *camera;
+        f->camera.width = f->params.width;
+        f->camera.height = f->params.height;
+        float dx = 0.0f, dy = 0.0f;
+        if (passes > 1) {
+            aa_offset(k, passes, &dx, &dy);
+        }
+        f->camera.film_shift_x += dx;
+        f->camera.film_shift_y += dy;
+        // Pass 0 keeps the frame's seed (one pass is the frame it always was); the others
+        // draw other sampler streams.
+        f->params.seed = k ? drift_hash_combine(seed, 0x41410000u + k) : seed;
+        r = render_pass(f, cancel, &inputs);
+        if (r == DRIFT_OK && passes > 1) {
+            r = accumulate(h, k, passes);
+        }
+    }
+    f->params.seed = seed;
+    f->camera.film_shift_x = camera->film_shift_x;
+    f->camera.film_shift_y = camera->film_shift_y;
     f->prev_camera = f->camera;
     f->has_prev_camera = true;
     collect_planes(h, inputs);

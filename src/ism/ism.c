@@ -134,7 +134,9 @@ drift_result drift__ism_reserve(drift_ism *ism, uint32_t vpls)
     // Point i is Sobol sample i whatever the count, so the larger set's subsets 0..old-1 are
     // the smaller set's: growing changes no image.
     drift_points *points = NULL;
-    if (p->points_per_vpl > 0) {
+    // A scene of analytic shapes alone has no triangles to scatter points on: no occluder is
+    // splatted and every VPL is taken as visible (the ISMs' points are triangle samples).
+    if (p->points_per_vpl > 0 && drift_scene_triangle_count(ism->scene) > 0) {
         drift_points_desc pd = { .count = p->points_per_vpl * capacity,
                                  .subset_count = capacity,
                                  .seed = p->seed };

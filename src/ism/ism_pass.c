@@ -21,7 +21,7 @@ static void state_destroy(drift_context *ctx, void *data)
 
 static drift_ism_params params_of(const drift_frame_state *f, drift_ism_visibility visibility)
 {
-    return (drift_ism_params){ .seed = f->params.seed,
+    return (drift_ism_params){ .seed = f->base_seed,
                                .visibility = visibility,
                                .vpl_count = f->params.ism.vpls,
                                .max_depth = f->params.max_depth,

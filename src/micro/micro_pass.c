@@ -23,7 +23,7 @@ static void state_destroy(drift_context *ctx, void *data)
 static drift_micro_params params_of(const drift_frame_state *f)
 {
     return drift_micro_params_resolve(&(drift_micro_params){
-        .seed = f->params.seed,
+        .seed = f->base_seed,
         .point_count = f->params.micro.points,
         .buffer_size = f->params.micro.buffer_size,
         .density = f->params.micro.density,

@@ -29,6 +29,8 @@ drift_ray drift_camera_frame_ray(const drift_camera_frame *f, float film_x, floa
                                  drift_vec2 lens)
 {
     const drift_camera *camera = &f->camera;
+    film_x += camera->film_shift_x;
+    film_y += camera->film_shift_y;
     float sx = (2.0f * film_x / (float)f->width - 1.0f) * f->tan_half * f->aspect;
     float sy = (1.0f - 2.0f * film_y / (float)f->height) * f->tan_half;
     drift_vec3 dir = drift_vec3_add(
@@ -58,8 +60,8 @@ bool drift_camera_frame_project(const drift_camera_frame *f, drift_vec3 p, drift
     }
     float sx = drift_vec3_dot(d, f->u) / (z * f->tan_half * f->aspect);
     float sy = drift_vec3_dot(d, f->v) / (z * f->tan_half);
-    *out_film = drift_vec2_make(0.5f * (sx + 1.0f) * (float)f->width,
-                                0.5f * (1.0f - sy) * (float)f->height);
+    *out_film = drift_vec2_make(0.5f * (sx + 1.0f) * (float)f->width - f->camera.film_shift_x,
+                                0.5f * (1.0f - sy) * (float)f->height - f->camera.film_shift_y);
     return true;
 }
 

@@ -29,6 +29,14 @@ for k in ("metrics", "sort", "trace", "refine"):
     assert s["milliseconds"][k] >= 0.0, k
 PY
 
+# SIR's tracer has no indirect light: without --indirect a refined frame starts from none (no
+# note that refined pixels lose it), though the hybrid frame's own default is ism.
+tiny=(--mode hybrid --width 16 --height 12 --threads 2 --refine sir --budget 50)
+expect 0 "$drift" render "${tiny[@]}" --out "$tmp/n.exr"
+! grep -q "no indirect light" "$tmp/err" || fail "--refine sir did not start from --indirect none"
+expect 0 "$drift" render "${tiny[@]}" --indirect ism --ism-vpls 8 --out "$tmp/n.exr"
+grep -q "no indirect light" "$tmp/err" || fail "--refine sir --indirect ism: no note"
+
 # An iteration limit stops early; the budget caps the samples of that iteration.
 expect 0 "$drift" render "${small[@]}" --refine sir --budget 10 --refine-iterations 1 \
     --out "$tmp/one.exr" --stats "$tmp/one.json"

@@ -26,9 +26,11 @@ python3 - "$tmp/s.json" <<'PY' || fail "hybrid stats JSON incomplete"
 import json, sys
 s = json.load(open(sys.argv[1]))
 assert s["mode"] == "hybrid" and s["width"] == 32 and s["height"] == 24, s
-# The chosen ones, and every other effect of the table at its default (the first row).
+# The chosen ones, and every other effect at the CLI's default (drift_hybrid_params_recommended:
+# hard shadows, ism indirect light, max depth 8; docs/frontier.md).
 t = s["techniques"]
-assert (t["shadows"], t["reflections"], t["dof"], t["indirect"]) == ("hard", "sharp", "post", "none"), t
+assert (t["shadows"], t["reflections"], t["dof"], t["indirect"]) == ("hard", "sharp", "post", "ism"), t
+assert s["max_depth"] == 8 and s["aa"] == 1, s
 assert t.get("occlusion") == "none" and t.get("glare") == "none", t
 assert set(s["effect_ms"]) == set(t) and all(v >= 0 for v in s["effect_ms"].values()), s["effect_ms"]
 passes = s["passes"]
@@ -48,11 +50,20 @@ done
 # is not the same estimator (the path tracer jitters within pixels), so only check it runs
 # and is finite here; the exact equality is tested in unit.hybrid.
 expect 0 "$drift" render --mode hybrid "${small[@]}" --shadows reference --reflections reference \
-    --indirect reference --out "$tmp/ref.exr"
+    --indirect reference --max-depth 2 --out "$tmp/ref.exr"
 # Against itself the MSE is 0 only where every value is finite (NaN or inf give null).
 expect 0 "$drift" diff "$tmp/ref.exr" "$tmp/ref.exr" --json
 python3 -c "import json,sys; d=json.load(open('$tmp/out')); sys.exit(0 if d['mse']==0 else 1)" \
     || fail "all-reference image is not finite"
+
+# Anti-aliasing passes: --aa N renders the frame N times (N G-buffers), --aa 0 is a usage error.
+expect 0 "$drift" render --mode hybrid "${small[@]}" --aa 4 --out "$tmp/aa.exr" --stats "$tmp/aa.json"
+python3 - "$tmp/aa.json" <<'PY' || fail "--aa 4: the stats do not count 4 passes"
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert s["aa"] == 4 and s["passes"]["primary"]["rays"] == 4 * 32 * 24, s
+PY
+expect 2 "$drift" render --mode hybrid --aa 0 --out "$tmp/x.exr"
 
 # Usage errors: unknown technique names, hybrid options in reference mode, bad values.
 expect 2 "$drift" render --mode hybrid --shadows soft --out "$tmp/x.exr"
