@@ -26,7 +26,7 @@ typedef struct ism_options {
     long size, height, threads, ref_spp, points, map, block, repeat;
     long vpls[MAX_LIST], spps[MAX_LIST];
     int vpl_count, spp_count;
-    bool no_ir, classic, json;
+    bool no_ir, no_ism, classic, json;
 } ism_options;
 
 // --vpls and --spp: `field` is the options.
@@ -56,6 +56,7 @@ static const cli_option ism_table[] = {
             "after each ism and ir row's first frame, R warm frames; the row\n"
             "reports the fastest of them (default 0: the first frame)"),
     CLI_FLAG("--no-ir", O, no_ir, "skip the ray-traced baseline"),
+    CLI_FLAG("--no-ism", O, no_ism, "skip the ism rows (e.g. to profile ir alone)"),
     CLI_FLAG("--classic", O, classic,
              "after each ism row, time exact (ray-cast) paraboloid maps for the\n"
              "same VPLs: the classic shadow maps ISMs replace (row sm)"),
@@ -343,7 +344,7 @@ int drift_bench_ism(int argc, char **argv)
     }
     for (int v = 0; v < 2 * o.vpl_count && r == DRIFT_OK; ++v) {
         bool ir = v % 2 == 1;
-        if (ir && o.no_ir) {
+        if ((ir && o.no_ir) || (!ir && o.no_ism)) {
             continue;
         }
         drift_ism_params ip = { .visibility =
