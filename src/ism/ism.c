@@ -320,6 +320,14 @@ static void maps_range(size_t begin, size_t end, int thread, void *user)
 #else
 #    define DRIFT_ISM_INLINE
 #endif
+// The gather's loops are also compiled for AVX2 (8 lanes, hardware gathers), picked at load
+// time where the CPU has it (GCC and clang function multi-versioning on x86-64 ELF). With
+// -ffp-contract=off both versions do the same IEEE operations: the same image to the bit.
+#if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__) && defined(__ELF__)
+#    define DRIFT_ISM_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#    define DRIFT_ISM_CLONES
+#endif
 // The map lookups are gathers through pointers the compiler cannot tell apart from the
 // receivers' sums; they never overlap (the map is only read).
 #if defined(__clang__)
@@ -424,8 +432,9 @@ gather_vpl_ism_levels(const drift_vpl *v, const drift_frame *f, const float *res
 
 // One copy of the loop per pyramid depth, each without a branch on it (so that it vectorises).
 #define GATHER_ISM_LEVELS(L)                                                                   \
-    static void gather_vpl_ism##L(const drift_vpl *v, const drift_frame *f, const float *map,  \
-                                  const gather_consts *c, receivers *rs)                       \
+    DRIFT_ISM_CLONES static void gather_vpl_ism##L(const drift_vpl *v, const drift_frame *f,   \
+                                                   const float *map, const gather_consts *c,   \
+                                                   receivers *rs)                              \
     {                                                                                          \
         gather_vpl_ism_levels(v, f, map, c, rs->count, rs->px, rs->py, rs->pz, rs->nx, rs->ny, \
                               rs->nz, rs->er, rs->eg, rs->eb, L);                              \
