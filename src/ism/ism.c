@@ -20,6 +20,7 @@ struct drift_ism {
     float *atlas;        // map_capacity maps of map_floats, when visibility is ISM
     size_t map_floats;   // one map: map_size^2 depths, then the lazy pyramid's levels
     int32_t lazy_levels; // pull-push levels the lookups push (1, 2), or 0: pushed at build
+    float *disc_counts;  // drift__ism_disc_counts of the lazy pyramid's top level
     float *scratch;      // one pull-push pyramid per thread
     int32_t width, height;
     drift_image irradiance, indirect, vpl_plane, tile;
@@ -225,6 +226,18 @@ drift_result drift_ism_create(drift_context *ctx, const drift_scene *scene,
     ism->lazy_levels = p.pull_push_levels == 1 || p.pull_push_levels == 2 ? p.pull_push_levels : 0;
     ism->map_floats = drift__ism_map_floats(p.map_size, ism->lazy_levels);
     drift_result r = DRIFT_OK;
+    if (ism->lazy_levels > 0) {
+        int32_t top = p.map_size;
+        for (int32_t l = 0; l < ism->lazy_levels; ++l) {
+            top = (top + 1) / 2;
+        }
+        ism->disc_counts = drift_alloc(ctx, (size_t)top * (size_t)top * sizeof(float));
+        if (ism->disc_counts) {
+            drift__ism_disc_counts(p.map_size, ism->lazy_levels, ism->disc_counts);
+        } else {
+            r = DRIFT_ERR_OUT_OF_MEMORY;
+        }
+    }
     if (ism->max_vpls > 0) {
         size_t map = (size_t)p.map_size * (size_t)p.map_size;
         ism->frames = drift_alloc(ctx, (size_t)ism->max_vpls * sizeof *ism->frames);
@@ -268,6 +281,7 @@ void drift_ism_destroy(drift_ism *ism)
     drift_free(ctx, ism->groups);
     drift_free(ctx, ism->atlas);
     drift_free(ctx, ism->scratch);
+    drift_free(ctx, ism->disc_counts);
     drift_free(ctx, ism);
 }
 
@@ -301,7 +315,8 @@ static void maps_range(size_t begin, size_t end, int thread, void *user)
         double t1 = drift_time_now();
         if (ism->lazy_levels > 0) {
             drift__ism_pull(depth, n, ism->lazy_levels, ism->params.pull_push_threshold);
-            job->empty[thread % 64] += drift__ism_holes(depth, n, ism->lazy_levels);
+            job->empty[thread % 64] +=
+                drift__ism_holes(depth, n, ism->lazy_levels, ism->disc_counts);
         } else {
             job->empty[thread % 64] += drift__ism_pull_push(
                 depth, n, levels > 0 ? levels : 0, ism->params.pull_push_threshold,

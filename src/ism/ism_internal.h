@@ -54,8 +54,10 @@ uint32_t drift__ism_pull_push(float *depth, int32_t n, int32_t levels, float thr
 size_t drift__ism_map_floats(int32_t n, int32_t levels);
 // Splatted depths in map[0, n^2) -> the pulled levels after them.
 void drift__ism_pull(float *map, int32_t n, int32_t levels, float threshold);
-// Texels inside the unit disc that the push leaves empty.
-uint32_t drift__ism_holes(const float *map, int32_t n, int32_t levels);
+// Texels inside the unit disc that the push leaves empty; `counts` (levels >= 1): the disc
+// texels under each top-level texel, from drift__ism_disc_counts (ceil(n / 2^levels)^2 floats).
+void drift__ism_disc_counts(int32_t n, int32_t levels, float *counts);
+uint32_t drift__ism_holes(const float *map, int32_t n, int32_t levels, const float *counts);
 
 // The pushed depth of texel (x, y) of a map with its pulled levels (levels 0..2). Written for
 // the gather's vectorised loop: 32-bit indices (64-bit ones kept the loads scalar) and one

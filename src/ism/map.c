@@ -230,7 +230,38 @@ void drift__ism_pull(float *map, int32_t n, int32_t levels, float threshold)
     }
 }
 
-uint32_t drift__ism_holes(const float *map, int32_t n, int32_t levels)
+// The top level of a map's lazy pyramid and its side.
+static const float *top_level(const float *map, int32_t n, int32_t levels, int32_t *side)
+{
+    const float *top = map + (size_t)n * (size_t)n;
+    int32_t s = (n + 1) / 2;
+    for (int32_t l = 2; l <= levels; ++l) {
+        top += 2 * (size_t)s * (size_t)s;
+        s = (s + 1) / 2;
+    }
+    *side = s;
+    return top;
+}
+
+void drift__ism_disc_counts(int32_t n, int32_t levels, float *counts)
+{
+    int32_t s = n;
+    for (int32_t l = 1; l <= levels; ++l) {
+        s = (s + 1) / 2;
+    }
+    for (int32_t i = 0; i < s * s; ++i) {
+        counts[i] = 0.0f;
+    }
+    for (int32_t y = 0; y < n; ++y) {
+        int32_t lo, hi;
+        disc_span(n, y, &lo, &hi);
+        for (int32_t x = lo; x < hi; ++x) {
+            counts[(size_t)(y >> levels) * (size_t)s + (size_t)(x >> levels)] += 1.0f;
+        }
+    }
+}
+
+uint32_t drift__ism_holes(const float *map, int32_t n, int32_t levels, const float *counts)
 {
     if (levels <= 0) {
         uint32_t empty = 0;
@@ -244,23 +275,15 @@ uint32_t drift__ism_holes(const float *map, int32_t n, int32_t levels)
         return empty;
     }
     // A texel stays empty after the push exactly when its top-level ancestor is empty (an
-    // empty coarse texel has only empty children, all the way down).
-    const float *top = map + (size_t)n * (size_t)n;
-    int32_t s = (n + 1) / 2;
-    for (int32_t l = 2; l <= levels; ++l) {
-        top += 2 * (size_t)s * (size_t)s;
-        s = (s + 1) / 2;
+    // empty coarse texel has only empty children, all the way down): the disc texels under
+    // each empty top-level texel.
+    int32_t s;
+    const float *top = top_level(map, n, levels, &s);
+    float empty = 0.0f;
+    for (int32_t i = 0; i < s * s; ++i) {
+        empty += top[i] == INFINITY ? counts[i] : 0.0f;
     }
-    uint32_t empty = 0;
-    for (int32_t y = 0; y < n; ++y) {
-        int32_t lo, hi;
-        disc_span(n, y, &lo, &hi);
-        const float *row = top + (size_t)(y >> levels) * (size_t)s;
-        for (int32_t x = lo; x < hi; ++x) {
-            empty += row[x >> levels] == INFINITY;
-        }
-    }
-    return empty;
+    return (uint32_t)empty;
 }
 
 void drift__ism_exact_map(float *depth, int32_t n, const drift_accel *accel, drift_vec3 origin,
