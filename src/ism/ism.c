@@ -477,7 +477,7 @@ static void gather_vpl_none(const drift_vpl *v, const gather_consts *c, int32_t 
         dist2 = dist2 > 1e-30f ? dist2 : 1e-30f;
         // cos_x cos_j / max(d^2, dmin^2) = dx dj / (d^2 max(d^2, dmin^2)).
         float g = dx * dj / (dist2 * (dist2 > dmin2 ? dist2 : dmin2));
-        g = (dx > 0.0f) & (dj > 0.0f) ? g : 0.0f;
+        g = ((dx > 0.0f) & (dj > 0.0f)) ? g : 0.0f;
         er[i] += fr * g;
         eg[i] += fg * g;
         eb[i] += fb * g;
