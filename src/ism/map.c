@@ -9,8 +9,17 @@
 // loop without branches the compiler vectorises, then the squares are z-tested into the map.
 #define SPLAT_BLOCK 256
 
-void drift__ism_splat(float *depth, const drift__ism_splat_desc *desc, drift_vec3 origin,
-                      const drift_frame *frame, const drift_vec3 *positions, uint32_t count)
+// Splatting and pulling are also compiled for AVX2 where the CPU has it, as the gather
+// (docs/decisions/0028-ism-vectorised-gather.md).
+#if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__) && defined(__ELF__)
+#    define DRIFT_ISM_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#    define DRIFT_ISM_CLONES
+#endif
+
+DRIFT_ISM_CLONES void drift__ism_splat(float *depth, const drift__ism_splat_desc *desc,
+                                       drift_vec3 origin, const drift_frame *frame,
+                                       const drift_vec3 *positions, uint32_t count)
 {
     int32_t n = desc->n;
     for (int32_t i = 0; i < n * n; ++i) {
@@ -97,8 +106,8 @@ static void disc_span(int32_t n, int32_t y, int32_t *lo, int32_t *hi)
 // One pull step: each coarse texel averages its valid children within t of the nearest one
 // (an empty child is INFINITY), and `members` counts them. Children past an odd edge read as
 // empty: row `inf_row` (fs floats of INFINITY) stands for the missing last row.
-static void pull_level(const float *fine, int32_t fs, float *coarse, float *members, int32_t cs,
-                       float t, const float *inf_row)
+DRIFT_ISM_CLONES static void pull_level(const float *fine, int32_t fs, float *coarse,
+                                        float *members, int32_t cs, float t, const float *inf_row)
 {
     int32_t pairs = fs / 2;
     for (int32_t y = 0; y < cs; ++y) {
