@@ -17,7 +17,10 @@ struct drift_ism {
     drift_vpl *vpls;
     uint32_t vpl_count;
     drift_frame *frames; // max_vpls
-    float *atlas;        // map_capacity maps of map_size^2, when visibility is ISM
+    float *atlas;        // map_capacity maps of map_floats, when visibility is ISM
+    size_t map_floats;   // one map: map_size^2 depths, then the lazy pyramid's levels
+    int32_t lazy_levels; // pull-push levels the lookups push (1, 2), or 0: pushed at build
+    float *disc_counts;  // drift__ism_disc_counts of the lazy pyramid's top level
     float *scratch;      // one pull-push pyramid per thread
     int32_t width, height;
     drift_image irradiance, indirect, vpl_plane, tile;
@@ -25,6 +28,8 @@ struct drift_ism {
     float splat_radius; // k sqrt(A_pt / pi) of the last render, world units
     uint32_t *groups;   // group_count + 1 starts of the runs of VPLs of one bounce and round
     uint32_t group_count;
+    uint64_t points_print; // vertex_fingerprint when points [0, points_valid) were derived
+    uint32_t points_valid;
 };
 
 static const char *const stage_names[DRIFT_ISM_STAGE_COUNT] = { "vpls",      "points", "splat",
@@ -116,6 +121,37 @@ static uint32_t initial_map_capacity(const drift_ism_params *p, uint32_t max_vpl
     return one_round < max_vpls ? (uint32_t)one_round : max_vpls;
 }
 
+// A fingerprint of every mesh's vertex positions: the points are re-derived only when it
+// changes (a moving or deforming mesh), so a static frame skips the 3.4M random vertex reads
+// that the Breakfast Room's 417 maps of 8192 points cost (~250 ms loaded, as much as the
+// gather). 64-bit multiply-xor over the float bits, four lanes.
+static uint64_t vertex_fingerprint(const drift_scene *scene)
+{
+    uint64_t h[4] = { 0x9e3779b97f4a7c15ull, 0xbf58476d1ce4e5b9ull, 0x94d049bb133111ebull,
+                      (uint64_t)scene->mesh_count };
+    for (uint32_t m = 0; m < scene->mesh_count; ++m) {
+        const drift_mesh *mesh = &scene->meshes[m];
+        size_t words = 3 * (size_t)mesh->vertex_count;
+        const float *p = mesh->positions;
+        size_t i = 0;
+        for (; i + 4 <= words; i += 4) {
+            for (int l = 0; l < 4; ++l) {
+                uint32_t bits;
+                memcpy(&bits, &p[i + (size_t)l], sizeof bits);
+                h[l] = (h[l] ^ bits) * 0x100000001b3ull;
+            }
+        }
+        for (; i < words; ++i) {
+            uint32_t bits;
+            memcpy(&bits, &p[i], sizeof bits);
+            h[0] = (h[0] ^ bits) * 0x100000001b3ull;
+        }
+        h[1] =
+            (h[1] ^ mesh->vertex_count ^ ((uint64_t)mesh->triangle_count << 32)) * 0x100000001b3ull;
+    }
+    return h[0] ^ (h[1] * 3) ^ (h[2] * 5) ^ (h[3] * 7);
+}
+
 drift_result drift__ism_reserve(drift_ism *ism, uint32_t vpls)
 {
     const drift_ism_params *p = &ism->params;
@@ -126,8 +162,7 @@ drift_result drift__ism_reserve(drift_ism *ism, uint32_t vpls)
     uint64_t want = (uint64_t)ism->map_capacity + ism->map_capacity / 2;
     want = want > vpls ? want : vpls;
     uint32_t capacity = want < ism->max_vpls ? (uint32_t)want : ism->max_vpls;
-    size_t map = (size_t)p->map_size * (size_t)p->map_size;
-    float *atlas = drift_alloc(ism->ctx, (size_t)capacity * map * sizeof *atlas);
+    float *atlas = drift_alloc(ism->ctx, (size_t)capacity * ism->map_floats * sizeof *atlas);
     if (!atlas) {
         return DRIFT_ERR_OUT_OF_MEMORY;
     }
@@ -151,6 +186,9 @@ drift_result drift__ism_reserve(drift_ism *ism, uint32_t vpls)
     ism->atlas = atlas;
     ism->points = points;
     ism->map_capacity = capacity;
+    // drift_points_create derived every point from the current vertices.
+    ism->points_print = points ? vertex_fingerprint(ism->scene) : 0;
+    ism->points_valid = points ? points->count : 0;
     return DRIFT_OK;
 }
 
@@ -185,7 +223,23 @@ drift_result drift_ism_create(drift_context *ctx, const drift_scene *scene,
     ism->params = p;
     ism->diagonal = drift_vec3_length(drift_vec3_sub(scene->bounds.max, scene->bounds.min));
     ism->max_vpls = drift__ism_max_vpls(&p);
+    // The push is left to the lookups for the usual 1 or 2 levels (drift__ism_lookup);
+    // deeper pyramids are pushed whole at build time.
+    ism->lazy_levels = p.pull_push_levels == 1 || p.pull_push_levels == 2 ? p.pull_push_levels : 0;
+    ism->map_floats = drift__ism_map_floats(p.map_size, ism->lazy_levels);
     drift_result r = DRIFT_OK;
+    if (ism->lazy_levels > 0) {
+        int32_t top = p.map_size;
+        for (int32_t l = 0; l < ism->lazy_levels; ++l) {
+            top = (top + 1) / 2;
+        }
+        ism->disc_counts = drift_alloc(ctx, (size_t)top * (size_t)top * sizeof(float));
+        if (ism->disc_counts) {
+            drift__ism_disc_counts(p.map_size, ism->lazy_levels, ism->disc_counts);
+        } else {
+            r = DRIFT_ERR_OUT_OF_MEMORY;
+        }
+    }
     if (ism->max_vpls > 0) {
         size_t map = (size_t)p.map_size * (size_t)p.map_size;
         ism->frames = drift_alloc(ctx, (size_t)ism->max_vpls * sizeof *ism->frames);
@@ -195,7 +249,7 @@ drift_result drift_ism_create(drift_context *ctx, const drift_scene *scene,
         }
         if (r == DRIFT_OK && p.visibility == DRIFT_ISM_VISIBILITY_ISM) {
             ism->scratch =
-                drift_alloc(ctx, (size_t)drift_context_thread_count(ctx) * map * sizeof(float));
+                drift_alloc(ctx, (size_t)drift_context_thread_count(ctx) * 2 * map * sizeof(float));
             r = ism->scratch ? drift__ism_reserve(ism, initial_map_capacity(&p, ism->max_vpls))
                              : DRIFT_ERR_OUT_OF_MEMORY;
         }
@@ -229,6 +283,7 @@ void drift_ism_destroy(drift_ism *ism)
     drift_free(ctx, ism->groups);
     drift_free(ctx, ism->atlas);
     drift_free(ctx, ism->scratch);
+    drift_free(ctx, ism->disc_counts);
     drift_free(ctx, ism);
 }
 
@@ -237,163 +292,338 @@ void drift_ism_destroy(drift_ism *ism)
 typedef struct map_job {
     drift_ism *ism;
     drift__ism_splat_desc splat;
-    uint32_t empty[64]; // per thread
+    uint32_t empty[64];    // per thread
+    double seconds[64][2]; // per thread: splatting, pull-push
 } map_job;
 
-static void splat_range(size_t begin, size_t end, int thread, void *user)
+// Splat and pull-push of one map back to back on one thread, so that the map (256 KB at 256^2)
+// is still in that core's cache for pull-push: as two passes over the atlas (109 MB for the
+// Breakfast Room's 417 maps of 256^2) each map went to memory and back in between.
+static void maps_range(size_t begin, size_t end, int thread, void *user)
 {
-    (void)thread;
     map_job *job = user;
     drift_ism *ism = job->ism;
-    size_t map = (size_t)job->splat.n * (size_t)job->splat.n;
+    int32_t n = job->splat.n, levels = ism->params.pull_push_levels;
+    size_t map = (size_t)n * (size_t)n;
     for (size_t j = begin; j < end; ++j) {
-        float *depth = ism->atlas + j * map;
+        float *depth = ism->atlas + j * ism->map_floats;
         uint32_t first = 0, count = 0;
         if (ism->points) {
             drift_points_subset(ism->points, (uint32_t)j, &first, &count);
         }
+        double t0 = drift_time_now();
         drift__ism_splat(depth, &job->splat, ism->vpls[j].position, &ism->frames[j],
                          ism->points ? ism->points->position + first : NULL, count);
-    }
-}
-
-static void pull_push_range(size_t begin, size_t end, int thread, void *user)
-{
-    map_job *job = user;
-    drift_ism *ism = job->ism;
-    int32_t n = job->splat.n;
-    size_t map = (size_t)n * (size_t)n;
-    for (size_t j = begin; j < end; ++j) {
-        job->empty[thread % 64] += drift__ism_pull_push(
-            ism->atlas + j * map, n, ism->params.pull_push_levels, ism->params.pull_push_threshold,
-            ism->scratch + (size_t)thread * map);
+        double t1 = drift_time_now();
+        if (ism->lazy_levels > 0) {
+            drift__ism_pull(depth, n, ism->lazy_levels, ism->params.pull_push_threshold);
+            job->empty[thread % 64] +=
+                drift__ism_holes(depth, n, ism->lazy_levels, ism->disc_counts);
+        } else {
+            job->empty[thread % 64] += drift__ism_pull_push(
+                depth, n, levels > 0 ? levels : 0, ism->params.pull_push_threshold,
+                ism->scratch + (size_t)thread * 2 * map);
+        }
+        job->seconds[thread % 64][0] += t1 - t0;
+        job->seconds[thread % 64][1] += drift_time_now() - t1;
     }
 }
 
 // --- GATHERING ---
 
-typedef struct receiver receiver;
+// The gather's loops are written once and specialised by inlining.
+#if defined(__GNUC__)
+#    define DRIFT_ISM_INLINE __attribute__((always_inline))
+#else
+#    define DRIFT_ISM_INLINE
+#endif
+// The gather's loops are also compiled for AVX2 (8 lanes, hardware gathers), picked at load
+// time where the CPU has it (GCC and clang function multi-versioning on x86-64 ELF). With
+// -ffp-contract=off both versions do the same IEEE operations: the same image to the bit.
+#if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__) && defined(__ELF__)
+#    define DRIFT_ISM_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#    define DRIFT_ISM_CLONES
+#endif
+// The map lookups are gathers through pointers the compiler cannot tell apart from the
+// receivers' sums; they never overlap (the map is only read).
+#if defined(__clang__)
+#    define DRIFT_ISM_IVDEP _Pragma("clang loop vectorize(assume_safety)")
+#elif defined(__GNUC__)
+#    define DRIFT_ISM_IVDEP _Pragma("GCC ivdep")
+#else
+#    define DRIFT_ISM_IVDEP
+#endif
+
+// A gather job's receivers: one interleaving subset's pixels in a band of rows. Each map is
+// read by all the receivers of a job, VPL after VPL, so the fewer the jobs the fewer times a
+// map comes into the cache: on the Breakfast Room (640x480, 417 maps of 256^2) gathering in
+// 16x16-receiver tiles cost 1.9x, bands of 12 subset rows 1.3x, 48 rows 1.0x (perf samples).
+// At most this many receivers a job (3.6 MB of buffers a thread).
+#define GATHER_MAX_RECEIVERS 65536
+
+// Receivers of one gather job, structure of arrays for the vectorised loop over them.
+typedef struct receivers {
+    float *px, *py, *pz; // position
+    float *nx, *ny, *nz; // shading normal
+    float *gx, *gy, *gz; // geometric normal (the shadow rays' origin offset)
+    float *er, *eg, *eb; // irradiance so far
+    int32_t *x, *y;
+    int32_t count;
+} receivers;
 
 typedef struct gather_job {
     drift_ism *ism;
     const drift_gbuffer *gb;
-    uint64_t rays[64];            // per thread
-    receiver *receivers;          // receivers_per_thread for each thread
-    int32_t receivers_per_thread; // one row's pixels of one subset
+    uint64_t rays[64];   // per thread
+    float *buffers;      // per thread: 12 arrays of `capacity` floats and 2 of int32
+    int32_t capacity;    // receivers a job can hold
+    int32_t subset_rows; // rows of one subset in a band (a band is subset_rows * B rows)
+    int32_t bands;
 } gather_job;
 
-// One receiver of a gather: a G-buffer pixel and its irradiance so far.
-typedef struct receiver {
-    drift_vec3 xp, n, ng; // position, shading and geometric normal
-    int32_t x;
-    double e[3];
-} receiver;
+// The constants of one render's lookups.
+typedef struct gather_consts {
+    float dmin2, bias, texel, splat_radius, diagonal;
+    float threshold; // pull-push's at level 0
+    int32_t n;
+    int32_t levels; // the levels the lookups push (drift__ism_lookup)
+} gather_consts;
 
-// Adds VPLs [first, last) to each of `count` receivers. VPL-major: every receiver reads VPL j's
-// map before the next map, so one map (n^2 floats) is in cache at a time. Receiver-major
-// lookups touched every map of the subset per pixel (~100 maps, 1.6 MB at 1600 VPLs of 64^2):
-// past the L2 cache the gather grew 6-7x for 4x the VPLs. Each receiver still sums its VPLs
-// in the same order, so the image is the same to the bit.
-static void gather_range(drift_ism *ism, receiver *rs, int32_t count, uint32_t first, uint32_t last,
-                         uint64_t *rays)
+// VPL j's contribution to every receiver, visibility from its map. One loop without branches
+// over the receivers (the compiler vectorises it): the facing tests, the paraboloid lookup
+// and the geometry term are computed for all and masked at the end. With a = y_j - x and
+// v = -a / |a| in the VPL's frame, v.xy / (1 + v.z) = -(a . t, a . b) / (|a| + c) where
+// c = -a . n_j = |a| cos theta_j: the lookup needs one reciprocal, not the normalised w.
+static inline DRIFT_ISM_INLINE void
+gather_vpl_ism_levels(const drift_vpl *v, const drift_frame *f, const float *restrict map,
+                      const gather_consts *c, int32_t count, const float *restrict px,
+                      const float *restrict py, const float *restrict pz, const float *restrict nx,
+                      const float *restrict ny, const float *restrict nz, float *restrict er,
+                      float *restrict eg, float *restrict eb, const int32_t levels)
 {
-    const drift_ism_params *p = &ism->params;
-    float dmin2 = p->clamp_distance * p->clamp_distance;
-    int32_t mn = p->map_size;
-    size_t map = (size_t)mn * (size_t)mn;
-    float texel = 2.0f / (float)mn;
-    float splat_radius = ism->splat_radius;
-    for (uint32_t j = first; j < last; ++j) {
-        const drift_vpl *v = &ism->vpls[j];
-        const float *depth = ism->atlas ? ism->atlas + j * map : NULL;
-        for (int32_t i = 0; i < count; ++i) {
-            receiver *r = &rs[i];
-            drift_vec3 d = drift_vec3_sub(v->position, r->xp);
-            // The facing tests first, on the unnormalised direction (about half the VPLs fail).
-            float dx = drift_vec3_dot(r->n, d), dj = -drift_vec3_dot(v->normal, d);
-            if (dx <= 0.0f || dj <= 0.0f) {
-                continue;
-            }
-            float dist2 = drift_vec3_dot(d, d);
-            float dist = sqrtf(dist2), inv = 1.0f / dist;
-            drift_vec3 w = drift_vec3_scale(d, inv);
-            float cos_x = dx * inv, cos_j = dj * inv;
-            if (p->visibility == DRIFT_ISM_VISIBILITY_ISM) {
-                drift_vec3 local = drift_frame_to_local(&ism->frames[j], drift_vec3_neg(w));
-                float stored = depth[drift__ism_texel(mn, local)];
-                // Slope-scaled: the receiver's own surface reaches the texel from as far as one
-                // texel (2 (1 + v.z) / n radians) plus one splat radius (k sqrt(A_pt / pi) in
-                // the world) away, over which its distance to the VPL changes by tan(theta_x)
-                // times.
-                float tan_x = fminf(sqrtf(fmaxf(1.0f - cos_x * cos_x, 0.0f)) / cos_x, 5.0f);
-                float reach = dist * texel * (1.0f - drift_vec3_dot(v->normal, w)) + splat_radius;
-                if (dist - p->depth_bias - reach * tan_x > stored) {
-                    continue;
-                }
-            } else if (p->visibility == DRIFT_ISM_VISIBILITY_RAYS) {
-                drift_vec3 o = drift_offset_origin(r->xp, r->ng, w);
-                float len = drift_vec3_length(drift_vec3_sub(v->position, o));
-                drift_ray ray = { o, 0.0f, w, len * 0.999f - 1e-4f * ism->diagonal };
-                (*rays)++;
-                if (ray.tmax > 0.0f && drift_accel_occluded(ism->accel, &ray)) {
-                    continue;
-                }
-            }
-            float g = cos_x * cos_j / fmaxf(dist2, dmin2);
-            r->e[0] += (double)(v->flux.x * g);
-            r->e[1] += (double)(v->flux.y * g);
-            r->e[2] += (double)(v->flux.z * g);
-        }
+    const float vx = v->position.x, vy = v->position.y, vz = v->position.z;
+    const float mx = v->normal.x, my = v->normal.y, mz = v->normal.z;
+    const float tx = f->x.x, ty = f->x.y, tz = f->x.z, bx = f->y.x, by = f->y.y, bz = f->y.z;
+    const float fr = v->flux.x, fg = v->flux.y, fb = v->flux.z;
+    const float half_n = 0.5f * (float)c->n, dmin2 = c->dmin2, bias = c->bias;
+    const float texel = c->texel, splat_radius = c->splat_radius, threshold = c->threshold;
+    const int32_t n = c->n;
+    const float *l[5];
+    drift__ism_levels_of(map, n, l);
+    DRIFT_ISM_IVDEP
+    for (int32_t i = 0; i < count; ++i) {
+        float ax = vx - px[i], ay = vy - py[i], az = vz - pz[i];
+        float dx = nx[i] * ax + ny[i] * ay + nz[i] * az;
+        float dj = -(mx * ax + my * ay + mz * az);
+        float dist2 = ax * ax + ay * ay + az * az;
+        dist2 = dist2 > 1e-30f ? dist2 : 1e-30f;
+        float dist = sqrtf(dist2), inv = 1.0f / dist;
+        float cos_x = dx * inv, cos_j = dj * inv;
+        float s = 1.0f / (dist + (dj > 0.0f ? dj : 0.0f));
+        float u = -(tx * ax + ty * ay + tz * az) * s, w = -(bx * ax + by * ay + bz * az) * s;
+        // Texel coordinates clamped in floats first (also maps a NaN to the edge).
+        float fu = (u + 1.0f) * half_n, fw = (w + 1.0f) * half_n;
+        fu = fu > 0.0f ? fu : 0.0f;
+        fw = fw > 0.0f ? fw : 0.0f;
+        fu = fu < (float)(n - 1) ? fu : (float)(n - 1);
+        fw = fw < (float)(n - 1) ? fw : (float)(n - 1);
+        float stored = drift__ism_lookup_at(l[0], l[1], l[2], l[3], l[4], n, levels, threshold,
+                                            (int32_t)fu, (int32_t)fw);
+        // Slope-scaled: the receiver's own surface reaches the texel from as far as one texel
+        // (2 (1 + v.z) / n radians) plus one splat radius (k sqrt(A_pt / pi) in the world)
+        // away, over which its distance to the VPL changes by tan(theta_x) times.
+        float cx = cos_x > 1e-6f ? cos_x : 1e-6f;
+        float sin2 = 1.0f - cx * cx;
+        float tan_x = sqrtf(sin2 > 0.0f ? sin2 : 0.0f) / cx;
+        tan_x = tan_x < 5.0f ? tan_x : 5.0f;
+        float reach = dist * texel * (1.0f + cos_j) + splat_radius;
+        bool lit = (dx > 0.0f) & (dj > 0.0f) & (dist - bias - reach * tan_x <= stored);
+        float g = cos_x * cos_j / (dist2 > dmin2 ? dist2 : dmin2);
+        g = lit ? g : 0.0f;
+        er[i] += fr * g;
+        eg[i] += fg * g;
+        eb[i] += fb * g;
     }
 }
 
-// Irradiance (without albedo) at the pixels of one row that fall in interleaving subset k,
-// from that subset's VPLs.
-static void gather_subset(drift_ism *ism, const drift_gbuffer *gb, int32_t y, int32_t k_x,
-                          receiver *rs, uint64_t *rays)
+// One copy of the loop per pyramid depth, each without a branch on it (so that it vectorises).
+#define GATHER_ISM_LEVELS(L)                                                                   \
+    DRIFT_ISM_CLONES static void gather_vpl_ism##L(const drift_vpl *v, const drift_frame *f,   \
+                                                   const float *map, const gather_consts *c,   \
+                                                   receivers *rs)                              \
+    {                                                                                          \
+        gather_vpl_ism_levels(v, f, map, c, rs->count, rs->px, rs->py, rs->pz, rs->nx, rs->ny, \
+                              rs->nz, rs->er, rs->eg, rs->eb, L);                              \
+    }
+GATHER_ISM_LEVELS(0)
+GATHER_ISM_LEVELS(1)
+GATHER_ISM_LEVELS(2)
+#undef GATHER_ISM_LEVELS
+
+// The same without a lookup: every facing VPL is visible.
+static void gather_vpl_none(const drift_vpl *v, const gather_consts *c, int32_t count,
+                            const float *restrict px, const float *restrict py,
+                            const float *restrict pz, const float *restrict nx,
+                            const float *restrict ny, const float *restrict nz, float *restrict er,
+                            float *restrict eg, float *restrict eb)
 {
-    const drift_ism_params *p = &ism->params;
-    int32_t b = p->block_size, count = 0;
-    for (int32_t x = k_x; x < gb->width; x += b) {
-        if (drift_image_pixel(&gb->material_id, x, y)[0] < 0.0f) {
-            drift_image_set3(&ism->irradiance, x, y, drift_vec3_splat(0.0f));
+    const float vx = v->position.x, vy = v->position.y, vz = v->position.z;
+    const float mx = v->normal.x, my = v->normal.y, mz = v->normal.z;
+    const float fr = v->flux.x, fg = v->flux.y, fb = v->flux.z, dmin2 = c->dmin2;
+    for (int32_t i = 0; i < count; ++i) {
+        float ax = vx - px[i], ay = vy - py[i], az = vz - pz[i];
+        float dx = nx[i] * ax + ny[i] * ay + nz[i] * az;
+        float dj = -(mx * ax + my * ay + mz * az);
+        float dist2 = ax * ax + ay * ay + az * az;
+        dist2 = dist2 > 1e-30f ? dist2 : 1e-30f;
+        // cos_x cos_j / max(d^2, dmin^2) = dx dj / (d^2 max(d^2, dmin^2)).
+        float g = dx * dj / (dist2 * (dist2 > dmin2 ? dist2 : dmin2));
+        g = ((dx > 0.0f) & (dj > 0.0f)) ? g : 0.0f;
+        er[i] += fr * g;
+        eg[i] += fg * g;
+        eb[i] += fb * g;
+    }
+}
+
+// The `ir` baseline: one shadow ray per facing receiver (Embree; not vectorised).
+static void gather_vpl_rays(const drift_ism *ism, const drift_vpl *v, receivers *rs,
+                            const gather_consts *c, uint64_t *rays)
+{
+    for (int32_t i = 0; i < rs->count; ++i) {
+        drift_vec3 xp = { rs->px[i], rs->py[i], rs->pz[i] };
+        drift_vec3 d = drift_vec3_sub(v->position, xp);
+        float dx = rs->nx[i] * d.x + rs->ny[i] * d.y + rs->nz[i] * d.z;
+        float dj = -drift_vec3_dot(v->normal, d);
+        if (dx <= 0.0f || dj <= 0.0f) {
             continue;
         }
-        rs[count++] = (receiver){ .xp = drift_image_get3(&gb->position, x, y),
-                                  .n = drift_image_get3(&gb->normal, x, y),
-                                  .ng = drift_image_get3(&gb->geometric_normal, x, y),
-                                  .x = x };
-    }
-    // Subset k of the S = B^2 subsets takes the k-th run of each group of VPLs (one bounce of
-    // one round of light paths). Consecutive paths are consecutive Sobol samples, so each run is
-    // a stratified sample of the group (a stride of S instead would give every subset one
-    // elementary interval of the light's domain). S times the subset's sum, averaged over the
-    // S pixels of a block, is the sum over all VPLs.
-    uint64_t subsets = (uint64_t)b * (uint64_t)b;
-    uint64_t k = (uint64_t)(y % b) * (uint64_t)b + (uint64_t)k_x;
-    for (uint32_t g = 0; g < ism->group_count; ++g) {
-        uint64_t begin = ism->groups[g], size = (uint64_t)ism->groups[g + 1] - begin;
-        uint32_t first = (uint32_t)(begin + size * k / subsets);
-        uint32_t last = (uint32_t)(begin + size * (k + 1) / subsets);
-        gather_range(ism, rs, count, first, last, rays);
-    }
-    float scale = (float)subsets * DRIFT_INV_PI;
-    for (int32_t i = 0; i < count; ++i) {
-        drift_image_set3(&ism->irradiance, rs[i].x, y,
-                         drift_vec3_make((float)rs[i].e[0] * scale, (float)rs[i].e[1] * scale,
-                                         (float)rs[i].e[2] * scale));
+        float dist2 = drift_vec3_dot(d, d);
+        float dist = sqrtf(dist2), inv = 1.0f / dist;
+        drift_vec3 w = drift_vec3_scale(d, inv);
+        drift_vec3 o = drift_offset_origin(xp, (drift_vec3){ rs->gx[i], rs->gy[i], rs->gz[i] }, w);
+        float len = drift_vec3_length(drift_vec3_sub(v->position, o));
+        drift_ray ray = { o, 0.0f, w, len * 0.999f - 1e-4f * c->diagonal };
+        (*rays)++;
+        if (ray.tmax > 0.0f && drift_accel_occluded(ism->accel, &ray)) {
+            continue;
+        }
+        float g = dx * inv * dj * inv / fmaxf(dist2, c->dmin2);
+        rs->er[i] += v->flux.x * g;
+        rs->eg[i] += v->flux.y * g;
+        rs->eb[i] += v->flux.z * g;
     }
 }
 
-static void gather_rows(size_t begin, size_t end, int thread, void *user)
+static receivers job_receivers(const gather_job *job, int thread)
+{
+    size_t cap = (size_t)job->capacity;
+    float *b = job->buffers + (size_t)thread * cap * 14;
+    receivers rs = { .px = b,
+                     .py = b + cap,
+                     .pz = b + 2 * cap,
+                     .nx = b + 3 * cap,
+                     .ny = b + 4 * cap,
+                     .nz = b + 5 * cap,
+                     .gx = b + 6 * cap,
+                     .gy = b + 7 * cap,
+                     .gz = b + 8 * cap,
+                     .er = b + 9 * cap,
+                     .eg = b + 10 * cap,
+                     .eb = b + 11 * cap,
+                     .x = (int32_t *)(b + 12 * cap),
+                     .y = (int32_t *)(b + 13 * cap) };
+    return rs;
+}
+
+// Job = (band of rows, subset k): the band's pixels of subset k gather that subset's VPLs,
+// VPL by VPL (one map in cache at a time, read by every receiver of the band), each receiver
+// summing its VPLs in the same order whatever the threads.
+static void gather_jobs(size_t begin, size_t end, int thread, void *user)
 {
     gather_job *job = user;
+    drift_ism *ism = job->ism;
     const drift_gbuffer *gb = job->gb;
-    int32_t b = job->ism->params.block_size;
-    receiver *rs = job->receivers + (size_t)thread * (size_t)job->receivers_per_thread;
-    for (size_t row = begin; row < end; ++row) {
-        for (int32_t k_x = 0; k_x < b; ++k_x) {
-            gather_subset(job->ism, gb, (int32_t)row, k_x, rs, &job->rays[thread % 64]);
+    const drift_ism_params *p = &ism->params;
+    int32_t b = p->block_size;
+    uint64_t subsets = (uint64_t)b * (uint64_t)b;
+    size_t map = ism->map_floats;
+    gather_consts c = { .dmin2 = p->clamp_distance * p->clamp_distance,
+                        .bias = p->depth_bias,
+                        .texel = 2.0f / (float)p->map_size,
+                        .splat_radius = ism->splat_radius,
+                        .diagonal = ism->diagonal,
+                        .threshold = p->pull_push_threshold,
+                        .n = p->map_size,
+                        .levels = ism->lazy_levels };
+    receivers rs = job_receivers(job, thread);
+    for (size_t id = begin; id < end; ++id) {
+        int32_t band = (int32_t)(id / subsets);
+        uint64_t k = id % subsets;
+        int32_t k_x = (int32_t)(k % (uint64_t)b), k_y = (int32_t)(k / (uint64_t)b);
+        rs.count = 0;
+        for (int32_t r = 0; r < job->subset_rows; ++r) {
+            int32_t y = (band * job->subset_rows + r) * b + k_y;
+            if (y >= gb->height) {
+                break;
+            }
+            const float *mat = drift_image_pixel(&gb->material_id, 0, y);
+            const float *pos = drift_image_pixel(&gb->position, 0, y);
+            const float *nrm = drift_image_pixel(&gb->normal, 0, y);
+            const float *geo = drift_image_pixel(&gb->geometric_normal, 0, y);
+            int32_t mc = gb->material_id.channels, pc = gb->position.channels;
+            int32_t nc = gb->normal.channels, gc = gb->geometric_normal.channels;
+            for (int32_t x = k_x; x < gb->width; x += b) {
+                if (mat[(size_t)x * (size_t)mc] < 0.0f) {
+                    drift_image_set3(&ism->irradiance, x, y, drift_vec3_splat(0.0f));
+                    continue;
+                }
+                int32_t i = rs.count++;
+                const float *q = pos + (size_t)x * (size_t)pc;
+                rs.px[i] = q[0], rs.py[i] = q[1], rs.pz[i] = q[2];
+                q = nrm + (size_t)x * (size_t)nc;
+                rs.nx[i] = q[0], rs.ny[i] = q[1], rs.nz[i] = q[2];
+                q = geo + (size_t)x * (size_t)gc;
+                rs.gx[i] = q[0], rs.gy[i] = q[1], rs.gz[i] = q[2];
+                rs.er[i] = rs.eg[i] = rs.eb[i] = 0.0f;
+                rs.x[i] = x;
+                rs.y[i] = y;
+            }
+        }
+        if (rs.count == 0) {
+            continue;
+        }
+        // Subset k of the S = B^2 subsets takes the k-th run of each group of VPLs (one bounce
+        // of one round of light paths). Consecutive paths are consecutive Sobol samples, so
+        // each run is a stratified sample of the group (a stride of S instead would give
+        // every subset one elementary interval of the light's domain). S times the subset's
+        // sum, averaged over the S pixels of a block, is the sum over all VPLs.
+        for (uint32_t g = 0; g < ism->group_count; ++g) {
+            uint64_t first_vpl = ism->groups[g], size = (uint64_t)ism->groups[g + 1] - first_vpl;
+            uint32_t first = (uint32_t)(first_vpl + size * k / subsets);
+            uint32_t last = (uint32_t)(first_vpl + size * (k + 1) / subsets);
+            for (uint32_t j = first; j < last; ++j) {
+                if (p->visibility == DRIFT_ISM_VISIBILITY_ISM) {
+                    const float *m = ism->atlas + j * map;
+                    if (c.levels == 2) {
+                        gather_vpl_ism2(&ism->vpls[j], &ism->frames[j], m, &c, &rs);
+                    } else if (c.levels == 1) {
+                        gather_vpl_ism1(&ism->vpls[j], &ism->frames[j], m, &c, &rs);
+                    } else {
+                        gather_vpl_ism0(&ism->vpls[j], &ism->frames[j], m, &c, &rs);
+                    }
+                } else if (p->visibility == DRIFT_ISM_VISIBILITY_RAYS) {
+                    gather_vpl_rays(ism, &ism->vpls[j], &rs, &c, &job->rays[thread % 64]);
+                } else {
+                    gather_vpl_none(&ism->vpls[j], &c, rs.count, rs.px, rs.py, rs.pz, rs.nx, rs.ny,
+                                    rs.nz, rs.er, rs.eg, rs.eb);
+                }
+            }
+        }
+        float scale = (float)subsets * DRIFT_INV_PI;
+        for (int32_t i = 0; i < rs.count; ++i) {
+            drift_image_set3(&ism->irradiance, rs.x[i], rs.y[i],
+                             drift_vec3_make(rs.er[i] * scale, rs.eg[i] * scale, rs.eb[i] * scale));
         }
     }
 }
@@ -408,42 +638,47 @@ static void blur_rows(size_t begin, size_t end, int thread, void *user)
     const drift_gbuffer *gb = job->gb;
     int32_t b = ism->params.no_blur ? 1 : ism->params.block_size;
     int32_t lo = -(b / 2), hi = lo + b;
+    float blur_normal = ism->params.blur_normal, blur_plane = ism->params.blur_plane;
+    const drift_image *mat = &gb->material_id, *pos = &gb->position, *nrm = &gb->normal;
+    const drift_image *irr = &ism->irradiance;
     for (size_t row = begin; row < end; ++row) {
         int32_t y = (int32_t)row;
+        int32_t y0 = y + lo < 0 ? 0 : y + lo, y1 = y + hi > gb->height ? gb->height : y + hi;
         for (int32_t x = 0; x < gb->width; ++x) {
-            if (drift_image_pixel(&gb->material_id, x, y)[0] < 0.0f) {
+            if (drift_image_pixel(mat, x, y)[0] < 0.0f) {
                 drift_image_set3(&ism->indirect, x, y, drift_vec3_splat(0.0f));
                 continue;
             }
-            drift_vec3 e = drift_image_get3(&ism->irradiance, x, y);
+            drift_vec3 e = drift_image_get3(irr, x, y);
             if (b > 1) {
-                drift_vec3 xp = drift_image_get3(&gb->position, x, y);
-                drift_vec3 n = drift_image_get3(&gb->normal, x, y);
-                drift_vec3 sum = drift_vec3_splat(0.0f);
-                float weight = 0.0f;
-                for (int32_t dy = lo; dy < hi; ++dy) {
-                    int32_t yy = y + dy;
-                    if (yy < 0 || yy >= gb->height) {
-                        continue;
-                    }
-                    for (int32_t dx = lo; dx < hi; ++dx) {
-                        int32_t xx = x + dx;
-                        if (xx < 0 || xx >= gb->width ||
-                            drift_image_pixel(&gb->material_id, xx, yy)[0] < 0.0f) {
+                int32_t x0 = x + lo < 0 ? 0 : x + lo, x1 = x + hi > gb->width ? gb->width : x + hi;
+                const float *c = drift_image_pixel(pos, x, y), *cn = drift_image_pixel(nrm, x, y);
+                float sr = 0.0f, sg = 0.0f, sb = 0.0f, weight = 0.0f;
+                for (int32_t yy = y0; yy < y1; ++yy) {
+                    const float *m = drift_image_pixel(mat, 0, yy);
+                    const float *pp = drift_image_pixel(pos, 0, yy);
+                    const float *nn = drift_image_pixel(nrm, 0, yy);
+                    const float *ee = drift_image_pixel(irr, 0, yy);
+                    for (int32_t xx = x0; xx < x1; ++xx) {
+                        const float *q = pp + (size_t)xx * (size_t)pos->channels;
+                        const float *qn = nn + (size_t)xx * (size_t)nrm->channels;
+                        float plane = fabsf(cn[0] * (q[0] - c[0]) + cn[1] * (q[1] - c[1]) +
+                                            cn[2] * (q[2] - c[2]));
+                        float cosn = cn[0] * qn[0] + cn[1] * qn[1] + cn[2] * qn[2];
+                        if (m[(size_t)xx * (size_t)mat->channels] < 0.0f || cosn < blur_normal ||
+                            plane > blur_plane) {
                             continue;
                         }
-                        drift_vec3 nn = drift_image_get3(&gb->normal, xx, yy);
-                        drift_vec3 pp = drift_image_get3(&gb->position, xx, yy);
-                        float plane = fabsf(drift_vec3_dot(n, drift_vec3_sub(pp, xp)));
-                        if (drift_vec3_dot(n, nn) < ism->params.blur_normal ||
-                            plane > ism->params.blur_plane) {
-                            continue;
-                        }
-                        sum = drift_vec3_add(sum, drift_image_get3(&ism->irradiance, xx, yy));
+                        const float *qe = ee + (size_t)xx * (size_t)irr->channels;
+                        sr += qe[0];
+                        sg += qe[1];
+                        sb += qe[2];
                         weight += 1.0f;
                     }
                 }
-                e = weight > 0.0f ? drift_vec3_scale(sum, 1.0f / weight) : e;
+                if (weight > 0.0f) {
+                    e = drift_vec3_make(sr / weight, sg / weight, sb / weight);
+                }
             }
             drift_vec3 kd = drift_image_get3(&gb->albedo, x, y);
             drift_image_set3(&ism->indirect, x, y,
@@ -490,10 +725,16 @@ static void diagnostic_planes(drift_ism *ism, const drift_camera *camera)
             }
         }
     }
+    // Map 0 as the lookups see it (pushed).
     int32_t n = ism->params.map_size;
-    for (int32_t i = 0; i < n * n; ++i) {
-        float d = ism->atlas && ism->vpl_count > 0 ? ism->atlas[i] : INFINITY;
-        ism->tile.pixels[i] = isfinite(d) ? d : 0.0f;
+    for (int32_t y = 0; y < n; ++y) {
+        for (int32_t x = 0; x < n; ++x) {
+            float d = ism->atlas && ism->vpl_count > 0
+                          ? drift__ism_lookup(ism->atlas, n, ism->lazy_levels,
+                                              ism->params.pull_push_threshold, x, y)
+                          : INFINITY;
+            ism->tile.pixels[(size_t)y * (size_t)n + (size_t)x] = isfinite(d) ? d : 0.0f;
+        }
     }
 }
 
@@ -540,12 +781,18 @@ drift_result drift_ism_render(drift_ism *ism, const drift_gbuffer *gbuffer,
             return r;
         }
         if (ism->points) {
-            // Only the subsets of this render's VPLs are read.
+            // Only the subsets of this render's VPLs are read, and only when a vertex moved
+            // since they were derived (or they were never derived this far).
             uint32_t first, count;
             drift_points_subset(ism->points, ism->vpl_count - 1, &first, &count);
-            r = drift_points_update_range(ism->points, ism->scene, 0, first + count);
-            if (r != DRIFT_OK) {
-                return r;
+            uint64_t print = vertex_fingerprint(ism->scene);
+            if (print != ism->points_print || first + count > ism->points_valid) {
+                r = drift_points_update_range(ism->points, ism->scene, 0, first + count);
+                if (r != DRIFT_OK) {
+                    return r;
+                }
+                ism->points_print = print;
+                ism->points_valid = first + count;
             }
         }
         now = drift_time_now();
@@ -558,41 +805,49 @@ drift_result drift_ism_render(drift_ism *ism, const drift_gbuffer *gbuffer,
         mj.splat.point_radius = sqrtf(area_per_point * DRIFT_INV_PI);
         mj.splat.splat_scale = ism->params.splat_scale;
         ism->splat_radius = mj.splat.splat_scale * mj.splat.point_radius;
-        drift_parallel_for(ism->ctx, ism->vpl_count, 4, splat_range, &mj);
+        drift_parallel_for(ism->ctx, ism->vpl_count, 1, maps_range, &mj);
         st.splats = (uint64_t)ism->vpl_count * ism->params.points_per_vpl;
-        now = drift_time_now();
-        st.ms[DRIFT_ISM_STAGE_SPLAT] = (now - t) * 1e3;
-        t = now;
         uint64_t empty = 0;
-        if (ism->params.pull_push_levels > 0) {
-            drift_parallel_for(ism->ctx, ism->vpl_count, 4, pull_push_range, &mj);
-            for (int i = 0; i < 64; ++i) {
-                empty += mj.empty[i];
-            }
-        } else {
-            for (uint32_t j = 0; j < ism->vpl_count; ++j) {
-                empty += drift__ism_pull_push(ism->atlas + (size_t)j * (size_t)mj.splat.n *
-                                                               (size_t)mj.splat.n,
-                                              mj.splat.n, 0, 1.0f, ism->scratch);
-            }
+        for (int i = 0; i < 64; ++i) {
+            empty += mj.empty[i];
         }
         double disc = (double)DRIFT_PI * 0.25 * (double)mj.splat.n * (double)mj.splat.n;
         st.hole_fraction = (double)empty / ((double)ism->vpl_count * disc);
         now = drift_time_now();
-        st.ms[DRIFT_ISM_STAGE_PULL_PUSH] = (now - t) * 1e3;
+        // Splat and pull-push run map by map on one thread: the pass's wall time is split
+        // between them in proportion to the threads' own clock of each.
+        double splat_s = 0.0, pull_s = 0.0;
+        for (int i = 0; i < 64; ++i) {
+            splat_s += mj.seconds[i][0];
+            pull_s += mj.seconds[i][1];
+        }
+        double maps_ms = (now - t) * 1e3;
+        double split = splat_s + pull_s > 0.0 ? splat_s / (splat_s + pull_s) : 0.5;
+        st.ms[DRIFT_ISM_STAGE_SPLAT] = maps_ms * split;
+        st.ms[DRIFT_ISM_STAGE_PULL_PUSH] = maps_ms * (1.0 - split);
         t = now;
     }
-    gather_job gj = { .ism = ism,
-                      .gb = gbuffer,
-                      .receivers_per_thread =
-                          (gbuffer->width + ism->params.block_size - 1) / ism->params.block_size };
-    gj.receivers = drift_alloc(ism->ctx, (size_t)drift_context_thread_count(ism->ctx) *
-                                             (size_t)gj.receivers_per_thread * sizeof(receiver));
-    if (!gj.receivers) {
+    int32_t b = ism->params.block_size;
+    int32_t cols = (gbuffer->width + b - 1) / b;
+    gather_job gj = { .ism = ism, .gb = gbuffer };
+    // Whole rows of a subset, as few bands as keep the threads busy and the receivers of a job
+    // under GATHER_MAX_RECEIVERS (the image does not depend on the split).
+    int32_t rows = (gbuffer->height + b - 1) / b;
+    int64_t subsets = (int64_t)b * b, threads = drift_context_thread_count(ism->ctx);
+    int64_t bands = (4 * threads + subsets - 1) / subsets;
+    int64_t by_size = ((int64_t)rows * cols + GATHER_MAX_RECEIVERS - 1) / GATHER_MAX_RECEIVERS;
+    bands = bands > by_size ? bands : by_size;
+    bands = bands < rows ? bands : rows;
+    gj.subset_rows = (int32_t)((rows + bands - 1) / bands);
+    gj.bands = (rows + gj.subset_rows - 1) / gj.subset_rows;
+    gj.capacity = gj.subset_rows * cols;
+    gj.buffers = drift_alloc(ism->ctx, (size_t)drift_context_thread_count(ism->ctx) *
+                                           (size_t)gj.capacity * 14 * sizeof(float));
+    if (!gj.buffers) {
         return DRIFT_ERR_OUT_OF_MEMORY;
     }
-    drift_parallel_for(ism->ctx, (size_t)gbuffer->height, 2, gather_rows, &gj);
-    drift_free(ism->ctx, gj.receivers);
+    drift_parallel_for(ism->ctx, (size_t)gj.bands * (size_t)b * (size_t)b, 1, gather_jobs, &gj);
+    drift_free(ism->ctx, gj.buffers);
     for (int i = 0; i < 64; ++i) {
         st.shadow_rays += gj.rays[i];
     }

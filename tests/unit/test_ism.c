@@ -290,6 +290,58 @@ static void test_pull_push_fills_holes(void **state)
     test_rig_destroy(&r);
 }
 
+// The lazy pull-push (pull at build time, the push replayed by each lookup along the texel's
+// ancestors) gives every texel the eager pull-push's depth, to the bit, and the same holes:
+// on random maps of near and far depths with holes (every push case: empty children, far
+// children behind a near majority, empty parents), odd and even sizes, one and two levels.
+static void test_lazy_push_equals_eager(void **state)
+{
+    (void)state;
+    const int32_t sizes[] = { 64, 37 };
+    uint32_t rng = 12345u;
+    for (int s = 0; s < 2; ++s) {
+        int32_t n = sizes[s];
+        size_t texels = (size_t)n * (size_t)n;
+        for (int32_t levels = 1; levels <= 2; ++levels) {
+            for (int trial = 0; trial < 4; ++trial) {
+                float *eager = malloc(texels * sizeof *eager);
+                float *lazy = malloc(drift__ism_map_floats(n, levels) * sizeof *lazy);
+                float *scratch = malloc(2 * texels * sizeof *scratch);
+                // Holes from 20% to 80%; depths in a near (1.0-1.1) and a far (3.0-3.1)
+                // cluster, the far one a third of the valid texels.
+                for (size_t i = 0; i < texels; ++i) {
+                    rng = rng * 1664525u + 1013904223u;
+                    float u = (float)(rng >> 8) / 16777216.0f;
+                    rng = rng * 1664525u + 1013904223u;
+                    float w = (float)(rng >> 8) / 16777216.0f;
+                    bool hole = u < 0.2f + 0.2f * (float)trial;
+                    eager[i] = hole ? INFINITY : (w < 0.33f ? 3.0f : 1.0f) + 0.1f * w;
+                    lazy[i] = eager[i];
+                }
+                float threshold = 0.3f;
+                uint32_t holes = drift__ism_pull_push(eager, n, levels, threshold, scratch);
+                drift__ism_pull(lazy, n, levels, threshold);
+                float *counts = malloc(texels * sizeof *counts);
+                drift__ism_disc_counts(n, levels, counts);
+                assert_int_equal(drift__ism_holes(lazy, n, levels, counts), holes);
+                free(counts);
+                int32_t differ = 0;
+                for (int32_t y = 0; y < n; ++y) {
+                    for (int32_t x = 0; x < n; ++x) {
+                        float got = drift__ism_lookup(lazy, n, levels, threshold, x, y);
+                        differ += memcmp(&got, &eager[(size_t)y * (size_t)n + (size_t)x],
+                                         sizeof got) != 0;
+                    }
+                }
+                assert_int_equal(differ, 0);
+                free(eager);
+                free(lazy);
+                free(scratch);
+            }
+        }
+    }
+}
+
 // The Cornell box at 32 x 32: `ir` with many VPLs, every pixel gathering every VPL, is close
 // to the path tracer's first-bounce diffuse light (max depth 2) up to the clamping bias, and
 // the visibility-free limit is brighter; ISM's error against `ir` falls as points grow and as
@@ -584,6 +636,7 @@ int main(void)
         cmocka_unit_test(test_vpl_flux_is_power_times_albedo),
         cmocka_unit_test(test_ism_of_an_occluder_matches_rays),
         cmocka_unit_test(test_pull_push_fills_holes),
+        cmocka_unit_test(test_lazy_push_equals_eager),
         cmocka_unit_test(test_ir_and_ism_against_path_tracer),
         cmocka_unit_test(test_environment_vpls_carry_its_power),
         cmocka_unit_test(test_gather_equals_the_formula),
