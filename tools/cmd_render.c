@@ -327,7 +327,7 @@ static const cli_option render_table[] = {
                "uniform numbers, the paper's Monte Carlo)"),
     CLI_INT("--occlusion-samples", "N", O, hybrid.occlusion_settings.samples, 1, 1024,
             "--occlusion ssao|gtao|ssdo (docs/ssdo.md): samples a pixel\n"
-            "(default 16)"),
+            "(default 16; ssdo 4, marched by --occlusion-steps)"),
     CLI_NUMBER("--occlusion-radius", "R", O, hybrid.occlusion_settings.radius, 1e-30, 1e30,
                "r_max in scene units (default 0.05 x scene diagonal)"),
     CLI_CHOICE("--ssdo-bounce", "off|on", O, hybrid.occlusion_settings.bounce, "off|on",
@@ -344,7 +344,8 @@ static const cli_option render_table[] = {
             "outside the image (ssao, ssdo, contact shadows; default 0)"),
     CLI_INT("--occlusion-steps", "K", O, hybrid.occlusion_settings.steps, 1, 64,
             "points on each ssao/ssdo sample direction: 1 the thesis's\n"
-            "point test (default), more a march to r_max (a ray test)"),
+            "point test (ssao default), more a march to r_max (a ray\n"
+            "test; ssdo default 4)"),
     CLI_CHOICE("--contact-shadows", "off|on", O, hybrid.shadow_map.contact_shadows, "off|on",
                "on: --shadows pcf|pcss march each lit pixel's shadow-map bias\n"
                "toward the light in screen space (thesis §4.5; default off)"),
