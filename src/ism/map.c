@@ -17,9 +17,11 @@
 #    define DRIFT_ISM_CLONES
 #endif
 
-DRIFT_ISM_CLONES void drift__ism_splat(float *depth, const drift__ism_splat_desc *desc,
-                                       drift_vec3 origin, const drift_frame *frame,
-                                       const drift_vec3 *positions, uint32_t count)
+// Static: clang 14 emits no plain symbol for an external multi-versioned function (the
+// fuzz build's link failed), so the clones stay inside this file behind drift__ism_splat.
+DRIFT_ISM_CLONES static void splat_points(float *depth, const drift__ism_splat_desc *desc,
+                                          drift_vec3 origin, const drift_frame *frame,
+                                          const drift_vec3 *positions, uint32_t count)
 {
     int32_t n = desc->n;
     for (int32_t i = 0; i < n * n; ++i) {
@@ -79,6 +81,12 @@ DRIFT_ISM_CLONES void drift__ism_splat(float *depth, const drift__ism_splat_desc
             }
         }
     }
+}
+
+void drift__ism_splat(float *depth, const drift__ism_splat_desc *desc, drift_vec3 origin,
+                      const drift_frame *frame, const drift_vec3 *positions, uint32_t count)
+{
+    splat_points(depth, desc, origin, frame, positions, count);
 }
 
 // The texels [*lo, *hi) of row y whose centres lie inside the unit disc (|u| <= sqrt(1 - v^2)),
