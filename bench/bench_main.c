@@ -57,7 +57,7 @@ bool bench_parse_list(const char *cmd, const char *flag, const char *text, long 
 int drift_cmd_bench(int argc, char **argv)
 {
     sweep_begin(); // mpirun -n N drift bench ...: the sweeps' renders over the ranks
-    static const char *const spread[] = { "aaf", "isg", "sir", "micro", "ism" };
+    static const char *const spread[] = { "aaf", "isg", "sir", "micro", "micro-bounces", "ism" };
     bool spreads = false;
     for (size_t k = 0; argc >= 2 && k < sizeof spread / sizeof *spread; ++k) {
         spreads = spreads || strcmp(argv[1], spread[k]) == 0;
