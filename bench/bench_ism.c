@@ -137,8 +137,10 @@ static drift_result copy_image(drift_context *ctx, const drift_image *src, drift
     return r;
 }
 
+// The path tracer's image of `components` at spp; `together` (a reference): rendered by every
+// rank at once (sweep_pt_render), *together saying whether every rank's part went well.
 static drift_result pt_image(bench_state *b, uint32_t components, long spp, drift_image *out,
-                             double *out_ms)
+                             double *out_ms, bool *together)
 {
     drift_pt *pt = NULL;
     drift_pt_params params = { .width = (int32_t)b->o->size,
@@ -150,7 +152,9 @@ static drift_result pt_image(bench_state *b, uint32_t components, long spp, drif
                                .pinhole = true };
     drift_result r = drift_pt_create(b->ctx, b->scene, b->accel, &params, &pt);
     double t0 = drift_time_now();
-    if (r == DRIFT_OK) {
+    if (together) {
+        *together = sweep_pt_render(pt, (uint32_t)spp, *together && r == DRIFT_OK);
+    } else if (r == DRIFT_OK) {
         r = drift_pt_render_samples(pt, (uint32_t)spp, NULL);
     }
     if (out_ms) {
@@ -306,10 +310,10 @@ static ism_row classic_row(bench_state *b, const drift_ism *ism, const drift_ism
     return make_row("sm", count, ms, detail, NULL);
 }
 
-// Under mpirun the rows are sweep items over the ranks (sweep.h): item 0 is the path-traced
-// I, item 1 the reference's other terms, item 2 + i the pt row of the i-th spp, and after
-// those one item per VPL count (its ism, sm and ir rows: ir is measured against that ism).
-// With --png rank 0 renders everything, since it alone writes files.
+// Under mpirun the two references are rendered by every rank together (sweep_pt_render), then
+// the rows are sweep items over the ranks (sweep.h): item i is the pt row of the i-th spp,
+// and after those one item per VPL count (its ism, sm and ir rows: ir is measured against
+// that ism). With --png rank 0 renders every row, since it alone writes files.
 static int row_owner(const ism_options *o, int item)
 {
     return o->png_dir ? 0 : item % sweep_ranks();
@@ -356,11 +360,11 @@ int drift_bench_ism(int argc, char **argv)
     int pt_first = 1, vpl_first = 1 + o.spp_count, row_count = vpl_first + 3 * o.vpl_count;
     owners[0] = 0;
     for (int i = 0; i < o.spp_count; ++i) {
-        owners[pt_first + i] = row_owner(&o, 2 + i);
+        owners[pt_first + i] = row_owner(&o, i);
     }
     for (int c = 0; c < o.vpl_count; ++c) {
         for (int k = 0; k < 3; ++k) {
-            owners[vpl_first + 3 * c + k] = row_owner(&o, 2 + o.spp_count + c);
+            owners[vpl_first + 3 * c + k] = row_owner(&o, o.spp_count + c);
         }
     }
     drift_hybrid *frame = NULL;
@@ -369,24 +373,23 @@ int drift_bench_ism(int argc, char **argv)
     if (r == DRIFT_OK) {
         r = drift_hybrid_render(frame, &b.scene->camera, NULL);
     }
-    if (r == DRIFT_OK && row_owner(&o, 0) == sweep_rank()) {
-        r = pt_image(&b, DRIFT_PT_COMPONENT_DIFFUSE, o.ref_spp, &b.ref_indirect, NULL);
-    }
-    if (r == DRIFT_OK && row_owner(&o, 1) == sweep_rank()) {
-        r = pt_image(&b,
-                     DRIFT_PT_COMPONENT_EMISSION | DRIFT_PT_COMPONENT_DIRECT |
-                         DRIFT_PT_COMPONENT_SPECULAR,
-                     o.ref_spp, &b.ref_rest, NULL);
-    }
-    for (int i = 0; i < o.spp_count && r == DRIFT_OK; ++i) {
+    // The two references by every rank together (their tiles over the ranks), then the rows.
+    bool ok = r == DRIFT_OK;
+    drift_result r1 =
+        pt_image(&b, DRIFT_PT_COMPONENT_DIFFUSE, o.ref_spp, &b.ref_indirect, NULL, &ok);
+    drift_result r2 = pt_image(
+        &b, DRIFT_PT_COMPONENT_EMISSION | DRIFT_PT_COMPONENT_DIRECT | DRIFT_PT_COMPONENT_SPECULAR,
+        o.ref_spp, &b.ref_rest, NULL, &ok);
+    r = r ? r : (r1 ? r1 : r2);
+    for (int i = 0; i < o.spp_count && ok && r == DRIFT_OK; ++i) {
         if (owners[pt_first + i] != sweep_rank()) {
             continue;
         }
         double ms;
-        r = pt_image(&b, DRIFT_PT_COMPONENT_DIFFUSE, o.spps[i], &images[pt_first + i], &ms);
+        r = pt_image(&b, DRIFT_PT_COMPONENT_DIFFUSE, o.spps[i], &images[pt_first + i], &ms, NULL);
         rows[pt_first + i] = make_row("pt", o.spps[i], ms, "spp, max depth 2", NULL);
     }
-    for (int v = 0; v < 2 * o.vpl_count && r == DRIFT_OK; ++v) {
+    for (int v = 0; v < 2 * o.vpl_count && ok && r == DRIFT_OK; ++v) {
         bool ir = v % 2 == 1;
         int slot = vpl_first + 3 * (v / 2) + (ir ? 2 : 0);
         if ((ir && o.no_ir) || (!ir && o.no_ism) || owners[slot] != sweep_rank()) {
@@ -466,19 +469,8 @@ int drift_bench_ism(int argc, char **argv)
         }
         drift_ism_destroy(ism);
     }
-    // The two reference images to every rank; each measures its own rows, rank 0 gathers.
-    bool ok = r == DRIFT_OK;
-    drift_image *refs[2] = { &b.ref_indirect, &b.ref_rest };
-    for (int k = 0; k < 2; ++k) {
-        int owner = row_owner(&o, k);
-        ok = sweep_share(NULL, 0, owner, ok);
-        if (ok && owner != sweep_rank()) {
-            ok = drift_image_create(b.ctx, (int32_t)o.size, (int32_t)o.height, 3, refs[k]) ==
-                 DRIFT_OK;
-        }
-        size_t bytes = sizeof(float) * 3 * (size_t)o.size * (size_t)o.height;
-        ok = sweep_share(ok ? refs[k]->pixels : NULL, ok ? bytes : 0, owner, ok);
-    }
+    // Each rank measures its own rows, rank 0 gathers them.
+    ok = ok && r == DRIFT_OK;
     ok = ok &&
          drift_image_create(b.ctx, (int32_t)o.size, (int32_t)o.height, 3, &b.ref_frame) == DRIFT_OK;
     if (ok) {

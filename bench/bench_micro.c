@@ -5,7 +5,7 @@
 //   size     the micro-buffer's K at every-pixel density (Fig. 6.17)
 //   density  1, 1/4 and 1/16 of the pixels gathering, bilaterally upsampled (Fig. 6.15)
 //   points   nodes visited a gather as the hierarchy's points double (Fig. 6.18; --csv)
-// Under mpirun the reference and the rows are sweep items spread over the ranks (sweep.h).
+// Under mpirun the reference's tiles, then the rows, are spread over the ranks (sweep.h).
 #include "bench.h"
 #include "distributed/sweep.h"
 #include "drift/accel.h"
@@ -105,8 +105,8 @@ typedef struct row_figures {
     double gathers, gathers_per_s, samples_per_s, visited, cast, rmse, nrms;
 } row_figures;
 
-// One micro render of the frame's G-buffer: its figures but the errors, and a copy of its I
-// (measured against the reference once that is here, measure_row).
+// One micro render of the frame's G-buffer: its figures but the errors (measure_row), and a
+// copy of its I.
 static drift_result render_row(cli_session *s, const micro_options *o, drift_hybrid *frame,
                                const row *w, row_figures *f, drift_image *out)
 {
@@ -218,7 +218,7 @@ int drift_bench_micro(int argc, char **argv)
         cli_session_close(&s);
         return 1;
     }
-    // The sweeps' rows, in order: sweep item 0 is the reference, item 1 + i row i (sweep.h).
+    // The sweeps' rows, in order.
     row list[3 * MAX_LIST];
     int count = 0;
     for (int i = 0; i < o.size_count; ++i) {
@@ -235,45 +235,31 @@ int drift_bench_micro(int argc, char **argv)
     drift_image images[3 * MAX_LIST] = { 0 };
     drift_hybrid *frame = NULL;
     drift_pt *pt = NULL;
-    drift_image ref = { 0 }, own_ref = { 0 };
+    drift_image ref = { 0 }; // owned by the pt
     cJSON *root = NULL, *rows = NULL;
     FILE *csv = NULL;
     drift_hybrid_params hp = { .width = (int32_t)o.size, .height = (int32_t)o.size };
     drift_result r = drift_hybrid_create(s.ctx, s.scene, s.accel, &hp, &frame);
     r = r ? r : drift_hybrid_render(frame, &s.scene->camera, NULL);
-    if (r == DRIFT_OK && sweep_mine(0)) {
-        drift_pt_params pp = { .width = (int32_t)o.size,
-                               .height = (int32_t)o.size,
-                               .seed = 99,
-                               .max_depth = 2,
-                               .components = DRIFT_PT_COMPONENT_DIFFUSE,
-                               .pixel_centre = true,
-                               .pinhole = true };
-        r = drift_pt_create(s.ctx, s.scene, s.accel, &pp, &pt);
-        r = r ? r : drift_pt_render_samples(pt, (uint32_t)o.ref_spp, NULL);
-        r = r ? r : drift_pt_resolve(pt, DRIFT_PT_AOV_BEAUTY, &ref);
-    }
-    for (int i = 0; i < count && r == DRIFT_OK; ++i) {
-        if (sweep_mine(1 + i)) {
+    // The reference by every rank together (tiles over the ranks, sweep.h), then the rows,
+    // sweep item i row i, each measured by its rank and gathered by rank 0.
+    drift_pt_params pp = { .width = (int32_t)o.size,
+                           .height = (int32_t)o.size,
+                           .seed = 99,
+                           .max_depth = 2,
+                           .components = DRIFT_PT_COMPONENT_DIFFUSE,
+                           .pixel_centre = true,
+                           .pinhole = true };
+    r = r ? r : drift_pt_create(s.ctx, s.scene, s.accel, &pp, &pt);
+    bool ok = sweep_pt_render(pt, (uint32_t)o.ref_spp, r == DRIFT_OK);
+    r = r || !ok ? r : drift_pt_resolve(pt, DRIFT_PT_AOV_BEAUTY, &ref);
+    for (int i = 0; i < count && ok && r == DRIFT_OK; ++i) {
+        if (sweep_mine(i)) {
             r = render_row(&s, &o, frame, &list[i], &figures[i], &images[i]);
-        }
-    }
-    // The reference to every rank (a view into the path tracer on its own rank), then each
-    // measures its own rows and rank 0 gathers them.
-    int32_t dims[3] = { ref.width, ref.height, ref.channels };
-    bool ok = sweep_share(dims, sizeof dims, 0, r == DRIFT_OK);
-    if (ok && !sweep_mine(0)) {
-        ok = drift_image_create(s.ctx, dims[0], dims[1], dims[2], &own_ref) == DRIFT_OK;
-        ref = own_ref;
-    }
-    size_t bytes = sizeof(float) * (size_t)dims[0] * (size_t)dims[1] * (size_t)dims[2];
-    ok = sweep_share(ref.pixels, ok ? bytes : 0, 0, ok);
-    for (int i = 0; i < count && ok; ++i) {
-        if (sweep_mine(1 + i)) {
             measure_row(&s, &ref, &images[i], &figures[i]);
         }
     }
-    if (!sweep_gather(figures, sizeof *figures, 1, count, ok)) {
+    if (!sweep_gather(figures, sizeof *figures, 0, count, ok && r == DRIFT_OK)) {
         goto done;
     }
     if (o.csv_path) {
@@ -314,7 +300,6 @@ done:
     for (int i = 0; i < count; ++i) {
         drift_image_destroy(s.ctx, &images[i]);
     }
-    drift_image_destroy(s.ctx, &own_ref);
     drift_pt_destroy(pt);
     drift_hybrid_destroy(frame);
     cli_session_close(&s);

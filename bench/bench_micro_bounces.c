@@ -4,7 +4,7 @@
 // milliseconds by stage (the lighting split into the direct light and the further bounces),
 // photons stored, NRMS, LDR-FLIP and the mean's ratio to the reference. The one-bounce
 // `direct` row is repeated against each reference: what the extra bounces add. Under mpirun
-// each bounce count (its reference and rows) is a sweep item over the ranks (sweep.h).
+// each reference's tiles, then the rows, are spread over the ranks (sweep.h).
 #include "bench.h"
 #include "distributed/sweep.h"
 #include "drift/accel.h"
@@ -170,13 +170,13 @@ int drift_bench_micro_bounces(int argc, char **argv)
     drift_hybrid_params hp = { .width = (int32_t)o.size, .height = (int32_t)o.size };
     drift_result r = drift_hybrid_create(s.ctx, s.scene, s.accel, &hp, &frame);
     r = r ? r : drift_hybrid_render(frame, &s.scene->camera, NULL);
-    // Sweep item i (sweep.h): the i-th bounce count's reference and its up to 3 rows.
-    bounce_row results[MAX_LIST][3];
+    // Each bounce count's reference by every rank together (its tiles over the ranks,
+    // sweep.h), then its up to 3 rows as sweep items, numbered over all the counts.
+    bounce_row results[MAX_LIST * 3];
     memset(results, 0, sizeof results);
-    for (int i = 0; i < o.bounce_count && r == DRIFT_OK; ++i) {
-        if (!sweep_mine(i)) {
-            continue;
-        }
+    bool ok = r == DRIFT_OK;
+    int items = 0;
+    for (int i = 0; i < o.bounce_count; ++i) {
         int32_t b = (int32_t)o.bounces[i];
         drift_pt *pt = NULL;
         drift_image ref = { 0 }; // owned by the pt
@@ -187,24 +187,23 @@ int drift_bench_micro_bounces(int argc, char **argv)
                                .components = DRIFT_PT_COMPONENT_DIFFUSE,
                                .pixel_centre = true,
                                .pinhole = true };
-        r = drift_pt_create(s.ctx, s.scene, s.accel, &pp, &pt);
-        r = r ? r : drift_pt_render_samples(pt, (uint32_t)o.ref_spp, NULL);
-        r = r ? r : drift_pt_resolve(pt, DRIFT_PT_AOV_BEAUTY, &ref);
-        r = r ? r : run_row(&s, &o, frame, &ref, 1, b, DRIFT_MICRO_LIGHTING_DIRECT, &results[i][0]);
-        if (b > 1) {
-            r = r ? r
-                  : run_row(&s, &o, frame, &ref, b, b, DRIFT_MICRO_LIGHTING_RADIOSITY,
-                            &results[i][1]);
-            r = r ? r
-                  : run_row(&s, &o, frame, &ref, b, b, DRIFT_MICRO_LIGHTING_PHOTONS,
-                            &results[i][2]);
+        r = r ? r : drift_pt_create(s.ctx, s.scene, s.accel, &pp, &pt);
+        ok = sweep_pt_render(pt, (uint32_t)o.ref_spp, ok && r == DRIFT_OK);
+        r = r || !ok ? r : drift_pt_resolve(pt, DRIFT_PT_AOV_BEAUTY, &ref);
+        static const drift_micro_lighting lightings[3] = { DRIFT_MICRO_LIGHTING_DIRECT,
+                                                           DRIFT_MICRO_LIGHTING_RADIOSITY,
+                                                           DRIFT_MICRO_LIGHTING_PHOTONS };
+        for (int k = 0; k < (b > 1 ? 3 : 1); ++k, ++items) {
+            if (ok && r == DRIFT_OK && sweep_mine(items)) {
+                r = run_row(&s, &o, frame, &ref, k == 0 ? 1 : b, b, lightings[k], &results[items]);
+            }
         }
         drift_pt_destroy(pt);
     }
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift bench micro-bounces: %s\n", drift_result_string(r));
     }
-    if (!sweep_gather(results, sizeof results[0], 0, o.bounce_count, r == DRIFT_OK)) {
+    if (!sweep_gather(results, sizeof *results, 0, items, ok && r == DRIFT_OK)) {
         goto done;
     }
     if (o.json) {
@@ -225,10 +224,8 @@ int drift_bench_micro_bounces(int argc, char **argv)
                "gather / upsample ms | photons | NRMS | FLIP | mean / reference |\n"
                "|---|---|---|---|---|---|---|---|---|\n");
     }
-    for (int i = 0; i < o.bounce_count; ++i) {
-        for (int k = 0; k < (o.bounces[i] > 1 ? 3 : 1); ++k) {
-            emit_row(&results[i][k], rows);
-        }
+    for (int k = 0; k < items; ++k) {
+        emit_row(&results[k], rows);
     }
     status = !root || cli_json_write("bench micro-bounces", root, NULL) ? 0 : 1;
     root = NULL; // cli_json_write destroys it
