@@ -57,8 +57,11 @@ bool bench_parse_list(const char *cmd, const char *flag, const char *text, long 
 int drift_cmd_bench(int argc, char **argv)
 {
     sweep_begin(); // mpirun -n N drift bench ...: the sweeps' renders over the ranks
-    bool spreads = argc >= 2 && (strcmp(argv[1], "aaf") == 0 || strcmp(argv[1], "isg") == 0 ||
-                                 strcmp(argv[1], "sir") == 0);
+    static const char *const spread[] = { "aaf", "isg", "sir", "micro", "micro-bounces", "ism" };
+    bool spreads = false;
+    for (size_t k = 0; argc >= 2 && k < sizeof spread / sizeof *spread; ++k) {
+        spreads = spreads || strcmp(argv[1], spread[k]) == 0;
+    }
     if (!spreads && sweep_rank() != 0) {
         return sweep_end(0); // a bench that does not spread runs on rank 0 alone
     }

@@ -5,7 +5,9 @@
 //   size     the micro-buffer's K at every-pixel density (Fig. 6.17)
 //   density  1, 1/4 and 1/16 of the pixels gathering, bilaterally upsampled (Fig. 6.15)
 //   points   nodes visited a gather as the hierarchy's points double (Fig. 6.18; --csv)
+// Under mpirun the reference's tiles, then the rows, are spread over the ranks (sweep.h).
 #include "bench.h"
+#include "distributed/sweep.h"
 #include "drift/accel.h"
 #include "drift/hybrid.h"
 #include "drift/metric.h"
@@ -97,9 +99,16 @@ typedef struct row {
     uint32_t points;
 } row;
 
-// One micro render of the frame's G-buffer; adds its row to `rows` (JSON) or prints it.
-static drift_result run_row(cli_session *s, const micro_options *o, drift_hybrid *frame,
-                            const drift_image *ref, const row *w, cJSON *rows, FILE *csv)
+// One row's figures: computed by the rank that renders it (mpirun, sweep.h), printed by rank 0.
+typedef struct row_figures {
+    double create_ms, total_ms, stage_ms[DRIFT_MICRO_STAGE_COUNT];
+    double gathers, gathers_per_s, samples_per_s, visited, cast, rmse, nrms;
+} row_figures;
+
+// One micro render of the frame's G-buffer: its figures but the errors (measure_row), and a
+// copy of its I.
+static drift_result render_row(cli_session *s, const micro_options *o, drift_hybrid *frame,
+                               const row *w, row_figures *f, drift_image *out)
 {
     drift_micro *m = NULL;
     drift_micro_params mp = { .point_count = w->points,
@@ -113,19 +122,42 @@ static drift_result run_row(cli_session *s, const micro_options *o, drift_hybrid
         r = drift_micro_render(m, drift_hybrid_gbuffer(frame), &s->scene->camera,
                                DRIFT_MICRO_LOBE_DIFFUSE);
     }
+    const drift_image *img = r == DRIFT_OK ? drift_micro_result(m) : NULL;
+    if (img) {
+        r = drift_image_create(s->ctx, img->width, img->height, img->channels, out);
+    }
     if (r != DRIFT_OK) {
         drift_micro_destroy(m);
         return r;
     }
+    memcpy(out->pixels, img->pixels,
+           sizeof(float) * (size_t)img->channels * (size_t)img->width * (size_t)img->height);
     drift_micro_stats st = drift_micro_get_stats(m);
-    double mse = 0.0;
-    drift_metric_mse(s->ctx, ref, drift_micro_result(m), &mse);
-    double rmse = sqrt(mse), nrms = rmse / drift_image_mean_luminance(ref);
     double gather_ms = st.ms[DRIFT_MICRO_STAGE_GATHER];
-    double gathers_per_s = gather_ms > 0.0 ? (double)st.gathers * 1e3 / gather_ms : 0.0;
-    double samples_per_s = gathers_per_s * (double)w->k * (double)w->k;
-    double visited = st.gathers ? (double)st.nodes_visited / (double)st.gathers : 0.0;
-    double cast = st.gathers ? (double)st.cast_gathers / (double)st.gathers : 0.0;
+    *f = (row_figures){ .create_ms = create_ms, .total_ms = st.total_ms };
+    memcpy(f->stage_ms, st.ms, sizeof f->stage_ms);
+    f->gathers = (double)st.gathers;
+    f->gathers_per_s = gather_ms > 0.0 ? (double)st.gathers * 1e3 / gather_ms : 0.0;
+    f->samples_per_s = f->gathers_per_s * (double)w->k * (double)w->k;
+    f->visited = st.gathers ? (double)st.nodes_visited / (double)st.gathers : 0.0;
+    f->cast = st.gathers ? (double)st.cast_gathers / (double)st.gathers : 0.0;
+    drift_micro_destroy(m);
+    return DRIFT_OK;
+}
+
+static void measure_row(cli_session *s, const drift_image *ref, const drift_image *img,
+                        row_figures *f)
+{
+    double mse = 0.0;
+    drift_metric_mse(s->ctx, ref, img, &mse);
+    f->rmse = sqrt(mse);
+    f->nrms = f->rmse / drift_image_mean_luminance(ref);
+}
+
+// A row's figures added to `rows` (JSON) or printed, and to the CSV.
+static void emit_row(const row *w, const row_figures *f, cJSON *rows, FILE *csv)
+{
+    double gather_ms = f->stage_ms[DRIFT_MICRO_STAGE_GATHER];
     if (rows) {
         cJSON *j = cJSON_CreateObject();
         cJSON_AddItemToArray(rows, j);
@@ -133,34 +165,32 @@ static drift_result run_row(cli_session *s, const micro_options *o, drift_hybrid
         cJSON_AddNumberToObject(j, "k", w->k);
         cJSON_AddNumberToObject(j, "density", w->density * w->density);
         cJSON_AddNumberToObject(j, "points", w->points);
-        cli_json_number(j, "create_ms", create_ms, 3);
-        cli_json_number(j, "ms", st.total_ms, 3);
+        cli_json_number(j, "create_ms", f->create_ms, 3);
+        cli_json_number(j, "ms", f->total_ms, 3);
         cJSON *stage_ms = cJSON_AddObjectToObject(j, "stage_ms");
         for (int k = 0; k < DRIFT_MICRO_STAGE_COUNT; ++k) {
-            cli_json_number(stage_ms, drift_micro_stage_name((drift_micro_stage)k), st.ms[k], 3);
+            cli_json_number(stage_ms, drift_micro_stage_name((drift_micro_stage)k), f->stage_ms[k],
+                            3);
         }
-        cJSON_AddNumberToObject(j, "gathers", (double)st.gathers);
-        cli_json_number(j, "gathers_per_s", gathers_per_s, 1);
-        cli_json_number(j, "gather_samples_per_s", samples_per_s, 1);
-        cli_json_number(j, "nodes_visited", visited, 1);
-        cli_json_number(j, "ray_cast_share", cast, 4);
-        cli_json_number(j, "rmse", rmse, 6);
-        cli_json_number(j, "nrms", nrms, 6);
+        cJSON_AddNumberToObject(j, "gathers", f->gathers);
+        cli_json_number(j, "gathers_per_s", f->gathers_per_s, 1);
+        cli_json_number(j, "gather_samples_per_s", f->samples_per_s, 1);
+        cli_json_number(j, "nodes_visited", f->visited, 1);
+        cli_json_number(j, "ray_cast_share", f->cast, 4);
+        cli_json_number(j, "rmse", f->rmse, 6);
+        cli_json_number(j, "nrms", f->nrms, 6);
     } else {
         printf("| %-7s | %2d | 1/%-2d | %7u | %8.1f | %5.1f / %6.1f / %8.1f / %5.1f | %8.0f | "
                "%6.2f | %6.0f | %.3f | %.4f |\n",
-               w->sweep, w->k, w->density * w->density, w->points, st.total_ms,
-               st.ms[DRIFT_MICRO_STAGE_HIERARCHY], st.ms[DRIFT_MICRO_STAGE_LIGHTING], gather_ms,
-               st.ms[DRIFT_MICRO_STAGE_UPSAMPLE], gathers_per_s, samples_per_s * 1e-6, visited,
-               cast, nrms);
-        fflush(stdout);
+               w->sweep, w->k, w->density * w->density, w->points, f->total_ms,
+               f->stage_ms[DRIFT_MICRO_STAGE_HIERARCHY], f->stage_ms[DRIFT_MICRO_STAGE_LIGHTING],
+               gather_ms, f->stage_ms[DRIFT_MICRO_STAGE_UPSAMPLE], f->gathers_per_s,
+               f->samples_per_s * 1e-6, f->visited, f->cast, f->nrms);
     }
     if (csv) {
-        fprintf(csv, "%u,%.1f,%.3f,%.3f\n", w->points, visited, st.ms[DRIFT_MICRO_STAGE_HIERARCHY],
-                gather_ms);
+        fprintf(csv, "%u,%.1f,%.3f,%.3f\n", w->points, f->visited,
+                f->stage_ms[DRIFT_MICRO_STAGE_HIERARCHY], gather_ms);
     }
-    drift_micro_destroy(m);
-    return DRIFT_OK;
 }
 
 int drift_bench_micro(int argc, char **argv)
@@ -182,19 +212,37 @@ int drift_bench_micro(int argc, char **argv)
     }
     status = 1;
     cli_session s;
-    if (!bench_open(&s, "bench micro", o.scene_path, "scenes/cornell-box/cornell_box.json",
-                    o.threads)) {
+    bool opened = bench_open(&s, "bench micro", o.scene_path, "scenes/cornell-box/cornell_box.json",
+                             o.threads);
+    if (!sweep_gather(NULL, 0, 0, 0, opened)) { // under mpirun: every rank, or none, goes on
         cli_session_close(&s);
         return 1;
     }
+    // The sweeps' rows, in order.
+    row list[3 * MAX_LIST];
+    int count = 0;
+    for (int i = 0; i < o.size_count; ++i) {
+        list[count++] = (row){ "size", o.sizes[i], (int32_t)o.sizes[i], 1, (uint32_t)o.points };
+    }
+    for (int i = 0; i < o.density_count; ++i) {
+        int32_t spacing = o.densities[i] == 1 ? 1 : (o.densities[i] == 4 ? 2 : 4);
+        list[count++] = (row){ "density", o.densities[i], 16, spacing, (uint32_t)o.points };
+    }
+    for (int i = 0; i < o.scaling_count; ++i) {
+        list[count++] = (row){ "points", o.scaling[i], 16, 4, 1u << o.scaling[i] };
+    }
+    row_figures figures[3 * MAX_LIST] = { 0 };
+    drift_image images[3 * MAX_LIST] = { 0 };
     drift_hybrid *frame = NULL;
     drift_pt *pt = NULL;
-    drift_image ref = { 0 };
+    drift_image ref = { 0 }; // owned by the pt
     cJSON *root = NULL, *rows = NULL;
     FILE *csv = NULL;
     drift_hybrid_params hp = { .width = (int32_t)o.size, .height = (int32_t)o.size };
     drift_result r = drift_hybrid_create(s.ctx, s.scene, s.accel, &hp, &frame);
     r = r ? r : drift_hybrid_render(frame, &s.scene->camera, NULL);
+    // The reference by every rank together (tiles over the ranks, sweep.h), then the rows,
+    // sweep item i row i, each measured by its rank and gathered by rank 0.
     drift_pt_params pp = { .width = (int32_t)o.size,
                            .height = (int32_t)o.size,
                            .seed = 99,
@@ -203,9 +251,18 @@ int drift_bench_micro(int argc, char **argv)
                            .pixel_centre = true,
                            .pinhole = true };
     r = r ? r : drift_pt_create(s.ctx, s.scene, s.accel, &pp, &pt);
-    r = r ? r : drift_pt_render_samples(pt, (uint32_t)o.ref_spp, NULL);
-    r = r ? r : drift_pt_resolve(pt, DRIFT_PT_AOV_BEAUTY, &ref);
-    if (r == DRIFT_OK && o.csv_path) {
+    bool ok = sweep_pt_render(pt, (uint32_t)o.ref_spp, r == DRIFT_OK);
+    r = r || !ok ? r : drift_pt_resolve(pt, DRIFT_PT_AOV_BEAUTY, &ref);
+    for (int i = 0; i < count && ok && r == DRIFT_OK; ++i) {
+        if (sweep_mine(i)) {
+            r = render_row(&s, &o, frame, &list[i], &figures[i], &images[i]);
+            measure_row(&s, &ref, &images[i], &figures[i]);
+        }
+    }
+    if (!sweep_gather(figures, sizeof *figures, 0, count, ok && r == DRIFT_OK)) {
+        goto done;
+    }
+    if (o.csv_path) {
         csv = fopen(o.csv_path, "w");
         if (!csv) {
             fprintf(stderr, "drift bench micro: cannot write '%s'\n", o.csv_path);
@@ -213,39 +270,25 @@ int drift_bench_micro(int argc, char **argv)
         }
         fprintf(csv, "points,nodes_visited,hierarchy_ms,gather_ms\n");
     }
-    if (r == DRIFT_OK) {
-        if (o.json) {
-            root = cJSON_CreateObject();
-            cJSON_AddStringToObject(root, "scene", s.scene_path);
-            cJSON_AddNumberToObject(root, "size", (double)o.size);
-            cJSON_AddNumberToObject(root, "threads", drift_context_thread_count(s.ctx));
-            cJSON_AddNumberToObject(root, "ref_spp", (double)o.ref_spp);
-            rows = cJSON_AddArrayToObject(root, "rows");
-        } else {
-            printf("# %s at %ldx%ld, %d threads; reference %ld spp (max depth 2, DIFFUSE)\n",
-                   s.scene_path, o.size, o.size, drift_context_thread_count(s.ctx), o.ref_spp);
-            printf("| sweep | K | density | points | ms | hierarchy / lighting / gather / "
-                   "upsample ms | gathers/s | M samples/s | nodes a gather | ray-cast share | "
-                   "NRMS of I |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
-        }
+    if (o.json) {
+        root = cJSON_CreateObject();
+        cJSON_AddStringToObject(root, "scene", s.scene_path);
+        cJSON_AddNumberToObject(root, "size", (double)o.size);
+        cJSON_AddNumberToObject(root, "threads", drift_context_thread_count(s.ctx));
+        cJSON_AddNumberToObject(root, "ref_spp", (double)o.ref_spp);
+        rows = cJSON_AddArrayToObject(root, "rows");
+    } else {
+        printf("# %s at %ldx%ld, %d threads; reference %ld spp (max depth 2, DIFFUSE)\n",
+               s.scene_path, o.size, o.size, drift_context_thread_count(s.ctx), o.ref_spp);
+        printf("| sweep | K | density | points | ms | hierarchy / lighting / gather / "
+               "upsample ms | gathers/s | M samples/s | nodes a gather | ray-cast share | "
+               "NRMS of I |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
     }
-    for (int i = 0; i < o.size_count && r == DRIFT_OK; ++i) {
-        row w = { "size", o.sizes[i], (int32_t)o.sizes[i], 1, (uint32_t)o.points };
-        r = run_row(&s, &o, frame, &ref, &w, rows, NULL);
+    for (int i = 0; i < count; ++i) {
+        emit_row(&list[i], &figures[i], rows, strcmp(list[i].sweep, "points") == 0 ? csv : NULL);
     }
-    for (int i = 0; i < o.density_count && r == DRIFT_OK; ++i) {
-        int32_t spacing = o.densities[i] == 1 ? 1 : (o.densities[i] == 4 ? 2 : 4);
-        row w = { "density", o.densities[i], 16, spacing, (uint32_t)o.points };
-        r = run_row(&s, &o, frame, &ref, &w, rows, NULL);
-    }
-    for (int i = 0; i < o.scaling_count && r == DRIFT_OK; ++i) {
-        row w = { "points", o.scaling[i], 16, 4, 1u << o.scaling[i] };
-        r = run_row(&s, &o, frame, &ref, &w, rows, csv);
-    }
-    if (r == DRIFT_OK) {
-        status = !root || cli_json_write("bench micro", root, NULL) ? 0 : 1;
-        root = NULL; // cli_json_write destroys it
-    }
+    status = !root || cli_json_write("bench micro", root, NULL) ? 0 : 1;
+    root = NULL; // cli_json_write destroys it
 done:
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift bench micro: %s\n", drift_result_string(r));
@@ -254,6 +297,9 @@ done:
         status = 1;
     }
     cJSON_Delete(root);
+    for (int i = 0; i < count; ++i) {
+        drift_image_destroy(s.ctx, &images[i]);
+    }
     drift_pt_destroy(pt);
     drift_hybrid_destroy(frame);
     cli_session_close(&s);

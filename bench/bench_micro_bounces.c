@@ -3,8 +3,10 @@
 // (DRIFT_PT_COMPONENT_DIFFUSE at max depth bounces + 1). One row a (bounces, lighting): the
 // milliseconds by stage (the lighting split into the direct light and the further bounces),
 // photons stored, NRMS, LDR-FLIP and the mean's ratio to the reference. The one-bounce
-// `direct` row is repeated against each reference: what the extra bounces add.
+// `direct` row is repeated against each reference: what the extra bounces add. Under mpirun
+// each reference's tiles, then the rows, are spread over the ranks (sweep.h).
 #include "bench.h"
+#include "distributed/sweep.h"
 #include "drift/accel.h"
 #include "drift/hybrid.h"
 #include "drift/metric.h"
@@ -60,9 +62,17 @@ static const cli_command bounces_command = {
     .help_column = 17,
 };
 
+// One row's figures: made by the rank that renders its bounce count (mpirun, sweep.h),
+// printed by rank 0.
+typedef struct bounce_row {
+    int32_t bounces, ref_bounces, lighting;
+    drift_micro_stats st;
+    double nrms, flip, ratio;
+} bounce_row;
+
 static drift_result run_row(cli_session *s, const bounces_options *o, drift_hybrid *frame,
                             const drift_image *ref, int32_t bounces, int32_t ref_bounces,
-                            drift_micro_lighting lighting, cJSON *rows)
+                            drift_micro_lighting lighting, bounce_row *out)
 {
     drift_micro *m = NULL;
     drift_micro_params mp = { .point_count = (uint32_t)o->points,
@@ -85,38 +95,47 @@ static drift_result run_row(cli_session *s, const bounces_options *o, drift_hybr
         drift_micro_destroy(m);
         return r;
     }
-    drift_micro_stats st = drift_micro_get_stats(m);
     double mean = drift_image_mean_luminance(ref);
-    double nrms = rep.rmse / mean;
-    double ratio = drift_image_mean_luminance(drift_micro_result(m)) / mean;
+    *out = (bounce_row){ .bounces = bounces,
+                         .ref_bounces = ref_bounces,
+                         .lighting = (int32_t)lighting,
+                         .st = drift_micro_get_stats(m),
+                         .nrms = rep.rmse / mean,
+                         .flip = rep.flip,
+                         .ratio = drift_image_mean_luminance(drift_micro_result(m)) / mean };
+    drift_micro_destroy(m);
+    return DRIFT_OK;
+}
+
+static void emit_row(const bounce_row *w, cJSON *rows)
+{
+    const drift_micro_stats *st = &w->st;
+    const char *lighting = drift_micro_lighting_name((drift_micro_lighting)w->lighting);
     if (rows) {
         cJSON *j = cJSON_CreateObject();
         cJSON_AddItemToArray(rows, j);
-        cJSON_AddNumberToObject(j, "reference_bounces", ref_bounces);
-        cJSON_AddNumberToObject(j, "bounces", bounces);
-        cJSON_AddStringToObject(j, "lighting", drift_micro_lighting_name(lighting));
-        cli_json_number(j, "ms", st.total_ms, 3);
+        cJSON_AddNumberToObject(j, "reference_bounces", w->ref_bounces);
+        cJSON_AddNumberToObject(j, "bounces", w->bounces);
+        cJSON_AddStringToObject(j, "lighting", lighting);
+        cli_json_number(j, "ms", st->total_ms, 3);
         cJSON *stage_ms = cJSON_AddObjectToObject(j, "stage_ms");
         for (int k = 0; k < DRIFT_MICRO_STAGE_COUNT; ++k) {
-            cli_json_number(stage_ms, drift_micro_stage_name((drift_micro_stage)k), st.ms[k], 3);
+            cli_json_number(stage_ms, drift_micro_stage_name((drift_micro_stage)k), st->ms[k], 3);
         }
-        cli_json_number(j, "direct_ms", st.direct_ms, 3);
-        cli_json_number(j, "bounces_ms", st.bounces_ms, 3);
-        cJSON_AddNumberToObject(j, "photons", (double)st.photons);
-        cli_json_number(j, "nrms", nrms, 6);
-        cli_json_number(j, "flip", rep.flip, 6);
-        cli_json_number(j, "mean_ratio", ratio, 4);
+        cli_json_number(j, "direct_ms", st->direct_ms, 3);
+        cli_json_number(j, "bounces_ms", st->bounces_ms, 3);
+        cJSON_AddNumberToObject(j, "photons", (double)st->photons);
+        cli_json_number(j, "nrms", w->nrms, 6);
+        cli_json_number(j, "flip", w->flip, 6);
+        cli_json_number(j, "mean_ratio", w->ratio, 4);
     } else {
         printf("| %d | %-9s | %d | %8.1f | %6.1f / %6.1f / %8.1f / %8.1f / %5.1f | %7llu | %.4f | "
                "%.4f | %.3f |\n",
-               ref_bounces, drift_micro_lighting_name(lighting), bounces, st.total_ms,
-               st.ms[DRIFT_MICRO_STAGE_HIERARCHY], st.direct_ms, st.bounces_ms,
-               st.ms[DRIFT_MICRO_STAGE_GATHER], st.ms[DRIFT_MICRO_STAGE_UPSAMPLE],
-               (unsigned long long)st.photons, nrms, rep.flip, ratio);
-        fflush(stdout);
+               w->ref_bounces, lighting, w->bounces, st->total_ms,
+               st->ms[DRIFT_MICRO_STAGE_HIERARCHY], st->direct_ms, st->bounces_ms,
+               st->ms[DRIFT_MICRO_STAGE_GATHER], st->ms[DRIFT_MICRO_STAGE_UPSAMPLE],
+               (unsigned long long)st->photons, w->nrms, w->flip, w->ratio);
     }
-    drift_micro_destroy(m);
-    return DRIFT_OK;
 }
 
 int drift_bench_micro_bounces(int argc, char **argv)
@@ -140,8 +159,9 @@ int drift_bench_micro_bounces(int argc, char **argv)
     }
     status = 1;
     cli_session s;
-    if (!bench_open(&s, "bench micro-bounces", o.scene_path, "scenes/cornell-box/cornell_box.json",
-                    o.threads)) {
+    bool opened = bench_open(&s, "bench micro-bounces", o.scene_path,
+                             "scenes/cornell-box/cornell_box.json", o.threads);
+    if (!sweep_gather(NULL, 0, 0, 0, opened)) { // under mpirun: every rank, or none, goes on
         cli_session_close(&s);
         return 1;
     }
@@ -150,27 +170,13 @@ int drift_bench_micro_bounces(int argc, char **argv)
     drift_hybrid_params hp = { .width = (int32_t)o.size, .height = (int32_t)o.size };
     drift_result r = drift_hybrid_create(s.ctx, s.scene, s.accel, &hp, &frame);
     r = r ? r : drift_hybrid_render(frame, &s.scene->camera, NULL);
-    if (r == DRIFT_OK) {
-        if (o.json) {
-            root = cJSON_CreateObject();
-            cJSON_AddStringToObject(root, "scene", s.scene_path);
-            cJSON_AddNumberToObject(root, "size", (double)o.size);
-            cJSON_AddNumberToObject(root, "threads", drift_context_thread_count(s.ctx));
-            cJSON_AddNumberToObject(root, "ref_spp", (double)o.ref_spp);
-            cJSON_AddNumberToObject(root, "points", (double)o.points);
-            cJSON_AddNumberToObject(root, "k", (double)o.k);
-            rows = cJSON_AddArrayToObject(root, "rows");
-        } else {
-            printf("# %s at %ldx%ld, %d threads; references %ld spp (DIFFUSE, max depth "
-                   "bounces + 1); %ld points, K = %ld, 1/%ld density, %ld photon paths\n",
-                   s.scene_path, o.size, o.size, drift_context_thread_count(s.ctx), o.ref_spp,
-                   o.points, o.k, o.density * o.density, o.photons);
-            printf("| reference bounces | lighting | bounces | ms | hierarchy / direct / bounces / "
-                   "gather / upsample ms | photons | NRMS | FLIP | mean / reference |\n"
-                   "|---|---|---|---|---|---|---|---|---|\n");
-        }
-    }
-    for (int i = 0; i < o.bounce_count && r == DRIFT_OK; ++i) {
+    // Each bounce count's reference by every rank together (its tiles over the ranks,
+    // sweep.h), then its up to 3 rows as sweep items, numbered over all the counts.
+    bounce_row results[MAX_LIST * 3];
+    memset(results, 0, sizeof results);
+    bool ok = r == DRIFT_OK;
+    int items = 0;
+    for (int i = 0; i < o.bounce_count; ++i) {
         int32_t b = (int32_t)o.bounces[i];
         drift_pt *pt = NULL;
         drift_image ref = { 0 }; // owned by the pt
@@ -181,22 +187,49 @@ int drift_bench_micro_bounces(int argc, char **argv)
                                .components = DRIFT_PT_COMPONENT_DIFFUSE,
                                .pixel_centre = true,
                                .pinhole = true };
-        r = drift_pt_create(s.ctx, s.scene, s.accel, &pp, &pt);
-        r = r ? r : drift_pt_render_samples(pt, (uint32_t)o.ref_spp, NULL);
-        r = r ? r : drift_pt_resolve(pt, DRIFT_PT_AOV_BEAUTY, &ref);
-        r = r ? r : run_row(&s, &o, frame, &ref, 1, b, DRIFT_MICRO_LIGHTING_DIRECT, rows);
-        if (b > 1) {
-            r = r ? r : run_row(&s, &o, frame, &ref, b, b, DRIFT_MICRO_LIGHTING_RADIOSITY, rows);
-            r = r ? r : run_row(&s, &o, frame, &ref, b, b, DRIFT_MICRO_LIGHTING_PHOTONS, rows);
+        r = r ? r : drift_pt_create(s.ctx, s.scene, s.accel, &pp, &pt);
+        ok = sweep_pt_render(pt, (uint32_t)o.ref_spp, ok && r == DRIFT_OK);
+        r = r || !ok ? r : drift_pt_resolve(pt, DRIFT_PT_AOV_BEAUTY, &ref);
+        static const drift_micro_lighting lightings[3] = { DRIFT_MICRO_LIGHTING_DIRECT,
+                                                           DRIFT_MICRO_LIGHTING_RADIOSITY,
+                                                           DRIFT_MICRO_LIGHTING_PHOTONS };
+        for (int k = 0; k < (b > 1 ? 3 : 1); ++k, ++items) {
+            if (ok && r == DRIFT_OK && sweep_mine(items)) {
+                r = run_row(&s, &o, frame, &ref, k == 0 ? 1 : b, b, lightings[k], &results[items]);
+            }
         }
         drift_pt_destroy(pt);
     }
-    if (r == DRIFT_OK) {
-        status = !root || cli_json_write("bench micro-bounces", root, NULL) ? 0 : 1;
-        root = NULL; // cli_json_write destroys it
-    } else {
+    if (r != DRIFT_OK) {
         fprintf(stderr, "drift bench micro-bounces: %s\n", drift_result_string(r));
     }
+    if (!sweep_gather(results, sizeof *results, 0, items, ok && r == DRIFT_OK)) {
+        goto done;
+    }
+    if (o.json) {
+        root = cJSON_CreateObject();
+        cJSON_AddStringToObject(root, "scene", s.scene_path);
+        cJSON_AddNumberToObject(root, "size", (double)o.size);
+        cJSON_AddNumberToObject(root, "threads", drift_context_thread_count(s.ctx));
+        cJSON_AddNumberToObject(root, "ref_spp", (double)o.ref_spp);
+        cJSON_AddNumberToObject(root, "points", (double)o.points);
+        cJSON_AddNumberToObject(root, "k", (double)o.k);
+        rows = cJSON_AddArrayToObject(root, "rows");
+    } else {
+        printf("# %s at %ldx%ld, %d threads; references %ld spp (DIFFUSE, max depth "
+               "bounces + 1); %ld points, K = %ld, 1/%ld density, %ld photon paths\n",
+               s.scene_path, o.size, o.size, drift_context_thread_count(s.ctx), o.ref_spp, o.points,
+               o.k, o.density * o.density, o.photons);
+        printf("| reference bounces | lighting | bounces | ms | hierarchy / direct / bounces / "
+               "gather / upsample ms | photons | NRMS | FLIP | mean / reference |\n"
+               "|---|---|---|---|---|---|---|---|---|\n");
+    }
+    for (int k = 0; k < items; ++k) {
+        emit_row(&results[k], rows);
+    }
+    status = !root || cli_json_write("bench micro-bounces", root, NULL) ? 0 : 1;
+    root = NULL; // cli_json_write destroys it
+done:
     cJSON_Delete(root);
     drift_hybrid_destroy(frame);
     cli_session_close(&s);

@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
 # same_figures.py A.json B.json: two `drift bench ... --json` outputs hold the same figures,
-# timings aside (keys ms, *_ms and the ratios of timings). tests/distributed/test_mpi.sh.
+# timings aside (keys ms, *_ms and the ratios of timings and rates). tests/distributed/test_mpi.sh.
 import json, sys
 
-TIMED = {"ms", "speedup", "speedup_to_flip", "raster_metrics_time_share", "filter_fraction"}
+TIMED = {"ms", "speedup", "gathers_per_s", "gather_samples_per_s", "speedup_to_flip", "raster_metrics_time_share", "filter_fraction"}
 def strip(v):
     if isinstance(v, dict):
         return {k: strip(x) for k, x in v.items() if k not in TIMED and not k.endswith("_ms")}

@@ -85,8 +85,9 @@ expect 1 "${mpirun[@]}" -n 1 "$drift" render "${small[@]}" --spp 1 --out "$tmp/b
     fail "a scene missing on rank 1 is not reported once, naming the rank: $(cat "$tmp/err")"
 ls "$tmp" | grep -q '^bad\.' && fail "bad input wrote output: $(ls "$tmp")"
 
-# mpirun -n N drift bench aaf|isg|sir: the sweep's renders spread over the ranks, the same
-# figures as one process (timings aside), printed once by rank 0.
+# mpirun -n N drift bench aaf|isg|sir|micro|micro-bounces|ism: the sweep's renders spread over
+# the ranks, the same figures as one process (timings aside), printed once by rank 0. micro,
+# micro-bounces and ism at 20 pixels wide: references of 2 or more tiles over the ranks.
 same_figures() { python3 "$(dirname "$0")/same_figures.py" "$@" >/dev/null || fail "$3: $(python3 "$(dirname "$0")/same_figures.py" "$1" "$2")"; }
 scenes="$(dirname "$0")/../../scenes"
 bench_aaf=(bench aaf --effect both --spp 1,2 --ref-spp 4 --width 16 --height 12 --timing-size 16x12
@@ -94,7 +95,13 @@ bench_aaf=(bench aaf --effect both --spp 1,2 --ref-spp 4 --width 16 --height 12 
 bench_isg=(bench isg --no-table --qwidth 16 --qheight 12 --ref-spp 2 --json)
 bench_sir=(bench sir "$scenes/cornell-box/cornell_box.json" --sizes 24x16,16x16 --spp 1 --budget 64
     --json)
-for b in aaf isg sir; do
+bench_micro=(bench micro --size 20 --ref-spp 2 --points 256 --sizes 8 --densities 1,4 --scaling 8
+    --json)
+bench_bounces=(bench micro-bounces --size 20 --ref-spp 2 --points 128 --micro-size 4 --photons 128
+    --bounces 1,2 --json)
+bench_ism=(bench ism --size 20 --height 12 --ref-spp 2 --vpls 4,8 --spp 1 --points 16 --map 8 --classic
+    --threads 1 --json)
+for b in aaf isg sir micro bounces ism; do
     declare -n cmd="bench_$b"
     "$drift" "${cmd[@]}" >"$tmp/$b.json" 2>"$tmp/err" || fail "bench $b failed: $(cat "$tmp/err")"
     ranks=(2)

@@ -209,3 +209,47 @@ bool sweep_share(void *data, size_t size, int owner, bool ok)
 }
 
 #endif
+
+bool sweep_pt_render(drift_pt *pt, uint32_t spp, bool ok)
+{
+    if (sweep_ranks() == 1) {
+        return ok && drift_pt_render_samples(pt, spp, NULL) == DRIFT_OK;
+    }
+    bool own = ok;
+    if (!sweep_share(NULL, 0, 0, ok)) { // every rank has its pt, or none goes on
+        if (own && sweep_rank() == 0) {
+            fprintf(stderr, "drift bench: a rank failed (run the command without mpirun to see "
+                            "why)\n");
+        }
+        return false;
+    }
+    uint32_t tiles = drift_pt_tile_count(pt), count = 0;
+    size_t most = 0;
+    uint32_t *mine = malloc((size_t)tiles * sizeof *mine);
+    for (uint32_t t = 0; mine && t < tiles; ++t) {
+        if (sweep_mine((int)t)) {
+            mine[count++] = t;
+        }
+        size_t size = drift_pt_tile_state_size(pt, t);
+        most = size > most ? size : most;
+    }
+    void *state = malloc(most ? most : 1);
+    ok = mine && state && drift_pt_render_tiles(pt, mine, count, spp, spp, NULL) == DRIFT_OK;
+    own = ok;
+    for (uint32_t t = 0; t < tiles; ++t) {
+        int owner = (int)(t % (uint32_t)sweep_ranks());
+        if (ok && owner == sweep_rank()) {
+            drift_pt_tile_get_state(pt, t, state);
+        }
+        ok = sweep_share(state, ok ? drift_pt_tile_state_size(pt, t) : 0, owner, ok);
+        if (ok && owner != sweep_rank()) {
+            drift_pt_tile_set_state(pt, t, state);
+        }
+    }
+    free(mine);
+    free(state);
+    if (!ok && own && sweep_rank() == 0) {
+        fprintf(stderr, "drift bench: a rank failed (run the command without mpirun to see why)\n");
+    }
+    return ok;
+}

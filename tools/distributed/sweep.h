@@ -5,6 +5,8 @@
 #ifndef DRIFT_TOOLS_DISTRIBUTED_SWEEP_H
 #define DRIFT_TOOLS_DISTRIBUTED_SWEEP_H
 
+#include "drift/pt.h"
+
 #include <stdbool.h>
 #include <stddef.h>
 
@@ -32,5 +34,11 @@ int sweep_owner_besides(int busy, int index);
 // `size` bytes at data from rank `owner` to every rank (every rank calls it). ok: this
 // rank's part went well; returns whether every rank's did.
 bool sweep_share(void *data, size_t size, int owner, bool ok);
+
+// A reference rendered by every rank together: `spp` samples to every pixel of a fresh pt,
+// tile t on rank t mod N, then every tile's state to every rank, so each holds the bits of
+// one process's drift_pt_render_samples (pt.h). Every rank calls it (pt may be NULL where
+// ok is false); returns whether every rank's part went well.
+bool sweep_pt_render(drift_pt *pt, uint32_t spp, bool ok);
 
 #endif // DRIFT_TOOLS_DISTRIBUTED_SWEEP_H
