@@ -274,50 +274,8 @@ static bool emit(const path_job *job, drift_sampler *s, drift_ray *out_ray, drif
         *out_flux = drift_vec3_scale(l->color, spot_falloff(l, w) / (pdf_dir * pmf * n));
         return true;
     }
-    // Area lights: a uniform point (density 1 / A) and a cosine direction (cos / pi) give
-    // L cos / (cos / pi / A) = pi A L per path.
-    drift_vec3 p, normal;
-    float area;
-    switch (l->type) {
-    case DRIFT_LIGHT_QUAD:
-        p = drift_vec3_fma(drift_vec3_fma(l->position, l->edge_u, u1.x), l->edge_v, u1.y);
-        normal = drift_vec3_cross(l->edge_u, l->edge_v);
-        area = drift_vec3_length(normal);
-        normal = drift_vec3_scale(normal, 1.0f / area);
-        break;
-    case DRIFT_LIGHT_DISK: {
-        drift_frame fr = drift_frame_from_normal(l->direction);
-        drift_vec2 d = drift_sample_disk_concentric(u1);
-        p = drift_vec3_fma(drift_vec3_fma(l->position, fr.x, d.x * l->radius), fr.y,
-                           d.y * l->radius);
-        normal = l->direction;
-        area = DRIFT_PI * l->radius * l->radius;
-        break;
-    }
-    case DRIFT_LIGHT_SPHERE:
-        normal = drift_sample_uniform_sphere(u1);
-        p = drift_vec3_fma(l->position, normal, l->radius);
-        area = 4.0f * DRIFT_PI * l->radius * l->radius;
-        break;
-    case DRIFT_LIGHT_TRIANGLE: {
-        drift_vec3 a, b, c;
-        drift_light_triangle_vertices(scene, l, &a, &b, &c);
-        drift_vec2 bc = drift_sample_triangle(u1);
-        p = drift_vec3_fma(drift_vec3_fma(drift_vec3_scale(a, 1.0f - bc.x - bc.y), b, bc.x), c,
-                           bc.y);
-        normal = drift_vec3_cross(drift_vec3_sub(b, a), drift_vec3_sub(c, a));
-        area = 0.5f * drift_vec3_length(normal);
-        normal = drift_vec3_normalize(normal);
-        break;
-    }
-    default:
-        return false;
-    }
-    drift_frame fr = drift_frame_from_normal(normal);
-    drift_vec3 w = drift_frame_to_world(&fr, drift_sample_cosine_hemisphere(u2));
-    *out_ray = (drift_ray){ drift_offset_origin(p, normal, w), 0.0f, w, INFINITY };
-    *out_flux = drift_vec3_scale(l->color, DRIFT_PI * area / (pmf * n));
-    return true;
+    // Area lights: a uniform point and a cosine direction, pi A L per path.
+    return drift_light_emit_area(scene, l, u1, u2, pmf * n, out_ray, out_flux);
 }
 
 static void trace_paths(size_t begin, size_t end, int thread, void *user)
