@@ -341,12 +341,19 @@ float drift_scene_light_pmf(const drift_scene *scene, uint32_t light);
 // light_count means the environment. u picks the point. pdf == 0 means no contribution.
 drift_light_sample drift_light_sample_li(const drift_scene *scene, uint32_t light, drift_vec3 ref,
                                          drift_vec2 u);
-// A ray leaving area light l (quad, disk, sphere, triangle) from a uniform point (u1) in a
-// cosine direction (u2), and the flux it carries, pi A L / divisor (divisor: the light's
-// pick probability times the path count). False for a point, spot or directional light.
-// What light tracing starts from (instant radiosity's VPLs, micro-rendering's photons).
+// Light tracing's first ray (instant radiosity's VPLs, micro-rendering's photons) and the
+// flux it carries for one of `paths` paths whose light was picked with probability pmf.
+// Area light l (quad, disk, sphere, triangle): a uniform point (u1), a cosine direction
+// (u2), pi A L / (pmf paths); false for a point, spot or directional light.
 bool drift_light_emit_area(const drift_scene *scene, const drift_light *l, drift_vec2 u1,
-                           drift_vec2 u2, float divisor, drift_ray *out_ray, drift_vec3 *out_flux);
+                           drift_vec2 u2, float pmf, float paths, drift_ray *out_ray,
+                           drift_vec3 *out_flux);
+// The environment (light == light_count; direction by u1) or a directional light: parallel
+// rays from a disc (u2) of `radius` around `centre` (the scene's bounding sphere); false for
+// any other light.
+bool drift_light_emit_distant(const drift_scene *scene, uint32_t light, drift_vec3 centre,
+                              float radius, drift_vec2 u1, drift_vec2 u2, float pmf, float paths,
+                              drift_ray *out_ray, drift_vec3 *out_flux);
 // Solid-angle pdf with which drift_light_sample_li would pick direction wi toward the point
 // `point` with normal `light_normal` on area light `light`, from `ref`.
 float drift_light_pdf_li(const drift_scene *scene, uint32_t light, drift_vec3 ref, drift_vec3 wi,

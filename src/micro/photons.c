@@ -44,29 +44,8 @@ static bool emit(const photon_job *job, drift_sampler *s, drift_ray *out_ray, dr
     }
     float n = (float)job->desc->paths;
     if (li == scene->light_count || scene->lights[li].type == DRIFT_LIGHT_DIRECTIONAL) {
-        drift_vec3 travel, radiance;
-        float pdf_dir = 1.0f;
-        if (li == scene->light_count) {
-            drift_light_sample ls = drift_environment_sample(scene, u1);
-            if (!(ls.pdf > 0.0f)) {
-                return false;
-            }
-            travel = drift_vec3_neg(ls.wi);
-            radiance = ls.radiance;
-            pdf_dir = ls.pdf;
-        } else {
-            travel = scene->lights[li].direction;
-            radiance = scene->lights[li].color;
-        }
-        drift_frame f = drift_frame_from_normal(travel);
-        drift_vec2 d = drift_sample_disk_concentric(u2);
-        drift_vec3 o = drift_vec3_fma(job->centre, travel, -1.5f * job->radius);
-        o = drift_vec3_fma(o, f.x, d.x * job->radius);
-        o = drift_vec3_fma(o, f.y, d.y * job->radius);
-        *out_ray = (drift_ray){ o, 0.0f, travel, INFINITY };
-        float area = DRIFT_PI * job->radius * job->radius;
-        *out_flux = drift_vec3_scale(radiance, area / (pdf_dir * pmf * n));
-        return true;
+        return drift_light_emit_distant(scene, li, job->centre, job->radius, u1, u2, pmf, n,
+                                        out_ray, out_flux);
     }
     const drift_light *l = &scene->lights[li];
     if (l->type == DRIFT_LIGHT_POINT || l->type == DRIFT_LIGHT_SPOT) {
@@ -91,7 +70,7 @@ static bool emit(const photon_job *job, drift_sampler *s, drift_ray *out_ray, dr
         return true;
     }
     // Area lights: a uniform point and a cosine direction, pi A L per path.
-    return drift_light_emit_area(scene, l, u1, u2, pmf * n, out_ray, out_flux);
+    return drift_light_emit_area(scene, l, u1, u2, pmf, n, out_ray, out_flux);
 }
 
 static void trace_range(size_t begin, size_t end, int thread, void *user)

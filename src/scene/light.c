@@ -390,8 +390,43 @@ float drift_light_pdf_li(const drift_scene *scene, uint32_t light, drift_vec3 re
     return 0.0f;
 }
 
+bool drift_light_emit_distant(const drift_scene *scene, uint32_t light, drift_vec3 centre,
+                              float radius, drift_vec2 u1, drift_vec2 u2, float pmf, float paths,
+                              drift_ray *out_ray, drift_vec3 *out_flux)
+{
+    // Parallel rays from a disc of radius R perpendicular to the direction of travel, 1.5 R
+    // before the centre: the disc's area stands in for the light's cross-section.
+    drift_vec3 travel;
+    drift_vec3 radiance;
+    float pdf_dir = 1.0f;
+    if (light == scene->light_count) {
+        drift_light_sample ls = drift_environment_sample(scene, u1);
+        if (!(ls.pdf > 0.0f)) {
+            return false;
+        }
+        travel = drift_vec3_neg(ls.wi);
+        radiance = ls.radiance;
+        pdf_dir = ls.pdf;
+    } else if (light < scene->light_count && scene->lights[light].type == DRIFT_LIGHT_DIRECTIONAL) {
+        travel = scene->lights[light].direction;
+        radiance = scene->lights[light].color;
+    } else {
+        return false;
+    }
+    drift_frame f = drift_frame_from_normal(travel);
+    drift_vec2 d = drift_sample_disk_concentric(u2);
+    drift_vec3 o = drift_vec3_fma(centre, travel, -1.5f * radius);
+    o = drift_vec3_fma(o, f.x, d.x * radius);
+    o = drift_vec3_fma(o, f.y, d.y * radius);
+    *out_ray = (drift_ray){ o, 0.0f, travel, INFINITY };
+    float area = DRIFT_PI * radius * radius;
+    *out_flux = drift_vec3_scale(radiance, area / (pdf_dir * pmf * paths));
+    return true;
+}
+
 bool drift_light_emit_area(const drift_scene *scene, const drift_light *l, drift_vec2 u1,
-                           drift_vec2 u2, float divisor, drift_ray *out_ray, drift_vec3 *out_flux)
+                           drift_vec2 u2, float pmf, float paths, drift_ray *out_ray,
+                           drift_vec3 *out_flux)
 {
     // A uniform point (density 1 / A) and a cosine direction (cos / pi) give
     // L cos / (cos / pi / A) = pi A L per path.
@@ -435,6 +470,6 @@ bool drift_light_emit_area(const drift_scene *scene, const drift_light *l, drift
     drift_frame fr = drift_frame_from_normal(normal);
     drift_vec3 w = drift_frame_to_world(&fr, drift_sample_cosine_hemisphere(u2));
     *out_ray = (drift_ray){ drift_offset_origin(p, normal, w), 0.0f, w, INFINITY };
-    *out_flux = drift_vec3_scale(l->color, DRIFT_PI * area / divisor);
+    *out_flux = drift_vec3_scale(l->color, DRIFT_PI * area / (pmf * paths));
     return true;
 }
