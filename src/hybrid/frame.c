@@ -527,16 +527,6 @@ static drift_result render_pass(drift_frame_state *f, const atomic_bool *cancel,
     return r;
 }
 
-static float radical_inverse2(uint32_t i)
-{
-    i = (i << 16) | (i >> 16);
-    i = ((i & 0x00ff00ffu) << 8) | ((i & 0xff00ff00u) >> 8);
-    i = ((i & 0x0f0f0f0fu) << 4) | ((i & 0xf0f0f0f0u) >> 4);
-    i = ((i & 0x33333333u) << 2) | ((i & 0xccccccccu) >> 2);
-    i = ((i & 0x55555555u) << 1) | ((i & 0xaaaaaaaau) >> 1);
-    return (float)i * 0x1p-32f;
-}
-
 // Pass k of n's film offset from the pixel centre: the Hammersley point set, shifted so that
 // one pass is the centre. n points stratify the pixel in x and (for n a power of two) in y,
 // so their mean converges to the path tracer's box pixel filter (its film sample is uniform
@@ -544,7 +534,7 @@ static float radical_inverse2(uint32_t i)
 static void aa_offset(uint32_t k, uint32_t n, float *dx, float *dy)
 {
     float x = ((float)k + 0.5f) / (float)n;
-    float y = radical_inverse2(k) + 0.5f / (float)n;
+    float y = (float)drift_reverse_bits(k) * 0x1p-32f + 0.5f / (float)n;
     *dx = x - 0.5f;
     *dy = (y >= 1.0f ? y - 1.0f : y) - 0.5f;
 }
