@@ -29,12 +29,9 @@ drift_refine_tracer drift_refine_tracer_make(const drift_frame_state *frame, uin
 
 // light_samples sampled points on each light, each with a shadow ray: an unbiased estimate of
 // sum_l U_l S_l with as many samples as the raster spends on U_l (delta lights take one).
-// visibility (one a light, or NULL): the shadow rays' answer is known (a pixel outside every
-// penumbra whose raster shadow the leak ray confirmed), so the same points are weighed by it
-// and no ray is cast.
 static drift_vec3 direct_light(const drift_refine_tracer *t, const drift_surface *s,
-                               const drift_bsdf *bsdf, drift_vec3 wo, const float *visibility,
-                               drift_sampler *sampler, uint64_t *rays)
+                               const drift_bsdf *bsdf, drift_vec3 wo, drift_sampler *sampler,
+                               uint64_t *rays)
 {
     drift_vec3 sum = drift_vec3_splat(0.0f);
     for (uint32_t l = 0; l < t->light_count; ++l) {
@@ -55,11 +52,6 @@ static drift_vec3 direct_light(const drift_refine_tracer *t, const drift_surface
             if (drift_vec3_is_zero(f) || cos_i <= 0.0f) {
                 continue;
             }
-            if (visibility) {
-                light_sum = drift_vec3_fma(light_sum, drift_vec3_mul(f, ls.radiance),
-                                           visibility[l] * cos_i / ls.pdf);
-                continue;
-            }
             drift_ray shadow = { .origin = drift_offset_origin(s->position, s->ng, ls.wi),
                                  .dir = ls.wi,
                                  .tmin = 0.0f,
@@ -74,6 +66,20 @@ static drift_vec3 direct_light(const drift_refine_tracer *t, const drift_surface
         sum = drift_vec3_fma(sum, light_sum, 1.0f / (float)n);
     }
     return sum;
+}
+
+// The sampler pairs direct_light and the environment's estimator draw at a hit: a
+// reflection-only sample skips them and still draws its lobe direction from the same pair as
+// the full sample, so its R is the full sample's R exactly.
+static uint32_t direct_light_pairs(const drift_refine_tracer *t)
+{
+    uint32_t pairs = drift_scene_has_environment(t->scene) ? 1u : 0u;
+    for (uint32_t l = 0; l < t->light_count; ++l) {
+        const drift_raster_light *light = &t->lights[l];
+        uint32_t n = drift_light_is_area(light->type) || light->light_cdf ? t->light_samples : 1;
+        pairs += 2u * (n ? n : 1u);
+    }
+    return pairs;
 }
 
 // A direction from the Phong lobe cos^n around the mirror direction r, and its weight
@@ -92,11 +98,11 @@ static drift_vec3 sample_glossy(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec
 }
 
 // Radiance back along ray. see_emission: emitters and the environment seen by this ray count
-// (camera and mirror rays; glossy rays leave them to the direct term). visibility (camera
-// rays of component samples, else NULL): this hit's area-light direct term weighed by these
-// known visibilities (no shadow rays), its emission and environment light left to the raster.
+// (camera and mirror rays; glossy rays leave them to the direct term). reflection_only: this
+// hit's emission and direct light are left out (the raster keeps them), only what its
+// reflection ray brings back counts.
 static drift_vec3 radiance(const drift_refine_tracer *t, drift_ray ray, int32_t depth,
-                           bool see_emission, const float *visibility, drift_sampler *sampler,
+                           bool see_emission, bool reflection_only, drift_sampler *sampler,
                            uint64_t *rays)
 {
     ++*rays;
@@ -107,19 +113,18 @@ static drift_vec3 radiance(const drift_refine_tracer *t, drift_ray ray, int32_t 
                    : drift_vec3_splat(0.0f);
     }
     drift_surface s = drift_scene_surface(t->scene, &ray, &hit);
-    drift_vec3 l = see_emission && !visibility ? s.emission : drift_vec3_splat(0.0f);
+    drift_vec3 l = see_emission && !reflection_only ? s.emission : drift_vec3_splat(0.0f);
     if (s.material == DRIFT_INVALID_INDEX) {
         return l;
     }
     drift_bsdf bsdf = drift_bsdf_make(t->scene, &s);
     drift_vec3 wo = drift_vec3_neg(ray.dir);
-    if (!drift_bsdf_is_delta(&bsdf) && visibility) {
-        l = drift_vec3_add(l, direct_light(t, &s, &bsdf, wo, visibility, sampler, rays));
-        // The environment's estimator draws one pair: skipped, so the lobe direction below is
-        // drawn from the full sample's pair.
-        sampler->dimension += drift_scene_has_environment(t->scene) ? 1u : 0u;
+    if (reflection_only) {
+        if (!drift_bsdf_is_delta(&bsdf)) {
+            sampler->dimension += direct_light_pairs(t);
+        }
     } else if (!drift_bsdf_is_delta(&bsdf)) {
-        l = drift_vec3_add(l, direct_light(t, &s, &bsdf, wo, NULL, sampler, rays));
+        l = drift_vec3_add(l, direct_light(t, &s, &bsdf, wo, sampler, rays));
         l = drift_vec3_add(l, drift_raster_environment_direct(t->scene, t->accel, &s, &bsdf, wo,
                                                               t->light_samples, sampler, rays));
     }
@@ -148,19 +153,19 @@ static drift_vec3 radiance(const drift_refine_tracer *t, drift_ray ray, int32_t 
                        .dir = dir,
                        .tmin = 0.0f,
                        .tmax = INFINITY };
-    drift_vec3 seen = radiance(t, next, depth + 1, mirror, NULL, sampler, rays);
+    drift_vec3 seen = radiance(t, next, depth + 1, mirror, false, sampler, rays);
     return drift_vec3_add(l, drift_vec3_mul(weight, seen));
 }
 
 drift_vec3 drift_refine_trace_ray(const drift_refine_tracer *t, drift_ray ray, bool see_emission,
                                   drift_sampler *sampler, uint64_t *rays)
 {
-    drift_vec3 l = radiance(t, ray, 1, see_emission, NULL, sampler, rays);
+    drift_vec3 l = radiance(t, ray, 1, see_emission, false, sampler, rays);
     return drift_vec3_is_finite(l) ? l : drift_vec3_splat(0.0f);
 }
 
 drift_vec3 drift_refine_trace_sample(const drift_refine_tracer *t, int32_t x, int32_t y,
-                                     uint32_t sample, const float *visibility, uint64_t *rays)
+                                     uint32_t sample, bool reflection_only, uint64_t *rays)
 {
     uint32_t pixel = (uint32_t)y * (uint32_t)t->camera.width + (uint32_t)x;
     drift_sampler sampler = drift_sampler_make(t->seed, pixel, sample);
@@ -168,6 +173,6 @@ drift_vec3 drift_refine_trace_sample(const drift_refine_tracer *t, int32_t x, in
     // Through the pixel centre, as the G-buffer: the comparison is of effects, not of
     // antialiasing.
     drift_ray ray = drift_camera_frame_ray(&t->camera, (float)x + 0.5f, (float)y + 0.5f, lens);
-    drift_vec3 l = radiance(t, ray, 0, true, visibility, &sampler, rays);
+    drift_vec3 l = radiance(t, ray, 0, true, reflection_only, &sampler, rays);
     return drift_vec3_is_finite(l) ? l : drift_vec3_splat(0.0f);
 }

@@ -222,20 +222,17 @@ static drift_refine_tracer make_tracer(const drift_refine *r)
 }
 
 // Component refinement (params.components): a pixel whose only non-zero metrics are the
-// reflection metrics lies outside every penumbra, and its raster shadows S_l are the leak
-// ray's answer: the shadow rays of its first hit are known. There a component sample traces
-// R and re-estimates sum_l U_l S_l from the pure tracer's own light points weighed by S_l (no
-// shadow rays), and the raster keeps the rest (E, the environment's light, I): raster -
-// R_raster - sum_l U_l S_l + the sample. Only where the pixel is the composed sum: one
-// anti-aliasing pass and a pinhole tracer (with a lens the post blur mixes neighbours into
-// the pixel); never with refine_zero_error, whose whole image converges to the pure one.
+// reflection metrics has its raster E + D right by the metrics' own account, so only R is
+// traced there and the raster's R replaced (raster - R_raster + R_traced). Only where the
+// pixel is the composed E + D + R (+ I): one anti-aliasing pass and a pinhole tracer (with a
+// lens, the post blur mixes neighbours into the pixel); never with refine_zero_error, whose
+// whole image converges to the pure one.
 static void mark_reflection_only(drift_refine *r)
 {
     uint32_t n = (uint32_t)r->width * (uint32_t)r->height;
     memset(r->reflection_only, 0, n);
     drift_hybrid_params h = drift_hybrid_get_params(r->frame);
     if (!r->params.components || r->params.refine_zero_error || h.aa > 1 ||
-        r->tracer.light_count > DRIFT_REFINE_COMPONENT_LIGHTS ||
         h.reflections == DRIFT_REFLECTIONS_NONE || r->tracer.camera.camera.aperture_radius > 0.0f) {
         return;
     }
@@ -319,7 +316,7 @@ static void trace_requests(size_t begin, size_t end, int thread_index, void *use
     drift_refine *r = job->refine;
     uint64_t *rays = &r->counters[thread_index].rays;
     const drift_image *raster = drift_hybrid_image(r->frame);
-    const drift_frame_state *f = drift_hybrid_frame(r->frame);
+    const drift_image *raster_r = &drift_hybrid_frame(r->frame)->reflections;
     uint32_t spp = r->params.spp;
     for (size_t i = begin; i < end; ++i) {
         if (job->cancel && atomic_load(job->cancel)) {
@@ -330,24 +327,13 @@ static void trace_requests(size_t begin, size_t end, int thread_index, void *use
                 y = (int32_t)(q->pixel / (uint32_t)r->width);
         double *sum = &r->sums[3 * (size_t)q->pixel];
         uint32_t first = r->counts[q->pixel];
-        bool component = r->reflection_only[q->pixel];
-        float visibility[DRIFT_REFINE_COMPONENT_LIGHTS];
-        drift_vec3 kept = drift_vec3_splat(0.0f);
-        if (component) {
-            // What the raster keeps: its pixel less R and sum_l U_l S_l.
-            kept = drift_vec3_sub(drift_image_get3(raster, x, y),
-                                  drift_image_get3(&f->reflections, x, y));
-            for (uint32_t l = 0; l < f->light_count; ++l) {
-                const drift_frame_light_buffers *b = &f->light_buffers[l];
-                visibility[l] = drift_image_pixel(&b->shadow, x, y)[0];
-                kept = drift_vec3_sub(
-                    kept, drift_vec3_scale(drift_image_get3(&b->unshadowed, x, y), visibility[l]));
-            }
-        }
+        bool only_r = r->reflection_only[q->pixel];
+        // Raster E + D (+ I) with this sample's R: the raster's R taken out.
+        drift_vec3 kept =
+            drift_vec3_sub(drift_image_get3(raster, x, y), drift_image_get3(raster_r, x, y));
         for (uint32_t s = first; s < first + q->samples; ++s) {
-            drift_vec3 l =
-                drift_refine_trace_sample(&r->tracer, x, y, s, component ? visibility : NULL, rays);
-            if (component) {
+            drift_vec3 l = drift_refine_trace_sample(&r->tracer, x, y, s, only_r, rays);
+            if (only_r) {
                 l = drift_vec3_add(kept, l);
             }
             sum[0] += (double)l.x;
@@ -494,7 +480,7 @@ static void pure_rows(size_t begin, size_t end, int thread_index, void *user)
         for (int32_t x = 0; x < job->out->width; ++x) {
             double sum[3] = { 0.0, 0.0, 0.0 };
             for (uint32_t s = 0; s < job->spp; ++s) {
-                drift_vec3 l = drift_refine_trace_sample(&job->tracer, x, y, s, NULL, rays);
+                drift_vec3 l = drift_refine_trace_sample(&job->tracer, x, y, s, false, rays);
                 sum[0] += (double)l.x;
                 sum[1] += (double)l.y;
                 sum[2] += (double)l.z;
