@@ -169,7 +169,13 @@ drift_vec3 drift_refine_trace_sample(const drift_refine_tracer *t, int32_t x, in
 {
     uint32_t pixel = (uint32_t)y * (uint32_t)t->camera.width + (uint32_t)x;
     drift_sampler sampler = drift_sampler_make(t->seed, pixel, sample);
-    drift_vec2 lens = drift_sampler_next2(&sampler);
+    // Component samples are pinhole only (refine.c): the lens pair is skipped, not drawn.
+    drift_vec2 lens = drift_vec2_make(0.5f, 0.5f);
+    if (reflection_only) {
+        ++sampler.dimension;
+    } else {
+        lens = drift_sampler_next2(&sampler);
+    }
     // Through the pixel centre, as the G-buffer: the comparison is of effects, not of
     // antialiasing.
     drift_ray ray = drift_camera_frame_ray(&t->camera, (float)x + 0.5f, (float)y + 0.5f, lens);
