@@ -37,6 +37,7 @@ typedef struct sir_options {
     bool noise_floor;
     bool paper_metrics;
     bool full_res_penumbra;
+    bool components;
     bool has_target;
     drift_vec3 target; // --target: look here instead of the scene camera's target
     double fov;        // --fov: vertical field of view, degrees (0: the camera's)
@@ -108,6 +109,9 @@ static const cli_option sir_table[] = {
              "expected error, penumbrae ungated, no leak metric (the before of issue 17)"),
     CLI_FLAG("--full-res-penumbra", O, full_res_penumbra,
              "search the penumbra estimate at every pixel, not once a 2 x 2 block"),
+    CLI_FLAG("--components", O, components,
+             "trace only R at pixels flagged by reflection metrics alone, keeping the\n"
+             "raster's E + D there (no shadow rays at their first hit)"),
     CLI_CUSTOM_ALL("--target", "X,Y,Z", parse_target,
                    "look at this point instead of the camera's target (other views,\n"
                    "as the paper's rows are views with more or fewer error pixels)"),
@@ -308,7 +312,8 @@ static drift_result run_one(drift_context *ctx, const drift_scene *scene, const 
                                                         .reflection_tolerance = tolerance,
                                                         .leak_tolerance = tolerance,
                                                         .shadow_tolerance = tolerance,
-                                                        .full_res_penumbra = o->full_res_penumbra },
+                                                        .full_res_penumbra = o->full_res_penumbra,
+                                                        .components = o->components },
                                 &sir);
     }
     if (r == DRIFT_OK) {

@@ -389,6 +389,8 @@ static const cli_option render_table[] = {
     CLI_INT("--refine-spp", "N", O, refine.spp, 1, 65536,
             "samples that make a pixel refined (default 16)"),
     CLI_FLAG("--refine-all", O, refine.all, "refine zero-error pixels too, after all the others"),
+    CLI_FLAG("--refine-components", O, refine.components,
+             "trace only the reflection term where reflection metrics alone flag a pixel"),
     CLI_STRING("--lambda", "FILE", O, refine.lambda_path,
                "combine the metrics with fitted weights (drift refine fit)"),
 };

@@ -19,6 +19,7 @@ typedef struct render_refine_options {
     double seconds;           // --refine-time: 0 = no limit
     long spp;                 // --refine-spp: samples that make a pixel refined; 0 = default
     bool all;                 // --refine-all: zero-error pixels too, after the others
+    bool components;          // --refine-components: only R where reflection metrics alone
     const char *lambda_path;  // --lambda FILE: the fitted linear combination
 } render_refine_options;
 

@@ -65,6 +65,7 @@ int render_refine_run(const render_options *o, const cli_session *session, drift
     drift_refine_params params = { .budget = (uint32_t)ro->budget,
                                    .spp = (uint32_t)ro->spp,
                                    .refine_zero_error = ro->all,
+                                   .components = ro->components,
                                    .seed = (uint32_t)o->seed };
     if (ro->lambda_path) {
         if (drift_refine_lambda_load(ctx, ro->lambda_path, params.lambda) != DRIFT_OK) {

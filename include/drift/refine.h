@@ -95,6 +95,9 @@ typedef enum drift_refine_combine {
 //   full_res_penumbra = false: with the gate (shadow_tolerance > 0) the penumbra estimate is
 //                       searched at one pixel of each 2 x 2 block on one surface; true: at
 //                       every pixel (always so without the gate)
+//   components        = false: every refined pixel is traced whole; true: a pixel flagged by
+//                       the reflection metrics alone gets only its reflection term R traced
+//                       (no shadow rays at its first hit) and keeps the raster's E + D
 //   seed              = 0
 typedef struct drift_refine_params {
     uint32_t budget;
@@ -112,6 +115,7 @@ typedef struct drift_refine_params {
     float leak_tolerance;
     float shadow_tolerance;
     bool full_res_penumbra;
+    bool components;
     uint32_t seed;
 } drift_refine_params;
 

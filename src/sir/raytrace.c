@@ -68,6 +68,20 @@ static drift_vec3 direct_light(const drift_refine_tracer *t, const drift_surface
     return sum;
 }
 
+// The sampler pairs direct_light and the environment's estimator draw at a hit: a
+// reflection-only sample skips them and still draws its lobe direction from the same pair as
+// the full sample, so its R is the full sample's R exactly.
+static uint32_t direct_light_pairs(const drift_refine_tracer *t)
+{
+    uint32_t pairs = drift_scene_has_environment(t->scene) ? 1u : 0u;
+    for (uint32_t l = 0; l < t->light_count; ++l) {
+        const drift_raster_light *light = &t->lights[l];
+        uint32_t n = drift_light_is_area(light->type) || light->light_cdf ? t->light_samples : 1;
+        pairs += 2u * (n ? n : 1u);
+    }
+    return pairs;
+}
+
 // A direction from the Phong lobe cos^n around the mirror direction r, and its weight
 // f_glossy cos / pdf = ks (n + 2) / (n + 1) cos(theta_i) (zero below the surface).
 static drift_vec3 sample_glossy(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec3 ng, drift_vec2 u,
@@ -84,9 +98,12 @@ static drift_vec3 sample_glossy(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec
 }
 
 // Radiance back along ray. see_emission: emitters and the environment seen by this ray count
-// (camera and mirror rays; glossy rays leave them to the direct term).
+// (camera and mirror rays; glossy rays leave them to the direct term). reflection_only: this
+// hit's emission and direct light are left out (the raster keeps them), only what its
+// reflection ray brings back counts.
 static drift_vec3 radiance(const drift_refine_tracer *t, drift_ray ray, int32_t depth,
-                           bool see_emission, drift_sampler *sampler, uint64_t *rays)
+                           bool see_emission, bool reflection_only, drift_sampler *sampler,
+                           uint64_t *rays)
 {
     ++*rays;
     drift_hit hit;
@@ -96,13 +113,17 @@ static drift_vec3 radiance(const drift_refine_tracer *t, drift_ray ray, int32_t 
                    : drift_vec3_splat(0.0f);
     }
     drift_surface s = drift_scene_surface(t->scene, &ray, &hit);
-    drift_vec3 l = see_emission ? s.emission : drift_vec3_splat(0.0f);
+    drift_vec3 l = see_emission && !reflection_only ? s.emission : drift_vec3_splat(0.0f);
     if (s.material == DRIFT_INVALID_INDEX) {
         return l;
     }
     drift_bsdf bsdf = drift_bsdf_make(t->scene, &s);
     drift_vec3 wo = drift_vec3_neg(ray.dir);
-    if (!drift_bsdf_is_delta(&bsdf)) {
+    if (reflection_only) {
+        if (!drift_bsdf_is_delta(&bsdf)) {
+            sampler->dimension += direct_light_pairs(t);
+        }
+    } else if (!drift_bsdf_is_delta(&bsdf)) {
         l = drift_vec3_add(l, direct_light(t, &s, &bsdf, wo, sampler, rays));
         l = drift_vec3_add(l, drift_raster_environment_direct(t->scene, t->accel, &s, &bsdf, wo,
                                                               t->light_samples, sampler, rays));
@@ -132,26 +153,32 @@ static drift_vec3 radiance(const drift_refine_tracer *t, drift_ray ray, int32_t 
                        .dir = dir,
                        .tmin = 0.0f,
                        .tmax = INFINITY };
-    drift_vec3 seen = radiance(t, next, depth + 1, mirror, sampler, rays);
+    drift_vec3 seen = radiance(t, next, depth + 1, mirror, false, sampler, rays);
     return drift_vec3_add(l, drift_vec3_mul(weight, seen));
 }
 
 drift_vec3 drift_refine_trace_ray(const drift_refine_tracer *t, drift_ray ray, bool see_emission,
                                   drift_sampler *sampler, uint64_t *rays)
 {
-    drift_vec3 l = radiance(t, ray, 1, see_emission, sampler, rays);
+    drift_vec3 l = radiance(t, ray, 1, see_emission, false, sampler, rays);
     return drift_vec3_is_finite(l) ? l : drift_vec3_splat(0.0f);
 }
 
 drift_vec3 drift_refine_trace_sample(const drift_refine_tracer *t, int32_t x, int32_t y,
-                                     uint32_t sample, uint64_t *rays)
+                                     uint32_t sample, bool reflection_only, uint64_t *rays)
 {
     uint32_t pixel = (uint32_t)y * (uint32_t)t->camera.width + (uint32_t)x;
     drift_sampler sampler = drift_sampler_make(t->seed, pixel, sample);
-    drift_vec2 lens = drift_sampler_next2(&sampler);
+    // Component samples are pinhole only (refine.c): the lens pair is skipped, not drawn.
+    drift_vec2 lens = drift_vec2_make(0.5f, 0.5f);
+    if (reflection_only) {
+        ++sampler.dimension;
+    } else {
+        lens = drift_sampler_next2(&sampler);
+    }
     // Through the pixel centre, as the G-buffer: the comparison is of effects, not of
     // antialiasing.
     drift_ray ray = drift_camera_frame_ray(&t->camera, (float)x + 0.5f, (float)y + 0.5f, lens);
-    drift_vec3 l = radiance(t, ray, 0, true, &sampler, rays);
+    drift_vec3 l = radiance(t, ray, 0, true, reflection_only, &sampler, rays);
     return drift_vec3_is_finite(l) ? l : drift_vec3_splat(0.0f);
 }

@@ -64,6 +64,7 @@ struct drift_refine {
     uint64_t lacking;           // samples the listed pixels still lack
     request *requests;          // the request buffer of one iteration
     uint32_t *counts;           // samples received, per pixel
+    uint8_t *reflection_only;   // 1: flagged by reflection metrics alone (params.components)
     double *sums;               // 3 a pixel
     drift_ray_counter *counters;
     int thread_count;
@@ -134,6 +135,7 @@ void drift_refine_destroy(drift_refine *r)
     drift_free(r->ctx, r->scratch);
     drift_free(r->ctx, r->requests);
     drift_free(r->ctx, r->counts);
+    drift_free(r->ctx, r->reflection_only);
     drift_free(r->ctx, r->sums);
     drift_free(r->ctx, r->counters);
     drift_free(r->ctx, r);
@@ -181,12 +183,13 @@ drift_result drift_refine_create(drift_context *ctx, drift_hybrid *frame,
         r->scratch = drift_alloc(ctx, sizeof(uint32_t) * n);
         r->requests = drift_alloc(ctx, sizeof(request) * n);
         r->counts = drift_alloc(ctx, sizeof(uint32_t) * n);
+        r->reflection_only = drift_alloc(ctx, n);
         r->sums = drift_alloc(ctx, sizeof(double) * 3 * n);
         r->counters = drift_alloc(ctx, sizeof(drift_ray_counter) * (size_t)r->thread_count);
-        result =
-            r->keys && r->order && r->scratch && r->requests && r->counts && r->sums && r->counters
-                ? DRIFT_OK
-                : DRIFT_ERR_OUT_OF_MEMORY;
+        result = r->keys && r->order && r->scratch && r->requests && r->counts &&
+                         r->reflection_only && r->sums && r->counters
+                     ? DRIFT_OK
+                     : DRIFT_ERR_OUT_OF_MEMORY;
     }
     if (result != DRIFT_OK) {
         drift_refine_destroy(r);
@@ -216,6 +219,35 @@ static drift_refine_tracer make_tracer(const drift_refine *r)
         t.camera.camera.aperture_radius = 0.0f;
     }
     return t;
+}
+
+// Component refinement (params.components): a pixel whose only non-zero metrics are the
+// reflection metrics has its raster E + D right by the metrics' own account, so only R is
+// traced there and the raster's R replaced (raster - R_raster + R_traced). Only where the
+// pixel is the composed E + D + R (+ I): one anti-aliasing pass and a pinhole tracer (with a
+// lens, the post blur mixes neighbours into the pixel); never with refine_zero_error, whose
+// whole image converges to the pure one.
+static void mark_reflection_only(drift_refine *r)
+{
+    uint32_t n = (uint32_t)r->width * (uint32_t)r->height;
+    memset(r->reflection_only, 0, n);
+    drift_hybrid_params h = drift_hybrid_get_params(r->frame);
+    if (!r->params.components || r->params.refine_zero_error || h.aa > 1 ||
+        h.reflections == DRIFT_REFLECTIONS_NONE || r->tracer.camera.camera.aperture_radius > 0.0f) {
+        return;
+    }
+    for (uint32_t i = 0; i < n; ++i) {
+        bool other = false, reflection = false;
+        for (int m = 0; m < DRIFT_METRIC_COUNT; ++m) {
+            bool set = r->metrics[m].pixels[i] > 0.0f;
+            if (m <= DRIFT_METRIC_REFLECTION5) {
+                reflection |= set;
+            } else {
+                other |= set;
+            }
+        }
+        r->reflection_only[i] = reflection && !other;
+    }
 }
 
 drift_result drift_refine_begin(drift_refine *r)
@@ -258,6 +290,7 @@ drift_result drift_refine_begin(drift_refine *r)
     r->lacking = (uint64_t)r->list_count * r->params.spp;
     st->requested = r->list_count;
     memset(r->counts, 0, sizeof(uint32_t) * n);
+    mark_reflection_only(r);
     memset(r->sums, 0, sizeof(double) * 3 * n);
     drift_pass_copy_rgb(drift_hybrid_image(r->frame), &r->refined);
     memset(r->mask.pixels, 0, sizeof(float) * n);
@@ -283,6 +316,7 @@ static void trace_requests(size_t begin, size_t end, int thread_index, void *use
     drift_refine *r = job->refine;
     uint64_t *rays = &r->counters[thread_index].rays;
     const drift_image *raster = drift_hybrid_image(r->frame);
+    const drift_image *raster_r = &drift_hybrid_frame(r->frame)->reflections;
     uint32_t spp = r->params.spp;
     for (size_t i = begin; i < end; ++i) {
         if (job->cancel && atomic_load(job->cancel)) {
@@ -293,8 +327,15 @@ static void trace_requests(size_t begin, size_t end, int thread_index, void *use
                 y = (int32_t)(q->pixel / (uint32_t)r->width);
         double *sum = &r->sums[3 * (size_t)q->pixel];
         uint32_t first = r->counts[q->pixel];
+        bool only_r = r->reflection_only[q->pixel];
+        // Raster E + D (+ I) with this sample's R: the raster's R taken out.
+        drift_vec3 kept =
+            drift_vec3_sub(drift_image_get3(raster, x, y), drift_image_get3(raster_r, x, y));
         for (uint32_t s = first; s < first + q->samples; ++s) {
-            drift_vec3 l = drift_refine_trace_sample(&r->tracer, x, y, s, rays);
+            drift_vec3 l = drift_refine_trace_sample(&r->tracer, x, y, s, only_r, rays);
+            if (only_r) {
+                l = drift_vec3_add(kept, l);
+            }
             sum[0] += (double)l.x;
             sum[1] += (double)l.y;
             sum[2] += (double)l.z;
@@ -439,7 +480,7 @@ static void pure_rows(size_t begin, size_t end, int thread_index, void *user)
         for (int32_t x = 0; x < job->out->width; ++x) {
             double sum[3] = { 0.0, 0.0, 0.0 };
             for (uint32_t s = 0; s < job->spp; ++s) {
-                drift_vec3 l = drift_refine_trace_sample(&job->tracer, x, y, s, rays);
+                drift_vec3 l = drift_refine_trace_sample(&job->tracer, x, y, s, false, rays);
                 sum[0] += (double)l.x;
                 sum[1] += (double)l.y;
                 sum[2] += (double)l.z;

@@ -28,9 +28,11 @@ typedef struct drift_refine_tracer {
 drift_refine_tracer drift_refine_tracer_make(const drift_frame_state *frame, uint32_t seed,
                                              int32_t max_depth);
 // One sample of pixel (x, y): the same for a sample index whoever asks (refinement or the pure
-// image), adding the rays it traced to *rays.
+// image), adding the rays it traced to *rays. reflection_only: only the camera hit's
+// reflection term R (no emission, no direct light there: no shadow rays at the first hit),
+// the same R as the full sample's, drawn from the same sampler pairs.
 drift_vec3 drift_refine_trace_sample(const drift_refine_tracer *tracer, int32_t x, int32_t y,
-                                     uint32_t sample, uint64_t *rays);
+                                     uint32_t sample, bool reflection_only, uint64_t *rays);
 // Radiance back along one ray, as a reflection ray of the tracer sees it (see_emission: a
 // mirror's ray; a glossy ray leaves emitters to the direct term), up to max_depth bounces.
 drift_vec3 drift_refine_trace_ray(const drift_refine_tracer *tracer, drift_ray ray,

@@ -56,6 +56,8 @@ assert "leak" in r[0]["quality"] and r[0]["raster_metrics_time_share"] > 0, r
 assert 0 < r[0]["raster_metrics_ray_share"] and r[0]["metrics_rays"] >= 0, r'
         expect 0 "$drift" bench sir "$box" --sizes 16x12 --spp 1 --budget 64 --paper-metrics --json
         check sir 'assert d["rows"][0]["quality"]["leak"]["flagged"] == 0, d'
+        expect 0 "$drift" bench sir "$box" --sizes 16x12 --spp 1 --budget 64 --components --json
+        check sir 'assert 0 <= d["rows"][0]["flip"] <= 1 and d["rows"][0]["sir_rays"] >= 0, d'
         ;;
     glare)
         expect 0 "$drift" bench glare --frames 1 --sizes 16,32 --no-convolution --json

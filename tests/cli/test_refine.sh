@@ -53,6 +53,14 @@ expect 0 "$drift" diff "$tmp/all1.exr" "$tmp/all2.exr" --json
 python3 -c "import json,sys; d=json.load(open('$tmp/out')); sys.exit(0 if d['mse']==0 else 1)" \
     || fail "refining everything with two budgets gave different images"
 
+# --refine-components changes only what a refined pixel traces: it is ignored with
+# --refine-all (still the pure image, bit for bit).
+expect 0 "$drift" render "${small[@]}" --refine sir --refine-all --refine-spp 2 \
+    --refine-components --out "$tmp/all3.exr"
+expect 0 "$drift" diff "$tmp/all1.exr" "$tmp/all3.exr" --json
+python3 -c "import json,sys; d=json.load(open('$tmp/out')); sys.exit(0 if d['mse']==0 else 1)" \
+    || fail "--refine-components with --refine-all did not give the pure image"
+
 # Fit lambda on the built-in Cornell box, then refine with it.
 expect 0 "$drift" refine fit --out "$tmp/lambda.json" --views 2 --width 24 --height 18 --spp 1 \
     --trials 50 --threads 2

@@ -680,6 +680,30 @@ static double precision_at_recall_90(const drift_image *error, const uint8_t *re
 }
 
 // Issue 17's open room in small: a diffuse sphere on a Phong-100 floor seen at a grazing
+// angle, a back wall, one quad light.
+static void build_glossy_room(rig *r, int32_t w, int32_t h)
+{
+    uint32_t glossy =
+        test_add_material(r->scene, (drift_material){ .type = DRIFT_MATERIAL_DEFAULT,
+                                                      .diffuse = { 0.3f, 0.28f, 0.25f },
+                                                      .specular = { 0.5f, 0.5f, 0.5f },
+                                                      .exponent = 100.0f,
+                                                      .diffuse_texture = DRIFT_INVALID_INDEX });
+    uint32_t white = test_add_material(r->scene, drift_material_make(drift_vec3_splat(0.7f)));
+    uint32_t green =
+        test_add_material(r->scene, drift_material_make(drift_vec3_make(0.2f, 0.5f, 0.25f)));
+    test_add_floor(r->scene, 3.0f, 0.0f, glossy);
+    test_add_quad(r->scene, drift_vec3_make(-3.0f, 0.0f, 3.0f), drift_vec3_make(6.0f, 0, 0),
+                  drift_vec3_make(0, 3.0f, 0), white);
+    test_add_sphere(r->scene, drift_vec3_make(0.0f, 0.6f, 0.8f), 0.6f, 24, 16, green);
+    test_add_quad_light(r->scene, drift_vec3_make(-0.5f, 3.6f, -0.5f), drift_vec3_make(1.0f, 0, 0),
+                        drift_vec3_make(0, 0, 1.0f), 40.0f);
+    r->scene->camera =
+        drift_camera_look_at(drift_vec3_make(0.0f, 1.3f, -5.5f), drift_vec3_make(0.0f, 0.5f, 1.0f),
+                             drift_vec3_make(0, 1, 0), 0.8f, w, h);
+}
+
+// Issue 17's open room in small: a diffuse sphere on a Phong-100 floor seen at a grazing
 // angle, a back wall, one quad light. Much of the floor's raster reflection is nearly right
 // (off by 0.01-0.02), the reflection of the sphere and the contact are not. Ordered by the
 // weighted metrics' largest (the expected error), the pixels SIR refines first are the wrong
@@ -690,24 +714,7 @@ static void test_glossy_room_refined_in_error_order(void **state)
     (void)state;
     rig r = rig_begin();
     const int32_t w = 64, h = 48;
-    uint32_t glossy =
-        test_add_material(r.scene, (drift_material){ .type = DRIFT_MATERIAL_DEFAULT,
-                                                     .diffuse = { 0.3f, 0.28f, 0.25f },
-                                                     .specular = { 0.5f, 0.5f, 0.5f },
-                                                     .exponent = 100.0f,
-                                                     .diffuse_texture = DRIFT_INVALID_INDEX });
-    uint32_t white = test_add_material(r.scene, drift_material_make(drift_vec3_splat(0.7f)));
-    uint32_t green =
-        test_add_material(r.scene, drift_material_make(drift_vec3_make(0.2f, 0.5f, 0.25f)));
-    test_add_floor(r.scene, 3.0f, 0.0f, glossy);
-    test_add_quad(r.scene, drift_vec3_make(-3.0f, 0.0f, 3.0f), drift_vec3_make(6.0f, 0, 0),
-                  drift_vec3_make(0, 3.0f, 0), white);
-    test_add_sphere(r.scene, drift_vec3_make(0.0f, 0.6f, 0.8f), 0.6f, 24, 16, green);
-    test_add_quad_light(r.scene, drift_vec3_make(-0.5f, 3.6f, -0.5f), drift_vec3_make(1.0f, 0, 0),
-                        drift_vec3_make(0, 0, 1.0f), 40.0f);
-    r.scene->camera =
-        drift_camera_look_at(drift_vec3_make(0.0f, 1.3f, -5.5f), drift_vec3_make(0.0f, 0.5f, 1.0f),
-                             drift_vec3_make(0, 1, 0), 0.8f, w, h);
+    build_glossy_room(&r, w, h);
     rig_commit(&r, &(drift_refine_params){ .spp = 16 });
     drift_image pure;
     assert_int_equal(drift_image_create(r.ctx, w, h, 3, &pure), DRIFT_OK);
@@ -741,6 +748,96 @@ static void test_glossy_room_refined_in_error_order(void **state)
         fail_msg("precision at recall 0.9 %.3f (averaged sum %.3f)", ours, averaged);
     }
     drift_image_destroy(r.ctx, &pure);
+    rig_destroy(&r);
+}
+
+// Largest per-channel difference of the display values of two pixels.
+static float display_difference(const drift_image *a, const drift_image *b, int32_t x, int32_t y)
+{
+    float d = 0.0f;
+    for (int c = 0; c < 3; ++c) {
+        d = fmaxf(d, fabsf(display_value(drift_image_pixel(a, x, y)[c]) -
+                           display_value(drift_image_pixel(b, x, y)[c])));
+    }
+    return d;
+}
+
+static uint64_t refine_to_done(rig *r, const drift_refine_params *params, drift_image *out)
+{
+    assert_int_equal(drift_refine_set_params(r->sir, params), DRIFT_OK);
+    assert_int_equal(drift_refine_begin(r->sir), DRIFT_OK);
+    for (int k = 0; k < 10000 && !drift_refine_done(r->sir); ++k) {
+        assert_int_equal(drift_refine_iterate(r->sir, NULL), DRIFT_OK);
+    }
+    assert_true(drift_refine_done(r->sir));
+    const drift_image *refined = drift_refine_image(r->sir);
+    for (int32_t y = 0; y < out->height; ++y) {
+        for (int32_t x = 0; x < out->width; ++x) {
+            drift_image_set3(out, x, y, drift_image_get3(refined, x, y));
+        }
+    }
+    return drift_refine_get_stats(r->sir).rays;
+}
+
+// Component refinement on the glossy room: a pixel flagged by the reflection metrics alone has
+// only its R traced (no shadow rays at its first hit) and keeps the raster's E + D. Such a
+// pixel must cost less than a whole one (the refinement's rays at most 80% of the whole
+// refinement's) and come close to the pure image: its display error against the pure ray
+// tracer at most a third of the raster's there. Every other pixel is the whole refinement's.
+static void test_component_refinement_cheaper_and_close(void **state)
+{
+    (void)state;
+    rig r = rig_begin();
+    const int32_t w = 64, h = 48;
+    build_glossy_room(&r, w, h);
+    rig_commit(&r, &(drift_refine_params){ .spp = 16 });
+    drift_image pure, whole, component;
+    assert_int_equal(drift_image_create(r.ctx, w, h, 3, &pure), DRIFT_OK);
+    assert_int_equal(drift_image_create(r.ctx, w, h, 3, &whole), DRIFT_OK);
+    assert_int_equal(drift_image_create(r.ctx, w, h, 3, &component), DRIFT_OK);
+    assert_int_equal(drift_refine_render_pure(r.sir, 16, &pure, NULL, NULL), DRIFT_OK);
+    uint64_t whole_rays = refine_to_done(&r, &(drift_refine_params){ .spp = 16 }, &whole);
+    uint64_t component_rays =
+        refine_to_done(&r, &(drift_refine_params){ .spp = 16, .components = true }, &component);
+    const drift_image *raster = drift_hybrid_image(r.frame);
+    uint32_t components = 0, others_differ = 0;
+    double raster_error = 0.0, component_error = 0.0;
+    for (int32_t y = 0; y < h; ++y) {
+        for (int32_t x = 0; x < w; ++x) {
+            bool reflection = false, other = false;
+            for (int m = 0; m < DRIFT_METRIC_COUNT; ++m) {
+                bool set =
+                    drift_image_pixel(drift_refine_metric_image(r.sir, (drift_refine_metric)m), x,
+                                      y)[0] > 0.0f;
+                reflection |= set && m <= DRIFT_METRIC_REFLECTION5;
+                other |= set && m > DRIFT_METRIC_REFLECTION5;
+            }
+            if (reflection && !other) {
+                ++components;
+                raster_error += (double)display_difference(raster, &pure, x, y);
+                component_error += (double)display_difference(&component, &pure, x, y);
+            } else {
+                others_differ += display_difference(&component, &whole, x, y) > 0.0f;
+            }
+        }
+    }
+    print_message("component refinement: %u component pixels, rays %llu against %llu whole; "
+                  "mean display error there %.4f (raster %.4f)\n",
+                  components, (unsigned long long)component_rays, (unsigned long long)whole_rays,
+                  component_error / (double)components, raster_error / (double)components);
+    assert_true(components >= 100); // the floor's reflection is what the scene shows
+    assert_int_equal(others_differ, 0);
+    if ((double)component_rays > 0.8 * (double)whole_rays) {
+        fail_msg("component refinement traced %llu rays, the whole %llu",
+                 (unsigned long long)component_rays, (unsigned long long)whole_rays);
+    }
+    if (!(component_error <= raster_error / 3.0)) {
+        fail_msg("component pixels off by %.4f on average, the raster by %.4f",
+                 component_error / (double)components, raster_error / (double)components);
+    }
+    drift_image_destroy(r.ctx, &pure);
+    drift_image_destroy(r.ctx, &whole);
+    drift_image_destroy(r.ctx, &component);
     rig_destroy(&r);
 }
 
@@ -1066,6 +1163,7 @@ int main(void)
         cmocka_unit_test(test_shadow_dilation_follows_resolution),
         cmocka_unit_test(test_glossy_plane_not_flagged),
         cmocka_unit_test(test_glossy_room_refined_in_error_order),
+        cmocka_unit_test(test_component_refinement_cheaper_and_close),
         cmocka_unit_test(test_half_res_penumbra_keeps_flags),
         cmocka_unit_test(test_leak_metric_finds_seams),
         cmocka_unit_test(test_radix_sort_stable_and_complete),
