@@ -140,26 +140,29 @@ static void sparse_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *r
     trace_samples(f, job, s, &bsdf, wo, (uint32_t)i, n, sums, rays);
 }
 
-// s1 and s2 of the pixel: its own when its sparse rays met an occluder, else the extremes of
-// its neighbours' (same surface) within DRIFT_AAF_DILATE pixels, so that a penumbra pixel
-// whose few sparse rays all happened to miss still gets samples and a filter. False when the
-// pixel is in full light or full shadow: no occluder near, or no ray of the pixel or of
-// those neighbours reached the light (an umbra, as flat as full light). Such a pixel keeps
+// s1 and s2 of the pixel, from its neighbours (same surface) within DRIFT_AAF_DILATE pixels,
+// its own left out: the means of theirs that met an occluder, or, when none did, the pixel's
+// own. Taken from its own sparse rays, beta and n(x) were functions of the samples they
+// filter and add to (a pixel whose few rays met a near occluder got more samples and a narrow
+// filter): adaptive sampling conditioned on a pixel's own first samples is biased, and on the
+// Cornell box at 4 spp that bias was most of AAF's error (docs/aaf.md). False when the pixel
+// is in full light or full shadow: no ray of the pixel or of those neighbours met an
+// occluder, or none reached the light (an umbra, as flat as full light). Such a pixel keeps
 // its sparse estimate, unfiltered: exactly 1 or 0.
 static bool occluder_ratios(const drift_frame_state *f, int32_t x, int32_t y, float *s1, float *s2)
 {
     const drift_aaf_state *st = f->aaf;
     const shadow_sums *own = (const shadow_sums *)&st->aux[DRIFT_AAF_AUX * pixel_index(f, x, y)];
-    *s1 = own->s1;
-    *s2 = own->s2;
-    bool lit = own->visible > 0.0f;
+    bool lit = own->visible > 0.0f, occluded = isfinite(own->s2);
+    double sum1 = 0.0, sum2 = 0.0;
+    int count = 0;
     const drift_gbuffer *g = &f->gbuffer;
     float depth = drift_image_pixel(&g->depth, x, y)[0];
     drift_vec3 normal = drift_image_get3(&g->normal, x, y);
     for (int32_t ny = y - DRIFT_AAF_DILATE; ny <= y + DRIFT_AAF_DILATE; ++ny) {
         for (int32_t nx = x - DRIFT_AAF_DILATE; nx <= x + DRIFT_AAF_DILATE; ++nx) {
             if (nx < 0 || ny < 0 || nx >= f->params.width || ny >= f->params.height ||
-                drift_image_pixel(&g->material_id, nx, ny)[0] < 0.0f) {
+                (nx == x && ny == y) || drift_image_pixel(&g->material_id, nx, ny)[0] < 0.0f) {
                 continue;
             }
             const shadow_sums *n =
@@ -171,13 +174,16 @@ static bool occluder_ratios(const drift_frame_state *f, int32_t x, int32_t y, fl
                 continue;
             }
             lit = lit || n->visible > 0.0f;
-            if (!isfinite(own->s2) && isfinite(n->s2)) {
-                *s1 = fmaxf(*s1, n->s1);
-                *s2 = fminf(*s2, n->s2);
+            if (isfinite(n->s2)) {
+                sum1 += (double)n->s1;
+                sum2 += (double)n->s2;
+                ++count;
             }
         }
     }
-    return isfinite(*s2) && lit;
+    *s1 = count > 0 ? (float)(sum1 / count) : own->s1;
+    *s2 = count > 0 ? (float)(sum2 / count) : own->s2;
+    return (occluded || count > 0) && lit;
 }
 
 // beta (eq. 3.4) and the wanted rate n(x) (eq. 3.5) from the sparse pass.
