@@ -58,7 +58,17 @@ typedef struct gbuffer_job {
     bool has_prev_camera;
     drift_gbuffer *gbuffer;
     int32_t tiles_x;
+    const drift_vec3 *gloss; // per material: the same for every pixel, so made once a frame
 } gbuffer_job;
+
+// The gloss plane's value of one material: (theta_max, exponent, roughness).
+static drift_vec3 material_gloss(const drift_material *m)
+{
+    float exponent = m->type == DRIFT_MATERIAL_MIRROR ? INFINITY : m->exponent;
+    // Roughness of the Beckmann lobe with the same width: alpha = sqrt(2 / (n + 2)).
+    float roughness = isfinite(exponent) ? sqrtf(2.0f / (exponent + 2.0f)) : 0.0f;
+    return drift_vec3_make(drift_gloss_theta_max(m), exponent, roughness);
+}
 
 static void write_pixel(const gbuffer_job *job, int32_t x, int32_t y, const drift_ray *ray,
                         const drift_hit *hit)
@@ -100,14 +110,11 @@ static void write_pixel(const gbuffer_job *job, int32_t x, int32_t y, const drif
     drift_vec3 albedo = zero, specular = zero, gloss = zero;
     float material_id = -1.0f;
     if (surface->material != DRIFT_INVALID_INDEX) {
-        const drift_material *m = &scene->materials[surface->material];
         drift_bsdf bsdf = drift_bsdf_make(scene, surface); // textures applied
         albedo = bsdf.diffuse;
         specular = bsdf.specular;
-        float exponent = m->type == DRIFT_MATERIAL_MIRROR ? INFINITY : m->exponent;
-        // Roughness of the Beckmann lobe with the same width: alpha = sqrt(2 / (n + 2)).
-        float roughness = isfinite(exponent) ? sqrtf(2.0f / (exponent + 2.0f)) : 0.0f;
-        gloss = drift_vec3_make(drift_gloss_theta_max(m), exponent, roughness);
+        gloss = job->gloss ? job->gloss[surface->material]
+                           : material_gloss(&scene->materials[surface->material]);
         material_id = (float)surface->material;
     }
     drift_image_set3(&g->albedo, x, y, albedo);
@@ -171,7 +178,17 @@ void drift_gbuffer_render(drift_context *ctx, const drift_scene *scene, const dr
     if (prev_camera) {
         job.prev_camera = drift_camera_frame_make(prev_camera, gbuffer->width, gbuffer->height);
     }
+    // A failed allocation only costs the per-pixel computation.
+    drift_vec3 *gloss =
+        scene->material_count ? drift_alloc(ctx, sizeof *gloss * scene->material_count) : NULL;
+    if (gloss) {
+        for (uint32_t i = 0; i < scene->material_count; ++i) {
+            gloss[i] = material_gloss(&scene->materials[i]);
+        }
+    }
+    job.gloss = gloss;
     int32_t tiles_y = (gbuffer->height + TILE - 1) / TILE;
     drift_parallel_for(ctx, (size_t)job.tiles_x * (size_t)tiles_y, 1, render_tiles, &job);
+    drift_free(ctx, gloss);
     *rays += (uint64_t)gbuffer->width * (uint64_t)gbuffer->height;
 }
