@@ -354,6 +354,10 @@ static const cli_option render_table[] = {
     CLI_INT("--ism-vpls", "N", O, hybrid.ism.vpls, 1, 65536,
             "instant radiosity (--indirect ism|ir, docs/ism.md): light\n"
             "paths, one first-bounce VPL each (default 256)"),
+    CLI_CHOICE("--ism-vpl-importance", "off|on", O, hybrid.ism.vpl_importance, "off|on",
+               "on: keep candidate VPLs with probability by their contribution\n"
+               "to the view, divided by it (Georgiev & Slusallek 2010;\n"
+               "default off)"),
     CLI_INT("--ism-map-size", "N", O, hybrid.ism.map_size, 4, 1024,
             "texels a side of each VPL's imperfect shadow map (default 64)"),
     CLI_INT("--ism-points", "N", O, hybrid.ism.points_per_vpl, 16, 1 << 20,

@@ -76,6 +76,10 @@ typedef enum drift_ism_visibility {
 //   no_blur           = false: the geometry-aware blur over the block runs
 //   blur_normal       = 0 -> 0.9: smallest cosine between two normals the blur mixes
 //   blur_plane        = 0 -> 0.01 x scene diagonal: largest distance to the centre's plane
+//   vpl_importance    = false: true accepts each candidate VPL with p = min(1, c / target), c
+//                       its unshadowed contribution to 256 G-buffer points, and divides the
+//                       accepted by p (Georgiev & Slusallek 2010); rounds go on until
+//                       vpl_count first-bounce VPLs are accepted or max_path_rounds
 typedef struct drift_ism_params {
     uint32_t seed;
     drift_ism_visibility visibility;
@@ -95,6 +99,7 @@ typedef struct drift_ism_params {
     bool no_blur;
     float blur_normal;
     float blur_plane;
+    bool vpl_importance;
 } drift_ism_params;
 
 drift_ism_params drift_ism_params_resolve(const drift_ism_params *params, const drift_scene *scene);

@@ -757,8 +757,23 @@ drift_result drift_ism_render(drift_ism *ism, const drift_gbuffer *gbuffer,
     drift_free(ism->ctx, ism->vpls);
     ism->vpls = NULL;
     ism->vpl_count = 0;
-    r = drift__ism_generate_vpls(ism->ctx, ism->scene, ism->accel, &ism->params, &ism->vpls,
-                                 &ism->vpl_count, NULL);
+    // The importance points: the visible surfaces at the centres of a 16 x 16 pixel grid.
+    drift_vec3 view_pos[256], view_nrm[256];
+    uint32_t view_count = 0;
+    for (int32_t gy = 0; ism->params.vpl_importance && gy < 16; ++gy) {
+        for (int32_t gx = 0; gx < 16; ++gx) {
+            int32_t x = (2 * gx + 1) * gbuffer->width / 32, y = (2 * gy + 1) * gbuffer->height / 32;
+            if (*drift_image_pixel(&gbuffer->material_id, x, y) < 0.0f) {
+                continue;
+            }
+            const float *ps = drift_image_pixel(&gbuffer->position, x, y);
+            const float *ns = drift_image_pixel(&gbuffer->normal, x, y);
+            view_pos[view_count] = drift_vec3_make(ps[0], ps[1], ps[2]);
+            view_nrm[view_count++] = drift_vec3_make(ns[0], ns[1], ns[2]);
+        }
+    }
+    r = drift__ism_generate_vpls_for(ism->ctx, ism->scene, ism->accel, &ism->params, view_pos,
+                                     view_nrm, view_count, &ism->vpls, &ism->vpl_count, NULL);
     if (r != DRIFT_OK) {
         return r;
     }

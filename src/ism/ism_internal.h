@@ -13,6 +13,14 @@ drift_result drift__ism_generate_vpls(drift_context *ctx, const drift_scene *sce
                                       drift_vpl **out_vpls, uint32_t *out_count,
                                       drift_vec3 *out_emitted);
 
+// The same with params->vpl_importance: `count` camera-visible points (positions, shading
+// normals) that candidate VPLs are weighed against; none: every candidate is kept.
+drift_result drift__ism_generate_vpls_for(drift_context *ctx, const drift_scene *scene,
+                                          const drift_accel *accel, const drift_ism_params *params,
+                                          const drift_vec3 *points, const drift_vec3 *normals,
+                                          uint32_t count, drift_vpl **out_vpls, uint32_t *out_count,
+                                          drift_vec3 *out_emitted);
+
 // The most VPLs drift__ism_generate_vpls can make with these (resolved) parameters.
 uint32_t drift__ism_max_vpls(const drift_ism_params *params);
 

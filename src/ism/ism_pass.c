@@ -26,14 +26,15 @@ static drift_ism_params params_of(const drift_frame_state *f, drift_ism_visibili
                                .vpl_count = f->params.ism.vpls,
                                .max_depth = f->params.max_depth,
                                .map_size = f->params.ism.map_size,
-                               .points_per_vpl = f->params.ism.points_per_vpl };
+                               .points_per_vpl = f->params.ism.points_per_vpl,
+                               .vpl_importance = f->params.ism.vpl_importance };
 }
 
 static bool same_params(const drift_ism_params *a, const drift_ism_params *b)
 {
     return a->seed == b->seed && a->visibility == b->visibility && a->vpl_count == b->vpl_count &&
            a->max_depth == b->max_depth && a->map_size == b->map_size &&
-           a->points_per_vpl == b->points_per_vpl;
+           a->points_per_vpl == b->points_per_vpl && a->vpl_importance == b->vpl_importance;
 }
 
 static drift_result indirect(drift_frame_state *f, const drift_pass_args *args,

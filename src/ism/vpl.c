@@ -310,13 +310,46 @@ uint32_t drift__ism_max_vpls(const drift_ism_params *params)
     // later_vpl_count a round.
     uint32_t rounds = params->max_path_rounds > 1 ? (uint32_t)params->max_path_rounds : 1;
     uint32_t first = rounds > 1 ? params->vpl_count + params->vpl_count / 2 : params->vpl_count;
+    if (params->vpl_importance && rounds > 1) {
+        first = 2 * params->vpl_count; // rounds stop once vpl_count are accepted
+    }
     return first + (bounces - 1) * params->later_vpl_count * rounds;
+}
+
+// --- IMPORTANCE (Georgiev & Slusallek 2010) ---
+
+// A candidate VPL's estimated contribution to the view: the luminance of its flux times the
+// unshadowed geometry term clamped at d_min, averaged over the camera-visible points (16
+// shadow rays each instead were measured worse: docs/ism.md).
+static float vpl_contribution(const drift_vpl *v, const drift_vec3 *points,
+                              const drift_vec3 *normals, uint32_t count, float d_min2)
+{
+    double sum = 0.0;
+    for (uint32_t k = 0; k < count; ++k) {
+        drift_vec3 d = drift_vec3_sub(points[k], v->position);
+        float d2 = drift_vec3_dot(d, d);
+        float cos_v = drift_vec3_dot(v->normal, d), cos_x = -drift_vec3_dot(normals[k], d);
+        if (cos_v > 0.0f && cos_x > 0.0f && d2 > 0.0f) {
+            sum += (double)(cos_v * cos_x / (d2 * fmaxf(d2, d_min2)));
+        }
+    }
+    return drift_luminance(v->flux) * (float)(sum / (double)count);
 }
 
 drift_result drift__ism_generate_vpls(drift_context *ctx, const drift_scene *scene,
                                       const drift_accel *accel, const drift_ism_params *params,
                                       drift_vpl **out_vpls, uint32_t *out_count,
                                       drift_vec3 *out_emitted)
+{
+    return drift__ism_generate_vpls_for(ctx, scene, accel, params, NULL, NULL, 0, out_vpls,
+                                        out_count, out_emitted);
+}
+
+drift_result drift__ism_generate_vpls_for(drift_context *ctx, const drift_scene *scene,
+                                          const drift_accel *accel, const drift_ism_params *params,
+                                          const drift_vec3 *points, const drift_vec3 *normals,
+                                          uint32_t point_count, drift_vpl **out_vpls,
+                                          uint32_t *out_count, drift_vec3 *out_emitted)
 {
     *out_vpls = NULL;
     *out_count = 0;
@@ -368,7 +401,17 @@ drift_result drift__ism_generate_vpls(drift_context *ctx, const drift_scene *sce
     }
     uint32_t count = 0, landed = 0, rounds = 0;
     double sum[3] = { 0, 0, 0 };
-    while (rounds < rounds_max && (rounds == 0 || 2 * landed < paths)) {
+    // Importance: candidates are accepted with p = min(1, c / target) and divided by p; the
+    // target is the mean contribution of the first round's candidates, so the ones that
+    // light the view are kept and the rest thinned. Rounds go on until vpl_count are kept.
+    bool importance = params->vpl_importance && point_count > 0;
+    uint32_t want = importance ? paths : (paths + 1) / 2;
+    float target = 0.0f;
+    drift_vec3 dd = drift_vec3_sub(hi, lo);
+    float d_min =
+        params->clamp_distance > 0.0f ? params->clamp_distance : 0.05f * drift_vec3_length(dd);
+    uint32_t accept_key = drift_hash_combine(params->seed, DRIFT_ISM_VPL_STREAM + 1u);
+    while (rounds < rounds_max && (rounds == 0 || landed < want)) {
         memset(slots, 0, (size_t)paths * bounces * sizeof *slots);
         job.first = rounds * paths;
         drift_parallel_for(ctx, paths, 16, trace_paths, &job);
@@ -378,14 +421,39 @@ drift_result drift__ism_generate_vpls(drift_context *ctx, const drift_scene *sce
             sum[1] += (double)emitted[i].y;
             sum[2] += (double)emitted[i].z;
         }
+        if (importance && rounds == 1) {
+            double total = 0.0;
+            uint32_t n = 0;
+            for (size_t j = 0; j < (size_t)paths * bounces; ++j) {
+                if (slots[j].bounce == (uint32_t)(j % bounces) + 1) {
+                    total += (double)vpl_contribution(&slots[j], points, normals, point_count,
+                                                      d_min * d_min);
+                    n++;
+                }
+            }
+            target = n > 0 ? (float)(total / (double)n) : 0.0f;
+        }
         // Append in (bounce, path) order: the same list for any thread count.
         for (uint32_t b = 0; b < bounces; ++b) {
             for (uint32_t i = 0; i < paths; ++i) {
-                const drift_vpl *v = &slots[(size_t)i * bounces + b];
-                if (v->bounce == b + 1) {
-                    vpls[count++] = *v;
-                    landed += b == 0;
+                drift_vpl v = slots[(size_t)i * bounces + b];
+                if (v.bounce != b + 1) {
+                    continue;
                 }
+                if (importance && target > 0.0f) {
+                    float c = vpl_contribution(&v, points, normals, point_count, d_min * d_min);
+                    // At least 1/10: a VPL the 16 points miss may still light a pixel.
+                    float p = fmaxf(0.1f, fminf(1.0f, c / target));
+                    uint32_t h = drift_hash_combine(accept_key, (rounds - 1) * paths * bounces +
+                                                                    i * bounces + b);
+                    float u = (float)(h >> 8) * (1.0f / 16777216.0f);
+                    if (!(u < p)) {
+                        continue;
+                    }
+                    v.flux = drift_vec3_scale(v.flux, 1.0f / p);
+                }
+                vpls[count++] = v;
+                landed += b == 0;
             }
         }
     }

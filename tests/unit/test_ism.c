@@ -501,6 +501,72 @@ static void test_ism_is_deterministic(void **state)
     test_rig_destroy(&r2);
 }
 
+// VPL importance (Georgiev & Slusallek 2010) on the Cornell box, where every VPL lights the
+// view: the indirect image's mean is unchanged within 4% (accepted VPLs are divided by
+// their acceptance probability), and the same for 1 and 2 threads.
+static void test_vpl_importance_is_unbiased(void **state)
+{
+    (void)state;
+    test_rig r1 = cornell_rig(1, 24), r2 = cornell_rig(2, 24);
+    drift_ism_params off = { .visibility = DRIFT_ISM_VISIBILITY_RAYS,
+                             .vpl_count = 2048,
+                             .max_depth = 3,
+                             .block_size = 1,
+                             .seed = 5 };
+    drift_ism_params on = off;
+    on.vpl_importance = true;
+    drift_ism *a = render_ism(&r2, &off), *b = render_ism(&r2, &on), *c = render_ism(&r1, &on);
+    double ratio = drift_image_mean_luminance(drift_ism_indirect(b)) /
+                   drift_image_mean_luminance(drift_ism_indirect(a));
+    printf("importance on / off mean: %.4f\n", ratio);
+    assert_true(ratio > 0.96 && ratio < 1.04);
+    assert_memory_equal(drift_ism_indirect(b)->pixels, drift_ism_indirect(c)->pixels,
+                        24 * 24 * 3 * sizeof(float));
+    drift_ism_destroy(a);
+    drift_ism_destroy(b);
+    drift_ism_destroy(c);
+    test_rig_destroy(&r1);
+    test_rig_destroy(&r2);
+}
+
+// A closed box lit by a point light, seen only at points on its floor (normals up): VPLs on
+// the floor light none of them. Importance keeps floor VPLs
+// with p = 0.1 only: their share falls to under 0.3 of what it is without.
+static void test_vpl_importance_keeps_useful_vpls(void **state)
+{
+    (void)state;
+    test_rig r = test_rig_begin(2);
+    add_closed_box(r.scene, 0.5f);
+    drift_light l = { .type = DRIFT_LIGHT_POINT,
+                      .color = drift_vec3_splat(2.0f),
+                      .position = drift_vec3_make(0.0f, 0.9f, 0.0f) };
+    assert_int_equal(drift_scene_add_light(r.scene, &l, NULL), DRIFT_OK);
+    test_rig_commit(&r);
+    drift_vec3 pos[16], nrm[16];
+    for (int i = 0; i < 16; ++i) {
+        pos[i] = drift_vec3_make(-0.75f + 0.1f * (float)i, -0.999f, 0.1f * (float)(i % 4));
+        nrm[i] = drift_vec3_make(0, 1, 0);
+    }
+    double useful[2];
+    for (int on = 0; on < 2; ++on) {
+        drift_ism_params p = drift_ism_params_resolve(
+            &(drift_ism_params){ .vpl_count = 512, .max_depth = 2, .vpl_importance = on }, r.scene);
+        drift_vpl *vpls = NULL;
+        uint32_t count = 0, n = 0;
+        assert_int_equal(drift__ism_generate_vpls_for(r.ctx, r.scene, r.accel, &p, pos, nrm, 16,
+                                                      &vpls, &count, NULL),
+                         DRIFT_OK);
+        for (uint32_t j = 0; j < count; ++j) {
+            n += vpls[j].position.y > -0.99f; // not on the floor
+        }
+        useful[on] = count ? (double)n / (double)count : 0.0;
+        drift_free(r.ctx, vpls);
+    }
+    printf("useful VPLs off %.3f on %.3f\n", useful[0], useful[1]);
+    assert_true(1.0 - useful[1] < 0.3 * (1.0 - useful[0]));
+    test_rig_destroy(&r);
+}
+
 // The atlas and the scene points start at one round of paths, not at the bound over eight
 // rounds (which sampled 14M points at 1024 VPLs, depth 8), and growing them changes no pixel:
 // point i is the same Sobol sample whatever the count.
@@ -641,6 +707,8 @@ int main(void)
         cmocka_unit_test(test_environment_vpls_carry_its_power),
         cmocka_unit_test(test_gather_equals_the_formula),
         cmocka_unit_test(test_ism_is_deterministic),
+        cmocka_unit_test(test_vpl_importance_is_unbiased),
+        cmocka_unit_test(test_vpl_importance_keeps_useful_vpls),
         cmocka_unit_test(test_maps_grow_without_changing_the_image),
         cmocka_unit_test(test_rigid_motion_leaves_the_image),
         cmocka_unit_test(test_bounces_add_shrinking_light),
