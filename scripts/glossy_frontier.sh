@@ -17,7 +17,5 @@ for r in isg envmap aaf sharp blur; do
   run ism128-$r $H --indirect ism --ism-vpls 128 --reflections $r
   run ir64-$r $H --indirect ir --ism-vpls 64 --reflections $r
 done
+# micro-rendering indirect (--indirect micro) measured ~390x pt 1 spp, FLIP 0.202: left out.
 run pt1 --mode reference --spp 1
-run micro-isg $H --indirect micro --reflections isg
-run pt1 --mode reference --spp 1
-run micro-micro $H --indirect micro --reflections micro
