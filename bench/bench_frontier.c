@@ -351,9 +351,10 @@ static drift_result hybrid_row(frontier_state *b, const char *name,
 // 16..1024 VPLs, aaf; AAF rows at 1, 2 and 4 spp; each at --aa 1 and 4 anti-aliasing passes;
 // max depth 8. The other effects keep the
 // technique that matches the reference: reflections none on a scene without glossy or mirror
-// materials (else aaf), depth of field none for a pinhole camera (else post: reference would
-// path-trace the whole frame through the lens, replacing every other row's output), occlusion
-// none, glare none.
+// materials (else isg: AAF's reflections scored only ~0.006 lower FLIP on the glossy box at
+// 11-15x the frame time, docs/frontier.md), depth of field none for a pinhole camera (else post:
+// reference would path-trace the whole frame through the lens, replacing every other row's output),
+// occlusion none, glare none.
 static drift_result hybrid_rows(frontier_state *b, double limit_ms)
 {
     static const char *const shadows[] = { "hard", "pcss", "isg", "aaf" };
@@ -389,7 +390,7 @@ static drift_result hybrid_rows(frontier_state *b, double limit_ms)
                     if (glossy) {
                         drift_hybrid_params_set_technique(
                             &p, DRIFT_EFFECT_REFLECTIONS,
-                            technique_index(DRIFT_EFFECT_REFLECTIONS, "aaf"));
+                            technique_index(DRIFT_EFFECT_REFLECTIONS, "isg"));
                     }
                     if (lens) {
                         drift_hybrid_params_set_technique(
