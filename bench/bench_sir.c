@@ -115,7 +115,7 @@ static const cli_option sir_table[] = {
              "raster's E + D there (no shadow rays at their first hit)"),
     CLI_CHOICE("--envmap-parallax", "P", O, parallax, "none|box",
                "the raster's environment-map lookup: none (as seen from the probe) or\n"
-               "box (parallax-corrected against the scene's bounds; default none)"),
+               "box (parallax-corrected against the scene's bounds; the default)"),
     CLI_CUSTOM_ALL("--target", "X,Y,Z", parse_target,
                    "look at this point instead of the camera's target (other views,\n"
                    "as the paper's rows are views with more or fewer error pixels)"),
@@ -147,7 +147,9 @@ static const cli_command sir_command = {
 
 static int parse(int argc, char **argv, sir_options *o)
 {
-    *o = (sir_options){ .spp = 4, .budget = 8192, .threads = 1, .threshold = 0.02 };
+    *o = (sir_options){
+        .spp = 4, .budget = 8192, .threads = 1, .threshold = 0.02, .parallax = 1 /* box */
+    };
     parse_sizes("bench sir", "--sizes", "800x600,1024x768,1920x1080", o);
     int status = cli_parse(&sir_command, argc, argv, o, NULL);
     if (status != CLI_PARSED) {
