@@ -38,6 +38,7 @@ typedef struct sir_options {
     bool paper_metrics;
     bool full_res_penumbra;
     bool components;
+    int parallax; // --envmap-parallax: 0 none, 1 box (drift_envmap_parallax)
     bool has_target;
     drift_vec3 target; // --target: look here instead of the scene camera's target
     double fov;        // --fov: vertical field of view, degrees (0: the camera's)
@@ -112,6 +113,9 @@ static const cli_option sir_table[] = {
     CLI_FLAG("--components", O, components,
              "trace only R at pixels flagged by reflection metrics alone, keeping the\n"
              "raster's E + D there (no shadow rays at their first hit)"),
+    CLI_CHOICE("--envmap-parallax", "P", O, parallax, "none|box",
+               "the raster's environment-map lookup: none (as seen from the probe) or\n"
+               "box (parallax-corrected against the scene's bounds; the default)"),
     CLI_CUSTOM_ALL("--target", "X,Y,Z", parse_target,
                    "look at this point instead of the camera's target (other views,\n"
                    "as the paper's rows are views with more or fewer error pixels)"),
@@ -143,7 +147,9 @@ static const cli_command sir_command = {
 
 static int parse(int argc, char **argv, sir_options *o)
 {
-    *o = (sir_options){ .spp = 4, .budget = 8192, .threads = 1, .threshold = 0.02 };
+    *o = (sir_options){
+        .spp = 4, .budget = 8192, .threads = 1, .threshold = 0.02, .parallax = 1 /* box */
+    };
     parse_sizes("bench sir", "--sizes", "800x600,1024x768,1920x1080", o);
     int status = cli_parse(&sir_command, argc, argv, o, NULL);
     if (status != CLI_PARSED) {
@@ -295,6 +301,7 @@ static drift_result run_one(drift_context *ctx, const drift_scene *scene, const 
                                .shadows = DRIFT_SHADOWS_PCSS,
                                .reflections = DRIFT_REFLECTIONS_ENVMAP,
                                .dof = DRIFT_DOF_POST,
+                               .envmap = { .parallax = (drift_envmap_parallax)o->parallax },
                                .light_samples = (uint32_t)o->light_samples };
     drift_hybrid *frame = NULL;
     drift_refine *sir = NULL;

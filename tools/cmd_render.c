@@ -160,6 +160,20 @@ static bool parse_probe(const char *cmd, const char *flag, const char *v, void *
     return cli_parse_vec3(cmd, flag, v, true, &h->envmap.probe);
 }
 
+static bool parse_envmap_parallax(const char *cmd, const char *flag, const char *v, void *field)
+{
+    drift_hybrid_params *h = field;
+    if (strcmp(v, "none") == 0) {
+        h->envmap.parallax = DRIFT_ENVMAP_PARALLAX_NONE;
+    } else if (strcmp(v, "box") == 0) {
+        h->envmap.parallax = DRIFT_ENVMAP_PARALLAX_BOX;
+    } else {
+        fprintf(stderr, "drift %s: %s expects none or box, got '%s'\n", cmd, flag, v);
+        return false;
+    }
+    return true;
+}
+
 static bool parse_ambient(const char *cmd, const char *flag, const char *v, void *field)
 {
     drift_hybrid_params *h = field;
@@ -296,6 +310,10 @@ static const cli_option render_table[] = {
     CLI_CUSTOM("--probe", "X,Y,Z|object", O, hybrid, parse_probe,
                "environment-map probe: a point, or one per reflective mesh\n"
                "(default: the scene's centre)"),
+    CLI_CUSTOM("--envmap-parallax", "none|box", O, hybrid, parse_envmap_parallax,
+               "environment-map lookup: none (along the reflected direction,\n"
+               "as seen from the probe) or box (parallax-corrected against the\n"
+               "scene's bounding box, a local cube map; default none)"),
     CLI_CUSTOM("--ambient", "R,G,B", O, hybrid, parse_ambient,
                "ambient radiance (default: the frame's mean direct light)"),
     CLI_NUMBER("--aperture", "R", O, aperture, 0.0, 1e30,

@@ -97,11 +97,21 @@ typedef struct drift_shadow_map_settings {
 //   size       = 0 -> 128 texels a cube face
 //   per_object = false: one probe at the scene centre (or `probe` when has_probe); true: one
 //                probe at the centre of every reflective mesh
+//   parallax   = NONE: the map looked up along the reflected direction, as if every pixel sat at
+//                the probe; BOX: parallax-corrected (a local cube map, Lagarde and Zanuttini
+//                2012): the reflected ray meets the scene's bounding box and the map is looked
+//                up from the probe toward that point
+typedef enum drift_envmap_parallax {
+    DRIFT_ENVMAP_PARALLAX_NONE = 0,
+    DRIFT_ENVMAP_PARALLAX_BOX = 1,
+} drift_envmap_parallax;
+
 typedef struct drift_envmap_settings {
     int32_t size;
     bool has_probe;
     drift_vec3 probe;
     bool per_object;
+    drift_envmap_parallax parallax;
 } drift_envmap_settings;
 
 // Image space gathering (docs/isg.md):

@@ -366,6 +366,49 @@ drift_vec3 drift_envmap_probe(const drift_envmap *map)
     return map->probe;
 }
 
+drift_vec3 drift_envmap_parallax_direction(drift_bounds3 box, drift_vec3 probe, drift_vec3 p,
+                                           drift_vec3 dir, float *out_ratio)
+{
+    if (out_ratio) {
+        *out_ratio = 1.0f;
+    }
+    // The exit distance: the nearest of the three far slabs along dir.
+    float t = INFINITY;
+    const float pp[3] = { p.x, p.y, p.z }, d[3] = { dir.x, dir.y, dir.z };
+    const float lo[3] = { box.min.x, box.min.y, box.min.z };
+    const float hi[3] = { box.max.x, box.max.y, box.max.z };
+    for (int a = 0; a < 3; ++a) {
+        if (pp[a] < lo[a] || pp[a] > hi[a]) {
+            return dir; // outside (or an empty box): nothing to correct against
+        }
+        if (d[a] > 0.0f) {
+            t = fminf(t, (hi[a] - pp[a]) / d[a]);
+        } else if (d[a] < 0.0f) {
+            t = fminf(t, (lo[a] - pp[a]) / d[a]);
+        }
+    }
+    if (!(t < INFINITY)) {
+        return dir;
+    }
+    drift_vec3 to = drift_vec3_sub(drift_vec3_fma(p, dir, t), probe);
+    float length = drift_vec3_length(to);
+    if (!(length > 0.0f)) {
+        return dir;
+    }
+    if (out_ratio) {
+        *out_ratio = t / length;
+    }
+    return drift_vec3_scale(to, 1.0f / length);
+}
+
+float drift_envmap_parallax_cone(float cone, float ratio)
+{
+    if (!(cone > 0.0f) || ratio == 1.0f) {
+        return cone;
+    }
+    return atanf(tanf(fminf(cone, 1.5f)) * ratio);
+}
+
 int32_t drift_envmap_face_size(const drift_envmap *map)
 {
     return map->size[0];

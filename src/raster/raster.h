@@ -174,6 +174,16 @@ void drift_envmap_destroy(drift_context *ctx, drift_envmap *map); // NULL-safe
 drift_raster_radiance drift_envmap_lookup(const drift_envmap *map, drift_vec3 dir,
                                           float cone_angle);
 drift_vec3 drift_envmap_probe(const drift_envmap *map);
+// Box projection (a local cube map, Lagarde and Zanuttini 2012; Bjorke 2004): the direction to
+// look a map captured at `probe` up in for the ray from p along dir, the direction from the
+// probe to where the ray leaves `box`. dir itself when p is outside the box or the box is empty.
+// out_ratio (may be NULL): that point's distance from p over its distance from the probe (1 when
+// not corrected), which scales a glossy lobe's footprint as the probe sees it.
+drift_vec3 drift_envmap_parallax_direction(drift_bounds3 box, drift_vec3 probe, drift_vec3 p,
+                                           drift_vec3 dir, float *out_ratio);
+// A lobe's cone half angle seen from the probe: a footprint of tan(cone) x distance from p,
+// seen from `ratio` times farther or nearer.
+float drift_envmap_parallax_cone(float cone, float ratio);
 
 // The capture with the radiance per texel from `radiance` instead of the scene (what
 // drift_envmap_capture wraps; tests pass a synthetic function of direction). `radiance` is

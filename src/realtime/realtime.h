@@ -33,6 +33,12 @@ drift_result drift_realtime_ensure_shadow_map(drift_frame_state *frame, uint32_t
 drift_result drift_realtime_pass_sharp_reflections(drift_frame_state *frame);
 // The environment-map probes, captured on first use (kept while the settings stand).
 drift_result drift_realtime_capture_probes(drift_frame_state *frame);
+// The direction R looks `map` up in for a reflected ray from p along dir: dir, or with
+// envmap.parallax = BOX the box-projected direction (drift_envmap_parallax_direction over
+// the scene's bounds; *cone, the lobe's half angle, then scaled to its footprint as the probe
+// sees it).
+drift_vec3 drift_realtime_envmap_direction(const drift_frame_state *frame, const drift_envmap *map,
+                                           drift_vec3 p, drift_vec3 dir, float *cone);
 
 // --- TECHNIQUES ---
 

@@ -82,6 +82,19 @@ static const drift_envmap *probe_for(const drift_frame_state *f, uint32_t mesh)
     return NULL;
 }
 
+drift_vec3 drift_realtime_envmap_direction(const drift_frame_state *f, const drift_envmap *map,
+                                           drift_vec3 p, drift_vec3 dir, float *cone)
+{
+    if (f->params.envmap.parallax != DRIFT_ENVMAP_PARALLAX_BOX) {
+        return dir;
+    }
+    float ratio;
+    drift_vec3 d =
+        drift_envmap_parallax_direction(f->scene->bounds, drift_envmap_probe(map), p, dir, &ratio);
+    *cone = drift_envmap_parallax_cone(*cone, ratio);
+    return d;
+}
+
 static void envmap_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
 {
     (void)rays;
@@ -102,6 +115,7 @@ static void envmap_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *r
     float cone = bsdf.type == DRIFT_MATERIAL_MIRROR
                      ? 0.0f
                      : drift_gloss_theta_max(&f->scene->materials[s->material]);
+    dir = drift_realtime_envmap_direction(f, map, s->position, dir, &cone);
     drift_image_set3(&f->reflections, x, y,
                      combine(&bsdf, wo, drift_envmap_lookup(map, dir, cone)));
 }

@@ -58,6 +58,10 @@ assert 0 < r[0]["raster_metrics_ray_share"] and r[0]["metrics_rays"] >= 0, r'
         check sir 'assert d["rows"][0]["quality"]["leak"]["flagged"] == 0, d'
         expect 0 "$drift" bench sir "$box" --sizes 16x12 --spp 1 --budget 64 --components --json
         check sir 'assert 0 <= d["rows"][0]["flip"] <= 1 and d["rows"][0]["sir_rays"] >= 0, d'
+        expect 0 "$drift" bench sir "$box" --sizes 16x12 --spp 1 --budget 64 --envmap-parallax none --json
+        check sir 'assert 0 <= d["rows"][0]["flip"] <= 1, d'
+        expect 2 "$drift" bench sir "$box" --sizes 16x12 --envmap-parallax sphere
+        expect 2 "$drift" render "$box" --mode hybrid --reflections envmap --envmap-parallax sphere
         ;;
     glare)
         expect 0 "$drift" bench glare --frames 1 --sizes 16,32 --no-convolution --json

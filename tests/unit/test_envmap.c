@@ -511,6 +511,79 @@ static void test_envmap_probe_and_bad_arguments(void **state)
     drift_context_destroy(ctx);
 }
 
+// --- PARALLAX CORRECTION (box projection) ---
+
+// A closed room, the box [-1, 1]^3, whose walls show their own position: the radiance along a
+// ray is where it leaves the box (offset so every channel is positive).
+static drift_vec3 room_exit(drift_vec3 p, drift_vec3 d)
+{
+    float t = INFINITY;
+    const float pp[3] = { p.x, p.y, p.z }, dd[3] = { d.x, d.y, d.z };
+    for (int a = 0; a < 3; ++a) {
+        if (dd[a] != 0.0f) {
+            t = fminf(t, ((dd[a] > 0.0f ? 1.0f : -1.0f) - pp[a]) / dd[a]);
+        }
+    }
+    return drift_vec3_fma(p, d, t);
+}
+
+static drift_raster_radiance room_fn(void *user, drift_ray ray, drift_sampler *sampler,
+                                     uint64_t *rays)
+{
+    (void)user;
+    (void)sampler;
+    *rays += 1;
+    drift_vec3 w = drift_vec3_add(room_exit(ray.origin, ray.dir), drift_vec3_splat(2.0f));
+    return (drift_raster_radiance){ w, w };
+}
+
+// A mirror floor (y = -1) in the room, the map captured off-centre: the texel a floor point's
+// reflected ray looks up must show the wall point that ray really meets. Box-projected, it does
+// within two texels' footprint; looked up along the reflected direction (the map as if the floor
+// point sat at the probe), it does not.
+static void test_envmap_box_projection_finds_the_reflected_wall_point(void **state)
+{
+    (void)state;
+    drift_context *ctx = test_context(2, NULL);
+    synthetic s = { .probe = { 0.1f, 0.2f, -0.15f } };
+    const int32_t n = 64;
+    drift_envmap *map = NULL;
+    assert_int_equal(drift_envmap_capture_fn(ctx, room_fn, &s, s.probe, n, 7, &map, NULL),
+                     DRIFT_OK);
+    drift_bounds3 room = { { -1.0f, -1.0f, -1.0f }, { 1.0f, 1.0f, 1.0f } };
+    // A texel spans 2/n of a face across; two of them, and the probe at most ~2 units away.
+    const float tolerance = 2.0f * 2.0f / (float)n * 2.0f;
+    int far_without = 0, count = 0;
+    double worst_with = 0.0;
+    for (uint32_t i = 0; i < 64; ++i) {
+        drift_vec3 p = { -0.8f + 1.0f * test_hash_unit(4 * i), -1.0f,
+                         -0.5f + 1.0f * test_hash_unit(4 * i + 1) };
+        drift_vec3 w = { 1.0f, -0.6f + 1.2f * test_hash_unit(4 * i + 2),
+                         -0.6f + 1.2f * test_hash_unit(4 * i + 3) };
+        drift_vec3 d = drift_vec3_normalize(drift_vec3_sub(w, p));
+        drift_vec3 seen_with = drift_vec3_sub(
+            drift_envmap_lookup(map, drift_envmap_parallax_direction(room, s.probe, p, d, NULL),
+                                0.0f)
+                .reflected,
+            drift_vec3_splat(2.0f));
+        drift_vec3 seen_without =
+            drift_vec3_sub(drift_envmap_lookup(map, d, 0.0f).reflected, drift_vec3_splat(2.0f));
+        double e_with = drift_vec3_length(drift_vec3_sub(seen_with, w));
+        worst_with = fmax(worst_with, e_with);
+        far_without += drift_vec3_length(drift_vec3_sub(seen_without, w)) > tolerance ? 1 : 0;
+        ++count;
+    }
+    assert_true(worst_with < (double)tolerance);
+    assert_true(far_without > count * 9 / 10);
+    // Outside the box there is nothing to correct against: the direction is kept.
+    drift_vec3 up = { 0.0f, 1.0f, 0.0f };
+    drift_vec3 kept =
+        drift_envmap_parallax_direction(room, s.probe, drift_vec3_make(3.0f, 0.0f, 0.0f), up, NULL);
+    assert_true(kept.x == up.x && kept.y == up.y && kept.z == up.z);
+    drift_envmap_destroy(ctx, map);
+    drift_context_destroy(ctx);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -526,6 +599,7 @@ int main(void)
         cmocka_unit_test(test_envmap_capture_is_deterministic_across_threads),
         cmocka_unit_test(test_envmap_capture_sees_the_scene),
         cmocka_unit_test(test_envmap_probe_and_bad_arguments),
+        cmocka_unit_test(test_envmap_box_projection_finds_the_reflected_wall_point),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
