@@ -20,13 +20,4 @@ done
 hall=(scenes/sir-hall/sir_hall.json --views scenes/sir-hall/sir_views_few.json --sizes 400x300)
 run hall_none "${hall[@]}" --envmap-parallax none
 run hall_box "${hall[@]}" --envmap-parallax box
-python3 - "$out" <<'PY'
-import json, sys, glob, os
-for path in sorted(glob.glob(os.path.join(sys.argv[1], '*.json'))):
-    for row in json.load(open(path))['rows']:
-        print(f"{os.path.basename(path)[:-5]:18s} {row['view']:10s} err {row['error_percent']:5.1f}% "
-              f"FLIP {row['flip']:.5f} same {row['same_image']!s:5s} speedup {row['speedup']:.2f}x "
-              f"to-0.01 {row['speedup_to_flip']:.2f}x PRT {row['prt_ms']:.0f} SIR {row['sir_ms']:.0f} "
-              f"(raster {row['raster_ms']:.0f} metrics {row['metrics_ms']:.0f} trace {row['trace_ms']:.0f}) "
-              f"rays {row['sir_rays']/row['prt_rays']:.3f} of PRT")
-PY
+python3 "$(dirname "$0")/sir_summary.py" "$out"
