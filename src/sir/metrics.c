@@ -185,14 +185,11 @@ static float expected_reflection_error(drift_frame_state *f, size_t index, const
     float cone = mirror ? 0.0f : drift_gloss_theta_max(&f->scene->materials[s->material]);
     drift_vec3 c = drift_envmap_probe(map);
     drift_vec3 r = drift_vec3_reflect(wo, s->ns);
-    // Where R looks the map up for r (box-projected under envmap.parallax = BOX).
-    // Box-projected, the lobe's cone is scaled to its footprint as the probe sees it, at the
-    // box (R) and at q (the expected value).
+    // Where R looks the map up for r, and the lobe's cone as the probe sees it there (the
+    // reflection pass's own lookup: box-projected under envmap.parallax = BOX).
     bool box = f->params.envmap.parallax == DRIFT_ENVMAP_PARALLAX_BOX;
-    float ratio = 1.0f;
-    drift_vec3 r_map =
-        box ? drift_envmap_parallax_direction(f->scene->bounds, c, s->position, r, &ratio) : r;
-    float cone_map = drift_envmap_parallax_cone(cone, ratio);
+    float cone_map = cone;
+    drift_vec3 r_map = drift_realtime_envmap_direction(f, map, s->position, r, &cone_map);
     drift_vec3 escaped = drift_vec3_splat(0.0f);
     uint32_t hits = 0, used = 0;
     drift_vec3 q = s->position;
@@ -251,11 +248,12 @@ static float expected_reflection_error(drift_frame_state *f, size_t index, const
             return hidden_reflection_error(f, index, &bsdf, lobe, lobe_count, mirror ? 1u : samples,
                                            raster, sampler, rays);
         }
-        float cone_q = !found ? cone_map
-                       : box
-                           ? drift_envmap_parallax_cone(
-                                 cone, drift_vec3_length(drift_vec3_sub(q, s->position)) / distance)
-                           : cone;
+        // The cone at q as the probe sees it: its footprint from p, seen from `distance`.
+        float cone_q = cone_map;
+        if (found) {
+            float from_p = drift_vec3_length(drift_vec3_sub(q, s->position));
+            cone_q = box ? drift_envmap_parallax_cone(cone, from_p / distance) : cone;
+        }
         expected = drift_vec3_fma(expected, seen_in_map(map, to_q, cone_q, mirror), (float)hits);
     }
     expected = drift_vec3_scale(expected, 1.0f / (float)used);
