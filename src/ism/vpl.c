@@ -442,11 +442,11 @@ drift_result drift__ism_generate_vpls_for(drift_context *ctx, const drift_scene 
                 }
                 if (importance && target > 0.0f) {
                     float c = vpl_contribution(&v, points, normals, point_count, d_min * d_min);
-                    // At least 1/10: a VPL the 16 points miss may still light a pixel.
+                    // At least 1/10: a VPL the 256 view points miss may still light a pixel.
                     float p = fmaxf(0.1f, fminf(1.0f, c / target));
                     uint32_t h = drift_hash_combine(accept_key, (rounds - 1) * paths * bounces +
                                                                     i * bounces + b);
-                    float u = (float)(h >> 8) * (1.0f / 16777216.0f);
+                    float u = drift_u32_to_unit(h);
                     if (!(u < p)) {
                         continue;
                     }
