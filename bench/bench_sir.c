@@ -640,6 +640,9 @@ int drift_bench_sir(int argc, char **argv)
                 drift_camera_view_apply(view, &scene->camera);
             }
             sir_row *row = &scene_rows[i];
+            // Named before the run: its figures are saved under these names.
+            row->scene = short_name(o.scenes[s]);
+            row->view = view ? view->name : "camera";
             r = run_one(ctx, scene, session.accel, &o, o.widths[k], o.heights[k],
                         o.lambda_path ? lambda : NULL, row);
             if (r != DRIFT_OK) {
@@ -647,8 +650,6 @@ int drift_bench_sir(int argc, char **argv)
                         drift_result_string(r));
                 ok = false;
             } else if (!spread) { // one process: each row as soon as it is measured
-                row->scene = short_name(o.scenes[s]);
-                row->view = view ? view->name : "camera";
                 if (rows) {
                     add_json_row(rows, row, o.lambda_path != NULL);
                 } else {
