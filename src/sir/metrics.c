@@ -20,6 +20,11 @@
 // A metric's value is its expected display-value error over this (the lambda fit's scale of
 // the real error), so it orders pixels as the error does.
 #define REAL_ERROR_SCALE 0.1f
+// A raster shadow this close to 0 or 1 claims an umbra or full light.
+#define CERTAIN_SHADOW 0.001f
+// Penumbra pixels whose raster shadows differ by more are not averaged together: across a
+// narrow contact shadow PCSS is too bright on one side and too dark on the other.
+#define SIMILAR_SHADOW 0.15f
 // The square over which the expected reflection error is averaged: 5 x 5 pixels.
 #define EXPECTED_RADIUS 2
 
@@ -29,6 +34,13 @@ typedef struct light_shape {
     drift_vec3 corner[MAX_CORNERS];
 } light_shape;
 
+// What a penumbra pixel's shadow rays say of the raster's shadow there.
+typedef struct penumbra_check {
+    drift_vec3 delta;  // the raster's estimated shadow error, summed over the area lights
+    float raster;      // the raster's shadow S_l, averaged over those lights
+    bool contradicted; // its own rays saw what a raster claiming certainty denies
+} penumbra_check;
+
 typedef struct metric_job {
     const drift_refine_metric_params *params;
     drift_image *out;
@@ -36,8 +48,8 @@ typedef struct metric_job {
     uint64_t ao_rays;
     light_shape *shapes; // one a frame light, or NULL: bounding spheres
     float *expected;     // a pixel's expected reflection error (-1: not reflective), or NULL
-    float *shadow_delta; // 3 a pixel: the raster's estimated shadow error in a penumbra
-    float *coarse;       // the penumbra estimate at each 2 x 2 block's corner pixel, a light
+    struct penumbra_check *checks; // a pixel: the raster's shadow checked by rays
+    float *coarse; // the penumbra estimate at each 2 x 2 block's corner pixel, a light
 } metric_job;
 
 static bool is_reflective(const drift_frame_state *f, const drift_surface *s)
@@ -165,10 +177,10 @@ static float hidden_reflection_error(drift_frame_state *f, size_t index, const d
 
 // The raster's own expected reflection error at a reflective pixel, in display values: R
 // looks the map up along the mirror direction r as if the pixel sat at the probe c. The mirror
-// ray finds where the reflection really lands (q), and rays drawn from the lobe the share of
-// it that escapes the scene; the map seen from c toward q, blurred over the lobe's cone as R
-// is (parallax-corrected, as local cube maps are), is what R would hold there. The change of
-// the pixel when R takes that value, weighted by the lobe's albedo as R is, is the expected
+// ray and rays drawn from the lobe find where the reflection really lands (q_k) and the share
+// of it that escapes the scene; the map seen from c toward each q_k, blurred over the lobe's
+// cone as R is (parallax-corrected, as local cube maps are), is what R would hold there. The change
+// of the pixel when R takes that value, weighted by the lobe's albedo as R is, is the expected
 // error. A q hidden from c is unknown to the map: there the lobe rays' hits are shaded as the
 // ray tracer would (hidden_reflection_error). Without a map (another reflection technique)
 // the error is unknown: 1.
@@ -191,9 +203,8 @@ static float expected_reflection_error(drift_frame_state *f, size_t index, const
     float cone_map = cone;
     drift_vec3 r_map = drift_realtime_envmap_direction(f, map, s->position, r, &cone_map);
     drift_vec3 escaped = drift_vec3_splat(0.0f);
-    uint32_t hits = 0, used = 0;
-    drift_vec3 q = s->position;
-    bool found = false;
+    uint32_t used = 0, hit_count = 0;
+    drift_vec3 hit_at[MAX_LOBE_RAYS + 1]; // the mirror ray's and the lobe rays' hit points
     drift_ray lobe[MAX_LOBE_RAYS];
     uint32_t lobe_count = 0;
     for (uint32_t k = 0; k <= (mirror ? 0u : samples); ++k) { // k = 0: the mirror ray
@@ -210,10 +221,8 @@ static float expected_reflection_error(drift_frame_state *f, size_t index, const
         ++*rays;
         ++used;
         if (drift_accel_intersect(f->accel, &ray, &hit)) {
-            ++hits;
-            if (k == 0) {
-                q = drift_vec3_fma(ray.origin, dir, hit.t);
-                found = true;
+            if (hit_count <= MAX_LOBE_RAYS) {
+                hit_at[hit_count++] = drift_vec3_fma(ray.origin, dir, hit.t);
             }
             if ((k > 0 || mirror) && lobe_count < MAX_LOBE_RAYS) {
                 lobe[lobe_count++] = ray;
@@ -228,10 +237,11 @@ static float expected_reflection_error(drift_frame_state *f, size_t index, const
     drift_vec3 expected = escaped;
     drift_vec3 weight = drift_raster_reflection_weight(&bsdf, wo);
     drift_vec3 raster = drift_vec3_mul(weight, seen_in_map(map, r_map, cone_map, mirror));
-    if (hits > 0) {
-        // The lobe's hits see what the mirror ray's q shows in the map (or, when the mirror ray
-        // escaped, what the map shows along r itself).
-        drift_vec3 to_q = found ? drift_vec3_sub(q, c) : r_map;
+    // Each hit q_k shows what the map sees toward it, blurred as R is over the lobe's cone at
+    // q_k as the probe sees it: the lobe rays that meet another surface than the mirror ray's
+    // (a statue's edge in a glossy floor) are part of the expectation, not of its blind spot.
+    for (uint32_t k = 0; k < hit_count; ++k) {
+        drift_vec3 to_q = drift_vec3_sub(hit_at[k], c);
         float distance = drift_vec3_length(to_q);
         if (!(distance > 0.0f)) {
             return 1.0f;
@@ -241,20 +251,16 @@ static float expected_reflection_error(drift_frame_state *f, size_t index, const
                                  .tmin = 0.0f,
                                  .tmax = 0.99f * distance };
         ++*rays;
-        if (found && drift_accel_occluded(f->accel, &from_probe)) {
+        if (drift_accel_occluded(f->accel, &from_probe)) {
             // A q the map cannot see (a contact, the underside of an object in the floor):
             // what the lobe's rays see there, shaded by the tracer's direct light (a few
             // shadow rays), is the reflection the ray tracer will find.
             return hidden_reflection_error(f, index, &bsdf, lobe, lobe_count, mirror ? 1u : samples,
                                            raster, sampler, rays);
         }
-        // The cone at q as the probe sees it: its footprint from p, seen from `distance`.
-        float cone_q = cone_map;
-        if (found) {
-            float from_p = drift_vec3_length(drift_vec3_sub(q, s->position));
-            cone_q = box ? drift_envmap_parallax_cone(cone, from_p / distance) : cone;
-        }
-        expected = drift_vec3_fma(expected, seen_in_map(map, to_q, cone_q, mirror), (float)hits);
+        float from_p = drift_vec3_length(drift_vec3_sub(hit_at[k], s->position));
+        float cone_q = box ? drift_envmap_parallax_cone(cone, from_p / distance) : cone;
+        expected = drift_vec3_add(expected, seen_in_map(map, to_q, cone_q, mirror));
     }
     expected = drift_vec3_scale(expected, 1.0f / (float)used);
     drift_vec3 delta = drift_vec3_sub(drift_vec3_mul(weight, expected), raster);
@@ -317,12 +323,7 @@ static void reflection_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_
         // The paper's metrics say where an environment map may be wrong; weigh them by how
         // wrong this one is expected to be here, so a glossy surface whose raster reflection
         // is already right is not flagged (0 below the tolerance).
-        // Box-projected, what the expected error cannot see (the lobe's rays meeting other
-        // surfaces than the mirror ray's q) is most of what stays wrong: half the tolerance
-        // (on scenes/open-glossy, 0.01 left the image at FLIP 0.011, 0.005 at 0.008).
-        float tolerance = f->params.envmap.parallax == DRIFT_ENVMAP_PARALLAX_BOX
-                              ? 0.5f * params->reflection_tolerance
-                              : params->reflection_tolerance;
+        float tolerance = params->reflection_tolerance;
         float expected = job->expected ? job->expected[index] : 1.0f;
         float weight =
             expected >= tolerance ? drift_clampf(expected / REAL_ERROR_SCALE, 0.0f, 1.0f) : 0.0f;
@@ -451,7 +452,8 @@ static drift_vec3 shadow_map_mistake(drift_frame_state *f, uint32_t l, int32_t x
 // Noisy alone (a quarter of U_l at 4 rays); smooth_shadow_mistakes averages it over a square
 // of penumbra pixels, where the raster's error varies slowly and the noise cancels.
 static drift_vec3 penumbra_mistake(drift_frame_state *f, uint32_t l, int32_t x, int32_t y,
-                                   const drift_surface *s, uint32_t samples, uint64_t *rays)
+                                   const drift_surface *s, uint32_t samples, bool *contradicted,
+                                   uint64_t *rays)
 {
     const drift_frame_light_buffers *b = &f->light_buffers[l];
     drift_vec3 unshadowed = drift_image_get3(&b->unshadowed, x, y);
@@ -484,28 +486,37 @@ static drift_vec3 penumbra_mistake(drift_frame_state *f, uint32_t l, int32_t x, 
     }
     float raster = drift_image_pixel(&b->shadow, x, y)[0];
     float visible = cast ? (float)seen / (float)cast : raster;
+    // A raster umbra whose rays see the light, or a fully lit raster with a ray blocked, is
+    // wrong however few rays were cast: no noise lets an umbra see the light.
+    *contradicted = *contradicted || (raster <= CERTAIN_SHADOW && seen > 0) ||
+                    (raster >= 1.0f - CERTAIN_SHADOW && seen < cast);
     return drift_vec3_scale(unshadowed, visible - raster);
 }
 
 // Second pass over the (dilated) penumbra estimate: the raster's shadow error there, summed
-// over the area lights, into job->shadow_delta.
+// over the area lights, into job->checks.
 static void penumbra_check_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays,
                                  void *user)
 {
     metric_job *job = user;
     size_t index = (size_t)y * (size_t)f->params.width + (size_t)x;
     const drift_surface *s = &f->gbuffer.surfaces[index];
-    drift_vec3 delta = drift_vec3_splat(0.0f);
+    penumbra_check check = { .delta = drift_vec3_splat(0.0f) };
+    uint32_t checked = 0;
     if (drift_image_pixel(&job->out[DRIFT_METRIC_SHADOW], x, y)[0] > 0.0f &&
         s->material != DRIFT_INVALID_INDEX) {
         for (uint32_t l = 0; l < f->light_count; ++l) {
             if (f->light_buffers[l].shadow_map && f->lights[l].radius > 0.0f) {
-                delta = drift_vec3_add(
-                    delta, penumbra_mistake(f, l, x, y, s, job->params->lobe_samples, rays));
+                check.delta = drift_vec3_add(
+                    check.delta, penumbra_mistake(f, l, x, y, s, job->params->lobe_samples,
+                                                  &check.contradicted, rays));
+                check.raster += drift_image_pixel(&f->light_buffers[l].shadow, x, y)[0];
+                ++checked;
             }
         }
     }
-    memcpy(&job->shadow_delta[3 * index], &delta, sizeof(float) * 3);
+    check.raster = checked ? check.raster / (float)checked : 0.0f;
+    job->checks[index] = check;
 }
 
 // Whether pixel b's shadow error says something about pixel a's: the same mesh, facing about
@@ -771,34 +782,42 @@ static int32_t shadow_dilation(const drift_frame_state *f)
 }
 
 // Keeps a penumbra pixel flagged only where the raster's shadow error, its estimate averaged
-// (signed, so the rays' noise cancels) over the penumbra pixels of the same surface in a 5 x 5
-// square, moves the displayed pixel by the tolerance or more: PCSS is right in much of a broad
-// penumbra. Valued by that change / 0.1, as the other weighted metrics, so that their largest
-// (DRIFT_COMBINE_MAX) orders pixels by the expected error.
-static void gate_penumbra(drift_frame_state *f, drift_image *shadow, const float *delta,
+// (signed, so the rays' noise cancels) over the penumbra pixels of the same surface and a
+// similar raster shadow in a 5 x 5 square, moves the displayed pixel by the tolerance or more
+// (or, where its own rays contradict a certain raster, its own estimate does): PCSS is right in
+// much of a broad penumbra. Valued by that change / 0.1, as the other weighted metrics, so that
+// their largest (DRIFT_COMBINE_MAX) orders pixels by the expected error.
+static void gate_penumbra(drift_frame_state *f, drift_image *shadow, const penumbra_check *checks,
                           float tolerance, float *scratch)
 {
     int32_t w = shadow->width, h = shadow->height;
     for (int32_t y = 0; y < h; ++y) {
         for (int32_t x = 0; x < w; ++x) {
+            size_t index = (size_t)y * (size_t)w + (size_t)x;
             drift_vec3 sum = drift_vec3_splat(0.0f);
             int count = 0;
             for (int32_t v = y - EXPECTED_RADIUS; v <= y + EXPECTED_RADIUS; ++v) {
                 for (int32_t u = x - EXPECTED_RADIUS; v >= 0 && v < h && u <= x + EXPECTED_RADIUS;
                      ++u) {
+                    size_t other = (size_t)v * (size_t)w + (size_t)u;
                     if (u < 0 || u >= w || drift_image_pixel(shadow, u, v)[0] <= 0.0f ||
-                        !same_surface(f, (size_t)y * (size_t)w + (size_t)x,
-                                      (size_t)v * (size_t)w + (size_t)u)) {
+                        !same_surface(f, index, other) ||
+                        fabsf(checks[other].raster - checks[index].raster) > SIMILAR_SHADOW) {
                         continue;
                     }
-                    const float *d = &delta[3 * ((size_t)v * (size_t)w + (size_t)u)];
-                    sum = drift_vec3_add(sum, drift_vec3_make(d[0], d[1], d[2]));
+                    sum = drift_vec3_add(sum, checks[other].delta);
                     ++count;
                 }
             }
             float change = count ? display_change(drift_image_get3(&f->final, x, y),
                                                   drift_vec3_scale(sum, 1.0f / (float)count))
                                  : 0.0f;
+            // The average hides a sliver the raster got wrong for certain (a fold of a
+            // scanned mesh letting light into an umbra): the pixel's own estimate speaks.
+            if (checks[index].contradicted) {
+                change = fmaxf(
+                    change, display_change(drift_image_get3(&f->final, x, y), checks[index].delta));
+            }
             scratch[(size_t)y * (size_t)w + (size_t)x] =
                 drift_image_pixel(shadow, x, y)[0] > 0.0f && change >= tolerance
                     ? drift_clampf(change / REAL_ERROR_SCALE, 0.0f, 1.0f)
@@ -856,13 +875,12 @@ uint64_t drift_refine_compute_metrics(drift_frame_state *f,
         dilate(&out[DRIFT_METRIC_SHADOW], shadow_dilation(f), scratch);
     }
     if (scratch && params->shadow_tolerance > 0.0f) { // without memory: the estimate ungated
-        job.shadow_delta = drift_alloc(f->ctx, 3 * sizeof(float) * pixels);
+        job.checks = drift_alloc(f->ctx, sizeof(penumbra_check) * pixels);
     }
-    if (job.shadow_delta) {
+    if (job.checks) {
         rays += drift_pass_for_each_pixel(f, penumbra_check_pixel, &job);
-        gate_penumbra(f, &out[DRIFT_METRIC_SHADOW], job.shadow_delta, params->shadow_tolerance,
-                      scratch);
-        drift_free(f->ctx, job.shadow_delta);
+        gate_penumbra(f, &out[DRIFT_METRIC_SHADOW], job.checks, params->shadow_tolerance, scratch);
+        drift_free(f->ctx, job.checks);
     }
     drift_free(f->ctx, scratch);
     dof_metric(f, params->edge_threshold, &out[DRIFT_METRIC_DOF]);

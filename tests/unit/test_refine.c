@@ -708,14 +708,19 @@ static void build_glossy_room(rig *r, int32_t w, int32_t h)
 // (off by 0.01-0.02), the reflection of the sphere and the contact are not. Ordered by the
 // weighted metrics' largest (the expected error), the pixels SIR refines first are the wrong
 // ones: precision at recall 0.9 of at least 0.6 against the pure ray tracer (16 spp), and
-// better than the paper's averaged sum of the same metrics.
-static void test_glossy_room_refined_in_error_order(void **state)
+// better than the paper's averaged sum of the same metrics. With the box-projected map the
+// raster is right on most of the floor (110 wrong pixels, not 367) and what stays wrong is the
+// sphere's contact: there recall 0.9 was out of reach (the penumbra check averaged the contact
+// shadow's too-bright and too-dark sides to nothing) and precision is asked to be 0.5.
+static void check_glossy_room_error_order(drift_envmap_parallax parallax, const char *name,
+                                          double least)
 {
-    (void)state;
     rig r = rig_begin();
     const int32_t w = 64, h = 48;
     build_glossy_room(&r, w, h);
-    rig_commit(&r, &(drift_refine_params){ .spp = 16 });
+    drift_hybrid_params raster = raster_params;
+    raster.envmap.parallax = parallax;
+    rig_commit_raster(&r, &raster, &(drift_refine_params){ .spp = 16 });
     drift_image pure;
     assert_int_equal(drift_image_create(r.ctx, w, h, 3, &pure), DRIFT_OK);
     assert_int_equal(drift_refine_render_pure(r.sir, 16, &pure, NULL, NULL), DRIFT_OK);
@@ -740,15 +745,22 @@ static void test_glossy_room_refined_in_error_order(void **state)
         DRIFT_OK);
     assert_int_equal(drift_refine_begin(r.sir), DRIFT_OK);
     double averaged = precision_at_recall_90(drift_refine_error(r.sir), real, w, h);
-    print_message("glossy room: %u wrong pixels; precision at recall 0.9: %.3f (averaged sum "
-                  "%.3f)\n",
-                  wrong, ours, averaged);
+    print_message("glossy room, %s map: %u wrong pixels; precision at recall 0.9: %.3f "
+                  "(averaged sum %.3f)\n",
+                  name, wrong, ours, averaged);
     assert_true(wrong >= 100); // the scene shows what the order is for
-    if (!(ours >= 0.6) || !(ours >= averaged)) {
-        fail_msg("precision at recall 0.9 %.3f (averaged sum %.3f)", ours, averaged);
+    if (!(ours >= least) || !(ours >= averaged)) {
+        fail_msg("%s map: precision at recall 0.9 %.3f (averaged sum %.3f)", name, ours, averaged);
     }
     drift_image_destroy(r.ctx, &pure);
     rig_destroy(&r);
+}
+
+static void test_glossy_room_refined_in_error_order(void **state)
+{
+    (void)state;
+    check_glossy_room_error_order(DRIFT_ENVMAP_PARALLAX_NONE, "plain", 0.6);
+    check_glossy_room_error_order(DRIFT_ENVMAP_PARALLAX_BOX, "box-projected", 0.5);
 }
 
 // Largest per-channel difference of the display values of two pixels.
