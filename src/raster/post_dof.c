@@ -1,12 +1,14 @@
 // Post-process depth of field: the thin lens's circle of confusion per pixel, and the usual
 // real-time gather over it.
 //
-// The gather averages taps on a disk of the pixel's own CoC radius, whatever depth the taps
-// land on. That is the known artefact of this technique, kept on purpose because it is what
-// the technique does: colour leaks across depth edges. A blurred background pixel next to a
-// sharp foreground object averages the foreground in (a halo around the object), and a
-// blurred foreground object's edge stays sharp against the background behind it, because
-// background pixels with small CoC do not gather it. The reference technique has neither.
+// The gather averages taps on a disk of the pixel's own CoC radius, each weighed by whether
+// the tap's own circle reaches the centre (scatter as gather, as real-time engines do it:
+// Jimenez 2014): a point is seen at the centre only if its blur spreads that far, so a blurred
+// background pixel beside a sharp foreground object leaves the object out (without the weight
+// it averaged it in: a bright rim of the in-focus object on the blurred wall, issue 17). The
+// artefact kept, because it is what a single-layer gather does: a blurred foreground object's
+// edge stays sharp against an in-focus background behind it, since those pixels (circles
+// under half a pixel) gather nothing. The reference technique and ISG's DOF have neither.
 #include "raster/raster.h"
 
 #include <math.h>
@@ -100,23 +102,41 @@ static uint32_t taps_for_radius(float radius, uint32_t table_size)
     return n + 1 < table_size ? n + 1 : table_size;
 }
 
-// Equal weights. Summing differences from the centre pixel keeps a flat region exactly flat
-// (a float sum of 64 equal values would not return the value). Inlined with a constant
-// channel count for RGB, so the channel loops unroll.
+// How much a tap `distance` pixels from the centre is seen there: 1 where its own circle of
+// confusion (at the nearest pixel) reaches the centre, 0 where it falls a pixel or more
+// short, linear between, so the weight does not switch on a sub-pixel change of depth.
+static inline float tap_weight(const drift_image *coc, float tx, float ty, float distance)
+{
+    int32_t px = clamp_index((int32_t)floorf(tx + 0.5f), coc->width);
+    int32_t py = clamp_index((int32_t)floorf(ty + 0.5f), coc->height);
+    float reach = drift_image_pixel(coc, px, py)[0];
+    return reach >= 0.0f ? drift_clampf(reach - distance + 1.0f, 0.0f, 1.0f) : 0.0f;
+}
+
+// Summing weighted differences from the centre pixel keeps a flat region exactly flat (a
+// float sum of 64 equal values would not return the value). Inlined with a constant channel
+// count for RGB, so the channel loops unroll.
 static inline void gather(const dof_job *job, int32_t x, int32_t y, float radius, float *out,
                           const int32_t channels)
 {
     const float *centre = drift_image_pixel(job->in, x, y);
     float sum[4] = { 0.0f, 0.0f, 0.0f, 0.0f }, tap[4];
+    float total = 1.0f; // the centre: its own circle reaches it
     uint32_t tap_count = taps_for_radius(radius, job->tap_count);
-    for (uint32_t k = 0; k < tap_count; ++k) {
-        float tx = (float)x + job->taps[k].x * radius, ty = (float)y + job->taps[k].y * radius;
+    for (uint32_t k = 1; k < tap_count; ++k) {
+        float ox = job->taps[k].x * radius, oy = job->taps[k].y * radius;
+        float tx = (float)x + ox, ty = (float)y + oy;
+        float weight = tap_weight(job->coc, tx, ty, sqrtf(ox * ox + oy * oy));
+        if (!(weight > 0.0f)) {
+            continue;
+        }
         fetch_bilinear(job->in, tx, ty, tap, channels);
         for (int32_t c = 0; c < channels; ++c) {
-            sum[c] += tap[c] - centre[c];
+            sum[c] += weight * (tap[c] - centre[c]);
         }
+        total += weight;
     }
-    float inv = 1.0f / (float)tap_count;
+    float inv = 1.0f / total;
     for (int32_t c = 0; c < channels; ++c) {
         out[c] = centre[c] + sum[c] * inv;
     }

@@ -389,7 +389,8 @@ static void test_zero_aperture_dof_is_identity(void **state)
 // The blurred near quad (one side) spreads over the in-focus wall (right of the edge), and the
 // wall far from the edge stays sharp.
 // Focus on the near quad and blur the wall: the in-focus quad must not bleed onto the blurred
-// wall beside it (post DOF does).
+// wall beside it (nor with post DOF, whose taps are weighed by their own circle since issue 17;
+// before, its error there was 0.37).
 static void test_dof_in_focus_foreground_does_not_bleed(void **state)
 {
     (void)state;
@@ -421,7 +422,7 @@ static void test_dof_in_focus_foreground_does_not_bleed(void **state)
     print_message("wall beside an in-focus quad: isg error %.4f, post %.4f\n", (double)isg_err,
                   (double)post_err);
     assert_true(isg_err < 0.05f);
-    assert_true(post_err > 2.0f * isg_err);
+    assert_true(post_err < 0.05f);
     test_rig_destroy(&r);
 }
 
