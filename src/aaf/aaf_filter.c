@@ -47,11 +47,13 @@ void drift_aaf_allocate(const float *want, size_t count, size_t active, uint32_t
         adaptive += want[i] > 0.0f;
         flat += want[i] == 0.0f;
     }
-    // Pixels that get adaptive samples take at least half the target: eq. 3.5 and 4.6 peak
-    // steeply (as 1/s2^4 near contact), and without a floor a few contact pixels took the
-    // budget from every penumbra (the Breakfast Room's sun through the blinds). The floor
-    // bounds the loss against uniform sampling by 2x in variance where n(x) is wrong.
-    double lo = fmax((double)sparse, 0.5 * (double)spp);
+    // Pixels that get adaptive samples take at least the target: eq. 3.5 and 4.6 peak steeply
+    // (as 1/s2^4 near contact), and with a lower floor the contact pixels took the budget from
+    // the other penumbra pixels. The adaptive pass then only moves to them what the flat pixels
+    // (exactly lit or hidden) do not need. With half the target as the floor, the Breakfast
+    // Room's sun through the blinds (penumbra over 60% of the image, few flat pixels) left
+    // 11645 of its 19200 pixels at 2 samples of 4 and AAF at 0.39x of uniform sampling.
+    double lo = fmax((double)sparse, (double)spp);
     double hi = fmax((double)max_spp, lo);
     // What the adaptive pixels may spend: the whole budget less the sparse-only pixels.
     double budget = (double)spp * (double)active - (double)sparse * (double)(active - adaptive);
