@@ -118,14 +118,40 @@ static int light_polygon(const drift_scene *scene, const drift_light *l, drift_v
     return 3;
 }
 
+// --- SPHERE LIGHTS IN CLOSED FORM ---
+
+// Irradiance at p (normal n) from a sphere of unit radiance: pi sin^2(sigma) cos(theta) while
+// the sphere stands wholly above p's horizon (sigma its angular radius, theta the angle to its
+// centre), else the exact integral over the part of its cap above the horizon (Snyder 1996,
+// as restated by Lagarde and de Rousiers 2014, "Moving Frostbite to PBR", sec. 4.7.2). Inside
+// the sphere every direction above the horizon sees it: pi.
+static float sphere_irradiance(drift_vec3 p, drift_vec3 n, drift_vec3 centre, float radius)
+{
+    drift_vec3 to_centre = drift_vec3_sub(centre, p);
+    float d2 = drift_vec3_dot(to_centre, to_centre);
+    if (!(d2 > radius * radius)) {
+        return DRIFT_PI;
+    }
+    float sin2 = radius * radius / d2;
+    float cos_t = drift_clampf(drift_vec3_dot(n, to_centre) / sqrtf(d2), -1.0f, 1.0f);
+    if (cos_t * cos_t > sin2) {
+        return cos_t > 0.0f ? DRIFT_PI * sin2 * cos_t : 0.0f;
+    }
+    float sin_t = sqrtf(fmaxf(1.0f - cos_t * cos_t, 0.0f)); // > 0: cos_t^2 <= sin2 < 1
+    float x = sqrtf(1.0f / sin2 - 1.0f);
+    float y = drift_clampf(-x * cos_t / sin_t, -1.0f, 1.0f);
+    float s = sin_t * sqrtf(fmaxf(1.0f - y * y, 0.0f));
+    return fmaxf((cos_t * acos_inline(y) - x * s) * sin2 + atanf(s / x), 0.0f);
+}
+
 static bool has_closed_form(const drift_raster_light *light)
 {
-    return light->type == DRIFT_LIGHT_QUAD ||
+    return light->type == DRIFT_LIGHT_QUAD || light->type == DRIFT_LIGHT_SPHERE ||
            (light->type == DRIFT_LIGHT_TRIANGLE && light->light_count <= MAX_CLOSED_FORM_TRIANGLES);
 }
 
-// The diffuse lobe's share of U_l in closed form: kd / pi * sum over polygons of L_e * E.
-// Each polygon emits from its front face only.
+// The diffuse lobe's share of U_l in closed form: kd / pi * sum over polygons (or the sphere)
+// of L_e * E. Each polygon emits from its front face only.
 static drift_vec3 polygon_diffuse(const drift_scene *scene, const drift_raster_light *light,
                                   const drift_surface *surface, const drift_bsdf *bsdf,
                                   drift_vec3 wo)
@@ -137,6 +163,11 @@ static drift_vec3 polygon_diffuse(const drift_scene *scene, const drift_raster_l
     }
     for (uint32_t i = 0; i < light->light_count; ++i) {
         const drift_light *l = &scene->lights[light->first_light + i];
+        if (l->type == DRIFT_LIGHT_SPHERE) {
+            sum = drift_vec3_fma(sum, l->color,
+                                 sphere_irradiance(surface->position, n, l->position, l->radius));
+            continue;
+        }
         drift_vec3 polygon[4], normal;
         int count = light_polygon(scene, l, polygon, &normal);
         if (drift_vec3_dot(drift_vec3_sub(surface->position, polygon[0]), normal) <= 0.0f) {
@@ -161,7 +192,8 @@ drift_vec3 drift_raster_unshadowed(const drift_scene *scene, const drift_raster_
                                                           drift_vec2_make(0.5f, 0.5f));
         return light_sample_contribution(surface, bsdf, wo, &ls, false);
     }
-    // Polygons: the diffuse lobe in closed form (no noise), samples for the glossy lobe only.
+    // Polygons and spheres: the diffuse lobe in closed form (no noise), samples for the glossy
+    // lobe only.
     bool closed_form = has_closed_form(light);
     if (closed_form) {
         sum = polygon_diffuse(scene, light, surface, bsdf, wo);

@@ -492,40 +492,28 @@ static void test_deterministic_across_threads(void **state)
 
 // --- UNSHADOWED LIGHT ---
 
-// The closed-form diffuse term of a quad light equals a brute-force Monte Carlo integral of
-// the same BSDF and light code, including points that see the light partly below their
-// horizon (clipping) and points behind it (zero).
-static void test_unshadowed_quad_matches_monte_carlo(void **state)
+typedef struct unshadowed_case {
+    drift_vec3 p, n;
+} unshadowed_case;
+
+// The closed-form diffuse term of `light` at each case equals a brute-force Monte Carlo
+// integral of the same BSDF and light code (the path tracer's light sampling); the cases
+// listed in `dark` must be exactly 0.
+static void check_unshadowed_matches_monte_carlo(const drift_light *light,
+                                                 const unshadowed_case *cases, size_t count,
+                                                 size_t dark)
 {
-    (void)state;
     test_rig r = test_rig_begin(1);
     uint32_t white =
         test_add_material(r.scene, drift_material_make(drift_vec3_make(0.8f, 0.5f, 0.2f)));
     test_add_floor(r.scene, 10.0f, -5.0f, white);
-    assert_int_equal(drift_scene_add_light(r.scene,
-                                           &(drift_light){ .type = DRIFT_LIGHT_QUAD,
-                                                           .position = { -0.5f, 1.0f, -0.5f },
-                                                           .edge_u = { 1, 0, 0 },
-                                                           .edge_v = { 0, 0, 1 },
-                                                           .color = { 3, 3, 3 } },
-                                           NULL),
-                     DRIFT_OK);
+    assert_int_equal(drift_scene_add_light(r.scene, light, NULL), DRIFT_OK);
     test_rig_commit(&r);
     drift_raster_light *lights = NULL;
-    uint32_t count = 0;
-    assert_int_equal(drift_raster_lights_build(r.ctx, r.scene, &lights, &count), DRIFT_OK);
-    assert_int_equal(count, 1);
-
-    const struct {
-        drift_vec3 p, n;
-    } cases[] = {
-        { { 0, 0, 0 }, { 0, 1, 0 } },              // straight below
-        { { 2, 0.5f, 0.3f }, { -0.6f, 0.8f, 0 } }, // off to the side, tilted
-        { { 0.2f, 0.9f, 0 }, { 1, 0, 0 } }, // a wall just below: the quad crosses its horizon
-        { { 0, 2, 0 }, { 0, -1, 0 } },      // above the light: behind its emitting side
-    };
-
-    for (size_t c = 0; c < sizeof cases / sizeof *cases; ++c) {
+    uint32_t light_count = 0;
+    assert_int_equal(drift_raster_lights_build(r.ctx, r.scene, &lights, &light_count), DRIFT_OK);
+    assert_int_equal(light_count, 1);
+    for (size_t c = 0; c < count; ++c) {
         drift_surface s = { .position = cases[c].p,
                             .material = white,
                             .light = DRIFT_INVALID_INDEX };
@@ -549,12 +537,52 @@ static void test_unshadowed_quad_matches_monte_carlo(void **state)
         mc /= n;
         print_message("case %zu: closed form %g, Monte Carlo %g\n", c, (double)closed.x, mc);
         assert_near(closed.x, mc, 0.01 * mc + 1e-6);
-        if (c == 3) {
+        if (c == dark) {
             assert_near(closed.x, 0.0, 0.0);
         }
     }
-    drift_raster_lights_destroy(r.ctx, lights, count);
+    drift_raster_lights_destroy(r.ctx, lights, light_count);
     test_rig_destroy(&r);
+}
+
+// A quad light, including points that see it partly below their horizon (clipping) and
+// points behind it (zero).
+static void test_unshadowed_quad_matches_monte_carlo(void **state)
+{
+    (void)state;
+    const unshadowed_case cases[] = {
+        { { 0, 0, 0 }, { 0, 1, 0 } },              // straight below
+        { { 2, 0.5f, 0.3f }, { -0.6f, 0.8f, 0 } }, // off to the side, tilted
+        { { 0.2f, 0.9f, 0 }, { 1, 0, 0 } }, // a wall just below: the quad crosses its horizon
+        { { 0, 2, 0 }, { 0, -1, 0 } },      // above the light: behind its emitting side
+    };
+    check_unshadowed_matches_monte_carlo(&(drift_light){ .type = DRIFT_LIGHT_QUAD,
+                                                         .position = { -0.5f, 1.0f, -0.5f },
+                                                         .edge_u = { 1, 0, 0 },
+                                                         .edge_v = { 0, 0, 1 },
+                                                         .color = { 3, 3, 3 } },
+                                         cases, sizeof cases / sizeof *cases, 3);
+}
+
+// A sphere light (radius 0.4 at height 1), wholly above the horizon, partly below it (a wall
+// beside and below it: the horizon cuts its cap, Snyder's clipped integral) and wholly below
+// it (zero). Before the sphere had its closed form, its diffuse term was 8 samples a pixel.
+static void test_unshadowed_sphere_matches_monte_carlo(void **state)
+{
+    (void)state;
+    const unshadowed_case cases[] = {
+        { { 0, 0, 0 }, { 0, 1, 0 } },              // straight below
+        { { 2, 0.5f, 0.3f }, { -0.6f, 0.8f, 0 } }, // off to the side, tilted
+        { { 0.45f, 1.0f, 0 }, { 0, 1, 0 } },       // beside it: the horizon halves the cap
+        { { 0.6f, 1.2f, 0 }, { -0.2f, 1, 0 } },    // close: most of the cap below
+        { { 0.6f, 1.0f, 0 }, { -0.3f, 1, 0 } },    // close: most of the cap above
+        { { 0, 0, 0 }, { 0, -1, 0 } },             // facing away: wholly below the horizon
+    };
+    check_unshadowed_matches_monte_carlo(&(drift_light){ .type = DRIFT_LIGHT_SPHERE,
+                                                         .position = { 0, 1.0f, 0 },
+                                                         .radius = 0.4f,
+                                                         .color = { 3, 3, 3 } },
+                                         cases, sizeof cases / sizeof *cases, 5);
 }
 
 // --- NAMES AND ARGUMENTS ---
@@ -614,6 +642,7 @@ int main(void)
         cmocka_unit_test(test_post_dof_pinhole_is_identity),
         cmocka_unit_test(test_deterministic_across_threads),
         cmocka_unit_test(test_unshadowed_quad_matches_monte_carlo),
+        cmocka_unit_test(test_unshadowed_sphere_matches_monte_carlo),
         cmocka_unit_test(test_technique_names_round_trip),
         cmocka_unit_test(test_rejects_bad_params),
     };
