@@ -46,10 +46,10 @@ typedef struct metric_job {
     drift_image *out;
     float ao_radius;
     uint64_t ao_rays;
-    light_shape *shapes; // one a frame light, or NULL: bounding spheres
-    float *expected;     // a pixel's expected reflection error (-1: not reflective), or NULL
-    struct penumbra_check *checks; // a pixel: the raster's shadow checked by rays
-    float *coarse; // the penumbra estimate at each 2 x 2 block's corner pixel, a light
+    light_shape *shapes;    // one a frame light, or NULL: bounding spheres
+    float *expected;        // a pixel's expected reflection error (-1: not reflective), or NULL
+    penumbra_check *checks; // a pixel: the raster's shadow checked by rays
+    float *coarse;          // the penumbra estimate at each 2 x 2 block's corner pixel, a light
 } metric_job;
 
 static bool is_reflective(const drift_frame_state *f, const drift_surface *s)
@@ -207,7 +207,9 @@ static float expected_reflection_error(drift_frame_state *f, size_t index, const
     drift_vec3 hit_at[MAX_LOBE_RAYS + 1]; // the mirror ray's and the lobe rays' hit points
     drift_ray lobe[MAX_LOBE_RAYS];
     uint32_t lobe_count = 0;
-    for (uint32_t k = 0; k <= (mirror ? 0u : samples); ++k) { // k = 0: the mirror ray
+    // At most MAX_LOBE_RAYS lobe rays, so that every ray cast is kept and counted.
+    uint32_t lobe_rays = mirror ? 0u : (samples < MAX_LOBE_RAYS ? samples : MAX_LOBE_RAYS);
+    for (uint32_t k = 0; k <= lobe_rays; ++k) { // k = 0: the mirror ray
         drift_vec3 dir =
             k == 0 ? r : drift_bsdf_sample_glossy_lobe(&bsdf, wo, drift_sampler_next2(sampler));
         if (drift_vec3_dot(dir, s->ng) <= 0.0f) {
@@ -221,10 +223,8 @@ static float expected_reflection_error(drift_frame_state *f, size_t index, const
         ++*rays;
         ++used;
         if (drift_accel_intersect(f->accel, &ray, &hit)) {
-            if (hit_count <= MAX_LOBE_RAYS) {
-                hit_at[hit_count++] = drift_vec3_fma(ray.origin, dir, hit.t);
-            }
-            if ((k > 0 || mirror) && lobe_count < MAX_LOBE_RAYS) {
+            hit_at[hit_count++] = drift_vec3_fma(ray.origin, dir, hit.t);
+            if (k > 0 || mirror) {
                 lobe[lobe_count++] = ray;
             }
         } else if (mirror && drift_scene_has_environment(f->scene)) {
@@ -255,8 +255,8 @@ static float expected_reflection_error(drift_frame_state *f, size_t index, const
             // A q the map cannot see (a contact, the underside of an object in the floor):
             // what the lobe's rays see there, shaded by the tracer's direct light (a few
             // shadow rays), is the reflection the ray tracer will find.
-            return hidden_reflection_error(f, index, &bsdf, lobe, lobe_count, mirror ? 1u : samples,
-                                           raster, sampler, rays);
+            return hidden_reflection_error(f, index, &bsdf, lobe, lobe_count,
+                                           mirror ? 1u : lobe_rays, raster, sampler, rays);
         }
         float from_p = drift_vec3_length(drift_vec3_sub(hit_at[k], s->position));
         float cone_q = box ? drift_envmap_parallax_cone(cone, from_p / distance) : cone;
