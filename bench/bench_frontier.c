@@ -28,14 +28,17 @@
 #define MAX_BUDGETS    16
 #define MAX_ROWS       512
 #define FRONTIER_DEPTH 8
-#define REF_SEED       0x5eedu
+// The hybrid frame's own default (drift_hybrid_params.light_samples = 0 -> 8); a row at
+// another count is named with it.
+#define DEFAULT_LIGHT_SAMPLES 8
+#define REF_SEED              0x5eedu
 
 typedef struct frontier_options {
     const char *scene_path, *csv_path, *svg_path, *cache_dir;
     long size, threads, ref_spp, runs, max_spp;
     long budgets[MAX_BUDGETS], vpls[MAX_BUDGETS], aaf_spps[MAX_BUDGETS], aa[MAX_BUDGETS],
-        sir[MAX_BUDGETS];
-    int budget_count, vpl_count, aaf_spp_count, aa_count, sir_count;
+        sir[MAX_BUDGETS], light_samples[MAX_BUDGETS];
+    int budget_count, vpl_count, aaf_spp_count, aa_count, sir_count, light_sample_count;
     bool json;
 } frontier_options;
 
@@ -50,6 +53,10 @@ static bool parse_budgets(const char *cmd, const char *flag, const char *value, 
     }
     if (strcmp(flag, "--aa") == 0) {
         return bench_parse_list(cmd, flag, value, 1, 4096, MAX_BUDGETS, o->aa, &o->aa_count);
+    }
+    if (strcmp(flag, "--light-samples") == 0) {
+        return bench_parse_list(cmd, flag, value, 1, 4096, MAX_BUDGETS, o->light_samples,
+                                &o->light_sample_count);
     }
     if (strcmp(flag, "--aaf-spp") == 0) {
         return bench_parse_list(cmd, flag, value, 1, 1024, MAX_BUDGETS, o->aaf_spps,
@@ -71,6 +78,9 @@ static const cli_option frontier_table[] = {
                    "SIR rows refine for these iterations (default 1,4,16)"),
     CLI_CUSTOM_ALL("--aa", "LIST", parse_budgets,
                    "anti-aliasing passes of every hybrid row (default 1,4)"),
+    CLI_CUSTOM_ALL("--light-samples", "LIST", parse_budgets,
+                   "unshadowed-light samples of every hybrid row (default 8; 1 or 2\n"
+                   "fit a frame of the plants into 100 ms, docs/frontier.md)"),
     CLI_INT("--size", "N", O, size, 4, 4096, "N x N pixels (default 400)"),
     CLI_INT("--threads", "T", O, threads, 0, 256, "worker threads (default 2)"),
     CLI_INT("--ref-spp", "N", O, ref_spp, 1, 1 << 20, "reference samples a pixel (default 512)"),
@@ -348,8 +358,8 @@ static drift_result hybrid_row(frontier_state *b, const char *name,
 }
 
 // The hybrid combinations: shadows hard, pcss, isg, aaf x indirect none, ambient, ism and ir at
-// 16..1024 VPLs, aaf; AAF rows at 1, 2 and 4 spp; each at --aa 1 and 4 anti-aliasing passes;
-// max depth 8. The other effects keep the
+// 16..1024 VPLs, aaf; AAF rows at 1, 2 and 4 spp; each at every --light-samples count (8) and
+// at --aa 1 and 4 anti-aliasing passes; max depth 8. The other effects keep the
 // technique that matches the reference: reflections none on a scene without glossy or mirror
 // materials (else isg: AAF's reflections scored only ~0.006 lower FLIP on the glossy box at
 // 11-15x the frame time, docs/frontier.md), depth of field none for a pinhole camera (else post:
@@ -373,13 +383,17 @@ static drift_result hybrid_rows(frontier_state *b, double limit_ms)
             bool aaf = strcmp(shadows[s], "aaf") == 0 || strcmp(indirect[i], "aaf") == 0;
             size_t vpl_count = vpl ? (size_t)b->o->vpl_count : 1;
             size_t spp_count = aaf ? (size_t)b->o->aaf_spp_count : 1;
+            size_t ls_count = (size_t)b->o->light_sample_count;
+            size_t variants = spp_count * ls_count * (size_t)b->o->aa_count;
             for (size_t v = 0; v < vpl_count && r == DRIFT_OK; ++v) {
-                for (size_t k = 0; k < spp_count * (size_t)b->o->aa_count && r == DRIFT_OK; ++k) {
-                    long aa_passes = b->o->aa[k / spp_count];
+                for (size_t k = 0; k < variants && r == DRIFT_OK; ++k) {
+                    long aa_passes = b->o->aa[k / (spp_count * ls_count)];
+                    long light_samples = b->o->light_samples[(k / spp_count) % ls_count];
                     drift_hybrid_params p = { .width = (int32_t)b->o->size,
                                               .height = (int32_t)b->o->size,
                                               .max_depth = FRONTIER_DEPTH,
                                               .spp = aaf ? (uint32_t)spps[k % spp_count] : 1,
+                                              .light_samples = (uint32_t)light_samples,
                                               .aa = (uint32_t)aa_passes };
                     drift_hybrid_params_set_technique(
                         &p, DRIFT_EFFECT_SHADOWS,
@@ -406,6 +420,10 @@ static drift_result hybrid_rows(frontier_state *b, double limit_ms)
                     if (aaf) {
                         len += snprintf(name + len, sizeof name - (size_t)len, " %ld spp",
                                         spps[k % spp_count]);
+                    }
+                    if (light_samples != DEFAULT_LIGHT_SAMPLES) {
+                        len += snprintf(name + len, sizeof name - (size_t)len, " ls %ld",
+                                        light_samples);
                     }
                     if (aa_passes > 1) {
                         snprintf(name + len, sizeof name - (size_t)len, " aa %ld", aa_passes);
@@ -711,6 +729,8 @@ int drift_bench_frontier(int argc, char **argv)
                            .aaf_spp_count = 3,
                            .aa = { 1, 4 },
                            .aa_count = 2,
+                           .light_samples = { DEFAULT_LIGHT_SAMPLES },
+                           .light_sample_count = 1,
                            .sir = { 1, 4, 16 },
                            .sir_count = 3 };
     int status = cli_parse(&frontier_command, argc, argv, &o, NULL);

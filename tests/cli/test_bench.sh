@@ -120,7 +120,8 @@ assert d["rows"][3]["photons"] > 0 and d["rows"][2]["photons"] == 0, d'
         # Twice: the second run must reuse the cached reference and give the same FLIP values.
         for run in 1 2; do
             expect 0 "$drift" bench frontier "$box" --size 12 --ref-spp 4 --runs 1 --max-spp 2 \
-                --vpls 8 --aaf-spp 1 --aa 1,2 --sir-iterations 1,2 --budgets 1,20,1000 \
+                --vpls 8 --aaf-spp 1 --aa 1,2 --light-samples 8,1 --sir-iterations 1,2 \
+                --budgets 1,20,1000 \
                 --cache "$tmp/cache" --threads 1 \
                 --csv "$tmp/frontier.csv" --svg "$tmp/frontier.svg" --json
             cp "$tmp/out" "$tmp/frontier$run.json"
@@ -131,9 +132,12 @@ assert [r["flip"] for r in first["rows"] if r["family"] != "hybrid"] == \
     [r["flip"] for r in d["rows"] if r["family"] != "hybrid"], d
 fam = [r["family"] for r in d["rows"]]
 assert fam.count("pt") == 2 and fam.count("pt+atrous") == 2 and fam.count("hybrid") >= 20, fam
-# Every hybrid combination once more at --aa 2; SIR rows refine the pcss frame.
+# Every hybrid combination once more at --aa 2 and at one light sample; SIR rows refine the
+# pcss frame.
 names = [r["name"] for r in d["rows"] if r["family"] == "hybrid"]
 assert sum(n.endswith(" aa 2") for n in names) * 2 == len(names), names
+assert sum(" ls 1" in n for n in names) * 2 == len(names), names
+assert not any(" ls 8" in n for n in names), names
 assert 1 <= fam.count("sir") <= 2, fam
 assert all(r["ms"] > 0 and 0 <= r["flip"] <= 1 and r["rmse"] >= 0 for r in d["rows"]), d
 prev = 2.0
