@@ -364,6 +364,10 @@ static const cli_option render_table[] = {
             "points on each ssao/ssdo sample direction: 1 the thesis's\n"
             "point test (ssao default), more a march to r_max (a ray\n"
             "test; ssdo default 4)"),
+    CLI_CHOICE("--env-interleave", "off|on", O, hybrid.environment_interleave, "off|on",
+               "on: a quarter of the environment's --light-samples shadow rays a\n"
+               "pixel, interleaved over 2 x 2 pixels and gathered back over 3 x 3\n"
+               "of the same surface (default off; docs/hybrid.md)"),
     CLI_CHOICE("--contact-shadows", "off|on", O, hybrid.shadow_map.contact_shadows, "off|on",
                "on: --shadows pcf|pcss march each lit pixel's shadow-map bias\n"
                "toward the light in screen space (thesis §4.5; default off)"),

@@ -203,6 +203,10 @@ typedef struct drift_occlusion_settings {
 //   max_depth        = 0 -> 2 for reference reflections and indirect light (pt convention:
 //                      2 = one bounce, what the sharp buffers can capture)
 //   light_samples    = 0 -> 8 samples per area light for the unshadowed light U_l
+//   environment_interleave = false: each pixel traces its light_samples environment shadow
+//                      rays; true: interleaved sampling (Keller and Heidrich 2001), each pixel
+//                      of a 2 x 2 block traces a quarter of one shared set, and a 3 x 3
+//                      tent gather over pixels of the same surface sums the set again
 //   aa               = 0 -> 1: anti-aliasing passes. N > 1 renders the whole frame N times,
 //                      each pass with the camera's film shifted by a stratified sub-pixel
 //                      offset (the path tracer's box pixel filter) and its own seed, and
@@ -234,6 +238,7 @@ typedef struct drift_hybrid_params {
     uint32_t spp;
     int32_t max_depth;
     uint32_t light_samples;
+    bool environment_interleave;
     uint32_t aa;
     bool has_ambient;
     drift_vec3 ambient;

@@ -77,6 +77,14 @@ drift_vec3 drift_raster_environment_direct(const drift_scene *scene, const drift
                                            const drift_surface *surface, const drift_bsdf *bsdf,
                                            drift_vec3 wo, uint32_t sample_count,
                                            drift_sampler *sampler, uint64_t *rays);
+// The same estimate over the points first, first + stride, ... of a Hammersley set of
+// set_size points shifted by `shift`: interleaved sampling, where neighbouring pixels take
+// the set's other points (realtime/direct.c).
+drift_vec3
+drift_raster_environment_direct_subset(const drift_scene *scene, const drift_accel *accel,
+                                       const drift_surface *surface, const drift_bsdf *bsdf,
+                                       drift_vec3 wo, uint32_t set_size, uint32_t first,
+                                       uint32_t stride, drift_vec2 shift, uint64_t *rays);
 
 // A shadow ray from the surface toward the light's centre (or against a directional
 // light's direction). Returns whether the centre is visible; distances to the nearest

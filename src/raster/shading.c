@@ -222,13 +222,28 @@ drift_vec3 drift_raster_environment_direct(const drift_scene *scene, const drift
                                            drift_vec3 wo, uint32_t sample_count,
                                            drift_sampler *sampler, uint64_t *rays)
 {
-    drift_vec3 sum = drift_vec3_splat(0.0f);
     if (!drift_scene_has_environment(scene) || drift_bsdf_is_delta(bsdf)) {
-        return sum;
+        return drift_vec3_splat(0.0f);
     }
     uint32_t n = sample_count > 0 ? sample_count : 1;
-    drift_vec2 shift = drift_sampler_next2(sampler);
-    for (uint32_t k = 0; k < n; ++k) {
+    return drift_raster_environment_direct_subset(scene, accel, surface, bsdf, wo, n, 0, 1,
+                                                  drift_sampler_next2(sampler), rays);
+}
+
+drift_vec3 drift_raster_environment_direct_subset(const drift_scene *scene,
+                                                  const drift_accel *accel,
+                                                  const drift_surface *surface,
+                                                  const drift_bsdf *bsdf, drift_vec3 wo,
+                                                  uint32_t set_size, uint32_t first,
+                                                  uint32_t stride, drift_vec2 shift, uint64_t *rays)
+{
+    drift_vec3 sum = drift_vec3_splat(0.0f);
+    if (!drift_scene_has_environment(scene) || drift_bsdf_is_delta(bsdf) || stride == 0) {
+        return sum;
+    }
+    uint32_t n = set_size, taken = 0;
+    for (uint32_t k = first; k < n; k += stride) {
+        ++taken;
         drift_light_sample ls = drift_environment_sample(scene, shifted_hammersley(k, n, shift));
         drift_vec3 c = light_sample_contribution(surface, bsdf, wo, &ls, false);
         if (drift_vec3_is_zero(c)) {
@@ -243,7 +258,7 @@ drift_vec3 drift_raster_environment_direct(const drift_scene *scene, const drift
             sum = drift_vec3_add(sum, c);
         }
     }
-    return drift_vec3_scale(sum, 1.0f / (float)n);
+    return taken ? drift_vec3_scale(sum, 1.0f / (float)taken) : sum;
 }
 
 drift_ray drift_raster_hard_shadow_ray(const drift_raster_light *light,

@@ -5,6 +5,8 @@
 #include "realtime/realtime.h"
 
 #include <math.h>
+#include <stdlib.h>
+#include <string.h>
 
 static size_t pixel_index(const drift_frame_state *f, int32_t x, int32_t y)
 {
@@ -37,9 +39,62 @@ static void unshadowed_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_
     if (f->environment_diffuse_elsewhere) {
         env_bsdf.diffuse = zero;
     }
-    drift_image_set3(&f->environment_direct, x, y,
-                     drift_raster_environment_direct(f->scene, f->accel, s, &env_bsdf, wo,
-                                                     f->params.light_samples, &sampler, rays));
+    drift_vec3 env;
+    if (f->params.environment_interleave) {
+        // One shifted set of 4 m points for the 2 x 2 block; this pixel takes every fourth.
+        uint32_t m = (f->params.light_samples + 3) / 4;
+        drift_sampler block = drift_pass_sampler(f, DRIFT_STREAM_UNSHADOWED, x & ~1, y & ~1);
+        env = drift_raster_environment_direct_subset(f->scene, f->accel, s, &env_bsdf, wo, 4 * m,
+                                                     (uint32_t)((x & 1) | ((y & 1) << 1)), 4,
+                                                     drift_sampler_next2(&block), rays);
+    } else {
+        env = drift_raster_environment_direct(f->scene, f->accel, s, &env_bsdf, wo,
+                                              f->params.light_samples, &sampler, rays);
+    }
+    drift_image_set3(&f->environment_direct, x, y, env);
+}
+
+// Interleaved environment light gathered back: a 3 x 3 tent (1 2 1 x 1 2 1) weighs each of the
+// 2 x 2 block's four point sets alike at a pixel, over the neighbours on the same surface
+// (same mesh, normals within 25 degrees, depth within 5%), renormalised where some are not.
+typedef struct interleave_job {
+    const drift_image *in;
+    drift_image *out;
+} interleave_job;
+
+static void interleave_gather_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays,
+                                    void *user)
+{
+    (void)rays;
+    const interleave_job *job = user;
+    const drift_gbuffer *g = &f->gbuffer;
+    size_t centre = pixel_index(f, x, y);
+    if (g->surfaces[centre].material == DRIFT_INVALID_INDEX) {
+        drift_image_set3(job->out, x, y, drift_image_get3(job->in, x, y));
+        return;
+    }
+    float depth = drift_image_pixel(&g->depth, x, y)[0];
+    drift_vec3 normal = drift_image_get3(&g->normal, x, y);
+    drift_vec3 sum = drift_vec3_splat(0.0f);
+    float total = 0.0f;
+    for (int32_t dy = -1; dy <= 1; ++dy) {
+        for (int32_t dx = -1; dx <= 1; ++dx) {
+            int32_t u = x + dx, v = y + dy;
+            if (u < 0 || v < 0 || u >= f->params.width || v >= f->params.height) {
+                continue;
+            }
+            size_t other = pixel_index(f, u, v);
+            if (g->mesh_index[other] != g->mesh_index[centre] ||
+                drift_vec3_dot(drift_image_get3(&g->normal, u, v), normal) < 0.9f ||
+                fabsf(drift_image_pixel(&g->depth, u, v)[0] - depth) > 0.05f * depth) {
+                continue;
+            }
+            float w = (float)((2 - abs(dx)) * (2 - abs(dy)));
+            sum = drift_vec3_fma(sum, drift_image_get3(job->in, u, v), w);
+            total += w;
+        }
+    }
+    drift_image_set3(job->out, x, y, drift_vec3_scale(sum, 1.0f / total)); // total >= 4
 }
 
 // Hard shadows of one row toward one light, traced as coherent packets: neighbouring
@@ -142,6 +197,19 @@ drift_result drift_realtime_build_shadow_maps(drift_frame_state *f)
 drift_result drift_realtime_pass_unshadowed(drift_frame_state *f)
 {
     drift_pass_pixels(f, DRIFT_PASS_UNSHADOWED, unshadowed_pixel, NULL);
+    if (!f->params.environment_interleave || !drift_scene_has_environment(f->scene)) {
+        return DRIFT_OK;
+    }
+    drift_image gathered;
+    drift_result r = drift_image_create(f->ctx, f->params.width, f->params.height, 3, &gathered);
+    if (r != DRIFT_OK) {
+        return r;
+    }
+    interleave_job job = { .in = &f->environment_direct, .out = &gathered };
+    drift_pass_pixels(f, DRIFT_PASS_UNSHADOWED, interleave_gather_pixel, &job);
+    memcpy(f->environment_direct.pixels, gathered.pixels,
+           sizeof(float) * 3 * (size_t)f->params.width * (size_t)f->params.height);
+    drift_image_destroy(f->ctx, &gathered);
     return DRIFT_OK;
 }
 

@@ -585,6 +585,56 @@ static void test_unshadowed_sphere_matches_monte_carlo(void **state)
                                          cases, sizeof cases / sizeof *cases, 5);
 }
 
+// The environment's direct light, copied from the frame rendered with `params`.
+static drift_image environment_plane(test_rig *r, const drift_hybrid_params *params)
+{
+    test_rig_frame(r, params);
+    const drift_image *plane = test_rig_plane(r, "environment_direct");
+    drift_image copy;
+    assert_int_equal(drift_image_create(r->ctx, plane->width, plane->height, 3, &copy), DRIFT_OK);
+    memcpy(copy.pixels, plane->pixels, sizeof(float) * 3 * (size_t)plane->width * plane->height);
+    return copy;
+}
+
+// Interleaved environment samples (each pixel of a 2 x 2 block a quarter of one set of 8,
+// gathered back over 3 x 3 of the same surface) against 2 samples a pixel, the same shadow
+// rays: closer to the converged light (a floor under a constant sky, half shaded by a low
+// roof, and the roof's top), with the same mean.
+static void test_environment_interleave_beats_equal_rays(void **state)
+{
+    (void)state;
+    test_rig r = test_rig_begin(2);
+    uint32_t white = test_add_material(r.scene, drift_material_make(drift_vec3_splat(0.7f)));
+    test_add_floor(r.scene, 4.0f, 0.0f, white);
+    test_add_quad(r.scene, drift_vec3_make(-1.0f, 0.4f, -1.0f), drift_vec3_make(2.0f, 0, 0),
+                  drift_vec3_make(0, 0, 2.0f), white);
+    r.scene->environment.color = drift_vec3_splat(0.5f);
+    r.scene->camera =
+        drift_camera_look_at(drift_vec3_make(0, 3.0f, -3.0f), drift_vec3_make(0, 0, 0),
+                             drift_vec3_make(0, 1, 0), 0.9f, 64, 48);
+    test_rig_commit(&r);
+    drift_image truth = environment_plane(&r, &(drift_hybrid_params){ .light_samples = 1024 });
+    drift_image plain = environment_plane(&r, &(drift_hybrid_params){ .light_samples = 2 });
+    uint64_t plain_rays = drift_hybrid_get_stats(r.frame).rays[DRIFT_PASS_UNSHADOWED];
+    drift_image interleaved = environment_plane(
+        &r, &(drift_hybrid_params){ .light_samples = 8, .environment_interleave = true });
+    uint64_t interleaved_rays = drift_hybrid_get_stats(r.frame).rays[DRIFT_PASS_UNSHADOWED];
+    double e_plain = test_rmse(r.ctx, &plain, &truth);
+    double e_interleaved = test_rmse(r.ctx, &interleaved, &truth);
+    double mean = drift_image_mean_luminance(&interleaved) / drift_image_mean_luminance(&truth);
+    print_message("environment light: rmse 2 a pixel %g, interleaved 8 over 2 x 2 %g; rays %llu "
+                  "and %llu; interleaved mean / converged %g\n",
+                  e_plain, e_interleaved, (unsigned long long)plain_rays,
+                  (unsigned long long)interleaved_rays, mean);
+    assert_true(interleaved_rays <= plain_rays + plain_rays / 20);
+    assert_true(e_interleaved < 0.7 * e_plain);
+    assert_near(mean, 1.0, 0.02);
+    drift_image_destroy(r.ctx, &truth);
+    drift_image_destroy(r.ctx, &plain);
+    drift_image_destroy(r.ctx, &interleaved);
+    test_rig_destroy(&r);
+}
+
 // --- NAMES AND ARGUMENTS ---
 
 static void test_technique_names_round_trip(void **state)
@@ -643,6 +693,7 @@ int main(void)
         cmocka_unit_test(test_deterministic_across_threads),
         cmocka_unit_test(test_unshadowed_quad_matches_monte_carlo),
         cmocka_unit_test(test_unshadowed_sphere_matches_monte_carlo),
+        cmocka_unit_test(test_environment_interleave_beats_equal_rays),
         cmocka_unit_test(test_technique_names_round_trip),
         cmocka_unit_test(test_rejects_bad_params),
     };
