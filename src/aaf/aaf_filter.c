@@ -53,7 +53,7 @@ void drift_aaf_allocate(const float *want, size_t count, size_t active, uint32_t
     // (exactly lit or hidden) do not need. With half the target as the floor, the Breakfast
     // Room's sun through the blinds (penumbra over 60% of the image, few flat pixels) left
     // 11645 of its 19200 pixels at 2 samples of 4 and AAF at 0.39x of uniform sampling.
-    double lo = fmax((double)sparse, (double)spp);
+    double lo = (double)spp; // never under `sparse`: the counts are held at it below
     double hi = fmax((double)max_spp, lo);
     // What the adaptive pixels may spend: the whole budget less the sparse-only pixels.
     double budget = (double)spp * (double)active - (double)sparse * (double)(active - adaptive);
