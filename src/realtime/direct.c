@@ -6,7 +6,6 @@
 
 #include <math.h>
 #include <stdlib.h>
-#include <string.h>
 
 static size_t pixel_index(const drift_frame_state *f, int32_t x, int32_t y)
 {
@@ -207,9 +206,11 @@ drift_result drift_realtime_pass_unshadowed(drift_frame_state *f)
     }
     interleave_job job = { .in = &f->environment_direct, .out = &gathered };
     drift_pass_pixels(f, DRIFT_PASS_UNSHADOWED, interleave_gather_pixel, &job);
-    memcpy(f->environment_direct.pixels, gathered.pixels,
-           sizeof(float) * 3 * (size_t)f->params.width * (size_t)f->params.height);
-    drift_image_destroy(f->ctx, &gathered);
+    // The gathered image becomes the plane (the frame's planes point at the struct, not at
+    // its pixels); the interleaved one is freed.
+    drift_image interleaved = f->environment_direct;
+    f->environment_direct = gathered;
+    drift_image_destroy(f->ctx, &interleaved);
     return DRIFT_OK;
 }
 
