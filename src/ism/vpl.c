@@ -255,6 +255,27 @@ static bool emit(const path_job *job, drift_sampler *s, drift_ray *out_ray, drif
     return drift_light_emit_area(scene, l, u1, u2, pmf, n, out_ray, out_flux);
 }
 
+// The closest hit of `ray` and its BSDF; false when the ray misses or hits a pure emitter.
+static bool trace_vertex(const drift_scene *scene, const drift_accel *accel, const drift_ray *ray,
+                         drift_surface *out_surface, drift_bsdf *out_bsdf)
+{
+    drift_hit hit;
+    if (!drift_accel_intersect(accel, ray, &hit)) {
+        return false;
+    }
+    *out_surface = drift_scene_surface(scene, ray, &hit);
+    if (out_surface->material == DRIFT_INVALID_INDEX) {
+        return false;
+    }
+    *out_bsdf = drift_bsdf_make(scene, out_surface);
+    return true;
+}
+
+// Every vertex leaves a VPL of the light its diffuse lobe reflects (a VPL shines diffusely).
+// The path goes on by the cosine of a diffuse surface, or by drift_bsdf_sample_wi's lobes
+// where the surface has a glossy or mirror lobe: that carries the light a glossy floor
+// reflects to the ceiling, which a diffuse-only path dropped (40% of the glossy Cornell
+// floor's reflected light; docs/ism.md, "VPLs").
 static void trace_paths(size_t begin, size_t end, int thread, void *user)
 {
     (void)thread;
@@ -279,18 +300,38 @@ static void trace_paths(size_t begin, size_t end, int thread, void *user)
                 flux = drift_vec3_scale(flux, (float)job->params->vpl_count / (float)later);
             }
             drift_surface surf;
-            drift_vec3 kd;
-            if (!trace_surface(job->scene, job->accel, &ray, &surf, &kd)) {
+            drift_bsdf bsdf;
+            if (!trace_vertex(job->scene, job->accel, &ray, &surf, &bsdf)) {
                 break;
             }
-            flux = drift_vec3_mul(flux, kd);
-            if (drift_vec3_is_zero(flux)) {
-                break;
+            bool mirror = bsdf.type == DRIFT_MATERIAL_MIRROR;
+            drift_vec3 diffuse =
+                drift_vec3_mul(flux, mirror ? drift_vec3_splat(0.0f) : bsdf.diffuse);
+            if (!drift_vec3_is_zero(diffuse)) {
+                slots[b] = (drift_vpl){ surf.position, surf.ns, diffuse, b + 1 };
             }
-            slots[b] = (drift_vpl){ surf.position, surf.ns, flux, b + 1 };
-            drift_frame fr = drift_frame_from_normal(surf.ns);
-            drift_vec3 w =
-                drift_frame_to_world(&fr, drift_sample_cosine_hemisphere(drift_sampler_next2(&s)));
+            drift_vec3 w;
+            if (!mirror && drift_vec3_is_zero(bsdf.specular)) {
+                flux = diffuse;
+                if (drift_vec3_is_zero(flux)) {
+                    break;
+                }
+                drift_frame fr = drift_frame_from_normal(surf.ns);
+                w = drift_frame_to_world(&fr,
+                                         drift_sample_cosine_hemisphere(drift_sampler_next2(&s)));
+            } else {
+                float u_lobe = drift_sampler_next1(&s);
+                drift_bsdf_sample bs = drift_bsdf_sample_wi(&bsdf, drift_vec3_neg(ray.dir), u_lobe,
+                                                            drift_sampler_next2(&s));
+                if (!(bs.pdf > 0.0f)) {
+                    break;
+                }
+                flux = drift_vec3_mul(flux, bs.weight);
+                w = bs.wi;
+                if (drift_vec3_is_zero(flux)) {
+                    break;
+                }
+            }
             if (drift_vec3_dot(w, surf.ng) <= 0.0f) {
                 break;
             }

@@ -170,6 +170,43 @@ static void test_vpl_flux_is_power_times_albedo(void **state)
     }
 }
 
+// Light paths go on through glossy and mirror lobes (drift_bsdf_sample_wi), not only diffuse
+// ones: a quad light faces a mirror floor (ks 0.8) under a diffuse ceiling (albedo 0.5), both
+// so large that almost no path escapes. The mirror leaves no VPL; the ceiling's VPLs, the
+// paths' second vertex, carry the emitted power times 0.8 x 0.5 (a path that stopped at the
+// mirror, as a diffuse-only path did, carried none).
+static void test_paths_go_on_through_mirrors(void **state)
+{
+    (void)state;
+    test_rig r = test_rig_begin(2);
+    drift_material m = drift_material_make(drift_vec3_splat(0.0f));
+    m.type = DRIFT_MATERIAL_MIRROR;
+    m.specular = drift_vec3_splat(0.8f);
+    uint32_t mirror = test_add_material(r.scene, m);
+    uint32_t white = test_add_material(r.scene, drift_material_make(drift_vec3_splat(0.5f)));
+    test_add_floor(r.scene, 100.0f, -1.0f, mirror);
+    // The ceiling at y = 1, facing down.
+    test_add_quad(r.scene, drift_vec3_make(-100, 1, -100), drift_vec3_make(200, 0, 0),
+                  drift_vec3_make(0, 0, 200), white);
+    test_add_quad_light(r.scene, drift_vec3_make(-0.25f, 0.9f, -0.25f), drift_vec3_make(0.5f, 0, 0),
+                        drift_vec3_make(0, 0, 0.5f), 4.0f);
+    test_rig_commit(&r);
+    double power = (double)DRIFT_PI * 0.25 * 4.0;
+    drift_ism_params p = drift_ism_params_resolve(
+        &(drift_ism_params){ .vpl_count = 4096, .max_depth = 3, .later_vpl_count = 4096 }, r.scene);
+    drift_vpl *vpls = NULL;
+    uint32_t count = 0;
+    assert_int_equal(drift__ism_generate_vpls(r.ctx, r.scene, r.accel, &p, &vpls, &count, NULL),
+                     DRIFT_OK);
+    double sum[4], sigma;
+    flux_by_bounce(vpls, count, p.vpl_count, sum, &sigma);
+    assert_true(sum[0] == 0.0);
+    // The light's own quad stops ~0.4% of the reflected paths.
+    assert_near(sum[1] / (power * 0.4), 0.995, 0.02);
+    drift_free(r.ctx, vpls);
+    test_rig_destroy(&r);
+}
+
 // A VPL at the origin facing +z, a 1 x 1 occluder at z = 1 inside a sphere of radius 3 (so
 // every direction of the map sees a surface at a steady depth).
 static void build_occluder_scene(test_rig *r)
@@ -700,6 +737,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_paraboloid_round_trip),
         cmocka_unit_test(test_vpl_flux_is_power_times_albedo),
+        cmocka_unit_test(test_paths_go_on_through_mirrors),
         cmocka_unit_test(test_ism_of_an_occluder_matches_rays),
         cmocka_unit_test(test_pull_push_fills_holes),
         cmocka_unit_test(test_lazy_push_equals_eager),
