@@ -106,12 +106,22 @@ drift_ism_params drift_ism_params_resolve(const drift_ism_params *params, const 
 
 // One virtual point light: a cosine emitter of total flux `flux` on the surface at position
 // with normal `normal` (facing the side the light came from).
+// A VPL shines I(w) = (flux + glossy cos^m(w, lobe)) cos(w, normal) / pi: its diffuse lobe,
+// and on a glossy surface the Phong lobe around the incoming light's mirror direction, its
+// exponent m clamped to DRIFT_VPL_MAX_EXPONENT (a wider lobe of the same energy, so that a
+// few hundred VPLs do not paint the glossy floor's reflected light as spots).
 typedef struct drift_vpl {
     drift_vec3 position;
     drift_vec3 normal;
-    drift_vec3 flux;
-    uint32_t bounce; // 1 for the first surface a light path reaches
+    drift_vec3 flux;    // the light its diffuse lobe reflects
+    uint32_t bounce;    // 1 for the first surface a light path reaches
+    drift_vec3 glossy;  // incoming flux x ks (m + 2) / 2; zero for a diffuse or mirror VPL
+    drift_vec3 lobe;    // the glossy lobe's axis
+    uint32_t squarings; // m = 2^squarings
 } drift_vpl;
+
+#define DRIFT_VPL_MAX_SQUARINGS 6 // DRIFT_VPL_MAX_EXPONENT = 2^6
+#define DRIFT_VPL_MAX_EXPONENT  64.0f
 
 typedef enum drift_ism_stage {
     DRIFT_ISM_STAGE_VPLS = 0, // reflective shadow maps, CDFs and the VPL paths

@@ -390,6 +390,35 @@ typedef struct gather_consts {
     int32_t levels; // the levels the lookups push (drift__ism_lookup)
 } gather_consts;
 
+// A glossy VPL's lobe in the receiver loop: its axis and, for m = 2^squarings, a flag per
+// squaring (1 to square, 0 to keep), so that cos^m is a fixed chain of multiplies with no
+// select in the loop, which then stays vectorised.
+typedef struct vpl_lobe {
+    float x, y, z;
+    float square[DRIFT_VPL_MAX_SQUARINGS];
+} vpl_lobe;
+
+static vpl_lobe vpl_lobe_of(const drift_vpl *v)
+{
+    vpl_lobe l = { .x = v->lobe.x, .y = v->lobe.y, .z = v->lobe.z };
+    for (uint32_t k = 0; k < DRIFT_VPL_MAX_SQUARINGS; ++k) {
+        l.square[k] = k < v->squarings ? 1.0f : 0.0f;
+    }
+    return l;
+}
+
+// cos^m of the angle between the lobe and the direction -a / |a| to the receiver.
+static inline DRIFT_ISM_INLINE float lobe_power(const vpl_lobe *l, float ax, float ay, float az,
+                                                float inv)
+{
+    float c = -(l->x * ax + l->y * ay + l->z * az) * inv;
+    c = c > 0.0f ? c : 0.0f;
+    for (uint32_t k = 0; k < DRIFT_VPL_MAX_SQUARINGS; ++k) {
+        c *= 1.0f + l->square[k] * (c - 1.0f);
+    }
+    return c;
+}
+
 // VPL j's contribution to every receiver, visibility from its map. One loop without branches
 // over the receivers (the compiler vectorises it): the facing tests, the paraboloid lookup
 // and the geometry term are computed for all and masked at the end. With a = y_j - x and
@@ -400,7 +429,8 @@ gather_vpl_ism_levels(const drift_vpl *v, const drift_frame *f, const float *res
                       const gather_consts *c, int32_t count, const float *restrict px,
                       const float *restrict py, const float *restrict pz, const float *restrict nx,
                       const float *restrict ny, const float *restrict nz, float *restrict er,
-                      float *restrict eg, float *restrict eb, const int32_t levels)
+                      float *restrict eg, float *restrict eb, const int32_t levels,
+                      const bool glossy)
 {
     const float vx = v->position.x, vy = v->position.y, vz = v->position.z;
     const float mx = v->normal.x, my = v->normal.y, mz = v->normal.z;
@@ -411,6 +441,8 @@ gather_vpl_ism_levels(const drift_vpl *v, const drift_frame *f, const float *res
     const int32_t n = c->n;
     const float *l[5];
     drift__ism_levels_of(map, n, l);
+    const vpl_lobe lobe = vpl_lobe_of(v);
+    const float sr = v->glossy.x, sg = v->glossy.y, sb = v->glossy.z;
     DRIFT_ISM_IVDEP
     for (int32_t i = 0; i < count; ++i) {
         float ax = vx - px[i], ay = vy - py[i], az = vz - pz[i];
@@ -441,24 +473,34 @@ gather_vpl_ism_levels(const drift_vpl *v, const drift_frame *f, const float *res
         bool lit = (dx > 0.0f) & (dj > 0.0f) & (dist - bias - reach * tan_x <= stored);
         float g = cos_x * cos_j / (dist2 > dmin2 ? dist2 : dmin2);
         g = lit ? g : 0.0f;
-        er[i] += fr * g;
-        eg[i] += fg * g;
-        eb[i] += fb * g;
+        if (glossy) {
+            float t = lobe_power(&lobe, ax, ay, az, inv) * g;
+            er[i] += fr * g + sr * t;
+            eg[i] += fg * g + sg * t;
+            eb[i] += fb * g + sb * t;
+        } else {
+            er[i] += fr * g;
+            eg[i] += fg * g;
+            eb[i] += fb * g;
+        }
     }
 }
 
-// One copy of the loop per pyramid depth, each without a branch on it (so that it vectorises).
-#define GATHER_ISM_LEVELS(L)                                                                   \
-    DRIFT_ISM_CLONES static void gather_vpl_ism##L(const drift_vpl *v, const drift_frame *f,   \
-                                                   const float *map, const gather_consts *c,   \
-                                                   receivers *rs)                              \
-    {                                                                                          \
-        gather_vpl_ism_levels(v, f, map, c, rs->count, rs->px, rs->py, rs->pz, rs->nx, rs->ny, \
-                              rs->nz, rs->er, rs->eg, rs->eb, L);                              \
+// One copy of the loop per pyramid depth and lobe, each without a branch on them (so that it
+// vectorises).
+#define GATHER_ISM_LEVELS(L, G, NAME)                                                             \
+    DRIFT_ISM_CLONES static void NAME(const drift_vpl *v, const drift_frame *f, const float *map, \
+                                      const gather_consts *c, receivers *rs)                      \
+    {                                                                                             \
+        gather_vpl_ism_levels(v, f, map, c, rs->count, rs->px, rs->py, rs->pz, rs->nx, rs->ny,    \
+                              rs->nz, rs->er, rs->eg, rs->eb, L, G);                              \
     }
-GATHER_ISM_LEVELS(0)
-GATHER_ISM_LEVELS(1)
-GATHER_ISM_LEVELS(2)
+GATHER_ISM_LEVELS(0, false, gather_vpl_ism0)
+GATHER_ISM_LEVELS(1, false, gather_vpl_ism1)
+GATHER_ISM_LEVELS(2, false, gather_vpl_ism2)
+GATHER_ISM_LEVELS(0, true, gather_vpl_ism0_glossy)
+GATHER_ISM_LEVELS(1, true, gather_vpl_ism1_glossy)
+GATHER_ISM_LEVELS(2, true, gather_vpl_ism2_glossy)
 #undef GATHER_ISM_LEVELS
 
 // The same without a lookup: every facing VPL is visible.
@@ -471,6 +513,9 @@ static void gather_vpl_none(const drift_vpl *v, const gather_consts *c, int32_t 
     const float vx = v->position.x, vy = v->position.y, vz = v->position.z;
     const float mx = v->normal.x, my = v->normal.y, mz = v->normal.z;
     const float fr = v->flux.x, fg = v->flux.y, fb = v->flux.z, dmin2 = c->dmin2;
+    const bool glossy = !drift_vec3_is_zero(v->glossy);
+    const vpl_lobe lobe = vpl_lobe_of(v);
+    const float sr = v->glossy.x, sg = v->glossy.y, sb = v->glossy.z;
     for (int32_t i = 0; i < count; ++i) {
         float ax = vx - px[i], ay = vy - py[i], az = vz - pz[i];
         float dx = nx[i] * ax + ny[i] * ay + nz[i] * az;
@@ -480,9 +525,10 @@ static void gather_vpl_none(const drift_vpl *v, const gather_consts *c, int32_t 
         // cos_x cos_j / max(d^2, dmin^2) = dx dj / (d^2 max(d^2, dmin^2)).
         float g = dx * dj / (dist2 * (dist2 > dmin2 ? dist2 : dmin2));
         g = ((dx > 0.0f) & (dj > 0.0f)) ? g : 0.0f;
-        er[i] += fr * g;
-        eg[i] += fg * g;
-        eb[i] += fb * g;
+        float t = glossy ? lobe_power(&lobe, ax, ay, az, 1.0f / sqrtf(dist2)) * g : 0.0f;
+        er[i] += fr * g + sr * t;
+        eg[i] += fg * g + sg * t;
+        eb[i] += fb * g + sb * t;
     }
 }
 
@@ -509,9 +555,11 @@ static void gather_vpl_rays(const drift_ism *ism, const drift_vpl *v, receivers 
             continue;
         }
         float g = dx * inv * dj * inv / fmaxf(dist2, c->dmin2);
-        rs->er[i] += v->flux.x * g;
-        rs->eg[i] += v->flux.y * g;
-        rs->eb[i] += v->flux.z * g;
+        vpl_lobe lobe = vpl_lobe_of(v);
+        float t = lobe_power(&lobe, d.x, d.y, d.z, inv) * g;
+        rs->er[i] += v->flux.x * g + v->glossy.x * t;
+        rs->eg[i] += v->flux.y * g + v->glossy.y * t;
+        rs->eb[i] += v->flux.z * g + v->glossy.z * t;
     }
 }
 
@@ -605,13 +653,15 @@ static void gather_jobs(size_t begin, size_t end, int thread, void *user)
             for (uint32_t j = first; j < last; ++j) {
                 if (p->visibility == DRIFT_ISM_VISIBILITY_ISM) {
                     const float *m = ism->atlas + j * map;
-                    if (c.levels == 2) {
-                        gather_vpl_ism2(&ism->vpls[j], &ism->frames[j], m, &c, &rs);
-                    } else if (c.levels == 1) {
-                        gather_vpl_ism1(&ism->vpls[j], &ism->frames[j], m, &c, &rs);
-                    } else {
-                        gather_vpl_ism0(&ism->vpls[j], &ism->frames[j], m, &c, &rs);
-                    }
+                    typedef void gather_fn(const drift_vpl *, const drift_frame *, const float *,
+                                           const gather_consts *, receivers *);
+                    static gather_fn *const gathers[2][3] = {
+                        { gather_vpl_ism0, gather_vpl_ism1, gather_vpl_ism2 },
+                        { gather_vpl_ism0_glossy, gather_vpl_ism1_glossy, gather_vpl_ism2_glossy },
+                    };
+                    bool glossy = !drift_vec3_is_zero(ism->vpls[j].glossy);
+                    gathers[glossy][c.levels == 2 ? 2 : c.levels == 1](&ism->vpls[j],
+                                                                       &ism->frames[j], m, &c, &rs);
                 } else if (p->visibility == DRIFT_ISM_VISIBILITY_RAYS) {
                     gather_vpl_rays(ism, &ism->vpls[j], &rs, &c, &job->rays[thread % 64]);
                 } else {

@@ -271,7 +271,24 @@ static bool trace_vertex(const drift_scene *scene, const drift_accel *accel, con
     return true;
 }
 
-// Every vertex leaves a VPL of the light its diffuse lobe reflects (a VPL shines diffusely).
+// The glossy lobe a VPL at a glossy vertex shines: the Phong lobe ks (n + 2) / (2 pi) cos^n
+// around the mirror direction of the light's incoming direction, n clamped to a power of two
+// m <= DRIFT_VPL_MAX_EXPONENT (the gather raises to m by squaring), energy kept by (m + 2).
+static void glossy_lobe(const drift_bsdf *bsdf, drift_vec3 toward_light, drift_vec3 flux,
+                        drift_vpl *vpl)
+{
+    float n = fminf(bsdf->exponent, DRIFT_VPL_MAX_EXPONENT);
+    uint32_t k = 0;
+    while (k < DRIFT_VPL_MAX_SQUARINGS && (float)(2u << k) <= n) {
+        ++k;
+    }
+    float m = (float)(1u << k);
+    vpl->squarings = k;
+    vpl->lobe = drift_bsdf_mirror_direction(bsdf, toward_light);
+    vpl->glossy = drift_vec3_scale(drift_vec3_mul(flux, bsdf->specular), 0.5f * (m + 2.0f));
+}
+
+// Every vertex leaves a VPL of the light its diffuse lobe reflects, and of its glossy lobe's.
 // The path goes on by the cosine of a diffuse surface, or by drift_bsdf_sample_wi's lobes
 // where the surface has a glossy or mirror lobe: that carries the light a glossy floor
 // reflects to the ceiling, which a diffuse-only path dropped (40% of the glossy Cornell
@@ -307,8 +324,14 @@ static void trace_paths(size_t begin, size_t end, int thread, void *user)
             bool mirror = bsdf.type == DRIFT_MATERIAL_MIRROR;
             drift_vec3 diffuse =
                 drift_vec3_mul(flux, mirror ? drift_vec3_splat(0.0f) : bsdf.diffuse);
-            if (!drift_vec3_is_zero(diffuse)) {
-                slots[b] = (drift_vpl){ surf.position, surf.ns, diffuse, b + 1 };
+            drift_vpl vpl = {
+                .position = surf.position, .normal = surf.ns, .flux = diffuse, .bounce = b + 1
+            };
+            if (!mirror && !drift_vec3_is_zero(bsdf.specular)) {
+                glossy_lobe(&bsdf, drift_vec3_neg(ray.dir), flux, &vpl);
+            }
+            if (!drift_vec3_is_zero(vpl.flux) || !drift_vec3_is_zero(vpl.glossy)) {
+                slots[b] = vpl;
             }
             drift_vec3 w;
             if (!mirror && drift_vec3_is_zero(bsdf.specular)) {
@@ -374,7 +397,9 @@ static float vpl_contribution(const drift_vpl *v, const drift_vec3 *points,
             sum += (double)(cos_v * cos_x / (d2 * fmaxf(d2, d_min2)));
         }
     }
-    return drift_luminance(v->flux) * (float)(sum / (double)count);
+    // The glossy lobe's power is about glossy x 2 / (m + 2); its direction is not weighed.
+    float glossy = drift_luminance(v->glossy) * 2.0f / ((float)(1u << v->squarings) + 2.0f);
+    return (drift_luminance(v->flux) + glossy) * (float)(sum / (double)count);
 }
 
 drift_result drift__ism_generate_vpls(drift_context *ctx, const drift_scene *scene,
@@ -492,6 +517,7 @@ drift_result drift__ism_generate_vpls_for(drift_context *ctx, const drift_scene 
                         continue;
                     }
                     v.flux = drift_vec3_scale(v.flux, 1.0f / p);
+                    v.glossy = drift_vec3_scale(v.glossy, 1.0f / p);
                 }
                 vpls[count++] = v;
                 landed += b == 0;
@@ -501,6 +527,7 @@ drift_result drift__ism_generate_vpls_for(drift_context *ctx, const drift_scene 
     if (rounds > 1) {
         for (uint32_t j = 0; j < count; ++j) {
             vpls[j].flux = drift_vec3_scale(vpls[j].flux, 1.0f / (float)rounds);
+            vpls[j].glossy = drift_vec3_scale(vpls[j].glossy, 1.0f / (float)rounds);
         }
     }
     *out_vpls = vpls;
