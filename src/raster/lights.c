@@ -53,6 +53,52 @@ static drift_raster_light single_light(const drift_scene *scene, uint32_t index)
     return h;
 }
 
+// The radius of the sphere a mesh light's triangles tile, or 0. A tessellated sphere (the
+// Breakfast Room's sun, most OBJ exports of a sphere emitter) has every vertex at one distance
+// from the area centroid, every triangle's centre close to it (which rules out a cube or an
+// icosahedron, whose corners lie on a sphere too), normals pointing out and one radiance.
+// The stand-in sphere has the mesh's area, so the same power (pi A L) and, by Cauchy's
+// formula, the same mean projected area.
+static float tiled_sphere_radius(const drift_scene *scene, const drift_mesh *m, drift_vec3 centre,
+                                 double area)
+{
+    enum {
+        MIN_TRIANGLES = 32
+    };
+
+    if (m->triangle_count < MIN_TRIANGLES) {
+        return 0.0f;
+    }
+    float radius = sqrtf((float)(area / (4.0 * (double)DRIFT_PI)));
+    drift_vec3 colour = scene->lights[m->first_light].color;
+    for (uint32_t t = 0; t < m->triangle_count; ++t) {
+        const drift_light *l = &scene->lights[m->first_light + t];
+        if (l->color.x != colour.x || l->color.y != colour.y || l->color.z != colour.z) {
+            return 0.0f;
+        }
+        drift_vec3 c[3];
+        drift_light_triangle_vertices(scene, l, &c[0], &c[1], &c[2]);
+        for (int k = 0; k < 3; ++k) {
+            float d = drift_vec3_length(drift_vec3_sub(c[k], centre));
+            if (fabsf(d - radius) > 0.03f * radius) {
+                return 0.0f;
+            }
+        }
+        drift_vec3 mid = drift_vec3_sub(
+            drift_vec3_scale(drift_vec3_add(c[0], drift_vec3_add(c[1], c[2])), 1.0f / 3.0f),
+            centre);
+        drift_vec3 normal =
+            drift_vec3_cross(drift_vec3_sub(c[1], c[0]), drift_vec3_sub(c[2], c[0]));
+        // A sliver at a pole (no area) has no direction to check.
+        bool sliver = drift_vec3_length(normal) < 1e-6f * radius * radius;
+        if (drift_vec3_length(mid) < 0.95f * radius ||
+            (!sliver && drift_vec3_dot(normal, mid) <= 0.0f)) {
+            return 0.0f;
+        }
+    }
+    return radius;
+}
+
 // Gathers the triangle lights first_light .. first_light + count - 1 of one mesh: area CDF,
 // area-weighted centroid and mean normal, bounding radius about the centroid.
 static drift_result mesh_light(drift_context *ctx, const drift_scene *scene, uint32_t mesh,
@@ -98,6 +144,7 @@ static drift_result mesh_light(drift_context *ctx, const drift_scene *scene, uin
         drift_vec3 d = drift_vec3_sub(drift_vec3_make(p[0], p[1], p[2]), out->centre);
         out->radius = fmaxf(out->radius, drift_vec3_length(d));
     }
+    out->sphere_radius = out->one_sided ? 0.0f : tiled_sphere_radius(scene, m, out->centre, total);
     return DRIFT_OK;
 }
 

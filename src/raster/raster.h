@@ -35,6 +35,8 @@ typedef struct drift_raster_light {
     uint32_t light_count;  //   first_light + light_count - 1 (1 unless a mesh)
     uint32_t mesh;         // the emissive mesh, or DRIFT_INVALID_INDEX
     float *light_cdf;      // light_count entries: area CDF over the triangles (meshes), or NULL
+    float sphere_radius;   // > 0: a mesh whose triangles tile a sphere about `centre` of one
+                           // radiance; the sphere of the same area stands in for its diffuse U
 } drift_raster_light;
 
 // Whether scene light `scene_light` (e.g. drift_hit.light) is part of this light: a ray that

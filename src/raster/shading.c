@@ -147,7 +147,8 @@ static float sphere_irradiance(drift_vec3 p, drift_vec3 n, drift_vec3 centre, fl
 static bool has_closed_form(const drift_raster_light *light)
 {
     return light->type == DRIFT_LIGHT_QUAD || light->type == DRIFT_LIGHT_SPHERE ||
-           (light->type == DRIFT_LIGHT_TRIANGLE && light->light_count <= MAX_CLOSED_FORM_TRIANGLES);
+           (light->type == DRIFT_LIGHT_TRIANGLE &&
+            (light->light_count <= MAX_CLOSED_FORM_TRIANGLES || light->sphere_radius > 0.0f));
 }
 
 // The diffuse lobe's share of U_l in closed form: kd / pi * sum over polygons (or the sphere)
@@ -160,6 +161,11 @@ static drift_vec3 polygon_diffuse(const drift_scene *scene, const drift_raster_l
     drift_vec3 sum = drift_vec3_splat(0.0f);
     if (drift_vec3_dot(wo, n) <= 0.0f) {
         return sum; // the diffuse lobe is zero for a viewer below the shading normal
+    }
+    if (light->sphere_radius > 0.0f) {
+        float e = sphere_irradiance(surface->position, n, light->centre, light->sphere_radius);
+        drift_vec3 colour = scene->lights[light->first_light].color;
+        return drift_vec3_scale(drift_vec3_mul(colour, bsdf->diffuse), e * DRIFT_INV_PI);
     }
     for (uint32_t i = 0; i < light->light_count; ++i) {
         const drift_light *l = &scene->lights[light->first_light + i];
