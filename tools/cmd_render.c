@@ -557,7 +557,8 @@ void render_spp_range(const drift_pt *pt, uint32_t *lowest, uint32_t *highest)
 // The EXR (beauty, --aov layers; an "spp" layer of each pixel's sample count when the tiles
 // hold different counts) and the PNG beside it, to the paths given (staged by the caller).
 static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_options *o,
-                                 float fov_y, const char *exr_path, const char *png_path)
+                                 float fov_y, const char *exr_path, const char *png_path,
+                                 double *out_denoise_ms)
 {
     drift_image beauty, albedo, normal, depth;
     drift_result r = drift_pt_resolve(pt, DRIFT_PT_AOV_BEAUTY, &beauty);
@@ -566,6 +567,7 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
     }
     drift_image denoised = { 0 }, glared = { 0 }, spp = { 0 };
     if (o->denoise) { // --denoise atrous, before glare (the last pass)
+        double t_denoise = drift_time_now();
         if ((r = drift_pt_resolve(pt, DRIFT_PT_AOV_ALBEDO, &albedo)) != DRIFT_OK ||
             (r = drift_pt_resolve(pt, DRIFT_PT_AOV_NORMAL, &normal)) != DRIFT_OK ||
             (r = drift_pt_resolve(pt, DRIFT_PT_AOV_DEPTH, &depth)) != DRIFT_OK ||
@@ -574,6 +576,7 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
             return r;
         }
         beauty = denoised; // destroyed below
+        *out_denoise_ms = 1e3 * (drift_time_now() - t_denoise);
     }
     if (o->hybrid.glare != DRIFT_GLARE_NONE) {
         if ((r = apply_glare(ctx, o, fov_y, &beauty, &glared)) != DRIFT_OK) {
@@ -673,6 +676,11 @@ static cJSON *reference_stats(const render_reference_run *run, double t_rendered
     cli_json_number(ms, "accel", 1e3 * (session->t_built - session->t_loaded), 3);
     cli_json_number(ms, "render", 1e3 * (t_rendered - run->t_render), 3);
     cli_json_number(ms, "write", 1e3 * (t_written - t_rendered), 3);
+    if (run->o->denoise) {
+        // The filter runs as the image is written: part of "write", what a denoised frame adds
+        // to "render".
+        cli_json_number(ms, "denoise", run->denoise_ms, 3);
+    }
     cli_json_number(ms, "total", 1e3 * (t_written - session->t_start), 3);
     return root;
 }
@@ -766,7 +774,7 @@ static bool write_outputs(render_reference_run *run, bool final, double t_render
     const char *exr_temp = render_stage_add(&stage, o->out_path);
     const char *png_temp = render_stage_add(&stage, png);
     drift_result r = write_images(run->session->ctx, run->pt, o, run->session->scene->camera.fov_y,
-                                  exr_temp, png_temp);
+                                  exr_temp, png_temp, &run->denoise_ms);
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift render: cannot write %s: %s; nothing written\n", o->out_path,
                 drift_result_string(r));

@@ -116,6 +116,7 @@ typedef struct render_reference_run {
     uint32_t resumed_spp; // the lowest tile count the checkpoint held (0: a fresh render)
     int ranks;            // processes that rendered (0: not distributed)
     double t_render;      // drift_time_now() when rendering began
+    double denoise_ms;    // --denoise's filter, within the write (the stats' "denoise")
     char key[1024];       // render_checkpoint_key
     char checkpoint_path[4096];
 } render_reference_run;

@@ -76,8 +76,16 @@ python3 -c "import json; s=json.load(open('$tmp/int.json')); assert 0 < s['spp']
 # closer to a converged render; a bad value is a usage error.
 for d in none atrous; do
     expect 0 "$drift" render --spp 2 --width 32 --height 32 --threads 2 --checkpoint 0 --quiet \
-        --denoise "$d" --out "$tmp/dn-$d.exr"
+        --denoise "$d" --out "$tmp/dn-$d.exr" --stats "$tmp/dn-$d-stats.json"
 done
+# The filter's milliseconds are in --stats (a denoised frame costs render + denoise), and
+# only when it ran.
+python3 - "$tmp/dn-atrous-stats.json" "$tmp/dn-none-stats.json" <<'PY' || fail "--stats lacks the filter's milliseconds"
+import json, sys
+filtered, plain = (json.load(open(p))["milliseconds"] for p in sys.argv[1:3])
+assert 0 < filtered["denoise"] <= filtered["write"], filtered
+assert "denoise" not in plain, plain
+PY
 expect 0 "$drift" render --spp 128 --width 32 --height 32 --threads 2 --checkpoint 0 --quiet \
     --out "$tmp/dn-ref.exr"
 expect 0 "$drift" diff "$tmp/dn-ref.exr" "$tmp/dn-none.exr" --json
