@@ -375,7 +375,7 @@ static const cli_option render_table[] = {
             "points on each contact-shadow march (default 8)"),
     CLI_INT("--ism-vpls", "N", O, hybrid.ism.vpls, 1, 65536,
             "instant radiosity (--indirect ism|ir, docs/ism.md): light\n"
-            "paths, one first-bounce VPL each (default 256)"),
+            "paths, one first-bounce VPL each (default 512)"),
     CLI_CHOICE("--ism-vpl-importance", "off|on", O, hybrid.ism.vpl_importance, "off|on",
                "on: keep candidate VPLs with probability by their contribution\n"
                "to the view, divided by it (Georgiev & Slusallek 2010;\n"

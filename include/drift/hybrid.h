@@ -256,7 +256,7 @@ drift_hybrid_params drift_hybrid_params_resolve(const drift_hybrid_params *param
                                                 const drift_scene *scene);
 // What `drift render --mode hybrid` and `drift view` start from: the lowest-FLIP combination
 // of the equal-time frontier within ~100 ms on the built-in Cornell box at 400x400, 2 threads
-// (docs/frontier.md): hard shadows, instant radiosity from imperfect shadow maps (256 VPLs)
+// (docs/frontier.md): hard shadows, instant radiosity from imperfect shadow maps (512 VPLs)
 // and max depth 8 (multiple bounces). A zeroed drift_hybrid_params stays hard shadows, no
 // indirect light, max depth 2: the library's and the tests' neutral frame.
 drift_hybrid_params drift_hybrid_params_recommended(void);
