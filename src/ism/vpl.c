@@ -49,10 +49,9 @@ static drift_vec3 rsm_dir(const rsm *m, int32_t f, float a, float b)
         m->axis[f], drift_vec3_add(drift_vec3_scale(m->u[f], x), drift_vec3_scale(m->v[f], y)));
 }
 
-// The diffuse albedo at the closest hit of `ray`, with the surface; false when the ray misses
-// or hits a pure emitter (a light's shape).
-static bool trace_surface(const drift_scene *scene, const drift_accel *accel, const drift_ray *ray,
-                          drift_surface *out_surface, drift_vec3 *out_kd)
+// The closest hit of `ray` and its BSDF; false when the ray misses or hits a pure emitter.
+static bool trace_vertex(const drift_scene *scene, const drift_accel *accel, const drift_ray *ray,
+                         drift_surface *out_surface, drift_bsdf *out_bsdf)
 {
     drift_hit hit;
     if (!drift_accel_intersect(accel, ray, &hit)) {
@@ -62,7 +61,19 @@ static bool trace_surface(const drift_scene *scene, const drift_accel *accel, co
     if (out_surface->material == DRIFT_INVALID_INDEX) {
         return false;
     }
-    drift_bsdf bsdf = drift_bsdf_make(scene, out_surface);
+    *out_bsdf = drift_bsdf_make(scene, out_surface);
+    return true;
+}
+
+// The diffuse albedo at the closest hit of `ray`, with the surface; false when the ray misses
+// or hits a pure emitter (a light's shape).
+static bool trace_surface(const drift_scene *scene, const drift_accel *accel, const drift_ray *ray,
+                          drift_surface *out_surface, drift_vec3 *out_kd)
+{
+    drift_bsdf bsdf;
+    if (!trace_vertex(scene, accel, ray, out_surface, &bsdf)) {
+        return false;
+    }
     *out_kd = bsdf.type == DRIFT_MATERIAL_MIRROR ? drift_vec3_splat(0.0f) : bsdf.diffuse;
     return true;
 }
@@ -253,22 +264,6 @@ static bool emit(const path_job *job, drift_sampler *s, drift_ray *out_ray, drif
     }
     // Area lights: a uniform point and a cosine direction, pi A L per path.
     return drift_light_emit_area(scene, l, u1, u2, pmf, n, out_ray, out_flux);
-}
-
-// The closest hit of `ray` and its BSDF; false when the ray misses or hits a pure emitter.
-static bool trace_vertex(const drift_scene *scene, const drift_accel *accel, const drift_ray *ray,
-                         drift_surface *out_surface, drift_bsdf *out_bsdf)
-{
-    drift_hit hit;
-    if (!drift_accel_intersect(accel, ray, &hit)) {
-        return false;
-    }
-    *out_surface = drift_scene_surface(scene, ray, &hit);
-    if (out_surface->material == DRIFT_INVALID_INDEX) {
-        return false;
-    }
-    *out_bsdf = drift_bsdf_make(scene, out_surface);
-    return true;
 }
 
 // The glossy lobe a VPL at a glossy vertex shines: the Phong lobe ks (n + 2) / (2 pi) cos^n

@@ -114,6 +114,17 @@ static void flux_by_bounce(const drift_vpl *vpls, uint32_t count, uint32_t paths
     *sigma1 = sqrt(fmax(sq - sum[0] * sum[0] / (double)paths, 0.0));
 }
 
+// The VPLs of `p` in the rig's scene, their flux summed per bounce (flux_by_bounce).
+static drift_vpl *vpls_by_bounce(test_rig *r, const drift_ism_params *p, uint32_t *count,
+                                 double *sum, double *sigma1)
+{
+    drift_vpl *vpls = NULL;
+    assert_int_equal(drift__ism_generate_vpls(r->ctx, r->scene, r->accel, p, &vpls, count, NULL),
+                     DRIFT_OK);
+    flux_by_bounce(vpls, *count, p->vpl_count, sum, sigma1);
+    return vpls;
+}
+
 // In a closed box of albedo a, the first bounce's VPL flux sums to the emitted power times a
 // (within 3 sigma), and every later bounce to a times the one before: for a quad light, a
 // point light (RSM cube) and a spot (one RSM face).
@@ -194,12 +205,9 @@ static void test_paths_go_on_through_mirrors(void **state)
     double power = (double)DRIFT_PI * 0.25 * 4.0;
     drift_ism_params p = drift_ism_params_resolve(
         &(drift_ism_params){ .vpl_count = 4096, .max_depth = 3, .later_vpl_count = 4096 }, r.scene);
-    drift_vpl *vpls = NULL;
     uint32_t count = 0;
-    assert_int_equal(drift__ism_generate_vpls(r.ctx, r.scene, r.accel, &p, &vpls, &count, NULL),
-                     DRIFT_OK);
     double sum[4], sigma;
-    flux_by_bounce(vpls, count, p.vpl_count, sum, &sigma);
+    drift_vpl *vpls = vpls_by_bounce(&r, &p, &count, sum, &sigma);
     assert_true(sum[0] == 0.0);
     // The light's own quad stops ~0.4% of the reflected paths.
     assert_near(sum[1] / (power * 0.4), 0.995, 0.02);
@@ -506,12 +514,9 @@ static void test_environment_vpls_carry_its_power(void **state)
         test_rig_commit(&r);
         drift_ism_params p =
             drift_ism_params_resolve(&(drift_ism_params){ .vpl_count = 4096 }, r.scene);
-        drift_vpl *vpls = NULL;
         uint32_t count = 0;
-        assert_int_equal(drift__ism_generate_vpls(r.ctx, r.scene, r.accel, &p, &vpls, &count, NULL),
-                         DRIFT_OK);
         double sum[4], sigma;
-        flux_by_bounce(vpls, count, p.vpl_count, sum, &sigma);
+        drift_vpl *vpls = vpls_by_bounce(&r, &p, &count, sum, &sigma);
         if (far) {
             // Several rounds ran: the VPLs of all of them count, divided by the rounds.
             assert_true(count > p.vpl_count / 16);
