@@ -52,11 +52,13 @@
     X(P, REFERENCE, "reference", "direct light path-traced at --spp", drift_hybrid_pass_reference, \
       0, DRIFT_ROW_PATH_TRACED, drift_planes_none, 0, DRIFT_PT_COMPONENT_DIRECT)                   \
     X(P, ISG, "isg", "image space gathering over the hard-shadow buffer (docs/isg.md)",            \
-      drift_isg_pass_shadows, DRIFT_INPUT_UNSHADOWED | DRIFT_INPUT_HARD_SHADOWS,                   \
+      drift_isg_pass_shadows,                                                                      \
+      DRIFT_INPUT_UNSHADOWED | DRIFT_INPUT_HARD_SHADOWS | DRIFT_INPUT_OCCLUDER_DISTANCES,          \
       DRIFT_ROW_SUMS_DIRECT, drift_isg_shadow_planes, DRIFT_STREAM_ISG_SHADOWS,                    \
       DRIFT_PT_COMPONENT_DIRECT)                                                                   \
     X(P, BLUR, "blur", "baseline: the hard-shadow bits blurred over a fixed disk",                 \
-      drift_isg_pass_shadows, DRIFT_INPUT_UNSHADOWED | DRIFT_INPUT_HARD_SHADOWS,                   \
+      drift_isg_pass_shadows,                                                                      \
+      DRIFT_INPUT_UNSHADOWED | DRIFT_INPUT_HARD_SHADOWS | DRIFT_INPUT_OCCLUDER_DISTANCES,          \
       DRIFT_ROW_SUMS_DIRECT, drift_planes_none, DRIFT_STREAM_ISG_SHADOWS,                          \
       DRIFT_PT_COMPONENT_DIRECT)                                                                   \
     X(P, AAF, "aaf", "axis-aligned filtering of ray-traced area-light visibility (docs/aaf.md)",   \

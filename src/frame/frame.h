@@ -172,11 +172,13 @@ void drift_planes_none(const drift_frame_state *frame, drift_pass_plane_fn add, 
 // Inputs a row needs, prepared by the conductor before any row's pass (each at most once a
 // frame, whichever rows ask): the table's `inputs` column.
 enum {
-    DRIFT_INPUT_UNSHADOWED = 1u << 0,        // U_l per light and the environment term
-    DRIFT_INPUT_HARD_SHADOWS = 1u << 1,      // the hard-shadow buffer (S_l = its bits)
-    DRIFT_INPUT_SHADOW_MAPS = 1u << 2,       // a shadow map per light (cached)
-    DRIFT_INPUT_SHARP_REFLECTIONS = 1u << 3, // one mirror ray a pixel (R = its light)
-    DRIFT_INPUT_PROBES = 1u << 4,            // the environment-map probes (cached)
+    DRIFT_INPUT_UNSHADOWED = 1u << 0,         // U_l per light and the environment term
+    DRIFT_INPUT_HARD_SHADOWS = 1u << 1,       // the hard-shadow buffer (S_l = its bits)
+    DRIFT_INPUT_SHADOW_MAPS = 1u << 2,        // a shadow map per light (cached)
+    DRIFT_INPUT_SHARP_REFLECTIONS = 1u << 3,  // one mirror ray a pixel (R = its light)
+    DRIFT_INPUT_PROBES = 1u << 4,             // the environment-map probes (cached)
+    DRIFT_INPUT_OCCLUDER_DISTANCES = 1u << 5, // the hard-shadow buffer's occluder distances
+                                              // (ISG's search): closest-hit shadow rays
 };
 
 // How the conductor treats a row: the table's `flags` column.

@@ -418,7 +418,7 @@ static drift_result prepare_inputs(drift_frame_state *f, uint32_t inputs)
         r = drift_realtime_pass_unshadowed(f);
     }
     if (r == DRIFT_OK && (inputs & DRIFT_INPUT_HARD_SHADOWS)) {
-        r = drift_realtime_pass_hard_shadows(f);
+        r = drift_realtime_pass_hard_shadows(f, (inputs & DRIFT_INPUT_OCCLUDER_DISTANCES) != 0);
     }
     if (r == DRIFT_OK && (inputs & DRIFT_INPUT_SHADOW_MAPS)) {
         r = drift_realtime_build_shadow_maps(f);

@@ -33,6 +33,7 @@ static drift_raster_light single_light(const drift_scene *scene, uint32_t index)
         break;
     case DRIFT_LIGHT_SPHERE:
         h.radius = l->radius;
+        h.shadow_clearance = 1.001f * l->radius;
         break;
     case DRIFT_LIGHT_TRIANGLE: {
         drift_vec3 c[3];
@@ -99,6 +100,23 @@ static float tiled_sphere_radius(const drift_scene *scene, const drift_mesh *m, 
     return radius;
 }
 
+// Whether every vertex of a one-sided mesh light lies in the plane through its centre along
+// its mean normal (a quad as two triangles): a ray toward the centre then meets none of it.
+static bool is_flat(const drift_mesh *m, const drift_raster_light *light)
+{
+    if (!light->one_sided) {
+        return false;
+    }
+    for (uint32_t v = 0; v < m->vertex_count; ++v) {
+        const float *p = m->positions + 3u * v;
+        drift_vec3 d = drift_vec3_sub(drift_vec3_make(p[0], p[1], p[2]), light->centre);
+        if (fabsf(drift_vec3_dot(d, light->direction)) > 1e-4f * light->radius) {
+            return false;
+        }
+    }
+    return true;
+}
+
 // Gathers the triangle lights first_light .. first_light + count - 1 of one mesh: area CDF,
 // area-weighted centroid and mean normal, bounding radius about the centroid.
 static drift_result mesh_light(drift_context *ctx, const drift_scene *scene, uint32_t mesh,
@@ -145,6 +163,9 @@ static drift_result mesh_light(drift_context *ctx, const drift_scene *scene, uin
         out->radius = fmaxf(out->radius, drift_vec3_length(d));
     }
     out->sphere_radius = out->one_sided ? 0.0f : tiled_sphere_radius(scene, m, out->centre, total);
+    out->shadow_clearance = out->sphere_radius > 0.0f ? 1.001f * out->radius
+                            : is_flat(m, out)         ? 0.0f
+                                                      : -1.0f;
     return DRIFT_OK;
 }
 

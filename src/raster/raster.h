@@ -23,20 +23,23 @@ void drift_gbuffer_render(drift_context *ctx, const drift_scene *scene, const dr
 // gathered into one (the Cornell box's ceiling quad is two triangle lights, one light here).
 // Shadow maps, hard shadows and the gathers of later issues work per hybrid light.
 typedef struct drift_raster_light {
-    drift_light_type type; // DRIFT_LIGHT_TRIANGLE stands for an emissive mesh
-    drift_vec3 centre;     // where hard-shadow rays aim and shadow maps look from
-                           // (area-weighted centroid for meshes); unused for directional
-    drift_vec3 direction;  // directional: the way light travels; spot: its axis; quad, disk
-                           // and mesh: the (mean) normal light leaves along; else zero
-    float radius;          // light size L: 0 for point, spot and directional lights; for
-                           // area lights the radius of a bounding sphere about `centre`
-    bool one_sided;        // emits only into the hemisphere around `direction`
-    uint32_t first_light;  // the scene lights it stands for: first_light ..
-    uint32_t light_count;  //   first_light + light_count - 1 (1 unless a mesh)
-    uint32_t mesh;         // the emissive mesh, or DRIFT_INVALID_INDEX
-    float *light_cdf;      // light_count entries: area CDF over the triangles (meshes), or NULL
-    float sphere_radius;   // > 0: a mesh whose triangles tile a sphere about `centre` of one
-                           // radiance; the sphere of the same area stands in for its diffuse U
+    drift_light_type type;  // DRIFT_LIGHT_TRIANGLE stands for an emissive mesh
+    drift_vec3 centre;      // where hard-shadow rays aim and shadow maps look from
+                            // (area-weighted centroid for meshes); unused for directional
+    drift_vec3 direction;   // directional: the way light travels; spot: its axis; quad, disk
+                            // and mesh: the (mean) normal light leaves along; else zero
+    float radius;           // light size L: 0 for point, spot and directional lights; for
+                            // area lights the radius of a bounding sphere about `centre`
+    bool one_sided;         // emits only into the hemisphere around `direction`
+    uint32_t first_light;   // the scene lights it stands for: first_light ..
+    uint32_t light_count;   //   first_light + light_count - 1 (1 unless a mesh)
+    uint32_t mesh;          // the emissive mesh, or DRIFT_INVALID_INDEX
+    float *light_cdf;       // light_count entries: area CDF over the triangles (meshes), or NULL
+    float sphere_radius;    // > 0: a mesh whose triangles tile a sphere about `centre` of one
+                            // radiance; the sphere of the same area stands in for its diffuse U
+    float shadow_clearance; // how far short of `centre` a shadow ray must stop to meet none of
+                            // the light's own surface (0: a flat emitter, the radius: a sphere);
+                            // < 0: it may meet it anywhere (a curved mesh): closest hits only
 } drift_raster_light;
 
 // Whether scene light `scene_light` (e.g. drift_hit.light) is part of this light: a ray that

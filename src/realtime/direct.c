@@ -102,13 +102,16 @@ static void interleave_gather_pixel(drift_frame_state *f, int32_t x, int32_t y, 
 
 static void hard_shadow_row(drift_frame_state *f, int32_t y, uint64_t *rays, void *user)
 {
-    (void)user;
+    bool occluder_distances = *(const bool *)user;
     drift_ray batch[SHADOW_BATCH];
     drift_hit hits[SHADOW_BATCH];
+    uint8_t occluded[SHADOW_BATCH];
     int32_t xs[SHADOW_BATCH];
     float light_distance[SHADOW_BATCH];
     for (uint32_t l = 0; l < f->light_count; ++l) {
         drift_frame_light_buffers *b = &f->light_buffers[l];
+        float clearance = f->lights[l].shadow_clearance;
+        bool any_hit = !occluder_distances && clearance >= 0.0f;
         for (int32_t x0 = 0; x0 < f->params.width; x0 += SHADOW_BATCH) {
             int32_t x1 = x0 + SHADOW_BATCH < f->params.width ? x0 + SHADOW_BATCH : f->params.width;
             uint32_t n = 0;
@@ -125,11 +128,24 @@ static void hard_shadow_row(drift_frame_state *f, int32_t y, uint64_t *rays, voi
                 batch[n] = drift_raster_hard_shadow_ray(&f->lights[l], s, &light_distance[n]);
                 ++n;
             }
-            drift_accel_intersect_coherent(f->accel, batch, hits, n);
+            if (any_hit) {
+                for (uint32_t k = 0; k < n; ++k) {
+                    batch[k].tmax -= clearance;
+                }
+                drift_accel_occluded_coherent(f->accel, batch, occluded, n);
+            } else {
+                drift_accel_intersect_coherent(f->accel, batch, hits, n);
+            }
             *rays += n;
             for (uint32_t k = 0; k < n; ++k) {
                 float *out = drift_image_pixel(&b->hard_shadow, xs[k], y);
-                bool visible = drift_raster_hard_shadow_visible(&f->lights[l], &hits[k], &out[1]);
+                bool visible;
+                if (any_hit) {
+                    visible = !occluded[k];
+                    out[1] = visible ? INFINITY : 0.0f;
+                } else {
+                    visible = drift_raster_hard_shadow_visible(&f->lights[l], &hits[k], &out[1]);
+                }
                 out[0] = visible ? 1.0f : 0.0f;
                 out[2] = light_distance[k];
                 drift_image_pixel(&b->shadow, xs[k], y)[0] = out[0];
@@ -214,9 +230,9 @@ drift_result drift_realtime_pass_unshadowed(drift_frame_state *f)
     return DRIFT_OK;
 }
 
-drift_result drift_realtime_pass_hard_shadows(drift_frame_state *f)
+drift_result drift_realtime_pass_hard_shadows(drift_frame_state *f, bool occluder_distances)
 {
-    drift_pass_rows(f, DRIFT_PASS_HARD_SHADOWS, hard_shadow_row, NULL);
+    drift_pass_rows(f, DRIFT_PASS_HARD_SHADOWS, hard_shadow_row, &occluder_distances);
     return DRIFT_OK;
 }
 

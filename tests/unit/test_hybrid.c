@@ -12,6 +12,7 @@
 #include "test_rig.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -304,7 +305,8 @@ static void test_reference_shadows_converge(void **state)
 // A floor under a point light with a square occluder at height h: where the occluder blocks
 // the light, the hard-shadow buffer reports it at the distance of the crossing of y = h, and
 // the light's distance everywhere. The light stands to the side so the camera above sees the
-// shadow.
+// shadow. The distances are traced for a row that reads them (`isg`); `hard` alone traces
+// any-hit rays and leaves 0 in shadow.
 static void test_hard_shadow_buffer_distances(void **state)
 {
     (void)state;
@@ -319,37 +321,40 @@ static void test_hard_shadow_buffer_distances(void **state)
     r.scene->camera = drift_camera_look_at(drift_vec3_make(0, 8, -0.01f), drift_vec3_make(0, 0, 0),
                                            drift_vec3_make(0, 1, 0), 0.6f, 32, 32);
     test_rig_commit(&r);
-    test_rig_frame(&r, &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_HARD });
-    const drift_gbuffer *g = drift_hybrid_gbuffer(r.frame);
-    const drift_image *hard = test_rig_plane(&r, "light0.hard_shadow");
-    int shadowed = 0, lit = 0;
-    for (int y = 0; y < 32; ++y) {
-        for (int x = 0; x < 32; ++x) {
-            drift_vec3 p = pixel3(&g->position, x, y);
-            if (fabsf(p.y) > 1e-3f) {
-                continue; // the occluder itself
-            }
-            const float *v = drift_image_pixel(hard, x, y);
-            drift_vec3 to_light = drift_vec3_sub(drift_vec3_make(light_x, light_height, 0), p);
-            float dist = drift_vec3_length(to_light);
-            assert_near(v[2], dist, 1e-4 * (double)dist);
-            // Where the ray toward the light crosses y = h, inside the square or not.
-            drift_vec3 cross = drift_vec3_fma(p, to_light, h / to_light.y);
-            bool inside = fabsf(cross.x) < 0.49f && fabsf(cross.z) < 0.49f;
-            bool outside = fabsf(cross.x) > 0.51f || fabsf(cross.z) > 0.51f;
-            if (inside) {
-                assert_near(v[0], 0.0, 0.0);
-                assert_near(v[1], dist * h / to_light.y, 1e-3);
-                ++shadowed;
-            } else if (outside) {
-                assert_near(v[0], 1.0, 0.0);
-                assert_true(isinf(v[1]));
-                ++lit;
+    for (int any_hit = 0; any_hit < 2; ++any_hit) {
+        test_rig_frame(&r, &(drift_hybrid_params){ .shadows = any_hit ? DRIFT_SHADOWS_HARD
+                                                                      : DRIFT_SHADOWS_ISG });
+        const drift_gbuffer *g = drift_hybrid_gbuffer(r.frame);
+        const drift_image *hard = test_rig_plane(&r, "light0.hard_shadow");
+        int shadowed = 0, lit = 0;
+        for (int y = 0; y < 32; ++y) {
+            for (int x = 0; x < 32; ++x) {
+                drift_vec3 p = pixel3(&g->position, x, y);
+                if (fabsf(p.y) > 1e-3f) {
+                    continue; // the occluder itself
+                }
+                const float *v = drift_image_pixel(hard, x, y);
+                drift_vec3 to_light = drift_vec3_sub(drift_vec3_make(light_x, light_height, 0), p);
+                float dist = drift_vec3_length(to_light);
+                assert_near(v[2], dist, 1e-4 * (double)dist);
+                // Where the ray toward the light crosses y = h, inside the square or not.
+                drift_vec3 cross = drift_vec3_fma(p, to_light, h / to_light.y);
+                bool inside = fabsf(cross.x) < 0.49f && fabsf(cross.z) < 0.49f;
+                bool outside = fabsf(cross.x) > 0.51f || fabsf(cross.z) > 0.51f;
+                if (inside) {
+                    assert_near(v[0], 0.0, 0.0);
+                    assert_near(v[1], any_hit ? 0.0f : dist * h / to_light.y, 1e-3);
+                    ++shadowed;
+                } else if (outside) {
+                    assert_near(v[0], 1.0, 0.0);
+                    assert_true(isinf(v[1]));
+                    ++lit;
+                }
             }
         }
+        assert_true(shadowed > 10);
+        assert_true(lit > 100);
     }
-    assert_true(shadowed > 10);
-    assert_true(lit > 100);
     test_rig_destroy(&r);
 }
 
@@ -654,6 +659,127 @@ static void test_tessellated_sphere_light_in_closed_form(void **state)
     }
 }
 
+// `--shadows hard` traces any-hit rays toward a light whose own surface the ray cannot meet
+// (flat emitters, spheres: drift_raster_light.shadow_clearance), closest hits otherwise and
+// whenever a row reads the occluder distances (`blur`, `isg`). Five lights over a floor
+// under an occluder: a quad light, a sphere light, an emissive quad mesh (flat: clearance 0),
+// a tessellated sphere (its radius) and an emissive tent (curved: -1, closest hits). The
+// hard-shadow bits of `hard` (any-hit) equal those of `blur` (closest hit) at every pixel
+// but the emitters' own (kd 0 here: their bits light nothing), where the two queries part on
+// ~80 pixels of the flat emissive quad's back, seen from above; 4910 shadowed bits agree.
+static void test_hard_shadows_any_hit_match_closest_hit(void **state)
+{
+    (void)state;
+    test_rig r = test_rig_begin(2);
+    uint32_t white = test_add_material(r.scene, drift_material_make(drift_vec3_splat(0.7f)));
+    drift_material glow_material = drift_material_make(drift_vec3_splat(0.0f));
+    glow_material.emission = drift_vec3_splat(5.0f);
+    uint32_t glow = test_add_material(r.scene, glow_material);
+    test_add_floor(r.scene, 4.0f, 0.0f, white);
+    test_add_quad(r.scene, drift_vec3_make(-0.5f, 1.0f, -0.5f), drift_vec3_make(1, 0, 0),
+                  drift_vec3_make(0, 0, 1), white);
+    // Heights apart (3.2, 2.8, 3.5, 2.4, 2.6-3.0), so that no emitter's pixel sends a ray in
+    // the plane of a flat light, where the two queries may part on a grazing hit.
+    test_add_quad_light(r.scene, drift_vec3_make(-2.25f, 3.2f, -0.25f), drift_vec3_make(0.5f, 0, 0),
+                        drift_vec3_make(0, 0, 0.5f), 4.0f);
+    drift_light sphere = { .type = DRIFT_LIGHT_SPHERE,
+                           .position = { 2.0f, 2.8f, 0.0f },
+                           .radius = 0.3f,
+                           .color = { 4, 4, 4 } };
+    assert_int_equal(drift_scene_add_light(r.scene, &sphere, NULL), DRIFT_OK);
+    test_add_quad(r.scene, drift_vec3_make(-0.25f, 3.5f, -2.25f), drift_vec3_make(0.5f, 0, 0),
+                  drift_vec3_make(0, 0, 0.5f), glow);
+    test_add_sphere(r.scene, drift_vec3_make(0.0f, 2.4f, 2.0f), 0.3f, 48, 24, glow);
+    // A tent opening upward: four triangles down to an apex, facing down and out.
+    const float tent[] = { -0.4f, 3.0f,  -0.4f, 0.4f, 3.0f, -0.4f, 0.4f, 3.0f,
+                           0.4f,  -0.4f, 3.0f,  0.4f, 0.0f, 2.6f,  0.0f };
+    float moved[15];
+    for (int k = 0; k < 15; ++k) {
+        moved[k] = tent[k] + (k % 3 == 0 ? -2.0f : k % 3 == 2 ? 2.0f : 0.0f);
+    }
+    const uint32_t tent_index[] = { 0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4 };
+    test_add_mesh(r.scene, moved, 5, tent_index, 4, glow);
+    r.scene->camera =
+        drift_camera_look_at(drift_vec3_make(0, 6.0f, -5.0f), drift_vec3_make(0, 0, 0),
+                             drift_vec3_make(0, 1, 0), 0.9f, 64, 64);
+    test_rig_commit(&r);
+    drift_raster_light *lights = NULL;
+    uint32_t light_count = 0;
+    assert_int_equal(drift_raster_lights_build(r.ctx, r.scene, &lights, &light_count), DRIFT_OK);
+    assert_int_equal(light_count, 5);
+    int seen = 0;
+    for (uint32_t l = 0; l < light_count; ++l) {
+        const drift_raster_light *h = &lights[l];
+        print_message("light %u: type %d, %u triangles, clearance %g\n", l, (int)h->type,
+                      h->light_count, (double)h->shadow_clearance);
+        if (h->type == DRIFT_LIGHT_QUAD ||
+            (h->type == DRIFT_LIGHT_TRIANGLE && h->light_count == 2)) {
+            assert_true(h->shadow_clearance == 0.0f);
+            seen |= h->type == DRIFT_LIGHT_QUAD ? 1 : 2;
+        } else if (h->type == DRIFT_LIGHT_SPHERE) {
+            assert_near(h->shadow_clearance, 0.3003, 1e-5);
+            seen |= 4;
+        } else if (h->sphere_radius > 0.0f) {
+            assert_true(h->shadow_clearance >= 0.3f && h->shadow_clearance < 0.31f);
+            seen |= 8;
+        } else {
+            assert_true(h->shadow_clearance < 0.0f); // the tent
+            seen |= 16;
+        }
+    }
+    assert_int_equal(seen, 31);
+    drift_raster_lights_destroy(r.ctx, lights, light_count);
+    drift_image bits[2][5], emitting;
+    drift_shadow_technique shadows[2] = { DRIFT_SHADOWS_HARD, DRIFT_SHADOWS_BLUR };
+    for (int t = 0; t < 2; ++t) {
+        test_rig_frame(&r, &(drift_hybrid_params){ .shadows = shadows[t] });
+        if (t == 0) {
+            // The emitters' pixels, front or back: the glow material's.
+            const drift_image *m = test_rig_plane(&r, "material_id");
+            assert_int_equal(drift_image_create(r.ctx, m->width, m->height, 1, &emitting),
+                             DRIFT_OK);
+            for (int32_t y = 0; y < m->height; ++y) {
+                for (int32_t x = 0; x < m->width; ++x) {
+                    drift_image_pixel(&emitting, x, y)[0] =
+                        drift_image_pixel(m, x, y)[0] == (float)glow ? 1.0f : 0.0f;
+                }
+            }
+        }
+        for (uint32_t l = 0; l < 5; ++l) {
+            char name[32];
+            snprintf(name, sizeof name, "light%u.hard_shadow", l);
+            const drift_image *plane = test_rig_plane(&r, name);
+            assert_int_equal(drift_image_create(r.ctx, plane->width, plane->height, 1, &bits[t][l]),
+                             DRIFT_OK);
+            for (int32_t y = 0; y < plane->height; ++y) {
+                for (int32_t x = 0; x < plane->width; ++x) {
+                    drift_image_pixel(&bits[t][l], x, y)[0] = drift_image_pixel(plane, x, y)[0];
+                }
+            }
+        }
+    }
+    int64_t shadowed = 0;
+    for (uint32_t l = 0; l < 5; ++l) {
+        for (int32_t y = 0; y < bits[0][l].height; ++y) {
+            for (int32_t x = 0; x < bits[0][l].width; ++x) {
+                float a = drift_image_pixel(&bits[0][l], x, y)[0];
+                if (drift_image_pixel(&emitting, x, y)[0] > 0.0f) {
+                    continue;
+                }
+                assert_true(a == drift_image_pixel(&bits[1][l], x, y)[0]);
+                shadowed += a == 0.0f;
+            }
+        }
+        drift_image_destroy(r.ctx, &bits[0][l]);
+        drift_image_destroy(r.ctx, &bits[1][l]);
+    }
+    drift_image_destroy(r.ctx, &emitting);
+    print_message("%lld shadowed pixel-lights, the same under any-hit and closest-hit rays\n",
+                  (long long)shadowed);
+    assert_true(shadowed > 100);
+    test_rig_destroy(&r);
+}
+
 // The environment's direct light, copied from the frame rendered with `params`.
 static drift_image environment_plane(test_rig *r, const drift_hybrid_params *params)
 {
@@ -763,6 +889,7 @@ int main(void)
         cmocka_unit_test(test_unshadowed_quad_matches_monte_carlo),
         cmocka_unit_test(test_unshadowed_sphere_matches_monte_carlo),
         cmocka_unit_test(test_tessellated_sphere_light_in_closed_form),
+        cmocka_unit_test(test_hard_shadows_any_hit_match_closest_hit),
         cmocka_unit_test(test_environment_interleave_beats_equal_rays),
         cmocka_unit_test(test_technique_names_round_trip),
         cmocka_unit_test(test_rejects_bad_params),
