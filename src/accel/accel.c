@@ -424,8 +424,9 @@ bool drift_accel_occluded(const drift_accel *accel, const drift_ray *ray)
     struct RTCRay r;
     ray_to_rtc(ray, &r);
     rtcOccluded1(accel->rtc_scene, &context, &r);
-    // Embree marks an occluded ray by setting tfar to -inf.
-    return r.tfar < 0.0f;
+    // Embree marks an occluded ray by setting tfar to -inf; an empty segment (tmax < tmin,
+    // e.g. a shadow ray that starts inside the sphere light it aims at) keeps its own tfar.
+    return r.tfar == -INFINITY;
 }
 
 // Coherent batches go to Embree as 16-wide packets: on this Embree build (AVX-512) they
@@ -498,8 +499,8 @@ void drift_accel_occluded_coherent(const drift_accel *accel, const drift_ray *ra
         packet_load(rays + begin, n, &p, valid);
         rtcOccluded16(valid, accel->rtc_scene, &context, &p);
         for (uint32_t i = 0; i < n; ++i) {
-            // Embree marks an occluded ray by setting tfar to -inf.
-            out_occluded[begin + i] = p.tfar[i] < 0.0f;
+            // Embree marks an occluded ray by setting tfar to -inf (not a negative tmax).
+            out_occluded[begin + i] = p.tfar[i] == -INFINITY;
         }
     }
 }
