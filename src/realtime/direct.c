@@ -100,6 +100,25 @@ static void interleave_gather_pixel(drift_frame_state *f, int32_t x, int32_t y, 
 // pixels aim at the same centre.
 #define SHADOW_BATCH 64
 
+// Where an any-hit shadow ray toward `light` must stop to meet none of the light's own
+// surface: shadow_clearance short of its tmax, and for a flat emitter (one-sided with a
+// clearance of 0) short of where the ray crosses the emitter's plane. The ray leaves from an
+// origin offset off the surface, so at a grazing angle that crossing comes before the
+// centre's distance d (1 - 1e-4) that tmax holds.
+static float any_hit_tmax(const drift_raster_light *light, const drift_ray *ray)
+{
+    float tmax = ray->tmax - light->shadow_clearance;
+    if (light->one_sided) {
+        float cos_plane = drift_vec3_dot(ray->dir, light->direction);
+        float t = drift_vec3_dot(drift_vec3_sub(light->centre, ray->origin), light->direction) /
+                  cos_plane;
+        if (cos_plane != 0.0f && t > 0.0f) {
+            tmax = fminf(tmax, t * (1.0f - 1e-4f));
+        }
+    }
+    return tmax;
+}
+
 static void hard_shadow_row(drift_frame_state *f, int32_t y, uint64_t *rays, void *user)
 {
     bool occluder_distances = *(const bool *)user;
@@ -110,8 +129,7 @@ static void hard_shadow_row(drift_frame_state *f, int32_t y, uint64_t *rays, voi
     float light_distance[SHADOW_BATCH];
     for (uint32_t l = 0; l < f->light_count; ++l) {
         drift_frame_light_buffers *b = &f->light_buffers[l];
-        float clearance = f->lights[l].shadow_clearance;
-        bool any_hit = !occluder_distances && clearance >= 0.0f;
+        bool any_hit = !occluder_distances && f->lights[l].shadow_clearance >= 0.0f;
         for (int32_t x0 = 0; x0 < f->params.width; x0 += SHADOW_BATCH) {
             int32_t x1 = x0 + SHADOW_BATCH < f->params.width ? x0 + SHADOW_BATCH : f->params.width;
             uint32_t n = 0;
@@ -130,7 +148,7 @@ static void hard_shadow_row(drift_frame_state *f, int32_t y, uint64_t *rays, voi
             }
             if (any_hit) {
                 for (uint32_t k = 0; k < n; ++k) {
-                    batch[k].tmax -= clearance;
+                    batch[k].tmax = any_hit_tmax(&f->lights[l], &batch[k]);
                 }
                 drift_accel_occluded_coherent(f->accel, batch, occluded, n);
             } else {
