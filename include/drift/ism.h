@@ -120,8 +120,8 @@ typedef struct drift_vpl {
     uint32_t squarings; // m = 2^squarings
 } drift_vpl;
 
-#define DRIFT_VPL_MAX_SQUARINGS 6 // DRIFT_VPL_MAX_EXPONENT = 2^6
-#define DRIFT_VPL_MAX_EXPONENT  64.0f
+#define DRIFT_VPL_MAX_SQUARINGS 6
+#define DRIFT_VPL_MAX_EXPONENT  ((float)(1u << DRIFT_VPL_MAX_SQUARINGS))
 
 typedef enum drift_ism_stage {
     DRIFT_ISM_STAGE_VPLS = 0, // reflective shadow maps, CDFs and the VPL paths

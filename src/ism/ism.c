@@ -536,6 +536,8 @@ static void gather_vpl_none(const drift_vpl *v, const gather_consts *c, int32_t 
 static void gather_vpl_rays(const drift_ism *ism, const drift_vpl *v, receivers *rs,
                             const gather_consts *c, uint64_t *rays)
 {
+    const bool glossy = !drift_vec3_is_zero(v->glossy);
+    const vpl_lobe lobe = vpl_lobe_of(v);
     for (int32_t i = 0; i < rs->count; ++i) {
         drift_vec3 xp = { rs->px[i], rs->py[i], rs->pz[i] };
         drift_vec3 d = drift_vec3_sub(v->position, xp);
@@ -555,8 +557,7 @@ static void gather_vpl_rays(const drift_ism *ism, const drift_vpl *v, receivers 
             continue;
         }
         float g = dx * inv * dj * inv / fmaxf(dist2, c->dmin2);
-        vpl_lobe lobe = vpl_lobe_of(v);
-        float t = lobe_power(&lobe, d.x, d.y, d.z, inv) * g;
+        float t = glossy ? lobe_power(&lobe, d.x, d.y, d.z, inv) * g : 0.0f;
         rs->er[i] += v->flux.x * g + v->glossy.x * t;
         rs->eg[i] += v->flux.y * g + v->glossy.y * t;
         rs->eb[i] += v->flux.z * g + v->glossy.z * t;

@@ -328,12 +328,11 @@ static void trace_paths(size_t begin, size_t end, int thread, void *user)
             if (!drift_vec3_is_zero(vpl.flux) || !drift_vec3_is_zero(vpl.glossy)) {
                 slots[b] = vpl;
             }
+            // A diffuse surface keeps the cosine direction (and its sampler dimensions) the
+            // paths always took, so diffuse scenes' VPLs are unchanged.
             drift_vec3 w;
             if (!mirror && drift_vec3_is_zero(bsdf.specular)) {
                 flux = diffuse;
-                if (drift_vec3_is_zero(flux)) {
-                    break;
-                }
                 drift_frame fr = drift_frame_from_normal(surf.ns);
                 w = drift_frame_to_world(&fr,
                                          drift_sample_cosine_hemisphere(drift_sampler_next2(&s)));
@@ -341,16 +340,10 @@ static void trace_paths(size_t begin, size_t end, int thread, void *user)
                 float u_lobe = drift_sampler_next1(&s);
                 drift_bsdf_sample bs = drift_bsdf_sample_wi(&bsdf, drift_vec3_neg(ray.dir), u_lobe,
                                                             drift_sampler_next2(&s));
-                if (!(bs.pdf > 0.0f)) {
-                    break;
-                }
-                flux = drift_vec3_mul(flux, bs.weight);
+                flux = bs.pdf > 0.0f ? drift_vec3_mul(flux, bs.weight) : drift_vec3_splat(0.0f);
                 w = bs.wi;
-                if (drift_vec3_is_zero(flux)) {
-                    break;
-                }
             }
-            if (drift_vec3_dot(w, surf.ng) <= 0.0f) {
+            if (drift_vec3_is_zero(flux) || drift_vec3_dot(w, surf.ng) <= 0.0f) {
                 break;
             }
             ray = (drift_ray){ drift_offset_origin(surf.position, surf.ng, w), 0.0f, w, INFINITY };
