@@ -17,6 +17,15 @@ void drift_gbuffer_render(drift_context *ctx, const drift_scene *scene, const dr
                           const drift_camera *camera, const drift_camera *prev_camera,
                           drift_gbuffer *gbuffer, uint64_t *rays);
 
+// Whether pixels a and b (indices y * width + x) lie on one surface as an image-space filter
+// sees it: the same mesh, shading normals within ~25 degrees (a thin part of an object in
+// front of the floor is not averaged with it). Each filter adds its own depth tolerance.
+static inline bool drift_gbuffer_same_surface(const drift_gbuffer *g, size_t a, size_t b)
+{
+    return g->mesh_index[a] == g->mesh_index[b] &&
+           drift_vec3_dot(g->surfaces[a].ns, g->surfaces[b].ns) > 0.9f;
+}
+
 // --- LIGHTS AS THE HYBRID FRAME SEES THEM (lights.c) ---
 
 // One light of the frame: a scene light, or every triangle light of one emissive mesh

@@ -73,7 +73,6 @@ static void interleave_gather_pixel(drift_frame_state *f, int32_t x, int32_t y, 
         return;
     }
     float depth = drift_image_pixel(&g->depth, x, y)[0];
-    drift_vec3 normal = drift_image_get3(&g->normal, x, y);
     drift_vec3 sum = drift_vec3_splat(0.0f);
     float total = 0.0f;
     for (int32_t dy = -1; dy <= 1; ++dy) {
@@ -83,8 +82,7 @@ static void interleave_gather_pixel(drift_frame_state *f, int32_t x, int32_t y, 
                 continue;
             }
             size_t other = pixel_index(f, u, v);
-            if (g->mesh_index[other] != g->mesh_index[centre] ||
-                drift_vec3_dot(drift_image_get3(&g->normal, u, v), normal) < 0.9f ||
+            if (!drift_gbuffer_same_surface(g, centre, other) ||
                 fabsf(drift_image_pixel(&g->depth, u, v)[0] - depth) > 0.05f * depth) {
                 continue;
             }

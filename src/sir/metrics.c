@@ -519,14 +519,6 @@ static void penumbra_check_pixel(drift_frame_state *f, int32_t x, int32_t y, uin
     job->checks[index] = check;
 }
 
-// Whether pixel b's shadow error says something about pixel a's: the same mesh, facing about
-// the same way (a thin part of an object in front of the floor is not averaged with it).
-static bool same_surface(const drift_frame_state *f, size_t a, size_t b)
-{
-    return f->gbuffer.mesh_index[a] == f->gbuffer.mesh_index[b] &&
-           drift_vec3_dot(f->gbuffer.surfaces[a].ns, f->gbuffer.surfaces[b].ns) > 0.9f;
-}
-
 // The penumbra estimate (the metrics' largest cost: the blocker search's shadow-map taps) is
 // evaluated at half resolution: at the corner pixel of each 2 x 2 block, for every light; the
 // block's other pixels take it when they lie on the same surface (same mesh, normals within
@@ -570,7 +562,8 @@ static float coarse_estimate(const drift_frame_state *f, const metric_job *job, 
     if (corner != index) {
         float za = drift_image_pixel(&f->gbuffer.depth, x, y)[0];
         float zb = drift_image_pixel(&f->gbuffer.depth, x & ~1, y & ~1)[0];
-        if (!same_surface(f, index, corner) || !(fabsf(za - zb) <= 0.02f * za)) {
+        if (!drift_gbuffer_same_surface(&f->gbuffer, index, corner) ||
+            !(fabsf(za - zb) <= 0.02f * za)) {
             return -1.0f;
         }
     }
@@ -801,7 +794,7 @@ static void gate_penumbra(drift_frame_state *f, drift_image *shadow, const penum
                      ++u) {
                     size_t other = (size_t)v * (size_t)w + (size_t)u;
                     if (u < 0 || u >= w || drift_image_pixel(shadow, u, v)[0] <= 0.0f ||
-                        !same_surface(f, index, other) ||
+                        !drift_gbuffer_same_surface(&f->gbuffer, index, other) ||
                         fabsf(checks[other].raster - checks[index].raster) > SIMILAR_SHADOW) {
                         continue;
                     }
