@@ -209,8 +209,11 @@ static void test_paths_go_on_through_mirrors(void **state)
     double sum[4], sigma;
     drift_vpl *vpls = vpls_by_bounce(&r, &p, &count, sum, &sigma);
     assert_true(sum[0] == 0.0);
-    // The light's own quad stops ~0.4% of the reflected paths.
-    assert_near(sum[1] / (power * 0.4), 0.995, 0.02);
+    // Within 2%: the light's own quad stops a few tenths of a percent of the reflected paths
+    // (those within ~4 degrees of the vertical), the planes' finite size lets fewer escape.
+    printf("mirror floor: ceiling VPLs carry %.4f of 0.8 x 0.5 of the power\n",
+           sum[1] / (power * 0.4));
+    assert_near(sum[1] / (power * 0.4), 1.0, 0.02);
     drift_free(r.ctx, vpls);
     test_rig_destroy(&r);
 }
