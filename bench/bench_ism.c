@@ -400,10 +400,12 @@ int drift_bench_ism(int argc, char **argv)
                                 .vpl_count = (uint32_t)o.vpls[v / 2],
                                 .points_per_vpl = (uint32_t)o.points,
                                 .map_size = (int32_t)o.map,
-                                .block_size = (int32_t)o.block };
+                                .block_size = (int32_t)o.block,
+                                // The VPL gather alone: the compensation needs a frame.
+                                .no_near_field = true };
         drift_ism *ism = NULL;
         r = drift_ism_create(b.ctx, b.scene, b.accel, &ip, &ism);
-        r = r ? r : drift_ism_render(ism, drift_hybrid_gbuffer(frame), &b.scene->camera);
+        r = r ? r : drift_ism_render(ism, drift_hybrid_gbuffer(frame), &b.scene->camera, NULL);
         if (r != DRIFT_OK) {
             drift_ism_destroy(ism);
             break;
@@ -413,7 +415,7 @@ int drift_bench_ism(int argc, char **argv)
         // Warm frames: the same VPLs and maps again (nothing is cached across renders but
         // the points and the buffers); the fastest stands for the row under a noisy load.
         for (long k = 0; k < o.repeat && r == DRIFT_OK; ++k) {
-            r = drift_ism_render(ism, drift_hybrid_gbuffer(frame), &b.scene->camera);
+            r = drift_ism_render(ism, drift_hybrid_gbuffer(frame), &b.scene->camera, NULL);
             drift_ism_stats again = drift_ism_get_stats(ism);
             st = again.total_ms < st.total_ms || k == 0 ? again : st;
         }

@@ -380,6 +380,10 @@ static const cli_option render_table[] = {
                "on: keep candidate VPLs with probability by their contribution\n"
                "to the view, divided by it (Georgiev & Slusallek 2010;\n"
                "default off)"),
+    CLI_CHOICE("--ism-near-field", "on|off", O, hybrid.ism.no_near_field, "on|off",
+               "off: no near-field compensation (short rays from a quarter of the\n"
+               "pixels give back the light of surfaces nearer than the VPLs'\n"
+               "clamp; default on)"),
     CLI_INT("--ism-map-size", "N", O, hybrid.ism.map_size, 4, 1024,
             "texels a side of each VPL's imperfect shadow map (default 64)"),
     CLI_INT("--ism-points", "N", O, hybrid.ism.points_per_vpl, 16, 1 << 20,

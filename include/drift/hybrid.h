@@ -152,11 +152,13 @@ typedef struct drift_aaf_settings {
 //   map_size       = 0 -> 64: each VPL's imperfect shadow map is map_size^2 texels
 //   points_per_vpl = 0 -> 1024 scene points splatted into each map
 //   vpl_importance = false: true keeps VPLs by their contribution to the view (docs/ism.md)
+//   no_near_field  = false: the near-field compensation runs (short rays, docs/ism.md)
 typedef struct drift_ism_settings {
     uint32_t vpls;
     int32_t map_size;
     uint32_t points_per_vpl;
     bool vpl_importance;
+    bool no_near_field;
 } drift_ism_settings;
 
 // Micro-rendering (indirect micro and reflections micro, docs/micro.md):

@@ -70,7 +70,13 @@ typedef enum drift_ism_visibility {
 //   pull_push_levels  = 0 -> 2; negative: no hole filling
 //   pull_push_threshold = 0 -> 0.05 x scene diagonal at level 0 (times 2^l at level l)
 //   depth_bias        = 0 -> 0.01 x scene diagonal, plus one texel's footprint at the receiver
-//   clamp_distance    = 0 -> 0.05 x scene diagonal: d_min of the geometry term
+//   clamp_distance    = 0 -> 0.1 x scene diagonal (0.05 with no_near_field): d_min of the
+//                       geometry term
+//   no_near_field     = false: one ray a pixel, at most d_min long, adds back the light of the
+//                       surfaces nearer than d_min that the clamp takes away (near-field
+//                       compensation; it needs drift_ism_render's direct image)
+//   near_field_stride = 0 -> 2 (1 for an odd block_size): the compensation's rays leave one
+//                       pixel in stride x stride, weighed by stride^2; divides block_size
 //   block_size        = 0 -> 4: interleaved sampling over 4x4 pixel blocks (1 = every pixel
 //                       gathers every VPL)
 //   no_blur           = false: the geometry-aware blur over the block runs
@@ -95,6 +101,8 @@ typedef struct drift_ism_params {
     float pull_push_threshold;
     float depth_bias;
     float clamp_distance;
+    bool no_near_field;
+    int32_t near_field_stride;
     int32_t block_size;
     bool no_blur;
     float blur_normal;
@@ -128,8 +136,9 @@ typedef enum drift_ism_stage {
     DRIFT_ISM_STAGE_POINTS,   // re-deriving the scene points from the meshes
     DRIFT_ISM_STAGE_SPLAT,    // splatting the points into the ISMs
     DRIFT_ISM_STAGE_PULL_PUSH,
-    DRIFT_ISM_STAGE_GATHER, // interleaved gathering (with the shadow rays for `ir`)
-    DRIFT_ISM_STAGE_BLUR,   // geometry-aware blur and the albedo multiply
+    DRIFT_ISM_STAGE_GATHER,     // interleaved gathering (with the shadow rays for `ir`)
+    DRIFT_ISM_STAGE_BLUR,       // geometry-aware blur and the albedo multiply
+    DRIFT_ISM_STAGE_NEAR_FIELD, // the near-field compensation's rays (its blur is BLUR's)
     DRIFT_ISM_STAGE_COUNT
 } drift_ism_stage;
 
@@ -140,6 +149,7 @@ typedef struct drift_ism_stats {
     double total_ms;
     uint32_t vpl_count;   // VPLs of the last render (all bounces)
     uint64_t shadow_rays; // `ir` visibility rays
+    uint64_t near_field_rays;
     uint64_t splats;      // points splatted
     double hole_fraction; // ISM texels still empty after pull-push
 } drift_ism_stats;
@@ -156,15 +166,21 @@ void drift_ism_destroy(drift_ism *ism); // NULL-safe
 
 // Renders the indirect light of one frame: re-derives the points from the meshes, draws the
 // VPLs, builds the maps and gathers at every G-buffer pixel. The G-buffer's position, normal,
-// geometric_normal, albedo and material_id planes are read. `camera` may be NULL (it only
-// places the "ism.vpls" plane). Errors: DRIFT_ERR_INVALID_ARGUMENT (G-buffer of another size
-// than the last call is fine; an empty one is not), DRIFT_ERR_OUT_OF_MEMORY.
+// geometric_normal, albedo and material_id planes are read. `direct` is the frame's direct
+// radiance at each pixel (RGB, the G-buffer's size): the near-field compensation reads the light
+// the surfaces it hits reflect off it, and needs the camera and the G-buffer's surfaces and
+// depth. NULL skips the compensation (as no_near_field does, but with the wider clamp
+// of its default: pass no_near_field to get the narrower one). `camera` may be NULL without
+// the compensation (it then only places the "ism.vpls" plane). Errors:
+// DRIFT_ERR_INVALID_ARGUMENT (G-buffer of another size than the last call is fine; an empty
+// one is not), DRIFT_ERR_OUT_OF_MEMORY.
 drift_result drift_ism_render(drift_ism *ism, const drift_gbuffer *gbuffer,
-                              const drift_camera *camera);
+                              const drift_camera *camera, const drift_image *direct);
 
 // RGB radiance: the diffuse indirect light I at each pixel (0 where the G-buffer missed).
 const drift_image *drift_ism_indirect(const drift_ism *ism);
-// Diagnostic planes by name: "ism.irradiance" (RGB, before blur and albedo), "ism.vpls" (RGB,
+// Diagnostic planes by name: "ism.irradiance" (RGB, before blur and albedo), "ism.near_field"
+// (RGB, the compensation's irradiance a pixel, before blur and albedo), "ism.vpls" (RGB,
 // the VPLs' flux splatted where they project on the camera image), "ism.tile" (1 channel,
 // the depth map of VPL 0 after pull-push, 0 where empty). NULL when the last render has none.
 const drift_image *drift_ism_plane_named(const drift_ism *ism, const char *name);

@@ -1,5 +1,5 @@
-// drift ism (include/drift/ism.h): the object, the per-frame passes, interleaved gathering and
-// the geometry-aware blur.
+// drift ism (include/drift/ism.h): the object, the per-frame passes, interleaved gathering,
+// the geometry-aware blur and the near-field compensation.
 #include "ism/ism_internal.h"
 
 #include <math.h>
@@ -23,7 +23,7 @@ struct drift_ism {
     float *disc_counts;  // drift__ism_disc_counts of the lazy pyramid's top level
     float *scratch;      // one pull-push pyramid per thread
     int32_t width, height;
-    drift_image irradiance, indirect, vpl_plane, tile;
+    drift_image irradiance, indirect, vpl_plane, tile, near_field;
     drift_ism_stats stats;
     float splat_radius; // k sqrt(A_pt / pi) of the last render, world units
     uint32_t *groups;   // group_count + 1 starts of the runs of VPLs of one bounce and round
@@ -33,7 +33,8 @@ struct drift_ism {
 };
 
 static const char *const stage_names[DRIFT_ISM_STAGE_COUNT] = { "vpls",      "points", "splat",
-                                                                "pull_push", "gather", "blur" };
+                                                                "pull_push", "gather", "blur",
+                                                                "near_field" };
 
 const char *drift_ism_stage_name(drift_ism_stage stage)
 {
@@ -84,10 +85,15 @@ drift_ism_params drift_ism_params_resolve(const drift_ism_params *params, const 
         p.depth_bias = 0.01f * diag;
     }
     if (p.clamp_distance == 0.0f) {
-        p.clamp_distance = 0.05f * diag;
+        // The compensation gives back what the clamp takes: a wider clamp removes more of the
+        // VPLs' near-field spikes (docs/ism.md, "Near-field compensation").
+        p.clamp_distance = (p.no_near_field ? 0.05f : 0.1f) * diag;
     }
     if (p.block_size == 0) {
         p.block_size = 4;
+    }
+    if (p.near_field_stride == 0) {
+        p.near_field_stride = p.block_size % 2 == 0 ? 2 : 1;
     }
     if (p.blur_normal == 0.0f) {
         p.blur_normal = 0.9f;
@@ -106,7 +112,9 @@ static bool params_valid(const drift_ism_params *p)
            p->map_size >= 4 && p->map_size <= 1024 && p->points_per_vpl <= (1u << 20) &&
            p->splat_scale > 0.0f && p->pull_push_levels <= 7 && p->pull_push_threshold > 0.0f &&
            p->depth_bias >= 0.0f && p->clamp_distance >= 0.0f && p->block_size >= 1 &&
-           p->block_size <= 64 && p->blur_normal <= 1.0f && p->blur_plane > 0.0f &&
+           p->block_size <= 64 && p->near_field_stride >= 1 &&
+           p->block_size % p->near_field_stride == 0 && p->blur_normal <= 1.0f &&
+           p->blur_plane > 0.0f &&
            (uint64_t)p->points_per_vpl * drift__ism_max_vpls(p) <= (1u << 28);
 }
 
@@ -268,6 +276,7 @@ static void destroy_planes(drift_ism *ism)
     drift_image_destroy(ism->ctx, &ism->indirect);
     drift_image_destroy(ism->ctx, &ism->vpl_plane);
     drift_image_destroy(ism->ctx, &ism->tile);
+    drift_image_destroy(ism->ctx, &ism->near_field);
 }
 
 void drift_ism_destroy(drift_ism *ism)
@@ -380,6 +389,7 @@ typedef struct gather_job {
     int32_t capacity;    // receivers a job can hold
     int32_t subset_rows; // rows of one subset in a band (a band is subset_rows * B rows)
     int32_t bands;
+    bool near_field; // the blur adds the near-field plane
 } gather_job;
 
 // The constants of one render's lookups.
@@ -679,62 +689,208 @@ static void gather_jobs(size_t begin, size_t end, int thread, void *user)
     }
 }
 
-// The block-sized window around each pixel, averaging only the pixels whose normal and plane
-// agree with the centre's (Segovia et al. 2006), then times albedo / pi.
+// The block-sized window of `in` (plus `more`, when not NULL) around (x, y), averaging only the
+// pixels whose normal and plane agree with the centre's (Segovia et al. 2006).
+static drift_vec3 block_average(const drift_ism *ism, const drift_gbuffer *gb,
+                                const drift_image *in, const drift_image *more, int32_t x,
+                                int32_t y)
+{
+    int32_t b = ism->params.no_blur ? 1 : ism->params.block_size;
+    drift_vec3 e = drift_image_get3(in, x, y);
+    if (more) {
+        e = drift_vec3_add(e, drift_image_get3(more, x, y));
+    }
+    if (b <= 1) {
+        return e;
+    }
+    int32_t lo = -(b / 2), hi = lo + b;
+    float blur_normal = ism->params.blur_normal, blur_plane = ism->params.blur_plane;
+    const drift_image *mat = &gb->material_id, *pos = &gb->position, *nrm = &gb->normal;
+    int32_t y0 = y + lo < 0 ? 0 : y + lo, y1 = y + hi > gb->height ? gb->height : y + hi;
+    int32_t x0 = x + lo < 0 ? 0 : x + lo, x1 = x + hi > gb->width ? gb->width : x + hi;
+    const float *c = drift_image_pixel(pos, x, y), *cn = drift_image_pixel(nrm, x, y);
+    float sr = 0.0f, sg = 0.0f, sb = 0.0f, weight = 0.0f;
+    for (int32_t yy = y0; yy < y1; ++yy) {
+        const float *m = drift_image_pixel(mat, 0, yy);
+        const float *pp = drift_image_pixel(pos, 0, yy);
+        const float *nn = drift_image_pixel(nrm, 0, yy);
+        const float *ee = drift_image_pixel(in, 0, yy);
+        const float *mm = more ? drift_image_pixel(more, 0, yy) : NULL;
+        for (int32_t xx = x0; xx < x1; ++xx) {
+            const float *q = pp + (size_t)xx * (size_t)pos->channels;
+            const float *qn = nn + (size_t)xx * (size_t)nrm->channels;
+            float plane =
+                fabsf(cn[0] * (q[0] - c[0]) + cn[1] * (q[1] - c[1]) + cn[2] * (q[2] - c[2]));
+            float cosn = cn[0] * qn[0] + cn[1] * qn[1] + cn[2] * qn[2];
+            if (m[(size_t)xx * (size_t)mat->channels] < 0.0f || cosn < blur_normal ||
+                plane > blur_plane) {
+                continue;
+            }
+            const float *qe = ee + (size_t)xx * (size_t)in->channels;
+            sr += qe[0];
+            sg += qe[1];
+            sb += qe[2];
+            if (mm) {
+                const float *qm = mm + (size_t)xx * (size_t)more->channels;
+                sr += qm[0];
+                sg += qm[1];
+                sb += qm[2];
+            }
+            weight += 1.0f;
+        }
+    }
+    return weight > 0.0f ? drift_vec3_make(sr / weight, sg / weight, sb / weight) : e;
+}
+
+// I = kd / pi times the block average of the irradiance and the near-field compensation's.
 static void blur_rows(size_t begin, size_t end, int thread, void *user)
 {
     (void)thread;
     gather_job *job = user;
     drift_ism *ism = job->ism;
     const drift_gbuffer *gb = job->gb;
-    int32_t b = ism->params.no_blur ? 1 : ism->params.block_size;
-    int32_t lo = -(b / 2), hi = lo + b;
-    float blur_normal = ism->params.blur_normal, blur_plane = ism->params.blur_plane;
-    const drift_image *mat = &gb->material_id, *pos = &gb->position, *nrm = &gb->normal;
-    const drift_image *irr = &ism->irradiance;
+    const drift_image *near_field = job->near_field ? &ism->near_field : NULL;
     for (size_t row = begin; row < end; ++row) {
         int32_t y = (int32_t)row;
-        int32_t y0 = y + lo < 0 ? 0 : y + lo, y1 = y + hi > gb->height ? gb->height : y + hi;
         for (int32_t x = 0; x < gb->width; ++x) {
-            if (drift_image_pixel(mat, x, y)[0] < 0.0f) {
-                drift_image_set3(&ism->indirect, x, y, drift_vec3_splat(0.0f));
-                continue;
-            }
-            drift_vec3 e = drift_image_get3(irr, x, y);
-            if (b > 1) {
-                int32_t x0 = x + lo < 0 ? 0 : x + lo, x1 = x + hi > gb->width ? gb->width : x + hi;
-                const float *c = drift_image_pixel(pos, x, y), *cn = drift_image_pixel(nrm, x, y);
-                float sr = 0.0f, sg = 0.0f, sb = 0.0f, weight = 0.0f;
-                for (int32_t yy = y0; yy < y1; ++yy) {
-                    const float *m = drift_image_pixel(mat, 0, yy);
-                    const float *pp = drift_image_pixel(pos, 0, yy);
-                    const float *nn = drift_image_pixel(nrm, 0, yy);
-                    const float *ee = drift_image_pixel(irr, 0, yy);
-                    for (int32_t xx = x0; xx < x1; ++xx) {
-                        const float *q = pp + (size_t)xx * (size_t)pos->channels;
-                        const float *qn = nn + (size_t)xx * (size_t)nrm->channels;
-                        float plane = fabsf(cn[0] * (q[0] - c[0]) + cn[1] * (q[1] - c[1]) +
-                                            cn[2] * (q[2] - c[2]));
-                        float cosn = cn[0] * qn[0] + cn[1] * qn[1] + cn[2] * qn[2];
-                        if (m[(size_t)xx * (size_t)mat->channels] < 0.0f || cosn < blur_normal ||
-                            plane > blur_plane) {
-                            continue;
-                        }
-                        const float *qe = ee + (size_t)xx * (size_t)irr->channels;
-                        sr += qe[0];
-                        sg += qe[1];
-                        sb += qe[2];
-                        weight += 1.0f;
-                    }
-                }
-                if (weight > 0.0f) {
-                    e = drift_vec3_make(sr / weight, sg / weight, sb / weight);
-                }
+            drift_vec3 e = drift_vec3_splat(0.0f);
+            if (drift_image_pixel(&gb->material_id, x, y)[0] >= 0.0f) {
+                e = block_average(ism, gb, &ism->irradiance, near_field, x, y);
             }
             drift_vec3 kd = drift_image_get3(&gb->albedo, x, y);
             drift_image_set3(&ism->indirect, x, y,
                              drift_vec3_scale(drift_vec3_mul(kd, e), DRIFT_INV_PI));
         }
+    }
+}
+
+// --- NEAR-FIELD COMPENSATION ---
+//
+// The clamp d_min in the geometry term keeps a VPL next to a receiver from painting a spike, and
+// takes away the light that nearby surfaces really send (corners, contact, a wall beside a sunlit
+// floor). Written over directions, the clamped gather is
+//   E_clamped(x) = integral of L_o(y(w)) cos(theta_x) min(1, d^2 / d_min^2) dw,
+// so the part it misses is the same integral with max(0, 1 - d^2 / d_min^2): zero beyond d_min.
+// A cosine ray at most d_min long estimates it as pi L_o(y) (1 - d^2 / d_min^2) (Kollig and
+// Keller 2004's bias compensation, cut to one bounce). L_o(y) is read off the frame where the
+// hit is the surface a pixel sees (its direct radiance plus the clamped indirect light just
+// gathered; Novak et al. 2011 compensate in screen space alone); a hit the camera does not see
+// adds nothing. One pixel in stride x stride shoots (a quarter by default: 1 ray a pixel cost
+// 3x as much for 0.001-0.003 FLIP), a block's rays take stratified directions, and the block
+// average blurs them with the VPLs' subsets.
+
+typedef struct near_field_job {
+    drift_ism *ism;
+    const drift_gbuffer *gb;
+    drift_camera_frame camera;
+    const drift_image *direct;
+    float dmin;
+    uint32_t seed;
+    uint64_t rays[64]; // per thread
+} near_field_job;
+
+// Point k of a Hammersley set of n points in [0,1)^2 shifted by `shift` modulo 1.
+static drift_vec2 shifted_hammersley(uint32_t k, uint32_t n, drift_vec2 shift)
+{
+    float x = ((float)k + 0.5f) / (float)n + shift.x;
+    float y = (float)drift_reverse_bits(k) * 0x1p-32f + shift.y;
+    return drift_vec2_make(x - floorf(x), y - floorf(y));
+}
+
+// L_o of hit point p, read off the frame: the pixel p projects to must see p itself (its depth
+// within 2%, its normal facing the ray that found p). False where the camera does not see p.
+static bool frame_radiance(const near_field_job *job, drift_vec3 p, drift_vec3 dir, drift_vec3 *out)
+{
+    const drift_gbuffer *gb = job->gb;
+    drift_vec2 film;
+    if (!drift_camera_frame_project(&job->camera, p, &film) || !(film.x >= 0.0f) ||
+        !(film.y >= 0.0f) || film.x >= (float)gb->width || film.y >= (float)gb->height) {
+        return false;
+    }
+    int32_t qx = (int32_t)film.x, qy = (int32_t)film.y;
+    if (drift_image_pixel(&gb->material_id, qx, qy)[0] < 0.0f) {
+        return false;
+    }
+    float seen = drift_image_pixel(&gb->depth, qx, qy)[0];
+    float depth = drift_vec3_dot(drift_vec3_sub(p, job->camera.camera.position), job->camera.w);
+    const float *n = drift_image_pixel(&gb->normal, qx, qy);
+    if (!(fabsf(seen - depth) < 0.02f * depth) ||
+        n[0] * dir.x + n[1] * dir.y + n[2] * dir.z >= 0.0f) {
+        return false;
+    }
+    *out = drift_image_get3(job->direct, qx, qy);
+    if (job->ism->params.max_depth > 2) {
+        // Paths of max_depth 2 bounce once: p sends its direct light alone. Deeper ones add the
+        // indirect light gathered at p (all of its bounces: one more than max_depth allows).
+        drift_vec3 kd = drift_image_get3(&gb->albedo, qx, qy);
+        drift_vec3 e = block_average(job->ism, gb, &job->ism->irradiance, NULL, qx, qy);
+        *out = drift_vec3_fma(*out, drift_vec3_mul(kd, e), DRIFT_INV_PI);
+    }
+    return true;
+}
+
+static void near_field_rows(size_t begin, size_t end, int thread, void *user)
+{
+    near_field_job *job = user;
+    drift_ism *ism = job->ism;
+    const drift_gbuffer *gb = job->gb;
+    int32_t b = ism->params.block_size;
+    // One ray per stride x stride pixels, weighed by stride^2: the block's B^2 / stride^2 rays
+    // stratify its hemisphere.
+    int32_t stride = ism->params.near_field_stride;
+    int32_t per_side = b / stride;
+    uint32_t directions = (uint32_t)(per_side * per_side);
+    float weight = DRIFT_PI * (float)(stride * stride);
+    for (size_t row = begin; row < end; ++row) {
+        int32_t y = (int32_t)row, by = y / b, ky = y % b, bx = 0, kx = 0;
+        for (int32_t x = 0; x < gb->width; ++x, kx = kx + 1 < b ? kx + 1 : (++bx, 0)) {
+            drift_vec3 e = drift_vec3_splat(0.0f);
+            const drift_surface *s = &gb->surfaces[(size_t)y * (size_t)gb->width + (size_t)x];
+            if (s->material == DRIFT_INVALID_INDEX || kx % stride || ky % stride) {
+                drift_image_set3(&ism->near_field, x, y, e);
+                continue;
+            }
+            // Direction k of the block's set, the set shifted block by block.
+            uint32_t k = (uint32_t)((ky / stride) * per_side + kx / stride);
+            uint32_t h = drift_hash_combine(job->seed, (uint32_t)by * 65536u + (uint32_t)bx);
+            drift_vec2 shift =
+                drift_vec2_make((float)(h & 0xffffu) * 0x1p-16f, (float)(h >> 16) * 0x1p-16f);
+            drift_frame frame = drift_frame_from_normal(s->ns);
+            drift_vec3 dir = drift_frame_to_world(
+                &frame, drift_sample_cosine_hemisphere(shifted_hammersley(k, directions, shift)));
+            drift_hit hit;
+            drift_vec3 lo;
+            if (drift_vec3_dot(dir, s->ng) > 0.0f) {
+                drift_ray ray = { .origin = drift_offset_origin(s->position, s->ng, dir),
+                                  .dir = dir,
+                                  .tmin = 0.0f,
+                                  .tmax = job->dmin };
+                ++job->rays[thread % 64];
+                // Emitters are the direct light's; only a reflecting surface is near-field light.
+                if (drift_accel_intersect(ism->accel, &ray, &hit) &&
+                    hit.mesh != DRIFT_INVALID_INDEX && hit.light == DRIFT_INVALID_INDEX &&
+                    frame_radiance(job, drift_vec3_fma(ray.origin, dir, hit.t), dir, &lo)) {
+                    float falloff = 1.0f - (hit.t * hit.t) / (job->dmin * job->dmin);
+                    e = drift_vec3_scale(lo, weight * fmaxf(falloff, 0.0f));
+                }
+            }
+            drift_image_set3(&ism->near_field, x, y, e);
+        }
+    }
+}
+
+static void add_near_field(drift_ism *ism, const drift_gbuffer *gb, const drift_camera *camera,
+                           const drift_image *direct, drift_ism_stats *st)
+{
+    near_field_job job = { .ism = ism,
+                           .gb = gb,
+                           .camera = drift_camera_frame_make(camera, gb->width, gb->height),
+                           .direct = direct,
+                           .dmin = ism->params.clamp_distance,
+                           .seed = drift_hash_combine(ism->params.seed, 0x4e454152u) };
+    drift_parallel_for(ism->ctx, (size_t)gb->height, 4, near_field_rows, &job);
+    for (int i = 0; i < 64; ++i) {
+        st->near_field_rays += job.rays[i];
     }
 }
 
@@ -752,6 +908,7 @@ static drift_result ensure_planes(drift_ism *ism, int32_t w, int32_t h)
     if (drift_image_create(ism->ctx, w, h, 3, &ism->irradiance) != DRIFT_OK ||
         drift_image_create(ism->ctx, w, h, 3, &ism->indirect) != DRIFT_OK ||
         drift_image_create(ism->ctx, w, h, 3, &ism->vpl_plane) != DRIFT_OK ||
+        drift_image_create(ism->ctx, w, h, 3, &ism->near_field) != DRIFT_OK ||
         drift_image_create(ism->ctx, n, n, 1, &ism->tile) != DRIFT_OK) {
         destroy_planes(ism);
         ism->width = ism->height = 0;
@@ -790,13 +947,22 @@ static void diagnostic_planes(drift_ism *ism, const drift_camera *camera)
 }
 
 drift_result drift_ism_render(drift_ism *ism, const drift_gbuffer *gbuffer,
-                              const drift_camera *camera)
+                              const drift_camera *camera, const drift_image *direct)
 {
     if (!gbuffer || gbuffer->width <= 0 || gbuffer->height <= 0 || !gbuffer->position.pixels ||
         !gbuffer->normal.pixels || !gbuffer->albedo.pixels || !gbuffer->material_id.pixels ||
         !gbuffer->geometric_normal.pixels) {
         drift_log(ism->ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, __FILE__, __LINE__,
                   "ism: the G-buffer lacks a plane gathering reads");
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    bool near_field = direct && !ism->params.no_near_field;
+    if (near_field && (!camera || !gbuffer->surfaces || !gbuffer->depth.pixels ||
+                       direct->width != gbuffer->width || direct->height != gbuffer->height ||
+                       direct->channels < 3)) {
+        drift_log(ism->ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, __FILE__, __LINE__,
+                  "ism: the near-field compensation needs the camera, the G-buffer's surfaces "
+                  "and depth, and a direct image of its size");
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
     drift_result r = ensure_planes(ism, gbuffer->width, gbuffer->height);
@@ -920,6 +1086,16 @@ drift_result drift_ism_render(drift_ism *ism, const drift_gbuffer *gbuffer,
     now = drift_time_now();
     st.ms[DRIFT_ISM_STAGE_GATHER] = (now - t) * 1e3;
     t = now;
+    if (near_field) {
+        add_near_field(ism, gbuffer, camera, direct, &st);
+    } else {
+        memset(ism->near_field.pixels, 0,
+               (size_t)ism->width * (size_t)ism->height * 3 * sizeof(float));
+    }
+    now = drift_time_now();
+    st.ms[DRIFT_ISM_STAGE_NEAR_FIELD] = (now - t) * 1e3;
+    t = now;
+    gj.near_field = near_field;
     drift_parallel_for(ism->ctx, (size_t)gbuffer->height, 4, blur_rows, &gj);
     now = drift_time_now();
     st.ms[DRIFT_ISM_STAGE_BLUR] = (now - t) * 1e3;
@@ -945,6 +1121,9 @@ const drift_image *drift_ism_plane_named(const drift_ism *ism, const char *name)
     }
     if (strcmp(name, "ism.vpls") == 0) {
         return &ism->vpl_plane;
+    }
+    if (strcmp(name, "ism.near_field") == 0) {
+        return &ism->near_field;
     }
     if (strcmp(name, "ism.tile") == 0 && ism->atlas) {
         return &ism->tile;

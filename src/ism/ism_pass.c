@@ -27,14 +27,16 @@ static drift_ism_params params_of(const drift_frame_state *f, drift_ism_visibili
                                .max_depth = f->params.max_depth,
                                .map_size = f->params.ism.map_size,
                                .points_per_vpl = f->params.ism.points_per_vpl,
-                               .vpl_importance = f->params.ism.vpl_importance };
+                               .vpl_importance = f->params.ism.vpl_importance,
+                               .no_near_field = f->params.ism.no_near_field };
 }
 
 static bool same_params(const drift_ism_params *a, const drift_ism_params *b)
 {
     return a->seed == b->seed && a->visibility == b->visibility && a->vpl_count == b->vpl_count &&
            a->max_depth == b->max_depth && a->map_size == b->map_size &&
-           a->points_per_vpl == b->points_per_vpl && a->vpl_importance == b->vpl_importance;
+           a->points_per_vpl == b->points_per_vpl && a->vpl_importance == b->vpl_importance &&
+           a->no_near_field == b->no_near_field;
 }
 
 static drift_result indirect(drift_frame_state *f, const drift_pass_args *args,
@@ -56,7 +58,7 @@ static drift_result indirect(drift_frame_state *f, const drift_pass_args *args,
         drift_pass_set_state(f, args, made, state_destroy);
         s = made;
     }
-    drift_result r = drift_ism_render(s->ism, &f->gbuffer, &f->camera);
+    drift_result r = drift_ism_render(s->ism, &f->gbuffer, &f->camera, &f->direct);
     if (r == DRIFT_OK) {
         drift_pass_copy_rgb(drift_ism_indirect(s->ism), &f->indirect);
     }
@@ -79,7 +81,7 @@ void drift_ism_indirect_planes(const drift_frame_state *f, drift_pass_plane_fn a
                                    .technique = f->params.indirect };
     const ism_pass_state *s = drift_pass_state(f, &args);
     // ism.tile (one VPL's map) is the map's size, not the frame's: not an --aov plane.
-    static const char *const names[] = { "ism.irradiance", "ism.vpls" };
+    static const char *const names[] = { "ism.irradiance", "ism.near_field", "ism.vpls" };
     for (size_t i = 0; s && i < sizeof names / sizeof *names; ++i) {
         const drift_image *plane = drift_ism_plane_named(s->ism, names[i]);
         if (plane && plane->width == f->params.width && plane->height == f->params.height) {

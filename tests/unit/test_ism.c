@@ -42,7 +42,7 @@ static drift_ism *render_ism(test_rig *r, const drift_ism_params *params)
 {
     drift_ism *ism = NULL;
     assert_int_equal(drift_ism_create(r->ctx, r->scene, r->accel, params, &ism), DRIFT_OK);
-    assert_int_equal(drift_ism_render(ism, drift_hybrid_gbuffer(r->frame), &r->scene->camera),
+    assert_int_equal(drift_ism_render(ism, drift_hybrid_gbuffer(r->frame), &r->scene->camera, NULL),
                      DRIFT_OK);
     return ism;
 }
@@ -450,6 +450,57 @@ static void test_ir_and_ism_against_path_tracer(void **state)
     test_rig_destroy(&r);
 }
 
+// The near-field compensation gives back the light the clamp takes: `ir` with 2048 VPLs and a
+// wide clamp (0.2 of the diagonal) against the path tracer's one-bounce diffuse light, without
+// the compensation (measured: 0.89 of the mean) and with it fed the path tracer's direct light
+// (0.985; the rest is near surfaces the camera does not see). With a clamp that reaches no
+// surface it adds nothing.
+static void test_near_field_gives_back_the_clamp(void **state)
+{
+    (void)state;
+    test_rig r = cornell_rig(2, 64); // at 32 x 32 a hit's pixel is too often another surface
+    drift_pt *pt = NULL, *pt_direct = NULL;
+    drift_image ref = render_pt(&r, DRIFT_PT_COMPONENT_DIFFUSE, 2, 512, &pt);
+    drift_image direct = render_pt(&r, DRIFT_PT_COMPONENT_DIRECT, 1, 256, &pt_direct);
+    const drift_gbuffer *gb = drift_hybrid_gbuffer(r.frame);
+    drift_ism_params p = { .visibility = DRIFT_ISM_VISIBILITY_RAYS,
+                           .vpl_count = 2048,
+                           .max_depth = 2 };
+    float diag = 10.0f * drift_ism_params_resolve(&p, r.scene).clamp_distance;
+    double ratio[2], error[2];
+    for (int on = 0; on < 2; ++on) {
+        p.clamp_distance = 0.2f * diag;
+        drift_ism *ism = NULL;
+        assert_int_equal(drift_ism_create(r.ctx, r.scene, r.accel, &p, &ism), DRIFT_OK);
+        assert_int_equal(drift_ism_render(ism, gb, &r.scene->camera, on ? &direct : NULL),
+                         DRIFT_OK);
+        ratio[on] =
+            drift_image_mean_luminance(drift_ism_indirect(ism)) / drift_image_mean_luminance(&ref);
+        error[on] = test_nrmse(r.ctx, &ref, drift_ism_indirect(ism));
+        assert_true((drift_ism_get_stats(ism).near_field_rays > 0) == (on == 1));
+        drift_ism_destroy(ism);
+    }
+    printf("clamp 0.2 x diagonal: mean ratio %.4f without, %.4f with; nrmse %.4f, %.4f\n", ratio[0],
+           ratio[1], error[0], error[1]);
+    assert_true(ratio[0] < 0.92); // the clamp's loss is there to give back
+    assert_true(fabs(ratio[1] - 1.0) < 0.03);
+    assert_true(error[1] < error[0]);
+    // A clamp shorter than any ray's way to a surface: the same image.
+    p.clamp_distance = 1e-4f * diag;
+    drift_ism *a = NULL, *b = NULL;
+    assert_int_equal(drift_ism_create(r.ctx, r.scene, r.accel, &p, &a), DRIFT_OK);
+    assert_int_equal(drift_ism_create(r.ctx, r.scene, r.accel, &p, &b), DRIFT_OK);
+    assert_int_equal(drift_ism_render(a, gb, &r.scene->camera, NULL), DRIFT_OK);
+    assert_int_equal(drift_ism_render(b, gb, &r.scene->camera, &direct), DRIFT_OK);
+    assert_memory_equal(drift_ism_indirect(a)->pixels, drift_ism_indirect(b)->pixels,
+                        64 * 64 * 3 * sizeof(float));
+    drift_ism_destroy(a);
+    drift_ism_destroy(b);
+    drift_pt_destroy(pt_direct);
+    drift_pt_destroy(pt);
+    test_rig_destroy(&r);
+}
+
 // The Cornell box with every surface glossy (kd halved, ks 0.4, n 32: under
 // DRIFT_VPL_MAX_EXPONENT, so no lobe is widened): `ir` with many VPLs against the path
 // tracer's first-bounce diffuse light, whose second vertex scatters by the whole BSDF. The
@@ -675,7 +726,7 @@ static void test_maps_grow_without_changing_the_image(void **state)
     assert_int_equal(drift_ism_create(r.ctx, r.scene, r.accel, &p, &big), DRIFT_OK);
     assert_int_equal(drift__ism_reserve(big, drift__ism_max_vpls(&resolved)), DRIFT_OK);
     assert_int_equal(drift__ism_map_capacity(big), drift__ism_max_vpls(&resolved));
-    assert_int_equal(drift_ism_render(big, drift_hybrid_gbuffer(r.frame), &r.scene->camera),
+    assert_int_equal(drift_ism_render(big, drift_hybrid_gbuffer(r.frame), &r.scene->camera, NULL),
                      DRIFT_OK);
     const drift_image *a = drift_ism_indirect(lazy), *b = drift_ism_indirect(big);
     assert_memory_equal(a->pixels, b->pixels, 24 * 24 * 3 * sizeof(float));
@@ -762,6 +813,7 @@ static void test_parameters_and_planes(void **state)
         { .max_depth = -3 },
         { .splat_scale = -1.0f },
         { .max_path_rounds = 100 },
+        { .block_size = 4, .near_field_stride = 3 },
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
         drift_ism *ism = (drift_ism *)&log;
@@ -769,10 +821,11 @@ static void test_parameters_and_planes(void **state)
                          DRIFT_ERR_INVALID_ARGUMENT);
         assert_null(ism);
     }
-    assert_true(log.errors >= 6);
+    assert_true(log.errors >= 7);
     drift_ism *ism = render_ism(&r, &(drift_ism_params){ .vpl_count = 32 });
     assert_non_null(drift_ism_plane_named(ism, "ism.irradiance"));
     assert_non_null(drift_ism_plane_named(ism, "ism.vpls"));
+    assert_non_null(drift_ism_plane_named(ism, "ism.near_field"));
     assert_non_null(drift_ism_plane_named(ism, "ism.tile"));
     assert_null(drift_ism_plane_named(ism, "ism.nothing"));
     drift_ism_stats st = drift_ism_get_stats(ism);
@@ -797,6 +850,7 @@ int main(void)
         cmocka_unit_test(test_pull_push_fills_holes),
         cmocka_unit_test(test_lazy_push_equals_eager),
         cmocka_unit_test(test_ir_and_ism_against_path_tracer),
+        cmocka_unit_test(test_near_field_gives_back_the_clamp),
         cmocka_unit_test(test_glossy_vpls_against_path_tracer),
         cmocka_unit_test(test_environment_vpls_carry_its_power),
         cmocka_unit_test(test_gather_equals_the_formula),
