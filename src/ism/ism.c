@@ -727,14 +727,15 @@ static drift_vec3 block_average(const drift_ism *ism, const drift_gbuffer *gb,
                 continue;
             }
             const float *qe = ee + (size_t)xx * (size_t)in->channels;
-            sr += qe[0];
-            sg += qe[1];
-            sb += qe[2];
             if (mm) {
                 const float *qm = mm + (size_t)xx * (size_t)more->channels;
-                sr += qm[0];
-                sg += qm[1];
-                sb += qm[2];
+                sr += qe[0] + qm[0];
+                sg += qe[1] + qm[1];
+                sb += qe[2] + qm[2];
+            } else {
+                sr += qe[0];
+                sg += qe[1];
+                sb += qe[2];
             }
             weight += 1.0f;
         }
@@ -742,26 +743,136 @@ static drift_vec3 block_average(const drift_ism *ism, const drift_gbuffer *gb,
     return weight > 0.0f ? drift_vec3_make(sr / weight, sg / weight, sb / weight) : e;
 }
 
-// I = kd / pi times the block average of the irradiance and the near-field compensation's.
+// The blur over rows as structure of arrays, so that each offset of the window is one loop
+// over x that vectorises: a row's positions, normals, a mask of the pixels with a surface, and
+// the irradiance (plus the near-field compensation's). block_average's arithmetic in its order:
+// the same image to the bit.
+typedef struct blur_row {
+    float *px, *py, *pz, *nx, *ny, *nz, *surface, *er, *eg, *eb;
+} blur_row;
+
+#define BLUR_ROW_ARRAYS 10
+// Rows a job blurs: its copies hold b - 1 rows more (<= 64 + 3 with block_size <= 64).
+#define BLUR_JOB_ROWS 4
+
+static void blur_copy_row(const drift_ism *ism, const drift_gbuffer *gb, bool near_field, int32_t y,
+                          const blur_row *r)
+{
+    const float *p = drift_image_pixel(&gb->position, 0, y);
+    const float *n = drift_image_pixel(&gb->normal, 0, y);
+    const float *m = drift_image_pixel(&gb->material_id, 0, y);
+    const float *e = drift_image_pixel(&ism->irradiance, 0, y);
+    const float *f = drift_image_pixel(&ism->near_field, 0, y);
+    for (int32_t x = 0; x < gb->width; ++x, p += 3, n += 3, e += 3, f += 3) {
+        r->px[x] = p[0];
+        r->py[x] = p[1];
+        r->pz[x] = p[2];
+        r->nx[x] = n[0];
+        r->ny[x] = n[1];
+        r->nz[x] = n[2];
+        r->surface[x] = m[x] < 0.0f ? 0.0f : 1.0f;
+        r->er[x] = near_field ? e[0] + f[0] : e[0];
+        r->eg[x] = near_field ? e[1] + f[1] : e[1];
+        r->eb[x] = near_field ? e[2] + f[2] : e[2];
+    }
+}
+
+// Adds the pixels of row q at offset dx that pass the centres' tests (row c) to the sums of
+// centres x0..x1-1.
+DRIFT_ISM_CLONES static void blur_accumulate(const blur_row *c, const blur_row *q, int32_t x0,
+                                             int32_t x1, int32_t dx, float blur_normal,
+                                             float blur_plane, float *restrict sr,
+                                             float *restrict sg, float *restrict sb,
+                                             float *restrict weight)
+{
+    const float *restrict cpx = c->px, *restrict cpy = c->py, *restrict cpz = c->pz;
+    const float *restrict cnx = c->nx, *restrict cny = c->ny, *restrict cnz = c->nz;
+    const float *restrict qpx = q->px + dx, *restrict qpy = q->py + dx, *restrict qpz = q->pz + dx;
+    const float *restrict qnx = q->nx + dx, *restrict qny = q->ny + dx, *restrict qnz = q->nz + dx;
+    const float *restrict qs = q->surface + dx, *restrict qr = q->er + dx;
+    const float *restrict qg = q->eg + dx, *restrict qb = q->eb + dx;
+    DRIFT_ISM_IVDEP
+    for (int32_t x = x0; x < x1; ++x) {
+        float d =
+            cnx[x] * (qpx[x] - cpx[x]) + cny[x] * (qpy[x] - cpy[x]) + cnz[x] * (qpz[x] - cpz[x]);
+        float cosn = cnx[x] * qnx[x] + cny[x] * qny[x] + cnz[x] * qnz[x];
+        // block_average's tests without branches (& not &&), so that the loop vectorises.
+        bool keep =
+            (qs[x] != 0.0f) & (cosn >= blur_normal) & (d <= blur_plane) & (-d <= blur_plane);
+        sr[x] += keep ? qr[x] : 0.0f;
+        sg[x] += keep ? qg[x] : 0.0f;
+        sb[x] += keep ? qb[x] : 0.0f;
+        weight[x] += keep ? 1.0f : 0.0f;
+    }
+}
+
+// I = kd / pi times the block average of the irradiance and the near-field compensation's,
+// rows begin..end-1 of one job.
 static void blur_rows(size_t begin, size_t end, int thread, void *user)
 {
     (void)thread;
     gather_job *job = user;
     drift_ism *ism = job->ism;
     const drift_gbuffer *gb = job->gb;
-    const drift_image *near_field = job->near_field ? &ism->near_field : NULL;
+    int32_t w = gb->width, b = ism->params.no_blur ? 1 : ism->params.block_size;
+    int32_t lo = -(b / 2), hi = lo + b;
+    int32_t first = (int32_t)begin + lo < 0 ? 0 : (int32_t)begin + lo;
+    int32_t last = (int32_t)end - 1 + hi > gb->height ? gb->height : (int32_t)end - 1 + hi;
+    int32_t rows = last - first;
+    float *scratch =
+        drift_alloc(ism->ctx, sizeof(float) * (size_t)w * ((size_t)rows * BLUR_ROW_ARRAYS + 4));
+    if (!scratch) {
+        // Out of memory for the copies: the same blur pixel by pixel.
+        const drift_image *near_field = job->near_field ? &ism->near_field : NULL;
+        for (size_t row = begin; row < end; ++row) {
+            for (int32_t x = 0; x < w; ++x) {
+                int32_t y = (int32_t)row;
+                drift_vec3 e = drift_vec3_splat(0.0f);
+                if (drift_image_pixel(&gb->material_id, x, y)[0] >= 0.0f) {
+                    e = block_average(ism, gb, &ism->irradiance, near_field, x, y);
+                }
+                drift_vec3 kd = drift_image_get3(&gb->albedo, x, y);
+                drift_image_set3(&ism->indirect, x, y,
+                                 drift_vec3_scale(drift_vec3_mul(kd, e), DRIFT_INV_PI));
+            }
+        }
+        return;
+    }
+    blur_row soa[64 + 3];
+    for (int32_t i = 0; i < rows; ++i) {
+        float *a = scratch + (size_t)i * BLUR_ROW_ARRAYS * (size_t)w;
+        soa[i] = (blur_row){ a,         a + w,     a + 2 * w, a + 3 * w, a + 4 * w,
+                             a + 5 * w, a + 6 * w, a + 7 * w, a + 8 * w, a + 9 * w };
+        blur_copy_row(ism, gb, job->near_field, first + i, &soa[i]);
+    }
+    float *sums = scratch + (size_t)rows * BLUR_ROW_ARRAYS * (size_t)w;
+    float *sr = sums, *sg = sums + w, *sb = sums + 2 * w, *weight = sums + 3 * w;
+    float blur_normal = ism->params.blur_normal, blur_plane = ism->params.blur_plane;
     for (size_t row = begin; row < end; ++row) {
         int32_t y = (int32_t)row;
-        for (int32_t x = 0; x < gb->width; ++x) {
+        const blur_row *c = &soa[y - first];
+        memset(sums, 0, sizeof(float) * 4 * (size_t)w);
+        int32_t y0 = y + lo < 0 ? 0 : y + lo, y1 = y + hi > gb->height ? gb->height : y + hi;
+        for (int32_t yy = y0; yy < y1; ++yy) {
+            for (int32_t dx = lo; dx < hi; ++dx) {
+                int32_t x0 = dx < 0 ? -dx : 0, x1 = dx > 0 ? w - dx : w;
+                blur_accumulate(c, &soa[yy - first], x0, x1, dx, blur_normal, blur_plane, sr, sg,
+                                sb, weight);
+            }
+        }
+        for (int32_t x = 0; x < w; ++x) {
             drift_vec3 e = drift_vec3_splat(0.0f);
-            if (drift_image_pixel(&gb->material_id, x, y)[0] >= 0.0f) {
-                e = block_average(ism, gb, &ism->irradiance, near_field, x, y);
+            if (c->surface[x] != 0.0f) {
+                e = weight[x] > 0.0f
+                        ? drift_vec3_make(sr[x] / weight[x], sg[x] / weight[x], sb[x] / weight[x])
+                        : drift_vec3_make(c->er[x], c->eg[x], c->eb[x]);
             }
             drift_vec3 kd = drift_image_get3(&gb->albedo, x, y);
             drift_image_set3(&ism->indirect, x, y,
                              drift_vec3_scale(drift_vec3_mul(kd, e), DRIFT_INV_PI));
         }
     }
+    drift_free(ism->ctx, scratch);
 }
 
 // --- NEAR-FIELD COMPENSATION ---
@@ -1096,7 +1207,7 @@ drift_result drift_ism_render(drift_ism *ism, const drift_gbuffer *gbuffer,
     st.ms[DRIFT_ISM_STAGE_NEAR_FIELD] = (now - t) * 1e3;
     t = now;
     gj.near_field = near_field;
-    drift_parallel_for(ism->ctx, (size_t)gbuffer->height, 4, blur_rows, &gj);
+    drift_parallel_for(ism->ctx, (size_t)gbuffer->height, BLUR_JOB_ROWS, blur_rows, &gj);
     now = drift_time_now();
     st.ms[DRIFT_ISM_STAGE_BLUR] = (now - t) * 1e3;
     diagnostic_planes(ism, camera);

@@ -629,6 +629,65 @@ static void test_gather_equals_the_formula(void **state)
     test_rig_destroy(&r);
 }
 
+// The blur is the documented window average: at every pixel, I = kd / pi times the mean of the
+// irradiance ("ism.irradiance") over the B x B window of pixels with a surface whose normal is
+// within blur_normal and whose position within blur_plane of the centre's plane, recomputed here
+// pixel by pixel for an even and an odd block (the vectorised rows' edges included).
+static void test_blur_is_the_window_average(void **state)
+{
+    (void)state;
+    test_rig r = cornell_rig(2, 37);
+    const drift_gbuffer *gb = drift_hybrid_gbuffer(r.frame);
+    int32_t blocks[2] = { 4, 5 };
+    for (int k = 0; k < 2; ++k) {
+        int32_t b = blocks[k];
+        drift_ism *ism = render_ism(&r, &(drift_ism_params){ .vpl_count = 64, .block_size = b });
+        drift_ism_params p = drift_ism_get_params(ism);
+        const drift_image *e = drift_ism_plane_named(ism, "ism.irradiance");
+        const drift_image *out = drift_ism_indirect(ism);
+        double worst = 0.0;
+        for (int32_t y = 0; y < gb->height; ++y) {
+            for (int32_t x = 0; x < gb->width; ++x) {
+                drift_vec3 expected = drift_vec3_splat(0.0f);
+                if (drift_image_pixel(&gb->material_id, x, y)[0] >= 0.0f) {
+                    drift_vec3 c = drift_image_get3(&gb->position, x, y);
+                    drift_vec3 n = drift_image_get3(&gb->normal, x, y);
+                    drift_vec3 sum = drift_vec3_splat(0.0f);
+                    float weight = 0.0f;
+                    for (int32_t v = y - b / 2; v < y - b / 2 + b; ++v) {
+                        for (int32_t u = x - b / 2; u < x - b / 2 + b; ++u) {
+                            if (u < 0 || v < 0 || u >= gb->width || v >= gb->height ||
+                                drift_image_pixel(&gb->material_id, u, v)[0] < 0.0f) {
+                                continue;
+                            }
+                            drift_vec3 q = drift_image_get3(&gb->position, u, v);
+                            drift_vec3 qn = drift_image_get3(&gb->normal, u, v);
+                            float plane = fabsf(drift_vec3_dot(n, drift_vec3_sub(q, c)));
+                            if (drift_vec3_dot(n, qn) >= p.blur_normal && plane <= p.blur_plane) {
+                                sum = drift_vec3_add(sum, drift_image_get3(e, u, v));
+                                weight += 1.0f;
+                            }
+                        }
+                    }
+                    assert_true(weight >= 1.0f); // the centre passes its own tests
+                    expected =
+                        drift_vec3_scale(drift_vec3_mul(drift_image_get3(&gb->albedo, x, y), sum),
+                                         DRIFT_INV_PI / weight);
+                }
+                drift_vec3 got = drift_image_get3(out, x, y);
+                double scale = 1e-6 + (double)drift_luminance(expected);
+                worst = fmax(worst, fabs((double)(got.x - expected.x)) / scale);
+                worst = fmax(worst, fabs((double)(got.y - expected.y)) / scale);
+                worst = fmax(worst, fabs((double)(got.z - expected.z)) / scale);
+            }
+        }
+        printf("block %d: worst relative difference %.2e\n", b, worst);
+        assert_true(worst < 1e-4);
+        drift_ism_destroy(ism);
+    }
+    test_rig_destroy(&r);
+}
+
 // The same seed gives bit-identical indirect light on 1 and 2 threads.
 static void test_ism_is_deterministic(void **state)
 {
@@ -854,6 +913,7 @@ int main(void)
         cmocka_unit_test(test_glossy_vpls_against_path_tracer),
         cmocka_unit_test(test_environment_vpls_carry_its_power),
         cmocka_unit_test(test_gather_equals_the_formula),
+        cmocka_unit_test(test_blur_is_the_window_average),
         cmocka_unit_test(test_ism_is_deterministic),
         cmocka_unit_test(test_vpl_importance_is_unbiased),
         cmocka_unit_test(test_vpl_importance_keeps_useful_vpls),
