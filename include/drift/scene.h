@@ -365,6 +365,8 @@ bool drift_scene_has_environment(const drift_scene *scene);
 drift_vec3 drift_environment_eval(const drift_scene *scene, drift_vec3 dir);
 drift_light_sample drift_environment_sample(const drift_scene *scene, drift_vec2 u);
 float drift_environment_pdf(const drift_scene *scene, drift_vec3 dir);
+// True for an environment of one radiance in every direction (no texture).
+bool drift_environment_is_constant(const drift_scene *scene);
 // Probability of choosing the environment rather than a scene light for NEE.
 float drift_scene_environment_pmf(const drift_scene *scene);
 

@@ -248,9 +248,24 @@ drift_vec3 drift_raster_environment_direct_subset(const drift_scene *scene,
         return sum;
     }
     uint32_t n = set_size, taken = 0;
+    // A constant sky: directions by the cosine around the shading normal, the diffuse lobe's
+    // own weight (f cos / pdf = kd), instead of the uniform sphere, half of which lies below the
+    // horizon and whose survivors weigh 4 kd cos.
+    bool cosine = drift_environment_is_constant(scene);
+    drift_frame frame = drift_frame_from_normal(surface->ns);
     for (uint32_t k = first; k < n; k += stride) {
         ++taken;
-        drift_light_sample ls = drift_environment_sample(scene, shifted_hammersley(k, n, shift));
+        drift_vec2 u = shifted_hammersley(k, n, shift);
+        drift_light_sample ls;
+        if (cosine) {
+            drift_vec3 local = drift_sample_cosine_hemisphere(u);
+            ls = (drift_light_sample){ .wi = drift_frame_to_world(&frame, local),
+                                       .pdf = local.z * DRIFT_INV_PI,
+                                       .distance = INFINITY };
+            ls.radiance = drift_environment_eval(scene, ls.wi);
+        } else {
+            ls = drift_environment_sample(scene, u);
+        }
         drift_vec3 c = light_sample_contribution(surface, bsdf, wo, &ls, false);
         if (drift_vec3_is_zero(c)) {
             continue;

@@ -149,6 +149,11 @@ static int32_t sample_cdf(const float *cdf, int32_t n, float u, float *out_offse
     return lo;
 }
 
+bool drift_environment_is_constant(const drift_scene *scene)
+{
+    return drift_scene_has_environment(scene) && !drift__light_table_environment(scene);
+}
+
 float drift_environment_pdf(const drift_scene *scene, drift_vec3 dir)
 {
     const drift__env_distribution *d = drift__light_table_environment(scene);

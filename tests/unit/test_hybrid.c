@@ -814,6 +814,42 @@ static void test_environment_interleave_beats_equal_rays(void **state)
     test_rig_destroy(&r);
 }
 
+// A constant sky over an open floor: every cosine-sampled direction sees the sky, and the
+// diffuse lobe's f cos / pdf is kd, so one sample a pixel gives the environment's direct light
+// kd L exactly (the uniform sphere it replaced left half the samples below the horizon and
+// weighed the rest 4 kd cos).
+static void test_constant_sky_is_exact_with_one_sample(void **state)
+{
+    (void)state;
+    test_rig r = test_rig_begin(2);
+    uint32_t white = test_add_material(r.scene, drift_material_make(drift_vec3_splat(0.7f)));
+    test_add_floor(r.scene, 40.0f, 0.0f, white);
+    r.scene->environment.color = drift_vec3_splat(0.5f);
+    r.scene->camera =
+        drift_camera_look_at(drift_vec3_make(0, 3.0f, -3.0f), drift_vec3_make(0, 0, 0),
+                             drift_vec3_make(0, 1, 0), 0.9f, 64, 48);
+    test_rig_commit(&r);
+    drift_image e = environment_plane(&r, &(drift_hybrid_params){ .light_samples = 1 });
+    const drift_gbuffer *gb = drift_hybrid_gbuffer(r.frame);
+    double worst = 0.0;
+    int64_t floor_pixels = 0;
+    for (int32_t y = 0; y < e.height; ++y) {
+        for (int32_t x = 0; x < e.width; ++x) {
+            if (drift_image_pixel(&gb->material_id, x, y)[0] < 0.0f) {
+                continue;
+            }
+            ++floor_pixels;
+            drift_vec3 v = drift_image_get3(&e, x, y);
+            worst = fmax(worst, fabs((double)v.y - 0.35));
+        }
+    }
+    print_message("%lld floor pixels, worst |E - kd L| %g\n", (long long)floor_pixels, worst);
+    assert_true(floor_pixels > 1000);
+    assert_true(worst < 1e-5);
+    drift_image_destroy(r.ctx, &e);
+    test_rig_destroy(&r);
+}
+
 // --- NAMES AND ARGUMENTS ---
 
 static void test_technique_names_round_trip(void **state)
@@ -875,6 +911,7 @@ int main(void)
         cmocka_unit_test(test_tessellated_sphere_light_in_closed_form),
         cmocka_unit_test(test_hard_shadows_any_hit_match_closest_hit),
         cmocka_unit_test(test_environment_interleave_beats_equal_rays),
+        cmocka_unit_test(test_constant_sky_is_exact_with_one_sample),
         cmocka_unit_test(test_technique_names_round_trip),
         cmocka_unit_test(test_rejects_bad_params),
     };
