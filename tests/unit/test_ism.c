@@ -453,7 +453,7 @@ static void test_ir_and_ism_against_path_tracer(void **state)
 // The near-field compensation gives back the light the clamp takes: `ir` with 2048 VPLs and a
 // wide clamp (0.2 of the diagonal) against the path tracer's one-bounce diffuse light, without
 // the compensation (measured: 0.89 of the mean) and with it fed the path tracer's direct light
-// (0.985; the rest is near surfaces the camera does not see). With a clamp that reaches no
+// (0.98; the rest is near surfaces the camera does not see). With a clamp that reaches no
 // surface it adds nothing.
 static void test_near_field_gives_back_the_clamp(void **state)
 {
