@@ -244,6 +244,15 @@ static inline uint32_t drift_reverse_bits(uint32_t x)
     return (x >> 16) | (x << 16);
 }
 
+// Point k of a Hammersley set of n points in [0,1)^2, shifted by `shift` modulo 1 (a
+// Cranley-Patterson rotation: each pixel or block its own shift, the set stays stratified).
+static inline drift_vec2 drift_hammersley_shifted(uint32_t k, uint32_t n, drift_vec2 shift)
+{
+    float x = ((float)k + 0.5f) / (float)n + shift.x;
+    float y = (float)drift_reverse_bits(k) * 0x1p-32f + shift.y;
+    return drift_vec2_make(x - floorf(x), y - floorf(y));
+}
+
 // 24 high bits to a float in [0, 1).
 static inline float drift_u32_to_unit(uint32_t x)
 {

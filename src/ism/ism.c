@@ -906,14 +906,6 @@ typedef struct near_field_job {
 // 4 rays over 25 blocks' worth, 0.001-0.003 FLIP on the four frontier scenes for ~1-4 ms.
 #define NEAR_FIELD_SPREAD 2
 
-// Point k of a Hammersley set of n points in [0,1)^2 shifted by `shift` modulo 1.
-static drift_vec2 shifted_hammersley(uint32_t k, uint32_t n, drift_vec2 shift)
-{
-    float x = ((float)k + 0.5f) / (float)n + shift.x;
-    float y = (float)drift_reverse_bits(k) * 0x1p-32f + shift.y;
-    return drift_vec2_make(x - floorf(x), y - floorf(y));
-}
-
 // L_o of hit point p, read off the frame: the pixel p projects to must see p itself (its depth
 // within 2%, its normal facing the ray that found p). False where the camera does not see p.
 static bool frame_radiance(const near_field_job *job, drift_vec3 p, drift_vec3 dir, drift_vec3 *out)
@@ -974,7 +966,8 @@ static void near_field_rows(size_t begin, size_t end, int thread, void *user)
                 drift_vec2_make((float)(h & 0xffffu) * 0x1p-16f, (float)(h >> 16) * 0x1p-16f);
             drift_frame frame = drift_frame_from_normal(s->ns);
             drift_vec3 dir = drift_frame_to_world(
-                &frame, drift_sample_cosine_hemisphere(shifted_hammersley(k, directions, shift)));
+                &frame,
+                drift_sample_cosine_hemisphere(drift_hammersley_shifted(k, directions, shift)));
             drift_hit hit;
             drift_vec3 lo;
             if (drift_vec3_dot(dir, s->ng) > 0.0f) {

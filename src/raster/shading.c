@@ -6,14 +6,6 @@
 
 #include <math.h>
 
-// Point k of a Hammersley set of n points in [0,1)^2 shifted by `shift` modulo 1.
-static drift_vec2 shifted_hammersley(uint32_t k, uint32_t n, drift_vec2 shift)
-{
-    float x = ((float)k + 0.5f) / (float)n + shift.x;
-    float y = (float)drift_reverse_bits(k) * 0x1p-32f + shift.y;
-    return drift_vec2_make(x - floorf(x), y - floorf(y));
-}
-
 // f * L * cos / pdf of one light sample, without visibility (the pt's NEE, minus the ray);
 // with glossy_only, f is the glossy lobe alone.
 static drift_vec3 light_sample_contribution(const drift_surface *surface, const drift_bsdf *bsdf,
@@ -212,7 +204,7 @@ drift_vec3 drift_raster_unshadowed(const drift_scene *scene, const drift_raster_
     drift_vec2 shift = drift_sampler_next2(sampler);
     float pick_shift = drift_sampler_next1(sampler);
     for (uint32_t k = 0; k < n; ++k) {
-        drift_vec2 u = shifted_hammersley(k, n, shift);
+        drift_vec2 u = drift_hammersley_shifted(k, n, shift);
         // Golden-ratio sequence for the triangle pick of mesh lights.
         float pick = (float)k * 0.618034f + pick_shift;
         drift_light_sample ls =
@@ -255,7 +247,7 @@ drift_vec3 drift_raster_environment_direct_subset(const drift_scene *scene,
     drift_frame frame = drift_frame_from_normal(surface->ns);
     for (uint32_t k = first; k < n; k += stride) {
         ++taken;
-        drift_vec2 u = shifted_hammersley(k, n, shift);
+        drift_vec2 u = drift_hammersley_shifted(k, n, shift);
         drift_light_sample ls;
         if (cosine) {
             drift_vec3 local = drift_sample_cosine_hemisphere(u);

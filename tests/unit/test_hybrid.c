@@ -775,6 +775,25 @@ static drift_image environment_plane(test_rig *r, const drift_hybrid_params *par
     return copy;
 }
 
+// A white floor (albedo 0.7, half size `half`) under a constant sky of 0.5, with a low 2 x 2
+// roof over its middle when `roof`, seen from above at 64 x 48.
+static test_rig sky_rig(float half, bool roof)
+{
+    test_rig r = test_rig_begin(2);
+    uint32_t white = test_add_material(r.scene, drift_material_make(drift_vec3_splat(0.7f)));
+    test_add_floor(r.scene, half, 0.0f, white);
+    if (roof) {
+        test_add_quad(r.scene, drift_vec3_make(-1.0f, 0.4f, -1.0f), drift_vec3_make(2.0f, 0, 0),
+                      drift_vec3_make(0, 0, 2.0f), white);
+    }
+    r.scene->environment.color = drift_vec3_splat(0.5f);
+    r.scene->camera =
+        drift_camera_look_at(drift_vec3_make(0, 3.0f, -3.0f), drift_vec3_make(0, 0, 0),
+                             drift_vec3_make(0, 1, 0), 0.9f, 64, 48);
+    test_rig_commit(&r);
+    return r;
+}
+
 // Interleaved environment samples (each pixel of a 2 x 2 block a quarter of one set of 8,
 // gathered back over 3 x 3 of the same surface) against 2 samples a pixel, the same shadow
 // rays: closer to the converged light (a floor under a constant sky, half shaded by a low
@@ -782,16 +801,7 @@ static drift_image environment_plane(test_rig *r, const drift_hybrid_params *par
 static void test_environment_interleave_beats_equal_rays(void **state)
 {
     (void)state;
-    test_rig r = test_rig_begin(2);
-    uint32_t white = test_add_material(r.scene, drift_material_make(drift_vec3_splat(0.7f)));
-    test_add_floor(r.scene, 4.0f, 0.0f, white);
-    test_add_quad(r.scene, drift_vec3_make(-1.0f, 0.4f, -1.0f), drift_vec3_make(2.0f, 0, 0),
-                  drift_vec3_make(0, 0, 2.0f), white);
-    r.scene->environment.color = drift_vec3_splat(0.5f);
-    r.scene->camera =
-        drift_camera_look_at(drift_vec3_make(0, 3.0f, -3.0f), drift_vec3_make(0, 0, 0),
-                             drift_vec3_make(0, 1, 0), 0.9f, 64, 48);
-    test_rig_commit(&r);
+    test_rig r = sky_rig(4.0f, true);
     drift_image truth = environment_plane(&r, &(drift_hybrid_params){ .light_samples = 1024 });
     drift_image plain = environment_plane(&r, &(drift_hybrid_params){ .light_samples = 2 });
     uint64_t plain_rays = drift_hybrid_get_stats(r.frame).rays[DRIFT_PASS_UNSHADOWED];
@@ -821,14 +831,7 @@ static void test_environment_interleave_beats_equal_rays(void **state)
 static void test_constant_sky_is_exact_with_one_sample(void **state)
 {
     (void)state;
-    test_rig r = test_rig_begin(2);
-    uint32_t white = test_add_material(r.scene, drift_material_make(drift_vec3_splat(0.7f)));
-    test_add_floor(r.scene, 40.0f, 0.0f, white);
-    r.scene->environment.color = drift_vec3_splat(0.5f);
-    r.scene->camera =
-        drift_camera_look_at(drift_vec3_make(0, 3.0f, -3.0f), drift_vec3_make(0, 0, 0),
-                             drift_vec3_make(0, 1, 0), 0.9f, 64, 48);
-    test_rig_commit(&r);
+    test_rig r = sky_rig(40.0f, false);
     drift_image e = environment_plane(&r, &(drift_hybrid_params){ .light_samples = 1 });
     const drift_gbuffer *gb = drift_hybrid_gbuffer(r.frame);
     double worst = 0.0;
