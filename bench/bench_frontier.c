@@ -35,7 +35,7 @@
 
 typedef struct frontier_options {
     const char *scene_path, *csv_path, *svg_path, *cache_dir;
-    long size, threads, ref_spp, runs, max_spp;
+    long size, threads, ref_spp, runs, max_spp, near_field_off_vpls;
     long budgets[MAX_BUDGETS], vpls[MAX_BUDGETS], aaf_spps[MAX_BUDGETS], aa[MAX_BUDGETS],
         sir[MAX_BUDGETS], light_samples[MAX_BUDGETS];
     int budget_count, vpl_count, aaf_spp_count, aa_count, sir_count, light_sample_count;
@@ -81,6 +81,10 @@ static const cli_option frontier_table[] = {
     CLI_CUSTOM_ALL("--light-samples", "LIST", parse_budgets,
                    "unshadowed-light samples of every hybrid row (default 8; 1 or 2\n"
                    "fit a frame of the plants into 100 ms, docs/frontier.md)"),
+    CLI_INT("--near-field-off-vpls", "N", O, near_field_off_vpls, 0, 1 << 16,
+            "ism and ir rows of at most N VPLs run without the near-field\n"
+            "compensation too (default 256: below it the VPLs its rays cost\n"
+            "can be worth more, docs/frontier.md; 0 = never)"),
     CLI_INT("--size", "N", O, size, 4, 4096, "N x N pixels (default 400)"),
     CLI_INT("--threads", "T", O, threads, 0, 256, "worker threads (default 2)"),
     CLI_INT("--ref-spp", "N", O, ref_spp, 1, 1 << 20, "reference samples a pixel (default 512)"),
@@ -358,13 +362,13 @@ static drift_result hybrid_row(frontier_state *b, const char *name,
 }
 
 // The hybrid combinations: shadows hard, pcss, isg, aaf x indirect none, ambient, ism and ir at
-// 16..1024 VPLs, aaf; AAF rows at 1, 2 and 4 spp; each at every --light-samples count (8) and
-// at --aa 1 and 4 anti-aliasing passes; max depth 8. The other effects keep the
-// technique that matches the reference: reflections none on a scene without glossy or mirror
-// materials (else isg: AAF's reflections scored only ~0.006 lower FLIP on the glossy box at
-// 11-15x the frame time, docs/frontier.md), depth of field none for a pinhole camera (else post:
-// reference would path-trace the whole frame through the lens, replacing every other row's output),
-// occlusion none, glare none.
+// 16..1024 VPLs (up to --near-field-off-vpls also without the near-field compensation), aaf; AAF
+// rows at 1, 2 and 4 spp; each at every --light-samples count (8) and at --aa 1 and 4 anti-aliasing
+// passes; max depth 8. The other effects keep the technique that matches the reference: reflections
+// none on a scene without glossy or mirror materials (else isg: AAF's reflections scored only
+// ~0.006 lower FLIP on the glossy box at 11-15x the frame time, docs/frontier.md), depth of field
+// none for a pinhole camera (else post: reference would path-trace the whole frame through the
+// lens, replacing every other row's output), occlusion none, glare none.
 static drift_result hybrid_rows(frontier_state *b, double limit_ms)
 {
     static const char *const shadows[] = { "hard", "pcss", "isg", "aaf" };
@@ -385,7 +389,12 @@ static drift_result hybrid_rows(frontier_state *b, double limit_ms)
             size_t spp_count = aaf ? (size_t)b->o->aaf_spp_count : 1;
             size_t ls_count = (size_t)b->o->light_sample_count;
             size_t variants = spp_count * ls_count * (size_t)b->o->aa_count;
-            for (size_t v = 0; v < vpl_count && r == DRIFT_OK; ++v) {
+            for (size_t v = 0; v < vpl_count * 2 && r == DRIFT_OK; ++v) {
+                // v / 2 is the VPL count; odd v the same rows without the near field.
+                bool near_field_off = v % 2 == 1;
+                if (near_field_off && (!vpl || vpls[v / 2] > b->o->near_field_off_vpls)) {
+                    continue;
+                }
                 for (size_t k = 0; k < variants && r == DRIFT_OK; ++k) {
                     long aa_passes = b->o->aa[k / (spp_count * ls_count)];
                     long light_samples = b->o->light_samples[(k / spp_count) % ls_count];
@@ -413,9 +422,10 @@ static drift_result hybrid_rows(frontier_state *b, double limit_ms)
                     char name[96];
                     int len = snprintf(name, sizeof name, "%s + %s", shadows[s], indirect[i]);
                     if (vpl) {
-                        p.ism.vpls = (uint32_t)vpls[v];
-                        len +=
-                            snprintf(name + len, sizeof name - (size_t)len, " %ld VPLs", vpls[v]);
+                        p.ism.vpls = (uint32_t)vpls[v / 2];
+                        p.ism.no_near_field = near_field_off;
+                        len += snprintf(name + len, sizeof name - (size_t)len, " %ld VPLs%s",
+                                        vpls[v / 2], near_field_off ? " nf off" : "");
                     }
                     if (aaf) {
                         len += snprintf(name + len, sizeof name - (size_t)len, " %ld spp",
@@ -732,7 +742,8 @@ int drift_bench_frontier(int argc, char **argv)
                            .light_samples = { DEFAULT_LIGHT_SAMPLES },
                            .light_sample_count = 1,
                            .sir = { 1, 4, 16 },
-                           .sir_count = 3 };
+                           .sir_count = 3,
+                           .near_field_off_vpls = 256 };
     int status = cli_parse(&frontier_command, argc, argv, &o, NULL);
     if (status != CLI_PARSED) {
         return cli_parse_exit(status);

@@ -138,6 +138,10 @@ names = [r["name"] for r in d["rows"] if r["family"] == "hybrid"]
 assert sum(n.endswith(" aa 2") for n in names) * 2 == len(names), names
 assert sum(" ls 1" in n for n in names) * 2 == len(names), names
 assert not any(" ls 8" in n for n in names), names
+# Each ism and ir row of 8 VPLs (under the default --near-field-off-vpls 256) once more without the
+# near-field compensation.
+vpl_rows = [n for n in names if " VPLs" in n]
+assert vpl_rows and sum(" nf off" in n for n in vpl_rows) * 2 == len(vpl_rows), vpl_rows
 assert 1 <= fam.count("sir") <= 2, fam
 assert all(r["ms"] > 0 and 0 <= r["flip"] <= 1 and r["rmse"] >= 0 for r in d["rows"]), d
 prev = 2.0
