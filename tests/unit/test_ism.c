@@ -688,7 +688,8 @@ static void test_blur_is_the_window_average(void **state)
     test_rig_destroy(&r);
 }
 
-// The same seed gives bit-identical indirect light on 1 and 2 threads.
+// The same seed gives bit-identical indirect light on 1 and 2 threads, with and without the
+// near-field compensation.
 static void test_ism_is_deterministic(void **state)
 {
     (void)state;
@@ -696,6 +697,12 @@ static void test_ism_is_deterministic(void **state)
     drift_ism_params p = { .vpl_count = 64, .max_depth = 3, .seed = 3 };
     drift_ism *a = render_ism(&r1, &p), *b = render_ism(&r2, &p);
     const drift_image *ia = drift_ism_indirect(a), *ib = drift_ism_indirect(b);
+    assert_memory_equal(ia->pixels, ib->pixels, 24 * 24 * 3 * sizeof(float));
+    // And with the near-field compensation's rays, fed any direct image (here the albedo).
+    const drift_gbuffer *g1 = drift_hybrid_gbuffer(r1.frame), *g2 = drift_hybrid_gbuffer(r2.frame);
+    assert_int_equal(drift_ism_render(a, g1, &r1.scene->camera, &g1->albedo), DRIFT_OK);
+    assert_int_equal(drift_ism_render(b, g2, &r2.scene->camera, &g2->albedo), DRIFT_OK);
+    assert_true(drift_ism_get_stats(a).near_field_rays > 0);
     assert_memory_equal(ia->pixels, ib->pixels, 24 * 24 * 3 * sizeof(float));
     drift_ism_destroy(a);
     drift_ism_destroy(b);
