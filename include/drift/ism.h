@@ -72,9 +72,10 @@ typedef enum drift_ism_visibility {
 //   depth_bias        = 0 -> 0.01 x scene diagonal, plus one texel's footprint at the receiver
 //   clamp_distance    = 0 -> 0.1 x scene diagonal (0.05 with no_near_field): d_min of the
 //                       geometry term
-//   no_near_field     = false: one ray a pixel, at most d_min long, adds back the light of the
-//                       surfaces nearer than d_min that the clamp takes away (near-field
-//                       compensation; it needs drift_ism_render's direct image)
+//   no_near_field     = false: rays at most d_min long, from one pixel in near_field_stride^2,
+//                       add back the light of the surfaces nearer than d_min that the clamp
+//                       takes away (near-field compensation; it needs drift_ism_render's direct
+//                       image)
 //   near_field_stride = 0 -> 2 (1 for an odd block_size): the compensation's rays leave one
 //                       pixel in stride x stride, weighed by stride^2; divides block_size
 //   block_size        = 0 -> 4: interleaved sampling over 4x4 pixel blocks (1 = every pixel
@@ -168,12 +169,11 @@ void drift_ism_destroy(drift_ism *ism); // NULL-safe
 // VPLs, builds the maps and gathers at every G-buffer pixel. The G-buffer's position, normal,
 // geometric_normal, albedo and material_id planes are read. `direct` is the frame's direct
 // radiance at each pixel (RGB, the G-buffer's size): the near-field compensation reads the light
-// the surfaces it hits reflect off it, and needs the camera and the G-buffer's surfaces and
-// depth. NULL skips the compensation (as no_near_field does, but with the wider clamp
-// of its default: pass no_near_field to get the narrower one). `camera` may be NULL without
-// the compensation (it then only places the "ism.vpls" plane). Errors:
-// DRIFT_ERR_INVALID_ARGUMENT (G-buffer of another size than the last call is fine; an empty
-// one is not), DRIFT_ERR_OUT_OF_MEMORY.
+// the surfaces it hits reflect off it, and needs it, the camera and the G-buffer's surfaces and
+// depth. With params.no_near_field `direct` is not read (may be NULL) and `camera` may be NULL
+// (it then only places the "ism.vpls" plane). Errors: DRIFT_ERR_INVALID_ARGUMENT (the
+// compensation's inputs missing; a G-buffer of another size than the last call is fine, an
+// empty one is not), DRIFT_ERR_OUT_OF_MEMORY.
 drift_result drift_ism_render(drift_ism *ism, const drift_gbuffer *gbuffer,
                               const drift_camera *camera, const drift_image *direct);
 

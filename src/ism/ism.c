@@ -390,7 +390,8 @@ typedef struct gather_job {
     int32_t capacity;    // receivers a job can hold
     int32_t subset_rows; // rows of one subset in a band (a band is subset_rows * B rows)
     int32_t bands;
-    bool near_field; // the blur adds the near-field plane
+    bool near_field;     // the blur adds the near-field plane
+    float *blur_scratch; // per thread: blur_scratch_floats
 } gather_job;
 
 // The constants of one render's lookups.
@@ -690,17 +691,13 @@ static void gather_jobs(size_t begin, size_t end, int thread, void *user)
     }
 }
 
-// The block-sized window of `in` (plus `more`, when not NULL) around (x, y), averaging only the
-// pixels whose normal and plane agree with the centre's (Segovia et al. 2006).
+// The block-sized window of `in` around (x, y), averaging only the pixels whose normal and plane
+// agree with the centre's (Segovia et al. 2006): the blur's rule at one pixel.
 static drift_vec3 block_average(const drift_ism *ism, const drift_gbuffer *gb,
-                                const drift_image *in, const drift_image *more, int32_t x,
-                                int32_t y)
+                                const drift_image *in, int32_t x, int32_t y)
 {
     int32_t b = ism->params.no_blur ? 1 : ism->params.block_size;
     drift_vec3 e = drift_image_get3(in, x, y);
-    if (more) {
-        e = drift_vec3_add(e, drift_image_get3(more, x, y));
-    }
     if (b <= 1) {
         return e;
     }
@@ -716,7 +713,6 @@ static drift_vec3 block_average(const drift_ism *ism, const drift_gbuffer *gb,
         const float *pp = drift_image_pixel(pos, 0, yy);
         const float *nn = drift_image_pixel(nrm, 0, yy);
         const float *ee = drift_image_pixel(in, 0, yy);
-        const float *mm = more ? drift_image_pixel(more, 0, yy) : NULL;
         for (int32_t xx = x0; xx < x1; ++xx) {
             const float *q = pp + (size_t)xx * (size_t)pos->channels;
             const float *qn = nn + (size_t)xx * (size_t)nrm->channels;
@@ -728,16 +724,9 @@ static drift_vec3 block_average(const drift_ism *ism, const drift_gbuffer *gb,
                 continue;
             }
             const float *qe = ee + (size_t)xx * (size_t)in->channels;
-            if (mm) {
-                const float *qm = mm + (size_t)xx * (size_t)more->channels;
-                sr += qe[0] + qm[0];
-                sg += qe[1] + qm[1];
-                sb += qe[2] + qm[2];
-            } else {
-                sr += qe[0];
-                sg += qe[1];
-                sb += qe[2];
-            }
+            sr += qe[0];
+            sg += qe[1];
+            sb += qe[2];
             weight += 1.0f;
         }
     }
@@ -746,8 +735,8 @@ static drift_vec3 block_average(const drift_ism *ism, const drift_gbuffer *gb,
 
 // The blur over rows as structure of arrays, so that each offset of the window is one loop
 // over x that vectorises: a row's positions, normals, a mask of the pixels with a surface, and
-// the irradiance (plus the near-field compensation's). block_average's arithmetic in its order:
-// the same image to the bit.
+// the irradiance (plus the near-field compensation's). block_average's rule, whole rows at a
+// time.
 typedef struct blur_row {
     float *px, *py, *pz, *nx, *ny, *nz, *surface, *er, *eg, *eb;
 } blur_row;
@@ -755,6 +744,12 @@ typedef struct blur_row {
 #define BLUR_ROW_ARRAYS 10
 // Rows a job blurs: its copies hold b - 1 rows more (<= 64 + 3 with block_size <= 64).
 #define BLUR_JOB_ROWS 4
+
+// Floats of one thread's blur scratch: the row copies of a job and four sums a pixel.
+static size_t blur_scratch_floats(int32_t width, int32_t block_size)
+{
+    return (size_t)width * ((size_t)(BLUR_JOB_ROWS + block_size - 1) * BLUR_ROW_ARRAYS + 4);
+}
 
 static void blur_copy_row(const drift_ism *ism, const drift_gbuffer *gb, bool near_field, int32_t y,
                           const blur_row *r)
@@ -811,7 +806,6 @@ DRIFT_ISM_CLONES static void blur_accumulate(const blur_row *c, const blur_row *
 // rows begin..end-1 of one job.
 static void blur_rows(size_t begin, size_t end, int thread, void *user)
 {
-    (void)thread;
     gather_job *job = user;
     drift_ism *ism = job->ism;
     const drift_gbuffer *gb = job->gb;
@@ -820,25 +814,7 @@ static void blur_rows(size_t begin, size_t end, int thread, void *user)
     int32_t first = (int32_t)begin + lo < 0 ? 0 : (int32_t)begin + lo;
     int32_t last = (int32_t)end - 1 + hi > gb->height ? gb->height : (int32_t)end - 1 + hi;
     int32_t rows = last - first;
-    float *scratch =
-        drift_alloc(ism->ctx, sizeof(float) * (size_t)w * ((size_t)rows * BLUR_ROW_ARRAYS + 4));
-    if (!scratch) {
-        // Out of memory for the copies: the same blur pixel by pixel.
-        const drift_image *near_field = job->near_field ? &ism->near_spread : NULL;
-        for (size_t row = begin; row < end; ++row) {
-            for (int32_t x = 0; x < w; ++x) {
-                int32_t y = (int32_t)row;
-                drift_vec3 e = drift_vec3_splat(0.0f);
-                if (drift_image_pixel(&gb->material_id, x, y)[0] >= 0.0f) {
-                    e = block_average(ism, gb, &ism->irradiance, near_field, x, y);
-                }
-                drift_vec3 kd = drift_image_get3(&gb->albedo, x, y);
-                drift_image_set3(&ism->indirect, x, y,
-                                 drift_vec3_scale(drift_vec3_mul(kd, e), DRIFT_INV_PI));
-            }
-        }
-        return;
-    }
+    float *scratch = job->blur_scratch + (size_t)thread * blur_scratch_floats(w, b);
     blur_row soa[64 + 3];
     for (int32_t i = 0; i < rows; ++i) {
         float *a = scratch + (size_t)i * BLUR_ROW_ARRAYS * (size_t)w;
@@ -873,7 +849,6 @@ static void blur_rows(size_t begin, size_t end, int thread, void *user)
                              drift_vec3_scale(drift_vec3_mul(kd, e), DRIFT_INV_PI));
         }
     }
-    drift_free(ism->ctx, scratch);
 }
 
 // --- NEAR-FIELD COMPENSATION ---
@@ -932,7 +907,7 @@ static bool frame_radiance(const near_field_job *job, drift_vec3 p, drift_vec3 d
         // Paths of max_depth 2 bounce once: p sends its direct light alone. Deeper ones add the
         // indirect light gathered at p (all of its bounces: one more than max_depth allows).
         drift_vec3 kd = drift_image_get3(&gb->albedo, qx, qy);
-        drift_vec3 e = block_average(job->ism, gb, &job->ism->irradiance, NULL, qx, qy);
+        drift_vec3 e = block_average(job->ism, gb, &job->ism->irradiance, qx, qy);
         *out = drift_vec3_fma(*out, drift_vec3_mul(kd, e), DRIFT_INV_PI);
     }
     return true;
@@ -1113,13 +1088,15 @@ drift_result drift_ism_render(drift_ism *ism, const drift_gbuffer *gbuffer,
                   "ism: the G-buffer lacks a plane gathering reads");
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
-    bool near_field = direct && !ism->params.no_near_field;
-    if (near_field && (!camera || !gbuffer->surfaces || !gbuffer->depth.pixels ||
+    // The clamp's default was chosen with the compensation on: without its inputs the render
+    // fails rather than clamp wide and give nothing back.
+    bool near_field = !ism->params.no_near_field;
+    if (near_field && (!direct || !camera || !gbuffer->surfaces || !gbuffer->depth.pixels ||
                        direct->width != gbuffer->width || direct->height != gbuffer->height ||
                        direct->channels < 3)) {
         drift_log(ism->ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, __FILE__, __LINE__,
                   "ism: the near-field compensation needs the camera, the G-buffer's surfaces "
-                  "and depth, and a direct image of its size");
+                  "and depth, and a direct image of its size (or params.no_near_field)");
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
     drift_result r = ensure_planes(ism, gbuffer->width, gbuffer->height);
@@ -1253,7 +1230,15 @@ drift_result drift_ism_render(drift_ism *ism, const drift_gbuffer *gbuffer,
     st.ms[DRIFT_ISM_STAGE_NEAR_FIELD] = (now - t) * 1e3;
     t = now;
     gj.near_field = near_field;
+    int32_t blur_block = ism->params.no_blur ? 1 : b;
+    gj.blur_scratch =
+        drift_alloc(ism->ctx, sizeof(float) * (size_t)drift_context_thread_count(ism->ctx) *
+                                  blur_scratch_floats(gbuffer->width, blur_block));
+    if (!gj.blur_scratch) {
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
     drift_parallel_for(ism->ctx, (size_t)gbuffer->height, BLUR_JOB_ROWS, blur_rows, &gj);
+    drift_free(ism->ctx, gj.blur_scratch);
     now = drift_time_now();
     st.ms[DRIFT_ISM_STAGE_BLUR] = (now - t) * 1e3;
     diagnostic_planes(ism, camera);

@@ -244,7 +244,7 @@ drift_vec3 drift_raster_environment_direct_subset(const drift_scene *scene,
     // own weight (f cos / pdf = kd), instead of the uniform sphere, half of which lies below the
     // horizon and whose survivors weigh 4 kd cos.
     bool cosine = drift_environment_is_constant(scene);
-    drift_frame frame = drift_frame_from_normal(surface->ns);
+    drift_frame frame = cosine ? drift_frame_from_normal(surface->ns) : (drift_frame){ 0 };
     for (uint32_t k = first; k < n; k += stride) {
         ++taken;
         drift_vec2 u = drift_hammersley_shifted(k, n, shift);

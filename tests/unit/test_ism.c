@@ -37,11 +37,14 @@ static drift_image render_pt(test_rig *r, uint32_t components, int32_t max_depth
     return test_rig_render_pt(r, components, max_depth, spp, 99, pt);
 }
 
-// Renders the rig's G-buffer with `params`; the ism is returned for its planes.
+// Renders the rig's G-buffer with `params`, the VPL gather alone (no_near_field: the
+// compensation needs a direct image); the ism is returned for its planes.
 static drift_ism *render_ism(test_rig *r, const drift_ism_params *params)
 {
+    drift_ism_params gather_alone = *params;
+    gather_alone.no_near_field = true;
     drift_ism *ism = NULL;
-    assert_int_equal(drift_ism_create(r->ctx, r->scene, r->accel, params, &ism), DRIFT_OK);
+    assert_int_equal(drift_ism_create(r->ctx, r->scene, r->accel, &gather_alone, &ism), DRIFT_OK);
     assert_int_equal(drift_ism_render(ism, drift_hybrid_gbuffer(r->frame), &r->scene->camera, NULL),
                      DRIFT_OK);
     return ism;
@@ -469,7 +472,8 @@ static void test_near_field_gives_back_the_clamp(void **state)
     float diag = 10.0f * drift_ism_params_resolve(&p, r.scene).clamp_distance;
     double ratio[2], error[2];
     for (int on = 0; on < 2; ++on) {
-        p.clamp_distance = 0.2f * diag;
+        p.clamp_distance = 0.2f * diag; // the same clamp either way
+        p.no_near_field = !on;
         drift_ism *ism = NULL;
         assert_int_equal(drift_ism_create(r.ctx, r.scene, r.accel, &p, &ism), DRIFT_OK);
         assert_int_equal(drift_ism_render(ism, gb, &r.scene->camera, on ? &direct : NULL),
@@ -488,7 +492,10 @@ static void test_near_field_gives_back_the_clamp(void **state)
     // A clamp shorter than any ray's way to a surface: the same image.
     p.clamp_distance = 1e-4f * diag;
     drift_ism *a = NULL, *b = NULL;
-    assert_int_equal(drift_ism_create(r.ctx, r.scene, r.accel, &p, &a), DRIFT_OK);
+    drift_ism_params without = p;
+    without.no_near_field = true;
+    p.no_near_field = false;
+    assert_int_equal(drift_ism_create(r.ctx, r.scene, r.accel, &without, &a), DRIFT_OK);
     assert_int_equal(drift_ism_create(r.ctx, r.scene, r.accel, &p, &b), DRIFT_OK);
     assert_int_equal(drift_ism_render(a, gb, &r.scene->camera, NULL), DRIFT_OK);
     assert_int_equal(drift_ism_render(b, gb, &r.scene->camera, &direct), DRIFT_OK);
@@ -698,11 +705,17 @@ static void test_ism_is_deterministic(void **state)
     drift_ism *a = render_ism(&r1, &p), *b = render_ism(&r2, &p);
     const drift_image *ia = drift_ism_indirect(a), *ib = drift_ism_indirect(b);
     assert_memory_equal(ia->pixels, ib->pixels, 24 * 24 * 3 * sizeof(float));
+    drift_ism_destroy(a);
+    drift_ism_destroy(b);
     // And with the near-field compensation's rays, fed any direct image (here the albedo).
     const drift_gbuffer *g1 = drift_hybrid_gbuffer(r1.frame), *g2 = drift_hybrid_gbuffer(r2.frame);
+    assert_int_equal(drift_ism_create(r1.ctx, r1.scene, r1.accel, &p, &a), DRIFT_OK);
+    assert_int_equal(drift_ism_create(r2.ctx, r2.scene, r2.accel, &p, &b), DRIFT_OK);
     assert_int_equal(drift_ism_render(a, g1, &r1.scene->camera, &g1->albedo), DRIFT_OK);
     assert_int_equal(drift_ism_render(b, g2, &r2.scene->camera, &g2->albedo), DRIFT_OK);
     assert_true(drift_ism_get_stats(a).near_field_rays > 0);
+    ia = drift_ism_indirect(a);
+    ib = drift_ism_indirect(b);
     assert_memory_equal(ia->pixels, ib->pixels, 24 * 24 * 3 * sizeof(float));
     drift_ism_destroy(a);
     drift_ism_destroy(b);
@@ -783,7 +796,7 @@ static void test_maps_grow_without_changing_the_image(void **state)
 {
     (void)state;
     test_rig r = cornell_rig(2, 24);
-    drift_ism_params p = { .vpl_count = 64, .max_depth = 4, .seed = 5 };
+    drift_ism_params p = { .vpl_count = 64, .max_depth = 4, .seed = 5, .no_near_field = true };
     drift_ism *lazy = render_ism(&r, &p), *big = NULL;
     drift_ism_params resolved = drift_ism_params_resolve(&p, r.scene);
     uint32_t one_round = 64 + 2 * resolved.later_vpl_count;
@@ -888,6 +901,16 @@ static void test_parameters_and_planes(void **state)
         assert_null(ism);
     }
     assert_true(log.errors >= 7);
+    // The compensation on (the default) without its direct image: an error, not a wide clamp
+    // that gives nothing back.
+    drift_ism *strict = NULL;
+    assert_int_equal(
+        drift_ism_create(ctx, r.scene, r.accel, &(drift_ism_params){ .vpl_count = 32 }, &strict),
+        DRIFT_OK);
+    assert_int_equal(
+        drift_ism_render(strict, drift_hybrid_gbuffer(r.frame), &r.scene->camera, NULL),
+        DRIFT_ERR_INVALID_ARGUMENT);
+    drift_ism_destroy(strict);
     drift_ism *ism = render_ism(&r, &(drift_ism_params){ .vpl_count = 32 });
     assert_non_null(drift_ism_plane_named(ism, "ism.irradiance"));
     assert_non_null(drift_ism_plane_named(ism, "ism.vpls"));
