@@ -153,12 +153,14 @@ typedef struct drift_aaf_settings {
 //   points_per_vpl = 0 -> 1024 scene points splatted into each map
 //   vpl_importance = false: true keeps VPLs by their contribution to the view (docs/ism.md)
 //   no_near_field  = false: the near-field compensation runs (short rays, docs/ism.md)
+//   gather_scale   = 0 -> 1: every pixel gathers; 2 or 4: one in 2 x 2 or 4 x 4, upsampled
 typedef struct drift_ism_settings {
     uint32_t vpls;
     int32_t map_size;
     uint32_t points_per_vpl;
     bool vpl_importance;
     bool no_near_field;
+    int32_t gather_scale;
 } drift_ism_settings;
 
 // Micro-rendering (indirect micro and reflections micro, docs/micro.md):

@@ -81,6 +81,11 @@ typedef enum drift_ism_visibility {
 //   block_size        = 0 -> 4: interleaved sampling over 4x4 pixel blocks (1 = every pixel
 //                       gathers every VPL)
 //   no_blur           = false: the geometry-aware blur over the block runs
+//   gather_scale      = 0 -> 1: every G-buffer pixel gathers; 2 (or 4): one pixel in 2 x 2
+//                       (4 x 4) gathers, blurs and compensates at that lower resolution, and
+//                       the irradiance is upsampled to every pixel through the blur's tests
+//                       (a pixel none of its four nearest gathering pixels passes gathers
+//                       every VPL itself); the albedo is applied at full resolution
 //   blur_normal       = 0 -> 0.9: smallest cosine between two normals the blur mixes
 //   blur_plane        = 0 -> 0.01 x scene diagonal: largest distance to the centre's plane
 //   vpl_importance    = false: true accepts each candidate VPL with p = min(1, c / target), c
@@ -106,6 +111,7 @@ typedef struct drift_ism_params {
     int32_t near_field_stride;
     int32_t block_size;
     bool no_blur;
+    int32_t gather_scale;
     float blur_normal;
     float blur_plane;
     bool vpl_importance;
@@ -140,6 +146,8 @@ typedef enum drift_ism_stage {
     DRIFT_ISM_STAGE_GATHER,     // interleaved gathering (with the shadow rays for `ir`)
     DRIFT_ISM_STAGE_BLUR,       // geometry-aware blur and the albedo multiply
     DRIFT_ISM_STAGE_NEAR_FIELD, // the near-field compensation's rays (its blur is BLUR's)
+    DRIFT_ISM_STAGE_UPSAMPLE,   // gather_scale > 1: the decimated G-buffer, the upsampling and
+                                // the gathers of the pixels it has no neighbour for
     DRIFT_ISM_STAGE_COUNT
 } drift_ism_stage;
 
@@ -151,8 +159,9 @@ typedef struct drift_ism_stats {
     uint32_t vpl_count;   // VPLs of the last render (all bounces)
     uint64_t shadow_rays; // `ir` visibility rays
     uint64_t near_field_rays;
-    uint64_t splats;      // points splatted
-    double hole_fraction; // ISM texels still empty after pull-push
+    uint64_t fallback_pixels; // gather_scale > 1: pixels that gathered every VPL themselves
+    uint64_t splats;          // points splatted
+    double hole_fraction;     // ISM texels still empty after pull-push
 } drift_ism_stats;
 
 typedef struct drift_ism drift_ism;
@@ -166,7 +175,8 @@ drift_result drift_ism_create(drift_context *ctx, const drift_scene *scene,
 void drift_ism_destroy(drift_ism *ism); // NULL-safe
 
 // Renders the indirect light of one frame: re-derives the points from the meshes, draws the
-// VPLs, builds the maps and gathers at every G-buffer pixel. The G-buffer's position, normal,
+// VPLs, builds the maps and gathers at every G-buffer pixel (or one in gather_scale^2, then
+// upsampled). The G-buffer's position, normal,
 // geometric_normal, albedo and material_id planes are read. `direct` is the frame's direct
 // radiance at each pixel (RGB, the G-buffer's size): the near-field compensation reads the light
 // the surfaces it hits reflect off it, and needs it, the camera and the G-buffer's surfaces and
@@ -180,7 +190,8 @@ drift_result drift_ism_render(drift_ism *ism, const drift_gbuffer *gbuffer,
 // RGB radiance: the diffuse indirect light I at each pixel (0 where the G-buffer missed).
 const drift_image *drift_ism_indirect(const drift_ism *ism);
 // Diagnostic planes by name: "ism.irradiance" (RGB, before blur and albedo), "ism.near_field"
-// (RGB, the compensation's irradiance a pixel, before blur and albedo), "ism.vpls" (RGB,
+// (RGB, the compensation's irradiance a pixel, before blur and albedo; these two and ism.vpls
+// at the gathering resolution, the G-buffer's divided by gather_scale), "ism.vpls" (RGB,
 // the VPLs' flux splatted where they project on the camera image), "ism.tile" (1 channel,
 // the depth map of VPL 0 after pull-push, 0 where empty). NULL when the last render has none.
 const drift_image *drift_ism_plane_named(const drift_ism *ism, const char *name);

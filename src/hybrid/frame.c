@@ -6,6 +6,7 @@
 #include "hybrid/frame_access.h"
 #include "hybrid/techniques.h"
 #include "isg/isg.h"
+#include "ism/ism_pass.h"
 #include "realtime/realtime.h"
 #include "ssdo/ssdo_pass.h"
 
@@ -111,6 +112,7 @@ static bool params_valid(const drift_context *ctx, const drift_hybrid_params *p)
     problem = problem ? problem : drift_realtime_settings_problem(&p->shadow_map, &p->envmap);
     problem = problem ? problem : drift_isg_settings_problem(&p->isg);
     problem = problem ? problem : drift_aaf_settings_problem(&p->aaf, p->spp);
+    problem = problem ? problem : drift_ism_settings_problem(&p->ism);
     if (problem) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, NULL, 0, "hybrid frame: %s",
                   problem);

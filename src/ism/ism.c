@@ -16,14 +16,19 @@ struct drift_ism {
     uint32_t map_capacity; // VPLs the atlas and the points hold now (<= max_vpls)
     drift_vpl *vpls;
     uint32_t vpl_count;
-    drift_frame *frames; // max_vpls
-    float *atlas;        // map_capacity maps of map_floats, when visibility is ISM
-    size_t map_floats;   // one map: map_size^2 depths, then the lazy pyramid's levels
-    int32_t lazy_levels; // pull-push levels the lookups push (1, 2), or 0: pushed at build
-    float *disc_counts;  // drift__ism_disc_counts of the lazy pyramid's top level
-    float *scratch;      // one pull-push pyramid per thread
-    int32_t width, height;
+    drift_frame *frames;   // max_vpls
+    float *atlas;          // map_capacity maps of map_floats, when visibility is ISM
+    size_t map_floats;     // one map: map_size^2 depths, then the lazy pyramid's levels
+    int32_t lazy_levels;   // pull-push levels the lookups push (1, 2), or 0: pushed at build
+    float *disc_counts;    // drift__ism_disc_counts of the lazy pyramid's top level
+    float *scratch;        // one pull-push pyramid per thread
+    int32_t width, height; // the gathering resolution (the G-buffer's / gather_scale)
+    int32_t full_width, full_height; // the G-buffer's, of `indirect`
     drift_image irradiance, indirect, vpl_plane, tile, near_field, near_spread;
+    // gather_scale > 1: the G-buffer and the direct image at one pixel in scale^2, and the
+    // blurred irradiance there (what is upsampled).
+    drift_gbuffer coarse;
+    drift_image coarse_direct, coarse_blurred;
     drift_ism_stats stats;
     float splat_radius; // k sqrt(A_pt / pi) of the last render, world units
     uint32_t *groups;   // group_count + 1 starts of the runs of VPLs of one bounce and round
@@ -32,9 +37,9 @@ struct drift_ism {
     uint32_t points_valid;
 };
 
-static const char *const stage_names[DRIFT_ISM_STAGE_COUNT] = { "vpls",      "points", "splat",
-                                                                "pull_push", "gather", "blur",
-                                                                "near_field" };
+static const char *const stage_names[DRIFT_ISM_STAGE_COUNT] = { "vpls",       "points",  "splat",
+                                                                "pull_push",  "gather",  "blur",
+                                                                "near_field", "upsample" };
 
 const char *drift_ism_stage_name(drift_ism_stage stage)
 {
@@ -92,6 +97,9 @@ drift_ism_params drift_ism_params_resolve(const drift_ism_params *params, const 
     if (p.block_size == 0) {
         p.block_size = 4;
     }
+    if (p.gather_scale == 0) {
+        p.gather_scale = 1;
+    }
     if (p.near_field_stride == 0) {
         p.near_field_stride = p.block_size % 2 == 0 ? 2 : 1;
     }
@@ -113,8 +121,9 @@ static bool params_valid(const drift_ism_params *p)
            p->splat_scale > 0.0f && p->pull_push_levels <= 7 && p->pull_push_threshold > 0.0f &&
            p->depth_bias >= 0.0f && p->clamp_distance >= 0.0f && p->block_size >= 1 &&
            p->block_size <= 64 && p->near_field_stride >= 1 &&
-           p->block_size % p->near_field_stride == 0 && p->blur_normal <= 1.0f &&
-           p->blur_plane > 0.0f &&
+           p->block_size % p->near_field_stride == 0 &&
+           (p->gather_scale == 1 || p->gather_scale == 2 || p->gather_scale == 4) &&
+           p->blur_normal <= 1.0f && p->blur_plane > 0.0f &&
            (uint64_t)p->points_per_vpl * drift__ism_max_vpls(p) <= (1u << 28);
 }
 
@@ -278,6 +287,16 @@ static void destroy_planes(drift_ism *ism)
     drift_image_destroy(ism->ctx, &ism->tile);
     drift_image_destroy(ism->ctx, &ism->near_field);
     drift_image_destroy(ism->ctx, &ism->near_spread);
+    drift_image_destroy(ism->ctx, &ism->coarse.depth);
+    drift_image_destroy(ism->ctx, &ism->coarse.position);
+    drift_image_destroy(ism->ctx, &ism->coarse.normal);
+    drift_image_destroy(ism->ctx, &ism->coarse.geometric_normal);
+    drift_image_destroy(ism->ctx, &ism->coarse.albedo);
+    drift_image_destroy(ism->ctx, &ism->coarse.material_id);
+    drift_free(ism->ctx, ism->coarse.surfaces);
+    ism->coarse = (drift_gbuffer){ 0 };
+    drift_image_destroy(ism->ctx, &ism->coarse_direct);
+    drift_image_destroy(ism->ctx, &ism->coarse_blurred);
 }
 
 void drift_ism_destroy(drift_ism *ism)
@@ -391,6 +410,7 @@ typedef struct gather_job {
     int32_t subset_rows; // rows of one subset in a band (a band is subset_rows * B rows)
     int32_t bands;
     bool near_field;     // the blur adds the near-field plane
+    bool blur_to_coarse; // the blur writes the irradiance to coarse_blurred, not I to indirect
     float *blur_scratch; // per thread: blur_scratch_floats
 } gather_job;
 
@@ -597,6 +617,43 @@ static receivers job_receivers(const gather_job *job, int thread)
     return rs;
 }
 
+static gather_consts gather_consts_of(const drift_ism *ism)
+{
+    const drift_ism_params *p = &ism->params;
+    return (gather_consts){ .dmin2 = p->clamp_distance * p->clamp_distance,
+                            .bias = p->depth_bias,
+                            .texel = 2.0f / (float)p->map_size,
+                            .splat_radius = ism->splat_radius,
+                            .diagonal = ism->diagonal,
+                            .threshold = p->pull_push_threshold,
+                            .n = p->map_size,
+                            .levels = ism->lazy_levels };
+}
+
+// VPL j's irradiance added to every receiver of rs, its visibility as the params choose.
+static void gather_vpl(const drift_ism *ism, uint32_t j, const gather_consts *c, receivers *rs,
+                       uint64_t *rays)
+{
+    const drift_ism_params *p = &ism->params;
+    if (p->visibility == DRIFT_ISM_VISIBILITY_ISM) {
+        const float *m = ism->atlas + j * ism->map_floats;
+        typedef void gather_fn(const drift_vpl *, const drift_frame *, const float *,
+                               const gather_consts *, receivers *);
+        static gather_fn *const gathers[2][3] = {
+            { gather_vpl_ism0, gather_vpl_ism1, gather_vpl_ism2 },
+            { gather_vpl_ism0_glossy, gather_vpl_ism1_glossy, gather_vpl_ism2_glossy },
+        };
+        bool glossy = !drift_vec3_is_zero(ism->vpls[j].glossy);
+        gathers[glossy][c->levels == 2 ? 2 : c->levels == 1](&ism->vpls[j], &ism->frames[j], m, c,
+                                                             rs);
+    } else if (p->visibility == DRIFT_ISM_VISIBILITY_RAYS) {
+        gather_vpl_rays(ism, &ism->vpls[j], rs, c, rays);
+    } else {
+        gather_vpl_none(&ism->vpls[j], c, rs->count, rs->px, rs->py, rs->pz, rs->nx, rs->ny, rs->nz,
+                        rs->er, rs->eg, rs->eb);
+    }
+}
+
 // Job = (band of rows, subset k): the band's pixels of subset k gather that subset's VPLs,
 // VPL by VPL (one map in cache at a time, read by every receiver of the band), each receiver
 // summing its VPLs in the same order whatever the threads.
@@ -608,15 +665,7 @@ static void gather_jobs(size_t begin, size_t end, int thread, void *user)
     const drift_ism_params *p = &ism->params;
     int32_t b = p->block_size;
     uint64_t subsets = (uint64_t)b * (uint64_t)b;
-    size_t map = ism->map_floats;
-    gather_consts c = { .dmin2 = p->clamp_distance * p->clamp_distance,
-                        .bias = p->depth_bias,
-                        .texel = 2.0f / (float)p->map_size,
-                        .splat_radius = ism->splat_radius,
-                        .diagonal = ism->diagonal,
-                        .threshold = p->pull_push_threshold,
-                        .n = p->map_size,
-                        .levels = ism->lazy_levels };
+    gather_consts c = gather_consts_of(ism);
     receivers rs = job_receivers(job, thread);
     for (size_t id = begin; id < end; ++id) {
         int32_t band = (int32_t)(id / subsets);
@@ -664,23 +713,7 @@ static void gather_jobs(size_t begin, size_t end, int thread, void *user)
             uint32_t first = (uint32_t)(first_vpl + size * k / subsets);
             uint32_t last = (uint32_t)(first_vpl + size * (k + 1) / subsets);
             for (uint32_t j = first; j < last; ++j) {
-                if (p->visibility == DRIFT_ISM_VISIBILITY_ISM) {
-                    const float *m = ism->atlas + j * map;
-                    typedef void gather_fn(const drift_vpl *, const drift_frame *, const float *,
-                                           const gather_consts *, receivers *);
-                    static gather_fn *const gathers[2][3] = {
-                        { gather_vpl_ism0, gather_vpl_ism1, gather_vpl_ism2 },
-                        { gather_vpl_ism0_glossy, gather_vpl_ism1_glossy, gather_vpl_ism2_glossy },
-                    };
-                    bool glossy = !drift_vec3_is_zero(ism->vpls[j].glossy);
-                    gathers[glossy][c.levels == 2 ? 2 : c.levels == 1](&ism->vpls[j],
-                                                                       &ism->frames[j], m, &c, &rs);
-                } else if (p->visibility == DRIFT_ISM_VISIBILITY_RAYS) {
-                    gather_vpl_rays(ism, &ism->vpls[j], &rs, &c, &job->rays[thread % 64]);
-                } else {
-                    gather_vpl_none(&ism->vpls[j], &c, rs.count, rs.px, rs.py, rs.pz, rs.nx, rs.ny,
-                                    rs.nz, rs.er, rs.eg, rs.eb);
-                }
+                gather_vpl(ism, j, &c, &rs, &job->rays[thread % 64]);
             }
         }
         float scale = (float)subsets * DRIFT_INV_PI;
@@ -843,6 +876,10 @@ static void blur_rows(size_t begin, size_t end, int thread, void *user)
                 e = weight[x] > 0.0f
                         ? drift_vec3_make(sr[x] / weight[x], sg[x] / weight[x], sb[x] / weight[x])
                         : drift_vec3_make(c->er[x], c->eg[x], c->eb[x]);
+            }
+            if (job->blur_to_coarse) {
+                drift_image_set3(&ism->coarse_blurred, x, y, e);
+                continue;
             }
             drift_vec3 kd = drift_image_get3(&gb->albedo, x, y);
             drift_image_set3(&ism->indirect, x, y,
@@ -1025,25 +1062,284 @@ static void add_near_field(drift_ism *ism, const drift_gbuffer *gb, const drift_
     }
 }
 
+// --- GATHERING AT A LOWER RESOLUTION (gather_scale > 1) ---
+//
+// Indirect diffuse light is smooth where the surface is. One pixel in s x s gathers, with the
+// interleaving, the blur and the near-field compensation run at that resolution (a block's
+// window then spans s^2 times the pixels), and every pixel takes the irradiance of its four
+// nearest gathering pixels that pass the blur's tests against it, weighed bilinearly (or of
+// those of the twelve around them that do); the albedo is its own. The thesis upsamples
+// micro-rendering's gathers so (§6.2.4, with Sloan et al. 2007's weights; the blur's tests keep ISM
+// to one rule). A pixel none of the 16 passes (a chair's leg, a leaf, a silhouette's rim) gathers
+// every VPL itself, as §6.2.4's extra pass does: exact there, and few (stats.fallback_pixels). It
+// takes no near-field compensation.
+
+// The G-buffer pixel gathering pixel i stands for: its s x s cell's centre.
+static int32_t cell_pixel(int32_t i, int32_t s, int32_t full)
+{
+    int32_t v = i * s + s / 2;
+    return v < full ? v : full - 1;
+}
+
+static void copy_pixel(const drift_image *from, int32_t x, int32_t y, drift_image *to, int32_t i,
+                       int32_t j)
+{
+    if (from->pixels) {
+        memcpy(drift_image_pixel(to, i, j), drift_image_pixel(from, x, y),
+               sizeof(float) * (size_t)to->channels);
+    }
+}
+
+typedef struct decimate_job {
+    drift_ism *ism;
+    const drift_gbuffer *gb;
+    const drift_image *direct; // NULL without the near field
+} decimate_job;
+
+static void decimate_rows(size_t begin, size_t end, int thread, void *user)
+{
+    (void)thread;
+    const decimate_job *job = user;
+    drift_ism *ism = job->ism;
+    const drift_gbuffer *gb = job->gb;
+    drift_gbuffer *c = &ism->coarse;
+    int32_t s = ism->params.gather_scale;
+    for (size_t row = begin; row < end; ++row) {
+        int32_t j = (int32_t)row, y = cell_pixel(j, s, gb->height);
+        for (int32_t i = 0; i < c->width; ++i) {
+            int32_t x = cell_pixel(i, s, gb->width);
+            size_t from = (size_t)y * (size_t)gb->width + (size_t)x;
+            c->surfaces[(size_t)j * (size_t)c->width + (size_t)i] =
+                gb->surfaces ? gb->surfaces[from]
+                             : (drift_surface){ .material = DRIFT_INVALID_INDEX };
+            copy_pixel(&gb->depth, x, y, &c->depth, i, j);
+            copy_pixel(&gb->position, x, y, &c->position, i, j);
+            copy_pixel(&gb->normal, x, y, &c->normal, i, j);
+            copy_pixel(&gb->geometric_normal, x, y, &c->geometric_normal, i, j);
+            copy_pixel(&gb->albedo, x, y, &c->albedo, i, j);
+            copy_pixel(&gb->material_id, x, y, &c->material_id, i, j);
+            if (job->direct) {
+                drift_image_set3(&ism->coarse_direct, i, j, drift_image_get3(job->direct, x, y));
+            }
+        }
+    }
+}
+
+typedef struct upsample_job {
+    drift_ism *ism;
+    const drift_gbuffer *gb;
+    uint8_t *fallback; // per G-buffer pixel: 1 where it must gather itself
+    uint64_t rays[64]; // per thread, the fallback's `ir` rays
+    const uint32_t *fallback_pixels;
+    size_t fallback_count;
+    size_t job_pixels;       // receivers of one fallback job
+    float *receiver_buffers; // per thread: 12 arrays of job_pixels floats and 2 of int32
+} upsample_job;
+
+static void upsample_rows(size_t begin, size_t end, int thread, void *user)
+{
+    (void)thread;
+    upsample_job *job = user;
+    drift_ism *ism = job->ism;
+    const drift_gbuffer *gb = job->gb, *c = &ism->coarse;
+    int32_t s = ism->params.gather_scale;
+    float blur_normal = ism->params.blur_normal, blur_plane = ism->params.blur_plane;
+    for (size_t row = begin; row < end; ++row) {
+        int32_t y = (int32_t)row;
+        float fy = ((float)y - (float)(s / 2)) / (float)s;
+        int32_t j0 = (int32_t)floorf(fy);
+        float wy = fy - (float)j0;
+        for (int32_t x = 0; x < gb->width; ++x) {
+            size_t index = (size_t)y * (size_t)gb->width + (size_t)x;
+            drift_vec3 e = drift_vec3_splat(0.0f);
+            job->fallback[index] = 0;
+            if (drift_image_pixel(&gb->material_id, x, y)[0] >= 0.0f) {
+                const float *p = drift_image_pixel(&gb->position, x, y);
+                const float *n = drift_image_pixel(&gb->normal, x, y);
+                float fx = ((float)x - (float)(s / 2)) / (float)s;
+                int32_t i0 = (int32_t)floorf(fx);
+                float wx = fx - (float)i0, total = 0.0f;
+                // The four nearest, bilinearly; where none passes, the ring of twelve around
+                // them alike (a thin object's pixels are some gathering pixel's in the ring).
+                for (int32_t k = 0; k < 16 && !(k == 4 && total > 0.0f); ++k) {
+                    static const int8_t ring[12][2] = {
+                        { -1, -1 }, { 0, -1 }, { 1, -1 }, { 2, -1 }, { -1, 0 }, { 2, 0 },
+                        { -1, 1 },  { 2, 1 },  { -1, 2 }, { 0, 2 },  { 1, 2 },  { 2, 2 }
+                    };
+                    int32_t i = i0 + (k < 4 ? (k & 1) : ring[k - 4][0]);
+                    int32_t j = j0 + (k < 4 ? (k >> 1) : ring[k - 4][1]);
+                    if (i < 0 || j < 0 || i >= c->width || j >= c->height ||
+                        drift_image_pixel(&c->material_id, i, j)[0] < 0.0f) {
+                        continue;
+                    }
+                    const float *q = drift_image_pixel(&c->position, i, j);
+                    const float *qn = drift_image_pixel(&c->normal, i, j);
+                    float d = n[0] * (q[0] - p[0]) + n[1] * (q[1] - p[1]) + n[2] * (q[2] - p[2]);
+                    float cosn = n[0] * qn[0] + n[1] * qn[1] + n[2] * qn[2];
+                    if (cosn < blur_normal || fabsf(d) > blur_plane) {
+                        continue;
+                    }
+                    // A little weight even where the bilinear one is 0: a pixel on a gathering
+                    // pixel's row still reads the next row when its own fails the tests.
+                    float w = k < 4
+                                  ? ((k & 1) ? wx : 1.0f - wx) * ((k >> 1) ? wy : 1.0f - wy) + 1e-3f
+                                  : 1.0f;
+                    e = drift_vec3_fma(e, drift_image_get3(&ism->coarse_blurred, i, j), w);
+                    total += w;
+                }
+                if (total > 0.0f) {
+                    e = drift_vec3_scale(e, 1.0f / total);
+                } else {
+                    job->fallback[index] = 1;
+                }
+            }
+            drift_vec3 kd = drift_image_get3(&gb->albedo, x, y);
+            drift_image_set3(&ism->indirect, x, y,
+                             drift_vec3_scale(drift_vec3_mul(kd, e), DRIFT_INV_PI));
+        }
+    }
+}
+
+// A fallback job's receivers read every VPL's map once: as few jobs as keep the threads busy.
+static void fallback_jobs(size_t begin, size_t end, int thread, void *user)
+{
+    upsample_job *job = user;
+    drift_ism *ism = job->ism;
+    const drift_gbuffer *gb = job->gb;
+    gather_consts c = gather_consts_of(ism);
+    size_t cap = job->job_pixels;
+    float *b = job->receiver_buffers + (size_t)thread * cap * 14;
+    for (size_t id = begin; id < end; ++id) {
+        size_t first = id * cap;
+        size_t last = first + cap < job->fallback_count ? first + cap : job->fallback_count;
+        receivers rs = { b,
+                         b + cap,
+                         b + 2 * cap,
+                         b + 3 * cap,
+                         b + 4 * cap,
+                         b + 5 * cap,
+                         b + 6 * cap,
+                         b + 7 * cap,
+                         b + 8 * cap,
+                         b + 9 * cap,
+                         b + 10 * cap,
+                         b + 11 * cap,
+                         (int32_t *)(b + 12 * cap),
+                         (int32_t *)(b + 13 * cap),
+                         0 };
+        for (size_t k = first; k < last; ++k) {
+            int32_t i = rs.count++;
+            int32_t x = (int32_t)(job->fallback_pixels[k] % (uint32_t)gb->width);
+            int32_t y = (int32_t)(job->fallback_pixels[k] / (uint32_t)gb->width);
+            const float *q = drift_image_pixel(&gb->position, x, y);
+            rs.px[i] = q[0], rs.py[i] = q[1], rs.pz[i] = q[2];
+            q = drift_image_pixel(&gb->normal, x, y);
+            rs.nx[i] = q[0], rs.ny[i] = q[1], rs.nz[i] = q[2];
+            q = drift_image_pixel(&gb->geometric_normal, x, y);
+            rs.gx[i] = q[0], rs.gy[i] = q[1], rs.gz[i] = q[2];
+            rs.er[i] = rs.eg[i] = rs.eb[i] = 0.0f;
+            rs.x[i] = x;
+            rs.y[i] = y;
+        }
+        for (uint32_t j = 0; j < ism->vpl_count; ++j) {
+            gather_vpl(ism, j, &c, &rs, &job->rays[thread % 64]);
+        }
+        for (int32_t i = 0; i < rs.count; ++i) {
+            drift_vec3 e = drift_vec3_make(rs.er[i], rs.eg[i], rs.eb[i]);
+            drift_vec3 kd = drift_image_get3(&gb->albedo, rs.x[i], rs.y[i]);
+            drift_image_set3(&ism->indirect, rs.x[i], rs.y[i],
+                             drift_vec3_scale(drift_vec3_mul(kd, e), DRIFT_INV_PI * DRIFT_INV_PI));
+        }
+    }
+}
+
+// The blurred irradiance of the gathering pixels to every pixel of `gb`, times its albedo.
+static drift_result upsample(drift_ism *ism, const drift_gbuffer *gb, drift_ism_stats *st)
+{
+    size_t count = (size_t)gb->width * (size_t)gb->height;
+    upsample_job job = { .ism = ism, .gb = gb, .fallback = drift_alloc(ism->ctx, count) };
+    if (!job.fallback) {
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    drift_parallel_for(ism->ctx, (size_t)gb->height, 4, upsample_rows, &job);
+    size_t fallbacks = 0;
+    for (size_t i = 0; i < count; ++i) {
+        fallbacks += job.fallback[i];
+    }
+    drift_result r = DRIFT_OK;
+    if (fallbacks > 0) {
+        size_t threads = (size_t)drift_context_thread_count(ism->ctx);
+        job.job_pixels = (fallbacks + 2 * threads - 1) / (2 * threads);
+        uint32_t *pixels = drift_alloc(ism->ctx, fallbacks * sizeof *pixels);
+        job.receiver_buffers = drift_alloc(ism->ctx, threads * job.job_pixels * 14 * sizeof(float));
+        if (pixels && job.receiver_buffers) {
+            for (size_t i = 0, k = 0; i < count; ++i) {
+                if (job.fallback[i]) {
+                    pixels[k++] = (uint32_t)i;
+                }
+            }
+            job.fallback_pixels = pixels;
+            job.fallback_count = fallbacks;
+            drift_parallel_for(ism->ctx, (fallbacks + job.job_pixels - 1) / job.job_pixels, 1,
+                               fallback_jobs, &job);
+            for (int i = 0; i < 64; ++i) {
+                st->shadow_rays += job.rays[i];
+            }
+        } else {
+            r = DRIFT_ERR_OUT_OF_MEMORY;
+        }
+        drift_free(ism->ctx, pixels);
+        drift_free(ism->ctx, job.receiver_buffers);
+    }
+    st->fallback_pixels = fallbacks;
+    drift_free(ism->ctx, job.fallback);
+    return r;
+}
+
 // --- FRAME ---
 
-static drift_result ensure_planes(drift_ism *ism, int32_t w, int32_t h)
+// The gathering resolution's side for a G-buffer side of `full` pixels.
+static int32_t gathering_side(const drift_ism *ism, int32_t full)
 {
-    if (ism->width == w && ism->height == h && ism->indirect.pixels) {
+    int32_t s = ism->params.gather_scale;
+    return (full + s - 1) / s;
+}
+
+static drift_result ensure_planes(drift_ism *ism, int32_t fw, int32_t fh)
+{
+    if (ism->full_width == fw && ism->full_height == fh && ism->indirect.pixels) {
         return DRIFT_OK;
     }
     destroy_planes(ism);
+    int32_t w = gathering_side(ism, fw), h = gathering_side(ism, fh);
     ism->width = w;
     ism->height = h;
+    ism->full_width = fw;
+    ism->full_height = fh;
     int32_t n = ism->params.map_size;
+    bool coarse = ism->params.gather_scale > 1;
+    drift_gbuffer *c = &ism->coarse;
+    if (coarse) {
+        c->width = w;
+        c->height = h;
+        c->surfaces = drift_alloc(ism->ctx, sizeof(drift_surface) * (size_t)w * (size_t)h);
+    }
     if (drift_image_create(ism->ctx, w, h, 3, &ism->irradiance) != DRIFT_OK ||
-        drift_image_create(ism->ctx, w, h, 3, &ism->indirect) != DRIFT_OK ||
+        drift_image_create(ism->ctx, fw, fh, 3, &ism->indirect) != DRIFT_OK ||
+        (coarse && (!c->surfaces || drift_image_create(ism->ctx, w, h, 1, &c->depth) != DRIFT_OK ||
+                    drift_image_create(ism->ctx, w, h, 3, &c->position) != DRIFT_OK ||
+                    drift_image_create(ism->ctx, w, h, 3, &c->normal) != DRIFT_OK ||
+                    drift_image_create(ism->ctx, w, h, 3, &c->geometric_normal) != DRIFT_OK ||
+                    drift_image_create(ism->ctx, w, h, 3, &c->albedo) != DRIFT_OK ||
+                    drift_image_create(ism->ctx, w, h, 1, &c->material_id) != DRIFT_OK ||
+                    drift_image_create(ism->ctx, w, h, 3, &ism->coarse_direct) != DRIFT_OK ||
+                    drift_image_create(ism->ctx, w, h, 3, &ism->coarse_blurred) != DRIFT_OK)) ||
         drift_image_create(ism->ctx, w, h, 3, &ism->vpl_plane) != DRIFT_OK ||
         drift_image_create(ism->ctx, w, h, 3, &ism->near_field) != DRIFT_OK ||
         drift_image_create(ism->ctx, w, h, 3, &ism->near_spread) != DRIFT_OK ||
         drift_image_create(ism->ctx, n, n, 1, &ism->tile) != DRIFT_OK) {
         destroy_planes(ism);
-        ism->width = ism->height = 0;
+        ism->width = ism->height = ism->full_width = ism->full_height = 0;
         return DRIFT_ERR_OUT_OF_MEMORY;
     }
     return DRIFT_OK;
@@ -1105,6 +1401,18 @@ drift_result drift_ism_render(drift_ism *ism, const drift_gbuffer *gbuffer,
     }
     drift_ism_stats st = { 0 };
     double t0 = drift_time_now(), t = t0, now;
+    // gb: the G-buffer the VPLs are gathered at (one pixel in gather_scale^2 of gbuffer's).
+    const drift_gbuffer *gb = gbuffer;
+    bool coarse = ism->params.gather_scale > 1;
+    if (coarse) {
+        decimate_job dj = { .ism = ism, .gb = gbuffer, .direct = near_field ? direct : NULL };
+        drift_parallel_for(ism->ctx, (size_t)ism->coarse.height, 4, decimate_rows, &dj);
+        gb = &ism->coarse;
+        direct = &ism->coarse_direct;
+        now = drift_time_now();
+        st.ms[DRIFT_ISM_STAGE_UPSAMPLE] = (now - t) * 1e3;
+        t = now;
+    }
     drift_free(ism->ctx, ism->vpls);
     ism->vpls = NULL;
     ism->vpl_count = 0;
@@ -1194,11 +1502,11 @@ drift_result drift_ism_render(drift_ism *ism, const drift_gbuffer *gbuffer,
         t = now;
     }
     int32_t b = ism->params.block_size;
-    int32_t cols = (gbuffer->width + b - 1) / b;
-    gather_job gj = { .ism = ism, .gb = gbuffer };
+    int32_t cols = (gb->width + b - 1) / b;
+    gather_job gj = { .ism = ism, .gb = gb, .blur_to_coarse = coarse };
     // Whole rows of a subset, as few bands as keep the threads busy and the receivers of a job
     // under GATHER_MAX_RECEIVERS (the image does not depend on the split).
-    int32_t rows = (gbuffer->height + b - 1) / b;
+    int32_t rows = (gb->height + b - 1) / b;
     int64_t subsets = (int64_t)b * b, threads = drift_context_thread_count(ism->ctx);
     int64_t bands = (4 * threads + subsets - 1) / subsets;
     int64_t by_size = ((int64_t)rows * cols + GATHER_MAX_RECEIVERS - 1) / GATHER_MAX_RECEIVERS;
@@ -1221,7 +1529,7 @@ drift_result drift_ism_render(drift_ism *ism, const drift_gbuffer *gbuffer,
     st.ms[DRIFT_ISM_STAGE_GATHER] = (now - t) * 1e3;
     t = now;
     if (near_field) {
-        add_near_field(ism, gbuffer, camera, direct, &st);
+        add_near_field(ism, gb, camera, direct, &st);
     } else {
         memset(ism->near_field.pixels, 0,
                (size_t)ism->width * (size_t)ism->height * 3 * sizeof(float));
@@ -1233,14 +1541,23 @@ drift_result drift_ism_render(drift_ism *ism, const drift_gbuffer *gbuffer,
     int32_t blur_block = ism->params.no_blur ? 1 : b;
     gj.blur_scratch =
         drift_alloc(ism->ctx, sizeof(float) * (size_t)drift_context_thread_count(ism->ctx) *
-                                  blur_scratch_floats(gbuffer->width, blur_block));
+                                  blur_scratch_floats(gb->width, blur_block));
     if (!gj.blur_scratch) {
         return DRIFT_ERR_OUT_OF_MEMORY;
     }
-    drift_parallel_for(ism->ctx, (size_t)gbuffer->height, BLUR_JOB_ROWS, blur_rows, &gj);
+    drift_parallel_for(ism->ctx, (size_t)gb->height, BLUR_JOB_ROWS, blur_rows, &gj);
     drift_free(ism->ctx, gj.blur_scratch);
     now = drift_time_now();
     st.ms[DRIFT_ISM_STAGE_BLUR] = (now - t) * 1e3;
+    t = now;
+    if (coarse) {
+        r = upsample(ism, gbuffer, &st);
+        if (r != DRIFT_OK) {
+            return r;
+        }
+        now = drift_time_now();
+        st.ms[DRIFT_ISM_STAGE_UPSAMPLE] += (now - t) * 1e3;
+    }
     diagnostic_planes(ism, camera);
     st.total_ms = (drift_time_now() - t0) * 1e3;
     st.vpl_count = ism->vpl_count;

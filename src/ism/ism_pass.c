@@ -28,7 +28,8 @@ static drift_ism_params params_of(const drift_frame_state *f, drift_ism_visibili
                                .map_size = f->params.ism.map_size,
                                .points_per_vpl = f->params.ism.points_per_vpl,
                                .vpl_importance = f->params.ism.vpl_importance,
-                               .no_near_field = f->params.ism.no_near_field };
+                               .no_near_field = f->params.ism.no_near_field,
+                               .gather_scale = f->params.ism.gather_scale };
 }
 
 static bool same_params(const drift_ism_params *a, const drift_ism_params *b)
@@ -36,7 +37,7 @@ static bool same_params(const drift_ism_params *a, const drift_ism_params *b)
     return a->seed == b->seed && a->visibility == b->visibility && a->vpl_count == b->vpl_count &&
            a->max_depth == b->max_depth && a->map_size == b->map_size &&
            a->points_per_vpl == b->points_per_vpl && a->vpl_importance == b->vpl_importance &&
-           a->no_near_field == b->no_near_field;
+           a->no_near_field == b->no_near_field && a->gather_scale == b->gather_scale;
 }
 
 static drift_result indirect(drift_frame_state *f, const drift_pass_args *args,
@@ -63,6 +64,12 @@ static drift_result indirect(drift_frame_state *f, const drift_pass_args *args,
         drift_pass_copy_rgb(drift_ism_indirect(s->ism), &f->indirect);
     }
     return r;
+}
+
+const char *drift_ism_settings_problem(const drift_ism_settings *s)
+{
+    int32_t g = s->gather_scale;
+    return g == 0 || g == 1 || g == 2 || g == 4 ? NULL : "ism gather scale not 1, 2 or 4";
 }
 
 drift_result drift_ism_pass_indirect(drift_frame_state *f, const drift_pass_args *args)
