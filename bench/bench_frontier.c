@@ -35,7 +35,7 @@
 
 typedef struct frontier_options {
     const char *scene_path, *csv_path, *svg_path, *cache_dir;
-    long size, threads, ref_spp, runs, max_spp, near_field_off_vpls;
+    long size, threads, ref_spp, runs, max_spp, near_field_off_vpls, half_gather_vpls;
     long budgets[MAX_BUDGETS], vpls[MAX_BUDGETS], aaf_spps[MAX_BUDGETS], aa[MAX_BUDGETS],
         sir[MAX_BUDGETS], light_samples[MAX_BUDGETS];
     int budget_count, vpl_count, aaf_spp_count, aa_count, sir_count, light_sample_count;
@@ -85,6 +85,10 @@ static const cli_option frontier_table[] = {
             "ism and ir rows of at most N VPLs run without the near-field\n"
             "compensation too (default 256: below it the VPLs its rays cost\n"
             "can be worth more, docs/frontier.md; 0 = never)"),
+    CLI_INT("--half-gather-vpls", "N", O, half_gather_vpls, 0, 1 << 16,
+            "ism and ir rows of at least N VPLs also gather at one pixel in\n"
+            "2 x 2 (--ism-gather-scale 2; default 256: the gather is then most\n"
+            "of the indirect pass, docs/ism.md; 0 = never)"),
     CLI_INT("--size", "N", O, size, 4, 4096, "N x N pixels (default 400)"),
     CLI_INT("--threads", "T", O, threads, 0, 256, "worker threads (default 2)"),
     CLI_INT("--ref-spp", "N", O, ref_spp, 1, 1 << 20, "reference samples a pixel (default 512)"),
@@ -362,7 +366,8 @@ static drift_result hybrid_row(frontier_state *b, const char *name,
 }
 
 // The hybrid combinations: shadows hard, pcss, isg, aaf x indirect none, ambient, ism and ir at
-// 16..1024 VPLs (up to --near-field-off-vpls also without the near-field compensation), aaf; AAF
+// 16..1024 VPLs (up to --near-field-off-vpls also without the near-field compensation, from
+// --half-gather-vpls also gathering at one pixel in 2 x 2), aaf; AAF
 // rows at 1, 2 and 4 spp; each at every --light-samples count (8) and at --aa 1 and 4 anti-aliasing
 // passes; max depth 8. The other effects keep the technique that matches the reference: reflections
 // none on a scene without glossy or mirror materials (else isg: AAF's reflections scored only
@@ -389,10 +394,13 @@ static drift_result hybrid_rows(frontier_state *b, double limit_ms)
             size_t spp_count = aaf ? (size_t)b->o->aaf_spp_count : 1;
             size_t ls_count = (size_t)b->o->light_sample_count;
             size_t variants = spp_count * ls_count * (size_t)b->o->aa_count;
-            for (size_t v = 0; v < vpl_count * 2 && r == DRIFT_OK; ++v) {
-                // v / 2 is the VPL count; odd v the same rows without the near field.
-                bool near_field_off = v % 2 == 1;
-                if (near_field_off && (!vpl || vpls[v / 2] > b->o->near_field_off_vpls)) {
+            for (size_t v = 0; v < vpl_count * 3 && r == DRIFT_OK; ++v) {
+                // v / 3 is the VPL count; v % 3 == 1 the same rows without the near field,
+                // v % 3 == 2 gathering at one pixel in 2 x 2.
+                bool near_field_off = v % 3 == 1, half_gather = v % 3 == 2;
+                if ((near_field_off && (!vpl || vpls[v / 3] > b->o->near_field_off_vpls)) ||
+                    (half_gather && (!vpl || b->o->half_gather_vpls == 0 ||
+                                     vpls[v / 3] < b->o->half_gather_vpls))) {
                     continue;
                 }
                 for (size_t k = 0; k < variants && r == DRIFT_OK; ++k) {
@@ -422,10 +430,14 @@ static drift_result hybrid_rows(frontier_state *b, double limit_ms)
                     char name[96];
                     int len = snprintf(name, sizeof name, "%s + %s", shadows[s], indirect[i]);
                     if (vpl) {
-                        p.ism.vpls = (uint32_t)vpls[v / 2];
+                        p.ism.vpls = (uint32_t)vpls[v / 3];
                         p.ism.no_near_field = near_field_off;
+                        p.ism.gather_scale = half_gather ? 2 : 1;
                         len += snprintf(name + len, sizeof name - (size_t)len, " %ld VPLs%s",
-                                        vpls[v / 2], near_field_off ? " nf off" : "");
+                                        vpls[v / 3],
+                                        near_field_off ? " nf off"
+                                        : half_gather  ? " g2"
+                                                       : "");
                     }
                     if (aaf) {
                         len += snprintf(name + len, sizeof name - (size_t)len, " %ld spp",
@@ -743,7 +755,8 @@ int drift_bench_frontier(int argc, char **argv)
                            .light_sample_count = 1,
                            .sir = { 1, 4, 16 },
                            .sir_count = 3,
-                           .near_field_off_vpls = 256 };
+                           .near_field_off_vpls = 256,
+                           .half_gather_vpls = 256 };
     int status = cli_parse(&frontier_command, argc, argv, &o, NULL);
     if (status != CLI_PARSED) {
         return cli_parse_exit(status);

@@ -384,6 +384,10 @@ static const cli_option render_table[] = {
                "off: no near-field compensation (short rays from a quarter of the\n"
                "pixels give back the light of surfaces nearer than the VPLs'\n"
                "clamp; default on)"),
+    CLI_INT("--ism-gather-scale", "N", O, hybrid.ism.gather_scale, 1, 4,
+            "1: every pixel gathers the VPLs (default); 2 or 4: one pixel in\n"
+            "2x2 or 4x4 does, its irradiance upsampled to the others\n"
+            "(docs/ism.md)"),
     CLI_INT("--ism-map-size", "N", O, hybrid.ism.map_size, 4, 1024,
             "texels a side of each VPL's imperfect shadow map (default 64)"),
     CLI_INT("--ism-points", "N", O, hybrid.ism.points_per_vpl, 16, 1 << 20,

@@ -120,7 +120,8 @@ assert d["rows"][3]["photons"] > 0 and d["rows"][2]["photons"] == 0, d'
         # Twice: the second run must reuse the cached reference and give the same FLIP values.
         for run in 1 2; do
             expect 0 "$drift" bench frontier "$box" --size 12 --ref-spp 4 --runs 1 --max-spp 2 \
-                --vpls 8 --aaf-spp 1 --aa 1,2 --light-samples 8,1 --sir-iterations 1,2 \
+                --vpls 8 --half-gather-vpls 8 --aaf-spp 1 --aa 1,2 --light-samples 8,1 \
+                --sir-iterations 1,2 \
                 --budgets 1,20,1000 \
                 --cache "$tmp/cache" --threads 1 \
                 --csv "$tmp/frontier.csv" --svg "$tmp/frontier.svg" --json
@@ -139,9 +140,10 @@ assert sum(n.endswith(" aa 2") for n in names) * 2 == len(names), names
 assert sum(" ls 1" in n for n in names) * 2 == len(names), names
 assert not any(" ls 8" in n for n in names), names
 # Each ism and ir row of 8 VPLs (under the default --near-field-off-vpls 256) once more without the
-# near-field compensation.
+# near-field compensation, and (from --half-gather-vpls 8) once more gathering at 2 x 2.
 vpl_rows = [n for n in names if " VPLs" in n]
-assert vpl_rows and sum(" nf off" in n for n in vpl_rows) * 2 == len(vpl_rows), vpl_rows
+assert vpl_rows and sum(" nf off" in n for n in vpl_rows) * 3 == len(vpl_rows), vpl_rows
+assert sum(n.split(" VPLs")[1].startswith(" g2") for n in vpl_rows) * 3 == len(vpl_rows), vpl_rows
 assert 1 <= fam.count("sir") <= 2, fam
 assert all(r["ms"] > 0 and 0 <= r["flip"] <= 1 and r["rmse"] >= 0 for r in d["rows"]), d
 prev = 2.0
