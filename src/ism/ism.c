@@ -2,6 +2,8 @@
 // the geometry-aware blur and the near-field compensation.
 #include "ism/ism_internal.h"
 
+#include "core/vectorise.h"
+
 #include <math.h>
 #include <string.h>
 
@@ -360,29 +362,6 @@ static void maps_range(size_t begin, size_t end, int thread, void *user)
 
 // --- GATHERING ---
 
-// The gather's loops are written once and specialised by inlining.
-#if defined(__GNUC__)
-#    define DRIFT_ISM_INLINE __attribute__((always_inline))
-#else
-#    define DRIFT_ISM_INLINE
-#endif
-// The gather's loops are also compiled for AVX2 (8 lanes, hardware gathers), picked at load
-// time where the CPU has it (GCC and clang function multi-versioning on x86-64 ELF). With
-// -ffp-contract=off both versions do the same IEEE operations: the same image to the bit.
-#if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__) && defined(__ELF__)
-#    define DRIFT_ISM_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#    define DRIFT_ISM_CLONES
-#endif
-// The map lookups are gathers through pointers the compiler cannot tell apart from the
-// receivers' sums; they never overlap (the map is only read).
-#if defined(__clang__)
-#    define DRIFT_ISM_IVDEP _Pragma("clang loop vectorize(assume_safety)")
-#elif defined(__GNUC__)
-#    define DRIFT_ISM_IVDEP _Pragma("GCC ivdep")
-#else
-#    define DRIFT_ISM_IVDEP
-#endif
 
 // A gather job's receivers: one interleaving subset's pixels in a band of rows. Each map is
 // read by all the receivers of a job, VPL after VPL, so the fewer the jobs the fewer times a
@@ -440,7 +419,7 @@ static vpl_lobe vpl_lobe_of(const drift_vpl *v)
 }
 
 // cos^m of the angle between the lobe and the direction -a / |a| to the receiver.
-static inline DRIFT_ISM_INLINE float lobe_power(const vpl_lobe *l, float ax, float ay, float az,
+static inline DRIFT_ALWAYS_INLINE float lobe_power(const vpl_lobe *l, float ax, float ay, float az,
                                                 float inv)
 {
     float c = -(l->x * ax + l->y * ay + l->z * az) * inv;
@@ -456,7 +435,7 @@ static inline DRIFT_ISM_INLINE float lobe_power(const vpl_lobe *l, float ax, flo
 // and the geometry term are computed for all and masked at the end. With a = y_j - x and
 // v = -a / |a| in the VPL's frame, v.xy / (1 + v.z) = -(a . t, a . b) / (|a| + c) where
 // c = -a . n_j = |a| cos theta_j: the lookup needs one reciprocal, not the normalised w.
-static inline DRIFT_ISM_INLINE void
+static inline DRIFT_ALWAYS_INLINE void
 gather_vpl_ism_levels(const drift_vpl *v, const drift_frame *f, const float *restrict map,
                       const gather_consts *c, int32_t count, const float *restrict px,
                       const float *restrict py, const float *restrict pz, const float *restrict nx,
@@ -475,7 +454,7 @@ gather_vpl_ism_levels(const drift_vpl *v, const drift_frame *f, const float *res
     drift__ism_levels_of(map, n, l);
     const vpl_lobe lobe = vpl_lobe_of(v);
     const float sr = v->glossy.x, sg = v->glossy.y, sb = v->glossy.z;
-    DRIFT_ISM_IVDEP
+    DRIFT_IVDEP
     for (int32_t i = 0; i < count; ++i) {
         float ax = vx - px[i], ay = vy - py[i], az = vz - pz[i];
         float dx = nx[i] * ax + ny[i] * ay + nz[i] * az;
@@ -521,7 +500,7 @@ gather_vpl_ism_levels(const drift_vpl *v, const drift_frame *f, const float *res
 // One copy of the loop per pyramid depth and lobe, each without a branch on them (so that it
 // vectorises).
 #define GATHER_ISM_LEVELS(L, G, NAME)                                                             \
-    DRIFT_ISM_CLONES static void NAME(const drift_vpl *v, const drift_frame *f, const float *map, \
+    DRIFT_AVX2_CLONES static void NAME(const drift_vpl *v, const drift_frame *f, const float *map, \
                                       const gather_consts *c, receivers *rs)                      \
     {                                                                                             \
         gather_vpl_ism_levels(v, f, map, c, rs->count, rs->px, rs->py, rs->pz, rs->nx, rs->ny,    \
@@ -808,7 +787,7 @@ static void blur_copy_row(const drift_ism *ism, const drift_gbuffer *gb, bool ne
 
 // Adds the pixels of row q at offset dx that pass the centres' tests (row c) to the sums of
 // centres x0..x1-1.
-DRIFT_ISM_CLONES static void blur_accumulate(const blur_row *c, const blur_row *q, int32_t x0,
+DRIFT_AVX2_CLONES static void blur_accumulate(const blur_row *c, const blur_row *q, int32_t x0,
                                              int32_t x1, int32_t dx, float blur_normal,
                                              float blur_plane, float *restrict sr,
                                              float *restrict sg, float *restrict sb,
@@ -820,7 +799,7 @@ DRIFT_ISM_CLONES static void blur_accumulate(const blur_row *c, const blur_row *
     const float *restrict qnx = q->nx + dx, *restrict qny = q->ny + dx, *restrict qnz = q->nz + dx;
     const float *restrict qs = q->surface + dx, *restrict qr = q->er + dx;
     const float *restrict qg = q->eg + dx, *restrict qb = q->eb + dx;
-    DRIFT_ISM_IVDEP
+    DRIFT_IVDEP
     for (int32_t x = x0; x < x1; ++x) {
         float d =
             cnx[x] * (qpx[x] - cpx[x]) + cny[x] * (qpy[x] - cpy[x]) + cnz[x] * (qpz[x] - cpz[x]);

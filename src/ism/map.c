@@ -1,6 +1,7 @@
 // One imperfect shadow map: paraboloid point splatting with a z-test, and pull-push hole
 // filling (Ritschel et al. 2008, §5.2.2; docs/ism.md, "Maps").
 #include "drift/accel.h"
+#include "core/vectorise.h"
 #include "ism/ism_internal.h"
 
 #include <math.h>
@@ -9,17 +10,11 @@
 // loop without branches the compiler vectorises, then the squares are z-tested into the map.
 #define SPLAT_BLOCK 256
 
-// Splatting and pulling are also compiled for AVX2 where the CPU has it, as the gather
-// (docs/decisions/0028-ism-vectorised-gather.md).
-#if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__) && defined(__ELF__)
-#    define DRIFT_ISM_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#    define DRIFT_ISM_CLONES
-#endif
-
+// Splatting and pulling are also compiled for AVX2 where the CPU has it (DRIFT_AVX2_CLONES),
+// as the gather (docs/decisions/0028-ism-vectorised-gather.md).
 // Static: clang 14 emits no plain symbol for an external multi-versioned function (the
 // fuzz build's link failed), so the clones stay inside this file behind drift__ism_splat.
-DRIFT_ISM_CLONES static void splat_points(float *depth, const drift__ism_splat_desc *desc,
+DRIFT_AVX2_CLONES static void splat_points(float *depth, const drift__ism_splat_desc *desc,
                                           drift_vec3 origin, const drift_frame *frame,
                                           const drift_vec3 *positions, uint32_t count)
 {
@@ -114,7 +109,7 @@ static void disc_span(int32_t n, int32_t y, int32_t *lo, int32_t *hi)
 // One pull step: each coarse texel averages its valid children within t of the nearest one
 // (an empty child is INFINITY), and `members` counts them. Children past an odd edge read as
 // empty: row `inf_row` (fs floats of INFINITY) stands for the missing last row.
-DRIFT_ISM_CLONES static void pull_level(const float *fine, int32_t fs, float *coarse,
+DRIFT_AVX2_CLONES static void pull_level(const float *fine, int32_t fs, float *coarse,
                                         float *members, int32_t cs, float t, const float *inf_row)
 {
     int32_t pairs = fs / 2;
