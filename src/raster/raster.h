@@ -84,6 +84,31 @@ drift_vec3 drift_raster_unshadowed(const drift_scene *scene, const drift_raster_
                                    const drift_surface *surface, const drift_bsdf *bsdf,
                                    drift_vec3 wo, uint32_t sample_count, drift_sampler *sampler);
 
+// Receivers of drift_raster_polygon_rows: up to DRIFT_RASTER_ROW_MAX positions and the shading
+// normals of their BSDFs (bsdf.frame.z), structure of arrays.
+#define DRIFT_RASTER_ROW_MAX 64
+
+typedef struct drift_raster_receivers {
+    const float *px, *py, *pz, *nx, *ny, *nz;
+    int32_t count;
+} drift_raster_receivers;
+
+// Whether `light`'s diffuse lobe is a sum of quads or triangles in closed form, which
+// drift_raster_polygon_rows gives for many receivers at once (not a sphere's).
+bool drift_raster_has_polygon_rows(const drift_raster_light *light);
+// At each receiver i, sum over the light's polygons of L_e E(p_i, n_i), E the irradiance of the
+// unit-radiance polygon clipped to the hemisphere (Lambert's formula), vectorised over the
+// receivers: the RGB that drift_raster_unshadowed's diffuse lobe is kd / pi times.
+void drift_raster_polygon_rows(const drift_scene *scene, const drift_raster_light *light,
+                               const drift_raster_receivers *receivers, float *er, float *eg,
+                               float *eb);
+// drift_raster_unshadowed with that sum given for this surface (from drift_raster_polygon_rows;
+// only for a light drift_raster_has_polygon_rows): the same value, the closed form not redone.
+drift_vec3 drift_raster_unshadowed_given(const drift_scene *scene, const drift_raster_light *light,
+                                         const drift_surface *surface, const drift_bsdf *bsdf,
+                                         drift_vec3 wo, uint32_t sample_count,
+                                         drift_sampler *sampler, drift_vec3 polygon_irradiance);
+
 // Direct light from the environment with ray-traced visibility (`sample_count` shadow rays,
 // counted in *rays). The environment has no centre, so the shadow techniques do not apply
 // to it: every technique shades it this way (docs/hybrid.md).

@@ -2,6 +2,7 @@
 // shadow toward a light's centre, and the radiance a secondary ray sees (what the sharp
 // reflection buffer and the environment map store). It calls the same BSDF and light code
 // as the reference path tracer, so a technique's error is its own.
+#include "core/vectorise.h"
 #include "raster/raster.h"
 
 #include <math.h>
@@ -177,9 +178,132 @@ static drift_vec3 polygon_diffuse(const drift_scene *scene, const drift_raster_l
     return drift_vec3_scale(drift_vec3_mul(sum, bsdf->diffuse), DRIFT_INV_PI);
 }
 
-drift_vec3 drift_raster_unshadowed(const drift_scene *scene, const drift_raster_light *light,
-                                   const drift_surface *surface, const drift_bsdf *bsdf,
-                                   drift_vec3 wo, uint32_t sample_count, drift_sampler *sampler)
+// --- POLYGON LIGHTS IN CLOSED FORM, A ROW AT A TIME ---
+//
+// Lambert's formula is the unshadowed pass's hot loop (27% of the Cornell box's frame, its
+// acos and square roots scalar per pixel and edge). Here it runs for many receivers and one
+// polygon at once, branch-free over structure-of-arrays receivers so that it vectorises
+// (docs/decisions/0028): the same operations in the same order as polygon_irradiance, so the
+// same values. A receiver whose horizon the polygon straddles needs the clip, and takes the
+// scalar polygon_irradiance afterwards.
+
+// acos_inline with both branches computed and one selected.
+static inline DRIFT_ALWAYS_INLINE float acos_select(float x)
+{
+    float a = fabsf(x);
+    bool half = a > 0.5f;
+    float s = half ? sqrtf(0.5f * (1.0f - a)) : a;
+    float z = s * s;
+    float p = (((4.2163199048e-2f * z + 2.4181311049e-2f) * z + 4.5470025998e-2f) * z +
+               7.4953002686e-2f) *
+                  z +
+              1.6666752422e-1f;
+    float asin_s = s + s * z * p;
+    float above = x > 0.0f ? 2.0f * asin_s : DRIFT_PI - 2.0f * asin_s;
+    float below = 0.5f * DRIFT_PI - (x > 0.0f ? asin_s : -asin_s);
+    return half ? above : below;
+}
+
+// E of a unit-radiance polygon of M corners (v, its emitting normal en) at receivers i: e[i],
+// 0 behind its emitting side or below the horizon; straddles[i] = 1 where the horizon cuts it
+// (e[i] is then to be computed with the clip).
+static inline DRIFT_ALWAYS_INLINE void
+polygon_irradiance_rows(const float (*v)[3], const int m, drift_vec3 en, int32_t count,
+                        const float *restrict px, const float *restrict py,
+                        const float *restrict pz, const float *restrict nx,
+                        const float *restrict ny, const float *restrict nz, float *restrict e,
+                        int32_t *restrict straddles)
+{
+    DRIFT_IVDEP
+    for (int32_t i = 0; i < count; ++i) {
+        float dx[4], dy[4], dz[4];
+        bool above = true, below = true;
+        for (int k = 0; k < m; ++k) {
+            float ax = v[k][0] - px[i], ay = v[k][1] - py[i], az = v[k][2] - pz[i];
+            float da = ax * nx[i] + ay * ny[i] + az * nz[i];
+            above = above & (da >= 0.0f);
+            below = below & !(da >= 0.0f);
+            float len = sqrtf(ax * ax + ay * ay + az * az);
+            float inv = len > 0.0f ? 1.0f / len : 1.0f;
+            dx[k] = ax * inv, dy[k] = ay * inv, dz[k] = az * inv;
+        }
+        float sum = 0.0f;
+        for (int k = 0; k < m; ++k) {
+            int k1 = k + 1 < m ? k + 1 : 0;
+            float cx = dy[k] * dz[k1] - dz[k] * dy[k1];
+            float cy = dz[k] * dx[k1] - dx[k] * dz[k1];
+            float cz = dx[k] * dy[k1] - dy[k] * dx[k1];
+            float length = sqrtf(cx * cx + cy * cy + cz * cz);
+            float cosab = dx[k] * dx[k1] + dy[k] * dy[k1] + dz[k] * dz[k1];
+            cosab = cosab < -1.0f ? -1.0f : (cosab > 1.0f ? 1.0f : cosab);
+            float t = acos_select(cosab) * (cx * nx[i] + cy * ny[i] + cz * nz[i]) / length;
+            sum += length > 1e-12f ? t : 0.0f;
+        }
+        float side = (px[i] - v[0][0]) * en.x + (py[i] - v[0][1]) * en.y + (pz[i] - v[0][2]) * en.z;
+        bool lit = side > 0.0f;
+        e[i] = lit & above ? 0.5f * fabsf(sum) : 0.0f;
+        straddles[i] = lit & !above & !below;
+    }
+}
+
+DRIFT_AVX2_CLONES static void triangle_rows(const float (*v)[3], drift_vec3 en, int32_t count,
+                                            const float *px, const float *py, const float *pz,
+                                            const float *nx, const float *ny, const float *nz,
+                                            float *e, int32_t *straddles)
+{
+    polygon_irradiance_rows(v, 3, en, count, px, py, pz, nx, ny, nz, e, straddles);
+}
+
+DRIFT_AVX2_CLONES static void quad_rows(const float (*v)[3], drift_vec3 en, int32_t count,
+                                        const float *px, const float *py, const float *pz,
+                                        const float *nx, const float *ny, const float *nz, float *e,
+                                        int32_t *straddles)
+{
+    polygon_irradiance_rows(v, 4, en, count, px, py, pz, nx, ny, nz, e, straddles);
+}
+
+bool drift_raster_has_polygon_rows(const drift_raster_light *light)
+{
+    return has_closed_form(light) && light->sphere_radius == 0.0f &&
+           (light->type == DRIFT_LIGHT_QUAD || light->type == DRIFT_LIGHT_TRIANGLE);
+}
+
+void drift_raster_polygon_rows(const drift_scene *scene, const drift_raster_light *light,
+                               const drift_raster_receivers *rs, float *er, float *eg, float *eb)
+{
+    float e[DRIFT_RASTER_ROW_MAX];
+    int32_t straddles[DRIFT_RASTER_ROW_MAX];
+    int32_t count = rs->count < DRIFT_RASTER_ROW_MAX ? rs->count : DRIFT_RASTER_ROW_MAX;
+    for (int32_t i = 0; i < count; ++i) {
+        er[i] = eg[i] = eb[i] = 0.0f;
+    }
+    for (uint32_t j = 0; j < light->light_count; ++j) {
+        const drift_light *l = &scene->lights[light->first_light + j];
+        drift_vec3 polygon[4], normal;
+        int m = light_polygon(scene, l, polygon, &normal);
+        float v[4][3];
+        for (int k = 0; k < m; ++k) {
+            v[k][0] = polygon[k].x, v[k][1] = polygon[k].y, v[k][2] = polygon[k].z;
+        }
+        (m == 4 ? quad_rows : triangle_rows)((const float(*)[3])v, normal, count, rs->px, rs->py,
+                                             rs->pz, rs->nx, rs->ny, rs->nz, e, straddles);
+        for (int32_t i = 0; i < count; ++i) {
+            if (straddles[i]) {
+                e[i] = polygon_irradiance(drift_vec3_make(rs->px[i], rs->py[i], rs->pz[i]),
+                                          drift_vec3_make(rs->nx[i], rs->ny[i], rs->nz[i]), polygon,
+                                          m);
+            }
+            er[i] += l->color.x * e[i];
+            eg[i] += l->color.y * e[i];
+            eb[i] += l->color.z * e[i];
+        }
+    }
+}
+
+static drift_vec3 unshadowed(const drift_scene *scene, const drift_raster_light *light,
+                             const drift_surface *surface, const drift_bsdf *bsdf, drift_vec3 wo,
+                             uint32_t sample_count, drift_sampler *sampler,
+                             const drift_vec3 *polygon_irradiance_given)
 {
     drift_vec3 sum = drift_vec3_splat(0.0f);
     if (drift_bsdf_is_delta(bsdf)) {
@@ -193,7 +317,15 @@ drift_vec3 drift_raster_unshadowed(const drift_scene *scene, const drift_raster_
     // Polygons and spheres: the diffuse lobe in closed form (no noise), samples for the glossy
     // lobe only.
     bool closed_form = has_closed_form(light);
-    if (closed_form) {
+    if (closed_form && polygon_irradiance_given) {
+        if (drift_vec3_dot(wo, bsdf->frame.z) > 0.0f) {
+            sum = drift_vec3_scale(drift_vec3_mul(*polygon_irradiance_given, bsdf->diffuse),
+                                   DRIFT_INV_PI);
+        }
+        if (drift_vec3_is_zero(bsdf->specular)) {
+            return sum;
+        }
+    } else if (closed_form) {
         sum = polygon_diffuse(scene, light, surface, bsdf, wo);
         if (drift_vec3_is_zero(bsdf->specular)) {
             return sum;
@@ -213,6 +345,21 @@ drift_vec3 drift_raster_unshadowed(const drift_scene *scene, const drift_raster_
             drift_vec3_add(sampled, light_sample_contribution(surface, bsdf, wo, &ls, closed_form));
     }
     return drift_vec3_fma(sum, sampled, 1.0f / (float)n);
+}
+
+drift_vec3 drift_raster_unshadowed(const drift_scene *scene, const drift_raster_light *light,
+                                   const drift_surface *surface, const drift_bsdf *bsdf,
+                                   drift_vec3 wo, uint32_t sample_count, drift_sampler *sampler)
+{
+    return unshadowed(scene, light, surface, bsdf, wo, sample_count, sampler, NULL);
+}
+
+drift_vec3 drift_raster_unshadowed_given(const drift_scene *scene, const drift_raster_light *light,
+                                         const drift_surface *surface, const drift_bsdf *bsdf,
+                                         drift_vec3 wo, uint32_t sample_count,
+                                         drift_sampler *sampler, drift_vec3 polygon_irradiance)
+{
+    return unshadowed(scene, light, surface, bsdf, wo, sample_count, sampler, &polygon_irradiance);
 }
 
 drift_vec3 drift_raster_environment_direct(const drift_scene *scene, const drift_accel *accel,

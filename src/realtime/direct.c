@@ -12,45 +12,85 @@ static size_t pixel_index(const drift_frame_state *f, int32_t x, int32_t y)
     return (size_t)y * (size_t)f->params.width + (size_t)x;
 }
 
-static void unshadowed_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
+// The unshadowed light of pixels x0 .. x0 + n - 1 of row y (n <= DRIFT_RASTER_ROW_MAX): each
+// closed-form polygon light for the whole run at once (drift_raster_polygon_rows, vectorised),
+// the rest pixel by pixel, each pixel's sampler drawn in the same order as one pixel alone.
+static void unshadowed_run(drift_frame_state *f, int32_t x0, int32_t n, int32_t y, uint64_t *rays)
+{
+    drift_vec3 zero = drift_vec3_splat(0.0f);
+    drift_bsdf bsdf[DRIFT_RASTER_ROW_MAX];
+    drift_vec3 wo[DRIFT_RASTER_ROW_MAX];
+    drift_sampler sampler[DRIFT_RASTER_ROW_MAX];
+    float p[6][DRIFT_RASTER_ROW_MAX], e[3][DRIFT_RASTER_ROW_MAX];
+    const drift_surface *s = &f->gbuffer.surfaces[pixel_index(f, x0, y)];
+    for (int32_t i = 0; i < n; ++i) {
+        int32_t x = x0 + i;
+        if (s[i].material == DRIFT_INVALID_INDEX) {
+            for (int k = 0; k < 6; ++k) {
+                p[k][i] = 0.0f;
+            }
+            continue;
+        }
+        bsdf[i] = drift_bsdf_make(f->scene, &s[i]);
+        wo[i] = drift_pass_wo(f, x, y);
+        sampler[i] = drift_pass_sampler(f, DRIFT_STREAM_UNSHADOWED, x, y);
+        p[0][i] = s[i].position.x, p[1][i] = s[i].position.y, p[2][i] = s[i].position.z;
+        p[3][i] = bsdf[i].frame.z.x, p[4][i] = bsdf[i].frame.z.y, p[5][i] = bsdf[i].frame.z.z;
+    }
+    drift_raster_receivers rs = { p[0], p[1], p[2], p[3], p[4], p[5], n };
+    for (uint32_t l = 0; l < f->light_count; ++l) {
+        const drift_raster_light *light = &f->lights[l];
+        bool rows = drift_raster_has_polygon_rows(light);
+        if (rows) {
+            drift_raster_polygon_rows(f->scene, light, &rs, e[0], e[1], e[2]);
+        }
+        for (int32_t i = 0; i < n; ++i) {
+            drift_vec3 u = zero;
+            if (s[i].material != DRIFT_INVALID_INDEX) {
+                u = rows ? drift_raster_unshadowed_given(f->scene, light, &s[i], &bsdf[i], wo[i],
+                                                         f->params.light_samples, &sampler[i],
+                                                         drift_vec3_make(e[0][i], e[1][i], e[2][i]))
+                         : drift_raster_unshadowed(f->scene, light, &s[i], &bsdf[i], wo[i],
+                                                   f->params.light_samples, &sampler[i]);
+            }
+            drift_image_set3(&f->light_buffers[l].unshadowed, x0 + i, y, u);
+        }
+    }
+    for (int32_t i = 0; i < n; ++i) {
+        int32_t x = x0 + i;
+        if (s[i].material == DRIFT_INVALID_INDEX) {
+            drift_image_set3(&f->environment_direct, x, y, zero);
+            continue;
+        }
+        // A row that renders the environment's diffuse light itself (occlusion) leaves D its
+        // glossy part only.
+        drift_bsdf env_bsdf = bsdf[i];
+        if (f->environment_diffuse_elsewhere) {
+            env_bsdf.diffuse = zero;
+        }
+        drift_vec3 env;
+        if (f->params.environment_interleave) {
+            // One shifted set of 4 m points for the 2 x 2 block; this pixel takes every fourth.
+            uint32_t m = (f->params.light_samples + 3) / 4;
+            drift_sampler block = drift_pass_sampler(f, DRIFT_STREAM_UNSHADOWED, x & ~1, y & ~1);
+            env = drift_raster_environment_direct_subset(
+                f->scene, f->accel, &s[i], &env_bsdf, wo[i], 4 * m,
+                (uint32_t)((x & 1) | ((y & 1) << 1)), 4, drift_sampler_next2(&block), rays);
+        } else {
+            env = drift_raster_environment_direct(f->scene, f->accel, &s[i], &env_bsdf, wo[i],
+                                                  f->params.light_samples, &sampler[i], rays);
+        }
+        drift_image_set3(&f->environment_direct, x, y, env);
+    }
+}
+
+static void unshadowed_row(drift_frame_state *f, int32_t y, uint64_t *rays, void *user)
 {
     (void)user;
-    const drift_surface *s = &f->gbuffer.surfaces[pixel_index(f, x, y)];
-    drift_vec3 zero = drift_vec3_splat(0.0f);
-    if (s->material == DRIFT_INVALID_INDEX) {
-        for (uint32_t l = 0; l < f->light_count; ++l) {
-            drift_image_set3(&f->light_buffers[l].unshadowed, x, y, zero);
-        }
-        drift_image_set3(&f->environment_direct, x, y, zero);
-        return;
+    for (int32_t x0 = 0; x0 < f->params.width; x0 += DRIFT_RASTER_ROW_MAX) {
+        int32_t n = f->params.width - x0;
+        unshadowed_run(f, x0, n < DRIFT_RASTER_ROW_MAX ? n : DRIFT_RASTER_ROW_MAX, y, rays);
     }
-    drift_bsdf bsdf = drift_bsdf_make(f->scene, s);
-    drift_vec3 wo = drift_pass_wo(f, x, y);
-    drift_sampler sampler = drift_pass_sampler(f, DRIFT_STREAM_UNSHADOWED, x, y);
-    for (uint32_t l = 0; l < f->light_count; ++l) {
-        drift_vec3 u = drift_raster_unshadowed(f->scene, &f->lights[l], s, &bsdf, wo,
-                                               f->params.light_samples, &sampler);
-        drift_image_set3(&f->light_buffers[l].unshadowed, x, y, u);
-    }
-    // A row that renders the environment's diffuse light itself (occlusion) leaves D its
-    // glossy part only.
-    drift_bsdf env_bsdf = bsdf;
-    if (f->environment_diffuse_elsewhere) {
-        env_bsdf.diffuse = zero;
-    }
-    drift_vec3 env;
-    if (f->params.environment_interleave) {
-        // One shifted set of 4 m points for the 2 x 2 block; this pixel takes every fourth.
-        uint32_t m = (f->params.light_samples + 3) / 4;
-        drift_sampler block = drift_pass_sampler(f, DRIFT_STREAM_UNSHADOWED, x & ~1, y & ~1);
-        env = drift_raster_environment_direct_subset(f->scene, f->accel, s, &env_bsdf, wo, 4 * m,
-                                                     (uint32_t)((x & 1) | ((y & 1) << 1)), 4,
-                                                     drift_sampler_next2(&block), rays);
-    } else {
-        env = drift_raster_environment_direct(f->scene, f->accel, s, &env_bsdf, wo,
-                                              f->params.light_samples, &sampler, rays);
-    }
-    drift_image_set3(&f->environment_direct, x, y, env);
 }
 
 // Interleaved environment light gathered back: a 3 x 3 tent (1 2 1 x 1 2 1) weighs each of the
@@ -227,7 +267,7 @@ drift_result drift_realtime_build_shadow_maps(drift_frame_state *f)
 
 drift_result drift_realtime_pass_unshadowed(drift_frame_state *f)
 {
-    drift_pass_pixels(f, DRIFT_PASS_UNSHADOWED, unshadowed_pixel, NULL);
+    drift_pass_rows(f, DRIFT_PASS_UNSHADOWED, unshadowed_row, NULL);
     if (!f->params.environment_interleave || !drift_scene_has_environment(f->scene)) {
         return DRIFT_OK;
     }
