@@ -375,7 +375,7 @@ static const cli_option render_table[] = {
             "points on each contact-shadow march (default 8)"),
     CLI_INT("--ism-vpls", "N", O, hybrid.ism.vpls, 1, 65536,
             "instant radiosity (--indirect ism|ir, docs/ism.md): light\n"
-            "paths, one first-bounce VPL each (default 512)"),
+            "paths, one first-bounce VPL each (default 1024)"),
     CLI_CHOICE("--ism-vpl-importance", "off|on", O, hybrid.ism.vpl_importance, "off|on",
                "on: keep candidate VPLs with probability by their contribution\n"
                "to the view, divided by it (Georgiev & Slusallek 2010;\n"
@@ -385,9 +385,9 @@ static const cli_option render_table[] = {
                "pixels give back the light of surfaces nearer than the VPLs'\n"
                "clamp; default on)"),
     CLI_INT("--ism-gather-scale", "N", O, hybrid.ism.gather_scale, 1, 4,
-            "1: every pixel gathers the VPLs (default); 2 or 4: one pixel in\n"
-            "2x2 or 4x4 does, its irradiance upsampled to the others\n"
-            "(docs/ism.md)"),
+            "1: every pixel gathers the VPLs; 2 or 4: one pixel in 2x2 or\n"
+            "4x4 does, its irradiance upsampled to the others (default 2;\n"
+            "docs/ism.md)"),
     CLI_INT("--ism-map-size", "N", O, hybrid.ism.map_size, 4, 1024,
             "texels a side of each VPL's imperfect shadow map (default 64)"),
     CLI_INT("--ism-points", "N", O, hybrid.ism.points_per_vpl, 16, 1 << 20,

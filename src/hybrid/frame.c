@@ -78,7 +78,7 @@ drift_hybrid_params drift_hybrid_params_recommended(void)
     return (drift_hybrid_params){ .shadows = DRIFT_SHADOWS_HARD,
                                   .indirect = DRIFT_INDIRECT_ISM,
                                   .max_depth = 8,
-                                  .ism = { .vpls = 512 } };
+                                  .ism = { .vpls = 1024, .gather_scale = 2 } };
 }
 
 static bool techniques_valid(const drift_hybrid_params *p)
