@@ -7,6 +7,7 @@
 typedef struct compose_job {
     int terms[DRIFT_EFFECT_COUNT]; // the effects added after D, in the table's order
     int count;
+    drift_coc_lens lens;
 } compose_job;
 
 static void compose_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
@@ -24,8 +25,7 @@ static void compose_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *
     drift_image_set3(&f->focus, x, y, l);
     float z = drift_image_pixel(&f->gbuffer.depth, x, y)[0];
     // A miss is infinitely far: its circle of confusion is the limit A / F in pixels.
-    drift_image_pixel(&f->coc, x, y)[0] =
-        drift_coc_radius_pixels(&f->camera, f->params.height, z > 0.0f ? z : 1e30f);
+    drift_image_pixel(&f->coc, x, y)[0] = drift_coc_lens_radius(&job->lens, z > 0.0f ? z : 1e30f);
 }
 
 // Whether the effect's term is part of the frame: a term effect (other than D, always there)
@@ -39,7 +39,7 @@ static bool adds_term(const drift_frame_state *f, drift_effect effect)
 
 drift_result drift_hybrid_pass_compose(drift_frame_state *f)
 {
-    compose_job job = { .count = 0 };
+    compose_job job = { .count = 0, .lens = drift_coc_lens_make(&f->camera, f->params.height) };
     for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
         if (adds_term(f, (drift_effect)e)) {
             job.terms[job.count++] = e;

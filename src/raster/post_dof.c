@@ -21,20 +21,28 @@
 // drift_camera_ray aims every lens ray at the pinhole ray's point at view depth F, so two
 // lens points 2A apart see a point at depth z through film points 2 A |z - F| / z scene
 // units apart on the focus plane; the focus plane spans 2 F tan(fov_y / 2) over H pixels.
-float drift_coc_radius_pixels(const drift_camera *camera, int32_t image_height, float z)
+drift_coc_lens drift_coc_lens_make(const drift_camera *camera, int32_t image_height)
 {
-    if (!camera || !(camera->aperture_radius > 0.0f) || !(z > 0.0f) || image_height <= 0) {
-        return 0.0f;
+    drift_coc_lens none = { 0 };
+    if (!camera || !(camera->aperture_radius > 0.0f) || image_height <= 0) {
+        return none;
     }
     float focus = camera->focus_distance > 0.0f
                       ? camera->focus_distance
                       : drift_vec3_length(drift_vec3_sub(camera->target, camera->position));
     float tan_half = tanf(0.5f * camera->fov_y);
     if (!(focus > 0.0f) || !(tan_half > 0.0f)) {
-        return 0.0f;
+        return none;
     }
-    float pixels_per_unit = (float)image_height / (2.0f * focus * tan_half);
-    return camera->aperture_radius * fabsf(z - focus) / z * pixels_per_unit;
+    return (drift_coc_lens){ .aperture = camera->aperture_radius,
+                             .focus = focus,
+                             .pixels_per_unit = (float)image_height / (2.0f * focus * tan_half) };
+}
+
+float drift_coc_radius_pixels(const drift_camera *camera, int32_t image_height, float z)
+{
+    drift_coc_lens lens = drift_coc_lens_make(camera, image_height);
+    return drift_coc_lens_radius(&lens, z);
 }
 
 // --- GATHER ---
