@@ -1,8 +1,7 @@
 // drift ism (include/drift/ism.h): the object, the per-frame passes, interleaved gathering,
 // the geometry-aware blur and the near-field compensation.
-#include "ism/ism_internal.h"
-
 #include "core/vectorise.h"
+#include "ism/ism_internal.h"
 
 #include <math.h>
 #include <string.h>
@@ -362,7 +361,6 @@ static void maps_range(size_t begin, size_t end, int thread, void *user)
 
 // --- GATHERING ---
 
-
 // A gather job's receivers: one interleaving subset's pixels in a band of rows. Each map is
 // read by all the receivers of a job, VPL after VPL, so the fewer the jobs the fewer times a
 // map comes into the cache: on the Breakfast Room (640x480, 417 maps of 256^2) gathering in
@@ -420,7 +418,7 @@ static vpl_lobe vpl_lobe_of(const drift_vpl *v)
 
 // cos^m of the angle between the lobe and the direction -a / |a| to the receiver.
 static inline DRIFT_ALWAYS_INLINE float lobe_power(const vpl_lobe *l, float ax, float ay, float az,
-                                                float inv)
+                                                   float inv)
 {
     float c = -(l->x * ax + l->y * ay + l->z * az) * inv;
     c = c > 0.0f ? c : 0.0f;
@@ -499,12 +497,12 @@ gather_vpl_ism_levels(const drift_vpl *v, const drift_frame *f, const float *res
 
 // One copy of the loop per pyramid depth and lobe, each without a branch on them (so that it
 // vectorises).
-#define GATHER_ISM_LEVELS(L, G, NAME)                                                             \
+#define GATHER_ISM_LEVELS(L, G, NAME)                                                              \
     DRIFT_AVX2_CLONES static void NAME(const drift_vpl *v, const drift_frame *f, const float *map, \
-                                      const gather_consts *c, receivers *rs)                      \
-    {                                                                                             \
-        gather_vpl_ism_levels(v, f, map, c, rs->count, rs->px, rs->py, rs->pz, rs->nx, rs->ny,    \
-                              rs->nz, rs->er, rs->eg, rs->eb, L, G);                              \
+                                       const gather_consts *c, receivers *rs)                      \
+    {                                                                                              \
+        gather_vpl_ism_levels(v, f, map, c, rs->count, rs->px, rs->py, rs->pz, rs->nx, rs->ny,     \
+                              rs->nz, rs->er, rs->eg, rs->eb, L, G);                               \
     }
 GATHER_ISM_LEVELS(0, false, gather_vpl_ism0)
 GATHER_ISM_LEVELS(1, false, gather_vpl_ism1)
@@ -788,10 +786,10 @@ static void blur_copy_row(const drift_ism *ism, const drift_gbuffer *gb, bool ne
 // Adds the pixels of row q at offset dx that pass the centres' tests (row c) to the sums of
 // centres x0..x1-1.
 DRIFT_AVX2_CLONES static void blur_accumulate(const blur_row *c, const blur_row *q, int32_t x0,
-                                             int32_t x1, int32_t dx, float blur_normal,
-                                             float blur_plane, float *restrict sr,
-                                             float *restrict sg, float *restrict sb,
-                                             float *restrict weight)
+                                              int32_t x1, int32_t dx, float blur_normal,
+                                              float blur_plane, float *restrict sr,
+                                              float *restrict sg, float *restrict sb,
+                                              float *restrict weight)
 {
     const float *restrict cpx = c->px, *restrict cpy = c->py, *restrict cpz = c->pz;
     const float *restrict cnx = c->nx, *restrict cny = c->ny, *restrict cnz = c->nz;
