@@ -1,7 +1,7 @@
 // One imperfect shadow map: paraboloid point splatting with a z-test, and pull-push hole
 // filling (Ritschel et al. 2008, §5.2.2; docs/ism.md, "Maps").
-#include "drift/accel.h"
 #include "core/vectorise.h"
+#include "drift/accel.h"
 #include "ism/ism_internal.h"
 
 #include <math.h>
@@ -15,8 +15,8 @@
 // Static: clang 14 emits no plain symbol for an external multi-versioned function (the
 // fuzz build's link failed), so the clones stay inside this file behind drift__ism_splat.
 DRIFT_AVX2_CLONES static void splat_points(float *depth, const drift__ism_splat_desc *desc,
-                                          drift_vec3 origin, const drift_frame *frame,
-                                          const drift_vec3 *positions, uint32_t count)
+                                           drift_vec3 origin, const drift_frame *frame,
+                                           const drift_vec3 *positions, uint32_t count)
 {
     int32_t n = desc->n;
     for (int32_t i = 0; i < n * n; ++i) {
@@ -110,7 +110,7 @@ static void disc_span(int32_t n, int32_t y, int32_t *lo, int32_t *hi)
 // (an empty child is INFINITY), and `members` counts them. Children past an odd edge read as
 // empty: row `inf_row` (fs floats of INFINITY) stands for the missing last row.
 DRIFT_AVX2_CLONES static void pull_level(const float *fine, int32_t fs, float *coarse,
-                                        float *members, int32_t cs, float t, const float *inf_row)
+                                         float *members, int32_t cs, float t, const float *inf_row)
 {
     int32_t pairs = fs / 2;
     for (int32_t y = 0; y < cs; ++y) {

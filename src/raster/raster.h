@@ -261,12 +261,15 @@ drift_vec3 drift_cube_texel_direction(int32_t face_size, int face, int32_t i, in
 // (aperture radius A, focus distance F, image height H): A |z - F| / z scaled by the
 // pixels per scene unit on the focus plane, H / (2 F tan(fov_y / 2)). 0 for a pinhole.
 float drift_coc_radius_pixels(const drift_camera *camera, int32_t image_height, float z);
+
 // The same made once for a frame (its tanf was a per-pixel call of the composition):
 // drift_coc_lens_radius(&lens, z) == drift_coc_radius_pixels(camera, image_height, z) for z > 0.
 typedef struct drift_coc_lens {
     float aperture, focus, pixels_per_unit; // aperture 0: a pinhole, every radius 0
 } drift_coc_lens;
+
 drift_coc_lens drift_coc_lens_make(const drift_camera *camera, int32_t image_height);
+
 static inline float drift_coc_lens_radius(const drift_coc_lens *lens, float z)
 {
     return lens->aperture > 0.0f && z > 0.0f
