@@ -50,7 +50,8 @@ static int clip_to_hemisphere(drift_vec3 p, drift_vec3 n, const drift_vec3 *in, 
 
 // acos to ~2 ulp, inline (Cephes' acosf: asin's minimax polynomial on [0, 1/2], the half-angle
 // identity above it): the libm call cannot overlap a polygon's edges, and was ~5% of a frame.
-static inline float acos_inline(float x)
+// Both branches are computed and one selected, so that the polygon rows' loop vectorises.
+static inline DRIFT_ALWAYS_INLINE float acos_inline(float x)
 {
     float a = fabsf(x);
     bool half = a > 0.5f;
@@ -61,10 +62,9 @@ static inline float acos_inline(float x)
                   z +
               1.6666752422e-1f;
     float asin_s = s + s * z * p;
-    if (half) {
-        return x > 0.0f ? 2.0f * asin_s : DRIFT_PI - 2.0f * asin_s;
-    }
-    return 0.5f * DRIFT_PI - (x > 0.0f ? asin_s : -asin_s);
+    float above = x > 0.0f ? 2.0f * asin_s : DRIFT_PI - 2.0f * asin_s;
+    float below = 0.5f * DRIFT_PI - (x > 0.0f ? asin_s : -asin_s);
+    return half ? above : below;
 }
 
 // Irradiance at p (normal n) from a polygon of unit radiance: Lambert's formula,
@@ -187,23 +187,6 @@ static drift_vec3 polygon_diffuse(const drift_scene *scene, const drift_raster_l
 // same values. A receiver whose horizon the polygon straddles needs the clip, and takes the
 // scalar polygon_irradiance afterwards.
 
-// acos_inline with both branches computed and one selected.
-static inline DRIFT_ALWAYS_INLINE float acos_select(float x)
-{
-    float a = fabsf(x);
-    bool half = a > 0.5f;
-    float s = half ? sqrtf(0.5f * (1.0f - a)) : a;
-    float z = s * s;
-    float p = (((4.2163199048e-2f * z + 2.4181311049e-2f) * z + 4.5470025998e-2f) * z +
-               7.4953002686e-2f) *
-                  z +
-              1.6666752422e-1f;
-    float asin_s = s + s * z * p;
-    float above = x > 0.0f ? 2.0f * asin_s : DRIFT_PI - 2.0f * asin_s;
-    float below = 0.5f * DRIFT_PI - (x > 0.0f ? asin_s : -asin_s);
-    return half ? above : below;
-}
-
 // E of a unit-radiance polygon of M corners (v, its emitting normal en) at receivers i: e[i],
 // 0 behind its emitting side or below the horizon; straddles[i] = 1 where the horizon cuts it
 // (e[i] is then to be computed with the clip).
@@ -236,7 +219,7 @@ polygon_irradiance_rows(const float (*v)[3], const int m, drift_vec3 en, int32_t
             float length = sqrtf(cx * cx + cy * cy + cz * cz);
             float cosab = dx[k] * dx[k1] + dy[k] * dy[k1] + dz[k] * dz[k1];
             cosab = cosab < -1.0f ? -1.0f : (cosab > 1.0f ? 1.0f : cosab);
-            float t = acos_select(cosab) * (cx * nx[i] + cy * ny[i] + cz * nz[i]) / length;
+            float t = acos_inline(cosab) * (cx * nx[i] + cy * ny[i] + cz * nz[i]) / length;
             sum += length > 1e-12f ? t : 0.0f;
         }
         float side = (px[i] - v[0][0]) * en.x + (py[i] - v[0][1]) * en.y + (pz[i] - v[0][2]) * en.z;

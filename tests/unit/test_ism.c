@@ -636,6 +636,31 @@ static void test_gather_equals_the_formula(void **state)
     test_rig_destroy(&r);
 }
 
+// Whether G-buffer pixel (u, v) has a surface and passes the blur's tests against pixel (x, y):
+// its normal within blur_normal of (x, y)'s, its position within blur_plane of (x, y)'s plane.
+static bool passes_blur_tests(const drift_gbuffer *gb, const drift_ism_params *p, int32_t x,
+                              int32_t y, int32_t u, int32_t v)
+{
+    if (u < 0 || v < 0 || u >= gb->width || v >= gb->height ||
+        drift_image_pixel(&gb->material_id, u, v)[0] < 0.0f) {
+        return false;
+    }
+    drift_vec3 c = drift_image_get3(&gb->position, x, y);
+    drift_vec3 n = drift_image_get3(&gb->normal, x, y);
+    drift_vec3 q = drift_image_get3(&gb->position, u, v);
+    float plane = fabsf(drift_vec3_dot(n, drift_vec3_sub(q, c)));
+    return drift_vec3_dot(n, drift_image_get3(&gb->normal, u, v)) >= p->blur_normal &&
+           plane <= p->blur_plane;
+}
+
+// The largest channel difference of `got` from `expected`, relative to expected's luminance.
+static double relative_difference(drift_vec3 got, drift_vec3 expected)
+{
+    double scale = 1e-6 + (double)drift_luminance(expected);
+    double d = fmax(fabs((double)(got.x - expected.x)), fabs((double)(got.y - expected.y)));
+    return fmax(d, fabs((double)(got.z - expected.z))) / scale;
+}
+
 // The blur is the documented window average: at every pixel, I = kd / pi times the mean of the
 // irradiance ("ism.irradiance") over the B x B window of pixels with a surface whose normal is
 // within blur_normal and whose position within blur_plane of the centre's plane, recomputed here
@@ -657,20 +682,11 @@ static void test_blur_is_the_window_average(void **state)
             for (int32_t x = 0; x < gb->width; ++x) {
                 drift_vec3 expected = drift_vec3_splat(0.0f);
                 if (drift_image_pixel(&gb->material_id, x, y)[0] >= 0.0f) {
-                    drift_vec3 c = drift_image_get3(&gb->position, x, y);
-                    drift_vec3 n = drift_image_get3(&gb->normal, x, y);
                     drift_vec3 sum = drift_vec3_splat(0.0f);
                     float weight = 0.0f;
                     for (int32_t v = y - b / 2; v < y - b / 2 + b; ++v) {
                         for (int32_t u = x - b / 2; u < x - b / 2 + b; ++u) {
-                            if (u < 0 || v < 0 || u >= gb->width || v >= gb->height ||
-                                drift_image_pixel(&gb->material_id, u, v)[0] < 0.0f) {
-                                continue;
-                            }
-                            drift_vec3 q = drift_image_get3(&gb->position, u, v);
-                            drift_vec3 qn = drift_image_get3(&gb->normal, u, v);
-                            float plane = fabsf(drift_vec3_dot(n, drift_vec3_sub(q, c)));
-                            if (drift_vec3_dot(n, qn) >= p.blur_normal && plane <= p.blur_plane) {
+                            if (passes_blur_tests(gb, &p, x, y, u, v)) {
                                 sum = drift_vec3_add(sum, drift_image_get3(e, u, v));
                                 weight += 1.0f;
                             }
@@ -681,11 +697,7 @@ static void test_blur_is_the_window_average(void **state)
                         drift_vec3_scale(drift_vec3_mul(drift_image_get3(&gb->albedo, x, y), sum),
                                          DRIFT_INV_PI / weight);
                 }
-                drift_vec3 got = drift_image_get3(out, x, y);
-                double scale = 1e-6 + (double)drift_luminance(expected);
-                worst = fmax(worst, fabs((double)(got.x - expected.x)) / scale);
-                worst = fmax(worst, fabs((double)(got.y - expected.y)) / scale);
-                worst = fmax(worst, fabs((double)(got.z - expected.z)) / scale);
+                worst = fmax(worst, relative_difference(drift_image_get3(out, x, y), expected));
             }
         }
         printf("block %d: worst relative difference %.2e\n", b, worst);
@@ -725,8 +737,6 @@ static void test_gather_scale_upsamples_by_the_blur_tests(void **state)
         for (int32_t x = 0; x < gb->width; ++x) {
             drift_vec3 expected = drift_vec3_splat(0.0f);
             if (drift_image_pixel(&gb->material_id, x, y)[0] >= 0.0f) {
-                drift_vec3 c = drift_image_get3(&gb->position, x, y);
-                drift_vec3 n = drift_image_get3(&gb->normal, x, y);
                 float fx = (float)(x - 1) / 2.0f, fy = (float)(y - 1) / 2.0f;
                 int32_t i0 = (int32_t)floorf(fx), j0 = (int32_t)floorf(fy);
                 drift_vec3 sum = drift_vec3_splat(0.0f);
@@ -741,13 +751,7 @@ static void test_gather_scale_upsamples_by_the_blur_tests(void **state)
                             }
                             int32_t u = 2 * i + 1 < gb->width ? 2 * i + 1 : gb->width - 1;
                             int32_t v = 2 * j + 1 < gb->height ? 2 * j + 1 : gb->height - 1;
-                            if (drift_image_pixel(&gb->material_id, u, v)[0] < 0.0f) {
-                                continue;
-                            }
-                            drift_vec3 q = drift_image_get3(&gb->position, u, v);
-                            drift_vec3 qn = drift_image_get3(&gb->normal, u, v);
-                            float plane = fabsf(drift_vec3_dot(n, drift_vec3_sub(q, c)));
-                            if (drift_vec3_dot(n, qn) < p.blur_normal || plane > p.blur_plane) {
+                            if (!passes_blur_tests(gb, &p, x, y, u, v)) {
                                 continue;
                             }
                             float w = 1.0f;
@@ -770,11 +774,7 @@ static void test_gather_scale_upsamples_by_the_blur_tests(void **state)
                 expected = drift_vec3_scale(
                     drift_vec3_mul(drift_image_get3(&gb->albedo, x, y), irradiance), DRIFT_INV_PI);
             }
-            drift_vec3 got = drift_image_get3(out, x, y);
-            double scale = 1e-6 + (double)drift_luminance(expected);
-            worst = fmax(worst, fabs((double)(got.x - expected.x)) / scale);
-            worst = fmax(worst, fabs((double)(got.y - expected.y)) / scale);
-            worst = fmax(worst, fabs((double)(got.z - expected.z)) / scale);
+            worst = fmax(worst, relative_difference(drift_image_get3(out, x, y), expected));
         }
     }
     printf("scale 2: worst relative difference %.2e, %llu pixels from the ring, %llu fallback "
