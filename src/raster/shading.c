@@ -224,7 +224,7 @@ polygon_irradiance_rows(const float (*v)[3], const int m, drift_vec3 en, int32_t
         }
         float side = (px[i] - v[0][0]) * en.x + (py[i] - v[0][1]) * en.y + (pz[i] - v[0][2]) * en.z;
         bool lit = side > 0.0f;
-        e[i] = lit & above ? 0.5f * fabsf(sum) : 0.0f;
+        e[i] = (lit & above) ? 0.5f * fabsf(sum) : 0.0f;
         straddles[i] = lit & !above & !below;
     }
 }

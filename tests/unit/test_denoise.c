@@ -66,7 +66,7 @@ static double variance(const drift_image *img, int32_t x0, int32_t x1)
     for (int32_t y = 0; y < img->height; ++y) {
         for (int32_t x = x0; x < x1; ++x) {
             for (int c = 0; c < 3; ++c) {
-                double v = drift_image_pixel(img, x, y)[c];
+                double v = (double)drift_image_pixel(img, x, y)[c];
                 sum += v;
                 sum2 += v * v;
                 ++n;
