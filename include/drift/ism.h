@@ -84,8 +84,9 @@ typedef enum drift_ism_visibility {
 //   gather_scale      = 0 -> 1: every G-buffer pixel gathers; 2 (or 4): one pixel in 2 x 2
 //                       (4 x 4) gathers, blurs and compensates at that lower resolution, and
 //                       the irradiance is upsampled to every pixel through the blur's tests
-//                       (a pixel none of its four nearest gathering pixels passes gathers
-//                       every VPL itself); the albedo is applied at full resolution
+//                       (its four nearest gathering pixels, else the twelve around them; a
+//                       pixel none of those passes gathers every VPL itself); the albedo is
+//                       applied at full resolution
 //   blur_normal       = 0 -> 0.9: smallest cosine between two normals the blur mixes
 //   blur_plane        = 0 -> 0.01 x scene diagonal: largest distance to the centre's plane
 //   vpl_importance    = false: true accepts each candidate VPL with p = min(1, c / target), c
