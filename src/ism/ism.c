@@ -24,7 +24,6 @@ struct drift_ism {
     float *disc_counts;    // drift__ism_disc_counts of the lazy pyramid's top level
     float *scratch;        // one pull-push pyramid per thread
     int32_t width, height; // the gathering resolution (the G-buffer's / gather_scale)
-    int32_t full_width, full_height; // the G-buffer's, of `indirect`
     drift_image irradiance, indirect, vpl_plane, tile, near_field, near_spread;
     // gather_scale > 1: the G-buffer and the direct image at one pixel in scale^2, and the
     // blurred irradiance there (what is upsampled).
@@ -382,7 +381,7 @@ typedef struct gather_job {
     drift_ism *ism;
     const drift_gbuffer *gb;
     uint64_t rays[64];   // per thread
-    float *buffers;      // per thread: 12 arrays of `capacity` floats and 2 of int32
+    float *buffers;      // per thread: receivers_in of `capacity`
     int32_t capacity;    // receivers a job can hold
     int32_t subset_rows; // rows of one subset in a band (a band is subset_rows * B rows)
     int32_t bands;
@@ -573,10 +572,11 @@ static void gather_vpl_rays(const drift_ism *ism, const drift_vpl *v, receivers 
     }
 }
 
-static receivers job_receivers(const gather_job *job, int thread)
+// Receivers in a buffer of RECEIVER_ARRAYS arrays of `cap` entries (floats, the last two int32).
+#define RECEIVER_ARRAYS 14
+
+static receivers receivers_in(float *b, size_t cap)
 {
-    size_t cap = (size_t)job->capacity;
-    float *b = job->buffers + (size_t)thread * cap * 14;
     receivers rs = { .px = b,
                      .py = b + cap,
                      .pz = b + 2 * cap,
@@ -592,6 +592,12 @@ static receivers job_receivers(const gather_job *job, int thread)
                      .x = (int32_t *)(b + 12 * cap),
                      .y = (int32_t *)(b + 13 * cap) };
     return rs;
+}
+
+static receivers job_receivers(const gather_job *job, int thread)
+{
+    size_t cap = (size_t)job->capacity;
+    return receivers_in(job->buffers + (size_t)thread * cap * RECEIVER_ARRAYS, cap);
 }
 
 static gather_consts gather_consts_of(const drift_ism *ism)
@@ -1110,7 +1116,7 @@ typedef struct upsample_job {
     const uint32_t *fallback_pixels;
     size_t fallback_count;
     size_t job_pixels;       // receivers of one fallback job
-    float *receiver_buffers; // per thread: 12 arrays of job_pixels floats and 2 of int32
+    float *receiver_buffers; // per thread: receivers_in of job_pixels
 } upsample_job;
 
 static void upsample_rows(size_t begin, size_t end, int thread, void *user)
@@ -1185,25 +1191,11 @@ static void fallback_jobs(size_t begin, size_t end, int thread, void *user)
     const drift_gbuffer *gb = job->gb;
     gather_consts c = gather_consts_of(ism);
     size_t cap = job->job_pixels;
-    float *b = job->receiver_buffers + (size_t)thread * cap * 14;
+    float *b = job->receiver_buffers + (size_t)thread * cap * RECEIVER_ARRAYS;
     for (size_t id = begin; id < end; ++id) {
         size_t first = id * cap;
         size_t last = first + cap < job->fallback_count ? first + cap : job->fallback_count;
-        receivers rs = { b,
-                         b + cap,
-                         b + 2 * cap,
-                         b + 3 * cap,
-                         b + 4 * cap,
-                         b + 5 * cap,
-                         b + 6 * cap,
-                         b + 7 * cap,
-                         b + 8 * cap,
-                         b + 9 * cap,
-                         b + 10 * cap,
-                         b + 11 * cap,
-                         (int32_t *)(b + 12 * cap),
-                         (int32_t *)(b + 13 * cap),
-                         0 };
+        receivers rs = receivers_in(b, cap);
         for (size_t k = first; k < last; ++k) {
             int32_t i = rs.count++;
             int32_t x = (int32_t)(job->fallback_pixels[k] % (uint32_t)gb->width);
@@ -1248,7 +1240,8 @@ static drift_result upsample(drift_ism *ism, const drift_gbuffer *gb, drift_ism_
         size_t threads = (size_t)drift_context_thread_count(ism->ctx);
         job.job_pixels = (fallbacks + 2 * threads - 1) / (2 * threads);
         uint32_t *pixels = drift_alloc(ism->ctx, fallbacks * sizeof *pixels);
-        job.receiver_buffers = drift_alloc(ism->ctx, threads * job.job_pixels * 14 * sizeof(float));
+        job.receiver_buffers =
+            drift_alloc(ism->ctx, threads * job.job_pixels * RECEIVER_ARRAYS * sizeof(float));
         if (pixels && job.receiver_buffers) {
             for (size_t i = 0, k = 0; i < count; ++i) {
                 if (job.fallback[i]) {
@@ -1284,15 +1277,13 @@ static int32_t gathering_side(const drift_ism *ism, int32_t full)
 
 static drift_result ensure_planes(drift_ism *ism, int32_t fw, int32_t fh)
 {
-    if (ism->full_width == fw && ism->full_height == fh && ism->indirect.pixels) {
+    if (ism->indirect.pixels && ism->indirect.width == fw && ism->indirect.height == fh) {
         return DRIFT_OK;
     }
     destroy_planes(ism);
     int32_t w = gathering_side(ism, fw), h = gathering_side(ism, fh);
     ism->width = w;
     ism->height = h;
-    ism->full_width = fw;
-    ism->full_height = fh;
     int32_t n = ism->params.map_size;
     bool coarse = ism->params.gather_scale > 1;
     drift_gbuffer *c = &ism->coarse;
@@ -1316,7 +1307,7 @@ static drift_result ensure_planes(drift_ism *ism, int32_t fw, int32_t fh)
         drift_image_create(ism->ctx, w, h, 3, &ism->near_spread) != DRIFT_OK ||
         drift_image_create(ism->ctx, n, n, 1, &ism->tile) != DRIFT_OK) {
         destroy_planes(ism);
-        ism->width = ism->height = ism->full_width = ism->full_height = 0;
+        ism->width = ism->height = 0;
         return DRIFT_ERR_OUT_OF_MEMORY;
     }
     return DRIFT_OK;
@@ -1493,7 +1484,7 @@ drift_result drift_ism_render(drift_ism *ism, const drift_gbuffer *gbuffer,
     gj.bands = (rows + gj.subset_rows - 1) / gj.subset_rows;
     gj.capacity = gj.subset_rows * cols;
     gj.buffers = drift_alloc(ism->ctx, (size_t)drift_context_thread_count(ism->ctx) *
-                                           (size_t)gj.capacity * 14 * sizeof(float));
+                                           (size_t)gj.capacity * RECEIVER_ARRAYS * sizeof(float));
     if (!gj.buffers) {
         return DRIFT_ERR_OUT_OF_MEMORY;
     }
