@@ -27,6 +27,10 @@
 // without a variance estimate (SVGF's temporal part), a looser colour weight lets the
 // emitter bleed into the ceiling (the path tracer's albedo AOV does not tell them apart).
 //
+// With small_kernel each pass takes the 3x3 linear B-spline (1/4, 1/2, 1/4) instead: 9 taps,
+// not 25, for a footprint of 2^(n+1) - 1 pixels after n passes (the hybrid frame's filter of
+// the environment light, drift_hybrid_params.environment_filter).
+//
 // Every output pixel is a gather over the previous pass alone, so the result is bit-identical
 // for any thread count. A constant image (with constant guides) comes back unchanged up to
 // float rounding.
@@ -53,11 +57,11 @@ typedef struct drift_denoise_params {
     int32_t iterations; // 0 -> 5 (kernel footprint 2^(n+1)+1 pixels); at most 10
     float sigma_color;  // 0 -> 1: relative colour distance, halved in variance each pass
     float sigma_normal; // 0 -> 128: exponent of the normal dot product
-    float sigma_depth;
-    float sigma_albedo; // 0 -> 0.1: albedo difference (keeps emitters and texture edges)  // 0 ->
-                        // 0.1: relative depth difference per tap step
+    float sigma_depth;  // 0 -> 0.1: relative depth difference per tap step
+    float sigma_albedo; // 0 -> 0.1: albedo difference (keeps emitters and texture edges)
     bool no_demodulate; // true: filter the colour as it is even when albedo is given
     bool disable_color; // true: no colour weight (a guide-only cross-bilateral filter)
+    bool small_kernel;  // true: the 3x3 kernel (1/4, 1/2, 1/4): 9 taps a pass, not 25
 } drift_denoise_params;
 
 drift_denoise_params drift_denoise_params_resolve(const drift_denoise_params *params);

@@ -1,6 +1,7 @@
 // The edge-avoiding a-trous filter (include/drift/denoise.h): a constant image is a fixed
 // point, i.i.d. noise on a flat image loses most of its variance, a step edge in the guides is
-// kept, and the output does not depend on the thread count.
+// kept, one pass is the header's formula evaluated directly (either kernel), and the output
+// does not depend on the thread count.
 #include "drift/denoise.h"
 #include "drift/image.h"
 #include "drift_test.h"
@@ -219,6 +220,141 @@ static void test_denoise_bit_identical_for_any_thread_count(void **state)
     }
 }
 
+// One pass of the filter written straight from drift/denoise.h's formulas, in double
+// precision and with libm's exp, at pixel (x, y): the vectorised filter must agree with it.
+static void reference_pass(const drift_image *color, const guides *g, int radius,
+                           double sigma_color, int32_t x, int32_t y, double out[3])
+{
+    static const double b3[5] = { 1.0 / 16, 1.0 / 4, 3.0 / 8, 1.0 / 4, 1.0 / 16 };
+    static const double b1[3] = { 1.0 / 4, 1.0 / 2, 1.0 / 4 };
+    const double *kernel = radius == 1 ? b1 : b3;
+    // Demodulated colour (the albedo guide is above the 1e-3 floor everywhere here).
+#define DEMOD(px, py, c) \
+    ((double)drift_image_pixel(color, px, py)[c] / (double)drift_image_pixel(&g->albedo, px, py)[c])
+#define LUM(px, py) \
+    fabs(0.2126 * DEMOD(px, py, 0) + 0.7152 * DEMOD(px, py, 1) + 0.0722 * DEMOD(px, py, 2))
+    double sum[3] = { 0, 0, 0 }, wsum = 0;
+    const float *np = drift_image_pixel(&g->normal, x, y),
+                *ap = drift_image_pixel(&g->albedo, x, y);
+    double zp = drift_image_pixel(&g->depth, x, y)[0];
+    for (int dy = -radius; dy <= radius; ++dy) {
+        for (int dx = -radius; dx <= radius; ++dx) {
+            int32_t qx = x + dx, qy = y + dy;
+            if (qx < 0 || qy < 0 || qx >= W || qy >= H) {
+                continue;
+            }
+            const float *nq = drift_image_pixel(&g->normal, qx, qy);
+            const float *aq = drift_image_pixel(&g->albedo, qx, qy);
+            double zq = drift_image_pixel(&g->depth, qx, qy)[0];
+            double dot = (double)np[0] * (double)nq[0] + (double)np[1] * (double)nq[1] +
+                         (double)np[2] * (double)nq[2];
+            double e = fabs(zp - zq) / (0.1 * zp), da = 0, dc = 0;
+            for (int c = 0; c < 3; ++c) {
+                double d_albedo = (double)ap[c] - (double)aq[c];
+                da += d_albedo * d_albedo;
+                double d = DEMOD(x, y, c) - DEMOD(qx, qy, c);
+                dc += d * d;
+            }
+            double mean = 0.5 * (LUM(x, y) + LUM(qx, qy)) + 1e-2;
+            e += da / (0.1 * 0.1) + dc / (sigma_color * sigma_color * mean * mean);
+            double w = kernel[dx + radius] * kernel[dy + radius];
+            if (dx != 0 || dy != 0) {
+                w = e > 30.0 ? 0.0 : w * pow(fmax(dot, 0.0), 128.0) * exp(-e);
+            }
+            for (int c = 0; c < 3; ++c) {
+                sum[c] += w * DEMOD(qx, qy, c);
+            }
+            wsum += w;
+        }
+    }
+    for (int c = 0; c < 3; ++c) {
+        out[c] = sum[c] / wsum * (double)ap[c];
+    }
+#undef LUM
+#undef DEMOD
+}
+
+// Random colour over random guides (depth, albedo and a normal tilted up to ~10 degrees, so
+// that every weight is between 0 and 1): one pass of either kernel equals the formulas of
+// drift/denoise.h evaluated directly, to 1e-4 relative.
+static void test_denoise_one_pass_is_the_formula(void **state)
+{
+    (void)state;
+    drift_context *ctx = test_context(2, NULL);
+    drift_image color = make_noise(ctx, 5);
+    guides g = make_flat_guides(ctx);
+    for (int32_t y = 0; y < H; ++y) {
+        for (int32_t x = 0; x < W; ++x) {
+            uint32_t i = (uint32_t)(y * W + x) * 2654435761u;
+            float tx = 0.15f * (test_hash_unit(i ^ 1u) - 0.5f);
+            float ty = 0.15f * (test_hash_unit(i ^ 2u) - 0.5f);
+            float *n = drift_image_pixel(&g.normal, x, y);
+            float len = sqrtf(tx * tx + ty * ty + 1.0f);
+            n[0] = tx / len, n[1] = ty / len, n[2] = 1.0f / len;
+            for (int c = 0; c < 3; ++c) {
+                drift_image_pixel(&g.albedo, x, y)[c] = 0.4f + 0.1f * test_hash_unit(i ^ (3u + c));
+            }
+            drift_image_pixel(&g.depth, x, y)[0] = 3.0f + 0.1f * test_hash_unit(i ^ 7u);
+        }
+    }
+    for (int radius = 1; radius <= 2; ++radius) {
+        drift_image out;
+        drift_denoise_params params = { .iterations = 1,
+                                        .sigma_color = 4.0f,
+                                        .small_kernel = radius == 1 };
+        assert_int_equal(
+            drift_denoise_atrous(ctx, &color, &g.albedo, &g.normal, &g.depth, &params, &out),
+            DRIFT_OK);
+        double worst = 0.0, moved = 0.0;
+        for (int32_t y = 0; y < H; ++y) {
+            for (int32_t x = 0; x < W; ++x) {
+                double want[3];
+                reference_pass(&color, &g, radius, 4.0, x, y, want);
+                for (int c = 0; c < 3; ++c) {
+                    double got = drift_image_pixel(&out, x, y)[c];
+                    worst = fmax(worst, fabs(got - want[c]) / want[c]);
+                    moved = fmax(moved, fabs(want[c] - (double)drift_image_pixel(&color, x, y)[c]));
+                }
+            }
+        }
+        print_message("%dx%d kernel: worst relative difference from the formula %.3g (the "
+                      "filter moves pixels by up to %.3g)\n",
+                      2 * radius + 1, 2 * radius + 1, worst, moved);
+        assert_true(moved > 0.05); // the weights do mix
+        assert_true(worst < 1e-4);
+        drift_image_destroy(ctx, &out);
+    }
+    destroy_guides(ctx, &g);
+    drift_image_destroy(ctx, &color);
+    drift_context_destroy(ctx);
+}
+
+// The 3x3 kernel: a constant image stays, and noise on a flat image falls as with the 5x5.
+static void test_denoise_small_kernel_smooths(void **state)
+{
+    (void)state;
+    drift_context *ctx = test_context(2, NULL);
+    drift_image color = make_noise(ctx, 13), flat = make_fill(ctx, 3, 0.25f, 0.5f, 2.0f);
+    guides g = make_flat_guides(ctx);
+    drift_denoise_params params = { .iterations = 4, .small_kernel = true, .disable_color = true };
+    drift_image out;
+    assert_int_equal(
+        drift_denoise_atrous(ctx, &color, &g.albedo, &g.normal, &g.depth, &params, &out), DRIFT_OK);
+    double before = variance(&color, 0, W), after = variance(&out, 0, W);
+    print_message("3x3, 4 passes: noise variance %.3g -> %.3g (x%.1f)\n", before, after,
+                  before / after);
+    assert_true(after * 20.0 < before);
+    drift_image_destroy(ctx, &out);
+    assert_int_equal(
+        drift_denoise_atrous(ctx, &flat, &g.albedo, &g.normal, &g.depth, &params, &out), DRIFT_OK);
+    assert_true(fabsf(drift_image_pixel(&out, 9, 3)[1] - 0.5f) <= 1e-6f);
+    drift_image_destroy(ctx, &out);
+    destroy_guides(ctx, &g);
+    drift_image_destroy(ctx, &color);
+    drift_image_destroy(ctx, &flat);
+    drift_context_destroy(ctx);
+}
+
 static void test_denoise_rejects_bad_arguments(void **state)
 {
     (void)state;
@@ -246,6 +382,8 @@ int main(void)
         cmocka_unit_test(test_denoise_noise_variance_falls),
         cmocka_unit_test(test_denoise_guide_step_edge_stays_sharp),
         cmocka_unit_test(test_denoise_bit_identical_for_any_thread_count),
+        cmocka_unit_test(test_denoise_one_pass_is_the_formula),
+        cmocka_unit_test(test_denoise_small_kernel_smooths),
         cmocka_unit_test(test_denoise_rejects_bad_arguments),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
