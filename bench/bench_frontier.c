@@ -35,7 +35,7 @@
 
 typedef struct frontier_options {
     const char *scene_path, *csv_path, *svg_path, *cache_dir;
-    long size, threads, ref_spp, runs, max_spp, near_field_off_vpls, half_gather_vpls;
+    long size, threads, ref_spp, runs, max_spp, near_field_off_vpls, half_gather_vpls, env_filter;
     long budgets[MAX_BUDGETS], vpls[MAX_BUDGETS], aaf_spps[MAX_BUDGETS], aa[MAX_BUDGETS],
         sir[MAX_BUDGETS], light_samples[MAX_BUDGETS];
     int budget_count, vpl_count, aaf_spp_count, aa_count, sir_count, light_sample_count;
@@ -89,6 +89,10 @@ static const cli_option frontier_table[] = {
             "ism and ir rows of at least N VPLs also gather at one pixel in\n"
             "2 x 2 (--ism-gather-scale 2; default 256: the gather is then most\n"
             "of the indirect pass, docs/ism.md; 0 = never)"),
+    CLI_INT("--env-filter", "N", O, env_filter, 0, 10,
+            "on a scene with an environment, every hybrid row also with N\n"
+            "a-trous passes over the environment's direct light (named ef N;\n"
+            "--env-filter of drift render; default 4, 0 = never)"),
     CLI_INT("--size", "N", O, size, 4, 4096, "N x N pixels (default 400)"),
     CLI_INT("--threads", "T", O, threads, 0, 256, "worker threads (default 2)"),
     CLI_INT("--ref-spp", "N", O, ref_spp, 1, 1 << 20, "reference samples a pixel (default 512)"),
@@ -367,13 +371,14 @@ static drift_result hybrid_row(frontier_state *b, const char *name,
 
 // The hybrid combinations: shadows hard, pcss, isg, aaf x indirect none, ambient, ism and ir at
 // 16..1024 VPLs (up to --near-field-off-vpls also without the near-field compensation, from
-// --half-gather-vpls also gathering at one pixel in 2 x 2), aaf; AAF
-// rows at 1, 2 and 4 spp; each at every --light-samples count (8) and at --aa 1 and 4 anti-aliasing
-// passes; max depth 8. The other effects keep the technique that matches the reference: reflections
-// none on a scene without glossy or mirror materials (else isg: AAF's reflections scored only
-// ~0.006 lower FLIP on the glossy box at 11-15x the frame time, docs/frontier.md), depth of field
-// none for a pinhole camera (else post: reference would path-trace the whole frame through the
-// lens, replacing every other row's output), occlusion none, glare none.
+// --half-gather-vpls also gathering at one pixel in 2 x 2), aaf; AAF rows at 1, 2 and 4 spp;
+// each at every --light-samples count (8), on a scene with an environment without and with
+// --env-filter's passes over its direct light, and at --aa 1 and 4 anti-aliasing passes; max
+// depth 8. The other effects keep the technique that matches the reference: reflections none
+// on a scene without glossy or mirror materials (else isg: AAF's reflections scored only
+// ~0.006 lower FLIP on the glossy box at 11-15x the frame time, docs/frontier.md), depth of
+// field none for a pinhole camera (else post: reference would path-trace the whole frame
+// through the lens, replacing every other row's output), occlusion none, glare none.
 static drift_result hybrid_rows(frontier_state *b, double limit_ms)
 {
     static const char *const shadows[] = { "hard", "pcss", "isg", "aaf" };
@@ -393,7 +398,8 @@ static drift_result hybrid_rows(frontier_state *b, double limit_ms)
             size_t vpl_count = vpl ? (size_t)b->o->vpl_count : 1;
             size_t spp_count = aaf ? (size_t)b->o->aaf_spp_count : 1;
             size_t ls_count = (size_t)b->o->light_sample_count;
-            size_t variants = spp_count * ls_count * (size_t)b->o->aa_count;
+            size_t ef_count = b->o->env_filter > 0 && drift_scene_has_environment(b->scene) ? 2 : 1;
+            size_t variants = spp_count * ls_count * ef_count * (size_t)b->o->aa_count;
             for (size_t v = 0; v < vpl_count * 3 && r == DRIFT_OK; ++v) {
                 // v / 3 is the VPL count; v % 3 == 1 the same rows without the near field,
                 // v % 3 == 2 gathering at one pixel in 2 x 2.
@@ -404,14 +410,19 @@ static drift_result hybrid_rows(frontier_state *b, double limit_ms)
                     continue;
                 }
                 for (size_t k = 0; k < variants && r == DRIFT_OK; ++k) {
-                    long aa_passes = b->o->aa[k / (spp_count * ls_count)];
+                    // k: the AAF spp fastest, then the light samples, the environment
+                    // filter (off, on) and the anti-aliasing passes.
+                    long aa_passes = b->o->aa[k / (spp_count * ls_count * ef_count)];
                     long light_samples = b->o->light_samples[(k / spp_count) % ls_count];
+                    bool env_filter = (k / (spp_count * ls_count)) % ef_count == 1;
                     drift_hybrid_params p = { .width = (int32_t)b->o->size,
                                               .height = (int32_t)b->o->size,
                                               .max_depth = FRONTIER_DEPTH,
                                               .spp = aaf ? (uint32_t)spps[k % spp_count] : 1,
                                               .light_samples = (uint32_t)light_samples,
-                                              .aa = (uint32_t)aa_passes };
+                                              .aa = (uint32_t)aa_passes,
+                                              .environment_filter =
+                                                  env_filter ? (uint32_t)b->o->env_filter : 0 };
                     drift_hybrid_params_set_technique(
                         &p, DRIFT_EFFECT_SHADOWS,
                         technique_index(DRIFT_EFFECT_SHADOWS, shadows[s]));
@@ -446,6 +457,10 @@ static drift_result hybrid_rows(frontier_state *b, double limit_ms)
                     if (light_samples != DEFAULT_LIGHT_SAMPLES) {
                         len += snprintf(name + len, sizeof name - (size_t)len, " ls %ld",
                                         light_samples);
+                    }
+                    if (env_filter) {
+                        len += snprintf(name + len, sizeof name - (size_t)len, " ef %ld",
+                                        b->o->env_filter);
                     }
                     if (aa_passes > 1) {
                         snprintf(name + len, sizeof name - (size_t)len, " aa %ld", aa_passes);
@@ -756,7 +771,8 @@ int drift_bench_frontier(int argc, char **argv)
                            .sir = { 1, 4, 16 },
                            .sir_count = 3,
                            .near_field_off_vpls = 256,
-                           .half_gather_vpls = 256 };
+                           .half_gather_vpls = 256,
+                           .env_filter = 4 };
     int status = cli_parse(&frontier_command, argc, argv, &o, NULL);
     if (status != CLI_PARSED) {
         return cli_parse_exit(status);

@@ -368,6 +368,10 @@ static const cli_option render_table[] = {
                "on: a quarter of the environment's --light-samples shadow rays a\n"
                "pixel, interleaved over 2 x 2 pixels and gathered back over 3 x 3\n"
                "of the same surface (default off; docs/hybrid.md)"),
+    CLI_INT("--env-filter", "N", O, hybrid.environment_filter, 0, 10,
+            "N passes of the edge-avoiding a-trous filter over the\n"
+            "environment's direct light, guided by the G-buffer (default 0:\n"
+            "none; docs/hybrid.md)"),
     CLI_CHOICE("--contact-shadows", "off|on", O, hybrid.shadow_map.contact_shadows, "off|on",
                "on: --shadows pcf|pcss march each lit pixel's shadow-map bias\n"
                "toward the light in screen space (thesis §4.5; default off)"),

@@ -211,6 +211,12 @@ typedef struct drift_occlusion_settings {
 //                      rays; true: interleaved sampling (Keller and Heidrich 2001), each pixel
 //                      of a 2 x 2 block traces a quarter of one shared set, and a 3 x 3
 //                      tent gather over pixels of the same surface sums the set again
+//   environment_filter = 0: the environment's direct light as traced; N (at most 10):
+//                      N passes of the edge-avoiding a-trous filter (drift/denoise.h; its
+//                      3 x 3 kernel) over it, guided by the G-buffer's normal, depth and
+//                      albedo (the light is demodulated), with no colour weight: its noise is
+//                      visibility's, which the colour weight would keep. A footprint of
+//                      2^(N+1) - 1 pixels
 //   aa               = 0 -> 1: anti-aliasing passes. N > 1 renders the whole frame N times,
 //                      each pass with the camera's film shifted by a stratified sub-pixel
 //                      offset (the path tracer's box pixel filter) and its own seed, and
@@ -243,6 +249,7 @@ typedef struct drift_hybrid_params {
     int32_t max_depth;
     uint32_t light_samples;
     bool environment_interleave;
+    uint32_t environment_filter;
     uint32_t aa;
     bool has_ambient;
     drift_vec3 ambient;

@@ -103,6 +103,8 @@ static bool params_valid(const drift_context *ctx, const drift_hybrid_params *p)
         problem = "max_depth outside 1..1024";
     } else if (p->light_samples > 4096) {
         problem = "light samples over 4096";
+    } else if (p->environment_filter > 10) {
+        problem = "environment filter passes over 10";
     } else if (p->aa > 4096) {
         problem = "anti-aliasing passes over 4096";
     } else if (p->has_ambient && !drift_vec3_is_finite(p->ambient)) {
