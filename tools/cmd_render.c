@@ -294,7 +294,8 @@ static const cli_option render_table[] = {
             "are a frame with warm caches (default 1; first_frame_ms in\n"
             "--stats has the first)"),
     CLI_INT("--light-samples", "N", O, hybrid.light_samples, 1, 4096,
-            "samples per area light for unshadowed light (default 8)"),
+            "samples per area light for unshadowed light, and the environment's\n"
+            "shadow rays a pixel (default 2; docs/frontier.md#the-defaults)"),
     CLI_INT("--aa", "N", O, hybrid.aa, 1, 4096,
             "anti-aliasing: the whole frame N times, each through a\n"
             "stratified sub-pixel offset with its own seed, averaged (the\n"
@@ -370,8 +371,8 @@ static const cli_option render_table[] = {
                "of the same surface (default off; docs/hybrid.md)"),
     CLI_INT("--env-filter", "N", O, hybrid.environment_filter, 0, 10,
             "N passes of the edge-avoiding a-trous filter over the\n"
-            "environment's direct light, guided by the G-buffer (default 0:\n"
-            "none; docs/hybrid.md)"),
+            "environment's direct light, guided by the G-buffer (default 4;\n"
+            "0: none; docs/hybrid.md)"),
     CLI_CHOICE("--contact-shadows", "off|on", O, hybrid.shadow_map.contact_shadows, "off|on",
                "on: --shadows pcf|pcss march each lit pixel's shadow-map bias\n"
                "toward the light in screen space (thesis §4.5; default off)"),

@@ -78,6 +78,8 @@ drift_hybrid_params drift_hybrid_params_recommended(void)
     return (drift_hybrid_params){ .shadows = DRIFT_SHADOWS_HARD,
                                   .indirect = DRIFT_INDIRECT_ISM,
                                   .max_depth = 8,
+                                  .light_samples = 2,
+                                  .environment_filter = 4,
                                   .ism = { .vpls = 1024, .gather_scale = 2 } };
 }
 
