@@ -70,8 +70,9 @@ static drift_vec3 material_gloss(const drift_material *m)
     return drift_vec3_make(drift_gloss_theta_max(m), exponent, roughness);
 }
 
+// hit_surface: drift_scene_surface of the hit, made by the caller (unread for a miss).
 static void write_pixel(const gbuffer_job *job, int32_t x, int32_t y, const drift_ray *ray,
-                        const drift_hit *hit)
+                        const drift_hit *hit, const drift_surface *hit_surface)
 {
     const drift_scene *scene = job->scene;
     drift_gbuffer *g = job->gbuffer;
@@ -100,7 +101,7 @@ static void write_pixel(const gbuffer_job *job, int32_t x, int32_t y, const drif
         drift_image_pixel(&g->motion, x, y)[1] = 0.0f;
         return;
     }
-    *surface = drift_scene_surface(scene, ray, hit);
+    *surface = *hit_surface;
     drift_image_pixel(&g->depth, x, y)[0] =
         drift_vec3_dot(drift_vec3_sub(surface->position, ray->origin), job->camera.w);
     drift_image_set3(&g->position, x, y, surface->position);
@@ -139,6 +140,7 @@ static void render_tiles(size_t begin, size_t end, int thread_index, void *user)
     const drift_gbuffer *g = job->gbuffer;
     drift_ray rays[TILE * TILE];
     drift_hit hits[TILE * TILE];
+    drift_surface surfaces[TILE * TILE];
     for (size_t tile = begin; tile < end; ++tile) {
         int32_t x0 = (int32_t)(tile % (size_t)job->tiles_x) * TILE;
         int32_t y0 = (int32_t)(tile / (size_t)job->tiles_x) * TILE;
@@ -152,10 +154,16 @@ static void render_tiles(size_t begin, size_t end, int thread_index, void *user)
             }
         }
         drift_accel_intersect_coherent(job->accel, rays, hits, n);
+        // The surfaces first, then the planes: the vertex loads of a whole tile overlap.
+        for (uint32_t i = 0; i < n; ++i) {
+            if (hits[i].mesh != DRIFT_INVALID_INDEX || hits[i].light != DRIFT_INVALID_INDEX) {
+                surfaces[i] = drift_scene_surface(job->scene, &rays[i], &hits[i]);
+            }
+        }
         n = 0;
         for (int32_t y = y0; y < y1; ++y) {
             for (int32_t x = x0; x < x1; ++x, ++n) {
-                write_pixel(job, x, y, &rays[n], &hits[n]);
+                write_pixel(job, x, y, &rays[n], &hits[n], &surfaces[n]);
             }
         }
     }
