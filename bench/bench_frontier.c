@@ -91,8 +91,9 @@ static const cli_option frontier_table[] = {
             "of the indirect pass, docs/ism.md; 0 = never)"),
     CLI_INT("--env-filter", "N", O, env_filter, 0, 10,
             "on a scene with an environment, every hybrid row also with N\n"
-            "a-trous passes over the environment's direct light (named ef N;\n"
-            "--env-filter of drift render; default 4, 0 = never)"),
+            "a-trous passes over the environment's direct light, its shadow\n"
+            "rays at one pixel in 2 x 2 (named ef N; drift render's\n"
+            "--env-filter N --env-scale 2; default 4, 0 = never)"),
     CLI_INT("--size", "N", O, size, 4, 4096, "N x N pixels (default 400)"),
     CLI_INT("--threads", "T", O, threads, 0, 256, "worker threads (default 2)"),
     CLI_INT("--ref-spp", "N", O, ref_spp, 1, 1 << 20, "reference samples a pixel (default 512)"),
@@ -373,12 +374,13 @@ static drift_result hybrid_row(frontier_state *b, const char *name,
 // 16..1024 VPLs (up to --near-field-off-vpls also without the near-field compensation, from
 // --half-gather-vpls also gathering at one pixel in 2 x 2), aaf; AAF rows at 1, 2 and 4 spp;
 // each at every --light-samples count (8), on a scene with an environment without and with
-// --env-filter's passes over its direct light, and at --aa 1 and 4 anti-aliasing passes; max
-// depth 8. The other effects keep the technique that matches the reference: reflections none
-// on a scene without glossy or mirror materials (else isg: AAF's reflections scored only
-// ~0.006 lower FLIP on the glossy box at 11-15x the frame time, docs/frontier.md), depth of
-// field none for a pinhole camera (else post: reference would path-trace the whole frame
-// through the lens, replacing every other row's output), occlusion none, glare none.
+// --env-filter's passes over its direct light (and its rays at one pixel in 2 x 2), and at
+// --aa 1 and 4 anti-aliasing passes; max depth 8. The other effects keep the technique that
+// matches the reference: reflections none on a scene without glossy or mirror materials (else
+// isg: AAF's reflections scored only ~0.006 lower FLIP on the glossy box at 11-15x the frame
+// time, docs/frontier.md), depth of field none for a pinhole camera (else post: reference
+// would path-trace the whole frame through the lens, replacing every other row's output),
+// occlusion none, glare none.
 static drift_result hybrid_rows(frontier_state *b, double limit_ms)
 {
     static const char *const shadows[] = { "hard", "pcss", "isg", "aaf" };
@@ -422,7 +424,8 @@ static drift_result hybrid_rows(frontier_state *b, double limit_ms)
                                               .light_samples = (uint32_t)light_samples,
                                               .aa = (uint32_t)aa_passes,
                                               .environment_filter =
-                                                  env_filter ? (uint32_t)b->o->env_filter : 0 };
+                                                  env_filter ? (uint32_t)b->o->env_filter : 0,
+                                              .environment_scale = env_filter ? 2 : 1 };
                     drift_hybrid_params_set_technique(
                         &p, DRIFT_EFFECT_SHADOWS,
                         technique_index(DRIFT_EFFECT_SHADOWS, shadows[s]));

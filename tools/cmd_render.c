@@ -369,6 +369,10 @@ static const cli_option render_table[] = {
                "on: a quarter of the environment's --light-samples shadow rays a\n"
                "pixel, interleaved over 2 x 2 pixels and gathered back over 3 x 3\n"
                "of the same surface (default off; docs/hybrid.md)"),
+    CLI_INT("--env-scale", "N", O, hybrid.environment_scale, 1, 2,
+            "2: one pixel in 2 x 2 traces the environment's shadow rays, the\n"
+            "others take the traced ones on their surface (default 2; 1:\n"
+            "every pixel; docs/hybrid.md)"),
     CLI_INT("--env-filter", "N", O, hybrid.environment_filter, 0, 10,
             "N passes of the edge-avoiding a-trous filter over the\n"
             "environment's direct light, guided by the G-buffer (default 4;\n"

@@ -211,6 +211,10 @@ typedef struct drift_occlusion_settings {
 //                      rays; true: interleaved sampling (Keller and Heidrich 2001), each pixel
 //                      of a 2 x 2 block traces a quarter of one shared set, and a 3 x 3
 //                      tent gather over pixels of the same surface sums the set again
+//   environment_scale = 0 or 1: every pixel traces the environment's shadow rays; 2: one
+//                      pixel in 2 x 2 does, and the other three take the bilinear mix of
+//                      the traced ones on their surface (demodulated by the albedo), or
+//                      trace their own where none is (not with environment_interleave)
 //   environment_filter = 0: the environment's direct light as traced; N (at most 10):
 //                      N passes of the edge-avoiding a-trous filter (drift/denoise.h; its
 //                      3 x 3 kernel) over it, guided by the G-buffer's normal, depth and
@@ -250,6 +254,7 @@ typedef struct drift_hybrid_params {
     uint32_t light_samples;
     bool environment_interleave;
     uint32_t environment_filter;
+    uint32_t environment_scale;
     uint32_t aa;
     bool has_ambient;
     drift_vec3 ambient;
@@ -268,8 +273,9 @@ drift_hybrid_params drift_hybrid_params_resolve(const drift_hybrid_params *param
 // What `drift render --mode hybrid` and `drift view` start from: a combination of the
 // equal-time frontier within ~100 ms on the Cornell box, the glossy box, the plants and the
 // Breakfast Room at 400x400, 2 threads (docs/frontier.md): hard shadows, instant radiosity from
-// imperfect shadow maps (1024 VPLs, gathered at one pixel in 2 x 2), 2 light samples with the
-// environment filter's 4 passes, and max depth 8 (multiple bounces). A zeroed
+// imperfect shadow maps (1024 VPLs, gathered at one pixel in 2 x 2), 2 light samples, the
+// environment's shadow rays at one pixel in 2 x 2 and its filter's 4 passes, and max depth 8
+// (multiple bounces). A zeroed
 // drift_hybrid_params stays hard shadows, no indirect light, 8 light samples, max depth 2: the
 // library's and the tests' neutral frame.
 drift_hybrid_params drift_hybrid_params_recommended(void);

@@ -80,6 +80,7 @@ drift_hybrid_params drift_hybrid_params_recommended(void)
                                   .max_depth = 8,
                                   .light_samples = 2,
                                   .environment_filter = 4,
+                                  .environment_scale = 2,
                                   .ism = { .vpls = 1024, .gather_scale = 2 } };
 }
 
@@ -107,6 +108,10 @@ static bool params_valid(const drift_context *ctx, const drift_hybrid_params *p)
         problem = "light samples over 4096";
     } else if (p->environment_filter > 10) {
         problem = "environment filter passes over 10";
+    } else if (p->environment_scale > 2) {
+        problem = "environment scale not 1 or 2";
+    } else if (p->environment_scale == 2 && p->environment_interleave) {
+        problem = "environment scale 2 with interleaving";
     } else if (p->aa > 4096) {
         problem = "anti-aliasing passes over 4096";
     } else if (p->has_ambient && !drift_vec3_is_finite(p->ambient)) {

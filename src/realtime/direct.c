@@ -57,10 +57,15 @@ static void unshadowed_run(drift_frame_state *f, int32_t x0, int32_t n, int32_t 
             drift_image_set3(&f->light_buffers[l].unshadowed, x0 + i, y, u);
         }
     }
+    const bool sparse = f->params.environment_scale == 2 && drift_scene_has_environment(f->scene);
     for (int32_t i = 0; i < n; ++i) {
         int32_t x = x0 + i;
         if (s[i].material == DRIFT_INVALID_INDEX) {
             drift_image_set3(&f->environment_direct, x, y, zero);
+            continue;
+        }
+        if (sparse && ((x | y) & 1)) { // filled from the traced pixels (fill_sparse_pixel)
+            drift_image_set3(&f->environment_direct, x, y, drift_vec3_splat(-1.0f));
             continue;
         }
         // A row that renders the environment's diffuse light itself (occlusion) leaves D its
@@ -266,6 +271,71 @@ drift_result drift_realtime_build_shadow_maps(drift_frame_state *f)
     return r;
 }
 
+// One pixel in 2 x 2 traced the environment's shadow rays (--env-scale 2); the others take
+// the bilinear mix of the four traced pixels around them that lie on their surface (same
+// mesh, normals within 25 degrees, depth within 5%), divided by those pixels' albedo and
+// multiplied by their own: the visibility and irradiance carry over, the texture does not.
+// A pixel with no such neighbour (a silhouette, a thin leaf) traces its own rays.
+static float demodulating_albedo(const drift_gbuffer *g, int32_t x, int32_t y, int c)
+{
+    float a = drift_image_pixel(&g->albedo, x, y)[c];
+    return a < 1e-3f ? 1.0f : a;
+}
+
+static void fill_sparse_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays,
+                              void *user)
+{
+    (void)user;
+    float *out = drift_image_pixel(&f->environment_direct, x, y);
+    if (out[0] >= 0.0f) {
+        return; // traced, or no surface
+    }
+    const drift_gbuffer *g = &f->gbuffer;
+    size_t centre = pixel_index(f, x, y);
+    float depth = drift_image_pixel(&g->depth, x, y)[0];
+    int32_t bx = x & ~1, by = y & ~1;
+    float sum[3] = { 0.0f, 0.0f, 0.0f }, total = 0.0f;
+    for (int32_t k = 0; k < 4; ++k) {
+        int32_t u = bx + 2 * (k & 1), v = by + (k & 2);
+        if (u >= f->params.width || v >= f->params.height) {
+            continue;
+        }
+        size_t other = pixel_index(f, u, v);
+        if (g->surfaces[other].material == DRIFT_INVALID_INDEX ||
+            !drift_gbuffer_same_surface(g, centre, other) ||
+            fabsf(drift_image_pixel(&g->depth, u, v)[0] - depth) > 0.05f * depth) {
+            continue;
+        }
+        // Bilinear: a pixel halfway between two traced ones weighs each 1/2.
+        float w = ((x - bx) == 0 ? (k & 1 ? 0.0f : 1.0f) : 0.5f) *
+                  ((y - by) == 0 ? (k & 2 ? 0.0f : 1.0f) : 0.5f);
+        if (w == 0.0f) {
+            continue;
+        }
+        const float *e = drift_image_pixel(&f->environment_direct, u, v);
+        for (int c = 0; c < 3; ++c) {
+            sum[c] += w * e[c] / demodulating_albedo(g, u, v, c);
+        }
+        total += w;
+    }
+    if (total > 0.0f) {
+        for (int c = 0; c < 3; ++c) {
+            out[c] = sum[c] / total * demodulating_albedo(g, x, y, c);
+        }
+        return;
+    }
+    const drift_surface *s = &g->surfaces[centre];
+    drift_bsdf bsdf = drift_bsdf_make(f->scene, s);
+    if (f->environment_diffuse_elsewhere) {
+        bsdf.diffuse = drift_vec3_splat(0.0f);
+    }
+    drift_sampler sampler = drift_pass_sampler(f, DRIFT_STREAM_UNSHADOWED, x, y);
+    drift_vec3 env =
+        drift_raster_environment_direct(f->scene, f->accel, s, &bsdf, drift_pass_wo(f, x, y),
+                                        f->params.light_samples, &sampler, rays);
+    out[0] = env.x, out[1] = env.y, out[2] = env.z;
+}
+
 // The environment's direct light through the a-trous filter: its noise is the visibility of
 // a few shadow rays a pixel, smooth where the surface is, so the G-buffer guides it and no
 // colour weight keeps the noise itself. Demodulated by the albedo: texture stays sharp. The
@@ -312,6 +382,9 @@ drift_result drift_realtime_pass_unshadowed(drift_frame_state *f)
 {
     drift_pass_rows(f, DRIFT_PASS_UNSHADOWED, unshadowed_row, NULL);
     drift_result r = DRIFT_OK;
+    if (f->params.environment_scale == 2 && drift_scene_has_environment(f->scene)) {
+        drift_pass_pixels(f, DRIFT_PASS_UNSHADOWED, fill_sparse_pixel, NULL);
+    }
     if (f->params.environment_interleave && drift_scene_has_environment(f->scene)) {
         r = gather_interleaved(f);
     }

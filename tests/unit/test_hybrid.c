@@ -914,6 +914,62 @@ static void test_environment_filter_beats_two_rays(void **state)
     test_rig_destroy(&r);
 }
 
+// The environment's shadow rays at one pixel in 2 x 2 (4 a traced pixel) against 1 a pixel
+// everywhere, about the same rays: closer to the converged light (each filled pixel mixes up
+// to four 4-ray estimates), the mean kept, and a constant sky over the open floor still exact
+// (kd L) at every pixel, filled or traced. Scale 3, and scale 2 with interleaving, are refused.
+static void test_environment_scale_two_carries_the_light(void **state)
+{
+    (void)state;
+    test_rig r = sky_rig(4.0f, true);
+    drift_image truth = environment_plane(&r, &(drift_hybrid_params){ .light_samples = 1024 });
+    drift_image full = environment_plane(&r, &(drift_hybrid_params){ .light_samples = 1 });
+    uint64_t full_rays = drift_hybrid_get_stats(r.frame).rays[DRIFT_PASS_UNSHADOWED];
+    drift_image sparse =
+        environment_plane(&r, &(drift_hybrid_params){ .light_samples = 4, .environment_scale = 2 });
+    uint64_t sparse_rays = drift_hybrid_get_stats(r.frame).rays[DRIFT_PASS_UNSHADOWED];
+    double e_full = test_rmse(r.ctx, &full, &truth), e_sparse = test_rmse(r.ctx, &sparse, &truth);
+    double mean = drift_image_mean_luminance(&sparse) / drift_image_mean_luminance(&truth);
+    print_message("environment light: rmse 1 ray every pixel %g (%llu rays), 4 rays one pixel in "
+                  "2 x 2 %g (%llu rays); mean / converged %g\n",
+                  e_full, (unsigned long long)full_rays, e_sparse, (unsigned long long)sparse_rays,
+                  mean);
+    assert_true(sparse_rays <= full_rays + full_rays / 4);
+    assert_true(e_sparse < e_full);
+    assert_near(mean, 1.0, 0.02);
+    drift_image_destroy(r.ctx, &truth);
+    drift_image_destroy(r.ctx, &full);
+    drift_image_destroy(r.ctx, &sparse);
+    drift_hybrid *h = NULL;
+    assert_int_equal(drift_hybrid_create(r.ctx, r.scene, r.accel,
+                                         &(drift_hybrid_params){ .environment_scale = 3 }, &h),
+                     DRIFT_ERR_INVALID_ARGUMENT);
+    assert_int_equal(drift_hybrid_create(r.ctx, r.scene, r.accel,
+                                         &(drift_hybrid_params){ .environment_scale = 2,
+                                                                 .environment_interleave = true },
+                                         &h),
+                     DRIFT_ERR_INVALID_ARGUMENT);
+    assert_null(h);
+    test_rig_destroy(&r);
+
+    test_rig open = sky_rig(40.0f, false);
+    drift_image e = environment_plane(
+        &open, &(drift_hybrid_params){ .light_samples = 1, .environment_scale = 2 });
+    const drift_gbuffer *gb = drift_hybrid_gbuffer(open.frame);
+    double worst = 0.0;
+    for (int32_t y = 0; y < e.height; ++y) {
+        for (int32_t x = 0; x < e.width; ++x) {
+            if (drift_image_pixel(&gb->material_id, x, y)[0] >= 0.0f) {
+                worst = fmax(worst, fabs((double)drift_image_get3(&e, x, y).y - 0.35));
+            }
+        }
+    }
+    print_message("open floor, one pixel in 2 x 2 traced: worst |E - kd L| %g\n", worst);
+    assert_true(worst < 1e-5);
+    drift_image_destroy(open.ctx, &e);
+    test_rig_destroy(&open);
+}
+
 // A constant sky over an open floor: every cosine-sampled direction sees the sky, and the
 // diffuse lobe's f cos / pdf is kd, so one sample a pixel gives the environment's direct light
 // kd L exactly (the uniform sphere it replaced left half the samples below the horizon and
@@ -1006,6 +1062,7 @@ int main(void)
         cmocka_unit_test(test_hard_shadows_any_hit_match_closest_hit),
         cmocka_unit_test(test_environment_interleave_beats_equal_rays),
         cmocka_unit_test(test_environment_filter_beats_two_rays),
+        cmocka_unit_test(test_environment_scale_two_carries_the_light),
         cmocka_unit_test(test_constant_sky_is_exact_with_one_sample),
         cmocka_unit_test(test_technique_names_round_trip),
         cmocka_unit_test(test_rejects_bad_params),
