@@ -66,6 +66,14 @@ typedef struct drift_denoise_params {
 
 drift_denoise_params drift_denoise_params_resolve(const drift_denoise_params *params);
 
+// The albedo the filter divides the colour by and multiplies back: below 1e-3 (black, or an
+// emitter's) it is 1, so that such a pixel's colour is filtered as it is. Also the hybrid
+// frame's, where it carries the environment's light from pixel to pixel (docs/hybrid.md).
+static inline float drift_denoise_albedo_divisor(float albedo)
+{
+    return albedo < 1e-3f ? 1.0f : albedo;
+}
+
 // Filters the first three channels of `color` into *out, a new 3-channel image of the same
 // size (the caller destroys it). albedo and normal are read as RGB, depth as its first channel.
 drift_result drift_denoise_atrous(drift_context *ctx, const drift_image *color,

@@ -5,7 +5,6 @@
 #include <math.h>
 #include <string.h>
 
-#define DENOISE_ALBEDO_MIN 1e-3f
 #define DENOISE_LUM_EPS    1e-2f
 #define DENOISE_EXP_CUTOFF 30.0f // exp(-30) ~ 1e-13: the tap adds nothing
 
@@ -244,7 +243,7 @@ static bool guide_ok(drift_context *ctx, const drift_image *guide, const drift_i
 static float albedo_factor(const drift_image *albedo, int32_t x, int32_t y, int c)
 {
     float a = drift_image_pixel(albedo, x, y)[c];
-    return a < DENOISE_ALBEDO_MIN ? 1.0f : a;
+    return drift_denoise_albedo_divisor(a);
 }
 
 // The copies into the planes (demodulated colour, the guides or their neutral values) and

@@ -278,8 +278,7 @@ drift_result drift_realtime_build_shadow_maps(drift_frame_state *f)
 // A pixel with no such neighbour (a silhouette, a thin leaf) traces its own rays.
 static float demodulating_albedo(const drift_gbuffer *g, int32_t x, int32_t y, int c)
 {
-    float a = drift_image_pixel(&g->albedo, x, y)[c];
-    return a < 1e-3f ? 1.0f : a;
+    return drift_denoise_albedo_divisor(drift_image_pixel(&g->albedo, x, y)[c]);
 }
 
 static void fill_sparse_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays,
