@@ -371,8 +371,8 @@ static const cli_option render_table[] = {
                "of the same surface (default off; docs/hybrid.md)"),
     CLI_INT("--env-scale", "N", O, hybrid.environment_scale, 1, 2,
             "2: one pixel in 2 x 2 traces the environment's shadow rays, the\n"
-            "others take the traced ones on their surface (default 2; 1:\n"
-            "every pixel; docs/hybrid.md)"),
+            "others take the traced ones on their surface (default 2, or 1\n"
+            "with --env-interleave on; 1: every pixel; docs/hybrid.md)"),
     CLI_INT("--env-filter", "N", O, hybrid.environment_filter, 0, 10,
             "N passes of the edge-avoiding a-trous filter over the\n"
             "environment's direct light, guided by the G-buffer (default 4;\n"
@@ -471,6 +471,7 @@ int render_parse_options(int argc, char **argv, render_options *o)
     const char *first[CLI_GROUP_COUNT] = { 0 };
     // Whether --indirect is given decides its default (see --refine below).
     o->hybrid.techniques[DRIFT_EFFECT_INDIRECT] = CLI_TECHNIQUE_UNSET;
+    o->hybrid.environment_scale = 0; // unset: decided below (interleaving takes every pixel)
     int status = cli_parse(&render_command, argc, argv, o, first);
     if (status != CLI_PARSED) {
         return status;
@@ -479,6 +480,11 @@ int render_parse_options(int argc, char **argv, render_options *o)
     if (o->hybrid.techniques[DRIFT_EFFECT_INDIRECT] == CLI_TECHNIQUE_UNSET) {
         o->hybrid.indirect =
             o->refine.enabled ? DRIFT_INDIRECT_NONE : drift_hybrid_params_recommended().indirect;
+    }
+    if (o->hybrid.environment_scale == 0) {
+        o->hybrid.environment_scale = o->hybrid.environment_interleave
+                                          ? 1
+                                          : drift_hybrid_params_recommended().environment_scale;
     }
     o->hybrid_option = first[0];
     o->refine.first_option = first[1];

@@ -73,7 +73,14 @@ grep -q "needs --mode hybrid" "$tmp/err" || fail "hybrid option in reference mod
 expect 2 "$drift" render --mode hybrid --probe 1,2 --out "$tmp/x.exr"
 expect 2 "$drift" render --mode hybrid --pcf-kernel 0 --out "$tmp/x.exr"
 expect 2 "$drift" render --aov "$tmp/x-aov.exr" --out "$tmp/x.exr"
+# The environment's rays at one pixel in 2 x 2 (the default) give way to --env-interleave on;
+# asked for together they are refused, by name.
+expect 2 "$drift" render --mode hybrid "${small[@]}" --env-scale 2 --env-interleave on \
+    --out "$tmp/x.exr"
+grep -q "environment scale 2 with interleaving" "$tmp/err" || fail "--env-scale 2 with interleaving not explained"
+expect 2 "$drift" render --mode hybrid --env-filter 11 --out "$tmp/x.exr"
 [ -e "$tmp/x.exr" ] && fail "an output was written after a usage error"
+expect 0 "$drift" render --mode hybrid "${small[@]}" --env-interleave on --out "$tmp/il.exr"
 expect 0 "$drift" render --help
 grep -q -- "--reflections" "$tmp/out" || fail "--help does not list --reflections"
 
