@@ -275,9 +275,8 @@ drift_hybrid_params drift_hybrid_params_resolve(const drift_hybrid_params *param
 // Breakfast Room at 400x400, 2 threads (docs/frontier.md): hard shadows, instant radiosity from
 // imperfect shadow maps (1024 VPLs, gathered at one pixel in 2 x 2), 2 light samples, the
 // environment's shadow rays at one pixel in 2 x 2 and its filter's 4 passes, and max depth 8
-// (multiple bounces). A zeroed
-// drift_hybrid_params stays hard shadows, no indirect light, 8 light samples, max depth 2: the
-// library's and the tests' neutral frame.
+// (multiple bounces). A zeroed drift_hybrid_params stays hard shadows, no indirect light, 8
+// light samples, max depth 2: the library's and the tests' neutral frame.
 drift_hybrid_params drift_hybrid_params_recommended(void);
 // The technique `params` chooses for `effect` (-1 for an invalid effect), and setting it: one
 // int per effect for code that walks the effects (the viewer's keys and overlay, the CLI).

@@ -139,6 +139,7 @@ names = [r["name"] for r in d["rows"] if r["family"] == "hybrid"]
 assert sum(n.endswith(" aa 2") for n in names) * 2 == len(names), names
 assert sum(" ls 1" in n for n in names) * 2 == len(names), names
 assert not any(" ls 8" in n for n in names), names
+assert not any(" ef " in n for n in names), names  # no environment, no environment filter rows
 # Each ism and ir row of 8 VPLs (under the default --near-field-off-vpls 256) once more without the
 # near-field compensation, and (from --half-gather-vpls 8) once more gathering at 2 x 2.
 vpl_rows = [n for n in names if " VPLs" in n]
@@ -174,6 +175,17 @@ for f in d["front"]:
         assert any(r["pareto"] and r["name"] == f["best"]["name"] and r["family"] == f["best"]["family"]
                    for r in d["rows"]), f'
         [ "$(wc -l < "$tmp/frontier.csv")" -ge 15 ] || fail "bench frontier: --csv has too few rows"
+        # A scene lit by an environment: every hybrid row once more with --env-filter's passes
+        # (and its rays at one pixel in 2 x 2), named "ef 4", a different image.
+        expect 0 "$drift" bench frontier "${box%/cornell-box/*}/ssdo-blocks/ssdo_blocks.json" --size 12 \
+            --ref-spp 4 --runs 1 --max-spp 1 --vpls 8 --half-gather-vpls 0 --aaf-spp 1 --aa 1 \
+            --sir-iterations 1 --budgets 1000 --cache "$tmp/cache" --threads 1 --json
+        check frontier 'rows = {r["name"]: r for r in d["rows"] if r["family"] == "hybrid"}
+filtered = [n for n in rows if n.endswith(" ef 4")]
+assert filtered and len(filtered) * 2 == len(rows), sorted(rows)
+assert all(n[:-len(" ef 4")] in rows for n in filtered), sorted(rows)
+assert any(rows[n]["flip"] != rows[n[:-len(" ef 4")]]["flip"] for n in filtered), rows'
+
         python3 -c 'import sys, xml.etree.ElementTree as E; t = E.parse(sys.argv[1]).getroot()
 ns = "{http://www.w3.org/2000/svg}"
 assert t.tag == ns + "svg" and len(t.findall(ns + "circle")) > 15 and t.findall(ns + "polyline"), t' \
