@@ -342,7 +342,7 @@ static void fill_sparse_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64
 // a few shadow rays a pixel, smooth where the surface is, so the G-buffer guides it and no
 // colour weight keeps the noise itself. Demodulated by the albedo: texture stays sharp. The
 // 3 x 3 kernel: 9 taps a pass, and at 4 passes (a 31-pixel footprint) the Breakfast Room's
-// sky light is as smooth as with the 5 x 5 one at ~2.5x the time (docs/hybrid.md).
+// sky light is as smooth as with the 5 x 5 one at 2.7x the time (docs/hybrid.md).
 static drift_result filter_environment(drift_frame_state *f)
 {
     double t = drift_time_now();
