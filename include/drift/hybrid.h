@@ -220,7 +220,8 @@ typedef struct drift_occlusion_settings {
 //                      3 x 3 kernel) over it, guided by the G-buffer's normal, depth and
 //                      albedo (the light is demodulated), with no colour weight: its noise is
 //                      visibility's, which the colour weight would keep. A footprint of
-//                      2^(N+1) - 1 pixels
+//                      2^(N+1) - 1 pixels; with environment_scale 2 the passes run over the
+//                      traced pixels alone, before the fill (2^(N+2) - 2 full pixels)
 //   aa               = 0 -> 1: anti-aliasing passes. N > 1 renders the whole frame N times,
 //                      each pass with the camera's film shifted by a stratified sub-pixel
 //                      offset (the path tracer's box pixel filter) and its own seed, and
