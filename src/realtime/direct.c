@@ -343,60 +343,47 @@ static void fill_sparse_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64
 // colour weight keeps the noise itself. Demodulated by the albedo: texture stays sharp. The
 // 3 x 3 kernel: 9 taps a pass, and at 4 passes (a 31-pixel footprint) the Breakfast Room's
 // sky light is as smooth as with the 5 x 5 one at 2.7x the time (docs/hybrid.md).
-static drift_result filter_environment(drift_frame_state *f)
+// step 2 (--env-scale 2): the filter sees the traced pixels alone (one in 2 x 2, so a quarter
+// of the work), copied out with their albedo, normal and depth, before the fill carries them
+// to the rest: the same passes reach twice as far in full pixels, and the other three pixels
+// only ever read filtered light.
+static drift_result filter_environment(drift_frame_state *f, int32_t step)
 {
     double t = drift_time_now();
     const drift_gbuffer *g = &f->gbuffer;
-    drift_denoise_params params = { .iterations = (int32_t)f->params.environment_filter,
-                                    .disable_color = true,
-                                    .small_kernel = true };
-    drift_image filtered;
-    drift_result r = drift_denoise_atrous(f->ctx, &f->environment_direct, &g->albedo, &g->normal,
-                                          &g->depth, &params, &filtered);
-    if (r == DRIFT_OK) { // the plane's struct is what the frame's planes point at
-        drift_image traced = f->environment_direct;
-        f->environment_direct = filtered;
-        drift_image_destroy(f->ctx, &traced);
-    }
-    drift_pass_time(f, DRIFT_PASS_UNSHADOWED, t);
-    return r;
-}
-
-// With --env-scale 2 the filter sees the traced pixels alone (one in 2 x 2, so a quarter of
-// the work) before the fill carries them to the rest: the same passes reach twice as far in
-// full pixels, and the other three pixels only ever read filtered light. Each plane is the
-// traced grid's own: colour, and the albedo, normal and depth that guide it.
-static drift_result filter_environment_traced(drift_frame_state *f)
-{
-    double t = drift_time_now();
-    const drift_gbuffer *g = &f->gbuffer;
-    int32_t w = (f->params.width + 1) / 2, h = (f->params.height + 1) / 2;
-    drift_image grid[4] = { 0 }; // colour, albedo, normal, depth
     const drift_image *full[4] = { &f->environment_direct, &g->albedo, &g->normal, &g->depth };
+    const drift_image *in[4] = { full[0], full[1], full[2], full[3] };
+    drift_image grid[4] = { 0 }; // step 2: colour, albedo, normal, depth of the traced pixels
+    int32_t w = (f->params.width + step - 1) / step, h = (f->params.height + step - 1) / step;
     drift_result r = DRIFT_OK;
-    for (int k = 0; k < 4 && r == DRIFT_OK; ++k) {
+    for (int k = 0; step > 1 && k < 4 && r == DRIFT_OK; ++k) {
         r = drift_image_create(f->ctx, w, h, full[k]->channels < 3 ? 1 : 3, &grid[k]);
         for (int32_t y = 0; r == DRIFT_OK && y < h; ++y) {
             for (int32_t x = 0; x < w; ++x) {
-                const float *from = drift_image_pixel(full[k], 2 * x, 2 * y);
+                const float *from = drift_image_pixel(full[k], step * x, step * y);
                 float *to = drift_image_pixel(&grid[k], x, y);
                 for (int32_t c = 0; c < grid[k].channels; ++c) {
                     to[c] = from[c];
                 }
             }
         }
+        in[k] = &grid[k];
     }
     drift_denoise_params params = { .iterations = (int32_t)f->params.environment_filter,
                                     .disable_color = true,
                                     .small_kernel = true };
     drift_image filtered = { 0 };
     if (r == DRIFT_OK) {
-        r = drift_denoise_atrous(f->ctx, &grid[0], &grid[1], &grid[2], &grid[3], &params,
-                                 &filtered);
+        r = drift_denoise_atrous(f->ctx, in[0], in[1], in[2], in[3], &params, &filtered);
     }
-    for (int32_t y = 0; r == DRIFT_OK && y < h; ++y) {
+    if (r == DRIFT_OK && step == 1) { // the plane's struct is what the frame's planes point at
+        drift_image traced = f->environment_direct;
+        f->environment_direct = filtered;
+        filtered = traced;
+    }
+    for (int32_t y = 0; r == DRIFT_OK && step > 1 && y < h; ++y) {
         for (int32_t x = 0; x < w; ++x) {
-            drift_image_set3(&f->environment_direct, 2 * x, 2 * y,
+            drift_image_set3(&f->environment_direct, step * x, step * y,
                              drift_image_get3(&filtered, x, y));
         }
     }
@@ -429,20 +416,23 @@ static drift_result gather_interleaved(drift_frame_state *f)
 drift_result drift_realtime_pass_unshadowed(drift_frame_state *f)
 {
     drift_pass_rows(f, DRIFT_PASS_UNSHADOWED, unshadowed_row, NULL);
+    if (!drift_scene_has_environment(f->scene)) {
+        return DRIFT_OK;
+    }
     drift_result r = DRIFT_OK;
-    bool filter = f->params.environment_filter && drift_scene_has_environment(f->scene);
-    if (f->params.environment_scale == 2 && drift_scene_has_environment(f->scene)) {
+    const bool filter = f->params.environment_filter > 0;
+    if (f->params.environment_scale == 2) { // (never with interleaving: params_valid)
         if (filter) {
-            r = filter_environment_traced(f);
-            filter = false;
+            r = filter_environment(f, 2);
         }
         drift_pass_pixels(f, DRIFT_PASS_UNSHADOWED, fill_sparse_pixel, NULL);
+        return r;
     }
-    if (f->params.environment_interleave && drift_scene_has_environment(f->scene)) {
+    if (f->params.environment_interleave) {
         r = gather_interleaved(f);
     }
     if (r == DRIFT_OK && filter) {
-        r = filter_environment(f);
+        r = filter_environment(f, 1);
     }
     return r;
 }
