@@ -46,6 +46,8 @@ extern "C" {
 //   .png          8- or 16-bit, grey or colour, sRGB-decoded to linear.
 //   .jpg, .jpeg   8-bit baseline/progressive, sRGB-decoded to linear.
 //   .hdr          Radiance RGBE, linear.
+// The content must be the format its extension names (PNG's signature, JPEG's start of image,
+// Radiance's header); anything else, say a PNM or BMP behind a .png name, is DRIFT_ERR_PARSE.
 // *out_image receives a 3-channel image owned by the caller (drift_image_destroy); it is
 // zeroed on failure. Sizes are checked against DRIFT_IMAGE_MAX_DIMENSION before allocating.
 drift_result drift_image_load(drift_context *ctx, const char *path, drift_image *out_image);

@@ -283,6 +283,39 @@ static bool png_has_end(const uint8_t *data, size_t size)
     }
 }
 
+// The format the bytes themselves are, by their signature (PNG's eight bytes, JPEG's start of
+// image, Radiance's "#?"), or FORMAT_UNKNOWN. stb would decode anything it knows (PNM, BMP,
+// GIF, TGA, PSD) behind any name, and its 16-bit PNM converts channels into too short a
+// buffer (found by fuzz_image_load): only what the extension says is decoded.
+static image_format content_format(const uint8_t *data, size_t size)
+{
+    static const uint8_t png[8] = { 0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n' };
+    if (size >= sizeof png && memcmp(data, png, sizeof png) == 0) {
+        return FORMAT_PNG;
+    }
+    if (size >= 3 && data[0] == 0xff && data[1] == 0xd8 && data[2] == 0xff) {
+        return FORMAT_JPEG;
+    }
+    if (size <= (size_t)INT_MAX && stbi_is_hdr_from_memory(data, (int)size)) {
+        return FORMAT_HDR;
+    }
+    return FORMAT_UNKNOWN;
+}
+
+static const char *format_name(image_format format)
+{
+    switch (format) {
+    case FORMAT_PNG:
+        return "PNG";
+    case FORMAT_JPEG:
+        return "JPEG";
+    case FORMAT_HDR:
+        return "Radiance HDR";
+    default:
+        return "not PNG, JPEG or Radiance HDR";
+    }
+}
+
 static drift_result stb_load(drift_context *ctx, const char *path, image_format format,
                              const uint8_t *data, size_t size, drift_image *out_image)
 {
@@ -291,6 +324,12 @@ static drift_result stb_load(drift_context *ctx, const char *path, image_format 
         return DRIFT_ERR_UNSUPPORTED;
     }
     int len = (int)size;
+    image_format content = content_format(data, size);
+    if (content != format) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, path, 0,
+                  "content does not match the extension (%s data)", format_name(content));
+        return DRIFT_ERR_PARSE;
+    }
     int width = 0, height = 0, file_channels = 0;
     // Header first, so the size is checked before stb allocates the pixels.
     if (!stbi_info_from_memory(data, len, &width, &height, &file_channels)) {
@@ -310,13 +349,7 @@ static drift_result stb_load(drift_context *ctx, const char *path, image_format 
                   "truncated PNG: no complete IEND chunk");
         return DRIFT_ERR_PARSE;
     }
-    bool is_hdr = stbi_is_hdr_from_memory(data, len) != 0;
-    if ((format == FORMAT_HDR) != is_hdr) {
-        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, path, 0,
-                  "content does not match the extension (%s data)",
-                  is_hdr ? "Radiance HDR" : "8/16-bit");
-        return DRIFT_ERR_PARSE;
-    }
+    bool is_hdr = format == FORMAT_HDR;
     if (is_hdr && !hdr_is_complete(data, size, width)) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, path, 0,
                   "truncated Radiance HDR: the file ends before its %d scanlines do", height);

@@ -787,6 +787,24 @@ static void test_image_io_fuzz_regressions(void **state)
     drift_image img;
     assert_int_equal(drift_image_load(ctx, path, &img), DRIFT_ERR_UNSUPPORTED);
     assert_non_null(strstr(cap.last_message, "subsampled"));
+
+    // A 16-bit PGM ("P557 3 557", 57 x 3 pixels) behind a .png name: stb's PNM decoder
+    // converted its one channel to three into too short a buffer (heap-buffer-overflow). Its
+    // content is not PNG, so it is refused before any decoder runs; so it is behind .jpg and
+    // .hdr names.
+    static const uint8_t pgm16[] = { 0x50, 0x35, 0x35, 0x37, 0x0a, 0x33, 0x09, 0x35,
+                                     0x35, 0x37, 0x0a, 0x33, 0xff, 0xff, 0x5d, 0x00,
+                                     0x00, 0x00, 0x00, 0x49, 0x45, 0x4e, 0x44, 0xff,
+                                     0xff, 0xff, 0xff, 0xf7, 0xff, 0x59, 0x1c, 0x20 };
+    const char *disguises[] = { "io_fuzz_pgm16.png", "io_fuzz_pgm16.jpg", "io_fuzz_pgm16.hdr" };
+    for (int k = 0; k < 3; ++k) {
+        test_out_path(path, disguises[k]);
+        write_bytes(path, pgm16, sizeof(pgm16));
+        cap.last_code = DRIFT_OK;
+        assert_int_equal(drift_image_load(ctx, path, &img), DRIFT_ERR_PARSE);
+        assert_non_null(strstr(cap.last_message, "does not match the extension"));
+        assert_null(img.pixels);
+    }
     drift_context_destroy(ctx);
 }
 
