@@ -187,6 +187,17 @@ void drift_ism_destroy(drift_ism *ism); // NULL-safe
 // empty one is not), DRIFT_ERR_OUT_OF_MEMORY.
 drift_result drift_ism_render(drift_ism *ism, const drift_gbuffer *gbuffer,
                               const drift_camera *camera, const drift_image *direct);
+// One of `slices` renders of the same lights from nearly the same view (the anti-aliasing
+// passes of one frame, whose cameras differ by a sub-pixel shift): slice 0 draws the VPLs and
+// builds their maps as drift_ism_render does, a later slice keeps the last render's (it draws
+// them only when there are none). Each gathers its own 1/slices of every group of VPLs, at
+// `slices` times their light, so the mean of the slices' images gathers every VPL once: the
+// lights of slices renders at the gathering cost of one. The near-field compensation runs in
+// full in each. Errors: those of drift_ism_render; DRIFT_ERR_INVALID_ARGUMENT for
+// slice >= slices.
+drift_result drift_ism_render_slice(drift_ism *ism, const drift_gbuffer *gbuffer,
+                                    const drift_camera *camera, const drift_image *direct,
+                                    uint32_t slice, uint32_t slices);
 
 // RGB radiance: the diffuse indirect light I at each pixel (0 where the G-buffer missed).
 const drift_image *drift_ism_indirect(const drift_ism *ism);

@@ -22,6 +22,8 @@ typedef enum drift_stream {
     DRIFT_STREAM_PCSS = 2,             // PCSS tap rotation (realtime/direct.c)
     DRIFT_STREAM_REFLECTION = 3,       // the sharp mirror ray's shading (realtime/reflections.c)
     DRIFT_STREAM_PROBE = 4,            // environment-map capture (realtime/reflections.c)
+    DRIFT_STREAM_HARD_SHADOW_AIM = 5,  // --aa's shadow-ray aim points, keyed on base_seed
+                                       // (one stratified set over the passes; direct.c)
     DRIFT_STREAM_ISG_SHADOWS = 11,     // isg/isg_shadows.c
     DRIFT_STREAM_ISG_REFLECTIONS = 12, // isg/isg_reflections.c
     DRIFT_STREAM_ISG_DOF = 13,         // isg/isg_dof.c
@@ -72,6 +74,7 @@ typedef struct drift_frame_state {
     // (each pass mixes its index in); state kept across passes (ISM's VPLs, micro-rendering's
     // points) keys on this one so that a pass does not rebuild it.
     uint32_t base_seed;
+    uint32_t aa_pass; // this anti-aliasing pass's index (0 .. params.aa - 1)
     drift_camera camera, prev_camera;
     bool has_prev_camera;
 

@@ -576,12 +576,14 @@ drift_result drift_hybrid_render(drift_hybrid *h, const drift_camera *camera,
         // Pass 0 keeps the frame's seed (one pass is the frame it always was); the others
         // draw other sampler streams.
         f->params.seed = k ? drift_hash_combine(seed, 0x41410000u + k) : seed;
+        f->aa_pass = k;
         r = render_pass(f, cancel, &inputs);
         if (r == DRIFT_OK && passes > 1) {
             r = accumulate(h, k, passes);
         }
     }
     f->params.seed = seed;
+    f->aa_pass = 0;
     f->camera.film_shift_x = camera->film_shift_x;
     f->camera.film_shift_y = camera->film_shift_y;
     f->prev_camera = f->camera;

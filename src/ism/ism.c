@@ -35,6 +35,10 @@ struct drift_ism {
     uint32_t group_count;
     uint64_t points_print; // vertex_fingerprint when points [0, points_valid) were derived
     uint32_t points_valid;
+    bool lights_ready; // vpls and the atlas hold a render's lights (drift_ism_render_slice)
+    // This render gathers run `slice` of `slices` of every group of VPLs, at slices times their
+    // light (drift_ism_render_slice; 0 of 1 for drift_ism_render).
+    uint32_t slice, slices;
 };
 
 static const char *const stage_names[DRIFT_ISM_STAGE_COUNT] = { "vpls",       "points",  "splat",
@@ -690,16 +694,18 @@ static void gather_jobs(size_t begin, size_t end, int thread, void *user)
         // of one round of light paths). Consecutive paths are consecutive Sobol samples, so
         // each run is a stratified sample of the group (a stride of S instead would give
         // every subset one elementary interval of the light's domain). S times the subset's
-        // sum, averaged over the S pixels of a block, is the sum over all VPLs.
+        // sum, averaged over the S pixels of a block, is the sum over all VPLs. A slice of n
+        // splits each run in n again and takes its own part, at n times the light.
+        uint64_t runs = subsets * ism->slices, run = k * ism->slices + ism->slice;
         for (uint32_t g = 0; g < ism->group_count; ++g) {
             uint64_t first_vpl = ism->groups[g], size = (uint64_t)ism->groups[g + 1] - first_vpl;
-            uint32_t first = (uint32_t)(first_vpl + size * k / subsets);
-            uint32_t last = (uint32_t)(first_vpl + size * (k + 1) / subsets);
+            uint32_t first = (uint32_t)(first_vpl + size * run / runs);
+            uint32_t last = (uint32_t)(first_vpl + size * (run + 1) / runs);
             for (uint32_t j = first; j < last; ++j) {
                 gather_vpl(ism, j, &c, &rs, &job->rays[thread % 64]);
             }
         }
-        float scale = (float)subsets * DRIFT_INV_PI;
+        float scale = (float)runs * DRIFT_INV_PI;
         for (int32_t i = 0; i < rs.count; ++i) {
             drift_image_set3(&ism->irradiance, rs.x[i], rs.y[i],
                              drift_vec3_make(rs.er[i] * scale, rs.eg[i] * scale, rs.eb[i] * scale));
@@ -1210,14 +1216,21 @@ static void fallback_jobs(size_t begin, size_t end, int thread, void *user)
             rs.x[i] = x;
             rs.y[i] = y;
         }
-        for (uint32_t j = 0; j < ism->vpl_count; ++j) {
-            gather_vpl(ism, j, &c, &rs, &job->rays[thread % 64]);
+        // Every VPL of the render's slice: its part of each group, at `slices` times the light.
+        for (uint32_t g = 0; g < ism->group_count; ++g) {
+            uint64_t first_vpl = ism->groups[g], size = (uint64_t)ism->groups[g + 1] - first_vpl;
+            uint32_t from = (uint32_t)(first_vpl + size * ism->slice / ism->slices);
+            uint32_t to = (uint32_t)(first_vpl + size * (ism->slice + 1) / ism->slices);
+            for (uint32_t j = from; j < to; ++j) {
+                gather_vpl(ism, j, &c, &rs, &job->rays[thread % 64]);
+            }
         }
+        float scale = (float)ism->slices * DRIFT_INV_PI * DRIFT_INV_PI;
         for (int32_t i = 0; i < rs.count; ++i) {
             drift_vec3 e = drift_vec3_make(rs.er[i], rs.eg[i], rs.eb[i]);
             drift_vec3 kd = drift_image_get3(&gb->albedo, rs.x[i], rs.y[i]);
             drift_image_set3(&ism->indirect, rs.x[i], rs.y[i],
-                             drift_vec3_scale(drift_vec3_mul(kd, e), DRIFT_INV_PI * DRIFT_INV_PI));
+                             drift_vec3_scale(drift_vec3_mul(kd, e), scale));
         }
     }
 }
@@ -1342,9 +1355,114 @@ static void diagnostic_planes(drift_ism *ism, const drift_camera *camera)
     }
 }
 
-drift_result drift_ism_render(drift_ism *ism, const drift_gbuffer *gbuffer,
-                              const drift_camera *camera, const drift_image *direct)
+// Passes 1 and 2: the VPLs (their importance points from `gbuffer`, the full-size one) and,
+// with ISM visibility, their maps. *t is the stage clock, advanced past what ran.
+static drift_result make_lights(drift_ism *ism, const drift_gbuffer *gbuffer, drift_ism_stats *st,
+                                double *t)
 {
+    double now;
+    drift_result r;
+    drift_free(ism->ctx, ism->vpls);
+    ism->vpls = NULL;
+    ism->vpl_count = 0;
+    // The importance points: the visible surfaces at the centres of a 16 x 16 pixel grid.
+    drift_vec3 view_pos[256], view_nrm[256];
+    uint32_t view_count = 0;
+    for (int32_t gy = 0; ism->params.vpl_importance && gy < 16; ++gy) {
+        for (int32_t gx = 0; gx < 16; ++gx) {
+            int32_t x = (2 * gx + 1) * gbuffer->width / 32, y = (2 * gy + 1) * gbuffer->height / 32;
+            if (*drift_image_pixel(&gbuffer->material_id, x, y) < 0.0f) {
+                continue;
+            }
+            const float *ps = drift_image_pixel(&gbuffer->position, x, y);
+            const float *ns = drift_image_pixel(&gbuffer->normal, x, y);
+            view_pos[view_count] = drift_vec3_make(ps[0], ps[1], ps[2]);
+            view_nrm[view_count++] = drift_vec3_make(ns[0], ns[1], ns[2]);
+        }
+    }
+    r = drift__ism_generate_vpls_for(ism->ctx, ism->scene, ism->accel, &ism->params, view_pos,
+                                     view_nrm, view_count, &ism->vpls, &ism->vpl_count, NULL);
+    if (r != DRIFT_OK) {
+        return r;
+    }
+    ism->group_count = 0;
+    for (uint32_t j = 0; j < ism->vpl_count; ++j) {
+        ism->frames[j] = drift_frame_from_normal(ism->vpls[j].normal);
+        if (j == 0 || ism->vpls[j].bounce != ism->vpls[j - 1].bounce) {
+            ism->groups[ism->group_count++] = j;
+        }
+    }
+    if (ism->groups) {
+        ism->groups[ism->group_count] = ism->vpl_count;
+    }
+    now = drift_time_now();
+    st->ms[DRIFT_ISM_STAGE_VPLS] = (now - *t) * 1e3;
+    *t = now;
+    if (ism->params.visibility == DRIFT_ISM_VISIBILITY_ISM && ism->vpl_count > 0) {
+        r = drift__ism_reserve(ism, ism->vpl_count);
+        if (r != DRIFT_OK) {
+            return r;
+        }
+        if (ism->points) {
+            // Only the subsets of this render's VPLs are read, and only when a vertex moved
+            // since they were derived (or they were never derived this far).
+            uint32_t first, count;
+            drift_points_subset(ism->points, ism->vpl_count - 1, &first, &count);
+            uint64_t print = vertex_fingerprint(ism->scene);
+            if (print != ism->points_print || first + count > ism->points_valid) {
+                r = drift_points_update_range(ism->points, ism->scene, 0, first + count);
+                if (r != DRIFT_OK) {
+                    return r;
+                }
+                ism->points_print = print;
+                ism->points_valid = first + count;
+            }
+        }
+        now = drift_time_now();
+        st->ms[DRIFT_ISM_STAGE_POINTS] = (now - *t) * 1e3;
+        *t = now;
+        map_job mj = { .ism = ism };
+        mj.splat.n = ism->params.map_size;
+        float area_per_point =
+            ism->points ? (float)(ism->points->area / (double)ism->params.points_per_vpl) : 0.0f;
+        mj.splat.point_radius = sqrtf(area_per_point * DRIFT_INV_PI);
+        mj.splat.splat_scale = ism->params.splat_scale;
+        ism->splat_radius = mj.splat.splat_scale * mj.splat.point_radius;
+        drift_parallel_for(ism->ctx, ism->vpl_count, 1, maps_range, &mj);
+        st->splats = (uint64_t)ism->vpl_count * ism->params.points_per_vpl;
+        uint64_t empty = 0;
+        for (int i = 0; i < 64; ++i) {
+            empty += mj.empty[i];
+        }
+        double disc = (double)DRIFT_PI * 0.25 * (double)mj.splat.n * (double)mj.splat.n;
+        st->hole_fraction = (double)empty / ((double)ism->vpl_count * disc);
+        now = drift_time_now();
+        // Splat and pull-push run map by map on one thread: the pass's wall time is split
+        // between them in proportion to the threads' own clock of each.
+        double splat_s = 0.0, pull_s = 0.0;
+        for (int i = 0; i < 64; ++i) {
+            splat_s += mj.seconds[i][0];
+            pull_s += mj.seconds[i][1];
+        }
+        double maps_ms = (now - *t) * 1e3;
+        double split = splat_s + pull_s > 0.0 ? splat_s / (splat_s + pull_s) : 0.5;
+        st->ms[DRIFT_ISM_STAGE_SPLAT] = maps_ms * split;
+        st->ms[DRIFT_ISM_STAGE_PULL_PUSH] = maps_ms * (1.0 - split);
+        *t = now;
+    }
+    ism->lights_ready = true;
+    return DRIFT_OK;
+}
+
+static drift_result render(drift_ism *ism, const drift_gbuffer *gbuffer, const drift_camera *camera,
+                           const drift_image *direct, uint32_t slice, uint32_t slices)
+{
+    if (slices == 0 || slice >= slices) {
+        drift_log(ism->ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, __FILE__, __LINE__,
+                  "ism: slice %u of %u", slice, slices);
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    bool keep_lights = slice > 0 && ism->lights_ready;
     if (!gbuffer || gbuffer->width <= 0 || gbuffer->height <= 0 || !gbuffer->position.pixels ||
         !gbuffer->normal.pixels || !gbuffer->albedo.pixels || !gbuffer->material_id.pixels ||
         !gbuffer->geometric_normal.pixels) {
@@ -1381,93 +1499,18 @@ drift_result drift_ism_render(drift_ism *ism, const drift_gbuffer *gbuffer,
         st.ms[DRIFT_ISM_STAGE_UPSAMPLE] = (now - t) * 1e3;
         t = now;
     }
-    drift_free(ism->ctx, ism->vpls);
-    ism->vpls = NULL;
-    ism->vpl_count = 0;
-    // The importance points: the visible surfaces at the centres of a 16 x 16 pixel grid.
-    drift_vec3 view_pos[256], view_nrm[256];
-    uint32_t view_count = 0;
-    for (int32_t gy = 0; ism->params.vpl_importance && gy < 16; ++gy) {
-        for (int32_t gx = 0; gx < 16; ++gx) {
-            int32_t x = (2 * gx + 1) * gbuffer->width / 32, y = (2 * gy + 1) * gbuffer->height / 32;
-            if (*drift_image_pixel(&gbuffer->material_id, x, y) < 0.0f) {
-                continue;
-            }
-            const float *ps = drift_image_pixel(&gbuffer->position, x, y);
-            const float *ns = drift_image_pixel(&gbuffer->normal, x, y);
-            view_pos[view_count] = drift_vec3_make(ps[0], ps[1], ps[2]);
-            view_nrm[view_count++] = drift_vec3_make(ns[0], ns[1], ns[2]);
-        }
-    }
-    r = drift__ism_generate_vpls_for(ism->ctx, ism->scene, ism->accel, &ism->params, view_pos,
-                                     view_nrm, view_count, &ism->vpls, &ism->vpl_count, NULL);
-    if (r != DRIFT_OK) {
-        return r;
-    }
-    ism->group_count = 0;
-    for (uint32_t j = 0; j < ism->vpl_count; ++j) {
-        ism->frames[j] = drift_frame_from_normal(ism->vpls[j].normal);
-        if (j == 0 || ism->vpls[j].bounce != ism->vpls[j - 1].bounce) {
-            ism->groups[ism->group_count++] = j;
-        }
-    }
-    if (ism->groups) {
-        ism->groups[ism->group_count] = ism->vpl_count;
-    }
-    now = drift_time_now();
-    st.ms[DRIFT_ISM_STAGE_VPLS] = (now - t) * 1e3;
-    t = now;
-    if (ism->params.visibility == DRIFT_ISM_VISIBILITY_ISM && ism->vpl_count > 0) {
-        r = drift__ism_reserve(ism, ism->vpl_count);
+    ism->slice = slice;
+    ism->slices = slices;
+    if (!keep_lights) {
+        ism->lights_ready = false;
+        r = make_lights(ism, gbuffer, &st, &t);
         if (r != DRIFT_OK) {
             return r;
         }
-        if (ism->points) {
-            // Only the subsets of this render's VPLs are read, and only when a vertex moved
-            // since they were derived (or they were never derived this far).
-            uint32_t first, count;
-            drift_points_subset(ism->points, ism->vpl_count - 1, &first, &count);
-            uint64_t print = vertex_fingerprint(ism->scene);
-            if (print != ism->points_print || first + count > ism->points_valid) {
-                r = drift_points_update_range(ism->points, ism->scene, 0, first + count);
-                if (r != DRIFT_OK) {
-                    return r;
-                }
-                ism->points_print = print;
-                ism->points_valid = first + count;
-            }
-        }
-        now = drift_time_now();
-        st.ms[DRIFT_ISM_STAGE_POINTS] = (now - t) * 1e3;
-        t = now;
-        map_job mj = { .ism = ism };
-        mj.splat.n = ism->params.map_size;
-        float area_per_point =
-            ism->points ? (float)(ism->points->area / (double)ism->params.points_per_vpl) : 0.0f;
-        mj.splat.point_radius = sqrtf(area_per_point * DRIFT_INV_PI);
-        mj.splat.splat_scale = ism->params.splat_scale;
-        ism->splat_radius = mj.splat.splat_scale * mj.splat.point_radius;
-        drift_parallel_for(ism->ctx, ism->vpl_count, 1, maps_range, &mj);
-        st.splats = (uint64_t)ism->vpl_count * ism->params.points_per_vpl;
-        uint64_t empty = 0;
-        for (int i = 0; i < 64; ++i) {
-            empty += mj.empty[i];
-        }
-        double disc = (double)DRIFT_PI * 0.25 * (double)mj.splat.n * (double)mj.splat.n;
-        st.hole_fraction = (double)empty / ((double)ism->vpl_count * disc);
-        now = drift_time_now();
-        // Splat and pull-push run map by map on one thread: the pass's wall time is split
-        // between them in proportion to the threads' own clock of each.
-        double splat_s = 0.0, pull_s = 0.0;
-        for (int i = 0; i < 64; ++i) {
-            splat_s += mj.seconds[i][0];
-            pull_s += mj.seconds[i][1];
-        }
-        double maps_ms = (now - t) * 1e3;
-        double split = splat_s + pull_s > 0.0 ? splat_s / (splat_s + pull_s) : 0.5;
-        st.ms[DRIFT_ISM_STAGE_SPLAT] = maps_ms * split;
-        st.ms[DRIFT_ISM_STAGE_PULL_PUSH] = maps_ms * (1.0 - split);
-        t = now;
+    } else {
+        // The lights' figures are the render's that made them.
+        st.splats = ism->stats.splats;
+        st.hole_fraction = ism->stats.hole_fraction;
     }
     int32_t b = ism->params.block_size;
     int32_t cols = (gb->width + b - 1) / b;
@@ -1530,7 +1573,28 @@ drift_result drift_ism_render(drift_ism *ism, const drift_gbuffer *gbuffer,
     st.total_ms = (drift_time_now() - t0) * 1e3;
     st.vpl_count = ism->vpl_count;
     ism->stats = st;
+    drift_log(ism->ctx, DRIFT_LOG_DEBUG, DRIFT_OK, __FILE__, __LINE__,
+              "ism: %u VPLs%s; ms: vpls %.2f points %.2f splat %.2f pull-push %.2f gather %.2f "
+              "blur %.2f near-field %.2f upsample %.2f (total %.2f); %llu pixels gathered alone",
+              st.vpl_count, keep_lights ? " kept" : "", st.ms[DRIFT_ISM_STAGE_VPLS],
+              st.ms[DRIFT_ISM_STAGE_POINTS], st.ms[DRIFT_ISM_STAGE_SPLAT],
+              st.ms[DRIFT_ISM_STAGE_PULL_PUSH], st.ms[DRIFT_ISM_STAGE_GATHER],
+              st.ms[DRIFT_ISM_STAGE_BLUR], st.ms[DRIFT_ISM_STAGE_NEAR_FIELD],
+              st.ms[DRIFT_ISM_STAGE_UPSAMPLE], st.total_ms, (unsigned long long)st.fallback_pixels);
     return DRIFT_OK;
+}
+
+drift_result drift_ism_render(drift_ism *ism, const drift_gbuffer *gbuffer,
+                              const drift_camera *camera, const drift_image *direct)
+{
+    return render(ism, gbuffer, camera, direct, 0, 1);
+}
+
+drift_result drift_ism_render_slice(drift_ism *ism, const drift_gbuffer *gbuffer,
+                                    const drift_camera *camera, const drift_image *direct,
+                                    uint32_t slice, uint32_t slices)
+{
+    return render(ism, gbuffer, camera, direct, slice, slices);
 }
 
 const drift_image *drift_ism_indirect(const drift_ism *ism)

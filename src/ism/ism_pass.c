@@ -59,7 +59,12 @@ static drift_result indirect(drift_frame_state *f, const drift_pass_args *args,
         drift_pass_set_state(f, args, made, state_destroy);
         s = made;
     }
-    drift_result r = drift_ism_render(s->ism, &f->gbuffer, &f->camera, &f->direct);
+    // The lights do not move between the anti-aliasing passes of a frame (their paths key on
+    // the frame's seed, not the pass's): pass 0 draws them, and each pass gathers its own
+    // share of them, so the frame's mean gathers each VPL once.
+    uint32_t passes = f->params.aa ? f->params.aa : 1;
+    drift_result r =
+        drift_ism_render_slice(s->ism, &f->gbuffer, &f->camera, &f->direct, f->aa_pass, passes);
     if (r == DRIFT_OK) {
         drift_pass_copy_rgb(drift_ism_indirect(s->ism), &f->indirect);
     }

@@ -798,6 +798,69 @@ static void test_gather_scale_upsamples_by_the_blur_tests(void **state)
     test_rig_destroy(&r);
 }
 
+// drift_ism_render_slice: the mean of the n slices' images of one G-buffer is the full
+// render's (each VPL is gathered in one slice at n times its light; the gather, the blur and
+// the upsampling are linear), at gather scales 1 and 2 with their fallback pixels; a later
+// slice keeps the VPLs and maps (no VPL stage) and a bad slice is refused.
+static void test_slices_average_to_the_full_render(void **state)
+{
+    (void)state;
+    test_rig r = cornell_rig(2, 40);
+    const drift_gbuffer *gb = drift_hybrid_gbuffer(r.frame);
+    for (int32_t scale = 1; scale <= 2; ++scale) {
+        drift_ism_params p = {
+            .vpl_count = 256, .max_depth = 3, .gather_scale = scale, .no_near_field = true
+        };
+        drift_ism *full = NULL, *sliced = NULL;
+        assert_int_equal(drift_ism_create(r.ctx, r.scene, r.accel, &p, &full), DRIFT_OK);
+        assert_int_equal(drift_ism_create(r.ctx, r.scene, r.accel, &p, &sliced), DRIFT_OK);
+        assert_int_equal(drift_ism_render(full, gb, &r.scene->camera, NULL), DRIFT_OK);
+        const drift_image *want = drift_ism_indirect(full);
+        size_t floats = (size_t)want->width * (size_t)want->height * 3;
+        double *mean = calloc(floats, sizeof *mean);
+        assert_non_null(mean);
+        const uint32_t slices = 4;
+        for (uint32_t k = 0; k < slices; ++k) {
+            assert_int_equal(drift_ism_render_slice(sliced, gb, &r.scene->camera, NULL, k, slices),
+                             DRIFT_OK);
+            drift_ism_stats st = drift_ism_get_stats(sliced);
+            assert_int_equal(st.vpl_count, drift_ism_get_stats(full).vpl_count);
+            if (k > 0) {
+                assert_true(st.ms[DRIFT_ISM_STAGE_VPLS] == 0.0 &&
+                            st.ms[DRIFT_ISM_STAGE_SPLAT] == 0.0); // the lights were kept
+            }
+            const float *px = drift_ism_indirect(sliced)->pixels;
+            for (size_t i = 0; i < floats; ++i) {
+                mean[i] += (double)px[i] / slices;
+            }
+        }
+        double worst = 0.0, sum = 0.0;
+        for (size_t i = 0; i < floats; ++i) {
+            worst = fmax(worst, fabs(mean[i] - (double)want->pixels[i]) /
+                                    (1e-4 + fabs((double)want->pixels[i])));
+            sum += (double)want->pixels[i];
+        }
+        printf("scale %d: the mean of %u slices against the full render: worst relative "
+               "difference %.2e (%llu fallback pixels)\n",
+               scale, slices, worst, (unsigned long long)drift_ism_get_stats(full).fallback_pixels);
+        assert_true(sum > 1.0); // there is indirect light to compare
+        assert_true(worst < 1e-3);
+        // One slice alone is not the full image: each gathers its own quarter.
+        assert_int_equal(drift_ism_render_slice(sliced, gb, &r.scene->camera, NULL, 1, slices),
+                         DRIFT_OK);
+        assert_memory_not_equal(drift_ism_indirect(sliced)->pixels, want->pixels,
+                                floats * sizeof(float));
+        assert_int_equal(drift_ism_render_slice(sliced, gb, &r.scene->camera, NULL, 4, 4),
+                         DRIFT_ERR_INVALID_ARGUMENT);
+        assert_int_equal(drift_ism_render_slice(sliced, gb, &r.scene->camera, NULL, 0, 0),
+                         DRIFT_ERR_INVALID_ARGUMENT);
+        free(mean);
+        drift_ism_destroy(full);
+        drift_ism_destroy(sliced);
+    }
+    test_rig_destroy(&r);
+}
+
 // The same seed gives bit-identical indirect light on 1 and 2 threads, with and without the
 // near-field compensation.
 static void test_ism_is_deterministic(void **state)
@@ -1048,6 +1111,7 @@ int main(void)
         cmocka_unit_test(test_gather_equals_the_formula),
         cmocka_unit_test(test_blur_is_the_window_average),
         cmocka_unit_test(test_gather_scale_upsamples_by_the_blur_tests),
+        cmocka_unit_test(test_slices_average_to_the_full_render),
         cmocka_unit_test(test_ism_is_deterministic),
         cmocka_unit_test(test_vpl_importance_is_unbiased),
         cmocka_unit_test(test_vpl_importance_keeps_useful_vpls),
