@@ -159,6 +159,19 @@ static void interleave_gather_pixel(drift_frame_state *f, int32_t x, int32_t y, 
 // pixels aim at the same centre.
 #define SHADOW_BATCH 64
 
+// Where a ray from `ray`'s origin toward a point inside a sphere light (a tessellated sphere
+// or a sphere; its vertices lie within `radius` of its centre) enters the sphere 1.001 times
+// that size, short of which it can meet none of the light's own surface; `fallback` when it
+// misses it (only rounding: the ray aims inside).
+static float sphere_entry(const drift_raster_light *light, const drift_ray *ray, float fallback)
+{
+    float r = 1.001f * light->radius;
+    drift_vec3 oc = drift_vec3_sub(light->centre, ray->origin);
+    float b = drift_vec3_dot(oc, ray->dir), c = drift_vec3_dot(oc, oc) - r * r;
+    float disc = b * b - c;
+    return disc > 0.0f && b - sqrtf(disc) > 0.0f ? (b - sqrtf(disc)) * (1.0f - 1e-4f) : fallback;
+}
+
 // Where an any-hit shadow ray toward `light` must stop to meet none of the light's own
 // surface: shadow_clearance short of its tmax, and for a flat emitter (one-sided with a
 // clearance of 0) short of where the ray crosses the emitter's plane. The ray leaves from an
@@ -167,6 +180,11 @@ static void interleave_gather_pixel(drift_frame_state *f, int32_t x, int32_t y, 
 static float any_hit_tmax(const drift_raster_light *light, const drift_ray *ray)
 {
     float tmax = ray->tmax - light->shadow_clearance;
+    if (light->sphere_radius > 0.0f || light->type == DRIFT_LIGHT_SPHERE) {
+        // The ray may aim off the centre (aimed_shadow_ray): stop where it enters the sphere,
+        // if that is sooner (toward the centre it is not).
+        tmax = fminf(tmax, sphere_entry(light, ray, tmax));
+    }
     if (light->one_sided) {
         float cos_plane = drift_vec3_dot(ray->dir, light->direction);
         float t = drift_vec3_dot(drift_vec3_sub(light->centre, ray->origin), light->direction) /
@@ -176,6 +194,59 @@ static float any_hit_tmax(const drift_raster_light *light, const drift_ray *ray)
         }
     }
     return tmax;
+}
+
+// The hard-shadow ray of pass k of --aa N (N > 1) with `hard` shadows: toward point k of a
+// stratified set of N on the light, each pixel's set rotated by its own hash (keyed on the
+// frame's seed, not the pass's, so the N passes take the N points of one set): the passes'
+// mean is the accumulation buffer's soft shadow (Haeberli and Akeley 1990), noise in the
+// penumbra where one shared set would draw N shifted hard edges. A sphere (or tessellated
+// sphere) is aimed at through its silhouette disc facing the pixel, the other area lights
+// through drift_raster_light_sample; point, spot and directional lights keep the centre ray.
+static drift_ray aimed_shadow_ray(const drift_frame_state *f, uint32_t l, const drift_surface *s,
+                                  int32_t x, int32_t y, float *light_distance)
+{
+    const drift_raster_light *light = &f->lights[l];
+    uint32_t passes = f->params.aa;
+    bool sphere = light->sphere_radius > 0.0f || light->type == DRIFT_LIGHT_SPHERE;
+    if (passes < 2 || f->params.shadows != DRIFT_SHADOWS_HARD || light->radius <= 0.0f ||
+        !drift_light_is_area(light->type)) {
+        return drift_raster_hard_shadow_ray(light, s, light_distance);
+    }
+    // A hash, not a sampler: this is one rotation a pixel, and a ray is all the pass costs.
+    uint32_t pixel = (uint32_t)y * (uint32_t)f->params.width + (uint32_t)x;
+    uint32_t h = drift_hash_combine(
+        drift_hash_combine(f->base_seed, DRIFT_STREAM_HARD_SHADOW_AIM + 16u * l), pixel);
+    uint32_t h2 = drift_hash_u32(h), h3 = drift_hash_u32(h2);
+    drift_vec2 shift = drift_vec2_make((float)(h >> 8) * 0x1p-24f, (float)(h2 >> 8) * 0x1p-24f);
+    drift_vec2 u = drift_hammersley_shifted(f->aa_pass, passes, shift);
+    drift_vec3 target;
+    if (sphere) {
+        // The disc through the centre facing the pixel, of the radius the surface spans.
+        float radius = light->sphere_radius > 0.0f ? light->sphere_radius : light->radius;
+        drift_frame frame = drift_frame_from_normal(
+            drift_vec3_normalize(drift_vec3_sub(s->position, light->centre)));
+        drift_vec2 d = drift_sample_disk_concentric(u);
+        target = drift_vec3_add(
+            light->centre,
+            drift_frame_to_world(
+                &frame, drift_vec3_make(0.99f * radius * d.x, 0.99f * radius * d.y, 0.0f)));
+    } else {
+        float pick = (float)(h3 >> 8) * 0x1p-24f + (float)f->aa_pass * 0.618034f;
+        target =
+            drift_raster_light_sample(f->scene, light, s->position, pick - floorf(pick), u).point;
+    }
+    drift_vec3 d = drift_vec3_sub(target, s->position);
+    float distance = drift_vec3_length(d);
+    if (!(distance > 0.0f)) {
+        return drift_raster_hard_shadow_ray(light, s, light_distance);
+    }
+    drift_vec3 dir = drift_vec3_scale(d, 1.0f / distance);
+    *light_distance = distance;
+    return (drift_ray){ .origin = drift_offset_origin(s->position, s->ng, dir),
+                        .dir = dir,
+                        .tmin = 0.0f,
+                        .tmax = distance * (1.0f - 1e-4f) };
 }
 
 static void hard_shadow_row(drift_frame_state *f, int32_t y, uint64_t *rays, void *user)
@@ -202,7 +273,7 @@ static void hard_shadow_row(drift_frame_state *f, int32_t y, uint64_t *rays, voi
                     continue;
                 }
                 xs[n] = x;
-                batch[n] = drift_raster_hard_shadow_ray(&f->lights[l], s, &light_distance[n]);
+                batch[n] = aimed_shadow_ray(f, l, s, x, y, &light_distance[n]);
                 ++n;
             }
             if (any_hit) {

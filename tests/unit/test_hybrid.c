@@ -714,6 +714,74 @@ static void test_tessellated_sphere_light_in_closed_form(void **state)
     }
 }
 
+// `hard` shadows under --aa N aim pass k's ray at point k of a stratified set on the light
+// (the accumulation buffer's soft shadows): N passes draw the penumbra that one hard ray
+// toward the centre leaves out. A floor under a square occluder, lit by one light at a time:
+// a quad light, a sphere light and a tessellated sphere (an emissive mesh, the Breakfast
+// Room's sun). Each `hard` frame is scored against `reference` shadows at the same passes, so
+// the pixel filter is the same and only the shadow differs: 16 passes must come within 0.4 of
+// one pass's RMSE, and one pass must still be the centre ray's hard edge.
+static void test_aa_hard_shadows_draw_the_penumbra(void **state)
+{
+    (void)state;
+    for (int kind = 0; kind < 3; ++kind) {
+        test_rig r = test_rig_begin(2);
+        uint32_t white = test_add_material(r.scene, drift_material_make(drift_vec3_splat(0.7f)));
+        test_add_floor(r.scene, 4.0f, 0.0f, white);
+        test_add_quad(r.scene, drift_vec3_make(-0.5f, 1.0f, -0.5f), drift_vec3_make(1, 0, 0),
+                      drift_vec3_make(0, 0, 1), white);
+        const drift_vec3 at = drift_vec3_make(0.6f, 3.0f, 0.2f);
+        if (kind == 0) {
+            test_add_quad_light(r.scene, drift_vec3_sub(at, drift_vec3_make(0.4f, 0, 0.4f)),
+                                drift_vec3_make(0.8f, 0, 0), drift_vec3_make(0, 0, 0.8f), 4.0f);
+        } else if (kind == 1) {
+            drift_light sphere = {
+                .type = DRIFT_LIGHT_SPHERE, .position = at, .radius = 0.4f, .color = { 4, 4, 4 }
+            };
+            assert_int_equal(drift_scene_add_light(r.scene, &sphere, NULL), DRIFT_OK);
+        } else {
+            drift_material glow = drift_material_make(drift_vec3_splat(0.0f));
+            glow.emission = drift_vec3_splat(4.0f);
+            test_add_sphere(r.scene, at, 0.4f, 48, 24, test_add_material(r.scene, glow));
+        }
+        r.scene->camera =
+            drift_camera_look_at(drift_vec3_make(0, 5.0f, -0.01f), drift_vec3_make(0, 0, 0),
+                                 drift_vec3_make(0, 1, 0), 0.8f, 48, 48);
+        test_rig_commit(&r);
+        double rmse[2];
+        const uint32_t passes[2] = { 1, 16 };
+        for (int k = 0; k < 2; ++k) {
+            drift_hybrid_params p = { .aa = passes[k], .seed = 3 };
+            p.shadows = DRIFT_SHADOWS_REFERENCE;
+            p.spp = 2048 / passes[k]; // the mesh's triangle picks are noisy
+            test_rig_frame(&r, &p);
+            drift_image truth;
+            const drift_image *img = drift_hybrid_image(r.frame);
+            assert_int_equal(drift_image_create(r.ctx, img->width, img->height, 3, &truth),
+                             DRIFT_OK);
+            memcpy(truth.pixels, img->pixels, (size_t)img->width * img->height * 3 * sizeof(float));
+            p.shadows = DRIFT_SHADOWS_HARD;
+            test_rig_frame(&r, &p);
+            rmse[k] = test_rmse(r.ctx, drift_hybrid_image(r.frame), &truth);
+            if (k == 0) {
+                // One pass: every shadow bit is the centre ray's, 0 or 1.
+                const drift_image *bits = test_rig_plane(&r, "light0.hard_shadow");
+                for (int32_t i = 0; i < bits->width * bits->height; ++i) {
+                    float b = bits->pixels[(size_t)i * (size_t)bits->channels];
+                    assert_true(b == 0.0f || b == 1.0f);
+                }
+            }
+            drift_image_destroy(r.ctx, &truth);
+        }
+        print_message("light kind %d: hard against reference shadows, RMSE 1 pass %.4f, 16 "
+                      "passes %.4f\n",
+                      kind, rmse[0], rmse[1]);
+        assert_true(rmse[0] > 0.002); // the penumbra is there to miss
+        assert_true(rmse[1] < 0.4 * rmse[0]);
+        test_rig_destroy(&r);
+    }
+}
+
 // `--shadows hard` traces any-hit rays toward a light whose own surface the ray cannot meet
 // (flat emitters, spheres: drift_raster_light.shadow_clearance), closest hits otherwise and
 // whenever a row reads the occluder distances (`blur`, `isg`). Five lights over a floor
@@ -1085,6 +1153,7 @@ int main(void)
         cmocka_unit_test(test_unshadowed_sphere_matches_monte_carlo),
         cmocka_unit_test(test_tessellated_sphere_light_in_closed_form),
         cmocka_unit_test(test_hard_shadows_any_hit_match_closest_hit),
+        cmocka_unit_test(test_aa_hard_shadows_draw_the_penumbra),
         cmocka_unit_test(test_environment_interleave_beats_equal_rays),
         cmocka_unit_test(test_environment_filter_beats_two_rays),
         cmocka_unit_test(test_environment_scale_two_carries_the_light),
