@@ -299,7 +299,9 @@ static const cli_option render_table[] = {
     CLI_INT("--aa", "N", O, hybrid.aa, 1, 4096,
             "anti-aliasing: the whole frame N times, each through a\n"
             "stratified sub-pixel offset with its own seed, averaged (the\n"
-            "path tracer's box pixel filter; default 1 = pixel centres)"),
+            "path tracer's box pixel filter; default 1 = pixel centres);\n"
+            "hard shadows aim at a stratified point of the light a pass\n"
+            "(soft shadows), ISM gathers 1/N of one frame's VPLs a pass"),
     CLI_INT("--shadow-map-size", "N", O, hybrid.shadow_map.size, 1, 8192,
             "texels a cube face (default 512)"),
     CLI_NUMBER("--shadow-bias", "B", O, hybrid.shadow_map.bias, 1e-3, 1e3,

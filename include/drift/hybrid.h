@@ -226,7 +226,10 @@ typedef struct drift_occlusion_settings {
 //                      each pass with the camera's film shifted by a stratified sub-pixel
 //                      offset (the path tracer's box pixel filter) and its own seed, and
 //                      averages them: edges converge to the path tracer's pixel filter. 1 is
-//                      one sample through each pixel centre. Costs N frames.
+//                      one sample through each pixel centre. Costs about N frames: ISM's
+//                      VPLs and maps are built once and each pass gathers 1/N of them, and
+//                      `hard` shadow rays aim at a stratified point of an area light per pass
+//                      (the passes average N shadow samples: soft shadows; docs/hybrid.md).
 //   ambient          = used when has_ambient; otherwise the mean direct radiance of the frame
 //   shadow_map, envmap, isg, aaf, ism, micro, occlusion_settings: each family's settings (above)
 //   reflection_edits = NULL: physical reflections. Otherwise the sharp and environment-map
