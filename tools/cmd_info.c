@@ -64,6 +64,7 @@ static bool print_json(const char *path, const drift_scene *scene, const uint32_
     cJSON *bounds = cJSON_AddObjectToObject(root, "bounds");
     add_vec3(bounds, "min", scene->bounds.min);
     add_vec3(bounds, "max", scene->bounds.max);
+    cJSON_AddNumberToObject(root, "extent", (double)drift_scene_extent(scene));
     cJSON *camera = cJSON_AddObjectToObject(root, "camera");
     add_vec3(camera, "position", c->position);
     add_vec3(camera, "target", c->target);
@@ -104,6 +105,9 @@ static void print_text(const char *path, const drift_scene *scene, const uint32_
     printf("bounds     (%g %g %g) - (%g %g %g)\n", (double)scene->bounds.min.x,
            (double)scene->bounds.min.y, (double)scene->bounds.min.z, (double)scene->bounds.max.x,
            (double)scene->bounds.max.y, (double)scene->bounds.max.z);
+    // The length scale the techniques' defaults are fractions of (drift_scene_extent).
+    printf("extent     %g (the diagonal of the reflecting meshes)\n",
+           (double)drift_scene_extent(scene));
     printf("camera     position (%g %g %g) target (%g %g %g) up (%g %g %g)\n",
            (double)c->position.x, (double)c->position.y, (double)c->position.z, (double)c->target.x,
            (double)c->target.y, (double)c->target.z, (double)c->up.x, (double)c->up.y,

@@ -329,7 +329,7 @@ static const cli_option render_table[] = {
                "and gather samples, perfect squares (default 25 and 49)"),
     CLI_NUMBER("--isg-sigma", "S", O, hybrid.isg.sigma, 1e-30, 1e30,
                "range sigma of eq. 6 and 10, squared scene units\n"
-               "(default (0.02 x scene diagonal)^2)"),
+               "(default (0.02 x scene extent)^2)"),
     CLI_NUMBER("--blur-radius", "R", O, hybrid.isg.blur_radius, 1e-30, 1024.0,
                "disk radius in pixels of the blur baselines (default 4)"),
     CLI_INT("--isg-layers", "1|2", O, hybrid.isg.layers, 1, 2,
@@ -350,7 +350,7 @@ static const cli_option render_table[] = {
             "--occlusion ssao|gtao|ssdo (docs/ssdo.md): samples a pixel\n"
             "(default 16; ssdo 4, marched by --occlusion-steps)"),
     CLI_NUMBER("--occlusion-radius", "R", O, hybrid.occlusion_settings.radius, 1e-30, 1e30,
-               "r_max in scene units (default 0.05 x scene diagonal)"),
+               "r_max in scene units (default 0.05 x scene extent)"),
     CLI_CHOICE("--ssdo-bounce", "off|on", O, hybrid.occlusion_settings.bounce, "off|on",
                "on: SSDO's one indirect bounce (when --indirect is none)"),
     CLI_INT("--occlusion-layers", "1|2", O, hybrid.occlusion_settings.layers, 1, 2,

@@ -116,7 +116,7 @@ typedef struct drift_envmap_settings {
 
 // Image space gathering (docs/isg.md):
 //   search, gather = 0 -> 25, 49 samples (perfect squares 1..1024: 9, 25, 49, 81)
-//   sigma       = 0 -> (0.02 x scene diagonal)^2, sigma of eq. 6 and 10 in squared scene units
+//   sigma       = 0 -> (0.02 x scene extent)^2, sigma of eq. 6 and 10 in squared scene units
 //   a, b        = 0 -> 1 and 100 sigma (eq. 10: a normal difference n = 0.1 costs 1/e)
 //   blur_radius = 0 -> 4 pixels, the disk of the `blur` baselines
 //   layers      = 0 -> 1; 2 adds a second depth layer (one more ray a pixel) that ISG depth of
@@ -178,7 +178,7 @@ typedef struct drift_micro_settings {
 
 // Light from the environment in screen space (occlusion ssao, gtao, ssdo; docs/ssdo.md):
 //   samples = 0 -> 16: N sample points a pixel (GTAO: slices x steps x 2 horizon samples)
-//   radius  = 0 -> 0.05 x the scene's diagonal: r_max, the sample hemisphere's radius
+//   radius  = 0 -> 0.05 x the scene's extent: r_max, the sample hemisphere's radius
 //   bounce  = false: SSDO's one indirect bounce (only when no indirect technique is chosen)
 //   layers  = 0 -> 1; 2: a second depth layer (one more ray a pixel) so that a sample behind a
 //             thin object is not taken for occluded (thesis §4.3.2, drift_ssdo_peel)

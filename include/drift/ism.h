@@ -68,9 +68,9 @@ typedef enum drift_ism_visibility {
 //   splat_scale       = 0 -> 0.6: k of the splat side in texels,
 //                       s = clamp(k sqrt(A_pt / pi) n / (r (1 + v.z)), 1, 8)
 //   pull_push_levels  = 0 -> 2; negative: no hole filling
-//   pull_push_threshold = 0 -> 0.05 x scene diagonal at level 0 (times 2^l at level l)
-//   depth_bias        = 0 -> 0.01 x scene diagonal, plus one texel's footprint at the receiver
-//   clamp_distance    = 0 -> 0.1 x scene diagonal (0.05 with no_near_field): d_min of the
+//   pull_push_threshold = 0 -> 0.05 x scene extent at level 0 (times 2^l at level l)
+//   depth_bias        = 0 -> 0.01 x scene extent, plus one texel's footprint at the receiver
+//   clamp_distance    = 0 -> 0.1 x scene extent (0.05 with no_near_field): d_min of the
 //                       geometry term
 //   no_near_field     = false: rays at most d_min long, from one pixel in near_field_stride^2,
 //                       add back the light of the surfaces nearer than d_min that the clamp
@@ -88,7 +88,7 @@ typedef enum drift_ism_visibility {
 //                       pixel none of those passes gathers every VPL itself); the albedo is
 //                       applied at full resolution
 //   blur_normal       = 0 -> 0.9: smallest cosine between two normals the blur mixes
-//   blur_plane        = 0 -> 0.01 x scene diagonal: largest distance to the centre's plane
+//   blur_plane        = 0 -> 0.01 x scene extent: largest distance to the centre's plane
 //   vpl_importance    = false: true accepts each candidate VPL with p = min(1, c / target), c
 //                       its unshadowed contribution to 256 G-buffer points, and divides the
 //                       accepted by p (Georgiev & Slusallek 2010); rounds go on until

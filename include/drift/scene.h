@@ -200,7 +200,10 @@ typedef struct drift_scene {
     uint32_t light_count;
     drift_image *textures; // linear RGB(A); owned
     uint32_t texture_count;
-    drift_bounds3 bounds;           // of all geometry, set by commit
+    drift_bounds3 bounds; // of all geometry, set by commit
+    // Of the meshes that reflect light (a pure emitter, emission and no reflectance, is not
+    // one), set by commit: the scene's extent as a length scale (drift_scene_extent).
+    drift_bounds3 reflector_bounds;
     drift_light_table *light_table; // set by commit
     bool committed;
 } drift_scene;
@@ -232,6 +235,12 @@ uint64_t drift_scene_triangle_count(const drift_scene *scene);
 
 // Bounds of one mesh's vertices.
 drift_bounds3 drift_mesh_bounds(const drift_mesh *mesh);
+
+// The scene's length scale for the techniques' defaults (a clamp distance, a search radius, a
+// depth bias): the diagonal of the reflecting meshes' bounds, so that a sun far outside a
+// window (the Breakfast Room's, 14 m beyond a 6 m room) does not stretch it; the diagonal of
+// all of `bounds` when no mesh reflects, 1 when the scene is empty.
+float drift_scene_extent(const drift_scene *scene);
 
 // The corners of a DRIFT_LIGHT_TRIANGLE light, in the order of its mesh triangle (their
 // cross product points the way it emits).

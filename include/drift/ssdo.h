@@ -97,7 +97,7 @@ drift_vec3 drift_ssdo_env_radiance(const drift_ssdo_env *env, drift_vec3 dir, in
 //   method          = ssao
 //   samples         = 0 -> 16: N, sample points a pixel (SSAO, SSDO); GTAO takes
 //                     slices x steps x 2 = N horizon samples
-//   radius          = 0 -> 0.05 x the diagonal of scene bounds (drift_ssdo_params_resolve):
+//   radius          = 0 -> 0.05 x drift_scene_extent (drift_ssdo_params_resolve):
 //                     r_max in scene units, the sample hemisphere and the horizon search
 //   bounce          = false: SSDO's one indirect bounce (--ssdo-bounce)
 //   bounce_area     = 0 -> 1: A_s = bounce_area x pi r_max^2 / N, the bleeding strength

@@ -95,11 +95,7 @@ void drift_isg_settings_resolve(drift_isg_settings *s, const drift_scene *scene)
     s->search = s->search ? s->search : 25;
     s->gather = s->gather ? s->gather : 49;
     if (!(s->sigma > 0.0f)) {
-        float diagonal = 1.0f;
-        if (scene && !drift_bounds3_is_empty(scene->bounds)) {
-            diagonal = drift_vec3_length(drift_vec3_sub(scene->bounds.max, scene->bounds.min));
-        }
-        float width = 0.02f * (diagonal > 0.0f ? diagonal : 1.0f);
+        float width = 0.02f * (scene ? drift_scene_extent(scene) : 1.0f);
         s->sigma = width * width;
     }
     s->a = s->a > 0.0f ? s->a : 1.0f;

@@ -53,10 +53,7 @@ const char *drift_ism_stage_name(drift_ism_stage stage)
 drift_ism_params drift_ism_params_resolve(const drift_ism_params *params, const drift_scene *scene)
 {
     drift_ism_params p = params ? *params : (drift_ism_params){ 0 };
-    float diag = 1.0f;
-    if (scene && !drift_bounds3_is_empty(scene->bounds)) {
-        diag = drift_vec3_length(drift_vec3_sub(scene->bounds.max, scene->bounds.min));
-    }
+    float diag = scene ? drift_scene_extent(scene) : 1.0f;
     if (p.vpl_count == 0) {
         p.vpl_count = 256;
     }
@@ -242,7 +239,7 @@ drift_result drift_ism_create(drift_context *ctx, const drift_scene *scene,
     ism->scene = scene;
     ism->accel = accel;
     ism->params = p;
-    ism->diagonal = drift_vec3_length(drift_vec3_sub(scene->bounds.max, scene->bounds.min));
+    ism->diagonal = drift_scene_extent(scene);
     ism->max_vpls = drift__ism_max_vpls(&p);
     // The push is left to the lookups for the usual 1 or 2 levels (drift__ism_lookup);
     // deeper pyramids are pushed whole at build time.

@@ -433,7 +433,11 @@ drift_result drift__ism_generate_vpls_for(drift_context *ctx, const drift_scene 
     if (result != DRIFT_OK) {
         goto done;
     }
-    drift_vec3 lo = scene->bounds.min, hi = scene->bounds.max;
+    // Distant light's parallel rays cover the reflecting geometry (a pure emitter sends none
+    // of it back), so a sun far outside the room does not widen their disc.
+    drift_bounds3 reach =
+        drift_bounds3_is_empty(scene->reflector_bounds) ? scene->bounds : scene->reflector_bounds;
+    drift_vec3 lo = reach.min, hi = reach.max;
     path_job job = { .scene = scene,
                      .accel = accel,
                      .params = params,

@@ -336,7 +336,10 @@ drift_result drift__micro_photons_trace(drift_context *ctx, const drift_scene *s
         goto done;
     }
     memset(job, 0, sizeof *job);
-    drift_vec3 lo = scene->bounds.min, hi = scene->bounds.max;
+    // The distant lights' disc covers the reflecting geometry (as instant radiosity's).
+    drift_bounds3 reach =
+        drift_bounds3_is_empty(scene->reflector_bounds) ? scene->bounds : scene->reflector_bounds;
+    drift_vec3 lo = reach.min, hi = reach.max;
     job->scene = scene;
     job->accel = accel;
     job->desc = desc;

@@ -19,6 +19,7 @@ drift_result drift_scene_create(drift_context *ctx, drift_scene **out_scene)
     scene->ctx = ctx;
     scene->environment.texture = DRIFT_INVALID_INDEX;
     scene->bounds = drift_bounds3_empty();
+    scene->reflector_bounds = drift_bounds3_empty();
     scene->camera = drift_camera_look_at(drift_vec3_make(0, 0, 1), drift_vec3_make(0, 0, 0),
                                          drift_vec3_make(0, 1, 0), 0.8f, 512, 512);
     *out_scene = scene;
@@ -346,6 +347,16 @@ drift_result drift_scene_add_texture(drift_scene *scene, drift_image image, uint
     return DRIFT_OK;
 }
 
+float drift_scene_extent(const drift_scene *scene)
+{
+    drift_bounds3 b = scene->reflector_bounds;
+    if (drift_bounds3_is_empty(b)) {
+        b = scene->bounds;
+    }
+    float d = drift_bounds3_is_empty(b) ? 0.0f : drift_vec3_length(drift_vec3_sub(b.max, b.min));
+    return d > 0.0f ? d : 1.0f;
+}
+
 drift_bounds3 drift__scene_mesh_bounds(const drift_scene *scene)
 {
     drift_bounds3 b = drift_bounds3_empty();
@@ -453,6 +464,18 @@ drift_result drift_scene_commit(drift_scene *scene)
         }
     }
     scene->bounds = bounds;
+    scene->reflector_bounds = drift_bounds3_empty();
+    for (uint32_t m = 0; m < scene->mesh_count; ++m) {
+        const drift_material *mat = &scene->materials[scene->meshes[m].material];
+        bool pure_emitter = !drift_vec3_is_zero(mat->emission) &&
+                            drift_vec3_is_zero(mat->diffuse) && drift_vec3_is_zero(mat->specular) &&
+                            mat->diffuse_texture == DRIFT_INVALID_INDEX &&
+                            mat->type != DRIFT_MATERIAL_MIRROR;
+        if (!pure_emitter) {
+            scene->reflector_bounds =
+                drift_bounds3_union(scene->reflector_bounds, drift_mesh_bounds(&scene->meshes[m]));
+        }
+    }
 
     // One triangle light per emissive mesh triangle, consecutive per mesh.
     for (uint32_t m = 0; m < scene->mesh_count; ++m) {

@@ -48,7 +48,7 @@ drift_ssdo_params drift_ssdo_params_resolve(const drift_ssdo_params *params,
     drift_ssdo_params p = params ? *params : (drift_ssdo_params){ 0 };
     p.samples = p.samples ? p.samples : 16;
     if (p.radius == 0.0f && scene && !drift_bounds3_is_empty(scene->bounds)) {
-        p.radius = 0.05f * drift_vec3_length(drift_vec3_sub(scene->bounds.max, scene->bounds.min));
+        p.radius = 0.05f * drift_scene_extent(scene);
     }
     p.bounce_area = p.bounce_area != 0.0f ? p.bounce_area : 1.0f;
     p.bounce_clamp = p.bounce_clamp != 0.0f ? p.bounce_clamp : 0.5f;

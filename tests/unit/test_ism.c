@@ -798,6 +798,34 @@ static void test_gather_scale_upsamples_by_the_blur_tests(void **state)
     test_rig_destroy(&r);
 }
 
+// The length scale of the defaults (drift_scene_extent) is the reflecting geometry's: a pure
+// emitter far outside (a sun 100 m off a 10 m floor) does not stretch ISM's clamp distance,
+// while the same sphere made to reflect does, and so does every mesh when none reflects.
+static void test_extent_ignores_a_distant_pure_emitter(void **state)
+{
+    (void)state;
+    for (int reflects = 0; reflects < 2; ++reflects) {
+        test_rig r = test_rig_begin(1);
+        uint32_t white = test_add_material(r.scene, drift_material_make(drift_vec3_splat(0.5f)));
+        drift_material glow = drift_material_make(drift_vec3_splat(reflects ? 0.5f : 0.0f));
+        glow.emission = drift_vec3_splat(100.0f);
+        test_add_floor(r.scene, 5.0f, 0.0f, white);
+        test_add_sphere(r.scene, drift_vec3_make(100, 50, 0), 1.0f, 16, 8,
+                        test_add_material(r.scene, glow));
+        test_rig_commit(&r);
+        float all = drift_vec3_length(drift_vec3_sub(r.scene->bounds.max, r.scene->bounds.min));
+        float want = reflects ? all : sqrtf(200.0f); // the floor's 10 x 10 diagonal
+        float clamp = drift_ism_params_resolve(NULL, r.scene).clamp_distance;
+        print_message("sphere %s: bounds' diagonal %g, extent %g, ISM clamp %g\n",
+                      reflects ? "reflects" : "a pure emitter", (double)all,
+                      (double)drift_scene_extent(r.scene), (double)clamp);
+        assert_near(drift_scene_extent(r.scene), want, 1e-3 * (double)want);
+        assert_near(clamp, 0.1 * (double)want, 1e-3 * (double)want);
+        assert_true(reflects || drift_scene_extent(r.scene) < 0.2f * all);
+        test_rig_destroy(&r);
+    }
+}
+
 // drift_ism_render_slice: the mean of the n slices' images of one G-buffer is the full
 // render's (each VPL is gathered in one slice at n times its light; the gather, the blur and
 // the upsampling are linear), at gather scales 1 and 2 with their fallback pixels; a later
@@ -1112,6 +1140,7 @@ int main(void)
         cmocka_unit_test(test_blur_is_the_window_average),
         cmocka_unit_test(test_gather_scale_upsamples_by_the_blur_tests),
         cmocka_unit_test(test_slices_average_to_the_full_render),
+        cmocka_unit_test(test_extent_ignores_a_distant_pure_emitter),
         cmocka_unit_test(test_ism_is_deterministic),
         cmocka_unit_test(test_vpl_importance_is_unbiased),
         cmocka_unit_test(test_vpl_importance_keeps_useful_vpls),
