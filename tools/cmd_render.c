@@ -403,6 +403,9 @@ static const cli_option render_table[] = {
             "texels a side of each VPL's imperfect shadow map (default 64)"),
     CLI_INT("--ism-points", "N", O, hybrid.ism.points_per_vpl, 16, 1 << 20,
             "scene points splatted into each map (default 1024)"),
+    CLI_INT("--ism-later-paths", "N", O, hybrid.ism.later_paths, 1, 65536,
+            "of the --ism-vpls paths, how many go on past their first VPL\n"
+            "(default a quarter; at most all of them; docs/ism.md)"),
     CLI_INT("--micro-points", "N", O, hybrid.micro.points, 2, 1 << 22,
             "micro-rendering (--indirect micro, --reflections micro,\n"
             "docs/micro.md): scene points in the hierarchy, rounded up to\n"

@@ -161,6 +161,7 @@ typedef struct drift_ism_settings {
     bool vpl_importance;
     bool no_near_field;
     int32_t gather_scale;
+    uint32_t later_paths; // drift_ism_params.later_vpl_count: 0 -> vpls / 4
 } drift_ism_settings;
 
 // Micro-rendering (indirect micro and reflections micro, docs/micro.md):

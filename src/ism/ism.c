@@ -227,8 +227,19 @@ drift_result drift_ism_create(drift_context *ctx, const drift_scene *scene,
     }
     drift_ism_params p = drift_ism_params_resolve(params, scene);
     if (!params_valid(&p)) {
-        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, __FILE__, __LINE__,
-                  "ism: a parameter is out of range (docs/ism.md lists them)");
+        uint64_t points = (uint64_t)p.points_per_vpl * drift__ism_max_vpls(&p);
+        if (points > (1u << 28)) {
+            // The one limit a user meets by combining in-range values: say which.
+            drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, __FILE__, __LINE__,
+                      "ism: %u points a map x %u VPLs (the most %u paths, %u going on, can "
+                      "leave in %d rounds at max depth %d) exceed 2^28 scene points; lower "
+                      "the points, the VPLs or the later paths",
+                      p.points_per_vpl, drift__ism_max_vpls(&p), p.vpl_count, p.later_vpl_count,
+                      p.max_path_rounds, p.max_depth);
+        } else {
+            drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, __FILE__, __LINE__,
+                      "ism: a parameter is out of range (docs/ism.md lists them)");
+        }
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
     drift_ism *ism = drift_alloc(ctx, sizeof *ism);

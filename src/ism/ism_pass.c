@@ -29,7 +29,8 @@ static drift_ism_params params_of(const drift_frame_state *f, drift_ism_visibili
                                .points_per_vpl = f->params.ism.points_per_vpl,
                                .vpl_importance = f->params.ism.vpl_importance,
                                .no_near_field = f->params.ism.no_near_field,
-                               .gather_scale = f->params.ism.gather_scale };
+                               .gather_scale = f->params.ism.gather_scale,
+                               .later_vpl_count = f->params.ism.later_paths };
 }
 
 static bool same_params(const drift_ism_params *a, const drift_ism_params *b)
@@ -37,7 +38,8 @@ static bool same_params(const drift_ism_params *a, const drift_ism_params *b)
     return a->seed == b->seed && a->visibility == b->visibility && a->vpl_count == b->vpl_count &&
            a->max_depth == b->max_depth && a->map_size == b->map_size &&
            a->points_per_vpl == b->points_per_vpl && a->vpl_importance == b->vpl_importance &&
-           a->no_near_field == b->no_near_field && a->gather_scale == b->gather_scale;
+           a->no_near_field == b->no_near_field && a->gather_scale == b->gather_scale &&
+           a->later_vpl_count == b->later_vpl_count;
 }
 
 static drift_result indirect(drift_frame_state *f, const drift_pass_args *args,

@@ -95,6 +95,21 @@ assert d['frames'] == 3 and m['first_frame'] > 0 and m['frame'] > 0, d" "$tmp/f3
     || fail "--frames stats"
 expect 2 "$drift" render --mode hybrid "${small[@]}" --frames 0 --out "$tmp/f0.exr"
 
+# --ism-later-paths: more of the paths go on past their first VPL, so more VPLs (--verbose logs
+# each ISM render's count); a count whose maps would pass the scene-point limit is refused,
+# naming the limit, and writes nothing.
+for later in 2 8; do
+    expect 0 "$drift" render --mode hybrid "${small[@]}" --indirect ism --ism-vpls 8 \
+        --ism-later-paths "$later" --verbose --out "$tmp/later$later.exr"
+    grep -o "ism: [0-9]* VPLs" "$tmp/err" | head -1 | tr -dc 0-9 >"$tmp/later$later.count"
+done
+[ "$(cat "$tmp/later8.count")" -gt "$(cat "$tmp/later2.count")" ] 2>/dev/null ||
+    fail "--ism-later-paths 8 left no more VPLs than 2 ($(cat "$tmp/later8.count") vs $(cat "$tmp/later2.count"))"
+expect 1 "$drift" render --mode hybrid "${small[@]}" --indirect ism --ism-vpls 65536 \
+    --ism-later-paths 65536 --out "$tmp/too-many.exr"
+grep -q "exceed 2^28 scene points" "$tmp/err" || fail "--ism-later-paths over the limit not explained"
+[ ! -e "$tmp/too-many.exr" ] || fail "a refused ISM render wrote an image"
+
 # Micro-rendering (docs/micro.md): both rows, with their planes, at the three densities; bad
 # values of its options exit 2 naming the option.
 for density in 1 1/4 1/16; do
