@@ -222,10 +222,15 @@ static drift_ray aimed_shadow_ray(const drift_frame_state *f, uint32_t l, const 
     drift_vec2 u = drift_hammersley_shifted(f->aa_pass, passes, shift);
     drift_vec3 target;
     if (sphere) {
-        // The disc through the centre facing the pixel, of the radius the surface spans.
+        // The disc through the centre facing the pixel, of the radius the surface spans (a
+        // pixel inside the sphere keeps the centre ray: it has no silhouette).
         float radius = light->sphere_radius > 0.0f ? light->sphere_radius : light->radius;
-        drift_frame frame = drift_frame_from_normal(
-            drift_vec3_normalize(drift_vec3_sub(s->position, light->centre)));
+        drift_vec3 away = drift_vec3_sub(s->position, light->centre);
+        float far = drift_vec3_length(away);
+        if (!(far > light->radius)) {
+            return drift_raster_hard_shadow_ray(light, s, light_distance);
+        }
+        drift_frame frame = drift_frame_from_normal(drift_vec3_scale(away, 1.0f / far));
         drift_vec2 d = drift_sample_disk_concentric(u);
         target = drift_vec3_add(
             light->centre,
