@@ -652,6 +652,16 @@ static void gather_vpl(const drift_ism *ism, uint32_t j, const gather_consts *c,
 // Job = (band of rows, subset k): the band's pixels of subset k gather that subset's VPLs,
 // VPL by VPL (one map in cache at a time, read by every receiver of the band), each receiver
 // summing its VPLs in the same order whatever the threads.
+// Run `run` of `runs` equal runs of group g's VPLs: [*first, *last). Consecutive runs tile the
+// group, so summing them gathers each VPL once.
+static void group_run(const drift_ism *ism, uint32_t g, uint64_t run, uint64_t runs,
+                      uint32_t *first, uint32_t *last)
+{
+    uint64_t first_vpl = ism->groups[g], size = (uint64_t)ism->groups[g + 1] - first_vpl;
+    *first = (uint32_t)(first_vpl + size * run / runs);
+    *last = (uint32_t)(first_vpl + size * (run + 1) / runs);
+}
+
 static void gather_jobs(size_t begin, size_t end, int thread, void *user)
 {
     gather_job *job = user;
@@ -706,9 +716,8 @@ static void gather_jobs(size_t begin, size_t end, int thread, void *user)
         // splits each run in n again and takes its own part, at n times the light.
         uint64_t runs = subsets * ism->slices, run = k * ism->slices + ism->slice;
         for (uint32_t g = 0; g < ism->group_count; ++g) {
-            uint64_t first_vpl = ism->groups[g], size = (uint64_t)ism->groups[g + 1] - first_vpl;
-            uint32_t first = (uint32_t)(first_vpl + size * run / runs);
-            uint32_t last = (uint32_t)(first_vpl + size * (run + 1) / runs);
+            uint32_t first, last;
+            group_run(ism, g, run, runs, &first, &last);
             for (uint32_t j = first; j < last; ++j) {
                 gather_vpl(ism, j, &c, &rs, &job->rays[thread % 64]);
             }
@@ -1226,9 +1235,8 @@ static void fallback_jobs(size_t begin, size_t end, int thread, void *user)
         }
         // Every VPL of the render's slice: its part of each group, at `slices` times the light.
         for (uint32_t g = 0; g < ism->group_count; ++g) {
-            uint64_t first_vpl = ism->groups[g], size = (uint64_t)ism->groups[g + 1] - first_vpl;
-            uint32_t from = (uint32_t)(first_vpl + size * ism->slice / ism->slices);
-            uint32_t to = (uint32_t)(first_vpl + size * (ism->slice + 1) / ism->slices);
+            uint32_t from, to;
+            group_run(ism, g, ism->slice, ism->slices, &from, &to);
             for (uint32_t j = from; j < to; ++j) {
                 gather_vpl(ism, j, &c, &rs, &job->rays[thread % 64]);
             }
