@@ -13,9 +13,6 @@ static size_t pixel_index(const drift_frame_state *f, int32_t x, int32_t y)
     return (size_t)y * (size_t)f->params.width + (size_t)x;
 }
 
-// The unshadowed light of pixels x0 .. x0 + n - 1 of row y (n <= DRIFT_RASTER_ROW_MAX): each
-// closed-form polygon light for the whole run at once (drift_raster_polygon_rows, vectorised),
-// the rest pixel by pixel, each pixel's sampler drawn in the same order as one pixel alone.
 // The environment's direct light at pixel (x, y) of surface s: --light-samples shadow rays,
 // or with interleaving this pixel's quarter of its 2 x 2 block's shared set.
 static drift_vec3 environment_light(const drift_frame_state *f, const drift_surface *s,
@@ -39,6 +36,9 @@ static drift_vec3 environment_light(const drift_frame_state *f, const drift_surf
                                                   drift_sampler_next2(&block), rays);
 }
 
+// The unshadowed light of pixels x0 .. x0 + n - 1 of row y (n <= DRIFT_RASTER_ROW_MAX): each
+// closed-form polygon light for the whole run at once (drift_raster_polygon_rows, vectorised),
+// the rest pixel by pixel, each pixel's sampler drawn in the same order as one pixel alone.
 static void unshadowed_run(drift_frame_state *f, int32_t x0, int32_t n, int32_t y, uint64_t *rays)
 {
     drift_vec3 zero = drift_vec3_splat(0.0f);
@@ -177,12 +177,12 @@ static float sphere_entry(const drift_raster_light *light, const drift_ray *ray,
 // clearance of 0) short of where the ray crosses the emitter's plane. The ray leaves from an
 // origin offset off the surface, so at a grazing angle that crossing comes before the
 // centre's distance d (1 - 1e-4) that tmax holds.
-static float any_hit_tmax(const drift_raster_light *light, const drift_ray *ray)
+static float any_hit_tmax(const drift_raster_light *light, const drift_ray *ray, bool aimed)
 {
     float tmax = ray->tmax - light->shadow_clearance;
-    if (light->sphere_radius > 0.0f || light->type == DRIFT_LIGHT_SPHERE) {
-        // The ray may aim off the centre (aimed_shadow_ray): stop where it enters the sphere,
-        // if that is sooner (toward the centre it is not).
+    if (aimed && (light->sphere_radius > 0.0f || light->type == DRIFT_LIGHT_SPHERE)) {
+        // Aimed off the centre (aimed_shadow_ray): stop where it enters the sphere, if that is
+        // sooner.
         tmax = fminf(tmax, sphere_entry(light, ray, tmax));
     }
     if (light->one_sided) {
@@ -196,23 +196,26 @@ static float any_hit_tmax(const drift_raster_light *light, const drift_ray *ray)
     return tmax;
 }
 
-// The hard-shadow ray of pass k of --aa N (N > 1) with `hard` shadows: toward point k of a
-// stratified set of N on the light, each pixel's set rotated by its own hash (keyed on the
+// Under --aa N (N > 1) with `hard` shadows, pass k's hard-shadow ray toward an area light aims
+// at point k of a stratified set of N on it, each pixel's set rotated by its own hash (keyed on the
 // frame's seed, not the pass's, so the N passes take the N points of one set): the passes'
 // mean is the accumulation buffer's soft shadow (Haeberli and Akeley 1990), noise in the
 // penumbra where one shared set would draw N shifted hard edges. A sphere (or tessellated
 // sphere) is aimed at through its silhouette disc facing the pixel, the other area lights
 // through drift_raster_light_sample; point, spot and directional lights keep the centre ray.
+static bool aims_off_centre(const drift_frame_state *f, const drift_raster_light *light)
+{
+    return f->params.aa > 1 && f->params.shadows == DRIFT_SHADOWS_HARD && light->radius > 0.0f &&
+           drift_light_is_area(light->type);
+}
+
+// That ray (only where aims_off_centre).
 static drift_ray aimed_shadow_ray(const drift_frame_state *f, uint32_t l, const drift_surface *s,
                                   int32_t x, int32_t y, float *light_distance)
 {
     const drift_raster_light *light = &f->lights[l];
     uint32_t passes = f->params.aa;
     bool sphere = light->sphere_radius > 0.0f || light->type == DRIFT_LIGHT_SPHERE;
-    if (passes < 2 || f->params.shadows != DRIFT_SHADOWS_HARD || light->radius <= 0.0f ||
-        !drift_light_is_area(light->type)) {
-        return drift_raster_hard_shadow_ray(light, s, light_distance);
-    }
     // A hash, not a sampler: this is one rotation a pixel, and a ray is all the pass costs.
     uint32_t pixel = (uint32_t)y * (uint32_t)f->params.width + (uint32_t)x;
     uint32_t h = drift_hash_combine(
@@ -265,6 +268,7 @@ static void hard_shadow_row(drift_frame_state *f, int32_t y, uint64_t *rays, voi
     for (uint32_t l = 0; l < f->light_count; ++l) {
         drift_frame_light_buffers *b = &f->light_buffers[l];
         bool any_hit = !occluder_distances && f->lights[l].shadow_clearance >= 0.0f;
+        bool aimed = aims_off_centre(f, &f->lights[l]);
         for (int32_t x0 = 0; x0 < f->params.width; x0 += SHADOW_BATCH) {
             int32_t x1 = x0 + SHADOW_BATCH < f->params.width ? x0 + SHADOW_BATCH : f->params.width;
             uint32_t n = 0;
@@ -278,12 +282,14 @@ static void hard_shadow_row(drift_frame_state *f, int32_t y, uint64_t *rays, voi
                     continue;
                 }
                 xs[n] = x;
-                batch[n] = aimed_shadow_ray(f, l, s, x, y, &light_distance[n]);
+                batch[n] = aimed
+                               ? aimed_shadow_ray(f, l, s, x, y, &light_distance[n])
+                               : drift_raster_hard_shadow_ray(&f->lights[l], s, &light_distance[n]);
                 ++n;
             }
             if (any_hit) {
                 for (uint32_t k = 0; k < n; ++k) {
-                    batch[k].tmax = any_hit_tmax(&f->lights[l], &batch[k]);
+                    batch[k].tmax = any_hit_tmax(&f->lights[l], &batch[k], aimed);
                 }
                 drift_accel_occluded_coherent(f->accel, batch, occluded, n);
             } else {
