@@ -235,19 +235,13 @@ drift_edit_distance drift_reflection_edits_distance(const drift_reflection_edits
 static float region_influence(const drift_reflection_edits *edits, const drift__region *r,
                               const drift_edit_point *q);
 
-static float scene_size(const drift_scene *scene)
-{
-    float d = drift_vec3_length(drift_vec3_sub(scene->bounds.max, scene->bounds.min));
-    return d > 0.0f && isfinite(d) ? d : 1.0f;
-}
-
 // Where the ray from the constraint's view toward its red handle meets the mirror, and r_n.
 static drift_result place_constraint(drift_reflection_edits *edits, uint32_t index)
 {
     drift__constraint *c = &edits->constraints[index];
     drift_vec3 to_point = drift_vec3_sub(c->desc.point, c->desc.view);
     float length = drift_vec3_length(to_point);
-    float tolerance = 1e-2f * scene_size(edits->scene);
+    float tolerance = 1e-2f * drift_scene_extent(edits->scene);
     drift_ray ray = { .origin = c->desc.view,
                       .dir = drift_vec3_scale(to_point, 1.0f / fmaxf(length, 1e-30f)),
                       .tmin = 0.0f,

@@ -354,7 +354,7 @@ float drift_scene_extent(const drift_scene *scene)
         b = scene->bounds;
     }
     float d = drift_bounds3_is_empty(b) ? 0.0f : drift_vec3_length(drift_vec3_sub(b.max, b.min));
-    return d > 0.0f ? d : 1.0f;
+    return d > 0.0f && isfinite(d) ? d : 1.0f;
 }
 
 drift_bounds3 drift__scene_mesh_bounds(const drift_scene *scene)

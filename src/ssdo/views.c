@@ -64,8 +64,7 @@ drift_result drift_ssdo_views_render(drift_context *ctx, const drift_scene *scen
     }
     memset(views, 0, sizeof(*views) * (size_t)count);
     drift_camera_frame eye = drift_camera_frame_make(camera, width, height);
-    float radius = 0.5f * drift_vec3_length(drift_vec3_sub(scene->bounds.max, scene->bounds.min));
-    radius = radius > 0.0f && isfinite(radius) ? radius : 1.0f;
+    float radius = 0.5f * drift_scene_extent(scene);
     // The centre of interest: where the viewer's centre ray meets the scene (or one radius on).
     drift_vec3 from = camera->position;
     float t = free_distance(accel, from, eye.w, INFINITY);

@@ -12,8 +12,7 @@
 
 float drift_view_camera_step(const drift_scene *scene)
 {
-    drift_vec3 extent = drift_vec3_sub(scene->bounds.max, scene->bounds.min);
-    float diagonal = drift_bounds3_is_empty(scene->bounds) ? 0.0f : drift_vec3_length(extent);
+    float diagonal = drift_bounds3_is_empty(scene->bounds) ? 0.0f : drift_scene_extent(scene);
     if (!(diagonal > 0.0f) || !isfinite(diagonal)) {
         diagonal = drift_vec3_length(drift_vec3_sub(scene->camera.target, scene->camera.position));
     }

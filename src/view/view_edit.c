@@ -179,12 +179,6 @@ static bool is_reflective(const drift_view *view, const drift_surface *s)
            !drift_vec3_is_zero(view->scene->materials[s->material].specular);
 }
 
-static float scene_size(const drift_scene *scene)
-{
-    float d = drift_vec3_length(drift_vec3_sub(scene->bounds.max, scene->bounds.min));
-    return d > 0.0f && isfinite(d) ? d : 1.0f;
-}
-
 // What the point reflects now: the hit along r, or a point far along it.
 static drift_vec3 reflected_point(const drift_view *view, const drift_surface *s, drift_vec3 r)
 {
@@ -196,7 +190,7 @@ static drift_vec3 reflected_point(const drift_view *view, const drift_surface *s
     if (drift_accel_intersect(view->accel, &ray, &hit)) {
         return drift_vec3_fma(ray.origin, r, hit.t);
     }
-    return drift_vec3_fma(s->position, r, scene_size(view->scene));
+    return drift_vec3_fma(s->position, r, drift_scene_extent(view->scene));
 }
 
 bool drift_view_edit_event(drift_view *view, const drift_view_event *event)
@@ -274,7 +268,7 @@ bool drift_view_edit_key(drift_view *view, drift_view_key key)
         // Around the red handle; a geodesic region measures along the handle's own mesh, so
         // it does not reach across a gap to another part of the object.
         const drift_reflection_constraint *c = &next->constraints[view->selected];
-        float size = 0.05f * scene_size(view->scene);
+        float size = 0.05f * drift_scene_extent(view->scene);
         next->regions[next->region_count++] =
             (drift_reflection_region){ .type = key == DRIFT_VIEW_KEY_EDIT_REGION
                                                    ? DRIFT_EDIT_REGION_EUCLIDEAN
