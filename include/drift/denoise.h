@@ -141,8 +141,9 @@ typedef struct drift_denoise_inputs {
 } drift_denoise_inputs;
 
 typedef struct drift_denoise_report {
-    uint64_t nonfinite; // input values that were NaN or infinite (taken as 0)
-    uint64_t clamped;   // pixels the firefly rule scaled down
+    uint64_t nonfinite;   // input values that were NaN or infinite (taken as 0)
+    uint64_t clamped;     // pixels the firefly rule scaled down
+    double mean_variance; // the mean over pixels of stage 4's variance (demodulated units)
 } drift_denoise_report;
 
 // Filters in->color into *out (a new 3-channel image; the caller destroys it). report may be

@@ -261,6 +261,10 @@ drift_result drift_denoise_feature(drift_context *ctx, const drift_denoise_input
         drift_parallel_for(ctx, (size_t)f.height, 4, spatial_rows, &sj);
         memcpy(f.var, scratch, f.pixels * sizeof(float));
     }
+    double variance_sum = 0.0;
+    for (size_t i = 0; i < f.pixels; ++i) {
+        variance_sum += (double)f.var[i];
+    }
     if (!p.no_firefly_clamp) {
         firefly_job fj = { &f, scratch, clamped };
         drift_parallel_for(ctx, (size_t)f.height, 4, firefly_rows, &fj);
@@ -293,6 +297,7 @@ drift_result drift_denoise_feature(drift_context *ctx, const drift_denoise_input
         if (report) {
             report->nonfinite = nonfinite;
             report->clamped = clamp_count;
+            report->mean_variance = variance_sum / (double)f.pixels;
         }
     }
 done:
