@@ -98,98 +98,84 @@ static void prepare_rows(size_t begin, size_t end, int thread_index, void *user)
     }
 }
 
-// --- STAGE 3: FIREFLIES ---
+// --- STAGES 3-4: BOX MOMENTS ---
 
-typedef struct firefly_job {
-    const denoise_frame *f;
-    float *irr_out;
-    uint8_t *clamped; // a pixel
-} firefly_job;
-
-static void firefly_rows(size_t begin, size_t end, int thread_index, void *user)
+// The mean and mean square of the demodulated luminance over the (2r+1)^2 box around every
+// pixel (clipped at the image's edges), by separable running sums in double precision: O(1)
+// a pixel, and the same bits for any thread count (one thread).
+static void box_moments(const denoise_frame *f, int r, float *mean, float *mean_sq, double *row_sum,
+                        double *row_sum_sq)
 {
-    (void)thread_index;
-    firefly_job *job = user;
-    const denoise_frame *f = job->f;
     int32_t w = f->width, h = f->height;
-    for (size_t yy = begin; yy < end; ++yy) {
-        int32_t y = (int32_t)yy;
+    for (int32_t y = 0; y < h; ++y) { // horizontal sums of l and l^2
+        double s = 0.0, s2 = 0.0;
+        const float *irr = f->irr + 3 * (size_t)y * (size_t)w;
+        for (int32_t x = 0; x < r && x < w; ++x) {
+            double l = denoise_lum(irr + 3 * x);
+            s += l;
+            s2 += l * l;
+        }
         for (int32_t x = 0; x < w; ++x) {
-            size_t i = (size_t)y * (size_t)w + (size_t)x;
+            if (x + r < w) {
+                double l = denoise_lum(irr + 3 * (x + r));
+                s += l;
+                s2 += l * l;
+            }
+            if (x - r - 1 >= 0) {
+                double l = denoise_lum(irr + 3 * (x - r - 1));
+                s -= l;
+                s2 -= l * l;
+            }
+            row_sum[(size_t)y * (size_t)w + (size_t)x] = s;
+            row_sum_sq[(size_t)y * (size_t)w + (size_t)x] = s2;
+        }
+    }
+    for (int32_t x = 0; x < w; ++x) { // vertical sums of those, over the box's pixel count
+        int32_t cols = (x + r < w ? x + r : w - 1) - (x - r > 0 ? x - r : 0) + 1;
+        for (int32_t y = 0; y < h; ++y) {
+            int32_t y0 = y - r > 0 ? y - r : 0, y1 = y + r < h ? y + r : h - 1;
             double s = 0.0, s2 = 0.0;
-            int count = 0;
-            for (int32_t qy = y - 2; qy <= y + 2; ++qy) {
-                for (int32_t qx = x - 2; qx <= x + 2; ++qx) {
-                    if (qx < 0 || qy < 0 || qx >= w || qy >= h) {
-                        continue;
-                    }
-                    double l = denoise_lum(f->irr + 3 * ((size_t)qy * (size_t)w + (size_t)qx));
-                    s += l;
-                    s2 += l * l;
-                    ++count;
-                }
+            for (int32_t q = y0; q <= y1; ++q) {
+                s += row_sum[(size_t)q * (size_t)w + (size_t)x];
+                s2 += row_sum_sq[(size_t)q * (size_t)w + (size_t)x];
             }
-            double mean = s / count, sd = sqrt(fmax(s2 / count - mean * mean, 0.0));
-            double own = f->sample_count >= 4 ? sqrt((double)f->var[i]) : 0.0;
-            double limit = mean + 3.0 * sd + 3.0 * own;
-            const float *c = f->irr + 3 * i;
-            float l = denoise_lum(c);
-            float scale = (double)l > limit && l > 0.0f ? (float)(limit / (double)l) : 1.0f;
-            job->clamped[i] = scale < 1.0f;
-            for (int k = 0; k < 3; ++k) {
-                job->irr_out[3 * i + k] = c[k] * scale;
-            }
+            double count = (double)(cols * (y1 - y0 + 1));
+            mean[(size_t)y * (size_t)w + (size_t)x] = (float)(s / count);
+            mean_sq[(size_t)y * (size_t)w + (size_t)x] = (float)(s2 / count);
         }
     }
 }
 
-// --- STAGE 4: VARIANCE BELOW 4 SAMPLES ---
-
-typedef struct spatial_job {
-    const denoise_frame *f;
-    float *var_out;
-} spatial_job;
-
-// The 7x7 moments of the demodulated luminance, each tap weighed by the normal and depth
-// weights of stage 5 (so that the variance does not straddle edges): sigma^2 / n.
-static void spatial_rows(size_t begin, size_t end, int thread_index, void *user)
+// Stage 4 below 4 samples: SVGF's spatial estimate (§4.1), the 7x7 variance of the
+// demodulated luminance, over n; at least the pixel's own estimate.
+static void spatial_variance(denoise_frame *f, const float *mean, const float *mean_sq)
 {
-    (void)thread_index;
-    spatial_job *job = user;
-    const denoise_frame *f = job->f;
-    int32_t w = f->width, h = f->height;
     float inv_n = 1.0f / (float)f->sample_count;
-    for (size_t yy = begin; yy < end; ++yy) {
-        int32_t y = (int32_t)yy;
-        for (int32_t x = 0; x < w; ++x) {
-            size_t p = (size_t)y * (size_t)w + (size_t)x;
-            const float *np = f->normal + 3 * p;
-            float zp = f->depth[p];
-            double sw = 0.0, s = 0.0, s2 = 0.0;
-            for (int32_t qy = y - 3; qy <= y + 3; ++qy) {
-                for (int32_t qx = x - 3; qx <= x + 3; ++qx) {
-                    if (qx < 0 || qy < 0 || qx >= w || qy >= h) {
-                        continue;
-                    }
-                    size_t q = (size_t)qy * (size_t)w + (size_t)qx;
-                    const float *nq = f->normal + 3 * q;
-                    float dot = denoise_normal_dot(np, nq);
-                    float zq = f->depth[q];
-                    float wz = (zp > 0.0f) != (zq > 0.0f) ? 0.0f
-                               : zp > 0.0f                ? expf(-fabsf(zp - zq) / (0.1f * zp))
-                                                          : 1.0f;
-                    float d2 = dot * dot, d4 = d2 * d2, d8 = d4 * d4;
-                    double wgt = dot > 0.0f ? (double)(d8 * d8 * wz) : 0.0; // dot^16
-                    double l = denoise_lum(f->irr + 3 * q);
-                    sw += wgt;
-                    s += wgt * l;
-                    s2 += wgt * l * l;
-                }
-            }
-            double mean = s / sw, var = fmax(s2 / sw - mean * mean, 0.0);
-            job->var_out[p] = fmaxf(f->var[p], (float)var * inv_n);
+    for (size_t i = 0; i < f->pixels; ++i) {
+        float var = fmaxf(mean_sq[i] - mean[i] * mean[i], 0.0f);
+        f->var[i] = fmaxf(f->var[i], var * inv_n);
+    }
+}
+
+// Stage 3: the firefly rule over the 5x5 moments (drift/denoise.h). Returns the count.
+static uint64_t clamp_fireflies(denoise_frame *f, const float *mean, const float *mean_sq)
+{
+    uint64_t count = 0;
+    for (size_t i = 0; i < f->pixels; ++i) {
+        float sd = sqrtf(fmaxf(mean_sq[i] - mean[i] * mean[i], 0.0f));
+        float own = f->sample_count >= 4 ? sqrtf(f->var[i]) : 0.0f;
+        float limit = mean[i] + 3.0f * sd + 3.0f * own;
+        float *c = f->irr + 3 * i;
+        float l = denoise_lum(c);
+        if (l > limit && l > 0.0f) {
+            float scale = limit / l;
+            c[0] *= scale;
+            c[1] *= scale;
+            c[2] *= scale;
+            ++count;
         }
     }
+    return count;
 }
 
 // --- THE CALL ---
@@ -239,10 +225,10 @@ drift_result drift_denoise_feature(drift_context *ctx, const drift_denoise_input
     f.albedo_lum = drift_alloc(ctx, f.pixels * sizeof(float));
     float *scratch = drift_alloc(ctx, f.pixels * 3 * sizeof(float));
     uint64_t *row_bad = drift_alloc(ctx, (size_t)f.height * sizeof(uint64_t));
-    uint8_t *clamped = drift_alloc(ctx, f.pixels);
+    double *sums = drift_alloc(ctx, f.pixels * 2 * sizeof(double));
     drift_result r = DRIFT_ERR_OUT_OF_MEMORY;
     if (!f.irr || !f.var || !f.normal || !f.depth || !f.albedo_lum || !scratch || !row_bad ||
-        !clamped) {
+        !sums) {
         goto done;
     }
     prepare_job pj = { in, &f, row_bad };
@@ -257,23 +243,16 @@ drift_result drift_denoise_feature(drift_context *ctx, const drift_denoise_input
                   (unsigned long long)nonfinite);
     }
     if (f.sample_count < 4 || !in->variance) {
-        spatial_job sj = { &f, scratch };
-        drift_parallel_for(ctx, (size_t)f.height, 4, spatial_rows, &sj);
-        memcpy(f.var, scratch, f.pixels * sizeof(float));
+        box_moments(&f, 3, scratch, scratch + f.pixels, sums, sums + f.pixels);
+        spatial_variance(&f, scratch, scratch + f.pixels);
     }
     double variance_sum = 0.0;
     for (size_t i = 0; i < f.pixels; ++i) {
         variance_sum += (double)f.var[i];
     }
     if (!p.no_firefly_clamp) {
-        firefly_job fj = { &f, scratch, clamped };
-        drift_parallel_for(ctx, (size_t)f.height, 4, firefly_rows, &fj);
-        float *t = f.irr;
-        f.irr = scratch;
-        scratch = t;
-        for (size_t i = 0; i < f.pixels; ++i) {
-            clamp_count += clamped[i];
-        }
+        box_moments(&f, 2, scratch, scratch + f.pixels, sums, sums + f.pixels);
+        clamp_count = clamp_fireflies(&f, scratch, scratch + f.pixels);
     }
     r = p.method == DRIFT_DENOISE_REGRESSION ? denoise_regression(&f, scratch)
                                              : denoise_variance_guided(&f, scratch);
@@ -304,6 +283,6 @@ done:
     frame_free(&f);
     drift_free(ctx, scratch);
     drift_free(ctx, row_bad);
-    drift_free(ctx, clamped);
+    drift_free(ctx, sums);
     return r;
 }

@@ -24,19 +24,6 @@ static inline float denoise_lum(const float *c)
     return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2];
 }
 
-// n_p . n_q of two unit normals, where a zero normal (no guide, or an escaped ray) counts as
-// parallel to another zero normal and perpendicular to any other (so that misses mix only
-// with misses and no pixel loses its own centre tap).
-static inline float denoise_normal_dot(const float *np, const float *nq)
-{
-    bool zp = np[0] == 0.0f && np[1] == 0.0f && np[2] == 0.0f;
-    bool zq = nq[0] == 0.0f && nq[1] == 0.0f && nq[2] == 0.0f;
-    if (zp || zq) {
-        return zp == zq ? 1.0f : 0.0f;
-    }
-    return np[0] * nq[0] + np[1] * nq[1] + np[2] * nq[2];
-}
-
 // Stage 5, each writing 3 floats a pixel of filtered irradiance into out.
 drift_result denoise_variance_guided(const denoise_frame *f, float *out);
 drift_result denoise_regression(const denoise_frame *f, float *out);

@@ -17,170 +17,222 @@
 //     w_a = exp(-(|a_p - a_q| / max(a_p, a_q, 0.05))^2 / sigma_a^2) on albedo luminance:
 //           keeps emitters (albedo = emission) from bleeding into what they light
 // g3x3 is the 3x3 Gaussian (1/4 1/2 1/4 separable) of the variance: SVGF's prefilter.
+// A pixel whose normal is zero (an escaped ray) keeps its value; exp is exp_neg (exp_neg.h).
+// The passes work on planes, a tap's weights over a run of a row in one loop the compiler
+// vectorises, as the a-trous filter's (docs/decisions/0028).
+#include "core/vectorise.h"
+#include "denoise/exp_neg.h"
 #include "feature_internal.h"
 
 #include <math.h>
 #include <string.h>
 
+#define SVGF_RUN 128 // pixels of a row whose taps are weighed together
+
 static const float b3[5] = { 1.0f / 16.0f, 1.0f / 4.0f, 3.0f / 8.0f, 1.0f / 4.0f, 1.0f / 16.0f };
 static const float g1[3] = { 0.25f, 0.5f, 0.25f };
 
+typedef struct svgf_planes {
+    float *c[3], *lum, *var; // this pass's input
+} svgf_planes;
+
 typedef struct svgf_job {
     const denoise_frame *f;
-    const float *c_in, *v_in;
-    float *v_blur; // g3x3(v_in), made by the job's first stage
-    float *c_out, *v_out;
+    const float *normal[3], *depth, *albedo;
+    svgf_planes in, out;
+    float *inv_sigma; // 1 / (sigma_l sqrt(g3x3(v)) + 1e-10), made by the first stage
     int32_t step;
     float inv_depth; // 1 / (sigma_z 2^i)
+    float inv_albedo2;
+    int normal_pow; // sigma_normal when a whole number up to 4096, else -1
+    float sigma_normal;
 } svgf_job;
-
-// dot^e for e a whole number (sigma_normal 128: seven squarings instead of a powf).
-static float power(float dot, float e, int whole)
-{
-    if (whole < 0) {
-        return powf(dot, e);
-    }
-    float r = 1.0f;
-    for (int n = whole; n; n >>= 1) {
-        if (n & 1) {
-            r *= dot;
-        }
-        dot *= dot;
-    }
-    return r;
-}
-
-static float variance_prefilter(const denoise_frame *f, const float *v, int32_t x, int32_t y)
-{
-    float s = 0.0f, sw = 0.0f;
-    for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) {
-            int32_t qx = x + dx, qy = y + dy;
-            if (qx < 0 || qy < 0 || qx >= f->width || qy >= f->height) {
-                continue;
-            }
-            float k = g1[dx + 1] * g1[dy + 1];
-            s += k * v[(size_t)qy * (size_t)f->width + (size_t)qx];
-            sw += k;
-        }
-    }
-    return s / sw;
-}
 
 static void prefilter_rows(size_t begin, size_t end, int thread_index, void *user)
 {
     (void)thread_index;
-    const svgf_job *job = user;
-    for (size_t y = begin; y < end; ++y) {
-        for (int32_t x = 0; x < job->f->width; ++x) {
-            job->v_blur[y * (size_t)job->f->width + (size_t)x] =
-                variance_prefilter(job->f, job->v_in, x, (int32_t)y);
+    const svgf_job *j = user;
+    int32_t w = j->f->width, h = j->f->height;
+    float sigma = j->f->params.sigma_luminance;
+    for (size_t yy = begin; yy < end; ++yy) {
+        int32_t y = (int32_t)yy;
+        for (int32_t x = 0; x < w; ++x) {
+            float s = 0.0f, sw = 0.0f;
+            for (int dy = -1; dy <= 1; ++dy) {
+                for (int dx = -1; dx <= 1; ++dx) {
+                    int32_t qx = x + dx, qy = y + dy;
+                    if (qx < 0 || qy < 0 || qx >= w || qy >= h) {
+                        continue;
+                    }
+                    float k = g1[dx + 1] * g1[dy + 1];
+                    s += k * j->in.var[(size_t)qy * (size_t)w + (size_t)qx];
+                    sw += k;
+                }
+            }
+            j->inv_sigma[(size_t)y * (size_t)w + (size_t)x] =
+                1.0f / (sigma * sqrtf(s / sw) + 1e-10f);
         }
     }
 }
 
-static void svgf_rows(size_t begin, size_t end, int thread_index, void *user)
+// One tap (kernel weight wk, the neighbour `offset` pixels away) over pixels [p, p + n).
+static inline DRIFT_ALWAYS_INLINE void svgf_tap(const svgf_job *j, size_t p, ptrdiff_t offset,
+                                                int32_t n, float wk, float *restrict sum0,
+                                                float *restrict sum1, float *restrict sum2,
+                                                float *restrict wsum, float *restrict vsum)
+{
+    size_t q = (size_t)((ptrdiff_t)p + offset);
+    float nw[SVGF_RUN];
+    const float *restrict nc0 = j->normal[0] + p, *restrict nq0 = j->normal[0] + q;
+    const float *restrict nc1 = j->normal[1] + p, *restrict nq1 = j->normal[1] + q;
+    const float *restrict nc2 = j->normal[2] + p, *restrict nq2 = j->normal[2] + q;
+    DRIFT_IVDEP
+    for (int32_t i = 0; i < n; ++i) {
+        float d = nc0[i] * nq0[i] + nc1[i] * nq1[i] + nc2[i] * nq2[i];
+        d = d > 0.0f ? d : 0.0f;
+        nw[i] = d < 1.0f ? d : 1.0f;
+    }
+    if (j->normal_pow == 128) {
+        DRIFT_IVDEP
+        for (int32_t i = 0; i < n; ++i) {
+            float d = nw[i];
+            for (int k = 0; k < 7; ++k) {
+                d *= d;
+            }
+            nw[i] = d;
+        }
+    } else {
+        for (int32_t i = 0; i < n; ++i) {
+            nw[i] = nw[i] > 0.0f ? powf(nw[i], j->sigma_normal) : 0.0f;
+        }
+    }
+    const float *restrict zc = j->depth + p, *restrict zq = j->depth + q;
+    const float *restrict ac = j->albedo + p, *restrict aq = j->albedo + q;
+    const float *restrict lc = j->in.lum + p, *restrict lq = j->in.lum + q;
+    const float *restrict is = j->inv_sigma + p;
+    const float *restrict c0 = j->in.c[0] + q, *restrict c1 = j->in.c[1] + q;
+    const float *restrict c2 = j->in.c[2] + q, *restrict vq = j->in.var + q;
+    const float inv_depth = j->inv_depth, inv_albedo2 = j->inv_albedo2;
+    DRIFT_IVDEP
+    for (int32_t i = 0; i < n; ++i) {
+        float z = zc[i] > 1e-30f ? zc[i] : 1e-30f;
+        float e = fabsf(lc[i] - lq[i]) * is[i] + fabsf(zc[i] - zq[i]) * (inv_depth / z);
+        float amax = ac[i] > aq[i] ? ac[i] : aq[i];
+        amax = amax > 0.05f ? amax : 0.05f;
+        float da = (ac[i] - aq[i]) / amax;
+        e += da * da * inv_albedo2;
+        float hit_c = zc[i] > 0.0f ? 1.0f : 0.0f, hit_q = zq[i] > 0.0f ? 1.0f : 0.0f;
+        float keep = hit_c == hit_q ? 1.0f : 0.0f;
+        keep = e <= DENOISE_EXP_CUTOFF ? keep : 0.0f;
+        float w = keep * wk * nw[i] * exp_neg(e < DENOISE_EXP_CUTOFF ? e : DENOISE_EXP_CUTOFF);
+        sum0[i] += w * c0[i];
+        sum1[i] += w * c1[i];
+        sum2[i] += w * c2[i];
+        wsum[i] += w;
+        vsum[i] += w * w * vq[i];
+    }
+}
+
+static DRIFT_AVX2_CLONES void svgf_rows(size_t begin, size_t end, int thread_index, void *user)
 {
     (void)thread_index;
-    const svgf_job *job = user;
-    const denoise_frame *f = job->f;
-    const drift_denoise_feature_params *p = &f->params;
-    int32_t w = f->width, h = f->height, step = job->step;
-    float inv_albedo2 = 1.0f / (p->sigma_albedo * p->sigma_albedo);
-    int whole = p->sigma_normal == floorf(p->sigma_normal) && p->sigma_normal <= 4096.0f
-                    ? (int)p->sigma_normal
-                    : -1;
-    for (size_t yy = begin; yy < end; ++yy) {
-        int32_t y = (int32_t)yy;
-        for (int32_t x = 0; x < w; ++x) {
-            size_t pi = (size_t)y * (size_t)w + (size_t)x;
-            const float *cp = job->c_in + 3 * pi;
-            const float *np = f->normal + 3 * pi;
-            float lp = denoise_lum(cp), zp = f->depth[pi], ap = f->albedo_lum[pi];
-            float sigma = p->sigma_luminance * sqrtf(job->v_blur[pi]) + 1e-10f;
-            float inv_sigma = 1.0f / sigma;
-            double sw = 0.0, sv = 0.0, sc[3] = { 0.0, 0.0, 0.0 };
-            for (int ky = -2; ky <= 2; ++ky) {
-                int32_t qy = y + ky * step;
+    const svgf_job *j = user;
+    const int32_t w = j->f->width, h = j->f->height;
+    const float centre = b3[2] * b3[2];
+    float sum0[SVGF_RUN], sum1[SVGF_RUN], sum2[SVGF_RUN], wsum[SVGF_RUN], vsum[SVGF_RUN];
+    for (int32_t y = (int32_t)begin; y < (int32_t)end; ++y) {
+        for (int32_t x0 = 0; x0 < w; x0 += SVGF_RUN) {
+            int32_t n = w - x0 < SVGF_RUN ? w - x0 : SVGF_RUN;
+            size_t p = (size_t)y * (size_t)w + (size_t)x0;
+            for (int32_t i = 0; i < n; ++i) {
+                sum0[i] = centre * j->in.c[0][p + (size_t)i];
+                sum1[i] = centre * j->in.c[1][p + (size_t)i];
+                sum2[i] = centre * j->in.c[2][p + (size_t)i];
+                wsum[i] = centre;
+                vsum[i] = centre * centre * j->in.var[p + (size_t)i];
+            }
+            for (int dy = -2; dy <= 2; ++dy) {
+                int32_t qy = y + dy * j->step;
                 if (qy < 0 || qy >= h) {
                     continue;
                 }
-                for (int kx = -2; kx <= 2; ++kx) {
-                    int32_t qx = x + kx * step;
-                    if (qx < 0 || qx >= w) {
+                for (int dx = -2; dx <= 2; ++dx) {
+                    if (dx == 0 && dy == 0) {
                         continue;
                     }
-                    size_t qi = (size_t)qy * (size_t)w + (size_t)qx;
-                    const float *cq = job->c_in + 3 * qi;
-                    const float *nq = f->normal + 3 * qi;
-                    float zq = f->depth[qi], aq = f->albedo_lum[qi];
-                    float e = fabsf(lp - denoise_lum(cq)) * inv_sigma;
-                    if ((zp > 0.0f) != (zq > 0.0f)) {
-                        continue; // a miss only mixes with misses
-                    }
-                    if (zp > 0.0f) {
-                        e += fabsf(zp - zq) / zp * job->inv_depth;
-                    }
-                    float amax = fmaxf(fmaxf(ap, aq), 0.05f);
-                    float da = (ap - aq) / amax;
-                    e += da * da * inv_albedo2;
-                    float dot = denoise_normal_dot(np, nq);
-                    if (e > 30.0f || dot <= 0.0f) {
+                    int32_t shift = dx * j->step;
+                    int32_t lo = -(x0 + shift) > 0 ? -(x0 + shift) : 0;
+                    int32_t hi = w - x0 - shift < n ? w - x0 - shift : n;
+                    if (lo >= hi) {
                         continue;
                     }
-                    double wgt = (double)(b3[kx + 2] * b3[ky + 2] * expf(-e) *
-                                          power(dot, p->sigma_normal, whole));
-                    sw += wgt;
-                    sv += wgt * wgt * (double)job->v_in[qi];
-                    for (int k = 0; k < 3; ++k) {
-                        sc[k] += wgt * (double)cq[k];
-                    }
+                    ptrdiff_t offset = (ptrdiff_t)dy * j->step * w + shift;
+                    svgf_tap(j, p + (size_t)lo, offset, hi - lo, b3[dx + 2] * b3[dy + 2], sum0 + lo,
+                             sum1 + lo, sum2 + lo, wsum + lo, vsum + lo);
                 }
             }
-            // The centre tap has weight h(0)^2 > 0 (e = 0, dot = 1): sw > 0.
-            for (int k = 0; k < 3; ++k) {
-                job->c_out[3 * pi + k] = (float)(sc[k] / sw);
+            // wsum >= the centre tap's weight (3/8)^2 > 0.
+            for (int32_t i = 0; i < n; ++i) {
+                float c0 = sum0[i] / wsum[i], c1 = sum1[i] / wsum[i], c2 = sum2[i] / wsum[i];
+                j->out.c[0][p + (size_t)i] = c0;
+                j->out.c[1][p + (size_t)i] = c1;
+                j->out.c[2][p + (size_t)i] = c2;
+                j->out.lum[p + (size_t)i] = 0.2126f * c0 + 0.7152f * c1 + 0.0722f * c2;
+                j->out.var[p + (size_t)i] = vsum[i] / (wsum[i] * wsum[i]);
             }
-            job->v_out[pi] = (float)(sv / (sw * sw));
         }
     }
 }
 
 drift_result denoise_variance_guided(const denoise_frame *f, float *out)
 {
-    float *c[2] = { drift_alloc(f->ctx, f->pixels * 3 * sizeof(float)), out };
-    float *v[2] = { drift_alloc(f->ctx, f->pixels * sizeof(float)),
-                    drift_alloc(f->ctx, f->pixels * sizeof(float)) };
-    float *v_blur = drift_alloc(f->ctx, f->pixels * sizeof(float));
-    if (!c[0] || !v[0] || !v[1] || !v_blur) {
-        drift_free(f->ctx, v_blur);
-        drift_free(f->ctx, c[0]);
-        drift_free(f->ctx, v[0]);
-        drift_free(f->ctx, v[1]);
+    size_t n = f->pixels;
+    // Planes: 2 x (c0 c1 c2 lum var) ping-pong, n0 n1 n2, inv_sigma.
+    float *mem = drift_alloc(f->ctx, n * 14 * sizeof(float));
+    if (!mem) {
         return DRIFT_ERR_OUT_OF_MEMORY;
     }
-    // Ping-pong so that the last pass writes into out: pass i reads buffer src, writes dst.
-    int iterations = f->params.iterations;
-    int dst = (iterations % 2 == 1) ? 1 : 0; // c[1] is out
-    memcpy(c[1 - dst], f->irr, f->pixels * 3 * sizeof(float));
-    memcpy(v[1 - dst], f->var, f->pixels * sizeof(float));
-    for (int i = 0; i < iterations; ++i) {
-        int src = 1 - dst;
+    svgf_planes planes[2];
+    for (int b = 0; b < 2; ++b) {
+        float *base = mem + (size_t)b * 5 * n;
+        planes[b] = (svgf_planes){ { base, base + n, base + 2 * n }, base + 3 * n, base + 4 * n };
+    }
+    float *normal[3] = { mem + 10 * n, mem + 11 * n, mem + 12 * n };
+    float *inv_sigma = mem + 13 * n;
+    for (size_t i = 0; i < n; ++i) {
+        for (int k = 0; k < 3; ++k) {
+            planes[0].c[k][i] = f->irr[3 * i + k];
+            normal[k][i] = f->normal[3 * i + k];
+        }
+        planes[0].lum[i] = denoise_lum(f->irr + 3 * i);
+        planes[0].var[i] = f->var[i];
+    }
+    const drift_denoise_feature_params *p = &f->params;
+    int whole = p->sigma_normal == floorf(p->sigma_normal) && p->sigma_normal <= 4096.0f
+                    ? (int)p->sigma_normal
+                    : -1;
+    int src = 0;
+    for (int i = 0; i < p->iterations; ++i, src = 1 - src) {
         svgf_job job = { .f = f,
-                         .c_in = c[src],
-                         .v_in = v[src],
-                         .c_out = c[dst],
-                         .v_out = v[dst],
-                         .v_blur = v_blur,
+                         .normal = { normal[0], normal[1], normal[2] },
+                         .depth = f->depth,
+                         .albedo = f->albedo_lum,
+                         .in = planes[src],
+                         .out = planes[1 - src],
+                         .inv_sigma = inv_sigma,
                          .step = 1 << i,
-                         .inv_depth = 1.0f / (f->params.sigma_depth * (float)(1 << i)) };
+                         .inv_depth = 1.0f / (p->sigma_depth * (float)(1 << i)),
+                         .inv_albedo2 = 1.0f / (p->sigma_albedo * p->sigma_albedo),
+                         .normal_pow = whole,
+                         .sigma_normal = p->sigma_normal };
         drift_parallel_for(f->ctx, (size_t)f->height, 8, prefilter_rows, &job);
         drift_parallel_for(f->ctx, (size_t)f->height, 2, svgf_rows, &job);
-        dst = src;
     }
-    drift_free(f->ctx, c[0]);
-    drift_free(f->ctx, v[0]);
-    drift_free(f->ctx, v[1]);
-    drift_free(f->ctx, v_blur);
+    for (size_t i = 0; i < n; ++i) {
+        for (int k = 0; k < 3; ++k) {
+            out[3 * i + k] = planes[src].c[k][i];
+        }
+    }
+    drift_free(f->ctx, mem);
     return DRIFT_OK;
 }
