@@ -102,7 +102,7 @@ drift_result drift_denoise_atrous(drift_context *ctx, const drift_image *color,
 //          luminance exp(-|l_p - l_q| / (sigma_luminance sqrt(g3x3(v_p)) + eps))
 //          normal    max(0, n_p . n_q)^sigma_normal
 //          depth     exp(-|z_p - z_q| / (sigma_depth 2^i z_p))
-//          albedo    exp(-(|a_p - a_q| / max(a_p, a_q, 0.05))^2 / sigma_albedo^2) (luminances)
+//          albedo    exp(-ln((a_p + 0.01) / (a_q + 0.01))^2 / sigma_albedo^2) (luminances)
 //        with the variance carried through each pass (sum w^2 v / (sum w)^2): where the
 //        samples agree (many spp) the luminance weight closes and little is blurred
 //      REGRESSION  blockwise first-order feature regression (BMFR, Koskela et al. 2019):

@@ -14,8 +14,9 @@
 //     w_z = exp(-|z_p - z_q| / (sigma_z 2^i z_p)): a relative depth step (drift's a-trous
 //           form, as the path tracer gives no screen-space depth gradient); misses only
 //           mix with misses
-//     w_a = exp(-(|a_p - a_q| / max(a_p, a_q, 0.05))^2 / sigma_a^2) on albedo luminance:
-//           keeps emitters (albedo = emission) from bleeding into what they light
+//     w_a = exp(-ln((a_p + 0.01) / (a_q + 0.01))^2 / sigma_a^2) on albedo luminance, a
+//           scale-free ratio: keeps emitters (albedo = emission, ~50x a wall's) from
+//           mixing with what they light, and weakly (0.15) texels 4x apart
 // g3x3 is the 3x3 Gaussian (1/4 1/2 1/4 separable) of the variance: SVGF's prefilter.
 // A pixel whose normal is zero (an escaped ray) keeps its value; exp is exp_neg (exp_neg.h).
 // The passes work on planes, a tap's weights over a run of a row in one loop the compiler
@@ -38,7 +39,7 @@ typedef struct svgf_planes {
 
 typedef struct svgf_job {
     const denoise_frame *f;
-    const float *normal[3], *depth, *albedo;
+    const float *normal[3], *depth, *log_albedo;
     svgf_planes in, out;
     float *inv_sigma; // 1 / (sigma_l sqrt(g3x3(v)) + 1e-10), made by the first stage
     int32_t step;
@@ -109,7 +110,7 @@ static inline DRIFT_ALWAYS_INLINE void svgf_tap(const svgf_job *j, size_t p, ptr
         }
     }
     const float *restrict zc = j->depth + p, *restrict zq = j->depth + q;
-    const float *restrict ac = j->albedo + p, *restrict aq = j->albedo + q;
+    const float *restrict ac = j->log_albedo + p, *restrict aq = j->log_albedo + q;
     const float *restrict lc = j->in.lum + p, *restrict lq = j->in.lum + q;
     const float *restrict is = j->inv_sigma + p;
     const float *restrict c0 = j->in.c[0] + q, *restrict c1 = j->in.c[1] + q;
@@ -119,9 +120,7 @@ static inline DRIFT_ALWAYS_INLINE void svgf_tap(const svgf_job *j, size_t p, ptr
     for (int32_t i = 0; i < n; ++i) {
         float z = zc[i] > 1e-30f ? zc[i] : 1e-30f;
         float e = fabsf(lc[i] - lq[i]) * is[i] + fabsf(zc[i] - zq[i]) * (inv_depth / z);
-        float amax = ac[i] > aq[i] ? ac[i] : aq[i];
-        amax = amax > 0.05f ? amax : 0.05f;
-        float da = (ac[i] - aq[i]) / amax;
+        float da = ac[i] - aq[i];
         e += da * da * inv_albedo2;
         float hit_c = zc[i] > 0.0f ? 1.0f : 0.0f, hit_q = zq[i] > 0.0f ? 1.0f : 0.0f;
         float keep = hit_c == hit_q ? 1.0f : 0.0f;
@@ -189,8 +188,8 @@ static DRIFT_AVX2_CLONES void svgf_rows(size_t begin, size_t end, int thread_ind
 drift_result denoise_variance_guided(const denoise_frame *f, float *out)
 {
     size_t n = f->pixels;
-    // Planes: 2 x (c0 c1 c2 lum var) ping-pong, n0 n1 n2, inv_sigma.
-    float *mem = drift_alloc(f->ctx, n * 14 * sizeof(float));
+    // Planes: 2 x (c0 c1 c2 lum var) ping-pong, n0 n1 n2, inv_sigma, log albedo.
+    float *mem = drift_alloc(f->ctx, n * 15 * sizeof(float));
     if (!mem) {
         return DRIFT_ERR_OUT_OF_MEMORY;
     }
@@ -200,7 +199,7 @@ drift_result denoise_variance_guided(const denoise_frame *f, float *out)
         planes[b] = (svgf_planes){ { base, base + n, base + 2 * n }, base + 3 * n, base + 4 * n };
     }
     float *normal[3] = { mem + 10 * n, mem + 11 * n, mem + 12 * n };
-    float *inv_sigma = mem + 13 * n;
+    float *inv_sigma = mem + 13 * n, *log_albedo = mem + 14 * n;
     for (size_t i = 0; i < n; ++i) {
         for (int k = 0; k < 3; ++k) {
             planes[0].c[k][i] = f->irr[3 * i + k];
@@ -208,6 +207,7 @@ drift_result denoise_variance_guided(const denoise_frame *f, float *out)
         }
         planes[0].lum[i] = denoise_lum(f->irr + 3 * i);
         planes[0].var[i] = f->var[i];
+        log_albedo[i] = logf(f->albedo_lum[i] + 0.01f);
     }
     const drift_denoise_feature_params *p = &f->params;
     int whole = p->sigma_normal == floorf(p->sigma_normal) && p->sigma_normal <= 4096.0f
@@ -218,7 +218,7 @@ drift_result denoise_variance_guided(const denoise_frame *f, float *out)
         svgf_job job = { .f = f,
                          .normal = { normal[0], normal[1], normal[2] },
                          .depth = f->depth,
-                         .albedo = f->albedo_lum,
+                         .log_albedo = log_albedo,
                          .in = planes[src],
                          .out = planes[1 - src],
                          .inv_sigma = inv_sigma,
