@@ -9,7 +9,8 @@
 //   c'_p = sum_q h(q) w(p, q) c_q / sum_q h(q) w(p, q)
 //   v'_p = sum_q h(q)^2 w(p, q)^2 v_q / (sum_q h(q) w(p, q))^2          (SVGF eq. 4)
 //   w(p, q) = w_l w_n w_z w_a:
-//     w_l = exp(-|l_p - l_q| / (sigma_l sqrt(g3x3(v)_p) + 1e-10))         (eq. 5)
+//     w_l = exp(-|l_p - l_q| / (sigma_l' sqrt(g3x3(v)_p) + 1e-10))        (eq. 5)
+//           with sigma_l' = sigma_l (1 + 1 / sqrt(n)) (see prefilter_rows)
 //     w_n = max(0, n_p . n_q)^sigma_n                                      (eq. 3)
 //     w_z = exp(-|z_p - z_q| / (sigma_z 2^i z_p)): a relative depth step (drift's a-trous
 //           form, as the path tracer gives no screen-space depth gradient); misses only
