@@ -152,6 +152,15 @@ void cli_session_close(cli_session *s);
 // options (--refine sir starts from --indirect none).
 #define CLI_TECHNIQUE_UNSET (-1)
 
+// The two defaults that depend on other options, around cli_parse of a command with
+// CLI_KNOBS: cli_knobs_unset marks --indirect and --env-scale as not given (params holds
+// drift_hybrid_params_default()); cli_knobs_finish gives them their value: --indirect none
+// under --refine sir (SIR's tracer has no indirect light, docs/sir.md), else the default
+// technique; --env-scale 1 with --env-interleave on (interleaving takes every pixel), else
+// the row's default.
+void cli_knobs_unset(drift_hybrid_params *params);
+void cli_knobs_finish(drift_hybrid_params *params, bool refine);
+
 #define CLI_FNV_BASIS 0xcbf29ce484222325ull
 uint64_t cli_fnv1a(uint64_t h, const void *data, size_t size);
 // cli_fnv1a of the files' contents in order, a NUL between files; false (errno set) when one

@@ -1,5 +1,6 @@
 #include "cli.h"
 #include "drift/accel.h"
+#include "drift/knobs.h"
 #include "drift/scene_io.h"
 
 #include <errno.h>
@@ -71,6 +72,25 @@ bool cli_parse_vec3(const char *cmd, const char *flag, const char *text, bool sc
     }
     *out = drift_vec3_make(a, b, c);
     return true;
+}
+
+void cli_knobs_unset(drift_hybrid_params *params)
+{
+    params->techniques[DRIFT_EFFECT_INDIRECT] = CLI_TECHNIQUE_UNSET;
+    params->environment_scale = 0;
+}
+
+void cli_knobs_finish(drift_hybrid_params *params, bool refine)
+{
+    if (params->techniques[DRIFT_EFFECT_INDIRECT] == CLI_TECHNIQUE_UNSET) {
+        params->indirect =
+            refine ? DRIFT_INDIRECT_NONE
+                   : (drift_indirect_technique)drift_technique_default(DRIFT_EFFECT_INDIRECT);
+    }
+    if (params->environment_scale == 0) {
+        params->environment_scale =
+            params->environment_interleave ? 1 : drift_hybrid_params_default().environment_scale;
+    }
 }
 
 bool cli_parse_refine(const char *cmd, const char *flag, const char *value, void *field)

@@ -2,6 +2,7 @@
 // and PNG, with every plane (--aov FILE.exr) and per-pass milliseconds and rays (--stats).
 #include "cli.h"
 #include "drift/image_io.h"
+#include "drift/knobs.h"
 #include "drift/refine.h"
 #include "render.h"
 
@@ -22,7 +23,30 @@ static bool write_stats(const render_options *o, const cli_session *session,
                                 drift_technique_name((drift_effect)e, drift_hybrid_params_technique(
                                                                           &p, (drift_effect)e)));
     }
-    cli_json_count(root, "spp", p.spp);
+    // --spp counts only where a chosen technique path-traces (reference, aaf, ...): a
+    // real-time frame takes one sample a pixel ('aa' passes of it).
+    bool path_traced = false;
+    for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
+        path_traced |= drift_technique_path_traced(
+            (drift_effect)e, drift_hybrid_params_technique(&p, (drift_effect)e));
+    }
+    if (path_traced) {
+        cli_json_count(root, "spp", p.spp);
+    }
+    // Every knob of the knob table as the frame resolved it (drift/knobs.h): the options
+    // --KNOB VALUE that render this frame again.
+    cJSON *knobs = cJSON_AddObjectToObject(root, "knobs");
+    for (int k = 0; k < drift_knob_count(); ++k) {
+        const drift_knob *knob = drift_knob_get(k);
+        double value = drift_knob_value(&p, k);
+        char text[64];
+        drift_knob_format(knob, value, text, sizeof text);
+        if (knob->type == DRIFT_KNOB_CHOICE || strcmp(text, "auto") == 0) {
+            cJSON_AddStringToObject(knobs, knob->name, text);
+        } else {
+            cJSON_AddNumberToObject(knobs, knob->name, value);
+        }
+    }
     cli_json_count(root, "seed", p.seed);
     cli_json_count(root, "aa", p.aa ? p.aa : 1);
     cJSON_AddNumberToObject(root, "max_depth", p.max_depth);

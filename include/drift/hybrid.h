@@ -275,13 +275,11 @@ typedef struct drift_hybrid_params {
 
 drift_hybrid_params drift_hybrid_params_resolve(const drift_hybrid_params *params,
                                                 const drift_scene *scene);
-// What `drift render --mode hybrid` and `drift view` start from: a combination of the
-// equal-time frontier within ~100 ms on the Cornell box, the glossy box, the plants and the
-// Breakfast Room at 400x400, 2 threads (docs/frontier.md): hard shadows, instant radiosity from
-// imperfect shadow maps (1024 VPLs, gathered at one pixel in 2 x 2), 2 light samples, the
-// environment's shadow rays at one pixel in 2 x 2 and its filter's 4 passes, and max depth 8
-// (multiple bounces). A zeroed drift_hybrid_params stays hard shadows, no indirect light, 8
-// light samples, max depth 2: the library's and the tests' neutral frame.
+// drift_hybrid_params_default() (drift/knobs.h): every effect's default technique and every
+// knob at the default in its row of the knob table, the one default the command line, the
+// viewer and --help use. Kept for the callers of the earlier name. A zeroed
+// drift_hybrid_params stays the library's neutral frame (hard shadows, no indirect light, 8
+// light samples, max depth 2, each family's zero fallbacks).
 drift_hybrid_params drift_hybrid_params_recommended(void);
 // The technique `params` chooses for `effect` (-1 for an invalid effect), and setting it: one
 // int per effect for code that walks the effects (the viewer's keys and overlay, the CLI).

@@ -3,6 +3,7 @@
 // (hybrid/techniques.h); the passes live in the technique folders (src/realtime, src/isg,
 // src/aaf, ...) and reach the frame's buffers through frame/frame.h, never through here.
 #include "aaf/aaf.h"
+#include "drift/knobs.h"
 #include "hybrid/frame_access.h"
 #include "hybrid/techniques.h"
 #include "isg/isg.h"
@@ -75,13 +76,7 @@ drift_hybrid_params drift_hybrid_params_resolve(const drift_hybrid_params *param
 
 drift_hybrid_params drift_hybrid_params_recommended(void)
 {
-    return (drift_hybrid_params){ .shadows = DRIFT_SHADOWS_HARD,
-                                  .indirect = DRIFT_INDIRECT_ISM,
-                                  .max_depth = 8,
-                                  .light_samples = 2,
-                                  .environment_filter = 4,
-                                  .environment_scale = 2,
-                                  .ism = { .vpls = 1024, .gather_scale = 2 } };
+    return drift_hybrid_params_default(); // the knob table's rows (src/hybrid/knobs.c)
 }
 
 static bool techniques_valid(const drift_hybrid_params *p)
