@@ -10,6 +10,21 @@
 #include <stdlib.h>
 #include <string.h>
 
+// A stage's label: an effect's stage names its technique ("indirect ism").
+static void render_stage_label(const drift_hybrid_params *p, const char *stage, char *out,
+                               size_t size)
+{
+    for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
+        if (strcmp(stage, drift_effect_name((drift_effect)e)) == 0) {
+            snprintf(out, size, "%s %s", stage,
+                     drift_technique_name((drift_effect)e,
+                                          drift_hybrid_params_technique(p, (drift_effect)e)));
+            return;
+        }
+    }
+    snprintf(out, size, "%s", stage);
+}
+
 static bool write_stats(const render_options *o, const cli_session *session,
                         const drift_hybrid *frame, double first_frame_ms, double t_done,
                         const char *path)
@@ -64,6 +79,15 @@ static bool write_stats(const render_options *o, const cli_session *session,
     cJSON *effects = cJSON_AddObjectToObject(root, "effect_ms");
     for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
         cli_json_number(effects, drift_effect_name((drift_effect)e), s.effect_ms[e], 3);
+    }
+    // The frame's stages: each timed once, none inside another; they add up to the frame.
+    cJSON *stages = cJSON_AddObjectToObject(root, "stages");
+    const char *stage_name;
+    double stage_ms;
+    for (uint32_t k = 0; drift_hybrid_stats_stage(&s, k, &stage_name, &stage_ms); ++k) {
+        char label[64];
+        render_stage_label(&p, stage_name, label, sizeof label);
+        cli_json_number(stages, label, stage_ms, 3);
     }
     cJSON *ms = cJSON_AddObjectToObject(root, "milliseconds");
     cli_json_number(ms, "load", 1e3 * (session->t_loaded - session->t_start), 3);
@@ -214,11 +238,22 @@ int render_hybrid(const render_options *o, const cli_session *session)
         goto done;
     }
     if (!o->quiet) {
+        // The frame's stages (they add up to the frame), then the rays of each pass.
         drift_hybrid_stats s = drift_hybrid_get_stats(frame);
+        const char *name;
+        double ms;
+        for (uint32_t k = 0; drift_hybrid_stats_stage(&s, k, &name, &ms); ++k) {
+            char label[64];
+            render_stage_label(&params, name, label, sizeof label);
+            if (ms > 0.0) {
+                fprintf(stderr, "  %-22s %9.2f ms\n", label, ms);
+            }
+        }
+        fprintf(stderr, "  %-22s %9.2f ms\n", "frame", s.frame_ms);
         for (int k = 0; k < DRIFT_PASS_COUNT; ++k) {
-            if (s.ms[k] > 0.0) {
-                fprintf(stderr, "  %-14s %9.2f ms %12llu rays\n",
-                        drift_hybrid_pass_name((drift_hybrid_pass)k), s.ms[k],
+            if (s.rays[k] > 0) {
+                fprintf(stderr, "  %-22s %12llu rays\n",
+                        drift_hybrid_pass_name((drift_hybrid_pass)k),
                         (unsigned long long)s.rays[k]);
             }
         }

@@ -336,7 +336,20 @@ typedef struct drift_hybrid_stats {
     double effect_ms[DRIFT_EFFECT_COUNT];
     uint64_t rays[DRIFT_PASS_COUNT];
     double frame_ms; // the whole drift_hybrid_render call
+    // With ms[DRIFT_PASS_PRIMARY] and effect_ms, the frame's stages, each timed once at the
+    // top level of drift_hybrid_render and none inside another (drift_hybrid_stats_stage).
+    double inputs_ms;  // the inputs the chosen rows share (U_l, hard shadows, maps, probes, ...)
+    double compose_ms; // L = E + D + R + I + ...
+    double other_ms;   // --aa's running sum and the list of planes
 } drift_hybrid_stats;
+
+// The frame's stages, in order: "primary", "inputs", every effect by name (its chosen row's
+// whole work: the ISM or AAF pass, summing D after a shadow row, ...), "compose", "other".
+// Each is timed once at the top level of the frame, so they add up to frame_ms but for the
+// frame's own bookkeeping: the pass table, the viewer's overlay and --stats print these and
+// cannot leave a stage out. Returns false past the last stage.
+bool drift_hybrid_stats_stage(const drift_hybrid_stats *stats, uint32_t index,
+                              const char **out_name, double *out_ms);
 
 typedef struct drift_hybrid drift_hybrid;
 

@@ -168,13 +168,15 @@ void drift_view_draw_overlay(drift_view *view)
         }
         drift_hybrid_stats stats = drift_hybrid_get_stats(view->hybrid);
         append(text, &len, "frame\t%.2f ms\n", stats.frame_ms);
+        // The frame's stages (they add up to the frame: none is left out), two a line.
         int column = 0;
-        for (int p = 0; p < DRIFT_PASS_COUNT; ++p) {
-            if (!(stats.ms[p] > 0.0)) {
-                continue; // the pass did not run (or was cached) this frame
+        const char *name;
+        double ms;
+        for (uint32_t k = 0; drift_hybrid_stats_stage(&stats, k, &name, &ms); ++k) {
+            if (!(ms > 0.0)) {
+                continue; // the stage did not run this frame
             }
-            const char *name = drift_hybrid_pass_name((drift_hybrid_pass)p);
-            append(text, &len, "%s%s\t%.2f ms", column ? "\t" : "", name ? name : "?", stats.ms[p]);
+            append(text, &len, "%s%s\t%.2f ms", column ? "\t" : "", name, ms);
             column = !column;
             if (!column) {
                 append(text, &len, "\n");
