@@ -57,6 +57,8 @@ static const char other_keys_text[] =
     "wheel\tdolly toward / away from the target\n"
     "+ -\texposure +/- 0.5 stops\n"
     "R, Home\treset the camera\n"
+    "K, Shift-K\tnext / previous knob (every knob of --help's tables)\n"
+    ". ,\tthe knob up / down\n"
     "O\toverlay on/off\n"
     "H, F1\tthis help on/off\n"
     "Ctrl-click\tedit: a constraint at a reflective point\n"
@@ -327,6 +329,12 @@ static drift_view_key key_of(SDL_Keycode sym, bool shift)
         return DRIFT_VIEW_KEY_EDIT_UNDO;
     case SDLK_p:
         return DRIFT_VIEW_KEY_EDIT_SAVE;
+    case SDLK_k:
+        return shift ? DRIFT_VIEW_KEY_KNOB_PREV : DRIFT_VIEW_KEY_KNOB_NEXT;
+    case SDLK_PERIOD:
+        return DRIFT_VIEW_KEY_KNOB_UP;
+    case SDLK_COMMA:
+        return DRIFT_VIEW_KEY_KNOB_DOWN;
     default:
         return DRIFT_VIEW_KEY_NONE;
     }

@@ -90,6 +90,12 @@ bool drift_knob_set(drift_hybrid_params *params, int index, double value);
 // same value ("%.9g" for numbers) and returns snprintf's count.
 bool drift_knob_parse(const drift_knob *knob, const char *text, double *out_value);
 int drift_knob_format(const drift_knob *knob, double value, char *out, size_t size);
+// The value a step up (direction > 0) or down from `value` gives, within the range: the
+// next or previous choice; +-1 for an integer of a short range (at most 16 values), else
+// x2 or /2 (the next or previous perfect square where squares are needed); x2 or /2 for a
+// number. Down from the lower bound of an auto knob is auto (0), up from auto the lower
+// bound. A step past the end gives the value back. For the viewer's keys and searches.
+double drift_knob_step(const drift_knob *knob, double value, int direction);
 // What the knob accepts, for error messages: "an integer in [1, 65536]", "off or on".
 int drift_knob_expects(const drift_knob *knob, char *out, size_t size);
 

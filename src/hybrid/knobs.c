@@ -262,6 +262,49 @@ int drift_knob_format(const drift_knob *k, double value, char *out, size_t size)
     return snprintf(out, size, "%.9g", value);
 }
 
+double drift_knob_step(const drift_knob *k, double value, int direction)
+{
+    if (!k || direction == 0) {
+        return value;
+    }
+    bool up = direction > 0;
+    if ((k->flags & DRIFT_KNOB_AUTO) && value == 0.0) {
+        return up ? k->lo : value;
+    }
+    double next = value;
+    if (k->type == DRIFT_KNOB_CHOICE) {
+        int index = choice_of_value(k, value), count = 1;
+        for (const char *p = k->choices; (p = strchr(p, '|')) != NULL; ++p) {
+            ++count;
+        }
+        int to = index + (up ? 1 : -1);
+        if (index < 0 || to < 0 || to >= count) {
+            return value;
+        }
+        return k->choice_values ? (double)k->choice_values[to] : (double)to;
+    }
+    if (k->flags & DRIFT_KNOB_SQUARE) {
+        double root = floor(sqrt(value) + 0.5);
+        next = up ? (root * 2.0) * (root * 2.0) : floor(root / 2.0) * floor(root / 2.0);
+        next = next < 1.0 ? 1.0 : next;
+        while (next > k->hi) {
+            root = floor(sqrt(next)) - 1.0;
+            next = root * root;
+        }
+    } else if (k->type == DRIFT_KNOB_INT && k->hi - k->lo <= 16.0) {
+        next = value + (up ? 1.0 : -1.0);
+    } else if (k->type == DRIFT_KNOB_INT) {
+        next = up ? value * 2.0 : floor(value / 2.0);
+    } else {
+        next = up ? value * 2.0 : value * 0.5;
+    }
+    if (next < k->lo) {
+        next = (k->flags & DRIFT_KNOB_AUTO) && value == k->lo ? 0.0 : k->lo;
+    }
+    next = next > k->hi ? k->hi : next;
+    return value_valid(k, next) ? next : value;
+}
+
 int drift_knob_expects(const drift_knob *k, char *out, size_t size)
 {
     if (!k) {

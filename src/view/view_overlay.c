@@ -1,5 +1,6 @@
 // The viewer's text overlay: a table of lines and tab-separated cells drawn with
 // stb_easy_font's quads on a dark box, top left of the framebuffer.
+#include "drift/knobs.h"
 #include "view/view_internal.h"
 
 #include <math.h>
@@ -151,6 +152,13 @@ void drift_view_draw_overlay(drift_view *view)
         for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
             append(text, &len, "%s\t%s\n", drift_effect_name((drift_effect)e),
                    technique_of(&view->params, (drift_effect)e));
+        }
+        {
+            const drift_knob *k = drift_knob_get(view->knob);
+            char value[64];
+            drift_knob_format(k, drift_knob_value(&view->params, view->knob), value, sizeof value);
+            append(text, &len, "knob %d/%d\t%s %s\n", view->knob + 1, drift_knob_count(), k->name,
+                   value);
         }
         append(text, &len, "buffer\t%s\n", view->buffer_name);
         append(text, &len, "exposure\t%+.1f stops\n", (double)view->exposure_stops);
