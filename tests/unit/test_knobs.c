@@ -124,6 +124,12 @@ static void test_bounds(void **state)
         if (k->flags & DRIFT_KNOB_SQUARE) {
             assert_false(drift_knob_set(&p, i, 24.0));
         }
+        // The viewer's steps stay in range and move off the default, up or down.
+        double up = drift_knob_step(k, k->def, 1), down = drift_knob_step(k, k->def, -1);
+        assert_true(drift_knob_set(&p, i, up));
+        assert_true(drift_knob_set(&p, i, down));
+        assert_true(up != k->def || down != k->def);
+        assert_true(drift_knob_step(k, up, -1) <= up && drift_knob_step(k, down, 1) >= down);
     }
     assert_int_equal(drift_knob_find("no-such-knob"), -1);
 }
