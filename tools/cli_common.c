@@ -93,6 +93,37 @@ void cli_knobs_finish(drift_hybrid_params *params, bool refine)
     }
 }
 
+bool cli_parse_list(const char *cmd, const char *flag, const char *text, long lo, long hi, int max,
+                    long *out, int *count)
+{
+    long values[64];
+    int n = 0;
+    bool ok = max > 0 && max <= (int)(sizeof values / sizeof *values);
+    for (const char *p = text; ok;) {
+        char *end = NULL;
+        errno = 0;
+        long v = strtol(p, &end, 10);
+        ok = end != p && errno == 0 && v >= lo && v <= hi && n < max &&
+             (*end == ',' || *end == '\0') && *p != ' ' && *p != '+';
+        if (ok) {
+            values[n++] = v;
+        }
+        if (!ok || *end == '\0') {
+            break;
+        }
+        p = end + 1;
+    }
+    if (!ok) {
+        fprintf(stderr,
+                "drift %s: %s expects 1 to %d comma-separated integers in [%ld, %ld], got '%s'\n",
+                cmd, flag, max, lo, hi, text);
+        return false;
+    }
+    memcpy(out, values, (size_t)n * sizeof *out);
+    *count = n;
+    return true;
+}
+
 bool cli_parse_refine(const char *cmd, const char *flag, const char *value, void *field)
 {
     if (strcmp(value, "sir") != 0) {
