@@ -18,6 +18,7 @@
 #include "drift/pt.h"
 #include "drift/refine.h"
 #include "drift/scene_io.h"
+#include "render.h"
 
 #include <errno.h>
 #include <math.h>
@@ -28,11 +29,11 @@
 
 #define MAX_BUDGETS    16
 #define MAX_ROWS       512
-#define FRONTIER_DEPTH 8
+#define FRONTIER_DEPTH RENDER_WHOLE_FRAME_DEPTH
 // The hybrid frame's own default (drift_hybrid_params.light_samples = 0 -> 8); a row at
 // another count is named with it.
 #define DEFAULT_LIGHT_SAMPLES 8
-#define REF_SEED              0x5eedu
+#define REF_SEED              RENDER_WHOLE_FRAME_REF_SEED
 
 typedef struct frontier_options {
     const char *scene_path, *csv_path, *svg_path, *cache_dir;
@@ -208,29 +209,14 @@ drift_result bench_frontier_path_trace(drift_context *ctx, const drift_scene *sc
                                        uint32_t spp, uint32_t seed, const atomic_bool *cancel,
                                        drift_image *out, uint64_t *rays)
 {
-    drift_pt_params params = {
-        .width = width, .height = height, .seed = seed, .max_depth = FRONTIER_DEPTH
-    };
-    drift_pt *pt = NULL;
-    drift_result r = drift_pt_create(ctx, scene, accel, &params, &pt);
-    r = r ? r : drift_pt_render_samples(pt, spp, cancel);
-    drift_image beauty;
-    r = r ? r : drift_pt_resolve(pt, DRIFT_PT_AOV_BEAUTY, &beauty);
-    r = r ? r : copy_rgb(ctx, &beauty, out);
-    if (r == DRIFT_OK && rays) {
-        drift_pt_stats st = drift_pt_get_stats(pt);
-        *rays = st.camera_rays + st.shadow_rays + st.bounce_rays;
-    }
-    drift_pt_destroy(pt);
-    return r;
+    return render_whole_frame_pt(ctx, scene, accel, width, height, spp, seed, cancel, out, rays);
 }
 
 drift_result bench_frontier_reference(drift_context *ctx, const drift_scene *scene,
                                       const drift_accel *accel, int32_t width, int32_t height,
                                       uint32_t spp, drift_image *out)
 {
-    return bench_frontier_path_trace(ctx, scene, accel, width, height, spp, REF_SEED, NULL, out,
-                                     NULL);
+    return render_whole_frame_reference(ctx, scene, accel, width, height, spp, out);
 }
 
 // Loads the cached reference or renders and caches it; *cached says which.

@@ -26,32 +26,7 @@ bool bench_open(cli_session *s, const char *cmd, const char *scene_path, const c
 bool bench_parse_list(const char *cmd, const char *flag, const char *text, long lo, long hi,
                       int max, long *out, int *count)
 {
-    long values[64];
-    int n = 0;
-    bool ok = max > 0 && max <= (int)(sizeof values / sizeof *values);
-    for (const char *p = text; ok;) {
-        char *end = NULL;
-        errno = 0;
-        long v = strtol(p, &end, 10);
-        ok = end != p && errno == 0 && v >= lo && v <= hi && n < max &&
-             (*end == ',' || *end == '\0') && *p != ' ' && *p != '+';
-        if (ok) {
-            values[n++] = v;
-        }
-        if (!ok || *end == '\0') {
-            break;
-        }
-        p = end + 1;
-    }
-    if (!ok) {
-        fprintf(stderr,
-                "drift %s: %s expects 1 to %d comma-separated integers in [%ld, %ld], got '%s'\n",
-                cmd, flag, max, lo, hi, text);
-        return false;
-    }
-    memcpy(out, values, (size_t)n * sizeof *out);
-    *count = n;
-    return true;
+    return cli_parse_list(cmd, flag, text, lo, hi, max, out, count);
 }
 
 int drift_cmd_bench(int argc, char **argv)

@@ -152,6 +152,22 @@ void cli_session_close(cli_session *s);
 // options (--refine sir starts from --indirect none).
 #define CLI_TECHNIQUE_UNSET (-1)
 
+// A list option ("--vpls 64,256,1024"): 1 to `max` comma-separated integers in [lo, hi] into
+// out[0 .. *count - 1]. Otherwise prints "drift <cmd>: <flag> expects 1 to <max>
+// comma-separated integers in [lo, hi], got '<text>'", leaves *count and out as they were
+// and returns false.
+bool cli_parse_list(const char *cmd, const char *flag, const char *text, long lo, long hi, int max,
+                    long *out, int *count);
+
+// The two defaults that depend on other options, around cli_parse of a command with
+// CLI_KNOBS: cli_knobs_unset marks --indirect and --env-scale as not given (params holds
+// drift_hybrid_params_default()); cli_knobs_finish gives them their value: --indirect none
+// under --refine sir (SIR's tracer has no indirect light, docs/sir.md), else the default
+// technique; --env-scale 1 with --env-interleave on (interleaving takes every pixel), else
+// the row's default.
+void cli_knobs_unset(drift_hybrid_params *params);
+void cli_knobs_finish(drift_hybrid_params *params, bool refine);
+
 #define CLI_FNV_BASIS 0xcbf29ce484222325ull
 uint64_t cli_fnv1a(uint64_t h, const void *data, size_t size);
 // cli_fnv1a of the files' contents in order, a NUL between files; false (errno set) when one

@@ -1,5 +1,6 @@
 #include "cli.h"
 #include "drift/accel.h"
+#include "drift/knobs.h"
 #include "drift/scene_io.h"
 
 #include <errno.h>
@@ -70,6 +71,56 @@ bool cli_parse_vec3(const char *cmd, const char *flag, const char *text, bool sc
         return false;
     }
     *out = drift_vec3_make(a, b, c);
+    return true;
+}
+
+void cli_knobs_unset(drift_hybrid_params *params)
+{
+    params->techniques[DRIFT_EFFECT_INDIRECT] = CLI_TECHNIQUE_UNSET;
+    params->environment_scale = 0;
+}
+
+void cli_knobs_finish(drift_hybrid_params *params, bool refine)
+{
+    if (params->techniques[DRIFT_EFFECT_INDIRECT] == CLI_TECHNIQUE_UNSET) {
+        params->indirect =
+            refine ? DRIFT_INDIRECT_NONE
+                   : (drift_indirect_technique)drift_technique_default(DRIFT_EFFECT_INDIRECT);
+    }
+    if (params->environment_scale == 0) {
+        params->environment_scale =
+            params->environment_interleave ? 1 : drift_hybrid_params_default().environment_scale;
+    }
+}
+
+bool cli_parse_list(const char *cmd, const char *flag, const char *text, long lo, long hi, int max,
+                    long *out, int *count)
+{
+    long values[64];
+    int n = 0;
+    bool ok = max > 0 && max <= (int)(sizeof values / sizeof *values);
+    for (const char *p = text; ok;) {
+        char *end = NULL;
+        errno = 0;
+        long v = strtol(p, &end, 10);
+        ok = end != p && errno == 0 && v >= lo && v <= hi && n < max &&
+             (*end == ',' || *end == '\0') && *p != ' ' && *p != '+';
+        if (ok) {
+            values[n++] = v;
+        }
+        if (!ok || *end == '\0') {
+            break;
+        }
+        p = end + 1;
+    }
+    if (!ok) {
+        fprintf(stderr,
+                "drift %s: %s expects 1 to %d comma-separated integers in [%ld, %ld], got '%s'\n",
+                cmd, flag, max, lo, hi, text);
+        return false;
+    }
+    memcpy(out, values, (size_t)n * sizeof *out);
+    *count = n;
     return true;
 }
 

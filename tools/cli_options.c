@@ -3,6 +3,7 @@
 
 #include "cli.h"
 #include "drift/hybrid.h"
+#include "drift/knobs.h"
 
 #include <stdint.h>
 #include <stdio.h>
@@ -133,6 +134,17 @@ static bool read_value(const char *cmd, const char *flag, const cli_option *opt,
         drift_hybrid_params_set_technique(field, (drift_effect)effect, t);
         return true;
     }
+    case CLI_KIND_KNOBS: {
+        const drift_knob *knob = drift_knob_get(effect);
+        double v = 0.0;
+        if (!drift_knob_parse(knob, value, &v)) {
+            char expects[256];
+            drift_knob_expects(knob, expects, sizeof expects);
+            fprintf(stderr, "drift %s: %s expects %s, got '%s'\n", cmd, flag, expects, value);
+            return false;
+        }
+        return drift_knob_set(field, effect, v);
+    }
     case CLI_KIND_CUSTOM:
         return opt->parse(cmd, flag, value, field);
     case CLI_KIND_SECTION:
@@ -182,7 +194,14 @@ static int technique_row_effect(const cli_command *c, const cli_option *opt, con
     return effect_has_own_row(c, e) ? -1 : e;
 }
 
-// The row for `arg`, the groups of the section it is in and, for technique rows, the effect.
+// The knob `arg` (--ism-vpls, ...) names, or -1.
+static int knob_of(const char *arg)
+{
+    return strncmp(arg, "--", 2) == 0 ? drift_knob_find(arg + 2) : -1;
+}
+
+// The row for `arg`, the groups of the section it is in and, for technique rows, the effect
+// (for the knob row, the knob's index).
 static const cli_option *find_option(const cli_command *c, const char *arg, unsigned *groups,
                                      int *effect)
 {
@@ -192,6 +211,10 @@ static const cli_option *find_option(const cli_command *c, const char *arg, unsi
         *effect = technique_row_effect(c, opt, arg);
         if (opt->kind == CLI_KIND_SECTION) {
             section = opt->groups;
+        } else if (opt->kind == CLI_KIND_KNOBS && knob_of(arg) >= 0) {
+            *effect = knob_of(arg);
+            *groups = section;
+            return opt;
         } else if (*effect >= 0 || (opt->kind != CLI_KIND_TECHNIQUES && opt->name &&
                                     name_matches(opt->name, arg))) {
             *groups = section;
@@ -246,7 +269,8 @@ int cli_parse(const cli_command *c, int argc, char **argv, void *opts,
             if (next && next[0] != '-' && n > m && strcmp(next + n - m, opt->optional_if) == 0) {
                 value = argv[++i];
             }
-        } else if (opt->arg && !(value = cli_next_value(c->name, argc, argv, &i))) {
+        } else if ((opt->arg || opt->kind == CLI_KIND_KNOBS) &&
+                   !(value = cli_next_value(c->name, argc, argv, &i))) {
             return CLI_USAGE_ERROR;
         }
         if (!read_value(c->name, a, opt, effect, value, opts)) {
@@ -276,7 +300,7 @@ static void print_indented(FILE *out, const char *text, int column)
     }
 }
 
-// "hard (default), pcf, pcss or aaf": the first technique is the zero (default) one.
+// "hard (default), pcf, pcss or aaf": the default is drift_technique_default's.
 static void print_techniques(FILE *out, drift_effect effect)
 {
     if (drift_technique_count(effect) < 1) {
@@ -289,7 +313,8 @@ static void print_techniques(FILE *out, drift_effect effect)
                 t == 0          ? ""
                 : t + 1 < count ? ", "
                                 : " or ",
-                drift_technique_name(effect, t), t == 0 ? " (default)" : "");
+                drift_technique_name(effect, t),
+                t == drift_technique_default(effect) ? " (default)" : "");
     }
     fprintf(out, "\n");
 }
@@ -315,6 +340,36 @@ static void print_label(FILE *out, const char *name, const char *arg, int column
     snprintf(label, sizeof label, "%s%s%s", name, arg ? " " : "", arg ? arg : "");
     int len = (int)strlen(label) + 2;
     fprintf(out, "  %s%*s", label, len < column ? column - len : 2, "");
+}
+
+// Every knob, under its family's title: the label, the row's help, and its default, unit and
+// range.
+static void print_knobs(FILE *out, int column)
+{
+    const char *family = NULL;
+    for (int i = 0, n = drift_knob_count(); i < n; ++i) {
+        const drift_knob *k = drift_knob_get(i);
+        if (!family || strcmp(family, k->family) != 0) {
+            family = k->family;
+            fprintf(out, "  %s:\n", drift_knob_family_title(family));
+        }
+        char name[64];
+        snprintf(name, sizeof name, "--%s", k->name);
+        if ((int)(strlen(name) + strlen(k->arg) + 3) >= column) { // its help on the next line
+            fprintf(out, "  %s %s\n%*s", name, k->arg, column, "");
+        } else {
+            print_label(out, name, k->arg, column);
+        }
+        print_indented(out, k->help, column);
+        char def[64], range[128] = "";
+        drift_knob_format(k, k->def, def, sizeof def);
+        if (k->type != DRIFT_KNOB_CHOICE) {
+            snprintf(range, sizeof range, "; %.9g..%.9g%s%s", k->lo, k->hi, *k->unit ? " " : "",
+                     k->unit);
+        }
+        fprintf(out, "%*s(default %s%s%s%s)\n", column, "", def, k->default_text ? ": " : "",
+                k->default_text ? k->default_text : "", range);
+    }
 }
 
 void cli_print_help(const cli_command *c, FILE *out)
@@ -351,6 +406,8 @@ void cli_print_help(const cli_command *c, FILE *out)
                 print_label(out, name, opt->arg, column);
                 print_techniques(out, (drift_effect)e);
             }
+        } else if (opt->kind == CLI_KIND_KNOBS) {
+            print_knobs(out, column);
         } else if (opt->help) { // no help: a hidden alias
             print_label(out, opt->name, opt->arg, column);
             print_indented(out, opt->help, column);

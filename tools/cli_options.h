@@ -37,6 +37,8 @@ typedef enum cli_kind {
     CLI_KIND_CHOICE,     // one of `choices` ("full|plane"): stores its index
     CLI_KIND_TECHNIQUES, // one row for every effect: --<effect name> T sets that effect's
                          // technique in the drift_hybrid_params at `offset`
+    CLI_KIND_KNOBS,      // one row for every knob of the knob table (drift/knobs.h): --<knob
+                         // name> V sets that knob in the drift_hybrid_params at `offset`
     CLI_KIND_CUSTOM,     // `parse` reads the value (NULL when the option takes none)
     CLI_KIND_SECTION,    // help only: a heading; the options after it join its `groups`
     CLI_KIND_NOTE,       // help only: a line under the option before it
@@ -124,6 +126,13 @@ typedef struct cli_option {
     {                                                                      \
         .name = (n), .arg = (a), .help = (h), .kind = CLI_KIND_TECHNIQUES, \
         .offset = offsetof(T, f)                                           \
+    }
+// --shadow-map-size N, --ism-vpls N, ...: one option per row of the knob table
+// (include/drift/knobs.h), its help, range, unit and default printed from the row, grouped by
+// the family that owns it. A new knob needs no row here.
+#define CLI_KNOBS(T, f)                                  \
+    {                                                    \
+        .kind = CLI_KIND_KNOBS, .offset = offsetof(T, f) \
     }
 #define CLI_CUSTOM(n, a, T, f, fn, h)                                                 \
     {                                                                                 \

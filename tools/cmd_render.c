@@ -7,6 +7,7 @@
 #include "drift/denoise.h"
 #include "drift/glare.h"
 #include "drift/image_io.h"
+#include "drift/knobs.h"
 #include "drift/pt.h"
 #include "drift/reflect_edit.h"
 #include "drift/scene_io.h"
@@ -160,60 +161,11 @@ static bool parse_probe(const char *cmd, const char *flag, const char *v, void *
     return cli_parse_vec3(cmd, flag, v, true, &h->envmap.probe);
 }
 
-static bool parse_envmap_parallax(const char *cmd, const char *flag, const char *v, void *field)
-{
-    drift_hybrid_params *h = field;
-    if (strcmp(v, "none") == 0) {
-        h->envmap.parallax = DRIFT_ENVMAP_PARALLAX_NONE;
-    } else if (strcmp(v, "box") == 0) {
-        h->envmap.parallax = DRIFT_ENVMAP_PARALLAX_BOX;
-    } else {
-        fprintf(stderr, "drift %s: %s expects none or box, got '%s'\n", cmd, flag, v);
-        return false;
-    }
-    return true;
-}
-
 static bool parse_ambient(const char *cmd, const char *flag, const char *v, void *field)
 {
     drift_hybrid_params *h = field;
     h->has_ambient = true;
     return cli_parse_vec3(cmd, flag, v, true, &h->ambient);
-}
-
-// ISG sample counts are k x k grids on the disk: 9, 25, 49, 81 (any square up to 1024).
-static bool parse_isg_count(const char *cmd, const char *flag, const char *v, void *field)
-{
-    long n = 0;
-    if (!cli_parse_int(cmd, flag, v, 1, 1024, &n)) {
-        return false;
-    }
-    long k = 1;
-    while (k * k < n) {
-        ++k;
-    }
-    if (k * k != n) {
-        fprintf(stderr, "drift %s: %s expects a perfect square (9, 25, 49, 81, ...), got '%s'\n",
-                cmd, flag, v);
-        return false;
-    }
-    *(int32_t *)field = (int32_t)n;
-    return true;
-}
-
-// --micro-density: the share of pixels that gather, as 1, 1/4 or 1/16 (the grid's spacing).
-static bool parse_micro_density(const char *cmd, const char *flag, const char *v, void *field)
-{
-    static const char *const names[] = { "1", "1/4", "1/16" };
-    static const int32_t spacing[] = { 1, 2, 4 };
-    for (int i = 0; i < 3; ++i) {
-        if (strcmp(v, names[i]) == 0) {
-            *(int32_t *)field = spacing[i];
-            return true;
-        }
-    }
-    fprintf(stderr, "drift %s: %s expects 1, 1/4 or 1/16, got '%s'\n", cmd, flag, v);
-    return false;
 }
 
 // Groups of options (cli_parse's first_in_group): hybrid-only, and refinement-only.
@@ -294,137 +246,18 @@ static const cli_option render_table[] = {
             "render N frames of the view and write the last: its stats\n"
             "are a frame with warm caches (default 1; first_frame_ms in\n"
             "--stats has the first)"),
-    CLI_INT("--light-samples", "N", O, hybrid.light_samples, 1, 4096,
-            "samples per area light for unshadowed light, and the environment's\n"
-            "shadow rays a pixel (default 2; docs/frontier.md#the-defaults)"),
-    CLI_INT("--aa", "N", O, hybrid.aa, 1, 4096,
-            "anti-aliasing: the whole frame N times, each through a\n"
-            "stratified sub-pixel offset with its own seed, averaged (the\n"
-            "path tracer's box pixel filter; default 1 = pixel centres);\n"
-            "hard shadows aim at a stratified point of the light a pass\n"
-            "(soft shadows), ISM gathers 1/N of one frame's VPLs a pass"),
-    CLI_INT("--shadow-map-size", "N", O, hybrid.shadow_map.size, 1, 8192,
-            "texels a cube face (default 512)"),
-    CLI_NUMBER("--shadow-bias", "B", O, hybrid.shadow_map.bias, 1e-3, 1e3,
-               "shadow-map depth bias in texel footprints (default 1.5)"),
-    CLI_INT("--pcf-kernel", "K", O, hybrid.shadow_map.pcf_kernel, 1, 63,
-            "PCF texels across (default 3)"),
-    CLI_INT("--envmap-size", "N", O, hybrid.envmap.size, 1, 4096,
-            "texels a cube face (default 128)"),
     CLI_CUSTOM("--probe", "X,Y,Z|object", O, hybrid, parse_probe,
                "environment-map probe: a point, or one per reflective mesh\n"
                "(default: the scene's centre)"),
-    CLI_CUSTOM("--envmap-parallax", "none|box", O, hybrid, parse_envmap_parallax,
-               "environment-map lookup: none (along the reflected direction,\n"
-               "as seen from the probe) or box (parallax-corrected against the\n"
-               "scene's bounding box, a local cube map; default none)"),
     CLI_CUSTOM("--ambient", "R,G,B", O, hybrid, parse_ambient,
                "ambient radiance (default: the frame's mean direct light)"),
     CLI_NUMBER("--aperture", "R", O, aperture, 0.0, 1e30,
                "lens radius in scene units (default: the scene camera's)"),
     CLI_NUMBER("--focus-distance", "F", O, focus_distance, 1e-30, 1e30,
                "distance to the plane in focus (default: the camera's)"),
-    CLI_CUSTOM("--isg-search", "N", O, hybrid.isg.search, parse_isg_count,
-               "image space gathering (docs/isg.md): parameter-search"),
-    CLI_CUSTOM("--isg-gather", "M", O, hybrid.isg.gather, parse_isg_count,
-               "and gather samples, perfect squares (default 25 and 49)"),
-    CLI_NUMBER("--isg-sigma", "S", O, hybrid.isg.sigma, 1e-30, 1e30,
-               "range sigma of eq. 6 and 10, squared scene units\n"
-               "(default (0.02 x scene extent)^2)"),
-    CLI_NUMBER("--blur-radius", "R", O, hybrid.isg.blur_radius, 1e-30, 1024.0,
-               "disk radius in pixels of the blur baselines (default 4)"),
-    CLI_INT("--isg-layers", "1|2", O, hybrid.isg.layers, 1, 2,
-            "2: a second depth layer behind objects for --dof isg"),
-    CLI_CHOICE("--isg-range", "full|plane", O, hybrid.isg.range_plane, "full|plane",
-               "l of the range functions: world distance (default, the\n"
-               "paper) or distance to the centre's tangent plane"),
-    CLI_INT("--aaf-max-spp", "N", O, hybrid.aaf.max_spp, 1, 65536,
-            "cap on AAF's adaptive samples a pixel (default 8 x spp)"),
-    CLI_CHOICE("--aaf-sampling", "M", O, hybrid.aaf.uniform, "adaptive|uniform",
-               "adaptive (default) or uniform: spp in every pixel"),
-    CLI_CHOICE("--aaf-filter", "on|off", O, hybrid.aaf.unfiltered, "on|off",
-               "off: AAF's unfiltered estimate (with uniform: plain MC)"),
-    CLI_CHOICE("--aaf-sampler", "S", O, hybrid.aaf.random, "sobol|random",
-               "sobol (default: Owen-scrambled Sobol) or random (independent\n"
-               "uniform numbers, the paper's Monte Carlo)"),
-    CLI_INT("--occlusion-samples", "N", O, hybrid.occlusion_settings.samples, 1, 1024,
-            "--occlusion ssao|gtao|ssdo (docs/ssdo.md): samples a pixel\n"
-            "(default 16; ssdo 4, marched by --occlusion-steps)"),
-    CLI_NUMBER("--occlusion-radius", "R", O, hybrid.occlusion_settings.radius, 1e-30, 1e30,
-               "r_max in scene units (default 0.05 x scene extent)"),
-    CLI_CHOICE("--ssdo-bounce", "off|on", O, hybrid.occlusion_settings.bounce, "off|on",
-               "on: SSDO's one indirect bounce (when --indirect is none)"),
-    CLI_INT("--occlusion-layers", "1|2", O, hybrid.occlusion_settings.layers, 1, 2,
-            "2: a second depth layer (one more ray a pixel) behind thin\n"
-            "objects (default 1)"),
-    CLI_CHOICE("--occlusion-fade", "on|off", O, hybrid.occlusion_settings.no_fade, "on|off",
-               "off: occluders near r_max count fully (default on)"),
-    CLI_CHOICE("--occlusion-blur", "on|off", O, hybrid.occlusion_settings.no_blur, "on|off",
-               "off: no geometry-aware blur of the sample sets (default on)"),
-    CLI_INT("--occlusion-cameras", "N", O, hybrid.occlusion_settings.cameras, 0, 5,
-            "additional depth-only cameras at half size that find occluders\n"
-            "outside the image (ssao, ssdo, contact shadows; default 0)"),
-    CLI_INT("--occlusion-steps", "K", O, hybrid.occlusion_settings.steps, 1, 64,
-            "points on each ssao/ssdo sample direction: 1 the thesis's\n"
-            "point test (ssao default), more a march to r_max (a ray\n"
-            "test; ssdo default 4)"),
-    CLI_CHOICE("--env-interleave", "off|on", O, hybrid.environment_interleave, "off|on",
-               "on: a quarter of the environment's --light-samples shadow rays a\n"
-               "pixel, interleaved over 2 x 2 pixels and gathered back over 3 x 3\n"
-               "of the same surface (default off; docs/hybrid.md)"),
-    CLI_INT("--env-scale", "N", O, hybrid.environment_scale, 1, 2,
-            "2: one pixel in 2 x 2 traces the environment's shadow rays, the\n"
-            "others take the traced ones on their surface (default 2, or 1\n"
-            "with --env-interleave on; 1: every pixel; docs/hybrid.md)"),
-    CLI_INT("--env-filter", "N", O, hybrid.environment_filter, 0, 10,
-            "N passes of the edge-avoiding a-trous filter over the\n"
-            "environment's direct light, guided by the G-buffer (default 4;\n"
-            "0: none; docs/hybrid.md)"),
-    CLI_CHOICE("--contact-shadows", "off|on", O, hybrid.shadow_map.contact_shadows, "off|on",
-               "on: --shadows pcf|pcss march each lit pixel's shadow-map bias\n"
-               "toward the light in screen space (thesis §4.5; default off)"),
-    CLI_INT("--contact-samples", "N", O, hybrid.shadow_map.contact_samples, 1, 1024,
-            "points on each contact-shadow march (default 8)"),
-    CLI_INT("--ism-vpls", "N", O, hybrid.ism.vpls, 1, 65536,
-            "instant radiosity (--indirect ism|ir, docs/ism.md): light\n"
-            "paths, one first-bounce VPL each (default 1024)"),
-    CLI_CHOICE("--ism-vpl-importance", "off|on", O, hybrid.ism.vpl_importance, "off|on",
-               "on: keep candidate VPLs with probability by their contribution\n"
-               "to the view, divided by it (Georgiev & Slusallek 2010;\n"
-               "default off)"),
-    CLI_CHOICE("--ism-near-field", "on|off", O, hybrid.ism.no_near_field, "on|off",
-               "off: no near-field compensation (short rays from a quarter of the\n"
-               "pixels give back the light of surfaces nearer than the VPLs'\n"
-               "clamp; default on)"),
-    CLI_INT("--ism-gather-scale", "N", O, hybrid.ism.gather_scale, 1, 4,
-            "1: every pixel gathers the VPLs; 2 or 4: one pixel in 2x2 or\n"
-            "4x4 does, its irradiance upsampled to the others (default 2;\n"
-            "docs/ism.md)"),
-    CLI_INT("--ism-map-size", "N", O, hybrid.ism.map_size, 4, 1024,
-            "texels a side of each VPL's imperfect shadow map (default 64)"),
-    CLI_INT("--ism-points", "N", O, hybrid.ism.points_per_vpl, 16, 1 << 20,
-            "scene points splatted into each map (default 1024)"),
-    CLI_INT("--ism-later-paths", "N", O, hybrid.ism.later_paths, 1, 65536,
-            "of the --ism-vpls paths, how many go on past their first VPL\n"
-            "(default a quarter; at most all of them; docs/ism.md)"),
-    CLI_INT("--micro-points", "N", O, hybrid.micro.points, 2, 1 << 22,
-            "micro-rendering (--indirect micro, --reflections micro,\n"
-            "docs/micro.md): scene points in the hierarchy, rounded up to\n"
-            "a power of two (default 65536)"),
-    CLI_INT("--micro-size", "K", O, hybrid.micro.buffer_size, 4, 32,
-            "each gather's micro-buffer is K x K pixels (default 16)"),
-    CLI_CUSTOM("--micro-density", "1|1/4|1/16", O, hybrid.micro.density, parse_micro_density,
-               "gather at every pixel, 1/4 or 1/16 of them and upsample\n"
-               "bilaterally (default 1)"),
-    CLI_INT("--micro-bounces", "N", O, hybrid.micro.bounces, 1, 8,
-            "light bounces the micro-buffers gather: the points hold\n"
-            "direct light plus N - 1 bounces (default 1)"),
-    CLI_CHOICE("--micro-lighting", "MODE", O, hybrid.micro.lighting,
-               "auto|direct|radiosity|photons",
-               "auto, direct, radiosity or photons: how the points get\n"
-               "bounces 2..N, by Jacobi gathers over the hierarchy or a\n"
-               "photon map (caustics included); direct is one bounce; auto\n"
-               "(default): direct for one bounce, else radiosity"),
+    CLI_SECTION("technique knobs (hybrid mode; each family's table, include/drift/knobs.h):",
+                GROUP_HYBRID),
+    CLI_KNOBS(O, hybrid),
 
     CLI_SECTION("smart image refinement (hybrid mode; docs/sir.md):", GROUP_HYBRID | GROUP_REFINE),
     CLI_CUSTOM("--refine", "sir", O, refine.enabled, cli_parse_refine,
@@ -464,7 +297,7 @@ static const cli_command render_command = {
 int render_parse_options(int argc, char **argv, render_options *o)
 {
     *o = (render_options){ .out_path = "out/render.exr",
-                           .hybrid = drift_hybrid_params_recommended(),
+                           .hybrid = drift_hybrid_params_default(),
                            .frames = 1,
                            .spp = 64,
                            .checkpoint_seconds = 60.0,
@@ -475,23 +308,12 @@ int render_parse_options(int argc, char **argv, render_options *o)
                            .aperture = -1.0,
                            .focus_distance = -1.0 };
     const char *first[CLI_GROUP_COUNT] = { 0 };
-    // Whether --indirect is given decides its default (see --refine below).
-    o->hybrid.techniques[DRIFT_EFFECT_INDIRECT] = CLI_TECHNIQUE_UNSET;
-    o->hybrid.environment_scale = 0; // unset: decided below (interleaving takes every pixel)
+    cli_knobs_unset(&o->hybrid);
     int status = cli_parse(&render_command, argc, argv, o, first);
     if (status != CLI_PARSED) {
         return status;
     }
-    // SIR's tracer has no indirect light (docs/sir.md): a refined frame starts from none.
-    if (o->hybrid.techniques[DRIFT_EFFECT_INDIRECT] == CLI_TECHNIQUE_UNSET) {
-        o->hybrid.indirect =
-            o->refine.enabled ? DRIFT_INDIRECT_NONE : drift_hybrid_params_recommended().indirect;
-    }
-    if (o->hybrid.environment_scale == 0) {
-        o->hybrid.environment_scale = o->hybrid.environment_interleave
-                                          ? 1
-                                          : drift_hybrid_params_recommended().environment_scale;
-    }
+    cli_knobs_finish(&o->hybrid, o->refine.enabled);
     o->hybrid_option = first[0];
     o->refine.first_option = first[1];
     if (!o->hybrid_mode && o->hybrid_option) {

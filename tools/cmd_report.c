@@ -10,7 +10,6 @@
 // content, the frame's parameters and drift's version, so a rerun renders only what is
 // missing and Ctrl-C keeps what is finished. The `sir` cell is the whole frame refined by
 // smart image refinement, against drift bench frontier's whole-frame path-traced truth.
-#include "bench.h"
 #include "cli.h"
 #include "drift/image_io.h"
 #include "drift/metric.h"
@@ -100,8 +99,8 @@ static bool parse_effects(const char *cmd, const char *flag, const char *value, 
 static bool parse_sir_iterations(const char *cmd, const char *flag, const char *value, void *field)
 {
     report_options *o = field;
-    if (!bench_parse_list(cmd, flag, value, 1, 1 << 20, REPORT_MAX_SIR, o->sir_iterations,
-                          &o->sir_iteration_count)) {
+    if (!cli_parse_list(cmd, flag, value, 1, 1 << 20, REPORT_MAX_SIR, o->sir_iterations,
+                        &o->sir_iteration_count)) {
         return false;
     }
     for (int i = 1; i < o->sir_iteration_count; ++i) { // ascending: one refinement gives all
@@ -679,8 +678,8 @@ static const cJSON *sir_truth(report_run *run, const cli_session *s, const char 
     }
     drift_image truth = { 0 };
     double t0 = drift_time_now();
-    drift_result r = bench_frontier_reference(run->ctx, s->scene, s->accel, p->width, p->height,
-                                              (uint32_t)run->o->ref_spp, &truth);
+    drift_result r = render_whole_frame_reference(run->ctx, s->scene, s->accel, p->width, p->height,
+                                                  (uint32_t)run->o->ref_spp, &truth);
     double ms = 1e3 * (drift_time_now() - t0);
     run->render_seconds += ms / 1e3;
     run->units_done += (double)run->o->ref_spp;
@@ -717,8 +716,8 @@ static const cJSON *sir_pt(report_run *run, const cli_session *s, const char *la
     drift_image image = { 0 };
     uint64_t rays = 0;
     double t0 = drift_time_now();
-    drift_result r = bench_frontier_path_trace(run->ctx, s->scene, s->accel, p->width, p->height,
-                                               (uint32_t)spp, 1u, run->cancel, &image, &rays);
+    drift_result r = render_whole_frame_pt(run->ctx, s->scene, s->accel, p->width, p->height,
+                                           (uint32_t)spp, 1u, run->cancel, &image, &rays);
     double ms = 1e3 * (drift_time_now() - t0);
     run->render_seconds += ms / 1e3;
     run->units_done += (double)spp;

@@ -15,6 +15,7 @@
 #include "drift/hybrid.h"
 #include "drift/image.h"
 #include "drift/image_io.h"
+#include "drift/knobs.h"
 #include "drift/scene_io.h"
 #include "drift/view.h"
 
@@ -35,7 +36,7 @@ typedef struct view_options {
     const char *press; // --press: view keys applied before the first frame
     long width, height, threads, spp_per_frame, spp, seed, frames;
     double exposure;
-    drift_hybrid_params hybrid; // the techniques given (drift_hybrid_params_recommended else)
+    drift_hybrid_params hybrid; // techniques and knobs (drift_hybrid_params_default else)
     bool split, no_overlay, verbose;
     bool refine;            // --refine sir
     long refine_budget;     // --budget: SIR samples a frame (0: the default)
@@ -56,6 +57,8 @@ static const char other_keys_text[] =
     "wheel\tdolly toward / away from the target\n"
     "+ -\texposure +/- 0.5 stops\n"
     "R, Home\treset the camera\n"
+    "K, Shift-K\tnext / previous knob (every knob of --help's tables)\n"
+    ". ,\tthe knob up / down\n"
     "O\toverlay on/off\n"
     "H, F1\tthis help on/off\n"
     "Ctrl-click\tedit: a constraint at a reflective point\n"
@@ -146,6 +149,8 @@ static const cli_option view_table[] = {
                "'wrote FILE (WxH, N frames, SOURCE): mean M, C colours'\n"
                "(M the mean 8-bit value / 255, C the distinct RGB colours)"),
     CLI_FLAG("--verbose", O, verbose, "more log output"),
+    CLI_SECTION("technique knobs, each family's table (include/drift/knobs.h):", 0),
+    CLI_KNOBS(O, hybrid),
 };
 #undef O
 
@@ -244,19 +249,13 @@ static bool parse_press(const char *cmd, const char *flag, const char *v, void *
 // Returns 0 on success, 2 on a usage error (message printed), -1 after --help.
 static int parse_options(int argc, char **argv, view_options *o)
 {
-    *o =
-        (view_options){ .spp = 4, .spp_per_frame = 1, .hybrid = drift_hybrid_params_recommended() };
-    // Whether --indirect is given decides its default (see --refine below).
-    o->hybrid.techniques[DRIFT_EFFECT_INDIRECT] = CLI_TECHNIQUE_UNSET;
+    *o = (view_options){ .spp = 4, .spp_per_frame = 1, .hybrid = drift_hybrid_params_default() };
+    cli_knobs_unset(&o->hybrid);
     int status = cli_parse(&view_command, argc, argv, o, NULL);
     if (status != CLI_PARSED) {
         return status;
     }
-    // SIR's tracer has no indirect light (docs/sir.md): a refined view starts from none.
-    if (o->hybrid.techniques[DRIFT_EFFECT_INDIRECT] == CLI_TECHNIQUE_UNSET) {
-        o->hybrid.indirect =
-            o->refine ? DRIFT_INDIRECT_NONE : drift_hybrid_params_recommended().indirect;
-    }
+    cli_knobs_finish(&o->hybrid, o->refine);
     if (o->screenshot_path) {
         size_t len = strlen(o->screenshot_path);
         if (len < 5 || strcmp(o->screenshot_path + len - 4, ".png") != 0) {
@@ -330,6 +329,12 @@ static drift_view_key key_of(SDL_Keycode sym, bool shift)
         return DRIFT_VIEW_KEY_EDIT_UNDO;
     case SDLK_p:
         return DRIFT_VIEW_KEY_EDIT_SAVE;
+    case SDLK_k:
+        return shift ? DRIFT_VIEW_KEY_KNOB_PREV : DRIFT_VIEW_KEY_KNOB_NEXT;
+    case SDLK_PERIOD:
+        return DRIFT_VIEW_KEY_KNOB_UP;
+    case SDLK_COMMA:
+        return DRIFT_VIEW_KEY_KNOB_DOWN;
     default:
         return DRIFT_VIEW_KEY_NONE;
     }

@@ -174,4 +174,18 @@ const atomic_bool *render_catch_sigint(void);
 // The exit status of an interrupted run: 128 + the signal (130 SIGINT, 143 SIGTERM).
 int render_interrupt_status(void);
 
+// The equal-time frontier's whole-frame path tracer (drift bench frontier, drift report's
+// cells; tools/render_whole_frame.c): every effect, max depth RENDER_WHOLE_FRAME_DEPTH,
+// `spp` samples a pixel from `seed`; its RGB into a new *out, its rays (camera, shadow,
+// bounce) into *rays when not NULL. The reference: the same at RENDER_WHOLE_FRAME_REF_SEED.
+#define RENDER_WHOLE_FRAME_DEPTH    8
+#define RENDER_WHOLE_FRAME_REF_SEED 0x5eedu
+drift_result render_whole_frame_pt(drift_context *ctx, const drift_scene *scene,
+                                   const drift_accel *accel, int32_t width, int32_t height,
+                                   uint32_t spp, uint32_t seed, const atomic_bool *cancel,
+                                   drift_image *out, uint64_t *rays);
+drift_result render_whole_frame_reference(drift_context *ctx, const drift_scene *scene,
+                                          const drift_accel *accel, int32_t width, int32_t height,
+                                          uint32_t spp, drift_image *out);
+
 #endif

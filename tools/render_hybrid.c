@@ -2,12 +2,28 @@
 // and PNG, with every plane (--aov FILE.exr) and per-pass milliseconds and rays (--stats).
 #include "cli.h"
 #include "drift/image_io.h"
+#include "drift/knobs.h"
 #include "drift/refine.h"
 #include "render.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+// A stage's label: an effect's stage names its technique ("indirect ism").
+static void render_stage_label(const drift_hybrid_params *p, const char *stage, char *out,
+                               size_t size)
+{
+    for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
+        if (strcmp(stage, drift_effect_name((drift_effect)e)) == 0) {
+            snprintf(out, size, "%s %s", stage,
+                     drift_technique_name((drift_effect)e,
+                                          drift_hybrid_params_technique(p, (drift_effect)e)));
+            return;
+        }
+    }
+    snprintf(out, size, "%s", stage);
+}
 
 static bool write_stats(const render_options *o, const cli_session *session,
                         const drift_hybrid *frame, double first_frame_ms, double t_done,
@@ -22,7 +38,30 @@ static bool write_stats(const render_options *o, const cli_session *session,
                                 drift_technique_name((drift_effect)e, drift_hybrid_params_technique(
                                                                           &p, (drift_effect)e)));
     }
-    cli_json_count(root, "spp", p.spp);
+    // --spp counts only where a chosen technique path-traces (reference, aaf, ...): a
+    // real-time frame takes one sample a pixel ('aa' passes of it).
+    bool path_traced = false;
+    for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
+        path_traced |= drift_technique_path_traced(
+            (drift_effect)e, drift_hybrid_params_technique(&p, (drift_effect)e));
+    }
+    if (path_traced) {
+        cli_json_count(root, "spp", p.spp);
+    }
+    // Every knob of the knob table as the frame resolved it (drift/knobs.h): the options
+    // --KNOB VALUE that render this frame again.
+    cJSON *knobs = cJSON_AddObjectToObject(root, "knobs");
+    for (int k = 0; k < drift_knob_count(); ++k) {
+        const drift_knob *knob = drift_knob_get(k);
+        double value = drift_knob_value(&p, k);
+        char text[64];
+        drift_knob_format(knob, value, text, sizeof text);
+        if (knob->type == DRIFT_KNOB_CHOICE || strcmp(text, "auto") == 0) {
+            cJSON_AddStringToObject(knobs, knob->name, text);
+        } else {
+            cJSON_AddNumberToObject(knobs, knob->name, value);
+        }
+    }
     cli_json_count(root, "seed", p.seed);
     cli_json_count(root, "aa", p.aa ? p.aa : 1);
     cJSON_AddNumberToObject(root, "max_depth", p.max_depth);
@@ -40,6 +79,15 @@ static bool write_stats(const render_options *o, const cli_session *session,
     cJSON *effects = cJSON_AddObjectToObject(root, "effect_ms");
     for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
         cli_json_number(effects, drift_effect_name((drift_effect)e), s.effect_ms[e], 3);
+    }
+    // The frame's stages: each timed once, none inside another; they add up to the frame.
+    cJSON *stages = cJSON_AddObjectToObject(root, "stages");
+    const char *stage_name;
+    double stage_ms;
+    for (uint32_t k = 0; drift_hybrid_stats_stage(&s, k, &stage_name, &stage_ms); ++k) {
+        char label[64];
+        render_stage_label(&p, stage_name, label, sizeof label);
+        cli_json_number(stages, label, stage_ms, 3);
     }
     cJSON *ms = cJSON_AddObjectToObject(root, "milliseconds");
     cli_json_number(ms, "load", 1e3 * (session->t_loaded - session->t_start), 3);
@@ -190,11 +238,22 @@ int render_hybrid(const render_options *o, const cli_session *session)
         goto done;
     }
     if (!o->quiet) {
+        // The frame's stages (they add up to the frame), then the rays of each pass.
         drift_hybrid_stats s = drift_hybrid_get_stats(frame);
+        const char *name;
+        double ms;
+        for (uint32_t k = 0; drift_hybrid_stats_stage(&s, k, &name, &ms); ++k) {
+            char label[64];
+            render_stage_label(&params, name, label, sizeof label);
+            if (ms > 0.0) {
+                fprintf(stderr, "  %-22s %9.2f ms\n", label, ms);
+            }
+        }
+        fprintf(stderr, "  %-22s %9.2f ms\n", "frame", s.frame_ms);
         for (int k = 0; k < DRIFT_PASS_COUNT; ++k) {
-            if (s.ms[k] > 0.0) {
-                fprintf(stderr, "  %-14s %9.2f ms %12llu rays\n",
-                        drift_hybrid_pass_name((drift_hybrid_pass)k), s.ms[k],
+            if (s.rays[k] > 0) {
+                fprintf(stderr, "  %-22s %12llu rays\n",
+                        drift_hybrid_pass_name((drift_hybrid_pass)k),
                         (unsigned long long)s.rays[k]);
             }
         }

@@ -275,13 +275,11 @@ typedef struct drift_hybrid_params {
 
 drift_hybrid_params drift_hybrid_params_resolve(const drift_hybrid_params *params,
                                                 const drift_scene *scene);
-// What `drift render --mode hybrid` and `drift view` start from: a combination of the
-// equal-time frontier within ~100 ms on the Cornell box, the glossy box, the plants and the
-// Breakfast Room at 400x400, 2 threads (docs/frontier.md): hard shadows, instant radiosity from
-// imperfect shadow maps (1024 VPLs, gathered at one pixel in 2 x 2), 2 light samples, the
-// environment's shadow rays at one pixel in 2 x 2 and its filter's 4 passes, and max depth 8
-// (multiple bounces). A zeroed drift_hybrid_params stays hard shadows, no indirect light, 8
-// light samples, max depth 2: the library's and the tests' neutral frame.
+// drift_hybrid_params_default() (drift/knobs.h): every effect's default technique and every
+// knob at the default in its row of the knob table, the one default the command line, the
+// viewer and --help use. Kept for the callers of the earlier name. A zeroed
+// drift_hybrid_params stays the library's neutral frame (hard shadows, no indirect light, 8
+// light samples, max depth 2, each family's zero fallbacks).
 drift_hybrid_params drift_hybrid_params_recommended(void);
 // The technique `params` chooses for `effect` (-1 for an invalid effect), and setting it: one
 // int per effect for code that walks the effects (the viewer's keys and overlay, the CLI).
@@ -338,7 +336,20 @@ typedef struct drift_hybrid_stats {
     double effect_ms[DRIFT_EFFECT_COUNT];
     uint64_t rays[DRIFT_PASS_COUNT];
     double frame_ms; // the whole drift_hybrid_render call
+    // With ms[DRIFT_PASS_PRIMARY] and effect_ms, the frame's stages, each timed once at the
+    // top level of drift_hybrid_render and none inside another (drift_hybrid_stats_stage).
+    double inputs_ms;  // the inputs the chosen rows share (U_l, hard shadows, maps, probes, ...)
+    double compose_ms; // L = E + D + R + I + ...
+    double other_ms;   // --aa's running sum and the list of planes
 } drift_hybrid_stats;
+
+// The frame's stages, in order: "primary", "inputs", every effect by name (its chosen row's
+// whole work: the ISM or AAF pass, summing D after a shadow row, ...), "compose", "other".
+// Each is timed once at the top level of the frame, so they add up to frame_ms but for the
+// frame's own bookkeeping: the pass table, the viewer's overlay and --stats print these and
+// cannot leave a stage out. Returns false past the last stage.
+bool drift_hybrid_stats_stage(const drift_hybrid_stats *stats, uint32_t index,
+                              const char **out_name, double *out_ms);
 
 typedef struct drift_hybrid drift_hybrid;
 

@@ -67,6 +67,12 @@ typedef enum drift_view_key {
     DRIFT_VIEW_KEY_EDIT_UNDO,            // undo the last edit
     DRIFT_VIEW_KEY_EDIT_SAVE,            // write the edit file (desc.reflection_edits_path)
     DRIFT_VIEW_KEY_EDIT_GEODESIC_REGION, // add a geodesic region around it, along its mesh
+    // The knob panel (drift/knobs.h): select a knob of the knob table, step its value
+    // (drift_knob_step); the overlay shows the selected knob and its value.
+    DRIFT_VIEW_KEY_KNOB_NEXT,
+    DRIFT_VIEW_KEY_KNOB_PREV,
+    DRIFT_VIEW_KEY_KNOB_UP,
+    DRIFT_VIEW_KEY_KNOB_DOWN,
     DRIFT_VIEW_KEY_COUNT
 } drift_view_key;
 

@@ -3,6 +3,7 @@
 // (hybrid/techniques.h); the passes live in the technique folders (src/realtime, src/isg,
 // src/aaf, ...) and reach the frame's buffers through frame/frame.h, never through here.
 #include "aaf/aaf.h"
+#include "drift/knobs.h"
 #include "hybrid/frame_access.h"
 #include "hybrid/techniques.h"
 #include "isg/isg.h"
@@ -75,13 +76,7 @@ drift_hybrid_params drift_hybrid_params_resolve(const drift_hybrid_params *param
 
 drift_hybrid_params drift_hybrid_params_recommended(void)
 {
-    return (drift_hybrid_params){ .shadows = DRIFT_SHADOWS_HARD,
-                                  .indirect = DRIFT_INDIRECT_ISM,
-                                  .max_depth = 8,
-                                  .light_samples = 2,
-                                  .environment_filter = 4,
-                                  .environment_scale = 2,
-                                  .ism = { .vpls = 1024, .gather_scale = 2 } };
+    return drift_hybrid_params_default(); // the knob table's rows (src/hybrid/knobs.c)
 }
 
 static bool techniques_valid(const drift_hybrid_params *p)
@@ -469,6 +464,38 @@ static drift_result accumulate(drift_hybrid *h, uint32_t k, uint32_t n)
     return DRIFT_OK;
 }
 
+bool drift_hybrid_stats_stage(const drift_hybrid_stats *stats, uint32_t index,
+                              const char **out_name, double *out_ms)
+{
+    const char *name = NULL;
+    double ms = 0.0;
+    if (index == 0) {
+        name = "primary";
+        ms = stats->ms[DRIFT_PASS_PRIMARY];
+    } else if (index == 1) {
+        name = "inputs";
+        ms = stats->inputs_ms;
+    } else if (index < 2u + DRIFT_EFFECT_COUNT) {
+        name = drift_effect_name((drift_effect)(index - 2));
+        ms = stats->effect_ms[index - 2];
+    } else if (index == 2u + DRIFT_EFFECT_COUNT) {
+        name = "compose";
+        ms = stats->compose_ms;
+    } else if (index == 3u + DRIFT_EFFECT_COUNT) {
+        name = "other";
+        ms = stats->other_ms;
+    } else {
+        return false;
+    }
+    if (out_name) {
+        *out_name = name;
+    }
+    if (out_ms) {
+        *out_ms = ms;
+    }
+    return true;
+}
+
 static drift_result run_row(drift_frame_state *f, const drift_technique_row *row,
                             const atomic_bool *cancel)
 {
@@ -516,7 +543,9 @@ static drift_result render_pass(drift_frame_state *f, const atomic_bool *cancel,
     }
     *out_inputs = inputs;
     f->environment_diffuse_elsewhere = diffuse_environment;
+    t = drift_time_now();
     drift_result r = prepare_inputs(f, inputs);
+    f->stats.inputs_ms += 1000.0 * (drift_time_now() - t);
     // The terms in the table's order (direct light first: ambient light reads D), then the
     // composition, then the post effects (depth of field turns focus into final).
     for (int e = 0; r == DRIFT_OK && e < DRIFT_EFFECT_COUNT; ++e) {
@@ -528,7 +557,9 @@ static drift_result render_pass(drift_frame_state *f, const atomic_bool *cancel,
         }
     }
     if (r == DRIFT_OK && !replaced) {
+        t = drift_time_now();
         r = drift_hybrid_pass_compose(f);
+        f->stats.compose_ms += 1000.0 * (drift_time_now() - t);
     }
     for (int e = 0; r == DRIFT_OK && e < DRIFT_EFFECT_COUNT; ++e) {
         if (drift_effect_info_of((drift_effect)e)->kind == DRIFT_EFFECT_KIND_POST) {
@@ -579,7 +610,9 @@ drift_result drift_hybrid_render(drift_hybrid *h, const drift_camera *camera,
         f->aa_pass = k;
         r = render_pass(f, cancel, &inputs);
         if (r == DRIFT_OK && passes > 1) {
+            double t = drift_time_now();
             r = accumulate(h, k, passes);
+            f->stats.other_ms += 1000.0 * (drift_time_now() - t);
         }
     }
     f->params.seed = seed;
@@ -588,7 +621,9 @@ drift_result drift_hybrid_render(drift_hybrid *h, const drift_camera *camera,
     f->camera.film_shift_y = camera->film_shift_y;
     f->prev_camera = f->camera;
     f->has_prev_camera = true;
+    double t_planes = drift_time_now();
     collect_planes(h, inputs);
+    f->stats.other_ms += 1000.0 * (drift_time_now() - t_planes);
     if (r == DRIFT_OK && h->planes_out_of_memory) {
         h->planes_out_of_memory = false;
         r = DRIFT_ERR_OUT_OF_MEMORY;

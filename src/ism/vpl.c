@@ -9,6 +9,7 @@
 // over paths is an unbiased estimate of the emitted power and the sum of the VPLs' flux is the
 // reflected flux, bounce by bounce.
 #include "ism/ism_internal.h"
+#include "scene/light_path.h"
 
 #include <math.h>
 #include <string.h>
@@ -220,50 +221,42 @@ typedef struct path_job {
     float radius;
 } path_job;
 
+// A point or spot light's first ray, importance-sampled from its reflective shadow map.
+static bool emit_point_rsm(const void *user, uint32_t li, drift_vec2 u1, drift_vec2 u2, float pmf,
+                           float n, drift_ray *out_ray, drift_vec3 *out_flux)
+{
+    const path_job *job = user;
+    const drift_light *l = &job->scene->lights[li];
+    const rsm *m = job->rsms[li];
+    if (!m || !(m->total > 0.0)) {
+        return false;
+    }
+    float p_row, p_col;
+    int32_t rows = m->faces * m->size;
+    int32_t row = cdf_pick(m->marginal, rows, u1.y, &p_row);
+    int32_t col =
+        cdf_pick(m->conditional + (size_t)row * ((size_t)m->size + 1), m->size, u1.x, &p_col);
+    int32_t f = row / m->size, y = row % m->size;
+    drift_vec3 d =
+        rsm_dir(m, f, ((float)col + u2.x) / (float)m->size, ((float)y + u2.y) / (float)m->size);
+    float len = drift_vec3_length(d);
+    drift_vec3 w = drift_vec3_scale(d, 1.0f / len);
+    float texel_area = (2.0f * m->extent / (float)m->size) * (2.0f * m->extent / (float)m->size);
+    // Solid-angle pdf: the texel's probability over its solid angle (dA / d^3).
+    float pdf_dir = p_row * p_col * len * len * len / texel_area;
+    if (!(pdf_dir > 0.0f)) {
+        return false;
+    }
+    *out_ray = (drift_ray){ l->position, 0.0f, w, INFINITY };
+    *out_flux = drift_vec3_scale(l->color, spot_falloff(l, w) / (pdf_dir * pmf * n));
+    return true;
+}
+
 // The first ray of path i and the flux it carries; false when the path carries nothing.
 static bool emit(const path_job *job, drift_sampler *s, drift_ray *out_ray, drift_vec3 *out_flux)
 {
-    const drift_scene *scene = job->scene;
-    float pmf;
-    uint32_t li = drift_scene_pick_light(scene, drift_sampler_next1(s), &pmf);
-    drift_vec2 u1 = drift_sampler_next2(s), u2 = drift_sampler_next2(s);
-    if (li == DRIFT_INVALID_INDEX || !(pmf > 0.0f)) {
-        return false;
-    }
-    float n = (float)job->params->vpl_count;
-    if (li == scene->light_count || scene->lights[li].type == DRIFT_LIGHT_DIRECTIONAL) {
-        return drift_light_emit_distant(scene, li, job->centre, job->radius, u1, u2, pmf, n,
-                                        out_ray, out_flux);
-    }
-    const drift_light *l = &scene->lights[li];
-    if (l->type == DRIFT_LIGHT_POINT || l->type == DRIFT_LIGHT_SPOT) {
-        const rsm *m = job->rsms[li];
-        if (!m || !(m->total > 0.0)) {
-            return false;
-        }
-        float p_row, p_col;
-        int32_t rows = m->faces * m->size;
-        int32_t row = cdf_pick(m->marginal, rows, u1.y, &p_row);
-        int32_t col =
-            cdf_pick(m->conditional + (size_t)row * ((size_t)m->size + 1), m->size, u1.x, &p_col);
-        int32_t f = row / m->size, y = row % m->size;
-        drift_vec3 d =
-            rsm_dir(m, f, ((float)col + u2.x) / (float)m->size, ((float)y + u2.y) / (float)m->size);
-        float len = drift_vec3_length(d);
-        drift_vec3 w = drift_vec3_scale(d, 1.0f / len);
-        float texel_area =
-            (2.0f * m->extent / (float)m->size) * (2.0f * m->extent / (float)m->size);
-        // Solid-angle pdf: the texel's probability over its solid angle (dA / d^3).
-        float pdf_dir = p_row * p_col * len * len * len / texel_area;
-        if (!(pdf_dir > 0.0f)) {
-            return false;
-        }
-        *out_ray = (drift_ray){ l->position, 0.0f, w, INFINITY };
-        *out_flux = drift_vec3_scale(l->color, spot_falloff(l, w) / (pdf_dir * pmf * n));
-        return true;
-    }
-    // Area lights: a uniform point and a cosine direction, pi A L per path.
-    return drift_light_emit_area(scene, l, u1, u2, pmf, n, out_ray, out_flux);
+    return drift__light_path_emit(job->scene, s, (float)job->params->vpl_count, job->centre,
+                                  job->radius, emit_point_rsm, job, out_ray, out_flux);
 }
 
 // The glossy lobe a VPL at a glossy vertex shines: the Phong lobe ks (n + 2) / (2 pi) cos^n

@@ -13,6 +13,7 @@
 // environment parallel rays from a disc covering the scene. Every path's flux is divided by
 // its pdf and the path count: the paths' sum is an unbiased estimate of the emitted power.
 #include "micro/micro_internal.h"
+#include "scene/light_path.h"
 
 #include <math.h>
 #include <string.h>
@@ -32,45 +33,12 @@ typedef struct photon_job {
     uint64_t rays[64];
 } photon_job;
 
-// The first ray of a path and its flux; false when it carries nothing.
+// The first ray of a path and its flux; false when it carries nothing (point and spot lights
+// in a uniform direction).
 static bool emit(const photon_job *job, drift_sampler *s, drift_ray *out_ray, drift_vec3 *out_flux)
 {
-    const drift_scene *scene = job->scene;
-    float pmf = 0.0f;
-    uint32_t li = drift_scene_pick_light(scene, drift_sampler_next1(s), &pmf);
-    drift_vec2 u1 = drift_sampler_next2(s), u2 = drift_sampler_next2(s);
-    if (li == DRIFT_INVALID_INDEX || !(pmf > 0.0f)) {
-        return false;
-    }
-    float n = (float)job->desc->paths;
-    if (li == scene->light_count || scene->lights[li].type == DRIFT_LIGHT_DIRECTIONAL) {
-        return drift_light_emit_distant(scene, li, job->centre, job->radius, u1, u2, pmf, n,
-                                        out_ray, out_flux);
-    }
-    const drift_light *l = &scene->lights[li];
-    if (l->type == DRIFT_LIGHT_POINT || l->type == DRIFT_LIGHT_SPOT) {
-        float pdf_dir = 1.0f / (4.0f * DRIFT_PI);
-        drift_vec3 w;
-        if (l->type == DRIFT_LIGHT_SPOT) {
-            float cos_max = cosf(l->spot_outer);
-            drift_frame fr = drift_frame_from_normal(l->direction);
-            w = drift_frame_to_world(&fr, drift_sample_uniform_cone(u1, cos_max));
-            pdf_dir = 1.0f / (2.0f * DRIFT_PI * (1.0f - cos_max));
-        } else {
-            w = drift_sample_uniform_sphere(u1);
-        }
-        // The intensity toward w: the radiance one unit away (the scene's falloff).
-        drift_light_sample ls =
-            drift_light_sample_li(scene, li, drift_vec3_add(l->position, w), u2);
-        if (drift_vec3_is_zero(ls.radiance)) {
-            return false;
-        }
-        *out_ray = (drift_ray){ l->position, 0.0f, w, INFINITY };
-        *out_flux = drift_vec3_scale(ls.radiance, 1.0f / (pdf_dir * pmf * n));
-        return true;
-    }
-    // Area lights: a uniform point and a cosine direction, pi A L per path.
-    return drift_light_emit_area(scene, l, u1, u2, pmf, n, out_ray, out_flux);
+    return drift__light_path_emit(job->scene, s, (float)job->desc->paths, job->centre, job->radius,
+                                  NULL, NULL, out_ray, out_flux);
 }
 
 static void trace_range(size_t begin, size_t end, int thread, void *user)

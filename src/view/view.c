@@ -3,6 +3,7 @@
 // overlay, into an RGB8 framebuffer. The camera controller is in view_camera.c, how buffers
 // are drawn in view_buffers.c, the text overlay in view_overlay.c (view_internal.h). No window
 // code here (tools/cmd_view.c is the window); see include/drift/view.h and docs/viewer.md.
+#include "drift/knobs.h"
 #include "view/view_internal.h"
 
 #include <math.h>
@@ -38,6 +39,10 @@ static const char *const key_names[DRIFT_VIEW_KEY_COUNT - DRIFT_VIEW_KEY_NEXT_BU
     "undo",
     "save-edits",
     "edit-geodesic-region",
+    "knob-next",
+    "knob-prev",
+    "knob-up",
+    "knob-down",
 };
 
 drift_view_key drift_view_key_of_effect(drift_effect effect)
@@ -292,6 +297,24 @@ static void cycle_technique(drift_view *view, drift_effect effect)
     view->params_changed = true;
 }
 
+// Steps the selected knob; interleaving the environment's rays takes every pixel's (the
+// frame refuses --env-scale 2 with it), as on the command line.
+static bool step_knob(drift_view *view, int direction)
+{
+    const drift_knob *k = drift_knob_get(view->knob);
+    double before = drift_knob_value(&view->params, view->knob);
+    double after = drift_knob_step(k, before, direction);
+    if (after == before || !drift_knob_set(&view->params, view->knob, after)) {
+        return false;
+    }
+    if (view->params.environment_interleave && view->params.environment_scale == 2) {
+        view->params.environment_scale = 1;
+    }
+    view->params_changed = true;
+    view->overlay = true;
+    return true;
+}
+
 // Passes on whether the camera controller moved the camera, noting a move for the reference.
 static bool note_camera_move(drift_view *view, bool moved)
 {
@@ -350,6 +373,16 @@ static bool handle_key(drift_view *view, drift_view_key key)
     case DRIFT_VIEW_KEY_EDIT_SAVE:
     case DRIFT_VIEW_KEY_EDIT_GEODESIC_REGION:
         return drift_view_edit_key(view, key);
+    case DRIFT_VIEW_KEY_KNOB_NEXT:
+    case DRIFT_VIEW_KEY_KNOB_PREV: {
+        int n = drift_knob_count();
+        view->knob = (view->knob + (key == DRIFT_VIEW_KEY_KNOB_NEXT ? 1 : n - 1)) % n;
+        view->overlay = true;
+        return true;
+    }
+    case DRIFT_VIEW_KEY_KNOB_UP:
+    case DRIFT_VIEW_KEY_KNOB_DOWN:
+        return step_knob(view, key == DRIFT_VIEW_KEY_KNOB_UP ? 1 : -1);
     default:
         return false;
     }

@@ -24,6 +24,7 @@ struct drift_view {
     drift_hybrid *hybrid;
     drift_hybrid_params params;
     bool params_changed;
+    int knob;             // the knob panel's selected row (drift/knobs.h)
     bool hybrid_rendered; // a frame was rendered: drift_hybrid_plane has planes
 
     drift_pt *reference;           // NULL until a frame with the split on, and after a move

@@ -1,5 +1,6 @@
 // The viewer's text overlay: a table of lines and tab-separated cells drawn with
 // stb_easy_font's quads on a dark box, top left of the framebuffer.
+#include "drift/knobs.h"
 #include "view/view_internal.h"
 
 #include <math.h>
@@ -152,6 +153,13 @@ void drift_view_draw_overlay(drift_view *view)
             append(text, &len, "%s\t%s\n", drift_effect_name((drift_effect)e),
                    technique_of(&view->params, (drift_effect)e));
         }
+        {
+            const drift_knob *k = drift_knob_get(view->knob);
+            char value[64];
+            drift_knob_format(k, drift_knob_value(&view->params, view->knob), value, sizeof value);
+            append(text, &len, "knob %d/%d\t%s %s\n", view->knob + 1, drift_knob_count(), k->name,
+                   value);
+        }
         append(text, &len, "buffer\t%s\n", view->buffer_name);
         append(text, &len, "exposure\t%+.1f stops\n", (double)view->exposure_stops);
         if (drift_reflection_edits_constraint_count(view->edits) > 0 ||
@@ -168,13 +176,15 @@ void drift_view_draw_overlay(drift_view *view)
         }
         drift_hybrid_stats stats = drift_hybrid_get_stats(view->hybrid);
         append(text, &len, "frame\t%.2f ms\n", stats.frame_ms);
+        // The frame's stages (they add up to the frame: none is left out), two a line.
         int column = 0;
-        for (int p = 0; p < DRIFT_PASS_COUNT; ++p) {
-            if (!(stats.ms[p] > 0.0)) {
-                continue; // the pass did not run (or was cached) this frame
+        const char *name;
+        double ms;
+        for (uint32_t k = 0; drift_hybrid_stats_stage(&stats, k, &name, &ms); ++k) {
+            if (!(ms > 0.0)) {
+                continue; // the stage did not run this frame
             }
-            const char *name = drift_hybrid_pass_name((drift_hybrid_pass)p);
-            append(text, &len, "%s%s\t%.2f ms", column ? "\t" : "", name ? name : "?", stats.ms[p]);
+            append(text, &len, "%s%s\t%.2f ms", column ? "\t" : "", name, ms);
             column = !column;
             if (!column) {
                 append(text, &len, "\n");

@@ -53,6 +53,24 @@ expect 0 "$drift" diff "$tmp/plain.png" "$tmp/split.png" --json
 python3 -c "import json,sys; d=json.load(open('$tmp/out')); sys.exit(0 if d['mse'] > 0 else 1)" \
     || fail "split view with another buffer looks the same as the plain frame"
 
+# The knob panel: a knob of the knob table set from the viewer (knob-next/-prev select,
+# knob-up steps: the second knob, --aa, from 1 to 2) gives the frame the command line's
+# --aa 2 gives, and not the default frame.
+expect 0 xvfb-run -a "$drift" view --width 160 --height 120 --threads 2 --frames 2 --no-overlay \
+    --press knob-next,knob-prev,knob-next,knob-up,overlay --screenshot "$tmp/knob.png"
+check_shot knob
+expect 0 xvfb-run -a "$drift" view --width 160 --height 120 --threads 2 --frames 2 --no-overlay \
+    --aa 2 --screenshot "$tmp/knob_cli.png"
+check_shot knob_cli
+expect 0 "$drift" diff "$tmp/knob.png" "$tmp/knob_cli.png" --json
+python3 -c "import json,sys; d=json.load(open('$tmp/out')); sys.exit(0 if d['mse'] == 0 else 1)" \
+    || fail "--press knob-up does not give the frame of --aa 2"
+expect 0 "$drift" diff "$tmp/plain.png" "$tmp/knob.png" --json
+python3 -c "import json,sys; d=json.load(open('$tmp/out')); sys.exit(0 if d['mse'] > 0 else 1)" \
+    || fail "--press knob-up left the frame as it was"
+expect 2 "$drift" view --light-samples 0
+grep -q -- "--light-samples" "$tmp/err" || fail "a knob's range error does not name it"
+
 # Usage errors: exit 2 with a message, before any window opens.
 expect 2 "$drift" view --bogus
 expect 2 "$drift" view --shadows nope

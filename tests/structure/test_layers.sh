@@ -31,5 +31,23 @@ for m in $modules; do
   done
 done
 [ "$checked" -gt 0 ] || { echo "layers: no private includes found under $root/src"; exit 1; }
+# The commands: tools/ (the commands and what they share) sits below bench/ (drift bench ...):
+# a command may not reach up into a benchmark's header (drift report takes the frontier's
+# whole-frame path tracer from tools/render_whole_frame.c, not from bench/).
+bench_headers=$(cd "$root/bench" && ls *.h 2>/dev/null | tr '\n' '|')
+for file in "$root"/tools/*.[ch] "$root"/tools/*/*.[ch]; do
+  [ -e "$file" ] || continue
+  while IFS= read -r line; do
+    echo "layers: ${file#$root/} (tools) includes $line from bench/, a higher layer"
+    bad=1
+  done < <(grep -E '^#include "[a-z_]+\.h"' "$file" | grep -E "\"(${bench_headers%|})\"" || true)
+done
+# The knob tables: each technique folder's knobs.c includes the rows' header of src/frame, a
+# lower layer (checked above with every private include), and nothing of src/hybrid.
+for file in "$root"/src/*/knobs.c; do
+  [ -e "$file" ] || continue
+  grep -q '^#include "frame/knob_rows.h"' "$file" \
+    || { echo "layers: ${file#$root/} does not declare its rows with frame/knob_rows.h"; bad=1; }
+done
 [ "$bad" -eq 0 ] && echo "layers: $checked private includes, every one points down or within its folder"
 exit "$bad"
