@@ -201,6 +201,8 @@ static const cli_option *find_option(const cli_command *c, const char *arg, unsi
     return NULL;
 }
 
+static void print_help(const cli_command *c, FILE *out, const void *defaults);
+
 int cli_parse(const cli_command *c, int argc, char **argv, void *opts,
               const char *first_in_group[CLI_GROUP_COUNT])
 {
@@ -209,7 +211,7 @@ int cli_parse(const cli_command *c, int argc, char **argv, void *opts,
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i];
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            cli_print_help(c, stdout);
+            print_help(c, stdout, opts);
             return CLI_HELP_SHOWN;
         }
         if (a[0] != '-' || a[1] == '\0') {
@@ -276,8 +278,27 @@ static void print_indented(FILE *out, const char *text, int column)
     }
 }
 
-// "hard (default), pcf, pcss or aaf": the first technique is the zero (default) one.
-static void print_techniques(FILE *out, drift_effect effect)
+// The technique the command starts from for `effect`: the one in its option struct's
+// drift_hybrid_params (`defaults`, what it parses into, holding the defaults), or the
+// recommended one where the command decides after parsing (CLI_TECHNIQUE_UNSET), or the zero
+// one without an option struct.
+static int default_technique(const void *defaults, const cli_option *opt, drift_effect effect)
+{
+    if (!defaults) {
+        return 0;
+    }
+    const drift_hybrid_params *p =
+        (const drift_hybrid_params *)((const char *)defaults + opt->offset);
+    int t = drift_hybrid_params_technique(p, effect);
+    if (t < 0 || t >= drift_technique_count(effect)) {
+        drift_hybrid_params r = drift_hybrid_params_recommended();
+        t = drift_hybrid_params_technique(&r, effect);
+    }
+    return t;
+}
+
+// "hard (default), pcf, pcss or aaf": the command's default technique marked.
+static void print_techniques(FILE *out, drift_effect effect, int default_t)
 {
     if (drift_technique_count(effect) < 1) {
         fprintf(out, "(none)\n");
@@ -289,7 +310,7 @@ static void print_techniques(FILE *out, drift_effect effect)
                 t == 0          ? ""
                 : t + 1 < count ? ", "
                                 : " or ",
-                drift_technique_name(effect, t), t == 0 ? " (default)" : "");
+                drift_technique_name(effect, t), t == default_t ? " (default)" : "");
     }
     fprintf(out, "\n");
 }
@@ -317,7 +338,9 @@ static void print_label(FILE *out, const char *name, const char *arg, int column
     fprintf(out, "  %s%*s", label, len < column ? column - len : 2, "");
 }
 
-void cli_print_help(const cli_command *c, FILE *out)
+// --help, with each technique's default read from `defaults` (the options struct; NULL: the
+// zero technique).
+static void print_help(const cli_command *c, FILE *out, const void *defaults)
 {
     int column = c->help_column > 0 ? c->help_column : 24;
     fputs(c->usage, out);
@@ -336,7 +359,8 @@ void cli_print_help(const cli_command *c, FILE *out)
         }
         if (opt->kind == CLI_KIND_TECHNIQUES && opt->name) {
             print_label(out, opt->name, opt->arg, column);
-            print_techniques(out, (drift_effect)effect_of(opt->name));
+            drift_effect effect = (drift_effect)effect_of(opt->name);
+            print_techniques(out, effect, default_technique(defaults, opt, effect));
             if (opt->help) {
                 fprintf(out, "%*s", column, "");
                 print_indented(out, opt->help, column);
@@ -349,7 +373,8 @@ void cli_print_help(const cli_command *c, FILE *out)
                 char name[64];
                 snprintf(name, sizeof name, "--%s", drift_effect_name((drift_effect)e));
                 print_label(out, name, opt->arg, column);
-                print_techniques(out, (drift_effect)e);
+                print_techniques(out, (drift_effect)e,
+                                 default_technique(defaults, opt, (drift_effect)e));
             }
         } else if (opt->help) { // no help: a hidden alias
             print_label(out, opt->name, opt->arg, column);
@@ -370,4 +395,9 @@ void cli_print_help(const cli_command *c, FILE *out)
     if (c->epilogue) {
         fputs(c->epilogue, out);
     }
+}
+
+void cli_print_help(const cli_command *c, FILE *out)
+{
+    print_help(c, out, NULL);
 }

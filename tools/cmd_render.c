@@ -326,7 +326,8 @@ static const cli_option render_table[] = {
     CLI_CUSTOM("--isg-search", "N", O, hybrid.isg.search, parse_isg_count,
                "image space gathering (docs/isg.md): parameter-search"),
     CLI_CUSTOM("--isg-gather", "M", O, hybrid.isg.gather, parse_isg_count,
-               "and gather samples, perfect squares (default 25 and 49)"),
+               "and gather samples, perfect squares (default 9 and 25;\n"
+               "the library's 25 and 49)"),
     CLI_NUMBER("--isg-sigma", "S", O, hybrid.isg.sigma, 1e-30, 1e30,
                "range sigma of eq. 6 and 10, squared scene units\n"
                "(default (0.02 x scene extent)^2)"),

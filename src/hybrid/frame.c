@@ -75,13 +75,21 @@ drift_hybrid_params drift_hybrid_params_resolve(const drift_hybrid_params *param
 
 drift_hybrid_params drift_hybrid_params_recommended(void)
 {
-    return (drift_hybrid_params){ .shadows = DRIFT_SHADOWS_HARD,
+    // Every effect a scene has is rendered by something (issue 40): area lights' penumbrae by
+    // ISG over the hard-shadow buffer (a point light's stays hard), glossy and metal surfaces
+    // by ISG's gather over the sharp reflection buffer (`none` left a metal sphere black).
+    // ISG at 9 search and 25 gather samples: on the Cornell box at 200^2 it keeps 80% of the
+    // full 25/49's gain over hard shadows (FLIP 0.0851 hard, 0.0833, 0.0828) at 45% of its ms
+    // (docs/lab/2026-12-07-issue-40.md).
+    return (drift_hybrid_params){ .shadows = DRIFT_SHADOWS_ISG,
+                                  .reflections = DRIFT_REFLECTIONS_ISG,
                                   .indirect = DRIFT_INDIRECT_ISM,
                                   .max_depth = 8,
                                   .light_samples = 2,
                                   .environment_filter = 4,
                                   .environment_scale = 2,
-                                  .ism = { .vpls = 1024, .gather_scale = 2 } };
+                                  .ism = { .vpls = 1024, .gather_scale = 2 },
+                                  .isg = { .search = 9, .gather = 25 } };
 }
 
 static bool techniques_valid(const drift_hybrid_params *p)
