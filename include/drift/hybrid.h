@@ -279,7 +279,7 @@ drift_hybrid_params drift_hybrid_params_resolve(const drift_hybrid_params *param
 // equal-time frontier within ~100 ms on the Cornell box, the glossy box, the plants and the
 // Breakfast Room at 400x400, 2 threads (docs/frontier.md), with every effect on (issue 40):
 // ISG shadows (soft under area lights) and reflections (glossy and metal) at 9 search and 25
-// gather samples, instant radiosity from
+// gather samples, post-process depth of field (none through a pinhole), instant radiosity from
 // imperfect shadow maps (1024 VPLs, gathered at one pixel in 2 x 2), 2 light samples, the
 // environment's shadow rays at one pixel in 2 x 2 and its filter's 4 passes, and max depth 8
 // (multiple bounces). A zeroed drift_hybrid_params stays hard shadows, no indirect light, 8

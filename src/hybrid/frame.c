@@ -77,12 +77,14 @@ drift_hybrid_params drift_hybrid_params_recommended(void)
 {
     // Every effect a scene has is rendered by something (issue 40): area lights' penumbrae by
     // ISG over the hard-shadow buffer (a point light's stays hard), glossy and metal surfaces
-    // by ISG's gather over the sharp reflection buffer (`none` left a metal sphere black).
+    // by ISG's gather over the sharp reflection buffer (`none` left a metal sphere black), a
+    // lens's depth of field by the post-process gather (a pinhole's circles of confusion are 0).
     // ISG at 9 search and 25 gather samples: on the Cornell box at 200^2 it keeps 80% of the
     // full 25/49's gain over hard shadows (FLIP 0.0851 hard, 0.0833, 0.0828) at 45% of its ms
     // (docs/lab/2026-12-07-issue-40.md).
     return (drift_hybrid_params){ .shadows = DRIFT_SHADOWS_ISG,
                                   .reflections = DRIFT_REFLECTIONS_ISG,
+                                  .dof = DRIFT_DOF_POST,
                                   .indirect = DRIFT_INDIRECT_ISM,
                                   .max_depth = 8,
                                   .light_samples = 2,

@@ -80,6 +80,7 @@ static void test_defaults_render_every_effect(void **state)
     assert_true(p.shadows != DRIFT_SHADOWS_HARD || p.aa > 1);
     assert_true(p.shadows != DRIFT_SHADOWS_PCF);
     assert_int_not_equal(p.indirect, DRIFT_INDIRECT_NONE);
+    assert_int_not_equal(p.dof, DRIFT_DOF_NONE); // a lens's depth of field
     test_rig_frame(&r, &p);
     double got = sphere_quartile(&r, drift_hybrid_image(r.frame));
     double want = sphere_quartile(&r, &truth);
