@@ -218,6 +218,16 @@ drift_result frontier_reference_image(frontier_state *b, const char *scene_path,
         bench_frontier_reference(b->ctx, b->scene, b->accel, (int32_t)o->size, (int32_t)o->size,
                                  (uint32_t)o->ref_spp, &b->reference);
     if (r == DRIFT_OK) {
+        // The folder and its parents (mkdir -p).
+        char dir[4096];
+        snprintf(dir, sizeof dir, "%s", o->cache_dir);
+        for (char *c = dir + 1; *c; ++c) {
+            if (*c == '/') {
+                *c = '\0';
+                mkdir(dir, 0777);
+                *c = '/';
+            }
+        }
         if (mkdir(o->cache_dir, 0777) != 0 && errno != EEXIST) {
             fprintf(stderr, "drift bench frontier: cannot create %s (reference not cached)\n",
                     o->cache_dir);

@@ -8,6 +8,7 @@
 #include "drift/denoise.h"
 #include "drift/image_io.h"
 #include "drift/pt.h"
+#include "scene_features.h"
 
 #include <dirent.h>
 #include <math.h>
@@ -395,6 +396,12 @@ static drift_result corpus_scene_rows(frontier_options *o, corpus_scene *cs, int
         cJSON *root = cJSON_CreateObject();
         cJSON_AddStringToObject(root, "scene", cs->path);
         cJSON_AddNumberToObject(root, "size", (double)o->size);
+        double features[SCENE_FEATURE_COUNT];
+        scene_features(b->scene, features);
+        cJSON *fs = cJSON_AddObjectToObject(root, "features");
+        for (int k = 0; k < SCENE_FEATURE_COUNT; ++k) {
+            cli_json_number(fs, scene_feature_name(k), features[k], 4);
+        }
         cJSON *rows = cJSON_AddArrayToObject(root, "rows");
         for (int i = 0; i < b->row_count; ++i) {
             cJSON *row = cJSON_CreateObject();

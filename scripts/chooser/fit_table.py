@@ -1,117 +1,196 @@
 #!/usr/bin/env python3
-"""Fits the budget table (issue 40, part 5, a first step) from `drift bench frontier --corpus
-... --json` output and validates it leave-one-scene-out.
+"""Fits the technique chooser (issue 40) from `drift bench frontier --corpus ... --json` and
+validates it leave-one-scene-out.
 
-    python3 scripts/chooser/fit_table.py ROWS.jsonl [--fit LIST] [--out TABLE.json]
+    python3 scripts/chooser/fit_table.py ROWS.jsonl [--fit corpus-fit.txt] \\
+        [--model scenes/corpus/chooser.json] [--drift build/release/bin/drift]
 
-ROWS.jsonl: one JSON object a scene (the bench's --json lines: scene, rows of family, name, ms,
-FLIP). The model is a table: for each budget, the one combination (a hybrid row, or the path
-tracer plain, denoised or at reduced resolution) with the lowest geometric-mean FLIP ratio to
-each scene's best row within the budget, a combination over the budget on a scene counting as
-a ratio of 3. It uses no scene features yet: it is the baseline a feature-based chooser must
-beat. --fit LIST (a corpus-fit.txt) fits the table on those scenes only and reports the others
-as unseen. Validation: each scene's pick is fitted without that scene (leave-one-scene-out);
-the regret of a cell is the picked row's FLIP over the best row's in hindsight within the
-budget. Prints a table scene x budget and a summary line a budget.
+ROWS.jsonl: the bench's --json lines, one a scene (scene, features, rows of family, name, ms,
+FLIP). Scenes without features get them from `drift render SCENE --features`.
+
+Two choosers, both judged leave-one-scene-out (each scene's pick fitted without it):
+- table: for each budget the one combination with the lowest geometric-mean FLIP ratio to each
+  training scene's best row within the budget (over the budget on a scene counts as 3): no
+  scene features, the baseline;
+- nearest (what `drift render --budget-ms` runs): the training scene nearest in standardised
+  features, and the row that was best there within the budget.
+The regret of a cell is the chosen row's FLIP over the best row's in hindsight within the budget;
+a chosen row that takes longer than the budget on the scene itself is marked `over`. Only rows
+the renderer can run are picked: hybrid frames, the path tracer plain or through a-trous.
+--model writes the nearest chooser fitted on every --fit scene (all, without --fit).
 """
 import argparse
 import json
 import math
 import os
+import re
+import subprocess
 import sys
 
-OVER = 3.0  # the ratio a combination over the budget on a scene counts as
+OVER = 3.0
+PICKABLE = {"hybrid", "pt", "pt+atrous"}
+PT = {"pt", "pt+atrous", "pt-low", "pt-low+atrous"}
+FEATURES = ["log_triangles", "log_lights", "area_share", "delta_share", "environment",
+            "glossy_share", "emissive_share", "lens", "depth_range"]
 
 
-def load(path):
+def load(path, drift):
     scenes = []
     for line in open(path):
         line = line.strip()
-        if line.startswith("{"):
-            d = json.loads(line)
-            rows = {(r["family"], r["name"]): (r["ms"], r["flip"]) for r in d["rows"]}
-            scenes.append((d["scene"], rows))
+        if not line.startswith("{"):
+            continue
+        d = json.loads(line)
+        rows = {(r["family"], r["name"]): (r["ms"], r["flip"]) for r in d["rows"]}
+        feats = d.get("features")
+        if feats is None:
+            out = subprocess.run([drift, "render", d["scene"], "--features", "--quiet"],
+                                 capture_output=True, text=True, check=True).stdout
+            feats = json.loads(out)
+        scenes.append({"size": d.get("size", 400), "path": d["scene"], "name": os.path.basename(d["scene"]).split(".")[0],
+                       "rows": rows, "features": [feats[k] for k in FEATURES]})
     return scenes
 
 
+def lookup(rows, key):
+    """The row `key` on a scene; a row with the environment filter on a scene without an
+    environment is the same row without it (the filter has no light to filter there)."""
+    if key in rows:
+        return rows[key]
+    plain = (key[0], re.sub(r" ef \d+", "", key[1]))
+    return rows.get(plain, (math.inf, math.inf))
+
+
 def best_within(rows, budget, families=None):
-    cands = [(f, key) for key, (ms, f) in rows.items()
-             if ms <= budget and (families is None or key[0] in families)]
-    return min(cands) if cands else (None, None)
+    c = [(f, key) for key, (ms, f) in rows.items()
+         if ms <= budget and (families is None or key[0] in families)]
+    return min(c) if c else (None, None)
 
 
-PT = {"pt", "pt+atrous", "pt-low", "pt-low+atrous"}
-
-
-def fit(scenes, budget):
+def fit_table(train, budget):
     keys = set()
-    for _, rows in scenes:
-        keys.update(rows)
-    best, best_score = None, math.inf
+    for s in train:
+        keys.update(k for k in s["rows"] if k[0] in PICKABLE)
+    best, score = None, math.inf
     for key in sorted(keys):
         logs = 0.0
-        for _, rows in scenes:
-            top, _ = best_within(rows, budget)
+        for s in train:
+            top, _ = best_within(s["rows"], budget)
             if top is None:
                 continue
-            ms, f = rows.get(key, (math.inf, math.inf))
-            logs += math.log(f / top if ms <= budget and f < math.inf else OVER)
-        if logs < best_score:
-            best, best_score = key, logs
+            ms, f = lookup(s["rows"], key)
+            logs += math.log(f / top if ms <= budget else OVER)
+        if logs < score:
+            best, score = key, logs
     return best
 
 
+def scales(train):
+    out = []
+    for k in range(len(FEATURES)):
+        v = [s["features"][k] for s in train]
+        m = sum(v) / len(v)
+        out.append(max(math.sqrt(sum((x - m) ** 2 for x in v) / len(v)), 0.1))
+    return out
+
+
+def nearest(train, feats, sc):
+    return min(train, key=lambda s: sum(((a - b) / w) ** 2 for a, b, w in zip(s["features"], feats, sc)))
+
+
+def pick_nearest(train, scene, budget):
+    n = nearest(train, scene["features"], scales(train))
+    _, key = best_within(n["rows"], budget, PICKABLE)
+    return key, n["name"]
+
+
+def to_pick(key, ms, flip):
+    fam, name = key
+    if fam in ("pt", "pt+atrous"):
+        return {"kind": "pt", "row": "%s %s" % (fam, name), "spp": int(name.split()[0]),
+                "denoise": fam == "pt+atrous", "ms": ms, "flip": flip}
+    m = re.match(r"(\w+) \+ (\w+)(.*)$", name)
+    p = {"kind": "hybrid", "row": name, "shadows": m.group(1), "indirect": m.group(2), "ms": ms, "flip": flip}
+    rest = m.group(3)
+    for pat, field, conv in ((r" (\d+) VPLs", "vpls", int), (r"VPLs (?:\S+ )*?(?:\d+ )?spp", None, None),
+                             (r" (\d+) spp", "spp", int), (r" ls (\d+)", "light_samples", int),
+                             (r" ef (\d+)", "environment_filter", int), (r" aa (\d+)", "aa", int)):
+        if field:
+            mm = re.search(pat, rest)
+            if mm:
+                p[field] = conv(mm.group(1))
+    p["gather_scale"] = 2 if " g2" in rest else 1
+    p["no_near_field"] = " nf off" in rest
+    p.setdefault("light_samples", 8)
+    p["environment_scale"] = 2 if "environment_filter" in p else 1
+    return p
+
+
 def main():
-    p = argparse.ArgumentParser()
-    p.add_argument("rows")
-    p.add_argument("--fit", help="a list of the scenes to fit on (corpus-fit.txt)")
-    p.add_argument("--budgets", default="50,100,250,500,1000")
-    p.add_argument("--out", help="write the table fitted on every fit scene as JSON")
-    a = p.parse_args()
-    budgets = [float(b) for b in a.budgets.split(",")]
-    scenes = load(a.rows)
-    fit_set = None
-    if a.fit:
-        fit_set = {os.path.realpath(l.strip()) for l in open(a.fit) if l.strip()}
-    name = lambda s: os.path.basename(s).split(".")[0]
-    is_fit = lambda s: fit_set is None or os.path.realpath(s) in fit_set
-    print("| scene | fit? | " + " | ".join("%g ms: pick, FLIP, regret, beats best pt" % b for b in budgets) + " |")
+    a = argparse.ArgumentParser()
+    a.add_argument("rows")
+    a.add_argument("--fit")
+    a.add_argument("--budgets", default="50,100,250,500,1000")
+    a.add_argument("--model")
+    a.add_argument("--drift", default="build/release/bin/drift")
+    o = a.parse_args()
+    budgets = [float(b) for b in o.budgets.split(",")]
+    scenes = load(o.rows, o.drift)
+    fit_set = {os.path.realpath(l.strip()) for l in open(o.fit) if l.strip()} if o.fit else None
+    is_fit = lambda s: fit_set is None or os.path.realpath(s["path"]) in fit_set
+    print("| scene | role | " + " | ".join("%g ms" % b for b in budgets) + " |")
     print("|---|---|" + "---|" * len(budgets))
-    stats = {b: {"regret": [], "beats": 0, "cells": 0, "unseen_regret": [], "unseen_beats": 0, "unseen": 0} for b in budgets}
-    for i, (path, rows) in enumerate(scenes):
-        train = [s for j, s in enumerate(scenes) if j != i and is_fit(s[0])]
+    st = {(c, b, u): [] for c in ("table", "nearest") for b in budgets for u in (0, 1)}
+    for s in scenes:
+        train = [t for t in scenes if t is not s and is_fit(t)]
         cells = []
         for b in budgets:
-            key = fit(train, b)
-            top, _ = best_within(rows, b)
-            pt, _ = best_within(rows, b, PT)
-            ms, f = rows.get(key, (math.inf, math.inf)) if key else (math.inf, math.inf)
-            if ms > b:  # over budget here: the renderer falls back to the best pt row
-                f, key = (pt, ("fallback", "best pt")) if pt is not None else (math.inf, key)
-            regret = f / top if top else math.inf
-            beats = pt is not None and f < pt or (pt is None and f < math.inf)
-            st = stats[b]
-            st["regret"].append(regret)
-            st["beats"] += beats
-            st["cells"] += 1
-            if not is_fit(path):
-                st["unseen_regret"].append(regret)
-                st["unseen_beats"] += beats
-                st["unseen"] += 1
-            cells.append("%s %s, %.3f, %.2f, %s" % (key[0], key[1], f, regret, "yes" if beats else "no"))
-        print("| %s | %s | %s |" % (name(path), "fit" if is_fit(path) else "unseen", " | ".join(cells)))
-    print()
-    print("| budget | median regret (all) | chosen beats the best pt (all) | median regret (unseen) | beats (unseen) |")
-    print("|---|---|---|---|---|")
+            top, _ = best_within(s["rows"], b)
+            pt, _ = best_within(s["rows"], b, PT)
+            cell = []
+            for chooser in ("nearest", "table"):
+                if chooser == "nearest":
+                    key, via = pick_nearest(train, s, b)
+                else:
+                    key, via = fit_table(train, b), None
+                ms, f = lookup(s["rows"], key) if key else (math.inf, math.inf)
+                regret = f / top if top else math.inf
+                beats = f < pt if pt is not None else f < math.inf
+                rec = (regret, beats, ms <= b)
+                st[(chooser, b, 0)].append(rec)
+                if not is_fit(s):
+                    st[(chooser, b, 1)].append(rec)
+                if chooser == "nearest":
+                    cell.append("%s %s (via %s) %.3f, regret %.2f%s%s" % (
+                        key[0] if key else "-", key[1] if key else "", via, f, regret,
+                        "" if ms <= b else ", over", ", beats pt" if beats else ""))
+            cells.append("; ".join(cell))
+        print("| %s | %s | %s |" % (s["name"], "fit" if is_fit(s) else "judge", " | ".join(cells)))
+    print("\n| budget | chooser | cells | median regret | mean regret | beats the best pt | within budget | unseen: cells, median regret, beats pt |")
+    print("|---|---|---|---|---|---|---|---|")
     med = lambda v: sorted(v)[len(v) // 2] if v else float("nan")
     for b in budgets:
-        st = stats[b]
-        print("| %g ms | %.2f | %d / %d | %.2f | %d / %d |" % (b, med(st["regret"]), st["beats"], st["cells"],
-                                                     med(st["unseen_regret"]), st["unseen_beats"], st["unseen"]))
-    if a.out:
-        table = {"comment": "fitted by scripts/chooser/fit_table.py from %s" % a.rows,
-                 "budgets": {("%g" % b): list(fit([s for s in scenes if is_fit(s[0])], b)) for b in budgets}}
-        json.dump(table, open(a.out, "w"), indent=1)
+        for c in ("nearest", "table"):
+            a_, u = st[(c, b, 0)], st[(c, b, 1)]
+            fin = [r[0] for r in a_ if r[0] < math.inf]
+            print("| %g | %s | %d | %.2f | %.2f | %d | %d | %d, %.2f, %d |" % (
+                b, c, len(a_), med([r[0] for r in a_]), sum(fin) / len(fin) if fin else float("nan"),
+                sum(r[1] for r in a_), sum(r[2] for r in a_), len(u), med([r[0] for r in u]), sum(r[1] for r in u)))
+    if o.model:
+        train = [s for s in scenes if is_fit(s)]
+        model = {"comment": "The technique chooser of drift render --budget-ms (tools/render_choose.c), "
+                            "fitted by scripts/chooser/fit_table.py from %s: for each fitted scene its "
+                            "features and, a budget, the best row the renderer can run." % os.path.basename(o.rows),
+                 "size": train[0]["size"], "features": FEATURES, "scale": scales(train), "scenes": []}
+        for s in train:
+            picks = {}
+            for b in budgets:
+                f, key = best_within(s["rows"], b, PICKABLE)
+                if key:
+                    picks["%g" % b] = to_pick(key, s["rows"][key][0], f)
+            model["scenes"].append({"name": s["name"], "features": s["features"], "picks": picks})
+        with open(o.model, "w") as fh:
+            json.dump(model, fh, indent=1)
 
 
 if __name__ == "__main__":
