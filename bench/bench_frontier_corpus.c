@@ -249,13 +249,15 @@ static int read_corpus(const char *path, corpus_scene *scenes, int max)
     char list[4096];
     snprintf(list, sizeof list, "%s", path);
     if (S_ISDIR(st.st_mode)) {
-        snprintf(list, sizeof list, "%s/corpus.txt", path);
-        if (stat(list, &st) != 0) {
+        int len = snprintf(list, sizeof list, "%s/corpus.txt", path);
+        if (len < 0 || (size_t)len >= sizeof list || stat(list, &st) != 0) {
             DIR *dir = opendir(path);
             int n = 0;
             for (struct dirent *e = dir ? readdir(dir) : NULL; e && n < max; e = readdir(dir)) {
                 if (e->d_name[0] != '.' && has_scene_extension(e->d_name)) {
-                    snprintf(scenes[n++].path, sizeof scenes->path, "%s/%s", path, e->d_name);
+                    int plen =
+                        snprintf(scenes[n].path, sizeof scenes->path, "%s/%s", path, e->d_name);
+                    n += plen > 0 && (size_t)plen < sizeof scenes->path;
                 }
             }
             if (dir) {
@@ -296,8 +298,8 @@ static int read_corpus(const char *path, corpus_scene *scenes, int max)
             fclose(f);
             return -1;
         }
-        snprintf(scenes[n].path, sizeof scenes->path, "%s%s", t[0] == '/' ? "" : dir, t);
-        if (stat(scenes[n].path, &st) != 0) {
+        int len = snprintf(scenes[n].path, sizeof scenes->path, "%s%s", t[0] == '/' ? "" : dir, t);
+        if (len < 0 || (size_t)len >= sizeof scenes->path || stat(scenes[n].path, &st) != 0) {
             fprintf(stderr, "drift bench frontier: %s:%d: no scene %s\n", list, line_no,
                     scenes[n].path);
             fclose(f);
