@@ -416,6 +416,7 @@ static drift_result corpus_scene_rows(frontier_options *o, corpus_scene *cs, int
         char *text = cJSON_PrintUnformatted(root);
         if (text) {
             printf("%s\n", text);
+            fflush(stdout); // a scene's line whole, for whoever reads it as the bench goes
             free(text);
         }
         cJSON_Delete(root);
