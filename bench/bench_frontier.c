@@ -1,14 +1,15 @@
 // drift bench frontier: the equal-time frontier (issue 21). Every row renders the whole frame
 // and is compared with one converged path-traced image of the whole frame (all effects, max
 // depth 8, the path tracer's pixel filter): the path tracer at 1, 2, 4, ... spp, the same
-// images through the edge-avoiding a-trous filter and through drift's best denoiser, the
-// feature-guided one (pt+denoise, `--denoise on`; drift/denoise.h), and hybrid frames built
+// images through the edge-avoiding a-trous filter (drift/denoise.h), and hybrid frames built
 // from the technique table (shadows x indirect, VPL counts and AAF spp swept, max depth 8).
 // --svg plots FLIP against ms with the Pareto front; every row names its budget band.
-// Each row's milliseconds are the median of --runs renders; then, per budget, the row with
+// Each row's milliseconds are the frontier_median of --runs renders; then, per budget, the row with
 // the lowest FLIP within it (the Pareto front) and whether a hybrid row beats both the plain
-// and the denoised path tracer (pt+denoise) there. The reference is cached as an EXR keyed by
-// scene, size, spp and max depth, so reruns reuse it. docs/frontier.md has the measured table.
+// and the denoised path tracer there. The reference is cached as an EXR keyed by scene, size,
+// spp and max depth, so reruns reuse it. docs/frontier.md has the measured table.
+#include "bench_frontier.h"
+
 #include "bench.h"
 #include "drift/accel.h"
 #include "drift/denoise.h"
@@ -27,22 +28,8 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#define MAX_BUDGETS    16
-#define MAX_ROWS       512
-#define FRONTIER_DEPTH RENDER_WHOLE_FRAME_DEPTH
-// The hybrid frame's own default (drift_hybrid_params.light_samples = 0 -> 8); a row at
-// another count is named with it.
-#define DEFAULT_LIGHT_SAMPLES 8
-#define REF_SEED              RENDER_WHOLE_FRAME_REF_SEED
-
-typedef struct frontier_options {
-    const char *scene_path, *csv_path, *svg_path, *cache_dir;
-    long size, threads, ref_spp, runs, max_spp, near_field_off_vpls, half_gather_vpls, env_filter;
-    long budgets[MAX_BUDGETS], vpls[MAX_BUDGETS], aaf_spps[MAX_BUDGETS], aa[MAX_BUDGETS],
-        sir[MAX_BUDGETS], light_samples[MAX_BUDGETS];
-    int budget_count, vpl_count, aaf_spp_count, aa_count, sir_count, light_sample_count;
-    bool json;
-} frontier_options;
+const char *const family_names[FAMILY_COUNT] = { "pt",     "pt+atrous",     "hybrid",    "sir",
+                                                 "pt-low", "pt-low+atrous", "pt+denoise" };
 
 static bool parse_budgets(const char *cmd, const char *flag, const char *value, void *field)
 {
@@ -99,11 +86,15 @@ static const cli_option frontier_table[] = {
     CLI_INT("--size", "N", O, size, 4, 4096, "N x N pixels (default 400)"),
     CLI_INT("--threads", "T", O, threads, 0, 256, "worker threads (default 2)"),
     CLI_INT("--ref-spp", "N", O, ref_spp, 1, 1 << 20, "reference samples a pixel (default 512)"),
-    CLI_INT("--runs", "N", O, runs, 1, 100, "renders a row, the median is its ms (default 3)"),
+    CLI_INT("--runs", "N", O, runs, 1, 100,
+            "renders a row, the frontier_median is its ms (default 3)"),
     CLI_INT("--max-spp", "N", O, max_spp, 1, 1 << 16,
             "the path tracer's largest spp (default: until a render exceeds the\n"
             "largest budget)"),
     CLI_STRING("--cache", "DIR", O, cache_dir, "where the reference is cached (default out)"),
+    CLI_STRING("--corpus", "DIR|LIST", O, corpus_path,
+               "every scene of a folder (or a file listing one a line,\n"
+               "scripts/corpus/build.sh): one table scene x budget"),
     CLI_STRING("--csv", "FILE", O, csv_path, "every row as CSV"),
     CLI_STRING("--svg", "FILE", O, svg_path,
                "the plot: FLIP against ms per family, the Pareto front and the budgets"),
@@ -113,48 +104,16 @@ static const cli_option frontier_table[] = {
 
 static const cli_command frontier_command = {
     .name = "bench frontier",
-    .usage = "usage: drift bench frontier [SCENE] [options]\n\n"
-             "The equal-time frontier: the path tracer, the path tracer + a-trous, + drift's\n"
-             "best denoiser (pt+denoise) and hybrid technique combinations against one\n"
-             "converged path-traced image of the whole\n"
-             "frame; every row's median ms, FLIP and RMSE, then per budget the lowest FLIP\n"
-             "within it. SCENE defaults to scenes/cornell-box/cornell_box.json.\n\n",
+    .usage =
+        "usage: drift bench frontier [SCENE] [options]\n\n"
+        "The equal-time frontier: the path tracer, the path tracer + a-trous and hybrid\n"
+        "technique combinations against one converged path-traced image of the whole\n"
+        "frame; every row's frontier_median ms, FLIP and RMSE, then per budget the lowest FLIP\n"
+        "within it. SCENE defaults to scenes/cornell-box/cornell_box.json.\n\n",
     CLI_TABLE(frontier_table),
     CLI_POSITIONAL("SCENE", frontier_options, scene_path, 1),
     .help_column = 15,
 };
-
-typedef enum row_family {
-    FAMILY_PT = 0,
-    FAMILY_PT_ATROUS,
-    FAMILY_PT_DENOISE, // the path tracer + drift's best denoiser (`--denoise on`)
-    FAMILY_HYBRID,
-    FAMILY_SIR,
-    FAMILY_COUNT
-} row_family;
-
-// best_within's family for a drift technique of either kind: a hybrid frame, or one refined
-// by SIR.
-#define FAMILY_DRIFT (-2)
-
-static const char *const family_names[FAMILY_COUNT] = { "pt", "pt+atrous", "pt+denoise", "hybrid",
-                                                        "sir" };
-
-typedef struct frontier_row {
-    char name[96];
-    row_family family;
-    double ms, flip, rmse;
-} frontier_row;
-
-typedef struct frontier_state {
-    drift_context *ctx;
-    const drift_scene *scene;
-    const drift_accel *accel;
-    const frontier_options *o;
-    drift_image reference;
-    frontier_row rows[MAX_ROWS];
-    int row_count;
-} frontier_state;
 
 static int compare_double(const void *a, const void *b)
 {
@@ -162,7 +121,7 @@ static int compare_double(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-static double median(double *v, long n)
+double frontier_median(double *v, long n)
 {
     qsort(v, (size_t)n, sizeof *v, compare_double);
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
@@ -220,8 +179,8 @@ drift_result bench_frontier_reference(drift_context *ctx, const drift_scene *sce
 }
 
 // Loads the cached reference or renders and caches it; *cached says which.
-static drift_result reference_image(frontier_state *b, const char *scene_path, bool *cached,
-                                    char *path, size_t path_size)
+drift_result frontier_reference_image(frontier_state *b, const char *scene_path, bool *cached,
+                                      char *path, size_t path_size)
 {
     const frontier_options *o = b->o;
     const char *base = strrchr(scene_path, '/');
@@ -245,6 +204,16 @@ static drift_result reference_image(frontier_state *b, const char *scene_path, b
         bench_frontier_reference(b->ctx, b->scene, b->accel, (int32_t)o->size, (int32_t)o->size,
                                  (uint32_t)o->ref_spp, &b->reference);
     if (r == DRIFT_OK) {
+        // The folder and its parents (mkdir -p).
+        char dir[4096];
+        snprintf(dir, sizeof dir, "%s", o->cache_dir);
+        for (char *c = dir + 1; *c; ++c) {
+            if (*c == '/') {
+                *c = '\0';
+                mkdir(dir, 0777);
+                *c = '/';
+            }
+        }
         if (mkdir(o->cache_dir, 0777) != 0 && errno != EEXIST) {
             fprintf(stderr, "drift bench frontier: cannot create %s (reference not cached)\n",
                     o->cache_dir);
@@ -258,8 +227,8 @@ static drift_result reference_image(frontier_state *b, const char *scene_path, b
     return r;
 }
 
-static drift_result add_row(frontier_state *b, row_family family, const char *name, double ms,
-                            const drift_image *image)
+drift_result frontier_add_row(frontier_state *b, row_family family, const char *name, double ms,
+                              const drift_image *image)
 {
     if (b->row_count >= MAX_ROWS) {
         return DRIFT_OK;
@@ -283,10 +252,10 @@ static drift_result add_row(frontier_state *b, row_family family, const char *na
     return DRIFT_OK;
 }
 
-// The path tracer at `spp` (median of --runs fresh renders), then the same image through the
-// a-trous filter and through the feature-guided denoiser, drift_denoise_feature (their ms: the
-// render's plus the filter's median). *out_ms: the render's.
-static drift_result pt_rows(frontier_state *b, long spp, double *out_ms)
+// The path tracer at `spp` (frontier_median of --runs fresh renders), then the same image through
+// the a-trous filter and through the feature-guided denoiser, drift_denoise_feature (their ms:
+// the render's plus the filter's frontier_median). *out_ms: the render's.
+drift_result frontier_pt_rows(frontier_state *b, long spp, double *out_ms)
 {
     const frontier_options *o = b->o;
     double render_ms[100], filter_ms[100], feature_ms[100];
@@ -324,13 +293,13 @@ static drift_result pt_rows(frontier_state *b, long spp, double *out_ms)
         drift_pt_destroy(pt);
     }
     if (r == DRIFT_OK) {
-        double ms = median(render_ms, o->runs), fms = median(filter_ms, o->runs),
-               dms = median(feature_ms, o->runs);
+        double ms = frontier_median(render_ms, o->runs), fms = frontier_median(filter_ms, o->runs),
+               dms = frontier_median(feature_ms, o->runs);
         char name[64];
         snprintf(name, sizeof name, "%ld spp", spp);
-        r = add_row(b, FAMILY_PT, name, ms, &plain);
-        r = r ? r : add_row(b, FAMILY_PT_ATROUS, name, ms + fms, &denoised);
-        r = r ? r : add_row(b, FAMILY_PT_DENOISE, name, ms + dms, &featured);
+        r = frontier_add_row(b, FAMILY_PT, name, ms, &plain);
+        r = r ? r : frontier_add_row(b, FAMILY_PT_ATROUS, name, ms + fms, &denoised);
+        r = r ? r : frontier_add_row(b, FAMILY_PT_DENOISE, name, ms + dms, &featured);
         *out_ms = ms;
     }
     drift_image_destroy(b->ctx, &plain);
@@ -350,7 +319,7 @@ static int technique_index(drift_effect effect, const char *name)
 }
 
 // One hybrid frame: a warm-up render (it builds what the frame caches across frames), then
-// the median frame ms of --runs renders, stopping after the first when that one is already
+// the frontier_median frame ms of --runs renders, stopping after the first when that one is already
 // over `limit_ms` (twice the largest budget: the row holds none of them). The warm-up is never
 // the row's time: a first frame pays one-time work (the ISM's scene points: 12 s on the
 // Breakfast Room at 1024 VPLs) that a viewer pays once.
@@ -368,7 +337,8 @@ static drift_result hybrid_row(frontier_state *b, const char *name,
         ms[n++] = drift_hybrid_get_stats(frame).frame_ms;
     }
     if (r == DRIFT_OK) {
-        r = add_row(b, FAMILY_HYBRID, name, median(ms, n), drift_hybrid_image(frame));
+        r = frontier_add_row(b, FAMILY_HYBRID, name, frontier_median(ms, n),
+                             drift_hybrid_image(frame));
     }
     drift_hybrid_destroy(frame);
     return r;
@@ -385,7 +355,7 @@ static drift_result hybrid_row(frontier_state *b, const char *name,
 // time, docs/frontier.md), depth of field none for a pinhole camera (else post: reference
 // would path-trace the whole frame through the lens, replacing every other row's output),
 // occlusion none, glare none.
-static drift_result hybrid_rows(frontier_state *b, double limit_ms)
+drift_result frontier_hybrid_rows(frontier_state *b, double limit_ms)
 {
     static const char *const shadows[] = { "hard", "pcss", "isg", "aaf" };
     static const char *const indirect[] = { "none", "ambient", "ism", "ir", "aaf" };
@@ -485,8 +455,8 @@ static drift_result hybrid_rows(frontier_state *b, double limit_ms)
 // Whitted-style tracer has no indirect light, so a refined pixel would lose the raster's).
 // One refinement per --sir-iterations count (one sample budget a pixel an iteration, SIR's
 // default): a row's ms are the warm raster frame's plus the refinement's (metrics, sort,
-// tracing), as drift report's sir cell counts them; the median of --runs refinements.
-static drift_result sir_rows(frontier_state *b, double limit_ms)
+// tracing), as drift report's sir cell counts them; the frontier_median of --runs refinements.
+drift_result frontier_sir_rows(frontier_state *b, double limit_ms)
 {
     const frontier_options *o = b->o;
     bool glossy = false;
@@ -510,7 +480,7 @@ static drift_result sir_rows(frontier_state *b, double limit_ms)
         r = drift_hybrid_render(frame, &b->scene->camera, NULL);
         raster[n++] = drift_hybrid_get_stats(frame).frame_ms;
     }
-    double raster_ms = r == DRIFT_OK ? median(raster, n) : 0.0;
+    double raster_ms = r == DRIFT_OK ? frontier_median(raster, n) : 0.0;
     for (int k = 0; k < o->sir_count && r == DRIFT_OK; ++k) {
         double ms[100];
         drift_refine *sir = NULL;
@@ -530,7 +500,8 @@ static drift_result sir_rows(frontier_state *b, double limit_ms)
             char name[96];
             snprintf(name, sizeof name, "pcss%s + none, %ld iterations", glossy ? " + envmap" : "",
                      o->sir[k]);
-            r = add_row(b, FAMILY_SIR, name, median(ms, o->runs), drift_refine_image(sir));
+            r = frontier_add_row(b, FAMILY_SIR, name, frontier_median(ms, o->runs),
+                                 drift_refine_image(sir));
         }
         bool over = r == DRIFT_OK && b->rows[b->row_count - 1].ms > limit_ms;
         bool done = sir && drift_refine_done(sir); // every error pixel refined: no more to show
@@ -544,7 +515,7 @@ static drift_result sir_rows(frontier_state *b, double limit_ms)
 }
 
 // The row with the lowest FLIP among `family` (-1: any) within `budget` ms; -1 if none.
-static int best_within(const frontier_state *b, int family, double budget)
+int frontier_best_within(const frontier_state *b, int family, double budget)
 {
     int best = -1;
     for (int i = 0; i < b->row_count; ++i) {
@@ -703,8 +674,8 @@ static bool write_svg(const frontier_state *b, const char *path, const char *sce
         fprintf(f, "%.1f,%.1f ", PX(row->ms), PY(row->flip));
     }
     fprintf(f, "\"/>\n");
-    static const char *const colours[FAMILY_COUNT] = { "#c62f1f", "#e08a1e", "#8a3ffc", "#1f63c6",
-                                                       "#2f9e44" };
+    static const char *const colours[FAMILY_COUNT] = { "#c62f1f", "#e08a1e", "#1f63c6", "#2f9e44",
+                                                       "#9c4dc4", "#c44d8f", "#8a3ffc" };
     for (int i = 0; i < b->row_count; ++i) {
         const frontier_row *row = &b->rows[i];
         fprintf(f,
@@ -786,6 +757,13 @@ int drift_bench_frontier(int argc, char **argv)
         return cli_parse_exit(status);
     }
     qsort(o.budgets, (size_t)o.budget_count, sizeof *o.budgets, compare_long);
+    if (o.corpus_path) {
+        if (o.scene_path) {
+            fprintf(stderr, "drift bench frontier: give SCENE or --corpus, not both\n");
+            return 2;
+        }
+        return frontier_corpus(&o);
+    }
     status = 1;
     frontier_state *b = calloc(1, sizeof *b);
     cli_session session;
@@ -803,7 +781,8 @@ int drift_bench_frontier(int argc, char **argv)
     bool cached = false;
     char ref_path[4096];
     double t0 = drift_time_now();
-    drift_result r = reference_image(b, session.scene_path, &cached, ref_path, sizeof ref_path);
+    drift_result r =
+        frontier_reference_image(b, session.scene_path, &cached, ref_path, sizeof ref_path);
     double ref_s = drift_time_now() - t0;
     if (r == DRIFT_OK && !o.json) {
         fprintf(stderr, "drift bench frontier: reference %s (%s, %.1f s)\n", ref_path,
@@ -812,14 +791,15 @@ int drift_bench_frontier(int argc, char **argv)
     // The path tracer at 1, 2, 4, ... spp until a render is over the largest budget.
     for (long spp = 1; r == DRIFT_OK; spp *= 2) {
         double ms = 0.0;
-        r = pt_rows(b, spp, &ms);
+        r = frontier_pt_rows(b, spp, &ms);
         if ((o.max_spp > 0 && spp * 2 > o.max_spp) || (o.max_spp == 0 && ms > max_budget) ||
             spp >= (1 << 16)) {
             break;
         }
     }
-    r = r ? r : hybrid_rows(b, 2.0 * max_budget);
-    r = r ? r : sir_rows(b, 2.0 * max_budget);
+    r = r ? r : frontier_low_res_rows(b, max_budget);
+    r = r ? r : frontier_hybrid_rows(b, 2.0 * max_budget);
+    r = r ? r : frontier_sir_rows(b, 2.0 * max_budget);
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift bench frontier: %s\n", drift_result_string(r));
         goto done;
@@ -858,10 +838,11 @@ int drift_bench_frontier(int argc, char **argv)
         cJSON *front = cJSON_AddArrayToObject(root, "front");
         for (int k = 0; k < o.budget_count; ++k) {
             double budget = (double)o.budgets[k];
-            int best = best_within(b, -1, budget), pt = best_within(b, FAMILY_PT, budget),
-                at = best_within(b, FAMILY_PT_ATROUS, budget),
-                dn = best_within(b, FAMILY_PT_DENOISE, budget),
-                h = best_within(b, FAMILY_DRIFT, budget);
+            int best = frontier_best_within(b, -1, budget),
+                pt = frontier_best_within(b, FAMILY_PT, budget),
+                at = frontier_best_within(b, FAMILY_PT_ATROUS, budget),
+                dn = frontier_best_within(b, FAMILY_PT_DENOISE, budget),
+                h = frontier_best_within(b, FAMILY_DRIFT, budget);
             cJSON *item = cJSON_CreateObject();
             cJSON_AddItemToArray(front, item);
             cJSON_AddNumberToObject(item, "budget_ms", budget);
@@ -876,10 +857,11 @@ int drift_bench_frontier(int argc, char **argv)
             goto done;
         }
     } else {
-        printf("# %s at %ldx%ld, %d threads; reference %ld spp, max depth %d; median of %ld "
-               "runs\n\n",
-               session.scene_path, o.size, o.size, drift_context_thread_count(b->ctx), o.ref_spp,
-               FRONTIER_DEPTH, o.runs);
+        printf(
+            "# %s at %ldx%ld, %d threads; reference %ld spp, max depth %d; frontier_median of %ld "
+            "runs\n\n",
+            session.scene_path, o.size, o.size, drift_context_thread_count(b->ctx), o.ref_spp,
+            FRONTIER_DEPTH, o.runs);
         printf("| family | row | ms | FLIP | RMSE | budget | front |\n"
                "|---|---|---|---|---|---|---|\n");
         for (int i = 0; i < b->row_count; ++i) {
@@ -898,12 +880,12 @@ int drift_bench_frontier(int argc, char **argv)
                "|---|---|---|---|---|---|---|\n");
         for (int k = 0; k < o.budget_count; ++k) {
             double budget = (double)o.budgets[k];
-            int pt = best_within(b, FAMILY_PT, budget),
-                at = best_within(b, FAMILY_PT_ATROUS, budget),
-                dn = best_within(b, FAMILY_PT_DENOISE, budget),
-                h = best_within(b, FAMILY_DRIFT, budget);
+            int pt = frontier_best_within(b, FAMILY_PT, budget),
+                at = frontier_best_within(b, FAMILY_PT_ATROUS, budget),
+                dn = frontier_best_within(b, FAMILY_PT_DENOISE, budget),
+                h = frontier_best_within(b, FAMILY_DRIFT, budget);
             printf("| %ld |", o.budgets[k]);
-            print_best(b, best_within(b, -1, budget));
+            print_best(b, frontier_best_within(b, -1, budget));
             print_best(b, pt);
             print_best(b, at);
             print_best(b, dn);

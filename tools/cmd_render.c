@@ -236,9 +236,16 @@ static const cli_option render_table[] = {
                "tracer's first specular bounce follow e(q) (docs/reflection-editing.md)"),
     CLI_FLAG("--quiet", O, quiet, "no progress output"),
     CLI_FLAG("--verbose", O, verbose, "more log output"),
+    CLI_FLAG("--features", O, print_features,
+             "print the scene's features (the chooser's inputs) as JSON; render nothing"),
 
     CLI_SECTION("hybrid mode (docs/hybrid.md):", GROUP_HYBRID),
     CLI_TECHNIQUES("T", O, hybrid),
+    CLI_NUMBER("--budget-ms", "T", O, budget_ms, 1e-3, 1e9,
+               "pick the techniques (or the path tracer) expected to give the\n"
+               "lowest FLIP within T ms, from the scene's features (docs/corpus.md)"),
+    CLI_STRING("--chooser", "FILE", O, chooser_path,
+               "--budget-ms's model (default scenes/corpus/chooser.json)"),
     CLI_NOTE("each technique is listed below; reference = that effect\n"
              "alone path-traced at --spp; aaf: --spp rays a pixel on\n"
              "average (shadows: per area light)"),
@@ -851,7 +858,15 @@ int drift_cmd_render(int argc, char **argv)
         return 2;
     }
     cli_session session;
-    int exit_code = render_open_session(&o, true, &session);
+    int exit_code = render_open_session(&o, !o.print_features, &session);
+    if (exit_code == 0 && o.print_features) {
+        exit_code = render_print_features(&session);
+        render_close_session(&o, &session);
+        return exit_code;
+    }
+    if (exit_code == 0 && o.budget_ms > 0.0) {
+        exit_code = render_choose(&o, &session);
+    }
     if (exit_code == 0) {
         exit_code = o.hybrid_mode ? render_hybrid(&o, &session) : render_reference(&o, &session);
     }

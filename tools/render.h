@@ -58,6 +58,9 @@ typedef struct render_options {
     double aperture, focus_distance; // < 0: the scene camera's
     render_refine_options refine;    // --refine sir (tools/render_refine.c)
     const char *edits_path;          // --reflection-edits FILE.json (docs/reflection-editing.md)
+    double budget_ms;                // --budget-ms T: the chooser picks (tools/render_choose.c)
+    const char *chooser_path;        // --chooser FILE: its model (default: the repository's)
+    bool print_features;             // --features: the scene's features as JSON, then exit
 } render_options;
 
 // drift render's options from argv: 0, 2 after a usage error (message printed), -1 after
@@ -66,6 +69,11 @@ int render_parse_options(int argc, char **argv, render_options *o);
 // Opens the context, scene and accel and loads --reflection-edits into o->hybrid; with
 // outputs_here, refuses outputs that name an input and checks each can be written. Returns 0,
 // or the exit status (message printed); render_close_session in both cases.
+// --budget-ms: picks the techniques, or the path tracer, for the loaded scene (0 or an exit
+// status); --features prints the chooser's inputs. tools/render_choose.c.
+int render_choose(render_options *o, const cli_session *session);
+int render_print_features(const cli_session *session);
+
 int render_open_session(render_options *o, bool outputs_here, cli_session *session);
 void render_close_session(render_options *o, cli_session *session);
 

@@ -26,9 +26,10 @@ static void render_stage_label(const drift_hybrid_params *p, const char *stage, 
 }
 
 static bool write_stats(const render_options *o, const cli_session *session,
-                        const drift_hybrid *frame, double first_frame_ms, double t_done,
+                        const drift_hybrid *frame, const drift_hybrid_stats *first, double t_done,
                         const char *path)
 {
+    double first_frame_ms = first->frame_ms;
     drift_hybrid_params p = drift_hybrid_get_params(frame);
     drift_hybrid_stats s = drift_hybrid_get_stats(frame);
     cJSON *root = render_stats_begin(o, session, "hybrid", p.width, p.height);
@@ -88,6 +89,30 @@ static bool write_stats(const render_options *o, const cli_session *session,
         char label[64];
         render_stage_label(&p, stage_name, label, sizeof label);
         cli_json_number(stages, label, stage_ms, 3);
+    }
+    // The first frame by pass and by effect (ISM's points, VPLs and maps are the indirect
+    // effect's), and with --frames > 1 what it spent over the warm last frame: the set-up the
+    // frame pays once (scene points, shadow maps, probes, techniques' state).
+    cJSON *first_frame = cJSON_AddObjectToObject(root, "first_frame");
+    cJSON *setup = o->frames > 1 ? cJSON_AddObjectToObject(root, "setup_ms") : NULL;
+    const char *groups[] = { "passes", "effect_ms" };
+    for (int g = 0; g < 2; ++g) {
+        cJSON *firsts = cJSON_AddObjectToObject(first_frame, groups[g]);
+        cJSON *extras = setup ? cJSON_AddObjectToObject(setup, groups[g]) : NULL;
+        int count = g == 0 ? DRIFT_PASS_COUNT : DRIFT_EFFECT_COUNT;
+        for (int k = 0; k < count; ++k) {
+            const char *name = g == 0 ? drift_hybrid_pass_name((drift_hybrid_pass)k)
+                                      : drift_effect_name((drift_effect)k);
+            double at_first = g == 0 ? first->ms[k] : first->effect_ms[k];
+            double warm = g == 0 ? s.ms[k] : s.effect_ms[k];
+            cli_json_number(firsts, name, at_first, 3);
+            if (extras) {
+                cli_json_number(extras, name, at_first > warm ? at_first - warm : 0.0, 3);
+            }
+        }
+    }
+    if (setup) {
+        cli_json_number(setup, "frame", first->frame_ms - s.frame_ms, 3);
     }
     cJSON *ms = cJSON_AddObjectToObject(root, "milliseconds");
     cli_json_number(ms, "load", 1e3 * (session->t_loaded - session->t_start), 3);
@@ -201,11 +226,11 @@ int render_hybrid(const render_options *o, const cli_session *session)
     }
     // Frames after the first reuse what the frame keeps (shadow maps, probes, the techniques'
     // state slots): the last frame's stats are the interactive cost.
-    double first_frame_ms = 0.0;
+    drift_hybrid_stats first = { 0 };
     for (long k = 0; k < o->frames && r == DRIFT_OK; ++k) {
         r = drift_hybrid_render(frame, &scene->camera, render_catch_sigint());
         if (k == 0) {
-            first_frame_ms = drift_hybrid_get_stats(frame).frame_ms;
+            first = drift_hybrid_get_stats(frame);
         }
     }
     if (r == DRIFT_ERR_CANCELLED) {
@@ -228,8 +253,8 @@ int render_hybrid(const render_options *o, const cli_session *session)
         goto done;
     }
     double t_done = drift_time_now();
-    if (o->stats_path && !write_stats(o, session, frame, first_frame_ms, t_done,
-                                      render_stage_add(&stage, o->stats_path))) {
+    if (o->stats_path &&
+        !write_stats(o, session, frame, &first, t_done, render_stage_add(&stage, o->stats_path))) {
         fprintf(stderr, "drift render: nothing written\n");
         render_stage_abort(&stage);
         goto done;

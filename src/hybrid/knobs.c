@@ -48,10 +48,14 @@ enum {
 
 // Each effect's default technique: the equal-time frontier's pick (docs/frontier.md): hard
 // shadows and instant radiosity from imperfect shadow maps; the others off.
+// Every effect a scene has is rendered by something (issue 40): area lights' penumbrae by ISG
+// over the hard-shadow buffer (a point light's stays hard), glossy and metal surfaces by ISG's
+// gather over the sharp reflection buffer (`none` left a metal sphere black), a lens's depth of
+// field by the post-process gather (a pinhole's circles of confusion are 0).
 static const int default_techniques[DRIFT_EFFECT_COUNT] = {
-    [DRIFT_EFFECT_SHADOWS] = DRIFT_SHADOWS_HARD,
-    [DRIFT_EFFECT_REFLECTIONS] = DRIFT_REFLECTIONS_NONE,
-    [DRIFT_EFFECT_DOF] = DRIFT_DOF_NONE,
+    [DRIFT_EFFECT_SHADOWS] = DRIFT_SHADOWS_ISG,
+    [DRIFT_EFFECT_REFLECTIONS] = DRIFT_REFLECTIONS_ISG,
+    [DRIFT_EFFECT_DOF] = DRIFT_DOF_POST,
     [DRIFT_EFFECT_INDIRECT] = DRIFT_INDIRECT_ISM,
     [DRIFT_EFFECT_OCCLUSION] = DRIFT_OCCLUSION_NONE,
     [DRIFT_EFFECT_GLARE] = DRIFT_GLARE_NONE,

@@ -46,18 +46,55 @@ typedef struct sample_job {
     const double *cdf;       // total_triangles + 1, normalised to [0, 1]
     const uint32_t *mesh_of; // global triangle -> mesh
     const uint32_t *first;   // mesh -> first global triangle
+    const uint32_t *guide;   // guides + 1: guide[j] = the last triangle with cdf <= j / guides
+    uint32_t guides;
     uint32_t total;
     uint32_t key;
 } sample_job;
 
-static void sample_range(size_t begin, size_t end, int thread, void *user)
+// The subset of point i: begin(s) = floor(count * s / subset_count) <= i < begin(s + 1).
+static uint32_t subset_of(uint64_t i, uint64_t count, uint64_t subsets, uint64_t *out_begin,
+                          uint64_t *out_n)
 {
-    (void)thread;
-    const sample_job *job = user;
-    for (size_t i = begin; i < end; ++i) {
-        drift_sampler s = drift_sampler_make(job->key, 0, (uint32_t)i);
-        double u = (double)drift_sampler_next1(&s);
-        uint32_t lo = 0, hi = job->total;
+    uint64_t s = i * subsets / count;
+    while (s > 0 && count * s / subsets > i) {
+        --s;
+    }
+    while (s + 1 < subsets && count * (s + 1) / subsets <= i) {
+        ++s;
+    }
+    *out_begin = count * s / subsets;
+    *out_n = count * (s + 1) / subsets - *out_begin;
+    return (uint32_t)s;
+}
+
+static double unit_of(uint32_t h)
+{
+    return (double)h * 0x1p-32;
+}
+
+// The R2 sequence's generators (Roberts 2018): 1/phi2 and 1/phi2^2, phi2^3 = phi2 + 1.
+#define R2_A1 0.7548776662466927
+#define R2_A2 0.5698402909980532
+
+// Points k0 .. k1 - 1 of subset s (points first .. first + n - 1).
+static void sample_subset(const sample_job *job, uint32_t s, uint64_t first, uint64_t n,
+                          uint64_t k0, uint64_t k1)
+{
+    uint32_t h = drift_hash_combine(job->key, s);
+    double shift = unit_of(h);
+    double x0 = unit_of(drift_hash_u32(h ^ 0x68bc21ebu));
+    double y0 = unit_of(drift_hash_u32(h ^ 0x02e5be93u));
+    for (uint64_t k = k0; k < k1; ++k) {
+        double u = ((double)k + 0.5) / (double)n + shift;
+        u -= floor(u);
+        // The guide table narrows the search to the triangles whose CDF interval meets
+        // u's 1 / guides cell (the cutpoint method): O(1) reads on average, not log2(total)
+        // cache misses.
+        uint32_t j = (uint32_t)(u * (double)job->guides);
+        j = j < job->guides ? j : job->guides - 1;
+        uint32_t lo = job->guide[j], hi = job->guide[j + 1] + 1;
+        hi = hi < job->total ? hi : job->total;
         while (hi - lo > 1) {
             uint32_t mid = lo + (hi - lo) / 2;
             if (job->cdf[mid] <= u) {
@@ -69,11 +106,42 @@ static void sample_range(size_t begin, size_t end, int thread, void *user)
         while (lo + 1 < job->total && !(job->cdf[lo + 1] > job->cdf[lo])) {
             lo++;
         }
-        drift_vec2 b = drift_sample_triangle(drift_sampler_next2(&s));
+        double x = x0 + (double)k * R2_A1, y = y0 + (double)k * R2_A2;
+        x -= floor(x);
+        y -= floor(y);
+        drift_vec2 b = drift_sample_triangle(
+            drift_vec2_make(fminf((float)x, 0x1.fffffep-1f), fminf((float)y, 0x1.fffffep-1f)));
         uint32_t mesh = job->mesh_of[lo];
-        job->points->points[i] = (drift_scene_point){
+        job->points->points[first + k] = (drift_scene_point){
             .mesh = mesh, .triangle = lo - job->first[mesh], .b1 = b.x, .b2 = b.y
         };
+    }
+}
+
+// Many subsets (the ISMs' maps): a job a subset.
+static void sample_subsets(size_t begin, size_t end, int thread, void *user)
+{
+    (void)thread;
+    const sample_job *job = user;
+    const uint64_t count = job->points->count, subsets = job->points->subset_count;
+    for (size_t s = begin; s < end; ++s) {
+        uint64_t first = count * s / subsets, n = count * (s + 1) / subsets - first;
+        sample_subset(job, (uint32_t)s, first, n, 0, n);
+    }
+}
+
+// Few subsets: a job a range of points.
+static void sample_range(size_t begin, size_t end, int thread, void *user)
+{
+    (void)thread;
+    const sample_job *job = user;
+    const uint64_t count = job->points->count, subsets = job->points->subset_count;
+    for (size_t i = begin; i < end;) {
+        uint64_t first, n;
+        uint32_t s = subset_of(i, count, subsets, &first, &n);
+        uint64_t stop = first + n < end ? first + n : end;
+        sample_subset(job, s, first, n, i - first, stop - first);
+        i = (size_t)stop;
     }
 }
 
@@ -136,11 +204,29 @@ drift_result drift_points_create(drift_context *ctx, const drift_scene *scene,
         for (uint32_t i = 0; i <= total; ++i) {
             cdf[i] /= sum;
         }
-        sample_job job = {
-            pts, scene, cdf, mesh_of, first, total, drift_hash_combine(d.seed, DRIFT_POINTS_STREAM)
-        };
-        drift_parallel_for(ctx, d.count, 4096, sample_range, &job);
-        result = drift_points_update(pts, scene);
+        uint32_t guides = total < (1u << 22) ? total : (1u << 22);
+        uint32_t *guide = drift_alloc(ctx, ((size_t)guides + 1) * sizeof *guide);
+        if (!guide) {
+            result = DRIFT_ERR_OUT_OF_MEMORY;
+        } else {
+            for (uint32_t j = 0, i = 0; j <= guides; ++j) {
+                double at = (double)j / (double)guides;
+                while (i + 1 < total && cdf[i + 1] <= at) {
+                    ++i;
+                }
+                guide[j] = i;
+            }
+            sample_job job = { pts,     scene, cdf,
+                               mesh_of, first, guide,
+                               guides,  total, drift_hash_combine(d.seed, DRIFT_POINTS_STREAM) };
+            if (d.subset_count >= 64) {
+                drift_parallel_for(ctx, d.subset_count, 16, sample_subsets, &job);
+            } else {
+                drift_parallel_for(ctx, d.count, 4096, sample_range, &job);
+            }
+            result = drift_points_update(pts, scene);
+            drift_free(ctx, guide);
+        }
     }
     drift_free(ctx, cdf);
     drift_free(ctx, mesh_of);

@@ -56,6 +56,6 @@ grep -q "needs --mode hybrid" "$tmp/err" || fail "aaf option in reference mode n
 expect 0 "$drift" render --help
 grep -q -- "--aaf-max-spp" "$tmp/out" || fail "--help does not list --aaf-max-spp"
 grep -q -- "--aaf-sampler" "$tmp/out" || fail "--help does not list --aaf-sampler"
-grep -q -- "isg, blur or aaf" "$tmp/out" || fail "--help does not list --reflections aaf"
+grep -qE -- "isg( \(default\))?, blur or aaf" "$tmp/out" || fail "--help does not list --reflections aaf"
 
 exit $((failures > 0))

@@ -27,9 +27,9 @@ import json, sys
 s = json.load(open(sys.argv[1]))
 assert s["mode"] == "hybrid" and s["width"] == 32 and s["height"] == 24, s
 # The chosen ones, and every other effect at the CLI's default (drift_hybrid_params_recommended:
-# hard shadows, ism indirect light, max depth 8; docs/frontier.md).
+# isg shadows and reflections, post dof, ism indirect light, max depth 8; issue 40).
 t = s["techniques"]
-assert (t["shadows"], t["reflections"], t["dof"], t["indirect"]) == ("hard", "sharp", "post", "ism"), t
+assert (t["shadows"], t["reflections"], t["dof"], t["indirect"]) == ("isg", "sharp", "post", "ism"), t
 assert s["max_depth"] == 8 and s["aa"] == 1, s
 assert t.get("occlusion") == "none" and t.get("glare") == "none", t
 assert set(s["effect_ms"]) == set(t) and all(v >= 0 for v in s["effect_ms"].values()), s["effect_ms"]
