@@ -51,7 +51,13 @@ bool cli_parse_technique(const char *cmd, drift_effect effect, const char *flag,
     for (int i = 0; i < drift_technique_count(effect); ++i) {
         fprintf(stderr, "%s %s", i ? "," : "", drift_technique_name(effect, i));
     }
-    fprintf(stderr, ", got '%s'\n", text);
+    cli_suggestion s = cli_suggestion_begin(text);
+    for (int i = 0; i < drift_technique_count(effect); ++i) {
+        const char *name = drift_technique_name(effect, i);
+        cli_suggestion_offer(&s, name, strlen(name));
+    }
+    char hint[96];
+    fprintf(stderr, ", got '%s'%s\n", text, cli_suggestion_text(&s, hint, sizeof hint));
     return false;
 }
 

@@ -12,12 +12,16 @@
 #include "drift/scene_io.h"
 #include "render.h"
 
+#include <errno.h>
 #include <math.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
+
+#define RENDER_DEFAULT_OUT "out/render.exr"
 
 // Set from the SIGINT and SIGTERM handler; the render loop polls it between tiles.
 static atomic_bool interrupted;
@@ -250,7 +254,7 @@ static const cli_option render_table[] = {
                   "(docs/glare.md)"),
     { .name = "--aov",
       .arg = "[FILE.exr]",
-      .help = "reference: add albedo, normal and depth layers to the EXR;\n"
+      .help = "reference: add albedo.RGB, N.XYZ (normals) and Z (depth) to the EXR;\n"
               "hybrid: write every plane and buffer as layers of FILE.exr",
       .kind = CLI_KIND_CUSTOM,
       .parse = parse_aov,
@@ -462,7 +466,7 @@ static const cli_command render_command = {
 
 int render_parse_options(int argc, char **argv, render_options *o)
 {
-    *o = (render_options){ .out_path = "out/render.exr",
+    *o = (render_options){ .out_path = RENDER_DEFAULT_OUT,
                            .hybrid = drift_hybrid_params_recommended(),
                            .frames = 1,
                            .spp = 64,
@@ -623,16 +627,26 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
             drift_image_destroy(ctx, &denoised);
             return r;
         }
+        // The names tev, Nuke and Blender's compositor take as theirs: Z, N.XYZ, albedo.RGB.
         layers[1] = (drift_image_layer){ "albedo", &albedo };
-        layers[2] = (drift_image_layer){ "normal", &normal };
-        layers[3] = (drift_image_layer){ "depth", &depth };
+        layers[2] = (drift_image_layer){ "N", &normal };
+        layers[3] = (drift_image_layer){ NULL, &depth };
         layer_count = 4;
     }
     uint32_t lowest, highest;
     render_spp_range(pt, &lowest, &highest);
-    char spp_text[64], note[256];
-    drift_image_attribute attributes[2] = { { "drift.spp", spp_text }, { "drift.spp_note", note } };
-    uint32_t attribute_count = 1;
+    char spp_text[64], note[256], depth_text[32], seed_text[32];
+    snprintf(depth_text, sizeof depth_text, "%d", (int)drift_pt_get_params(pt).max_depth);
+    snprintf(seed_text, sizeof seed_text, "%ld", o->seed);
+    // The render's settings, for whoever opens the file later (drift.spp_note last: optional).
+    drift_image_attribute attributes[5] = {
+        { "drift.scene", o->scene_path ? o->scene_path : cli_default_scene_path() },
+        { "drift.max_depth", depth_text },
+        { "drift.seed", seed_text },
+        { "drift.spp", spp_text },
+        { "drift.spp_note", note },
+    };
+    uint32_t attribute_count = 4;
     snprintf(spp_text, sizeof spp_text, "%u", lowest);
     if (lowest != highest && r == DRIFT_OK) {
         snprintf(spp_text, sizeof spp_text, "%u..%u", lowest, highest);
@@ -640,7 +654,7 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
                  "interrupted: tiles of %dx%d pixels hold %u to %u samples; the spp layer has "
                  "each pixel's count",
                  DRIFT_PT_TILE_SIZE, DRIFT_PT_TILE_SIZE, lowest, highest);
-        attribute_count = 2;
+        attribute_count = 5;
         r = drift_image_create(ctx, beauty.width, beauty.height, 1, &spp);
         for (uint32_t t = 0; r == DRIFT_OK && t < drift_pt_tile_count(pt); ++t) {
             drift_pt_tile rect = drift_pt_tile_rect(pt, t);
@@ -654,8 +668,9 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
         layers[layer_count++] = (drift_image_layer){ "spp", &spp };
     }
     if (r == DRIFT_OK) {
-        r = drift_image_save_exr_attributes(ctx, exr_path, layers, layer_count, attributes,
-                                            attribute_count);
+        const char *const channels[5] = { NULL, NULL, "X,Y,Z", "Z", NULL };
+        r = drift_image_save_exr_channels(ctx, exr_path, layers, layer_count,
+                                          o->aov ? channels : NULL, attributes, attribute_count);
     }
     if (r == DRIFT_OK) {
         drift_tonemap_params tonemap = render_png_tonemap(o, &beauty);
@@ -942,6 +957,19 @@ done:
     return exit_code;
 }
 
+// The default --out's folder ("out/"), made when it is missing so that `drift render` works in
+// an empty directory. A folder the user named must exist (a typo should not make one).
+static bool make_default_out_folder(const render_options *o)
+{
+    if (strcmp(o->out_path, RENDER_DEFAULT_OUT) != 0 || mkdir("out", 0777) == 0 ||
+        errno == EEXIST) {
+        return true;
+    }
+    fprintf(stderr, "drift render: cannot make the folder 'out' for --out %s: %s\n", o->out_path,
+            strerror(errno));
+    return false;
+}
+
 int render_open_session(render_options *o, bool outputs_here, cli_session *session)
 {
     char png[4096];
@@ -956,6 +984,9 @@ int render_open_session(render_options *o, bool outputs_here, cli_session *sessi
     const cli_file inputs[] = { { "--lambda", o->refine.lambda_path },
                                 { "--reflection-edits", o->edits_path } };
     bool writes = outputs_here && o->debug_sample < 0;
+    if (writes && !make_default_out_folder(o)) {
+        return 1;
+    }
     o->edits = NULL;
     o->hybrid.reflection_edits = NULL;
     if (!cli_session_open(&(cli_session_desc){ .cmd = "render",

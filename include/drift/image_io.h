@@ -75,11 +75,24 @@ typedef struct drift_image_attribute {
 } drift_image_attribute;
 
 // drift_image_save_exr plus string attributes in the header ("drift.spp": how the image was
-// made). Names must be unique and not those the EXR format itself defines.
+// made). Names must be unique and not those the EXR format itself defines. Every EXR drift
+// writes also carries the standard `chromaticities` attribute: linear Rec.709 / sRGB
+// primaries with a D65 white, the colour space drift renders in.
 drift_result drift_image_save_exr_attributes(drift_context *ctx, const char *path,
                                              const drift_image_layer *layers, uint32_t layer_count,
                                              const drift_image_attribute *attributes,
                                              uint32_t attribute_count);
+
+// drift_image_save_exr_attributes with the channels of layer i named by channels[i] instead
+// of the defaults, comma-separated, one name per image channel: "X,Y,Z" for a layer "N" gives
+// normals as N.X, N.Y, N.Z; "Z" for an unnamed 1-channel layer gives depth as the conventional
+// Z channel (such a layer may sit beside the default R, G, B one). channels, or any entry of
+// it, may be NULL: the defaults.
+drift_result drift_image_save_exr_channels(drift_context *ctx, const char *path,
+                                           const drift_image_layer *layers, uint32_t layer_count,
+                                           const char *const *channels,
+                                           const drift_image_attribute *attributes,
+                                           uint32_t attribute_count);
 
 // Writes an 8-bit RGB PNG of the image tone-mapped by drift_image_tonemap (tonemap may be NULL:
 // defaults). 1-channel images are written grey in RGB; alpha is dropped. Errors:

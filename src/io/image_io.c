@@ -452,18 +452,39 @@ typedef struct png_sink {
     int error;
 } png_sink;
 
+static void png_write_bytes(png_sink *sink, const void *data, size_t size)
+{
+    if (sink->failed) {
+        return;
+    }
+    if (!drift__image_temp_write(sink->temp, data, size, sink->offset)) {
+        sink->failed = true;
+        sink->error = errno;
+        return;
+    }
+    sink->offset += (uint64_t)size;
+}
+
+// stb writes the whole file in one call: its signature and IHDR chunk (33 bytes), then the
+// rest. An sRGB chunk (rendering intent 0, perceptual) goes between them, where the PNG spec
+// wants it (before IDAT), so viewers and browsers take the 8-bit values as sRGB.
 static void png_write(void *context, void *data, int size)
 {
     png_sink *sink = context;
     if (sink->failed || size <= 0) {
         return;
     }
-    if (!drift__image_temp_write(sink->temp, data, (size_t)size, sink->offset)) {
-        sink->failed = true;
-        sink->error = errno;
+    static const uint8_t srgb_chunk[13] = {
+        0, 0, 0, 1, 's', 'R', 'G', 'B', 0, 0xae, 0xce, 0x1c, 0xe9
+    }; // length, type, 0, CRC
+    const uint8_t *bytes = data;
+    if (sink->offset == 0 && size > 33 && memcmp(bytes + 12, "IHDR", 4) == 0) {
+        png_write_bytes(sink, bytes, 33);
+        png_write_bytes(sink, srgb_chunk, sizeof srgb_chunk);
+        png_write_bytes(sink, bytes + 33, (size_t)size - 33);
         return;
     }
-    sink->offset += (uint64_t)size;
+    png_write_bytes(sink, data, (size_t)size);
 }
 
 drift_result drift_image_save_png(drift_context *ctx, const char *path, const drift_image *image,
