@@ -52,6 +52,11 @@ extern "C" {
 // zeroed on failure. Sizes are checked against DRIFT_IMAGE_MAX_DIMENSION before allocating.
 drift_result drift_image_load(drift_context *ctx, const char *path, drift_image *out_image);
 
+// drift_image_load of an image already in memory (a texture embedded in a .glb or a data URI),
+// its format told by its bytes (PNG, JPEG, Radiance HDR, OpenEXR); `name` is for messages.
+drift_result drift_image_load_memory(drift_context *ctx, const char *name, const void *data,
+                                     size_t size, drift_image *out_image);
+
 // One layer of a multi-layer EXR. name NULL or "" is the default layer (plain channel names);
 // any other name prefixes the channels ("name.R"). Borrowed for the duration of the call.
 typedef struct drift_image_layer {

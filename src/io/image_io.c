@@ -445,6 +445,29 @@ drift_result drift_image_load(drift_context *ctx, const char *path, drift_image 
     return r;
 }
 
+drift_result drift_image_load_memory(drift_context *ctx, const char *name, const void *data,
+                                     size_t size, drift_image *out_image)
+{
+    if (!out_image) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    *out_image = (drift_image){ 0 };
+    if (!name || !data) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    static const uint8_t exr_magic[4] = { 0x76, 0x2f, 0x31, 0x01 };
+    if (size >= 4 && memcmp(data, exr_magic, 4) == 0) {
+        return drift__image_exr_load(ctx, name, data, size, out_image);
+    }
+    image_format format = content_format(data, size);
+    if (format == FORMAT_UNKNOWN) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_UNSUPPORTED, name, 0,
+                  "image data is not PNG, JPEG, Radiance HDR or OpenEXR");
+        return DRIFT_ERR_UNSUPPORTED;
+    }
+    return stb_load(ctx, name, format, data, size, out_image);
+}
+
 typedef struct png_sink {
     drift__image_temp *temp;
     uint64_t offset;

@@ -91,6 +91,7 @@ typedef struct import_state {
     uint32_t *material_map;    // assimp material -> drift material
     bool *light_placed;        // assimp light already added through its node
     int *material_uv_set;      // assimp material -> UV set of its diffuse texture
+    uint32_t *embedded;        // assimp embedded texture -> drift texture (or invalid)
     drift__gltf *gltf;         // the glTF JSON (glTF files only)
     unsigned camera;           // assimp camera to use (glTF: chosen by params->camera)
     drift__import_info *info;
@@ -130,9 +131,20 @@ static void material_texture(import_state *s, const struct aiMaterial *mat, drif
         }
         char rel[DRIFT__PATH_MAX];
         ai_name(&tex, rel, sizeof(rel));
-        if (rel[0] == '*' || rel[0] == '\0') {
-            drift_log(s->ctx, DRIFT_LOG_WARNING, DRIFT_ERR_UNSUPPORTED, s->where, s->line,
-                      "material '%s': embedded textures are not supported; ignored", m->name);
+        uint32_t index;
+        if (rel[0] != '\0' && drift__is_embedded_texture(s->ai, rel)) { // .glb, data URI
+            if (drift__embedded_texture(s->scene, s->ai, rel, s->embedded, s->where, s->line,
+                                        &index) != DRIFT_OK) {
+                drift_log(s->ctx, DRIFT_LOG_WARNING, DRIFT_ERR_IO, s->where, s->line,
+                          "material '%s': embedded texture %s not loaded; using its colour",
+                          m->name, rel);
+                return;
+            }
+            m->diffuse_texture = index;
+            m->diffuse = drift_vec3_is_zero(m->diffuse) ? drift_vec3_splat(1.0f) : m->diffuse;
+            return;
+        }
+        if (rel[0] == '\0') {
             return;
         }
         // Files written on Windows use backslashes.
@@ -142,7 +154,6 @@ static void material_texture(import_state *s, const struct aiMaterial *mat, drif
             }
         }
         char full[DRIFT__PATH_MAX];
-        uint32_t index;
         if (!drift__path_join(s->dir, rel, full, sizeof(full)) ||
             drift__texture_cache_get(s->scene, s->params->textures, full, s->where, s->line,
                                      &index) != DRIFT_OK) {
@@ -520,8 +531,12 @@ static drift_result import_scene(import_state *s)
     s->material_map = drift_alloc(ctx, ((size_t)ai->mNumMaterials + 1) * sizeof(uint32_t));
     s->light_placed = drift_alloc(ctx, ((size_t)ai->mNumLights + 1) * sizeof(bool));
     s->material_uv_set = drift_alloc(ctx, ((size_t)ai->mNumMaterials + 1) * sizeof(int));
-    if (!s->material_map || !s->light_placed || !s->material_uv_set) {
+    s->embedded = drift_alloc(ctx, ((size_t)ai->mNumTextures + 1) * sizeof(uint32_t));
+    if (!s->material_map || !s->light_placed || !s->material_uv_set || !s->embedded) {
         r = DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    for (unsigned i = 0; r == DRIFT_OK && i < ai->mNumTextures; ++i) {
+        s->embedded[i] = DRIFT_INVALID_INDEX;
     }
     if (r == DRIFT_OK) {
         r = convert_materials(s);
@@ -543,6 +558,7 @@ static drift_result import_scene(import_state *s)
     drift_free(ctx, s->material_map);
     drift_free(ctx, s->light_placed);
     drift_free(ctx, s->material_uv_set);
+    drift_free(ctx, s->embedded);
     return r;
 }
 

@@ -66,6 +66,18 @@ typedef struct drift__import_info {
 drift_result drift__scene_import_mesh_file(drift_scene *scene, const drift__import_params *params,
                                            drift__import_info *out_info);
 
+// --- Embedded textures (scene_embedded.c): a .glb's images, data URIs ---
+
+struct aiScene;
+// Whether an assimp texture reference names a texture inside the file ("*N", or the name of
+// one of ai->mTextures).
+bool drift__is_embedded_texture(const struct aiScene *ai, const char *ref);
+// The scene texture of embedded texture `ref`, decoded on first use; loaded[] (one entry per
+// ai->mTextures, DRIFT_INVALID_INDEX at first) remembers them. Warns against (where, line).
+drift_result drift__embedded_texture(drift_scene *scene, const struct aiScene *ai, const char *ref,
+                                     uint32_t *loaded, const char *where, int line,
+                                     uint32_t *out_index);
+
 // --- glTF JSON (scene_gltf.c): what assimp 5.2 drops ---
 
 typedef struct drift__gltf drift__gltf;
