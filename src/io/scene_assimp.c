@@ -425,6 +425,7 @@ static drift_result add_light(import_state *s, unsigned index, const drift__mat4
                                    ? gl.outer_angle
                                    : DRIFT_PI / 4.0f;
             light.spot_inner = drift_clampf(gl.inner_angle, 0.0f, light.spot_outer);
+            light.spot_falloff = gl.falloff;
         }
         if (gl.has_range) {
             drift_log(s->ctx, DRIFT_LOG_WARNING, DRIFT_ERR_UNSUPPORTED, s->where, s->line,

@@ -87,6 +87,7 @@ typedef struct drift__gltf_light {
     drift_vec3 color;               // W/sr (point, spot) or W/m² (directional): cd or lux / 683
     float inner_angle, outer_angle; // spot cone half angles, radians (defaults 0, π/4)
     bool has_range;                 // a `range` is given (drift ignores it)
+    drift_spot_falloff falloff;     // Blender's exporter wrote the file: Cycles' cone; else glTF's
 } drift__gltf_light;
 
 // A glTF metallic-roughness material as drift's diffuse + glossy (docs/scene-format.md).
