@@ -280,6 +280,13 @@ static const cli_option render_table[] = {
                    "PNG exposure of f-number N, shutter T seconds, ISO (EV100 from them)"),
     CLI_CUSTOM("--tonemap", "OP", O, tonemap, parse_tonemap,
                "PNG operator: clamp (default), reinhard or filmic (ACES fit)"),
+    CLI_STRING("--view", "NAME", O, view,
+               "PNG through an OpenColorIO view transform instead of --tonemap\n"
+               "(Filmic, Standard, ...: Blender's config by default; docs/colour.md)"),
+    CLI_STRING("--display", "NAME", O, display, "--view's display (default: the config's, sRGB)"),
+    CLI_STRING("--look", "NAME", O, look, "--view's look (e.g. \"Medium High Contrast\")"),
+    CLI_STRING("--ocio-config", "FILE", O, ocio_config,
+               "the OpenColorIO config of --view (default: $OCIO, else Blender's)"),
     CLI_CUSTOM_ALL("--debug-sample", "X,Y,S", parse_debug_sample,
                    "trace one sample of one pixel and print its radiance"),
     CLI_STRING("--reflection-edits", "FILE.json", O, edits_path,
@@ -523,6 +530,9 @@ int render_parse_options(int argc, char **argv, render_options *o)
                         "adds layers to --out)\n");
         return 2;
     }
+    if (!render_check_view(o)) {
+        return 2;
+    }
     size_t len = strlen(o->out_path);
     if (len < 5 || strcmp(o->out_path + len - 4, ".exr") != 0) {
         fprintf(stderr, "drift render: --out must name a .exr file, got '%s'\n", o->out_path);
@@ -673,8 +683,7 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
                                           o->aov ? channels : NULL, attributes, attribute_count);
     }
     if (r == DRIFT_OK) {
-        drift_tonemap_params tonemap = render_png_tonemap(o, &beauty);
-        r = drift_image_save_png(ctx, png_path, &beauty, &tonemap);
+        r = render_save_png(ctx, o, png_path, &beauty);
     }
     drift_image_destroy(ctx, &spp);
     drift_image_destroy(ctx, &glared); // NULL-safe on a zero image

@@ -105,6 +105,33 @@ drift_result drift_image_save_exr_channels(drift_context *ctx, const char *path,
 drift_result drift_image_save_png(drift_context *ctx, const char *path, const drift_image *image,
                                   const drift_tonemap_params *tonemap);
 
+// Colour management through OpenColorIO (docs/colour.md): how drift_image_save_png_view
+// turns the scene-linear image into display values.
+typedef struct drift_ocio_view {
+    const char *config;   // an OCIO config file; NULL: drift_ocio_default_config()
+    const char *display;  // NULL: the config's default display ("sRGB" in Blender's)
+    const char *view;     // the view transform: "Filmic", "Standard", ...
+    const char *look;     // NULL: none ("Medium High Contrast", ...)
+    float exposure_stops; // scales the image by 2^stops before the view (Blender's Exposure)
+} drift_ocio_view;
+
+// Whether this build has OpenColorIO (the CMake option DRIFT_OCIO found libopencolorio).
+bool drift_ocio_available(void);
+// The config used when none is named: $OCIO, else Blender's own (the blender-data package:
+// /usr/share/blender/datafiles/colormanagement/config.ocio, or under a version folder), else
+// NULL.
+const char *drift_ocio_default_config(void);
+// Whether the config exists and has the view's display, view and look (before a render:
+// the errors drift_image_save_png_view would give, logged against `where`).
+drift_result drift_ocio_check_view(drift_context *ctx, const char *where,
+                                   const drift_ocio_view *view);
+// Writes an 8-bit RGB PNG (with its sRGB chunk) of the image through the config's display and
+// view transform. Errors: DRIFT_ERR_UNSUPPORTED (no OpenColorIO in this build, no config),
+// DRIFT_ERR_INVALID_ARGUMENT (unknown display, view or look; the log says which exist),
+// DRIFT_ERR_IO, DRIFT_ERR_OUT_OF_MEMORY.
+drift_result drift_image_save_png_view(drift_context *ctx, const char *path,
+                                       const drift_image *image, const drift_ocio_view *view);
+
 #ifdef __cplusplus
 }
 #endif
