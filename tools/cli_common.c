@@ -414,8 +414,13 @@ int cli_dispatch(const char *cmd, const char *heading, const char *footer,
             return table[i].run(argc - 1, argv + 1);
         }
     }
-    fprintf(stderr, "drift%s%s: unknown %s '%s'\n\n", cmd ? " " : "", cmd ? cmd : "",
-            cmd ? "benchmark" : "command", argv[1]);
+    cli_suggestion s = cli_suggestion_begin(argv[1]);
+    for (size_t i = 0; i < count; ++i) {
+        cli_suggestion_offer(&s, table[i].name, strlen(table[i].name));
+    }
+    char hint[96];
+    fprintf(stderr, "drift%s%s: unknown %s '%s'%s\n\n", cmd ? " " : "", cmd ? cmd : "",
+            cmd ? "benchmark" : "command", argv[1], cli_suggestion_text(&s, hint, sizeof hint));
     print_subcommands(stderr, cmd, heading, footer, table, count);
     return 2;
 }

@@ -265,7 +265,7 @@ static drift_result convert_materials(import_state *s)
         }
         material_texture(s, mat, &m);
         const drift__obj_material *om = drift__obj_get_material(s->obj, m.name);
-        if (om) { // MTL: Blender's importer's rule (scene_obj.c)
+        if (om && om->blender) { // Blender's MTL: Blender's importer's rule (scene_obj.c)
             drift__obj_blender_material(om, &m);
         }
         uint32_t index;

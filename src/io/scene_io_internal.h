@@ -89,6 +89,7 @@ typedef struct drift__obj_material {
     char map_kd[DRIFT__PATH_MAX]; // map_Kd's file, options and surrounding whitespace removed
     int map_kd_line;              // its line in mtl_path (0: no map_Kd)
     int illum;                    // 2 when not given
+    bool blender;                 // the library says Blender 2.8+ wrote it (its header)
     bool has_ks, has_ns;          // Ks, Ns given
     float ks, ns;                 // mean of Ks; Ns
     const char *mtl_path;         // the library that defines it

@@ -142,6 +142,14 @@ static drift_result read_mtl(drift_context *ctx, drift__obj *o, const char *path
         { "refl", "reflection map" },
     };
 
+    // Blender 2.8 and later head their MTLs "# Blender 3.4.1 MTL File" ("# Blender v2.93.0
+    // MTL File" before 3.2): their materials are Principled BSDFs, read back by Blender's rule
+    // (drift__obj_blender_material). Older ones ("# Blender MTL File", 2.7x) and other
+    // writers' keep the plain MTL reading.
+    bool blender = size > 11 && strncmp(text, "# Blender ", 10) == 0 &&
+                   (isdigit((unsigned char)text[10]) ||
+                    (text[10] == 'v' && isdigit((unsigned char)text[11]) && text[11] >= '2' &&
+                     !(text[11] == '2' && size > 13 && text[13] < '8')));
     drift__obj_material *m = NULL;
     char line[DRIFT__PATH_MAX];
     size_t at = 0;
@@ -153,6 +161,7 @@ static drift_result read_mtl(drift_context *ctx, drift__obj *o, const char *path
                 r = DRIFT_ERR_OUT_OF_MEMORY;
                 break;
             }
+            m->blender = blender;
             continue;
         }
         if (!m) {
