@@ -8,6 +8,7 @@
 #   emissive.glb   an emissive quad as the only light (KHR_materials_emissive_strength)
 #   emissive.obj   the same scene through Blender's OBJ exporter (map_Kd without Kd, s 1
 #                  without normals), framed by emissive_obj.json (OBJ has no camera)
+# and textured.glb rewritten as a .gltf with data: URIs renders as the .glb.
 # Each: drift at 256 spp, 40×30, within ꟻLIP 0.05 of Cycles (2048 spp) and 3% in mean
 # luminance. Then the OBJ/MTL details Blender's files need: trailing whitespace after map_Kd,
 # a missing .mtl or texture named with its file and line.
@@ -52,6 +53,27 @@ compare obj "$data/emissive_obj.json" "$data/cycles_emissive.exr"
 # The .glb's texture is read from inside it.
 expect 0 "$drift" info "$data/textured.glb"
 grep -q "^textures *1$" "$tmp/out" || fail "textured.glb: its embedded texture was not loaded"
+
+# The same file as a .gltf with data: URIs (buffer and image) renders as the .glb.
+python3 - "$data/textured.glb" "$tmp/datauri.gltf" <<'PY' || fail "cannot write the data-URI glTF"
+import base64, json, struct, sys
+d = open(sys.argv[1], "rb").read()
+n = struct.unpack("<I", d[12:16])[0]
+j = json.loads(d[20:20 + n])
+b = d[28 + n:28 + n + struct.unpack("<I", d[20 + n:24 + n])[0]]
+image = j["images"][0]
+view = j["bufferViews"][image.pop("bufferView")]
+start = view.get("byteOffset", 0)
+image["uri"] = "data:image/png;base64," + base64.b64encode(b[start:start + view["byteLength"]]).decode()
+j["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64.b64encode(b).decode()
+json.dump(j, open(sys.argv[2], "w"))
+PY
+tiny=(--spp 2 --width 16 --height 12 --threads 2 --checkpoint 0 --quiet --seed 4)
+expect 0 "$drift" render "$tmp/datauri.gltf" "${tiny[@]}" --out "$tmp/datauri.exr"
+grep -qi "warn" "$tmp/err" && fail "data-URI glTF: warnings: $(cat "$tmp/err")"
+expect 0 "$drift" render "$data/textured.glb" "${tiny[@]}" --out "$tmp/glb.exr"
+expect 0 "$drift" diff "$tmp/glb.exr" "$tmp/datauri.exr" --json
+grep -q '"rmse": 0[,}]' "$tmp/out" || fail "the data-URI .gltf and the .glb differ: $(cat "$tmp/out")"
 
 # OBJ/MTL: a map_Kd with trailing tabs and spaces loads its texture; a missing texture and a
 # missing .mtl are warnings naming the file and line that named them.
