@@ -75,6 +75,25 @@ expect 0 "$drift" render "$data/textured.glb" "${tiny[@]}" --out "$tmp/glb.exr"
 expect 0 "$drift" diff "$tmp/glb.exr" "$tmp/datauri.exr" --json
 grep -q '"rmse": 0[,}]' "$tmp/out" || fail "the data-URI .gltf and the .glb differ: $(cat "$tmp/out")"
 
+# Smoothing groups: the OBJ's sphere (s 1, no normals) shades as the .glb's (with normals);
+# with its s 1 turned off it is faceted and further from it.
+mkdir -p "$tmp/flat"
+cp "$data/emissive.mtl" "$data/checker.png" "$data/emissive_obj.json" "$tmp/flat/"
+sed 's/^s 1$/s 0/' "$data/emissive.obj" >"$tmp/flat/emissive.obj"
+mid=(--spp 16 --width 40 --height 30 --threads 2 --checkpoint 0 --quiet --seed 4)
+expect 0 "$drift" render "$data/emissive.glb" "${mid[@]}" --out "$tmp/s_glb.exr"
+expect 0 "$drift" render "$data/emissive_obj.json" "${mid[@]}" --out "$tmp/s_smooth.exr"
+expect 0 "$drift" render "$tmp/flat/emissive_obj.json" "${mid[@]}" --out "$tmp/s_flat.exr"
+expect 0 "$drift" diff "$tmp/s_glb.exr" "$tmp/s_smooth.exr" --json
+cp "$tmp/out" "$tmp/s_smooth.json"
+expect 0 "$drift" diff "$tmp/s_glb.exr" "$tmp/s_flat.exr" --json
+python3 - "$tmp/s_smooth.json" "$tmp/out" <<'PY' || fail "s 1 without normals is not shaded smooth"
+import json, sys
+smooth, flat = (json.load(open(p))["rmse"] for p in sys.argv[1:3])
+print("cli.interchange: OBJ against .glb: rmse %.5f with s 1, %.5f faceted" % (smooth, flat))
+sys.exit(0 if smooth < 0.5 * flat else 1)
+PY
+
 # OBJ/MTL: a map_Kd with trailing tabs and spaces loads its texture; a missing texture and a
 # missing .mtl are warnings naming the file and line that named them.
 mkdir -p "$tmp/obj"
