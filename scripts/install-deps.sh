@@ -10,6 +10,7 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config clang libclang-rt-14-dev
   libembree-dev libassimp-dev libcjson-dev libopenexr-dev libstb-dev zlib1g-dev libkissfft-dev libexpat1-dev
+  libopencolorio-dev
   libcmocka-dev valgrind clang-format git python3
   libsdl2-dev xvfb xauth
   chromium

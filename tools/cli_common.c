@@ -52,7 +52,13 @@ bool cli_parse_technique(const char *cmd, drift_effect effect, const char *flag,
     for (int i = 0; i < drift_technique_count(effect); ++i) {
         fprintf(stderr, "%s %s", i ? "," : "", drift_technique_name(effect, i));
     }
-    fprintf(stderr, ", got '%s'\n", text);
+    cli_suggestion s = cli_suggestion_begin(text);
+    for (int i = 0; i < drift_technique_count(effect); ++i) {
+        const char *name = drift_technique_name(effect, i);
+        cli_suggestion_offer(&s, name, strlen(name));
+    }
+    char hint[96];
+    fprintf(stderr, ", got '%s'%s\n", text, cli_suggestion_text(&s, hint, sizeof hint));
     return false;
 }
 
@@ -459,8 +465,13 @@ int cli_dispatch(const char *cmd, const char *heading, const char *footer,
             return table[i].run(argc - 1, argv + 1);
         }
     }
-    fprintf(stderr, "drift%s%s: unknown %s '%s'\n\n", cmd ? " " : "", cmd ? cmd : "",
-            cmd ? "benchmark" : "command", argv[1]);
+    cli_suggestion s = cli_suggestion_begin(argv[1]);
+    for (size_t i = 0; i < count; ++i) {
+        cli_suggestion_offer(&s, table[i].name, strlen(table[i].name));
+    }
+    char hint[96];
+    fprintf(stderr, "drift%s%s: unknown %s '%s'%s\n\n", cmd ? " " : "", cmd ? cmd : "",
+            cmd ? "benchmark" : "command", argv[1], cli_suggestion_text(&s, hint, sizeof hint));
     print_subcommands(stderr, cmd, heading, footer, table, count);
     return 2;
 }

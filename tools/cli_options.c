@@ -9,6 +9,105 @@
 #include <stdio.h>
 #include <string.h>
 
+cli_suggestion cli_suggestion_begin(const char *given)
+{
+    return (cli_suggestion){ .given = given, .distance = 1 << 20 };
+}
+
+// The optimal-string-alignment distance between a[0 .. n) and b[0 .. m) (both < 64).
+static int edit_distance(const char *a, size_t n, const char *b, size_t m)
+{
+    int d[64][64];
+    for (size_t i = 0; i <= n; ++i) {
+        d[i][0] = (int)i;
+    }
+    for (size_t j = 0; j <= m; ++j) {
+        d[0][j] = (int)j;
+    }
+    for (size_t i = 1; i <= n; ++i) {
+        for (size_t j = 1; j <= m; ++j) {
+            int cost = a[i - 1] != b[j - 1];
+            int best = d[i - 1][j - 1] + cost;
+            best = d[i - 1][j] + 1 < best ? d[i - 1][j] + 1 : best;
+            best = d[i][j - 1] + 1 < best ? d[i][j - 1] + 1 : best;
+            if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] &&
+                d[i - 2][j - 2] + 1 < best) {
+                best = d[i - 2][j - 2] + 1;
+            }
+            d[i][j] = best;
+        }
+    }
+    return d[n][m];
+}
+
+void cli_suggestion_offer(cli_suggestion *s, const char *candidate, size_t length)
+{
+    size_t n = strlen(s->given);
+    if (n >= 64 || length >= 64 || length == 0) {
+        return;
+    }
+    int d = edit_distance(s->given, n, candidate, length);
+    if (d < s->distance) {
+        s->distance = d;
+        snprintf(s->best, sizeof s->best, "%.*s", (int)length, candidate);
+    }
+}
+
+const char *cli_suggestion_text(const cli_suggestion *s, char *buffer, size_t size)
+{
+    int limit = (int)strlen(s->given) / 3;
+    limit = limit > 2 ? limit : 2;
+    if (s->distance > 0 && s->distance <= limit) {
+        snprintf(buffer, size, " (did you mean '%s'?)", s->best);
+    } else {
+        snprintf(buffer, size, "%s", "");
+    }
+    return buffer;
+}
+
+// Offers each ", "-separated name of `names`.
+static void offer_names(cli_suggestion *s, const char *names)
+{
+    for (const char *p = names; p && *p;) {
+        const char *end = strstr(p, ", ");
+        cli_suggestion_offer(s, p, end ? (size_t)(end - p) : strlen(p));
+        p = end ? end + 2 : NULL;
+    }
+}
+
+// Offers each "|"-separated choice of `choices`.
+static void offer_choices(cli_suggestion *s, const char *choices)
+{
+    for (const char *p = choices; p;) {
+        const char *end = strchr(p, '|');
+        cli_suggestion_offer(s, p, end ? (size_t)(end - p) : strlen(p));
+        p = end ? end + 1 : NULL;
+    }
+}
+
+// The nearest option name of the command to `arg` (technique rows: --<effect>).
+static const char *suggest_option(const cli_command *c, const char *arg, char *buffer, size_t size)
+{
+    cli_suggestion s = cli_suggestion_begin(arg);
+    for (size_t k = 0; k < c->option_count; ++k) {
+        const cli_option *opt = &c->options[k];
+        if (opt->kind == CLI_KIND_SECTION || opt->kind == CLI_KIND_NOTE) {
+            continue;
+        }
+        if (opt->kind == CLI_KIND_TECHNIQUES && !opt->name) {
+            for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
+                char name[64];
+                int n = snprintf(name, sizeof name, "--%s", drift_effect_name((drift_effect)e));
+                cli_suggestion_offer(&s, name, (size_t)n);
+            }
+        } else if (opt->name) {
+            offer_names(&s, opt->name);
+        }
+    }
+    cli_suggestion_offer(&s, "--help", 6);
+    return cli_suggestion_text(&s, buffer, size);
+}
+
 // Whether `arg` is one of the ", "-separated names of `names`.
 static bool name_matches(const char *names, const char *arg)
 {
@@ -121,7 +220,10 @@ static bool read_value(const char *cmd, const char *flag, const cli_option *opt,
         if (index < 0) {
             fprintf(stderr, "drift %s: %s expects ", cmd, flag);
             print_choices(stderr, opt->choices);
-            fprintf(stderr, ", got '%s'\n", value);
+            cli_suggestion s = cli_suggestion_begin(value);
+            offer_choices(&s, opt->choices);
+            char hint[96];
+            fprintf(stderr, ", got '%s'%s\n", value, cli_suggestion_text(&s, hint, sizeof hint));
             return false;
         }
         return store_long(field, opt->store, index);
@@ -253,8 +355,9 @@ int cli_parse(const cli_command *c, int argc, char **argv, void *opts,
         int effect = -1;
         const cli_option *opt = find_option(c, a, &groups, &effect);
         if (!opt) {
-            fprintf(stderr, "drift %s: unknown option '%s' (see drift %s --help)\n", c->name, a,
-                    c->name);
+            char hint[96];
+            fprintf(stderr, "drift %s: unknown option '%s'%s (see drift %s --help)\n", c->name, a,
+                    suggest_option(c, a, hint, sizeof hint), c->name);
             return CLI_USAGE_ERROR;
         }
         for (int g = 0; first_in_group && g < CLI_GROUP_COUNT; ++g) {

@@ -194,4 +194,19 @@ int cli_parse_exit(int status);
 
 void cli_print_help(const cli_command *command, FILE *out);
 
+// "did you mean ...": the nearest of the candidates offered to what the user typed, by edit
+// distance (Damerau: a swap of two letters is one edit), when it is near enough to be a typo
+// (at most 2 edits, or a third of the word's length for longer words).
+typedef struct cli_suggestion {
+    const char *given;
+    char best[64];
+    int distance; // of `best`; large while there is none
+} cli_suggestion;
+
+cli_suggestion cli_suggestion_begin(const char *given);
+// Offers the first `length` characters of `candidate`.
+void cli_suggestion_offer(cli_suggestion *s, const char *candidate, size_t length);
+// " (did you mean '--spp'?)" or "" when no candidate was near enough.
+const char *cli_suggestion_text(const cli_suggestion *s, char *buffer, size_t size);
+
 #endif

@@ -13,12 +13,16 @@
 #include "drift/scene_io.h"
 #include "render.h"
 
+#include <errno.h>
 #include <math.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
+
+#define RENDER_DEFAULT_OUT "out/render.exr"
 
 // Set from the SIGINT and SIGTERM handler; the render loop polls it between tiles.
 static atomic_bool interrupted;
@@ -203,7 +207,7 @@ static const cli_option render_table[] = {
                   "(docs/glare.md)"),
     { .name = "--aov",
       .arg = "[FILE.exr]",
-      .help = "reference: add albedo, normal and depth layers to the EXR;\n"
+      .help = "reference: add albedo.RGB, N.XYZ (normals) and Z (depth) to the EXR;\n"
               "hybrid: write every plane and buffer as layers of FILE.exr",
       .kind = CLI_KIND_CUSTOM,
       .parse = parse_aov,
@@ -229,6 +233,13 @@ static const cli_option render_table[] = {
                    "PNG exposure of f-number N, shutter T seconds, ISO (EV100 from them)"),
     CLI_CUSTOM("--tonemap", "OP", O, tonemap, parse_tonemap,
                "PNG operator: clamp (default), reinhard or filmic (ACES fit)"),
+    CLI_STRING("--view", "NAME", O, view,
+               "PNG through an OpenColorIO view transform instead of --tonemap\n"
+               "(Filmic, Standard, ...: Blender's config by default; docs/colour.md)"),
+    CLI_STRING("--display", "NAME", O, display, "--view's display (default: the config's, sRGB)"),
+    CLI_STRING("--look", "NAME", O, look, "--view's look (e.g. \"Medium High Contrast\")"),
+    CLI_STRING("--ocio-config", "FILE", O, ocio_config,
+               "the OpenColorIO config of --view (default: $OCIO, else Blender's)"),
     CLI_CUSTOM_ALL("--debug-sample", "X,Y,S", parse_debug_sample,
                    "trace one sample of one pixel and print its radiance"),
     CLI_STRING("--reflection-edits", "FILE.json", O, edits_path,
@@ -303,7 +314,7 @@ static const cli_command render_command = {
 
 int render_parse_options(int argc, char **argv, render_options *o)
 {
-    *o = (render_options){ .out_path = "out/render.exr",
+    *o = (render_options){ .out_path = RENDER_DEFAULT_OUT,
                            .hybrid = drift_hybrid_params_default(),
                            .frames = 1,
                            .spp = 64,
@@ -347,6 +358,9 @@ int render_parse_options(int argc, char **argv, render_options *o)
     if (!o->hybrid_mode && o->aov_path) {
         fprintf(stderr, "drift render: --aov FILE needs --mode hybrid (reference mode: --aov "
                         "adds layers to --out)\n");
+        return 2;
+    }
+    if (!render_check_view(o)) {
         return 2;
     }
     size_t len = strlen(o->out_path);
@@ -474,9 +488,10 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
             drift_image_destroy(ctx, &denoised);
             return r;
         }
+        // The names tev, Nuke and Blender's compositor take as theirs: Z, N.XYZ, albedo.RGB.
         layers[1] = (drift_image_layer){ "albedo", &albedo };
-        layers[2] = (drift_image_layer){ "normal", &normal };
-        layers[3] = (drift_image_layer){ "depth", &depth };
+        layers[2] = (drift_image_layer){ "N", &normal };
+        layers[3] = (drift_image_layer){ NULL, &depth };
         // The feature-guided denoiser's inputs (drift/pt.h, DRIFT_PT_AOV_VARIANCE on).
         layers[4] = (drift_image_layer){ "variance", &variance };
         layers[5] = (drift_image_layer){ "feature_albedo", &f_albedo };
@@ -486,9 +501,18 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
     }
     uint32_t lowest, highest;
     render_spp_range(pt, &lowest, &highest);
-    char spp_text[64], note[256];
-    drift_image_attribute attributes[2] = { { "drift.spp", spp_text }, { "drift.spp_note", note } };
-    uint32_t attribute_count = 1;
+    char spp_text[64], note[256], depth_text[32], seed_text[32];
+    snprintf(depth_text, sizeof depth_text, "%d", (int)drift_pt_get_params(pt).max_depth);
+    snprintf(seed_text, sizeof seed_text, "%ld", o->seed);
+    // The render's settings, for whoever opens the file later (drift.spp_note last: optional).
+    drift_image_attribute attributes[5] = {
+        { "drift.scene", o->scene_path ? o->scene_path : cli_default_scene_path() },
+        { "drift.max_depth", depth_text },
+        { "drift.seed", seed_text },
+        { "drift.spp", spp_text },
+        { "drift.spp_note", note },
+    };
+    uint32_t attribute_count = 4;
     snprintf(spp_text, sizeof spp_text, "%u", lowest);
     if (lowest != highest && r == DRIFT_OK) {
         snprintf(spp_text, sizeof spp_text, "%u..%u", lowest, highest);
@@ -496,7 +520,7 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
                  "interrupted: tiles of %dx%d pixels hold %u to %u samples; the spp layer has "
                  "each pixel's count",
                  DRIFT_PT_TILE_SIZE, DRIFT_PT_TILE_SIZE, lowest, highest);
-        attribute_count = 2;
+        attribute_count = 5;
         r = drift_image_create(ctx, beauty.width, beauty.height, 1, &spp);
         for (uint32_t t = 0; r == DRIFT_OK && t < drift_pt_tile_count(pt); ++t) {
             drift_pt_tile rect = drift_pt_tile_rect(pt, t);
@@ -510,12 +534,12 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
         layers[layer_count++] = (drift_image_layer){ "spp", &spp };
     }
     if (r == DRIFT_OK) {
-        r = drift_image_save_exr_attributes(ctx, exr_path, layers, layer_count, attributes,
-                                            attribute_count);
+        const char *const channels[5] = { NULL, NULL, "X,Y,Z", "Z", NULL };
+        r = drift_image_save_exr_channels(ctx, exr_path, layers, layer_count,
+                                          o->aov ? channels : NULL, attributes, attribute_count);
     }
     if (r == DRIFT_OK) {
-        drift_tonemap_params tonemap = render_png_tonemap(o, &beauty);
-        r = drift_image_save_png(ctx, png_path, &beauty, &tonemap);
+        r = render_save_png(ctx, o, png_path, &beauty);
     }
     drift_image_destroy(ctx, &spp);
     drift_image_destroy(ctx, &glared); // NULL-safe on a zero image
@@ -798,6 +822,19 @@ done:
     return exit_code;
 }
 
+// The default --out's folder ("out/"), made when it is missing so that `drift render` works in
+// an empty directory. A folder the user named must exist (a typo should not make one).
+static bool make_default_out_folder(const render_options *o)
+{
+    if (strcmp(o->out_path, RENDER_DEFAULT_OUT) != 0 || mkdir("out", 0777) == 0 ||
+        errno == EEXIST) {
+        return true;
+    }
+    fprintf(stderr, "drift render: cannot make the folder 'out' for --out %s: %s\n", o->out_path,
+            strerror(errno));
+    return false;
+}
+
 int render_open_session(render_options *o, bool outputs_here, cli_session *session)
 {
     char png[4096];
@@ -812,6 +849,9 @@ int render_open_session(render_options *o, bool outputs_here, cli_session *sessi
     const cli_file inputs[] = { { "--lambda", o->refine.lambda_path },
                                 { "--reflection-edits", o->edits_path } };
     bool writes = outputs_here && o->debug_sample < 0;
+    if (writes && !make_default_out_folder(o)) {
+        return 1;
+    }
     o->edits = NULL;
     o->hybrid.reflection_edits = NULL;
     if (!cli_session_open(&(cli_session_desc){ .cmd = "render",

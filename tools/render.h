@@ -47,6 +47,7 @@ typedef struct render_options {
     bool exposure_given; // one of the three exposure options was seen
     double ev100;        // --ev100, or from --camera-exposure
     drift_tonemap_operator tonemap;
+    const char *view, *display, *look, *ocio_config; // --view ...: the PNG through OpenColorIO
     bool aov;
     int denoise; // --denoise: 0 none, 1 atrous, 2 on (drift_denoise_feature), 3 regression
     bool quiet;
@@ -99,6 +100,12 @@ int render_refine_run(const render_options *o, const cli_session *session,
 
 // The PNG's tone mapping for `image` (--exposure, --ev100, --camera-exposure, --tonemap).
 drift_tonemap_params render_png_tonemap(const render_options *o, const drift_image *image);
+// Writes the PNG of `image`: tone-mapped (render_png_tonemap) or, with --view, through the
+// OpenColorIO config's view transform after the same exposure.
+drift_result render_save_png(drift_context *ctx, const render_options *o, const char *path,
+                             const drift_image *image);
+// --view and its options checked (the config read, the names found); false: message printed.
+bool render_check_view(const render_options *o);
 // Writes the refiner's planes (sir may be NULL), then every plane of the frame, as the
 // layers of one EXR.
 struct drift_refine;

@@ -163,8 +163,7 @@ bool render_stage_hybrid_images(drift_context *ctx, const render_options *o,
     const char *aov_temp = render_stage_add(stage, o->aov_path);
     drift_result r = drift_image_save_exr(ctx, exr_temp, &(drift_image_layer){ NULL, image }, 1);
     if (r == DRIFT_OK) {
-        drift_tonemap_params tonemap = render_png_tonemap(o, image);
-        r = drift_image_save_png(ctx, png_temp, image, &tonemap);
+        r = render_save_png(ctx, o, png_temp, image);
     }
     if (r == DRIFT_OK && aov_temp) {
         r = render_write_aov(ctx, aov_temp, frame, sir);

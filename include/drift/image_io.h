@@ -52,6 +52,11 @@ extern "C" {
 // zeroed on failure. Sizes are checked against DRIFT_IMAGE_MAX_DIMENSION before allocating.
 drift_result drift_image_load(drift_context *ctx, const char *path, drift_image *out_image);
 
+// drift_image_load of an image already in memory (a texture embedded in a .glb or a data URI),
+// its format told by its bytes (PNG, JPEG, Radiance HDR, OpenEXR); `name` is for messages.
+drift_result drift_image_load_memory(drift_context *ctx, const char *name, const void *data,
+                                     size_t size, drift_image *out_image);
+
 // One layer of a multi-layer EXR. name NULL or "" is the default layer (plain channel names);
 // any other name prefixes the channels ("name.R"). Borrowed for the duration of the call.
 typedef struct drift_image_layer {
@@ -75,17 +80,57 @@ typedef struct drift_image_attribute {
 } drift_image_attribute;
 
 // drift_image_save_exr plus string attributes in the header ("drift.spp": how the image was
-// made). Names must be unique and not those the EXR format itself defines.
+// made). Names must be unique and not those the EXR format itself defines. Every EXR drift
+// writes also carries the standard `chromaticities` attribute: linear Rec.709 / sRGB
+// primaries with a D65 white, the colour space drift renders in.
 drift_result drift_image_save_exr_attributes(drift_context *ctx, const char *path,
                                              const drift_image_layer *layers, uint32_t layer_count,
                                              const drift_image_attribute *attributes,
                                              uint32_t attribute_count);
+
+// drift_image_save_exr_attributes with the channels of layer i named by channels[i] instead
+// of the defaults, comma-separated, one name per image channel: "X,Y,Z" for a layer "N" gives
+// normals as N.X, N.Y, N.Z; "Z" for an unnamed 1-channel layer gives depth as the conventional
+// Z channel (such a layer may sit beside the default R, G, B one). channels, or any entry of
+// it, may be NULL: the defaults.
+drift_result drift_image_save_exr_channels(drift_context *ctx, const char *path,
+                                           const drift_image_layer *layers, uint32_t layer_count,
+                                           const char *const *channels,
+                                           const drift_image_attribute *attributes,
+                                           uint32_t attribute_count);
 
 // Writes an 8-bit RGB PNG of the image tone-mapped by drift_image_tonemap (tonemap may be NULL:
 // defaults). 1-channel images are written grey in RGB; alpha is dropped. Errors:
 // DRIFT_ERR_INVALID_ARGUMENT, DRIFT_ERR_IO, DRIFT_ERR_OUT_OF_MEMORY.
 drift_result drift_image_save_png(drift_context *ctx, const char *path, const drift_image *image,
                                   const drift_tonemap_params *tonemap);
+
+// Colour management through OpenColorIO (docs/colour.md): how drift_image_save_png_view
+// turns the scene-linear image into display values.
+typedef struct drift_ocio_view {
+    const char *config;   // an OCIO config file; NULL: drift_ocio_default_config()
+    const char *display;  // NULL: the config's default display ("sRGB" in Blender's)
+    const char *view;     // the view transform: "Filmic", "Standard", ...
+    const char *look;     // NULL: none ("Medium High Contrast", ...)
+    float exposure_stops; // scales the image by 2^stops before the view (Blender's Exposure)
+} drift_ocio_view;
+
+// Whether this build has OpenColorIO (the CMake option DRIFT_OCIO found libopencolorio).
+bool drift_ocio_available(void);
+// The config used when none is named: $OCIO, else Blender's own (the blender-data package:
+// /usr/share/blender/datafiles/colormanagement/config.ocio, or under a version folder), else
+// NULL.
+const char *drift_ocio_default_config(void);
+// Whether the config exists and has the view's display, view and look (before a render:
+// the errors drift_image_save_png_view would give, logged against `where`).
+drift_result drift_ocio_check_view(drift_context *ctx, const char *where,
+                                   const drift_ocio_view *view);
+// Writes an 8-bit RGB PNG (with its sRGB chunk) of the image through the config's display and
+// view transform. Errors: DRIFT_ERR_UNSUPPORTED (no OpenColorIO in this build, no config),
+// DRIFT_ERR_INVALID_ARGUMENT (unknown display, view or look; the log says which exist),
+// DRIFT_ERR_IO, DRIFT_ERR_OUT_OF_MEMORY.
+drift_result drift_image_save_png_view(drift_context *ctx, const char *path,
+                                       const drift_image *image, const drift_ocio_view *view);
 
 #ifdef __cplusplus
 }

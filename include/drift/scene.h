@@ -134,6 +134,15 @@ typedef enum drift_light_type {
     DRIFT_LIGHT_COUNT
 } drift_light_type;
 
+// How a spot light's intensity falls off from its inner to its outer cone (cos θ: the
+// angle from its axis; docs/scene-format.md "Spot lights").
+typedef enum drift_spot_falloff {
+    DRIFT_SPOT_SMOOTHSTEP = 0, // smoothstep of the cosine from outer to inner (pbrt-v4)
+    DRIFT_SPOT_GLTF,           // KHR_lights_punctual's reference: the linear ramp in cos, squared
+    DRIFT_SPOT_BLENDER, // Cycles (Blender 3.x): cos θ · smoothstep over the last (1 − cos outer)
+                        // · blend of the cosine, blend = 1 − inner / outer (Blender's glTF I/O)
+} drift_spot_falloff;
+
 typedef struct drift_light {
     drift_light_type type;
     drift_vec3 color; // intensity, irradiance or radiance by type (see above)
@@ -142,11 +151,16 @@ typedef struct drift_light {
     drift_vec3 edge_u, edge_v;
     float radius;
     float spot_inner, spot_outer; // half angles, radians
-    uint32_t mesh, triangle;      // DRIFT_LIGHT_TRIANGLE only
+    drift_spot_falloff spot_falloff;
+    uint32_t mesh, triangle; // DRIFT_LIGHT_TRIANGLE only
 } drift_light;
 
 // True for lights with area (they are geometry: rays can hit them).
 bool drift_light_is_area(drift_light_type type);
+
+// The fraction of a spot light's intensity sent at cos θ from its axis (1 inside the inner
+// cone, 0 outside the outer one, by its spot_falloff); 1 for other lights.
+float drift_light_spot_falloff(const drift_light *light, float cos_theta);
 
 // --- MESHES ---
 

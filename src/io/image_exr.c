@@ -388,9 +388,35 @@ static const char *const channel_names[4][4] = {
     { "Y" }, { "Y", "A" }, { "R", "G", "B" }, { "R", "G", "B", "A" }
 };
 
+// The name of channel `c` of a layer (its `channels` list, or the defaults) into out[32];
+// false when the list has no c-th name, or one past 30 bytes. out may be NULL.
+static bool channel_suffix(const drift_image_layer *layer, const char *list, int c, char *out)
+{
+    if (!list) {
+        if (out) {
+            snprintf(out, 32, "%s", channel_names[layer->image->channels - 1][c]);
+        }
+        return true;
+    }
+    const char *p = list;
+    for (int k = 0; k < c && p; ++k) {
+        p = strchr(p, ',');
+        p = p ? p + 1 : NULL;
+    }
+    const char *end = p ? strchr(p, ',') : NULL;
+    size_t n = !p ? 0 : end ? (size_t)(end - p) : strlen(p);
+    if (n == 0 || n > 30 || (c == layer->image->channels - 1 && end)) {
+        return false;
+    }
+    if (out) {
+        snprintf(out, 32, "%.*s", (int)n, p);
+    }
+    return true;
+}
+
 static drift_result check_layers(drift_context *ctx, const char *path,
                                  const drift_image_layer *layers, uint32_t layer_count,
-                                 size_t *out_channel_count)
+                                 const char *const *names, size_t *out_channel_count)
 {
     if (!path || !layers || layer_count == 0) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, path, 0,
@@ -409,8 +435,22 @@ static drift_result check_layers(drift_context *ctx, const char *path,
                       i, name);
             return DRIFT_ERR_INVALID_ARGUMENT;
         }
+        const char *list = names ? names[i] : NULL;
+        bool named = true;
+        for (int c = 0; list && c < im->channels; ++c) {
+            named = named && channel_suffix(&layers[i], list, c, NULL);
+        }
+        if (!named) {
+            drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, path, 0,
+                      "layer %u ('%s'): channels '%s' do not name its %d channels", i, name, list,
+                      im->channels);
+            return DRIFT_ERR_INVALID_ARGUMENT;
+        }
         for (uint32_t j = 0; j < i; ++j) {
-            if (strcmp(name, layers[j].name ? layers[j].name : "") == 0) {
+            // Layers with their own channel names may share one ("" for Z beside R, G, B):
+            // their channels are checked for collisions one by one.
+            if (!list && !(names && names[j]) &&
+                strcmp(name, layers[j].name ? layers[j].name : "") == 0) {
                 drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, path, 0,
                           "layers %u and %u share the name '%s'", j, i, name);
                 return DRIFT_ERR_INVALID_ARGUMENT;
@@ -517,8 +557,18 @@ drift_result drift_image_save_exr_attributes(drift_context *ctx, const char *pat
                                              const drift_image_attribute *attributes,
                                              uint32_t attribute_count)
 {
+    return drift_image_save_exr_channels(ctx, path, layers, layer_count, NULL, attributes,
+                                         attribute_count);
+}
+
+drift_result drift_image_save_exr_channels(drift_context *ctx, const char *path,
+                                           const drift_image_layer *layers, uint32_t layer_count,
+                                           const char *const *channels,
+                                           const drift_image_attribute *attributes,
+                                           uint32_t attribute_count)
+{
     size_t chan_count = 0;
-    drift_result r = check_layers(ctx, path, layers, layer_count, &chan_count);
+    drift_result r = check_layers(ctx, path, layers, layer_count, channels, &chan_count);
     if (r != DRIFT_OK) {
         return r;
     }
@@ -535,7 +585,8 @@ drift_result drift_image_save_exr_attributes(drift_context *ctx, const char *pat
         const char *name = layers[i].name ? layers[i].name : "";
         const drift_image *im = layers[i].image;
         for (int c = 0; c < im->channels; ++c) {
-            const char *suffix = channel_names[im->channels - 1][c];
+            char suffix[32];
+            channel_suffix(&layers[i], channels ? channels[i] : NULL, c, suffix);
             snprintf(chans[n].name, sizeof(chans[n].name), "%s%s%s", name, name[0] ? "." : "",
                      suffix);
             chans[n].image = im;
@@ -580,6 +631,11 @@ drift_result drift_image_save_exr_attributes(drift_context *ctx, const char *pat
     for (size_t i = 0; rv == EXR_ERR_SUCCESS && i < chan_count; ++i) {
         rv = exr_add_channel(f, part, chans[i].name, EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LOGARITHMIC,
                              1, 1);
+    }
+    if (rv == EXR_ERR_SUCCESS) { // linear Rec.709 primaries, D65 white (ITU-R BT.709)
+        const exr_attr_chromaticities_t rec709 = { 0.64f, 0.33f, 0.30f,   0.60f,
+                                                   0.15f, 0.06f, 0.3127f, 0.3290f };
+        rv = exr_attr_set_chromaticities(f, part, "chromaticities", &rec709);
     }
     for (uint32_t i = 0; rv == EXR_ERR_SUCCESS && i < attribute_count; ++i) {
         rv = exr_attr_set_string(f, part, attributes[i].name, attributes[i].value);

@@ -5,13 +5,16 @@
 // contains stb_image and stb_image_write, so only the declarations are included.
 #include "drift/math.h"
 #include "image_io_internal.h"
+#include "image_ocio.h"
 
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
+#include <math.h>
 #include <stb/stb_image.h>
 #include <stb/stb_image_write.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -445,6 +448,29 @@ drift_result drift_image_load(drift_context *ctx, const char *path, drift_image 
     return r;
 }
 
+drift_result drift_image_load_memory(drift_context *ctx, const char *name, const void *data,
+                                     size_t size, drift_image *out_image)
+{
+    if (!out_image) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    *out_image = (drift_image){ 0 };
+    if (!name || !data) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    static const uint8_t exr_magic[4] = { 0x76, 0x2f, 0x31, 0x01 };
+    if (size >= 4 && memcmp(data, exr_magic, 4) == 0) {
+        return drift__image_exr_load(ctx, name, data, size, out_image);
+    }
+    image_format format = content_format(data, size);
+    if (format == FORMAT_UNKNOWN) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_UNSUPPORTED, name, 0,
+                  "image data is not PNG, JPEG, Radiance HDR or OpenEXR");
+        return DRIFT_ERR_UNSUPPORTED;
+    }
+    return stb_load(ctx, name, format, data, size, out_image);
+}
+
 typedef struct png_sink {
     drift__image_temp *temp;
     uint64_t offset;
@@ -452,18 +478,39 @@ typedef struct png_sink {
     int error;
 } png_sink;
 
+static void png_write_bytes(png_sink *sink, const void *data, size_t size)
+{
+    if (sink->failed) {
+        return;
+    }
+    if (!drift__image_temp_write(sink->temp, data, size, sink->offset)) {
+        sink->failed = true;
+        sink->error = errno;
+        return;
+    }
+    sink->offset += (uint64_t)size;
+}
+
+// stb writes the whole file in one call: its signature and IHDR chunk (33 bytes), then the
+// rest. An sRGB chunk (rendering intent 0, perceptual) goes between them, where the PNG spec
+// wants it (before IDAT), so viewers and browsers take the 8-bit values as sRGB.
 static void png_write(void *context, void *data, int size)
 {
     png_sink *sink = context;
     if (sink->failed || size <= 0) {
         return;
     }
-    if (!drift__image_temp_write(sink->temp, data, (size_t)size, sink->offset)) {
-        sink->failed = true;
-        sink->error = errno;
+    static const uint8_t srgb_chunk[13] = {
+        0, 0, 0, 1, 's', 'R', 'G', 'B', 0, 0xae, 0xce, 0x1c, 0xe9
+    }; // length, type, 0, CRC
+    const uint8_t *bytes = data;
+    if (sink->offset == 0 && size > 33 && memcmp(bytes + 12, "IHDR", 4) == 0) {
+        png_write_bytes(sink, bytes, 33);
+        png_write_bytes(sink, srgb_chunk, sizeof srgb_chunk);
+        png_write_bytes(sink, bytes + 33, (size_t)size - 33);
         return;
     }
-    sink->offset += (uint64_t)size;
+    png_write_bytes(sink, data, (size_t)size);
 }
 
 drift_result drift_image_save_png(drift_context *ctx, const char *path, const drift_image *image,
@@ -502,4 +549,126 @@ drift_result drift_image_save_png(drift_context *ctx, const char *path, const dr
     }
     drift_free(ctx, rgb);
     return r;
+}
+
+// --- OPENCOLORIO (image_ocio.cpp) ---
+
+bool drift_ocio_available(void)
+{
+#ifdef DRIFT_HAVE_OCIO
+    return true;
+#else
+    return false;
+#endif
+}
+
+const char *drift_ocio_default_config(void)
+{
+    const char *env = getenv("OCIO");
+    if (env && *env) {
+        return env;
+    }
+    static const char *const blender[] = {
+        "/usr/share/blender/datafiles/colormanagement/config.ocio", // Debian's blender-data
+        "/usr/share/blender/3.4/datafiles/colormanagement/config.ocio",
+        "/usr/share/blender/3.6/datafiles/colormanagement/config.ocio",
+        "/usr/share/blender/4.0/datafiles/colormanagement/config.ocio",
+    };
+    for (size_t i = 0; i < sizeof blender / sizeof blender[0]; ++i) {
+        if (access(blender[i], R_OK) == 0) {
+            return blender[i];
+        }
+    }
+    return NULL;
+}
+
+drift_result drift_ocio_check_view(drift_context *ctx, const char *where,
+                                   const drift_ocio_view *view)
+{
+    if (!view || !view->view) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+#ifndef DRIFT_HAVE_OCIO
+    drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_UNSUPPORTED, where, 0,
+              "this drift was built without OpenColorIO (libopencolorio-dev)");
+    return DRIFT_ERR_UNSUPPORTED;
+#else
+    const char *config = view->config ? view->config : drift_ocio_default_config();
+    char why[512] = "";
+    if (!config || drift__ocio_apply(config, view->display, view->view, view->look, NULL, 0, why,
+                                     sizeof why) != 0) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, where, 0, "OpenColorIO: %s",
+                  config ? why : "no config (name one, set $OCIO or install blender-data)");
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    return DRIFT_OK;
+#endif
+}
+
+drift_result drift_image_save_png_view(drift_context *ctx, const char *path,
+                                       const drift_image *image, const drift_ocio_view *view)
+{
+    if (!path || !view || !view->view || !drift_image_is_valid(image)) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+#ifndef DRIFT_HAVE_OCIO
+    drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_UNSUPPORTED, path, 0,
+              "this drift was built without OpenColorIO (libopencolorio-dev): no view '%s'",
+              view->view);
+    return DRIFT_ERR_UNSUPPORTED;
+#else
+    const char *config = view->config ? view->config : drift_ocio_default_config();
+    if (!config) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_UNSUPPORTED, path, 0,
+                  "no OpenColorIO config: name one, set $OCIO or install Blender's "
+                  "(blender-data)");
+        return DRIFT_ERR_UNSUPPORTED;
+    }
+    size_t count = (size_t)image->width * (size_t)image->height, bytes;
+    if (!drift_size_mul(count, 3 * sizeof(float), &bytes)) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    float *rgb = drift_alloc(ctx, bytes);
+    drift_image display = { 0 };
+    drift_result r = rgb ? drift_image_create(ctx, image->width, image->height, 3, &display)
+                         : DRIFT_ERR_OUT_OF_MEMORY;
+    if (r != DRIFT_OK) {
+        drift_free(ctx, rgb);
+        return r;
+    }
+    float scale = exp2f(view->exposure_stops);
+    for (int32_t y = 0; y < image->height; ++y) {
+        for (int32_t x = 0; x < image->width; ++x) {
+            const float *p = drift_image_pixel(image, x, y);
+            float *q = rgb + 3 * ((size_t)y * (size_t)image->width + (size_t)x);
+            for (int c = 0; c < 3; ++c) {
+                q[c] = scale * p[image->channels >= 3 ? c : 0];
+            }
+        }
+    }
+    char why[512] = "";
+    if (drift__ocio_apply(config, view->display, view->view, view->look, rgb, count, why,
+                          sizeof why) != 0) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, path, 0, "OpenColorIO: %s",
+                  why);
+        r = DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    // The view's output is display-encoded: decoded here, drift_image_save_png's own sRGB
+    // encoding (exposure 0, clamp) gives the same values back, quantized to 8 bits.
+    for (size_t i = 0; r == DRIFT_OK && i < count; ++i) {
+        float *q = drift_image_pixel(&display, (int32_t)(i % (size_t)image->width),
+                                     (int32_t)(i / (size_t)image->width));
+        for (int c = 0; c < 3; ++c) {
+            float v = rgb[3 * i + (size_t)c];
+            q[c] = drift_srgb_to_linear(isfinite(v) ? fminf(fmaxf(v, 0.0f), 1.0f) : 0.0f);
+        }
+    }
+    if (r == DRIFT_OK) {
+        const drift_tonemap_params identity = { .exposure_stops = 0.0f, .op = DRIFT_TONEMAP_CLAMP };
+        r = drift_image_save_png(ctx, path, &display, &identity);
+    }
+    drift_image_destroy(ctx, &display);
+    drift_free(ctx, rgb);
+    return r;
+#endif
 }

@@ -91,7 +91,9 @@ typedef struct import_state {
     uint32_t *material_map;    // assimp material -> drift material
     bool *light_placed;        // assimp light already added through its node
     int *material_uv_set;      // assimp material -> UV set of its diffuse texture
+    uint32_t *embedded;        // assimp embedded texture -> drift texture (or invalid)
     drift__gltf *gltf;         // the glTF JSON (glTF files only)
+    drift__obj *obj;           // the OBJ and MTL text (OBJ files only)
     unsigned camera;           // assimp camera to use (glTF: chosen by params->camera)
     drift__import_info *info;
 } import_state;
@@ -130,9 +132,20 @@ static void material_texture(import_state *s, const struct aiMaterial *mat, drif
         }
         char rel[DRIFT__PATH_MAX];
         ai_name(&tex, rel, sizeof(rel));
-        if (rel[0] == '*' || rel[0] == '\0') {
-            drift_log(s->ctx, DRIFT_LOG_WARNING, DRIFT_ERR_UNSUPPORTED, s->where, s->line,
-                      "material '%s': embedded textures are not supported; ignored", m->name);
+        uint32_t index;
+        if (rel[0] != '\0' && drift__is_embedded_texture(s->ai, rel)) { // .glb, data URI
+            if (drift__embedded_texture(s->scene, s->ai, rel, s->embedded, s->where, s->line,
+                                        &index) != DRIFT_OK) {
+                drift_log(s->ctx, DRIFT_LOG_WARNING, DRIFT_ERR_IO, s->where, s->line,
+                          "material '%s': embedded texture %s not loaded; using its colour",
+                          m->name, rel);
+                return;
+            }
+            m->diffuse_texture = index;
+            m->diffuse = drift_vec3_is_zero(m->diffuse) ? drift_vec3_splat(1.0f) : m->diffuse;
+            return;
+        }
+        if (rel[0] == '\0') {
             return;
         }
         // Files written on Windows use backslashes.
@@ -141,14 +154,25 @@ static void material_texture(import_state *s, const struct aiMaterial *mat, drif
                 *c = '/';
             }
         }
+        // An MTL's map_Kd as its text says (whitespace and options removed), named by the
+        // library's file and line when it cannot be loaded.
+        const drift__obj_material *om = drift__obj_get_material(s->obj, m->name);
+        bool from_mtl = om && om->map_kd[0];
+        if (from_mtl) {
+            snprintf(rel, sizeof rel, "%s", om->map_kd);
+        }
+        const char *where = from_mtl ? om->mtl_path : s->where;
+        int line = from_mtl ? om->map_kd_line : s->line;
         char full[DRIFT__PATH_MAX];
-        uint32_t index;
         if (!drift__path_join(s->dir, rel, full, sizeof(full)) ||
-            drift__texture_cache_get(s->scene, s->params->textures, full, s->where, s->line,
-                                     &index) != DRIFT_OK) {
-            drift_log(s->ctx, DRIFT_LOG_WARNING, DRIFT_ERR_IO, s->where, s->line,
+            drift__texture_cache_get(s->scene, s->params->textures, full, where, line, &index) !=
+                DRIFT_OK) {
+            drift_log(s->ctx, DRIFT_LOG_WARNING, DRIFT_ERR_IO, where, line,
                       "material '%s': texture '%s' not loaded; using its colour", m->name, rel);
             return;
+        }
+        if (from_mtl && !om->has_kd) {
+            m->diffuse = drift_vec3_splat(1.0f); // Blender writes map_Kd without Kd: the texture
         }
         m->diffuse_texture = index;
         // A texture multiplies the diffuse colour; a black Kd would hide it.
@@ -240,6 +264,10 @@ static drift_result convert_materials(import_state *s)
             s->material_uv_set[i] = gm.base_color_uv_set;
         }
         material_texture(s, mat, &m);
+        const drift__obj_material *om = drift__obj_get_material(s->obj, m.name);
+        if (om && om->blender) { // Blender's MTL: Blender's importer's rule (scene_obj.c)
+            drift__obj_blender_material(om, &m);
+        }
         uint32_t index;
         drift_result r = drift_scene_add_material(s->scene, &m, &index);
         if (r != DRIFT_OK) {
@@ -325,6 +353,14 @@ static drift_result add_mesh(import_state *s, const struct aiMesh *mesh, const d
         indices[3 * t + 1] = face->mIndices[flip ? 2 : 1];
         indices[3 * t + 2] = face->mIndices[flip ? 1 : 2];
         t++;
+    }
+    // OBJ smoothing groups (s 1) without normals: smooth, as Blender shows them.
+    if (!normals && !mesh->mNormals && !s->params->face_normals &&
+        drift__obj_smooth(s->obj, node_name)) {
+        r = drift__smooth_normals(ctx, positions, nv, indices, tri_count, &normals);
+        if (r != DRIFT_OK) {
+            goto done;
+        }
     }
     uint32_t material = s->params->material_override;
     if (material == DRIFT_INVALID_INDEX) {
@@ -414,6 +450,7 @@ static drift_result add_light(import_state *s, unsigned index, const drift__mat4
                                    ? gl.outer_angle
                                    : DRIFT_PI / 4.0f;
             light.spot_inner = drift_clampf(gl.inner_angle, 0.0f, light.spot_outer);
+            light.spot_falloff = gl.falloff;
         }
         if (gl.has_range) {
             drift_log(s->ctx, DRIFT_LOG_WARNING, DRIFT_ERR_UNSUPPORTED, s->where, s->line,
@@ -520,8 +557,12 @@ static drift_result import_scene(import_state *s)
     s->material_map = drift_alloc(ctx, ((size_t)ai->mNumMaterials + 1) * sizeof(uint32_t));
     s->light_placed = drift_alloc(ctx, ((size_t)ai->mNumLights + 1) * sizeof(bool));
     s->material_uv_set = drift_alloc(ctx, ((size_t)ai->mNumMaterials + 1) * sizeof(int));
-    if (!s->material_map || !s->light_placed || !s->material_uv_set) {
+    s->embedded = drift_alloc(ctx, ((size_t)ai->mNumTextures + 1) * sizeof(uint32_t));
+    if (!s->material_map || !s->light_placed || !s->material_uv_set || !s->embedded) {
         r = DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    for (unsigned i = 0; r == DRIFT_OK && i < ai->mNumTextures; ++i) {
+        s->embedded[i] = DRIFT_INVALID_INDEX;
     }
     if (r == DRIFT_OK) {
         r = convert_materials(s);
@@ -543,6 +584,7 @@ static drift_result import_scene(import_state *s)
     drift_free(ctx, s->material_map);
     drift_free(ctx, s->light_placed);
     drift_free(ctx, s->material_uv_set);
+    drift_free(ctx, s->embedded);
     return r;
 }
 
@@ -596,66 +638,6 @@ static drift_result check_ply_file(const import_state *s, size_t file_size)
     size_t n = fread(head, 1, sizeof(head), f);
     fclose(f);
     return check_ply_header(s, head, n, file_size);
-}
-
-// An OBJ cut short: assimp reads what is there without a word. A last record (v, vt, vn, f,
-// l, p) that no newline ends is taken as the file cut mid-line and is an error naming the
-// line. The scan goes through the text in pieces, keeping the line count and how the
-// current line starts.
-typedef struct obj_tail {
-    int line;      // lines begun so far (1-based number of the current one)
-    char head[4];  // the current line's first characters
-    size_t length; // characters of the current line seen
-} obj_tail;
-
-static void obj_tail_feed(obj_tail *t, const char *text, size_t size)
-{
-    for (size_t i = 0; i < size; ++i) {
-        if (text[i] == '\n') {
-            ++t->line;
-            t->length = 0;
-        } else {
-            if (t->length < sizeof t->head) {
-                t->head[t->length] = text[i];
-            }
-            ++t->length;
-        }
-    }
-}
-
-static drift_result obj_tail_check(const import_state *s, const obj_tail *t)
-{
-    if (t->length == 0) {
-        return DRIFT_OK;
-    }
-    char head[5] = { 0 };
-    memcpy(head, t->head, t->length < 4 ? t->length : 4);
-    static const char *const records[] = { "v ", "vt ", "vn ", "f ", "l ", "p ", "v\t", "f\t" };
-    for (size_t i = 0; i < sizeof records / sizeof records[0]; ++i) {
-        if (strncmp(head, records[i], strlen(records[i])) == 0) {
-            drift_log(s->ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, s->params->path, t->line + 1,
-                      "the file ends in the middle of this line (cut short?); no newline ends "
-                      "its last record");
-            return DRIFT_ERR_PARSE;
-        }
-    }
-    return DRIFT_OK;
-}
-
-static drift_result check_obj_file(const import_state *s)
-{
-    FILE *f = fopen(s->params->path, "rb");
-    if (!f) {
-        return DRIFT_OK; // drift__check_file just saw it; let assimp report what changed
-    }
-    obj_tail t = { 0 };
-    char buf[65536];
-    size_t n;
-    while ((n = fread(buf, 1, sizeof buf, f)) > 0) {
-        obj_tail_feed(&t, buf, n);
-    }
-    fclose(f);
-    return obj_tail_check(s, &t);
 }
 
 drift_result drift__scene_import_mesh_file(drift_scene *scene, const drift__import_params *params,
@@ -723,12 +705,18 @@ drift_result drift__scene_import_mesh_file(drift_scene *scene, const drift__impo
             return r;
         }
     }
-    if (strcmp(ext, "obj") == 0) {
-        obj_tail t = { 0 };
-        if (gz) {
-            obj_tail_feed(&t, data, size);
+    if (strcmp(ext, "obj") == 0) { // its text and MTLs: scene_obj.c
+        char *text = data;
+        size_t text_size = size;
+        if (!gz) {
+            r = drift__read_file(ctx, params->path, false, s.where, s.line, &text, &text_size);
         }
-        r = gz ? obj_tail_check(&s, &t) : check_obj_file(&s);
+        if (r == DRIFT_OK) {
+            r = drift__obj_open(ctx, params->path, text, text_size, &s.obj);
+        }
+        if (text != data) {
+            drift_free(ctx, text);
+        }
         if (r != DRIFT_OK) {
             drift_free(ctx, data);
             return r;
@@ -755,6 +743,7 @@ drift_result drift__scene_import_mesh_file(drift_scene *scene, const drift__impo
                   params->path, ai ? "no scene" : aiGetErrorString());
         aiReleaseImport(ai);
         drift__gltf_close(ctx, s.gltf);
+        drift__obj_close(ctx, s.obj);
         return DRIFT_ERR_PARSE;
     }
     s.ai = ai;
@@ -772,6 +761,7 @@ drift_result drift__scene_import_mesh_file(drift_scene *scene, const drift__impo
         r = import_scene(&s);
     }
     drift__gltf_close(ctx, s.gltf);
+    drift__obj_close(ctx, s.obj);
     aiReleaseImport(ai);
     return r;
 }

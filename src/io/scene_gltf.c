@@ -193,6 +193,21 @@ static bool numbers(const cJSON *object, const char *key, float *out, int n)
     return true;
 }
 
+// The cone a file's spot lights mean. Blender's exporter writes Blender's spot (size, blend)
+// as outer = size / 2, inner = outer · (1 − blend), and Blender's importer reads them back the
+// same way: such a file renders as Cycles shows the spot (DRIFT_SPOT_BLENDER). Any other file
+// gets the falloff of KHR_lights_punctual's reference code (DRIFT_SPOT_GLTF).
+static drift_spot_falloff gltf_spot_falloff(const drift__gltf *g)
+{
+    const cJSON *asset = cJSON_GetObjectItemCaseSensitive(g->root, "asset");
+    const cJSON *generator = cJSON_GetObjectItemCaseSensitive(asset, "generator");
+    static const char blender[] = "Khronos glTF Blender I/O";
+    return cJSON_IsString(generator) &&
+                   strncmp(generator->valuestring, blender, sizeof blender - 1) == 0
+               ? DRIFT_SPOT_BLENDER
+               : DRIFT_SPOT_GLTF;
+}
+
 bool drift__gltf_get_light(const drift__gltf *g, unsigned index, drift__gltf_light *out)
 {
     const cJSON *l = g && g->lights ? cJSON_GetArrayItem(g->lights, (int)index) : NULL;
@@ -209,6 +224,7 @@ bool drift__gltf_get_light(const drift__gltf *g, unsigned index, drift__gltf_lig
     out->outer_angle = number_or(spot, "outerConeAngle", DRIFT_PI / 4.0f);
     out->inner_angle = number_or(spot, "innerConeAngle", 0.0f);
     out->has_range = cJSON_GetObjectItemCaseSensitive(l, "range") != NULL;
+    out->falloff = gltf_spot_falloff(g);
     return true;
 }
 

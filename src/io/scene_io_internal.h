@@ -66,6 +66,54 @@ typedef struct drift__import_info {
 drift_result drift__scene_import_mesh_file(drift_scene *scene, const drift__import_params *params,
                                            drift__import_info *out_info);
 
+// --- Embedded textures (scene_embedded.c): a .glb's images, data URIs ---
+
+struct aiScene;
+// Whether an assimp texture reference names a texture inside the file ("*N", or the name of
+// one of ai->mTextures).
+bool drift__is_embedded_texture(const struct aiScene *ai, const char *ref);
+// The scene texture of embedded texture `ref`, decoded on first use; loaded[] (one entry per
+// ai->mTextures, DRIFT_INVALID_INDEX at first) remembers them. Warns against (where, line).
+drift_result drift__embedded_texture(drift_scene *scene, const struct aiScene *ai, const char *ref,
+                                     uint32_t *loaded, const char *where, int line,
+                                     uint32_t *out_index);
+
+// --- OBJ and MTL text (scene_obj.c): what assimp 5.2 drops ---
+
+typedef struct drift__obj drift__obj;
+
+// A material of the OBJ's MTL libraries, as its text says.
+typedef struct drift__obj_material {
+    char name[DRIFT_NAME_MAX];
+    bool has_kd;                  // a Kd statement (else, beside map_Kd, the texture alone)
+    char map_kd[DRIFT__PATH_MAX]; // map_Kd's file, options and surrounding whitespace removed
+    int map_kd_line;              // its line in mtl_path (0: no map_Kd)
+    int illum;                    // 2 when not given
+    bool blender;                 // the library says Blender 2.8+ wrote it (its header)
+    bool has_ks, has_ns;          // Ks, Ns given
+    float ks, ns;                 // mean of Ks; Ns
+    const char *mtl_path;         // the library that defines it
+} drift__obj_material;
+
+// Reads the OBJ's text (already in memory) and its MTL libraries. Errors: a file cut short
+// (DRIFT_ERR_PARSE, naming the line). A missing library and what drift's material drops are
+// warnings naming the file and line.
+drift_result drift__obj_open(drift_context *ctx, const char *path, const char *text, size_t size,
+                             drift__obj **out);
+void drift__obj_close(drift_context *ctx, drift__obj *o);
+// Whether object (o) or group (g) `object` has a smoothing group on (s 1 ...).
+bool drift__obj_smooth(const drift__obj *o, const char *object);
+const drift__obj_material *drift__obj_get_material(const drift__obj *o, const char *name);
+// The highlight and diffuse of an MTL material as Blender 3.4's importer reads it: roughness
+// 1 − sqrt(Ns / 1000), Principled specular mean(Ks) (F0 = 0.08 · it), Burley diffuse of that
+// roughness; drift's glossy lobe by the glTF rule (docs/scene-format.md, "OBJ and MTL").
+// m->diffuse holds the colour (Kd or the texture's 1) and is kept below 1 − F0.
+void drift__obj_blender_material(const drift__obj_material *om, drift_material *m);
+// Area-weighted smooth normals of a triangle mesh (vertices at one position share one).
+drift_result drift__smooth_normals(drift_context *ctx, const float *positions, size_t vertex_count,
+                                   const uint32_t *indices, size_t triangle_count,
+                                   float **out_normals);
+
 // --- glTF JSON (scene_gltf.c): what assimp 5.2 drops ---
 
 typedef struct drift__gltf drift__gltf;
@@ -75,6 +123,7 @@ typedef struct drift__gltf_light {
     drift_vec3 color;               // W/sr (point, spot) or W/m² (directional): cd or lux / 683
     float inner_angle, outer_angle; // spot cone half angles, radians (defaults 0, π/4)
     bool has_range;                 // a `range` is given (drift ignores it)
+    drift_spot_falloff falloff;     // Blender's exporter wrote the file: Cycles' cone; else glTF's
 } drift__gltf_light;
 
 // A glTF metallic-roughness material as drift's diffuse + glossy (docs/scene-format.md).

@@ -1,8 +1,10 @@
-// Mitsuba 0.5/0.6 scene files (.xml), the subset Bitterli's "Rendering Resources" use, read
+// Mitsuba 0.5/0.6 scene files (.xml), and Mitsuba 3's brought to that form by
+// scene_mitsuba3.c, the subset Bitterli's "Rendering Resources" use, read
 // with expat into a small element tree and then mapped onto drift's scene (the mapping table
 // is in docs/scene-format.md). Unsupported elements are named in a warning with their line;
 // malformed XML, unknown shape types and bad values are errors naming the file and line.
 #include "scene_io_internal.h"
+#include "scene_mitsuba_xml.h"
 
 #include <expat.h>
 #include <math.h>
@@ -12,13 +14,6 @@
 #include <sys/stat.h>
 
 #define XML_MAX_DEPTH 64
-
-typedef struct xml_node {
-    char *name;
-    char **attrs; // name, value, name, value, ..., NULL
-    int line;
-    struct xml_node *parent, *first, *last, *next;
-} xml_node;
 
 typedef struct xml_reader {
     drift_context *ctx;
@@ -884,6 +879,10 @@ drift_result drift__scene_load_mitsuba(drift_context *ctx, const char *path,
         return code;
     }
     XML_ParserFree(parser);
+    if ((r = drift__mitsuba3_normalize(ctx, path, x.root)) != DRIFT_OK) {
+        free_node(ctx, x.root);
+        return r;
+    }
 
     drift_scene *scene = NULL;
     if ((r = drift_scene_create(ctx, &scene)) != DRIFT_OK) {

@@ -35,11 +35,7 @@ static float spot_falloff(const drift_light *l, drift_vec3 dir)
     if (l->type != DRIFT_LIGHT_SPOT) {
         return 1.0f;
     }
-    float cos_theta = drift_vec3_dot(l->direction, dir);
-    float lo = cosf(l->spot_outer), hi = cosf(l->spot_inner);
-    float t = hi > lo ? drift_clampf((cos_theta - lo) / (hi - lo), 0.0f, 1.0f)
-                      : (cos_theta >= lo ? 1.0f : 0.0f);
-    return t * t * (3.0f - 2.0f * t);
+    return drift_light_spot_falloff(l, drift_vec3_dot(l->direction, dir));
 }
 
 // Direction (unnormalised) through face coordinates (a, b) in [0, 1)^2 of face f.

@@ -60,6 +60,54 @@ static float light_area(const drift_scene *scene, const drift_light *l)
     return 0.0f;
 }
 
+static float smoothstep01(float t)
+{
+    t = drift_clampf(t, 0.0f, 1.0f);
+    return t * t * (3.0f - 2.0f * t);
+}
+
+float drift_light_spot_falloff(const drift_light *l, float cos_theta)
+{
+    if (l->type != DRIFT_LIGHT_SPOT) {
+        return 1.0f;
+    }
+    float lo = cosf(l->spot_outer), hi = cosf(l->spot_inner);
+    if (cos_theta <= lo) {
+        return 0.0f;
+    }
+    switch (l->spot_falloff) {
+    case DRIFT_SPOT_GLTF: {
+        // lightAngleScale = 1 / max(0.001, cos inner − cos outer), as the extension's code.
+        float t = drift_clampf((cos_theta - lo) / fmaxf(0.001f, hi - lo), 0.0f, 1.0f);
+        return t * t;
+    }
+    case DRIFT_SPOT_BLENDER: {
+        // Cycles' spot_attenuation: the cosine times a smoothstep over spot_smooth =
+        // (1 − cos(size / 2)) · blend; Blender's glTF importer reads blend = 1 − inner / outer.
+        float blend = l->spot_outer > 0.0f ? 1.0f - l->spot_inner / l->spot_outer : 0.0f;
+        float smooth = (1.0f - lo) * drift_clampf(blend, 0.0f, 1.0f);
+        float t = cos_theta - lo;
+        return cos_theta * (t < smooth && smooth > 0.0f ? smoothstep01(t / smooth) : 1.0f);
+    }
+    case DRIFT_SPOT_SMOOTHSTEP:
+    default:
+        return hi > lo ? smoothstep01((cos_theta - lo) / (hi - lo)) : 1.0f;
+    }
+}
+
+// ∫ falloff dω over the sphere of a spot light: 2π ∫ f(c) dc from cos outer to 1 (midpoint
+// rule; the integrands are smooth but for the ramp's ends, 512 steps hold 1e-5).
+static float spot_solid_angle(const drift_light *l)
+{
+    float lo = cosf(l->spot_outer), sum = 0.0f;
+    const int steps = 512;
+    for (int i = 0; i < steps; ++i) {
+        float c = lo + (1.0f - lo) * ((float)i + 0.5f) / (float)steps;
+        sum += drift_light_spot_falloff(l, c);
+    }
+    return 2.0f * DRIFT_PI * sum * (1.0f - lo) / (float)steps;
+}
+
 // Emitted power (luminance-weighted), the weight of the light in the pick distribution.
 static float light_power(const drift_scene *scene, const drift_light *l, float scene_radius)
 {
@@ -68,7 +116,10 @@ static float light_power(const drift_scene *scene, const drift_light *l, float s
     case DRIFT_LIGHT_POINT:
         return 4.0f * DRIFT_PI * lum;
     case DRIFT_LIGHT_SPOT:
-        return 2.0f * DRIFT_PI * (1.0f - 0.5f * (cosf(l->spot_inner) + cosf(l->spot_outer))) * lum;
+        return l->spot_falloff == DRIFT_SPOT_SMOOTHSTEP
+                   ? 2.0f * DRIFT_PI * (1.0f - 0.5f * (cosf(l->spot_inner) + cosf(l->spot_outer))) *
+                         lum
+                   : spot_solid_angle(l) * lum;
     case DRIFT_LIGHT_DIRECTIONAL:
         return DRIFT_PI * scene_radius * scene_radius * lum;
     case DRIFT_LIGHT_QUAD:
@@ -290,12 +341,9 @@ drift_light_sample drift_light_sample_li(const drift_scene *scene, uint32_t ligh
         s.is_delta = true;
         float falloff = 1.0f;
         if (l->type == DRIFT_LIGHT_SPOT) {
-            // pbrt-v4 SpotLight: smoothstep between the outer and inner cone cosines.
+            // pbrt-v4 SpotLight's smoothstep, glTF's or Blender's (spot_falloff).
             float cos_theta = drift_vec3_dot(l->direction, drift_vec3_neg(s.wi));
-            float lo = cosf(l->spot_outer), hi = cosf(l->spot_inner);
-            float t = hi > lo ? drift_clampf((cos_theta - lo) / (hi - lo), 0.0f, 1.0f)
-                              : (cos_theta >= lo ? 1.0f : 0.0f);
-            falloff = t * t * (3.0f - 2.0f * t);
+            falloff = drift_light_spot_falloff(l, cos_theta);
         }
         s.radiance = drift_vec3_scale(l->color, falloff / dist2);
         return s;

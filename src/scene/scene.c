@@ -274,6 +274,9 @@ static const char *light_problem(const drift_light *l)
             l->spot_inner > l->spot_outer) {
             return "spot light needs 0 <= inner <= outer <= pi, outer > 0";
         }
+        if ((unsigned)l->spot_falloff > (unsigned)DRIFT_SPOT_BLENDER) {
+            return "spot light falloff is not a drift_spot_falloff";
+        }
         return drift_vec3_length(l->direction) > 1e-12f ? NULL : "light direction is zero";
     case DRIFT_LIGHT_DIRECTIONAL:
         return drift_vec3_length(l->direction) > 1e-12f ? NULL : "light direction is zero";

@@ -22,7 +22,7 @@ for phase in ("load", "accel", "render", "write", "total"):
     assert s["milliseconds"][phase] >= 0.0
 assert s["nan_samples"] == 0
 PY
-for layer in albedo.R normal.R depth.Y; do
+for layer in albedo.R N.X Z; do
     grep -aq "$layer" "$tmp/a.exr" || fail "EXR lacks the $layer channel"
 done
 
@@ -44,6 +44,12 @@ expect 2 "$drift" render --spp zero --out "$tmp/c.exr"
 expect 2 "$drift" render --spp 0 --out "$tmp/c.exr"
 expect 2 "$drift" render --out "$tmp/c.png"
 expect 2 "$drift" render --bogus
+expect 2 "$drift" render --sp 4 --out "$tmp/c.exr"
+grep -q "did you mean '--spp'" "$tmp/err" || fail "no 'did you mean' for --sp"
+expect 2 "$drift" render --shadows pcff --out "$tmp/c.exr"
+grep -q "did you mean 'pcf'" "$tmp/err" || fail "no 'did you mean' for a technique"
+expect 2 "$drift" render --mode hybird --out "$tmp/c.exr"
+grep -q "did you mean 'hybrid'" "$tmp/err" || fail "no 'did you mean' for a choice"
 expect 2 "$drift" render --mode bogus --out "$tmp/c.exr"
 [ -e "$tmp/c.exr" ] && fail "an output was written after a usage error"
 expect 0 "$drift" render --help
@@ -138,6 +144,16 @@ expect 2 "$drift" render --ev100 99 --out "$tmp/never.exr"
 expect 2 "$drift" render --camera-exposure 16,0,100 --out "$tmp/never.exr"
 expect 2 "$drift" render --tonemap aces --out "$tmp/never.exr"
 grep -q "\-\-tonemap expects clamp, reinhard or filmic" "$tmp/err" || fail "--tonemap names its values"
+
+# In an empty directory the default output folder out/ is made.
+mkdir "$tmp/empty"
+(cd "$tmp/empty" && "$drift" render --spp 1 --width 8 --height 8 --quiet --checkpoint 0 \
+    >/dev/null) || fail "drift render in an empty directory failed"
+[ -s "$tmp/empty/out/render.exr" ] && [ -s "$tmp/empty/out/render.png" ] ||
+    fail "drift render in an empty directory wrote no out/render.exr"
+# A folder the user names is not made (a typo would make one).
+expect 1 "$drift" render --spp 1 --width 8 --height 8 --quiet --out "$tmp/typo-dir/f.exr"
+[ -e "$tmp/typo-dir" ] && fail "a missing --out folder was made"
 
 if [ "$failures" -ne 0 ]; then
     echo "$failures render CLI check(s) failed"
