@@ -163,12 +163,11 @@ static void material_texture(import_state *s, const struct aiMaterial *mat, drif
 // part drift's material cannot hold.
 static void gltf_material(import_state *s, const drift__gltf_material *gm, drift_material *m)
 {
-    m->diffuse = gm->diffuse;
-    m->specular = gm->specular;
-    m->exponent = gm->exponent;
+    // GGX metallic-roughness (material_gltf.c); the base colour texture multiplies `diffuse`.
+    m->type = DRIFT_MATERIAL_GGX;
+    m->diffuse = gm->base_color;
+    m->ggx = gm->ggx;
     m->emission = gm->emission;
-    m->diffuse_model = DRIFT_DIFFUSE_BURLEY;
-    m->diffuse_roughness = gm->roughness;
 
     const struct {
         bool present;
@@ -179,6 +178,7 @@ static void gltf_material(import_state *s, const drift__gltf_material *gm, drift
         { gm->has_emissive_texture, "emissive texture (its factor is used)" },
         { gm->has_occlusion_texture, "occlusion texture" },
         { gm->alpha_blended, "alpha mode (drawn opaque)" },
+        { gm->has_clearcoat, "clearcoat (KHR_materials_clearcoat; drift has one coat)" },
         { !gm->base_color_sampler_supported,
           "base colour sampler (clamp/mirror wrap or nearest filter; drift repeats and filters "
           "bilinearly)" },

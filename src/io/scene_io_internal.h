@@ -86,7 +86,16 @@ typedef struct drift__gltf_material {
     bool base_color_sampler_supported; // repeat wrap, linear magnification (or no sampler)
     bool has_metallic_roughness_texture, has_normal_texture, has_emissive_texture,
         has_occlusion_texture, alpha_blended;
+    // The same material for DRIFT_MATERIAL_GGX (material_gltf.c): base colour, metallic,
+    // roughness and the KHR_materials_transmission / _ior / _specular / _clearcoat values.
+    drift_vec3 base_color;
+    drift_ggx_params ggx;
+    bool has_clearcoat; // drift has no second coat: folded in as noted in docs/materials.md
 } drift__gltf_material;
+
+// Fills out->base_color and out->ggx from a glTF material object (material_gltf.c).
+struct cJSON;
+void drift__gltf_read_ggx(const struct cJSON *material, drift__gltf_material *out);
 
 // Reads the JSON of a .gltf or .glb (gunzipped when gz), warns once for each extension in
 // extensionsUsed that drift ignores. Errors (logged against where/line, naming path):
