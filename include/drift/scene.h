@@ -319,6 +319,10 @@ typedef struct drift_bsdf_ggx {
     drift_vec3 eta, k;                          // otherwise complex IOR
     float eta_rel; // dielectric: IOR on the far side over the IOR on wo's side
     bool thin;
+    // >= 0: the plastic's base is Burley's diffuse of this roughness, not dimmed by the coat
+    // (Blender 3.4's Principled BSDF; the material's diffuse_model BURLEY); < 0: the
+    // energy-conserving layering of docs/materials.md.
+    float burley_roughness;
 } drift_bsdf_ggx;
 
 // Resolved material at one point (textures applied). All directions in world space.

@@ -1,9 +1,12 @@
 // glTF's metallic-roughness material and its KHR_materials_transmission, _ior, _specular and
 // _volume extensions onto DRIFT_MATERIAL_GGX (docs/materials.md, "glTF").
+#include "drift/image_io.h"
 #include "scene_io_internal.h"
 
 #include <cjson/cJSON.h>
 #include <math.h>
+#include <stdio.h>
+#include <string.h>
 
 static float number_at(const cJSON *obj, const char *key, float fallback)
 {
@@ -28,7 +31,52 @@ static drift_vec3 color_at(const cJSON *obj, const char *key, drift_vec3 fallbac
     return drift_vec3_make(c[0], c[1], c[2]);
 }
 
-void drift__gltf_read_ggx(const cJSON *material, drift__gltf_material *out)
+// The uri of the image that texture reference `ref` ({"index": i, ...}) shows, or NULL.
+static const char *texture_uri(const cJSON *root, const cJSON *ref)
+{
+    const cJSON *index = cJSON_GetObjectItemCaseSensitive(ref, "index");
+    if (!cJSON_IsNumber(index)) {
+        return NULL;
+    }
+    const cJSON *texture =
+        cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(root, "textures"), index->valueint);
+    const cJSON *source = cJSON_GetObjectItemCaseSensitive(texture, "source");
+    if (!cJSON_IsNumber(source)) {
+        return NULL;
+    }
+    const cJSON *image =
+        cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(root, "images"), source->valueint);
+    const cJSON *uri = cJSON_GetObjectItemCaseSensitive(image, "uri");
+    return cJSON_IsString(uri) && strncmp(uri->valuestring, "data:", 5) != 0 ? uri->valuestring
+                                                                             : NULL;
+}
+
+drift_result drift__texture_load_data(drift_scene *scene, const char *path, const char *where,
+                                      int line, uint32_t *out_index)
+{
+    size_t size = 0;
+    drift_result r = drift__check_file(scene->ctx, path, where, line, &size);
+    drift_image image = { 0 };
+    if (r == DRIFT_OK) {
+        r = drift_image_load(scene->ctx, path, &image);
+    }
+    if (r != DRIFT_OK) {
+        drift_log(scene->ctx, DRIFT_LOG_WARNING, r, where, line, "cannot load texture '%s'", path);
+        return r;
+    }
+    // drift_image_load decodes 8- and 16-bit files as sRGB; data textures are stored as is.
+    const char *dot = strrchr(path, '.');
+    bool linear_file = dot && (strcmp(dot, ".exr") == 0 || strcmp(dot, ".hdr") == 0);
+    for (int32_t y = 0; y < image.height && !linear_file; ++y) {
+        float *row = drift_image_pixel(&image, 0, y);
+        for (int32_t i = 0; i < image.width * image.channels; ++i) {
+            row[i] = drift_linear_to_srgb(row[i]);
+        }
+    }
+    return drift_scene_add_texture(scene, image, out_index);
+}
+
+void drift__gltf_read_ggx(const cJSON *root, const cJSON *material, drift__gltf_material *out)
 {
     const cJSON *pbr = cJSON_GetObjectItemCaseSensitive(material, "pbrMetallicRoughness");
     const cJSON *ext = cJSON_GetObjectItemCaseSensitive(material, "extensions");
@@ -58,4 +106,9 @@ void drift__gltf_read_ggx(const cJSON *material, drift__gltf_material *out)
     const cJSON *volume = cJSON_GetObjectItemCaseSensitive(ext, "KHR_materials_volume");
     g->thin = !(number_at(volume, "thicknessFactor", 0.0f) > 0.0f);
     out->has_clearcoat = cJSON_GetObjectItemCaseSensitive(ext, "KHR_materials_clearcoat") != NULL;
+    const cJSON *mr = cJSON_GetObjectItemCaseSensitive(pbr, "metallicRoughnessTexture");
+    const char *uri = texture_uri(root, mr);
+    snprintf(out->metallic_roughness_uri, sizeof(out->metallic_roughness_uri), "%s",
+             uri ? uri : "");
+    out->metallic_roughness_uv_set = (int)drift_clampf(number_at(mr, "texCoord", 0.0f), 0.0f, 7.0f);
 }

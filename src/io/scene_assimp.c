@@ -168,12 +168,25 @@ static void gltf_material(import_state *s, const drift__gltf_material *gm, drift
     m->diffuse = gm->base_color;
     m->ggx = gm->ggx;
     m->emission = gm->emission;
+    // The diffuse of Blender's Principled BSDF (Cycles 3.4), the reference of glTF scenes here.
+    m->diffuse_model = DRIFT_DIFFUSE_BURLEY;
+    m->diffuse_roughness = sqrtf(gm->ggx.alpha);
+    char full[DRIFT__PATH_MAX];
+    uint32_t index;
+    bool mr_loaded =
+        gm->metallic_roughness_uri[0] &&
+        drift__path_join(s->dir, gm->metallic_roughness_uri, full, sizeof(full)) &&
+        drift__texture_load_data(s->scene, full, s->where, s->line, &index) == DRIFT_OK;
+    if (mr_loaded) {
+        m->ggx.metallic_roughness_texture = index;
+    }
 
     const struct {
         bool present;
         const char *what;
     } ignored[] = {
-        { gm->has_metallic_roughness_texture, "metallic-roughness texture (its factors are used)" },
+        { gm->has_metallic_roughness_texture && !mr_loaded,
+          "metallic-roughness texture (embedded or not loaded; its factors are used)" },
         { gm->has_normal_texture, "normal texture" },
         { gm->has_emissive_texture, "emissive texture (its factor is used)" },
         { gm->has_occlusion_texture, "occlusion texture" },

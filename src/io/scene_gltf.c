@@ -297,7 +297,7 @@ bool drift__gltf_get_material(const drift__gltf *g, unsigned index, drift__gltf_
     out->has_occlusion_texture = cJSON_GetObjectItemCaseSensitive(m, "occlusionTexture") != NULL;
     const cJSON *alpha_mode = cJSON_GetObjectItemCaseSensitive(m, "alphaMode");
     out->alpha_blended = cJSON_IsString(alpha_mode) && strcmp(alpha_mode->valuestring, "OPAQUE");
-    drift__gltf_read_ggx(m, out);
+    drift__gltf_read_ggx(g->root, m, out);
     return true;
 }
 

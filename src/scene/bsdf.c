@@ -66,6 +66,7 @@ static void make_ggx(const drift_scene *scene, const drift_material *m,
         drift_vec3_is_zero(p->specular_tint) ? drift_vec3_splat(1.0f) : p->specular_tint;
     g->f0_coat = drift_vec3_min(drift_vec3_scale(tint, f0 * f0), drift_vec3_splat(1.0f));
     g->thin = p->thin;
+    g->burley_roughness = m->diffuse_model == DRIFT_DIFFUSE_BURLEY ? m->diffuse_roughness : -1.0f;
     g->eta_rel = p->thin || surface->front_face ? ior : 1.0f / ior;
     if (p->k.x > 0.0f || p->k.y > 0.0f || p->k.z > 0.0f) {
         g->eta = p->eta;

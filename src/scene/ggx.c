@@ -167,7 +167,10 @@ static float plastic_p_coat(const drift_bsdf_ggx *g, drift_vec3 wo)
 {
     drift_vec3 ec = coat_albedo(g->f0_coat, drift__ggx_e1(wo.z, ra(g)), drift__ggx_es(wo.z, ra(g)));
     float lc = drift_luminance(ec);
-    float ld = drift_luminance(drift_vec3_mul(g->base, drift_vec3_sub(drift_vec3_splat(1.0f), ec)));
+    float ld =
+        drift_luminance(g->burley_roughness >= 0.0f
+                            ? g->base
+                            : drift_vec3_mul(g->base, drift_vec3_sub(drift_vec3_splat(1.0f), ec)));
     return lc + ld > 0.0f ? lc / (lc + ld) : 1.0f;
 }
 

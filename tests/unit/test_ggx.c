@@ -168,8 +168,11 @@ static void test_ggx_reflection_is_reciprocal(void **state)
     tinted.ggx.edge_tint = drift_vec3_make(0.8f, 0.9f, 1.0f);
     drift_material plastic = ggx_material(drift_vec3_make(0.2f, 0.5f, 0.8f), 0.2f, 0.0f, 0.0f);
     drift_material blend = ggx_material(drift_vec3_make(0.7f, 0.7f, 0.2f), 0.6f, 0.4f, 0.0f);
-    const drift_material *materials[] = { &metal, &gold, &tinted, &plastic, &blend };
-    for (int k = 0; k < 5; ++k) {
+    drift_material principled = plastic; // Blender 3.4's undimmed Burley base
+    principled.diffuse_model = DRIFT_DIFFUSE_BURLEY;
+    principled.diffuse_roughness = 0.6f;
+    const drift_material *materials[] = { &metal, &gold, &tinted, &plastic, &blend, &principled };
+    for (int k = 0; k < 6; ++k) {
         drift_bsdf b = make_bsdf(materials[k], true);
         for (uint32_t i = 0; i < 200; ++i) {
             drift_vec3 wo = drift_sample_cosine_hemisphere(
@@ -299,8 +302,12 @@ static void test_ggx_sampling_matches_pdf(void **state)
     drift_material plastic = ggx_material(drift_vec3_make(0.6f, 0.3f, 0.1f), 0.2f, 0.0f, 0.0f);
     drift_material glass = ggx_material(drift_vec3_splat(1.0f), 0.3f, 0.0f, 1.0f);
     drift_material blend = ggx_material(drift_vec3_make(0.5f, 0.5f, 0.5f), 0.4f, 0.3f, 0.5f);
+    drift_material principled = plastic;
+    principled.diffuse_model = DRIFT_DIFFUSE_BURLEY;
+    principled.diffuse_roughness = 0.45f;
     const float theta[] = { 0.1f, 0.8f, 1.3f };
     for (int t = 0; t < 3; ++t) {
+        chi_square_check("plastic, Burley base", &principled, true, theta[t]);
         chi_square_check("conductor alpha 0.1", &conductor, true, theta[t]);
         chi_square_check("conductor alpha 0.7", &rough_conductor, true, theta[t]);
         chi_square_check("plastic alpha 0.2", &plastic, true, theta[t]);
