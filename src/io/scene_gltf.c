@@ -33,8 +33,11 @@ struct drift__gltf {
 
 // The extensions this file turns into drift's quantities; any other in extensionsUsed is
 // named in a warning.
-static const char *const handled_extensions[] = { "KHR_lights_punctual",
-                                                  "KHR_materials_emissive_strength" };
+static const char *const handled_extensions[] = {
+    "KHR_lights_punctual",        "KHR_materials_emissive_strength",
+    "KHR_materials_transmission", "KHR_materials_ior",
+    "KHR_materials_specular",     "KHR_materials_volume" // material_gltf.c
+};
 
 static uint32_t read_u32(const uint8_t *p)
 {

@@ -150,6 +150,15 @@ static drift_vec3 plastic_eval(const drift_bsdf_ggx *g, drift_vec3 wo, drift_vec
     drift_vec3 h;
     float ss = reflect_ss(ra(g), wo, wi, &h);
     drift_vec3 coat = drift_vec3_scale(schlick(g->f0_coat, drift_vec3_dot(wo, h)), ss);
+    if (g->burley_roughness >= 0.0f) {
+        // Burley's factor (docs/materials.md): F_D90 = 1/2 + r (1 + wi.wo).
+        float fd90_minus_1 = g->burley_roughness * (1.0f + drift_vec3_dot(wo, wi)) - 0.5f;
+        float fo = 1.0f - wo.z, fi = 1.0f - wi.z;
+        float fo5 = (fo * fo) * (fo * fo) * fo, fi5 = (fi * fi) * (fi * fi) * fi;
+        float burley = (1.0f + fd90_minus_1 * fi5) * (1.0f + fd90_minus_1 * fo5);
+        *out_diffuse = drift_vec3_scale(g->base, burley * DRIFT_INV_PI);
+        return drift_vec3_add(coat, *out_diffuse);
+    }
     drift_vec3 ec_o =
         coat_albedo(g->f0_coat, drift__ggx_e1(wo.z, ra(g)), drift__ggx_es(wo.z, ra(g)));
     drift_vec3 ec_i =

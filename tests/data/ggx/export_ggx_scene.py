@@ -68,12 +68,12 @@ def main():
         sphere("Metal%d" % i, -2.4 + 1.2 * i, material("Metal%d" % i, gold, r, metallic=1.0))
     sphere("Glass", 2.4, material("Glass", (1.0, 1.0, 1.0), 0.0, transmission=1.0))
 
-    # A 4 m x 2 m emissive panel behind the camera's shoulder, facing the spheres.
-    bpy.ops.mesh.primitive_plane_add(size=1.0, location=(0.0, -4.0, 3.0))
+    # A 4 m x 2 m emissive slab above the camera's line of sight, facing the spheres: a closed
+    # box, since Cycles' emission is two-sided and drift's leaves the front faces only.
+    bpy.ops.mesh.primitive_cube_add(size=1.0, location=(0.0, -4.0, 3.0))
     panel = bpy.context.object
     panel.name = "Panel"
-    panel.scale = (4.0, 2.0, 1.0)
-    place(panel, (0.0, -4.0, 3.0))
+    panel.scale = (4.0, 2.0, 0.05)
     panel.rotation_euler = (Vector((0, 0, 0.5)) - Vector((0.0, -4.0, 3.0))).to_track_quat("Z", "Y").to_euler()
     panel.data.materials.append(
         material("Panel", (0.0, 0.0, 0.0), 1.0, emission=(1.0, 0.95, 0.9), strength=3.0))
