@@ -83,7 +83,8 @@ void drift__gltf_read_ggx(const cJSON *root, const cJSON *material, drift__gltf_
     drift_vec3 base = color_at(pbr, "baseColorFactor", drift_vec3_splat(1.0f));
     out->base_color = drift_vec3_min(base, drift_vec3_splat(1.0f));
     drift_ggx_params *g = &out->ggx;
-    *g = (drift_ggx_params){ .metallic_roughness_texture = DRIFT_INVALID_INDEX };
+    *g = (drift_ggx_params){ .metallic_roughness_texture = DRIFT_INVALID_INDEX,
+                             .normal_texture = DRIFT_INVALID_INDEX };
     g->metallic = drift_clampf(number_at(pbr, "metallicFactor", 1.0f), 0.0f, 1.0f);
     float roughness = drift_clampf(number_at(pbr, "roughnessFactor", 1.0f), 0.0f, 1.0f);
     g->alpha = roughness * roughness;
@@ -102,13 +103,19 @@ void drift__gltf_read_ggx(const cJSON *root, const cJSON *material, drift__gltf_
             g->specular_tint = drift_vec3_splat(1e-6f); // zero means "untinted" to drift
         }
     }
-    // Without KHR_materials_volume (or with thickness 0) glTF's transmission is thin-walled.
+    // KHR_materials_volume of thickness 0 is thin-walled. Without the extension the glTF
+    // specification says thin-walled too, but Blender exports its solid glass so and imports
+    // it back as solid: drift follows Blender there (docs/materials.md).
     const cJSON *volume = cJSON_GetObjectItemCaseSensitive(ext, "KHR_materials_volume");
-    g->thin = !(number_at(volume, "thicknessFactor", 0.0f) > 0.0f);
+    g->thin = volume && !(number_at(volume, "thicknessFactor", 0.0f) > 0.0f);
     out->has_clearcoat = cJSON_GetObjectItemCaseSensitive(ext, "KHR_materials_clearcoat") != NULL;
     const cJSON *mr = cJSON_GetObjectItemCaseSensitive(pbr, "metallicRoughnessTexture");
     const char *uri = texture_uri(root, mr);
     snprintf(out->metallic_roughness_uri, sizeof(out->metallic_roughness_uri), "%s",
              uri ? uri : "");
+    const cJSON *normal = cJSON_GetObjectItemCaseSensitive(material, "normalTexture");
+    uri = texture_uri(root, normal);
+    snprintf(out->normal_uri, sizeof(out->normal_uri), "%s", uri ? uri : "");
+    out->normal_scale = number_at(normal, "scale", 1.0f);
     out->metallic_roughness_uv_set = (int)drift_clampf(number_at(mr, "texCoord", 0.0f), 0.0f, 7.0f);
 }

@@ -180,6 +180,13 @@ static void gltf_material(import_state *s, const drift__gltf_material *gm, drift
     if (mr_loaded) {
         m->ggx.metallic_roughness_texture = index;
     }
+    bool normal_loaded =
+        gm->normal_uri[0] && drift__path_join(s->dir, gm->normal_uri, full, sizeof(full)) &&
+        drift__texture_load_data(s->scene, full, s->where, s->line, &index) == DRIFT_OK;
+    if (normal_loaded) {
+        m->ggx.normal_texture = index;
+        m->ggx.normal_scale = gm->normal_scale;
+    }
 
     const struct {
         bool present;
@@ -187,7 +194,7 @@ static void gltf_material(import_state *s, const drift__gltf_material *gm, drift
     } ignored[] = {
         { gm->has_metallic_roughness_texture && !mr_loaded,
           "metallic-roughness texture (embedded or not loaded; its factors are used)" },
-        { gm->has_normal_texture, "normal texture" },
+        { gm->has_normal_texture && !normal_loaded, "normal texture (embedded or not loaded)" },
         { gm->has_emissive_texture, "emissive texture (its factor is used)" },
         { gm->has_occlusion_texture, "occlusion texture" },
         { gm->alpha_blended, "alpha mode (drawn opaque)" },

@@ -95,6 +95,8 @@ typedef struct drift__gltf_material {
     // when the image is embedded) and its texCoord.
     char metallic_roughness_uri[DRIFT__PATH_MAX];
     int metallic_roughness_uv_set;
+    char normal_uri[DRIFT__PATH_MAX]; // normalTexture's image file, as above
+    float normal_scale;
 } drift__gltf_material;
 
 // Fills out->base_color, out->ggx and the metallic-roughness texture's file from a glTF

@@ -39,6 +39,62 @@ void drift__ggx_phong_equivalent(const drift_material *m, drift_vec3 base, float
     *exponent = phong_exponent_of_alpha(alpha);
 }
 
+// The shading normal bent by a tangent-space normal map: tangent and bitangent from the uv
+// derivatives of the hit triangle (pbrt's dp/du, dp/dv), made orthogonal to the interpolated
+// normal. Unchanged where the mesh has no uvs or the map would turn the normal below the surface.
+static drift_vec3 normal_mapped(const drift_scene *scene, const drift_material *m,
+                                const drift_surface *surface)
+{
+    drift_vec3 n = surface->ns;
+    if (surface->mesh == DRIFT_INVALID_INDEX) {
+        return n;
+    }
+    const drift_mesh *mesh = &scene->meshes[surface->mesh];
+    if (!mesh->uvs) {
+        return n;
+    }
+    const uint32_t *tri = mesh->indices + 3 * (size_t)surface->triangle;
+    const float *p = mesh->positions, *t = mesh->uvs;
+    drift_vec3 p0 = drift_vec3_make(p[3 * tri[0]], p[3 * tri[0] + 1], p[3 * tri[0] + 2]);
+    drift_vec3 dp1 =
+        drift_vec3_sub(drift_vec3_make(p[3 * tri[1]], p[3 * tri[1] + 1], p[3 * tri[1] + 2]), p0);
+    drift_vec3 dp2 =
+        drift_vec3_sub(drift_vec3_make(p[3 * tri[2]], p[3 * tri[2] + 1], p[3 * tri[2] + 2]), p0);
+    float du1 = t[2 * tri[1]] - t[2 * tri[0]], dv1 = t[2 * tri[1] + 1] - t[2 * tri[0] + 1];
+    float du2 = t[2 * tri[2]] - t[2 * tri[0]], dv2 = t[2 * tri[2] + 1] - t[2 * tri[0] + 1];
+    float det = du1 * dv2 - dv1 * du2;
+    if (!(fabsf(det) > 1e-12f)) {
+        return n;
+    }
+    drift_vec3 dpdu = drift_vec3_scale(
+        drift_vec3_sub(drift_vec3_scale(dp1, dv2), drift_vec3_scale(dp2, dv1)), 1.0f / det);
+    drift_vec3 dpdv = drift_vec3_scale(
+        drift_vec3_sub(drift_vec3_scale(dp2, du1), drift_vec3_scale(dp1, du2)), 1.0f / det);
+    drift_vec3 tangent = drift_vec3_fma(dpdu, n, -drift_vec3_dot(n, dpdu));
+    float len = drift_vec3_length(tangent);
+    if (!(len > 0.0f)) {
+        return n;
+    }
+    tangent = drift_vec3_scale(tangent, 1.0f / len);
+    drift_vec3 bitangent = drift_vec3_cross(n, tangent);
+    if (drift_vec3_dot(bitangent, dpdv) < 0.0f) {
+        bitangent = drift_vec3_neg(bitangent);
+    }
+    drift_vec3 c = drift__texture_bilinear(&scene->textures[m->ggx.normal_texture], surface->uv);
+    float scale = m->ggx.normal_scale > 0.0f ? m->ggx.normal_scale : 1.0f;
+    drift_vec3 local = drift_vec3_make((2.0f * c.x - 1.0f) * scale, (2.0f * c.y - 1.0f) * scale,
+                                       fmaxf(2.0f * c.z - 1.0f, 0.0f));
+    drift_vec3 bent = drift_vec3_add(
+        drift_vec3_add(drift_vec3_scale(tangent, local.x), drift_vec3_scale(bitangent, local.y)),
+        drift_vec3_scale(n, local.z));
+    float bent_len = drift_vec3_length(bent);
+    if (!(bent_len > 0.0f)) {
+        return n;
+    }
+    bent = drift_vec3_scale(bent, 1.0f / bent_len);
+    return drift_vec3_dot(bent, surface->ng) > 0.0f ? bent : n;
+}
+
 static void make_ggx(const drift_scene *scene, const drift_material *m,
                      const drift_surface *surface, drift_bsdf *b)
 {
@@ -50,6 +106,9 @@ static void make_ggx(const drift_scene *scene, const drift_material *m,
         float r = sqrtf(fmaxf(alpha, 0.0f)) * t.y;
         alpha = r * r;
         metallic *= t.z;
+    }
+    if (p->normal_texture != DRIFT_INVALID_INDEX && scene) {
+        b->frame = drift_frame_from_normal(normal_mapped(scene, m, surface));
     }
     alpha = drift_clampf(alpha, 0.0f, 1.0f);
     metallic = drift_clampf(metallic, 0.0f, 1.0f);

@@ -213,7 +213,8 @@ drift_material drift_material_make(drift_vec3 diffuse)
 {
     return (drift_material){ .diffuse = diffuse,
                              .diffuse_texture = DRIFT_INVALID_INDEX,
-                             .ggx = { .metallic_roughness_texture = DRIFT_INVALID_INDEX } };
+                             .ggx = { .metallic_roughness_texture = DRIFT_INVALID_INDEX,
+                                      .normal_texture = DRIFT_INVALID_INDEX } };
 }
 
 static bool vec3_is_nonnegative_finite(drift_vec3 v)
@@ -435,10 +436,11 @@ drift_result drift_scene_commit(drift_scene *scene)
             return DRIFT_ERR_INVALID_ARGUMENT;
         }
         if (m->type == DRIFT_MATERIAL_GGX) {
-            uint32_t t = m->ggx.metallic_roughness_texture;
-            if (t != DRIFT_INVALID_INDEX && t >= scene->texture_count) {
+            uint32_t t = m->ggx.metallic_roughness_texture, tn = m->ggx.normal_texture;
+            if ((t != DRIFT_INVALID_INDEX && t >= scene->texture_count) ||
+                (tn != DRIFT_INVALID_INDEX && tn >= scene->texture_count)) {
                 drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, m->name, 0,
-                          "metallic-roughness texture %u out of range (scene has %u)", t,
+                          "metallic-roughness or normal texture out of range (scene has %u)",
                           scene->texture_count);
                 return DRIFT_ERR_INVALID_ARGUMENT;
             }

@@ -3,6 +3,7 @@
 // dielectric reflects plus transmits 1), reciprocity, each lobe's sampling against its pdf
 // (chi-square, as pbrt and Mitsuba test theirs) with the pdf integrating to the sampling's
 // success rate, Snell's law, total internal reflection and Fresnel at normal incidence.
+#include "drift/image.h"
 #include "drift/math.h"
 #include "drift/scene.h"
 #include "drift_test.h"
@@ -411,6 +412,63 @@ static void test_ggx_conductor_fresnel(void **state)
     assert_false(drift_ggx_named_metal("unobtainium", &gold));
 }
 
+// A normal map of one texel bends the normal of a uv-mapped quad by the angle it encodes, about
+// the direction of increasing u (its tangent), on both faces.
+static void test_ggx_normal_map_bends_the_normal(void **state)
+{
+    (void)state;
+    drift_context *ctx = test_context(1, NULL);
+    drift_scene *scene = NULL;
+    assert_int_equal(drift_scene_create(ctx, &scene), DRIFT_OK);
+    drift_image texel = { 0 };
+    assert_int_equal(drift_image_create(ctx, 1, 1, 3, &texel), DRIFT_OK);
+    const float angle = 0.5f; // tilt toward +u (world +x on this quad)
+    texel.pixels[0] = 0.5f + 0.5f * sinf(angle);
+    texel.pixels[1] = 0.5f;
+    texel.pixels[2] = 0.5f + 0.5f * cosf(angle);
+    uint32_t tex;
+    assert_int_equal(drift_scene_add_texture(scene, texel, &tex), DRIFT_OK);
+    drift_material m = ggx_material(drift_vec3_splat(0.5f), 0.3f, 0.0f, 0.0f);
+    m.ggx.normal_texture = tex;
+    uint32_t mat;
+    assert_int_equal(drift_scene_add_material(scene, &m, &mat), DRIFT_OK);
+    // A quad in the xy plane facing +z, u along +x and v along +y.
+    const float positions[] = { 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0 };
+    const float uvs[] = { 0, 0, 1, 0, 1, 1, 0, 1 };
+    const uint32_t indices[] = { 0, 1, 2, 0, 2, 3 };
+    uint32_t mesh;
+    assert_int_equal(drift_scene_add_mesh(scene,
+                                          &(drift_mesh_desc){ .positions = positions,
+                                                              .uvs = uvs,
+                                                              .indices = indices,
+                                                              .vertex_count = 4,
+                                                              .triangle_count = 2,
+                                                              .material = mat },
+                                          &mesh),
+                     DRIFT_OK);
+    assert_int_equal(drift_scene_commit(scene), DRIFT_OK);
+    for (int side = 0; side < 2; ++side) {
+        float z = side == 0 ? 1.0f : -1.0f;
+        drift_ray ray = { .origin = drift_vec3_make(0.3f, 0.6f, 2.0f * z),
+                          .dir = drift_vec3_make(0, 0, -z),
+                          .tmax = INFINITY };
+        drift_hit hit = { .t = 2.0f,
+                          .u = 0.3f,
+                          .v = 0.3f,
+                          .mesh = mesh,
+                          .prim = 0,
+                          .light = DRIFT_INVALID_INDEX,
+                          .ng = drift_vec3_make(0, 0, 1) };
+        drift_surface s = drift_scene_surface(scene, &ray, &hit);
+        drift_bsdf b = drift_bsdf_make(scene, &s);
+        assert_near(b.frame.z.x, sin(angle), 1e-3);
+        assert_near(b.frame.z.y, 0.0, 1e-3);
+        assert_near(b.frame.z.z, z * cos(angle), 1e-3);
+    }
+    drift_scene_destroy(scene);
+    drift_context_destroy(ctx);
+}
+
 // The generated tables (scripts/gen_ggx_tables.sh) hold the integrals they claim to, between
 // grid points too: recomputed here on a finer grid of visible normals.
 static void test_ggx_albedo_tables_match_their_integrals(void **state)
@@ -443,6 +501,7 @@ int main(void)
         cmocka_unit_test(test_ggx_snell_and_total_internal_reflection),
         cmocka_unit_test(test_ggx_conductor_fresnel),
         cmocka_unit_test(test_ggx_albedo_tables_match_their_integrals),
+        cmocka_unit_test(test_ggx_normal_map_bends_the_normal),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
