@@ -125,6 +125,11 @@ typedef struct drift_ggx_params {
     // Textures (DRIFT_INVALID_INDEX for none; drift_material_make sets none): glTF's
     // metallic-roughness (B = metallic, G = perceptual roughness, multiplying the factors).
     uint32_t metallic_roughness_texture;
+    // A tangent-space normal map (glTF's convention: +X along increasing u, +Y along
+    // increasing v of drift's bottom-up uv, RGB = (n + 1) / 2), its XY scaled by normal_scale
+    // (0 means 1). Tangents come from each triangle's uv derivatives (docs/materials.md).
+    uint32_t normal_texture;
+    float normal_scale;
 } drift_ggx_params;
 
 // Fills `ggx` with the measured complex IOR of a named metal ("Au", "Ag", "Cu", "Al", and the
