@@ -461,9 +461,9 @@ static void test_ggx_normal_map_bends_the_normal(void **state)
                           .ng = drift_vec3_make(0, 0, 1) };
         drift_surface s = drift_scene_surface(scene, &ray, &hit);
         drift_bsdf b = drift_bsdf_make(scene, &s);
-        assert_near(b.frame.z.x, sin(angle), 1e-3);
+        assert_near(b.frame.z.x, sin((double)angle), 1e-3);
         assert_near(b.frame.z.y, 0.0, 1e-3);
-        assert_near(b.frame.z.z, z * cos(angle), 1e-3);
+        assert_near(b.frame.z.z, (double)z * cos((double)angle), 1e-3);
     }
     drift_scene_destroy(scene);
     drift_context_destroy(ctx);
