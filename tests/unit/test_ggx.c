@@ -93,7 +93,7 @@ static double albedo_quadrature(const drift_bsdf *b, drift_vec3 wo)
 static void test_ggx_white_conductor_reflects_everything(void **state)
 {
     (void)state;
-    int n = (int)(16000 * test_intensity());
+    int n = (int)(10000 * test_intensity());
     const float roughness[] = { 0.0f, 0.2f, 0.4f, 0.6f, 0.8f, 1.0f }; // perceptual
     const float theta[] = { 0.0f, 0.7f, 1.2f };
     for (int r = 0; r < 6; ++r) {
@@ -122,7 +122,7 @@ static void test_ggx_white_conductor_reflects_everything(void **state)
 static void test_ggx_white_plastic_reflects_everything(void **state)
 {
     (void)state;
-    int n = (int)(16000 * test_intensity());
+    int n = (int)(10000 * test_intensity());
     const float alphas[] = { 0.01f, 0.1f, 0.5f, 1.0f };
     for (int r = 0; r < 4; ++r) {
         drift_material m = ggx_material(drift_vec3_splat(1.0f), alphas[r], 0.0f, 0.0f);
@@ -140,7 +140,7 @@ static void test_ggx_white_plastic_reflects_everything(void **state)
 static void test_ggx_rough_dielectric_reflects_plus_transmits_one(void **state)
 {
     (void)state;
-    int n = (int)(16000 * test_intensity());
+    int n = (int)(10000 * test_intensity());
     const float alphas[] = { 0.05f, 0.3f, 0.6f, 1.0f };
     for (int r = 0; r < 4; ++r) {
         for (int side = 0; side < 2; ++side) {
@@ -290,7 +290,7 @@ static void chi_square_check(const char *what, const drift_material *m, bool fro
     ggx_case c = { .bsdf = make_bsdf(m, front), .wo = dir_at(theta) };
     char why[256] = "", label[128];
     snprintf(label, sizeof(label), "%s theta_o=%.1f", what, (double)theta);
-    if (!chi_square_passes(label, &c, &c, (int)(60000 * test_intensity()), why, sizeof(why))) {
+    if (!chi_square_passes(label, &c, &c, (int)(40000 * test_intensity()), why, sizeof(why))) {
         fail_msg("%s", why);
     }
 }
