@@ -54,6 +54,13 @@ static const char *texture_uri(const cJSON *root, const cJSON *ref)
 drift_result drift__texture_load_data(drift_scene *scene, const char *path, const char *where,
                                       int line, uint32_t *out_index)
 {
+    FILE *probe = fopen(path, "rb"); // a missing image is a warning here, not an error
+    if (!probe) {
+        drift_log(scene->ctx, DRIFT_LOG_WARNING, DRIFT_ERR_IO, where, line,
+                  "cannot open texture '%s'", path);
+        return DRIFT_ERR_IO;
+    }
+    fclose(probe);
     size_t size = 0;
     drift_result r = drift__check_file(scene->ctx, path, where, line, &size);
     drift_image image = { 0 };

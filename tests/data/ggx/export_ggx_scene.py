@@ -5,9 +5,10 @@
 #
 #   blender -b --factory-startup -noaudio --python tests/data/ggx/export_ggx_scene.py -- --out DIR
 #
-# writes DIR/ggx_scene.gltf (+ .bin and the two texture images beside it: drift reads glTF
-# textures from image files). The floor carries a metallic-roughness texture (a checker of
-# metal / plastic and roughness 0.3 / 0.8), the back wall a tangent-space normal map (ridges).
+# writes DIR/ggx_scene.glb. With --textured: DIR/ggx_scene.gltf (+ .bin and two texture
+# images beside it: drift reads glTF textures from image files) where the floor carries a
+# metallic-roughness texture (a checker of metal / plastic and roughness 0.3 / 0.8) and a back
+# wall a tangent-space normal map (ridges).
 import argparse
 import os
 import sys
@@ -20,6 +21,7 @@ def parse_args():
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
     p = argparse.ArgumentParser(prog="export_ggx_scene.py")
     p.add_argument("--out", required=True)
+    p.add_argument("--textured", action="store_true")
     return p.parse_args(argv)
 
 
@@ -132,15 +134,19 @@ def main():
     os.makedirs(args.out, exist_ok=True)
     bpy.ops.mesh.primitive_plane_add(size=12.0, location=(0, 0, 0))
     bpy.context.object.name = "Floor"
-    bpy.context.object.data.materials.append(textured_floor(args.out))
+    if args.textured:
+        bpy.context.object.data.materials.append(textured_floor(args.out))
+    else:
+        bpy.context.object.data.materials.append(material("Floor", (0.6, 0.6, 0.6), 0.7))
 
     # The back wall, 8 m x 3 m, facing the camera (-Y), normal-mapped.
-    bpy.ops.mesh.primitive_plane_add(size=1.0, location=(0.0, 2.0, 1.5))
-    wall = bpy.context.object
-    wall.name = "Wall"
-    wall.scale = (8.0, 3.0, 1.0)
-    wall.rotation_euler = (1.5707963, 0.0, 0.0)
-    wall.data.materials.append(bumpy_wall(args.out))
+    if args.textured:
+        bpy.ops.mesh.primitive_plane_add(size=1.0, location=(0.0, 2.0, 1.5))
+        wall = bpy.context.object
+        wall.name = "Wall"
+        wall.scale = (8.0, 3.0, 1.0)
+        wall.rotation_euler = (1.5707963, 0.0, 0.0)
+        wall.data.materials.append(bumpy_wall(args.out))
 
     gold = (1.0, 0.78, 0.34)
     for i, r in enumerate((0.05, 0.25, 0.5, 0.8)):
@@ -172,10 +178,14 @@ def main():
     scene.camera = ob
 
     # The panel is a mesh: its scale and rotation are applied by the exporter's node transform.
-    bpy.ops.export_scene.gltf(filepath=os.path.join(args.out, "ggx_scene.gltf"),
-                              export_format="GLTF_SEPARATE", export_cameras=True,
-                              export_lights=True)
-    write_png(os.path.join(args.out, "floor_mr.png"), 64, checker)
+    if args.textured:
+        bpy.ops.export_scene.gltf(filepath=os.path.join(args.out, "ggx_scene.gltf"),
+                                  export_format="GLTF_SEPARATE", export_cameras=True,
+                                  export_lights=True)
+        write_png(os.path.join(args.out, "floor_mr.png"), 64, checker)
+    else:
+        bpy.ops.export_scene.gltf(filepath=os.path.join(args.out, "ggx_scene.glb"),
+                                  export_format="GLB", export_cameras=True, export_lights=True)
     print("EXPORTED", args.out)
 
 

@@ -7,5 +7,5 @@ here="$(cd "$(dirname "$0")" && pwd)"
 src="$(cd "$here/../../.." && pwd)"
 blend() { blender -b --factory-startup -noaudio --python "$@"; }
 blend "$here/export_ggx_scene.py" -- --out "$here"
-blend "$src/bench/cycles/gltf_cycles.py" -- --gltf "$here/ggx_scene.gltf" --spp "${SPP:-1024}" --multiscatter \
+blend "$src/bench/cycles/gltf_cycles.py" -- --gltf "$here/ggx_scene.glb" --spp "${SPP:-1024}" --multiscatter \
     --width 64 --height 48 --threads 2 --out "$here/cycles_64x48.exr"
