@@ -328,6 +328,10 @@ typedef struct drift_bsdf_ggx {
     // (Blender 3.4's Principled BSDF; the material's diffuse_model BURLEY); < 0: the
     // energy-conserving layering of docs/materials.md.
     float burley_roughness;
+    // Set by drift_bsdf_make from the clamped roughness: its row of the albedo tables and
+    // their cosine-weighted averages (src/scene/ggx_tables.c).
+    int alpha_row;
+    float alpha_frac, e1_avg, es_avg;
 } drift_bsdf_ggx;
 
 // Resolved material at one point (textures applied). All directions in world space.

@@ -125,6 +125,10 @@ static void make_ggx(const drift_scene *scene, const drift_material *m,
         drift_vec3_is_zero(p->specular_tint) ? drift_vec3_splat(1.0f) : p->specular_tint;
     g->f0_coat = drift_vec3_min(drift_vec3_scale(tint, f0 * f0), drift_vec3_splat(1.0f));
     g->thin = p->thin;
+    float table_alpha = fmaxf(alpha, DRIFT_GGX_MIN_ALPHA);
+    drift__ggx_alpha_slot(table_alpha, &g->alpha_row, &g->alpha_frac);
+    g->e1_avg = drift__ggx_e1_avg(table_alpha);
+    g->es_avg = drift__ggx_es_avg(table_alpha);
     g->burley_roughness = m->diffuse_model == DRIFT_DIFFUSE_BURLEY ? m->diffuse_roughness : -1.0f;
     g->eta_rel = p->thin || surface->front_face ? ior : 1.0f / ior;
     if (p->k.x > 0.0f || p->k.y > 0.0f || p->k.z > 0.0f) {

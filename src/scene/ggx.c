@@ -107,6 +107,12 @@ static float ra(const drift_bsdf_ggx *g)
     return fmaxf(g->alpha, DRIFT_GGX_MIN_ALPHA);
 }
 
+// E1 and Es at cos theta = mu for this BSDF's roughness.
+static void albedos(const drift_bsdf_ggx *g, float mu, float *e1, float *es)
+{
+    drift__ggx_e1_es_at(mu, g->alpha_row, g->alpha_frac, e1, es);
+}
+
 // --- CONDUCTOR ---
 
 static drift_vec3 conductor_eval(const drift_bsdf_ggx *g, drift_vec3 wo, drift_vec3 wi)
@@ -114,12 +120,14 @@ static drift_vec3 conductor_eval(const drift_bsdf_ggx *g, drift_vec3 wo, drift_v
     drift_vec3 h;
     float ss = reflect_ss(ra(g), wo, wi, &h);
     drift_vec3 f = drift_vec3_scale(conductor_fresnel(g, drift_vec3_dot(wo, h)), ss);
-    float e_avg = drift__ggx_e1_avg(ra(g));
+    float e_avg = g->e1_avg;
     if (e_avg < 0.9999f) {
         drift_vec3 f0 = conductor_fresnel(g, 1.0f);
         drift_vec3 f_avg = drift_vec3_add(
             f0, drift_vec3_scale(drift_vec3_sub(drift_vec3_splat(1.0f), f0), 1.0f / 21.0f));
-        float e_o = drift__ggx_e1(wo.z, ra(g)), e_i = drift__ggx_e1(wi.z, ra(g));
+        float e_o, e_i, unused;
+        albedos(g, wo.z, &e_o, &unused);
+        albedos(g, wi.z, &e_i, &unused);
         float ms = (1.0f - e_o) * (1.0f - e_i) / (DRIFT_PI * (1.0f - e_avg));
         drift_vec3 f_ms;
         f_ms.x = f_avg.x * f_avg.x * e_avg / (1.0f - f_avg.x * (1.0f - e_avg));
@@ -133,7 +141,9 @@ static drift_vec3 conductor_eval(const drift_bsdf_ggx *g, drift_vec3 wo, drift_v
 // Probability of sampling the single-scattering lobe (the rest goes to the cosine lobe).
 static float conductor_p_ss(const drift_bsdf_ggx *g, drift_vec3 wo)
 {
-    return drift_clampf(drift__ggx_e1(wo.z, ra(g)), 0.0f, 1.0f);
+    float e1, es;
+    albedos(g, wo.z, &e1, &es);
+    return drift_clampf(e1, 0.0f, 1.0f);
 }
 
 static float conductor_pdf(const drift_bsdf_ggx *g, drift_vec3 wo, drift_vec3 wi)
@@ -159,11 +169,12 @@ static drift_vec3 plastic_eval(const drift_bsdf_ggx *g, drift_vec3 wo, drift_vec
         *out_diffuse = drift_vec3_scale(g->base, burley * DRIFT_INV_PI);
         return drift_vec3_add(coat, *out_diffuse);
     }
-    drift_vec3 ec_o =
-        coat_albedo(g->f0_coat, drift__ggx_e1(wo.z, ra(g)), drift__ggx_es(wo.z, ra(g)));
-    drift_vec3 ec_i =
-        coat_albedo(g->f0_coat, drift__ggx_e1(wi.z, ra(g)), drift__ggx_es(wi.z, ra(g)));
-    drift_vec3 ec_avg = coat_albedo(g->f0_coat, drift__ggx_e1_avg(ra(g)), drift__ggx_es_avg(ra(g)));
+    float e1_o, es_o, e1_i, es_i;
+    albedos(g, wo.z, &e1_o, &es_o);
+    albedos(g, wi.z, &e1_i, &es_i);
+    drift_vec3 ec_o = coat_albedo(g->f0_coat, e1_o, es_o);
+    drift_vec3 ec_i = coat_albedo(g->f0_coat, e1_i, es_i);
+    drift_vec3 ec_avg = coat_albedo(g->f0_coat, g->e1_avg, g->es_avg);
     drift_vec3 one = drift_vec3_splat(1.0f);
     drift_vec3 base = drift_vec3_mul(drift_vec3_sub(one, ec_o), drift_vec3_sub(one, ec_i));
     drift_vec3 denom = drift_vec3_scale(drift_vec3_sub(one, ec_avg), DRIFT_PI);
@@ -174,7 +185,9 @@ static drift_vec3 plastic_eval(const drift_bsdf_ggx *g, drift_vec3 wo, drift_vec
 
 static float plastic_p_coat(const drift_bsdf_ggx *g, drift_vec3 wo)
 {
-    drift_vec3 ec = coat_albedo(g->f0_coat, drift__ggx_e1(wo.z, ra(g)), drift__ggx_es(wo.z, ra(g)));
+    float e1, es;
+    albedos(g, wo.z, &e1, &es);
+    drift_vec3 ec = coat_albedo(g->f0_coat, e1, es);
     float lc = drift_luminance(ec);
     float ld =
         drift_luminance(g->burley_roughness >= 0.0f

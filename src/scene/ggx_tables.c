@@ -70,3 +70,21 @@ float drift__ggx_e_dielectric(float mu, float alpha, float eta)
                       DRIFT_GGX_TABLE_D_MU_N, mu, alpha, true);
     return a + (b - a) * fe;
 }
+
+void drift__ggx_alpha_slot(float alpha, int *row, float *frac)
+{
+    *row = grid_pos(sqrtf(fmaxf(0.0f, alpha)) * (float)(DRIFT_GGX_TABLE_ALPHA_N - 1),
+                    DRIFT_GGX_TABLE_ALPHA_N, frac);
+}
+
+void drift__ggx_e1_es_at(float mu, int row, float frac, float *e1, float *es)
+{
+    float fm;
+    int im = grid_pos(mu * (float)DRIFT_GGX_TABLE_MU_N - 0.5f, DRIFT_GGX_TABLE_MU_N, &fm);
+    const float *a0 = &ggx_table_e1[row][im], *a1 = &ggx_table_e1[row + 1][im];
+    const float *b0 = &ggx_table_es[row][im], *b1 = &ggx_table_es[row + 1][im];
+    float a = a0[0] + (a0[1] - a0[0]) * fm, b = a1[0] + (a1[1] - a1[0]) * fm;
+    float c = b0[0] + (b0[1] - b0[0]) * fm, d = b1[0] + (b1[1] - b1[0]) * fm;
+    *e1 = a + (b - a) * frac;
+    *es = c + (d - c) * frac;
+}

@@ -40,6 +40,9 @@ float drift__ggx_es(float mu, float alpha);
 float drift__ggx_e1_avg(float alpha);
 float drift__ggx_es_avg(float alpha);
 float drift__ggx_e_dielectric(float mu, float alpha, float eta);
+// The same lookups with the roughness's row of the table found once (a BSDF's alpha is fixed).
+void drift__ggx_alpha_slot(float alpha, int *row, float *frac);
+void drift__ggx_e1_es_at(float mu, int row, float frac, float *e1, float *es);
 
 // The tables' grids: mu at (i + 0.5) / MU_N (dielectric: at drift__ggx_grid_mu_d(i), from
 // 0 to 1 inclusive, for the steep change near normal incidence inside); sqrt(alpha) at j / (ALPHA_N
