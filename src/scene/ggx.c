@@ -302,6 +302,81 @@ float drift__ggx_pdf(const drift_bsdf_ggx *g, drift_vec3 wo, drift_vec3 wi)
     return pdf;
 }
 
+// drift__ggx_eval and drift__ggx_pdf at once for a material without a dielectric part and
+// wo, wi above the surface (the sampling's case): the half vector, D, both Lambdas and the
+// albedo lookups are shared.
+static drift_vec3 reflection_eval_pdf(const drift_bsdf_ggx *g, drift_vec3 wo, drift_vec3 wi,
+                                      float *out_pdf)
+{
+    float a = ra(g);
+    drift_vec3 h = drift_vec3_add(wo, wi);
+    float len = drift_vec3_length(h);
+    *out_pdf = 0.0f;
+    if (!(len > 0.0f)) {
+        return drift_vec3_splat(0.0f);
+    }
+    h = drift_vec3_scale(h, 1.0f / len);
+    float wo_h = drift_vec3_dot(wo, h);
+    float d = drift__ggx_d(a, h);
+    float lo = drift__ggx_lambda(a, wo), li = drift__ggx_lambda(a, wi);
+    float ss = d / ((1.0f + lo + li) * 4.0f * wo.z * wi.z);
+    // D_wo(h) / (4 wo.h) = G1(wo) D / (4 wo.z).
+    float pdf_r = wo_h > 0.0f ? d / ((1.0f + lo) * 4.0f * wo.z) : 0.0f;
+    float pdf_c = wi.z * DRIFT_INV_PI;
+    float e1_o, es_o, e1_i, es_i;
+    albedos(g, wo.z, &e1_o, &es_o);
+    albedos(g, wi.z, &e1_i, &es_i);
+    drift_vec3 f = drift_vec3_splat(0.0f);
+    float pdf = 0.0f;
+    if (g->w_conductor > 0.0f) {
+        drift_vec3 fc = drift_vec3_scale(conductor_fresnel(g, wo_h), ss);
+        float e_avg = g->e1_avg;
+        if (e_avg < 0.9999f) {
+            drift_vec3 f0 = conductor_fresnel(g, 1.0f);
+            drift_vec3 f_avg = drift_vec3_add(
+                f0, drift_vec3_scale(drift_vec3_sub(drift_vec3_splat(1.0f), f0), 1.0f / 21.0f));
+            float ms = (1.0f - e1_o) * (1.0f - e1_i) / (DRIFT_PI * (1.0f - e_avg));
+            drift_vec3 f_ms;
+            f_ms.x = f_avg.x * f_avg.x * e_avg / (1.0f - f_avg.x * (1.0f - e_avg));
+            f_ms.y = f_avg.y * f_avg.y * e_avg / (1.0f - f_avg.y * (1.0f - e_avg));
+            f_ms.z = f_avg.z * f_avg.z * e_avg / (1.0f - f_avg.z * (1.0f - e_avg));
+            fc = drift_vec3_fma(fc, f_ms, ms);
+        }
+        float p = drift_clampf(e1_o, 0.0f, 1.0f);
+        f = drift_vec3_scale(fc, g->w_conductor);
+        pdf += g->w_conductor * (p * pdf_r + (1.0f - p) * pdf_c);
+    }
+    if (g->w_plastic > 0.0f) {
+        drift_vec3 coat = drift_vec3_scale(schlick(g->f0_coat, wo_h), ss);
+        drift_vec3 one = drift_vec3_splat(1.0f);
+        drift_vec3 ec_o = coat_albedo(g->f0_coat, e1_o, es_o);
+        drift_vec3 base;
+        if (g->burley_roughness >= 0.0f) {
+            float fd90_minus_1 = g->burley_roughness * (1.0f + drift_vec3_dot(wo, wi)) - 0.5f;
+            float fo = 1.0f - wo.z, fi = 1.0f - wi.z;
+            float fo5 = (fo * fo) * (fo * fo) * fo, fi5 = (fi * fi) * (fi * fi) * fi;
+            float burley = (1.0f + fd90_minus_1 * fi5) * (1.0f + fd90_minus_1 * fo5);
+            base = drift_vec3_scale(g->base, burley * DRIFT_INV_PI);
+        } else {
+            drift_vec3 ec_i = coat_albedo(g->f0_coat, e1_i, es_i);
+            drift_vec3 ec_avg = coat_albedo(g->f0_coat, g->e1_avg, g->es_avg);
+            base = drift_vec3_mul(drift_vec3_sub(one, ec_o), drift_vec3_sub(one, ec_i));
+            drift_vec3 denom = drift_vec3_scale(drift_vec3_sub(one, ec_avg), DRIFT_PI);
+            base = drift_vec3_mul(
+                g->base, drift_vec3_make(base.x / denom.x, base.y / denom.y, base.z / denom.z));
+        }
+        float lc = drift_luminance(ec_o);
+        float ld = drift_luminance(g->burley_roughness >= 0.0f
+                                       ? g->base
+                                       : drift_vec3_mul(g->base, drift_vec3_sub(one, ec_o)));
+        float p = lc + ld > 0.0f ? lc / (lc + ld) : 1.0f;
+        f = drift_vec3_fma(f, drift_vec3_add(coat, base), g->w_plastic);
+        pdf += g->w_plastic * (p * pdf_r + (1.0f - p) * pdf_c);
+    }
+    *out_pdf = pdf;
+    return f;
+}
+
 // A smooth (or thin-walled) dielectric: reflect with probability R, else transmit.
 static drift_bsdf_sample sample_smooth_dielectric(const drift_bsdf_ggx *g, drift_vec3 wo, float u)
 {
@@ -365,11 +440,17 @@ drift_bsdf_sample drift__ggx_sample(const drift_bsdf_ggx *g, drift_vec3 wo, floa
             return s;
         }
     }
-    s.pdf = drift__ggx_pdf(g, wo, wi);
+    drift_vec3 f;
+    if (g->w_dielectric <= 0.0f && wi.z > 0.0f) {
+        f = reflection_eval_pdf(g, wo, wi, &s.pdf);
+    } else {
+        s.pdf = drift__ggx_pdf(g, wo, wi);
+        f = drift__ggx_eval(g, wo, wi, NULL);
+    }
     if (!(s.pdf > 0.0f) || wi.z == 0.0f) {
         return (drift_bsdf_sample){ 0 };
     }
     s.wi = wi;
-    s.weight = drift_vec3_scale(drift__ggx_eval(g, wo, wi, NULL), fabsf(wi.z) / s.pdf);
+    s.weight = drift_vec3_scale(f, fabsf(wi.z) / s.pdf);
     return s;
 }

@@ -190,6 +190,41 @@ static void test_ggx_reflection_is_reciprocal(void **state)
     }
 }
 
+// Sampling reports the pdf drift_bsdf_pdf gives its direction and the weight f |cos| / pdf of
+// drift_bsdf_eval (sampling computes both in one pass for reflective materials).
+static void test_ggx_sample_agrees_with_eval_and_pdf(void **state)
+{
+    (void)state;
+    drift_material metal = ggx_material(drift_vec3_make(0.9f, 0.6f, 0.3f), 0.4f, 1.0f, 0.0f);
+    drift_material plastic = ggx_material(drift_vec3_make(0.2f, 0.5f, 0.8f), 0.2f, 0.0f, 0.0f);
+    drift_material principled = plastic;
+    principled.diffuse_model = DRIFT_DIFFUSE_BURLEY;
+    principled.diffuse_roughness = 0.5f;
+    drift_material blend = ggx_material(drift_vec3_make(0.7f, 0.7f, 0.2f), 0.6f, 0.4f, 0.0f);
+    drift_material glass = ggx_material(drift_vec3_splat(1.0f), 0.3f, 0.2f, 0.7f);
+    const drift_material *materials[] = { &metal, &plastic, &principled, &blend, &glass };
+    for (int k = 0; k < 5; ++k) {
+        drift_bsdf b = make_bsdf(materials[k], true);
+        drift_vec3 wo = dir_at(0.7f);
+        for (uint32_t i = 0; i < 300; ++i) {
+            drift_sampler s = drift_sampler_make(9, 1, i);
+            drift_vec2 u = drift_sampler_next2(&s);
+            drift_bsdf_sample bs = drift_bsdf_sample_wi(&b, wo, drift_sampler_next1(&s), u);
+            if (!(bs.pdf > 0.0f) || bs.is_delta) {
+                continue;
+            }
+            float pdf = drift_bsdf_pdf(&b, wo, bs.wi);
+            drift_vec3 w = drift_vec3_scale(drift_bsdf_eval(&b, wo, bs.wi), fabsf(bs.wi.z) / pdf);
+            if (fabsf(pdf - bs.pdf) > 1e-3f * pdf ||
+                fabsf(w.x - bs.weight.x) > 1e-3f * w.x + 1e-6f ||
+                fabsf(w.z - bs.weight.z) > 1e-3f * w.z + 1e-6f) {
+                fail_msg("material %d: sample pdf %g weight %g, eval/pdf give %g and %g", k,
+                         (double)bs.pdf, (double)bs.weight.x, (double)pdf, (double)w.x);
+            }
+        }
+    }
+}
+
 // --- CHI-SQUARE (the same test as test_sampling.c's, over the whole sphere) ---
 
 #define THETA_BINS 16
@@ -496,6 +531,7 @@ int main(void)
         cmocka_unit_test(test_ggx_white_plastic_reflects_everything),
         cmocka_unit_test(test_ggx_rough_dielectric_reflects_plus_transmits_one),
         cmocka_unit_test(test_ggx_reflection_is_reciprocal),
+        cmocka_unit_test(test_ggx_sample_agrees_with_eval_and_pdf),
         cmocka_unit_test(test_ggx_sampling_matches_pdf),
         cmocka_unit_test(test_ggx_chi_square_detects_a_wrong_pdf),
         cmocka_unit_test(test_ggx_snell_and_total_internal_reflection),
