@@ -27,6 +27,9 @@ def parse_args():
     p.add_argument("--max-bounces", type=int, default=8)
     p.add_argument("--out", required=True)
     p.add_argument("--seed", type=int, default=0, help="Cycles' sampling seed")
+    p.add_argument("--multiscatter", action="store_true",
+                   help="set each Principled BSDF to Multiscatter GGX (energy-conserving rough "
+                        "metals, as drift's GGX material compensates; issue 41)")
     p.add_argument("--lambert", action="store_true",
                    help="replace each Principled BSDF by a Diffuse BSDF of its base colour "
                         "(emission kept): separates the material model from the light units")
@@ -44,6 +47,11 @@ def main():
         bpy.data.objects.remove(ob, do_unlink=True)
     bpy.ops.import_scene.gltf(filepath=args.gltf)
     scene = bpy.context.scene
+    if args.multiscatter:
+        for mat in bpy.data.materials:
+            for node in (mat.node_tree.nodes if mat.use_nodes else []):
+                if node.type == "BSDF_PRINCIPLED":
+                    node.distribution = "MULTI_GGX"
     if args.lambert:
         for mat in bpy.data.materials:
             nodes = mat.node_tree.nodes if mat.use_nodes else []

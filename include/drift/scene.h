@@ -97,6 +97,7 @@ drift_ray drift_camera_ray(const drift_camera *camera, int32_t width, int32_t he
 typedef enum drift_material_type {
     DRIFT_MATERIAL_DEFAULT = 0, // diffuse + glossy (either may be zero)
     DRIFT_MATERIAL_MIRROR,      // perfect specular reflection with reflectance `specular`
+    DRIFT_MATERIAL_GGX,         // microfacet conductor / plastic / dielectric (`ggx`)
     DRIFT_MATERIAL_COUNT
 } drift_material_type;
 
@@ -105,6 +106,35 @@ typedef enum drift_diffuse_model {
     DRIFT_DIFFUSE_LAMBERT = 0, // kd / pi
     DRIFT_DIFFUSE_BURLEY,      // Burley's (Disney's) diffuse of roughness `diffuse_roughness`
 } drift_diffuse_model;
+
+// DRIFT_MATERIAL_GGX (docs/materials.md): GGX (Trowbridge-Reitz) microfacets with Smith
+// height-correlated masking-shadowing and multiple-scattering energy compensation. Its base
+// colour is the material's `diffuse` (times diffuse_texture). Three components, blended as
+// glTF's metallic-roughness model does: a conductor (weight metallic), a dielectric-coated
+// diffuse "plastic" (weight (1 - metallic)(1 - transmission)) and a dielectric that refracts
+// (weight (1 - metallic) transmission). All zero is a rough-free white plastic of IOR 1.5.
+typedef struct drift_ggx_params {
+    float alpha;              // GGX roughness alpha (glTF's perceptual roughness squared); 0..1
+    float metallic;           // 0..1
+    float transmission;       // 0..1, of the non-metallic part
+    float ior;                // coat and dielectric IOR; 0 means 1.5
+    drift_vec3 specular_tint; // scales the coat's F0 (KHR_materials_specular); 0 means 1
+    drift_vec3 edge_tint;     // conductor: Gulbrandsen edge tint; 0 = Schlick from F0 = base
+    drift_vec3 eta, k;        // conductor: measured complex IOR per RGB, used when k != 0
+    bool thin;                // dielectric: thin-walled (no bend, light passes straight)
+    // Textures (DRIFT_INVALID_INDEX for none; drift_material_make sets none): glTF's
+    // metallic-roughness (B = metallic, G = perceptual roughness, multiplying the factors).
+    uint32_t metallic_roughness_texture;
+    // A tangent-space normal map (glTF's convention: +X along increasing u, +Y along
+    // increasing v of drift's bottom-up uv, RGB = (n + 1) / 2), its XY scaled by normal_scale
+    // (0 means 1). Tangents come from each triangle's uv derivatives (docs/materials.md).
+    uint32_t normal_texture;
+    float normal_scale;
+} drift_ggx_params;
+
+// Fills `ggx` with the measured complex IOR of a named metal ("Au", "Ag", "Cu", "Al", and the
+// English names); false when the name is unknown.
+bool drift_ggx_named_metal(const char *name, drift_ggx_params *ggx);
 
 typedef struct drift_material {
     char name[DRIFT_NAME_MAX];
@@ -116,6 +146,7 @@ typedef struct drift_material {
     uint32_t diffuse_texture; // texture index modulating `diffuse`, or DRIFT_INVALID_INDEX
     drift_diffuse_model diffuse_model;
     float diffuse_roughness; // Burley only: in [0, 1] (glTF's perceptual roughness)
+    drift_ggx_params ggx;    // DRIFT_MATERIAL_GGX only
 } drift_material;
 
 // A material with no texture: the value to start from when filling one in.
@@ -297,7 +328,30 @@ drift_vec3 drift_offset_origin(drift_vec3 position, drift_vec3 ng, drift_vec3 di
 
 // --- BSDF ---
 
+// A DRIFT_MATERIAL_GGX material resolved at one point (textures applied).
+typedef struct drift_bsdf_ggx {
+    float alpha;
+    float w_conductor, w_plastic, w_dielectric; // component weights, summing to 1
+    drift_vec3 base;                            // base colour: conductor F0, plastic diffuse
+    drift_vec3 f0_coat;                         // plastic coat's F0 (Schlick)
+    bool schlick;                               // conductor Fresnel: Schlick from base
+    drift_vec3 eta, k;                          // otherwise complex IOR
+    float eta_rel; // dielectric: IOR on the far side over the IOR on wo's side
+    bool thin;
+    // >= 0: the plastic's base is Burley's diffuse of this roughness, not dimmed by the coat
+    // (Blender 3.4's Principled BSDF; the material's diffuse_model BURLEY); < 0: the
+    // energy-conserving layering of docs/materials.md.
+    float burley_roughness;
+    // Set by drift_bsdf_make from the clamped roughness: its row of the albedo tables and
+    // their cosine-weighted averages (src/scene/ggx_tables.c).
+    int alpha_row;
+    float alpha_frac, e1_avg, es_avg;
+} drift_bsdf_ggx;
+
 // Resolved material at one point (textures applied). All directions in world space.
+// For DRIFT_MATERIAL_GGX, diffuse, specular and exponent hold the Phong-equivalent lobe
+// (docs/materials.md, "Phong-equivalent") for the techniques whose papers shade with Phong;
+// drift_bsdf_eval, _pdf and _sample_wi evaluate the GGX model itself.
 typedef struct drift_bsdf {
     drift_material_type type;
     drift_vec3 diffuse, specular;
@@ -309,6 +363,7 @@ typedef struct drift_bsdf {
     // centre on instead, for the one wo it was made for: an edited reflection e(q)
     // (drift/reflect_edit.h). The diffuse lobe does not change.
     drift_vec3 edited_mirror;
+    drift_bsdf_ggx ggx; // DRIFT_MATERIAL_GGX only
 } drift_bsdf;
 
 drift_bsdf drift_bsdf_make(const drift_scene *scene, const drift_surface *surface);
@@ -327,7 +382,7 @@ typedef struct drift_bsdf_sample {
     drift_vec3 wi;
     drift_vec3 weight; // f * cos / pdf (for mirrors: ks)
     float pdf;         // solid-angle pdf; 0 on failure
-    bool is_delta;     // sampled from a delta lobe (mirror): skip MIS and NEE there
+    bool is_delta;     // sampled from a delta lobe (mirror, smooth glass): skip MIS and NEE
 } drift_bsdf_sample;
 
 // Samples wi. u_lobe picks the lobe, u the direction. pdf == 0 means no sample.

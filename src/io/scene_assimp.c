@@ -187,22 +187,42 @@ static void material_texture(import_state *s, const struct aiMaterial *mat, drif
 // part drift's material cannot hold.
 static void gltf_material(import_state *s, const drift__gltf_material *gm, drift_material *m)
 {
-    m->diffuse = gm->diffuse;
-    m->specular = gm->specular;
-    m->exponent = gm->exponent;
+    // GGX metallic-roughness (material_gltf.c); the base colour texture multiplies `diffuse`.
+    m->type = DRIFT_MATERIAL_GGX;
+    m->diffuse = gm->base_color;
+    m->ggx = gm->ggx;
     m->emission = gm->emission;
+    // The diffuse of Blender's Principled BSDF (Cycles 3.4), the reference of glTF scenes here.
     m->diffuse_model = DRIFT_DIFFUSE_BURLEY;
-    m->diffuse_roughness = gm->roughness;
+    m->diffuse_roughness = sqrtf(gm->ggx.alpha);
+    char full[DRIFT__PATH_MAX];
+    uint32_t index;
+    bool mr_loaded =
+        gm->metallic_roughness_uri[0] &&
+        drift__path_join(s->dir, gm->metallic_roughness_uri, full, sizeof(full)) &&
+        drift__texture_load_data(s->scene, full, s->where, s->line, &index) == DRIFT_OK;
+    if (mr_loaded) {
+        m->ggx.metallic_roughness_texture = index;
+    }
+    bool normal_loaded =
+        gm->normal_uri[0] && drift__path_join(s->dir, gm->normal_uri, full, sizeof(full)) &&
+        drift__texture_load_data(s->scene, full, s->where, s->line, &index) == DRIFT_OK;
+    if (normal_loaded) {
+        m->ggx.normal_texture = index;
+        m->ggx.normal_scale = gm->normal_scale;
+    }
 
     const struct {
         bool present;
         const char *what;
     } ignored[] = {
-        { gm->has_metallic_roughness_texture, "metallic-roughness texture (its factors are used)" },
-        { gm->has_normal_texture, "normal texture" },
+        { gm->has_metallic_roughness_texture && !mr_loaded,
+          "metallic-roughness texture (embedded or not loaded; its factors are used)" },
+        { gm->has_normal_texture && !normal_loaded, "normal texture (embedded or not loaded)" },
         { gm->has_emissive_texture, "emissive texture (its factor is used)" },
         { gm->has_occlusion_texture, "occlusion texture" },
         { gm->alpha_blended, "alpha mode (drawn opaque)" },
+        { gm->has_clearcoat, "clearcoat (KHR_materials_clearcoat; drift has one coat)" },
         { !gm->base_color_sampler_supported,
           "base colour sampler (clamp/mirror wrap or nearest filter; drift repeats and filters "
           "bilinearly)" },

@@ -33,8 +33,11 @@ struct drift__gltf {
 
 // The extensions this file turns into drift's quantities; any other in extensionsUsed is
 // named in a warning.
-static const char *const handled_extensions[] = { "KHR_lights_punctual",
-                                                  "KHR_materials_emissive_strength" };
+static const char *const handled_extensions[] = {
+    "KHR_lights_punctual",        "KHR_materials_emissive_strength",
+    "KHR_materials_transmission", "KHR_materials_ior",
+    "KHR_materials_specular",     "KHR_materials_volume" // material_gltf.c
+};
 
 static uint32_t read_u32(const uint8_t *p)
 {
@@ -313,6 +316,7 @@ bool drift__gltf_get_material(const drift__gltf *g, unsigned index, drift__gltf_
     out->has_occlusion_texture = cJSON_GetObjectItemCaseSensitive(m, "occlusionTexture") != NULL;
     const cJSON *alpha_mode = cJSON_GetObjectItemCaseSensitive(m, "alphaMode");
     out->alpha_blended = cJSON_IsString(alpha_mode) && strcmp(alpha_mode->valuestring, "OPAQUE");
+    drift__gltf_read_ggx(g->root, m, out);
     return true;
 }
 

@@ -135,7 +135,28 @@ typedef struct drift__gltf_material {
     bool base_color_sampler_supported; // repeat wrap, linear magnification (or no sampler)
     bool has_metallic_roughness_texture, has_normal_texture, has_emissive_texture,
         has_occlusion_texture, alpha_blended;
+    // The same material for DRIFT_MATERIAL_GGX (material_gltf.c): base colour, metallic,
+    // roughness and the KHR_materials_transmission / _ior / _specular / _clearcoat values.
+    drift_vec3 base_color;
+    drift_ggx_params ggx;
+    bool has_clearcoat; // drift has no second coat: folded in as noted in docs/materials.md
+    // metallicRoughnessTexture's image file (relative to the glTF file; "" when none or
+    // when the image is embedded) and its texCoord.
+    char metallic_roughness_uri[DRIFT__PATH_MAX];
+    int metallic_roughness_uv_set;
+    char normal_uri[DRIFT__PATH_MAX]; // normalTexture's image file, as above
+    float normal_scale;
 } drift__gltf_material;
+
+// Fills out->base_color, out->ggx and the metallic-roughness texture's file from a glTF
+// material object of the file whose JSON root is `root` (material_gltf.c).
+struct cJSON;
+void drift__gltf_read_ggx(const struct cJSON *root, const struct cJSON *material,
+                          drift__gltf_material *out);
+// Loads an image of data (metallic-roughness, normals: not sRGB-encoded) as a scene texture.
+// Errors are logged against (where, line).
+drift_result drift__texture_load_data(drift_scene *scene, const char *path, const char *where,
+                                      int line, uint32_t *out_index);
 
 // Reads the JSON of a .gltf or .glb (gunzipped when gz), warns once for each extension in
 // extensionsUsed that drift ignores. Errors (logged against where/line, naming path):

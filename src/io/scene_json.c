@@ -342,6 +342,56 @@ static drift_result load_texture(json_reader *r, const cJSON *obj, const char *p
 
 // --- MATERIALS ---
 
+// type "ggx" (docs/materials.md): diffuse is the base colour; roughness is glTF's perceptual
+// roughness (alpha = roughness^2); metal names a measured conductor (and makes it metallic).
+static drift_result read_ggx_material(json_reader *r, const cJSON *item, const char *path)
+{
+    const char *unused = cJSON_HasObjectItem(item, "specular")            ? "specular"
+                         : cJSON_HasObjectItem(item, "exponent")          ? "exponent"
+                         : cJSON_HasObjectItem(item, "diffuse_roughness") ? "diffuse_roughness"
+                                                                          : NULL;
+    if (unused) {
+        return FAIL(r, cJSON_GetObjectItemCaseSensitive(item, unused), DRIFT_ERR_INVALID_ARGUMENT,
+                    "%s: a ggx material takes no '%s'", path, unused);
+    }
+    drift_material m = drift_material_make(drift_vec3_splat(0.8f));
+    snprintf(m.name, sizeof(m.name), "%s", item->string);
+    m.type = DRIFT_MATERIAL_GGX;
+    float roughness = 0.5f;
+    const char *metal = NULL;
+    drift_result res;
+    if ((res = read_vec3(r, item, path, "diffuse", false, VEC3_COLOR, &m.diffuse)) != DRIFT_OK ||
+        (res = read_vec3(r, item, path, "emission", false, VEC3_COLOR, &m.emission)) != DRIFT_OK ||
+        (res = load_texture(r, item, path, "diffuse_texture", &m.diffuse_texture)) != DRIFT_OK ||
+        (res = read_float(r, item, path, "roughness", false, 0.0, 1.0, &roughness)) != DRIFT_OK ||
+        (res = read_float(r, item, path, "metallic", false, 0.0, 1.0, &m.ggx.metallic)) !=
+            DRIFT_OK ||
+        (res = read_float(r, item, path, "transmission", false, 0.0, 1.0, &m.ggx.transmission)) !=
+            DRIFT_OK ||
+        (res = read_float(r, item, path, "ior", false, 1.0, 10.0, &m.ggx.ior)) != DRIFT_OK ||
+        (res = read_vec3(r, item, path, "edge_tint", false, VEC3_COLOR, &m.ggx.edge_tint)) !=
+            DRIFT_OK ||
+        (res = read_string(r, item, path, "metal", false, &metal)) != DRIFT_OK) {
+        return res;
+    }
+    m.ggx.alpha = roughness * roughness;
+    const cJSON *thin = cJSON_GetObjectItemCaseSensitive(item, "thin");
+    if (thin && !cJSON_IsBool(thin)) {
+        return FAIL(r, thin, DRIFT_ERR_PARSE, "%s.thin must be true or false", path);
+    }
+    m.ggx.thin = cJSON_IsTrue(thin);
+    if (metal && !drift_ggx_named_metal(metal, &m.ggx)) {
+        return FAIL(r, cJSON_GetObjectItemCaseSensitive(item, "metal"), DRIFT_ERR_INVALID_ARGUMENT,
+                    "%s.metal '%s' is not one of Au, Ag, Cu, Al (gold, silver, copper, aluminium)",
+                    path, metal);
+    }
+    res = drift_scene_add_material(r->scene, &m, NULL);
+    if (res != DRIFT_OK) {
+        return FAIL(r, item, res, "%s is not valid", path);
+    }
+    return DRIFT_OK;
+}
+
 static drift_result read_material(json_reader *r, const cJSON *item)
 {
     char path[KEY_PATH_MAX];
@@ -351,7 +401,8 @@ static drift_result read_material(json_reader *r, const cJSON *item)
         return res;
     }
     res = CHECK_KEYS(r, item, path, "type", "diffuse", "specular", "exponent", "emission",
-                     "diffuse_texture", "diffuse_roughness");
+                     "diffuse_texture", "diffuse_roughness", "roughness", "metallic",
+                     "transmission", "ior", "metal", "edge_tint", "thin");
     if (res != DRIFT_OK) {
         return res;
     }
@@ -369,9 +420,21 @@ static drift_result read_material(json_reader *r, const cJSON *item)
     bool is_glossy = strcmp(type, "glossy") == 0;
     bool is_mirror = strcmp(type, "mirror") == 0;
     const cJSON *type_item = cJSON_GetObjectItemCaseSensitive(item, "type");
+    if (strcmp(type, "ggx") == 0) {
+        return read_ggx_material(r, item, path);
+    }
     if (!is_diffuse && !is_glossy && !is_mirror) {
         return FAIL(r, type_item, DRIFT_ERR_INVALID_ARGUMENT,
-                    "%s.type '%s' is not one of diffuse, glossy, mirror", path, type);
+                    "%s.type '%s' is not one of diffuse, glossy, mirror, ggx", path, type);
+    }
+    static const char *const ggx_only[] = { "roughness", "metallic",  "transmission", "ior",
+                                            "metal",     "edge_tint", "thin" };
+    for (size_t k = 0; k < sizeof(ggx_only) / sizeof(ggx_only[0]); ++k) {
+        if (cJSON_HasObjectItem(item, ggx_only[k])) {
+            return FAIL(r, cJSON_GetObjectItemCaseSensitive(item, ggx_only[k]),
+                        DRIFT_ERR_INVALID_ARGUMENT, "%s: a %s material takes no '%s'", path, type,
+                        ggx_only[k]);
+        }
     }
     // Keys that the type has no use for are mistakes, not something to ignore quietly.
     const char *unused = NULL;

@@ -328,13 +328,39 @@ static drift_result read_transform(mitsuba_state *s, const xml_node *n, drift__m
     return DRIFT_OK;
 }
 
-// Glossy exponent for a Beckmann/GGX roughness α (the rule of the glTF loader, with α given).
-static float alpha_to_exponent(float alpha)
+// Mitsuba's interior and exterior IORs (numbers or its names) as intIOR / extIOR.
+static float ior_value(mitsuba_state *s, const xml_node *b, const char *name, float fallback)
 {
-    if (!(alpha > 1e-2f)) {
-        return 10000.0f;
+    static const struct {
+        const char *name;
+        float ior;
+    } named[] = { { "vacuum", 1.0f },         { "air", 1.000277f },  { "water", 1.333f },
+                  { "bk7", 1.5046f },         { "glass", 1.5046f },  { "acrylic glass", 1.49f },
+                  { "polypropylene", 1.49f }, { "diamond", 2.419f }, { "fused quartz", 1.458f },
+                  { "sapphire", 1.77f },      { "ethanol", 1.361f }, { "pyrex", 1.47f } };
+
+    const xml_node *p = property(b, name);
+    const char *v = p ? attr(p, "value") : NULL;
+    float f;
+    if (!v) {
+        return fallback;
     }
-    return drift_clampf(0.25f * (2.0f / (alpha * alpha) - 2.0f), 1.0f, 10000.0f);
+    if (parse_numbers(v, &f, 1) == 1 && f >= 1.0f && f <= 10.0f) {
+        return f;
+    }
+    for (size_t i = 0; i < sizeof(named) / sizeof(named[0]); ++i) {
+        if (strcmp(v, named[i].name) == 0) {
+            return named[i].ior;
+        }
+    }
+    warn(s, p, "is an IOR drift does not know (the default used)");
+    return fallback;
+}
+
+static float mitsuba_ior(mitsuba_state *s, const xml_node *b, float int_fallback)
+{
+    float ior = ior_value(s, b, "intIOR", int_fallback) / ior_value(s, b, "extIOR", 1.000277f);
+    return drift_clampf(ior, 1.0f, 10.0f);
 }
 
 static drift_result diffuse_texture(mitsuba_state *s, const xml_node *bsdf, const char *name,
@@ -390,50 +416,58 @@ static drift_result convert_bsdf(mitsuba_state *s, const xml_node *b, const char
             r = diffuse_texture(s, b, "reflectance", m);
         }
     } else if (strcmp(type, "plastic") == 0 || strcmp(type, "roughplastic") == 0) {
-        // A diffuse base under a dielectric coat: 4% at normal incidence (IOR 1.5) taken
-        // from the base, the coat's roughness as the lobe's exponent.
-        drift_vec3 kd;
+        // A diffuse base under a dielectric coat of the file's alpha, on GGX (docs/materials.md).
         bool found = false;
-        r = read_color(s, b, "diffuseReflectance", drift_vec3_splat(0.5f), &kd, &found);
+        r = read_color(s, b, "diffuseReflectance", drift_vec3_splat(0.5f), &m->diffuse, &found);
         if (r == DRIFT_OK && !found) {
-            r = read_color(s, b, "reflectance", drift_vec3_splat(0.5f), &kd, NULL);
+            r = read_color(s, b, "reflectance", drift_vec3_splat(0.5f), &m->diffuse, NULL);
         }
         if (r == DRIFT_OK) {
             r = read_float(s, b, "alpha", type[0] == 'r' ? 0.1f : 0.0f, &alpha);
         }
-        m->diffuse = drift_vec3_scale(kd, 0.96f);
-        m->specular = drift_vec3_splat(0.04f);
-        m->exponent = alpha_to_exponent(alpha);
+        m->type = DRIFT_MATERIAL_GGX;
+        m->ggx.alpha = drift_clampf(alpha, 0.0f, 1.0f);
+        m->ggx.ior = mitsuba_ior(s, b, 1.49f);
         if (r == DRIFT_OK) {
             r = diffuse_texture(
                 s, b, property(b, "diffuseReflectance") ? "diffuseReflectance" : "reflectance", m);
             m->diffuse =
-                m->diffuse_texture != DRIFT_INVALID_INDEX ? drift_vec3_splat(0.96f) : m->diffuse;
+                m->diffuse_texture != DRIFT_INVALID_INDEX ? drift_vec3_splat(1.0f) : m->diffuse;
         }
     } else if (strcmp(type, "conductor") == 0 || strcmp(type, "roughconductor") == 0) {
-        // The metal's complex IOR is not evaluated: its reflectance is specularReflectance
-        // (default 0.9, a bright metal at normal incidence).
+        // A named metal (material=) by its measured complex IOR; otherwise the reflectance
+        // specularReflectance (default 0.9) as F0. Smooth conductors without a metal stay mirrors.
         drift_vec3 ks;
         r = read_color(s, b, "specularReflectance", drift_vec3_splat(0.9f), &ks, NULL);
         if (r == DRIFT_OK) {
             r = read_float(s, b, "alpha", type[0] == 'r' ? 0.1f : 0.0f, &alpha);
         }
-        m->diffuse = drift_vec3_splat(0.0f);
-        m->specular = ks;
-        if (type[0] == 'c') {
+        const xml_node *metal = property(b, "material");
+        const char *metal_name = metal ? attr(metal, "value") : NULL;
+        bool named = metal_name && drift_ggx_named_metal(metal_name, &m->ggx);
+        if (metal_name && !named && strcmp(metal_name, "none") != 0) {
+            warn(s, b,
+                 "names a metal drift has no table for (Au, Ag, Cu, Al); specularReflectance used");
+        }
+        if (type[0] == 'c' && !named) {
+            m->diffuse = drift_vec3_splat(0.0f);
+            m->specular = ks;
             m->type = DRIFT_MATERIAL_MIRROR;
         } else {
-            m->exponent = alpha_to_exponent(alpha);
+            m->type = DRIFT_MATERIAL_GGX;
+            m->diffuse = ks; // F0 without a named metal
+            m->ggx.metallic = 1.0f;
+            m->ggx.alpha = drift_clampf(alpha, 0.0f, 1.0f);
         }
     } else if (strcmp(type, "dielectric") == 0 || strcmp(type, "thindielectric") == 0 ||
                strcmp(type, "roughdielectric") == 0) {
-        // drift has no refraction: the 4% surface reflection alone.
-        drift_log(s->ctx, DRIFT_LOG_WARNING, DRIFT_ERR_UNSUPPORTED, s->path, b->line,
-                  "<bsdf type=%s>: drift has no refraction; a 4%% mirror (transmission dropped)",
-                  type);
-        m->diffuse = drift_vec3_splat(0.0f);
-        m->specular = drift_vec3_splat(0.04f);
-        m->type = DRIFT_MATERIAL_MIRROR;
+        r = read_float(s, b, "alpha", type[0] == 'r' ? 0.1f : 0.0f, &alpha);
+        m->type = DRIFT_MATERIAL_GGX;
+        m->diffuse = drift_vec3_splat(1.0f);
+        m->ggx.transmission = 1.0f;
+        m->ggx.alpha = drift_clampf(alpha, 0.0f, 1.0f);
+        m->ggx.ior = mitsuba_ior(s, b, 1.5046f);
+        m->ggx.thin = type[0] == 't';
     } else {
         warn(s, b, "is not a supported bsdf (grey diffuse 0.5 used)");
     }

@@ -3,9 +3,145 @@
 // mirror; or, for materials from Blender and glTF, Burley's diffuse ("Physically-Based Shading
 // at Disney", 2012, section 5.3) in place of the Lambertian one. Directions are world space;
 // the lobe frame's z is the shading normal.
+#include "microfacet.h"
 #include "scene_internal.h"
 
 #include <math.h>
+
+// The Phong exponent of the lobe as wide as GGX of roughness alpha: Blinn-Phong's
+// m = 2 / alpha^2 - 2 (Walter et al. 2007, eq. 33, Beckmann ~ GGX near the peak) and Phong's
+// n ~ m / 4 (docs/materials.md).
+static float phong_exponent_of_alpha(float alpha)
+{
+    float a = fmaxf(alpha, DRIFT_GGX_MIN_ALPHA);
+    return drift_clampf(0.5f / (a * a) - 0.5f, 0.5f, 1e6f);
+}
+
+void drift__ggx_phong_equivalent(const drift_material *m, drift_vec3 base, float alpha,
+                                 float metallic, drift_vec3 *kd, drift_vec3 *ks, float *exponent)
+{
+    const drift_ggx_params *p = &m->ggx;
+    float ior = p->ior > 0.0f ? p->ior : 1.5f;
+    float f0 = (ior - 1.0f) / (ior + 1.0f);
+    drift_vec3 tint =
+        drift_vec3_is_zero(p->specular_tint) ? drift_vec3_splat(1.0f) : p->specular_tint;
+    drift_vec3 f0_coat = drift_vec3_min(drift_vec3_scale(tint, f0 * f0), drift_vec3_splat(1.0f));
+    drift_vec3 f0_metal = base;
+    if (p->k.x > 0.0f || p->k.y > 0.0f || p->k.z > 0.0f) {
+        f0_metal = drift__fresnel_conductor(1.0f, p->eta, p->k);
+    }
+    float w_plastic = (1.0f - metallic) * (1.0f - p->transmission);
+    float w_dielectric = (1.0f - metallic) * p->transmission;
+    *ks = drift_vec3_add(drift_vec3_scale(f0_metal, metallic),
+                         drift_vec3_scale(f0_coat, w_plastic + w_dielectric));
+    *kd = drift_vec3_scale(drift_vec3_mul(base, drift_vec3_sub(drift_vec3_splat(1.0f), f0_coat)),
+                           w_plastic);
+    *exponent = phong_exponent_of_alpha(alpha);
+}
+
+// The shading normal bent by a tangent-space normal map: tangent and bitangent from the uv
+// derivatives of the hit triangle (pbrt's dp/du, dp/dv), made orthogonal to the interpolated
+// normal. Unchanged where the mesh has no uvs or the map would turn the normal below the surface.
+static drift_vec3 normal_mapped(const drift_scene *scene, const drift_material *m,
+                                const drift_surface *surface)
+{
+    drift_vec3 n = surface->ns;
+    if (surface->mesh == DRIFT_INVALID_INDEX) {
+        return n;
+    }
+    const drift_mesh *mesh = &scene->meshes[surface->mesh];
+    if (!mesh->uvs) {
+        return n;
+    }
+    const uint32_t *tri = mesh->indices + 3 * (size_t)surface->triangle;
+    const float *p = mesh->positions, *t = mesh->uvs;
+    drift_vec3 p0 = drift_vec3_make(p[3 * tri[0]], p[3 * tri[0] + 1], p[3 * tri[0] + 2]);
+    drift_vec3 dp1 =
+        drift_vec3_sub(drift_vec3_make(p[3 * tri[1]], p[3 * tri[1] + 1], p[3 * tri[1] + 2]), p0);
+    drift_vec3 dp2 =
+        drift_vec3_sub(drift_vec3_make(p[3 * tri[2]], p[3 * tri[2] + 1], p[3 * tri[2] + 2]), p0);
+    float du1 = t[2 * tri[1]] - t[2 * tri[0]], dv1 = t[2 * tri[1] + 1] - t[2 * tri[0] + 1];
+    float du2 = t[2 * tri[2]] - t[2 * tri[0]], dv2 = t[2 * tri[2] + 1] - t[2 * tri[0] + 1];
+    float det = du1 * dv2 - dv1 * du2;
+    if (!(fabsf(det) > 1e-12f)) {
+        return n;
+    }
+    drift_vec3 dpdu = drift_vec3_scale(
+        drift_vec3_sub(drift_vec3_scale(dp1, dv2), drift_vec3_scale(dp2, dv1)), 1.0f / det);
+    drift_vec3 dpdv = drift_vec3_scale(
+        drift_vec3_sub(drift_vec3_scale(dp2, du1), drift_vec3_scale(dp1, du2)), 1.0f / det);
+    drift_vec3 tangent = drift_vec3_fma(dpdu, n, -drift_vec3_dot(n, dpdu));
+    float len = drift_vec3_length(tangent);
+    if (!(len > 0.0f)) {
+        return n;
+    }
+    tangent = drift_vec3_scale(tangent, 1.0f / len);
+    drift_vec3 bitangent = drift_vec3_cross(n, tangent);
+    if (drift_vec3_dot(bitangent, dpdv) < 0.0f) {
+        bitangent = drift_vec3_neg(bitangent);
+    }
+    drift_vec3 c = drift__texture_bilinear(&scene->textures[m->ggx.normal_texture], surface->uv);
+    float scale = m->ggx.normal_scale > 0.0f ? m->ggx.normal_scale : 1.0f;
+    drift_vec3 local = drift_vec3_make((2.0f * c.x - 1.0f) * scale, (2.0f * c.y - 1.0f) * scale,
+                                       fmaxf(2.0f * c.z - 1.0f, 0.0f));
+    drift_vec3 bent = drift_vec3_add(
+        drift_vec3_add(drift_vec3_scale(tangent, local.x), drift_vec3_scale(bitangent, local.y)),
+        drift_vec3_scale(n, local.z));
+    float bent_len = drift_vec3_length(bent);
+    if (!(bent_len > 0.0f)) {
+        return n;
+    }
+    bent = drift_vec3_scale(bent, 1.0f / bent_len);
+    return drift_vec3_dot(bent, surface->ng) > 0.0f ? bent : n;
+}
+
+static void make_ggx(const drift_scene *scene, const drift_material *m,
+                     const drift_surface *surface, drift_bsdf *b)
+{
+    const drift_ggx_params *p = &m->ggx;
+    float alpha = p->alpha, metallic = p->metallic;
+    if (p->metallic_roughness_texture != DRIFT_INVALID_INDEX && scene) {
+        drift_vec3 t =
+            drift__texture_bilinear(&scene->textures[p->metallic_roughness_texture], surface->uv);
+        float r = sqrtf(fmaxf(alpha, 0.0f)) * t.y;
+        alpha = r * r;
+        metallic *= t.z;
+    }
+    if (p->normal_texture != DRIFT_INVALID_INDEX && scene) {
+        b->frame = drift_frame_from_normal(normal_mapped(scene, m, surface));
+    }
+    alpha = drift_clampf(alpha, 0.0f, 1.0f);
+    metallic = drift_clampf(metallic, 0.0f, 1.0f);
+    float transmission = drift_clampf(p->transmission, 0.0f, 1.0f);
+    drift_bsdf_ggx *g = &b->ggx;
+    g->base = b->diffuse;
+    g->alpha = alpha;
+    g->w_conductor = metallic;
+    g->w_plastic = (1.0f - metallic) * (1.0f - transmission);
+    g->w_dielectric = (1.0f - metallic) * transmission;
+    float ior = p->ior > 0.0f ? p->ior : 1.5f;
+    float f0 = (ior - 1.0f) / (ior + 1.0f);
+    drift_vec3 tint =
+        drift_vec3_is_zero(p->specular_tint) ? drift_vec3_splat(1.0f) : p->specular_tint;
+    g->f0_coat = drift_vec3_min(drift_vec3_scale(tint, f0 * f0), drift_vec3_splat(1.0f));
+    g->thin = p->thin;
+    float table_alpha = fmaxf(alpha, DRIFT_GGX_MIN_ALPHA);
+    drift__ggx_alpha_slot(table_alpha, &g->alpha_row, &g->alpha_frac);
+    g->e1_avg = drift__ggx_e1_avg(table_alpha);
+    g->es_avg = drift__ggx_es_avg(table_alpha);
+    g->burley_roughness = m->diffuse_model == DRIFT_DIFFUSE_BURLEY ? m->diffuse_roughness : -1.0f;
+    g->eta_rel = p->thin || surface->front_face ? ior : 1.0f / ior;
+    if (p->k.x > 0.0f || p->k.y > 0.0f || p->k.z > 0.0f) {
+        g->eta = p->eta;
+        g->k = p->k;
+    } else if (!drift_vec3_is_zero(p->edge_tint)) {
+        drift__conductor_from_tint(g->base, p->edge_tint, &g->eta, &g->k);
+    } else {
+        g->schlick = true;
+    }
+    drift__ggx_phong_equivalent(m, g->base, alpha, metallic, &b->diffuse, &b->specular,
+                                &b->exponent);
+}
 
 drift_bsdf drift_bsdf_make(const drift_scene *scene, const drift_surface *surface)
 {
@@ -21,11 +157,17 @@ drift_bsdf drift_bsdf_make(const drift_scene *scene, const drift_surface *surfac
         b.diffuse = drift_vec3_mul(
             b.diffuse, drift__texture_bilinear(&scene->textures[m->diffuse_texture], surface->uv));
     }
+    if (m->type == DRIFT_MATERIAL_GGX) {
+        make_ggx(scene, m, surface, &b);
+    }
     return b;
 }
 
 bool drift_bsdf_is_delta(const drift_bsdf *bsdf)
 {
+    if (bsdf->type == DRIFT_MATERIAL_GGX) {
+        return drift__ggx_is_delta(&bsdf->ggx);
+    }
     return bsdf->type == DRIFT_MATERIAL_MIRROR;
 }
 
@@ -73,6 +215,12 @@ void drift_bsdf_eval_lobes(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec3 wi,
 {
     *out_diffuse = drift_vec3_splat(0.0f);
     *out_glossy = drift_vec3_splat(0.0f);
+    if (bsdf->type == DRIFT_MATERIAL_GGX) {
+        drift_vec3 f = drift__ggx_eval(&bsdf->ggx, drift_frame_to_local(&bsdf->frame, wo),
+                                       drift_frame_to_local(&bsdf->frame, wi), out_diffuse);
+        *out_glossy = drift_vec3_sub(f, *out_diffuse);
+        return;
+    }
     float cos_o = drift_vec3_dot(wo, bsdf->frame.z), cos_i = drift_vec3_dot(wi, bsdf->frame.z);
     if (bsdf->type == DRIFT_MATERIAL_MIRROR || cos_o <= 0.0f || cos_i <= 0.0f) {
         return;
@@ -98,6 +246,10 @@ drift_vec3 drift_bsdf_eval(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec3 wi)
 
 float drift_bsdf_pdf(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec3 wi)
 {
+    if (bsdf->type == DRIFT_MATERIAL_GGX) {
+        return drift__ggx_pdf(&bsdf->ggx, drift_frame_to_local(&bsdf->frame, wo),
+                              drift_frame_to_local(&bsdf->frame, wi));
+    }
     float cos_o = drift_vec3_dot(wo, bsdf->frame.z), cos_i = drift_vec3_dot(wi, bsdf->frame.z);
     if (bsdf->type == DRIFT_MATERIAL_MIRROR || cos_o <= 0.0f || cos_i <= 0.0f) {
         return 0.0f;
@@ -126,6 +278,11 @@ drift_bsdf_sample drift_bsdf_sample_wi(const drift_bsdf *bsdf, drift_vec3 wo, fl
     drift_bsdf_sample s = { 0 };
     float cos_o = drift_vec3_dot(wo, bsdf->frame.z);
     if (cos_o <= 0.0f) {
+        return s;
+    }
+    if (bsdf->type == DRIFT_MATERIAL_GGX) {
+        s = drift__ggx_sample(&bsdf->ggx, drift_frame_to_local(&bsdf->frame, wo), u_lobe, u);
+        s.wi = drift_frame_to_world(&bsdf->frame, s.wi);
         return s;
     }
     if (bsdf->type == DRIFT_MATERIAL_MIRROR) {

@@ -1,5 +1,6 @@
 #include "drift/scene.h"
 
+#include "microfacet.h"
 #include "scene_internal.h"
 
 #include <math.h>
@@ -210,12 +211,29 @@ drift_result drift_scene_add_mesh(drift_scene *scene, const drift_mesh_desc *des
 
 drift_material drift_material_make(drift_vec3 diffuse)
 {
-    return (drift_material){ .diffuse = diffuse, .diffuse_texture = DRIFT_INVALID_INDEX };
+    return (drift_material){ .diffuse = diffuse,
+                             .diffuse_texture = DRIFT_INVALID_INDEX,
+                             .ggx = { .metallic_roughness_texture = DRIFT_INVALID_INDEX,
+                                      .normal_texture = DRIFT_INVALID_INDEX } };
 }
 
 static bool vec3_is_nonnegative_finite(drift_vec3 v)
 {
     return drift_vec3_is_finite(v) && v.x >= 0.0f && v.y >= 0.0f && v.z >= 0.0f;
+}
+
+static bool unit_range(float v)
+{
+    return v >= 0.0f && v <= 1.0f;
+}
+
+static bool ggx_params_valid(const drift_ggx_params *g)
+{
+    return unit_range(g->alpha) && unit_range(g->metallic) && unit_range(g->transmission) &&
+           (g->ior == 0.0f || (g->ior >= 1.0f && g->ior <= 10.0f)) &&
+           vec3_is_nonnegative_finite(g->specular_tint) &&
+           vec3_is_nonnegative_finite(g->edge_tint) && vec3_is_nonnegative_finite(g->eta) &&
+           vec3_is_nonnegative_finite(g->k);
 }
 
 drift_result drift_scene_add_material(drift_scene *scene, const drift_material *material,
@@ -230,7 +248,8 @@ drift_result drift_scene_add_material(drift_scene *scene, const drift_material *
         !vec3_is_nonnegative_finite(m.emission) || !isfinite(m.exponent) || m.exponent < 0.0f ||
         (unsigned)m.type >= DRIFT_MATERIAL_COUNT ||
         (unsigned)m.diffuse_model > DRIFT_DIFFUSE_BURLEY ||
-        !(m.diffuse_roughness >= 0.0f && m.diffuse_roughness <= 1.0f)) {
+        !(m.diffuse_roughness >= 0.0f && m.diffuse_roughness <= 1.0f) ||
+        !ggx_params_valid(&m.ggx)) {
         drift_log(scene->ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, m.name, 0,
                   "material has a negative, non-finite or out-of-range value");
         return DRIFT_ERR_INVALID_ARGUMENT;
@@ -418,6 +437,21 @@ drift_result drift_scene_commit(drift_scene *scene)
             drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, m->name, 0,
                       "glossy material needs an exponent > 0");
             return DRIFT_ERR_INVALID_ARGUMENT;
+        }
+        if (m->type == DRIFT_MATERIAL_GGX) {
+            uint32_t t = m->ggx.metallic_roughness_texture, tn = m->ggx.normal_texture;
+            if ((t != DRIFT_INVALID_INDEX && t >= scene->texture_count) ||
+                (tn != DRIFT_INVALID_INDEX && tn >= scene->texture_count)) {
+                drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, m->name, 0,
+                          "metallic-roughness or normal texture out of range (scene has %u)",
+                          scene->texture_count);
+                return DRIFT_ERR_INVALID_ARGUMENT;
+            }
+            // What the Phong-shading techniques read of it (docs/materials.md).
+            drift_vec3 kd;
+            drift__ggx_phong_equivalent(m, m->diffuse, m->ggx.alpha, m->ggx.metallic, &kd,
+                                        &m->specular, &m->exponent);
+            continue;
         }
         enforce_energy_conservation(scene, m);
     }

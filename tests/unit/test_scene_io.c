@@ -752,13 +752,14 @@ static void test_scene_io_gltf_photometry_and_materials(void **state)
     }
     assert_int_equal(point, 1);
     assert_int_equal(spot, 1);
-    // Red: base (0.8, 0.05, 0.05), metallic 0, roughness 0.3: a Burley diffuse of the base
-    // and roughness 0.3, F0 = 0.04 on top, n = (2/α² − 2)/4 with α = 0.09.
+    // Red: base (0.8, 0.05, 0.05), metallic 0, roughness 0.3: a GGX plastic of the base with
+    // alpha = 0.09 and F0 = 0.04; its Phong equivalent n = (2/α² − 2)/4.
     const drift_material *red = material_named(scene, "Red");
+    assert_int_equal(red->type, DRIFT_MATERIAL_GGX);
     assert_float_equal(red->diffuse.x, 0.8f, 1e-6f);
     assert_float_equal(red->diffuse.y, 0.05f, 1e-6f);
-    assert_int_equal(red->diffuse_model, DRIFT_DIFFUSE_BURLEY);
-    assert_float_equal(red->diffuse_roughness, 0.3f, 1e-6f);
+    assert_float_equal(red->ggx.alpha, 0.09f, 1e-6f);
+    assert_float_equal(red->ggx.metallic, 0.0f, 0.0f);
     assert_float_equal(red->specular.x, 0.04f, 1e-6f);
     float alpha = 0.3f * 0.3f;
     assert_float_equal(red->exponent, 0.25f * (2.0f / (alpha * alpha) - 2.0f), 1e-2f);
@@ -815,16 +816,19 @@ static void test_scene_io_gltf_extensions_and_cameras(void **state)
     assert_int_equal(log.errors, 0);
     assert_non_null(strstr(log.text, "KHR_materials_clearcoat is not supported"));
     assert_non_null(strstr(log.text, "KHR_texture_transform is not supported"));
-    assert_non_null(strstr(log.text, "normal texture ignored"));
+    assert_non_null(strstr(log.text, "normal texture (embedded or not loaded) ignored"));
     assert_non_null(strstr(log.text, "range ignored"));
     assert_float_equal(scene->camera.position.z, 5.0f, 1e-5f); // the first camera
     assert_int_equal(scene->lights[0].type, DRIFT_LIGHT_POINT);
     assert_float_equal(scene->lights[0].color.x, 1.0f, 1e-6f); // 683 cd = 1 W/sr
-    // The metal reflects its base colour as a sharp lobe and has no diffuse part.
+    // The metal: a smooth GGX conductor of F0 = its base colour (its Phong equivalent
+    // reflects the base colour).
     const drift_material *m = &scene->materials[0];
+    assert_int_equal(m->type, DRIFT_MATERIAL_GGX);
+    assert_float_equal(m->ggx.metallic, 1.0f, 0.0f);
+    assert_float_equal(m->ggx.alpha, 0.0f, 0.0f);
     assert_float_equal(m->specular.y, 0.4f, 1e-6f);
-    assert_float_equal(m->diffuse.y, 0.0f, 0.0f);
-    assert_float_equal(m->exponent, 10000.0f, 0.0f);
+    assert_float_equal(m->diffuse.y, 0.4f, 1e-6f);
     drift_scene_destroy(scene);
 
     const char *selectors[] = { "side", "1", "front", "0" };
@@ -916,9 +920,17 @@ static void test_scene_io_mitsuba_subset(void **state)
     const drift_material *wall = material_named(scene, "wall");
     assert_float_equal(wall->diffuse.y, 0.4f, 1e-6f);
     const drift_material *coat = material_named(scene, "coat");
-    assert_float_equal(coat->diffuse.x, 0.48f, 1e-6f);
-    assert_float_equal(coat->specular.x, 0.04f, 1e-6f);
+    // roughplastic: a GGX plastic of the file's alpha (0.3) and IOR 1.49 / 1.000277.
+    assert_int_equal(coat->type, DRIFT_MATERIAL_GGX);
+    assert_float_equal(coat->diffuse.x, 0.5f, 1e-6f);
+    assert_float_equal(coat->ggx.alpha, 0.3f, 1e-6f);
+    assert_float_equal(coat->ggx.ior, 1.49f / 1.000277f, 1e-5f);
     assert_float_equal(coat->exponent, 0.25f * (2.0f / 0.09f - 2.0f), 1e-3f);
+    // dielectric: a smooth GGX dielectric that refracts (bk7 inside, air outside).
+    const drift_material *glass = material_named(scene, "glass");
+    assert_int_equal(glass->type, DRIFT_MATERIAL_GGX);
+    assert_float_equal(glass->ggx.transmission, 1.0f, 0.0f);
+    assert_float_equal(glass->ggx.ior, 1.5046f / 1.000277f, 1e-5f);
     assert_int_equal(material_named(scene, "mirror")->type, DRIFT_MATERIAL_MIRROR);
     // The rectangle, scaled by 2 then moved to z = -1: corners at ±2.
     assert_float_equal(scene->bounds.min.z, -1.0f, 1e-5f);
@@ -931,11 +943,10 @@ static void test_scene_io_mitsuba_subset(void **state)
     assert_float_equal(spot->spot_outer, DRIFT_PI / 6.0f, 1e-6f);
     assert_float_equal(spot->direction.y, -1.0f, 1e-5f);
     assert_float_equal(scene->environment.color.z, 0.3f, 1e-6f);
-    // Warnings name the element and its line: the dielectric (9), the medium (10), sunsky (18).
-    assert_non_null(strstr(log.text, "no refraction"));
+    // Warnings name the element and its line: the medium (10), sunsky (18).
     assert_non_null(strstr(log.text, "<medium type=homogeneous> is not supported"));
     assert_non_null(strstr(log.text, "<emitter type=sunsky> is not a supported emitter"));
-    assert_int_equal(log.min_warning_line, 9);
+    assert_int_equal(log.min_warning_line, 10);
     drift_scene_destroy(scene);
 
     // Errors name the file and the line.

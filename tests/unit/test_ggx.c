@@ -1,0 +1,543 @@
+// The GGX material (DRIFT_MATERIAL_GGX) against closed-form truths: white furnaces (a white
+// rough conductor and a white plastic reflect 1 with the energy compensation; a rough
+// dielectric reflects plus transmits 1), reciprocity, each lobe's sampling against its pdf
+// (chi-square, as pbrt and Mitsuba test theirs) with the pdf integrating to the sampling's
+// success rate, Snell's law, total internal reflection and Fresnel at normal incidence.
+#include "drift/image.h"
+#include "drift/math.h"
+#include "drift/scene.h"
+#include "drift_test.h"
+#include "scene/microfacet.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define M_PI 3.14159265358979323846
+
+// --- MAKING A BSDF ---
+
+typedef struct ggx_case {
+    drift_bsdf bsdf;
+    drift_vec3 wo;
+} ggx_case;
+
+static drift_bsdf make_bsdf(const drift_material *m, bool front_face)
+{
+    drift_context *ctx = test_context(1, NULL);
+    drift_scene *scene = NULL;
+    assert_int_equal(drift_scene_create(ctx, &scene), DRIFT_OK);
+    uint32_t index;
+    assert_int_equal(drift_scene_add_material(scene, m, &index), DRIFT_OK);
+    drift_surface surf = { .material = index,
+                           .ns = drift_vec3_make(0, 0, 1),
+                           .ng = drift_vec3_make(0, 0, 1),
+                           .front_face = front_face };
+    drift_bsdf b = drift_bsdf_make(scene, &surf);
+    drift_scene_destroy(scene);
+    drift_context_destroy(ctx);
+    return b;
+}
+
+static drift_material ggx_material(drift_vec3 base, float alpha, float metallic, float transmission)
+{
+    drift_material m = drift_material_make(base);
+    m.type = DRIFT_MATERIAL_GGX;
+    m.ggx.alpha = alpha;
+    m.ggx.metallic = metallic;
+    m.ggx.transmission = transmission;
+    return m;
+}
+
+static drift_vec3 dir_at(float theta)
+{
+    return drift_vec3_make(sinf(theta), 0.0f, cosf(theta));
+}
+
+// Directional albedo (red channel) by the sampling estimator: the mean of f |cos| / pdf.
+static double albedo(const drift_bsdf *b, drift_vec3 wo, int n)
+{
+    double sum = 0.0;
+    for (int i = 0; i < n; ++i) {
+        drift_sampler s = drift_sampler_make(3, 7, (uint32_t)i);
+        drift_vec2 u = drift_sampler_next2(&s);
+        drift_bsdf_sample bs = drift_bsdf_sample_wi(b, wo, drift_sampler_next1(&s), u);
+        if (bs.pdf > 0.0f) {
+            sum += (double)bs.weight.x;
+        }
+    }
+    return sum / n;
+}
+
+// The same albedo by quadrature of f |cos| over the sphere (independent of the sampling).
+static double albedo_quadrature(const drift_bsdf *b, drift_vec3 wo)
+{
+    const int nt = 256, np = 128;
+    double sum = 0.0;
+    for (int i = 0; i < nt; ++i) {
+        for (int j = 0; j < np; ++j) {
+            double ct = -1.0 + (i + 0.5) * 2.0 / nt, phi = (j + 0.5) * M_PI / np;
+            double st = sqrt(1.0 - ct * ct);
+            drift_vec3 wi =
+                drift_vec3_make((float)(st * cos(phi)), (float)(st * sin(phi)), (float)ct);
+            // Symmetric in phi about the plane of wo: integrate half and double.
+            sum += 2.0 * (double)drift_bsdf_eval(b, wo, wi).x * fabs(ct) * (2.0 / nt) * (M_PI / np);
+        }
+    }
+    return sum;
+}
+
+// --- WHITE FURNACE ---
+
+static void test_ggx_white_conductor_reflects_everything(void **state)
+{
+    (void)state;
+    int n = (int)(10000 * test_intensity());
+    const float roughness[] = { 0.0f, 0.2f, 0.4f, 0.6f, 0.8f, 1.0f }; // perceptual
+    const float theta[] = { 0.0f, 0.7f, 1.2f };
+    for (int r = 0; r < 6; ++r) {
+        float alpha = roughness[r] * roughness[r];
+        drift_material m = ggx_material(drift_vec3_splat(1.0f), alpha, 1.0f, 0.0f);
+        drift_bsdf b = make_bsdf(&m, true);
+        for (int t = 0; t < 3; ++t) {
+            double a = albedo(&b, dir_at(theta[t]), n);
+            if (!(a >= 0.99 && a <= 1.01)) {
+                fail_msg("white conductor roughness %.1f theta %.1f reflects %.4f",
+                         (double)roughness[r], (double)theta[t], a);
+            }
+            if (roughness[r] >= 0.4f) { // sharper lobes need a finer quadrature
+                double q = albedo_quadrature(&b, dir_at(theta[t]));
+                if (!(q >= 0.99 && q <= 1.01)) {
+                    fail_msg("white conductor roughness %.1f theta %.1f: quadrature %.4f",
+                             (double)roughness[r], (double)theta[t], q);
+                }
+            }
+        }
+    }
+    // Without the compensation a rough conductor loses light: the test above can fail.
+    assert_true(drift__ggx_e1(0.5f, 1.0f) < 0.9f);
+}
+
+static void test_ggx_white_plastic_reflects_everything(void **state)
+{
+    (void)state;
+    int n = (int)(10000 * test_intensity());
+    const float alphas[] = { 0.01f, 0.1f, 0.5f, 1.0f };
+    for (int r = 0; r < 4; ++r) {
+        drift_material m = ggx_material(drift_vec3_splat(1.0f), alphas[r], 0.0f, 0.0f);
+        drift_bsdf b = make_bsdf(&m, true);
+        for (float theta = 0.0f; theta < 1.4f; theta += 0.6f) {
+            double a = albedo(&b, dir_at(theta), n);
+            if (!(a >= 0.99 && a <= 1.01)) {
+                fail_msg("white plastic alpha %.2f theta %.1f reflects %.4f", (double)alphas[r],
+                         (double)theta, a);
+            }
+        }
+    }
+}
+
+static void test_ggx_rough_dielectric_reflects_plus_transmits_one(void **state)
+{
+    (void)state;
+    int n = (int)(10000 * test_intensity());
+    const float alphas[] = { 0.05f, 0.3f, 0.6f, 1.0f };
+    for (int r = 0; r < 4; ++r) {
+        for (int side = 0; side < 2; ++side) {
+            drift_material m = ggx_material(drift_vec3_splat(1.0f), alphas[r], 0.0f, 1.0f);
+            drift_bsdf b = make_bsdf(&m, side == 0);
+            for (float theta = 0.1f; theta < 1.4f; theta += 0.6f) {
+                double a = albedo(&b, dir_at(theta), n);
+                if (!(a >= 0.975 && a <= 1.025)) { // the eta interpolation: docs/materials.md
+                    fail_msg("dielectric alpha %.2f %s theta %.1f: R + T = %.4f", (double)alphas[r],
+                             side == 0 ? "outside" : "inside", (double)theta, a);
+                }
+            }
+        }
+    }
+}
+
+// --- RECIPROCITY ---
+
+static void test_ggx_reflection_is_reciprocal(void **state)
+{
+    (void)state;
+    drift_material metal = ggx_material(drift_vec3_make(0.9f, 0.6f, 0.3f), 0.3f, 1.0f, 0.0f);
+    drift_material gold = ggx_material(drift_vec3_splat(1.0f), 0.5f, 0.0f, 0.0f);
+    assert_true(drift_ggx_named_metal("gold", &gold.ggx));
+    drift_material tinted = metal;
+    tinted.ggx.edge_tint = drift_vec3_make(0.8f, 0.9f, 1.0f);
+    drift_material plastic = ggx_material(drift_vec3_make(0.2f, 0.5f, 0.8f), 0.2f, 0.0f, 0.0f);
+    drift_material blend = ggx_material(drift_vec3_make(0.7f, 0.7f, 0.2f), 0.6f, 0.4f, 0.0f);
+    drift_material principled = plastic; // Blender 3.4's undimmed Burley base
+    principled.diffuse_model = DRIFT_DIFFUSE_BURLEY;
+    principled.diffuse_roughness = 0.6f;
+    const drift_material *materials[] = { &metal, &gold, &tinted, &plastic, &blend, &principled };
+    for (int k = 0; k < 6; ++k) {
+        drift_bsdf b = make_bsdf(materials[k], true);
+        for (uint32_t i = 0; i < 200; ++i) {
+            drift_vec3 wo = drift_sample_cosine_hemisphere(
+                drift_vec2_make(test_hash_unit(4 * i), test_hash_unit(4 * i + 1)));
+            drift_vec3 wi = drift_sample_cosine_hemisphere(
+                drift_vec2_make(test_hash_unit(4 * i + 2), test_hash_unit(4 * i + 3)));
+            drift_vec3 a = drift_bsdf_eval(&b, wo, wi), c = drift_bsdf_eval(&b, wi, wo);
+            float scale = fmaxf(1e-3f, drift_vec3_max_component(a));
+            if (fabsf(a.x - c.x) > 1e-3f * scale || fabsf(a.y - c.y) > 1e-3f * scale ||
+                fabsf(a.z - c.z) > 1e-3f * scale) {
+                fail_msg("material %d: f(wo, wi) %g != f(wi, wo) %g", k, (double)a.x, (double)c.x);
+            }
+        }
+    }
+}
+
+// Sampling reports the pdf drift_bsdf_pdf gives its direction and the weight f |cos| / pdf of
+// drift_bsdf_eval (sampling computes both in one pass for reflective materials).
+static void test_ggx_sample_agrees_with_eval_and_pdf(void **state)
+{
+    (void)state;
+    drift_material metal = ggx_material(drift_vec3_make(0.9f, 0.6f, 0.3f), 0.4f, 1.0f, 0.0f);
+    drift_material plastic = ggx_material(drift_vec3_make(0.2f, 0.5f, 0.8f), 0.2f, 0.0f, 0.0f);
+    drift_material principled = plastic;
+    principled.diffuse_model = DRIFT_DIFFUSE_BURLEY;
+    principled.diffuse_roughness = 0.5f;
+    drift_material blend = ggx_material(drift_vec3_make(0.7f, 0.7f, 0.2f), 0.6f, 0.4f, 0.0f);
+    drift_material glass = ggx_material(drift_vec3_splat(1.0f), 0.3f, 0.2f, 0.7f);
+    const drift_material *materials[] = { &metal, &plastic, &principled, &blend, &glass };
+    for (int k = 0; k < 5; ++k) {
+        drift_bsdf b = make_bsdf(materials[k], true);
+        drift_vec3 wo = dir_at(0.7f);
+        for (uint32_t i = 0; i < 300; ++i) {
+            drift_sampler s = drift_sampler_make(9, 1, i);
+            drift_vec2 u = drift_sampler_next2(&s);
+            drift_bsdf_sample bs = drift_bsdf_sample_wi(&b, wo, drift_sampler_next1(&s), u);
+            if (!(bs.pdf > 0.0f) || bs.is_delta) {
+                continue;
+            }
+            float pdf = drift_bsdf_pdf(&b, wo, bs.wi);
+            drift_vec3 w = drift_vec3_scale(drift_bsdf_eval(&b, wo, bs.wi), fabsf(bs.wi.z) / pdf);
+            if (fabsf(pdf - bs.pdf) > 1e-3f * pdf ||
+                fabsf(w.x - bs.weight.x) > 1e-3f * w.x + 1e-6f ||
+                fabsf(w.z - bs.weight.z) > 1e-3f * w.z + 1e-6f) {
+                fail_msg("material %d: sample pdf %g weight %g, eval/pdf give %g and %g", k,
+                         (double)bs.pdf, (double)bs.weight.x, (double)pdf, (double)w.x);
+            }
+        }
+    }
+}
+
+// --- CHI-SQUARE (the same test as test_sampling.c's, over the whole sphere) ---
+
+#define THETA_BINS 16
+#define PHI_BINS   32
+
+static double chi2_critical(int dof)
+{
+    double k = (double)dof, z = 3.09; // significance 1e-3
+    double t = 1.0 - 2.0 / (9.0 * k) + z * sqrt(2.0 / (9.0 * k));
+    return k * t * t * t;
+}
+
+// Bins use +y as the pole so that the lobes (in the xz plane) sit on the equator.
+static drift_vec3 bin_dir(double cos_theta, double phi)
+{
+    double s = sqrt(fmax(0.0, 1.0 - cos_theta * cos_theta));
+    return drift_vec3_make((float)(s * sin(phi)), (float)cos_theta, (float)(s * cos(phi)));
+}
+
+// Samples of `c` binned against the pdf of `pdf_case` (the same case but in the test that the
+// check can fail).
+static bool chi_square_passes(const char *what, const ggx_case *c, const ggx_case *pdf_case,
+                              int sample_count, char *why, size_t why_size)
+{
+    static double observed[THETA_BINS * PHI_BINS], expected[THETA_BINS * PHI_BINS];
+    memset(observed, 0, sizeof(observed));
+    int failed = 0;
+    for (int i = 0; i < sample_count; ++i) {
+        drift_sampler s = drift_sampler_make(11, 0, (uint32_t)i);
+        drift_vec2 u = drift_sampler_next2(&s);
+        drift_bsdf_sample bs = drift_bsdf_sample_wi(&c->bsdf, c->wo, drift_sampler_next1(&s), u);
+        if (!(bs.pdf > 0.0f)) {
+            failed++;
+            continue;
+        }
+        double ct = fmax(-1.0, fmin(1.0, (double)bs.wi.y));
+        double phi = atan2((double)bs.wi.x, (double)bs.wi.z);
+        phi += phi < 0.0 ? 2.0 * M_PI : 0.0;
+        int ti = (int)((ct + 1.0) * 0.5 * THETA_BINS), pi = (int)(phi / (2.0 * M_PI) * PHI_BINS);
+        ti = ti >= THETA_BINS ? THETA_BINS - 1 : ti;
+        pi = pi >= PHI_BINS ? PHI_BINS - 1 : pi;
+        observed[ti * PHI_BINS + pi] += 1.0;
+    }
+    double integral = 0.0, bin_area = (2.0 / THETA_BINS) * (2.0 * M_PI / PHI_BINS);
+    const int sub = 16;
+    for (int ti = 0; ti < THETA_BINS; ++ti) {
+        for (int pi = 0; pi < PHI_BINS; ++pi) {
+            double acc = 0.0;
+            for (int a = 0; a < sub; ++a) {
+                for (int b = 0; b < sub; ++b) {
+                    double ct = -1.0 + (ti + (a + 0.5) / sub) * (2.0 / THETA_BINS);
+                    double phi = (pi + (b + 0.5) / sub) * (2.0 * M_PI / PHI_BINS);
+                    acc += (double)drift_bsdf_pdf(&pdf_case->bsdf, pdf_case->wo, bin_dir(ct, phi));
+                }
+            }
+            double p = acc / (sub * sub) * bin_area;
+            expected[ti * PHI_BINS + pi] = p * sample_count;
+            integral += p;
+        }
+    }
+    double success = 1.0 - (double)failed / sample_count;
+    if (fabs(integral - success) > 0.01) {
+        snprintf(why, why_size, "%s: pdf integrates to %.4f, sampling succeeds %.4f", what,
+                 integral, success);
+        return false;
+    }
+    double chi2 = 0.0, pooled_obs = 0.0, pooled_exp = 0.0;
+    int dof = -1;
+    for (int i = 0; i < THETA_BINS * PHI_BINS; ++i) {
+        if (expected[i] < 5.0) {
+            pooled_obs += observed[i];
+            pooled_exp += expected[i];
+            continue;
+        }
+        double d = observed[i] - expected[i];
+        chi2 += d * d / expected[i];
+        dof++;
+    }
+    if (pooled_exp >= 5.0) {
+        double d = pooled_obs - pooled_exp;
+        chi2 += d * d / pooled_exp;
+        dof++;
+    } else if (pooled_obs > 5.0 + 5.0 * pooled_exp) {
+        snprintf(why, why_size, "%s: %.0f samples where the pdf expects %.2f", what, pooled_obs,
+                 pooled_exp);
+        return false;
+    }
+    if (dof < 1 || chi2 > chi2_critical(dof)) {
+        snprintf(why, why_size, "%s: chi-square %.1f exceeds %.1f (dof %d)", what, chi2,
+                 chi2_critical(dof), dof);
+        return false;
+    }
+    return true;
+}
+
+static void chi_square_check(const char *what, const drift_material *m, bool front, float theta)
+{
+    ggx_case c = { .bsdf = make_bsdf(m, front), .wo = dir_at(theta) };
+    char why[256] = "", label[128];
+    snprintf(label, sizeof(label), "%s theta_o=%.1f", what, (double)theta);
+    if (!chi_square_passes(label, &c, &c, (int)(40000 * test_intensity()), why, sizeof(why))) {
+        fail_msg("%s", why);
+    }
+}
+
+static void test_ggx_sampling_matches_pdf(void **state)
+{
+    (void)state;
+    drift_material conductor = ggx_material(drift_vec3_make(0.9f, 0.7f, 0.4f), 0.1f, 1.0f, 0.0f);
+    drift_material rough_conductor = ggx_material(drift_vec3_splat(0.9f), 0.7f, 1.0f, 0.0f);
+    drift_material plastic = ggx_material(drift_vec3_make(0.6f, 0.3f, 0.1f), 0.2f, 0.0f, 0.0f);
+    drift_material glass = ggx_material(drift_vec3_splat(1.0f), 0.3f, 0.0f, 1.0f);
+    drift_material blend = ggx_material(drift_vec3_make(0.5f, 0.5f, 0.5f), 0.4f, 0.3f, 0.5f);
+    drift_material principled = plastic;
+    principled.diffuse_model = DRIFT_DIFFUSE_BURLEY;
+    principled.diffuse_roughness = 0.45f;
+    const float theta[] = { 0.1f, 0.8f, 1.3f };
+    for (int t = 0; t < 3; ++t) {
+        chi_square_check("plastic, Burley base", &principled, true, theta[t]);
+        chi_square_check("conductor alpha 0.1", &conductor, true, theta[t]);
+        chi_square_check("conductor alpha 0.7", &rough_conductor, true, theta[t]);
+        chi_square_check("plastic alpha 0.2", &plastic, true, theta[t]);
+        chi_square_check("rough glass outside", &glass, true, theta[t]);
+        chi_square_check("rough glass inside", &glass, false, theta[t]);
+        chi_square_check("metal+plastic+glass", &blend, true, theta[t]);
+    }
+}
+
+// The chi-square test fails a sampler whose pdf is wrong: samples of alpha 0.2 against the pdf
+// of alpha 0.25.
+static void test_ggx_chi_square_detects_a_wrong_pdf(void **state)
+{
+    (void)state;
+    drift_material m = ggx_material(drift_vec3_splat(0.9f), 0.2f, 1.0f, 0.0f);
+    drift_material m2 = ggx_material(drift_vec3_splat(0.9f), 0.25f, 1.0f, 0.0f);
+    ggx_case right = { .bsdf = make_bsdf(&m, true), .wo = dir_at(0.5f) };
+    ggx_case wrong = { .bsdf = make_bsdf(&m2, true), .wo = dir_at(0.5f) };
+    char why[256];
+    assert_true(chi_square_passes("right pdf", &right, &right, 50000, why, sizeof(why)));
+    assert_false(chi_square_passes("wrong pdf", &right, &wrong, 50000, why, sizeof(why)));
+}
+
+// --- SNELL, TIR, FRESNEL ---
+
+static void test_ggx_snell_and_total_internal_reflection(void **state)
+{
+    (void)state;
+    drift_material glass = ggx_material(drift_vec3_splat(1.0f), 0.0f, 0.0f, 1.0f);
+    glass.ggx.ior = 1.5f;
+    // Outside, at 30 degrees: refracted at asin(sin 30 / 1.5) on the other side, in the plane.
+    drift_bsdf outside = make_bsdf(&glass, true);
+    assert_true(drift_bsdf_is_delta(&outside));
+    drift_vec3 wo = dir_at(0.5235988f);
+    double expect_sin = 0.5 / 1.5;
+    bool saw_t = false, saw_r = false;
+    double fraction_r = 0.0;
+    const int n = 1000;
+    for (int i = 0; i < n; ++i) {
+        drift_bsdf_sample s =
+            drift_bsdf_sample_wi(&outside, wo, (i + 0.5f) / n, drift_vec2_make(0.3f, 0.7f));
+        assert_true(s.pdf > 0.0f && s.is_delta);
+        if (s.wi.z < 0.0f) {
+            saw_t = true;
+            assert_near(-s.wi.x, expect_sin, 1e-5);
+            assert_near(s.wi.y, 0.0, 1e-6);
+            assert_near(s.wi.z, -sqrt(1.0 - expect_sin * expect_sin), 1e-5);
+        } else {
+            saw_r = true;
+            fraction_r += 1.0 / n;
+            assert_near(s.wi.x, -wo.x, 1e-6);
+            assert_near(s.wi.z, wo.z, 1e-6);
+        }
+    }
+    assert_true(saw_t && saw_r);
+    // Reflected fraction = Fresnel at 30 degrees (Fresnel's equations by hand).
+    double ci = cos(0.5235988), ct = sqrt(1.0 - expect_sin * expect_sin);
+    double rs = (ci - 1.5 * ct) / (ci + 1.5 * ct), rp = (1.5 * ci - ct) / (1.5 * ci + ct);
+    assert_near(fraction_r, 0.5 * (rs * rs + rp * rp), 2.0 / n);
+    // Normal incidence: ((n - 1) / (n + 1))^2 = 0.04.
+    assert_near(drift__fresnel_dielectric(1.0f, 1.5f), 0.04, 1e-6);
+    // Inside, past the critical angle asin(1 / 1.5) = 41.8 degrees: always reflected.
+    drift_bsdf inside = make_bsdf(&glass, false);
+    drift_vec3 steep = dir_at(0.8f); // 45.8 degrees
+    for (int i = 0; i < 100; ++i) {
+        drift_bsdf_sample s =
+            drift_bsdf_sample_wi(&inside, steep, (i + 0.5f) / 100.0f, drift_vec2_make(0.5f, 0.5f));
+        assert_true(s.pdf > 0.0f && s.wi.z > 0.0f);
+        assert_near(s.weight.x, 1.0, 1e-6);
+    }
+    // Just inside the critical angle, light leaves, and at normal incidence it goes straight.
+    drift_vec3 wt;
+    assert_true(drift__refract(dir_at(0.7f), drift_vec3_make(0, 0, 1), 1.0f / 1.5f, &wt));
+    assert_near(sqrt(wt.x * wt.x + wt.y * wt.y), 1.5 * sin(0.7), 1e-5);
+    assert_false(drift__refract(dir_at(0.75f), drift_vec3_make(0, 0, 1), 1.0f / 1.5f, &wt));
+    assert_near(drift__fresnel_dielectric(cosf(0.75f), 1.0f / 1.5f), 1.0, 0.0);
+    // A thin sheet transmits straight through.
+    glass.ggx.thin = true;
+    drift_bsdf thin = make_bsdf(&glass, true);
+    drift_bsdf_sample s = drift_bsdf_sample_wi(&thin, wo, 0.99f, drift_vec2_make(0.5f, 0.5f));
+    assert_near(s.wi.x, -wo.x, 1e-6);
+    assert_near(s.wi.z, -wo.z, 1e-6);
+}
+
+static void test_ggx_conductor_fresnel(void **state)
+{
+    (void)state;
+    // Gulbrandsen's mapping reproduces F0 at normal incidence and tends to 1 at grazing.
+    drift_vec3 f0 = drift_vec3_make(0.95f, 0.64f, 0.54f), eta, k;
+    drift__conductor_from_tint(f0, drift_vec3_make(1.0f, 0.9f, 0.6f), &eta, &k);
+    drift_vec3 f = drift__fresnel_conductor(1.0f, eta, k);
+    assert_near(f.x, f0.x, 1e-4);
+    assert_near(f.y, f0.y, 1e-4);
+    assert_near(f.z, f0.z, 1e-4);
+    assert_near(drift__fresnel_conductor(0.0f, eta, k).y, 1.0, 1e-4);
+    // Gold is yellow: red reflects more than blue at normal incidence.
+    drift_ggx_params gold = { 0 };
+    assert_true(drift_ggx_named_metal("Au", &gold));
+    drift_vec3 fg = drift__fresnel_conductor(1.0f, gold.eta, gold.k);
+    assert_true(fg.x > 0.9f && fg.z < 0.5f);
+    assert_false(drift_ggx_named_metal("unobtainium", &gold));
+}
+
+// A normal map of one texel bends the normal of a uv-mapped quad by the angle it encodes, about
+// the direction of increasing u (its tangent), on both faces.
+static void test_ggx_normal_map_bends_the_normal(void **state)
+{
+    (void)state;
+    drift_context *ctx = test_context(1, NULL);
+    drift_scene *scene = NULL;
+    assert_int_equal(drift_scene_create(ctx, &scene), DRIFT_OK);
+    drift_image texel = { 0 };
+    assert_int_equal(drift_image_create(ctx, 1, 1, 3, &texel), DRIFT_OK);
+    const float angle = 0.5f; // tilt toward +u (world +x on this quad)
+    texel.pixels[0] = 0.5f + 0.5f * sinf(angle);
+    texel.pixels[1] = 0.5f;
+    texel.pixels[2] = 0.5f + 0.5f * cosf(angle);
+    uint32_t tex;
+    assert_int_equal(drift_scene_add_texture(scene, texel, &tex), DRIFT_OK);
+    drift_material m = ggx_material(drift_vec3_splat(0.5f), 0.3f, 0.0f, 0.0f);
+    m.ggx.normal_texture = tex;
+    uint32_t mat;
+    assert_int_equal(drift_scene_add_material(scene, &m, &mat), DRIFT_OK);
+    // A quad in the xy plane facing +z, u along +x and v along +y.
+    const float positions[] = { 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0 };
+    const float uvs[] = { 0, 0, 1, 0, 1, 1, 0, 1 };
+    const uint32_t indices[] = { 0, 1, 2, 0, 2, 3 };
+    uint32_t mesh;
+    assert_int_equal(drift_scene_add_mesh(scene,
+                                          &(drift_mesh_desc){ .positions = positions,
+                                                              .uvs = uvs,
+                                                              .indices = indices,
+                                                              .vertex_count = 4,
+                                                              .triangle_count = 2,
+                                                              .material = mat },
+                                          &mesh),
+                     DRIFT_OK);
+    assert_int_equal(drift_scene_commit(scene), DRIFT_OK);
+    for (int side = 0; side < 2; ++side) {
+        float z = side == 0 ? 1.0f : -1.0f;
+        drift_ray ray = { .origin = drift_vec3_make(0.3f, 0.6f, 2.0f * z),
+                          .dir = drift_vec3_make(0, 0, -z),
+                          .tmax = INFINITY };
+        drift_hit hit = { .t = 2.0f,
+                          .u = 0.3f,
+                          .v = 0.3f,
+                          .mesh = mesh,
+                          .prim = 0,
+                          .light = DRIFT_INVALID_INDEX,
+                          .ng = drift_vec3_make(0, 0, 1) };
+        drift_surface s = drift_scene_surface(scene, &ray, &hit);
+        drift_bsdf b = drift_bsdf_make(scene, &s);
+        assert_near(b.frame.z.x, sin((double)angle), 1e-3);
+        assert_near(b.frame.z.y, 0.0, 1e-3);
+        assert_near(b.frame.z.z, (double)z * cos((double)angle), 1e-3);
+    }
+    drift_scene_destroy(scene);
+    drift_context_destroy(ctx);
+}
+
+// The generated tables (scripts/gen_ggx_tables.sh) hold the integrals they claim to, between
+// grid points too: recomputed here on a finer grid of visible normals.
+static void test_ggx_albedo_tables_match_their_integrals(void **state)
+{
+    (void)state;
+    const float mus[] = { 0.15f, 0.5f, 0.93f }, alphas[] = { 0.02f, 0.16f, 0.5f, 0.9f };
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 4; ++j) {
+            float e1, es;
+            drift__ggx_integrate_reflection(mus[i], alphas[j], 128, &e1, &es);
+            assert_near(drift__ggx_e1(mus[i], alphas[j]), e1, 4e-3);
+            assert_near(drift__ggx_es(mus[i], alphas[j]), es, 4e-3);
+            float ed = drift__ggx_integrate_dielectric(mus[i], alphas[j], 1.45f, 96);
+            assert_near(drift__ggx_e_dielectric(mus[i], alphas[j], 1.45f), ed, 0.012);
+            ed = drift__ggx_integrate_dielectric(mus[i], alphas[j], 1.0f / 1.45f, 96);
+            assert_near(drift__ggx_e_dielectric(mus[i], alphas[j], 1.0f / 1.45f), ed, 0.012);
+        }
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_ggx_white_conductor_reflects_everything),
+        cmocka_unit_test(test_ggx_white_plastic_reflects_everything),
+        cmocka_unit_test(test_ggx_rough_dielectric_reflects_plus_transmits_one),
+        cmocka_unit_test(test_ggx_reflection_is_reciprocal),
+        cmocka_unit_test(test_ggx_sample_agrees_with_eval_and_pdf),
+        cmocka_unit_test(test_ggx_sampling_matches_pdf),
+        cmocka_unit_test(test_ggx_chi_square_detects_a_wrong_pdf),
+        cmocka_unit_test(test_ggx_snell_and_total_internal_reflection),
+        cmocka_unit_test(test_ggx_conductor_fresnel),
+        cmocka_unit_test(test_ggx_albedo_tables_match_their_integrals),
+        cmocka_unit_test(test_ggx_normal_map_bends_the_normal),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
