@@ -5,6 +5,7 @@
 #include "drift/camera_path.h"
 #include "drift/image_io.h"
 #include "drift/temporal.h"
+#include "frame_pattern.h"
 #include "render.h"
 
 #include <math.h>
@@ -17,70 +18,8 @@
 bool render_parse_animation(const char *cmd, const char *flag, const char *v, void *field)
 {
     render_options *o = field;
-    long a = -1, b = -1;
-    char tail;
-    if (sscanf(v, "%ld:%ld%c", &a, &b, &tail) != 2 || a < 0 || b < a || b > 1000000) {
-        fprintf(stderr,
-                "drift %s: %s expects FIRST:LAST frame numbers, 0 <= FIRST <= LAST <= "
-                "1000000, got '%s'\n",
-                cmd, flag, v);
-        return false;
-    }
-    o->animation = true;
-    o->frame_first = a;
-    o->frame_last = b;
-    return true;
-}
-
-// The frame number's place in --out: one %d or %0Nd (N 1..9); any other '%' must be "%%".
-typedef struct frame_pattern {
-    size_t at, length; // the conversion's offset and length in the pattern
-    int width;
-} frame_pattern;
-
-static bool find_pattern(const char *s, frame_pattern *out)
-{
-    int found = 0;
-    for (size_t i = 0; s[i]; ++i) {
-        if (s[i] != '%') {
-            continue;
-        }
-        if (s[i + 1] == '%') {
-            ++i;
-            continue;
-        }
-        size_t j = i + 1;
-        int width = 0;
-        if (s[j] == '0' && s[j + 1] >= '1' && s[j + 1] <= '9') {
-            width = s[j + 1] - '0';
-            j += 2;
-        }
-        if (s[j] != 'd') {
-            return false;
-        }
-        *out = (frame_pattern){ .at = i, .length = j + 1 - i, .width = width };
-        ++found;
-        i = j;
-    }
-    return found == 1;
-}
-
-// The pattern with frame k in place and "%%" as '%'.
-static void format_frame(const char *pattern, const frame_pattern *p, long k, char *out,
-                         size_t size)
-{
-    size_t n = 0;
-    for (size_t i = 0; pattern[i] && n + 1 < size;) {
-        if (i == p->at) {
-            int w = snprintf(out + n, size - n, "%0*ld", p->width, k);
-            n += w > 0 ? (size_t)w : 0;
-            i += p->length;
-            continue;
-        }
-        out[n++] = pattern[i];
-        i += pattern[i] == '%' ? 2 : 1;
-    }
-    out[n < size ? n : size - 1] = '\0';
+    o->animation = frame_range_parse(cmd, flag, v, &o->frame_first, &o->frame_last);
+    return o->animation;
 }
 
 bool render_sequence_validate(const render_options *o)
@@ -101,7 +40,7 @@ bool render_sequence_validate(const render_options *o)
         }
         return true;
     }
-    if (!find_pattern(o->out_path, &p)) {
+    if (!frame_pattern_find(o->out_path, &p)) {
         fprintf(stderr,
                 "drift render: --animation needs --out with one frame number, %%04d or %%d "
                 "(e.g. out/frame_%%04d.exr), got '%s'\n",
@@ -259,11 +198,11 @@ static int run_frames(sequence_run *s)
         base.focus_distance = (float)o->focus_distance;
     }
     frame_pattern pattern;
-    find_pattern(o->out_path, &pattern); // validated
+    frame_pattern_find(o->out_path, &pattern); // validated
     double total_ms = 0.0;
     for (long k = o->frame_first; k <= o->frame_last; ++k) {
         char out_path[4096];
-        format_frame(o->out_path, &pattern, k, out_path, sizeof out_path);
+        frame_pattern_format(o->out_path, &pattern, k, out_path, sizeof out_path);
         double time = (double)k / s->fps;
         drift_camera cam = drift_camera_path_eval(&s->path, &base, time);
         cJSON *entry = cJSON_CreateObject();

@@ -43,6 +43,29 @@ assert all(e["ms"] > 0 and e["frame_ms"] > 0 and e["rays"] > 0 for e in f), f
 assert abs(f[1]["time"] - 3 / 24) < 1e-6, f
 PY
 
+# drift diff --frames: a sequence against itself has no error; against the hybrid frames it
+# has FLIP and temporal error per frame, in JSON, and the SVG plot.
+expect 0 "$drift" diff "$tmp/r1/f_%02d.exr" "$tmp/r2/f_%02d.exr" --frames 0:1 --json
+python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); assert d["mean_flip"]==0 and d["mean_temporal_error"]==0, d' \
+    "$tmp/out" || fail "a sequence against itself has an error"
+mkdir -p "$tmp/hn"
+expect 0 "$drift" render "$scene" "${small[@]}" --mode hybrid --indirect none --threads 2 \
+    --animation 0:1 --out "$tmp/hn/f_%d.exr"
+expect 0 "$drift" diff "$tmp/r1/f_%02d.exr" "$tmp/hn/f_%d.exr" --frames 0:1 --json \
+    --plot "$tmp/plot.svg"
+python3 - "$tmp/out" <<'PY' || fail "diff --frames JSON incomplete"
+import json, sys
+d = json.load(open(sys.argv[1]))
+f = d["frames"]
+assert [e["frame"] for e in f] == [0, 1] and f[0]["temporal_error"] is None, d
+assert all(0 < e["flip"] < 1 for e in f) and f[1]["temporal_error"] > 0, d
+assert abs(d["mean_flip"] - (f[0]["flip"] + f[1]["flip"]) / 2) < 1e-9, d
+PY
+grep -q "<polyline" "$tmp/plot.svg" || fail "--plot wrote no plot"
+expect 2 "$drift" diff "$tmp/r1/f_%02d.exr" "$tmp/hn/f_%d.exr" --plot "$tmp/p2.svg"
+expect 2 "$drift" diff "$tmp/r1/f_00.exr" "$tmp/hn/f_0.exr" --frames 0:1
+[ -e "$tmp/p2.svg" ] && fail "a usage error wrote the plot"
+
 # Usage errors: exit 2, nothing written.
 mkdir -p "$tmp/bad"
 expect 2 "$drift" render "$scene" "${small[@]}" --animation 0:1 --out "$tmp/bad/x.exr"
