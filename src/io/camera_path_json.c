@@ -5,7 +5,6 @@
 #include "io/scene_io_internal.h"
 
 #include <cjson/cJSON.h>
-#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -86,8 +85,9 @@ static drift_result read_vec3(const path_reader *r, const cJSON *obj, const char
     float c[3];
     int k = 0;
     for (const cJSON *e = v->child; e; e = e->next, ++k) {
-        if (!cJSON_IsNumber(e) || !(fabs(e->valuedouble) <= (double)FLT_MAX / 4)) {
-            return fail(r, e, DRIFT_ERR_PARSE, "%s.%s[%d] must be a finite number", where, key, k);
+        if (!cJSON_IsNumber(e) || !(fabs(e->valuedouble) <= 1e15)) {
+            return fail(r, e, DRIFT_ERR_PARSE, "%s.%s[%d] must be a number in [-1e15, 1e15]", where,
+                        key, k);
         }
         c[k] = (float)e->valuedouble;
     }
