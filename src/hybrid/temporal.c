@@ -18,11 +18,11 @@ struct drift_temporal {
     drift_temporal_settings s;
     int cur; // index of the current frame's planes
     bool has_prev;
-    drift_camera prev_camera;
     drift_image light[PLANES];    // 3: accumulated demodulated lighting
     drift_image moments[PLANES];  // 2: accumulated luminance moments
     drift_image length[PLANES];   // 1: history length in frames
     drift_image depth[PLANES];    // 1
+    drift_image position[PLANES]; // 3: world position
     drift_image normal[PLANES];   // 3
     drift_image material[PLANES]; // 1
     drift_image sample_lum;       // 1: this frame's demodulated luminance (spatial moments)
@@ -53,6 +53,7 @@ void drift_temporal_destroy(drift_temporal *t)
         drift_image_destroy(t->ctx, &t->moments[k]);
         drift_image_destroy(t->ctx, &t->length[k]);
         drift_image_destroy(t->ctx, &t->depth[k]);
+        drift_image_destroy(t->ctx, &t->position[k]);
         drift_image_destroy(t->ctx, &t->normal[k]);
         drift_image_destroy(t->ctx, &t->material[k]);
         drift_image_destroy(t->ctx, &t->filter[k]);
@@ -93,6 +94,7 @@ drift_result drift_temporal_create(drift_context *ctx, int32_t width, int32_t he
             (r = drift_image_create(ctx, width, height, 2, &t->moments[k])) != DRIFT_OK ||
             (r = drift_image_create(ctx, width, height, 1, &t->length[k])) != DRIFT_OK ||
             (r = drift_image_create(ctx, width, height, 1, &t->depth[k])) != DRIFT_OK ||
+            (r = drift_image_create(ctx, width, height, 3, &t->position[k])) != DRIFT_OK ||
             (r = drift_image_create(ctx, width, height, 3, &t->normal[k])) != DRIFT_OK ||
             (r = drift_image_create(ctx, width, height, 1, &t->material[k])) != DRIFT_OK ||
             (r = drift_image_create(ctx, width, height, 4, &t->filter[k])) != DRIFT_OK) {
@@ -136,7 +138,6 @@ typedef struct frame_job {
     drift_temporal *t;
     const drift_gbuffer *g;
     const drift_image *color;
-    drift_camera_frame prev_frame; // the previous camera (valid when t->has_prev)
     int cur, prev;
 } frame_job;
 
@@ -146,10 +147,12 @@ static drift_vec3 demodulation(const drift_gbuffer *g, int32_t x, int32_t y)
     return drift_vec3_make(fmaxf(a.x, 0.01f), fmaxf(a.y, 0.01f), fmaxf(a.z, 0.01f));
 }
 
-// Whether the previous frame's pixel (x, y) shows the surface at world point p with normal n and
-// material m (expected_depth: p's depth in the previous camera).
+// Whether the previous frame's pixel (x, y) shows the surface at world point p (view depth z)
+// with normal n and material m: the same material, normals within normal_tolerance, and the
+// previous point within depth_tolerance x z of p's tangent plane (a plane test, not a depth
+// test: sub-pixel offsets along a slanted surface keep their history).
 static bool tap_valid(const frame_job *job, int32_t x, int32_t y, float material, drift_vec3 n,
-                      float expected_depth)
+                      drift_vec3 p, float z)
 {
     const drift_temporal *t = job->t;
     if (x < 0 || y < 0 || x >= t->width || y >= t->height) {
@@ -163,8 +166,8 @@ static bool tap_valid(const frame_job *job, int32_t x, int32_t y, float material
     if (drift_vec3_dot(drift_image_get3(&t->normal[pr], x, y), n) < t->s.normal_tolerance) {
         return false;
     }
-    float z = drift_image_pixel(&t->depth[pr], x, y)[0];
-    return fabsf(z - expected_depth) <= t->s.depth_tolerance * expected_depth;
+    drift_vec3 q = drift_image_get3(&t->position[pr], x, y);
+    return fabsf(drift_vec3_dot(drift_vec3_sub(q, p), n)) <= t->s.depth_tolerance * z;
 }
 
 static void accumulate_rows(size_t begin, size_t end, int thread_index, void *user)
@@ -182,6 +185,7 @@ static void accumulate_rows(size_t begin, size_t end, int thread_index, void *us
             drift_image_pixel(&t->depth[c], x, y)[0] = z;
             drift_image_pixel(&t->material[c], x, y)[0] = material;
             drift_image_set3(&t->normal[c], x, y, n);
+            drift_image_set3(&t->position[c], x, y, drift_image_get3(&g->position, x, y));
             float *len = drift_image_pixel(&t->length[c], x, y);
             float *mom = drift_image_pixel(&t->moments[c], x, y);
             if (!(z > 0.0f)) { // a miss: passes through, no history
@@ -204,15 +208,13 @@ static void accumulate_rows(size_t begin, size_t end, int thread_index, void *us
             if (t->has_prev) {
                 const float *m = drift_image_pixel(&g->motion, x, y);
                 drift_vec3 p = drift_image_get3(&g->position, x, y);
-                float expected = drift_vec3_dot(drift_vec3_sub(p, job->prev_frame.camera.position),
-                                                job->prev_frame.w);
                 float qx = (float)x + m[0], qy = (float)y + m[1];
                 int32_t x0 = (int32_t)floorf(qx), y0 = (int32_t)floorf(qy);
                 float fx = qx - (float)x0, fy = qy - (float)y0;
                 for (int k = 0; k < 4; ++k) {
                     int32_t tx = x0 + (k & 1), ty = y0 + (k >> 1);
                     float w = ((k & 1) ? fx : 1.0f - fx) * ((k >> 1) ? fy : 1.0f - fy);
-                    if (w <= 0.0f || !tap_valid(job, tx, ty, material, n, expected)) {
+                    if (w <= 0.0f || !tap_valid(job, tx, ty, material, n, p, z)) {
                         continue;
                     }
                     hist = drift_vec3_fma(hist, drift_image_get3(&t->light[pr], tx, ty), w);
@@ -412,9 +414,6 @@ drift_result drift_temporal_apply(drift_temporal *t, const drift_gbuffer *g,
     }
     t->cur ^= 1;
     frame_job job = { .t = t, .g = g, .color = color, .cur = t->cur, .prev = t->cur ^ 1 };
-    if (t->has_prev) {
-        job.prev_frame = drift_camera_frame_make(&t->prev_camera, t->width, t->height);
-    }
     size_t rows = (size_t)t->height;
     drift_parallel_for(t->ctx, rows, 4, accumulate_rows, &job);
     drift_parallel_for(t->ctx, rows, 4, variance_rows, &job);
@@ -427,8 +426,7 @@ drift_result drift_temporal_apply(drift_temporal *t, const drift_gbuffer *g,
         drift_parallel_for(t->ctx, rows, 4, filter_rows, &fj);
     }
     drift_parallel_for(t->ctx, rows, 4, remodulate_rows, &job);
-    t->prev_camera = *camera;
-    t->prev_camera.film_shift_x = t->prev_camera.film_shift_y = 0.0f;
+    (void)camera; // the motion vectors carry the camera's move
     t->has_prev = true;
     return DRIFT_OK;
 }

@@ -5,12 +5,13 @@
 #include "drift/camera_path.h"
 #include "drift/hybrid.h"
 #include "drift/temporal.h"
+#include "drift/view.h"
 #include "drift_test.h"
 #include "test_rig.h"
 
 #include <math.h>
-#include <stdlib.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 // --- CAMERA PATHS ---
@@ -304,24 +305,29 @@ static void test_disocclusion(void **state)
 // new seed each frame: the accumulated frame's error against the same frame at 512 spp falls
 // with the frames (within 10 % noise from one check to the next) and ends below a third of
 // the first frame's; the filtered one starts and ends below the unfiltered one.
-static void test_still_camera_converges(void **state)
+static void add_lit_box(test_rig *r, int w)
 {
-    (void)state;
-    test_rig r = test_rig_begin(2);
-    uint32_t white = test_add_material(r.scene, drift_material_make(drift_vec3_splat(0.7f)));
+    uint32_t white = test_add_material(r->scene, drift_material_make(drift_vec3_splat(0.7f)));
     const float p[] = { -1, -1, -1, 1, -1, -1, 1, 1, -1, -1, 1, -1,
                         -1, -1, 1,  1, -1, 1,  1, 1, 1,  -1, 1, 1 };
     const uint32_t idx[] = { 0, 1, 2, 0, 2, 3, 4, 7, 6, 4, 6, 5, 0, 4, 5, 0, 5, 1,
                              3, 2, 6, 3, 6, 7, 0, 3, 7, 0, 7, 4, 1, 5, 6, 1, 6, 2 };
-    test_add_mesh(r.scene, p, 8, idx, 12, white);
+    test_add_mesh(r->scene, p, 8, idx, 12, white);
     drift_light light = { .type = DRIFT_LIGHT_POINT,
                           .position = drift_vec3_make(0.2f, 0.8f, 0.1f),
                           .color = drift_vec3_splat(2.0f) };
-    assert_int_equal(drift_scene_add_light(r.scene, &light, NULL), DRIFT_OK);
-    const int w = 32;
-    r.scene->camera = drift_camera_look_at(drift_vec3_make(0, 0, 0.95f), drift_vec3_make(0, 0, 0),
-                                           drift_vec3_make(0, 1, 0), 1.6f, w, w);
-    test_rig_commit(&r);
+    assert_int_equal(drift_scene_add_light(r->scene, &light, NULL), DRIFT_OK);
+    r->scene->camera = drift_camera_look_at(drift_vec3_make(0, 0, 0.95f), drift_vec3_make(0, 0, 0),
+                                            drift_vec3_make(0, 1, 0), 1.6f, w, w);
+    test_rig_commit(r);
+}
+
+static void test_still_camera_converges(void **state)
+{
+    (void)state;
+    test_rig r = test_rig_begin(2);
+    const int w = 24;
+    add_lit_box(&r, w);
     drift_hybrid_params params = {
         .width = w, .height = w, .indirect = DRIFT_INDIRECT_REFERENCE, .spp = 512
     };
@@ -369,6 +375,53 @@ static void test_still_camera_converges(void **state)
     test_rig_destroy(&r);
 }
 
+// The viewer with temporal reuse: a still camera's framebuffer after 16 frames is nearer the
+// converged frame's (8 x 64 spp over the pixel) than one frame's is, by more than half.
+static void test_view_converges(void **state)
+{
+    (void)state;
+    test_rig r = test_rig_begin(2);
+    const int w = 24;
+    add_lit_box(&r, w);
+    drift_view_desc desc = { .width = w,
+                             .height = w,
+                             .hide_overlay = true,
+                             .hybrid = { .indirect = DRIFT_INDIRECT_REFERENCE, .spp = 1 } };
+    drift_view *views[3] = { NULL, NULL, NULL };
+    desc.temporal = true;
+    assert_int_equal(drift_view_create(r.ctx, r.scene, r.accel, &desc, &views[0]), DRIFT_OK);
+    desc.temporal = false;
+    assert_int_equal(drift_view_create(r.ctx, r.scene, r.accel, &desc, &views[1]), DRIFT_OK);
+    // The converged frame through the pixel's box filter, as the temporal frames' sub-pixel
+    // offsets average it: 8 anti-aliasing passes of 64 samples.
+    desc.hybrid.spp = 64;
+    desc.hybrid.aa = 8;
+    assert_int_equal(drift_view_create(r.ctx, r.scene, r.accel, &desc, &views[2]), DRIFT_OK);
+    for (int k = 0; k < 16; ++k) {
+        assert_int_equal(drift_view_frame(views[0], NULL), DRIFT_OK);
+    }
+    assert_int_equal(drift_view_frame(views[1], NULL), DRIFT_OK);
+    assert_int_equal(drift_view_frame(views[2], NULL), DRIFT_OK);
+    double err[2] = { 0.0, 0.0 };
+    const uint8_t *ref = drift_view_pixels(views[2]);
+    for (int v = 0; v < 2; ++v) {
+        const uint8_t *px = drift_view_pixels(views[v]);
+        for (int i = 0; i < 3 * w * w; ++i) {
+            err[v] += fabs((double)px[i] - (double)ref[i]) / (3.0 * w * w);
+        }
+    }
+    if (getenv("DRIFT_TEST_VERBOSE")) {
+        fprintf(stderr, "temporal view error %g, one frame %g (sRGB levels)\n", err[0], err[1]);
+    }
+    if (!(err[0] < 0.5 * err[1])) {
+        fail_msg("temporal view error %g, one frame %g (sRGB levels)", err[0], err[1]);
+    }
+    for (int v = 0; v < 3; ++v) {
+        drift_view_destroy(views[v]);
+    }
+    test_rig_destroy(&r);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -378,6 +431,7 @@ int main(void)
         cmocka_unit_test(test_reprojection_subpixel),
         cmocka_unit_test(test_disocclusion),
         cmocka_unit_test(test_still_camera_converges),
+        cmocka_unit_test(test_view_converges),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
