@@ -137,7 +137,7 @@ static int hybrid_frame(sequence_run *s, long k, const drift_camera *camera, con
         // over the pixel's box filter, as the path tracer does.
         drift_hybrid_params p = drift_hybrid_get_params(s->frame);
         p.seed = (uint32_t)o->seed + (uint32_t)k;
-        if (drift_hybrid_set_params(s->frame, &p) != DRIFT_OK) {
+        if (drift_temporal_reseeds(&p) && drift_hybrid_set_params(s->frame, &p) != DRIFT_OK) {
             return 1;
         }
         cam.film_shift_x = halton(index + 1, 2) - 0.5f;

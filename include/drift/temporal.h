@@ -8,9 +8,10 @@
 //   1. demodulate: the lighting l = (c - e) / max(a, 0.01) per channel (c colour, e emission,
 //      a albedo); misses (depth 0) pass through untouched
 //   2. reproject: q = p + motion(p) in the previous frame; each of q's four bilinear taps is kept
-//      when its material equals m, its normal n' has n.n' >= normal_tolerance, and its depth
-//      differs from X's depth in the previous camera by at most depth_tolerance x that depth.
-//      No tap kept: a disocclusion, the history restarts (length 0)
+//      when its material equals m, its normal n' has n.n' >= normal_tolerance, and its world
+//      point X' lies within depth_tolerance x p's depth of X's tangent plane (|n.(X' - X)|: a
+//      plane test, so that sub-pixel offsets along a slanted surface keep their history).
+//      No tap kept: a disocclusion, the history restarts (length 1)
 //   3. accumulate: N = min(N_prev + 1, max_history), alpha = 1 / N; l_acc = lerp(l_hist, l,
 //      alpha), moments (mu1, mu2) of the luminance with max(alpha, moments_alpha); the variance
 //      of the mean is max(mu2 - mu1^2, 0) / N (below 4 frames the 7x7 spatial moments stand in)
@@ -78,10 +79,18 @@ void drift_temporal_destroy(drift_temporal *t); // NULL-safe
 void drift_temporal_reset(drift_temporal *t);
 
 // Accumulates and filters one frame: `gbuffer` (its motion relative to the previous call's
-// camera), the `camera` it was rendered with, and its noisy `color` (3 channels, the frame's
-// size). DRIFT_ERR_INVALID_ARGUMENT on a size mismatch.
+// camera), the `camera` it was rendered with (the motion vectors carry its move; kept for
+// drivers and later tests), and its noisy `color` (3 channels, the frame's size).
+// DRIFT_ERR_INVALID_ARGUMENT on a size mismatch.
 drift_result drift_temporal_apply(drift_temporal *t, const drift_gbuffer *gbuffer,
                                   const drift_camera *camera, const drift_image *color);
+// Whether a driver of temporal reuse should give each frame of `params` a new seed (so that
+// the history averages independent samples): true unless a chosen technique keeps state built
+// from the seed that a new seed rebuilds (indirect ism, ir and micro: the VPLs and their maps,
+// the point hierarchy; reflections micro and envmap: the hierarchy, the probes). Those keep
+// their seed, and the frames differ by their sub-pixel offsets (and the camera's move) alone.
+bool drift_temporal_reseeds(const drift_hybrid_params *params);
+
 // The last frame's result (RGB) and each pixel's history length in frames (1 channel; 0 where
 // the pixel sees no surface, 1 where its history was rejected).
 const drift_image *drift_temporal_image(const drift_temporal *t);

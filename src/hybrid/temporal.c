@@ -430,3 +430,10 @@ drift_result drift_temporal_apply(drift_temporal *t, const drift_gbuffer *g,
     t->has_prev = true;
     return DRIFT_OK;
 }
+
+bool drift_temporal_reseeds(const drift_hybrid_params *p)
+{
+    return p->indirect != DRIFT_INDIRECT_ISM && p->indirect != DRIFT_INDIRECT_IR &&
+           p->indirect != DRIFT_INDIRECT_MICRO && p->reflections != DRIFT_REFLECTIONS_MICRO &&
+           p->reflections != DRIFT_REFLECTIONS_ENVMAP;
+}

@@ -422,8 +422,11 @@ drift_result drift_view_temporal_begin(drift_view *view, drift_camera *camera)
 {
     uint32_t k = view->temporal_frame++;
     drift_hybrid_params p = drift_hybrid_get_params(view->hybrid);
-    p.seed = view->base_seed + k;
-    drift_result r = drift_hybrid_set_params(view->hybrid, &p);
+    drift_result r = DRIFT_OK;
+    if (drift_temporal_reseeds(&p)) {
+        p.seed = view->base_seed + k;
+        r = drift_hybrid_set_params(view->hybrid, &p);
+    }
     camera->film_shift_x += halton(k + 1, 2) - 0.5f;
     camera->film_shift_y += halton(k + 1, 3) - 0.5f;
     return r;
