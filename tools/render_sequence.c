@@ -3,6 +3,7 @@
 // hybrid mode (--temporal on, drift/temporal.h) and an MP4 through ffmpeg (--video).
 #include "cli.h"
 #include "drift/camera_path.h"
+#include "drift/glare.h"
 #include "drift/image_io.h"
 #include "drift/temporal.h"
 #include "frame_pattern.h"
@@ -120,6 +121,10 @@ typedef struct sequence_run {
     double fps;
     drift_hybrid *frame;
     drift_temporal *temporal;
+    // --glare static|dynamic: applied here, after the temporal reuse, with the sequence's time
+    // step 1 / fps (the hybrid frame's own glare pass steps by the wall clock)
+    drift_glare *glare;
+    drift_image glared;
     cJSON *stats;  // the --stats object
     cJSON *frames; // its "frames" array
 } sequence_run;
@@ -166,6 +171,15 @@ static int hybrid_frame(sequence_run *s, long k, const drift_camera *camera, con
             return 1;
         }
         image = drift_temporal_image(s->temporal);
+    }
+    if (s->glare) {
+        double dt = k > o->frame_first ? 1.0 / s->fps : 0.0;
+        r = drift_glare_apply_to(s->glare, image, dt, &s->glared);
+        if (r != DRIFT_OK) {
+            fprintf(stderr, "drift render: glare failed: %s\n", drift_result_string(r));
+            return 1;
+        }
+        image = &s->glared;
     }
     render_options fo = *o;
     fo.out_path = out_path;
@@ -268,6 +282,8 @@ int render_sequence(const render_options *o, const cli_session *session)
         if (o->max_depth > 0) {
             params.max_depth = (int32_t)o->max_depth;
         }
+        drift_glare_technique glare = params.glare;
+        params.glare = DRIFT_GLARE_NONE; // the sequence's own, below
         drift_result r =
             drift_hybrid_create(ctx, session->scene, session->accel, &params, &s.frame);
         if (r != DRIFT_OK) {
@@ -276,6 +292,22 @@ int render_sequence(const render_options *o, const cli_session *session)
             goto done;
         }
         params = drift_hybrid_get_params(s.frame);
+        if (glare != DRIFT_GLARE_NONE) {
+            // The PSF at the camera's angular pitch, as the hybrid frame's glare pass makes it.
+            double aspect = (double)params.width / (double)params.height;
+            double fov_x = 2.0 * atan(aspect * tan(0.5 * (double)session->scene->camera.fov_y));
+            drift_glare_params gp = { .mode = glare == DRIFT_GLARE_DYNAMIC
+                                                  ? DRIFT_GLARE_MODE_DYNAMIC
+                                                  : DRIFT_GLARE_MODE_STATIC,
+                                      .seed = params.seed,
+                                      .image_fov = fov_x };
+            if ((r = drift_glare_create(ctx, &gp, &s.glare)) != DRIFT_OK ||
+                (r = drift_image_create(ctx, params.width, params.height, 3, &s.glared)) !=
+                    DRIFT_OK) {
+                fprintf(stderr, "drift render: glare: %s\n", drift_result_string(r));
+                goto done;
+            }
+        }
         if (o->temporal &&
             (r = drift_temporal_create(ctx, params.width, params.height, &o->temporal_settings,
                                        &s.temporal)) != DRIFT_OK) {
@@ -300,6 +332,8 @@ int render_sequence(const render_options *o, const cli_session *session)
 done:
     cJSON_Delete(s.stats);
     drift_temporal_destroy(s.temporal);
+    drift_glare_destroy(s.glare);
+    drift_image_destroy(ctx, &s.glared);
     drift_hybrid_destroy(s.frame);
     drift_camera_path_free(ctx, &s.path);
     return exit_code;

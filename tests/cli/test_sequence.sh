@@ -33,6 +33,13 @@ for k in 00 01; do
     cmp -s "$tmp/r1/f_$k.exr" "$tmp/r2/f_$k.exr" || fail "reference frame $k differs across threads"
 done
 cmp -s "$tmp/h1/f_0002.exr" "$tmp/h1/f_0005.exr" && fail "the camera path did not move the camera"
+# Dynamic glare stepped by the sequence's 1 / fps: the same bits for 1 and 2 threads.
+for threads in 1 2; do
+    mkdir -p "$tmp/g$threads"
+    expect 0 "$drift" render "$scene" "${small[@]}" --mode hybrid --indirect none --glare dynamic \
+        --threads "$threads" --animation 0:2 --out "$tmp/g$threads/f_%d.exr"
+done
+cmp -s "$tmp/g1/f_2.exr" "$tmp/g2/f_2.exr" || fail "a glare sequence differs across threads"
 python3 - "$tmp/h1/s.json" <<'PY' || fail "sequence stats incomplete"
 import json, sys
 s = json.load(open(sys.argv[1]))
