@@ -1,9 +1,11 @@
 // drift diff: compares a test image against a reference with MSE, RMSE, relMSE, PSNR, SSIM
 // and LDR-FLIP (docs/metrics.md), optionally writing the FLIP error as a magma heat map.
 #include "cli.h"
+#include "diff_sequence.h"
 #include "drift/image.h"
 #include "drift/image_io.h"
 #include "drift/metric.h"
+#include "frame_pattern.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -15,7 +17,17 @@ typedef struct diff_options {
     bool json, verbose, ignore_nonfinite;
     double difftol; // < 0: none
     double ppd;     // 0: DRIFT_METRIC_DEFAULT_PPD
+    bool frames;    // --frames A:B: REF and TEST are frame patterns (tools/diff_sequence.c)
+    long first, last;
+    const char *plot_path;
 } diff_options;
+
+static bool parse_frames(const char *cmd, const char *flag, const char *v, void *field)
+{
+    diff_options *o = field;
+    o->frames = frame_range_parse(cmd, flag, v, &o->first, &o->last);
+    return o->frames;
+}
 
 #define O diff_options
 static const cli_option diff_table[] = {
@@ -32,6 +44,12 @@ static const cli_option diff_table[] = {
     CLI_NUMBER("--difftol", "X", O, difftol, 0.0, 1.0, "exit with status 1 when FLIP > X"),
     CLI_NUMBER("--ppd", "P", O, ppd, 1.0, 2000.0,
                "FLIP pixels per degree (default " CLI_STR(DRIFT_METRIC_DEFAULT_PPD) ")"),
+    CLI_CUSTOM_ALL("--frames", "A:B", parse_frames,
+                   "REF and TEST are frame patterns (frame_%04d.exr): per-frame\n"
+                   "FLIP and the temporal error, the frame-to-frame change of\n"
+                   "TEST - REF (docs/temporal.md)"),
+    CLI_STRING("--plot", "FILE.svg", O, plot_path,
+               "--frames: per-frame FLIP and temporal error as an SVG plot"),
     CLI_FLAG("-v, --verbose", O, verbose, "more log output"),
 };
 #undef O
@@ -71,6 +89,24 @@ int drift_cmd_diff(int argc, char **argv)
     if (!o.paths[1]) {
         cli_print_help(&diff_command, stderr);
         return 2;
+    }
+    if (o.frames || o.plot_path) {
+        if (!o.frames || o.heatmap_path) {
+            fprintf(stderr, "drift diff: %s\n",
+                    o.frames ? "--heatmap is for one image pair, not --frames"
+                             : "--plot needs --frames A:B");
+            return 2;
+        }
+        return diff_sequence(&(diff_sequence_options){ .ref_pattern = o.paths[0],
+                                                       .test_pattern = o.paths[1],
+                                                       .first = o.first,
+                                                       .last = o.last,
+                                                       .ppd = o.ppd,
+                                                       .difftol = o.difftol,
+                                                       .json = o.json,
+                                                       .verbose = o.verbose,
+                                                       .ignore_nonfinite = o.ignore_nonfinite,
+                                                       .plot_path = o.plot_path });
     }
     const char *paths[2] = { o.paths[0], o.paths[1] };
     const char *heatmap_path = o.heatmap_path;

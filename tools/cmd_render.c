@@ -245,6 +245,16 @@ static const cli_option render_table[] = {
     CLI_STRING("--reflection-edits", "FILE.json", O, edits_path,
                "edit the reflections: sharp, envmap and ISG reflections and the path\n"
                "tracer's first specular bounce follow e(q) (docs/reflection-editing.md)"),
+    CLI_CUSTOM_ALL("--animation", "A:B", render_parse_animation,
+                   "render frames A to B (time = frame / --fps) of --camera-path;\n"
+                   "--out names a pattern, DIR/frame_%04d.exr (docs/temporal.md)"),
+    CLI_NUMBER("--fps", "F", O, fps, 1e-3, 1e6,
+               "frames a second of --animation (default: the camera path's, 24)"),
+    CLI_STRING("--camera-path", "FILE.json", O, camera_path,
+               "keyframes of the camera (position, target, fov, aperture, focus),\n"
+               "interpolated by centripetal Catmull-Rom (docs/temporal.md)"),
+    CLI_STRING("--video", "FILE.mp4", O, video_path,
+               "--animation: also encode the PNG frames with ffmpeg when installed"),
     CLI_FLAG("--quiet", O, quiet, "no progress output"),
     CLI_FLAG("--verbose", O, verbose, "more log output"),
     CLI_FLAG("--features", O, print_features,
@@ -264,6 +274,13 @@ static const cli_option render_table[] = {
             "render N frames of the view and write the last: its stats\n"
             "are a frame with warm caches (default 1; first_frame_ms in\n"
             "--stats has the first)"),
+    CLI_CHOICE("--temporal", "off|on", O, temporal, "off|on",
+               "reuse across --animation frames: reprojection, disocclusion tests,\n"
+               "variance-guided accumulation and filtering (docs/temporal.md)"),
+    CLI_INT("--temporal-history", "N", O, temporal_settings.max_history, 1, 4096,
+            "frames the temporal accumulation averages at most (default 32)"),
+    CLI_INT("--temporal-passes", "N", O, temporal_settings.filter_passes, 0, 8,
+            "a-trous passes of the temporal filter (default 3; 0: none)"),
     CLI_CUSTOM("--probe", "X,Y,Z|object", O, hybrid, parse_probe,
                "environment-map probe: a point, or one per reflective mesh\n"
                "(default: the scene's centre)"),
@@ -324,7 +341,8 @@ int render_parse_options(int argc, char **argv, render_options *o)
                            .debug_y = -1,
                            .debug_sample = -1,
                            .aperture = -1.0,
-                           .focus_distance = -1.0 };
+                           .focus_distance = -1.0,
+                           .temporal_settings = { .filter_passes = -1 } };
     const char *first[CLI_GROUP_COUNT] = { 0 };
     cli_knobs_unset(&o->hybrid);
     int status = cli_parse(&render_command, argc, argv, o, first);
@@ -332,6 +350,10 @@ int render_parse_options(int argc, char **argv, render_options *o)
         return status;
     }
     cli_knobs_finish(&o->hybrid, o->refine.enabled);
+    // --temporal-passes 0 is no filter (0 in drift_temporal_settings is the default).
+    o->temporal_settings.no_filter = o->temporal_settings.filter_passes == 0;
+    o->temporal_settings.filter_passes =
+        o->temporal_settings.filter_passes > 0 ? o->temporal_settings.filter_passes : 0;
     o->hybrid_option = first[0];
     o->refine.first_option = first[1];
     if (!o->hybrid_mode && o->hybrid_option) {
@@ -748,7 +770,7 @@ int render_reference_finish(render_reference_run *run, bool cancelled, double t_
 }
 
 // The reference path tracer: passes of samples with progress, checkpoints and Ctrl-C.
-static int render_reference(const render_options *o, const cli_session *session)
+int render_reference(const render_options *o, const cli_session *session)
 {
     drift_context *ctx = session->ctx;
     render_reference_run run = { .o = o, .session = session };
@@ -847,7 +869,8 @@ int render_open_session(render_options *o, bool outputs_here, cli_session *sessi
                                  { "--aov", o->aov_path },
                                  { "--out's checkpoint", o->hybrid_mode ? NULL : checkpoint } };
     const cli_file inputs[] = { { "--lambda", o->refine.lambda_path },
-                                { "--reflection-edits", o->edits_path } };
+                                { "--reflection-edits", o->edits_path },
+                                { "--camera-path", o->camera_path } };
     bool writes = outputs_here && o->debug_sample < 0;
     if (writes && !make_default_out_folder(o)) {
         return 1;
@@ -861,7 +884,7 @@ int render_open_session(render_options *o, bool outputs_here, cli_session *sessi
                                                .outputs = outputs,
                                                .output_count = writes ? 5 : 0,
                                                .inputs = inputs,
-                                               .input_count = 2 },
+                                               .input_count = 3 },
                           session)) {
         return session->refused ? 2 : 1;
     }
@@ -894,7 +917,7 @@ int drift_cmd_render(int argc, char **argv)
     if (status != 0) {
         return status < 0 ? 0 : status;
     }
-    if (o.hybrid_mode && !render_refine_validate(&o)) {
+    if ((o.hybrid_mode && !render_refine_validate(&o)) || !render_sequence_validate(&o)) {
         return 2;
     }
     cli_session session;
@@ -908,7 +931,9 @@ int drift_cmd_render(int argc, char **argv)
         exit_code = render_choose(&o, &session);
     }
     if (exit_code == 0) {
-        exit_code = o.hybrid_mode ? render_hybrid(&o, &session) : render_reference(&o, &session);
+        exit_code = o.animation     ? render_sequence(&o, &session)
+                    : o.hybrid_mode ? render_hybrid(&o, &session)
+                                    : render_reference(&o, &session);
     }
     render_close_session(&o, &session);
     return exit_code;

@@ -40,6 +40,7 @@ typedef struct view_options {
     bool split, no_overlay, verbose;
     bool refine;            // --refine sir
     long refine_budget;     // --budget: SIR samples a frame (0: the default)
+    bool temporal;          // --temporal on: reuse across frames (docs/temporal.md)
     const char *edits_path; // --reflection-edits: loaded if it exists, saved by the save key
 } view_options;
 
@@ -132,6 +133,9 @@ static const cli_option view_table[] = {
                "planes add error.combined (heat map) and refine.mask"),
     CLI_INT("--budget", "N", O, refine_budget, 1, 1L << 30,
             "SIR samples a frame (default 16384; docs/sir.md)"),
+    CLI_CHOICE("--temporal", "off|on", O, temporal, "off|on",
+               "reuse across frames: a still camera converges, a moving one\n"
+               "reprojects its history (docs/temporal.md; not with --refine)"),
     CLI_NUMBER("--exposure", "STOPS", O, exposure, -64.0, 64.0, "display exposure (default 0)"),
     CLI_FLAG("--no-overlay", O, no_overlay, "start without the text overlay"),
     CLI_CUSTOM("--press", "KEY,KEY,...", O, press, parse_press,
@@ -654,6 +658,7 @@ int drift_cmd_view(int argc, char **argv)
                                               .help_text = help_text(),
                                               .refine = o.refine,
                                               .refine_budget = (uint32_t)o.refine_budget,
+                                              .temporal = o.temporal,
                                               .reflection_edits_path = o.edits_path },
                           &view);
     if (r != DRIFT_OK) {

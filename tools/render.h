@@ -5,6 +5,7 @@
 #include "cli.h"
 #include "drift/hybrid.h"
 #include "drift/image.h"
+#include "drift/temporal.h"
 
 #include <stdatomic.h>
 #include <stdbool.h>
@@ -62,6 +63,14 @@ typedef struct render_options {
     double budget_ms;                // --budget-ms T: the chooser picks (tools/render_choose.c)
     const char *chooser_path;        // --chooser FILE: its model (default: the repository's)
     bool print_features;             // --features: the scene's features as JSON, then exit
+    // sequences (tools/render_sequence.c, docs/temporal.md)
+    bool animation; // --animation A:B given: frames A..B, --out a %04d pattern
+    long frame_first, frame_last;
+    double fps;              // --fps; 0: the camera path's (24 unless it says)
+    const char *camera_path; // --camera-path F.json
+    const char *video_path;  // --video FILE.mp4 (ffmpeg, when installed)
+    bool temporal;           // --temporal on: reuse across frames (hybrid, drift/temporal.h)
+    drift_temporal_settings temporal_settings;
 } render_options;
 
 // drift render's options from argv: 0, 2 after a usage error (message printed), -1 after
@@ -85,6 +94,18 @@ int render_mpi(int argc, char **argv);
 
 // Renders in hybrid mode with the session's scene; returns the process exit code.
 int render_hybrid(const render_options *o, const cli_session *session);
+// The reference path tracer's image of the session's scene camera, written to --out.
+int render_reference(const render_options *o, const cli_session *session);
+
+// --- SEQUENCES (tools/render_sequence.c) ---
+
+// --animation A:B (frame numbers, 0 <= A <= B).
+bool render_parse_animation(const char *cmd, const char *flag, const char *v, void *field);
+// Checks the sequence options go together (--out's frame pattern, --camera-path needs
+// --animation); prints the usage error and returns false if not.
+bool render_sequence_validate(const render_options *o);
+// Renders frames A..B (either mode) and writes each; returns the exit code.
+int render_sequence(const render_options *o, const cli_session *session);
 
 // The --stats object's first fields (scene, mode, width, height); the caller adds the rest
 // and writes it with cli_json_write.

@@ -32,6 +32,7 @@
 #include "drift/hybrid.h"
 #include "drift/pt.h"
 #include "drift/scene.h"
+#include "drift/temporal.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -133,6 +134,11 @@ typedef struct drift_view_desc {
     bool refine;
     uint32_t refine_budget;
     const char *reflection_edits_path;
+    // Temporal reuse (docs/temporal.md): with `temporal`, each frame takes a new seed and a
+    // sub-pixel offset and drift/temporal.h accumulates and filters the frames (a still camera
+    // converges; a moving one reprojects its history). Not with `refine`.
+    bool temporal;
+    drift_temporal_settings temporal_settings;
 } drift_view_desc;
 
 // What the view shows now.

@@ -251,6 +251,13 @@ drift_result drift_view_create(drift_context *ctx, const drift_scene *scene,
         goto fail;
     }
     view->params = drift_hybrid_get_params(view->hybrid);
+    view->base_seed = view->params.seed;
+    if (d.temporal && !d.refine) {
+        r = drift_temporal_create(ctx, width, height, &d.temporal_settings, &view->temporal);
+        if (r != DRIFT_OK) {
+            goto fail;
+        }
+    }
     if (d.refine) {
         r = drift_refine_create(
             ctx, view->hybrid,
@@ -275,6 +282,7 @@ void drift_view_destroy(drift_view *view)
     }
     drift_context *ctx = view->ctx;
     drift_refine_destroy(view->sir);
+    drift_temporal_destroy(view->temporal);
     drift_hybrid_destroy(view->hybrid);
     drift_pt_destroy(view->reference);
     drift_view_edit_end(view);
@@ -429,6 +437,34 @@ void drift_view_set_camera(drift_view *view, const drift_camera *camera)
 
 // --- FRAME ---
 
+// The radical inverse of k in `base`: the frames' sub-pixel offsets (Halton 2, 3).
+static float halton(uint32_t k, uint32_t base)
+{
+    float f = 1.0f, r = 0.0f;
+    while (k > 0) {
+        f /= (float)base;
+        r += f * (float)(k % base);
+        k /= base;
+    }
+    return r;
+}
+
+// Temporal reuse: a new seed and a sub-pixel offset a frame, so that the history averages
+// independent samples over the pixel (the path tracer's box filter).
+drift_result drift_view_temporal_begin(drift_view *view, drift_camera *camera)
+{
+    uint32_t k = view->temporal_frame++;
+    drift_hybrid_params p = drift_hybrid_get_params(view->hybrid);
+    drift_result r = DRIFT_OK;
+    if (drift_temporal_reseeds(&p)) {
+        p.seed = view->base_seed + k;
+        r = drift_hybrid_set_params(view->hybrid, &p);
+    }
+    camera->film_shift_x += halton(k + 1, 2) - 0.5f;
+    camera->film_shift_y += halton(k + 1, 3) - 0.5f;
+    return r;
+}
+
 drift_result drift_view_frame(drift_view *view, const atomic_bool *cancel)
 {
     if (!view) {
@@ -436,6 +472,9 @@ drift_result drift_view_frame(drift_view *view, const atomic_bool *cancel)
     }
     drift_result r = DRIFT_OK;
     if (view->params_changed) {
+        drift_temporal_reset(view->temporal); // other techniques: the history is another image
+        view->temporal_frame = 0;
+        view->params.seed = view->base_seed;
         r = drift_hybrid_set_params(view->hybrid, &view->params);
         view->params_changed = false;
         view->sir_dirty = true;
@@ -444,7 +483,18 @@ drift_result drift_view_frame(drift_view *view, const atomic_bool *cancel)
             return r;
         }
     }
-    r = drift_hybrid_render(view->hybrid, &view->camera, cancel);
+    drift_camera camera = view->camera;
+    if (view->temporal) {
+        r = drift_view_temporal_begin(view, &camera);
+        if (r != DRIFT_OK) {
+            return r;
+        }
+    }
+    r = drift_hybrid_render(view->hybrid, &camera, cancel);
+    if (r == DRIFT_OK && view->temporal) {
+        r = drift_temporal_apply(view->temporal, drift_hybrid_gbuffer(view->hybrid), &camera,
+                                 drift_hybrid_image(view->hybrid));
+    }
     if (r != DRIFT_OK) {
         return r;
     }
@@ -494,8 +544,9 @@ drift_result drift_view_frame(drift_view *view, const atomic_bool *cancel)
 
     // The shown buffer: the composed frame, or a plane by name (it may have disappeared with
     // a technique change; then the frame again).
-    const drift_image *shown =
-        view->sir ? drift_refine_image(view->sir) : drift_hybrid_image(view->hybrid);
+    const drift_image *shown = view->sir        ? drift_refine_image(view->sir)
+                               : view->temporal ? drift_temporal_image(view->temporal)
+                                                : drift_hybrid_image(view->hybrid);
     const char *plane_name = NULL; // NULL: the composed frame
     uint32_t index = buffer_index(view, view->buffer_name);
     const char *name = NULL;

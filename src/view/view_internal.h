@@ -45,6 +45,10 @@ struct drift_view {
     bool overlay, help;
     char *help_text;
 
+    drift_temporal *temporal; // NULL unless desc.temporal
+    uint32_t temporal_frame;  // frames since the history began (seed and jitter index)
+    uint32_t base_seed;       // the hybrid frame's seed from the desc
+
     drift_refine *sir;       // NULL unless the view refines (desc.refine)
     drift_camera sir_camera; // the camera of the last sort: a move (or new techniques,
     bool sir_dirty;          // sir_dirty) re-sorts, a standing view keeps refining
@@ -113,5 +117,8 @@ void drift_view_draw_edits(drift_view *view);
 // Draws the overlay over the framebuffer, top left: the help text while help is on, else a
 // table of techniques, the shown buffer, exposure, the reference's samples and pass timings.
 void drift_view_draw_overlay(drift_view *view);
+
+// Temporal reuse's per-frame seed and sub-pixel offset (view.c).
+drift_result drift_view_temporal_begin(drift_view *view, drift_camera *camera);
 
 #endif

@@ -1,0 +1,439 @@
+// Temporal reuse (drift/temporal.h): reprojection, disocclusion tests, accumulation of the
+// demodulated lighting and its luminance moments, and the variance-guided a-trous filter.
+#include "drift/temporal.h"
+
+#include "drift/math.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum {
+    PLANES = 2 // current and previous
+};
+
+struct drift_temporal {
+    drift_context *ctx;
+    int32_t width, height;
+    drift_temporal_settings s;
+    int cur; // index of the current frame's planes
+    bool has_prev;
+    drift_image light[PLANES];    // 3: accumulated demodulated lighting
+    drift_image moments[PLANES];  // 2: accumulated luminance moments
+    drift_image length[PLANES];   // 1: history length in frames
+    drift_image depth[PLANES];    // 1
+    drift_image position[PLANES]; // 3: world position
+    drift_image normal[PLANES];   // 3
+    drift_image material[PLANES]; // 1
+    drift_image sample_lum;       // 1: this frame's demodulated luminance (spatial moments)
+    drift_image filter[2];        // 4: lighting and variance, ping-pong
+    drift_image out;              // 3
+};
+
+drift_temporal_settings drift_temporal_settings_resolve(const drift_temporal_settings *in)
+{
+    drift_temporal_settings s = in ? *in : (drift_temporal_settings){ 0 };
+    s.max_history = s.max_history ? s.max_history : 32;
+    s.moments_alpha = s.moments_alpha > 0.0f ? s.moments_alpha : 0.2f;
+    s.depth_tolerance = s.depth_tolerance > 0.0f ? s.depth_tolerance : 0.05f;
+    s.normal_tolerance = s.normal_tolerance > 0.0f ? s.normal_tolerance : 0.9f;
+    s.filter_passes = s.no_filter ? 0 : (s.filter_passes ? s.filter_passes : 3);
+    s.phi_luminance = s.phi_luminance > 0.0f ? s.phi_luminance : 4.0f;
+    s.depth_sigma = s.depth_sigma > 0.0f ? s.depth_sigma : 1.0f;
+    return s;
+}
+
+void drift_temporal_destroy(drift_temporal *t)
+{
+    if (!t) {
+        return;
+    }
+    for (int k = 0; k < PLANES; ++k) {
+        drift_image_destroy(t->ctx, &t->light[k]);
+        drift_image_destroy(t->ctx, &t->moments[k]);
+        drift_image_destroy(t->ctx, &t->length[k]);
+        drift_image_destroy(t->ctx, &t->depth[k]);
+        drift_image_destroy(t->ctx, &t->position[k]);
+        drift_image_destroy(t->ctx, &t->normal[k]);
+        drift_image_destroy(t->ctx, &t->material[k]);
+        drift_image_destroy(t->ctx, &t->filter[k]);
+    }
+    drift_image_destroy(t->ctx, &t->sample_lum);
+    drift_image_destroy(t->ctx, &t->out);
+    drift_free(t->ctx, t);
+}
+
+drift_result drift_temporal_create(drift_context *ctx, int32_t width, int32_t height,
+                                   const drift_temporal_settings *settings, drift_temporal **out)
+{
+    if (!out) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    *out = NULL;
+    drift_temporal_settings s = drift_temporal_settings_resolve(settings);
+    if (width < 1 || height < 1 || s.max_history < 1 || s.max_history > 4096 ||
+        !(s.moments_alpha <= 1.0f) || !(s.depth_tolerance <= 1.0f) ||
+        !(s.normal_tolerance <= 1.0f) || s.filter_passes < 0 || s.filter_passes > 8 ||
+        !isfinite(s.phi_luminance) || !isfinite(s.depth_sigma)) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, NULL, 0,
+                  "temporal: size %dx%d or settings out of range (drift/temporal.h)", width,
+                  height);
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    drift_temporal *t = drift_alloc(ctx, sizeof *t);
+    if (!t) {
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    t->ctx = ctx;
+    t->width = width;
+    t->height = height;
+    t->s = s;
+    drift_result r = DRIFT_OK;
+    for (int k = 0; k < PLANES && r == DRIFT_OK; ++k) {
+        if ((r = drift_image_create(ctx, width, height, 3, &t->light[k])) != DRIFT_OK ||
+            (r = drift_image_create(ctx, width, height, 2, &t->moments[k])) != DRIFT_OK ||
+            (r = drift_image_create(ctx, width, height, 1, &t->length[k])) != DRIFT_OK ||
+            (r = drift_image_create(ctx, width, height, 1, &t->depth[k])) != DRIFT_OK ||
+            (r = drift_image_create(ctx, width, height, 3, &t->position[k])) != DRIFT_OK ||
+            (r = drift_image_create(ctx, width, height, 3, &t->normal[k])) != DRIFT_OK ||
+            (r = drift_image_create(ctx, width, height, 1, &t->material[k])) != DRIFT_OK ||
+            (r = drift_image_create(ctx, width, height, 4, &t->filter[k])) != DRIFT_OK) {
+            break;
+        }
+    }
+    if (r == DRIFT_OK) {
+        r = drift_image_create(ctx, width, height, 1, &t->sample_lum);
+    }
+    if (r == DRIFT_OK) {
+        r = drift_image_create(ctx, width, height, 3, &t->out);
+    }
+    if (r != DRIFT_OK) {
+        drift_temporal_destroy(t);
+        return r;
+    }
+    *out = t;
+    return DRIFT_OK;
+}
+
+void drift_temporal_reset(drift_temporal *t)
+{
+    if (t) {
+        t->has_prev = false;
+    }
+}
+
+const drift_image *drift_temporal_image(const drift_temporal *t)
+{
+    return t ? &t->out : NULL;
+}
+
+const drift_image *drift_temporal_history(const drift_temporal *t)
+{
+    return t ? &t->length[t->cur] : NULL;
+}
+
+// --- REPROJECTION AND ACCUMULATION ---
+
+typedef struct frame_job {
+    drift_temporal *t;
+    const drift_gbuffer *g;
+    const drift_image *color;
+    int cur, prev;
+} frame_job;
+
+static drift_vec3 demodulation(const drift_gbuffer *g, int32_t x, int32_t y)
+{
+    drift_vec3 a = drift_image_get3(&g->albedo, x, y);
+    return drift_vec3_make(fmaxf(a.x, 0.01f), fmaxf(a.y, 0.01f), fmaxf(a.z, 0.01f));
+}
+
+// Whether the previous frame's pixel (x, y) shows the surface at world point p (view depth z)
+// with normal n and material m: the same material, normals within normal_tolerance, and the
+// previous point within depth_tolerance x z of p's tangent plane (a plane test, not a depth
+// test: sub-pixel offsets along a slanted surface keep their history).
+static bool tap_valid(const frame_job *job, int32_t x, int32_t y, float material, drift_vec3 n,
+                      drift_vec3 p, float z)
+{
+    const drift_temporal *t = job->t;
+    if (x < 0 || y < 0 || x >= t->width || y >= t->height) {
+        return false;
+    }
+    int pr = job->prev;
+    if (drift_image_pixel(&t->length[pr], x, y)[0] <= 0.0f ||
+        drift_image_pixel(&t->material[pr], x, y)[0] != material) {
+        return false;
+    }
+    if (drift_vec3_dot(drift_image_get3(&t->normal[pr], x, y), n) < t->s.normal_tolerance) {
+        return false;
+    }
+    drift_vec3 q = drift_image_get3(&t->position[pr], x, y);
+    return fabsf(drift_vec3_dot(drift_vec3_sub(q, p), n)) <= t->s.depth_tolerance * z;
+}
+
+static void accumulate_rows(size_t begin, size_t end, int thread_index, void *user)
+{
+    (void)thread_index;
+    const frame_job *job = user;
+    drift_temporal *t = job->t;
+    const drift_gbuffer *g = job->g;
+    int c = job->cur, pr = job->prev;
+    for (int32_t y = (int32_t)begin; y < (int32_t)end; ++y) {
+        for (int32_t x = 0; x < t->width; ++x) {
+            float z = drift_image_pixel(&g->depth, x, y)[0];
+            float material = drift_image_pixel(&g->material_id, x, y)[0];
+            drift_vec3 n = drift_image_get3(&g->normal, x, y);
+            drift_image_pixel(&t->depth[c], x, y)[0] = z;
+            drift_image_pixel(&t->material[c], x, y)[0] = material;
+            drift_image_set3(&t->normal[c], x, y, n);
+            drift_image_set3(&t->position[c], x, y, drift_image_get3(&g->position, x, y));
+            float *len = drift_image_pixel(&t->length[c], x, y);
+            float *mom = drift_image_pixel(&t->moments[c], x, y);
+            if (!(z > 0.0f)) { // a miss: passes through, no history
+                len[0] = 0.0f;
+                mom[0] = mom[1] = 0.0f;
+                drift_image_set3(&t->light[c], x, y, drift_vec3_splat(0.0f));
+                drift_image_pixel(&t->sample_lum, x, y)[0] = 0.0f;
+                continue;
+            }
+            drift_vec3 a = demodulation(g, x, y);
+            drift_vec3 col = drift_vec3_sub(drift_image_get3(job->color, x, y),
+                                            drift_image_get3(&g->emission, x, y));
+            drift_vec3 l = drift_vec3_make(col.x / a.x, col.y / a.y, col.z / a.z);
+            float lum = drift_luminance(l);
+            drift_image_pixel(&t->sample_lum, x, y)[0] = lum;
+            // The history: the valid bilinear taps around p + motion.
+            drift_vec3 hist = drift_vec3_splat(0.0f);
+            float hist_mom[2] = { 0.0f, 0.0f };
+            float hist_len = 0.0f, weight = 0.0f;
+            if (t->has_prev) {
+                const float *m = drift_image_pixel(&g->motion, x, y);
+                drift_vec3 p = drift_image_get3(&g->position, x, y);
+                float qx = (float)x + m[0], qy = (float)y + m[1];
+                int32_t x0 = (int32_t)floorf(qx), y0 = (int32_t)floorf(qy);
+                float fx = qx - (float)x0, fy = qy - (float)y0;
+                for (int k = 0; k < 4; ++k) {
+                    int32_t tx = x0 + (k & 1), ty = y0 + (k >> 1);
+                    float w = ((k & 1) ? fx : 1.0f - fx) * ((k >> 1) ? fy : 1.0f - fy);
+                    if (w <= 0.0f || !tap_valid(job, tx, ty, material, n, p, z)) {
+                        continue;
+                    }
+                    hist = drift_vec3_fma(hist, drift_image_get3(&t->light[pr], tx, ty), w);
+                    const float *hm = drift_image_pixel(&t->moments[pr], tx, ty);
+                    hist_mom[0] += w * hm[0];
+                    hist_mom[1] += w * hm[1];
+                    hist_len += w * drift_image_pixel(&t->length[pr], tx, ty)[0];
+                    weight += w;
+                }
+            }
+            float n_frames = 1.0f;
+            if (weight > 1e-3f) {
+                float inv = 1.0f / weight;
+                hist = drift_vec3_scale(hist, inv);
+                hist_mom[0] *= inv;
+                hist_mom[1] *= inv;
+                n_frames = fminf(hist_len * inv + 1.0f, (float)t->s.max_history);
+            }
+            float alpha = 1.0f / n_frames;
+            float alpha_m = fmaxf(alpha, t->s.moments_alpha);
+            drift_vec3 acc = n_frames > 1.0f ? drift_vec3_add(drift_vec3_scale(hist, 1.0f - alpha),
+                                                              drift_vec3_scale(l, alpha))
+                                             : l;
+            mom[0] = n_frames > 1.0f ? (1.0f - alpha_m) * hist_mom[0] + alpha_m * lum : lum;
+            mom[1] =
+                n_frames > 1.0f ? (1.0f - alpha_m) * hist_mom[1] + alpha_m * lum * lum : lum * lum;
+            len[0] = n_frames;
+            drift_image_set3(&t->light[c], x, y, acc);
+        }
+    }
+}
+
+// The variance of each pixel's accumulated lighting into filter[0]'s fourth channel (and the
+// lighting into its first three): the temporal moments' variance over N frames, or below 4
+// frames the 7x7 spatial moments of this frame's samples over the same surface.
+static void variance_rows(size_t begin, size_t end, int thread_index, void *user)
+{
+    (void)thread_index;
+    const frame_job *job = user;
+    drift_temporal *t = job->t;
+    int c = job->cur;
+    for (int32_t y = (int32_t)begin; y < (int32_t)end; ++y) {
+        for (int32_t x = 0; x < t->width; ++x) {
+            float *f = drift_image_pixel(&t->filter[0], x, y);
+            drift_vec3 l = drift_image_get3(&t->light[c], x, y);
+            f[0] = l.x;
+            f[1] = l.y;
+            f[2] = l.z;
+            float n_frames = drift_image_pixel(&t->length[c], x, y)[0];
+            if (n_frames <= 0.0f) {
+                f[3] = 0.0f;
+                continue;
+            }
+            const float *mom = drift_image_pixel(&t->moments[c], x, y);
+            float var = fmaxf(mom[1] - mom[0] * mom[0], 0.0f);
+            if (n_frames < 4.0f) {
+                float z = drift_image_pixel(&t->depth[c], x, y)[0];
+                drift_vec3 n = drift_image_get3(&t->normal[c], x, y);
+                float m1 = 0.0f, m2 = 0.0f, wsum = 0.0f;
+                for (int32_t dy = -3; dy <= 3; ++dy) {
+                    for (int32_t dx = -3; dx <= 3; ++dx) {
+                        int32_t qx = x + dx, qy = y + dy;
+                        if (qx < 0 || qy < 0 || qx >= t->width || qy >= t->height) {
+                            continue;
+                        }
+                        float zq = drift_image_pixel(&t->depth[c], qx, qy)[0];
+                        if (!(zq > 0.0f) || fabsf(zq - z) > 0.1f * z ||
+                            drift_vec3_dot(drift_image_get3(&t->normal[c], qx, qy), n) < 0.8f) {
+                            continue;
+                        }
+                        float s = drift_image_pixel(&t->sample_lum, qx, qy)[0];
+                        m1 += s;
+                        m2 += s * s;
+                        wsum += 1.0f;
+                    }
+                }
+                m1 /= wsum;
+                var = fmaxf(m2 / wsum - m1 * m1, 0.0f);
+            }
+            f[3] = var / n_frames; // the variance of the mean of N frames
+        }
+    }
+}
+
+// --- THE VARIANCE-GUIDED FILTER ---
+
+typedef struct filter_job {
+    const drift_temporal *t;
+    const drift_image *in;
+    drift_image *out;
+    int cur;
+    int32_t step;
+} filter_job;
+
+static void filter_rows(size_t begin, size_t end, int thread_index, void *user)
+{
+    (void)thread_index;
+    const filter_job *job = user;
+    const drift_temporal *t = job->t;
+    static const float kernel[3] = { 3.0f / 8.0f, 1.0f / 4.0f, 1.0f / 16.0f };
+    static const float gauss[2] = { 0.5f, 0.25f };
+    int c = job->cur;
+    for (int32_t y = (int32_t)begin; y < (int32_t)end; ++y) {
+        for (int32_t x = 0; x < t->width; ++x) {
+            const float *p = drift_image_pixel(job->in, x, y);
+            float *o = drift_image_pixel(job->out, x, y);
+            float z = drift_image_pixel(&t->depth[c], x, y)[0];
+            if (!(z > 0.0f)) {
+                memcpy(o, p, 4 * sizeof *o);
+                continue;
+            }
+            // SVGF's 3x3 Gaussian of the variance steers the luminance weight.
+            float var = 0.0f, gw = 0.0f;
+            for (int32_t dy = -1; dy <= 1; ++dy) {
+                for (int32_t dx = -1; dx <= 1; ++dx) {
+                    int32_t qx = x + dx, qy = y + dy;
+                    if (qx < 0 || qy < 0 || qx >= t->width || qy >= t->height ||
+                        !(drift_image_pixel(&t->depth[c], qx, qy)[0] > 0.0f)) {
+                        continue;
+                    }
+                    float w = gauss[abs(dx)] * gauss[abs(dy)];
+                    var += w * drift_image_pixel(job->in, qx, qy)[3];
+                    gw += w;
+                }
+            }
+            var /= gw;
+            float lum_p = drift_luminance(drift_vec3_make(p[0], p[1], p[2]));
+            float phi_l = t->s.phi_luminance * sqrtf(var) + 1e-4f;
+            float phi_z = t->s.depth_sigma * (float)job->step * z * 0.02f;
+            drift_vec3 n = drift_image_get3(&t->normal[c], x, y);
+            float material = drift_image_pixel(&t->material[c], x, y)[0];
+            float sum[4] = { 0 }, wsum = 0.0f;
+            for (int32_t j = -2; j <= 2; ++j) {
+                for (int32_t i = -2; i <= 2; ++i) {
+                    int32_t qx = x + i * job->step, qy = y + j * job->step;
+                    if (qx < 0 || qy < 0 || qx >= t->width || qy >= t->height) {
+                        continue;
+                    }
+                    float zq = drift_image_pixel(&t->depth[c], qx, qy)[0];
+                    if (!(zq > 0.0f) || drift_image_pixel(&t->material[c], qx, qy)[0] != material) {
+                        continue;
+                    }
+                    const float *q = drift_image_pixel(job->in, qx, qy);
+                    float nd =
+                        fmaxf(drift_vec3_dot(drift_image_get3(&t->normal[c], qx, qy), n), 0.0f);
+                    float nd2 = nd * nd, nd4 = nd2 * nd2, nd8 = nd4 * nd4, nd16 = nd8 * nd8;
+                    float nd32 = nd16 * nd16, nd64 = nd32 * nd32;
+                    float w_n = nd64 * nd64; // ^128
+                    float lum_q = drift_luminance(drift_vec3_make(q[0], q[1], q[2]));
+                    float w = kernel[abs(i)] * kernel[abs(j)] * w_n *
+                              expf(-fabsf(z - zq) / phi_z - fabsf(lum_p - lum_q) / phi_l);
+                    sum[0] += w * q[0];
+                    sum[1] += w * q[1];
+                    sum[2] += w * q[2];
+                    sum[3] += w * w * q[3];
+                    wsum += w;
+                }
+            }
+            // The centre tap always counts (weight 9/64), so wsum > 0.
+            o[0] = sum[0] / wsum;
+            o[1] = sum[1] / wsum;
+            o[2] = sum[2] / wsum;
+            o[3] = sum[3] / (wsum * wsum);
+        }
+    }
+}
+
+static void remodulate_rows(size_t begin, size_t end, int thread_index, void *user)
+{
+    (void)thread_index;
+    const frame_job *job = user;
+    drift_temporal *t = job->t;
+    const drift_gbuffer *g = job->g;
+    const drift_image *filtered = &t->filter[t->s.filter_passes & 1];
+    for (int32_t y = (int32_t)begin; y < (int32_t)end; ++y) {
+        for (int32_t x = 0; x < t->width; ++x) {
+            if (!(drift_image_pixel(&g->depth, x, y)[0] > 0.0f)) {
+                drift_image_set3(&t->out, x, y, drift_image_get3(job->color, x, y));
+                continue;
+            }
+            const float *l = drift_image_pixel(filtered, x, y);
+            drift_vec3 a = demodulation(g, x, y);
+            drift_vec3 e = drift_image_get3(&g->emission, x, y);
+            drift_image_set3(
+                &t->out, x, y,
+                drift_vec3_add(e, drift_vec3_make(a.x * l[0], a.y * l[1], a.z * l[2])));
+        }
+    }
+}
+
+drift_result drift_temporal_apply(drift_temporal *t, const drift_gbuffer *g,
+                                  const drift_camera *camera, const drift_image *color)
+{
+    if (!t || !g || !camera || !color || color->channels < 3 || color->width != t->width ||
+        color->height != t->height || g->width != t->width || g->height != t->height) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    t->cur ^= 1;
+    frame_job job = { .t = t, .g = g, .color = color, .cur = t->cur, .prev = t->cur ^ 1 };
+    size_t rows = (size_t)t->height;
+    drift_parallel_for(t->ctx, rows, 4, accumulate_rows, &job);
+    drift_parallel_for(t->ctx, rows, 4, variance_rows, &job);
+    for (int32_t pass = 0; pass < t->s.filter_passes; ++pass) {
+        filter_job fj = { .t = t,
+                          .in = &t->filter[pass & 1],
+                          .out = &t->filter[(pass & 1) ^ 1],
+                          .cur = t->cur,
+                          .step = 1 << pass };
+        drift_parallel_for(t->ctx, rows, 4, filter_rows, &fj);
+    }
+    drift_parallel_for(t->ctx, rows, 4, remodulate_rows, &job);
+    (void)camera; // the motion vectors carry the camera's move
+    t->has_prev = true;
+    return DRIFT_OK;
+}
+
+bool drift_temporal_reseeds(const drift_hybrid_params *p)
+{
+    return p->indirect != DRIFT_INDIRECT_ISM && p->indirect != DRIFT_INDIRECT_IR &&
+           p->indirect != DRIFT_INDIRECT_MICRO && p->reflections != DRIFT_REFLECTIONS_MICRO &&
+           p->reflections != DRIFT_REFLECTIONS_ENVMAP;
+}

@@ -1,0 +1,437 @@
+// Frames in time: camera paths (interpolation through the keys, errors with file and line) and
+// temporal reuse (drift/temporal.h) against closed forms: a reprojection under a known camera
+// move, a disocclusion behind a sphere, and a still camera converging to the reference.
+#include "drift/accel.h"
+#include "drift/camera_path.h"
+#include "drift/hybrid.h"
+#include "drift/temporal.h"
+#include "drift/view.h"
+#include "drift_test.h"
+#include "test_rig.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+// --- CAMERA PATHS ---
+
+typedef struct line_capture {
+    int line;
+    char message[512];
+} line_capture;
+
+static void capture_line(drift_log_level level, drift_result code, const char *file, int line,
+                         const char *message, void *user)
+{
+    (void)level;
+    (void)code;
+    (void)file;
+    line_capture *c = user;
+    c->line = line;
+    snprintf(c->message, sizeof c->message, "%s", message);
+}
+
+static drift_context *line_context(line_capture *c)
+{
+    drift_context *ctx = NULL;
+    drift_context_desc desc = { .thread_count = 1, .logger = { .func = capture_line, .user = c } };
+    assert_int_equal(drift_context_create(&desc, &ctx), DRIFT_OK);
+    return ctx;
+}
+
+static const char path_text[] =
+    "{\"fps\": 10, \"keyframes\": [\n"
+    "  {\"time\": 0, \"position\": [0, 0, 5], \"target\": [0, 0, 0], \"fov_y\": 40},\n"
+    "  {\"time\": 1, \"position\": [2, 0, 5], \"target\": [0, 0, 0], \"fov_y\": 50},\n"
+    "  {\"time\": 2, \"position\": [3, 1, 4], \"target\": [0, 1, 0]},\n"
+    "  {\"time\": 4, \"position\": [3, 1, 2], \"target\": [0, 1, 0], \"aperture_radius\": 0.1}\n"
+    "]}\n";
+
+// The spline passes through every key, holds the ends outside them, and is continuous.
+static void test_camera_path_keys(void **state)
+{
+    (void)state;
+    line_capture c = { 0 };
+    drift_context *ctx = line_context(&c);
+    drift_camera_path path;
+    assert_int_equal(
+        drift_camera_path_load_json_text(ctx, path_text, strlen(path_text), "p.json", &path),
+        DRIFT_OK);
+    assert_int_equal(path.count, 4);
+    assert_near(path.fps, 10.0, 0.0);
+    drift_camera base = drift_camera_look_at(drift_vec3_make(9, 9, 9), drift_vec3_make(0, 0, 0),
+                                             drift_vec3_make(0, 1, 0), 0.5f, 32, 32);
+    for (uint32_t k = 0; k < path.count; ++k) {
+        drift_camera cam = drift_camera_path_eval(&path, &base, path.keys[k].time);
+        assert_near(cam.position.x, path.keys[k].position.x, 1e-5);
+        assert_near(cam.position.y, path.keys[k].position.y, 1e-5);
+        assert_near(cam.position.z, path.keys[k].position.z, 1e-5);
+        assert_near(cam.target.y, path.keys[k].target.y, 1e-5);
+        assert_near(cam.fov_y, path.keys[k].has_fov ? path.keys[k].fov_y : base.fov_y, 1e-6);
+    }
+    drift_camera before = drift_camera_path_eval(&path, &base, -1.0);
+    drift_camera after = drift_camera_path_eval(&path, &base, 9.0);
+    assert_near(before.position.x, 0.0, 0.0);
+    assert_near(after.position.z, 2.0, 0.0);
+    assert_near(after.aperture_radius, 0.1, 1e-6);
+    // Continuity: a small step in time moves the camera a small distance.
+    drift_camera prev = drift_camera_path_eval(&path, &base, 0.0);
+    for (int k = 1; k <= 400; ++k) {
+        drift_camera cam = drift_camera_path_eval(&path, &base, 0.01 * k);
+        float step = drift_vec3_length(drift_vec3_sub(cam.position, prev.position));
+        assert_true((double)step < 0.06);
+        prev = cam;
+    }
+    // Linear interpolation: the midpoint of a segment is the keys' mean.
+    path.interpolation = DRIFT_CAMERA_PATH_LINEAR;
+    drift_camera mid = drift_camera_path_eval(&path, &base, 0.5);
+    assert_near(mid.position.x, 1.0, 1e-6);
+    assert_near(mid.fov_y, 0.5f * (path.keys[0].fov_y + path.keys[1].fov_y), 1e-6);
+    drift_camera_path_free(ctx, &path);
+    drift_context_destroy(ctx);
+}
+
+// Bad files fail with the line of the offending value.
+static void test_camera_path_errors(void **state)
+{
+    (void)state;
+
+    static const struct {
+        const char *text;
+        int line;
+        drift_result code;
+    } cases[] = {
+        { "{\"keyframes\": [\n{\"time\": 0, \"position\": [0,0,1], \"target\": [0,0,0]},\n"
+          "{\"time\": 0, \"position\": [0,0,2], \"target\": [0,0,0]}]}",
+          3, DRIFT_ERR_INVALID_ARGUMENT },
+        { "{\"keyframes\": [\n{\"time\": 0,\n \"position\": [0,0],\n \"target\": [0,0,0]}]}", 3,
+          DRIFT_ERR_PARSE },
+        { "{\"keyframes\": [\n{\"time\": 0, \"position\": [0,0,1], \"target\": [0,0,0],\n"
+          "\"fov_y\": 200}]}",
+          3, DRIFT_ERR_INVALID_ARGUMENT },
+        { "{\"fps\": 24,\n\"keyframes\": [\n}", 3, DRIFT_ERR_PARSE },
+        { "{\"keyframes\": [],\n \"colour\": 1}", 2, DRIFT_ERR_PARSE },
+    };
+
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        line_capture c = { 0 };
+        drift_context *ctx = line_context(&c);
+        drift_camera_path path;
+        drift_result r = drift_camera_path_load_json_text(ctx, cases[k].text, strlen(cases[k].text),
+                                                          "p.json", &path);
+        if (r != cases[k].code || c.line != cases[k].line) {
+            fail_msg("case %zu: %s at line %d (%s), expected %s at line %d", k,
+                     drift_result_string(r), c.line, c.message, drift_result_string(cases[k].code),
+                     cases[k].line);
+        }
+        assert_null(path.keys);
+        drift_context_destroy(ctx);
+    }
+}
+
+// --- REPROJECTION ---
+
+// A camera looking straight down at a floor lit by a low point light (a steep gradient), moved
+// sideways by exactly `pixels` pixel footprints: the history reprojected into the second frame
+// is the first frame shifted, and for a whole number of pixels it equals the second frame.
+static void reprojection_case(float pixels, double tolerance_scale)
+{
+    test_rig r = test_rig_begin(2);
+    uint32_t white = test_add_material(r.scene, drift_material_make(drift_vec3_splat(0.6f)));
+    test_add_floor(r.scene, 100.0f, 0.0f, white);
+    drift_light light = { .type = DRIFT_LIGHT_POINT,
+                          .position = drift_vec3_make(0.3f, 0.4f, 0.2f),
+                          .color = drift_vec3_splat(1.0f) };
+    assert_int_equal(drift_scene_add_light(r.scene, &light, NULL), DRIFT_OK);
+    const int w = 48, h = 32;
+    const float height = 3.0f, fov = 0.8f;
+    r.scene->camera = drift_camera_look_at(drift_vec3_make(0, height, 0), drift_vec3_make(0, 0, 0),
+                                           drift_vec3_make(0, 0, 1), fov, w, h);
+    test_rig_commit(&r);
+    test_rig_frame(&r, &(drift_hybrid_params){ .width = w, .height = h });
+    drift_temporal *t = NULL;
+    assert_int_equal(
+        drift_temporal_create(r.ctx, w, h, &(drift_temporal_settings){ .no_filter = true }, &t),
+        DRIFT_OK);
+    drift_camera a = r.scene->camera;
+    assert_int_equal(drift_hybrid_render(r.frame, &a, NULL), DRIFT_OK);
+    assert_int_equal(
+        drift_temporal_apply(t, drift_hybrid_gbuffer(r.frame), &a, drift_hybrid_image(r.frame)),
+        DRIFT_OK);
+    drift_image first;
+    assert_int_equal(drift_image_create(r.ctx, w, h, 3, &first), DRIFT_OK);
+    memcpy(first.pixels, drift_hybrid_image(r.frame)->pixels, sizeof(float) * 3 * w * h);
+    // One pixel spans 2 height tan(fov / 2) / h world units on the floor.
+    float footprint = 2.0f * height * tanf(0.5f * fov) / (float)h;
+    drift_camera b = a;
+    drift_camera_frame fa = drift_camera_frame_make(&a, w, h);
+    drift_vec3 shift = drift_vec3_scale(fa.u, pixels * footprint);
+    b.position = drift_vec3_add(a.position, shift);
+    b.target = drift_vec3_add(a.target, shift);
+    assert_int_equal(drift_hybrid_render(r.frame, &b, NULL), DRIFT_OK);
+    const drift_gbuffer *g = drift_hybrid_gbuffer(r.frame);
+    const drift_image *second = drift_hybrid_image(r.frame);
+    assert_int_equal(drift_temporal_apply(t, g, &b, second), DRIFT_OK);
+    const drift_image *out = drift_temporal_image(t);
+    const drift_image *len = drift_temporal_history(t);
+    int checked = 0;
+    for (int y = 1; y < h - 1; ++y) {
+        for (int x = 1; x < w - 1; ++x) {
+            // The camera moved +u: a point seen at x now was seen at x + pixels before.
+            assert_near(drift_image_pixel(&g->motion, x, y)[0], pixels, 1e-3);
+            assert_near(drift_image_pixel(&g->motion, x, y)[1], 0.0, 1e-3);
+            float qx = (float)x + pixels;
+            if (qx <= -1.0f || qx >= (float)w) {
+                assert_near(drift_image_pixel(len, x, y)[0], 1.0, 0.0); // off screen before
+                continue;
+            }
+            if (qx < 0.0f || qx > (float)(w - 1)) {
+                continue; // one of the two taps was on screen
+            }
+            assert_near(drift_image_pixel(len, x, y)[0], 2.0, 1e-5);
+            // out = (history + current) / 2 with no filter.
+            double hist = 2.0 * (double)drift_image_pixel(out, x, y)[0] -
+                          (double)drift_image_pixel(second, x, y)[0];
+            int x0 = (int)floorf(qx) < w - 1 ? (int)floorf(qx) : w - 2;
+            double f = (double)(qx - (float)x0);
+            double expected = (1.0 - f) * (double)drift_image_pixel(&first, x0, y)[0] +
+                              f * (double)drift_image_pixel(&first, x0 + 1, y)[0];
+            assert_near(hist, expected, 1e-3 * expected);
+            // Within the pixel's filter of the truth (the second frame at x).
+            double cur = (double)drift_image_pixel(second, x, y)[0];
+            double spread = fabs((double)drift_image_pixel(second, x + 1, y)[0] - cur) +
+                            fabs((double)drift_image_pixel(second, x - 1, y)[0] - cur);
+            assert_true(fabs(hist - cur) <= tolerance_scale * spread + 1e-4 * cur);
+            ++checked;
+        }
+    }
+    assert_true(checked > (w - 2) * (h - 2) / 2);
+    drift_image_destroy(r.ctx, &first);
+    drift_temporal_destroy(t);
+    test_rig_destroy(&r);
+}
+
+static void test_reprojection_whole_pixels(void **state)
+{
+    (void)state;
+    reprojection_case(3.0f, 0.0); // exact: the history is the frame itself
+}
+
+static void test_reprojection_subpixel(void **state)
+{
+    (void)state;
+    reprojection_case(-1.5f, 0.5); // within the bilinear filter
+}
+
+// --- DISOCCLUSION ---
+
+// A sphere above a floor; the camera moves sideways. Floor points the sphere hid from the first
+// camera (the segment from it to the point crosses the sphere) restart their history; floor
+// points both cameras saw keep it.
+static void test_disocclusion(void **state)
+{
+    (void)state;
+    test_rig r = test_rig_begin(2);
+    uint32_t white = test_add_material(r.scene, drift_material_make(drift_vec3_splat(0.5f)));
+    uint32_t red =
+        test_add_material(r.scene, drift_material_make(drift_vec3_make(0.6f, 0.1f, 0.1f)));
+    test_add_floor(r.scene, 100.0f, 0.0f, white);
+    const drift_vec3 centre = drift_vec3_make(0.0f, 1.0f, 0.0f);
+    const float radius = 0.6f;
+    test_add_sphere(r.scene, centre, radius, 48, 24, red);
+    drift_light light = { .type = DRIFT_LIGHT_POINT,
+                          .position = drift_vec3_make(0, 6, 0),
+                          .color = drift_vec3_splat(10.0f) };
+    assert_int_equal(drift_scene_add_light(r.scene, &light, NULL), DRIFT_OK);
+    const int w = 48, h = 48;
+    r.scene->camera = drift_camera_look_at(drift_vec3_make(0, 4, 0), drift_vec3_make(0, 0, 0),
+                                           drift_vec3_make(0, 0, 1), 1.0f, w, h);
+    test_rig_commit(&r);
+    test_rig_frame(&r, &(drift_hybrid_params){ .width = w, .height = h });
+    drift_temporal *t = NULL;
+    assert_int_equal(drift_temporal_create(r.ctx, w, h, NULL, &t), DRIFT_OK);
+    drift_camera a = r.scene->camera, b = a;
+    b.position = drift_vec3_add(a.position, drift_vec3_make(1.0f, 0, 0));
+    b.target = drift_vec3_add(a.target, drift_vec3_make(1.0f, 0, 0));
+    for (int k = 0; k < 2; ++k) {
+        const drift_camera *cam = k ? &b : &a;
+        assert_int_equal(drift_hybrid_render(r.frame, cam, NULL), DRIFT_OK);
+        assert_int_equal(drift_temporal_apply(t, drift_hybrid_gbuffer(r.frame), cam,
+                                              drift_hybrid_image(r.frame)),
+                         DRIFT_OK);
+    }
+    const drift_gbuffer *g = drift_hybrid_gbuffer(r.frame);
+    const drift_image *len = drift_temporal_history(t);
+    drift_camera_frame fa = drift_camera_frame_make(&a, w, h);
+    int hidden = 0, kept = 0;
+    for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+            if (drift_image_pixel(&g->material_id, x, y)[0] != (float)white) {
+                continue;
+            }
+            drift_vec3 p = drift_image_get3(&g->position, x, y);
+            drift_vec2 film;
+            if (!drift_camera_frame_project(&fa, p, &film) || film.x < 2.0f || film.y < 2.0f ||
+                film.x > (float)w - 2.0f || film.y > (float)h - 2.0f) {
+                continue; // outside the first frame
+            }
+            // The distance from the sphere's centre to the segment a -> p.
+            drift_vec3 d = drift_vec3_sub(p, a.position);
+            float s = drift_clampf(drift_vec3_dot(drift_vec3_sub(centre, a.position), d) /
+                                       drift_vec3_dot(d, d),
+                                   0.0f, 1.0f);
+            float dist =
+                drift_vec3_length(drift_vec3_sub(drift_vec3_fma(a.position, d, s), centre));
+            float n = drift_image_pixel(len, x, y)[0];
+            if (dist < radius - 0.1f) {
+                assert_near(n, 1.0, 0.0);
+                ++hidden;
+            } else if (dist > radius + 0.1f) {
+                assert_near(n, 2.0, 1e-5);
+                ++kept;
+            }
+        }
+    }
+    assert_true(hidden > 20);
+    assert_true(kept > 200);
+    drift_temporal_destroy(t);
+    test_rig_destroy(&r);
+}
+
+// --- CONVERGENCE ---
+
+// A still camera over a box lit by a point light, indirect light path-traced at 1 spp with a
+// new seed each frame: the accumulated frame's error against the same frame at 512 spp falls
+// with the frames (within 10 % noise from one check to the next) and ends below a third of
+// the first frame's; the filtered one starts and ends below the unfiltered one.
+static void add_lit_box(test_rig *r, int w)
+{
+    uint32_t white = test_add_material(r->scene, drift_material_make(drift_vec3_splat(0.7f)));
+    const float p[] = { -1, -1, -1, 1, -1, -1, 1, 1, -1, -1, 1, -1,
+                        -1, -1, 1,  1, -1, 1,  1, 1, 1,  -1, 1, 1 };
+    const uint32_t idx[] = { 0, 1, 2, 0, 2, 3, 4, 7, 6, 4, 6, 5, 0, 4, 5, 0, 5, 1,
+                             3, 2, 6, 3, 6, 7, 0, 3, 7, 0, 7, 4, 1, 5, 6, 1, 6, 2 };
+    test_add_mesh(r->scene, p, 8, idx, 12, white);
+    drift_light light = { .type = DRIFT_LIGHT_POINT,
+                          .position = drift_vec3_make(0.2f, 0.8f, 0.1f),
+                          .color = drift_vec3_splat(2.0f) };
+    assert_int_equal(drift_scene_add_light(r->scene, &light, NULL), DRIFT_OK);
+    r->scene->camera = drift_camera_look_at(drift_vec3_make(0, 0, 0.95f), drift_vec3_make(0, 0, 0),
+                                            drift_vec3_make(0, 1, 0), 1.6f, w, w);
+    test_rig_commit(r);
+}
+
+static void test_still_camera_converges(void **state)
+{
+    (void)state;
+    test_rig r = test_rig_begin(2);
+    const int w = 24;
+    add_lit_box(&r, w);
+    drift_hybrid_params params = {
+        .width = w, .height = w, .indirect = DRIFT_INDIRECT_REFERENCE, .spp = 512
+    };
+    test_rig_frame(&r, &params);
+    drift_image reference;
+    assert_int_equal(drift_image_create(r.ctx, w, w, 3, &reference), DRIFT_OK);
+    memcpy(reference.pixels, drift_hybrid_image(r.frame)->pixels, sizeof(float) * 3 * w * w);
+    params.spp = 1;
+    double first[2] = { 0 }, last[2] = { 0 };
+    for (int filtered = 0; filtered < 2; ++filtered) {
+        drift_temporal *t = NULL;
+        assert_int_equal(drift_temporal_create(
+                             r.ctx, w, w, &(drift_temporal_settings){ .no_filter = !filtered }, &t),
+                         DRIFT_OK);
+        double prev_error = INFINITY;
+        for (int k = 1; k <= 32; ++k) {
+            params.seed = (uint32_t)k;
+            assert_int_equal(drift_hybrid_set_params(r.frame, &params), DRIFT_OK);
+            assert_int_equal(drift_hybrid_render(r.frame, &r.scene->camera, NULL), DRIFT_OK);
+            assert_int_equal(drift_temporal_apply(t, drift_hybrid_gbuffer(r.frame),
+                                                  &r.scene->camera, drift_hybrid_image(r.frame)),
+                             DRIFT_OK);
+            if ((k & (k - 1)) == 0) { // 1, 2, 4, 8, 16, 32
+                double e = test_rmse(r.ctx, drift_temporal_image(t), &reference);
+                if (k == 1) {
+                    first[filtered] = e;
+                }
+                last[filtered] = e;
+                if (getenv("DRIFT_TEST_VERBOSE")) {
+                    fprintf(stderr, "filtered %d frames %d error %g\n", filtered, k, e);
+                }
+                if (!(e <= 1.1 * prev_error) && (!filtered || k > 4)) {
+                    fail_msg("filtered %d: error %g after %d frames, %g before", filtered, e, k,
+                             prev_error);
+                }
+                prev_error = e;
+            }
+        }
+        drift_temporal_destroy(t);
+    }
+    assert_true(last[0] < first[0] / 3.0);
+    assert_true(first[1] < first[0]);
+    assert_true(last[1] < first[1]);
+    drift_image_destroy(r.ctx, &reference);
+    test_rig_destroy(&r);
+}
+
+// The viewer with temporal reuse: a still camera's framebuffer after 16 frames is nearer the
+// converged frame's (8 x 64 spp over the pixel) than one frame's is, by more than half.
+static void test_view_converges(void **state)
+{
+    (void)state;
+    test_rig r = test_rig_begin(2);
+    const int w = 24;
+    add_lit_box(&r, w);
+    drift_view_desc desc = { .width = w,
+                             .height = w,
+                             .hide_overlay = true,
+                             .hybrid = { .indirect = DRIFT_INDIRECT_REFERENCE, .spp = 1 } };
+    drift_view *views[3] = { NULL, NULL, NULL };
+    desc.temporal = true;
+    assert_int_equal(drift_view_create(r.ctx, r.scene, r.accel, &desc, &views[0]), DRIFT_OK);
+    desc.temporal = false;
+    assert_int_equal(drift_view_create(r.ctx, r.scene, r.accel, &desc, &views[1]), DRIFT_OK);
+    // The converged frame through the pixel's box filter, as the temporal frames' sub-pixel
+    // offsets average it: 8 anti-aliasing passes of 64 samples.
+    desc.hybrid.spp = 64;
+    desc.hybrid.aa = 8;
+    assert_int_equal(drift_view_create(r.ctx, r.scene, r.accel, &desc, &views[2]), DRIFT_OK);
+    for (int k = 0; k < 16; ++k) {
+        assert_int_equal(drift_view_frame(views[0], NULL), DRIFT_OK);
+    }
+    assert_int_equal(drift_view_frame(views[1], NULL), DRIFT_OK);
+    assert_int_equal(drift_view_frame(views[2], NULL), DRIFT_OK);
+    double err[2] = { 0.0, 0.0 };
+    const uint8_t *ref = drift_view_pixels(views[2]);
+    for (int v = 0; v < 2; ++v) {
+        const uint8_t *px = drift_view_pixels(views[v]);
+        for (int i = 0; i < 3 * w * w; ++i) {
+            err[v] += fabs((double)px[i] - (double)ref[i]) / (3.0 * w * w);
+        }
+    }
+    if (getenv("DRIFT_TEST_VERBOSE")) {
+        fprintf(stderr, "temporal view error %g, one frame %g (sRGB levels)\n", err[0], err[1]);
+    }
+    if (!(err[0] < 0.5 * err[1])) {
+        fail_msg("temporal view error %g, one frame %g (sRGB levels)", err[0], err[1]);
+    }
+    for (int v = 0; v < 3; ++v) {
+        drift_view_destroy(views[v]);
+    }
+    test_rig_destroy(&r);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_camera_path_keys),
+        cmocka_unit_test(test_camera_path_errors),
+        cmocka_unit_test(test_reprojection_whole_pixels),
+        cmocka_unit_test(test_reprojection_subpixel),
+        cmocka_unit_test(test_disocclusion),
+        cmocka_unit_test(test_still_camera_converges),
+        cmocka_unit_test(test_view_converges),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
