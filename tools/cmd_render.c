@@ -845,6 +845,16 @@ int render_reference_finish(render_reference_run *run, bool cancelled, double t_
                 saved ? run->checkpoint_path : "", saved ? "" : "");
     }
     if (!write_outputs(run, true, t_rendered)) {
+        // Keep the work (a full disk): the checkpoint a resumed or stopped run has, else one
+        // written now; the same command writes the images from it once there is room.
+        bool kept = access(run->checkpoint_path, F_OK) == 0 ||
+                    render_checkpoint_write(run->checkpoint_path, run->key, run->pt);
+        if (kept) {
+            fprintf(stderr,
+                    "drift render: the render is kept in %s; run the same command to "
+                    "write it\n",
+                    run->checkpoint_path);
+        }
         return 1;
     }
     if (complete && access(run->checkpoint_path, F_OK) == 0 && unlink(run->checkpoint_path) != 0) {

@@ -12,6 +12,7 @@
 #include <stb/stb_image.h>
 #include <stb/stb_image_write.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -68,6 +69,21 @@ const char *drift__errno_text(int err, char *buf, size_t cap)
     // plain strerror is not thread-safe.
     if (strerror_r(err, buf, cap) != 0) {
         snprintf(buf, cap, "error %d", err);
+    }
+    return buf;
+}
+
+const char *drift__write_errno_text(int err, char *buf, size_t cap)
+{
+    char os[128];
+    drift__errno_text(err, os, sizeof(os));
+    const char *plain = err == ENOSPC || err == EDQUOT ? "disk full"
+                        : err == EFBIG                 ? "file size limit reached"
+                                                       : NULL;
+    if (plain) {
+        snprintf(buf, cap, "%s (%s)", plain, os);
+    } else {
+        snprintf(buf, cap, "%s", os);
     }
     return buf;
 }
@@ -154,9 +170,34 @@ drift_result drift__image_temp_open(drift_context *ctx, const char *path, drift_
     return DRIFT_ERR_IO;
 }
 
+// DRIFT_TEST_DISK_FULL: the bytes this process may still write, -1 when unset (parsed once).
+static _Atomic long long disk_full_left = -2;
+
+static bool disk_full_injected(size_t size)
+{
+    long long left = disk_full_left;
+    if (left == -2) {
+        const char *env = getenv("DRIFT_TEST_DISK_FULL");
+        left = env && *env ? atoll(env) : -1;
+        disk_full_left = left;
+    }
+    if (left < 0) {
+        return false;
+    }
+    if ((unsigned long long)left < size) {
+        errno = ENOSPC;
+        return true;
+    }
+    disk_full_left = left - (long long)size;
+    return false;
+}
+
 bool drift__image_temp_write(drift__image_temp *t, const void *data, size_t size, uint64_t offset)
 {
     const uint8_t *p = data;
+    if (disk_full_injected(size)) {
+        return false;
+    }
     while (size > 0) {
         ssize_t n = pwrite(t->fd, p, size, (off_t)offset);
         if (n < 0 && errno == EINTR) {
@@ -182,7 +223,7 @@ drift_result drift__image_temp_close(drift_context *ctx, drift__image_temp *t, d
         // close() can report a delayed write error (NFS, full disk); it counts as a failure.
         if (close(t->fd) != 0 && result == DRIFT_OK) {
             drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, t->path, 0, "write failed: %s",
-                      drift__errno_text(errno, why, sizeof(why)));
+                      drift__write_errno_text(errno, why, sizeof(why)));
             result = DRIFT_ERR_IO;
         }
         t->fd = -1;
@@ -492,9 +533,9 @@ drift_result drift_image_save_png(drift_context *ctx, const char *path, const dr
         int ok = stbi_write_png_to_func(png_write, &sink, image->width, image->height, 3, rgb,
                                         image->width * 3);
         if (!ok || sink.failed) {
-            char why[128];
+            char why[160];
             drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, path, 0, "PNG write failed: %s",
-                      sink.failed ? drift__errno_text(sink.error, why, sizeof(why))
+                      sink.failed ? drift__write_errno_text(sink.error, why, sizeof(why))
                                   : "encoder failed");
             r = DRIFT_ERR_IO;
         }
