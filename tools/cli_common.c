@@ -1,5 +1,6 @@
 #include "cli.h"
 #include "drift/accel.h"
+#include "drift/file.h"
 #include "drift/scene_io.h"
 
 #include <errno.h>
@@ -356,7 +357,8 @@ bool cli_hash_files(const char *const *paths, size_t count, uint64_t *out)
         if (!paths[i]) {
             continue;
         }
-        FILE *f = fopen(paths[i], "rb");
+        char why[128];
+        FILE *f = drift_input_fopen(paths[i], why, sizeof why);
         if (!f) {
             return false;
         }

@@ -8,6 +8,7 @@
 //   "drift checkpoint 1\n", key lines "name value\n", "\n",
 //   uint32 tile count, each tile's state (drift_pt_tile_get_state), uint64 FNV-1a of all
 //   the bytes before it (a cut or damaged file is refused, not half loaded).
+#include "drift/file.h"
 #include "drift/pt.h"
 #include "render.h"
 
@@ -130,9 +131,10 @@ static void key_difference(const char *have, const char *want, char *out, size_t
 
 int render_checkpoint_read(const char *path, const char *key, drift_pt *pt, uint32_t spp)
 {
-    FILE *f = fopen(path, "rb");
+    char reason[128];
+    FILE *f = drift_input_fopen(path, reason, sizeof reason);
     if (!f) {
-        fprintf(stderr, "drift render: cannot read the checkpoint %s: %s\n", path, strerror(errno));
+        fprintf(stderr, "drift render: cannot read the checkpoint %s: %s\n", path, reason);
         return 2;
     }
     uint8_t *data = NULL;

@@ -3,6 +3,7 @@
 //
 // The stb implementation is not compiled here: Debian's libstb (pkg-config stb, -lstb) already
 // contains stb_image and stb_image_write, so only the declarations are included.
+#include "drift/file.h"
 #include "drift/math.h"
 #include "image_io_internal.h"
 
@@ -96,16 +97,15 @@ drift_result drift__image_read_file(drift_context *ctx, const char *path, uint8_
     *out_data = NULL;
     *out_size = 0;
     char why[128];
-    // O_NONBLOCK: opening a FIFO would otherwise wait for a writer; it is refused below.
-    int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY);
+    int fd = drift_input_open(path, why, sizeof(why));
     if (fd < 0) {
-        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, path, 0, "cannot open image: %s",
-                  drift__errno_text(errno, why, sizeof(why)));
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, path, 0, "cannot open image: %s", why);
         return DRIFT_ERR_IO;
     }
     struct stat st;
-    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, path, 0, "not a regular file");
+    if (fstat(fd, &st) != 0) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, path, 0, "cannot open image: %s",
+                  drift__errno_text(errno, why, sizeof(why)));
         close(fd);
         return DRIFT_ERR_IO;
     }

@@ -1,5 +1,6 @@
 // Scene loading entry point: dispatch by extension, whole-file reads (gunzipped with zlib),
 // the texture cache, and the camera and light a bare mesh file is given.
+#include "drift/file.h"
 #include "drift/image_io.h"
 #include "drift/scene_io.h"
 #include "image_io_internal.h" // drift__errno_text
@@ -11,6 +12,7 @@
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 #include <zlib.h>
 
 void drift__path_extension(const char *path, char *out, size_t out_size, bool *out_gz)
@@ -120,11 +122,16 @@ drift_result drift__read_file(drift_context *ctx, const char *path, bool gzip, c
     }
     // gzread inflates gzip data and passes anything else through unchanged, so one loop reads
     // both kinds; gzdirect says which kind the file is, and it must match its name.
-    gzFile gz = gzopen(path, "rb");
+    char why[128];
+    int fd = drift_input_open(path, why, sizeof(why));
+    gzFile gz = fd >= 0 ? gzdopen(fd, "rb") : NULL;
     if (!gz) {
-        char why[128];
+        if (fd >= 0) {
+            drift__errno_text(errno, why, sizeof(why));
+            close(fd);
+        }
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, where, line, "cannot open '%s': %s", path,
-                  drift__errno_text(errno, why, sizeof(why)));
+                  why);
         return DRIFT_ERR_IO;
     }
     if (gzdirect(gz) == (int)gzip) {

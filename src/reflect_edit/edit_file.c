@@ -1,6 +1,7 @@
 // Edit files (.edit.json; format in docs/reflection-editing.md), read with cJSON. As for
 // scene files, src/io/json_lines.c pairs every cJSON node with the line its value starts on,
 // so each complaint names "file:line".
+#include "drift/file.h"
 #include "io/json_lines.h"
 #include "reflect_edit/reflect_edit_internal.h"
 
@@ -331,9 +332,10 @@ drift_result drift_reflection_edits_load(drift_context *ctx, const drift_scene *
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
     *out_edits = NULL;
-    FILE *f = fopen(path, "rb");
+    char why[128];
+    FILE *f = drift_input_fopen(path, why, sizeof why);
     if (!f) {
-        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, path, 0, "cannot open: %s", strerror(errno));
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, path, 0, "cannot open: %s", why);
         return DRIFT_ERR_IO;
     }
     char *text = drift_alloc(ctx, MAX_EDIT_FILE_BYTES + 1);
