@@ -65,9 +65,10 @@ bool cli_parse_vec3(const char *cmd, const char *flag, const char *text, bool sc
     if (n == 1 && scalar) {
         b = c = a; // one value: grey
     }
-    if (!(n == 3 || (n == 1 && scalar)) || !drift_vec3_is_finite(drift_vec3_make(a, b, c))) {
-        fprintf(stderr, "drift %s: %s expects X,Y,Z%s, got '%s'\n", cmd, flag,
-                scalar ? " (or one number)" : "", text);
+    double m = DRIFT_SCENE_COORD_MAX; // fabs(NaN) <= m is false too
+    if (!(n == 3 || (n == 1 && scalar)) || !(fabs(a) <= m && fabs(b) <= m && fabs(c) <= m)) {
+        fprintf(stderr, "drift %s: %s expects X,Y,Z%s, each within +-%g, got '%s'\n", cmd, flag,
+                scalar ? " (or one number)" : "", DRIFT_SCENE_COORD_MAX, text);
         return false;
     }
     *out = drift_vec3_make(a, b, c);

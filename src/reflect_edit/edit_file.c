@@ -51,8 +51,9 @@ fail(const reader *r, const cJSON *node, const char *fmt, ...)
 static drift_result read_number(const reader *r, const cJSON *node, const char *what, float lo,
                                 float *out)
 {
-    if (!cJSON_IsNumber(node) || !isfinite(node->valuedouble) || fabs(node->valuedouble) > 1e30) {
-        return fail(r, node, "%s must be a finite number", what);
+    // Positions beyond DRIFT_SCENE_COORD_MAX reached Embree and aborted it.
+    if (!cJSON_IsNumber(node) || !(fabs(node->valuedouble) <= DRIFT_SCENE_COORD_MAX)) {
+        return fail(r, node, "%s must be a finite number within +-%g", what, DRIFT_SCENE_COORD_MAX);
     }
     if (node->valuedouble < (double)lo) {
         return fail(r, node, "%s must be at least %g", what, (double)lo);
