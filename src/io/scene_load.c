@@ -196,6 +196,27 @@ drift_result drift__read_file(drift_context *ctx, const char *path, bool gzip, c
     return DRIFT_OK;
 }
 
+// Sets the texels of `image` that are NaN or infinite to 0 and says how many: one such texel
+// of a texture or environment map made NaN pixels in a hybrid frame.
+static void replace_nonfinite_texels(drift_context *ctx, drift_image *image, const char *path,
+                                     const char *where, int line)
+{
+    size_t count = 0;
+    for (int32_t y = 0; y < image->height; ++y) {
+        float *row = image->pixels + (size_t)y * (size_t)image->stride;
+        for (size_t i = 0; i < (size_t)image->width * (size_t)image->channels; ++i) {
+            if (!isfinite(row[i])) {
+                row[i] = 0.0f;
+                ++count;
+            }
+        }
+    }
+    if (count > 0) {
+        drift_log(ctx, DRIFT_LOG_WARNING, DRIFT_ERR_INVALID_ARGUMENT, where, line,
+                  "texture '%s': %zu texel values were NaN or infinite; set to 0", path, count);
+    }
+}
+
 drift_result drift__texture_cache_get(drift_scene *scene, drift__texture_cache *cache,
                                       const char *path, const char *where, int line,
                                       uint32_t *out_index)
@@ -218,6 +239,7 @@ drift_result drift__texture_cache_get(drift_scene *scene, drift__texture_cache *
         drift_log(ctx, DRIFT_LOG_ERROR, r, where, line, "cannot load texture '%s'", path);
         return r;
     }
+    replace_nonfinite_texels(ctx, &image, path, where, line);
     if (cache->on_input) {
         cache->on_input(path, cache->user);
     }
