@@ -333,8 +333,8 @@ void drift_ism_destroy(drift_ism *ism)
 typedef struct map_job {
     drift_ism *ism;
     drift__ism_splat_desc splat;
-    uint32_t empty[64];    // per thread
-    double seconds[64][2]; // per thread: splatting, pull-push
+    uint32_t empty[DRIFT_MAX_THREADS];    // per thread
+    double seconds[DRIFT_MAX_THREADS][2]; // per thread: splatting, pull-push
 } map_job;
 
 // Splat and pull-push of one map back to back on one thread, so that the map (256 KB at 256^2)
@@ -358,15 +358,14 @@ static void maps_range(size_t begin, size_t end, int thread, void *user)
         double t1 = drift_time_now();
         if (ism->lazy_levels > 0) {
             drift__ism_pull(depth, n, ism->lazy_levels, ism->params.pull_push_threshold);
-            job->empty[thread % 64] +=
-                drift__ism_holes(depth, n, ism->lazy_levels, ism->disc_counts);
+            job->empty[thread] += drift__ism_holes(depth, n, ism->lazy_levels, ism->disc_counts);
         } else {
-            job->empty[thread % 64] += drift__ism_pull_push(
-                depth, n, levels > 0 ? levels : 0, ism->params.pull_push_threshold,
-                ism->scratch + (size_t)thread * 2 * map);
+            job->empty[thread] += drift__ism_pull_push(depth, n, levels > 0 ? levels : 0,
+                                                       ism->params.pull_push_threshold,
+                                                       ism->scratch + (size_t)thread * 2 * map);
         }
-        job->seconds[thread % 64][0] += t1 - t0;
-        job->seconds[thread % 64][1] += drift_time_now() - t1;
+        job->seconds[thread][0] += t1 - t0;
+        job->seconds[thread][1] += drift_time_now() - t1;
     }
 }
 
@@ -392,9 +391,9 @@ typedef struct receivers {
 typedef struct gather_job {
     drift_ism *ism;
     const drift_gbuffer *gb;
-    uint64_t rays[64];   // per thread
-    float *buffers;      // per thread: receivers_in of `capacity`
-    int32_t capacity;    // receivers a job can hold
+    uint64_t rays[DRIFT_MAX_THREADS]; // per thread
+    float *buffers;                   // per thread: receivers_in of `capacity`
+    int32_t capacity;                 // receivers a job can hold
     int32_t subset_rows; // rows of one subset in a band (a band is subset_rows * B rows)
     int32_t bands;
     bool near_field;     // the blur adds the near-field plane
@@ -719,7 +718,7 @@ static void gather_jobs(size_t begin, size_t end, int thread, void *user)
             uint32_t first, last;
             group_run(ism, g, run, runs, &first, &last);
             for (uint32_t j = first; j < last; ++j) {
-                gather_vpl(ism, j, &c, &rs, &job->rays[thread % 64]);
+                gather_vpl(ism, j, &c, &rs, &job->rays[thread]);
             }
         }
         float scale = (float)runs * DRIFT_INV_PI;
@@ -917,7 +916,7 @@ typedef struct near_field_job {
     const drift_image *direct;
     float dmin;
     uint32_t seed;
-    uint64_t rays[64]; // per thread
+    uint64_t rays[DRIFT_MAX_THREADS]; // per thread
 } near_field_job;
 
 // Shooting pixels a side, either way, that near_field_spread_rows averages: 2 spreads a block's
@@ -993,7 +992,7 @@ static void near_field_rows(size_t begin, size_t end, int thread, void *user)
                                   .dir = dir,
                                   .tmin = 0.0f,
                                   .tmax = job->dmin };
-                ++job->rays[thread % 64];
+                ++job->rays[thread];
                 // Emitters are the direct light's; only a reflecting surface is near-field light.
                 if (drift_accel_intersect(ism->accel, &ray, &hit) &&
                     hit.mesh != DRIFT_INVALID_INDEX && hit.light == DRIFT_INVALID_INDEX &&
@@ -1063,7 +1062,7 @@ static void add_near_field(drift_ism *ism, const drift_gbuffer *gb, const drift_
                            .seed = drift_hash_combine(ism->params.seed, 0x4e454152u) };
     drift_parallel_for(ism->ctx, (size_t)gb->height, 4, near_field_rows, &job);
     drift_parallel_for(ism->ctx, (size_t)gb->height, 4, near_field_spread_rows, &job);
-    for (int i = 0; i < 64; ++i) {
+    for (int i = 0; i < DRIFT_MAX_THREADS; ++i) {
         st->near_field_rays += job.rays[i];
     }
 }
@@ -1134,8 +1133,8 @@ static void decimate_rows(size_t begin, size_t end, int thread, void *user)
 typedef struct upsample_job {
     drift_ism *ism;
     const drift_gbuffer *gb;
-    uint8_t *fallback; // per G-buffer pixel: 1 where it must gather itself
-    uint64_t rays[64]; // per thread, the fallback's `ir` rays
+    uint8_t *fallback;                // per G-buffer pixel: 1 where it must gather itself
+    uint64_t rays[DRIFT_MAX_THREADS]; // per thread, the fallback's `ir` rays
     const uint32_t *fallback_pixels;
     size_t fallback_count;
     size_t job_pixels;       // receivers of one fallback job
@@ -1238,7 +1237,7 @@ static void fallback_jobs(size_t begin, size_t end, int thread, void *user)
             uint32_t from, to;
             group_run(ism, g, ism->slice, ism->slices, &from, &to);
             for (uint32_t j = from; j < to; ++j) {
-                gather_vpl(ism, j, &c, &rs, &job->rays[thread % 64]);
+                gather_vpl(ism, j, &c, &rs, &job->rays[thread]);
             }
         }
         float scale = (float)ism->slices * DRIFT_INV_PI * DRIFT_INV_PI;
@@ -1281,7 +1280,7 @@ static drift_result upsample(drift_ism *ism, const drift_gbuffer *gb, drift_ism_
             job.fallback_count = fallbacks;
             drift_parallel_for(ism->ctx, (fallbacks + job.job_pixels - 1) / job.job_pixels, 1,
                                fallback_jobs, &job);
-            for (int i = 0; i < 64; ++i) {
+            for (int i = 0; i < DRIFT_MAX_THREADS; ++i) {
                 st->shadow_rays += job.rays[i];
             }
         } else {
@@ -1447,7 +1446,7 @@ static drift_result make_lights(drift_ism *ism, const drift_gbuffer *gbuffer, dr
         drift_parallel_for(ism->ctx, ism->vpl_count, 1, maps_range, &mj);
         st->splats = (uint64_t)ism->vpl_count * ism->params.points_per_vpl;
         uint64_t empty = 0;
-        for (int i = 0; i < 64; ++i) {
+        for (int i = 0; i < DRIFT_MAX_THREADS; ++i) {
             empty += mj.empty[i];
         }
         double disc = (double)DRIFT_PI * 0.25 * (double)mj.splat.n * (double)mj.splat.n;
@@ -1456,7 +1455,7 @@ static drift_result make_lights(drift_ism *ism, const drift_gbuffer *gbuffer, dr
         // Splat and pull-push run map by map on one thread: the pass's wall time is split
         // between them in proportion to the threads' own clock of each.
         double splat_s = 0.0, pull_s = 0.0;
-        for (int i = 0; i < 64; ++i) {
+        for (int i = 0; i < DRIFT_MAX_THREADS; ++i) {
             splat_s += mj.seconds[i][0];
             pull_s += mj.seconds[i][1];
         }
@@ -1549,7 +1548,7 @@ static drift_result render(drift_ism *ism, const drift_gbuffer *gbuffer, const d
     }
     drift_parallel_for(ism->ctx, (size_t)gj.bands * (size_t)b * (size_t)b, 1, gather_jobs, &gj);
     drift_free(ism->ctx, gj.buffers);
-    for (int i = 0; i < 64; ++i) {
+    for (int i = 0; i < DRIFT_MAX_THREADS; ++i) {
         st.shadow_rays += gj.rays[i];
     }
     now = drift_time_now();
