@@ -66,7 +66,8 @@ bool cli_parse_vec3(const char *cmd, const char *flag, const char *text, bool sc
         b = c = a; // one value: grey
     }
     double m = DRIFT_SCENE_COORD_MAX; // fabs(NaN) <= m is false too
-    if (!(n == 3 || (n == 1 && scalar)) || !(fabs(a) <= m && fabs(b) <= m && fabs(c) <= m)) {
+    if (!(n == 3 || (n == 1 && scalar)) ||
+        !(fabs((double)a) <= m && fabs((double)b) <= m && fabs((double)c) <= m)) {
         fprintf(stderr, "drift %s: %s expects X,Y,Z%s, each within +-%g, got '%s'\n", cmd, flag,
                 scalar ? " (or one number)" : "", DRIFT_SCENE_COORD_MAX, text);
         return false;
