@@ -18,6 +18,7 @@
 #include "drift/refine.h"
 #include "drift/scene.h"
 #include "render.h"
+#include "report_files.h"
 
 #include <errno.h>
 #include <inttypes.h>
@@ -1046,45 +1047,6 @@ static bool write_page(const char *out_dir, cJSON *data)
     return ok;
 }
 
-// --out DIR's manifest.json and index.html may only be files an earlier report wrote: the
-// manifest has the "drift" and "renders" members write_manifest gives it, the page the
-// template's first comment. Anything else (another program's file, a FIFO) is refused.
-static bool out_dir_is_ours(const char *out_dir)
-{
-    static const char *const names[] = { "manifest.json", "index.html" };
-    for (int i = 0; i < 2; ++i) {
-        char path[4200], why[128];
-        snprintf(path, sizeof path, "%s/%s", out_dir, names[i]);
-        struct stat st;
-        if (lstat(path, &st) != 0 && errno == ENOENT) {
-            continue;
-        }
-        FILE *f = drift_input_fopen(path, why, sizeof why);
-        if (f) {
-            fclose(f);
-        }
-        char *text = f ? read_text(path) : NULL;
-        bool ours = false;
-        if (text && i == 0) {
-            cJSON *root = cJSON_Parse(text);
-            ours = cJSON_IsString(cJSON_GetObjectItemCaseSensitive(root, "drift")) &&
-                   cJSON_IsObject(cJSON_GetObjectItemCaseSensitive(root, "renders"));
-            cJSON_Delete(root);
-        } else if (text) {
-            ours = strstr(text, "<!-- The drift report page") != NULL;
-        }
-        free(text);
-        if (!ours) {
-            fprintf(stderr,
-                    "drift report: --out '%s' holds %s, which drift report did not write%s%s; "
-                    "refusing to overwrite it, nothing written\n",
-                    out_dir, names[i], f ? "" : ": ", f ? "" : why);
-            return false;
-        }
-    }
-    return true;
-}
-
 static void load_manifest(report_run *run)
 {
     char *text = read_text(run->manifest_path);
@@ -1126,7 +1088,7 @@ int drift_cmd_report(int argc, char **argv)
         fprintf(stderr, "drift report: cannot create --out '%s': %s\n", o.out_dir, strerror(errno));
         return 1;
     }
-    if (!out_dir_is_ours(o.out_dir)) {
+    if (!report_out_dir_is_ours(o.out_dir)) {
         return 2;
     }
     cli_session session;

@@ -52,12 +52,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     const uint32_t indices[] = { 0, 1, 2, 0, 2, 3 };
     uint32_t material = 0;
     if (drift_scene_create(ctx, &scene) != DRIFT_OK ||
-        drift_scene_add_material(
-            scene,
-            &(drift_material){ .diffuse = { 0.5f, 0.5f, 0.5f },
-                               .emission = { 1, 1, 1 },
-                               .diffuse_texture = DRIFT_INVALID_INDEX },
-            &material) != DRIFT_OK ||
+        drift_scene_add_material(scene,
+                                 &(drift_material){ .diffuse = { 0.5f, 0.5f, 0.5f },
+                                                    .emission = { 1, 1, 1 },
+                                                    .diffuse_texture = DRIFT_INVALID_INDEX },
+                                 &material) != DRIFT_OK ||
         drift_scene_add_mesh(scene,
                              &(drift_mesh_desc){ .name = "quad",
                                                  .positions = positions,
@@ -76,8 +75,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                                     .height = 24 };
     if (drift_scene_commit(scene) != DRIFT_OK ||
         drift_accel_create(ctx, scene, &(drift_accel_desc){ 0 }, &accel) != DRIFT_OK ||
-        drift_pt_create(ctx, scene, accel, &(drift_pt_params){ .width = 40, .height = 24 },
-                        &pt) != DRIFT_OK) {
+        drift_pt_create(ctx, scene, accel, &(drift_pt_params){ .width = 40, .height = 24 }, &pt) !=
+            DRIFT_OK) {
         __builtin_trap();
     }
     char path[64] = "/tmp/drift-fuzz-XXXXXX.ckpt";
