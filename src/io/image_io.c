@@ -76,7 +76,7 @@ const char *drift__errno_text(int err, char *buf, size_t cap)
 
 const char *drift__write_errno_text(int err, char *buf, size_t cap)
 {
-    char os[128];
+    char os[96]; // with the plain words it fits the callers' 128 bytes
     drift__errno_text(err, os, sizeof(os));
     const char *plain = err == ENOSPC || err == EDQUOT ? "disk full"
                         : err == EFBIG                 ? "file size limit reached"
