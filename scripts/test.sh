@@ -2,7 +2,8 @@
 # The whole test suite: installs dependencies, checks the formatting (clang-format, the
 # repository's .clang-format), builds with ASan+UBSan and -Werror, runs every
 # unit and CLI test, builds the Release configuration (-Werror at -O2 sees more), runs the
-# fuzzers for a bounded time and the core tests under valgrind.
+# fuzzers for a bounded time, the threaded renders under ThreadSanitizer and the core tests
+# under valgrind.
 # DRIFT_TEST_INTENSITY scales statistical sample counts; DRIFT_FUZZ_SECONDS the fuzz time.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -37,6 +38,12 @@ for fuzzer in build/fuzz/fuzz_*; do
   rm -rf "$work"
   echo "fuzz: $name ok ($(grep -o 'Done [0-9]* runs' "build/fuzz/$name.log" || echo 'ran'))"
 done
+
+echo "== tsan (ThreadSanitizer: the threaded renders at --threads 1, 2, 16, 256)"
+cmake -S . -B build/tsan -DCMAKE_BUILD_TYPE=Debug -DDRIFT_SANITIZE=thread -DDRIFT_BUILD_TESTS=OFF \
+  -DDRIFT_WERROR=ON >/dev/null
+cmake --build build/tsan -j"$jobs" --target drift_cli
+bash tests/tsan/test_tsan.sh build/tsan/bin/drift
 
 echo "== valgrind (memcheck) on a plain Debug build of the core tests"
 cmake -S . -B build/valgrind -DCMAKE_BUILD_TYPE=Debug >/dev/null

@@ -1,5 +1,6 @@
 #include "cli.h"
 #include "drift/accel.h"
+#include "drift/file.h"
 #include "drift/knobs.h"
 #include "drift/scene_io.h"
 
@@ -71,9 +72,11 @@ bool cli_parse_vec3(const char *cmd, const char *flag, const char *text, bool sc
     if (n == 1 && scalar) {
         b = c = a; // one value: grey
     }
-    if (!(n == 3 || (n == 1 && scalar)) || !drift_vec3_is_finite(drift_vec3_make(a, b, c))) {
-        fprintf(stderr, "drift %s: %s expects X,Y,Z%s, got '%s'\n", cmd, flag,
-                scalar ? " (or one number)" : "", text);
+    double m = DRIFT_SCENE_COORD_MAX; // fabs(NaN) <= m is false too
+    if (!(n == 3 || (n == 1 && scalar)) ||
+        !(fabs((double)a) <= m && fabs((double)b) <= m && fabs((double)c) <= m)) {
+        fprintf(stderr, "drift %s: %s expects X,Y,Z%s, each within +-%g, got '%s'\n", cmd, flag,
+                scalar ? " (or one number)" : "", DRIFT_SCENE_COORD_MAX, text);
         return false;
     }
     *out = drift_vec3_make(a, b, c);
@@ -413,7 +416,8 @@ bool cli_hash_files(const char *const *paths, size_t count, uint64_t *out)
         if (!paths[i]) {
             continue;
         }
-        FILE *f = fopen(paths[i], "rb");
+        char why[128];
+        FILE *f = drift_input_fopen(paths[i], why, sizeof why);
         if (!f) {
             return false;
         }

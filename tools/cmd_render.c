@@ -556,7 +556,11 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
         layers[layer_count++] = (drift_image_layer){ "spp", &spp };
     }
     if (r == DRIFT_OK) {
-        const char *const channels[5] = { NULL, NULL, "X,Y,Z", "Z", NULL };
+        // One entry a layer of the --aov file (then the spp layer): beauty, albedo, N, Z,
+        // variance, feature_albedo, feature_normal, feature_depth.
+        const char *const channels[9] = {
+            NULL, NULL, "X,Y,Z", "Z", NULL, NULL, "X,Y,Z", NULL, NULL
+        };
         r = drift_image_save_exr_channels(ctx, exr_path, layers, layer_count,
                                           o->aov ? channels : NULL, attributes, attribute_count);
     }
@@ -747,6 +751,16 @@ int render_reference_finish(render_reference_run *run, bool cancelled, double t_
                 saved ? run->checkpoint_path : "", saved ? "" : "");
     }
     if (!write_outputs(run, true, t_rendered)) {
+        // Keep the work (a full disk): the checkpoint a resumed or stopped run has, else one
+        // written now; the same command writes the images from it once there is room.
+        bool kept = access(run->checkpoint_path, F_OK) == 0 ||
+                    render_checkpoint_write(run->checkpoint_path, run->key, run->pt);
+        if (kept) {
+            fprintf(stderr,
+                    "drift render: the render is kept in %s; run the same command to "
+                    "write it\n",
+                    run->checkpoint_path);
+        }
         return 1;
     }
     if (complete && access(run->checkpoint_path, F_OK) == 0 && unlink(run->checkpoint_path) != 0) {

@@ -11,11 +11,13 @@
 // missing and Ctrl-C keeps what is finished. The `sir` cell is the whole frame refined by
 // smart image refinement, against drift bench frontier's whole-frame path-traced truth.
 #include "cli.h"
+#include "drift/file.h"
 #include "drift/image_io.h"
 #include "drift/metric.h"
 #include "drift/refine.h"
 #include "drift/scene.h"
 #include "render.h"
+#include "report_files.h"
 
 #include <errno.h>
 #include <inttypes.h>
@@ -326,7 +328,8 @@ static void progress(report_run *run, const char *scene, const report_job *j, co
 
 static char *read_text(const char *path)
 {
-    FILE *f = fopen(path, "rb");
+    char why[128];
+    FILE *f = drift_input_fopen(path, why, sizeof why);
     if (!f) {
         return NULL;
     }
@@ -1083,6 +1086,9 @@ int drift_cmd_report(int argc, char **argv)
     if (!make_dir(o.out_dir)) {
         fprintf(stderr, "drift report: cannot create --out '%s': %s\n", o.out_dir, strerror(errno));
         return 1;
+    }
+    if (!report_out_dir_is_ours(o.out_dir)) {
+        return 2;
     }
     cli_session session;
     if (!cli_session_open(&(cli_session_desc){ .cmd = "report",

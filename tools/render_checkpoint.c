@@ -8,10 +8,13 @@
 //   "drift checkpoint 1\n", key lines "name value\n", "\n",
 //   uint32 tile count, each tile's state (drift_pt_tile_get_state), uint64 FNV-1a of all
 //   the bytes before it (a cut or damaged file is refused, not half loaded).
+#include "drift/file.h"
 #include "drift/pt.h"
 #include "render.h"
 
+#include <dirent.h>
 #include <errno.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -130,9 +133,10 @@ static void key_difference(const char *have, const char *want, char *out, size_t
 
 int render_checkpoint_read(const char *path, const char *key, drift_pt *pt, uint32_t spp)
 {
-    FILE *f = fopen(path, "rb");
+    char reason[128];
+    FILE *f = drift_input_fopen(path, reason, sizeof reason);
     if (!f) {
-        fprintf(stderr, "drift render: cannot read the checkpoint %s: %s\n", path, strerror(errno));
+        fprintf(stderr, "drift render: cannot read the checkpoint %s: %s\n", path, reason);
         return 2;
     }
     uint8_t *data = NULL;
@@ -223,11 +227,47 @@ int render_checkpoint_read(const char *path, const char *key, drift_pt *pt, uint
 
 // --- STAGED OUTPUTS ---
 
+// Removes what a killed run left beside `path`: "<name>.stage-PID" (and the writers' own
+// "<name>.stage-PID.tmp-..." inside it) whose process PID is gone. SIGKILL leaves them, as
+// no handler runs; a live PID is another run writing now and is left alone.
+static void sweep_stale_stage(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - path) + (slash == path) : 1,
+             slash ? path : ".");
+    const char *name = slash ? slash + 1 : path;
+    size_t name_len = strlen(name);
+    DIR *d = opendir(dir);
+    if (!d) {
+        return;
+    }
+    for (struct dirent *e; (e = readdir(d)) != NULL;) {
+        if (strncmp(e->d_name, name, name_len) != 0 ||
+            strncmp(e->d_name + name_len, ".stage-", 7) != 0) {
+            continue;
+        }
+        char *end = NULL;
+        long pid = strtol(e->d_name + name_len + 7, &end, 10);
+        if (end == e->d_name + name_len + 7 || pid <= 0 || (*end != '\0' && *end != '.') ||
+            pid == (long)getpid() || kill((pid_t)pid, 0) == 0 || errno != ESRCH) {
+            continue;
+        }
+        char stale[8192];
+        snprintf(stale, sizeof stale, "%s/%s", dir, e->d_name);
+        if (unlink(stale) == 0) {
+            fprintf(stderr, "drift render: removed %s, left by a run that was killed\n", stale);
+        }
+    }
+    closedir(d);
+}
+
 const char *render_stage_add(render_stage *s, const char *path)
 {
     if (!path || s->count == sizeof s->files / sizeof s->files[0]) {
         return path;
     }
+    sweep_stale_stage(path);
     render_staged_file *f = &s->files[s->count++];
     snprintf(f->path, sizeof f->path, "%s", path);
     snprintf(f->temp, sizeof f->temp, "%s.stage-%ld", path, (long)getpid());

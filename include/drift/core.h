@@ -72,8 +72,13 @@ typedef struct drift_allocator {
     void *user;
 } drift_allocator;
 
+// The most threads a context's pool has (a larger thread_count is cut to it). Per-thread
+// slots of a parallel job are sized by it: every thread_index is below it, so no two
+// threads share a slot.
+#define DRIFT_MAX_THREADS 256
+
 // How to create a context. The default configuration is:
-//   thread_count = 0   -> one thread per online core
+//   thread_count = 0   -> one thread per online core (at most DRIFT_MAX_THREADS)
 //   logger       = {0} -> silent
 //   allocator    = {0} -> malloc/free
 typedef struct drift_context_desc {

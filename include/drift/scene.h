@@ -43,7 +43,11 @@ extern "C" {
 #define DRIFT_SCENE_MAX_TRIANGLES (1u << 28)
 #define DRIFT_SCENE_MAX_VERTICES  (1u << 28)
 #define DRIFT_SCENE_MAX_LIGHTS    (1u << 24)
-#define DRIFT_NAME_MAX            64
+// Largest |coordinate| of a vertex, light, camera or probe (scene units): squares and
+// cross products stay far inside float range. Embree aborted on positions past ~1.8e18; a
+// scene reaching further is refused when it loads or commits (docs/scene-format.md).
+#define DRIFT_SCENE_COORD_MAX 1e12
+#define DRIFT_NAME_MAX        64
 
 // --- CAMERA ---
 

@@ -9,7 +9,7 @@
 #include <unistd.h>
 
 // Upper bound on pool size: far above any machine we run on, keeps per-thread arrays small.
-#define MAX_THREADS 256
+#define MAX_THREADS DRIFT_MAX_THREADS
 
 typedef struct worker_arg {
     drift_context *ctx;

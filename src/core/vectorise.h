@@ -13,8 +13,17 @@
 #endif
 // Compiled for AVX2 (8 lanes, hardware gathers) too, picked at load time where the CPU has it
 // (GCC and clang function multi-versioning on x86-64 ELF). With -ffp-contract=off both
-// versions do the same IEEE operations: the same image to the bit.
-#if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__) && defined(__ELF__)
+// versions do the same IEEE operations: the same image to the bit. Not under ThreadSanitizer:
+// the clones' resolver runs at load time, before TSan's runtime is up, and crashed.
+#if defined(__SANITIZE_THREAD__)
+#    define DRIFT__TSAN 1
+#elif defined(__has_feature)
+#    if __has_feature(thread_sanitizer)
+#        define DRIFT__TSAN 1
+#    endif
+#endif
+#if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__) && defined(__ELF__) && \
+    !defined(DRIFT__TSAN)
 #    define DRIFT_AVX2_CLONES __attribute__((target_clones("avx2", "default")))
 #else
 #    define DRIFT_AVX2_CLONES

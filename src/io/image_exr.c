@@ -27,11 +27,16 @@ typedef struct exr_stream {
     char message[256];       // last OpenEXRCore error text
 } exr_stream;
 
+// The stream of the load or save running on this thread. The error handler must not ask the
+// context for its user data: OpenEXRCore calls the handler with a write context's mutex held
+// and exr_get_user_data takes that mutex again, so a failed write (a full disk) deadlocked.
+static _Thread_local exr_stream *exr_active;
+
 static void exr_error_handler(exr_const_context_t f, exr_result_t code, const char *msg)
 {
-    void *user = NULL;
-    if (exr_get_user_data(f, &user) == EXR_ERR_SUCCESS && user) {
-        exr_stream *s = user;
+    (void)f;
+    exr_stream *s = exr_active;
+    if (s) {
         snprintf(s->message, sizeof(s->message), "%s",
                  msg ? msg : exr_get_error_code_as_string(code));
     }
@@ -62,8 +67,9 @@ static int64_t exr_write_temp(exr_const_context_t f, void *user, const void *buf
 {
     exr_stream *s = user;
     if (!drift__image_temp_write(s->temp, buffer, (size_t)size, offset)) {
-        error_cb(f, EXR_ERR_WRITE_IO, "write of %llu bytes failed: errno %d",
-                 (unsigned long long)size, errno);
+        char why[160];
+        error_cb(f, EXR_ERR_WRITE_IO, "write of %llu bytes failed: %s", (unsigned long long)size,
+                 drift__write_errno_text(errno, why, sizeof(why)));
         return -1;
     }
     return (int64_t)size;
@@ -236,10 +242,11 @@ static exr_result_t decode_part(exr_context_t f, int part, exr_storage_t storage
     return rv != EXR_ERR_SUCCESS ? rv : drv;
 }
 
-drift_result drift__image_exr_load(drift_context *ctx, const char *path, const uint8_t *data,
-                                   size_t size, drift_image *out_image)
+static drift_result exr_load(drift_context *ctx, const char *path, const uint8_t *data, size_t size,
+                             drift_image *out_image)
 {
     exr_stream stream = { .ctx = ctx, .path = path, .data = data, .size = size };
+    exr_active = &stream;
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
     init.error_handler_fn = exr_error_handler;
     init.user_data = &stream;
@@ -374,6 +381,14 @@ drift_result drift__image_exr_load(drift_context *ctx, const char *path, const u
     }
     *out_image = img;
     return DRIFT_OK;
+}
+
+drift_result drift__image_exr_load(drift_context *ctx, const char *path, const uint8_t *data,
+                                   size_t size, drift_image *out_image)
+{
+    drift_result r = exr_load(ctx, path, data, size, out_image);
+    exr_active = NULL;
+    return r;
 }
 
 // --- SAVING ---
@@ -613,6 +628,7 @@ drift_result drift_image_save_exr_channels(drift_context *ctx, const char *path,
         return r;
     }
     exr_stream stream = { .ctx = ctx, .path = path, .temp = &temp };
+    exr_active = &stream;
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
     init.error_handler_fn = exr_error_handler;
     init.user_data = &stream;
@@ -654,6 +670,7 @@ drift_result drift_image_save_exr_channels(drift_context *ctx, const char *path,
     if (rv != EXR_ERR_SUCCESS) {
         r = exr_fail(&stream, rv, "OpenEXR write failed");
     }
+    exr_active = NULL;
     drift_free(ctx, chans);
     return drift__image_temp_close(ctx, &temp, r);
 }

@@ -3,6 +3,7 @@
 //
 // The stb implementation is not compiled here: Debian's libstb (pkg-config stb, -lstb) already
 // contains stb_image and stb_image_write, so only the declarations are included.
+#include "drift/file.h"
 #include "drift/math.h"
 #include "image_io_internal.h"
 #include "image_ocio.h"
@@ -75,6 +76,21 @@ const char *drift__errno_text(int err, char *buf, size_t cap)
     return buf;
 }
 
+const char *drift__write_errno_text(int err, char *buf, size_t cap)
+{
+    char os[96]; // with the plain words it fits the callers' 128 bytes
+    drift__errno_text(err, os, sizeof(os));
+    const char *plain = err == ENOSPC || err == EDQUOT ? "disk full"
+                        : err == EFBIG                 ? "file size limit reached"
+                                                       : NULL;
+    if (plain) {
+        snprintf(buf, cap, "%s (%s)", plain, os);
+    } else {
+        snprintf(buf, cap, "%s", os);
+    }
+    return buf;
+}
+
 // --- WHOLE-FILE READS ---
 
 drift_result drift__image_read_file(drift_context *ctx, const char *path, uint8_t **out_data,
@@ -83,16 +99,15 @@ drift_result drift__image_read_file(drift_context *ctx, const char *path, uint8_
     *out_data = NULL;
     *out_size = 0;
     char why[128];
-    // O_NONBLOCK: opening a FIFO would otherwise wait for a writer; it is refused below.
-    int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY);
+    int fd = drift_input_open(path, why, sizeof(why));
     if (fd < 0) {
-        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, path, 0, "cannot open image: %s",
-                  drift__errno_text(errno, why, sizeof(why)));
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, path, 0, "cannot open image: %s", why);
         return DRIFT_ERR_IO;
     }
     struct stat st;
-    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, path, 0, "not a regular file");
+    if (fstat(fd, &st) != 0) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, path, 0, "cannot open image: %s",
+                  drift__errno_text(errno, why, sizeof(why)));
         close(fd);
         return DRIFT_ERR_IO;
     }
@@ -157,9 +172,34 @@ drift_result drift__image_temp_open(drift_context *ctx, const char *path, drift_
     return DRIFT_ERR_IO;
 }
 
+// DRIFT_TEST_DISK_FULL: the bytes this process may still write, -1 when unset (parsed once).
+static _Atomic long long disk_full_left = -2;
+
+static bool disk_full_injected(size_t size)
+{
+    long long left = disk_full_left;
+    if (left == -2) {
+        const char *env = getenv("DRIFT_TEST_DISK_FULL");
+        left = env && *env ? atoll(env) : -1;
+        disk_full_left = left;
+    }
+    if (left < 0) {
+        return false;
+    }
+    if ((unsigned long long)left < size) {
+        errno = ENOSPC;
+        return true;
+    }
+    disk_full_left = left - (long long)size;
+    return false;
+}
+
 bool drift__image_temp_write(drift__image_temp *t, const void *data, size_t size, uint64_t offset)
 {
     const uint8_t *p = data;
+    if (disk_full_injected(size)) {
+        return false;
+    }
     while (size > 0) {
         ssize_t n = pwrite(t->fd, p, size, (off_t)offset);
         if (n < 0 && errno == EINTR) {
@@ -185,7 +225,7 @@ drift_result drift__image_temp_close(drift_context *ctx, drift__image_temp *t, d
         // close() can report a delayed write error (NFS, full disk); it counts as a failure.
         if (close(t->fd) != 0 && result == DRIFT_OK) {
             drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, t->path, 0, "write failed: %s",
-                      drift__errno_text(errno, why, sizeof(why)));
+                      drift__write_errno_text(errno, why, sizeof(why)));
             result = DRIFT_ERR_IO;
         }
         t->fd = -1;
@@ -539,9 +579,9 @@ drift_result drift_image_save_png(drift_context *ctx, const char *path, const dr
         int ok = stbi_write_png_to_func(png_write, &sink, image->width, image->height, 3, rgb,
                                         image->width * 3);
         if (!ok || sink.failed) {
-            char why[128];
+            char why[160];
             drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, path, 0, "PNG write failed: %s",
-                      sink.failed ? drift__errno_text(sink.error, why, sizeof(why))
+                      sink.failed ? drift__write_errno_text(sink.error, why, sizeof(why))
                                   : "encoder failed");
             r = DRIFT_ERR_IO;
         }

@@ -11,6 +11,9 @@
 
 // strerror_r's text for `err` in buf (plain strerror is not thread-safe); returns buf.
 const char *drift__errno_text(int err, char *buf, size_t cap);
+// The same for a failed write, said plainly where it is a full disk or a size limit:
+// "disk full (No space left on device)". Returns buf.
+const char *drift__write_errno_text(int err, char *buf, size_t cap);
 
 // Reads a whole file into memory from drift_alloc (free with drift_free). Logs and returns
 // DRIFT_ERR_IO when the file cannot be opened or read.
@@ -28,6 +31,8 @@ typedef struct drift__image_temp {
 // Creates the temporary file (O_EXCL, mode 0666 less umask). Logs and returns DRIFT_ERR_IO.
 drift_result drift__image_temp_open(drift_context *ctx, const char *path, drift__image_temp *out);
 // Writes all of `size` bytes at `offset` (pwrite). Returns false on error (errno set).
+// DRIFT_TEST_DISK_FULL=N in the environment makes every write past the process's first N
+// bytes fail with ENOSPC (the tests' full disk; docs/reliability.md).
 bool drift__image_temp_write(drift__image_temp *t, const void *data, size_t size, uint64_t offset);
 // Closes the file. When `result` is DRIFT_OK, renames it over the target (a failing close or
 // rename is logged and turns the result into DRIFT_ERR_IO); otherwise, or when that fails,

@@ -4,6 +4,7 @@
 // Normals: the file's normals are kept; none are generated, so a file without them is
 // shaded flat (right for boxes like the Cornell box). UVs are kept as assimp gives them
 // (origin bottom-left, as docs/conventions.md wants).
+#include "drift/file.h"
 #include "scene_io_internal.h"
 
 #include <assimp/cimport.h>
@@ -650,8 +651,8 @@ static drift_result check_ply_header(const import_state *s, const char *head, si
 // Reads the start of a file for check_ply_header.
 static drift_result check_ply_file(const import_state *s, size_t file_size)
 {
-    char head[8192];
-    FILE *f = fopen(s->params->path, "rb");
+    char head[8192], why[128];
+    FILE *f = drift_input_fopen(s->params->path, why, sizeof why);
     if (!f) {
         return DRIFT_OK; // drift__check_file just saw it; let assimp report what changed
     }
@@ -755,9 +756,15 @@ drift_result drift__scene_import_mesh_file(drift_scene *scene, const drift__impo
         // From memory, assimp cannot open side files (an OBJ's .mtl, a glTF's .bin).
         ai = aiImportFileFromMemory(data, (unsigned)size, flags, ext);
     } else {
-        ai = aiImportFile(params->path, flags);
+        drift__texture_cache *t = params->textures;
+        r = drift__assimp_import_file(ctx, params->path, flags, s.where, s.line,
+                                      t ? t->on_input : NULL, t ? t->user : NULL, &ai);
     }
     drift_free(ctx, data);
+    if (r != DRIFT_OK) { // a side file that is not a regular file, already said
+        drift__gltf_close(ctx, s.gltf);
+        return r;
+    }
     if (!ai || !ai->mRootNode) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, s.where, s.line, "cannot read '%s': %s",
                   params->path, ai ? "no scene" : aiGetErrorString());

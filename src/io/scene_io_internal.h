@@ -194,7 +194,7 @@ drift_result drift__read_file(drift_context *ctx, const char *path, bool gzip, c
 
 // Checks a PLY file's header and that its data holds every element the header declares,
 // each with its values (scene_ply.c): errors name path and line (ASCII) or byte offset
-// (binary). A header with more elements or properties than any mesh needs is left to assimp.
+// (binary). A header with more elements or properties than any mesh needs is an error.
 drift_result drift__ply_check(drift_context *ctx, const char *path, const char *data, size_t size);
 
 // Lower-case extension of path without the dot ("" when none). A trailing ".gz" is looked
@@ -206,6 +206,16 @@ bool drift__is_mesh_extension(const char *ext);
 
 // base_dir + "/" + relative (relative unchanged when absolute or base_dir is NULL/empty).
 bool drift__path_join(const char *base_dir, const char *relative, char *out, size_t out_size);
+
+// aiImportFile through drift_input_open (scene_assimp_io.c): every file assimp opens (the
+// mesh, an OBJ's mtllib, a glTF's buffers) must be a regular file, and each one other than
+// `path` is told to on_input (may be NULL). *out_ai is assimp's result (NULL: see
+// aiGetErrorString). A side file that is not a regular file (a FIFO, /dev/zero) fails the
+// import with an error naming it against (where, line): DRIFT_ERR_IO, *out_ai NULL.
+struct aiScene;
+drift_result drift__assimp_import_file(drift_context *ctx, const char *path, unsigned flags,
+                                       const char *where, int line, drift_scene_input_fn on_input,
+                                       void *user, const struct aiScene **out_ai);
 
 // The framing camera of a bare mesh file (see scene_io.h).
 drift_camera drift__framing_camera(drift_bounds3 bounds);

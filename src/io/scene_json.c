@@ -262,10 +262,12 @@ static drift_result read_vec3(const json_reader *r, const cJSON *obj, const char
     }
     char full[KEY_PATH_MAX];
     key_path(full, path, key);
-    double lo = kind == VEC3_COLOR ? 0.0 : -(double)FLT_MAX;
+    // Positions and directions within the scene's coordinate range (DRIFT_SCENE_COORD_MAX).
+    double lo = kind == VEC3_COLOR ? 0.0 : -DRIFT_SCENE_COORD_MAX;
+    double hi = kind == VEC3_COLOR ? (double)FLT_MAX : DRIFT_SCENE_COORD_MAX;
     double v[3];
     if (kind == VEC3_COLOR && cJSON_IsNumber(item)) {
-        drift_result res = number_value(r, item, full, lo, (double)FLT_MAX, &v[0]);
+        drift_result res = number_value(r, item, full, lo, hi, &v[0]);
         if (res != DRIFT_OK) {
             return res;
         }
@@ -280,7 +282,7 @@ static drift_result read_vec3(const json_reader *r, const cJSON *obj, const char
     for (const cJSON *c = item->child; c; c = c->next, ++k) {
         char element[KEY_PATH_MAX];
         index_path(element, full, (size_t)k);
-        drift_result res = number_value(r, c, element, lo, (double)FLT_MAX, &v[k]);
+        drift_result res = number_value(r, c, element, lo, hi, &v[k]);
         if (res != DRIFT_OK) {
             return res;
         }

@@ -1,5 +1,6 @@
 // Scene loading entry point: dispatch by extension, whole-file reads (gunzipped with zlib),
 // the texture cache, and the camera and light a bare mesh file is given.
+#include "drift/file.h"
 #include "drift/image_io.h"
 #include "drift/scene_io.h"
 #include "image_io_internal.h" // drift__errno_text
@@ -11,6 +12,7 @@
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 #include <zlib.h>
 
 void drift__path_extension(const char *path, char *out, size_t out_size, bool *out_gz)
@@ -120,11 +122,16 @@ drift_result drift__read_file(drift_context *ctx, const char *path, bool gzip, c
     }
     // gzread inflates gzip data and passes anything else through unchanged, so one loop reads
     // both kinds; gzdirect says which kind the file is, and it must match its name.
-    gzFile gz = gzopen(path, "rb");
+    char why[128];
+    int fd = drift_input_open(path, why, sizeof(why));
+    gzFile gz = fd >= 0 ? gzdopen(fd, "rb") : NULL;
     if (!gz) {
-        char why[128];
+        if (fd >= 0) {
+            drift__errno_text(errno, why, sizeof(why));
+            close(fd);
+        }
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, where, line, "cannot open '%s': %s", path,
-                  drift__errno_text(errno, why, sizeof(why)));
+                  why);
         return DRIFT_ERR_IO;
     }
     if (gzdirect(gz) == (int)gzip) {
@@ -189,6 +196,27 @@ drift_result drift__read_file(drift_context *ctx, const char *path, bool gzip, c
     return DRIFT_OK;
 }
 
+// Sets the texels of `image` that are NaN or infinite to 0 and says how many: one such texel
+// of a texture or environment map made NaN pixels in a hybrid frame.
+static void replace_nonfinite_texels(drift_context *ctx, drift_image *image, const char *path,
+                                     const char *where, int line)
+{
+    size_t count = 0;
+    for (int32_t y = 0; y < image->height; ++y) {
+        float *row = image->pixels + (size_t)y * (size_t)image->stride;
+        for (size_t i = 0; i < (size_t)image->width * (size_t)image->channels; ++i) {
+            if (!isfinite(row[i])) {
+                row[i] = 0.0f;
+                ++count;
+            }
+        }
+    }
+    if (count > 0) {
+        drift_log(ctx, DRIFT_LOG_WARNING, DRIFT_ERR_INVALID_ARGUMENT, where, line,
+                  "texture '%s': %zu texel values were NaN or infinite; set to 0", path, count);
+    }
+}
+
 drift_result drift__texture_cache_get(drift_scene *scene, drift__texture_cache *cache,
                                       const char *path, const char *where, int line,
                                       uint32_t *out_index)
@@ -211,6 +239,7 @@ drift_result drift__texture_cache_get(drift_scene *scene, drift__texture_cache *
         drift_log(ctx, DRIFT_LOG_ERROR, r, where, line, "cannot load texture '%s'", path);
         return r;
     }
+    replace_nonfinite_texels(ctx, &image, path, where, line);
     if (cache->on_input) {
         cache->on_input(path, cache->user);
     }

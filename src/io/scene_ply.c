@@ -20,6 +20,7 @@ typedef struct ply_property {
     int size;       // bytes of a scalar, or of each list item
     int count_size; // bytes of a list's count; 0 for a scalar
     bool count_signed;
+    bool face_indices; // a face's vertex_indices (or vertex_index): a count of 0 is refused
 } ply_property;
 
 typedef struct ply_element {
@@ -99,11 +100,10 @@ static bool ply_next_line(ply_reader *r, char *buf, size_t buf_size, bool *ended
     return true;
 }
 
-static drift_result ply_read_header(ply_reader *r, bool *checkable)
+static drift_result ply_read_header(ply_reader *r)
 {
     char line[512];
     bool newline;
-    *checkable = true;
     r->line = 0;
     bool have_format = false;
     while (ply_next_line(r, line, sizeof line, &newline)) {
@@ -144,8 +144,9 @@ static drift_result ply_read_header(ply_reader *r, bool *checkable)
                     r, r->line, "an element line is 'element NAME COUNT'; got '%s %s'", a, b);
             }
             if (r->element_count == PLY_MAX_ELEMENTS) {
-                *checkable = false; // more than any mesh needs: leave it to assimp
-                return DRIFT_OK;
+                // More than any mesh needs; assimp hung on such headers.
+                return ply_error_at_line(r, r->line, "more than %d elements in a PLY header",
+                                         PLY_MAX_ELEMENTS);
             }
             ply_element *e = &r->elements[r->element_count++];
             snprintf(e->name, sizeof e->name, "%s", a);
@@ -177,9 +178,11 @@ static drift_result ply_read_header(ply_reader *r, bool *checkable)
                 }
             }
             if (e->property_count == PLY_MAX_PROPERTIES) {
-                *checkable = false;
-                return DRIFT_OK;
+                return ply_error_at_line(r, r->line, "more than %d properties in element '%s'",
+                                         PLY_MAX_PROPERTIES, e->name);
             }
+            p.face_indices = is_list && strcmp(e->name, "face") == 0 &&
+                             (strcmp(d, "vertex_indices") == 0 || strcmp(d, "vertex_index") == 0);
             e->properties[e->property_count++] = p;
         } else {
             return ply_error_at_line(r, r->line, "unknown PLY header line '%s'", word);
@@ -248,6 +251,11 @@ static drift_result ply_check_ascii(ply_reader *r)
                                                      value, element);
                         }
                         items = (long)v;
+                        if (items == 0 && p->face_indices) {
+                            return ply_error_at_line(r, r->line + 1,
+                                                     "a face with no vertex indices (element %s)",
+                                                     element);
+                        }
                     }
                 }
             }
@@ -302,6 +310,13 @@ static drift_result ply_check_binary(ply_reader *r)
                     }
                     bool negative;
                     items = ply_read_count(r, p, &negative);
+                    if (items == 0 && p->face_indices) {
+                        drift_log(r->ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, r->path, 0,
+                                  "byte %zu: a face with no vertex indices ('%s' element %llu of "
+                                  "%llu)",
+                                  r->pos, e->name, k + 1, e->count);
+                        return DRIFT_ERR_PARSE;
+                    }
                     if (negative || items > 1000000) {
                         drift_log(r->ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, r->path, 0,
                                   "byte %zu: a list count below 0 or over 10^6 in '%s' element "
@@ -329,9 +344,8 @@ drift_result drift__ply_check(drift_context *ctx, const char *path, const char *
         return DRIFT_ERR_OUT_OF_MEMORY;
     }
     *r = (ply_reader){ .ctx = ctx, .path = path, .data = data, .size = size };
-    bool checkable = true;
-    drift_result res = ply_read_header(r, &checkable);
-    if (res == DRIFT_OK && checkable) {
+    drift_result res = ply_read_header(r);
+    if (res == DRIFT_OK) {
         res = r->binary ? ply_check_binary(r) : ply_check_ascii(r);
     }
     drift_free(ctx, r);

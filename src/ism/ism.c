@@ -445,7 +445,7 @@ static drift_result make_lights(drift_ism *ism, const drift_gbuffer *gbuffer, dr
         drift_parallel_for(ism->ctx, ism->vpl_count, 1, drift__ism_maps_range, &mj);
         st->splats = (uint64_t)ism->vpl_count * ism->params.points_per_vpl;
         uint64_t empty = 0;
-        for (int i = 0; i < 64; ++i) {
+        for (int i = 0; i < DRIFT_MAX_THREADS; ++i) {
             empty += mj.empty[i];
         }
         double disc = (double)DRIFT_PI * 0.25 * (double)mj.splat.n * (double)mj.splat.n;
@@ -454,7 +454,7 @@ static drift_result make_lights(drift_ism *ism, const drift_gbuffer *gbuffer, dr
         // Splat and pull-push run map by map on one thread: the pass's wall time is split
         // between them in proportion to the threads' own clock of each.
         double splat_s = 0.0, pull_s = 0.0;
-        for (int i = 0; i < 64; ++i) {
+        for (int i = 0; i < DRIFT_MAX_THREADS; ++i) {
             splat_s += mj.seconds[i][0];
             pull_s += mj.seconds[i][1];
         }
@@ -548,7 +548,7 @@ static drift_result render(drift_ism *ism, const drift_gbuffer *gbuffer, const d
     drift_parallel_for(ism->ctx, (size_t)gj.bands * (size_t)b * (size_t)b, 1,
                        drift__ism_gather_jobs, &gj);
     drift_free(ism->ctx, gj.buffers);
-    for (int i = 0; i < 64; ++i) {
+    for (int i = 0; i < DRIFT_MAX_THREADS; ++i) {
         st.shadow_rays += gj.rays[i];
     }
     now = drift_time_now();

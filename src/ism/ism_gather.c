@@ -29,15 +29,14 @@ void drift__ism_maps_range(size_t begin, size_t end, int thread, void *user)
         double t1 = drift_time_now();
         if (ism->lazy_levels > 0) {
             drift__ism_pull(depth, n, ism->lazy_levels, ism->params.pull_push_threshold);
-            job->empty[thread % 64] +=
-                drift__ism_holes(depth, n, ism->lazy_levels, ism->disc_counts);
+            job->empty[thread] += drift__ism_holes(depth, n, ism->lazy_levels, ism->disc_counts);
         } else {
-            job->empty[thread % 64] += drift__ism_pull_push(
-                depth, n, levels > 0 ? levels : 0, ism->params.pull_push_threshold,
-                ism->scratch + (size_t)thread * 2 * map);
+            job->empty[thread] += drift__ism_pull_push(depth, n, levels > 0 ? levels : 0,
+                                                       ism->params.pull_push_threshold,
+                                                       ism->scratch + (size_t)thread * 2 * map);
         }
-        job->seconds[thread % 64][0] += t1 - t0;
-        job->seconds[thread % 64][1] += drift_time_now() - t1;
+        job->seconds[thread][0] += t1 - t0;
+        job->seconds[thread][1] += drift_time_now() - t1;
     }
 }
 
@@ -349,7 +348,7 @@ void drift__ism_gather_jobs(size_t begin, size_t end, int thread, void *user)
             uint32_t first, last;
             drift__ism_group_run(ism, g, run, runs, &first, &last);
             for (uint32_t j = first; j < last; ++j) {
-                drift__ism_gather_vpl(ism, j, &c, &rs, &job->rays[thread % 64]);
+                drift__ism_gather_vpl(ism, j, &c, &rs, &job->rays[thread]);
             }
         }
         float scale = (float)runs * DRIFT_INV_PI;

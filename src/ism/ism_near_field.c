@@ -29,7 +29,7 @@ typedef struct near_field_job {
     const drift_image *direct;
     float dmin;
     uint32_t seed;
-    uint64_t rays[64]; // per thread
+    uint64_t rays[DRIFT_MAX_THREADS]; // per thread
 } near_field_job;
 
 // Shooting pixels a side, either way, that near_field_spread_rows averages: 2 spreads a block's
@@ -105,7 +105,7 @@ static void near_field_rows(size_t begin, size_t end, int thread, void *user)
                                   .dir = dir,
                                   .tmin = 0.0f,
                                   .tmax = job->dmin };
-                ++job->rays[thread % 64];
+                ++job->rays[thread];
                 // Emitters are the direct light's; only a reflecting surface is near-field light.
                 if (drift_accel_intersect(ism->accel, &ray, &hit) &&
                     hit.mesh != DRIFT_INVALID_INDEX && hit.light == DRIFT_INVALID_INDEX &&
@@ -175,7 +175,7 @@ void drift__ism_add_near_field(drift_ism *ism, const drift_gbuffer *gb, const dr
                            .seed = drift_hash_combine(ism->params.seed, 0x4e454152u) };
     drift_parallel_for(ism->ctx, (size_t)gb->height, 4, near_field_rows, &job);
     drift_parallel_for(ism->ctx, (size_t)gb->height, 4, near_field_spread_rows, &job);
-    for (int i = 0; i < 64; ++i) {
+    for (int i = 0; i < DRIFT_MAX_THREADS; ++i) {
         st->near_field_rays += job.rays[i];
     }
 }

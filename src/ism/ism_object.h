@@ -44,8 +44,8 @@ struct drift_ism {
 typedef struct map_job {
     drift_ism *ism;
     drift__ism_splat_desc splat;
-    uint32_t empty[64];    // per thread
-    double seconds[64][2]; // per thread: splatting, pull-push
+    uint32_t empty[DRIFT_MAX_THREADS];    // per thread
+    double seconds[DRIFT_MAX_THREADS][2]; // per thread: splatting, pull-push
 } map_job;
 
 // Receivers of one gather job, structure of arrays for the vectorised loop over them.
@@ -61,9 +61,9 @@ typedef struct receivers {
 typedef struct gather_job {
     drift_ism *ism;
     const drift_gbuffer *gb;
-    uint64_t rays[64];   // per thread
-    float *buffers;      // per thread: receivers_in of `capacity`
-    int32_t capacity;    // receivers a job can hold
+    uint64_t rays[DRIFT_MAX_THREADS]; // per thread
+    float *buffers;                   // per thread: receivers_in of `capacity`
+    int32_t capacity;                 // receivers a job can hold
     int32_t subset_rows; // rows of one subset in a band (a band is subset_rows * B rows)
     int32_t bands;
     bool near_field;     // the blur adds the near-field plane

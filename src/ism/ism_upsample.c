@@ -66,8 +66,8 @@ void drift__ism_decimate_rows(size_t begin, size_t end, int thread, void *user)
 typedef struct upsample_job {
     drift_ism *ism;
     const drift_gbuffer *gb;
-    uint8_t *fallback; // per G-buffer pixel: 1 where it must gather itself
-    uint64_t rays[64]; // per thread, the fallback's `ir` rays
+    uint8_t *fallback;                // per G-buffer pixel: 1 where it must gather itself
+    uint64_t rays[DRIFT_MAX_THREADS]; // per thread, the fallback's `ir` rays
     const uint32_t *fallback_pixels;
     size_t fallback_count;
     size_t job_pixels;       // receivers of one fallback job
@@ -170,7 +170,7 @@ static void fallback_jobs(size_t begin, size_t end, int thread, void *user)
             uint32_t from, to;
             drift__ism_group_run(ism, g, ism->slice, ism->slices, &from, &to);
             for (uint32_t j = from; j < to; ++j) {
-                drift__ism_gather_vpl(ism, j, &c, &rs, &job->rays[thread % 64]);
+                drift__ism_gather_vpl(ism, j, &c, &rs, &job->rays[thread]);
             }
         }
         float scale = (float)ism->slices * DRIFT_INV_PI * DRIFT_INV_PI;
@@ -213,7 +213,7 @@ drift_result drift__ism_upsample(drift_ism *ism, const drift_gbuffer *gb, drift_
             job.fallback_count = fallbacks;
             drift_parallel_for(ism->ctx, (fallbacks + job.job_pixels - 1) / job.job_pixels, 1,
                                fallback_jobs, &job);
-            for (int i = 0; i < 64; ++i) {
+            for (int i = 0; i < DRIFT_MAX_THREADS; ++i) {
                 st->shadow_rays += job.rays[i];
             }
         } else {

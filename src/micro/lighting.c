@@ -15,7 +15,7 @@ typedef struct light_job {
     drift__micro_tree *tree;
     int32_t samples;
     uint32_t key;
-    uint64_t rays[64]; // per thread
+    uint64_t rays[DRIFT_MAX_THREADS]; // per thread
 } light_job;
 
 // E kd / pi on the side of `surf` its normals face, from `samples` light samples.
@@ -82,10 +82,10 @@ static void light_range(size_t begin, size_t end, int thread, void *user)
                 surf.ng = drift_vec3_neg(surf.ng);
                 surf.ns = drift_vec3_neg(surf.ns);
             }
-            front = reflected_direct(job, &surf, kd, &s, &job->rays[thread % 64]);
+            front = reflected_direct(job, &surf, kd, &s, &job->rays[thread]);
             surf.ng = drift_vec3_neg(surf.ng);
             surf.ns = drift_vec3_neg(surf.ns);
-            back = reflected_direct(job, &surf, kd, &s, &job->rays[thread % 64]);
+            back = reflected_direct(job, &surf, kd, &s, &job->rays[thread]);
         }
         tree->front[node] = front;
         tree->back[node] = back;
@@ -104,7 +104,7 @@ uint64_t drift__micro_light_leaves(drift_context *ctx, const drift_scene *scene,
                       .key = drift_hash_combine(seed, DRIFT_MICRO_LIGHT_STREAM) };
     drift_parallel_for(ctx, tree->leaf_count, 256, light_range, &job);
     uint64_t rays = 0;
-    for (int i = 0; i < 64; ++i) {
+    for (int i = 0; i < DRIFT_MAX_THREADS; ++i) {
         rays += job.rays[i];
     }
     return rays;

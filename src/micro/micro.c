@@ -140,8 +140,8 @@ typedef struct gather_job {
     drift_vec3 eye;
     drift_micro_lobe lobe;
     int32_t grid_w, grid_h;
-    drift__micro_gather_stats stats[64]; // per thread
-    uint64_t fallbacks[64];
+    drift__micro_gather_stats stats[DRIFT_MAX_THREADS]; // per thread
+    uint64_t fallbacks[DRIFT_MAX_THREADS];
 } gather_job;
 
 typedef struct glossy_slice {
@@ -261,7 +261,7 @@ static void gather_rows(size_t begin, size_t end, int thread, void *user)
         for (int32_t i = 0; i < job->grid_w; ++i) {
             int32_t x = grid_pixel(i, d, m->width);
             drift_vec3 in;
-            drift_vec3 out = gather_pixel(job, x, y, &job->stats[thread % 64], &in);
+            drift_vec3 out = gather_pixel(job, x, y, &job->stats[thread], &in);
             drift_image_set3(&m->coarse_in, i, j, in);
             drift_image_set3(&m->coarse_out, i, j, out);
             drift_image_pixel(&m->gathers, x, y)[0] = 1.0f;
@@ -359,9 +359,9 @@ static void upsample_rows(size_t begin, size_t end, int thread, void *user)
                     }
                 } else {
                     // No gather point on this surface nearby: gather here (the extra pass).
-                    out = gather_pixel(job, x, y, &job->stats[thread % 64], &in);
+                    out = gather_pixel(job, x, y, &job->stats[thread], &in);
                     drift_image_pixel(&m->gathers, x, y)[0] = 1.0f;
-                    job->fallbacks[thread % 64]++;
+                    job->fallbacks[thread]++;
                 }
             }
             drift_image_set3(&m->incident, x, y, in);
@@ -446,7 +446,7 @@ drift_result drift_micro_render(drift_micro *micro, const drift_gbuffer *gbuffer
     // 4. Upsampling (a copy, with the albedo, at every-pixel density).
     drift_parallel_for(m->ctx, (size_t)m->height, 1, upsample_rows, job);
     double t4 = drift_time_now();
-    for (int i = 0; i < 64; ++i) {
+    for (int i = 0; i < DRIFT_MAX_THREADS; ++i) {
         const drift__micro_gather_stats *s = &job->stats[i];
         m->stats.gathers += s->gathers;
         m->stats.nodes_visited += s->visited;

@@ -30,7 +30,7 @@ typedef struct photon_job {
     uint32_t key, per_path;
     drift_vec3 centre;
     float radius;
-    uint64_t rays[64];
+    uint64_t rays[DRIFT_MAX_THREADS];
 } photon_job;
 
 // The first ray of a path and its flux; false when it carries nothing (point and spot lights
@@ -45,7 +45,7 @@ static void trace_range(size_t begin, size_t end, int thread, void *user)
 {
     photon_job *job = user;
     const drift__micro_photon_desc *desc = job->desc;
-    uint64_t *rays = &job->rays[thread % 64];
+    uint64_t *rays = &job->rays[thread];
     for (size_t i = begin; i < end; ++i) {
         drift__micro_photon *slots = job->slots + i * job->per_path;
         uint8_t *stored = job->stored + i * job->per_path;
@@ -331,7 +331,7 @@ drift_result drift__micro_photons_trace(drift_context *ctx, const drift_scene *s
         sum[2] += (double)emitted[i].z;
     }
     out_map->emitted = drift_vec3_make((float)sum[0], (float)sum[1], (float)sum[2]);
-    for (int i = 0; i < 64; ++i) {
+    for (int i = 0; i < DRIFT_MAX_THREADS; ++i) {
         out_map->rays += job->rays[i];
     }
     if (count > 0) {

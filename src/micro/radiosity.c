@@ -25,14 +25,14 @@ typedef struct radiosity_job {
     const drift__micro_tree *tree;
     drift__micro_gather_desc gather;
     element *elements;
-    drift__micro_gather_stats stats[64]; // per thread
+    drift__micro_gather_stats stats[DRIFT_MAX_THREADS]; // per thread
 } radiosity_job;
 
 static void gather_elements(size_t begin, size_t end, int thread, void *user)
 {
     radiosity_job *job = user;
     const drift__micro_tree *tree = job->tree;
-    drift__micro_gather_stats *st = &job->stats[thread % 64];
+    drift__micro_gather_stats *st = &job->stats[thread];
     for (size_t e = begin; e < end; ++e) {
         element *el = &job->elements[e];
         drift_vec3 axis = tree->axis[el->node];
@@ -167,7 +167,7 @@ drift_result drift__micro_radiosity(drift_context *ctx, drift__micro_tree *tree,
         tree->back[n - 1 + j] = total[2 * j + 1];
     }
     if (out_rays) {
-        for (int i = 0; i < 64; ++i) {
+        for (int i = 0; i < DRIFT_MAX_THREADS; ++i) {
             *out_rays += job->stats[i].rays;
         }
     }

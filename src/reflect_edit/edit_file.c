@@ -1,6 +1,7 @@
 // Edit files (.edit.json; format in docs/reflection-editing.md), read with cJSON. As for
 // scene files, src/io/json_lines.c pairs every cJSON node with the line its value starts on,
 // so each complaint names "file:line".
+#include "drift/file.h"
 #include "io/json_lines.h"
 #include "reflect_edit/reflect_edit_internal.h"
 
@@ -50,8 +51,9 @@ fail(const reader *r, const cJSON *node, const char *fmt, ...)
 static drift_result read_number(const reader *r, const cJSON *node, const char *what, float lo,
                                 float *out)
 {
-    if (!cJSON_IsNumber(node) || !isfinite(node->valuedouble) || fabs(node->valuedouble) > 1e30) {
-        return fail(r, node, "%s must be a finite number", what);
+    // Positions beyond DRIFT_SCENE_COORD_MAX reached Embree and aborted it.
+    if (!cJSON_IsNumber(node) || !(fabs(node->valuedouble) <= DRIFT_SCENE_COORD_MAX)) {
+        return fail(r, node, "%s must be a finite number within +-%g", what, DRIFT_SCENE_COORD_MAX);
     }
     if (node->valuedouble < (double)lo) {
         return fail(r, node, "%s must be at least %g", what, (double)lo);
@@ -331,9 +333,10 @@ drift_result drift_reflection_edits_load(drift_context *ctx, const drift_scene *
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
     *out_edits = NULL;
-    FILE *f = fopen(path, "rb");
+    char why[128];
+    FILE *f = drift_input_fopen(path, why, sizeof why);
     if (!f) {
-        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, path, 0, "cannot open: %s", strerror(errno));
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, path, 0, "cannot open: %s", why);
         return DRIFT_ERR_IO;
     }
     char *text = drift_alloc(ctx, MAX_EDIT_FILE_BYTES + 1);

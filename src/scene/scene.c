@@ -416,6 +416,50 @@ static void enforce_energy_conservation(drift_scene *scene, drift_material *m)
     }
 }
 
+static bool within_coord_max(drift_vec3 p)
+{
+    const double m = DRIFT_SCENE_COORD_MAX;
+    return fabs((double)p.x) <= m && fabs((double)p.y) <= m && fabs((double)p.z) <= m;
+}
+
+// Every vertex, light and the camera within +-DRIFT_SCENE_COORD_MAX (NaN fails too).
+static drift_result check_coordinates(const drift_scene *scene)
+{
+    for (uint32_t m = 0; m < scene->mesh_count; ++m) {
+        const drift_mesh *mesh = &scene->meshes[m];
+        for (uint32_t v = 0; v < mesh->vertex_count; ++v) {
+            const float *p = mesh->positions + 3 * (size_t)v;
+            if (!within_coord_max(drift_vec3_make(p[0], p[1], p[2]))) {
+                drift_log(scene->ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, mesh->name, 0,
+                          "vertex %u is at (%g, %g, %g), outside the +-%g drift accepts", v,
+                          (double)p[0], (double)p[1], (double)p[2], DRIFT_SCENE_COORD_MAX);
+                return DRIFT_ERR_INVALID_ARGUMENT;
+            }
+        }
+    }
+    for (uint32_t i = 0; i < scene->light_count; ++i) {
+        const drift_light *l = &scene->lights[i];
+        if (l->type != DRIFT_LIGHT_TRIANGLE &&
+            (!within_coord_max(l->position) || !within_coord_max(l->edge_u) ||
+             !within_coord_max(l->edge_v) || !(fabs((double)l->radius) <= DRIFT_SCENE_COORD_MAX))) {
+            drift_log(scene->ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, NULL, 0,
+                      "light %u is at (%g, %g, %g) or spans further than the +-%g drift accepts", i,
+                      (double)l->position.x, (double)l->position.y, (double)l->position.z,
+                      DRIFT_SCENE_COORD_MAX);
+            return DRIFT_ERR_INVALID_ARGUMENT;
+        }
+    }
+    const drift_camera *cam = &scene->camera;
+    if (!within_coord_max(cam->position) || !within_coord_max(cam->target)) {
+        drift_log(scene->ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, NULL, 0,
+                  "the camera's position (%g, %g, %g) or target is outside the +-%g drift accepts",
+                  (double)cam->position.x, (double)cam->position.y, (double)cam->position.z,
+                  DRIFT_SCENE_COORD_MAX);
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    return DRIFT_OK;
+}
+
 drift_result drift_scene_commit(drift_scene *scene)
 {
     if (!scene) {
@@ -499,6 +543,10 @@ drift_result drift_scene_commit(drift_scene *scene)
         } else if (l->type == DRIFT_LIGHT_POINT || l->type == DRIFT_LIGHT_SPOT) {
             bounds = drift_bounds3_extend(bounds, l->position);
         }
+    }
+    drift_result far = check_coordinates(scene);
+    if (far != DRIFT_OK) {
+        return far;
     }
     scene->bounds = bounds;
     scene->reflector_bounds = drift_bounds3_empty();

@@ -2,6 +2,7 @@
 // rasterization and ray tracing, draw random lambda tuples, keep the one whose combined
 // metric is closest to the real error over all views. The averaged sum is the first
 // candidate, so the fit is never worse than it on its own training views.
+#include "drift/file.h"
 #include "sir/sir.h"
 
 #include <cjson/cJSON.h>
@@ -106,9 +107,11 @@ drift_result drift_refine_lambda_save(drift_context *ctx, const char *path,
 drift_result drift_refine_lambda_load(drift_context *ctx, const char *path,
                                       float out_lambda[DRIFT_METRIC_COUNT])
 {
-    FILE *f = fopen(path, "rb");
+    char why[128];
+    FILE *f = drift_input_fopen(path, why, sizeof why);
     if (!f) {
-        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, path, 0, "could not open the lambda file");
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_IO, path, 0, "could not open the lambda file: %s",
+                  why);
         return DRIFT_ERR_IO;
     }
     char text[4096];

@@ -3,12 +3,15 @@
 // red handle (the reflection slides across the surface) or its green handle (what the point
 // reflects), add and remove regions, undo, save. Every change re-commits the edit set, which
 // the hybrid frame and the reference borrow, and restarts the reference.
+#include "drift/file.h"
 #include "view/view_internal.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #define HISTORY_MAX 64
 
@@ -104,9 +107,14 @@ drift_result drift_view_edit_begin(drift_view *view, const char *path)
             return DRIFT_ERR_OUT_OF_MEMORY;
         }
         memcpy(view->edits_path, path, len);
-        FILE *f = fopen(path, "rb");
-        if (f) {
-            fclose(f);
+        // A file that is there is loaded (a FIFO or device too: the loader refuses it, where
+        // fopen here waited for a writer); a new one starts empty.
+        char why[128];
+        int fd = drift_input_open(path, why, sizeof why);
+        if (fd >= 0 || errno == EINVAL) {
+            if (fd >= 0) {
+                close(fd);
+            }
             return drift_reflection_edits_load(view->ctx, view->scene, view->accel, path,
                                                &view->edits);
         }

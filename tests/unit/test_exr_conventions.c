@@ -43,7 +43,11 @@ static void test_exr_conventions_channels_and_metadata(void **state)
         snprintf(names + len, sizeof names - len, "%s%s", i ? "," : "", list->entries[i].name.str);
     }
     // OpenEXR lists channels sorted by name.
-    assert_string_equal(names, "B,G,N.X,N.Y,N.Z,R,Z,albedo.B,albedo.G,albedo.R");
+    // The conventional layers, then the feature-guided denoiser's inputs (issue 48).
+    assert_string_equal(names, "B,G,N.X,N.Y,N.Z,R,Z,albedo.B,albedo.G,albedo.R,"
+                               "feature_albedo.B,feature_albedo.G,feature_albedo.R,"
+                               "feature_depth.Y,feature_normal.X,feature_normal.Y,"
+                               "feature_normal.Z,variance.Y");
 
     exr_attr_chromaticities_t chroma_value = { 0 }, *chroma = &chroma_value;
     assert_int_equal(exr_attr_get_chromaticities(f, 0, "chromaticities", chroma), EXR_ERR_SUCCESS);
