@@ -6,7 +6,6 @@
 set -u
 drift="$1"
 source "$(dirname "$0")/common.sh"
-# ctest-labels: slow
 # --ism-vpls 8: the default indirect light (ism, 1024 VPLs) costs seconds a frame at any size
 # under the sanitizers; these checks are of behaviour, not of the image's quality.
 small=(--width 32 --height 24 --threads 2 --spp 2 --quiet --ism-vpls 8)

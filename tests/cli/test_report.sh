@@ -7,7 +7,6 @@
 # a scene that fails to load and an effect without reference get cells saying so and a
 # non-zero exit. Without chromium (or with DRIFT_TEST_BROWSER=OFF, CMake's option) the browser
 # checks are left out and said so. $1 is the drift binary.
-# ctest-labels: slow
 set -u
 drift="$1"
 here="$(dirname "$0")"
