@@ -11,6 +11,12 @@ include(CMakePackageConfigHelpers)
 configure_file(${CMAKE_CURRENT_SOURCE_DIR}/include/drift/version.h.in
   ${CMAKE_BINARY_DIR}/generated/include/drift/version.h @ONLY)
 
+# A fuzzing build (DRIFT_BUILD_FUZZERS, libFuzzer's instrumentation in every object) makes no
+# product: no shared library, nothing to install.
+if(DRIFT_BUILD_FUZZERS)
+  return()
+endif()
+
 # A target needs a source of its own: an empty one.
 file(CONFIGURE OUTPUT ${CMAKE_BINARY_DIR}/generated/drift_shared.c
   CONTENT "// libdrift.so: the objects of libdrift.a (cmake/drift_install.cmake)\ntypedef int drift_shared_unit;\n")
