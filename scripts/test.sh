@@ -62,7 +62,7 @@ fuzz_one() {
 }
 export -f fuzz_one
 export DRIFT_FUZZ_SECONDS
-ls build/fuzz/fuzz_* | grep -v '\.log$' | xargs -P "$jobs" -I{} bash -c 'fuzz_one {}'
+for f in build/fuzz/fuzz_*; do [[ "$f" == *.log ]] || echo "$f"; done | xargs -P "$jobs" -I{} bash -c 'fuzz_one {}'
 
 phase "valgrind (memcheck) on a plain Debug build of the core tests"
 cmake -S . -B build/valgrind -DCMAKE_BUILD_TYPE=Debug "${launcher[@]}" >/dev/null
@@ -77,7 +77,7 @@ phase "tests (ctest -j$jobs)"
 status=0
 # shellcheck disable=SC2086 # DRIFT_CTEST_ARGS is words
 (cd build/dev && ctest -j"$jobs" --output-on-failure ${DRIFT_CTEST_ARGS:-}) || status=$?
-phase done
+phase "end"
 echo "== the ten slowest tests (ctest's last run)"
 bash scripts/slowest-tests.sh build/dev 10 || true
 printf "== time by phase\n%b" "$phases"
