@@ -1,13 +1,14 @@
 // drift bench frontier: the equal-time frontier (issue 21). Every row renders the whole frame
 // and is compared with one converged path-traced image of the whole frame (all effects, max
 // depth 8, the path tracer's pixel filter): the path tracer at 1, 2, 4, ... spp, the same
-// images through the edge-avoiding a-trous filter (drift/denoise.h), and hybrid frames built
+// images through the edge-avoiding a-trous filter and through drift's best denoiser, the
+// feature-guided one (pt+denoise, `--denoise on`; drift/denoise.h), and hybrid frames built
 // from the technique table (shadows x indirect, VPL counts and AAF spp swept, max depth 8).
 // --svg plots FLIP against ms with the Pareto front; every row names its budget band.
 // Each row's milliseconds are the median of --runs renders; then, per budget, the row with
 // the lowest FLIP within it (the Pareto front) and whether a hybrid row beats both the plain
-// and the denoised path tracer there. The reference is cached as an EXR keyed by scene, size,
-// spp and max depth, so reruns reuse it. docs/frontier.md has the measured table.
+// and the denoised path tracer (pt+denoise) there. The reference is cached as an EXR keyed by
+// scene, size, spp and max depth, so reruns reuse it. docs/frontier.md has the measured table.
 #include "bench.h"
 #include "drift/accel.h"
 #include "drift/denoise.h"
@@ -112,8 +113,9 @@ static const cli_option frontier_table[] = {
 static const cli_command frontier_command = {
     .name = "bench frontier",
     .usage = "usage: drift bench frontier [SCENE] [options]\n\n"
-             "The equal-time frontier: the path tracer, the path tracer + a-trous and hybrid\n"
-             "technique combinations against one converged path-traced image of the whole\n"
+             "The equal-time frontier: the path tracer, the path tracer + a-trous, + drift's\n"
+             "best denoiser (pt+denoise) and hybrid technique combinations against one\n"
+             "converged path-traced image of the whole\n"
              "frame; every row's median ms, FLIP and RMSE, then per budget the lowest FLIP\n"
              "within it. SCENE defaults to scenes/cornell-box/cornell_box.json.\n\n",
     CLI_TABLE(frontier_table),
@@ -124,6 +126,7 @@ static const cli_command frontier_command = {
 typedef enum row_family {
     FAMILY_PT = 0,
     FAMILY_PT_ATROUS,
+    FAMILY_PT_DENOISE, // the path tracer + drift's best denoiser (`--denoise on`)
     FAMILY_HYBRID,
     FAMILY_SIR,
     FAMILY_COUNT
@@ -133,7 +136,8 @@ typedef enum row_family {
 // by SIR.
 #define FAMILY_DRIFT (-2)
 
-static const char *const family_names[FAMILY_COUNT] = { "pt", "pt+atrous", "hybrid", "sir" };
+static const char *const family_names[FAMILY_COUNT] = { "pt", "pt+atrous", "pt+denoise", "hybrid",
+                                                        "sir" };
 
 typedef struct frontier_row {
     char name[96];
@@ -294,13 +298,14 @@ static drift_result add_row(frontier_state *b, row_family family, const char *na
 }
 
 // The path tracer at `spp` (median of --runs fresh renders), then the same image through the
-// a-trous filter (its ms: the render's plus the filter's median). *out_ms: the render's.
+// a-trous filter and through the feature-guided denoiser, drift_denoise_feature (their ms: the
+// render's plus the filter's median). *out_ms: the render's.
 static drift_result pt_rows(frontier_state *b, long spp, double *out_ms)
 {
     const frontier_options *o = b->o;
-    double render_ms[100], filter_ms[100];
+    double render_ms[100], filter_ms[100], feature_ms[100];
     drift_result r = DRIFT_OK;
-    drift_image plain = { 0 }, denoised = { 0 };
+    drift_image plain = { 0 }, denoised = { 0 }, featured = { 0 };
     for (long k = 0; k < o->runs && r == DRIFT_OK; ++k) {
         drift_pt_params params = pt_params(o, 1u);
         drift_pt *pt = NULL;
@@ -318,20 +323,33 @@ static drift_result pt_rows(frontier_state *b, long spp, double *out_ms)
         r = r ? r
               : drift_denoise_atrous(b->ctx, &beauty, &albedo, &normal, &depth, NULL, &denoised);
         filter_ms[k] = (drift_time_now() - t0) * 1e3;
+        drift_image var, f_albedo, f_normal, f_depth;
+        r = r ? r : drift_pt_resolve(pt, DRIFT_PT_AOV_VARIANCE, &var);
+        r = r ? r : drift_pt_resolve(pt, DRIFT_PT_AOV_FEATURE_ALBEDO, &f_albedo);
+        r = r ? r : drift_pt_resolve(pt, DRIFT_PT_AOV_FEATURE_NORMAL, &f_normal);
+        r = r ? r : drift_pt_resolve(pt, DRIFT_PT_AOV_FEATURE_DEPTH, &f_depth);
+        drift_image_destroy(b->ctx, &featured);
+        drift_denoise_inputs in = { &beauty, &f_albedo, &f_normal, &f_depth, &var, (uint32_t)spp };
+        t0 = drift_time_now();
+        r = r ? r : drift_denoise_feature(b->ctx, &in, NULL, &featured, NULL);
+        feature_ms[k] = (drift_time_now() - t0) * 1e3;
         drift_image_destroy(b->ctx, &plain);
         r = r ? r : copy_rgb(b->ctx, &beauty, &plain);
         drift_pt_destroy(pt);
     }
     if (r == DRIFT_OK) {
-        double ms = median(render_ms, o->runs), fms = median(filter_ms, o->runs);
+        double ms = median(render_ms, o->runs), fms = median(filter_ms, o->runs),
+               dms = median(feature_ms, o->runs);
         char name[64];
         snprintf(name, sizeof name, "%ld spp", spp);
         r = add_row(b, FAMILY_PT, name, ms, &plain);
         r = r ? r : add_row(b, FAMILY_PT_ATROUS, name, ms + fms, &denoised);
+        r = r ? r : add_row(b, FAMILY_PT_DENOISE, name, ms + dms, &featured);
         *out_ms = ms;
     }
     drift_image_destroy(b->ctx, &plain);
     drift_image_destroy(b->ctx, &denoised);
+    drift_image_destroy(b->ctx, &featured);
     return r;
 }
 
@@ -699,7 +717,8 @@ static bool write_svg(const frontier_state *b, const char *path, const char *sce
         fprintf(f, "%.1f,%.1f ", PX(row->ms), PY(row->flip));
     }
     fprintf(f, "\"/>\n");
-    static const char *const colours[FAMILY_COUNT] = { "#c62f1f", "#e08a1e", "#1f63c6", "#2f9e44" };
+    static const char *const colours[FAMILY_COUNT] = { "#c62f1f", "#e08a1e", "#8a3ffc", "#1f63c6",
+                                                       "#2f9e44" };
     for (int i = 0; i < b->row_count; ++i) {
         const frontier_row *row = &b->rows[i];
         fprintf(f,
@@ -854,14 +873,16 @@ int drift_bench_frontier(int argc, char **argv)
         for (int k = 0; k < o.budget_count; ++k) {
             double budget = (double)o.budgets[k];
             int best = best_within(b, -1, budget), pt = best_within(b, FAMILY_PT, budget),
-                dn = best_within(b, FAMILY_PT_ATROUS, budget),
+                at = best_within(b, FAMILY_PT_ATROUS, budget),
+                dn = best_within(b, FAMILY_PT_DENOISE, budget),
                 h = best_within(b, FAMILY_DRIFT, budget);
             cJSON *item = cJSON_CreateObject();
             cJSON_AddItemToArray(front, item);
             cJSON_AddNumberToObject(item, "budget_ms", budget);
             add_best(item, "best", b, best);
             add_best(item, "pt", b, pt);
-            add_best(item, "pt_atrous", b, dn);
+            add_best(item, "pt_atrous", b, at);
+            add_best(item, "pt_denoise", b, dn);
             add_best(item, "hybrid", b, h);
             cJSON_AddBoolToObject(item, "hybrid_beats_both", hybrid_wins(b, h, pt, dn));
         }
@@ -886,17 +907,19 @@ int drift_bench_frontier(int argc, char **argv)
             }
             printf(" | %s |\n", on_front(b, i) ? "yes" : "");
         }
-        printf("\n| budget ms | front (lowest FLIP) | best pt | best pt+atrous | best drift "
-               "(hybrid or sir) | "
-               "drift beats both |\n|---|---|---|---|---|---|\n");
+        printf("\n| budget ms | front (lowest FLIP) | best pt | best pt+atrous | best pt+denoise | "
+               "best drift (hybrid or sir) | drift beats pt and pt+denoise |\n"
+               "|---|---|---|---|---|---|---|\n");
         for (int k = 0; k < o.budget_count; ++k) {
             double budget = (double)o.budgets[k];
             int pt = best_within(b, FAMILY_PT, budget),
-                dn = best_within(b, FAMILY_PT_ATROUS, budget),
+                at = best_within(b, FAMILY_PT_ATROUS, budget),
+                dn = best_within(b, FAMILY_PT_DENOISE, budget),
                 h = best_within(b, FAMILY_DRIFT, budget);
             printf("| %ld |", o.budgets[k]);
             print_best(b, best_within(b, -1, budget));
             print_best(b, pt);
+            print_best(b, at);
             print_best(b, dn);
             print_best(b, h);
             printf(" %s |\n", hybrid_wins(b, h, pt, dn) ? "yes" : "no");

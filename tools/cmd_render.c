@@ -242,9 +242,10 @@ static const cli_option render_table[] = {
             "image size (default: the scene camera's)"),
     CLI_STRING("--out", "FILE.exr", O, out_path,
                "output (default out/render.exr); FILE.png is written too"),
-    CLI_CHOICE("--denoise", "none|atrous", O, denoise, "none|atrous",
-               "reference: the edge-avoiding a-trous filter guided by the\n"
-               "albedo, normal and depth AOVs over the image written (docs/frontier.md)"),
+    CLI_CHOICE("--denoise", "none|atrous|on|regression", O, denoise, "none|atrous|on|regression",
+               "reference: on = the feature-guided, variance-guided denoiser\n"
+               "(docs/denoiser.md); atrous = the edge-avoiding a-trous filter;\n"
+               "regression = the blockwise feature regression it was measured against"),
     CLI_TECHNIQUE("--glare", "T", O, hybrid,
                   "the last pass of either mode, at the camera's angular pitch\n"
                   "(docs/glare.md)"),
@@ -498,7 +499,7 @@ int render_parse_options(int argc, char **argv, render_options *o)
         return 2;
     }
     if (o->hybrid_mode && o->denoise) {
-        fprintf(stderr, "drift render: --denoise atrous filters the path tracer's image; the "
+        fprintf(stderr, "drift render: --denoise filters the path tracer's image; the "
                         "hybrid frame has its own techniques (drop --mode hybrid or --denoise)\n");
         return 2;
     }
@@ -594,13 +595,34 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
         return r;
     }
     drift_image denoised = { 0 }, glared = { 0 }, spp = { 0 };
-    if (o->denoise) { // --denoise atrous, before glare (the last pass)
+    drift_image variance = { 0 }, f_albedo = { 0 }, f_normal = { 0 }, f_depth = { 0 };
+    bool feature = o->denoise >= 2; // --denoise on|regression: drift_denoise_feature
+    if (feature || o->aov) {        // the images stay the pt's until its next render call
+        if ((r = drift_pt_resolve(pt, DRIFT_PT_AOV_VARIANCE, &variance)) != DRIFT_OK ||
+            (r = drift_pt_resolve(pt, DRIFT_PT_AOV_FEATURE_ALBEDO, &f_albedo)) != DRIFT_OK ||
+            (r = drift_pt_resolve(pt, DRIFT_PT_AOV_FEATURE_NORMAL, &f_normal)) != DRIFT_OK ||
+            (r = drift_pt_resolve(pt, DRIFT_PT_AOV_FEATURE_DEPTH, &f_depth)) != DRIFT_OK) {
+            return r;
+        }
+    }
+    if (o->denoise) { // before glare (the last pass)
         double t_denoise = drift_time_now();
-        if ((r = drift_pt_resolve(pt, DRIFT_PT_AOV_ALBEDO, &albedo)) != DRIFT_OK ||
-            (r = drift_pt_resolve(pt, DRIFT_PT_AOV_NORMAL, &normal)) != DRIFT_OK ||
-            (r = drift_pt_resolve(pt, DRIFT_PT_AOV_DEPTH, &depth)) != DRIFT_OK ||
-            (r = drift_denoise_atrous(ctx, &beauty, &albedo, &normal, &depth, NULL, &denoised)) !=
-                DRIFT_OK) {
+        if (feature) {
+            uint32_t lowest, highest;
+            render_spp_range(pt, &lowest, &highest);
+            drift_denoise_inputs in = {
+                &beauty, &f_albedo, &f_normal, &f_depth, &variance, lowest
+            };
+            drift_denoise_feature_params fp = { .method = o->denoise == 3
+                                                              ? DRIFT_DENOISE_REGRESSION
+                                                              : DRIFT_DENOISE_VARIANCE_GUIDED };
+            r = drift_denoise_feature(ctx, &in, &fp, &denoised, NULL);
+        } else if ((r = drift_pt_resolve(pt, DRIFT_PT_AOV_ALBEDO, &albedo)) == DRIFT_OK &&
+                   (r = drift_pt_resolve(pt, DRIFT_PT_AOV_NORMAL, &normal)) == DRIFT_OK &&
+                   (r = drift_pt_resolve(pt, DRIFT_PT_AOV_DEPTH, &depth)) == DRIFT_OK) {
+            r = drift_denoise_atrous(ctx, &beauty, &albedo, &normal, &depth, NULL, &denoised);
+        }
+        if (r != DRIFT_OK) {
             return r;
         }
         beauty = denoised; // destroyed below
@@ -613,7 +635,7 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
         }
         beauty = glared; // the glare's copy, destroyed below
     }
-    drift_image_layer layers[5] = { { NULL, &beauty } };
+    drift_image_layer layers[9] = { { NULL, &beauty } };
     uint32_t layer_count = 1;
     if (o->aov) {
         if ((r = drift_pt_resolve(pt, DRIFT_PT_AOV_ALBEDO, &albedo)) != DRIFT_OK ||
@@ -626,7 +648,12 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
         layers[1] = (drift_image_layer){ "albedo", &albedo };
         layers[2] = (drift_image_layer){ "normal", &normal };
         layers[3] = (drift_image_layer){ "depth", &depth };
-        layer_count = 4;
+        // The feature-guided denoiser's inputs (drift/pt.h, DRIFT_PT_AOV_VARIANCE on).
+        layers[4] = (drift_image_layer){ "variance", &variance };
+        layers[5] = (drift_image_layer){ "feature_albedo", &f_albedo };
+        layers[6] = (drift_image_layer){ "feature_normal", &f_normal };
+        layers[7] = (drift_image_layer){ "feature_depth", &f_depth };
+        layer_count = 8;
     }
     uint32_t lowest, highest;
     render_spp_range(pt, &lowest, &highest);

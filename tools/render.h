@@ -48,7 +48,7 @@ typedef struct render_options {
     double ev100;        // --ev100, or from --camera-exposure
     drift_tonemap_operator tonemap;
     bool aov;
-    bool denoise; // --denoise atrous (reference mode)
+    int denoise; // --denoise: 0 none, 1 atrous, 2 on (drift_denoise_feature), 3 regression
     bool quiet;
     bool verbose;
     long debug_x, debug_y, debug_sample; // -1: not replaying a sample

@@ -81,6 +81,79 @@ drift_result drift_denoise_atrous(drift_context *ctx, const drift_image *color,
                                   const drift_image *depth, const drift_denoise_params *params,
                                   drift_image *out);
 
+// --- THE FEATURE-GUIDED DENOISER (`drift render --denoise on`) ---
+//
+// drift's best denoiser for the path tracer (docs/denoiser.md). The input is the path
+// tracer's beauty with its guides at the first non-delta vertex (DRIFT_PT_AOV_FEATURE_*) and
+// the per-pixel variance of the mean (DRIFT_PT_AOV_VARIANCE, running moments). Stages:
+//   1. sanitise: a non-finite value of any input is taken as 0 and counted (a warning gives
+//      the count, drift_denoise_report.nonfinite); negative colour is taken as 0
+//   2. demodulate: irradiance = colour / albedo per channel (drift_denoise_albedo_divisor),
+//      so textures are multiplied back sharp at the end (Zimmer et al. 2015)
+//   3. fireflies: a pixel's demodulated luminance above mean + 3 sd of its 5x5 window
+//      (itself included), plus 3 sd of its own mean from 4 samples on, is scaled down to it
+//      (its chroma kept). Scale-free, so HDR-safe; a lone 1-spp firefly keeps ~60 %.
+//   4. variance v_p of the demodulated luminance's mean: the pixel's own (variance AOV over
+//      the albedo luminance squared); below 4 samples (or without a variance image) at
+//      least the 7x7 window's variance over n (SVGF §4.1's spatial estimate, unweighted)
+//   5. the filter (method):
+//      VARIANCE_GUIDED  SVGF's spatial filter (Schied et al. 2017, §4.2): `iterations`
+//        a-trous passes of the 5x5 B3 kernel, taps 2^i apart, each weighed by
+//          luminance exp(-|l_p - l_q| / (sigma_luminance (1 + 1/sqrt(n)) sqrt(g3x3(v_p))))
+//          normal    max(0, n_p . n_q)^sigma_normal
+//          depth     exp(-|z_p - z_q| / (sigma_depth 2^i z_p))
+//          albedo    exp(-ln((a_p + 0.01) / (a_q + 0.01))^2 / sigma_albedo^2) (luminances)
+//        with the variance carried through each pass (sum w^2 v / (sum w)^2): where the
+//        samples agree (many spp) the luminance weight closes and little is blurred
+//      REGRESSION  blockwise first-order feature regression (BMFR, Koskela et al. 2019):
+//        in 32x32 blocks, overlapping by half and blended with tent weights, the
+//        irradiance is fitted per channel by least squares (ridge 1e-3) to the features
+//        1, normal, depth, depth^2, x, y, x^2, y^2 (scaled to [-1, 1] in the block)
+//   6. remodulate: times the albedo divisor again; clamped to >= 0
+// VARIANCE_GUIDED is the default: never worse than the raw image on the five scenes measured
+// at 1, 4 and 16 spp, where REGRESSION (without BMFR's temporal part) is worse at 16 spp
+// (docs/lab/2026-12-07-issue-48.md). Every output pixel is a gather (or a block fit) over
+// the previous stage alone: bit-identical for any thread count.
+typedef enum drift_denoise_method {
+    DRIFT_DENOISE_VARIANCE_GUIDED = 0,
+    DRIFT_DENOISE_REGRESSION,
+    DRIFT_DENOISE_METHOD_COUNT
+} drift_denoise_method;
+
+typedef struct drift_denoise_feature_params {
+    drift_denoise_method method;
+    int32_t iterations;    // 0 -> 5 (variance-guided passes); at most 10
+    float sigma_luminance; // 0 -> 4 (SVGF's sigma_l)
+    float sigma_normal;    // 0 -> 128
+    float sigma_depth;     // 0 -> 0.1
+    float sigma_albedo;    // 0 -> 1
+    bool no_firefly_clamp; // true: skip stage 3
+} drift_denoise_feature_params;
+
+drift_denoise_feature_params
+drift_denoise_feature_params_resolve(const drift_denoise_feature_params *params);
+
+// The inputs, all of one size: color, albedo, normal RGB; depth, variance 1 channel.
+// albedo, normal, depth may be NULL (neutral guide); variance may be NULL (then the spatial
+// estimate of stage 4 is used whatever sample_count says).
+typedef struct drift_denoise_inputs {
+    const drift_image *color, *albedo, *normal, *depth, *variance;
+    uint32_t sample_count; // samples per pixel behind color (0 is taken as 1)
+} drift_denoise_inputs;
+
+typedef struct drift_denoise_report {
+    uint64_t nonfinite;   // input values that were NaN or infinite (taken as 0)
+    uint64_t clamped;     // pixels the firefly rule scaled down
+    double mean_variance; // the mean over pixels of stage 4's variance (demodulated units)
+} drift_denoise_report;
+
+// Filters in->color into *out (a new 3-channel image; the caller destroys it). report may be
+// NULL. Errors: DRIFT_ERR_INVALID_ARGUMENT (no colour, sizes differ, bad params; logged),
+// DRIFT_ERR_OUT_OF_MEMORY. *out is zeroed on failure.
+drift_result drift_denoise_feature(drift_context *ctx, const drift_denoise_inputs *in,
+                                   const drift_denoise_feature_params *params, drift_image *out,
+                                   drift_denoise_report *report);
+
 #ifdef __cplusplus
 }
 #endif

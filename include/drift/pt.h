@@ -102,6 +102,13 @@ typedef enum drift_pt_aov {
     DRIFT_PT_AOV_ALBEDO,     // diffuse + specular reflectance (or emission) at the first hit, RGB
     DRIFT_PT_AOV_NORMAL,     // shading normal at the first hit, RGB in [-1, 1]
     DRIFT_PT_AOV_DEPTH,      // distance along the camera ray to the first hit, 1 channel (0 = miss)
+    // The feature-guided denoiser's inputs (drift_denoise_feature, drift/denoise.h):
+    DRIFT_PT_AOV_VARIANCE,       // variance of the pixel's mean beauty luminance: the samples'
+                                 // unbiased variance over n (running moments; 0 below 2 samples)
+    DRIFT_PT_AOV_FEATURE_ALBEDO, // albedo at the first non-delta vertex (through mirrors and
+                                 // glass, times their throughput; plus its emission), RGB
+    DRIFT_PT_AOV_FEATURE_NORMAL, // shading normal there, RGB in [-1, 1]
+    DRIFT_PT_AOV_FEATURE_DEPTH,  // length of the path up to there, 1 channel (0 = escaped)
     DRIFT_PT_AOV_COUNT
 } drift_pt_aov;
 

@@ -1,12 +1,12 @@
 // The edge-avoiding a-trous filter (include/drift/denoise.h gives the weights and defaults).
 #include "core/vectorise.h"
+#include "denoise/exp_neg.h"
 #include "drift/denoise.h"
 
 #include <math.h>
 #include <string.h>
 
-#define DENOISE_LUM_EPS    1e-2f
-#define DENOISE_EXP_CUTOFF 30.0f // exp(-30) ~ 1e-13: the tap adds nothing
+#define DENOISE_LUM_EPS 1e-2f
 
 drift_denoise_params drift_denoise_params_resolve(const drift_denoise_params *params)
 {
@@ -56,33 +56,6 @@ static const float b3[5] = { 1.0f / 16.0f, 1.0f / 4.0f, 3.0f / 8.0f, 1.0f / 4.0f
 static const float b1[3] = { 1.0f / 4.0f, 1.0f / 2.0f, 1.0f / 4.0f };
 
 #define ATROUS_RUN 128 // pixels of a row whose taps are weighed together
-
-// exp(-e) for e in [0, DENOISE_EXP_CUTOFF]: 2^x with x = -e / ln 2 split into the nearest
-// integer n (by the 1.5 * 2^23 rounding trick: a float-to-int conversion keeps GCC from
-// vectorising the AVX2 clone) and f in [-1/2, 1/2], 2^f by its Taylor series to the 6th
-// power (relative error < 2e-7) and 2^n put in the exponent bits. Written out so that the
-// loops calling it vectorise (libm's expf does not).
-static inline DRIFT_ALWAYS_INLINE float exp_neg(float e)
-{
-    float x = -e * 1.44269504f;
-
-    union {
-        float f;
-        int32_t i;
-    } rounded = { .f = x + 12582912.0f };
-
-    float f = (x - (rounded.f - 12582912.0f)) * 0.69314718f; // 2^f = e^(f ln 2)
-    float p = 1.0f + f * (1.0f + f * (0.5f + f * (1.0f / 6.0f +
-                                                  f * (1.0f / 24.0f + f * (1.0f / 120.0f +
-                                                                           f * (1.0f / 720.0f))))));
-
-    union {
-        int32_t i;
-        float f;
-    } scale = { .i = (rounded.i - 0x4B400000 + 127) << 23 };
-
-    return p * scale.f;
-}
 
 // The weights of one tap (kernel weight wk, the neighbour `offset` pixels away) over pixels
 // [p, p + n) of the centre's planes, added into the run's sums.

@@ -5,8 +5,10 @@
 #include <string.h>
 
 #define TILE_SIZE DRIFT_PT_TILE_SIZE
-// Channels accumulated per pixel: beauty RGB, albedo RGB, normal XYZ, depth.
-#define SUM_CHANNELS 10
+// Channels accumulated per pixel: beauty RGB, albedo RGB, normal XYZ, depth, then the
+// denoiser's inputs: the sum of the squared beauty luminance (the running second moment), and
+// albedo RGB, normal XYZ and depth at the first non-delta vertex (drift/pt.h).
+#define SUM_CHANNELS 18
 
 // Per-thread counters, padded to a cache line so threads do not share one.
 typedef struct thread_stats {
@@ -33,6 +35,11 @@ typedef struct path_result {
     drift_vec3 albedo;
     drift_vec3 normal;
     float depth;
+    // At the first vertex whose BSDF is not a delta (mirror, glass): the feature the denoiser
+    // is guided by; the albedo is times the delta bounces' throughput up to there.
+    drift_vec3 feature_albedo;
+    drift_vec3 feature_normal;
+    float feature_depth; // length of the path up to that vertex (0 = it escaped first)
 } path_result;
 
 drift_pt_params drift_pt_params_resolve(const drift_pt_params *params, const drift_scene *scene)
@@ -263,6 +270,8 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
     float prev_bsdf_pdf = 0.0f;
     drift_vec3 prev_position = ray.origin;
     path_split split = { .active = p->components != DRIFT_PT_COMPONENT_ALL };
+    bool feature_open = true; // no non-delta vertex yet: the next one gives the features
+    float path_length = 0.0f;
     stats->camera_rays++;
 
     for (int32_t depth = 0;; ++depth) {
@@ -278,6 +287,9 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
                 split_add(&split, depth, true, c);
                 if (depth == 0) {
                     out->albedo = le;
+                }
+                if (feature_open) {
+                    out->feature_albedo = drift_vec3_mul(beta, le);
                 }
             }
             break;
@@ -306,6 +318,14 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
             radiance = drift_vec3_add(radiance, c);
             split_add(&split, depth, true, c);
         }
+        if (feature_open && (surf.material == DRIFT_INVALID_INDEX || depth >= p->max_depth)) {
+            out->feature_albedo =
+                drift_vec3_mul(beta, surf.material == DRIFT_INVALID_INDEX ? surf.emission
+                                                                          : drift_vec3_splat(1.0f));
+            out->feature_normal = surf.ns;
+            out->feature_depth = path_length + hit.t;
+            feature_open = false;
+        }
         if (surf.material == DRIFT_INVALID_INDEX || depth >= p->max_depth) {
             break;
         }
@@ -314,6 +334,17 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
             // The first specular bounce follows the edit: its lobes centre on e(q).
             drift_reflection_edits_aim_bsdf(p->reflection_edits, &surf, wo, &bsdf);
         }
+        if (feature_open && !drift_bsdf_is_delta(&bsdf)) {
+            // An emitter's own light counts as albedo (the denoiser's irradiance there is ~1,
+            // so that a small light is no outlier to its neighbours).
+            const drift_material *m = &scene->materials[surf.material];
+            drift_vec3 a = drift_vec3_add(drift_vec3_add(m->diffuse, m->specular), surf.emission);
+            out->feature_albedo = drift_vec3_mul(beta, a);
+            out->feature_normal = surf.ns;
+            out->feature_depth = path_length + hit.t;
+            feature_open = false;
+        }
+        path_length += hit.t;
         drift_vec2 u_choice = drift_sampler_next2(&sampler); // x: light pick, y: lobe pick
         if (!p->disable_nee && !drift_bsdf_is_delta(&bsdf)) {
             drift_vec3 ld = sample_direct(pt, &surf, &bsdf, wo, &sampler, u_choice.x, stats);
@@ -422,10 +453,16 @@ static void render_tiles(size_t begin, size_t end, int thread_index, void *user)
                         stats->nan_samples++;
                         r.radiance = drift_vec3_splat(0.0f);
                     }
-                    const float v[SUM_CHANNELS] = { r.radiance.x, r.radiance.y, r.radiance.z,
-                                                    r.albedo.x,   r.albedo.y,   r.albedo.z,
-                                                    r.normal.x,   r.normal.y,   r.normal.z,
-                                                    r.depth };
+                    float lum = drift_luminance(r.radiance);
+                    const float v[SUM_CHANNELS] = { r.radiance.x,       r.radiance.y,
+                                                    r.radiance.z,       r.albedo.x,
+                                                    r.albedo.y,         r.albedo.z,
+                                                    r.normal.x,         r.normal.y,
+                                                    r.normal.z,         r.depth,
+                                                    lum * lum,          r.feature_albedo.x,
+                                                    r.feature_albedo.y, r.feature_albedo.z,
+                                                    r.feature_normal.x, r.feature_normal.y,
+                                                    r.feature_normal.z, r.feature_depth };
                     for (int c = 0; c < SUM_CHANNELS; ++c) {
                         sum[c] += (double)v[c];
                     }
@@ -551,8 +588,8 @@ drift_result drift_pt_resolve(drift_pt *pt, drift_pt_aov aov, drift_image *out_i
     if (!pt || !out_image || (unsigned)aov >= DRIFT_PT_AOV_COUNT) {
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
-    static const int first_channel[DRIFT_PT_AOV_COUNT] = { 0, 3, 6, 9 };
-    static const int channel_count[DRIFT_PT_AOV_COUNT] = { 3, 3, 3, 1 };
+    static const int first_channel[DRIFT_PT_AOV_COUNT] = { 0, 3, 6, 9, 10, 11, 14, 17 };
+    static const int channel_count[DRIFT_PT_AOV_COUNT] = { 3, 3, 3, 1, 1, 3, 3, 1 };
     drift_image *img = &pt->resolved[aov];
     if (!img->pixels) {
         drift_result r = drift_image_create(pt->ctx, pt->params.width, pt->params.height,
@@ -567,6 +604,16 @@ drift_result drift_pt_resolve(drift_pt *pt, drift_pt_aov aov, drift_image *out_i
             uint32_t n = pt->counts[pixel];
             const double *sum = pt->sums + pixel * SUM_CHANNELS + first_channel[aov];
             float *dst = drift_image_pixel(img, x, y);
+            if (aov == DRIFT_PT_AOV_VARIANCE) {
+                // The unbiased sample variance of the luminance over n, the variance of the
+                // pixel's mean; 0 below two samples.
+                const double *beauty = pt->sums + pixel * SUM_CHANNELS;
+                double mean = (0.2126 * beauty[0] + 0.7152 * beauty[1] + 0.0722 * beauty[2]) /
+                              (double)(n ? n : 1);
+                double var = n > 1 ? (sum[0] - (double)n * mean * mean) / (double)(n - 1) : 0.0;
+                dst[0] = var > 0.0 ? (float)(var / (double)n) : 0.0f;
+                continue;
+            }
             for (int c = 0; c < channel_count[aov]; ++c) {
                 dst[c] = n ? (float)(sum[c] / (double)n) : 0.0f;
             }

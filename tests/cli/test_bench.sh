@@ -132,7 +132,8 @@ assert first["reference_cached"] is False and d["reference_cached"] is True, (fi
 assert [r["flip"] for r in first["rows"] if r["family"] != "hybrid"] == \
     [r["flip"] for r in d["rows"] if r["family"] != "hybrid"], d
 fam = [r["family"] for r in d["rows"]]
-assert fam.count("pt") == 2 and fam.count("pt+atrous") == 2 and fam.count("hybrid") >= 20, fam
+assert fam.count("pt") == 2 and fam.count("pt+atrous") == 2 and fam.count("pt+denoise") == 2 \
+    and fam.count("hybrid") >= 20, fam
 # Every hybrid combination once more at --aa 2 and at one light sample; SIR rows refine the
 # pcss frame.
 names = [r["name"] for r in d["rows"] if r["family"] == "hybrid"]
@@ -154,7 +155,7 @@ for f in d["front"]:
         continue
     assert best["ms"] <= f["budget_ms"] and best["flip"] <= prev, d["front"]
     prev = best["flip"]
-    for k in ("pt", "pt_atrous", "hybrid"):
+    for k in ("pt", "pt_atrous", "pt_denoise", "hybrid"):
         assert f[k] is None or (f[k]["ms"] <= f["budget_ms"] and f[k]["flip"] >= best["flip"]), f
 budgets = [f["budget_ms"] for f in d["front"]]
 for r in d["rows"]:
