@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Installs dependencies, builds drift (Release) and renders the built-in Cornell box with the
-# reference path tracer. Extra arguments go to `drift render` (e.g. --spp 256).
+# Installs what building and running drift needs (scripts/install-deps.sh: no test tools, no
+# viewer), builds drift (Release) and renders the built-in Cornell box with the reference path
+# tracer. Extra arguments go to `drift render` (e.g. --spp 256). For `drift view`:
+# bash scripts/install-deps.sh --viewer, then run this again.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh

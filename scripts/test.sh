@@ -1,52 +1,78 @@
 #!/usr/bin/env bash
-# The whole test suite: installs dependencies, checks the formatting (clang-format, the
-# repository's .clang-format), builds with ASan+UBSan and -Werror, runs every
-# unit and CLI test, builds the Release configuration (-Werror at -O2 sees more), runs the
-# fuzzers for a bounded time, the threaded renders under ThreadSanitizer and the core tests
-# under valgrind.
-# DRIFT_TEST_INTENSITY scales statistical sample counts; DRIFT_FUZZ_SECONDS the fuzz time.
+# The whole test suite: installs dependencies (the build set and the test tools), checks the
+# formatting (clang-format, the repository's .clang-format), builds with ASan+UBSan and
+# -Werror, builds the Release configuration (-Werror at -O2 sees more), runs the fuzzers for a
+# bounded time (side by side), the threaded renders under ThreadSanitizer and the core
+# tests under valgrind, then every ctest test.
+# It prints each phase's time and the ten slowest tests.
+# DRIFT_TEST_INTENSITY scales statistical sample counts; DRIFT_FUZZ_SECONDS the fuzz time
+# (10 s a target, the targets run side by side); DRIFT_CTEST_ARGS passes ctest options, e.g.
+# DRIFT_CTEST_ARGS="-L unit" or "-LE slow" (README: test labels).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/install-deps.sh
+bash scripts/install-deps.sh --test
 jobs=$(nproc)
+# ccache, when installed, makes a rebuild of unchanged files free.
+launcher=()
+if command -v ccache >/dev/null 2>&1; then
+  launcher=(-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+fi
+t_start=$(date +%s)
+t_phase=$t_start
+phases=""
+phase() { # phase NAME: ends the previous phase, names the next
+  local now
+  now=$(date +%s)
+  [ -n "${current:-}" ] && phases="$phases  $current $((now - t_phase)) s\n"
+  t_phase=$now
+  current="$1"
+  echo "== $1"
+}
 
-echo "== format (clang-format --dry-run -Werror over every tracked .c and .h)"
+phase "format (clang-format --dry-run -Werror over every tracked .c and .h)"
 git ls-files -z '*.c' '*.h' | xargs -0 clang-format --dry-run -Werror
 
-echo "== build (Debug, ASan+UBSan, -Werror)"
-cmake -S . -B build/dev -DCMAKE_BUILD_TYPE=Debug -DDRIFT_SANITIZE=address,undefined -DDRIFT_WERROR=ON >/dev/null
+phase "build (Debug, ASan+UBSan, -Werror)"
+cmake -S . -B build/dev -DCMAKE_BUILD_TYPE=Debug -DDRIFT_SANITIZE=address,undefined -DDRIFT_WERROR=ON \
+  "${launcher[@]}" >/dev/null
 cmake --build build/dev -j"$jobs"
 
-echo "== build (Release, -Werror)"
-cmake -S . -B build/release -DCMAKE_BUILD_TYPE=Release -DDRIFT_BUILD_TESTS=OFF -DDRIFT_WERROR=ON >/dev/null
+phase "build (Release, -Werror)"
+cmake -S . -B build/release -DCMAKE_BUILD_TYPE=Release -DDRIFT_BUILD_TESTS=OFF -DDRIFT_WERROR=ON \
+  "${launcher[@]}" >/dev/null
 cmake --build build/release -j"$jobs"
 
-echo "== fuzz smoke (libFuzzer, ${DRIFT_FUZZ_SECONDS:-20} s per target)"
+phase "fuzz smoke (libFuzzer, ${DRIFT_FUZZ_SECONDS:-10} s per target, $jobs at a time)"
 # fuzzer-no-link instruments the library too, so libFuzzer sees coverage inside drift.
 # CXX too: the library's one C++ file (src/io/image_exr_dwa.cpp) makes its links C++ links.
 CC=clang CXX=clang++ cmake -S . -B build/fuzz -DCMAKE_BUILD_TYPE=Debug -DDRIFT_BUILD_FUZZERS=ON \
   -DCMAKE_C_FLAGS=-fsanitize=fuzzer-no-link -DCMAKE_CXX_FLAGS=-fsanitize=fuzzer-no-link \
-  -DDRIFT_BUILD_TESTS=OFF -DDRIFT_SANITIZE=address,undefined -DDRIFT_WERROR=ON >/dev/null
+  -DDRIFT_BUILD_TESTS=OFF -DDRIFT_SANITIZE=address,undefined -DDRIFT_WERROR=ON \
+  "${launcher[@]}" >/dev/null
 cmake --build build/fuzz -j"$jobs"
-for fuzzer in build/fuzz/fuzz_*; do
+fuzz_one() {
+  local fuzzer=$1 name corpus work
   name=$(basename "$fuzzer")
   corpus=tests/fuzz/corpus/${name#fuzz_}
   work=$(mktemp -d)
   [ -d "$corpus" ] && cp -r "$corpus"/. "$work"/
-  "$fuzzer" -max_total_time="${DRIFT_FUZZ_SECONDS:-20}" -rss_limit_mb=4096 "$work" >"build/fuzz/$name.log" 2>&1 \
-    || { tail -40 "build/fuzz/$name.log"; echo "fuzz: $name failed"; exit 1; }
+  "$fuzzer" -max_total_time="${DRIFT_FUZZ_SECONDS:-10}" -rss_limit_mb=4096 "$work" >"build/fuzz/$name.log" 2>&1 \
+    || { tail -40 "build/fuzz/$name.log"; echo "fuzz: $name failed"; rm -rf "$work"; return 1; }
   rm -rf "$work"
   echo "fuzz: $name ok ($(grep -o 'Done [0-9]* runs' "build/fuzz/$name.log" || echo 'ran'))"
-done
+}
+export -f fuzz_one
+export DRIFT_FUZZ_SECONDS
+for f in build/fuzz/fuzz_*; do [[ "$f" == *.log ]] || echo "$f"; done | xargs -P "$jobs" -I{} bash -c 'fuzz_one {}'
 
-echo "== tsan (ThreadSanitizer: the threaded renders at --threads 1, 2, 16, 256)"
+phase "tsan (ThreadSanitizer: the threaded renders at --threads 1, 2, 16, 256)"
 cmake -S . -B build/tsan -DCMAKE_BUILD_TYPE=Debug -DDRIFT_SANITIZE=thread -DDRIFT_BUILD_TESTS=OFF \
-  -DDRIFT_WERROR=ON >/dev/null
+  -DDRIFT_WERROR=ON "${launcher[@]}" >/dev/null
 cmake --build build/tsan -j"$jobs" --target drift_cli
 bash tests/tsan/test_tsan.sh build/tsan/bin/drift
 
-echo "== valgrind (memcheck) on a plain Debug build of the core tests"
-cmake -S . -B build/valgrind -DCMAKE_BUILD_TYPE=Debug >/dev/null
+phase "valgrind (memcheck) on a plain Debug build of the core tests"
+cmake -S . -B build/valgrind -DCMAKE_BUILD_TYPE=Debug "${launcher[@]}" >/dev/null
 cmake --build build/valgrind -j"$jobs" --target test_core test_sampling
 for t in test_core test_sampling; do
   DRIFT_TEST_INTENSITY=0.1 valgrind --quiet --error-exitcode=9 --leak-check=full \
@@ -54,6 +80,13 @@ for t in test_core test_sampling; do
   echo "valgrind: $t clean"
 done
 
-echo "== tests (ctest)"
-cd build/dev
-ctest -j"$jobs" --output-on-failure
+phase "tests (ctest -j$jobs)"
+status=0
+# shellcheck disable=SC2086 # DRIFT_CTEST_ARGS is words
+(cd build/dev && ctest -j"$jobs" --output-on-failure ${DRIFT_CTEST_ARGS:-}) || status=$?
+phase "end"
+echo "== the ten slowest tests (ctest's last run)"
+bash scripts/slowest-tests.sh build/dev 10 || true
+printf "== time by phase\n%b" "$phases"
+echo "test.sh: $(($(date +%s) - t_start)) s in all (apt excluded), exit $status"
+exit "$status"

@@ -17,7 +17,14 @@
 #ifndef DRIFT_CORE_H
 #define DRIFT_CORE_H
 
-#include <stdatomic.h>
+#ifdef __cplusplus
+// C++ passes a std::atomic_bool where the C API takes an atomic_bool (the same object
+// representation; C++23's <stdatomic.h> says the same).
+#    include <atomic>
+using std::atomic_bool;
+#else
+#    include <stdatomic.h>
+#endif
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>

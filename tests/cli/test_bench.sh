@@ -4,6 +4,7 @@
 # with exit status 2 and a message naming it. The benchmarks are read from
 # `drift bench --help`, so a new one without a case here fails the test. Speed is not checked
 # (docs/benchmarks.md has the figures).
+# ctest-labels: slow
 set -u
 drift="$1"
 source "$(dirname "$0")/common.sh"

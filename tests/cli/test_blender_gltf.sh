@@ -11,6 +11,7 @@
 # Exits 77 (skipped) where Blender is not installed (scripts/install-cycles.sh).
 # DRIFT_BLENDER_SPP overrides the 256 spp (the targets are stated at 256).
 # $1 is the drift binary.
+# ctest-labels: quality slow
 set -u
 drift="$1"
 here="$(dirname "$0")"

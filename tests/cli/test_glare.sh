@@ -128,7 +128,7 @@ expect 0 "$drift" render --spp 2 --width 48 --height 48 --threads 2 --quiet --gl
     --out "$tmp/pt_glare.exr"
 cmp -s "$tmp/pt.exr" "$tmp/pt_glare.exr" && fail "render --glare static changes the path tracer's image"
 expect 0 "$drift" render --mode hybrid --width 48 --height 48 --threads 2 --quiet --glare dynamic \
-    --out "$tmp/hy_glare.exr"
+    --ism-vpls 8 --out "$tmp/hy_glare.exr"
 [ -s "$tmp/hy_glare.exr" ] || fail "render --mode hybrid --glare dynamic writes its image"
 expect 2 "$drift" render --glare sideways --out "$tmp/bad.exr"
 grep -q "\-\-glare expects one of none, static, dynamic, got .sideways." "$tmp/err" || fail "a bad --glare is named"

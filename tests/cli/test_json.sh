@@ -22,8 +22,8 @@ PY
 
 expect 0 "$drift" render "$scene" "${small[@]}" --checkpoint 0 --out "$tmp/r.exr" --stats "$tmp/r.json"
 valid "$tmp/r.json" scene
-expect 0 "$drift" render "$scene" "${small[@]}" --mode hybrid --shadows pcss --out "$tmp/h.exr" \
-    --stats "$tmp/h.json"
+expect 0 "$drift" render "$scene" "${small[@]}" --mode hybrid --shadows pcss --ism-vpls 8 \
+    --out "$tmp/h.exr" --stats "$tmp/h.json"
 valid "$tmp/h.json" scene
 expect 0 "$drift" render "$scene" "${small[@]}" --mode hybrid --shadows pcss --refine sir \
     --budget 50 --out "$tmp/s.exr" --stats "$tmp/s.json"

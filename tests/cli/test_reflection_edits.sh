@@ -12,7 +12,7 @@ small=(--width 32 --height 24 --spp 1 --quiet)
 
 expect 0 "$drift" render "$scene" --reflection-edits "$edits" "${small[@]}" --out "$tmp/ref.exr"
 expect 0 "$drift" render "$scene" --mode hybrid --reflections sharp --reflection-edits "$edits" \
-    "${small[@]}" --out "$tmp/hyb.exr"
+    "${small[@]}" --ism-vpls 8 --out "$tmp/hyb.exr"
 
 # bad NAME LINE TEXT...: the file NAME holding TEXT is refused at line LINE with exit 2.
 bad() {

@@ -105,7 +105,7 @@ plain, filtered = (json.load(open(p)) for p in sys.argv[1:3])
 assert filtered["flip"] < plain["flip"], (plain, filtered)
 PY
 # --denoise on: a finite image near the plain one (relative MSE < 0.25; its quality is
-# measured at 320x240 by scripts/bench-denoise.sh: at 32 px the filter's footprint spans the
+# measured at 320x240 by bench/experiments/bench-denoise.sh: at 32 px the filter's footprint spans the
 # whole box, docs/denoiser.md).
 expect 0 "$drift" diff "$tmp/dn-none.exr" "$tmp/dn-on.exr" --json
 python3 - "$tmp/out" <<'PY' || fail "--denoise on's image is not finite or far from the plain one"

@@ -16,7 +16,8 @@ if ! command -v xvfb-run >/dev/null 2>&1; then
 fi
 # SDL, X11 and Mesa keep memory until exit (see test_view.sh): no leak checks here.
 export ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0"
-view=(view "$scene" --width 160 --height 120 --threads 2 --frames 1 --reflections sharp)
+# --indirect none: the default ism costs seconds a frame under the sanitizers.
+view=(view "$scene" --width 160 --height 120 --threads 2 --frames 1 --reflections sharp --indirect none)
 
 expect 0 xvfb-run -a "$drift" "${view[@]}" --no-overlay --screenshot "$tmp/before.png"
 # The teapot's body at (80, 78); the red left wall at (3, 70).

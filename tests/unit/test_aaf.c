@@ -3,6 +3,7 @@
 // Monte Carlo at equal spp; full light and full shadow stay exactly 1 and 0; beta grows with
 // the receiver-to-occluder distance and n(x) peaks at contact edges; the separable filter
 // stays close to the exact 2-D filter on a smooth penumbra; the sample budget holds its mean.
+// ctest-labels: quality slow
 #include "aaf/aaf.h"
 #include "drift/accel.h"
 #include "drift/hybrid.h"

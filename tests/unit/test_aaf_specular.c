@@ -1,6 +1,7 @@
 // AAF's specular buffer (--reflections aaf, src/hybrid/aaf_specular.c): its R term converges
 // to the path-traced first-bounce glossy light as spp grows, and the filter width of eq. 4.4
 // with Omega_spec = 3.6 + 0.084 m (eq. 4.5) narrows as the lobe sharpens.
+// ctest-labels: quality slow
 #include "aaf/aaf.h"
 #include "drift/accel.h"
 #include "drift/hybrid.h"

@@ -1,6 +1,7 @@
 // Temporal glare (Ritschel 2009, thesis ch. 8): the nine objective tests of thesis-spec §6.7 —
 // the FFT against a naive DFT, the Airy pattern, chromatic scaling, energy, identity, the pupil
 // model, point symmetry, determinism and bounded change, supersampling — and bad input.
+// ctest-labels: slow
 #include "drift/glare.h"
 #include "drift/image.h"
 #include "drift_test.h"

@@ -2,6 +2,7 @@
 // plane and a sphere, reference effects summing to the full path tracer, the hard-shadow
 // buffer's distances, environment-map reflections of a mirror sphere at its probe, post DOF
 // with a pinhole, and determinism across thread counts.
+// ctest-labels: quality slow
 #include "drift/accel.h"
 #include "drift/hybrid.h"
 #include "drift/metric.h"

@@ -3,6 +3,7 @@
 // (identity), one gather per light, normalized weights, the fallback when every sample is
 // rejected, variance that falls with the gather's sample count, depth of field that spreads a
 // blurred foreground without bleeding an in-focus one, and the second depth layer.
+// ctest-labels: quality
 #include "drift/accel.h"
 #include "drift/hybrid.h"
 #include "drift/scene.h"

@@ -6,6 +6,7 @@
 // formula; `ir` converges to the path tracer's first-bounce diffuse light up to the clamping
 // bias; ISM approaches `ir` as points grow; results are deterministic across thread counts;
 // moving scene, light and camera rigidly leaves the image unchanged.
+// ctest-labels: quality
 #include "drift/accel.h"
 #include "drift/hybrid.h"
 #include "drift/ism.h"

@@ -7,6 +7,7 @@
 // visits grow sub-linearly with the points; every-pixel gathering matches the path tracer's
 // first-bounce diffuse light on the Cornell box (upsampled within 2x of that); no pixel
 // exceeds rho max L; the error shrinks from K = 8 to 16 to 24.
+// ctest-labels: quality
 #include "drift/accel.h"
 #include "drift/hybrid.h"
 #include "drift/metric.h"

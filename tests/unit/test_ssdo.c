@@ -1,6 +1,7 @@
 // Tests of src/ssdo: SSAO, GTAO and SSDO with its bounce (thesis spec §2.5, docs/ssdo.md).
 // Scenes are small and seen from straight above, where one depth layer sees everything the
 // sample points can reach.
+// ctest-labels: quality
 #include "drift/ssdo.h"
 #include "drift_test.h"
 #include "test_rig.h"

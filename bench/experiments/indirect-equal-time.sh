@@ -5,10 +5,10 @@
 # reference of the whole frame. Rows: no indirect light, ambient, AAF (1, 2, 4 spp), SSDO's
 # bounce, ir and ism (64 to 4096 VPLs at the defaults, and 1024 at the thesis's 256^2
 # maps with 8192 points). Writes OUT.csv (default docs/figures/indirect_<scene>.csv).
-#   BIN=build/release/bin/drift bash scripts/indirect-equal-time.sh [SCENE] [OUT] [W] [H] [REF_SPP]
+#   BIN=build/release/bin/drift bash bench/experiments/indirect-equal-time.sh [SCENE] [OUT] [W] [H] [REF_SPP]
 set -eu
 bin=${BIN:-drift}
-root="$(cd "$(dirname "$0")/.." && pwd)"
+root="$(cd "$(dirname "$0")/../.." && pwd)"
 scene=${1:-$root/scenes/cornell-box/cornell_box.json}
 name=$(basename "$scene" .json)
 out=${2:-$root/docs/figures/indirect_$name}

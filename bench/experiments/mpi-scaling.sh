@@ -9,7 +9,7 @@
 #        take with a core to itself for each rank; a bound that holds under load, blind to
 #        time a rank spends waiting for another.
 # Prints each round and the medians of 1 rank / plain and of 1 rank / N ranks for both.
-#   MPI=build/release/bin/drift PLAIN=build/plain/bin/drift bash scripts/mpi-scaling.sh
+#   MPI=build/release/bin/drift PLAIN=build/plain/bin/drift bash bench/experiments/mpi-scaling.sh
 # Options (environment): ROUNDS (5), SIZE (256), SPP (64), FOUR (0), SCENE (the built-in box).
 set -u
 mpi=${MPI:-build/release/bin/drift}

@@ -2,7 +2,7 @@
 # Equal-time rows on the built-in Cornell box, 400x400, 2 threads: each row's frame (or render)
 # milliseconds from its --stats and its FLIP against a 512-spp path-traced reference, rendered
 # first into the current folder when it is not there (about 100 s on 2 cores).
-#   BIN=build/release/bin/drift bash scripts/frontier-cornell.sh   (run it in an empty folder)
+#   BIN=build/release/bin/drift bash bench/experiments/frontier-cornell.sh   (run it in an empty folder)
 set -u
 bin=${BIN:-drift}
 [ -f ref512.exr ] || "$bin" render --spp 512 --width 400 --height 400 --threads 2 --quiet \

@@ -5,11 +5,11 @@
 # replace the block between the frontier-scenes markers of docs/frontier.md. Every hybrid row
 # at 1 and 4 anti-aliasing passes; SIR rows at 1, 4 and 16 iterations.
 # References are cached in out/ (the first run renders them: ~1-2 min each on 2 threads).
-#   BIN=build/release/bin/drift bash scripts/frontier-scenes.sh [SIZE]   (default 160)
+#   BIN=build/release/bin/drift bash bench/experiments/frontier-scenes.sh [SIZE]   (default 160)
 set -eu
 bin=${BIN:-drift}
 size=${1:-160}
-root="$(cd "$(dirname "$0")/.." && pwd)"
+root="$(cd "$(dirname "$0")/../.." && pwd)"
 fig="$root/docs/figures"
 names=()
 for scene in cornell-box/cornell_box.json cornell-glossy/cornell_glossy.json \

@@ -2,7 +2,7 @@
 # SIR with the raster's environment map looked up plainly and box-projected (parallax-
 # corrected), component refinement on, each pair back to back, on issue 17's open glossy room
 # and the SIR hall (docs/benchmarks.md, "SIR: parallax-corrected environment map").
-# usage: scripts/bench_sir_parallax.sh [DRIFT_BINARY] [OUT_DIR] [REPEATS]
+# usage: bench/experiments/bench_sir_parallax.sh [DRIFT_BINARY] [OUT_DIR] [REPEATS]
 set -euo pipefail
 drift=${1:-build/release/bin/drift}
 out=${2:-/tmp/sir_parallax}

@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
 # Renders every (effect, technique) of the hybrid frame at a small size, plus a few combined
 # frames and a SIR refinement, into OUTDIR with the drift binary BIN. Run it with the binary
-# before and after a refactor and compare the folders with `cmp` (scripts/technique-compare.sh):
+# before and after a refactor and compare the folders with `cmp` (bench/experiments/technique-compare.sh):
 # a refactor that changes no image leaves every file byte-identical.
-#   bash scripts/technique-images.sh BIN OUTDIR [SCENE]
+#   bash bench/experiments/technique-images.sh BIN OUTDIR [SCENE]
 set -euo pipefail
 bin=$1
 out=$2
-scene=${3:-$(dirname "$0")/../scenes/cornell-glossy/cornell_glossy.json}
+scene=${3:-$(dirname "$0")/../../scenes/cornell-glossy/cornell_glossy.json}
 mkdir -p "$out"
 size=(--width 48 --height 36 --spp 4 --threads 2 --quiet)
 effects=(shadows reflections dof indirect)

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Issue 17's AAF shadows at 4 spp: the equal-error ratio against plain MC before/after, and the
 # whole hybrid frame's FLIP with AAF shadows + AAF indirect at 4 spp (160x160, Cornell box).
-# Usage: OLD=path/to/old/drift NEW=build/release/bin/drift bash scripts/aaf-4spp-shadows.sh
+# Usage: OLD=path/to/old/drift NEW=build/release/bin/drift bash bench/experiments/aaf-4spp-shadows.sh
 set -euo pipefail
 OLD=${OLD:?old drift binary} NEW=${NEW:-build/release/bin/drift}
 T=${TMPDIR:-/tmp}/aaf-4spp; mkdir -p "$T"

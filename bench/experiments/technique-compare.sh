@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Compares two folders written by scripts/technique-images.sh byte for byte: prints each file
+# Compares two folders written by bench/experiments/technique-images.sh byte for byte: prints each file
 # that differs or is missing on either side, then a count; exits 1 when any does.
-#   bash scripts/technique-compare.sh BEFORE_DIR AFTER_DIR
+#   bash bench/experiments/technique-compare.sh BEFORE_DIR AFTER_DIR
 set -uo pipefail
 before=$1
 after=$2

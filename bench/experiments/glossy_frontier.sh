@@ -1,7 +1,7 @@
 #!/bin/bash
 # Glossy Cornell box at 400x400, 2 threads: pt 1 spp interleaved with hybrid rows varying the
 # reflections / indirect technique. Prints ms (from --stats), ms / pt-1spp ms, and FLIP vs REF.
-# usage: scripts/glossy_frontier.sh [DRIFT] [REF.exr]
+# usage: bench/experiments/glossy_frontier.sh [DRIFT] [REF.exr]
 D=${1:-build/release/bin/drift}; REF=${2:-/work/ref400/cornell_glossy.exr}
 S=scenes/cornell-glossy/cornell_glossy.json; O=out/g; mkdir -p $O
 ms() { python3 -c "import json,sys;d=json.load(open('$1'));m=d['milliseconds'];print(m.get('frame',m.get('render')))"; }

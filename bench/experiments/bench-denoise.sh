@@ -2,7 +2,7 @@
 # The denoisers against no denoiser (docs/denoiser.md): for each scene, ꟻLIP (drift diff)
 # against a high-spp path-traced reference of the raw path tracer and of each --denoise
 # choice at each spp, plus the filter's milliseconds beside the cost of 2 spp of that render.
-#   BIN=build/release/bin/drift REFS=out/denoise-refs bash scripts/bench-denoise.sh SCENE...
+#   BIN=build/release/bin/drift REFS=out/denoise-refs bash bench/experiments/bench-denoise.sh SCENE...
 # Options through the environment: SIZE (320x240), SPPS ("1 4 16"), REF_SPP (512), THREADS
 # (2), DENOISERS ("atrous on regression"). References are cached in $REFS as NAME-WxH-SPP.exr
 # (made on the first run). Prints one Markdown row a scene and spp:

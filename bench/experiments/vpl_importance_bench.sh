@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # VPL importance (docs/ism.md) on/off, interleaved, against a path-traced reference; prints
-# technique, VPLs, importance, frame ms, FLIP. Usage: scripts/vpl_importance_bench.sh [SIZE] [SCENE]
+# technique, VPLs, importance, frame ms, FLIP. Usage: bench/experiments/vpl_importance_bench.sh [SIZE] [SCENE]
 set -euo pipefail
 SIZE=${1:-160}
 SCENE=${2:-scenes/breakfast-room/breakfast_room.json}

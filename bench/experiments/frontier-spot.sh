@@ -5,7 +5,7 @@
 #   drift render SCENE --mode reference --width 400 --height 400 --spp 512 --max-depth 8 --out ref.exr
 # Every row is one line: a label, then drift render's options (the scene, size, threads,
 # depth and output are added here). A pt row is --mode reference; a hybrid row --mode hybrid.
-#   BIN=build/release/bin/drift bash scripts/frontier-spot.sh SCENE REF.exr SIZE ROWS.txt
+#   BIN=build/release/bin/drift bash bench/experiments/frontier-spot.sh SCENE REF.exr SIZE ROWS.txt
 # prints | row | ms | FLIP | RMSE | in Markdown. The full sweep is `drift bench frontier`; this
 # is for re-measuring a handful of budget edges on a quiet machine.
 set -eu

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Frame and per-pass ms of the hybrid frame at 400x400, 2 threads, two binaries interleaved:
-#   scripts/framespeed.sh OLD_DRIFT NEW_DRIFT [VPLS] [RUNS]
+#   bench/experiments/framespeed.sh OLD_DRIFT NEW_DRIFT [VPLS] [RUNS]
 # prints the median of each figure and the ratio old/new (> 1: the new binary is faster).
 set -euo pipefail
 old=$1 new=$2 vpls=${3:-256} runs=${4:-5}

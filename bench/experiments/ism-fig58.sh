@@ -3,10 +3,10 @@
 # resolution grow, 256 light paths, on the Cornell box (or SCENE): the NRMSE of ism's I
 # against ir's (the same VPLs with exact visibility) and the RMSE of I against the path
 # tracer. Writes OUT.csv and OUT.svg (default docs/figures/ism_fig58).
-#   BIN=build/release/bin/drift bash scripts/ism-fig58.sh [SCENE] [OUT]
+#   BIN=build/release/bin/drift bash bench/experiments/ism-fig58.sh [SCENE] [OUT]
 set -eu
 bin=${BIN:-drift}
-root="$(cd "$(dirname "$0")/.." && pwd)"
+root="$(cd "$(dirname "$0")/../.." && pwd)"
 scene=${1:-$root/scenes/cornell-box/cornell_box.json}
 out=${2:-$root/docs/figures/ism_fig58}
 tmp="$(mktemp -d)"

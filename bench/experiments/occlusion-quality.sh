@@ -7,7 +7,7 @@
 # truth of SSDO's bounce, "FLIP+b". `none` is the frame's own ray-traced environment term at
 # --light-samples 8. "occl ms" is the occlusion effect's own time in the last of --frames 3
 # (warm), the figure to match techniques by; the frame time is beside it.
-#   BIN=build/release/bin/drift bash scripts/occlusion-quality.sh [SCENE...]
+#   BIN=build/release/bin/drift bash bench/experiments/occlusion-quality.sh [SCENE...]
 # TECHS overrides the rows: specs name[,opt...] with name none|ssao|gtao|ssdo and opts n=N
 # (--occlusion-samples), s=K (--occlusion-steps), c=N (--occlusion-cameras), l=2
 # (--occlusion-layers), b (--ssdo-bounce on), e.g. TECHS="ssao,n=32 ssdo,n=8,s=4,b".

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # SIR's component refinement against the whole trace on issue 17's open glossy room and the
 # SIR hall, each pair back to back (docs/benchmarks.md, "SIR: component refinement").
-# usage: scripts/bench_sir_components.sh [DRIFT_BINARY] [OUT_DIR]
+# usage: bench/experiments/bench_sir_components.sh [DRIFT_BINARY] [OUT_DIR]
 set -euo pipefail
 drift=${1:-build/release/bin/drift}
 out=${2:-/tmp/sir_components}
