@@ -1,9 +1,10 @@
 // drift bind: what a language binding (Python's ctypes, cffi, a DCC plug-in) needs beyond the
 // other headers, in calls that pass only pointers and plain numbers: the hybrid frame's
 // parameters behind a pointer (no struct layout mirrored in the binding), set by name with
-// the names of the command line's options (an effect and a technique, or a knob such as
-// "ism.vpls"); the scene's camera; and a reference render into a caller-owned image.
-// python/drift (docs/python.md) is built on it.
+// the names of the command line's options (an effect and a technique, or a knob of the knob
+// table, drift/knobs.h, such as "ism-vpls", also written "ism_vpls" or "ism.vpls"); the scene's
+// camera; and a reference render into a caller-owned image. python/drift (docs/python.md) is built
+// on it.
 //
 // STEP BY STEP
 //   drift_hybrid_params *p = drift_bind_params_new();       // drift_hybrid_params_recommended()
@@ -31,18 +32,19 @@ drift_hybrid_params *drift_bind_params_new(void);
 void drift_bind_params_free(drift_hybrid_params *params);
 
 // Sets one parameter by name: an effect's name ("shadows", drift_effect_name) with one of its
-// technique names ("pcss", drift_technique_name), or a knob (drift_bind_knob_name) with a
-// number ("true"/"false" or 1/0 for a bool). DRIFT_ERR_INVALID_ARGUMENT for an unknown name
-// or a value that does not parse whole.
+// technique names ("pcss", drift_technique_name), or a knob (drift_bind_knob_name) with the
+// text its command-line option takes ("256", "on", "auto"). DRIFT_ERR_INVALID_ARGUMENT for an
+// unknown name, or a value that does not parse whole or is outside the knob's range.
 drift_result drift_bind_params_set(drift_hybrid_params *params, const char *name,
                                    const char *value);
 // The knob's value as a double (bools 0 or 1); NAN for an unknown name.
 double drift_bind_params_get(const drift_hybrid_params *params, const char *name);
 
-// The knobs drift_bind_params_set takes: index < drift_bind_knob_count(), else NULL.
+// The knobs drift_bind_params_set takes, the frame's width, height, seed, spp and max_depth
+// then the knob table's rows: index < drift_bind_knob_count(), else NULL.
 uint32_t drift_bind_knob_count(void);
 const char *drift_bind_knob_name(uint32_t index);
-const char *drift_bind_knob_type(uint32_t index); // "int", "uint", "float" or "bool"
+const char *drift_bind_knob_type(uint32_t index); // "int", "uint", "float" or "choice"
 
 // The scene's camera (borrowed from the scene).
 const drift_camera *drift_bind_scene_camera(const drift_scene *scene);

@@ -3,7 +3,7 @@
     import drift
     with drift.Context(threads=2) as ctx:
         scene = ctx.load_scene("scenes/cornell-box/cornell_box.json")
-        frame = scene.render_hybrid(width=64, height=64, shadows="pcss", **{"ism.vpls": 64})
+        frame = scene.render_hybrid(width=64, height=64, shadows="pcss", ism_vpls=64)
         ref = scene.render_reference(width=64, height=64, spp=64)
         print(drift.diff(ref, frame, ctx=ctx))        # mse, rmse, relmse, psnr, ssim, flip
         drift.save_exr(ctx, "frame.exr", frame)
@@ -193,12 +193,12 @@ class Scene:
     def render_hybrid(self, **settings):
         """The hybrid frame from drift_hybrid_params_recommended() (what `drift render --mode
         hybrid` starts from) with settings: effect=technique (shadows="pcss") and knobs by
-        name (width=64, **{"ism.vpls": 64}); see knobs() and techniques()."""
+        name (width=64, ism_vpls=64); see knobs() and techniques()."""
         params = _params_new()
         frame = _P()
         try:
             for name, value in settings.items():
-                text = ("true" if value else "false") if isinstance(value, bool) else str(value)
+                text = ("on" if value else "off") if isinstance(value, bool) else str(value)
                 _check(_params_set(params, name.encode(), text.encode()),
                        "%s = %r (knobs(), techniques())" % (name, value))
             _check(_hybrid_create(self.ctx._ptr, self._scene, self._accel, params,

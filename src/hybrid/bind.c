@@ -1,6 +1,7 @@
 // drift bind (include/drift/bind.h): the hybrid parameters by name for language bindings.
 #include "drift/bind.h"
 
+#include "drift/knobs.h"
 #include "drift/pt.h"
 
 #include <math.h>
@@ -8,68 +9,54 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef enum knob_type {
-    KNOB_INT,
-    KNOB_UINT,
-    KNOB_FLOAT,
-    KNOB_BOOL
-} knob_type;
+// The frame's own fields a binding sets besides the knob table's rows (drift/knobs.h, whose
+// names are the command line's options: --ism-vpls is "ism-vpls"; "ism_vpls" and "ism.vpls"
+// are read as the same name, for Python's keyword arguments).
+typedef enum field_type {
+    FIELD_INT,
+    FIELD_UINT
+} field_type;
 
-// The knobs, X(name, field of drift_hybrid_params, type): the command line's option names
-// with the family's prefix and a dot (--ism-vpls is "ism.vpls").
-#define DRIFT_BIND_KNOBS(X)                                                \
-    X("width", width, KNOB_INT)                                            \
-    X("height", height, KNOB_INT)                                          \
-    X("seed", seed, KNOB_UINT)                                             \
-    X("spp", spp, KNOB_UINT)                                               \
-    X("max_depth", max_depth, KNOB_INT)                                    \
-    X("light_samples", light_samples, KNOB_UINT)                           \
-    X("environment_interleave", environment_interleave, KNOB_BOOL)         \
-    X("environment_filter", environment_filter, KNOB_UINT)                 \
-    X("environment_scale", environment_scale, KNOB_UINT)                   \
-    X("aa", aa, KNOB_UINT)                                                 \
-    X("shadow_map.size", shadow_map.size, KNOB_INT)                        \
-    X("shadow_map.bias", shadow_map.bias, KNOB_FLOAT)                      \
-    X("shadow_map.pcf_kernel", shadow_map.pcf_kernel, KNOB_INT)            \
-    X("shadow_map.contact_shadows", shadow_map.contact_shadows, KNOB_BOOL) \
-    X("envmap.size", envmap.size, KNOB_INT)                                \
-    X("isg.search", isg.search, KNOB_INT)                                  \
-    X("isg.gather", isg.gather, KNOB_INT)                                  \
-    X("isg.sigma", isg.sigma, KNOB_FLOAT)                                  \
-    X("isg.layers", isg.layers, KNOB_INT)                                  \
-    X("aaf.max_spp", aaf.max_spp, KNOB_UINT)                               \
-    X("ism.vpls", ism.vpls, KNOB_UINT)                                     \
-    X("ism.map_size", ism.map_size, KNOB_INT)                              \
-    X("ism.points_per_vpl", ism.points_per_vpl, KNOB_UINT)                 \
-    X("ism.gather_scale", ism.gather_scale, KNOB_INT)                      \
-    X("ism.later_paths", ism.later_paths, KNOB_UINT)                       \
-    X("micro.points", micro.points, KNOB_UINT)                             \
-    X("micro.buffer_size", micro.buffer_size, KNOB_INT)                    \
-    X("micro.density", micro.density, KNOB_INT)                            \
-    X("micro.bounces", micro.bounces, KNOB_INT)                            \
-    X("occlusion.samples", occlusion_settings.samples, KNOB_INT)           \
-    X("occlusion.radius", occlusion_settings.radius, KNOB_FLOAT)           \
-    X("occlusion.steps", occlusion_settings.steps, KNOB_INT)
-
-typedef struct knob {
+typedef struct field {
     const char *name;
     size_t offset;
-    knob_type type;
-} knob;
+    field_type type;
+} field;
 
-#define KNOB_ROW(name, field, type) { name, offsetof(drift_hybrid_params, field), type },
-static const knob knobs[] = { DRIFT_BIND_KNOBS(KNOB_ROW) };
-#undef KNOB_ROW
-#define KNOB_COUNT (sizeof knobs / sizeof knobs[0])
+#define FIELD_ROW(name, member, type)                     \
+    {                                                     \
+        name, offsetof(drift_hybrid_params, member), type \
+    }
+static const field fields[] = {
+    FIELD_ROW("width", width, FIELD_INT),         FIELD_ROW("height", height, FIELD_INT),
+    FIELD_ROW("seed", seed, FIELD_UINT),          FIELD_ROW("spp", spp, FIELD_UINT),
+    FIELD_ROW("max_depth", max_depth, FIELD_INT),
+};
+#undef FIELD_ROW
+#define FIELD_COUNT ((uint32_t)(sizeof fields / sizeof fields[0]))
 
-static const knob *find_knob(const char *name)
+static const field *find_field(const char *name)
 {
-    for (size_t i = 0; name && i < KNOB_COUNT; ++i) {
-        if (strcmp(knobs[i].name, name) == 0) {
-            return &knobs[i];
+    for (uint32_t i = 0; name && i < FIELD_COUNT; ++i) {
+        if (strcmp(fields[i].name, name) == 0) {
+            return &fields[i];
         }
     }
     return NULL;
+}
+
+// The knob table's index of `name`, with '_' and '.' read as '-'; -1 when there is none.
+static int find_knob(const char *name)
+{
+    char key[64];
+    size_t n = name ? strlen(name) : sizeof key;
+    if (n >= sizeof key) {
+        return -1;
+    }
+    for (size_t i = 0; i <= n; ++i) {
+        key[i] = name[i] == '_' || name[i] == '.' ? '-' : name[i];
+    }
+    return drift_knob_find(key);
 }
 
 drift_hybrid_params *drift_bind_params_new(void)
@@ -101,85 +88,77 @@ drift_result drift_bind_params_set(drift_hybrid_params *params, const char *name
             return DRIFT_OK;
         }
     }
-    const knob *k = find_knob(name);
-    if (!k) {
-        return DRIFT_ERR_INVALID_ARGUMENT;
+    int knob = find_knob(name);
+    if (knob >= 0) {
+        double v;
+        return drift_knob_parse(drift_knob_get(knob), value, &v) && drift_knob_set(params, knob, v)
+                   ? DRIFT_OK
+                   : DRIFT_ERR_INVALID_ARGUMENT;
     }
+    const field *f = find_field(name);
     char *end = NULL;
-    char *field = (char *)params + k->offset;
-    if (k->type == KNOB_BOOL) {
-        bool b = strcmp(value, "true") == 0 || strcmp(value, "1") == 0;
-        if (!b && strcmp(value, "false") != 0 && strcmp(value, "0") != 0) {
-            return DRIFT_ERR_INVALID_ARGUMENT;
-        }
-        memcpy(field, &b, sizeof b);
-        return DRIFT_OK;
-    }
-    double v = strtod(value, &end);
-    if (end == value || *end != '\0' || !isfinite(v)) {
+    double v = f ? strtod(value, &end) : 0.0;
+    if (!f || end == value || *end != '\0' || !isfinite(v) || v != floor(v) || v > 2147483647.0 ||
+        v < (f->type == FIELD_UINT ? 0.0 : -2147483648.0)) {
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
-    if (k->type == KNOB_FLOAT) {
-        float f = (float)v;
-        memcpy(field, &f, sizeof f);
-    } else if (v != floor(v) || v > 2147483647.0 ||
-               v < (k->type == KNOB_UINT ? 0.0 : -2147483648.0)) {
-        return DRIFT_ERR_INVALID_ARGUMENT;
-    } else if (k->type == KNOB_UINT) {
+    char *at = (char *)params + f->offset;
+    if (f->type == FIELD_UINT) {
         uint32_t u = (uint32_t)v;
-        memcpy(field, &u, sizeof u);
+        memcpy(at, &u, sizeof u);
     } else {
         int32_t i = (int32_t)v;
-        memcpy(field, &i, sizeof i);
+        memcpy(at, &i, sizeof i);
     }
     return DRIFT_OK;
 }
 
 double drift_bind_params_get(const drift_hybrid_params *params, const char *name)
 {
-    const knob *k = find_knob(name);
-    if (!params || !k) {
+    int knob = find_knob(name);
+    const field *f = knob < 0 ? find_field(name) : NULL;
+    if (!params || (knob < 0 && !f)) {
         return (double)NAN;
     }
-    const char *field = (const char *)params + k->offset;
-    switch (k->type) {
-    case KNOB_BOOL: {
-        bool b;
-        memcpy(&b, field, sizeof b);
-        return b ? 1.0 : 0.0;
+    if (knob >= 0) {
+        return drift_knob_value(params, knob);
     }
-    case KNOB_FLOAT: {
-        float f;
-        memcpy(&f, field, sizeof f);
-        return (double)f;
-    }
-    case KNOB_UINT: {
+    const char *at = (const char *)params + f->offset;
+    if (f->type == FIELD_UINT) {
         uint32_t u;
-        memcpy(&u, field, sizeof u);
+        memcpy(&u, at, sizeof u);
         return (double)u;
     }
-    default: {
-        int32_t i;
-        memcpy(&i, field, sizeof i);
-        return (double)i;
-    }
-    }
+    int32_t i;
+    memcpy(&i, at, sizeof i);
+    return (double)i;
 }
 
+// The frame's fields first, then every row of the knob table.
 uint32_t drift_bind_knob_count(void)
 {
-    return (uint32_t)KNOB_COUNT;
+    return FIELD_COUNT + (uint32_t)drift_knob_count();
 }
 
 const char *drift_bind_knob_name(uint32_t index)
 {
-    return index < KNOB_COUNT ? knobs[index].name : NULL;
+    if (index < FIELD_COUNT) {
+        return fields[index].name;
+    }
+    const drift_knob *k = drift_knob_get((int)(index - FIELD_COUNT));
+    return k ? k->name : NULL;
 }
 
 const char *drift_bind_knob_type(uint32_t index)
 {
-    static const char *const names[] = { "int", "uint", "float", "bool" };
-    return index < KNOB_COUNT ? names[knobs[index].type] : NULL;
+    if (index < FIELD_COUNT) {
+        return fields[index].type == FIELD_UINT ? "uint" : "int";
+    }
+    const drift_knob *k = drift_knob_get((int)(index - FIELD_COUNT));
+    static const char *const names[] = {
+        [DRIFT_KNOB_INT] = "int", [DRIFT_KNOB_NUMBER] = "float", [DRIFT_KNOB_CHOICE] = "choice"
+    };
+    return k ? names[k->type] : NULL;
 }
 
 const drift_camera *drift_bind_scene_camera(const drift_scene *scene)

@@ -39,10 +39,10 @@ import drift
 scene_path, tmp = sys.argv[1], sys.argv[2]
 assert drift.library_path.startswith(tmp), drift.library_path  # the installed library
 assert drift.version().count(".") == 2, drift.version()
-assert "pcf" in drift.techniques()["shadows"] and drift.knobs()["ism.vpls"] == "uint"
+assert "pcf" in drift.techniques()["shadows"] and drift.knobs()["ism-vpls"] == "int"
 with drift.Context(threads=2) as ctx:
     scene = ctx.load_scene(scene_path)
-    frame = scene.render_hybrid(width=32, height=32, shadows="pcf", **{"ism.vpls": 8})
+    frame = scene.render_hybrid(width=32, height=32, shadows="pcf", ism_vpls=8)
     assert frame.shape == (32, 32, 3) and frame.dtype == np.float32
     cli = drift.load_image(ctx, tmp + "/cli.exr")
     assert np.array_equal(frame, cli), "not the CLI's image: max |d| %g" % np.abs(frame - cli).max()
@@ -53,7 +53,7 @@ with drift.Context(threads=2) as ctx:
     ref = scene.render_reference(width=32, height=32, spp=4)
     d = drift.diff(ref, frame, ctx=ctx)
     assert 0 < d["flip"] < 1 and d["mse"] > 0, d
-    for bad in ({"shadows": "soft"}, {"ism.vpls": -1}, {"no_such_knob": 1}):
+    for bad in ({"shadows": "soft"}, {"ism_vpls": -1}, {"ism_vpls": 1e9}, {"no_such_knob": 1}):
         try:
             scene.render_hybrid(width=8, height=8, **bad)
             raise AssertionError("accepted %r" % bad)
