@@ -61,18 +61,6 @@ bool render_sequence_validate(const render_options *o)
     return true;
 }
 
-// The radical inverse of k in `base`: the frames' sub-pixel jitter (Halton 2, 3).
-static float halton(uint32_t k, uint32_t base)
-{
-    float f = 1.0f, r = 0.0f;
-    while (k > 0) {
-        f /= (float)base;
-        r += f * (float)(k % base);
-        k /= base;
-    }
-    return r;
-}
-
 // Encodes the frames' PNGs with ffmpeg when it is installed; a warning otherwise.
 static void encode_video(const render_options *o, double fps)
 {
@@ -145,8 +133,9 @@ static int hybrid_frame(sequence_run *s, long k, const drift_camera *camera, con
         if (drift_temporal_reseeds(&p) && drift_hybrid_set_params(s->frame, &p) != DRIFT_OK) {
             return 1;
         }
-        cam.film_shift_x = halton(index + 1, 2) - 0.5f;
-        cam.film_shift_y = halton(index + 1, 3) - 0.5f;
+        drift_vec2 jitter = drift_temporal_jitter(index);
+        cam.film_shift_x = jitter.x;
+        cam.film_shift_y = jitter.y;
     }
     drift_result r = drift_hybrid_render(s->frame, &cam, render_catch_sigint());
     if (r == DRIFT_ERR_CANCELLED) {

@@ -90,6 +90,10 @@ drift_result drift_temporal_apply(drift_temporal *t, const drift_gbuffer *gbuffe
 // the point hierarchy; reflections micro and envmap: the hierarchy, the probes). Those keep
 // their seed, and the frames differ by their sub-pixel offsets (and the camera's move) alone.
 bool drift_temporal_reseeds(const drift_hybrid_params *params);
+// Frame k's sub-pixel offset in pixels, in [-0.5, 0.5)^2: the Halton (2, 3) point k + 1, so
+// that the history's samples cover the pixel's box filter evenly (add it to the camera's
+// film_shift_x, film_shift_y).
+drift_vec2 drift_temporal_jitter(uint32_t frame);
 
 // The last frame's result (RGB) and each pixel's history length in frames (1 channel; 0 where
 // the pixel sees no surface, 1 where its history was rejected).

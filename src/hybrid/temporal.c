@@ -437,3 +437,21 @@ bool drift_temporal_reseeds(const drift_hybrid_params *p)
            p->indirect != DRIFT_INDIRECT_MICRO && p->reflections != DRIFT_REFLECTIONS_MICRO &&
            p->reflections != DRIFT_REFLECTIONS_ENVMAP;
 }
+
+// The radical inverse of k in `base`.
+static float radical_inverse(uint32_t k, uint32_t base)
+{
+    float f = 1.0f, r = 0.0f;
+    while (k > 0) {
+        f /= (float)base;
+        r += f * (float)(k % base);
+        k /= base;
+    }
+    return r;
+}
+
+drift_vec2 drift_temporal_jitter(uint32_t frame)
+{
+    return (drift_vec2){ radical_inverse(frame + 1, 2) - 0.5f,
+                         radical_inverse(frame + 1, 3) - 0.5f };
+}

@@ -437,18 +437,6 @@ void drift_view_set_camera(drift_view *view, const drift_camera *camera)
 
 // --- FRAME ---
 
-// The radical inverse of k in `base`: the frames' sub-pixel offsets (Halton 2, 3).
-static float halton(uint32_t k, uint32_t base)
-{
-    float f = 1.0f, r = 0.0f;
-    while (k > 0) {
-        f /= (float)base;
-        r += f * (float)(k % base);
-        k /= base;
-    }
-    return r;
-}
-
 // Temporal reuse: a new seed and a sub-pixel offset a frame, so that the history averages
 // independent samples over the pixel (the path tracer's box filter).
 drift_result drift_view_temporal_begin(drift_view *view, drift_camera *camera)
@@ -460,8 +448,9 @@ drift_result drift_view_temporal_begin(drift_view *view, drift_camera *camera)
         p.seed = view->base_seed + k;
         r = drift_hybrid_set_params(view->hybrid, &p);
     }
-    camera->film_shift_x += halton(k + 1, 2) - 0.5f;
-    camera->film_shift_y += halton(k + 1, 3) - 0.5f;
+    drift_vec2 jitter = drift_temporal_jitter(k);
+    camera->film_shift_x += jitter.x;
+    camera->film_shift_y += jitter.y;
     return r;
 }
 
