@@ -153,7 +153,7 @@ int diff_sequence(const diff_sequence_options *o)
             display_error(&ref, &test, ref8, test8, err);
             fr->frame = k;
             fr->flip = rep.flip;
-            fr->temporal = NAN;
+            fr->temporal = (double)NAN;
             if (k > o->first) {
                 size_t n = (size_t)width * (size_t)height;
                 double sum = 0.0;

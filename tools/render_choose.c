@@ -73,7 +73,7 @@ static const cJSON *nearest_scene(const cJSON *model, const double f[SCENE_FEATU
 {
     const cJSON *scale = cJSON_GetObjectItemCaseSensitive(model, "scale");
     const cJSON *best = NULL;
-    double best_d = INFINITY;
+    double best_d = (double)INFINITY;
     const cJSON *scenes = cJSON_GetObjectItemCaseSensitive(model, "scenes");
     for (const cJSON *s = scenes ? scenes->child : NULL; s; s = s->next) {
         const cJSON *sf = cJSON_GetObjectItemCaseSensitive(s, "features");
@@ -100,7 +100,7 @@ static const cJSON *pick_for(const cJSON *scene, double budget_ms, double *out_b
 {
     const cJSON *picks = cJSON_GetObjectItemCaseSensitive(scene, "picks");
     const cJSON *best = NULL, *smallest = NULL;
-    double best_b = -1.0, small_b = INFINITY;
+    double best_b = -1.0, small_b = (double)INFINITY;
     for (const cJSON *p = picks ? picks->child : NULL; p; p = p->next) {
         double b = atof(p->string);
         if (b <= budget_ms && b > best_b) {
@@ -194,7 +194,7 @@ int render_choose(render_options *o, const cli_session *session)
                 o->budget_ms, at_model, size,
                 o->hybrid_mode ? "hybrid " : "the path tracer is expected to win: ",
                 row ? row : "?", string(scene, "name") ? string(scene, "name") : "?", budget,
-                number(pick, "ms", NAN), number(pick, "flip", NAN));
+                number(pick, "ms", (double)NAN), number(pick, "flip", (double)NAN));
     }
     cJSON_Delete(model);
     return 0;

@@ -111,18 +111,18 @@ static void box_moments(const denoise_frame *f, int r, float *mean, float *mean_
         double s = 0.0, s2 = 0.0;
         const float *irr = f->irr + 3 * (size_t)y * (size_t)w;
         for (int32_t x = 0; x < r && x < w; ++x) {
-            double l = denoise_lum(irr + 3 * x);
+            double l = (double)denoise_lum(irr + 3 * x);
             s += l;
             s2 += l * l;
         }
         for (int32_t x = 0; x < w; ++x) {
             if (x + r < w) {
-                double l = denoise_lum(irr + 3 * (x + r));
+                double l = (double)denoise_lum(irr + 3 * (x + r));
                 s += l;
                 s2 += l * l;
             }
             if (x - r - 1 >= 0) {
-                double l = denoise_lum(irr + 3 * (x - r - 1));
+                double l = (double)denoise_lum(irr + 3 * (x - r - 1));
                 s -= l;
                 s2 -= l * l;
             }
