@@ -89,6 +89,20 @@ static void test_step_and_cubic(void **state)
             assert_vec(fwd, -1, 0, 0, __LINE__);
         }
     }
+    // The same file as a .glb (its buffer in the BIN chunk) gives the same keys.
+    drift_camera_path q;
+    assert_int_equal(drift_camera_path_from_gltf(
+                         ctx, test_repo_path(path, "tests/data/gltf/camera_step_cubic.glb"), NULL,
+                         24.0, 0, 48, &q),
+                     DRIFT_OK);
+    assert_int_equal(q.count, p.count);
+    for (uint32_t k = 0; k < p.count; ++k) {
+        assert_true(q.keys[k].time == p.keys[k].time);
+        assert_memory_equal(&q.keys[k].position, &p.keys[k].position, sizeof(drift_vec3));
+        assert_memory_equal(&q.keys[k].target, &p.keys[k].target, sizeof(drift_vec3));
+        assert_memory_equal(&q.keys[k].up, &p.keys[k].up, sizeof(drift_vec3));
+    }
+    drift_camera_path_free(ctx, &q);
     drift_camera_path_free(ctx, &p);
     drift_context_destroy(ctx);
 }

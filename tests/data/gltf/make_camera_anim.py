@@ -7,6 +7,7 @@ Every file holds a floor quad, a tilted quad and a camera; its buffer is one bas
                        1 s, the camera below it moving (0, 1, 5) -> (2, 1, 5) (LINEAR), 24 fps
   camera_step_cubic.gltf  the camera's translation a CUBICSPLINE over [0, 2] s and its
                        rotation STEP (identity, then 90 degrees about +y from 0.5 s)
+  camera_step_cubic.glb  the same as a binary glTF (its buffer in the BIN chunk)
   mesh_anim.gltf       camera_linear plus a translation channel on the tilted quad's node
                        (not supported: the loader warns once)
 The unit test computes the same cameras in closed form from the numbers below.
@@ -116,6 +117,19 @@ def scene(kind):
     return gltf
 
 
+def write_glb(gltf, path):
+    """The same scene as a binary glTF: the buffer moves into the BIN chunk."""
+    uri = gltf["buffers"][0].pop("uri")
+    data = base64.b64decode(uri.split(",", 1)[1])
+    text = json.dumps(gltf).encode()
+    text += b" " * (-len(text) % 4)
+    data += b"\0" * (-len(data) % 4)
+    body = struct.pack("<I4s", len(text), b"JSON") + text + struct.pack("<I4s", len(data), b"BIN\0") + data
+    with open(path, "wb") as f:
+        f.write(struct.pack("<4sII", b"glTF", 2, 12 + len(body)) + body)
+
+
+write_glb(scene("step_cubic"), "camera_step_cubic.glb")
 for name, kind in (("camera_linear", "linear"), ("camera_step_cubic", "step_cubic"),
                    ("mesh_anim", "mesh")):
     with open(name + ".gltf", "w") as f:
