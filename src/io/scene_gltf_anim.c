@@ -74,7 +74,7 @@ static void channel_eval(const anim_channel *c, double t, float *out)
             memcpy(out, VALUE(lo), sizeof(float) * (size_t)w);
         } else if (!cubic) {
             if (c->path == PATH_ROTATION) {
-                slerp(VALUE(lo), VALUE(hi), u, out);
+                slerp(VALUE(lo), VALUE(hi), (double)u, out);
             } else {
                 lerp_n(VALUE(lo), VALUE(hi), u, out, w);
             }
