@@ -246,10 +246,11 @@ static const cli_option render_table[] = {
                "edit the reflections: sharp, envmap and ISG reflections and the path\n"
                "tracer's first specular bounce follow e(q) (docs/reflection-editing.md)"),
     CLI_CUSTOM_ALL("--animation", "A:B", render_parse_animation,
-                   "render frames A to B (time = frame / --fps) of --camera-path;\n"
+                   "render frames A to B (time = frame / --fps) of --camera-path,\n"
+                   "or of a glTF scene's camera animation;\n"
                    "--out names a pattern, DIR/frame_%04d.exr (docs/temporal.md)"),
     CLI_NUMBER("--fps", "F", O, fps, 1e-3, 1e6,
-               "frames a second of --animation (default: the camera path's, 24)"),
+               "frames a second of --animation (default: the camera path's; glTF 24)"),
     CLI_STRING("--camera-path", "FILE.json", O, camera_path,
                "keyframes of the camera (position, target, fov, aperture, focus),\n"
                "interpolated by centripetal Catmull-Rom (docs/temporal.md)"),

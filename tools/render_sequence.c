@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -21,6 +22,18 @@ bool render_parse_animation(const char *cmd, const char *flag, const char *v, vo
     render_options *o = field;
     o->animation = frame_range_parse(cmd, flag, v, &o->frame_first, &o->frame_last);
     return o->animation;
+}
+
+// A glTF scene file (.gltf, .glb, either .gz): --animation without --camera-path plays its
+// camera animation.
+static bool is_gltf(const char *path)
+{
+    size_t n = path ? strlen(path) : 0;
+    if (n > 3 && strcmp(path + n - 3, ".gz") == 0) {
+        n -= 3;
+    }
+    return (n > 5 && strncasecmp(path + n - 5, ".gltf", 5) == 0) ||
+           (n > 4 && strncasecmp(path + n - 4, ".glb", 4) == 0);
 }
 
 bool render_sequence_validate(const render_options *o)
@@ -48,9 +61,9 @@ bool render_sequence_validate(const render_options *o)
                 o->out_path);
         return false;
     }
-    if (!o->camera_path) {
-        fprintf(stderr, "drift render: --animation needs --camera-path FILE.json (the scene's own "
-                        "glTF animation is not read yet; docs/temporal.md)\n");
+    if (!o->camera_path && !is_gltf(o->scene_path)) {
+        fprintf(stderr, "drift render: --animation needs --camera-path FILE.json, or a glTF "
+                        "scene (.gltf, .glb) whose camera is animated (docs/temporal.md)\n");
         return false;
     }
     if (o->aov_path || o->refine.enabled || o->resume_path || o->debug_sample >= 0) {
@@ -247,7 +260,16 @@ int render_sequence(const render_options *o, const cli_session *session)
     drift_context *ctx = session->ctx;
     sequence_run s = { .o = o, .session = session };
     int exit_code = 1;
-    if (drift_camera_path_load(ctx, o->camera_path, &s.path) != DRIFT_OK) {
+    if (!o->camera_path) {
+        // The scene's own glTF camera animation, sampled at each frame (src/io/scene_gltf_anim.c).
+        s.fps = o->fps > 0.0 ? o->fps : 24.0;
+        if (drift_camera_path_from_gltf(ctx, o->scene_path, NULL, s.fps, o->frame_first,
+                                        o->frame_last, &s.path) != DRIFT_OK) {
+            fprintf(stderr, "drift render: cannot play the camera animation of %s\n",
+                    o->scene_path);
+            return 2;
+        }
+    } else if (drift_camera_path_load(ctx, o->camera_path, &s.path) != DRIFT_OK) {
         fprintf(stderr, "drift render: cannot read --camera-path %s\n", o->camera_path);
         return 2;
     }
@@ -255,7 +277,7 @@ int render_sequence(const render_options *o, const cli_session *session)
     s.stats = render_stats_begin(o, session, o->hybrid_mode ? "hybrid" : "reference",
                                  (int)(o->width ? o->width : session->scene->camera.width),
                                  (int)(o->height ? o->height : session->scene->camera.height));
-    cJSON_AddStringToObject(s.stats, "camera_path", o->camera_path);
+    cJSON_AddStringToObject(s.stats, "camera_path", o->camera_path ? o->camera_path : "gltf");
     cli_json_number(s.stats, "fps", s.fps, 6);
     cJSON_AddNumberToObject(s.stats, "first_frame", (double)o->frame_first);
     cJSON_AddNumberToObject(s.stats, "last_frame", (double)o->frame_last);

@@ -39,6 +39,8 @@ typedef struct drift_camera_key {
     float fov_y; // radians
     float aperture_radius;
     float focus_distance;
+    bool has_up;   // a glTF camera's roll; without it the scene camera's up
+    drift_vec3 up; // unit
 } drift_camera_key;
 
 typedef struct drift_camera_path {
@@ -58,9 +60,22 @@ drift_result drift_camera_path_load_json_text(drift_context *ctx, const char *te
                                               drift_camera_path *out);
 void drift_camera_path_free(drift_context *ctx, drift_camera_path *path); // NULL-safe
 
+// The camera animation of a glTF 2.0 file (.gltf, .glb, either .gz), sampled at frames
+// first_frame..last_frame (time = frame / fps) into keys of position, target (one unit ahead)
+// and up: the world transform of the node holding camera `camera` (a name or index of the
+// file's `cameras`; NULL: the first), its animated parents included. Every animation of the
+// file plays at once (translation, rotation, scale; LINEAR, STEP, CUBICSPLINE). Errors are
+// logged with the file: DRIFT_ERR_PARSE (malformed animations, accessors out of their
+// buffers), DRIFT_ERR_INVALID_ARGUMENT (NaN or absurd values; no animation moves the camera),
+// DRIFT_ERR_UNSUPPORTED (sparse accessors), DRIFT_ERR_IO, DRIFT_ERR_OUT_OF_MEMORY.
+drift_result drift_camera_path_from_gltf(drift_context *ctx, const char *path, const char *camera,
+                                         double fps, long first_frame, long last_frame,
+                                         drift_camera_path *out);
+
 // The camera at `time` seconds: `base` (the scene's camera: size, up, and the fields keys
 // leave out) with the path's position, target, field of view, aperture and focus
-// interpolated. Before the first key and after the last, the end keys hold.
+// interpolated (and the up vector when the keys have one). Before the first key and after the
+// last, the end keys hold.
 drift_camera drift_camera_path_eval(const drift_camera_path *path, const drift_camera *base,
                                     double time);
 

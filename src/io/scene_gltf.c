@@ -158,6 +158,7 @@ drift_result drift__gltf_open(drift_context *ctx, const char *path, bool gz, con
                       name->valuestring, is_required ? " (the file marks it required)" : "");
         }
     }
+    drift__gltf_anim_check(ctx, root, path); // scene_gltf_anim.c: warns of what won't move
     *out = g;
     return DRIFT_OK;
 }

@@ -118,6 +118,11 @@ drift_result drift__smooth_normals(drift_context *ctx, const float *positions, s
 
 typedef struct drift__gltf drift__gltf;
 
+// Reads the animations of a glTF file whose JSON is `root` (scene_gltf_anim.c): one warning
+// when they move nodes that hold no camera (rendered at rest), one when they are malformed.
+struct cJSON;
+void drift__gltf_anim_check(drift_context *ctx, const struct cJSON *root, const char *path);
+
 // A KHR_lights_punctual light in drift's units.
 typedef struct drift__gltf_light {
     drift_vec3 color;               // W/sr (point, spot) or W/m² (directional): cd or lux / 683

@@ -76,6 +76,17 @@ static float key_focus(const drift_camera_key *k, const drift_camera *base)
                                        : drift_vec3_length(drift_vec3_sub(k->target, k->position));
 }
 
+// The keys' up vectors between k1 and k2 (a glTF camera's roll), or the base camera's.
+static drift_vec3 key_up(const drift_camera_key *k1, const drift_camera_key *k2, float u,
+                         drift_vec3 base)
+{
+    if (!k1->has_up || !k2->has_up) {
+        return k1->has_up ? k1->up : base;
+    }
+    drift_vec3 up = lerp3(k1->up, k2->up, u);
+    return drift_vec3_length(up) > 1e-6f ? drift_vec3_normalize(up) : k1->up;
+}
+
 drift_camera drift_camera_path_eval(const drift_camera_path *path, const drift_camera *base,
                                     double time)
 {
@@ -110,12 +121,14 @@ drift_camera drift_camera_path_eval(const drift_camera_path *path, const drift_c
     if (i == n - 1 || path->interpolation == DRIFT_CAMERA_PATH_STEP || u <= 0.0f) {
         c.position = k[i].position;
         c.target = k[i].target;
+        c.up = key_up(&k[i], &k[i], 0.0f, base->up);
         c.fov_y = key_fov(&k[i], base);
         c.aperture_radius = key_aperture(&k[i], base);
         c.focus_distance = key_focus(&k[i], base);
         return c;
     }
     const drift_camera_key *k1 = &k[i], *k2 = &k[i + 1];
+    c.up = key_up(k1, k2, u, base->up);
     if (path->interpolation == DRIFT_CAMERA_PATH_LINEAR) {
         c.position = lerp3(k1->position, k2->position, u);
         c.target = lerp3(k1->target, k2->target, u);
