@@ -136,19 +136,33 @@ drift_result render_write_aov(drift_context *ctx, const char *path, const drift_
     while (sir && drift_refine_plane(sir, refine_count, &name, &image)) {
         ++refine_count;
     }
-    drift_image_layer *layers = calloc(hybrid_count + refine_count, sizeof *layers);
-    if (!layers) {
+    uint32_t count = hybrid_count + refine_count;
+    drift_image_layer *layers = calloc(count, sizeof *layers);
+    const char **channels = calloc(count, sizeof *channels);
+    if (!layers || !channels) {
+        free(layers);
+        free(channels);
         return DRIFT_ERR_OUT_OF_MEMORY;
     }
     for (uint32_t i = 0; i < refine_count; ++i) {
         drift_refine_plane(sir, i, &layers[i].name, &layers[i].image);
     }
     for (uint32_t i = 0; i < hybrid_count; ++i) {
-        drift_hybrid_plane(frame, i, &layers[refine_count + i].name,
-                           &layers[refine_count + i].image);
+        drift_image_layer *l = &layers[refine_count + i];
+        drift_hybrid_plane(frame, i, &l->name, &l->image);
+        // The G-buffer's depth and normal under the names tev, Nuke and Blender's compositor
+        // take as theirs (Z, N.X/N.Y/N.Z), as the path tracer's --aov file has them.
+        if (strcmp(l->name, "depth") == 0) {
+            l->name = NULL;
+            channels[refine_count + i] = "Z";
+        } else if (strcmp(l->name, "normal") == 0) {
+            l->name = "N";
+            channels[refine_count + i] = "X,Y,Z";
+        }
     }
-    drift_result r = drift_image_save_exr(ctx, path, layers, hybrid_count + refine_count);
+    drift_result r = drift_image_save_exr_channels(ctx, path, layers, count, channels, NULL, 0);
     free(layers);
+    free(channels);
     return r;
 }
 

@@ -15,7 +15,7 @@ expect 0 "$drift" render "${small[@]}" --refine sir --budget 100 --refine-spp 2 
     --out "$tmp/r.exr" --aov "$tmp/r-aov.exr" --stats "$tmp/r.json"
 [ -s "$tmp/r.exr" ] && [ -s "$tmp/r.png" ] || fail "--refine sir wrote no image"
 for layer in refined.R error.combined.Y refine.mask.Y refine.samples.Y error.reflection1.Y \
-             error.reflection5.Y error.dof.Y error.shadow.Y error.leak.Y final.R depth.Y; do
+             error.reflection5.Y error.dof.Y error.shadow.Y error.leak.Y final.R N.X; do
     grep -aq "$layer" "$tmp/r-aov.exr" || fail "AOV file lacks $layer"
 done
 python3 - "$tmp/r.json" <<'PY' || fail "refine stats JSON incomplete or not refined"

@@ -43,7 +43,7 @@ assert passes["primary"]["rays"] == 32 * 24
 assert passes["hard_shadows"]["rays"] > 0
 assert s["rays"] == sum(p["rays"] for p in passes.values())
 PY
-for layer in final.R depth.Y normal.R albedo.R gloss.R material_id.Y motion.Y light0.hard_shadow.R \
+for layer in final.R N.X albedo.R gloss.R material_id.Y motion.Y light0.hard_shadow.R \
              light0.unshadowed.R reflection.distance.Y coc.Y; do
     grep -aq "$layer" "$tmp/s-aov.exr" || fail "AOV file lacks $layer"
 done
