@@ -457,9 +457,39 @@ static void print_subcommands(FILE *out, const char *cmd, const char *heading, c
     fprintf(out, "\n%s", footer);
 }
 
+// --help-markdown: the list as a Markdown table, then each entry's own --help-markdown
+// (docs/reference/cli.md, scripts/gen-reference.sh).
+static int print_subcommands_markdown(const char *cmd, const char *heading,
+                                      const cli_subcommand *table, size_t count)
+{
+    printf("## drift%s%s\n\n```text\nusage: drift %s%s<%s> [options]\n```\n\n| %s | |\n|---|---|\n",
+           cmd ? " " : "", cmd ? cmd : "", cmd ? cmd : "", cmd ? " " : "", cmd ? "name" : "command",
+           heading);
+    for (size_t i = 0; i < count; ++i) {
+        printf("| [`%s`](#drift-%s%s%s) | %s |\n", table[i].name, cmd ? cmd : "", cmd ? "-" : "",
+               table[i].name, table[i].summary);
+    }
+    printf("\n");
+    int status = 0;
+    for (size_t i = 0; i < count; ++i) {
+        char *args[] = { (char *)table[i].name, "--help-markdown", NULL };
+        printf("<a id=\"drift-%s%s%s\"></a>\n\n", cmd ? cmd : "", cmd ? "-" : "", table[i].name);
+        fflush(stdout);
+        status |= table[i].run(2, args);
+    }
+    return status;
+}
+
 int cli_dispatch(const char *cmd, const char *heading, const char *footer,
                  const cli_subcommand *table, size_t count, int argc, char **argv)
 {
+    if (argc == 2 && strcmp(argv[1], "--help-markdown") == 0) {
+        return print_subcommands_markdown(cmd, heading, table, count);
+    }
+    if (argc == 2 && !cmd && strcmp(argv[1], "--knobs-markdown") == 0) {
+        cli_print_knobs_markdown(stdout); // docs/reference/knobs.md
+        return 0;
+    }
     if (argc < 2 || strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0) {
         print_subcommands(argc < 2 ? stderr : stdout, cmd, heading, footer, table, count);
         return argc < 2 ? 2 : 0;

@@ -337,6 +337,10 @@ int cli_parse(const cli_command *c, int argc, char **argv, void *opts,
             cli_print_help(c, stdout);
             return CLI_HELP_SHOWN;
         }
+        if (strcmp(a, "--help-markdown") == 0) { // docs/reference/cli.md
+            cli_print_markdown(c, stdout);
+            return CLI_HELP_SHOWN;
+        }
         if (a[0] != '-' || a[1] == '\0') {
             if (!c->positional) {
                 fprintf(stderr, "drift %s: unexpected argument '%s' (see drift %s --help)\n",

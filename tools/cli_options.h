@@ -193,6 +193,12 @@ int cli_parse(const cli_command *command, int argc, char **argv, void *opts,
 int cli_parse_exit(int status);
 
 void cli_print_help(const cli_command *command, FILE *out);
+// The same as Markdown (tools/cli_markdown.c): the usage, one table of options per section
+// (option, argument, description); `drift COMMAND --help-markdown` prints it. And the knob
+// reference: the techniques, then per knob family a table of its rows (`drift
+// --knobs-markdown`). scripts/gen-reference.sh writes docs/reference/ with both.
+void cli_print_markdown(const cli_command *command, FILE *out);
+void cli_print_knobs_markdown(FILE *out);
 
 // "did you mean ...": the nearest of the candidates offered to what the user typed, by edit
 // distance (Damerau: a swap of two letters is one edit), when it is near enough to be a typo

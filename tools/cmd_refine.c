@@ -180,6 +180,10 @@ int drift_cmd_refine(int argc, char **argv)
         cli_print_help(&fit_command, argc < 2 ? stderr : stdout);
         return argc < 2 ? 2 : 0;
     }
+    if (strcmp(argv[1], "--help-markdown") == 0) { // docs/reference/cli.md
+        cli_print_markdown(&fit_command, stdout);
+        return 0;
+    }
     if (strcmp(argv[1], "fit") != 0) {
         fprintf(stderr, "drift refine: unknown action '%s' (actions: fit)\n", argv[1]);
         return 2;
