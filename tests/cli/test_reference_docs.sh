@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# docs/reference/cli.md and knobs.md are what scripts/gen-reference.sh prints from this drift's
+# option and knob tables: regenerated into a temp dir, they must equal the committed pages (a
+# diff and the command that fixes them otherwise), and every table row must have its header's
+# columns (an unescaped '|' in a help text would break it). $1 is the drift binary.
+set -u
+drift="$1"
+source "$(dirname "$0")/common.sh"
+src="${DRIFT_SOURCE_DIR:-$(cd "$(dirname "$0")/../.." && pwd)}"
+
+if ! "$drift" view --help >/dev/null 2>&1; then
+    echo "SKIP: drift was built without the viewer; the reference is generated with it"
+    exit 77
+fi
+bash "$src/scripts/gen-reference.sh" "$drift" "$tmp/ref" || fail "scripts/gen-reference.sh failed"
+for page in cli.md knobs.md; do
+    if ! diff -u "$src/docs/reference/$page" "$tmp/ref/$page" >"$tmp/$page.diff"; then
+        fail "docs/reference/$page is stale: run scripts/gen-reference.sh build/dev/bin/drift and commit it"
+        head -40 "$tmp/$page.diff" >&2
+    fi
+done
+python3 - "$tmp/ref/cli.md" "$tmp/ref/knobs.md" <<'PY' || fail "a Markdown table row has the wrong number of columns"
+import re, sys
+bad = 0
+for path in sys.argv[1:]:
+    columns, fence = None, False
+    for n, line in enumerate(open(path), 1):
+        fence ^= line.startswith("```")
+        cells = len(re.findall(r"(?<!\\)\|", line)) if line.startswith("|") and not fence else 0
+        if not cells:
+            columns = None
+        elif columns is None:
+            columns = cells
+        elif cells != columns:
+            print(f"{path}:{n}: {cells - 1} columns, the header has {columns - 1}", file=sys.stderr)
+            bad += 1
+sys.exit(bad > 0)
+PY
+grep -q -- '--ism-vpls' "$tmp/ref/knobs.md" || fail "knobs.md does not list --ism-vpls"
+grep -q '^## drift bench isg' "$tmp/ref/cli.md" || fail "cli.md has no drift bench isg"
+exit $((failures > 0))
