@@ -34,7 +34,7 @@
 
 typedef struct cycles_options {
     const char *scene_path[1];
-    long size, spp, ref_spp, max_depth, threads;
+    long size, spp, ref_spp, fit_spp, max_depth, threads;
     const char *blender, *out_dir, *cache_dir;
     bool json;
 } cycles_options;
@@ -48,6 +48,8 @@ static const cli_option cycles_table[] = {
             "drift's --max-depth (scattering vertices); Cycles gets max_bounces D-1 (default 8)"),
     CLI_INT("--ref-spp", "N", O, ref_spp, 1, 1 << 22,
             "spp of drift's reference for FLIP and relMSE (default 4x --spp, at least 256)"),
+    CLI_INT("--fit-spp", "N", O, fit_spp, 0, 1 << 20,
+            "second, lower spp of both for the error slope (default --spp/4; 0: assume 1/spp)"),
     CLI_STRING("--blender", "BIN", O, blender, "Blender binary (default $BLENDER or blender)"),
     CLI_STRING("--out-dir", "DIR", O, out_dir,
                "where the images and logs go (default a new /tmp/drift-bench-cycles-*)"),
@@ -205,8 +207,8 @@ static void mkdirs(const char *path)
 }
 
 // Both images' metrics against the reference; false (message printed) on a load failure.
-static bool compare(drift_context *ctx, const char *ref_path, const char *paths[2],
-                    drift_metric_report out[2])
+static bool compare(drift_context *ctx, const char *ref_path, const char *const *paths, int count,
+                    drift_metric_report *out)
 {
     drift_image ref = { 0 }, test = { 0 };
     if (drift_image_load(ctx, ref_path, &ref) != DRIFT_OK) {
@@ -214,7 +216,7 @@ static bool compare(drift_context *ctx, const char *ref_path, const char *paths[
         return false;
     }
     bool ok = true;
-    for (int i = 0; i < 2 && ok; ++i) {
+    for (int i = 0; i < count && ok; ++i) {
         ok = drift_image_load(ctx, paths[i], &test) == DRIFT_OK &&
              drift_metric_compare(ctx, &ref, &test, &(drift_metric_params){ 0 }, &out[i], NULL) ==
                  DRIFT_OK;
@@ -231,8 +233,10 @@ typedef struct cycles_run {
     child_time drift_process, cycles_process;
     double drift_render_s, cycles_render_s, blender_render_s;
     drift_metric_report drift_q, cycles_q;
+    double drift_lo_relmse, cycles_lo_relmse, drift_slope, cycles_slope, equal_error;
     bool gltf;
     char scene[4096], dir[4096], ref[4352], drift_exr[4352], cycles_exr[4352], cycles_log[4352];
+    char drift_lo_exr[4352], cycles_lo_exr[4352];
 } cycles_run;
 
 static void print_json(const cycles_options *o, const cycles_run *r, double ratio_process,
@@ -270,6 +274,10 @@ static void print_json(const cycles_options *o, const cycles_run *r, double rati
     cli_json_number(root, "ratio_process", ratio_process, 4);
     cli_json_number(root, "ratio_render", ratio_render, 4);
     cli_json_number(root, "equal_error_ratio", equal_error, 4);
+    cli_json_count(root, "fit_spp",
+                   (uint64_t)(o->fit_spp > 0 && o->fit_spp < o->spp ? o->fit_spp : 0));
+    cli_json_number(root, "drift_error_slope", r->drift_slope, 4);
+    cli_json_number(root, "cycles_error_slope", r->cycles_slope, 4);
     cJSON_AddStringToObject(root, "reference", r->ref);
     cli_json_write("bench cycles", root, NULL);
 }
@@ -289,6 +297,8 @@ static void print_text(const cycles_options *o, const cycles_run *r, double rati
     printf("  Cycles / drift: whole process %.3f, render %.3f, equal relMSE %.3f (>1: drift "
            "faster)\n",
            ratio_process, ratio_render, equal_error);
+    printf("  relMSE ∝ spp^-k: k drift %.3f, Cycles %.3f (%s)\n", r->drift_slope, r->cycles_slope,
+           o->fit_spp > 0 && o->fit_spp < o->spp ? "fitted from --fit-spp" : "assumed");
     printf("  reference: drift %ld spp, %s\n  images: %s %s\n", o->ref_spp, r->ref, r->drift_exr,
            r->cycles_exr);
 }
@@ -314,10 +324,11 @@ static int render_drift(const cycles_options *o, const char *self, const char *s
     return run_child(argv, log, t);
 }
 
-static int render_cycles(const cycles_options *o, cycles_run *r)
+static int render_cycles(const cycles_options *o, const cycles_run *r, long spp, char *out,
+                         const char *log, child_time *t)
 {
     char s_spp[32], s_size[32], s_depth[32], s_bounces[32], s_threads[32], script[4200], obj[4200];
-    snprintf(s_spp, sizeof s_spp, "%ld", o->spp);
+    snprintf(s_spp, sizeof s_spp, "%ld", spp);
     snprintf(s_size, sizeof s_size, "%ld", o->size);
     snprintf(s_depth, sizeof s_depth, "%ld", o->max_depth);
     snprintf(s_bounces, sizeof s_bounces, "%ld", o->max_depth - 1);
@@ -328,13 +339,13 @@ static int render_cycles(const cycles_options *o, cycles_run *r)
     if (r->gltf) {
         char *argv[] = { blender,     "-b",       "--factory-startup",
                          "-noaudio",  "--python", script,
-                         "--",        "--gltf",   r->scene,
+                         "--",        "--gltf",   (char *)r->scene,
                          "--spp",     s_spp,      "--width",
                          s_size,      "--height", s_size,
                          "--threads", s_threads,  "--max-bounces",
-                         s_bounces,   "--out",    r->cycles_exr,
+                         s_bounces,   "--out",    out,
                          NULL };
-        return run_child(argv, r->cycles_log, &r->cycles_process);
+        return run_child(argv, log, t);
     }
     // The Cornell box's OBJ beside its .json, with drift's conventions (run_compare.sh's).
     snprintf(obj, sizeof obj, "%s", r->scene);
@@ -363,21 +374,24 @@ static int render_cycles(const cycles_options *o, cycles_run *r)
                      "--height",
                      s_size,
                      "--out",
-                     r->cycles_exr,
+                     out,
                      "--rr-min-bounces",
                      "2",
                      "--one-sided-light",
                      "--light-diffuse",
                      NULL };
-    return run_child(argv, r->cycles_log, &r->cycles_process);
+    return run_child(argv, log, t);
 }
 
 int drift_bench_cycles(int argc, char **argv)
 {
-    cycles_options o = { .size = 256, .spp = 64, .max_depth = 8, .threads = 2 };
+    cycles_options o = { .size = 256, .spp = 64, .fit_spp = -1, .max_depth = 8, .threads = 2 };
     int status = cli_parse(&cycles_command, argc, argv, &o, NULL);
     if (status != CLI_PARSED) {
         return cli_parse_exit(status);
+    }
+    if (o.fit_spp < 0) {
+        o.fit_spp = o.spp / 4;
     }
     if (!o.ref_spp) {
         o.ref_spp = o.spp * 4 > 256 ? o.spp * 4 : 256;
@@ -434,7 +448,7 @@ int drift_bench_cycles(int argc, char **argv)
             return 1;
         }
     }
-    char cache[4096], stats[4352], log[4352];
+    char cache[4096], stats[4352], drift_log[4352];
     const char *xdg = getenv("XDG_CACHE_HOME"), *home = getenv("HOME");
     if (o.cache_dir) {
         snprintf(cache, sizeof cache, "%s", o.cache_dir);
@@ -447,9 +461,11 @@ int drift_bench_cycles(int argc, char **argv)
     reference_path(&o, r.scene, cache, r.ref, sizeof r.ref);
     snprintf(r.drift_exr, sizeof r.drift_exr, "%s/drift.exr", r.dir);
     snprintf(r.cycles_exr, sizeof r.cycles_exr, "%s/cycles.exr", r.dir);
+    snprintf(r.drift_lo_exr, sizeof r.drift_lo_exr, "%s/drift-fit.exr", r.dir);
+    snprintf(r.cycles_lo_exr, sizeof r.cycles_lo_exr, "%s/cycles-fit.exr", r.dir);
     snprintf(r.cycles_log, sizeof r.cycles_log, "%s/cycles.log", r.dir);
     snprintf(stats, sizeof stats, "%s/drift.json", r.dir);
-    snprintf(log, sizeof log, "%s/drift.log", r.dir);
+    snprintf(drift_log, sizeof drift_log, "%s/drift.log", r.dir);
 
     if (access(r.ref, R_OK) != 0) {
         // Another seed than the timed render's, so the two are independent.
@@ -459,14 +475,15 @@ int drift_bench_cycles(int argc, char **argv)
             fprintf(stderr, "drift bench cycles: rendering the %ld-spp reference into %s\n",
                     o.ref_spp, r.ref);
         }
-        if (render_drift(&o, self, r.scene, o.ref_spp, "1000003", tmp, NULL, log, NULL) != 0 ||
+        if (render_drift(&o, self, r.scene, o.ref_spp, "1000003", tmp, NULL, drift_log, NULL) !=
+                0 ||
             rename(tmp, r.ref) != 0) {
-            fprintf(stderr, "drift bench cycles: the reference render failed, see %s\n", log);
+            fprintf(stderr, "drift bench cycles: the reference render failed, see %s\n", drift_log);
             return 1;
         }
     }
     // Cycles first, then drift: the order of run_compare.sh.
-    if (render_cycles(&o, &r) != 0) {
+    if (render_cycles(&o, &r, o.spp, r.cycles_exr, r.cycles_log, &r.cycles_process) != 0) {
         fprintf(stderr, "drift bench cycles: the Cycles render failed, see %s\n", r.cycles_log);
         return 1;
     }
@@ -474,9 +491,9 @@ int drift_bench_cycles(int argc, char **argv)
     if (!isfinite(r.cycles_render_s)) {
         r.cycles_render_s = r.blender_render_s; // gltf_cycles.py: Blender's own, sync included
     }
-    if (render_drift(&o, self, r.scene, o.spp, "0", r.drift_exr, stats, log, &r.drift_process) !=
-        0) {
-        fprintf(stderr, "drift bench cycles: the drift render failed, see %s\n", log);
+    if (render_drift(&o, self, r.scene, o.spp, "0", r.drift_exr, stats, drift_log,
+                     &r.drift_process) != 0) {
+        fprintf(stderr, "drift bench cycles: the drift render failed, see %s\n", drift_log);
         return 1;
     }
     r.drift_render_s = drift_render_seconds(stats);
@@ -484,24 +501,46 @@ int drift_bench_cycles(int argc, char **argv)
         fprintf(stderr, "drift bench cycles: no render time in %s or %s\n", r.cycles_log, stats);
         return 1;
     }
+    // The error slope of each: relMSE ∝ spp^-k from a second, lower spp (k = 1: pure variance).
+    r.drift_slope = r.cycles_slope = 1.0;
+    const char *images[4] = { r.drift_exr, r.cycles_exr, r.drift_lo_exr, r.cycles_lo_exr };
+    bool fit = o.fit_spp > 0 && o.fit_spp < o.spp;
+    if (fit && (render_cycles(&o, &r, o.fit_spp, r.cycles_lo_exr, r.cycles_log, NULL) != 0 ||
+                render_drift(&o, self, r.scene, o.fit_spp, "0", r.drift_lo_exr, NULL, drift_log,
+                             NULL) != 0)) {
+        fprintf(stderr, "drift bench cycles: a %ld-spp render failed, see %s and %s\n", o.fit_spp,
+                r.cycles_log, drift_log);
+        return 1;
+    }
     drift_context *ctx = NULL;
     if (drift_context_create(&(drift_context_desc){ .thread_count = (uint32_t)o.threads }, &ctx) !=
         DRIFT_OK) {
         return 1;
     }
-    const char *images[2] = { r.drift_exr, r.cycles_exr };
-    drift_metric_report q[2];
-    bool ok = compare(ctx, r.ref, images, q);
+    drift_metric_report q[4];
+    bool ok = compare(ctx, r.ref, images, fit ? 4 : 2, q);
     drift_context_destroy(ctx);
     if (!ok) {
         return 1;
     }
     r.drift_q = q[0];
     r.cycles_q = q[1];
+    if (fit) {
+        double span = log((double)o.spp / (double)o.fit_spp);
+        r.drift_lo_relmse = q[2].relmse;
+        r.cycles_lo_relmse = q[3].relmse;
+        r.drift_slope = log(q[2].relmse / q[0].relmse) / span;
+        r.cycles_slope = log(q[3].relmse / q[1].relmse) / span;
+    }
     double ratio_process = r.cycles_process.wall_s / r.drift_process.wall_s;
     double ratio_render = r.cycles_render_s / r.drift_render_s;
+    // Each one's render time to reach the larger of the two relMSEs, t (relMSE / e)^(1/k).
+    double e = fmax(r.drift_q.relmse, r.cycles_q.relmse);
     double equal_error =
-        r.cycles_render_s * r.cycles_q.relmse / (r.drift_render_s * r.drift_q.relmse);
+        r.drift_slope > 0 && r.cycles_slope > 0
+            ? r.cycles_render_s * pow(r.cycles_q.relmse / e, 1.0 / r.cycles_slope) /
+                  (r.drift_render_s * pow(r.drift_q.relmse / e, 1.0 / r.drift_slope))
+            : (double)NAN;
     if (o.json) {
         print_json(&o, &r, ratio_process, ratio_render, equal_error);
     } else {
