@@ -233,7 +233,7 @@ typedef struct cycles_run {
     child_time drift_process, cycles_process;
     double drift_render_s, cycles_render_s, blender_render_s;
     drift_metric_report drift_q, cycles_q;
-    double drift_lo_relmse, cycles_lo_relmse, drift_slope, cycles_slope, equal_error;
+    double drift_lo_relmse, cycles_lo_relmse, drift_slope, cycles_slope, ref_noise;
     bool gltf;
     char scene[4096], dir[4096], ref[4352], drift_exr[4352], cycles_exr[4352], cycles_log[4352];
     char drift_lo_exr[4352], cycles_lo_exr[4352];
@@ -276,6 +276,7 @@ static void print_json(const cycles_options *o, const cycles_run *r, double rati
     cli_json_number(root, "equal_error_ratio", equal_error, 4);
     cli_json_count(root, "fit_spp",
                    (uint64_t)(o->fit_spp > 0 && o->fit_spp < o->spp ? o->fit_spp : 0));
+    cli_json_number(root, "reference_relmse", r->ref_noise, 7);
     cli_json_number(root, "drift_error_slope", r->drift_slope, 4);
     cli_json_number(root, "cycles_error_slope", r->cycles_slope, 4);
     cJSON_AddStringToObject(root, "reference", r->ref);
@@ -297,7 +298,8 @@ static void print_text(const cycles_options *o, const cycles_run *r, double rati
     printf("  Cycles / drift: whole process %.3f, render %.3f, equal relMSE %.3f (>1: drift "
            "faster)\n",
            ratio_process, ratio_render, equal_error);
-    printf("  relMSE ∝ spp^-k: k drift %.3f, Cycles %.3f (%s)\n", r->drift_slope, r->cycles_slope,
+    printf("  relMSE ∝ spp^-k, less the reference's own %.3g: k drift %.3f, Cycles %.3f (%s)\n",
+           r->ref_noise, r->drift_slope, r->cycles_slope,
            o->fit_spp > 0 && o->fit_spp < o->spp ? "fitted from --fit-spp" : "assumed");
     printf("  reference: drift %ld spp, %s\n  images: %s %s\n", o->ref_spp, r->ref, r->drift_exr,
            r->cycles_exr);
@@ -525,22 +527,28 @@ int drift_bench_cycles(int argc, char **argv)
     }
     r.drift_q = q[0];
     r.cycles_q = q[1];
+    // The reference's own noise adds to every relMSE against it: drift's variance at ref_spp,
+    // relMSE_drift * spp / ref_spp under 1/spp. Taken off before the slopes and the ratio.
+    r.ref_noise = q[0].relmse * (double)o.spp / (double)o.ref_spp;
+    double err[4];
+    for (int i = 0; i < 4; ++i) {
+        err[i] = q[i].relmse - r.ref_noise;
+    }
     if (fit) {
         double span = log((double)o.spp / (double)o.fit_spp);
         r.drift_lo_relmse = q[2].relmse;
         r.cycles_lo_relmse = q[3].relmse;
-        r.drift_slope = log(q[2].relmse / q[0].relmse) / span;
-        r.cycles_slope = log(q[3].relmse / q[1].relmse) / span;
+        r.drift_slope = log(err[2] / err[0]) / span;
+        r.cycles_slope = log(err[3] / err[1]) / span;
     }
     double ratio_process = r.cycles_process.wall_s / r.drift_process.wall_s;
     double ratio_render = r.cycles_render_s / r.drift_render_s;
     // Each one's render time to reach the larger of the two relMSEs, t (relMSE / e)^(1/k).
-    double e = fmax(r.drift_q.relmse, r.cycles_q.relmse);
-    double equal_error =
-        r.drift_slope > 0 && r.cycles_slope > 0
-            ? r.cycles_render_s * pow(r.cycles_q.relmse / e, 1.0 / r.cycles_slope) /
-                  (r.drift_render_s * pow(r.drift_q.relmse / e, 1.0 / r.drift_slope))
-            : (double)NAN;
+    double e = fmax(err[0], err[1]);
+    double equal_error = err[0] > 0 && err[1] > 0 && r.drift_slope > 0 && r.cycles_slope > 0
+                             ? r.cycles_render_s * pow(err[1] / e, 1.0 / r.cycles_slope) /
+                                   (r.drift_render_s * pow(err[0] / e, 1.0 / r.drift_slope))
+                             : (double)NAN;
     if (o.json) {
         print_json(&o, &r, ratio_process, ratio_render, equal_error);
     } else {
