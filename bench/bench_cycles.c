@@ -236,7 +236,7 @@ typedef struct cycles_run {
     double drift_lo_relmse, cycles_lo_relmse, drift_slope, cycles_slope, ref_noise;
     bool gltf;
     char scene[4096], dir[4096], ref[4352], drift_exr[4352], cycles_exr[4352], cycles_log[4352];
-    char drift_lo_exr[4352], cycles_lo_exr[4352];
+    char drift_lo_exr[4352], cycles_lo_exr[4352], cycles_lo_log[4352];
 } cycles_run;
 
 static void print_json(const cycles_options *o, const cycles_run *r, double ratio_process,
@@ -465,6 +465,7 @@ int drift_bench_cycles(int argc, char **argv)
     snprintf(r.cycles_exr, sizeof r.cycles_exr, "%s/cycles.exr", r.dir);
     snprintf(r.drift_lo_exr, sizeof r.drift_lo_exr, "%s/drift-fit.exr", r.dir);
     snprintf(r.cycles_lo_exr, sizeof r.cycles_lo_exr, "%s/cycles-fit.exr", r.dir);
+    snprintf(r.cycles_lo_log, sizeof r.cycles_lo_log, "%s/cycles-fit.log", r.dir);
     snprintf(r.cycles_log, sizeof r.cycles_log, "%s/cycles.log", r.dir);
     snprintf(stats, sizeof stats, "%s/drift.json", r.dir);
     snprintf(drift_log, sizeof drift_log, "%s/drift.log", r.dir);
@@ -507,11 +508,11 @@ int drift_bench_cycles(int argc, char **argv)
     r.drift_slope = r.cycles_slope = 1.0;
     const char *images[4] = { r.drift_exr, r.cycles_exr, r.drift_lo_exr, r.cycles_lo_exr };
     bool fit = o.fit_spp > 0 && o.fit_spp < o.spp;
-    if (fit && (render_cycles(&o, &r, o.fit_spp, r.cycles_lo_exr, r.cycles_log, NULL) != 0 ||
+    if (fit && (render_cycles(&o, &r, o.fit_spp, r.cycles_lo_exr, r.cycles_lo_log, NULL) != 0 ||
                 render_drift(&o, self, r.scene, o.fit_spp, "0", r.drift_lo_exr, NULL, drift_log,
                              NULL) != 0)) {
         fprintf(stderr, "drift bench cycles: a %ld-spp render failed, see %s and %s\n", o.fit_spp,
-                r.cycles_log, drift_log);
+                r.cycles_lo_log, drift_log);
         return 1;
     }
     drift_context *ctx = NULL;
