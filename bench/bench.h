@@ -24,7 +24,9 @@
       "micro-rendering's points lit by radiosity or photons: NRMS, FLIP vs the pt, 1-3 bounces") \
     X("frontier", drift_bench_frontier,                                                          \
       "equal-time frontier: pt, pt + a-trous, hybrid rows vs a whole-frame reference")           \
-    X("redit", drift_bench_redit, "reflection editing: edit-field Mpixel/s vs constraints")
+    X("redit", drift_bench_redit, "reflection editing: edit-field Mpixel/s vs constraints")      \
+    X("cycles", drift_bench_cycles,                                                              \
+      "drift's path tracer vs Blender Cycles: process and render s, FLIP, equal-error ratio")
 
 #include "cli.h"
 

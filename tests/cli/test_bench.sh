@@ -199,6 +199,28 @@ assert t.tag == ns + "svg" and len(t.findall(ns + "circle")) > 15 and t.findall(
 assert d["reflective_pixels"] > 0 and all(r["mpixel_per_s"] > 0 for r in d["field"]), d
 assert d["frame_ms_unedited"] > 0 and d["frame_ms_edited"] > 0, d'
         ;;
+    cycles)
+        # Without Blender: skipped with exit status 77 and a message saying so.
+        expect 77 "$drift" bench cycles "$box" --blender /nonexistent/blender --size 8 --spp 1
+        grep -q "skipped: Blender" "$tmp/err" || fail "bench cycles: missing Blender not said"
+        expect 2 "$drift" bench cycles "${box%/cornell-box/*}/breakfast-room/breakfast_room.json"
+        grep -q "glTF" "$tmp/err" || fail "bench cycles: a scene Blender cannot read not named"
+        if blender --version >/dev/null 2>&1; then
+            expect 0 "$drift" bench cycles "$box" --size 16 --spp 4 --ref-spp 64 --max-depth 3 \
+                --threads 1 --cache "$tmp/cycles-cache" --out-dir "$tmp/cycles" --json
+            check cycles 'assert d["size"] == 16 and d["spp"] == 4 and d["threads"] == 1 and d["fit_spp"] == 1, d
+for k in ("drift", "cycles"):
+    r = d[k]
+    assert r["process_s"] > 0 and r["render_s"] > 0 and r["process_s"] > r["render_s"], r
+    assert 0 <= r["flip"] <= 1 and math.isfinite(r["relmse"]) and r["relmse"] > 0, r
+for k in ("ratio_process", "ratio_render", "equal_error_ratio", "drift_error_slope", "cycles_error_slope"):
+    assert math.isfinite(d[k]) and d[k] > 0, (k, d)
+assert 0 < d["reference_relmse"] < d["drift"]["relmse"], d
+assert abs(d["ratio_render"] - d["cycles"]["render_s"] / d["drift"]["render_s"]) < 0.05 * d["ratio_render"], d'
+        else
+            echo "cli.bench: Blender is not installed: bench cycles checked for its skip only"
+        fi
+        ;;
     *)
         fail "bench $1 has no smoke case in tests/cli/test_bench.sh"
         return
