@@ -130,8 +130,14 @@ assert d["rows"][3]["photons"] > 0 and d["rows"][2]["photons"] == 0, d'
         done
         check frontier 'first = json.load(open(sys.argv[1][:-3] + "frontier1.json"))
 assert first["reference_cached"] is False and d["reference_cached"] is True, (first, d)
-assert [r["flip"] for r in first["rows"] if r["family"] != "hybrid"] == \
-    [r["flip"] for r in d["rows"] if r["family"] != "hybrid"], d
+# The same rows give the same FLIP (the reduced-resolution path tracer doubles its spp until
+# a time limit, so how many of its rows there are depends on the machine's load: compare the
+# rows both runs have, and every row of the families with a fixed count).
+flips = lambda run: {(r["family"], r["name"]): r["flip"] for r in run["rows"] if r["family"] != "hybrid"}
+f1, f2 = flips(first), flips(d)
+assert all(f1[k] == f2[k] for k in f1.keys() & f2.keys()), (f1, f2)
+fixed = lambda rows: sorted(k for k in rows if not k[0].startswith("pt-low"))
+assert fixed(f1) == fixed(f2), (f1, f2)
 fam = [r["family"] for r in d["rows"]]
 assert fam.count("pt") == 2 and fam.count("pt+atrous") == 2 and fam.count("pt+denoise") == 2 \
     and fam.count("hybrid") >= 20, fam

@@ -87,11 +87,17 @@ expect 0 "$drift" render "$tmp/flat/emissive_obj.json" "${mid[@]}" --out "$tmp/s
 expect 0 "$drift" diff "$tmp/s_glb.exr" "$tmp/s_smooth.exr" --json
 cp "$tmp/out" "$tmp/s_smooth.json"
 expect 0 "$drift" diff "$tmp/s_glb.exr" "$tmp/s_flat.exr" --json
-python3 - "$tmp/s_smooth.json" "$tmp/out" <<'PY' || fail "s 1 without normals is not shaded smooth"
+cp "$tmp/out" "$tmp/s_flat.json"
+expect 0 "$drift" diff "$tmp/s_smooth.exr" "$tmp/s_flat.exr" --json
+# The .glb's materials are GGX (glTF metallic-roughness) and the OBJ's the MTL's mapping, so
+# both OBJ renders keep a material difference from the .glb: s 1 must change the image
+# (interpolated normals) and bring it closer to the .glb's, which has the normals.
+python3 - "$tmp/s_smooth.json" "$tmp/s_flat.json" "$tmp/out" <<'PY' || fail "s 1 without normals is not shaded smooth"
 import json, sys
-smooth, flat = (json.load(open(p))["rmse"] for p in sys.argv[1:3])
-print("cli.interchange: OBJ against .glb: rmse %.5f with s 1, %.5f faceted" % (smooth, flat))
-sys.exit(0 if smooth < 0.5 * flat else 1)
+smooth, flat, between = (json.load(open(p))["rmse"] for p in sys.argv[1:4])
+print("cli.interchange: OBJ against .glb: rmse %.5f with s 1, %.5f faceted; %.5f between them"
+      % (smooth, flat, between))
+sys.exit(0 if smooth < flat and between > 0.25 * flat else 1)
 PY
 
 # OBJ/MTL: a map_Kd with trailing tabs and spaces loads its texture; a missing texture and a
