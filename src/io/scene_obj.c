@@ -117,6 +117,23 @@ static drift__obj_material *add_material(drift_context *ctx, drift__obj *o, cons
     return m;
 }
 
+// OBJ and MTL files are text: a NUL byte is refused with its line, since assimp's MTL reader
+// writes through a null material on one (fuzz_scene_mtl).
+static drift_result check_text(drift_context *ctx, const char *path, const char *text, size_t size)
+{
+    const char *nul = memchr(text, '\0', size);
+    if (!nul) {
+        return DRIFT_OK;
+    }
+    int line = 1;
+    for (const char *c = text; c < nul; ++c) {
+        line += *c == '\n';
+    }
+    drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, path, line,
+              "a NUL byte: an OBJ or MTL file is text");
+    return DRIFT_ERR_PARSE;
+}
+
 // Reads one MTL library: its materials, and a warning for each statement drift drops.
 static drift_result read_mtl(drift_context *ctx, drift__obj *o, const char *path)
 {
@@ -124,6 +141,10 @@ static drift_result read_mtl(drift_context *ctx, drift__obj *o, const char *path
     size_t size = 0;
     drift_result r = drift__read_file(ctx, path, false, path, 0, &text, &size);
     if (r != DRIFT_OK) {
+        return r;
+    }
+    if ((r = check_text(ctx, path, text, size)) != DRIFT_OK) {
+        drift_free(ctx, text);
         return r;
     }
 
@@ -155,6 +176,28 @@ static drift_result read_mtl(drift_context *ctx, drift__obj *o, const char *path
     size_t at = 0;
     for (int number = 1; next_line(text, size, &at, line, sizeof line); ++number) {
         const char *arg = NULL;
+        // A texture statement names no material before the first newmtl, and assimp's MTL
+        // reader writes its texture through a null material there (fuzz_scene_mtl).
+        const char *head = line;
+        while (*head == ' ' || *head == '\t') {
+            ++head;
+        }
+        // A statement starts with a letter, a comment with '#': assimp's MTL reader misreads
+        // the lines after one that starts with another byte (0xce, 0x01; fuzz_scene_mtl).
+        if (*head && *head != '\r' && *head != '#' && !isalpha((unsigned char)*head)) {
+            drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, path, number,
+                      "not an MTL statement (a statement starts with a letter)");
+            drift_free(ctx, text);
+            return DRIFT_ERR_PARSE;
+        }
+        if (!m && (strncmp(head, "map_", 4) == 0 || statement(head, "bump", &arg) ||
+                   statement(head, "disp", &arg) || statement(head, "decal", &arg) ||
+                   statement(head, "refl", &arg) || statement(head, "norm", &arg))) {
+            drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, path, number,
+                      "a texture statement before any newmtl");
+            drift_free(ctx, text);
+            return DRIFT_ERR_PARSE;
+        }
         if (statement(line, "newmtl", &arg)) {
             m = add_material(ctx, o, arg, path);
             if (!m) {
@@ -277,7 +320,8 @@ drift_result drift__obj_open(drift_context *ctx, const char *path, const char *t
                              drift__obj **out)
 {
     *out = NULL;
-    drift_result r = check_tail(ctx, path, text, size);
+    drift_result r = check_text(ctx, path, text, size);
+    r = r ? r : check_tail(ctx, path, text, size);
     drift__obj *o = r == DRIFT_OK ? drift_alloc(ctx, sizeof *o) : NULL;
     if (r != DRIFT_OK || !o) {
         return r != DRIFT_OK ? r : DRIFT_ERR_OUT_OF_MEMORY;

@@ -230,6 +230,10 @@ static drift_result ply_check_ascii(ply_reader *r)
                     char value[64];
                     size_t len = 0;
                     while (t < line_end && *t != ' ' && *t != '\t' && *t != '\r') {
+                        if (*t == '\0') { // text: a NUL would end the number unseen
+                            return ply_error_at_line(
+                                r, r->line + 1, "a NUL byte in an ASCII PLY (element %s)", element);
+                        }
                         if (len < sizeof value - 1) {
                             value[len++] = *t;
                         }
@@ -251,10 +255,12 @@ static drift_result ply_check_ascii(ply_reader *r)
                                                      value, element);
                         }
                         items = (long)v;
-                        if (items == 0 && p->face_indices) {
-                            return ply_error_at_line(r, r->line + 1,
-                                                     "a face with no vertex indices (element %s)",
-                                                     element);
+                        // assimp's triangulation aborts on a face of 1 or 2 (fuzz_scene_ply).
+                        if (items < 3 && p->face_indices) {
+                            return ply_error_at_line(
+                                r, r->line + 1,
+                                "a face with %ld vertex indices, fewer than 3 (element %s)", items,
+                                element);
                         }
                     }
                 }
@@ -310,11 +316,11 @@ static drift_result ply_check_binary(ply_reader *r)
                     }
                     bool negative;
                     items = ply_read_count(r, p, &negative);
-                    if (items == 0 && p->face_indices) {
+                    if (items < 3 && p->face_indices) {
                         drift_log(r->ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, r->path, 0,
-                                  "byte %zu: a face with no vertex indices ('%s' element %llu of "
-                                  "%llu)",
-                                  r->pos, e->name, k + 1, e->count);
+                                  "byte %zu: a face with %llu vertex indices, fewer than 3 ('%s' "
+                                  "element %llu of %llu)",
+                                  r->pos, items, e->name, k + 1, e->count);
                         return DRIFT_ERR_PARSE;
                     }
                     if (negative || items > 1000000) {

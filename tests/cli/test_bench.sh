@@ -131,7 +131,7 @@ assert d["rows"][3]["photons"] > 0 and d["rows"][2]["photons"] == 0, d'
         check frontier 'first = json.load(open(sys.argv[1][:-3] + "frontier1.json"))
 assert first["reference_cached"] is False and d["reference_cached"] is True, (first, d)
 # The same rows give the same FLIP (the reduced-resolution path tracer doubles its spp until
-# a time limit, so how many of its rows there are depends on the machine's load: compare the
+# a time limit, so how many of its rows there are depends on the load of the machine: compare the
 # rows both runs have, and every row of the families with a fixed count).
 flips = lambda run: {(r["family"], r["name"]): r["flip"] for r in run["rows"] if r["family"] != "hybrid"}
 f1, f2 = flips(first), flips(d)
