@@ -622,18 +622,6 @@ static drift_result check_ply_header(const import_state *s, const char *head, si
         const char *end = memchr(line, '\n', head_size - pos);
         size_t len = end ? (size_t)(end - line) : head_size - pos;
         pos += len + 1;
-        // A header is printable ASCII: assimp splits its lines on other control characters
-        // too (a vertical tab in "property float\vnz"), disagrees with the data's layout and
-        // aborts in its triangulation (fuzz_scene_ply).
-        for (size_t i = 0; i < len; ++i) {
-            unsigned char c = (unsigned char)line[i];
-            if ((c < 0x20 && c != '\t' && c != '\r') || c > 0x7e) {
-                drift_log(s->ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, s->where, s->line,
-                          "'%s': the PLY header has a byte 0x%02x that is not printable text",
-                          s->params->path, c);
-                return DRIFT_ERR_PARSE;
-            }
-        }
         if (len >= 10 && memcmp(line, "end_header", 10) == 0) {
             size_t data = file_size > pos ? file_size - pos : 0;
             if (declared > data) {

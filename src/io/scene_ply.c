@@ -106,8 +106,20 @@ static drift_result ply_read_header(ply_reader *r)
     bool newline;
     r->line = 0;
     bool have_format = false;
-    while (ply_next_line(r, line, sizeof line, &newline)) {
+    for (size_t start = r->pos; ply_next_line(r, line, sizeof line, &newline); start = r->pos) {
         ++r->line;
+        // A header is printable text: assimp splits its lines on other control bytes too (a
+        // vertical tab in "property float\vnz"), disagrees with the data's layout and aborts
+        // in its triangulation (fuzz_scene_ply).
+        for (size_t i = start; i < r->pos; ++i) {
+            unsigned char ch = (unsigned char)r->data[i];
+            if ((ch < 0x20 && ch != '\t' && ch != '\r' && ch != '\n') || ch > 0x7e) {
+                return ply_error_at_line(r, r->line,
+                                         "the PLY header has a byte 0x%02x that is not printable "
+                                         "text",
+                                         ch);
+            }
+        }
         char word[32] = "", a[64] = "", b[64] = "", c[64] = "", d[64] = "";
         int n = sscanf(line, "%31s %63s %63s %63s %63s", word, a, b, c, d);
         if (r->line == 1) {
