@@ -100,3 +100,126 @@ uint32_t test_add_mesh(struct drift_scene *scene, const float *positions, uint32
     }
     return index;
 }
+
+// --- CHI-SQUARE (pbrt-v3's and Mitsuba's approach) ---
+
+#ifndef M_PI
+#    define M_PI 3.14159265358979323846
+#endif
+
+#define THETA_BINS 16
+#define PHI_BINS   32
+
+// Upper quantile of the chi-square distribution (Wilson-Hilferty approximation), for
+// significance 1e-3 per test: z = 3.09.
+static double chi2_critical(int dof)
+{
+    double k = (double)dof, z = 3.09;
+    double t = 1.0 - 2.0 / (9.0 * k) + z * sqrt(2.0 / (9.0 * k));
+    return k * t * t * t;
+}
+
+static drift_vec3 sphere_dir(double cos_theta, double phi)
+{
+    double s = sqrt(fmax(0.0, 1.0 - cos_theta * cos_theta));
+    return drift_vec3_make((float)(s * cos(phi)), (float)(s * sin(phi)), (float)cos_theta);
+}
+
+// Binning uses +y as its pole: every tested lobe lies in the xz plane, so it sits on the
+// binning equator where equal-area bins are well shaped (near a pole they are slivers and
+// the per-bin quadrature of a sharp lobe fails).
+static drift_vec3 bin_dir(double cos_theta, double phi)
+{
+    drift_vec3 d = sphere_dir(cos_theta, phi);
+    return drift_vec3_make(d.y, d.z, d.x);
+}
+
+// Bins sampled directions over (cos theta, phi) of the whole sphere and compares with the
+// pdf integrated over each bin. Bins expecting fewer than 5 samples are pooled. Returns
+// false, with the reason in `why`, when the sampler and pdf disagree.
+bool test_chi_square_passes(const char *what, test_pdf_fn pdf, test_sample_fn sample, void *user,
+                            int sample_count, int quadrature, char *why, size_t why_size)
+{
+    static double observed[THETA_BINS * PHI_BINS], expected[THETA_BINS * PHI_BINS];
+    memset(observed, 0, sizeof(observed));
+    memset(expected, 0, sizeof(expected));
+    int failed = 0;
+    for (int i = 0; i < sample_count; ++i) {
+        drift_sampler s = drift_sampler_make(11, 0, (uint32_t)i);
+        drift_vec2 u = drift_sampler_next2(&s);
+        float u_lobe = drift_sampler_next1(&s);
+        drift_vec3 wi;
+        if (!sample(user, u, u_lobe, &wi)) {
+            failed++;
+            continue;
+        }
+        double ct = fmax(-1.0, fmin(1.0, (double)wi.y));
+        double phi = atan2((double)wi.x, (double)wi.z);
+        if (phi < 0.0) {
+            phi += 2.0 * M_PI;
+        }
+        int ti = (int)((ct + 1.0) * 0.5 * THETA_BINS), pi = (int)(phi / (2.0 * M_PI) * PHI_BINS);
+        ti = ti >= THETA_BINS ? THETA_BINS - 1 : ti;
+        pi = pi >= PHI_BINS ? PHI_BINS - 1 : pi;
+        observed[ti * PHI_BINS + pi] += 1.0;
+    }
+    // Integrate the pdf over each bin with a midpoint rule (bins are equal-area); fine enough
+    // that the quadrature error stays far below the 1% tolerance for lobes up to n = 300.
+    double integral = 0.0;
+    const int sub = quadrature;
+    double bin_area = (2.0 / THETA_BINS) * (2.0 * M_PI / PHI_BINS);
+    for (int ti = 0; ti < THETA_BINS; ++ti) {
+        for (int pi = 0; pi < PHI_BINS; ++pi) {
+            double acc = 0.0;
+            for (int a = 0; a < sub; ++a) {
+                for (int b = 0; b < sub; ++b) {
+                    double ct = -1.0 + (ti + (a + 0.5) / sub) * (2.0 / THETA_BINS);
+                    double phi = (pi + (b + 0.5) / sub) * (2.0 * M_PI / PHI_BINS);
+                    acc += (double)pdf(user, bin_dir(ct, phi));
+                }
+            }
+            double p = acc / (sub * sub) * bin_area;
+            expected[ti * PHI_BINS + pi] = p * sample_count;
+            integral += p;
+        }
+    }
+    // The pdf integrates to the probability that sampling succeeds.
+    double success = 1.0 - (double)failed / sample_count;
+    if (fabs(integral - success) > 0.01) {
+        snprintf(why, why_size, "%s: pdf integrates to %.4f but sampling succeeds %.4f of the time",
+                 what, integral, success);
+        return false;
+    }
+    double chi2 = 0.0, pooled_obs = 0.0, pooled_exp = 0.0;
+    int dof = -1;
+    for (int i = 0; i < THETA_BINS * PHI_BINS; ++i) {
+        if (expected[i] < 5.0) {
+            pooled_obs += observed[i];
+            pooled_exp += expected[i];
+            continue;
+        }
+        double d = observed[i] - expected[i];
+        chi2 += d * d / expected[i];
+        dof++;
+    }
+    if (pooled_exp >= 5.0) {
+        double d = pooled_obs - pooled_exp;
+        chi2 += d * d / pooled_exp;
+        dof++;
+    } else if (pooled_obs > 5.0 + 5.0 * pooled_exp) {
+        snprintf(why, why_size, "%s: %.0f samples landed where the pdf expects %.2f", what,
+                 pooled_obs, pooled_exp);
+        return false;
+    }
+    if (dof < 1) {
+        snprintf(why, why_size, "%s: too few populated bins", what);
+        return false;
+    }
+    double critical = chi2_critical(dof);
+    if (chi2 > critical) {
+        snprintf(why, why_size, "%s: chi-square %.1f exceeds %.1f (dof %d)", what, chi2, critical,
+                 dof);
+        return false;
+    }
+    return true;
+}

@@ -14,6 +14,7 @@
 // clang-format on
 
 #include "drift/core.h"
+#include "drift/math.h"
 
 // Remembers the codes and levels of messages so tests can assert on codes, not text.
 typedef struct test_log_capture {
@@ -50,5 +51,15 @@ uint32_t test_add_mesh(struct drift_scene *scene, const float *positions, uint32
 
 // DRIFT_TEST_INTENSITY (default 1) scales sample counts in statistical tests.
 double test_intensity(void);
+
+// A sampler's pdf at wi, and its sampling from (u, u_lobe): false when it draws nothing.
+typedef float (*test_pdf_fn)(void *user, drift_vec3 wi);
+typedef bool (*test_sample_fn)(void *user, drift_vec2 u, float u_lobe, drift_vec3 *out_wi);
+// The chi-square test of sampling against its pdf (pbrt's and Mitsuba's): sample_count
+// directions binned over the sphere (16 x 32 equal-area bins, +y the pole) against the pdf
+// integrated over each bin by quadrature x quadrature points; the pdf must integrate to the
+// share of draws that succeed. False, with the reason in `why`, when they disagree.
+bool test_chi_square_passes(const char *what, test_pdf_fn pdf, test_sample_fn sample, void *user,
+                            int sample_count, int quadrature, char *why, size_t why_size);
 
 #endif

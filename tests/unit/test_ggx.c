@@ -225,99 +225,34 @@ static void test_ggx_sample_agrees_with_eval_and_pdf(void **state)
     }
 }
 
-// --- CHI-SQUARE (the same test as test_sampling.c's, over the whole sphere) ---
+// --- CHI-SQUARE (test_chi_square_passes, drift_test.h: the same test as test_sampling.c's) ---
 
-#define THETA_BINS 16
-#define PHI_BINS   32
-
-static double chi2_critical(int dof)
-{
-    double k = (double)dof, z = 3.09; // significance 1e-3
-    double t = 1.0 - 2.0 / (9.0 * k) + z * sqrt(2.0 / (9.0 * k));
-    return k * t * t * t;
-}
-
-// Bins use +y as the pole so that the lobes (in the xz plane) sit on the equator.
-static drift_vec3 bin_dir(double cos_theta, double phi)
-{
-    double s = sqrt(fmax(0.0, 1.0 - cos_theta * cos_theta));
-    return drift_vec3_make((float)(s * sin(phi)), (float)cos_theta, (float)(s * cos(phi)));
-}
-
-// Samples of `c` binned against the pdf of `pdf_case` (the same case but in the test that the
+// Samples of `sampled` against the pdf of `pdf` (the same case, but in the test that the
 // check can fail).
+typedef struct ggx_pair {
+    const ggx_case *sampled, *pdf;
+} ggx_pair;
+
+static bool ggx_sample_cb(void *user, drift_vec2 u, float u_lobe, drift_vec3 *out_wi)
+{
+    const ggx_pair *p = user;
+    drift_bsdf_sample bs = drift_bsdf_sample_wi(&p->sampled->bsdf, p->sampled->wo, u_lobe, u);
+    *out_wi = bs.wi;
+    return bs.pdf > 0.0f;
+}
+
+static float ggx_pdf_cb(void *user, drift_vec3 wi)
+{
+    const ggx_pair *p = user;
+    return drift_bsdf_pdf(&p->pdf->bsdf, p->pdf->wo, wi);
+}
+
 static bool chi_square_passes(const char *what, const ggx_case *c, const ggx_case *pdf_case,
                               int sample_count, char *why, size_t why_size)
 {
-    static double observed[THETA_BINS * PHI_BINS], expected[THETA_BINS * PHI_BINS];
-    memset(observed, 0, sizeof(observed));
-    int failed = 0;
-    for (int i = 0; i < sample_count; ++i) {
-        drift_sampler s = drift_sampler_make(11, 0, (uint32_t)i);
-        drift_vec2 u = drift_sampler_next2(&s);
-        drift_bsdf_sample bs = drift_bsdf_sample_wi(&c->bsdf, c->wo, drift_sampler_next1(&s), u);
-        if (!(bs.pdf > 0.0f)) {
-            failed++;
-            continue;
-        }
-        double ct = fmax(-1.0, fmin(1.0, (double)bs.wi.y));
-        double phi = atan2((double)bs.wi.x, (double)bs.wi.z);
-        phi += phi < 0.0 ? 2.0 * M_PI : 0.0;
-        int ti = (int)((ct + 1.0) * 0.5 * THETA_BINS), pi = (int)(phi / (2.0 * M_PI) * PHI_BINS);
-        ti = ti >= THETA_BINS ? THETA_BINS - 1 : ti;
-        pi = pi >= PHI_BINS ? PHI_BINS - 1 : pi;
-        observed[ti * PHI_BINS + pi] += 1.0;
-    }
-    double integral = 0.0, bin_area = (2.0 / THETA_BINS) * (2.0 * M_PI / PHI_BINS);
-    const int sub = 16;
-    for (int ti = 0; ti < THETA_BINS; ++ti) {
-        for (int pi = 0; pi < PHI_BINS; ++pi) {
-            double acc = 0.0;
-            for (int a = 0; a < sub; ++a) {
-                for (int b = 0; b < sub; ++b) {
-                    double ct = -1.0 + (ti + (a + 0.5) / sub) * (2.0 / THETA_BINS);
-                    double phi = (pi + (b + 0.5) / sub) * (2.0 * M_PI / PHI_BINS);
-                    acc += (double)drift_bsdf_pdf(&pdf_case->bsdf, pdf_case->wo, bin_dir(ct, phi));
-                }
-            }
-            double p = acc / (sub * sub) * bin_area;
-            expected[ti * PHI_BINS + pi] = p * sample_count;
-            integral += p;
-        }
-    }
-    double success = 1.0 - (double)failed / sample_count;
-    if (fabs(integral - success) > 0.01) {
-        snprintf(why, why_size, "%s: pdf integrates to %.4f, sampling succeeds %.4f", what,
-                 integral, success);
-        return false;
-    }
-    double chi2 = 0.0, pooled_obs = 0.0, pooled_exp = 0.0;
-    int dof = -1;
-    for (int i = 0; i < THETA_BINS * PHI_BINS; ++i) {
-        if (expected[i] < 5.0) {
-            pooled_obs += observed[i];
-            pooled_exp += expected[i];
-            continue;
-        }
-        double d = observed[i] - expected[i];
-        chi2 += d * d / expected[i];
-        dof++;
-    }
-    if (pooled_exp >= 5.0) {
-        double d = pooled_obs - pooled_exp;
-        chi2 += d * d / pooled_exp;
-        dof++;
-    } else if (pooled_obs > 5.0 + 5.0 * pooled_exp) {
-        snprintf(why, why_size, "%s: %.0f samples where the pdf expects %.2f", what, pooled_obs,
-                 pooled_exp);
-        return false;
-    }
-    if (dof < 1 || chi2 > chi2_critical(dof)) {
-        snprintf(why, why_size, "%s: chi-square %.1f exceeds %.1f (dof %d)", what, chi2,
-                 chi2_critical(dof), dof);
-        return false;
-    }
-    return true;
+    ggx_pair p = { .sampled = c, .pdf = pdf_case };
+    return test_chi_square_passes(what, ggx_pdf_cb, ggx_sample_cb, &p, sample_count, 16, why,
+                                  why_size);
 }
 
 static void chi_square_check(const char *what, const drift_material *m, bool front, float theta)
