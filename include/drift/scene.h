@@ -134,7 +134,44 @@ typedef struct drift_ggx_params {
     // (0 means 1). Tangents come from each triangle's uv derivatives (docs/materials.md).
     uint32_t normal_texture;
     float normal_scale;
+    // glTF's emissive texture (sRGB colour multiplying the material's emission) and occlusion
+    // texture (R: ambient occlusion, mixed in by occlusion_strength; 0 means 1). The path tracer
+    // computes occlusion itself and does not read it, as Cycles (docs/materials.md).
+    uint32_t emissive_texture;
+    uint32_t occlusion_texture;
+    float occlusion_strength;
 } drift_ggx_params;
+
+// How a material reads one of its textures (glTF's sampler, texCoord and KHR_texture_transform,
+// docs/materials.md "Textures"). All zero is drift's default: repeat, bilinear, mip-mapped by
+// the ray's footprint where the renderer gives one, the mesh's first uv set, no transform.
+typedef enum drift_texture_wrap {
+    DRIFT_WRAP_REPEAT = 0,
+    DRIFT_WRAP_CLAMP,  // clamp to the edge texel
+    DRIFT_WRAP_MIRROR, // mirrored repeat
+} drift_texture_wrap;
+
+typedef struct drift_texture_map {
+    uint8_t wrap_s, wrap_t; // drift_texture_wrap along u and along v
+    bool mag_nearest;       // magnification: the nearest texel (else bilinear)
+    bool min_nearest;       // minification: nearest texels (else bilinear)
+    bool no_mipmaps;        // minification reads the full-size image only
+    uint8_t uv_set;         // 0: the mesh's uvs, 1: its uvs1 (uvs when it has none)
+    bool has_transform;
+    // KHR_texture_transform as uv' = (t0 u + t1 v + t2, t3 u + t4 v + t5) on glTF's uv (origin at
+    // the image's top left: v_gltf = 1 - v of drift's bottom-up uv).
+    float transform[6];
+} drift_texture_map;
+
+// The textures of a material, by role: index into drift_material.maps.
+typedef enum drift_texture_slot {
+    DRIFT_TEXTURE_BASE = 0, // diffuse_texture
+    DRIFT_TEXTURE_METALLIC_ROUGHNESS,
+    DRIFT_TEXTURE_NORMAL,
+    DRIFT_TEXTURE_EMISSIVE,
+    DRIFT_TEXTURE_OCCLUSION,
+    DRIFT_TEXTURE_SLOT_COUNT
+} drift_texture_slot;
 
 // Fills `ggx` with the measured complex IOR of a named metal ("Au", "Ag", "Cu", "Al", and the
 // English names); false when the name is unknown.
@@ -151,6 +188,8 @@ typedef struct drift_material {
     drift_diffuse_model diffuse_model;
     float diffuse_roughness; // Burley only: in [0, 1] (glTF's perceptual roughness)
     drift_ggx_params ggx;    // DRIFT_MATERIAL_GGX only
+    drift_texture_map maps[DRIFT_TEXTURE_SLOT_COUNT]; // how each texture is read (zero: default)
+    bool emission_two_sided; // emits from both faces (glTF doubleSided, as Cycles)
 } drift_material;
 
 // A material with no texture: the value to start from when filling one in.
@@ -188,6 +227,7 @@ typedef struct drift_light {
     float spot_inner, spot_outer; // half angles, radians
     drift_spot_falloff spot_falloff;
     uint32_t mesh, triangle; // DRIFT_LIGHT_TRIANGLE only
+    bool two_sided;          // DRIFT_LIGHT_TRIANGLE: emits from both faces (set by commit)
 } drift_light;
 
 // True for lights with area (they are geometry: rays can hit them).
@@ -201,9 +241,14 @@ float drift_light_spot_falloff(const drift_light *light, float cos_theta);
 
 typedef struct drift_mesh {
     char name[DRIFT_NAME_MAX];
-    float *positions;  // 3 floats a vertex, plus 1 padding float at the end
-    float *normals;    // 3 floats a vertex (unit), or NULL for flat shading
-    float *uvs;        // 2 floats a vertex, or NULL
+    float *positions; // 3 floats a vertex, plus 1 padding float at the end
+    float *normals;   // 3 floats a vertex (unit), or NULL for flat shading
+    float *uvs;       // 2 floats a vertex, or NULL
+    float *uvs1;      // a second uv set (glTF TEXCOORD_1), or NULL
+    // 4 floats a vertex (unit tangent along increasing u of the normal map's uv set, and the
+    // sign w with bitangent = w cross(n, t)): the file's (glTF TANGENT), or computed by commit
+    // for normal-mapped meshes with normals and uvs (docs/materials.md); else NULL.
+    float *tangents;
     uint32_t *indices; // 3 a triangle
     uint32_t vertex_count;
     uint32_t triangle_count;
@@ -221,6 +266,8 @@ typedef struct drift_mesh_desc {
     uint32_t vertex_count;
     uint32_t triangle_count;
     uint32_t material;
+    const float *uvs1;     // optional second uv set
+    const float *tangents; // optional, 4 floats a vertex (see drift_mesh)
 } drift_mesh_desc;
 
 // --- ENVIRONMENT ---
@@ -254,6 +301,8 @@ typedef struct drift_scene {
     // one), set by commit: the scene's extent as a length scale (drift_scene_extent).
     drift_bounds3 reflector_bounds;
     drift_light_table *light_table; // set by commit
+    // Private: the mip-map pyramid of each texture materials read (built by commit).
+    struct drift_texture_pyramid *pyramids;
     bool committed;
 } drift_scene;
 
@@ -321,10 +370,27 @@ typedef struct drift_surface {
     uint32_t mesh;       // the mesh hit, or DRIFT_INVALID_INDEX (a light's shape, nothing)
     uint32_t triangle;   // its triangle, and the barycentrics of vertices 1 and 2 there
     drift_vec2 barycentric;
+    drift_vec2 uv1; // the mesh's second uv set (uv when it has none)
+    // The ray's footprint on the surface as a width in units of uv and of uv1
+    // (drift_surface_set_footprint); 0 (what drift_scene_surface leaves) reads textures at full
+    // size.
+    float uv_footprint, uv1_footprint;
 } drift_surface;
 
 drift_surface drift_scene_surface(const drift_scene *scene, const drift_ray *ray,
                                   const drift_hit *hit);
+
+// Sets surface->uv_footprint from a ray cone (Akenine-Moller et al. 2021, "Improved Shader and
+// Texture Level of Detail Using Ray Cones"): `width` is the cone's width at the hit, the ray
+// arrives along ray_dir; the footprint is width / |cos| scaled by the hit triangle's uv-to-world
+// density. Textures then read the mip level of that footprint.
+void drift_surface_set_footprint(const drift_scene *scene, drift_surface *surface, float width,
+                                 drift_vec3 ray_dir);
+
+// The value of texture slot `slot` of `material` at the surface (its map's uv set, transform,
+// wrap, filter and mip level), RGB linear; (1, 1, 1) when the material has no such texture.
+drift_vec3 drift_material_texture(const drift_scene *scene, const drift_material *material,
+                                  drift_texture_slot slot, const drift_surface *surface);
 
 // Ray origin offset along the geometric normal toward `dir`, scaled to the position's
 // magnitude, so secondary rays do not re-hit their own surface.
@@ -368,6 +434,9 @@ typedef struct drift_bsdf {
     // (drift/reflect_edit.h). The diffuse lobe does not change.
     drift_vec3 edited_mirror;
     drift_bsdf_ggx ggx; // DRIFT_MATERIAL_GGX only
+    // Ambient occlusion of the material's occlusion texture (1 without one), for techniques that
+    // approximate indirect light; the path tracer does not apply it.
+    float occlusion;
 } drift_bsdf;
 
 drift_bsdf drift_bsdf_make(const drift_scene *scene, const drift_surface *surface);

@@ -91,7 +91,6 @@ typedef struct import_state {
     const char *base_name;     // file name without folder, for unnamed meshes and materials
     uint32_t *material_map;    // assimp material -> drift material
     bool *light_placed;        // assimp light already added through its node
-    int *material_uv_set;      // assimp material -> UV set of its diffuse texture
     uint32_t *embedded;        // assimp embedded texture -> drift texture (or invalid)
     drift__gltf *gltf;         // the glTF JSON (glTF files only)
     drift__obj *obj;           // the OBJ and MTL text (OBJ files only)
@@ -184,59 +183,6 @@ static void material_texture(import_state *s, const struct aiMaterial *mat, drif
     }
 }
 
-// A glTF material by the metallic-roughness rule of scene_gltf.c, with a warning for each
-// part drift's material cannot hold.
-static void gltf_material(import_state *s, const drift__gltf_material *gm, drift_material *m)
-{
-    // GGX metallic-roughness (material_gltf.c); the base colour texture multiplies `diffuse`.
-    m->type = DRIFT_MATERIAL_GGX;
-    m->diffuse = gm->base_color;
-    m->ggx = gm->ggx;
-    m->emission = gm->emission;
-    // The diffuse of Blender's Principled BSDF (Cycles 3.4), the reference of glTF scenes here.
-    m->diffuse_model = DRIFT_DIFFUSE_BURLEY;
-    m->diffuse_roughness = sqrtf(gm->ggx.alpha);
-    char full[DRIFT__PATH_MAX];
-    uint32_t index;
-    bool mr_loaded =
-        gm->metallic_roughness_uri[0] &&
-        drift__path_join(s->dir, gm->metallic_roughness_uri, full, sizeof(full)) &&
-        drift__texture_load_data(s->scene, full, s->where, s->line, &index) == DRIFT_OK;
-    if (mr_loaded) {
-        m->ggx.metallic_roughness_texture = index;
-    }
-    bool normal_loaded =
-        gm->normal_uri[0] && drift__path_join(s->dir, gm->normal_uri, full, sizeof(full)) &&
-        drift__texture_load_data(s->scene, full, s->where, s->line, &index) == DRIFT_OK;
-    if (normal_loaded) {
-        m->ggx.normal_texture = index;
-        m->ggx.normal_scale = gm->normal_scale;
-    }
-
-    const struct {
-        bool present;
-        const char *what;
-    } ignored[] = {
-        { gm->has_metallic_roughness_texture && !mr_loaded,
-          "metallic-roughness texture (embedded or not loaded; its factors are used)" },
-        { gm->has_normal_texture && !normal_loaded, "normal texture (embedded or not loaded)" },
-        { gm->has_emissive_texture, "emissive texture (its factor is used)" },
-        { gm->has_occlusion_texture, "occlusion texture" },
-        { gm->alpha_blended, "alpha mode (drawn opaque)" },
-        { gm->has_clearcoat, "clearcoat (KHR_materials_clearcoat; drift has one coat)" },
-        { !gm->base_color_sampler_supported,
-          "base colour sampler (clamp/mirror wrap or nearest filter; drift repeats and filters "
-          "bilinearly)" },
-    };
-
-    for (size_t k = 0; k < sizeof(ignored) / sizeof(ignored[0]); ++k) {
-        if (ignored[k].present) {
-            drift_log(s->ctx, DRIFT_LOG_WARNING, DRIFT_ERR_UNSUPPORTED, s->where, s->line,
-                      "'%s': material '%s': %s ignored", s->params->path, m->name, ignored[k].what);
-        }
-    }
-}
-
 static drift_result convert_materials(import_state *s)
 {
     const struct aiScene *ai = s->ai;
@@ -278,11 +224,10 @@ static drift_result convert_materials(import_state *s)
             AI_SUCCESS) {
             m.emission = drift_vec3_scale(m.emission, strength);
         }
-        s->material_uv_set[i] = 0;
         drift__gltf_material gm;
         if (drift__gltf_get_material(s->gltf, i, &gm)) {
-            gltf_material(s, &gm, &m);
-            s->material_uv_set[i] = gm.base_color_uv_set;
+            drift__gltf_material_apply(s->scene, s->gltf, &gm, s->dir, s->params->textures,
+                                       s->params->path, s->where, s->line, &m);
         }
         material_texture(s, mat, &m);
         const drift__obj_material *om = drift__obj_get_material(s->obj, m.name);
@@ -320,22 +265,22 @@ static drift_result add_mesh(import_state *s, const struct aiMesh *mesh, const d
         return DRIFT_OK;
     }
     size_t nv = mesh->mNumVertices;
-    unsigned uv_set = 0;
-    if (s->params->material_override == DRIFT_INVALID_INDEX &&
-        mesh->mMaterialIndex < s->ai->mNumMaterials) {
-        uv_set = (unsigned)s->material_uv_set[mesh->mMaterialIndex];
-    }
-    if (uv_set >= AI_MAX_NUMBER_OF_TEXTURECOORDS || !mesh->mTextureCoords[uv_set]) {
-        uv_set = 0;
-    }
-    const struct aiVector3D *uv_source = mesh->mTextureCoords[uv_set];
+    // uv sets 0 and 1 (a material's texCoord picks one per texture: drift_texture_map).
+    const struct aiVector3D *uv_source = mesh->mTextureCoords[0];
+    const struct aiVector3D *uv1_source = uv_source ? mesh->mTextureCoords[1] : NULL;
+    // glTF TANGENT (assimp gives t and b = w cross(n, t)); other files' tangents are computed
+    // by commit where a normal map needs them.
+    bool keep_tangents = s->is_gltf && mesh->mTangents && mesh->mBitangents && mesh->mNormals;
     float *positions = drift_alloc(ctx, nv * 3 * sizeof(float));
     bool keep_normals = mesh->mNormals && !s->params->face_normals;
     float *normals = keep_normals ? drift_alloc(ctx, nv * 3 * sizeof(float)) : NULL;
     float *uvs = uv_source ? drift_alloc(ctx, nv * 2 * sizeof(float)) : NULL;
+    float *uvs1 = uv1_source ? drift_alloc(ctx, nv * 2 * sizeof(float)) : NULL;
+    float *tangents = keep_tangents ? drift_alloc(ctx, nv * 4 * sizeof(float)) : NULL;
     uint32_t *indices = drift_alloc(ctx, (size_t)tri_count * 3 * sizeof(uint32_t));
     drift_result r = DRIFT_OK;
-    if (!positions || !indices || (keep_normals && !normals) || (uv_source && !uvs)) {
+    if (!positions || !indices || (keep_normals && !normals) || (uv_source && !uvs) ||
+        (uv1_source && !uvs1) || (keep_tangents && !tangents)) {
         r = DRIFT_ERR_OUT_OF_MEMORY;
         goto done;
     }
@@ -360,6 +305,23 @@ static drift_result add_mesh(import_state *s, const struct aiMesh *mesh, const d
         if (uvs) {
             uvs[2 * v] = uv_source[v].x;
             uvs[2 * v + 1] = uv_source[v].y;
+        }
+        if (uvs1) {
+            uvs1[2 * v] = uv1_source[v].x;
+            uvs1[2 * v + 1] = uv1_source[v].y;
+        }
+        if (tangents) {
+            const struct aiVector3D *tl = &mesh->mTangents[v], *bl = &mesh->mBitangents[v];
+            const struct aiVector3D *nl = &mesh->mNormals[v];
+            drift_vec3 tv = drift_vec3_make(tl->x, tl->y, tl->z);
+            drift_vec3 nb = drift_vec3_cross(drift_vec3_make(nl->x, nl->y, nl->z), tv);
+            float w = nb.x * bl->x + nb.y * bl->y + nb.z * bl->z < 0.0f ? -1.0f : 1.0f;
+            drift_vec3 tw = drift_vec3_normalize(drift__mat4_vector(world, tv));
+            // A mirroring transform mirrors cross(n, t) against the transformed b: flip w.
+            tangents[4 * v] = drift_vec3_is_finite(tw) ? tw.x : 0.0f;
+            tangents[4 * v + 1] = drift_vec3_is_finite(tw) ? tw.y : 0.0f;
+            tangents[4 * v + 2] = drift_vec3_is_finite(tw) ? tw.z : 0.0f;
+            tangents[4 * v + 3] = w * normal_sign;
         }
     }
     // A mirroring transform reverses the winding; swap two corners to keep faces facing out.
@@ -403,6 +365,8 @@ static drift_result add_mesh(import_state *s, const struct aiMesh *mesh, const d
                              .positions = positions,
                              .normals = normals,
                              .uvs = uvs,
+                             .uvs1 = uvs1,
+                             .tangents = tangents,
                              .indices = indices,
                              .vertex_count = (uint32_t)nv,
                              .triangle_count = tri_count,
@@ -418,6 +382,8 @@ done:
     drift_free(ctx, positions);
     drift_free(ctx, normals);
     drift_free(ctx, uvs);
+    drift_free(ctx, uvs1);
+    drift_free(ctx, tangents);
     drift_free(ctx, indices);
     return r;
 }
@@ -577,9 +543,8 @@ static drift_result import_scene(import_state *s)
     drift_result r = DRIFT_OK;
     s->material_map = drift_alloc(ctx, ((size_t)ai->mNumMaterials + 1) * sizeof(uint32_t));
     s->light_placed = drift_alloc(ctx, ((size_t)ai->mNumLights + 1) * sizeof(bool));
-    s->material_uv_set = drift_alloc(ctx, ((size_t)ai->mNumMaterials + 1) * sizeof(int));
     s->embedded = drift_alloc(ctx, ((size_t)ai->mNumTextures + 1) * sizeof(uint32_t));
-    if (!s->material_map || !s->light_placed || !s->material_uv_set || !s->embedded) {
+    if (!s->material_map || !s->light_placed || !s->embedded) {
         r = DRIFT_ERR_OUT_OF_MEMORY;
     }
     for (unsigned i = 0; r == DRIFT_OK && i < ai->mNumTextures; ++i) {
@@ -604,7 +569,6 @@ static drift_result import_scene(import_state *s)
     }
     drift_free(ctx, s->material_map);
     drift_free(ctx, s->light_placed);
-    drift_free(ctx, s->material_uv_set);
     drift_free(ctx, s->embedded);
     return r;
 }

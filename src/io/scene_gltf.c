@@ -29,6 +29,9 @@ struct drift__gltf {
     cJSON *root;
     const cJSON *lights;    // extensions.KHR_lights_punctual.lights, or NULL
     const cJSON *materials; // materials, or NULL
+    uint8_t *bin;           // a .glb's BIN chunk (buffer 0 without a uri), or NULL
+    size_t bin_size;
+    char dir[DRIFT__PATH_MAX]; // the file's folder, for its buffers' files
 };
 
 // The extensions this file turns into drift's quantities; any other in extensionsUsed is
@@ -36,7 +39,8 @@ struct drift__gltf {
 static const char *const handled_extensions[] = {
     "KHR_lights_punctual",        "KHR_materials_emissive_strength",
     "KHR_materials_transmission", "KHR_materials_ior",
-    "KHR_materials_specular",     "KHR_materials_volume" // material_gltf.c
+    "KHR_materials_specular",     "KHR_materials_volume", // material_gltf.c
+    "KHR_texture_transform"
 };
 
 static uint32_t read_u32(const uint8_t *p)
@@ -58,6 +62,23 @@ static bool glb_json(const char *data, size_t size, const char **out_json, size_
     }
     *out_json = data + 20;
     *out_length = length;
+    return true;
+}
+
+// A .glb's BIN chunk: after the JSON chunk (padded to 4 bytes), an 8-byte header "BIN\0".
+static bool glb_bin(const char *data, size_t size, size_t json_length, const char **out_bin,
+                    size_t *out_size)
+{
+    size_t at = 20 + ((json_length + 3) & ~(size_t)3);
+    if (at + 8 > size || memcmp(data + at + 4, "BIN", 4) != 0) {
+        return false;
+    }
+    uint32_t length = read_u32((const uint8_t *)data + at);
+    if (length > size - at - 8) {
+        return false;
+    }
+    *out_bin = data + at + 8;
+    *out_size = length;
     return true;
 }
 
@@ -106,8 +127,18 @@ drift_result drift__gltf_open(drift_context *ctx, const char *path, bool gz, con
         drift_free(ctx, data);
         return DRIFT_ERR_PARSE;
     }
+    const char *bin = NULL;
+    size_t bin_size = 0;
+    uint8_t *bin_copy = NULL;
+    if (json != data && glb_bin(data, size, length, &bin, &bin_size) && bin_size > 0) {
+        bin_copy = drift_alloc(ctx, bin_size);
+        if (bin_copy) {
+            memcpy(bin_copy, bin, bin_size);
+        }
+    }
     drift_free(ctx, data);
     if (!cJSON_IsObject(root)) {
+        drift_free(ctx, bin_copy);
         cJSON_Delete(root);
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, where, line,
                   "'%s': not a glTF 2.0 file: its JSON is malformed or not an object", path);
@@ -116,9 +147,14 @@ drift_result drift__gltf_open(drift_context *ctx, const char *path, bool gz, con
     drift__gltf *g = drift_alloc(ctx, sizeof(*g));
     if (!g) {
         cJSON_Delete(root);
+        drift_free(ctx, bin_copy);
         return DRIFT_ERR_OUT_OF_MEMORY;
     }
-    g->root = root;
+    *g = (drift__gltf){ .root = root, .bin = bin_copy, .bin_size = bin_copy ? bin_size : 0 };
+    const char *slash = strrchr(path, '/');
+    if (slash) {
+        snprintf(g->dir, sizeof g->dir, "%.*s", (int)(slash - path), path);
+    }
     g->materials = cJSON_GetObjectItemCaseSensitive(root, "materials");
     const cJSON *ext = cJSON_GetObjectItemCaseSensitive(root, "extensions");
     const cJSON *punctual = cJSON_GetObjectItemCaseSensitive(ext, "KHR_lights_punctual");
@@ -167,6 +203,7 @@ void drift__gltf_close(drift_context *ctx, drift__gltf *g)
 {
     if (g) {
         cJSON_Delete(g->root);
+        drift_free(ctx, g->bin);
         drift_free(ctx, g);
     }
 }
@@ -257,23 +294,6 @@ static const cJSON *item_at(const cJSON *array, const cJSON *index)
     return cJSON_GetArrayItem(array, (int)index->valuedouble);
 }
 
-// Whether the sampler of a texture reference is what drift's textures do: repeat in u and v
-// (10497, the default) and bilinear magnification (9729 LINEAR, or unset).
-static bool sampler_supported(const drift__gltf *g, const cJSON *texture_ref)
-{
-    const cJSON *textures = cJSON_GetObjectItemCaseSensitive(g->root, "textures");
-    const cJSON *samplers = cJSON_GetObjectItemCaseSensitive(g->root, "samplers");
-    const cJSON *index = cJSON_GetObjectItemCaseSensitive(texture_ref, "index");
-    const cJSON *texture = item_at(textures, index);
-    const cJSON *sampler = item_at(samplers, cJSON_GetObjectItemCaseSensitive(texture, "sampler"));
-    if (!sampler) {
-        return true;
-    }
-    return number_or(sampler, "wrapS", 10497.0f) == 10497.0f &&
-           number_or(sampler, "wrapT", 10497.0f) == 10497.0f &&
-           number_or(sampler, "magFilter", 9729.0f) == 9729.0f;
-}
-
 bool drift__gltf_get_material(const drift__gltf *g, unsigned index, drift__gltf_material *out)
 {
     const cJSON *m = g && g->materials ? cJSON_GetArrayItem(g->materials, (int)index) : NULL;
@@ -307,14 +327,7 @@ bool drift__gltf_get_material(const drift__gltf *g, unsigned index, drift__gltf_
     out->emission =
         drift_vec3_make(fmaxf(emissive[0], 0.0f) * strength, fmaxf(emissive[1], 0.0f) * strength,
                         fmaxf(emissive[2], 0.0f) * strength);
-    const cJSON *base_tex = cJSON_GetObjectItemCaseSensitive(pbr, "baseColorTexture");
-    out->base_color_uv_set = (int)drift_clampf(number_or(base_tex, "texCoord", 0.0f), 0.0f, 7.0f);
-    out->base_color_sampler_supported = sampler_supported(g, base_tex);
-    out->has_metallic_roughness_texture =
-        cJSON_GetObjectItemCaseSensitive(pbr, "metallicRoughnessTexture") != NULL;
-    out->has_normal_texture = cJSON_GetObjectItemCaseSensitive(m, "normalTexture") != NULL;
-    out->has_emissive_texture = cJSON_GetObjectItemCaseSensitive(m, "emissiveTexture") != NULL;
-    out->has_occlusion_texture = cJSON_GetObjectItemCaseSensitive(m, "occlusionTexture") != NULL;
+    out->double_sided = cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(m, "doubleSided"));
     const cJSON *alpha_mode = cJSON_GetObjectItemCaseSensitive(m, "alphaMode");
     out->alpha_blended = cJSON_IsString(alpha_mode) && strcmp(alpha_mode->valuestring, "OPAQUE");
     drift__gltf_read_ggx(g->root, m, out);
@@ -338,4 +351,87 @@ int drift__gltf_camera_index(const drift__gltf *g, const char *selector)
         }
     }
     return -1;
+}
+
+// Bytes [offset, offset + length) of buffer `index`: the .glb's BIN chunk, a data URI or a file
+// beside the glTF; *out_data allocated.
+static drift_result buffer_bytes(drift_context *ctx, const drift__gltf *g, const cJSON *index,
+                                 size_t offset, size_t length, uint8_t **out_data)
+{
+    const cJSON *buffer = item_at(cJSON_GetObjectItemCaseSensitive(g->root, "buffers"), index);
+    if (!buffer) {
+        return DRIFT_ERR_PARSE;
+    }
+    const cJSON *uri = cJSON_GetObjectItemCaseSensitive(buffer, "uri");
+    uint8_t *whole = NULL;
+    size_t size = 0;
+    drift_result r = DRIFT_OK;
+    if (!cJSON_IsString(uri)) {
+        if (!g->bin) {
+            return DRIFT_ERR_PARSE;
+        }
+        whole = g->bin;
+        size = g->bin_size;
+    } else if (strncmp(uri->valuestring, "data:", 5) == 0) {
+        r = drift__data_uri_decode(ctx, uri->valuestring, &whole, &size);
+    } else {
+        char path[DRIFT__PATH_MAX];
+        char *text = NULL;
+        r = drift__path_join(g->dir, uri->valuestring, path, sizeof path)
+                ? drift__read_file(ctx, path, false, path, 0, &text, &size)
+                : DRIFT_ERR_IO;
+        whole = (uint8_t *)text;
+    }
+    if (r == DRIFT_OK && (offset > size || length > size - offset)) {
+        r = DRIFT_ERR_PARSE;
+    }
+    uint8_t *out = r == DRIFT_OK ? drift_alloc(ctx, length ? length : 1) : NULL;
+    if (r == DRIFT_OK && !out) {
+        r = DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    if (out) {
+        memcpy(out, whole + offset, length);
+    }
+    if (whole != g->bin) {
+        drift_free(ctx, whole);
+    }
+    *out_data = out;
+    return r;
+}
+
+drift_result drift__gltf_image_bytes(drift_context *ctx, const drift__gltf *g, int image,
+                                     uint8_t **out_data, size_t *out_size)
+{
+    *out_data = NULL;
+    *out_size = 0;
+    const cJSON *images = cJSON_GetObjectItemCaseSensitive(g->root, "images");
+    const cJSON *img =
+        image >= 0 && image < cJSON_GetArraySize(images) ? cJSON_GetArrayItem(images, image) : NULL;
+    if (!cJSON_IsObject(img)) {
+        return DRIFT_ERR_PARSE;
+    }
+    const cJSON *uri = cJSON_GetObjectItemCaseSensitive(img, "uri");
+    if (cJSON_IsString(uri)) {
+        return strncmp(uri->valuestring, "data:", 5) == 0
+                   ? drift__data_uri_decode(ctx, uri->valuestring, out_data, out_size)
+                   : DRIFT_ERR_UNSUPPORTED; // a file of its own
+    }
+    const cJSON *view = item_at(cJSON_GetObjectItemCaseSensitive(g->root, "bufferViews"),
+                                cJSON_GetObjectItemCaseSensitive(img, "bufferView"));
+    if (!view) {
+        return DRIFT_ERR_PARSE;
+    }
+    float offset = number_or(view, "byteOffset", 0.0f),
+          length = number_or(view, "byteLength", -1.0f);
+    if (!(offset >= 0.0f) || !(length >= 0.0f) || offset > 4e9f || length > 4e9f) {
+        return DRIFT_ERR_PARSE;
+    }
+    *out_size = (size_t)length;
+    return buffer_bytes(ctx, g, cJSON_GetObjectItemCaseSensitive(view, "buffer"), (size_t)offset,
+                        (size_t)length, out_data);
+}
+
+const cJSON *drift__gltf_root(const drift__gltf *g)
+{
+    return g ? g->root : NULL;
 }

@@ -131,33 +131,63 @@ typedef struct drift__gltf_light {
     drift_spot_falloff falloff;     // Blender's exporter wrote the file: Cycles' cone; else glTF's
 } drift__gltf_light;
 
+// One texture reference of a glTF material (textureInfo): which image, and how it is read.
+typedef struct drift__gltf_texture {
+    bool present;              // the material names this texture
+    int image;                 // index into the file's `images` (-1: none or malformed)
+    char uri[DRIFT__PATH_MAX]; // the image's file, relative to the glTF file ("": inside the file)
+    drift_texture_map map;     // sampler, texCoord (KHR_texture_transform's override) and transform
+    int tex_coord;             // the texCoord asked for (drift reads sets 0 and 1)
+} drift__gltf_texture;
+
 // A glTF metallic-roughness material as drift's diffuse + glossy (docs/scene-format.md).
 typedef struct drift__gltf_material {
     drift_vec3 diffuse, specular, emission; // emission includes KHR_materials_emissive_strength
     float exponent;
-    float roughness;                   // the Burley diffuse's (the clamped roughnessFactor)
-    int base_color_uv_set;             // baseColorTexture.texCoord
-    bool base_color_sampler_supported; // repeat wrap, linear magnification (or no sampler)
-    bool has_metallic_roughness_texture, has_normal_texture, has_emissive_texture,
-        has_occlusion_texture, alpha_blended;
+    float roughness; // the Burley diffuse's (the clamped roughnessFactor)
+    bool alpha_blended;
+    bool double_sided; // `doubleSided`: emits from both faces (Cycles does)
     // The same material for DRIFT_MATERIAL_GGX (material_gltf.c): base colour, metallic,
     // roughness and the KHR_materials_transmission / _ior / _specular / _clearcoat values.
     drift_vec3 base_color;
     drift_ggx_params ggx;
     bool has_clearcoat; // drift has no second coat: folded in as noted in docs/materials.md
-    // metallicRoughnessTexture's image file (relative to the glTF file; "" when none or
-    // when the image is embedded) and its texCoord.
-    char metallic_roughness_uri[DRIFT__PATH_MAX];
-    int metallic_roughness_uv_set;
-    char normal_uri[DRIFT__PATH_MAX]; // normalTexture's image file, as above
-    float normal_scale;
+    // Its textures by drift_texture_slot (base colour, metallic-roughness, normal, emissive,
+    // occlusion), with normalTexture.scale and occlusionTexture.strength.
+    drift__gltf_texture textures[DRIFT_TEXTURE_SLOT_COUNT];
+    float normal_scale, occlusion_strength;
 } drift__gltf_material;
 
-// Fills out->base_color, out->ggx and the metallic-roughness texture's file from a glTF
-// material object of the file whose JSON root is `root` (material_gltf.c).
+// Fills out->base_color, out->ggx and out->textures from a glTF material object of the file
+// whose JSON root is `root` (material_gltf.c).
 struct cJSON;
 void drift__gltf_read_ggx(const struct cJSON *root, const struct cJSON *material,
                           drift__gltf_material *out);
+// Loads texture `t` of a glTF material as a scene texture (material_gltf.c): an image file
+// beside the glTF (relative to dir; through `cache` when srgb), or one inside it (a .glb's
+// buffer view, a data URI, a buffer file's view). srgb: colour (base, emissive) decoded to
+// linear; else data stored as is. Warns against (where, line) when it cannot.
+drift_result drift__gltf_load_texture(drift_scene *scene, const drift__gltf *g,
+                                      const drift__gltf_texture *t, const char *dir,
+                                      drift__texture_cache *cache, bool srgb, const char *where,
+                                      int line, uint32_t *out_index);
+// The JSON root of an open glTF.
+const struct cJSON *drift__gltf_root(const drift__gltf *g);
+// Decodes a base64 `data:` URI (RFC 2397) into *out_data (allocated). DRIFT_ERR_PARSE when it
+// is not one.
+drift_result drift__data_uri_decode(drift_context *ctx, const char *uri, uint8_t **out_data,
+                                    size_t *out_size);
+// Material m (named, its assimp colours read) as glTF material gm says: GGX, its textures
+// loaded (the base colour's excepted: assimp's), a warning for each part drift cannot hold.
+void drift__gltf_material_apply(drift_scene *scene, const drift__gltf *gltf,
+                                const drift__gltf_material *gm, const char *dir,
+                                drift__texture_cache *cache, const char *path, const char *where,
+                                int line, drift_material *m);
+// The bytes of image `image` when it is inside the file or its buffers: *out_data allocated
+// (drift_free). DRIFT_ERR_UNSUPPORTED when the image is a file of its own (its uri), other errors
+// for a malformed reference.
+drift_result drift__gltf_image_bytes(drift_context *ctx, const drift__gltf *g, int image,
+                                     uint8_t **out_data, size_t *out_size);
 // Loads an image of data (metallic-roughness, normals: not sRGB-encoded) as a scene texture.
 // Errors are logged against (where, line).
 drift_result drift__texture_load_data(drift_scene *scene, const char *path, const char *where,

@@ -39,22 +39,37 @@ void drift__ggx_phong_equivalent(const drift_material *m, drift_vec3 base, float
     *exponent = phong_exponent_of_alpha(alpha);
 }
 
-// The shading normal bent by a tangent-space normal map: tangent and bitangent from the uv
-// derivatives of the hit triangle (pbrt's dp/du, dp/dv), made orthogonal to the interpolated
-// normal. Unchanged where the mesh has no uvs or the map would turn the normal below the surface.
-static drift_vec3 normal_mapped(const drift_scene *scene, const drift_material *m,
-                                const drift_surface *surface)
+// The tangent frame's first two axes at a surface point of a mesh with uvs: the mesh's
+// per-vertex tangents (the file's, or MikkTSpace-style from commit) interpolated, with
+// bitangent = w cross(n, t) as Cycles and glTF do; else (no normals, no tangents) the hit
+// triangle's dp/du and dp/dv (pbrt). False when the uvs are degenerate.
+static bool tangent_frame(const drift_mesh *mesh, const drift_material *m,
+                          const drift_surface *surface, drift_vec3 n, drift_vec3 *out_t,
+                          drift_vec3 *out_b)
 {
-    drift_vec3 n = surface->ns;
-    if (surface->mesh == DRIFT_INVALID_INDEX) {
-        return n;
-    }
-    const drift_mesh *mesh = &scene->meshes[surface->mesh];
-    if (!mesh->uvs) {
-        return n;
-    }
     const uint32_t *tri = mesh->indices + 3 * (size_t)surface->triangle;
-    const float *p = mesh->positions, *t = mesh->uvs;
+    if (mesh->tangents) {
+        float u = surface->barycentric.x, v = surface->barycentric.y, w0 = 1.0f - u - v;
+        const float *t0 = mesh->tangents + 4 * (size_t)tri[0];
+        const float *t1 = mesh->tangents + 4 * (size_t)tri[1];
+        const float *t2 = mesh->tangents + 4 * (size_t)tri[2];
+        drift_vec3 t =
+            drift_vec3_make(w0 * t0[0] + u * t1[0] + v * t2[0], w0 * t0[1] + u * t1[1] + v * t2[1],
+                            w0 * t0[2] + u * t1[2] + v * t2[2]);
+        // The file's frame is about the geometric side the normals point to; a back-face hit
+        // flipped n (drift_scene_surface), which mirrors cross(n, t): undo that in the sign.
+        float sign = (t0[3] < 0.0f ? -1.0f : 1.0f) * (surface->front_face ? 1.0f : -1.0f);
+        t = drift_vec3_fma(t, n, -drift_vec3_dot(n, t));
+        float len = drift_vec3_length(t);
+        if (!(len > 0.0f)) {
+            return false;
+        }
+        *out_t = drift_vec3_scale(t, 1.0f / len);
+        *out_b = drift_vec3_scale(drift_vec3_cross(n, *out_t), sign);
+        return true;
+    }
+    bool second = m->maps[DRIFT_TEXTURE_NORMAL].uv_set == 1 && mesh->uvs1;
+    const float *p = mesh->positions, *t = second ? mesh->uvs1 : mesh->uvs;
     drift_vec3 p0 = drift_vec3_make(p[3 * tri[0]], p[3 * tri[0] + 1], p[3 * tri[0] + 2]);
     drift_vec3 dp1 =
         drift_vec3_sub(drift_vec3_make(p[3 * tri[1]], p[3 * tri[1] + 1], p[3 * tri[1] + 2]), p0);
@@ -64,7 +79,7 @@ static drift_vec3 normal_mapped(const drift_scene *scene, const drift_material *
     float du2 = t[2 * tri[2]] - t[2 * tri[0]], dv2 = t[2 * tri[2] + 1] - t[2 * tri[0] + 1];
     float det = du1 * dv2 - dv1 * du2;
     if (!(fabsf(det) > 1e-12f)) {
-        return n;
+        return false;
     }
     drift_vec3 dpdu = drift_vec3_scale(
         drift_vec3_sub(drift_vec3_scale(dp1, dv2), drift_vec3_scale(dp2, dv1)), 1.0f / det);
@@ -73,14 +88,34 @@ static drift_vec3 normal_mapped(const drift_scene *scene, const drift_material *
     drift_vec3 tangent = drift_vec3_fma(dpdu, n, -drift_vec3_dot(n, dpdu));
     float len = drift_vec3_length(tangent);
     if (!(len > 0.0f)) {
-        return n;
+        return false;
     }
     tangent = drift_vec3_scale(tangent, 1.0f / len);
     drift_vec3 bitangent = drift_vec3_cross(n, tangent);
     if (drift_vec3_dot(bitangent, dpdv) < 0.0f) {
         bitangent = drift_vec3_neg(bitangent);
     }
-    drift_vec3 c = drift__texture_bilinear(&scene->textures[m->ggx.normal_texture], surface->uv);
+    *out_t = tangent;
+    *out_b = bitangent;
+    return true;
+}
+
+// The shading normal bent by a tangent-space normal map (glTF's convention: +X along the
+// tangent, +Y along the bitangent, RGB = (n + 1) / 2). Unchanged where the mesh has no uvs or
+// the map would turn the normal below the surface.
+static drift_vec3 normal_mapped(const drift_scene *scene, const drift_material *m,
+                                const drift_surface *surface)
+{
+    drift_vec3 n = surface->ns;
+    if (surface->mesh == DRIFT_INVALID_INDEX) {
+        return n;
+    }
+    const drift_mesh *mesh = &scene->meshes[surface->mesh];
+    drift_vec3 tangent, bitangent;
+    if (!mesh->uvs || !tangent_frame(mesh, m, surface, n, &tangent, &bitangent)) {
+        return n;
+    }
+    drift_vec3 c = drift_material_texture(scene, m, DRIFT_TEXTURE_NORMAL, surface);
     float scale = m->ggx.normal_scale > 0.0f ? m->ggx.normal_scale : 1.0f;
     drift_vec3 local = drift_vec3_make((2.0f * c.x - 1.0f) * scale, (2.0f * c.y - 1.0f) * scale,
                                        fmaxf(2.0f * c.z - 1.0f, 0.0f));
@@ -101,14 +136,19 @@ static void make_ggx(const drift_scene *scene, const drift_material *m,
     const drift_ggx_params *p = &m->ggx;
     float alpha = p->alpha, metallic = p->metallic;
     if (p->metallic_roughness_texture != DRIFT_INVALID_INDEX && scene) {
-        drift_vec3 t =
-            drift__texture_bilinear(&scene->textures[p->metallic_roughness_texture], surface->uv);
+        drift_vec3 t = drift_material_texture(scene, m, DRIFT_TEXTURE_METALLIC_ROUGHNESS, surface);
         float r = sqrtf(fmaxf(alpha, 0.0f)) * t.y;
         alpha = r * r;
         metallic *= t.z;
     }
     if (p->normal_texture != DRIFT_INVALID_INDEX && scene) {
         b->frame = drift_frame_from_normal(normal_mapped(scene, m, surface));
+    }
+    if (p->occlusion_texture != DRIFT_INVALID_INDEX && scene) {
+        // glTF: 1 + strength (ao - 1), from the texture's R channel.
+        float ao = drift_material_texture(scene, m, DRIFT_TEXTURE_OCCLUSION, surface).x;
+        float strength = p->occlusion_strength > 0.0f ? p->occlusion_strength : 1.0f;
+        b->occlusion = drift_clampf(1.0f + strength * (ao - 1.0f), 0.0f, 1.0f);
     }
     alpha = drift_clampf(alpha, 0.0f, 1.0f);
     metallic = drift_clampf(metallic, 0.0f, 1.0f);
@@ -152,10 +192,11 @@ drift_bsdf drift_bsdf_make(const drift_scene *scene, const drift_surface *surfac
                      .exponent = m->exponent,
                      .diffuse_model = m->diffuse_model,
                      .diffuse_roughness = m->diffuse_roughness,
-                     .frame = drift_frame_from_normal(surface->ns) };
+                     .frame = drift_frame_from_normal(surface->ns),
+                     .occlusion = 1.0f };
     if (m->diffuse_texture != DRIFT_INVALID_INDEX) {
-        b.diffuse = drift_vec3_mul(
-            b.diffuse, drift__texture_bilinear(&scene->textures[m->diffuse_texture], surface->uv));
+        b.diffuse = drift_vec3_mul(b.diffuse,
+                                   drift_material_texture(scene, m, DRIFT_TEXTURE_BASE, surface));
     }
     if (m->type == DRIFT_MATERIAL_GGX) {
         make_ggx(scene, m, surface, &b);

@@ -126,8 +126,9 @@ static float light_power(const drift_scene *scene, const drift_light *l, float s
     case DRIFT_LIGHT_DISK:
     case DRIFT_LIGHT_SPHERE:
     case DRIFT_LIGHT_TRIANGLE:
-        // A one-sided Lambertian emitter of area A and radiance L emits pi A L.
-        return DRIFT_PI * light_area(scene, l) * lum;
+        // A one-sided Lambertian emitter of area A and radiance L emits pi A L; a two-sided
+        // triangle twice that.
+        return (l->two_sided ? 2.0f : 1.0f) * DRIFT_PI * light_area(scene, l) * lum;
     case DRIFT_LIGHT_COUNT:
         break;
     }
@@ -311,10 +312,23 @@ static drift_light_sample sample_area_point(const drift_scene *scene, uint32_t l
                          ? drift_vec3_normalize(drift_vec3_sub(p, l->position))
                          : t->normal[light];
     s.pdf = area_to_solid_angle(t->inv_area[light], dist, s.wi, s.light_normal);
-    // One-sided emitters: light leaves along the normal only.
-    bool facing = drift_vec3_dot(s.light_normal, s.wi) < 0.0f;
+    // One-sided emitters: light leaves along the normal only (both ways for two-sided
+    // triangles: glTF doubleSided emissive materials, as Cycles).
+    bool facing = drift_vec3_dot(s.light_normal, s.wi) < 0.0f || l->two_sided;
     s.radiance = facing ? l->color : drift_vec3_splat(0.0f);
     return s;
+}
+
+// The emission of a triangle light at barycentrics bary: its material's, with the emissive
+// texture read there (l->color is only the triangle's mean, for picking it).
+static drift_vec3 triangle_radiance(const drift_scene *scene, const drift_light *l, drift_vec2 bary)
+{
+    const drift_material *m = &scene->materials[scene->meshes[l->mesh].material];
+    if (m->type != DRIFT_MATERIAL_GGX || m->ggx.emissive_texture == DRIFT_INVALID_INDEX) {
+        return l->color;
+    }
+    drift_surface s = drift__triangle_surface(scene, l->mesh, l->triangle, bary.x, bary.y);
+    return drift__material_emission(scene, m, &s);
 }
 
 drift_light_sample drift_light_sample_li(const drift_scene *scene, uint32_t light, drift_vec3 ref,
@@ -402,7 +416,11 @@ drift_light_sample drift_light_sample_li(const drift_scene *scene, uint32_t ligh
         drift_vec3 p = drift_vec3_add(
             drift_vec3_scale(a, 1.0f - bary.x - bary.y),
             drift_vec3_add(drift_vec3_scale(b, bary.x), drift_vec3_scale(c, bary.y)));
-        return sample_area_point(scene, light, ref, p);
+        s = sample_area_point(scene, light, ref, p);
+        if (!drift_vec3_is_zero(s.radiance)) {
+            s.radiance = triangle_radiance(scene, l, bary);
+        }
+        return s;
     }
     case DRIFT_LIGHT_COUNT:
         break;
@@ -478,8 +496,8 @@ bool drift_light_emit_area(const drift_scene *scene, const drift_light *l, drift
 {
     // A uniform point (density 1 / A) and a cosine direction (cos / pi) give
     // L cos / (cos / pi / A) = pi A L per path.
-    drift_vec3 p, normal;
-    float area;
+    drift_vec3 p, normal, radiance = l->color;
+    float area, sides = 1.0f;
     switch (l->type) {
     case DRIFT_LIGHT_QUAD:
         p = drift_vec3_fma(drift_vec3_fma(l->position, l->edge_u, u1.x), l->edge_v, u1.y);
@@ -510,6 +528,18 @@ bool drift_light_emit_area(const drift_scene *scene, const drift_light *l, drift
         normal = drift_vec3_cross(drift_vec3_sub(b, a), drift_vec3_sub(c, a));
         area = 0.5f * drift_vec3_length(normal);
         normal = drift_vec3_normalize(normal);
+        radiance = triangle_radiance(scene, l, bc);
+        if (l->two_sided) {
+            // Either face with probability 1/2 (u2.x picks it, then is reused as a fresh number).
+            sides = 2.0f;
+            if (u2.x < 0.5f) {
+                normal = drift_vec3_neg(normal);
+                u2.x *= 2.0f;
+            } else {
+                u2.x = 2.0f * u2.x - 1.0f;
+            }
+            u2.x = fminf(u2.x, 0x1.fffffep-1f);
+        }
         break;
     }
     default:
@@ -518,6 +548,6 @@ bool drift_light_emit_area(const drift_scene *scene, const drift_light *l, drift
     drift_frame fr = drift_frame_from_normal(normal);
     drift_vec3 w = drift_frame_to_world(&fr, drift_sample_cosine_hemisphere(u2));
     *out_ray = (drift_ray){ drift_offset_origin(p, normal, w), 0.0f, w, INFINITY };
-    *out_flux = drift_vec3_scale(l->color, DRIFT_PI * area / (pmf * paths));
+    *out_flux = drift_vec3_scale(radiance, sides * DRIFT_PI * area / (pmf * paths));
     return true;
 }

@@ -32,6 +32,8 @@ static void free_mesh(drift_context *ctx, drift_mesh *mesh)
     drift_free(ctx, mesh->positions);
     drift_free(ctx, mesh->normals);
     drift_free(ctx, mesh->uvs);
+    drift_free(ctx, mesh->uvs1);
+    drift_free(ctx, mesh->tangents);
     drift_free(ctx, mesh->indices);
 }
 
@@ -48,6 +50,7 @@ void drift_scene_destroy(drift_scene *scene)
         drift_image_destroy(ctx, &scene->textures[i]);
     }
     drift__light_table_destroy(scene);
+    drift__texture_pyramids_destroy(scene);
     drift_free(ctx, scene->meshes);
     drift_free(ctx, scene->materials);
     drift_free(ctx, scene->lights);
@@ -154,8 +157,16 @@ drift_result drift_scene_add_mesh(drift_scene *scene, const drift_mesh_desc *des
     if (desc->uvs) {
         mesh.uvs = copy_array(ctx, desc->uvs, (size_t)desc->vertex_count * 2, sizeof(float), 0);
     }
+    if (desc->uvs1) {
+        mesh.uvs1 = copy_array(ctx, desc->uvs1, (size_t)desc->vertex_count * 2, sizeof(float), 0);
+    }
+    if (desc->tangents) {
+        mesh.tangents =
+            copy_array(ctx, desc->tangents, (size_t)desc->vertex_count * 4, sizeof(float), 0);
+    }
     if (!mesh.positions || !mesh.indices || (desc->normals && !mesh.normals) ||
-        (desc->uvs && !mesh.uvs)) {
+        (desc->uvs && !mesh.uvs) || (desc->uvs1 && !mesh.uvs1) ||
+        (desc->tangents && !mesh.tangents)) {
         free_mesh(ctx, &mesh);
         return DRIFT_ERR_OUT_OF_MEMORY;
     }
@@ -214,7 +225,9 @@ drift_material drift_material_make(drift_vec3 diffuse)
     return (drift_material){ .diffuse = diffuse,
                              .diffuse_texture = DRIFT_INVALID_INDEX,
                              .ggx = { .metallic_roughness_texture = DRIFT_INVALID_INDEX,
-                                      .normal_texture = DRIFT_INVALID_INDEX } };
+                                      .normal_texture = DRIFT_INVALID_INDEX,
+                                      .emissive_texture = DRIFT_INVALID_INDEX,
+                                      .occlusion_texture = DRIFT_INVALID_INDEX } };
 }
 
 static bool vec3_is_nonnegative_finite(drift_vec3 v)
@@ -460,6 +473,53 @@ static drift_result check_coordinates(const drift_scene *scene)
     return DRIFT_OK;
 }
 
+// A triangle light's colour: its material's emission, times the mean of the emissive texture
+// at the triangle's corners, edge midpoints and centre, for the power the light is picked by
+// (sampling reads the texture at each point). Kept at 1% of the untextured emission or more, so
+// that no texel the mean misses goes unsampled.
+static drift_vec3 triangle_emission(const drift_scene *scene, const drift_material *mat,
+                                    uint32_t mesh, uint32_t triangle)
+{
+    if (mat->type != DRIFT_MATERIAL_GGX || mat->ggx.emissive_texture == DRIFT_INVALID_INDEX) {
+        return mat->emission;
+    }
+    static const float points[7][2] = { { 0, 0 },
+                                        { 1, 0 },
+                                        { 0, 1 },
+                                        { 0.5f, 0 },
+                                        { 0, 0.5f },
+                                        { 0.5f, 0.5f },
+                                        { 1 / 3.0f, 1 / 3.0f } };
+    drift_vec3 sum = drift_vec3_splat(0.0f);
+    for (int i = 0; i < 7; ++i) {
+        drift_surface s =
+            drift__triangle_surface(scene, mesh, triangle, points[i][0], points[i][1]);
+        sum = drift_vec3_add(sum, drift__material_emission(scene, mat, &s));
+    }
+    return drift_vec3_max(drift_vec3_scale(sum, 1.0f / 7.0f),
+                          drift_vec3_scale(mat->emission, 0.01f));
+}
+
+// Per-vertex tangents for the normal-mapped meshes that have normals and uvs but none from
+// their file (tangents.c).
+static drift_result compute_tangents(drift_scene *scene)
+{
+    for (uint32_t i = 0; i < scene->mesh_count; ++i) {
+        drift_mesh *mesh = &scene->meshes[i];
+        const drift_material *m = &scene->materials[mesh->material];
+        if (mesh->tangents || !mesh->normals || !mesh->uvs || m->type != DRIFT_MATERIAL_GGX ||
+            m->ggx.normal_texture == DRIFT_INVALID_INDEX) {
+            continue;
+        }
+        drift_result r = drift__mesh_tangents(
+            scene->ctx, mesh, m->maps[DRIFT_TEXTURE_NORMAL].uv_set, &mesh->tangents);
+        if (r != DRIFT_OK) {
+            return r;
+        }
+    }
+    return DRIFT_OK;
+}
+
 drift_result drift_scene_commit(drift_scene *scene)
 {
     if (!scene) {
@@ -483,11 +543,16 @@ drift_result drift_scene_commit(drift_scene *scene)
             return DRIFT_ERR_INVALID_ARGUMENT;
         }
         if (m->type == DRIFT_MATERIAL_GGX) {
-            uint32_t t = m->ggx.metallic_roughness_texture, tn = m->ggx.normal_texture;
-            if ((t != DRIFT_INVALID_INDEX && t >= scene->texture_count) ||
-                (tn != DRIFT_INVALID_INDEX && tn >= scene->texture_count)) {
+            const uint32_t t[] = { m->ggx.metallic_roughness_texture, m->ggx.normal_texture,
+                                   m->ggx.emissive_texture, m->ggx.occlusion_texture };
+            bool out_of_range = false;
+            for (size_t k = 0; k < sizeof t / sizeof t[0]; ++k) {
+                out_of_range |= t[k] != DRIFT_INVALID_INDEX && t[k] >= scene->texture_count;
+            }
+            if (out_of_range) {
                 drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, m->name, 0,
-                          "metallic-roughness or normal texture out of range (scene has %u)",
+                          "metallic-roughness, normal, emissive or occlusion texture out of range "
+                          "(scene has %u)",
                           scene->texture_count);
                 return DRIFT_ERR_INVALID_ARGUMENT;
             }
@@ -582,12 +647,21 @@ drift_result drift_scene_commit(drift_scene *scene)
             if (r != DRIFT_OK) {
                 return r;
             }
-            scene->lights[index] = (drift_light){
-                .type = DRIFT_LIGHT_TRIANGLE, .color = mat->emission, .mesh = m, .triangle = t
-            };
+            scene->lights[index] = (drift_light){ .type = DRIFT_LIGHT_TRIANGLE,
+                                                  .color = triangle_emission(scene, mat, m, t),
+                                                  .mesh = m,
+                                                  .triangle = t,
+                                                  .two_sided = mat->emission_two_sided };
         }
     }
-    drift_result r = drift__light_table_build(scene);
+    drift_result r = drift__texture_pyramids_build(scene);
+    if (r == DRIFT_OK) {
+        r = compute_tangents(scene);
+    }
+    if (r != DRIFT_OK) {
+        return r;
+    }
+    r = drift__light_table_build(scene);
     if (r != DRIFT_OK) {
         return r;
     }

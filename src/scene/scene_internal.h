@@ -33,4 +33,23 @@ const drift__env_distribution *drift__light_table_environment(const drift_scene 
 // flipped accordingly by loaders: v = 0 is the image's bottom row).
 drift_vec3 drift__texture_bilinear(const drift_image *texture, drift_vec2 uv);
 
+// Mip-map pyramids of the textures materials read (texture.c), built by commit.
+typedef struct drift_texture_pyramid drift_texture_pyramid;
+drift_result drift__texture_pyramids_build(drift_scene *scene);
+void drift__texture_pyramids_destroy(drift_scene *scene);
+// Texture `index` read through `map` (NULL: the default) at drift's bottom-up uv, at the mip
+// level of a footprint `footprint` wide in uv units (0: full size).
+drift_vec3 drift__texture_sample(const drift_scene *scene, uint32_t index,
+                                 const drift_texture_map *map, drift_vec2 uv, float footprint);
+// The surface of triangle `triangle` of mesh `mesh` at barycentrics (u, v), seen from its front.
+drift_surface drift__triangle_surface(const drift_scene *scene, uint32_t mesh, uint32_t triangle,
+                                      float u, float v);
+// The emission of material m at a surface point (its emissive texture applied).
+drift_vec3 drift__material_emission(const drift_scene *scene, const drift_material *m,
+                                    const drift_surface *surface);
+// Per-vertex tangents of a mesh with normals and uvs (uv set `uv_set`), MikkTSpace-style
+// (tangents.c): 4 floats a vertex into *out (allocated).
+drift_result drift__mesh_tangents(drift_context *ctx, const drift_mesh *mesh, int uv_set,
+                                  float **out);
+
 #endif
