@@ -72,6 +72,9 @@ typedef enum drift_pt_component {
 //   pixel_centre  = false: with true, every sample goes through its pixel's centre (no pixel
 //                   jitter), the footprint of a one-sample-per-pixel G-buffer
 //   pinhole       = false: with true, the camera's aperture is ignored (no depth of field)
+//   texture_point_sampling = false: textures are read at the mip level of the ray cone's
+//                   footprint (Akenine-Moller et al. 2021; docs/materials.md "Textures"), so
+//                   distant textures do not alias; true reads them at full size
 //   camera        = NULL -> scene->camera
 //   reflection_edits = NULL: physical reflection. Otherwise the glossy and mirror lobes of the
 //                   first vertex centre on the edited direction e(q) (drift/reflect_edit.h)
@@ -85,13 +88,14 @@ typedef struct drift_pt_params {
     bool disable_mis;
     bool disable_nee;
     bool disable_rr;
-    uint32_t components;        // bit set of drift_pt_component
-    bool pixel_centre;          // every sample through the pixel centre (no pixel jitter): the same
-                                // footprint as a one-sample-per-pixel G-buffer
-    bool pinhole;               // ignore the camera's aperture
-    const drift_camera *camera; // NULL = scene->camera; else this camera, copied at create
-                                // (moving it later does not move the pt's camera).
-                                // width/height still come from params.
+    uint32_t components; // bit set of drift_pt_component
+    bool pixel_centre;   // every sample through the pixel centre (no pixel jitter): the same
+                         // footprint as a one-sample-per-pixel G-buffer
+    bool pinhole;        // ignore the camera's aperture
+    bool texture_point_sampling; // read textures at full size: no mip level by ray cone
+    const drift_camera *camera;  // NULL = scene->camera; else this camera, copied at create
+                                 // (moving it later does not move the pt's camera).
+                                 // width/height still come from params.
     const drift_reflection_edits *reflection_edits;
 } drift_pt_params;
 

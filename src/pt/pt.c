@@ -272,6 +272,11 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
     path_split split = { .active = p->components != DRIFT_PT_COMPONENT_ALL };
     bool feature_open = true; // no non-delta vertex yet: the next one gives the features
     float path_length = 0.0f;
+    // The ray cone (Akenine-Moller et al. 2021): its width at the ray's origin and its spread
+    // angle, a pixel's at the camera. Textures read the mip level of its footprint.
+    float cone_width = 0.0f;
+    float cone_spread =
+        p->texture_point_sampling ? 0.0f : 2.0f * pt->camera.tan_half / (float)pt->camera.height;
     stats->camera_rays++;
 
     for (int32_t depth = 0;; ++depth) {
@@ -295,6 +300,10 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
             break;
         }
         drift_surface surf = drift_scene_surface(scene, &ray, &hit);
+        cone_width += cone_spread * hit.t;
+        if (cone_spread > 0.0f) {
+            drift_surface_set_footprint(scene, &surf, cone_width, ray.dir);
+        }
         drift_vec3 wo = drift_vec3_neg(ray.dir);
         if (depth == 0) {
             out->depth = hit.t;
@@ -367,6 +376,13 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
             }
         }
         beta = drift_vec3_mul(beta, bs.weight);
+        if (!bs.is_delta && cone_spread > 0.0f) {
+            // A glossy or diffuse bounce widens the cone to the solid angle 1 / pdf its sample
+            // stands for (a cone of angle 2 sqrt(1 / (pi pdf))), at most a right angle; a delta
+            // bounce keeps it (surface curvature is not tracked).
+            cone_spread =
+                fmaxf(cone_spread, fminf(2.0f / sqrtf(DRIFT_PI * bs.pdf), DRIFT_PI / 2.0f));
+        }
         prev_specular = bs.is_delta;
         prev_bsdf_pdf = bs.pdf;
         prev_position = surf.position;
