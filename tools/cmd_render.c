@@ -665,7 +665,8 @@ int render_reference_begin(render_reference_run *run)
                                .height = (int32_t)o->height,
                                .seed = (uint32_t)o->seed,
                                .max_depth = (int32_t)o->max_depth,
-                               .reflection_edits = o->hybrid.reflection_edits };
+                               .reflection_edits = o->hybrid.reflection_edits,
+                               .texture_filter_spp = (uint32_t)o->spp };
     drift_result r =
         drift_pt_create(session->ctx, session->scene, session->accel, &params, &run->pt);
     if (r != DRIFT_OK) {

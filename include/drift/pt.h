@@ -75,6 +75,9 @@ typedef enum drift_pt_component {
 //   texture_point_sampling = false: textures are read at the mip level of the ray cone's
 //                   footprint (Akenine-Moller et al. 2021; docs/materials.md "Textures"), so
 //                   distant textures do not alias; true reads them at full size
+//   texture_filter_spp = 0 -> 1: the samples each pixel will get; the camera's cone is
+//                   max(1/8, 1/sqrt(n)) of a pixel wide, as pbrt-v4 scales its ray
+//                   differentials, for the pixels' own supersampling filters the rest
 //   camera        = NULL -> scene->camera
 //   reflection_edits = NULL: physical reflection. Otherwise the glossy and mirror lobes of the
 //                   first vertex centre on the edited direction e(q) (drift/reflect_edit.h)
@@ -93,6 +96,7 @@ typedef struct drift_pt_params {
                          // footprint as a one-sample-per-pixel G-buffer
     bool pinhole;        // ignore the camera's aperture
     bool texture_point_sampling; // read textures at full size: no mip level by ray cone
+    uint32_t texture_filter_spp; // the samples a pixel will get (0: 1): see above
     const drift_camera *camera;  // NULL = scene->camera; else this camera, copied at create
                                  // (moving it later does not move the pt's camera).
                                  // width/height still come from params.

@@ -275,8 +275,11 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
     // The ray cone (Akenine-Moller et al. 2021): its width at the ray's origin and its spread
     // angle, a pixel's at the camera. Textures read the mip level of its footprint.
     float cone_width = 0.0f;
-    float cone_spread =
-        p->texture_point_sampling ? 0.0f : 2.0f * pt->camera.tan_half / (float)pt->camera.height;
+    uint32_t planned = p->texture_filter_spp > 1 ? p->texture_filter_spp : 1;
+    float spp_scale = fmaxf(0.125f, 1.0f / sqrtf((float)planned));
+    float cone_spread = p->texture_point_sampling
+                            ? 0.0f
+                            : spp_scale * 2.0f * pt->camera.tan_half / (float)pt->camera.height;
     stats->camera_rays++;
 
     for (int32_t depth = 0;; ++depth) {
