@@ -106,6 +106,7 @@ bool cli_check_writable(const char *cmd, const cli_file *outputs, size_t output_
 typedef struct cli_session_desc {
     const char *cmd;           // "render", "bench isg": in messages
     const char *scene_path;    // NULL: default_scene
+    const char *camera;        // a glTF scene's camera by name or index (NULL: its first)
     const char *default_scene; // NULL: cli_default_scene_path()
     int threads;               // worker threads; 0: one a core
     bool verbose;              // info-level log messages too
@@ -133,6 +134,7 @@ typedef struct cli_session {
     double t_loaded;        // for phase timings
     double t_built;
     bool refused;        // an output names an input (cli_session_desc's outputs): exit status 2
+    const char *camera;  // cli_session_desc's camera, for every load
     char **scene_inputs; // the files the scene load read (drift_scene_load_inputs)
     size_t scene_input_count;
     char path[4096];

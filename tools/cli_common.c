@@ -369,7 +369,8 @@ bool cli_session_load(cli_session *s, const char *cmd, const char *path, bool no
     snprintf(s->path, sizeof s->path, "%s", path);
     s->scene_path = s->path;
     free_scene_inputs(s);
-    drift_result r = drift_scene_load_inputs(s->ctx, s->path, note_scene_input, s, &s->scene);
+    drift_result r =
+        drift_scene_load_camera(s->ctx, s->path, s->camera, note_scene_input, s, &s->scene);
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift %s: cannot load scene %s: %s\n", cmd, s->path,
                 drift_result_string(r));
@@ -381,7 +382,7 @@ bool cli_session_load(cli_session *s, const char *cmd, const char *path, bool no
 
 bool cli_session_open(const cli_session_desc *desc, cli_session *s)
 {
-    *s = (cli_session){ .t_start = drift_time_now() };
+    *s = (cli_session){ .t_start = drift_time_now(), .camera = desc->camera };
     s->ctx = open_context(desc->cmd, desc->threads, desc->verbose);
     if (!s->ctx) {
         return false;

@@ -212,6 +212,11 @@ static const cli_option render_table[] = {
       .kind = CLI_KIND_CUSTOM,
       .parse = parse_aov,
       .optional_if = ".exr" },
+    CLI_CHOICE("--aov-normal", "N|Normal", O, aov_normal, "N|Normal",
+               "the --aov normals' layer: N (N.X/N.Y/N.Z, tev and Nuke; default)\n"
+               "or Normal (Normal.X/Y/Z, Blender's compositor)"),
+    CLI_STRING("--camera", "NAME", O, camera,
+               "a glTF scene's camera by name, or by index (default: its first)"),
     CLI_STRING("--stats", "FILE.json", O, stats_path,
                "spp, rays traced and milliseconds per phase"),
     CLI_NUMBER("--checkpoint", "SECONDS", O, checkpoint_seconds, 0.0, 1e9,
@@ -513,7 +518,7 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
         }
         // The names tev, Nuke and Blender's compositor take as theirs: Z, N.XYZ, albedo.RGB.
         layers[1] = (drift_image_layer){ "albedo", &albedo };
-        layers[2] = (drift_image_layer){ "N", &normal };
+        layers[2] = (drift_image_layer){ o->aov_normal ? "Normal" : "N", &normal };
         layers[3] = (drift_image_layer){ NULL, &depth };
         // The feature-guided denoiser's inputs (drift/pt.h, DRIFT_PT_AOV_VARIANCE on).
         layers[4] = (drift_image_layer){ "variance", &variance };
@@ -895,6 +900,7 @@ int render_open_session(render_options *o, bool outputs_here, cli_session *sessi
     o->hybrid.reflection_edits = NULL;
     if (!cli_session_open(&(cli_session_desc){ .cmd = "render",
                                                .scene_path = o->scene_path,
+                                               .camera = o->camera,
                                                .threads = (int)o->threads,
                                                .verbose = o->verbose,
                                                .outputs = outputs,

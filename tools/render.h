@@ -50,7 +50,8 @@ typedef struct render_options {
     drift_tonemap_operator tonemap;
     const char *view, *display, *look, *ocio_config; // --view ...: the PNG through OpenColorIO
     bool aov;
-    int denoise; // --denoise: 0 none, 1 atrous, 2 on (drift_denoise_feature), 3 regression
+    int aov_normal; // --aov-normal: 0 N (N.X/N.Y/N.Z), 1 Normal (Blender's Normal.X/Y/Z)
+    int denoise;    // --denoise: 0 none, 1 atrous, 2 on (drift_denoise_feature), 3 regression
     bool quiet;
     bool verbose;
     long debug_x, debug_y, debug_sample; // -1: not replaying a sample
@@ -68,6 +69,7 @@ typedef struct render_options {
     long frame_first, frame_last;
     double fps;              // --fps; 0: the camera path's (24 unless it says)
     const char *camera_path; // --camera-path F.json
+    const char *camera;      // --camera NAME: a glTF scene's camera
     const char *video_path;  // --video FILE.mp4 (ffmpeg, when installed)
     bool temporal;           // --temporal on: reuse across frames (hybrid, drift/temporal.h)
     drift_temporal_settings temporal_settings;

@@ -56,6 +56,15 @@ drift_result drift_scene_load_inputs(drift_context *ctx, const char *path,
                                      drift_scene_input_fn on_input, void *user,
                                      drift_scene **out_scene);
 
+// drift_scene_load_inputs with the camera of a glTF file (.gltf, .glb, the scene itself) chosen
+// by its name, or by its index in the file's `cameras` (`camera` NULL: the first). A camera the
+// file does not have is DRIFT_ERR_INVALID_ARGUMENT, logged with the names it has; another kind
+// of scene file is DRIFT_ERR_UNSUPPORTED (a JSON scene names its glTF's camera in the mesh
+// entry's "camera").
+drift_result drift_scene_load_camera(drift_context *ctx, const char *path, const char *camera,
+                                     drift_scene_input_fn on_input, void *user,
+                                     drift_scene **out_scene);
+
 // Parses a drift scene file from memory. `text` need not be NUL-terminated. Paths in the
 // file are relative to `base_dir` (NULL: the current directory). `name_for_messages` names
 // the text in log messages (NULL: "<memory>"). Returns a committed scene.

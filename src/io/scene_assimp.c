@@ -741,9 +741,11 @@ drift_result drift__scene_import_mesh_file(drift_scene *scene, const drift__impo
     if (r == DRIFT_OK && params->camera) {
         int camera = s.gltf ? drift__gltf_camera_index(s.gltf, params->camera) : -1;
         if (camera < 0 || (unsigned)camera >= ai->mNumCameras) {
+            char names[512];
+            drift__gltf_camera_names(s.gltf, names, sizeof names);
             drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, s.where, s.line,
-                      "'%s' has no camera named or numbered '%s' (it has %u)", params->path,
-                      params->camera, ai->mNumCameras);
+                      "'%s' has no camera named or numbered '%s' (it has %u%s%s)", params->path,
+                      params->camera, ai->mNumCameras, names[0] ? ": " : "", names);
             r = DRIFT_ERR_INVALID_ARGUMENT;
         }
         s.camera = (unsigned)camera;

@@ -435,3 +435,24 @@ const cJSON *drift__gltf_root(const drift__gltf *g)
 {
     return g ? g->root : NULL;
 }
+
+void drift__gltf_camera_names(const drift__gltf *g, char *out, size_t out_size)
+{
+    out[0] = '\0';
+    const cJSON *cameras = g ? cJSON_GetObjectItemCaseSensitive(g->root, "cameras") : NULL;
+    int count = cJSON_IsArray(cameras) ? cJSON_GetArraySize(cameras) : 0;
+    size_t used = 0;
+    for (int i = 0; i < count && used + 4 < out_size; ++i) {
+        const cJSON *name =
+            cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(cameras, i), "name");
+        int n = cJSON_IsString(name)
+                    ? snprintf(out + used, out_size - used, "%s%d '%s'", i ? ", " : "", i,
+                               name->valuestring)
+                    : snprintf(out + used, out_size - used, "%s%d", i ? ", " : "", i);
+        if (n < 0 || (size_t)n >= out_size - used) {
+            snprintf(out + (out_size > 4 ? out_size - 4 : 0), out_size > 4 ? 4 : out_size, "...");
+            return;
+        }
+        used += (size_t)n;
+    }
+}

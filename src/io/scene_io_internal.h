@@ -202,6 +202,9 @@ void drift__gltf_close(drift_context *ctx, drift__gltf *g);
 // Entry `index` of the file's lights / materials; false when the file has no such entry.
 bool drift__gltf_get_light(const drift__gltf *g, unsigned index, drift__gltf_light *out);
 bool drift__gltf_get_material(const drift__gltf *g, unsigned index, drift__gltf_material *out);
+// The names of the file's cameras, "0 'front', 1 'side'" (an unnamed one by its index alone),
+// into out (cut short with "..." when it does not fit).
+void drift__gltf_camera_names(const drift__gltf *g, char *out, size_t out_size);
 // The index in `cameras` of the camera named `selector`, or numbered by it; -1 if none.
 int drift__gltf_camera_index(const drift__gltf *g, const char *selector);
 

@@ -340,7 +340,7 @@ bool drift__is_mesh_extension(const char *ext)
            strcmp(ext, "ply") == 0;
 }
 
-static drift_result load_mesh_scene(drift_context *ctx, const char *path,
+static drift_result load_mesh_scene(drift_context *ctx, const char *path, const char *camera,
                                     drift_scene_input_fn on_input, void *user,
                                     drift_scene **out_scene)
 {
@@ -351,9 +351,11 @@ static drift_result load_mesh_scene(drift_context *ctx, const char *path,
     }
     drift__texture_cache textures = { .on_input = on_input, .user = user };
     drift__import_info info = { 0 };
-    drift__import_params params = {
-        .path = path, .where = path, .material_override = DRIFT_INVALID_INDEX, .textures = &textures
-    };
+    drift__import_params params = { .path = path,
+                                    .where = path,
+                                    .material_override = DRIFT_INVALID_INDEX,
+                                    .textures = &textures,
+                                    .camera = camera };
     r = drift__scene_import_mesh_file(scene, &params, &info);
     drift__texture_cache_clear(ctx, &textures);
     if (r == DRIFT_OK) {
@@ -394,6 +396,34 @@ drift_result drift_scene_load(drift_context *ctx, const char *path, drift_scene 
     return drift_scene_load_inputs(ctx, path, NULL, NULL, out_scene);
 }
 
+drift_result drift_scene_load_camera(drift_context *ctx, const char *path, const char *camera,
+                                     drift_scene_input_fn on_input, void *user,
+                                     drift_scene **out_scene)
+{
+    if (!camera) {
+        return drift_scene_load_inputs(ctx, path, on_input, user, out_scene);
+    }
+    if (!out_scene) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    *out_scene = NULL;
+    char ext[16];
+    bool gz = false;
+    drift__path_extension(path ? path : "", ext, sizeof(ext), &gz);
+    if (strcmp(ext, "gltf") != 0 && strcmp(ext, "glb") != 0) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_UNSUPPORTED, path, 0,
+                  "a camera by name ('%s') is chosen among a glTF file's cameras; this is not a "
+                  ".gltf or .glb (a JSON scene names its glTF's camera in the mesh entry's "
+                  "\"camera\")",
+                  camera);
+        return DRIFT_ERR_UNSUPPORTED;
+    }
+    if (strlen(path) >= DRIFT__PATH_MAX) {
+        return drift_scene_load_inputs(ctx, path, on_input, user, out_scene); // says why
+    }
+    return load_mesh_scene(ctx, path, camera, on_input, user, out_scene);
+}
+
 drift_result drift_scene_load_inputs(drift_context *ctx, const char *path,
                                      drift_scene_input_fn on_input, void *user,
                                      drift_scene **out_scene)
@@ -431,7 +461,7 @@ drift_result drift_scene_load_inputs(drift_context *ctx, const char *path,
         return r;
     }
     if (drift__is_mesh_extension(ext)) {
-        return load_mesh_scene(ctx, path, on_input, user, out_scene);
+        return load_mesh_scene(ctx, path, NULL, on_input, user, out_scene);
     }
     if (strcmp(ext, "xml") == 0 && !gz) {
         return drift__scene_load_mitsuba(ctx, path, on_input, user, out_scene);
