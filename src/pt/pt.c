@@ -216,7 +216,9 @@ static drift_vec3 sample_direct(const drift_pt *pt, const drift_surface *surf,
         return drift_vec3_splat(0.0f);
     }
     drift_vec3 f = drift_bsdf_eval(bsdf, wo, ls.wi);
-    float cos_i = fabsf(drift_vec3_dot(ls.wi, surf->ns));
+    // The cosine about the BSDF's own normal (a normal map's, where there is one), as BSDF
+    // sampling's weight has it: the two strategies then estimate the same integral.
+    float cos_i = fabsf(drift_vec3_dot(ls.wi, bsdf->frame.z));
     if (drift_vec3_is_zero(f) || cos_i <= 0.0f) {
         return drift_vec3_splat(0.0f);
     }
