@@ -150,6 +150,10 @@ def main():
         wall.name = "Wall"
         wall.scale = (8.0, 3.0, 1.0)
         wall.rotation_euler = (1.5707963, 0.0, 0.0)
+        # The scale goes into the vertices: with the object's own non-uniform scale Cycles
+        # applies the normal map in object space and the normal transform then shrinks the
+        # tilts along x by 8, where glTF (and drift) bend the normal in world space.
+        bpy.ops.object.transform_apply(location=False, rotation=False, scale=True)
         wall.data.materials.append(bumpy_wall(args.out))
 
     gold = (1.0, 0.78, 0.34)
