@@ -2,8 +2,8 @@
 # The GGX material against Blender Cycles (issue 41): Blender's glTF export of four gold metal
 # spheres of roughness 0.05, 0.25, 0.5, 0.8, a glass sphere, a floor, an emissive slab and a
 # point light (tests/data/ggx/export_ggx_scene.py; its --textured variant with a
-# metallic-roughness floor and a normal-mapped wall is not in this test: ꟻLIP 0.09 there,
-# docs/lab/2026-12-07-issue-41.md), rendered by Cycles 3.4 (Multiscatter GGX)
+# metallic-roughness floor and a normal-mapped wall is not in this test: ꟻLIP 0.12 there,
+# docs/lab/2026-12-07-issue-41-s2.md), rendered by Cycles 3.4 (Multiscatter GGX)
 # once into tests/data/ggx/cycles_64x48.exr (tests/data/ggx/make_reference.sh; 1024 spp).
 # drift renders the cached .glb at 64x48, 64 spp, and must agree within FLIP 0.055 and 3% in
 # mean luminance, the glass and the metals' reflections included. At 64 spp drift's own noise
