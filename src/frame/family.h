@@ -42,6 +42,15 @@ typedef struct drift_family {
     void (*report)(drift_frame_state *frame, drift_family_count_fn count);
 } drift_family;
 
+// Helpers of the report hooks (family.c): the pixels that see a surface, and the mean of a
+// one-channel plane over those of them where it is not 0 (*out_n of them; 0 with none).
+uint64_t drift_family_surface_pixels(const drift_frame_state *frame);
+double drift_family_nonzero_mean(const drift_frame_state *frame, const drift_image *plane,
+                                 uint64_t *out_n);
+// The number of the frame's pixels that see a surface where plane's channel c >= at.
+uint64_t drift_family_surface_at_least(const drift_frame_state *frame, const drift_image *plane,
+                                       int c, float at);
+
 // Every family (defined in the family's folder, listed by src/hybrid/families.c).
 extern const drift_family drift_realtime_family; // src/realtime/family.c
 extern const drift_family drift_isg_family;      // src/isg/family.c

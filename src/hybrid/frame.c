@@ -466,6 +466,46 @@ bool drift_hybrid_stats_stage(const drift_hybrid_stats *stats, uint32_t index,
     return true;
 }
 
+bool drift_hybrid_stats_count(const drift_hybrid_stats *stats, uint32_t index,
+                              const char **out_name, double *out_value)
+{
+    if (index >= stats->count_count) {
+        return false;
+    }
+    if (out_name) {
+        *out_name = stats->counts[index].name;
+    }
+    if (out_value) {
+        *out_value = stats->counts[index].value;
+    }
+    return true;
+}
+
+static void add_count(drift_frame_state *f, const char *name, double value)
+{
+    drift_hybrid_stats *s = &f->stats;
+    if (s->count_count < DRIFT_HYBRID_MAX_COUNTS) {
+        s->counts[s->count_count].name = name;
+        s->counts[s->count_count].value = value;
+        ++s->count_count;
+    } else {
+        drift_log(f->ctx, DRIFT_LOG_WARNING, DRIFT_OK, __FILE__, __LINE__,
+                  "hybrid frame: more than %d counts, '%s' left out", DRIFT_HYBRID_MAX_COUNTS,
+                  name);
+    }
+}
+
+// What the frame did, as each family reports it (after its last pass).
+static void report_counts(drift_frame_state *f)
+{
+    f->stats.count_count = 0;
+    for (int i = 0; drift_family_at(i); ++i) {
+        if (drift_family_at(i)->report) {
+            drift_family_at(i)->report(f, add_count);
+        }
+    }
+}
+
 static drift_result run_row(drift_frame_state *f, const drift_technique_row *row,
                             const atomic_bool *cancel)
 {
@@ -512,6 +552,7 @@ static drift_result render_pass(drift_frame_state *f, const atomic_bool *cancel,
         diffuse_environment |= (rows[e]->flags & DRIFT_ROW_ENVIRONMENT_DIFFUSE) != 0;
     }
     *out_inputs = inputs;
+    f->inputs = inputs;
     f->environment_diffuse_elsewhere = diffuse_environment;
     t = drift_time_now();
     drift_result r = prepare_inputs(f, inputs);
@@ -593,6 +634,9 @@ drift_result drift_hybrid_render(drift_hybrid *h, const drift_camera *camera,
     f->has_prev_camera = true;
     double t_planes = drift_time_now();
     collect_planes(h, inputs);
+    if (r == DRIFT_OK) {
+        report_counts(f);
+    }
     f->stats.other_ms += 1000.0 * (drift_time_now() - t_planes);
     if (r == DRIFT_OK && h->planes_out_of_memory) {
         h->planes_out_of_memory = false;

@@ -84,6 +84,34 @@ static void destroy(drift_frame_state *f)
     destroy_probes(f);
 }
 
+// The rays of the inputs this frame prepared; the shadow maps' and probes' rays are 0 on a
+// frame that found them cached.
+static void report(drift_frame_state *f, drift_family_count_fn count)
+{
+    const drift_hybrid_stats *s = &f->stats;
+    if ((f->inputs & DRIFT_INPUT_UNSHADOWED) && drift_scene_has_environment(f->scene)) {
+        count(f, "realtime.environment_shadow_rays", (double)s->rays[DRIFT_PASS_UNSHADOWED]);
+    }
+    if (f->inputs & DRIFT_INPUT_HARD_SHADOWS) {
+        count(f, "realtime.hard_shadow_rays", (double)s->rays[DRIFT_PASS_HARD_SHADOWS]);
+    }
+    if (f->inputs & DRIFT_INPUT_SHADOW_MAPS) {
+        uint32_t maps = 0;
+        for (uint32_t l = 0; l < f->light_count; ++l) {
+            maps += f->light_buffers[l].shadow_map != NULL;
+        }
+        count(f, "realtime.shadow_maps", maps);
+        count(f, "realtime.shadow_map_rays", (double)s->rays[DRIFT_PASS_SHADOW_MAPS]);
+    }
+    if (f->inputs & DRIFT_INPUT_SHARP_REFLECTIONS) {
+        count(f, "realtime.reflection_rays", (double)s->rays[DRIFT_PASS_REFLECTIONS]);
+    }
+    if (f->inputs & DRIFT_INPUT_PROBES) {
+        count(f, "realtime.probes", f->probe_count);
+        count(f, "realtime.probe_rays", (double)s->rays[DRIFT_PASS_ENVMAP]);
+    }
+}
+
 const drift_family drift_realtime_family = {
     .name = "realtime",
     .resolve = resolve,
@@ -94,4 +122,5 @@ const drift_family drift_realtime_family = {
     .after_row = after_row,
     .update = update,
     .destroy = destroy,
+    .report = report,
 };
