@@ -5,9 +5,11 @@
 // another family left behind, shows up as a byte of difference. ASan checks that destroy
 // frees everything.
 #include "drift_test.h"
+#include "hybrid/families.h"
 #include "hybrid/techniques.h"
 #include "test_rig.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -151,11 +153,123 @@ static void test_caches_follow_their_knobs(void **state)
     test_rig_destroy(&r);
 }
 
+// The count `name` of the frame's last render, or NAN when it reported none.
+static double count_of(drift_hybrid *frame, const char *name)
+{
+    drift_hybrid_stats s = drift_hybrid_get_stats(frame);
+    const char *n;
+    double v;
+    for (uint32_t k = 0; drift_hybrid_stats_count(&s, k, &n, &v); ++k) {
+        if (strcmp(n, name) == 0) {
+            return v;
+        }
+    }
+    return NAN;
+}
+
+// Every count is named "family.what" after a family of the list, once, and is a finite,
+// non-negative number; a family whose rows did not run reports nothing.
+static void check_counts_named(drift_hybrid *frame, const char *silent)
+{
+    drift_hybrid_stats s = drift_hybrid_get_stats(frame);
+    const char *name;
+    double value;
+    for (uint32_t k = 0; drift_hybrid_stats_count(&s, k, &name, &value); ++k) {
+        assert_true(isfinite(value) && value >= 0.0);
+        bool known = false;
+        for (int i = 0; drift_family_at(i); ++i) {
+            size_t n = strlen(drift_family_at(i)->name);
+            known |= strncmp(name, drift_family_at(i)->name, n) == 0 && name[n] == '.';
+        }
+        if (!known || (silent && strncmp(name, silent, strlen(silent)) == 0)) {
+            fail_msg("count '%s' is not its family's (or its rows did not run)", name);
+        }
+        for (uint32_t j = 0; j < k; ++j) {
+            assert_string_not_equal(s.counts[j].name, name);
+        }
+    }
+}
+
+static void render(test_rig *r, drift_hybrid *frame, const drift_hybrid_params *p)
+{
+    assert_int_equal(drift_hybrid_set_params(frame, p), DRIFT_OK);
+    assert_int_equal(drift_hybrid_render(frame, &r->scene->camera, NULL), DRIFT_OK);
+}
+
+// A frame reports what it did: the shadow maps and probes cast rays on the first frame and
+// none on the next (the caches survive), again after a knob they depend on changes; AAF
+// spends its --spp budget on average (exactly with uniform sampling); ISM reports its VPLs,
+// micro-rendering its points (a power of two); hard shadows cast at most a ray per surface
+// pixel and light.
+static void test_a_frame_reports_what_it_did(void **state)
+{
+    (void)state;
+    test_rig r = test_rig_begin(2);
+    build_scene(&r, 16);
+    test_rig_commit(&r);
+    drift_hybrid_params p = small_params();
+    p.indirect = DRIFT_INDIRECT_NONE;
+    drift_hybrid *frame = NULL;
+    assert_int_equal(drift_hybrid_create(r.ctx, r.scene, r.accel, &p, &frame), DRIFT_OK);
+
+    render(&r, frame, &p); // hard shadows alone
+    check_counts_named(frame, "isg");
+    double hard = count_of(frame, "realtime.hard_shadow_rays");
+    assert_true(hard > 0.0 && hard <= 16.0 * 16.0);
+    assert_true(count_of(frame, "realtime.environment_shadow_rays") > 0.0);
+    assert_true(isnan(count_of(frame, "ism.vpls")));
+
+    p.shadows = DRIFT_SHADOWS_PCSS;
+    p.reflections = DRIFT_REFLECTIONS_ENVMAP;
+    render(&r, frame, &p);
+    check_counts_named(frame, "aaf");
+    assert_true(count_of(frame, "realtime.shadow_map_rays") > 0.0);
+    assert_true(count_of(frame, "realtime.probe_rays") > 0.0);
+    render(&r, frame, &p);
+    assert_true(count_of(frame, "realtime.shadow_maps") == 1.0);
+    assert_true(count_of(frame, "realtime.shadow_map_rays") == 0.0);
+    assert_true(count_of(frame, "realtime.probe_rays") == 0.0);
+    p.shadow_map.size = 32;
+    render(&r, frame, &p);
+    assert_true(count_of(frame, "realtime.shadow_map_rays") > 0.0);
+    assert_true(count_of(frame, "realtime.probe_rays") == 0.0);
+
+    p = small_params();
+    p.spp = 8;
+    p.indirect = DRIFT_INDIRECT_AAF;
+    render(&r, frame, &p);
+    check_counts_named(frame, "ism");
+    double mean = count_of(frame, "aaf.indirect.mean_spp");
+    if (!(fabs(mean - 8.0) <= 0.8)) {
+        fail_msg("aaf: %.3f samples a pixel on average, --spp 8", mean);
+    }
+    assert_true(count_of(frame, "aaf.indirect.sampled_pixels") > 0.0);
+    p.aaf.uniform = true;
+    render(&r, frame, &p);
+    assert_true(count_of(frame, "aaf.indirect.mean_spp") == 8.0);
+
+    p = small_params();
+    p.indirect = DRIFT_INDIRECT_ISM;
+    render(&r, frame, &p);
+    check_counts_named(frame, "aaf");
+    assert_true(count_of(frame, "ism.vpls") > 0.0);
+    assert_true(count_of(frame, "ism.splats") > 0.0);
+
+    p.indirect = DRIFT_INDIRECT_MICRO;
+    render(&r, frame, &p);
+    check_counts_named(frame, "ism");
+    assert_true(count_of(frame, "micro.indirect.points") == 512.0);
+    assert_true(count_of(frame, "micro.indirect.gathers") > 0.0);
+    drift_hybrid_destroy(frame);
+    test_rig_destroy(&r);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_every_row_as_a_new_frame),
         cmocka_unit_test(test_caches_follow_their_knobs),
+        cmocka_unit_test(test_a_frame_reports_what_it_did),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
