@@ -134,6 +134,9 @@ void cli_print_markdown(const cli_command *c, FILE *out)
 {
     fprintf(out, "## drift %s\n\n```text\n", c->name);
     fputs(c->usage, out);
+    if (cli_takes_scene(c)) {
+        cli_print_scene_formats(out);
+    }
     fprintf(out, "```\n\n");
     bool table = false;
     for (size_t k = 0; k < c->option_count; ++k) {

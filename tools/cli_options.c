@@ -4,6 +4,7 @@
 #include "cli.h"
 #include "drift/hybrid.h"
 #include "drift/knobs.h"
+#include "drift/scene_io.h"
 
 #include <stdint.h>
 #include <stdio.h>
@@ -479,10 +480,30 @@ static void print_knobs(FILE *out, int column)
     }
 }
 
+bool cli_takes_scene(const cli_command *c)
+{
+    return c->positional && strcmp(c->positional, "SCENE") == 0;
+}
+
+void cli_print_scene_formats(FILE *out)
+{
+    fprintf(out, "SCENE is a file of one of these formats, by its extension:\n");
+    for (int i = 0; drift_scene_format_get(i); ++i) {
+        const drift_scene_format *f = drift_scene_format_get(i);
+        char label[32];
+        snprintf(label, sizeof label, ".%s%s", f->extension, f->gz ? "[.gz]" : "");
+        fprintf(out, "  %-11s %s\n", label, f->summary);
+    }
+    fprintf(out, "\n");
+}
+
 void cli_print_help(const cli_command *c, FILE *out)
 {
     int column = c->help_column > 0 ? c->help_column : 24;
     fputs(c->usage, out);
+    if (cli_takes_scene(c)) {
+        cli_print_scene_formats(out);
+    }
     bool first_section = true;
     for (size_t k = 0; k < c->option_count; ++k) {
         const cli_option *opt = &c->options[k];

@@ -193,6 +193,11 @@ int cli_parse(const cli_command *command, int argc, char **argv, void *opts,
 int cli_parse_exit(int status);
 
 void cli_print_help(const cli_command *command, FILE *out);
+// Whether the command's positional argument is a SCENE, and the scene formats it may be (the
+// loaders' registry, drift_scene_format_get): --help and --help-markdown print them after
+// the usage of every such command.
+bool cli_takes_scene(const cli_command *command);
+void cli_print_scene_formats(FILE *out);
 // The same as Markdown (tools/cli_markdown.c): the usage, one table of options per section
 // (option, argument, description); `drift COMMAND --help-markdown` prints it. And the knob
 // reference: the techniques, then per knob family a table of its rows (`drift

@@ -24,9 +24,9 @@ static const cli_command info_command = {
     .name = "info",
     .usage = "usage: drift info [options] [SCENE]\n"
              "\n"
-             "Loads SCENE (.json, .obj, .gltf, .glb, .ply, optionally .gz; default: the built-in\n"
-             "Cornell box) and prints its triangle, mesh, material, light (by type) and texture\n"
-             "counts, its bounding box and its camera.\n"
+             "Loads SCENE (a scene or mesh file, below; default: the built-in Cornell box) and\n"
+             "prints its triangle, mesh, material, light (by type) and texture counts, its\n"
+             "bounding box and its camera.\n"
              "\n",
     .epilogue = "\nExit status: 0 success, 1 the scene could not be loaded, 2 usage error.\n",
     CLI_TABLE(info_table),

@@ -324,8 +324,8 @@ static const cli_command render_command = {
     .usage =
         "usage: drift render [SCENE] [options]\n"
         "\n"
-        "Renders SCENE (a drift .json scene, or .obj/.gltf/.glb/.ply[.gz]); without SCENE, the\n"
-        "built-in Cornell box. Writes a linear EXR and a tone-mapped sRGB PNG beside it.\n"
+        "Renders SCENE (a scene or mesh file, below); without SCENE, the built-in Cornell box.\n"
+        "Writes a linear EXR and a tone-mapped sRGB PNG beside it.\n"
         "\n",
     .epilogue =
         "\nCtrl-C (or SIGTERM) stops the render and writes what it has, and the checkpoint\n"

@@ -90,6 +90,13 @@ static bool write_stats(const render_options *o, const cli_session *session,
         render_stage_label(&p, stage_name, label, sizeof label);
         cli_json_number(stages, label, stage_ms, 3);
     }
+    // What the frame did, as each chosen row's family reports it (its samples and set-up).
+    cJSON *counts = cJSON_AddObjectToObject(root, "counts");
+    const char *count_name;
+    double count_value;
+    for (uint32_t k = 0; drift_hybrid_stats_count(&s, k, &count_name, &count_value); ++k) {
+        cJSON_AddNumberToObject(counts, count_name, count_value);
+    }
     // The first frame by pass and by effect (ISM's points, VPLs and maps are the indirect
     // effect's), and with --frames > 1 what it spent over the warm last frame: the set-up the
     // frame pays once (scene points, shadow maps, probes, techniques' state).
@@ -294,6 +301,11 @@ int render_hybrid(const render_options *o, const cli_session *session)
                         drift_hybrid_pass_name((drift_hybrid_pass)k),
                         (unsigned long long)s.rays[k]);
             }
+        }
+        // Then what the frame did, family by family.
+        double value;
+        for (uint32_t k = 0; drift_hybrid_stats_count(&s, k, &name, &value); ++k) {
+            fprintf(stderr, "  %-34s %12.6g\n", name, value);
         }
     }
     char png[4096];

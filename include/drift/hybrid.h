@@ -329,6 +329,8 @@ typedef enum drift_hybrid_pass {
 
 const char *drift_hybrid_pass_name(drift_hybrid_pass pass);
 
+#define DRIFT_HYBRID_MAX_COUNTS 32 // the counts one frame can report
+
 typedef struct drift_hybrid_stats {
     double ms[DRIFT_PASS_COUNT]; // wall milliseconds of the last frame, per pass
     // Per effect: its chosen technique's own work (the row's pass, and summing D after a
@@ -341,6 +343,14 @@ typedef struct drift_hybrid_stats {
     double inputs_ms;  // the inputs the chosen rows share (U_l, hard shadows, maps, probes, ...)
     double compose_ms; // L = E + D + R + I + ...
     double other_ms;   // --aa's running sum and the list of planes
+
+    // What the frame did, as each technique family reports it (drift_hybrid_stats_count).
+    struct {
+        const char *name; // "family.what": "ism.vpls", "aaf.indirect.mean_spp", ...
+        double value;
+    } counts[DRIFT_HYBRID_MAX_COUNTS];
+
+    uint32_t count_count;
 } drift_hybrid_stats;
 
 // The frame's stages, in order: "primary", "inputs", every effect by name (its chosen row's
@@ -350,6 +360,13 @@ typedef struct drift_hybrid_stats {
 // cannot leave a stage out. Returns false past the last stage.
 bool drift_hybrid_stats_stage(const drift_hybrid_stats *stats, uint32_t index,
                               const char **out_name, double *out_ms);
+
+// What the frame did, count by count, in the order the families report them: each chosen
+// row's family reports its own samples and set-up ("realtime.environment_shadow_rays",
+// "isg.shadows.gather_samples", "aaf.indirect.mean_spp", "ism.vpls", "micro.indirect.points",
+// ...; docs/hybrid.md lists them). With --aa N, the last pass's. Returns false past the last.
+bool drift_hybrid_stats_count(const drift_hybrid_stats *stats, uint32_t index,
+                              const char **out_name, double *out_value);
 
 typedef struct drift_hybrid drift_hybrid;
 

@@ -46,6 +46,21 @@ extern "C" {
 // .gltf, .glb, .ply, or one of those followed by .gz. Returns a committed scene.
 drift_result drift_scene_load(drift_context *ctx, const char *path, drift_scene **out_scene);
 
+// The file formats drift_scene_load reads, one row each of the loaders' registry
+// (src/io/scene_formats.c): the commands' --help and the docs list them from it.
+typedef struct drift_scene_format {
+    const char *extension; // lower case, without the dot: "json", "obj", ...
+    const char *summary;   // one line: what the file is and what reads it
+    bool gz;               // also read gzip-compressed, as NAME.EXT.gz
+    bool mesh;             // a mesh file: a scene file's meshes may name one
+} drift_scene_format;
+
+int drift_scene_format_count(void);
+const drift_scene_format *drift_scene_format_get(int index); // NULL out of range
+// The format that reads `path`, by its extension (case-insensitive, looking through a
+// trailing .gz when the format reads gzip), or NULL when no loader reads it.
+const drift_scene_format *drift_scene_format_of(const char *path);
+
 // A file a scene load reads: the scene file, then each mesh file and texture it names, once
 // a path, as the loader opens them (drift render refuses outputs that name one of them).
 typedef void (*drift_scene_input_fn)(const char *path, void *user);

@@ -108,6 +108,7 @@ typedef struct drift_frame_state {
     // A chosen row (DRIFT_ROW_ENVIRONMENT_DIFFUSE: occlusion) renders the environment's light
     // through the diffuse lobe, so environment_direct (and D) keeps only its glossy part.
     bool environment_diffuse_elsewhere;
+    uint32_t inputs; // DRIFT_INPUT_* the chosen rows asked for (this pass's)
 
     drift_frame_probe *probes;
     uint32_t probe_count;

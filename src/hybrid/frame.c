@@ -2,14 +2,12 @@
 // planes (--aov, the viewer). It runs the chosen row of the technique table for every effect
 // (hybrid/techniques.h); the passes live in the technique folders (src/realtime, src/isg,
 // src/aaf, ...) and reach the frame's buffers through frame/frame.h, never through here.
-#include "aaf/aaf.h"
+// Each family's settings, shared inputs, caches and counts go through its hooks
+// (frame/family.h, the list in families.c): this file names no family.
 #include "drift/knobs.h"
+#include "hybrid/families.h"
 #include "hybrid/frame_access.h"
 #include "hybrid/techniques.h"
-#include "isg/isg.h"
-#include "ism/ism_pass.h"
-#include "realtime/realtime.h"
-#include "ssdo/ssdo_pass.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -68,9 +66,11 @@ drift_hybrid_params drift_hybrid_params_resolve(const drift_hybrid_params *param
     p.spp = p.spp ? p.spp : 64;
     p.max_depth = p.max_depth ? p.max_depth : 2;
     p.light_samples = p.light_samples ? p.light_samples : 8;
-    drift_realtime_settings_resolve(&p.shadow_map, &p.envmap);
-    drift_isg_settings_resolve(&p.isg, scene);
-    drift_aaf_settings_resolve(&p.aaf, p.spp);
+    for (int i = 0; drift_family_at(i); ++i) {
+        if (drift_family_at(i)->resolve) {
+            drift_family_at(i)->resolve(&p, scene);
+        }
+    }
     return p;
 }
 
@@ -113,10 +113,11 @@ static bool params_valid(const drift_context *ctx, const drift_hybrid_params *p)
         problem = "non-finite ambient";
     }
     // Then each technique family's own settings.
-    problem = problem ? problem : drift_realtime_settings_problem(&p->shadow_map, &p->envmap);
-    problem = problem ? problem : drift_isg_settings_problem(&p->isg);
-    problem = problem ? problem : drift_aaf_settings_problem(&p->aaf, p->spp);
-    problem = problem ? problem : drift_ism_settings_problem(&p->ism);
+    for (int i = 0; !problem && drift_family_at(i); ++i) {
+        if (drift_family_at(i)->problem) {
+            problem = drift_family_at(i)->problem(p);
+        }
+    }
     if (problem) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, NULL, 0, "hybrid frame: %s",
                   problem);
@@ -207,24 +208,6 @@ drift_result drift_hybrid_create(drift_context *ctx, const drift_scene *scene,
     return DRIFT_OK;
 }
 
-static void destroy_probes(drift_frame_state *f)
-{
-    for (uint32_t i = 0; i < f->probe_count; ++i) {
-        drift_envmap_destroy(f->ctx, f->probes[i].map);
-    }
-    drift_free(f->ctx, f->probes);
-    f->probes = NULL;
-    f->probe_count = 0;
-}
-
-static void destroy_shadow_maps(drift_frame_state *f)
-{
-    for (uint32_t l = 0; l < f->light_count; ++l) {
-        drift_shadow_map_destroy(f->ctx, f->light_buffers[l].shadow_map);
-        f->light_buffers[l].shadow_map = NULL;
-    }
-}
-
 void drift_hybrid_destroy(drift_hybrid *h)
 {
     if (!h) {
@@ -232,18 +215,20 @@ void drift_hybrid_destroy(drift_hybrid *h)
     }
     drift_frame_state *f = &h->frame;
     drift_context *ctx = f->ctx;
+    // Each family frees what it made (its caches, its buffers), then the frame its own.
+    for (int i = 0; drift_family_at(i); ++i) {
+        if (drift_family_at(i)->destroy) {
+            drift_family_at(i)->destroy(f);
+        }
+    }
+    drift_pass_free_states(f);
     if (f->light_buffers) {
-        destroy_shadow_maps(f);
         for (uint32_t l = 0; l < f->light_count; ++l) {
             drift_image_destroy(ctx, &f->light_buffers[l].unshadowed);
             drift_image_destroy(ctx, &f->light_buffers[l].hard_shadow);
             drift_image_destroy(ctx, &f->light_buffers[l].shadow);
         }
     }
-    destroy_probes(f);
-    drift_pass_free_states(f);
-    drift_isg_destroy(f);
-    drift_aaf_state_destroy(ctx, f->aaf);
     drift_gbuffer_destroy(ctx, &f->gbuffer);
     drift_image *images[] = { &f->environment_direct,
                               &f->reflection_emitted,
@@ -278,18 +263,11 @@ drift_result drift_hybrid_set_params(drift_hybrid *h, const drift_hybrid_params 
                   f->params.height, p.width, p.height);
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
-    // Cached maps that depend on a changed setting are rebuilt on next use.
-    if (p.shadow_map.size != f->params.shadow_map.size ||
-        p.shadow_map.bias != f->params.shadow_map.bias) {
-        destroy_shadow_maps(f);
-    }
-    if (p.envmap.size != f->params.envmap.size ||
-        p.envmap.has_probe != f->params.envmap.has_probe ||
-        p.envmap.per_object != f->params.envmap.per_object || p.seed != f->params.seed ||
-        p.light_samples != f->params.light_samples ||
-        (p.envmap.has_probe &&
-         !drift_vec3_is_zero(drift_vec3_sub(p.envmap.probe, f->params.envmap.probe)))) {
-        destroy_probes(f);
+    // Each family drops the caches the change invalidates (rebuilt on next use).
+    for (int i = 0; drift_family_at(i); ++i) {
+        if (drift_family_at(i)->update) {
+            drift_family_at(i)->update(f, &p);
+        }
     }
     f->params = p;
     f->shading.light_samples = p.light_samples;
@@ -416,24 +394,16 @@ const drift_image *drift_hybrid_plane_named(const drift_hybrid *h, const char *n
 
 // --- RENDER ---
 
-// The inputs rows share, each prepared once whichever rows asked for it.
+// The inputs rows share, each prepared once whichever rows asked for it, by the family that
+// provides it.
 static drift_result prepare_inputs(drift_frame_state *f, uint32_t inputs)
 {
     drift_result r = DRIFT_OK;
-    if (inputs & DRIFT_INPUT_UNSHADOWED) {
-        r = drift_realtime_pass_unshadowed(f);
-    }
-    if (r == DRIFT_OK && (inputs & DRIFT_INPUT_HARD_SHADOWS)) {
-        r = drift_realtime_pass_hard_shadows(f, (inputs & DRIFT_INPUT_OCCLUDER_DISTANCES) != 0);
-    }
-    if (r == DRIFT_OK && (inputs & DRIFT_INPUT_SHADOW_MAPS)) {
-        r = drift_realtime_build_shadow_maps(f);
-    }
-    if (r == DRIFT_OK && (inputs & DRIFT_INPUT_SHARP_REFLECTIONS)) {
-        r = drift_realtime_pass_sharp_reflections(f);
-    }
-    if (r == DRIFT_OK && (inputs & DRIFT_INPUT_PROBES)) {
-        r = drift_realtime_capture_probes(f);
+    for (int i = 0; r == DRIFT_OK && drift_family_at(i); ++i) {
+        const drift_family *family = drift_family_at(i);
+        if (family->prepare && (inputs & family->provides)) {
+            r = family->prepare(f, inputs & family->provides);
+        }
     }
     return r;
 }
@@ -496,6 +466,46 @@ bool drift_hybrid_stats_stage(const drift_hybrid_stats *stats, uint32_t index,
     return true;
 }
 
+bool drift_hybrid_stats_count(const drift_hybrid_stats *stats, uint32_t index,
+                              const char **out_name, double *out_value)
+{
+    if (index >= stats->count_count) {
+        return false;
+    }
+    if (out_name) {
+        *out_name = stats->counts[index].name;
+    }
+    if (out_value) {
+        *out_value = stats->counts[index].value;
+    }
+    return true;
+}
+
+static void add_count(drift_frame_state *f, const char *name, double value)
+{
+    drift_hybrid_stats *s = &f->stats;
+    if (s->count_count < DRIFT_HYBRID_MAX_COUNTS) {
+        s->counts[s->count_count].name = name;
+        s->counts[s->count_count].value = value;
+        ++s->count_count;
+    } else {
+        drift_log(f->ctx, DRIFT_LOG_WARNING, DRIFT_OK, __FILE__, __LINE__,
+                  "hybrid frame: more than %d counts, '%s' left out", DRIFT_HYBRID_MAX_COUNTS,
+                  name);
+    }
+}
+
+// What the frame did, as each family reports it (after its last pass).
+static void report_counts(drift_frame_state *f)
+{
+    f->stats.count_count = 0;
+    for (int i = 0; drift_family_at(i); ++i) {
+        if (drift_family_at(i)->report) {
+            drift_family_at(i)->report(f, add_count);
+        }
+    }
+}
+
 static drift_result run_row(drift_frame_state *f, const drift_technique_row *row,
                             const atomic_bool *cancel)
 {
@@ -506,12 +516,12 @@ static drift_result run_row(drift_frame_state *f, const drift_technique_row *row
                              .cancel = cancel };
     double t = drift_time_now();
     drift_result r = row->pass(f, &args);
-    if (r == DRIFT_OK && row->effect == DRIFT_EFFECT_SHADOWS &&
-        (row->inputs & DRIFT_INPUT_SHADOW_MAPS) && f->params.shadow_map.contact_shadows) {
-        r = drift_ssdo_pass_contact_shadows(f); // the shadow maps' bias, fixed in screen space
-    }
-    if (r == DRIFT_OK && (row->flags & DRIFT_ROW_SUMS_DIRECT)) {
-        r = drift_realtime_pass_sum_direct(f);
+    // What follows the pass (contact shadows, summing D), by the families that do it.
+    drift_family_row done = { .args = &args, .inputs = row->inputs, .flags = row->flags };
+    for (int i = 0; r == DRIFT_OK && drift_family_at(i); ++i) {
+        if (drift_family_at(i)->after_row) {
+            r = drift_family_at(i)->after_row(f, &done);
+        }
     }
     f->stats.effect_ms[row->effect] += 1000.0 * (drift_time_now() - t);
     return r;
@@ -542,6 +552,7 @@ static drift_result render_pass(drift_frame_state *f, const atomic_bool *cancel,
         diffuse_environment |= (rows[e]->flags & DRIFT_ROW_ENVIRONMENT_DIFFUSE) != 0;
     }
     *out_inputs = inputs;
+    f->inputs = inputs;
     f->environment_diffuse_elsewhere = diffuse_environment;
     t = drift_time_now();
     drift_result r = prepare_inputs(f, inputs);
@@ -623,6 +634,9 @@ drift_result drift_hybrid_render(drift_hybrid *h, const drift_camera *camera,
     f->has_prev_camera = true;
     double t_planes = drift_time_now();
     collect_planes(h, inputs);
+    if (r == DRIFT_OK) {
+        report_counts(f);
+    }
     f->stats.other_ms += 1000.0 * (drift_time_now() - t_planes);
     if (r == DRIFT_OK && h->planes_out_of_memory) {
         h->planes_out_of_memory = false;

@@ -239,8 +239,30 @@ drift_result drift__ply_check(drift_context *ctx, const char *path, const char *
 // through: "x.obj.gz" gives "obj" and sets *out_gz (false for any other name).
 void drift__path_extension(const char *path, char *out, size_t out_size, bool *out_gz);
 
-// True for the mesh file extensions assimp is asked to read (obj, gltf, glb, ply; lower case).
+// True for the extensions of the registry's mesh formats (obj, gltf, glb, ply; lower case).
 bool drift__is_mesh_extension(const char *ext);
+
+// --- The loaders' registry (scene_formats.c): extension -> load function ---
+
+// A format's load function: reads `path` (gunzipped when gz) into a committed scene.
+typedef drift_result (*drift__scene_load_fn)(drift_context *ctx, const char *path, bool gz,
+                                             drift_scene_input_fn on_input, void *user,
+                                             drift_scene **out_scene);
+// The load function of the format that reads `path` (NULL: none) and, when not NULL, whether
+// the file is gzip-compressed.
+drift__scene_load_fn drift__scene_loader_of(const char *path, bool *out_gz);
+// The registry's extensions as ".json, .obj, ..." (mesh_only: the mesh formats), and the
+// gzip note, for messages.
+void drift__scene_formats_text(char *out, size_t size, bool mesh_only);
+
+// The registry's load functions: a drift scene file (scene_load.c), a bare mesh file through
+// assimp with the camera and lights it lacks (scene_load.c), a Mitsuba file (scene_mitsuba.c).
+drift_result drift__scene_load_json_file(drift_context *ctx, const char *path, bool gz,
+                                         drift_scene_input_fn on_input, void *user,
+                                         drift_scene **out_scene);
+drift_result drift__scene_load_mesh_file(drift_context *ctx, const char *path, bool gz,
+                                         drift_scene_input_fn on_input, void *user,
+                                         drift_scene **out_scene);
 
 // base_dir + "/" + relative (relative unchanged when absolute or base_dir is NULL/empty).
 bool drift__path_join(const char *base_dir, const char *relative, char *out, size_t out_size);

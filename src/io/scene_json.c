@@ -672,9 +672,10 @@ static drift_result read_mesh(json_reader *r, const cJSON *item, const char *pat
     bool gz = false;
     drift__path_extension(rel, ext, sizeof(ext), &gz);
     if (!drift__is_mesh_extension(ext)) {
-        return FAIL(r, path_item, DRIFT_ERR_UNSUPPORTED,
-                    "%s.path '%s': meshes must be .obj, .gltf, .glb or .ply (optionally .gz)", path,
-                    rel);
+        char formats[128];
+        drift__scene_formats_text(formats, sizeof formats, true);
+        return FAIL(r, path_item, DRIFT_ERR_UNSUPPORTED, "%s.path '%s': meshes must be %s", path,
+                    rel, formats);
     }
     char full[DRIFT__PATH_MAX];
     if ((res = resolve_path(r, path_item, rel, full)) != DRIFT_OK) {

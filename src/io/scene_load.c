@@ -1,5 +1,5 @@
-// Scene loading entry point: dispatch by extension, whole-file reads (gunzipped with zlib),
-// the texture cache, and the camera and light a bare mesh file is given.
+// Scene loading entry point: the registry's loader for the path (scene_formats.c), whole-file reads
+// (gunzipped with zlib), the texture cache, and the camera and light a bare mesh file is given.
 #include "drift/file.h"
 #include "drift/image_io.h"
 #include "drift/scene_io.h"
@@ -334,12 +334,6 @@ static drift_result add_default_lights(drift_scene *scene, const char *path)
     return DRIFT_OK;
 }
 
-bool drift__is_mesh_extension(const char *ext)
-{
-    return strcmp(ext, "obj") == 0 || strcmp(ext, "gltf") == 0 || strcmp(ext, "glb") == 0 ||
-           strcmp(ext, "ply") == 0;
-}
-
 static drift_result load_mesh_scene(drift_context *ctx, const char *path, const char *camera,
                                     drift_scene_input_fn on_input, void *user,
                                     drift_scene **out_scene)
@@ -377,6 +371,14 @@ static drift_result load_mesh_scene(drift_context *ctx, const char *path, const 
     }
     *out_scene = scene;
     return DRIFT_OK;
+}
+
+drift_result drift__scene_load_mesh_file(drift_context *ctx, const char *path, bool gz,
+                                         drift_scene_input_fn on_input, void *user,
+                                         drift_scene **out_scene)
+{
+    (void)gz; // the importer looks at the name itself
+    return load_mesh_scene(ctx, path, NULL, on_input, user, out_scene);
 }
 
 static void dirname_of(const char *path, char *out, size_t out_size)
@@ -441,34 +443,37 @@ drift_result drift_scene_load_inputs(drift_context *ctx, const char *path,
                   "scene path is longer than %d bytes", DRIFT__PATH_MAX - 1);
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
-    char ext[16];
     bool gz = false;
-    drift__path_extension(path, ext, sizeof(ext), &gz);
-    if (strcmp(ext, "json") == 0) {
-        char *text = NULL;
-        size_t size = 0;
-        drift_result r = drift__read_file(ctx, path, gz, path, 0, &text, &size);
-        if (r != DRIFT_OK) {
-            return r;
-        }
-        if (on_input) {
-            on_input(path, user);
-        }
-        char base_dir[DRIFT__PATH_MAX];
-        dirname_of(path, base_dir, sizeof(base_dir));
-        r = drift__scene_load_json_text(ctx, text, size, base_dir, path, on_input, user, out_scene);
-        drift_free(ctx, text);
+    drift__scene_load_fn load = drift__scene_loader_of(path, &gz);
+    if (!load) {
+        char ext[16];
+        drift__path_extension(path, ext, sizeof(ext), &gz);
+        char formats[256];
+        drift__scene_formats_text(formats, sizeof formats, false);
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_UNSUPPORTED, path, 0,
+                  "unsupported scene file extension '%s%s' (drift reads %s)", ext, gz ? ".gz" : "",
+                  formats);
+        return DRIFT_ERR_UNSUPPORTED;
+    }
+    return load(ctx, path, gz, on_input, user, out_scene);
+}
+
+drift_result drift__scene_load_json_file(drift_context *ctx, const char *path, bool gz,
+                                         drift_scene_input_fn on_input, void *user,
+                                         drift_scene **out_scene)
+{
+    char *text = NULL;
+    size_t size = 0;
+    drift_result r = drift__read_file(ctx, path, gz, path, 0, &text, &size);
+    if (r != DRIFT_OK) {
         return r;
     }
-    if (drift__is_mesh_extension(ext)) {
-        return load_mesh_scene(ctx, path, NULL, on_input, user, out_scene);
+    if (on_input) {
+        on_input(path, user);
     }
-    if (strcmp(ext, "xml") == 0 && !gz) {
-        return drift__scene_load_mitsuba(ctx, path, on_input, user, out_scene);
-    }
-    drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_UNSUPPORTED, path, 0,
-              "unsupported scene file extension '%s' (drift reads .json, .obj, .gltf, .glb, "
-              ".ply, those with .gz, and Mitsuba .xml)",
-              ext);
-    return DRIFT_ERR_UNSUPPORTED;
+    char base_dir[DRIFT__PATH_MAX];
+    dirname_of(path, base_dir, sizeof(base_dir));
+    r = drift__scene_load_json_text(ctx, text, size, base_dir, path, on_input, user, out_scene);
+    drift_free(ctx, text);
+    return r;
 }

@@ -103,3 +103,14 @@ void drift_ism_indirect_planes(const drift_frame_state *f, drift_pass_plane_fn a
         }
     }
 }
+
+const drift_ism *drift_ism_pass_object(const drift_frame_state *f)
+{
+    if (f->params.indirect != DRIFT_INDIRECT_ISM && f->params.indirect != DRIFT_INDIRECT_IR) {
+        return NULL; // the slot is another technique's
+    }
+    const drift_pass_args args = { .effect = DRIFT_EFFECT_INDIRECT,
+                                   .technique = f->params.indirect };
+    const ism_pass_state *s = drift_pass_state(f, &args);
+    return s ? s->ism : NULL;
+}

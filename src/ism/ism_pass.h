@@ -12,4 +12,9 @@ const char *drift_ism_settings_problem(const drift_ism_settings *settings);
 // The ism.irradiance and ism.vpls planes of the last render.
 void drift_ism_indirect_planes(const drift_frame_state *frame, drift_pass_plane_fn add, void *sink);
 
+// The indirect row's drift_ism, or NULL when the chosen row is neither ism nor ir or has not
+// run (the family's report reads its stats).
+struct drift_ism;
+const struct drift_ism *drift_ism_pass_object(const drift_frame_state *frame);
+
 #endif // DRIFT_ISM_PASS_H

@@ -109,3 +109,15 @@ void drift_micro_reflection_planes(const drift_frame_state *f, drift_pass_plane_
 {
     planes(f, DRIFT_EFFECT_REFLECTIONS, "glossy_", add, sink);
 }
+
+const drift_micro *drift_micro_pass_object(const drift_frame_state *f, drift_effect effect)
+{
+    if (!(effect == DRIFT_EFFECT_INDIRECT && f->params.indirect == DRIFT_INDIRECT_MICRO) &&
+        !(effect == DRIFT_EFFECT_REFLECTIONS && f->params.reflections == DRIFT_REFLECTIONS_MICRO)) {
+        return NULL; // the slot is another technique's
+    }
+    const drift_pass_args args = { .effect = effect,
+                                   .technique = drift_hybrid_params_technique(&f->params, effect) };
+    const micro_pass_state *s = drift_pass_state(f, &args);
+    return s ? s->micro : NULL;
+}

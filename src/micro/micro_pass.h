@@ -14,4 +14,10 @@ void drift_micro_indirect_planes(const drift_frame_state *frame, drift_pass_plan
 void drift_micro_reflection_planes(const drift_frame_state *frame, drift_pass_plane_fn add,
                                    void *sink);
 
+// The effect's drift_micro (indirect or reflections), or NULL when its chosen row is not
+// micro-rendering or has not run (the family's report reads its stats).
+struct drift_micro;
+const struct drift_micro *drift_micro_pass_object(const drift_frame_state *frame,
+                                                  drift_effect effect);
+
 #endif // DRIFT_MICRO_PASS_H

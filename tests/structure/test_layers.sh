@@ -49,5 +49,44 @@ for file in "$root"/src/*/knobs.c; do
   grep -q '^#include "frame/knob_rows.h"' "$file" \
     || { echo "layers: ${file#$root/} does not declare its rows with frame/knob_rows.h"; bad=1; }
 done
+# The technique families (frame/family.h): the conductor (src/hybrid) includes no technique
+# folder's header; it reaches a family's settings, inputs, caches and counts only through the
+# hooks of the family list (src/hybrid/families.c). Each listed family defines its hooks in
+# its own folder's family.c, and each family.c is listed.
+listed=$(grep -o '&drift_[a-z_]*_family' "$root/src/hybrid/families.c" | sed 's/^&drift_//; s/_family$//' || true)
+listed=$(echo $listed)
+[ -n "$listed" ] || { echo "layers: src/hybrid/families.c lists no family"; bad=1; }
+technique_dirs=$(echo $listed | tr ' ' '|')
+for file in "$root"/src/hybrid/*.[ch]; do
+  [ -e "$file" ] || continue
+  while IFS= read -r line; do
+    echo "layers: ${file#$root/} (the conductor) includes $line: reach the family through its hooks"
+    bad=1
+  done < <(grep -E "^#include \"(${technique_dirs})/" "$file" || true)
+done
+for name in $listed; do
+  file="$root/src/$name/family.c"
+  if [ ! -e "$file" ] || ! grep -q "^const drift_family drift_${name}_family = {" "$file"; then
+    echo "layers: family '$name' is listed in src/hybrid/families.c but src/$name/family.c does not define drift_${name}_family"
+    bad=1
+  fi
+done
+for file in "$root"/src/*/family.c; do
+  [ -e "$file" ] || continue
+  name=$(basename "$(dirname "$file")")
+  [ "$name" = frame ] && continue # the hooks' own helpers
+  echo " $listed " | grep -q " $name " \
+    || { echo "layers: ${file#$root/} is not listed in src/hybrid/families.c"; bad=1; }
+done
+# The scene loaders: drift_scene_load reaches a format's loader only through the registry
+# (src/io/scene_formats.c); no other file calls a load function of the registry's rows.
+for fn in drift__scene_load_json_file drift__scene_load_mesh_file drift__scene_load_mitsuba; do
+  while IFS= read -r hit; do
+    echo "layers: $hit calls $fn outside the loaders' registry (src/io/scene_formats.c)"
+    bad=1
+  done < <(cd "$root" && grep -n "\b$fn(" src/*/*.c tools/*.c 2>/dev/null \
+             | grep -v '^src/io/scene_formats.c:' | grep -v ":drift_result $fn(" \
+             | cut -d: -f1,2 || true)
+done
 [ "$bad" -eq 0 ] && echo "layers: $checked private includes, every one points down or within its folder"
 exit "$bad"

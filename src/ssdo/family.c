@@ -1,0 +1,20 @@
+// Screen-space occlusion's hooks (frame/family.h): contact shadows after a shadow-map row
+// (--contact-shadows: the maps' bias, fixed in screen space). Its per-frame buffers live in
+// the occlusion effect's state slot (ssdo_pass.c).
+#include "frame/family.h"
+
+#include "ssdo/ssdo_pass.h"
+
+static drift_result after_row(drift_frame_state *f, const drift_family_row *row)
+{
+    if (row->args->effect == DRIFT_EFFECT_SHADOWS && (row->inputs & DRIFT_INPUT_SHADOW_MAPS) &&
+        f->params.shadow_map.contact_shadows) {
+        return drift_ssdo_pass_contact_shadows(f);
+    }
+    return DRIFT_OK;
+}
+
+const drift_family drift_ssdo_family = {
+    .name = "ssdo",
+    .after_row = after_row,
+};
