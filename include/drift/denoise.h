@@ -122,12 +122,13 @@ typedef enum drift_denoise_method {
 
 typedef struct drift_denoise_feature_params {
     drift_denoise_method method;
-    int32_t iterations;    // 0 -> 5 (variance-guided passes); at most 10
-    float sigma_luminance; // 0 -> 4 (SVGF's sigma_l)
-    float sigma_normal;    // 0 -> 128
-    float sigma_depth;     // 0 -> 0.1
-    float sigma_albedo;    // 0 -> 1
-    bool no_firefly_clamp; // true: skip stage 3
+    int32_t iterations;             // 0 -> 5 (variance-guided passes); at most 10
+    float sigma_luminance;          // 0 -> 4 (SVGF's sigma_l)
+    float sigma_luminance_indirect; // 0 -> 8: sigma_l of the rest when the direct part is apart
+    float sigma_normal;             // 0 -> 128
+    float sigma_depth;              // 0 -> 0.1
+    float sigma_albedo;             // 0 -> 1
+    bool no_firefly_clamp;          // true: skip stage 3
 } drift_denoise_feature_params;
 
 drift_denoise_feature_params
@@ -139,6 +140,12 @@ drift_denoise_feature_params_resolve(const drift_denoise_feature_params *params)
 typedef struct drift_denoise_inputs {
     const drift_image *color, *albedo, *normal, *depth, *variance;
     uint32_t sample_count; // samples per pixel behind color (0 is taken as 1)
+    // Optional, all three or none: color's direct part (RGB, DRIFT_PT_AOV_DIRECT) and the
+    // variances of the direct part's and of the rest's mean luminance. With them the direct
+    // part and the rest (color - direct) are filtered apart, each by its own variance, and
+    // summed (SVGF §4): sharp shadows of the little-noisy direct light are not blurred by the
+    // noise of the indirect.
+    const drift_image *direct, *direct_variance, *indirect_variance;
 } drift_denoise_inputs;
 
 typedef struct drift_denoise_report {
