@@ -346,8 +346,10 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
         if (feature_open && !drift_bsdf_is_delta(&bsdf)) {
             // An emitter's own light counts as albedo (the denoiser's irradiance there is ~1,
             // so that a small light is no outlier to its neighbours).
-            const drift_material *m = &scene->materials[surf.material];
-            drift_vec3 a = drift_vec3_add(drift_vec3_add(m->diffuse, m->specular), surf.emission);
+            // The BSDF's reflectances: the diffuse texture's texel, not the material's factor,
+            // so that demodulation keeps texture detail.
+            drift_vec3 a =
+                drift_vec3_add(drift_vec3_add(bsdf.diffuse, bsdf.specular), surf.emission);
             out->feature_albedo = drift_vec3_mul(beta, a);
             out->feature_normal = surf.ns;
             out->feature_depth = path_length + hit.t;
