@@ -177,7 +177,14 @@ int main(int argc, char **argv)
             in.indirect_variance = &im[L_IVAR];
         }
         double t0 = drift_time_now();
-        drift_denoise_feature(ctx, &in, NULL, &out, NULL);
+        // SIGL1, SIGL, SIGLI, ITER: the params' sigma_luminance (one filter),
+        // sigma_luminance_direct, sigma_luminance_indirect, iterations.
+        drift_denoise_feature_params fp = { 0 };
+        fp.sigma_luminance = getenv("SIGL1") ? (float)atof(getenv("SIGL1")) : 0.0f;
+        fp.sigma_luminance_direct = getenv("SIGL") ? (float)atof(getenv("SIGL")) : 0.0f;
+        fp.sigma_luminance_indirect = getenv("SIGLI") ? (float)atof(getenv("SIGLI")) : 0.0f;
+        fp.iterations = getenv("ITER") ? atoi(getenv("ITER")) : 0;
+        drift_denoise_feature(ctx, &in, &fp, &out, NULL);
         double ms = 1e3 * (drift_time_now() - t0);
         double fo = flip(ctx, &ref, &out);
         if (getenv("SAVE")) { // SAVE=DIR: the denoised and raw images as DIR/NAME-on.exr, -raw.exr

@@ -15,6 +15,9 @@ drift_denoise_feature_params_resolve(const drift_denoise_feature_params *params)
     if (p.sigma_luminance == 0.0f) {
         p.sigma_luminance = 4.0f;
     }
+    if (p.sigma_luminance_direct == 0.0f) {
+        p.sigma_luminance_direct = 3.0f;
+    }
     if (p.sigma_luminance_indirect == 0.0f) {
         p.sigma_luminance_indirect = 8.0f;
     }
@@ -209,8 +212,9 @@ static drift_result denoise_one(drift_context *ctx, const drift_denoise_inputs *
         !same_size(c, in->albedo, 3) || !same_size(c, in->normal, 3) ||
         !same_size(c, in->depth, 1) || !same_size(c, in->variance, 1) ||
         (unsigned)p.method >= DRIFT_DENOISE_METHOD_COUNT || p.iterations < 1 || p.iterations > 10 ||
-        !(p.sigma_luminance > 0.0f) || !(p.sigma_luminance_indirect > 0.0f) ||
-        !(p.sigma_normal > 0.0f) || !(p.sigma_depth > 0.0f) || !(p.sigma_albedo > 0.0f)) {
+        !(p.sigma_luminance > 0.0f) || !(p.sigma_luminance_direct > 0.0f) ||
+        !(p.sigma_luminance_indirect > 0.0f) || !(p.sigma_normal > 0.0f) ||
+        !(p.sigma_depth > 0.0f) || !(p.sigma_albedo > 0.0f)) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, NULL, 0,
                   "denoise: the colour must be RGB, every guide of its size and the params in "
                   "range (iterations 1..10, sigmas > 0)");
@@ -336,7 +340,9 @@ drift_result drift_denoise_feature(drift_context *ctx, const drift_denoise_input
     if (r == DRIFT_OK) {
         part.color = in->direct;
         part.variance = in->direct_variance;
-        r = denoise_one(ctx, &part, params, &direct_out, &rep_direct);
+        drift_denoise_feature_params pd = drift_denoise_feature_params_resolve(params);
+        pd.sigma_luminance = pd.sigma_luminance_direct;
+        r = denoise_one(ctx, &part, &pd, &direct_out, &rep_direct);
     }
     if (r == DRIFT_OK) {
         for (int32_t y = 0; y < c->height; ++y) {
