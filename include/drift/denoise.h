@@ -110,10 +110,13 @@ drift_result drift_denoise_atrous(drift_context *ctx, const drift_image *color,
 //        irradiance is fitted per channel by least squares (ridge 1e-3) to the features
 //        1, normal, depth, depth^2, x, y, x^2, y^2 (scaled to [-1, 1] in the block)
 //   6. remodulate: times the albedo divisor again; clamped to >= 0
-// VARIANCE_GUIDED is the default: never worse than the raw image on the five scenes measured
-// at 1, 4 and 16 spp, where REGRESSION (without BMFR's temporal part) is worse at 16 spp
-// (docs/lab/2026-12-07-issue-48.md). Every output pixel is a gather (or a block fit) over
-// the previous stage alone: bit-identical for any thread count.
+// With the direct part given (drift_denoise_inputs.direct), stages 1-6 run on the direct part
+// (sigma_luminance_direct) and on the rest (sigma_luminance_indirect) apart, and the two are
+// summed. VARIANCE_GUIDED is the default: with the direct part apart never worse than the raw
+// image on the 17 corpus scenes at 1, 4 and 16 spp, where REGRESSION (without BMFR's temporal
+// part) is worse at 16 spp on most (docs/lab/2026-12-07-issue-48-s2.md). Every output pixel
+// is a gather (or a block fit) over the previous stage alone: bit-identical for any thread
+// count.
 typedef enum drift_denoise_method {
     DRIFT_DENOISE_VARIANCE_GUIDED = 0,
     DRIFT_DENOISE_REGRESSION,
