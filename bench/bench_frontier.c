@@ -283,8 +283,13 @@ drift_result frontier_pt_rows(frontier_state *b, long spp, double *out_ms)
         r = r ? r : drift_pt_resolve(pt, DRIFT_PT_AOV_FEATURE_ALBEDO, &f_albedo);
         r = r ? r : drift_pt_resolve(pt, DRIFT_PT_AOV_FEATURE_NORMAL, &f_normal);
         r = r ? r : drift_pt_resolve(pt, DRIFT_PT_AOV_FEATURE_DEPTH, &f_depth);
+        drift_image direct, direct_var, indirect_var;
+        r = r ? r : drift_pt_resolve(pt, DRIFT_PT_AOV_DIRECT, &direct);
+        r = r ? r : drift_pt_resolve(pt, DRIFT_PT_AOV_DIRECT_VARIANCE, &direct_var);
+        r = r ? r : drift_pt_resolve(pt, DRIFT_PT_AOV_INDIRECT_VARIANCE, &indirect_var);
         drift_image_destroy(b->ctx, &featured);
-        drift_denoise_inputs in = { &beauty, &f_albedo, &f_normal, &f_depth, &var, (uint32_t)spp };
+        drift_denoise_inputs in = { &beauty,       &f_albedo, &f_normal,   &f_depth,     &var,
+                                    (uint32_t)spp, &direct,   &direct_var, &indirect_var };
         t0 = drift_time_now();
         r = r ? r : drift_denoise_feature(b->ctx, &in, NULL, &featured, NULL);
         feature_ms[k] = (drift_time_now() - t0) * 1e3;

@@ -467,12 +467,16 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
     }
     drift_image denoised = { 0 }, glared = { 0 }, spp = { 0 };
     drift_image variance = { 0 }, f_albedo = { 0 }, f_normal = { 0 }, f_depth = { 0 };
+    drift_image direct = { 0 }, direct_var = { 0 }, indirect_var = { 0 };
     bool feature = o->denoise >= 2; // --denoise on|regression: drift_denoise_feature
     if (feature || o->aov) {        // the images stay the pt's until its next render call
         if ((r = drift_pt_resolve(pt, DRIFT_PT_AOV_VARIANCE, &variance)) != DRIFT_OK ||
             (r = drift_pt_resolve(pt, DRIFT_PT_AOV_FEATURE_ALBEDO, &f_albedo)) != DRIFT_OK ||
             (r = drift_pt_resolve(pt, DRIFT_PT_AOV_FEATURE_NORMAL, &f_normal)) != DRIFT_OK ||
-            (r = drift_pt_resolve(pt, DRIFT_PT_AOV_FEATURE_DEPTH, &f_depth)) != DRIFT_OK) {
+            (r = drift_pt_resolve(pt, DRIFT_PT_AOV_FEATURE_DEPTH, &f_depth)) != DRIFT_OK ||
+            (r = drift_pt_resolve(pt, DRIFT_PT_AOV_DIRECT, &direct)) != DRIFT_OK ||
+            (r = drift_pt_resolve(pt, DRIFT_PT_AOV_DIRECT_VARIANCE, &direct_var)) != DRIFT_OK ||
+            (r = drift_pt_resolve(pt, DRIFT_PT_AOV_INDIRECT_VARIANCE, &indirect_var)) != DRIFT_OK) {
             return r;
         }
     }
@@ -481,9 +485,8 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
         if (feature) {
             uint32_t lowest, highest;
             render_spp_range(pt, &lowest, &highest);
-            drift_denoise_inputs in = {
-                &beauty, &f_albedo, &f_normal, &f_depth, &variance, lowest
-            };
+            drift_denoise_inputs in = { &beauty, &f_albedo, &f_normal,   &f_depth,     &variance,
+                                        lowest,  &direct,   &direct_var, &indirect_var };
             drift_denoise_feature_params fp = { .method = o->denoise == 3
                                                               ? DRIFT_DENOISE_REGRESSION
                                                               : DRIFT_DENOISE_VARIANCE_GUIDED };
@@ -506,7 +509,7 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
         }
         beauty = glared; // the glare's copy, destroyed below
     }
-    drift_image_layer layers[9] = { { NULL, &beauty } };
+    drift_image_layer layers[12] = { { NULL, &beauty } };
     uint32_t layer_count = 1;
     if (o->aov) {
         if ((r = drift_pt_resolve(pt, DRIFT_PT_AOV_ALBEDO, &albedo)) != DRIFT_OK ||
@@ -525,7 +528,10 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
         layers[5] = (drift_image_layer){ "feature_albedo", &f_albedo };
         layers[6] = (drift_image_layer){ "feature_normal", &f_normal };
         layers[7] = (drift_image_layer){ "feature_depth", &f_depth };
-        layer_count = 8;
+        layers[8] = (drift_image_layer){ "direct", &direct };
+        layers[9] = (drift_image_layer){ "direct_variance", &direct_var };
+        layers[10] = (drift_image_layer){ "indirect_variance", &indirect_var };
+        layer_count = 11;
     }
     uint32_t lowest, highest;
     render_spp_range(pt, &lowest, &highest);
@@ -563,10 +569,10 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
     }
     if (r == DRIFT_OK) {
         // One entry a layer of the --aov file (then the spp layer): beauty, albedo, N, Z,
-        // variance, feature_albedo, feature_normal, feature_depth.
-        const char *const channels[9] = {
-            NULL, NULL, "X,Y,Z", "Z", NULL, NULL, "X,Y,Z", NULL, NULL
-        };
+        // variance, feature_albedo, feature_normal, feature_depth, direct, direct_variance,
+        // indirect_variance.
+        const char *const channels[12] = { NULL,    NULL, "X,Y,Z", "Z",  NULL, NULL,
+                                           "X,Y,Z", NULL, NULL,    NULL, NULL, NULL };
         r = drift_image_save_exr_channels(ctx, exr_path, layers, layer_count,
                                           o->aov ? channels : NULL, attributes, attribute_count);
     }

@@ -110,10 +110,13 @@ drift_result drift_denoise_atrous(drift_context *ctx, const drift_image *color,
 //        irradiance is fitted per channel by least squares (ridge 1e-3) to the features
 //        1, normal, depth, depth^2, x, y, x^2, y^2 (scaled to [-1, 1] in the block)
 //   6. remodulate: times the albedo divisor again; clamped to >= 0
-// VARIANCE_GUIDED is the default: never worse than the raw image on the five scenes measured
-// at 1, 4 and 16 spp, where REGRESSION (without BMFR's temporal part) is worse at 16 spp
-// (docs/lab/2026-12-07-issue-48.md). Every output pixel is a gather (or a block fit) over
-// the previous stage alone: bit-identical for any thread count.
+// With the direct part given (drift_denoise_inputs.direct), stages 1-6 run on the direct part
+// (sigma_luminance_direct) and on the rest (sigma_luminance_indirect) apart, and the two are
+// summed. VARIANCE_GUIDED is the default: with the direct part apart never worse than the raw
+// image on the 17 corpus scenes at 1, 4 and 16 spp, where REGRESSION (without BMFR's temporal
+// part) is worse at 16 spp on most (docs/lab/2026-12-07-issue-48-s2.md). Every output pixel
+// is a gather (or a block fit) over the previous stage alone: bit-identical for any thread
+// count.
 typedef enum drift_denoise_method {
     DRIFT_DENOISE_VARIANCE_GUIDED = 0,
     DRIFT_DENOISE_REGRESSION,
@@ -122,12 +125,14 @@ typedef enum drift_denoise_method {
 
 typedef struct drift_denoise_feature_params {
     drift_denoise_method method;
-    int32_t iterations;    // 0 -> 5 (variance-guided passes); at most 10
-    float sigma_luminance; // 0 -> 4 (SVGF's sigma_l)
-    float sigma_normal;    // 0 -> 128
-    float sigma_depth;     // 0 -> 0.1
-    float sigma_albedo;    // 0 -> 1
-    bool no_firefly_clamp; // true: skip stage 3
+    int32_t iterations;             // 0 -> 5 (variance-guided passes); at most 10
+    float sigma_luminance;          // 0 -> 4 (SVGF's sigma_l)
+    float sigma_luminance_direct;   // 0 -> 3: sigma_l of the direct part when it is apart
+    float sigma_luminance_indirect; // 0 -> 8: sigma_l of the rest when the direct part is apart
+    float sigma_normal;             // 0 -> 128
+    float sigma_depth;              // 0 -> 0.1
+    float sigma_albedo;             // 0 -> 1
+    bool no_firefly_clamp;          // true: skip stage 3
 } drift_denoise_feature_params;
 
 drift_denoise_feature_params
@@ -139,6 +144,12 @@ drift_denoise_feature_params_resolve(const drift_denoise_feature_params *params)
 typedef struct drift_denoise_inputs {
     const drift_image *color, *albedo, *normal, *depth, *variance;
     uint32_t sample_count; // samples per pixel behind color (0 is taken as 1)
+    // Optional, all three or none: color's direct part (RGB, DRIFT_PT_AOV_DIRECT) and the
+    // variances of the direct part's and of the rest's mean luminance. With them the direct
+    // part and the rest (color - direct) are filtered apart, each by its own variance, and
+    // summed (SVGF §4): sharp shadows of the little-noisy direct light are not blurred by the
+    // noise of the indirect.
+    const drift_image *direct, *direct_variance, *indirect_variance;
 } drift_denoise_inputs;
 
 typedef struct drift_denoise_report {

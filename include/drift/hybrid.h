@@ -223,6 +223,10 @@ typedef struct drift_occlusion_settings {
 //                      visibility's, which the colour weight would keep. A footprint of
 //                      2^(N+1) - 1 pixels; with environment_scale 2 the passes run over the
 //                      traced pixels alone, before the fill (2^(N+2) - 2 full pixels)
+//   environment_denoise = false: environment_filter is the a-trous filter above; true: its N
+//                      passes are the path tracer's variance-guided filter instead
+//                      (drift_denoise_feature: demodulated, fireflies clamped, the luminance
+//                      weight set by the spatial variance of light_samples rays a pixel)
 //   aa               = 0 -> 1: anti-aliasing passes. N > 1 renders the whole frame N times,
 //                      each pass with the camera's film shifted by a stratified sub-pixel
 //                      offset (the path tracer's box pixel filter) and its own seed, and
@@ -260,6 +264,7 @@ typedef struct drift_hybrid_params {
     bool environment_interleave;
     uint32_t environment_filter;
     uint32_t environment_scale;
+    bool environment_denoise;
     uint32_t aa;
     bool has_ambient;
     drift_vec3 ambient;

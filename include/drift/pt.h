@@ -111,12 +111,18 @@ typedef enum drift_pt_aov {
     DRIFT_PT_AOV_NORMAL,     // shading normal at the first hit, RGB in [-1, 1]
     DRIFT_PT_AOV_DEPTH,      // distance along the camera ray to the first hit, 1 channel (0 = miss)
     // The feature-guided denoiser's inputs (drift_denoise_feature, drift/denoise.h):
-    DRIFT_PT_AOV_VARIANCE,       // variance of the pixel's mean beauty luminance: the samples'
-                                 // unbiased variance over n (running moments; 0 below 2 samples)
-    DRIFT_PT_AOV_FEATURE_ALBEDO, // albedo at the first non-delta vertex (through mirrors and
-                                 // glass, times their throughput; plus its emission), RGB
-    DRIFT_PT_AOV_FEATURE_NORMAL, // shading normal there, RGB in [-1, 1]
-    DRIFT_PT_AOV_FEATURE_DEPTH,  // length of the path up to there, 1 channel (0 = escaped)
+    DRIFT_PT_AOV_VARIANCE,        // variance of the pixel's mean beauty luminance: the samples'
+                                  // unbiased variance over n (running moments; 0 below 2 samples)
+    DRIFT_PT_AOV_FEATURE_ALBEDO,  // albedo at the first non-delta vertex (through mirrors and
+                                  // glass, times their throughput; plus its emission), RGB
+    DRIFT_PT_AOV_FEATURE_NORMAL,  // shading normal there, RGB in [-1, 1]
+    DRIFT_PT_AOV_FEATURE_DEPTH,   // length of the path up to there, 1 channel (0 = escaped)
+    DRIFT_PT_AOV_DIRECT,          // the beauty's direct part, RGB: light that reached the camera
+                                  // after at most one non-delta bounce (emitters and the sky seen
+                                  // directly or through mirrors/glass, next-event estimation at the
+                                  // first non-delta vertex and its bounce's emitter hit)
+    DRIFT_PT_AOV_DIRECT_VARIANCE, // variance of the pixel's mean direct luminance, 1 channel
+    DRIFT_PT_AOV_INDIRECT_VARIANCE, // the same of the rest (beauty - direct), 1 channel
     DRIFT_PT_AOV_COUNT
 } drift_pt_aov;
 

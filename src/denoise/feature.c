@@ -15,6 +15,12 @@ drift_denoise_feature_params_resolve(const drift_denoise_feature_params *params)
     if (p.sigma_luminance == 0.0f) {
         p.sigma_luminance = 4.0f;
     }
+    if (p.sigma_luminance_direct == 0.0f) {
+        p.sigma_luminance_direct = 3.0f;
+    }
+    if (p.sigma_luminance_indirect == 0.0f) {
+        p.sigma_luminance_indirect = 8.0f;
+    }
     if (p.sigma_normal == 0.0f) {
         p.sigma_normal = 128.0f;
     }
@@ -189,9 +195,9 @@ static void frame_free(denoise_frame *f)
     drift_free(f->ctx, f->albedo_lum);
 }
 
-drift_result drift_denoise_feature(drift_context *ctx, const drift_denoise_inputs *in,
-                                   const drift_denoise_feature_params *params, drift_image *out,
-                                   drift_denoise_report *report)
+static drift_result denoise_one(drift_context *ctx, const drift_denoise_inputs *in,
+                                const drift_denoise_feature_params *params, drift_image *out,
+                                drift_denoise_report *report)
 {
     if (out) {
         *out = (drift_image){ 0 };
@@ -200,13 +206,15 @@ drift_result drift_denoise_feature(drift_context *ctx, const drift_denoise_input
         *report = (drift_denoise_report){ 0 };
     }
     drift_denoise_feature_params p = drift_denoise_feature_params_resolve(params);
+
     const drift_image *c = in ? in->color : NULL;
     if (!out || !c || !c->pixels || c->channels < 3 || c->width <= 0 || c->height <= 0 ||
         !same_size(c, in->albedo, 3) || !same_size(c, in->normal, 3) ||
         !same_size(c, in->depth, 1) || !same_size(c, in->variance, 1) ||
         (unsigned)p.method >= DRIFT_DENOISE_METHOD_COUNT || p.iterations < 1 || p.iterations > 10 ||
-        !(p.sigma_luminance > 0.0f) || !(p.sigma_normal > 0.0f) || !(p.sigma_depth > 0.0f) ||
-        !(p.sigma_albedo > 0.0f)) {
+        !(p.sigma_luminance > 0.0f) || !(p.sigma_luminance_direct > 0.0f) ||
+        !(p.sigma_luminance_indirect > 0.0f) || !(p.sigma_normal > 0.0f) ||
+        !(p.sigma_depth > 0.0f) || !(p.sigma_albedo > 0.0f)) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, NULL, 0,
                   "denoise: the colour must be RGB, every guide of its size and the params in "
                   "range (iterations 1..10, sigmas > 0)");
@@ -284,5 +292,77 @@ done:
     drift_free(ctx, scratch);
     drift_free(ctx, row_bad);
     drift_free(ctx, sums);
+    return r;
+}
+
+// With a direct part: the rest (colour - direct, at least 0) and the direct part filtered
+// apart, each with its own variance, and summed.
+drift_result drift_denoise_feature(drift_context *ctx, const drift_denoise_inputs *in,
+                                   const drift_denoise_feature_params *params, drift_image *out,
+                                   drift_denoise_report *report)
+{
+    if (!in || (!in->direct && !in->direct_variance && !in->indirect_variance)) {
+        return denoise_one(ctx, in, params, out, report);
+    }
+    if (out) {
+        *out = (drift_image){ 0 };
+    }
+    const drift_image *c = in->color;
+    if (!out || !c || !c->pixels || c->channels < 3 || !in->direct || !in->direct_variance ||
+        !in->indirect_variance || !same_size(c, in->direct, 3) ||
+        !same_size(c, in->direct_variance, 1) || !same_size(c, in->indirect_variance, 1)) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, NULL, 0,
+                  "denoise: the direct part needs both variances, all of the colour's size");
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    drift_image rest = { 0 }, direct_out = { 0 };
+    drift_result r = drift_image_create(ctx, c->width, c->height, 3, &rest);
+    for (int32_t y = 0; r == DRIFT_OK && y < c->height; ++y) {
+        for (int32_t x = 0; x < c->width; ++x) {
+            const float *a = drift_image_pixel(c, x, y), *d = drift_image_pixel(in->direct, x, y);
+            float *dst = drift_image_pixel(&rest, x, y);
+            for (int k = 0; k < 3; ++k) {
+                float v = a[k] - d[k]; // NaN stays NaN: counted by the filter
+                dst[k] = v < 0.0f ? 0.0f : v;
+            }
+        }
+    }
+    drift_denoise_inputs part = *in;
+    part.direct = part.direct_variance = part.indirect_variance = NULL;
+    drift_denoise_report rep_rest = { 0 }, rep_direct = { 0 };
+    if (r == DRIFT_OK) {
+        part.color = &rest;
+        part.variance = in->indirect_variance;
+        drift_denoise_feature_params pi = drift_denoise_feature_params_resolve(params);
+        pi.sigma_luminance = pi.sigma_luminance_indirect;
+        r = denoise_one(ctx, &part, &pi, out, &rep_rest);
+    }
+    if (r == DRIFT_OK) {
+        part.color = in->direct;
+        part.variance = in->direct_variance;
+        drift_denoise_feature_params pd = drift_denoise_feature_params_resolve(params);
+        pd.sigma_luminance = pd.sigma_luminance_direct;
+        r = denoise_one(ctx, &part, &pd, &direct_out, &rep_direct);
+    }
+    if (r == DRIFT_OK) {
+        for (int32_t y = 0; y < c->height; ++y) {
+            for (int32_t x = 0; x < c->width; ++x) {
+                float *dst = drift_image_pixel(out, x, y);
+                const float *d = drift_image_pixel(&direct_out, x, y);
+                for (int k = 0; k < 3; ++k) {
+                    dst[k] += d[k];
+                }
+            }
+        }
+        if (report) {
+            report->nonfinite = rep_rest.nonfinite + rep_direct.nonfinite;
+            report->clamped = rep_rest.clamped + rep_direct.clamped;
+            report->mean_variance = rep_rest.mean_variance + rep_direct.mean_variance;
+        }
+    } else {
+        drift_image_destroy(ctx, out);
+    }
+    drift_image_destroy(ctx, &rest);
+    drift_image_destroy(ctx, &direct_out);
     return r;
 }

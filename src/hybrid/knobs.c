@@ -33,6 +33,10 @@ static const drift_knob frame_rows[] = {
                        "passes of the edge-avoiding a-trous filter over the environment's\n"
                        "direct light, guided by the G-buffer (0: none; docs/hybrid.md)",
                        -1, NULL),
+    DRIFT_KNOB_CHOICE_ROW("env-denoise", environment_denoise, "off|on", 0,
+                          "on: --env-filter's passes are the path tracer's variance-guided\n"
+                          "filter (--denoise on's), not the guide-only a-trous (docs/denoiser.md)",
+                          -1, NULL),
 };
 DRIFT_KNOB_FAMILY(drift_frame_knobs, "the frame (docs/hybrid.md)", frame_rows);
 

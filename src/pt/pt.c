@@ -7,8 +7,9 @@
 #define TILE_SIZE DRIFT_PT_TILE_SIZE
 // Channels accumulated per pixel: beauty RGB, albedo RGB, normal XYZ, depth, then the
 // denoiser's inputs: the sum of the squared beauty luminance (the running second moment), and
-// albedo RGB, normal XYZ and depth at the first non-delta vertex (drift/pt.h).
-#define SUM_CHANNELS 18
+// albedo RGB, normal XYZ and depth at the first non-delta vertex (drift/pt.h), the direct
+// part RGB and the squared luminances of the direct part and of the rest.
+#define SUM_CHANNELS 23
 
 // Per-thread counters, padded to a cache line so threads do not share one.
 typedef struct thread_stats {
@@ -40,6 +41,7 @@ typedef struct path_result {
     drift_vec3 feature_albedo;
     drift_vec3 feature_normal;
     float feature_depth; // length of the path up to that vertex (0 = it escaped first)
+    drift_vec3 direct;   // the radiance's direct part (DRIFT_PT_AOV_DIRECT)
 } path_result;
 
 drift_pt_params drift_pt_params_resolve(const drift_pt_params *params, const drift_scene *scene)
@@ -282,6 +284,7 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
     float cone_spread = p->texture_point_sampling
                             ? 0.0f
                             : spp_scale * 2.0f * pt->camera.tan_half / (float)pt->camera.height;
+    int bounces = 0; // non-delta bounces so far: light found after at most one is direct
     stats->camera_rays++;
 
     for (int32_t depth = 0;; ++depth) {
@@ -295,6 +298,9 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
                 drift_vec3 c = drift_vec3_scale(drift_vec3_mul(beta, le), w);
                 radiance = drift_vec3_add(radiance, c);
                 split_add(&split, depth, true, c);
+                if (bounces <= 1) {
+                    out->direct = drift_vec3_add(out->direct, c);
+                }
                 if (depth == 0) {
                     out->albedo = le;
                 }
@@ -331,6 +337,9 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
             drift_vec3 c = drift_vec3_scale(drift_vec3_mul(beta, surf.emission), w);
             radiance = drift_vec3_add(radiance, c);
             split_add(&split, depth, true, c);
+            if (bounces <= 1) {
+                out->direct = drift_vec3_add(out->direct, c);
+            }
         }
         if (feature_open && (surf.material == DRIFT_INVALID_INDEX || depth >= p->max_depth)) {
             out->feature_albedo =
@@ -351,8 +360,10 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
         if (feature_open && !drift_bsdf_is_delta(&bsdf)) {
             // An emitter's own light counts as albedo (the denoiser's irradiance there is ~1,
             // so that a small light is no outlier to its neighbours).
-            const drift_material *m = &scene->materials[surf.material];
-            drift_vec3 a = drift_vec3_add(drift_vec3_add(m->diffuse, m->specular), surf.emission);
+            // The BSDF's reflectances: the diffuse texture's texel, not the material's factor,
+            // so that demodulation keeps texture detail.
+            drift_vec3 a =
+                drift_vec3_add(drift_vec3_add(bsdf.diffuse, bsdf.specular), surf.emission);
             out->feature_albedo = drift_vec3_mul(beta, a);
             out->feature_normal = surf.ns;
             out->feature_depth = path_length + hit.t;
@@ -365,6 +376,9 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
             drift_vec3 c = drift_vec3_mul(beta, ld);
             radiance = drift_vec3_add(radiance, c);
             split_add(&split, depth, false, c);
+            if (bounces == 0) {
+                out->direct = drift_vec3_add(out->direct, c);
+            }
         } else {
             (void)drift_sampler_next2(&sampler); // keep the dimension layout fixed
         }
@@ -388,6 +402,7 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
             cone_spread =
                 fmaxf(cone_spread, fminf(2.0f / sqrtf(DRIFT_PI * bs.pdf), DRIFT_PI / 2.0f));
         }
+        bounces += bs.is_delta ? 0 : 1;
         prev_specular = bs.is_delta;
         prev_bsdf_pdf = bs.pdf;
         prev_position = surf.position;
@@ -407,6 +422,9 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
         stats->bounce_rays++;
     }
     out->radiance = split.active ? split_select(&split, p->components) : radiance;
+    if (split.active) {
+        out->direct = drift_vec3_splat(0.0f); // a component render: all of it is "the rest"
+    }
 }
 
 drift_vec3 drift_pt_trace_sample(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample)
@@ -473,8 +491,13 @@ static void render_tiles(size_t begin, size_t end, int thread_index, void *user)
                     if (!drift_vec3_is_finite(r.radiance)) {
                         stats->nan_samples++;
                         r.radiance = drift_vec3_splat(0.0f);
+                        r.direct = r.radiance;
+                    }
+                    if (!drift_vec3_is_finite(r.direct)) {
+                        r.direct = drift_vec3_splat(0.0f);
                     }
                     float lum = drift_luminance(r.radiance);
+                    float lum_direct = drift_luminance(r.direct), lum_rest = lum - lum_direct;
                     const float v[SUM_CHANNELS] = { r.radiance.x,       r.radiance.y,
                                                     r.radiance.z,       r.albedo.x,
                                                     r.albedo.y,         r.albedo.z,
@@ -483,7 +506,10 @@ static void render_tiles(size_t begin, size_t end, int thread_index, void *user)
                                                     lum * lum,          r.feature_albedo.x,
                                                     r.feature_albedo.y, r.feature_albedo.z,
                                                     r.feature_normal.x, r.feature_normal.y,
-                                                    r.feature_normal.z, r.feature_depth };
+                                                    r.feature_normal.z, r.feature_depth,
+                                                    r.direct.x,         r.direct.y,
+                                                    r.direct.z,         lum_direct * lum_direct,
+                                                    lum_rest * lum_rest };
                     for (int c = 0; c < SUM_CHANNELS; ++c) {
                         sum[c] += (double)v[c];
                     }
@@ -609,8 +635,8 @@ drift_result drift_pt_resolve(drift_pt *pt, drift_pt_aov aov, drift_image *out_i
     if (!pt || !out_image || (unsigned)aov >= DRIFT_PT_AOV_COUNT) {
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
-    static const int first_channel[DRIFT_PT_AOV_COUNT] = { 0, 3, 6, 9, 10, 11, 14, 17 };
-    static const int channel_count[DRIFT_PT_AOV_COUNT] = { 3, 3, 3, 1, 1, 3, 3, 1 };
+    static const int first_channel[DRIFT_PT_AOV_COUNT] = { 0, 3, 6, 9, 10, 11, 14, 17, 18, 21, 22 };
+    static const int channel_count[DRIFT_PT_AOV_COUNT] = { 3, 3, 3, 1, 1, 3, 3, 1, 3, 1, 1 };
     drift_image *img = &pt->resolved[aov];
     if (!img->pixels) {
         drift_result r = drift_image_create(pt->ctx, pt->params.width, pt->params.height,
@@ -625,11 +651,17 @@ drift_result drift_pt_resolve(drift_pt *pt, drift_pt_aov aov, drift_image *out_i
             uint32_t n = pt->counts[pixel];
             const double *sum = pt->sums + pixel * SUM_CHANNELS + first_channel[aov];
             float *dst = drift_image_pixel(img, x, y);
-            if (aov == DRIFT_PT_AOV_VARIANCE) {
+            if (aov == DRIFT_PT_AOV_VARIANCE || aov == DRIFT_PT_AOV_DIRECT_VARIANCE ||
+                aov == DRIFT_PT_AOV_INDIRECT_VARIANCE) {
                 // The unbiased sample variance of the luminance over n, the variance of the
                 // pixel's mean; 0 below two samples.
                 const double *beauty = pt->sums + pixel * SUM_CHANNELS;
-                double mean = (0.2126 * beauty[0] + 0.7152 * beauty[1] + 0.0722 * beauty[2]) /
+                const double *direct = beauty + first_channel[DRIFT_PT_AOV_DIRECT];
+                double lb = 0.2126 * beauty[0] + 0.7152 * beauty[1] + 0.0722 * beauty[2];
+                double ld = 0.2126 * direct[0] + 0.7152 * direct[1] + 0.0722 * direct[2];
+                double mean = (aov == DRIFT_PT_AOV_VARIANCE          ? lb
+                               : aov == DRIFT_PT_AOV_DIRECT_VARIANCE ? ld
+                                                                     : lb - ld) /
                               (double)(n ? n : 1);
                 double var = n > 1 ? (sum[0] - (double)n * mean * mean) / (double)(n - 1) : 0.0;
                 dst[0] = var > 0.0 ? (float)(var / (double)n) : 0.0f;

@@ -429,6 +429,21 @@ static void fill_sparse_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64
 // of the work), copied out with their albedo, normal and depth, before the fill carries them
 // to the rest: the same passes reach twice as far in full pixels, and the other three pixels
 // only ever read filtered light.
+// --env-denoise on: the path tracer's variance-guided filter over the same inputs. Its
+// variance is the spatial one (stage 4: no per-pixel moments are kept for the shadow rays),
+// over the light_samples rays of a pixel.
+static drift_result denoise_environment(drift_frame_state *f, const drift_image *in[4],
+                                        drift_image *out)
+{
+    const uint32_t rays = f->params.light_samples; // (interleaved: gathered back to a set)
+    const drift_denoise_inputs inputs = {
+        .color = in[0], .albedo = in[1], .normal = in[2], .depth = in[3], .sample_count = rays
+    };
+    const drift_denoise_feature_params params = { .iterations =
+                                                      (int32_t)f->params.environment_filter };
+    return drift_denoise_feature(f->ctx, &inputs, &params, out, NULL);
+}
+
 static drift_result filter_environment(drift_frame_state *f, int32_t step)
 {
     double t = drift_time_now();
@@ -455,7 +470,9 @@ static drift_result filter_environment(drift_frame_state *f, int32_t step)
                                     .disable_color = true,
                                     .small_kernel = true };
     drift_image filtered = { 0 };
-    if (r == DRIFT_OK) {
+    if (r == DRIFT_OK && f->params.environment_denoise) {
+        r = denoise_environment(f, in, &filtered);
+    } else if (r == DRIFT_OK) {
         r = drift_denoise_atrous(f->ctx, in[0], in[1], in[2], in[3], &params, &filtered);
     }
     if (r == DRIFT_OK && step == 1) { // the plane's struct is what the frame's planes point at

@@ -114,7 +114,7 @@ d = json.load(open(sys.argv[1]))
 assert d["nonfinite"] == 0 and d["relmse"] < 0.25, d
 PY
 # --aov writes the feature denoiser's inputs as layers.
-for layer in variance feature_albedo feature_normal feature_depth; do
+for layer in variance feature_albedo feature_normal feature_depth direct direct_variance indirect_variance; do
     grep -aq "$layer" "$tmp/a.exr" || fail "--aov lacks the $layer layer"
 done
 expect 2 "$drift" render --denoise oidn --out "$tmp/never.exr"
