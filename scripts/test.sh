@@ -20,11 +20,29 @@ fi
 t_start=$(date +%s)
 t_phase=$t_start
 phases=""
-phase() { # phase NAME: ends the previous phase, names the next
-  local now
+times_file=$(mktemp)
+trap 'rm -f "$times_file"' EXIT
+# cpu_ms: sets cpu_now to the CPU time (user + sys, ms) of every finished child of this shell
+# so far: the second line of the `times` builtin (run here, not in a $(...) subshell, whose
+# children it would count instead).
+cpu_ms() {
+  times >"$times_file"
+  cpu_now=$(awk 'NR == 2 { t = 0; for (i = 1; i <= 2; ++i) { split($i, a, /[ms]/); t += a[1] * 60 + a[2] }
+                 printf "%d\n", t * 1000 }' "$times_file")
+}
+cpu_ms
+cpu_phase=$cpu_now
+cpu_start=$cpu_now
+phase() { # phase NAME: ends the previous phase (its wall time and CPU time), names the next
+  local now cpu
   now=$(date +%s)
-  [ -n "${current:-}" ] && phases="$phases  $current $((now - t_phase)) s\n"
+  cpu_ms
+  cpu=$cpu_now
+  [ -n "${current:-}" ] &&
+    phases="$phases$(printf '%6d s wall %7.1f CPU-s  %s' $((now - t_phase)) \
+      "$(((cpu - cpu_phase) / 1000)).$((((cpu - cpu_phase) % 1000) / 100))" "$current")\n"
   t_phase=$now
+  cpu_phase=$cpu
   current="$1"
   echo "== $1"
 }
@@ -55,6 +73,7 @@ CC=clang CXX=clang++ cmake -S . -B build/fuzz -DCMAKE_BUILD_TYPE=Debug -DDRIFT_B
   -DDRIFT_BUILD_TESTS=OFF -DDRIFT_SANITIZE=address,undefined -DDRIFT_WERROR=ON \
   "${launcher[@]}" >/dev/null
 cmake --build build/fuzz -j"$jobs"
+# shellcheck disable=SC2317 # run by xargs through export -f
 fuzz_one() {
   local fuzzer=$1 name corpus work
   name=$(basename "$fuzzer")
@@ -100,6 +119,9 @@ status=0
 phase "end"
 echo "== the ten slowest tests (ctest's last run)"
 bash scripts/slowest-tests.sh build/dev 10 || true
-printf "== time by phase\n%b" "$phases"
-echo "test.sh: $(($(date +%s) - t_start)) s in all (apt excluded), exit $status"
+printf "== time by phase (CPU-s: user + sys of everything the phase ran; on 2 idle cores a
+   phase takes at least CPU-s / 2)\n%b" "$phases"
+cpu_ms
+cpu_all=$((cpu_now - cpu_start))
+echo "test.sh: $(($(date +%s) - t_start)) s in all (apt excluded), $((cpu_all / 1000)) CPU-s, exit $status"
 exit "$status"
