@@ -8,11 +8,15 @@ A page asks for a block with a marker line and gets its body between that line a
   <!-- generated: knobs FAMILY[,FAMILY...] -->   the knob table's rows of those families
                                                  (the `<a id="FAMILY">` sections of
                                                  `drift --knobs-markdown`)
+  <!-- generated: options COMMAND REGEX -->      the option-table rows of `drift COMMAND`
+                                                 (docs/reference/cli.md) whose option matches
+                                                 REGEX: a technique that is an option, not a
+                                                 knob family (glare, SIR, temporal reuse, ...)
   <!-- generated: frontier REGEX -->             per scene of the bench JSON, the hybrid row
                                                  of least FLIP whose name matches REGEX, and
                                                  the best path-tracer row at most as slow
 
-usage: gen-technique-blocks.py KNOBS_MD FRONTIER_JSONL DOCS_DIR OUT_DIR
+usage: gen-technique-blocks.py KNOBS_MD CLI_MD FRONTIER_JSONL DOCS_DIR OUT_DIR
 Pages with blocks are written to OUT_DIR (DOCS_DIR itself to update them in place).
 Run by scripts/gen-reference.sh; tests/cli/test_reference_docs.sh fails while a page is stale.
 """
@@ -21,7 +25,7 @@ import os
 import re
 import sys
 
-MARK = re.compile(r"^<!-- generated: (knobs|frontier) (.+?) -->$")
+MARK = re.compile(r"^<!-- generated: (knobs|options|frontier) (.+?) -->$")
 END = "<!-- end generated -->"
 PT_FAMILIES = ("pt", "pt+atrous", "pt+denoise", "pt-low", "pt-low+atrous")
 
@@ -58,6 +62,38 @@ def knobs_block(arg, sections, source):
         "[knob reference](reference/knobs.md)."
     )
     return out
+
+
+def command_rows(cli_md):
+    """{command: [option-table rows]} of `drift --help-markdown` (the `## drift COMMAND` sections)"""
+    commands, current = {}, None
+    for line in open(cli_md, encoding="utf-8"):
+        line = line.rstrip("\n")
+        if line.startswith("## drift"):
+            current = line[len("## drift"):].strip() or "drift"
+            commands[current] = []
+        elif current and line.startswith("| `--"):
+            commands[current].append(line)
+    return commands
+
+
+def options_block(arg, commands, source):
+    command, _, regex = arg.partition(" ")
+    if command not in commands:
+        sys.exit(f"{source}: no command 'drift {command}' in the CLI reference")
+    pattern = re.compile(regex)
+    rows = [r for r in commands[command] if pattern.search(r.split("`")[1])]
+    if not rows:
+        sys.exit(f"{source}: no option of drift {command} matches /{regex}/")
+    return (
+        ["| option | argument | description |", "|---|---|---|"]
+        + rows
+        + [
+            "",
+            f"Generated from the option table of `drift {command}` (`--help`); all its options "
+            f"are in the [command-line reference](reference/cli.md#drift-{command.replace(' ', '-')}).",
+        ]
+    )
 
 
 def frontier_block(arg, runs, rows_path, source):
@@ -98,8 +134,9 @@ def frontier_block(arg, runs, rows_path, source):
 
 
 def main():
-    knobs_md, rows_path, docs, out_dir = sys.argv[1:5]
+    knobs_md, cli_md, rows_path, docs, out_dir = sys.argv[1:6]
     sections = knob_sections(knobs_md)
+    commands = command_rows(cli_md)
     runs = [json.loads(l) for l in open(rows_path, encoding="utf-8") if l.strip()]
     rows_name = os.path.relpath(rows_path, os.path.dirname(os.path.abspath(docs)))
     os.makedirs(out_dir, exist_ok=True)
@@ -125,6 +162,8 @@ def main():
             source = f"{path}:{i}"
             if m.group(1) == "knobs":
                 result += knobs_block(m.group(2), sections, source)
+            elif m.group(1) == "options":
+                result += options_block(m.group(2), commands, source)
             else:
                 result += frontier_block(m.group(2), runs, rows_name, source)
             result.append(END)
