@@ -48,7 +48,7 @@ phase() { # phase NAME: ends the previous phase (its wall time and CPU time), na
 }
 
 phase "format (clang-format --dry-run -Werror over every tracked .c and .h)"
-git ls-files -z '*.c' '*.h' | xargs -0 clang-format --dry-run -Werror
+git ls-files -z '*.c' '*.h' | xargs -0 -P "$jobs" -n 40 clang-format --dry-run -Werror
 
 phase "build (Debug, ASan+UBSan, -Werror)"
 cmake -S . -B build/dev -DCMAKE_BUILD_TYPE=Debug -DDRIFT_SANITIZE=address,undefined -DDRIFT_WERROR=ON \
