@@ -432,7 +432,7 @@ static void test_indirect_converges(void **state)
                              drift_vec3_make(0, 1, 0), 1.4f, W, H);
     test_rig_commit(&r);
     drift_pt *pt = NULL;
-    uint32_t truth_spp = (uint32_t)(512 * test_intensity());
+    uint32_t truth_spp = (uint32_t)(256 * test_intensity());
     drift_image truth =
         render_pt(&r, DRIFT_PT_COMPONENT_DIFFUSE, 2, truth_spp < 256 ? 256 : truth_spp, &pt);
     const uint32_t spps[3] = { 4, 16, 64 };
