@@ -2,8 +2,8 @@
 # The whole test suite: installs dependencies (the build set and the test tools), checks the
 # formatting (clang-format, the repository's .clang-format), builds with ASan+UBSan and
 # -Werror, builds the Release configuration (-Werror at -O2 sees more), runs the fuzzers for a
-# bounded time (side by side), the threaded renders under ThreadSanitizer and the core
-# tests under valgrind, then every ctest test.
+# bounded time (side by side), the threaded renders under ThreadSanitizer, then every ctest
+# test with the core tests under valgrind beside them.
 # It prints each phase's time and the ten slowest tests.
 # DRIFT_TEST_INTENSITY scales statistical sample counts; DRIFT_FUZZ_SECONDS the fuzz time
 # (10 s a target, the targets run side by side); DRIFT_CTEST_ARGS passes ctest options, e.g.
@@ -20,17 +20,35 @@ fi
 t_start=$(date +%s)
 t_phase=$t_start
 phases=""
-phase() { # phase NAME: ends the previous phase, names the next
-  local now
+times_file=$(mktemp)
+trap 'rm -f "$times_file"' EXIT
+# cpu_ms: sets cpu_now to the CPU time (user + sys, ms) of every finished child of this shell
+# so far: the second line of the `times` builtin (run here, not in a $(...) subshell, whose
+# children it would count instead).
+cpu_ms() {
+  times >"$times_file"
+  cpu_now=$(awk 'NR == 2 { t = 0; for (i = 1; i <= 2; ++i) { split($i, a, /[ms]/); t += a[1] * 60 + a[2] }
+                 printf "%d\n", t * 1000 }' "$times_file")
+}
+cpu_ms
+cpu_phase=$cpu_now
+cpu_start=$cpu_now
+phase() { # phase NAME: ends the previous phase (its wall time and CPU time), names the next
+  local now cpu
   now=$(date +%s)
-  [ -n "${current:-}" ] && phases="$phases  $current $((now - t_phase)) s\n"
+  cpu_ms
+  cpu=$cpu_now
+  [ -n "${current:-}" ] &&
+    phases="$phases$(printf '%6d s wall %7.1f CPU-s  %s' $((now - t_phase)) \
+      "$(((cpu - cpu_phase) / 1000)).$((((cpu - cpu_phase) % 1000) / 100))" "$current")\n"
   t_phase=$now
+  cpu_phase=$cpu
   current="$1"
   echo "== $1"
 }
 
 phase "format (clang-format --dry-run -Werror over every tracked .c and .h)"
-git ls-files -z '*.c' '*.h' | xargs -0 clang-format --dry-run -Werror
+git ls-files -z '*.c' '*.h' | xargs -0 -P "$jobs" -n 40 clang-format --dry-run -Werror
 
 phase "build (Debug, ASan+UBSan, -Werror)"
 cmake -S . -B build/dev -DCMAKE_BUILD_TYPE=Debug -DDRIFT_SANITIZE=address,undefined -DDRIFT_WERROR=ON \
@@ -55,6 +73,7 @@ CC=clang CXX=clang++ cmake -S . -B build/fuzz -DCMAKE_BUILD_TYPE=Debug -DDRIFT_B
   -DDRIFT_BUILD_TESTS=OFF -DDRIFT_SANITIZE=address,undefined -DDRIFT_WERROR=ON \
   "${launcher[@]}" >/dev/null
 cmake --build build/fuzz -j"$jobs"
+# shellcheck disable=SC2317 # run by xargs through export -f
 fuzz_one() {
   local fuzzer=$1 name corpus work
   name=$(basename "$fuzzer")
@@ -84,22 +103,38 @@ cmake -S . -B build/tsan -DCMAKE_BUILD_TYPE=Debug -DDRIFT_SANITIZE=thread -DDRIF
 cmake --build build/tsan -j"$jobs" --target drift_cli
 bash tests/tsan/test_tsan.sh build/tsan/bin/drift
 
-phase "valgrind (memcheck) on a plain Debug build of the core tests"
+phase "valgrind build (memcheck on a plain Debug build of the core tests, run beside ctest)"
 cmake -S . -B build/valgrind -DCMAKE_BUILD_TYPE=Debug "${launcher[@]}" >/dev/null
 cmake --build build/valgrind -j"$jobs" --target test_core test_sampling
-for t in test_core test_sampling; do
-  DRIFT_TEST_INTENSITY=0.1 valgrind --quiet --error-exitcode=9 --leak-check=full \
-    --errors-for-leak-kinds=definite,indirect "build/valgrind/$t" >/dev/null
-  echo "valgrind: $t clean"
-done
+# memcheck is one thread and about 60 CPU-s (test_sampling's chi-square quadrature, slowed
+# ~50x): run before ctest, it left a core idle for a minute. It runs beside ctest instead, and
+# the suite waits for it (and fails with it) after ctest.
+valgrind_log=build/valgrind/memcheck.log
+(
+  for t in test_core test_sampling; do
+    DRIFT_TEST_INTENSITY=0.1 valgrind --quiet --error-exitcode=9 --leak-check=full \
+      --errors-for-leak-kinds=definite,indirect "build/valgrind/$t" >/dev/null ||
+      { echo "valgrind: $t failed"; exit 1; }
+    echo "valgrind: $t clean"
+  done
+) >"$valgrind_log" 2>&1 &
+valgrind_pid=$!
 
-phase "tests (ctest -j$jobs)"
+phase "tests (ctest -j$jobs, memcheck beside it)"
 status=0
 # shellcheck disable=SC2086 # DRIFT_CTEST_ARGS is words
 (cd build/dev && ctest -j"$jobs" --output-on-failure ${DRIFT_CTEST_ARGS:-}) || status=$?
+phase "valgrind (the rest of memcheck after ctest; its CPU-s are all counted here)"
+valgrind_status=0
+wait "$valgrind_pid" || valgrind_status=$?
+cat "$valgrind_log"
+[ "$valgrind_status" -eq 0 ] || { echo "valgrind: failed"; status=1; }
 phase "end"
 echo "== the ten slowest tests (ctest's last run)"
 bash scripts/slowest-tests.sh build/dev 10 || true
-printf "== time by phase\n%b" "$phases"
-echo "test.sh: $(($(date +%s) - t_start)) s in all (apt excluded), exit $status"
+printf "== time by phase (CPU-s: user + sys of everything the phase ran; on 2 idle cores a
+   phase takes at least CPU-s / 2)\n%b" "$phases"
+cpu_ms
+cpu_all=$((cpu_now - cpu_start))
+echo "test.sh: $(($(date +%s) - t_start)) s in all (apt excluded), $((cpu_all / 1000)) CPU-s, exit $status"
 exit "$status"

@@ -2,7 +2,9 @@
 # docs/reference/cli.md and knobs.md are what scripts/gen-reference.sh prints from this drift's
 # option and knob tables: regenerated into a temp dir, they must equal the committed pages (a
 # diff and the command that fixes them otherwise), and every table row must have its header's
-# columns (an unescaped '|' in a help text would break it). $1 is the drift binary.
+# columns (an unescaped '|' in a help text would break it). So must the technique pages'
+# generated blocks (their knobs and measured rows, scripts/gen-technique-blocks.py).
+# $1 is the drift binary.
 set -u
 drift="$1"
 source "$(dirname "$0")/common.sh"
@@ -19,6 +21,18 @@ for page in cli.md knobs.md; do
         head -40 "$tmp/$page.diff" >&2
     fi
 done
+pages=0
+for page in "$tmp"/ref/pages/*.md; do
+    [ -e "$page" ] || continue
+    pages=$((pages + 1))
+    name=$(basename "$page")
+    if ! diff -u "$src/docs/$name" "$page" >"$tmp/$name.diff"; then
+        fail "docs/$name's generated blocks are stale: run scripts/gen-reference.sh build/dev/bin/drift and commit it"
+        head -40 "$tmp/$name.diff" >&2
+    fi
+done
+[ "$pages" -ge 5 ] || fail "only $pages technique pages have generated blocks"
+grep -q -- '--isg-search' "$tmp/ref/pages/isg.md" || fail "docs/isg.md's knob block has no --isg-search"
 python3 - "$tmp/ref/cli.md" "$tmp/ref/knobs.md" <<'PY' || fail "a Markdown table row has the wrong number of columns"
 import re, sys
 bad = 0

@@ -29,6 +29,16 @@ static void capture_log(drift_log_level level, drift_result code, const char *fi
     }
 }
 
+// DRIFT_TEST_FILTER=PATTERN runs only the cmocka tests whose names match it (cmocka's * and ?),
+// e.g. `DRIFT_TEST_FILTER='test_aa_*' build/dev/test_hybrid`: a developer times or debugs one.
+__attribute__((constructor)) static void filter_from_environment(void)
+{
+    const char *pattern = getenv("DRIFT_TEST_FILTER");
+    if (pattern && *pattern) {
+        cmocka_set_test_filter(pattern);
+    }
+}
+
 drift_logger test_capture_logger(test_log_capture *capture)
 {
     return (drift_logger){ .func = capture ? capture_log : NULL, .user = capture };

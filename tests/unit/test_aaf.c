@@ -44,13 +44,14 @@ enum {
 
 // A floor under the light with a low square (h 0.6, x < 0), a high one (h 1.2, x > 0) and a
 // wall standing on the floor at z = -1.2 (a contact edge), seen from below the light. Large
-// enough (96x72) that the penumbrae span a few pixels.
+// enough (96x72) that the penumbrae span a few pixels; the convergence test, which measures
+// the whole image's error, takes 64x48.
 enum {
     SW = 96,
     SH = 72
 };
 
-static void build_shadow_scene(test_rig *r)
+static void build_shadow_scene_at(test_rig *r, int32_t width, int32_t height)
 {
     uint32_t white;
     drift_material m = drift_material_make(drift_vec3_splat(0.6f));
@@ -64,7 +65,12 @@ static void build_shadow_scene(test_rig *r)
     // Over the wall's far side, so the floor behind its foot is in view.
     r->scene->camera =
         drift_camera_look_at(drift_vec3_make(0, 2.5f, -1.25f), drift_vec3_make(0, 0, -1.24f),
-                             drift_vec3_make(0, 0, 1), 1.4f, SW, SH);
+                             drift_vec3_make(0, 0, 1), 1.4f, width, height);
+}
+
+static void build_shadow_scene(test_rig *r)
+{
+    build_shadow_scene_at(r, SW, SH);
 }
 
 // The shadow frame's error against the path-traced direct light falls as spp grows, and at
@@ -73,7 +79,7 @@ static void test_shadows_converge(void **state)
 {
     (void)state;
     test_rig r = test_rig_begin(2);
-    build_shadow_scene(&r);
+    build_shadow_scene_at(&r, 64, 48);
     test_rig_commit(&r);
     drift_pt *pt = NULL;
     uint32_t truth_spp = (uint32_t)(512 * test_intensity());
@@ -426,7 +432,7 @@ static void test_indirect_converges(void **state)
                              drift_vec3_make(0, 1, 0), 1.4f, W, H);
     test_rig_commit(&r);
     drift_pt *pt = NULL;
-    uint32_t truth_spp = (uint32_t)(512 * test_intensity());
+    uint32_t truth_spp = (uint32_t)(256 * test_intensity());
     drift_image truth =
         render_pt(&r, DRIFT_PT_COMPONENT_DIFFUSE, 2, truth_spp < 256 ? 256 : truth_spp, &pt);
     const uint32_t spps[3] = { 4, 16, 64 };

@@ -433,13 +433,16 @@ static void test_glare_pupil_model_values_and_bounds(void **state)
     drift__glare_eye_init(&eye, &p);
     double sum = 0.0, lo = 1e9, hi = 0.0;
     int32_t count = 0;
-    for (int32_t f = 0; f < 3000; ++f) {
+    // 1000 frames (33 s of the eye): the mean is 3.78, 3.76 at 3000 frames; a 0.15 mm bias
+    // fails it.
+    for (int32_t f = 0; f < 1000; ++f) {
         drift__glare_eye_step(&eye, &p, 1.0, 1.0 / 30.0, true);
         sum += eye.pub.pupil_mm;
         lo = fmin(lo, eye.pub.pupil_mm);
         hi = fmax(hi, eye.pub.pupil_mm);
         ++count;
     }
+    print_message("pupil over %d frames: mean %.4f mm, %.4f to %.4f\n", count, sum / count, lo, hi);
     assert_near(sum / count, 3.760, 0.1);
     assert_true(hi - lo > 0.05 && hi - lo < 1.0); // it pulsates, by tenths of a mm
 }

@@ -454,7 +454,7 @@ static void test_ir_and_ism_against_path_tracer(void **state)
     test_rig_destroy(&r);
 }
 
-// The near-field compensation gives back the light the clamp takes: `ir` with 2048 VPLs and a
+// The near-field compensation gives back the light the clamp takes: `ir` with 1024 VPLs and a
 // wide clamp (0.2 of the diagonal) against the path tracer's one-bounce diffuse light, without
 // the compensation (measured: 0.89 of the mean) and with it fed the path tracer's direct light
 // (0.98; the rest is near surfaces the camera does not see). With a clamp that reaches no
@@ -464,11 +464,11 @@ static void test_near_field_gives_back_the_clamp(void **state)
     (void)state;
     test_rig r = cornell_rig(2, 64); // at 32 x 32 a hit's pixel is too often another surface
     drift_pt *pt = NULL, *pt_direct = NULL;
-    drift_image ref = render_pt(&r, DRIFT_PT_COMPONENT_DIFFUSE, 2, 512, &pt);
-    drift_image direct = render_pt(&r, DRIFT_PT_COMPONENT_DIRECT, 1, 256, &pt_direct);
+    drift_image ref = render_pt(&r, DRIFT_PT_COMPONENT_DIFFUSE, 2, 256, &pt);
+    drift_image direct = render_pt(&r, DRIFT_PT_COMPONENT_DIRECT, 1, 128, &pt_direct);
     const drift_gbuffer *gb = drift_hybrid_gbuffer(r.frame);
     drift_ism_params p = { .visibility = DRIFT_ISM_VISIBILITY_RAYS,
-                           .vpl_count = 2048,
+                           .vpl_count = 1024,
                            .max_depth = 2 };
     float diag = 10.0f * drift_ism_params_resolve(&p, r.scene).clamp_distance;
     double ratio[2], error[2];
