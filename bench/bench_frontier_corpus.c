@@ -399,7 +399,7 @@ static drift_result corpus_scene_rows(frontier_options *o, corpus_scene *cs, int
         cJSON_AddStringToObject(root, "scene", cs->path);
         cJSON_AddNumberToObject(root, "size", (double)o->size);
         double features[SCENE_FEATURE_COUNT];
-        scene_features(b->scene, features);
+        scene_features(b->ctx, b->scene, b->accel, features);
         cJSON *fs = cJSON_AddObjectToObject(root, "features");
         for (int k = 0; k < SCENE_FEATURE_COUNT; ++k) {
             cli_json_number(fs, scene_feature_name(k), features[k], 4);
