@@ -322,7 +322,8 @@ def replace_block(path, text):
     if begin in doc and end in doc:
         doc = doc[:doc.index(begin)] + block + doc[doc.index(end) + len(end):]
     else:
-        doc = doc.rstrip("\n") + "\n\n" + block + "\n"
+        doc = (doc.rstrip("\n") + "\n\n## The chooser over the corpus, leave-one-scene-out\n\n" +
+               block + "\n")
     open(path, "w").write(doc)
 
 

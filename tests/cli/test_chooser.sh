@@ -42,11 +42,11 @@ done
 # A model of one fitted scene and two candidates, both predicted at 10 ms (alpha = ln 10 at
 # the model's 32 x 32, no cost features): the lower predicted FLIP ratio wins, but a hybrid
 # row only below pt_margin (0.9) x the path tracer's.
+"$drift" render --features --quiet >"$tmp/features.json" || fail "--features"
 model() { # $1: the hybrid row's FLIP ratio, $2: the path tracer's
-    python3 - "$1" "$2" "$tmp/model.json" "$drift" <<'PY'
-import json, math, subprocess, sys
-feats = json.loads(subprocess.run([sys.argv[4], "render", "--features", "--quiet"],
-                                  capture_output=True, text=True, check=True).stdout)
+    python3 - "$1" "$2" "$tmp/model.json" "$tmp/features.json" <<'PY'
+import json, math, sys
+feats = json.load(open(sys.argv[4]))
 names = list(feats)
 json.dump({"size": 32, "k": 1, "pt_margin": 0.9, "features": names, "cost_features": [],
            "beta": {"pt": [], "hybrid": []}, "safety": {"pt": 1.0, "hybrid": 1.0},
