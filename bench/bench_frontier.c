@@ -90,7 +90,7 @@ static const cli_option frontier_table[] = {
             "renders a row, the frontier_median is its ms (default 3)"),
     CLI_INT("--max-spp", "N", O, max_spp, 1, 1 << 16,
             "the path tracer's largest spp (default: until a render exceeds the\n"
-            "largest budget)"),
+            "largest budget); at 1/f resolution, f^2 x N"),
     CLI_STRING("--cache", "DIR", O, cache_dir, "where the reference is cached (default out)"),
     CLI_STRING("--corpus", "DIR|LIST", O, corpus_path,
                "every scene of a folder (or a file listing one a line,\n"
