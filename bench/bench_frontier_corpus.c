@@ -148,7 +148,9 @@ drift_result frontier_low_res_rows(frontier_state *b, double limit_ms)
     double guide_ms = (drift_time_now() - t0) * 1e3;
     for (int32_t f = 2; f <= 4 && r == DRIFT_OK; f *= 2) {
         int32_t lw = size / f > 0 ? size / f : 1;
-        for (uint32_t spp = 1; spp <= 1024 && r == DRIFT_OK; spp *= 2) {
+        // --max-spp caps the same cost as the full-resolution path tracer's: f^2 x its spp.
+        const long max_spp = o->max_spp > 0 ? o->max_spp * f * f : 1024;
+        for (uint32_t spp = 1; spp <= 1024 && spp <= max_spp && r == DRIFT_OK; spp *= 2) {
             double render_ms[100], filter_ms[100], up_ms[2][2][100];
             drift_image low[4] = { 0 }, den = { 0 };
             drift_image outs[2][2] = { { { 0 } } }; // [denoised][guided]
@@ -399,7 +401,7 @@ static drift_result corpus_scene_rows(frontier_options *o, corpus_scene *cs, int
         cJSON_AddStringToObject(root, "scene", cs->path);
         cJSON_AddNumberToObject(root, "size", (double)o->size);
         double features[SCENE_FEATURE_COUNT];
-        scene_features(b->scene, features);
+        scene_features(b->ctx, b->scene, b->accel, features);
         cJSON *fs = cJSON_AddObjectToObject(root, "features");
         for (int k = 0; k < SCENE_FEATURE_COUNT; ++k) {
             cli_json_number(fs, scene_feature_name(k), features[k], 4);

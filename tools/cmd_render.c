@@ -502,16 +502,28 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
         beauty = denoised; // destroyed below
         *out_denoise_ms = 1e3 * (drift_time_now() - t_denoise);
     }
+    drift_image upsampled = { 0 };
+    const bool upsample = o->upsample_width > 0 && o->upsample_height > 0;
+    if (upsample) { // the chooser's reduced-resolution pick (tools/render_choose.c)
+        r = render_upsample_bilinear(ctx, &beauty, (int32_t)o->upsample_width,
+                                     (int32_t)o->upsample_height, &upsampled);
+        if (r != DRIFT_OK) {
+            drift_image_destroy(ctx, &denoised);
+            return r;
+        }
+        beauty = upsampled; // destroyed below
+    }
     if (o->hybrid.glare != DRIFT_GLARE_NONE) {
         if ((r = apply_glare(ctx, o, fov_y, &beauty, &glared)) != DRIFT_OK) {
             drift_image_destroy(ctx, &denoised);
+            drift_image_destroy(ctx, &upsampled);
             return r;
         }
         beauty = glared; // the glare's copy, destroyed below
     }
     drift_image_layer layers[12] = { { NULL, &beauty } };
     uint32_t layer_count = 1;
-    if (o->aov) {
+    if (o->aov && !upsample) { // the AOVs are at the low resolution: left out
         if ((r = drift_pt_resolve(pt, DRIFT_PT_AOV_ALBEDO, &albedo)) != DRIFT_OK ||
             (r = drift_pt_resolve(pt, DRIFT_PT_AOV_NORMAL, &normal)) != DRIFT_OK ||
             (r = drift_pt_resolve(pt, DRIFT_PT_AOV_DEPTH, &depth)) != DRIFT_OK) {
@@ -548,7 +560,7 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
     };
     uint32_t attribute_count = 4;
     snprintf(spp_text, sizeof spp_text, "%u", lowest);
-    if (lowest != highest && r == DRIFT_OK) {
+    if (lowest != highest && r == DRIFT_OK && !upsample) {
         snprintf(spp_text, sizeof spp_text, "%u..%u", lowest, highest);
         snprintf(note, sizeof note,
                  "interrupted: tiles of %dx%d pixels hold %u to %u samples; the spp layer has "
@@ -574,7 +586,8 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
         const char *const channels[12] = { NULL,    NULL, "X,Y,Z", "Z",  NULL, NULL,
                                            "X,Y,Z", NULL, NULL,    NULL, NULL, NULL };
         r = drift_image_save_exr_channels(ctx, exr_path, layers, layer_count,
-                                          o->aov ? channels : NULL, attributes, attribute_count);
+                                          layer_count > 1 && o->aov ? channels : NULL, attributes,
+                                          attribute_count);
     }
     if (r == DRIFT_OK) {
         r = render_save_png(ctx, o, png_path, &beauty);
@@ -582,6 +595,7 @@ static drift_result write_images(drift_context *ctx, drift_pt *pt, const render_
     drift_image_destroy(ctx, &spp);
     drift_image_destroy(ctx, &glared); // NULL-safe on a zero image
     drift_image_destroy(ctx, &denoised);
+    drift_image_destroy(ctx, &upsampled);
     return r;
 }
 

@@ -64,6 +64,8 @@ typedef struct render_options {
     double budget_ms;                // --budget-ms T: the chooser picks (tools/render_choose.c)
     const char *chooser_path;        // --chooser FILE: its model (default: the repository's)
     bool print_features;             // --features: the scene's features as JSON, then exit
+    long upsample_width, upsample_height; // > 0: the chooser's path tracer at reduced
+                                          // resolution, written upsampled to this size
     // sequences (tools/render_sequence.c, docs/temporal.md)
     bool animation; // --animation A:B given: frames A..B, --out a %04d pattern
     long frame_first, frame_last;
@@ -85,6 +87,10 @@ int render_parse_options(int argc, char **argv, render_options *o);
 // status); --features prints the chooser's inputs. tools/render_choose.c.
 int render_choose(render_options *o, const cli_session *session);
 int render_print_features(const cli_session *session);
+// `low` (3 channels or more) bilinearly up to w x h (a new image, 3 channels): the chooser's
+// path tracer at 1/2 or 1/4 resolution, as drift bench frontier's rows upsample it.
+drift_result render_upsample_bilinear(drift_context *ctx, const drift_image *low, int32_t w,
+                                      int32_t h, drift_image *out);
 
 int render_open_session(render_options *o, bool outputs_here, cli_session *session);
 void render_close_session(render_options *o, cli_session *session);

@@ -18,7 +18,7 @@
 int render_print_features(const cli_session *session)
 {
     double f[SCENE_FEATURE_COUNT];
-    scene_features(session->scene, f);
+    scene_features(session->ctx, session->scene, session->accel, f);
     printf("{");
     for (int k = 0; k < SCENE_FEATURE_COUNT; ++k) {
         printf("%s\"%s\": %.4f", k ? ", " : "", scene_feature_name(k), f[k]);
@@ -68,14 +68,113 @@ static const char *string(const cJSON *o, const char *key)
     return cJSON_IsString(v) ? v->valuestring : NULL;
 }
 
-// The fitted scene nearest to `f` (standardised by the model's `scale`), or NULL.
-static const cJSON *nearest_scene(const cJSON *model, const double f[SCENE_FEATURE_COUNT])
+// log ms at the model's size of candidate `c` on a scene of features `f`: its alpha plus its
+// group's beta . the cost features.
+static double predict_log_ms(const cJSON *model, const cJSON *c,
+                             const double f[SCENE_FEATURE_COUNT],
+                             const int cost_index[SCENE_FEATURE_COUNT], int cost_count)
 {
+    const cJSON *beta = cJSON_GetObjectItemCaseSensitive(
+        cJSON_GetObjectItemCaseSensitive(model, "beta"), string(c, "group"));
+    double y = number(c, "alpha", (double)INFINITY);
+    for (int k = 0; k < cost_count; ++k) {
+        const cJSON *b = cJSON_GetArrayItem(beta, k);
+        y += (cJSON_IsNumber(b) ? b->valuedouble : 0.0) * f[cost_index[k]];
+    }
+    return y;
+}
+
+// A fitted scene's FLIP ratio for `key` ("family|name"), or for the same row without its
+// environment filter (" ef N": the filter has no light to filter on a scene without one).
+static double flip_ratio(const cJSON *flips, const char *key)
+{
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(flips, key);
+    if (cJSON_IsNumber(v)) {
+        return v->valuedouble;
+    }
+    const char *ef = strstr(key, " ef ");
+    if (!ef) {
+        return (double)NAN;
+    }
+    char plain[256];
+    const char *rest = ef + 4;
+    while (*rest >= '0' && *rest <= '9') {
+        ++rest;
+    }
+    snprintf(plain, sizeof plain, "%.*s%s", (int)(ef - key), key, rest);
+    v = cJSON_GetObjectItemCaseSensitive(flips, plain);
+    return cJSON_IsNumber(v) ? v->valuedouble : (double)NAN;
+}
+
+typedef struct neighbour {
+    const cJSON *scene;
+    double d2;
+} neighbour;
+
+static int compare_neighbour(const void *a, const void *b)
+{
+    double x = ((const neighbour *)a)->d2, y = ((const neighbour *)b)->d2;
+    return (x > y) - (x < y);
+}
+
+// The predicted FLIP ratio of `key`: the inverse-distance weighted geometric mean over the
+// k nearest fitted scenes (`near`, sorted) of their FLIP over their best row's.
+static double predict_flip(const neighbour *near, int k, const char *key)
+{
+    double num = 0.0, den = 0.0;
+    for (int i = 0; i < k; ++i) {
+        double v = flip_ratio(cJSON_GetObjectItemCaseSensitive(near[i].scene, "flip"), key);
+        if (v > 0.0) {
+            double w = 1.0 / (sqrt(near[i].d2) + 0.1);
+            num += w * log(v);
+            den += w;
+        }
+    }
+    return den > 0.0 ? exp(num / den) : (double)INFINITY;
+}
+
+typedef struct choice {
+    const cJSON *pick;
+    double ms, flip; // predicted at the frame's size; FLIP over the best row's
+} choice;
+
+// Scores every candidate of the model for a scene of features `f` at `budget_ms` ms for a
+// frame of `pixels`; *best_hybrid and *best_pt: the lowest predicted FLIP of each group that
+// fits (pick NULL: none), *fastest: the candidate of the lowest predicted ms. False when the
+// model is not one this build reads.
+static bool score(const cJSON *model, const double f[SCENE_FEATURE_COUNT], double budget_ms,
+                  double pixels, choice *best_hybrid, choice *best_pt, choice *fastest)
+{
+    const cJSON *names = cJSON_GetObjectItemCaseSensitive(model, "features");
+    const cJSON *cost_names = cJSON_GetObjectItemCaseSensitive(model, "cost_features");
+    if (cJSON_GetArraySize(names) != SCENE_FEATURE_COUNT) {
+        return false;
+    }
+    for (int k = 0; k < SCENE_FEATURE_COUNT; ++k) {
+        const cJSON *n = cJSON_GetArrayItem(names, k);
+        if (!cJSON_IsString(n) || strcmp(n->valuestring, scene_feature_name(k)) != 0) {
+            return false;
+        }
+    }
+    int cost_index[SCENE_FEATURE_COUNT], cost_count = 0;
+    for (const cJSON *n = cost_names ? cost_names->child : NULL;
+         n && cost_count < SCENE_FEATURE_COUNT; n = n->next) {
+        int k = 0;
+        while (k < SCENE_FEATURE_COUNT &&
+               (!cJSON_IsString(n) || strcmp(n->valuestring, scene_feature_name(k)) != 0)) {
+            ++k;
+        }
+        if (k == SCENE_FEATURE_COUNT) {
+            return false;
+        }
+        cost_index[cost_count++] = k;
+    }
+    // The k nearest fitted scenes in standardised features.
     const cJSON *scale = cJSON_GetObjectItemCaseSensitive(model, "scale");
-    const cJSON *best = NULL;
-    double best_d = (double)INFINITY;
     const cJSON *scenes = cJSON_GetObjectItemCaseSensitive(model, "scenes");
-    for (const cJSON *s = scenes ? scenes->child : NULL; s; s = s->next) {
+    int n_scenes = cJSON_GetArraySize(scenes), n = 0;
+    neighbour *near = calloc((size_t)(n_scenes > 0 ? n_scenes : 1), sizeof *near);
+    for (const cJSON *s = scenes ? scenes->child : NULL; near && s; s = s->next) {
         const cJSON *sf = cJSON_GetObjectItemCaseSensitive(s, "features");
         if (cJSON_GetArraySize(sf) != SCENE_FEATURE_COUNT) {
             continue;
@@ -87,33 +186,40 @@ static const cJSON *nearest_scene(const cJSON *model, const double f[SCENE_FEATU
             double x = (cJSON_GetArrayItem(sf, k)->valuedouble - f[k]) / w;
             d += x * x;
         }
-        if (d < best_d) {
-            best_d = d;
-            best = s;
+        near[n++] = (neighbour){ s, d };
+    }
+    if (!near || n == 0) {
+        free(near);
+        return false;
+    }
+    qsort(near, (size_t)n, sizeof *near, compare_neighbour);
+    int k = (int)number(model, "k", 2);
+    k = k < 1 ? 1 : k > n ? n : k;
+    double size = number(model, "size", 400.0);
+    const cJSON *safety = cJSON_GetObjectItemCaseSensitive(model, "safety");
+    *best_hybrid = *best_pt = *fastest = (choice){ NULL, (double)INFINITY, (double)INFINITY };
+    const cJSON *cands = cJSON_GetObjectItemCaseSensitive(model, "candidates");
+    for (const cJSON *c = cands ? cands->child : NULL; c; c = c->next) {
+        const char *group = string(c, "group"), *key = string(c, "key");
+        if (!group || !key) {
+            continue;
+        }
+        double ms =
+            exp(predict_log_ms(model, c, f, cost_index, cost_count)) * pixels / (size * size);
+        if (ms < fastest->ms) {
+            *fastest = (choice){ c, ms, predict_flip(near, k, key) };
+        }
+        if (ms * number(safety, group, 1.0) > budget_ms) {
+            continue;
+        }
+        choice *best = strcmp(group, "pt") == 0 ? best_pt : best_hybrid;
+        double flip = predict_flip(near, k, key);
+        if (flip < best->flip) {
+            *best = (choice){ c, ms, flip };
         }
     }
-    return best;
-}
-
-// The scene's pick at the largest budget <= T (else its smallest budget's).
-static const cJSON *pick_for(const cJSON *scene, double budget_ms, double *out_budget)
-{
-    const cJSON *picks = cJSON_GetObjectItemCaseSensitive(scene, "picks");
-    const cJSON *best = NULL, *smallest = NULL;
-    double best_b = -1.0, small_b = (double)INFINITY;
-    for (const cJSON *p = picks ? picks->child : NULL; p; p = p->next) {
-        double b = atof(p->string);
-        if (b <= budget_ms && b > best_b) {
-            best = p;
-            best_b = b;
-        }
-        if (b < small_b) {
-            smallest = p;
-            small_b = b;
-        }
-    }
-    *out_budget = best ? best_b : small_b;
-    return best ? best : smallest;
+    free(near);
+    return fastest->pick != NULL;
 }
 
 static bool apply_technique(drift_hybrid_params *p, drift_effect effect, const char *name)
@@ -132,11 +238,21 @@ static bool apply_pick(render_options *o, const cJSON *pick)
 {
     const char *kind = string(pick, "kind");
     if (kind && strcmp(kind, "pt") == 0) {
+        const char *denoise = string(pick, "denoise");
         o->hybrid_mode = false;
         o->spp = (long)number(pick, "spp", 1);
-        o->denoise = cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(pick, "denoise"));
+        o->denoise = !denoise || strcmp(denoise, "none") == 0 ? 0
+                     : strcmp(denoise, "atrous") == 0         ? 1
+                                                              : 2;
         o->max_depth = 8;
-        return o->spp >= 1;
+        long scale = (long)number(pick, "scale", 1);
+        if (scale > 1) { // at 1/scale of the size, upsampled bilinearly as it is written
+            o->upsample_width = o->width;
+            o->upsample_height = o->height;
+            o->width = o->width / scale > 0 ? o->width / scale : 1;
+            o->height = o->height / scale > 0 ? o->height / scale : 1;
+        }
+        return o->spp >= 1 && scale >= 1;
     }
     drift_hybrid_params *p = &o->hybrid;
     if (!kind || strcmp(kind, "hybrid") != 0 ||
@@ -147,13 +263,38 @@ static bool apply_pick(render_options *o, const cJSON *pick)
     p->ism.vpls = (uint32_t)number(pick, "vpls", p->ism.vpls);
     p->ism.gather_scale = (int32_t)number(pick, "gather_scale", 1);
     p->ism.no_near_field = cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(pick, "no_near_field"));
-    p->light_samples = (uint32_t)number(pick, "light_samples", 8);
+    p->light_samples = (uint32_t)number(pick, "light_samples", 8); // the bench's rows' count
     p->environment_filter = (uint32_t)number(pick, "environment_filter", 0);
     p->environment_scale = (uint32_t)number(pick, "environment_scale", 1);
     p->aa = (uint32_t)number(pick, "aa", 1);
     o->spp = (long)number(pick, "spp", 1);
     o->max_depth = 8;
     return true;
+}
+
+drift_result render_upsample_bilinear(drift_context *ctx, const drift_image *low, int32_t w,
+                                      int32_t h, drift_image *out)
+{
+    drift_result r = drift_image_create(ctx, w, h, 3, out);
+    double fx = (double)w / (double)low->width, fy = (double)h / (double)low->height;
+    for (int32_t y = 0; r == DRIFT_OK && y < h; ++y) {
+        for (int32_t x = 0; x < w; ++x) {
+            double u = fmin(fmax((x + 0.5) / fx - 0.5, 0.0), (double)low->width - 1.0);
+            double v = fmin(fmax((y + 0.5) / fy - 0.5, 0.0), (double)low->height - 1.0);
+            int32_t x0 = (int32_t)u, y0 = (int32_t)v;
+            int32_t x1 = x0 + 1 < low->width ? x0 + 1 : x0;
+            int32_t y1 = y0 + 1 < low->height ? y0 + 1 : y0;
+            float tx = (float)(u - x0), ty = (float)(v - y0);
+            for (int32_t c = 0; c < 3; ++c) {
+                float a = drift_image_pixel(low, x0, y0)[c] * (1.0f - tx) +
+                          drift_image_pixel(low, x1, y0)[c] * tx;
+                float b = drift_image_pixel(low, x0, y1)[c] * (1.0f - tx) +
+                          drift_image_pixel(low, x1, y1)[c] * tx;
+                drift_image_pixel(out, x, y)[c] = a * (1.0f - ty) + b * ty;
+            }
+        }
+    }
+    return r;
 }
 
 int render_choose(render_options *o, const cli_session *session)
@@ -168,18 +309,26 @@ int render_choose(render_options *o, const cli_session *session)
         fprintf(stderr, "drift render: --budget-ms: cannot read the chooser's model %s\n", path);
         return 1;
     }
-    double f[SCENE_FEATURE_COUNT], budget = 0.0;
-    scene_features(session->scene, f);
-    // The model's milliseconds are at its bench's size x size: a frame's cost grows with its
-    // pixels, so T is taken at that size.
-    double w = o->width > 0 ? (double)o->width : (double)session->scene->camera.width;
-    double h = o->height > 0 ? (double)o->height : (double)session->scene->camera.height;
-    double size = number(model, "size", 400.0);
-    double at_model = o->budget_ms * size * size / fmax(w * h, 1.0);
-    const cJSON *scene = nearest_scene(model, f);
-    const cJSON *pick = scene ? pick_for(scene, at_model, &budget) : NULL;
-    const char *row = pick ? string(pick, "row") : NULL;
-    if (!pick || !apply_pick(o, pick)) {
+    double f[SCENE_FEATURE_COUNT];
+    scene_features(session->ctx, session->scene, session->accel, f);
+    if (o->width <= 0) {
+        o->width = session->scene->camera.width;
+    }
+    if (o->height <= 0) {
+        o->height = session->scene->camera.height;
+    }
+    choice hybrid, pt, fastest;
+    bool ok =
+        score(model, f, o->budget_ms, (double)o->width * (double)o->height, &hybrid, &pt, &fastest);
+    double margin = number(model, "pt_margin", 1.0);
+    // A hybrid frame only where it is predicted clearly closer than the best path tracer that
+    // fits: the chooser must not trade the path tracer's image for a worse one.
+    const choice *c = !ok                                                           ? NULL
+                      : hybrid.pick && (!pt.pick || hybrid.flip < margin * pt.flip) ? &hybrid
+                      : pt.pick                                                     ? &pt
+                                                                                    : &fastest;
+    const char *row = c ? string(c->pick, "row") : NULL;
+    if (!c || !apply_pick(o, c->pick)) {
         fprintf(stderr,
                 "drift render: --budget-ms: %s has no usable pick (refit it: "
                 "scripts/chooser/fit_table.py)\n",
@@ -189,12 +338,14 @@ int render_choose(render_options *o, const cli_session *session)
     }
     if (!o->quiet) {
         fprintf(stderr,
-                "drift render: --budget-ms %g (%.0f ms at the model's %.0f^2): %s%s (the nearest "
-                "fitted scene, %s, at %g ms: %.1f ms, FLIP %.3f there)\n",
-                o->budget_ms, at_model, size,
-                o->hybrid_mode ? "hybrid " : "the path tracer is expected to win: ",
-                row ? row : "?", string(scene, "name") ? string(scene, "name") : "?", budget,
-                number(pick, "ms", (double)NAN), number(pick, "flip", (double)NAN));
+                "drift render: --budget-ms %g: %s%s (predicted %.0f ms, FLIP %.2fx the best "
+                "row's on the nearest fitted scenes)%s\n",
+                o->budget_ms,
+                c == &fastest    ? "nothing is predicted to fit, the fastest: "
+                : o->hybrid_mode ? "hybrid "
+                                 : "the path tracer is expected to win: ",
+                row ? row : "?", c->ms, c->flip,
+                c == &pt && hybrid.pick ? "; the best hybrid frame was predicted no closer" : "");
     }
     cJSON_Delete(model);
     return 0;

@@ -1,13 +1,34 @@
 // Cheap features of a loaded scene (tools/scene_features.h): one pass over the lights and the
-// triangles, no rays.
+// triangles, and a 16 x 16 one-sample path-tracer probe.
 #include "scene_features.h"
+
+#include "drift/pt.h"
 
 #include <math.h>
 
 static const char *const names[SCENE_FEATURE_COUNT] = {
     "log_triangles", "log_lights",     "area_share", "delta_share", "environment",
-    "glossy_share",  "emissive_share", "lens",       "depth_range"
+    "glossy_share",  "emissive_share", "lens",       "depth_range", "log_rays"
 };
+
+// log10 of the rays a sample casts: the path tracer at 16 x 16, 1 spp, depth 8.
+static double probe_rays(drift_context *ctx, const drift_scene *scene, const drift_accel *accel)
+{
+    enum {
+        N = 16
+    };
+
+    drift_pt_params params = { .width = N, .height = N, .seed = 1u, .max_depth = 8 };
+    drift_pt *pt = NULL;
+    double rays = 0.0;
+    if (drift_pt_create(ctx, scene, accel, &params, &pt) == DRIFT_OK &&
+        drift_pt_render_samples(pt, 1, NULL) == DRIFT_OK) {
+        drift_pt_stats st = drift_pt_get_stats(pt);
+        rays = (double)(st.camera_rays + st.shadow_rays + st.bounce_rays) / (N * N);
+    }
+    drift_pt_destroy(pt);
+    return rays > 0.0 ? log10(rays) : 0.0;
+}
 
 const char *scene_feature_name(int k)
 {
@@ -25,7 +46,8 @@ static double triangle_area(const drift_mesh *mesh, uint32_t t)
            (double)drift_vec3_length(drift_vec3_cross(drift_vec3_sub(b, a), drift_vec3_sub(c, a)));
 }
 
-void scene_features(const drift_scene *scene, double out[SCENE_FEATURE_COUNT])
+void scene_features(drift_context *ctx, const drift_scene *scene, const drift_accel *accel,
+                    double out[SCENE_FEATURE_COUNT])
 {
     uint64_t triangles = 0;
     double area = 0.0, glossy = 0.0, emissive = 0.0;
@@ -75,4 +97,5 @@ void scene_features(const drift_scene *scene, double out[SCENE_FEATURE_COUNT])
     out[6] = area > 0.0 ? emissive / area : 0.0;
     out[7] = cam->aperture_radius > 0.0f ? 1.0 : 0.0;
     out[8] = triangles > 0 ? log10(fmax((double)drift_scene_extent(scene), 1e-6) / dist) : 0.0;
+    out[9] = ctx && accel ? probe_rays(ctx, scene, accel) : 0.0;
 }

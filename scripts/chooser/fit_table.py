@@ -1,23 +1,31 @@
 #!/usr/bin/env python3
-"""Fits the technique chooser (issue 40) from `drift bench frontier --corpus ... --json` and
-validates it leave-one-scene-out.
+"""Fits the technique chooser of `drift render --budget-ms T` (issue 40) from
+`drift bench frontier --corpus ... --json`, and validates it leave-one-scene-out.
 
-    python3 scripts/chooser/fit_table.py ROWS.jsonl [--fit corpus-fit.txt] \\
-        [--model scenes/corpus/chooser.json] [--drift build/release/bin/drift]
+    python3 scripts/chooser/fit_table.py ROWS.jsonl --fit corpus-fit.txt \\
+        [--model scenes/corpus/chooser.json] [--frontier-md docs/frontier.md] \\
+        [--drift build/release/bin/drift]
 
-ROWS.jsonl: the bench's --json lines, one a scene (scene, features, rows of family, name, ms,
-FLIP). Scenes without features get them from `drift render SCENE --features`.
+ROWS.jsonl: the bench's --json lines, one a scene (scene, size, features, rows of family,
+name, ms, FLIP). Scenes without features get them from `drift render SCENE --features`.
 
-Two choosers, both judged leave-one-scene-out (each scene's pick fitted without it):
-- table: for each budget the one combination with the lowest geometric-mean FLIP ratio to each
-  training scene's best row within the budget (over the budget on a scene counts as 3): no
-  scene features, the baseline;
-- nearest (what `drift render --budget-ms` runs): the training scene nearest in standardised
-  features, and the row that was best there within the budget.
-The regret of a cell is the chosen row's FLIP over the best row's in hindsight within the budget;
-a chosen row that takes longer than the budget on the scene itself is marked `over`. Only rows
-the renderer can run are picked: hybrid frames, the path tracer plain or through a-trous.
---model writes the nearest chooser fitted on every --fit scene (all, without --fit).
+The model (what tools/render_choose.c reads) has two parts, both fitted on the --fit scenes:
+- a cost model: each candidate row's predicted milliseconds at the bench's size,
+  log ms = alpha_row + beta_group . x(scene), x = COST_FEATURES (triangles, lights,
+  environment), one beta for the path tracer's rows and one for the hybrid rows, ridge least
+  squares; a frame of P pixels costs P / size^2 of that;
+- a quality model: each fitted scene's features and its rows' FLIP over the scene's best;
+  a candidate's predicted FLIP on a new scene is the inverse-distance weighted geometric mean
+  over the K nearest fitted scenes (standardised features).
+The pick is the candidate with the lowest predicted FLIP whose predicted ms fit T; a hybrid
+row is taken only when it is predicted below PT_MARGIN x the best path-tracer candidate,
+else the path tracer (plain, a-trous, drift's feature denoiser, or at 1/2 or 1/4 resolution
+upsampled bilinearly) is picked and the renderer says so.
+
+Validation (printed): leave-one-scene-out, each scene's pick made by a model fitted on the
+--fit scenes without it; per (scene, budget) cell the regret = the chosen row's measured FLIP
+over the best row in hindsight within the budget (any row the bench ran), and the chosen
+FLIP over the best path tracer's. Fit and judged (unseen) scenes are summarised apart.
 """
 import argparse
 import json
@@ -27,11 +35,29 @@ import re
 import subprocess
 import sys
 
-OVER = 3.0
-PICKABLE = {"hybrid", "pt", "pt+atrous"}
-PT = {"pt", "pt+atrous", "pt-low", "pt-low+atrous"}
 FEATURES = ["log_triangles", "log_lights", "area_share", "delta_share", "environment",
-            "glossy_share", "emissive_share", "lens", "depth_range"]
+            "glossy_share", "emissive_share", "lens", "depth_range", "log_rays"]
+# What a frame costs beyond its pixels: triangles (the rays' traversal), lights (shadow maps,
+# light samples), the rays a path-tracer sample casts (tools/scene_features.c's probe), an
+# environment, a lens. (A timed probe instead of log_rays did no better leave-one-out on the
+# corpus rows: docs/lab/2026-12-07-issue-40-s2.md.)
+COST_FEATURES = ["log_triangles", "log_lights", "log_rays", "environment", "lens"]
+SAFETY_QUANTILE = 0.8
+PT_FAMILIES = {"pt", "pt+atrous", "pt+denoise", "pt-low", "pt-low+atrous"}
+# What drift render can run: every hybrid row; the path tracer plain, through a-trous or the
+# feature denoiser; at reduced resolution upsampled bilinearly (the joint-bilateral rows need
+# a full-resolution G-buffer the renderer does not build: in the hindsight best, not picked).
+PICKABLE = {"hybrid"} | PT_FAMILIES
+K = 2
+RIDGE = 0.1
+
+
+def key_text(key):
+    return "%s|%s" % key
+
+
+def pickable(key):
+    return key[0] in PICKABLE and "joint-bilateral" not in key[1]
 
 
 def load(path, drift):
@@ -46,12 +72,13 @@ def load(path, drift):
             print("fit_table.py: %s: an unfinished line left out" % path, file=sys.stderr)
             continue
         rows = {(r["family"], r["name"]): (r["ms"], r["flip"]) for r in d["rows"]}
-        feats = d.get("features")
-        if feats is None:
+        feats = d.get("features") or {}
+        if any(k not in feats for k in FEATURES):  # a bench older than a feature
             out = subprocess.run([drift, "render", d["scene"], "--features", "--quiet"],
                                  capture_output=True, text=True, check=True).stdout
-            feats = json.loads(out)
-        scenes.append({"size": d.get("size", 400), "path": d["scene"], "name": os.path.basename(d["scene"]).split(".")[0],
+            feats = dict(feats, **json.loads(out))
+        scenes.append({"size": d.get("size", 400), "path": d["scene"],
+                       "name": os.path.basename(d["scene"]).rsplit(".", 1)[0],
                        "rows": rows, "features": [feats[k] for k in FEATURES]})
     return scenes
 
@@ -71,22 +98,109 @@ def best_within(rows, budget, families=None):
     return min(c) if c else (None, None)
 
 
-def fit_table(train, budget):
-    keys = set()
-    for s in train:
-        keys.update(k for k in s["rows"] if k[0] in PICKABLE)
-    best, score = None, math.inf
-    for key in sorted(keys):
-        logs = 0.0
-        for s in train:
-            top, _ = best_within(s["rows"], budget)
-            if top is None:
-                continue
-            ms, f = lookup(s["rows"], key)
-            logs += math.log(f / top if ms <= budget else OVER)
-        if logs < score:
-            best, score = key, logs
-    return best
+def group(key):
+    return "pt" if key[0] in PT_FAMILIES else "hybrid"
+
+
+def cost_x(s):
+    return [s["features"][FEATURES.index(k)] for k in COST_FEATURES]
+
+
+def solve(a, b):
+    """a x = b by Gaussian elimination with partial pivoting (a small, square)."""
+    n = len(b)
+    m = [row[:] + [b[i]] for i, row in enumerate(a)]
+    for c in range(n):
+        p = max(range(c, n), key=lambda r: abs(m[r][c]))
+        m[c], m[p] = m[p], m[c]
+        for r in range(n):
+            if r != c and m[c][c] != 0.0:
+                f = m[r][c] / m[c][c]
+                m[r] = [x - f * y for x, y in zip(m[r], m[c])]
+    return [m[i][n] / m[i][i] if m[i][i] else 0.0 for i in range(n)]
+
+
+def pt_class(key):
+    """A path-tracer row's class (family and what is left of its name without the spp) and
+    its spp; (None, 0) for a hybrid row."""
+    m = re.match(r"(.*?)(\d+) spp(.*)$", key[1]) if group(key) == "pt" else None
+    return ((key[0], m.group(1), m.group(3)), int(m.group(2))) if m else (None, 0)
+
+
+def smooth_pt(alpha, count):
+    """The path tracer's rows of one class (family, resolution, upsampling) cost
+    c_class + gamma log spp, gamma shared: one row's time is a single noisy run, the class's
+    line pools them (weighted by the rows' scene counts)."""
+    cls = {}
+    for k, a in alpha.items():
+        c, spp = pt_class(k)
+        if c is not None:
+            cls.setdefault(c, []).append((math.log(spp), a, count[k]))
+    if not cls:
+        return alpha
+    # gamma from the within-class covariance, then each class's intercept
+    sxy = sxx = 0.0
+    for pts in cls.values():
+        w = sum(p[2] for p in pts)
+        mx = sum(p[0] * p[2] for p in pts) / w
+        my = sum(p[1] * p[2] for p in pts) / w
+        sxy += sum(p[2] * (p[0] - mx) * (p[1] - my) for p in pts)
+        sxx += sum(p[2] * (p[0] - mx) ** 2 for p in pts)
+    gamma = sxy / sxx if sxx > 0 else 1.0
+    out = dict(alpha)
+    for c, pts in cls.items():
+        w = sum(p[2] for p in pts)
+        icpt = sum(p[2] * (p[1] - gamma * p[0]) for p in pts) / w
+        for k in alpha:
+            kc, spp = pt_class(k)
+            if kc == c:
+                out[k] = icpt + gamma * math.log(spp)
+    return out
+
+
+def fit_cost(train):
+    """alpha per pickable row, beta per group: log ms = alpha + beta . x (block coordinate
+    descent on the ridge least squares; it is convex, 50 rounds converge)."""
+    obs = [(key, cost_x(s), math.log(ms)) for s in train for key, (ms, f) in s["rows"].items()
+           if pickable(key) and 0.0 < ms < math.inf]
+    d = len(COST_FEATURES)
+    beta = {"pt": [0.0] * d, "hybrid": [0.0] * d}
+    alpha = {}
+    for _ in range(50):
+        sums = {}
+        for key, x, y in obs:
+            r = y - sum(b * v for b, v in zip(beta[group(key)], x))
+            t = sums.setdefault(key, [0.0, 0])
+            t[0] += r
+            t[1] += 1
+        alpha = smooth_pt({k: t[0] / t[1] for k, t in sums.items()},
+                          {k: t[1] for k, t in sums.items()})
+        for g in beta:
+            ata = [[RIDGE * (i == j) for j in range(d)] for i in range(d)]
+            atb = [0.0] * d
+            for key, x, y in obs:
+                if group(key) != g:
+                    continue
+                r = y - alpha[key]
+                for i in range(d):
+                    atb[i] += x[i] * r
+                    for j in range(d):
+                        ata[i][j] += x[i] * x[j]
+            beta[g] = solve(ata, atb)
+    # The safety factor: a pick must fit the budget at its prediction x the SAFETY_QUANTILE of
+    # measured over predicted on the training rows (each group), so that most picks fit.
+    res = {"pt": [], "hybrid": []}
+    for key, x, y in obs:
+        res[group(key)].append(y - alpha[key] - sum(b * v for b, v in zip(beta[group(key)], x)))
+    safety = {g: math.exp(sorted(r)[int(SAFETY_QUANTILE * (len(r) - 1))]) if r else 1.0 for g, r in res.items()}
+    return alpha, beta, safety
+
+
+def predict_ms(cost, key, x):
+    alpha, beta = cost[0], cost[1]
+    if key not in alpha:
+        return math.inf
+    return math.exp(alpha[key] + sum(b * v for b, v in zip(beta[group(key)], x)))
 
 
 def scales(train):
@@ -98,121 +212,206 @@ def scales(train):
     return out
 
 
-def nearest(train, feats, sc):
-    return min(train, key=lambda s: sum(((a - b) / w) ** 2 for a, b, w in zip(s["features"], feats, sc)))
+def quality(s):
+    """The scene's pickable rows' FLIP over its best row's."""
+    best = min(f for _, f in s["rows"].values())
+    return {k: f / best for k, (ms, f) in s["rows"].items() if pickable(k)}
 
 
-MARGIN = 1.0  # a row is picked from a neighbour when it took at most MARGIN x the budget there
+def fit(train):
+    return {"cost": fit_cost(train), "scale": scales(train),
+            "scenes": [(s["name"], s["features"], quality(s)) for s in train]}
 
 
-def pick_nearest(train, scene, budget):
-    n = nearest(train, scene["features"], scales(train))
-    return best_or_fastest(n["rows"], MARGIN * budget)[1], n["name"]
+def predict_flip(model, feats, key):
+    sc = model["scale"]
+    near = sorted(((sum(((a - b) / w) ** 2 for a, b, w in zip(f, feats, sc)), q)
+                   for _, f, q in model["scenes"]), key=lambda t: t[0])[:K]
+    num = den = 0.0
+    for d, q in near:
+        v = q.get(key)
+        if v is None:
+            v = q.get((key[0], re.sub(r" ef \d+", "", key[1])))
+        if v is None:
+            continue
+        w = 1.0 / (math.sqrt(d) + 0.1)
+        num += w * math.log(v)
+        den += w
+    return math.exp(num / den) if den else math.inf
 
 
-def best_or_fastest(rows, budget):
-    """The best pickable row within the budget, else the fastest pickable row (its FLIP, key)."""
-    f, key = best_within(rows, budget, PICKABLE)
-    if key is None:
-        c = [(ms, k) for k, (ms, fl) in rows.items() if k[0] in PICKABLE]
-        if c:
-            key = min(c)[1]
-            f = rows[key][1]
-    return f, key
+def choose(model, feats, budget, pt_margin):
+    """(key, predicted ms, predicted FLIP ratio, why) for a scene of `feats` at `budget` ms
+    (at the model's size)."""
+    x = [feats[FEATURES.index(k)] for k in COST_FEATURES]
+    cands = []
+    for key in model["cost"][0]:
+        ms = predict_ms(model["cost"], key, x)
+        fits = ms * model["cost"][2][group(key)] <= budget
+        cands.append((key, ms, predict_flip(model, feats, key) if fits else math.inf))
+    fit_ = [c for c in cands if c[2] < math.inf]
+    if not fit_:
+        key, ms, _ = min(cands, key=lambda c: c[1])
+        return key, ms, predict_flip(model, feats, key), "nothing predicted within the budget: the fastest"
+    pt = min((c for c in fit_ if group(c[0]) == "pt"), key=lambda c: c[2], default=None)
+    hy = min((c for c in fit_ if group(c[0]) == "hybrid"), key=lambda c: c[2], default=None)
+    if hy and (pt is None or hy[2] < pt_margin * pt[2]):
+        return hy[0], hy[1], hy[2], "hybrid"
+    return pt[0], pt[1], pt[2], "path tracer"
 
 
 def to_pick(key, ms, flip):
     fam, name = key
-    if fam in ("pt", "pt+atrous"):
-        return {"kind": "pt", "row": "%s %s" % (fam, name), "spp": int(name.split()[0]),
-                "denoise": fam == "pt+atrous", "ms": ms, "flip": flip}
+    if group(key) == "pt":
+        m = re.match(r"(?:1/(\d+) res )?(\d+) spp", name)
+        return {"kind": "pt", "row": "%s %s" % (fam, name), "spp": int(m.group(2)),
+                "scale": int(m.group(1) or 1),
+                "denoise": {"pt+atrous": "atrous", "pt-low+atrous": "atrous",
+                            "pt+denoise": "on"}.get(fam, "none")}
     m = re.match(r"(\w+) \+ (\w+)(.*)$", name)
-    p = {"kind": "hybrid", "row": name, "shadows": m.group(1), "indirect": m.group(2), "ms": ms, "flip": flip}
+    p = {"kind": "hybrid", "row": name, "shadows": m.group(1), "indirect": m.group(2)}
     rest = m.group(3)
-    for pat, field, conv in ((r" (\d+) VPLs", "vpls", int), (r"VPLs (?:\S+ )*?(?:\d+ )?spp", None, None),
-                             (r" (\d+) spp", "spp", int), (r" ls (\d+)", "light_samples", int),
-                             (r" ef (\d+)", "environment_filter", int), (r" aa (\d+)", "aa", int)):
-        if field:
-            mm = re.search(pat, rest)
-            if mm:
-                p[field] = conv(mm.group(1))
+    for pat, field in ((r" (\d+) VPLs", "vpls"), (r" (\d+) spp", "spp"), (r" ls (\d+)", "light_samples"),
+                       (r" ef (\d+)", "environment_filter"), (r" aa (\d+)", "aa")):
+        mm = re.search(pat, rest)
+        if mm:
+            p[field] = int(mm.group(1))
     p["gather_scale"] = 2 if " g2" in rest else 1
     p["no_near_field"] = " nf off" in rest
-    p.setdefault("light_samples", 8)
     p["environment_scale"] = 2 if "environment_filter" in p else 1
     return p
 
 
+def model_json(model, size, source, pt_margin):
+    alpha, beta, safety = model["cost"]
+    cands = []
+    for key in sorted(alpha):
+        c = to_pick(key, None, None)
+        c.update({"key": key_text(key), "alpha": round(alpha[key], 5), "group": group(key)})
+        cands.append(c)
+    return {"comment": "The technique chooser of drift render --budget-ms (tools/render_choose.c), "
+                       "fitted by scripts/chooser/fit_table.py from %s on the corpus's fit scenes: "
+                       "a cost model (log ms at size^2 = alpha + beta[group] . cost features) and, "
+                       "for each fitted scene, its features and its rows' FLIP over its best." % source,
+            "size": size, "k": K, "pt_margin": pt_margin, "features": FEATURES,
+            "cost_features": COST_FEATURES, "beta": {g: [round(v, 5) for v in b] for g, b in beta.items()},
+            "safety": {g: round(v, 4) for g, v in safety.items()},
+            "scale": model["scale"], "candidates": cands,
+            "scenes": [{"name": n, "features": f, "flip": {key_text(k): round(v, 4) for k, v in sorted(q.items())}}
+                       for n, f, q in model["scenes"]]}
+
+
+def median(v):
+    v = sorted(v)
+    return (v[len(v) // 2] + v[(len(v) - 1) // 2]) / 2 if v else float("nan")
+
+
+def gmean(v):
+    v = [x for x in v if 0 < x < math.inf]
+    return math.exp(sum(math.log(x) for x in v) / len(v)) if v else float("nan")
+
+
+def validate(scenes, is_fit, budgets, pt_margin, out, train_all):
+    cells = []
+    for s in scenes:
+        train = [t for t in scenes if t is not s and (train_all or is_fit(t))]
+        model = fit(train)
+        for b in budgets:
+            key, pms, _, why = choose(model, s["features"], b, pt_margin)
+            ms, f = lookup(s["rows"], key)
+            top, topkey = best_within(s["rows"], b)
+            pt, _ = best_within(s["rows"], b, PT_FAMILIES)
+            cells.append({"scene": s["name"], "fit": is_fit(s), "budget": b, "key": key, "why": why,
+                          "pred_ms": pms, "ms": ms, "flip": f, "best": top, "best_key": topkey,
+                          "best_pt": pt,
+                          "regret": f / top if top and f < math.inf else math.inf,
+                          "vs_pt": f / pt if pt and f < math.inf else math.inf})
+    w = out.write
+    w("| scene | role | " + " | ".join("%g ms" % b for b in budgets) + " |\n")
+    w("|---|---|" + "---|" * len(budgets) + "\n")
+    for s in scenes:
+        row = []
+        for b in budgets:
+            c = next(c for c in cells if c["scene"] == s["name"] and c["budget"] == b)
+            if c["ms"] == math.inf:  # the bench stopped below it: over the budget there
+                row.append("%s %s: not run on this scene (over)" % c["key"])
+                continue
+            row.append("%s %s: %.3f (%.0f ms%s), regret %.2f, /pt %.2f" % (
+                c["key"][0], c["key"][1], c["flip"], c["ms"], "" if c["ms"] <= b else ", over",
+                c["regret"], c["vs_pt"]))
+        w("| %s | %s | %s |\n" % (s["name"], "fit" if is_fit(s) else "judge", " | ".join(row)))
+    w("\n| budget | scenes | cells | median regret | worst regret | median chosen/best pt | "
+      "cells <= 1.1x best pt | within budget (measured) | hybrid picked | median chosen FLIP |\n")
+    w("|---|---|---|---|---|---|---|---|---|---|\n")
+    for role in ("judge", "fit"):
+        for b in budgets:
+            cs = [c for c in cells if c["budget"] == b and c["fit"] == (role == "fit")]
+            if not cs:
+                continue
+            w("| %g | %s | %d | %.2f | %.2f | %.2f | %d | %d | %d | %.3f |\n" % (
+                b, role, len(cs), median([c["regret"] for c in cs]), max(c["regret"] for c in cs),
+                median([c["vs_pt"] for c in cs]), sum(c["vs_pt"] <= 1.1 for c in cs),
+                sum(c["ms"] <= b for c in cs), sum(group(c["key"]) == "hybrid" for c in cs),
+                median([c["flip"] for c in cs])))
+    return cells
+
+
+def replace_block(path, text):
+    begin, end = "<!-- chooser-loso:begin (scripts/chooser/fit_table.py --frontier-md) -->", \
+                 "<!-- chooser-loso:end -->"
+    doc = open(path).read() if os.path.exists(path) else ""
+    block = begin + "\n" + text + end
+    if begin in doc and end in doc:
+        doc = doc[:doc.index(begin)] + block + doc[doc.index(end) + len(end):]
+    else:
+        doc = (doc.rstrip("\n") + "\n\n## The chooser over the corpus, leave-one-scene-out\n\n" +
+               block + "\n")
+    open(path, "w").write(doc)
+
+
 def main():
-    a = argparse.ArgumentParser()
+    a = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     a.add_argument("rows")
-    a.add_argument("--fit")
+    a.add_argument("--fit", required=True, help="the fit scenes' list (build/corpus/corpus-fit.txt)")
     a.add_argument("--budgets", default="50,100,250,500,1000")
-    a.add_argument("--model")
+    a.add_argument("--model", help="write the model fitted on every fit scene here")
+    a.add_argument("--frontier-md", help="replace the generated leave-one-out block of this file")
     a.add_argument("--drift", default="build/release/bin/drift")
-    a.add_argument("--margin", type=float, default=1.0,
-                   help="pick a neighbour's best row within this share of the budget (default 1; "
-                        "0.7, 0.5 and 0.35 had higher leave-one-out regret, lab notes)")
+    a.add_argument("--pt-margin", type=float, default=0.9,
+                   help="a hybrid row is picked only when predicted below this x the best path "
+                        "tracer's FLIP (default 0.9)")
+    a.add_argument("--train", choices=("all", "fit"), default="all",
+                   help="what a left-out scene's model is fitted on: every other scene (all, the "
+                        "default) or the other fit scenes; --model is fitted likewise")
     o = a.parse_args()
-    global MARGIN
-    MARGIN = o.margin
     budgets = [float(b) for b in o.budgets.split(",")]
     scenes = load(o.rows, o.drift)
-    fit_set = {os.path.realpath(l.strip()) for l in open(o.fit) if l.strip()} if o.fit else None
-    is_fit = lambda s: fit_set is None or os.path.realpath(s["path"]) in fit_set
-    print("| scene | role | " + " | ".join("%g ms" % b for b in budgets) + " |")
-    print("|---|---|" + "---|" * len(budgets))
-    st = {(c, b, u): [] for c in ("table", "nearest") for b in budgets for u in (0, 1)}
-    for s in scenes:
-        train = [t for t in scenes if t is not s and is_fit(t)]
-        cells = []
-        for b in budgets:
-            top, _ = best_within(s["rows"], b)
-            pt, _ = best_within(s["rows"], b, PT)
-            cell = []
-            for chooser in ("nearest", "table"):
-                if chooser == "nearest":
-                    key, via = pick_nearest(train, s, b)
-                else:
-                    key, via = fit_table(train, b), None
-                ms, f = lookup(s["rows"], key) if key else (math.inf, math.inf)
-                regret = f / top if top else math.inf
-                beats = f < pt if pt is not None else f < math.inf
-                rec = (regret, beats, ms <= b)
-                st[(chooser, b, 0)].append(rec)
-                if not is_fit(s):
-                    st[(chooser, b, 1)].append(rec)
-                if chooser == "nearest":
-                    cell.append("%s %s (via %s) %.3f, regret %.2f%s%s" % (
-                        key[0] if key else "-", key[1] if key else "", via, f, regret,
-                        "" if ms <= b else ", over", ", beats pt" if beats else ""))
-            cells.append("; ".join(cell))
-        print("| %s | %s | %s |" % (s["name"], "fit" if is_fit(s) else "judge", " | ".join(cells)))
-    print("\n| budget | chooser | cells | median regret | mean regret | beats the best pt | within budget | unseen: cells, median regret, beats pt |")
-    print("|---|---|---|---|---|---|---|---|")
-    med = lambda v: sorted(v)[len(v) // 2] if v else float("nan")
-    for b in budgets:
-        for c in ("nearest", "table"):
-            a_, u = st[(c, b, 0)], st[(c, b, 1)]
-            fin = [r[0] for r in a_ if r[0] < math.inf]
-            print("| %g | %s | %d | %.2f | %.2f | %d | %d | %d, %.2f, %d |" % (
-                b, c, len(a_), med([r[0] for r in a_]), sum(fin) / len(fin) if fin else float("nan"),
-                sum(r[1] for r in a_), sum(r[2] for r in a_), len(u), med([r[0] for r in u]), sum(r[1] for r in u)))
+    fit_set = {os.path.realpath(l.strip()) for l in open(o.fit) if l.strip() and not l.startswith("#")}
+    fit_names = {os.path.basename(p).rsplit(".", 1)[0] for p in fit_set}
+    is_fit = lambda s: os.path.realpath(s["path"]) in fit_set or s["name"] in fit_names
+
+    class Tee:
+        def __init__(self):
+            self.parts = []
+
+        def write(self, t):
+            sys.stdout.write(t)
+            self.parts.append(t)
+
+    tee = Tee()
+    validate(scenes, is_fit, budgets, o.pt_margin, tee, o.train == "all")
+    if o.frontier_md:
+        head = ("Generated by `python3 scripts/chooser/fit_table.py %s --fit %s --pt-margin %g` "
+                "(leave-one-scene-out: each scene's pick by a model fitted on the fit scenes "
+                "without it; regret = chosen FLIP / best FLIP in hindsight within the budget; "
+                "/pt = chosen FLIP / best path tracer's; %d px, the bench's size).\n\n" % (
+                    os.path.basename(o.rows), os.path.basename(o.fit), o.pt_margin, scenes[0]["size"]))
+        replace_block(o.frontier_md, head + "".join(tee.parts))
     if o.model:
-        train = [s for s in scenes if is_fit(s)]
-        model = {"comment": "The technique chooser of drift render --budget-ms (tools/render_choose.c), "
-                            "fitted by scripts/chooser/fit_table.py from %s: for each fitted scene its "
-                            "features and, a budget, the best row the renderer can run." % os.path.basename(o.rows),
-                 "size": train[0]["size"], "margin": MARGIN, "features": FEATURES, "scale": scales(train), "scenes": []}
-        for s in train:
-            picks = {}
-            for b in budgets:
-                f, key = best_or_fastest(s["rows"], MARGIN * b)
-                if key:
-                    picks["%g" % b] = to_pick(key, s["rows"][key][0], f)
-            model["scenes"].append({"name": s["name"], "features": s["features"], "picks": picks})
+        train = [s for s in scenes if o.train == "all" or is_fit(s)]
         with open(o.model, "w") as fh:
-            json.dump(model, fh, indent=1)
+            json.dump(model_json(fit(train), train[0]["size"], os.path.basename(o.rows), o.pt_margin), fh, indent=1)
+            fh.write("\n")
 
 
 if __name__ == "__main__":
