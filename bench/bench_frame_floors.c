@@ -399,7 +399,7 @@ static void print_run(const char *scene_path, const bench_floor_options *o, int 
         cJSON_AddNumberToObject(root, "threads", threads);
         cJSON_AddNumberToObject(root, "repeats", (double)o->repeats);
         cJSON_AddStringToObject(root, "clock", cpu_clock ? "process cpu" : "wall");
-        cli_json_number(root, "copy_gb_per_s", run->copy_gbs, 3);
+        cli_json_number(root, "copy_gb_per_s", run->copy_gbs, 4);
         cli_json_number(root, "sample_floor_ns", run->sample_ns, 4);
         cJSON *array = cJSON_AddArrayToObject(root, "passes");
         for (int k = 0; k < run->count; ++k) {
@@ -408,9 +408,9 @@ static void print_run(const char *scene_path, const bench_floor_options *o, int 
             cJSON *item = cJSON_CreateObject();
             cJSON_AddItemToArray(array, item);
             cJSON_AddStringToObject(item, "name", p->name);
-            cli_json_number(item, "ms", p->ms, 3);
+            cli_json_number(item, "ms", p->ms, 4);
             cli_json_number(item, "bytes", p->bytes, 0);
-            cli_json_number(item, "floor_ms", floor_ms, 3);
+            cli_json_number(item, "floor_ms", floor_ms, 6);
             cli_json_number(item, "floor_ratio", p->ms / floor_ms, 2);
             if (p->compute_ms > 0.0) {
                 cli_json_number(item, "compute_floor_ms", p->compute_ms, 3);
