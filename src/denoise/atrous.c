@@ -59,10 +59,10 @@ static const float b1[3] = { 1.0f / 4.0f, 1.0f / 2.0f, 1.0f / 4.0f };
 
 // The weights of one tap (kernel weight wk, the neighbour `offset` pixels away) over pixels
 // [p, p + n) of the centre's planes, added into the run's sums.
-static inline DRIFT_ALWAYS_INLINE void
-atrous_tap(const atrous_job *j, bool color, size_t p, ptrdiff_t offset, int32_t n, float wk,
-           const float *restrict dscale, const float *restrict lum_c, float *restrict sum0,
-           float *restrict sum1, float *restrict sum2, float *restrict wsum)
+static inline DRIFT_ALWAYS_INLINE void atrous_tap(const atrous_job *j, bool color, size_t p,
+                                                  ptrdiff_t offset, int32_t n, float wk,
+                                                  float *restrict sum0, float *restrict sum1,
+                                                  float *restrict sum2, float *restrict wsum)
 {
     const atrous_planes *g = &j->in;
     size_t q = (size_t)((ptrdiff_t)p + offset);
@@ -113,17 +113,18 @@ atrous_tap(const atrous_job *j, bool color, size_t p, ptrdiff_t offset, int32_t 
     const float *restrict cc0 = g->color[0] + p, *restrict cq0 = g->color[0] + q;
     const float *restrict cc1 = g->color[1] + p, *restrict cq1 = g->color[1] + q;
     const float *restrict cc2 = g->color[2] + p, *restrict cq2 = g->color[2] + q;
-    const float inv_albedo = j->inv_albedo, inv_color = j->inv_color;
+    const float inv_depth = j->inv_depth, inv_albedo = j->inv_albedo, inv_color = j->inv_color;
     DRIFT_IVDEP
     for (int32_t i = 0; i < n; ++i) {
-        float e = fabsf(zc[i] - zq[i]) * dscale[i];
+        float z = zc[i] > 1e-30f ? zc[i] : 1e-30f; // a miss (z = 0): see keep
+        float e = fabsf(zc[i] - zq[i]) * (inv_depth / z);
         float a0 = ac0[i] - aq0[i], a1 = ac1[i] - aq1[i], a2 = ac2[i] - aq2[i];
         e += (a0 * a0 + a1 * a1 + a2 * a2) * inv_albedo;
         if (color) { // a constant at each call: two loops, one without the colour weight
             float c0 = cc0[i] - cq0[i], c1 = cc1[i] - cq1[i], c2 = cc2[i] - cq2[i];
-            float mean =
-                0.5f * (lum_c[i] + fabsf(0.2126f * cq0[i] + 0.7152f * cq1[i] + 0.0722f * cq2[i])) +
-                DENOISE_LUM_EPS;
+            float mean = 0.5f * (fabsf(0.2126f * cc0[i] + 0.7152f * cc1[i] + 0.0722f * cc2[i]) +
+                                 fabsf(0.2126f * cq0[i] + 0.7152f * cq1[i] + 0.0722f * cq2[i])) +
+                         DENOISE_LUM_EPS;
             e += (c0 * c0 + c1 * c1 + c2 * c2) * inv_color / (mean * mean);
         }
         // A pixel whose ray missed mixes only with other misses; past the cutoff a tap adds
@@ -148,9 +149,6 @@ static DRIFT_AVX2_CLONES void atrous_rows(size_t begin, size_t end, int thread_i
     const float *kernel = radius == 1 ? b1 : b3;
     const float centre = kernel[radius] * kernel[radius];
     float sum0[ATROUS_RUN], sum1[ATROUS_RUN], sum2[ATROUS_RUN], wsum[ATROUS_RUN];
-    // What every tap of a centre shares, found once a run: inv_depth / z (a miss, z = 0, is
-    // taken as 1e-30: see atrous_tap's keep) and the centre's luminance.
-    float dscale[ATROUS_RUN], lum_c[ATROUS_RUN];
     for (int32_t y = (int32_t)begin; y < (int32_t)end; ++y) {
         for (int32_t x0 = 0; x0 < w; x0 += ATROUS_RUN) {
             int32_t n = w - x0 < ATROUS_RUN ? w - x0 : ATROUS_RUN;
@@ -160,14 +158,6 @@ static DRIFT_AVX2_CLONES void atrous_rows(size_t begin, size_t end, int thread_i
                 sum1[i] = centre * j->in.color[1][p + (size_t)i];
                 sum2[i] = centre * j->in.color[2][p + (size_t)i];
                 wsum[i] = centre;
-            }
-            const float *restrict zc = j->in.depth + p, *restrict c0 = j->in.color[0] + p,
-                                  *restrict c1 = j->in.color[1] + p,
-                                  *restrict c2 = j->in.color[2] + p;
-            for (int32_t i = 0; i < n; ++i) {
-                float z = zc[i] > 1e-30f ? zc[i] : 1e-30f;
-                dscale[i] = j->inv_depth / z;
-                lum_c[i] = fabsf(0.2126f * c0[i] + 0.7152f * c1[i] + 0.0722f * c2[i]);
             }
             for (int dy = -radius; dy <= radius; ++dy) {
                 int32_t qy = y + dy * j->step;
@@ -189,11 +179,11 @@ static DRIFT_AVX2_CLONES void atrous_rows(size_t begin, size_t end, int thread_i
                     size_t first = p + (size_t)lo;
                     float wk = kernel[dx + radius] * kernel[dy + radius];
                     if (j->inv_color > 0.0f) {
-                        atrous_tap(j, true, first, offset, hi - lo, wk, dscale + lo, lum_c + lo,
-                                   sum0 + lo, sum1 + lo, sum2 + lo, wsum + lo);
+                        atrous_tap(j, true, first, offset, hi - lo, wk, sum0 + lo, sum1 + lo,
+                                   sum2 + lo, wsum + lo);
                     } else {
-                        atrous_tap(j, false, first, offset, hi - lo, wk, dscale + lo, lum_c + lo,
-                                   sum0 + lo, sum1 + lo, sum2 + lo, wsum + lo);
+                        atrous_tap(j, false, first, offset, hi - lo, wk, sum0 + lo, sum1 + lo,
+                                   sum2 + lo, wsum + lo);
                     }
                 }
             }
