@@ -2,6 +2,7 @@
 // run. The target: hard shadows + sharp reflections + post depth of field at 640x480
 // on the Cornell box with a glossy bunny cost at most 4x the primary pass.
 #include "bench.h"
+#include "bench_frame_floors.h"
 #include "cli.h"
 #include "drift/accel.h"
 #include "drift/hybrid.h"
@@ -14,7 +15,7 @@
 typedef struct frame_options {
     const char *scene_path;
     long width, height, frames, threads;
-    bool json;
+    bool json, floors;
 } frame_options;
 
 // The configurations measured; the first is the target frame.
@@ -26,10 +27,15 @@ typedef struct frame_config {
 #define O frame_options
 static const cli_option frame_table[] = {
     CLI_SECTION("options:", 0),
-    CLI_INT("--width", "W", O, width, 1, DRIFT_IMAGE_MAX_DIMENSION, "frame size (default 640x480)"),
+    CLI_INT("--width", "W", O, width, 1, DRIFT_IMAGE_MAX_DIMENSION,
+            "frame size (default 640x480; 1920x1080 with --floors)"),
     CLI_INT("--height", "H", O, height, 1, DRIFT_IMAGE_MAX_DIMENSION, "frame size"),
     CLI_INT("--frames", "N", O, frames, 1, 1000,
-            "frames per configuration after one warm-up frame (default 5)"),
+            "frames per configuration after one warm-up frame (default 5); with --floors, "
+            "runs of each pass (the least is kept)"),
+    CLI_FLAG("--floors", O, floors,
+             "each image pass (compose, post DOF, ISG, a-trous, glare convolution) as a multiple "
+             "of its bandwidth floor, the copy bandwidth measured in the same run"),
     BENCH_OPTION_THREADS(O),
     BENCH_OPTION_JSON(O),
 };
@@ -102,11 +108,14 @@ static drift_result measure(drift_context *ctx, const drift_scene *scene, const 
 
 int drift_bench_frame(int argc, char **argv)
 {
-    frame_options o = { .width = 640, .height = 480, .frames = 5, .threads = 1 };
+    frame_options o = { .frames = 0, .threads = 1 };
     int status = cli_parse(&frame_command, argc, argv, &o, NULL);
     if (status != CLI_PARSED) {
         return cli_parse_exit(status);
     }
+    o.width = o.width ? o.width : (o.floors ? 1920 : 640);
+    o.height = o.height ? o.height : (o.floors ? 1080 : 480);
+    o.frames = o.frames ? o.frames : 5;
     // The documented target first, then every real-time row of the technique table alone
     // (path-traced rows cost what --spp says: drift bench aaf and isg measure those).
     frame_config configs[64] = { { "hard+sharp+post",
@@ -135,6 +144,13 @@ int drift_bench_frame(int argc, char **argv)
     }
     drift_context *ctx = session.ctx;
     const char *scene_path = session.scene_path;
+    if (o.floors) {
+        exit_code = bench_frame_floors(
+            ctx, session.scene, session.accel, scene_path,
+            &(bench_floor_options){
+                .width = o.width, .height = o.height, .repeats = o.frames, .json = o.json });
+        goto done;
+    }
     drift_result r = DRIFT_OK;
     frame_result results[sizeof configs / sizeof *configs];
     memset(results, 0, sizeof results);

@@ -10,46 +10,10 @@
 
 // --- THE FILTER ---
 
-static inline int32_t nearest(float v)
-{
-    return (int32_t)floorf(v + 0.5f);
-}
-
 float drift_isg_filter(const drift_isg_kernel *k, const drift_image *image, int32_t first,
                        int32_t channels, int32_t x, int32_t y, float *out)
 {
-    const float *centre = drift_image_pixel(image, x, y) + first;
-    float ref[4], sum[4] = { 0.0f, 0.0f, 0.0f, 0.0f };
-    for (int32_t c = 0; c < channels; ++c) {
-        ref[c] = isfinite(centre[c]) ? centre[c] : 0.0f;
-    }
-    float weight_sum = 0.0f;
-    uint32_t n = k->pattern->count;
-    for (uint32_t i = 0; i <= n; ++i) {
-        int32_t sx = x, sy = y;
-        if (i > 0) { // i = 0 is the centre itself
-            drift_vec2 o = drift_isg_offset(k->pattern, &k->jitter, i - 1, k->radius);
-            sx = nearest((float)x + o.x);
-            sy = nearest((float)y + o.y);
-            if (sx < 0 || sy < 0 || sx >= image->width || sy >= image->height) {
-                continue;
-            }
-        }
-        float w = k->range(k->user, sx, sy);
-        if (!(w > 0.0f)) {
-            continue; // rejected; skipping also keeps an infinite value of a rejected sample out
-        }
-        const float *v = k->value ? k->value(k->user, sx, sy) : NULL;
-        v = v ? v : drift_image_pixel(image, sx, sy) + first;
-        for (int32_t c = 0; c < channels; ++c) {
-            sum[c] += w * (v[c] - ref[c]);
-        }
-        weight_sum += w;
-    }
-    for (int32_t c = 0; c < channels; ++c) {
-        out[c] = weight_sum > 0.0f ? ref[c] + sum[c] / weight_sum : centre[c];
-    }
-    return weight_sum;
+    return drift_isg_filter_inline(k, k->range, k->value, image, first, channels, x, y, out);
 }
 
 float drift_isg_pixels_per_unit(const drift_camera *camera, int32_t height)

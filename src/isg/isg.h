@@ -10,7 +10,10 @@
 #ifndef DRIFT_ISG_INTERNAL_H
 #define DRIFT_ISG_INTERNAL_H
 
+#include "core/vectorise.h"
 #include "frame/frame.h"
+
+#include <math.h>
 
 // --- SAMPLE SETS (isg_samples.c) ---
 
@@ -51,6 +54,30 @@ drift_isg_jitter drift_isg_jitter_at(uint32_t hash, int32_t x, int32_t y);
 drift_vec2 drift_isg_offset(const drift_isg_pattern *pattern, const drift_isg_jitter *jitter,
                             uint32_t i, drift_vec2 radius);
 
+// Wraps v into [-1, 1).
+static inline float drift_isg_wrap_unit(float v)
+{
+    float t = 0.5f * (v + 1.0f);
+    return 2.0f * (t - floorf(t)) - 1.0f;
+}
+
+// drift_isg_offset's body, inlined into the filters.
+static inline DRIFT_ALWAYS_INLINE drift_vec2 drift_isg_offset_inline(
+    const drift_isg_pattern *pattern, const drift_isg_jitter *jitter, uint32_t i, drift_vec2 radius)
+{
+    drift_vec2 p = pattern->points[i];
+    if (pattern->layout == DRIFT_ISG_DISK) {
+        p = drift_vec2_make(jitter->cos_a * p.x - jitter->sin_a * p.y,
+                            jitter->sin_a * p.x + jitter->cos_a * p.y);
+    } else {
+        // A shift of under one cell (2 / k) keeps the grid stratified over the rectangle.
+        float cell = 2.0f / sqrtf((float)pattern->count);
+        p = drift_vec2_make(drift_isg_wrap_unit(p.x + cell * jitter->shift.x),
+                            drift_isg_wrap_unit(p.y + cell * jitter->shift.y));
+    }
+    return drift_vec2_make(p.x * radius.x, p.y * radius.y);
+}
+
 // --- THE FILTER (isg.c) ---
 
 // Range function times spatial weight of the sample at pixel (x, y) for the centre the
@@ -76,6 +103,54 @@ typedef struct drift_isg_kernel {
 // Sums differences from the centre (when finite) so that a constant image stays exact.
 float drift_isg_filter(const drift_isg_kernel *kernel, const drift_image *image, int32_t first,
                        int32_t channels, int32_t x, int32_t y, float *out);
+
+// The filter's body for a range and value function known where it is inlined (the passes
+// wrap it once per range function in a function cloned for AVX2, so that the range function
+// is inlined and floorf is one instruction): the same operations in the same order as
+// drift_isg_filter, so the same result to the bit. First the samples' pixels (a loop over the
+// pattern that vectorises), then the weighted sum over them in the pattern's order.
+static inline DRIFT_ALWAYS_INLINE float
+drift_isg_filter_inline(const drift_isg_kernel *k, drift_isg_range_fn range,
+                        drift_isg_value_fn value, const drift_image *image, int32_t first,
+                        int32_t channels, int32_t x, int32_t y, float *out)
+{
+    const float *centre = drift_image_pixel(image, x, y) + first;
+    float ref[4], sum[4] = { 0.0f, 0.0f, 0.0f, 0.0f };
+    for (int32_t c = 0; c < channels; ++c) {
+        ref[c] = isfinite(centre[c]) ? centre[c] : 0.0f;
+    }
+    uint32_t n = k->pattern->count;
+    int32_t sxs[DRIFT_ISG_MAX_SAMPLES + 1], sys[DRIFT_ISG_MAX_SAMPLES + 1];
+    sxs[0] = x;
+    sys[0] = y;
+    uint32_t m = 1;
+    for (uint32_t i = 0; i < n; ++i) {
+        drift_vec2 o = drift_isg_offset_inline(k->pattern, &k->jitter, i, k->radius);
+        int32_t sx = (int32_t)floorf((float)x + o.x + 0.5f);
+        int32_t sy = (int32_t)floorf((float)y + o.y + 0.5f);
+        sxs[m] = sx;
+        sys[m] = sy;
+        m += sx >= 0 && sy >= 0 && sx < image->width && sy < image->height; // off the image: out
+    }
+    float weight_sum = 0.0f;
+    for (uint32_t i = 0; i < m; ++i) {
+        int32_t sx = sxs[i], sy = sys[i];
+        float w = range(k->user, sx, sy);
+        if (!(w > 0.0f)) {
+            continue; // rejected; skipping also keeps an infinite value of a rejected sample out
+        }
+        const float *v = value ? value(k->user, sx, sy) : NULL;
+        v = v ? v : drift_image_pixel(image, sx, sy) + first;
+        for (int32_t c = 0; c < channels; ++c) {
+            sum[c] += w * (v[c] - ref[c]);
+        }
+        weight_sum += w;
+    }
+    for (int32_t c = 0; c < channels; ++c) {
+        out[c] = weight_sum > 0.0f ? ref[c] + sum[c] / weight_sum : centre[c];
+    }
+    return weight_sum;
+}
 
 // Pixels per scene unit at view depth 1 (the projection's scale, H / (2 tan(fov_y / 2))), and
 // the horizontal field of view.

@@ -80,6 +80,18 @@ typedef struct dof_job {
     float search_radius;
 } dof_job;
 
+// The filter with each range (and value) function inlined (isg.h).
+#define DOF_FILTER(name, range, value, channels)                                             \
+    static DRIFT_AVX2_CLONES float name(const drift_isg_kernel *k, const drift_image *image, \
+                                        int32_t x, int32_t y, float *out)                    \
+    {                                                                                        \
+        return drift_isg_filter_inline(k, range, value, image, 0, channels, x, y, out);      \
+    }
+DOF_FILTER(filter_search, range_search, NULL, 1)
+DOF_FILTER(filter_gather, range_gather, NULL, 3)
+DOF_FILTER(filter_gather_behind, range_gather, value_behind, 3)
+#undef DOF_FILTER
+
 static void dof_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
 {
     (void)rays;
@@ -98,7 +110,7 @@ static void dof_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays
         range_search, &rc,    NULL
     };
     float radius;
-    drift_isg_filter(&search, &f->coc, 0, 1, x, y, &radius); // the centre always counts
+    filter_search(&search, &f->coc, x, y, &radius); // the centre always counts
     drift_image_pixel(&s->dof_search, x, y)[0] = radius;
     float *out = drift_image_pixel(&f->final, x, y);
     if (!(radius >= 0.5f)) {
@@ -114,7 +126,7 @@ static void dof_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays
     }
     drift_isg_kernel gather = { &s->gather,   jitter, drift_vec2_make(radius, radius),
                                 range_gather, &rc,    value };
-    drift_isg_filter(&gather, &f->focus, 0, 3, x, y, out);
+    (value ? filter_gather_behind : filter_gather)(&gather, &f->focus, x, y, out);
 }
 
 drift_result drift_isg_pass_dof(drift_frame_state *f, const drift_pass_args *args)

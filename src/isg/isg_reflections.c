@@ -60,6 +60,18 @@ static float range_lobe(const void *user, int32_t x, int32_t y)
     return has_lobe(c->g, x, y) ? 1.0f : 0.0f;
 }
 
+// The filter with each range function inlined (isg.h), for 1 or 3 channels.
+#define REFLECTION_FILTER(name, range, channels)                                             \
+    static DRIFT_AVX2_CLONES float name(const drift_isg_kernel *k, const drift_image *image, \
+                                        int32_t x, int32_t y, float *out)                    \
+    {                                                                                        \
+        return drift_isg_filter_inline(k, range, NULL, image, 0, channels, x, y, out);       \
+    }
+REFLECTION_FILTER(filter_lobe3, range_lobe, 3)
+REFLECTION_FILTER(filter_eq10_1, range_eq10, 1)
+REFLECTION_FILTER(filter_eq10_3, range_eq10, 3)
+#undef REFLECTION_FILTER
+
 typedef struct reflection_job {
     float fov_x, fov_y;
 } reflection_job;
@@ -102,7 +114,7 @@ static void reflection_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_
             &s->gather, jitter, drift_vec2_make(p->isg.blur_radius, p->isg.blur_radius),
             range_lobe, &rc,    NULL
         };
-        drift_isg_filter(&k, &f->reflection_reflected, 0, 3, x, y, &gathered.x);
+        filter_lobe3(&k, &f->reflection_reflected, x, y, &gathered.x);
     } else {
         float scale_x = (float)p->width / job->fov_x, scale_y = (float)p->height / job->fov_y;
         drift_vec2 search_radius = drift_vec2_make(theta * scale_x, theta * scale_y);
@@ -111,8 +123,7 @@ static void reflection_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_
         }
         drift_isg_kernel search = { &s->search, jitter, search_radius, range_eq10, &rc, NULL };
         float reflected_distance;
-        if (!(drift_isg_filter(&search, &f->reflection_distance, 0, 1, x, y, &reflected_distance) >
-              0.0f)) {
+        if (!(filter_eq10_1(&search, &f->reflection_distance, x, y, &reflected_distance) > 0.0f)) {
             reflected_distance = INFINITY; // nothing reflected in reach: the environment
         }
         float eye_distance = drift_vec3_length(drift_vec3_sub(f->camera.position, rc.p0));
@@ -132,7 +143,7 @@ static void reflection_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_
         rc.inv_rx = 1.0f / fmaxf(gather_radius.x, 1e-6f);
         rc.inv_ry = 1.0f / fmaxf(gather_radius.y, 1e-6f);
         drift_isg_kernel gather = { &s->gather, jitter, gather_radius, range_eq10, &rc, NULL };
-        drift_isg_filter(&gather, &f->reflection_reflected, 0, 3, x, y, &gathered.x);
+        filter_eq10_3(&gather, &f->reflection_reflected, x, y, &gathered.x);
     }
     drift_image_set3(&f->reflections, x, y,
                      drift_vec3_mul(drift_raster_reflection_weight(&bsdf, wo), gathered));

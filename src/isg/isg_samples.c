@@ -64,25 +64,8 @@ drift_isg_jitter drift_isg_jitter_at(uint32_t hash, int32_t x, int32_t y)
                                .shift = drift_vec2_make(sx - 0.5f, sy - 0.5f) };
 }
 
-// Wraps v into [-1, 1).
-static float wrap_unit(float v)
-{
-    float t = 0.5f * (v + 1.0f);
-    return 2.0f * (t - floorf(t)) - 1.0f;
-}
-
 drift_vec2 drift_isg_offset(const drift_isg_pattern *pattern, const drift_isg_jitter *jitter,
                             uint32_t i, drift_vec2 radius)
 {
-    drift_vec2 p = pattern->points[i];
-    if (pattern->layout == DRIFT_ISG_DISK) {
-        p = drift_vec2_make(jitter->cos_a * p.x - jitter->sin_a * p.y,
-                            jitter->sin_a * p.x + jitter->cos_a * p.y);
-    } else {
-        // A shift of under one cell (2 / k) keeps the grid stratified over the rectangle.
-        float cell = 2.0f / sqrtf((float)pattern->count);
-        p = drift_vec2_make(wrap_unit(p.x + cell * jitter->shift.x),
-                            wrap_unit(p.y + cell * jitter->shift.y));
-    }
-    return drift_vec2_make(p.x * radius.x, p.y * radius.y);
+    return drift_isg_offset_inline(pattern, jitter, i, radius);
 }

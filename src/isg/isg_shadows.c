@@ -94,6 +94,18 @@ static float range_surface(const void *user, int32_t x, int32_t y)
     return drift_image_pixel(c->material_id, x, y)[0] >= 0.0f ? 1.0f : 0.0f;
 }
 
+// The filter with each range function inlined, one channel (isg.h).
+#define SHADOW_FILTER(name, range)                                                           \
+    static DRIFT_AVX2_CLONES float name(const drift_isg_kernel *k, const drift_image *image, \
+                                        int32_t first, int32_t x, int32_t y, float *out)     \
+    {                                                                                        \
+        return drift_isg_filter_inline(k, range, NULL, image, first, 1, x, y, out);          \
+    }
+SHADOW_FILTER(filter_search, range_search)
+SHADOW_FILTER(filter_gather, range_gather)
+SHADOW_FILTER(filter_surface, range_surface)
+#undef SHADOW_FILTER
+
 typedef struct shadow_job {
     light_shape *shapes;
     float pixels_per_unit;
@@ -132,7 +144,7 @@ static void shadow_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *r
             float r = f->params.isg.blur_radius;
             drift_isg_kernel k = { &s->gather,    jitter, drift_vec2_make(r, r),
                                    range_surface, &rc,    NULL };
-            drift_isg_filter(&k, &b->hard_shadow, 0, 1, x, y, shadow);
+            filter_surface(&k, &b->hard_shadow, 0, x, y, shadow);
             continue;
         }
         const light_shape *shape = &job->shapes[l];
@@ -149,7 +161,7 @@ static void shadow_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *r
             rect ? &s->search_rect : &s->search, jitter, search_radius, range_search, &rc, NULL
         };
         float d;
-        if (!(drift_isg_filter(&search, &b->hard_shadow, 1, 1, x, y, &d) > 0.0f)) {
+        if (!(filter_search(&search, &b->hard_shadow, 1, x, y, &d) > 0.0f)) {
             continue; // no occluder in reach (every sample rejected): the centre's bit
         }
         // Eq. 8 per axis of the light's shape, then eq. 9.
@@ -164,7 +176,7 @@ static void shadow_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *r
         drift_isg_kernel gather = {
             rect ? &s->gather_rect : &s->gather, jitter, gather_radius, range_gather, &rc, NULL
         };
-        drift_isg_filter(&gather, &b->hard_shadow, 0, 1, x, y, shadow);
+        filter_gather(&gather, &b->hard_shadow, 0, x, y, shadow);
     }
 }
 

@@ -9,6 +9,7 @@
 // artefact kept, because it is what a single-layer gather does: a blurred foreground object's
 // edge stays sharp against an in-focus background behind it, since those pixels (circles
 // under half a pixel) gather nothing. The reference technique and ISG's DOF have neither.
+#include "core/vectorise.h"
 #include "raster/raster.h"
 
 #include <math.h>
@@ -193,7 +194,7 @@ static bool tile_is_uniform(const dof_job *job, int32_t tx, int32_t ty)
     return true;
 }
 
-static void classify_tiles(size_t begin, size_t end, int thread_index, void *user)
+static DRIFT_AVX2_CLONES void classify_tiles(size_t begin, size_t end, int thread_index, void *user)
 {
     (void)thread_index;
     const dof_job *job = user;
@@ -203,7 +204,9 @@ static void classify_tiles(size_t begin, size_t end, int thread_index, void *use
     }
 }
 
-static void dof_rows(size_t begin, size_t end, int thread_index, void *user)
+// Cloned for AVX2: floorf is one instruction there and sqrtf needs no errno (the file is built
+// with -fno-math-errno): 1.3x, the same image.
+static DRIFT_AVX2_CLONES void dof_rows(size_t begin, size_t end, int thread_index, void *user)
 {
     (void)thread_index;
     const dof_job *job = user;

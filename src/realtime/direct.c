@@ -333,17 +333,36 @@ static void shadow_filter_pixel(drift_frame_state *f, int32_t x, int32_t y, uint
     }
 }
 
-static void sum_direct_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
+// A row at a time (no call per pixel), the lights' terms added in the same order.
+static void sum_direct_row(drift_frame_state *f, int32_t y, uint64_t *rays, void *user)
 {
     (void)rays;
     (void)user;
-    drift_vec3 d = drift_image_get3(&f->environment_direct, x, y);
+    const int32_t w = f->params.width;
+    const float *env = drift_image_pixel(&f->environment_direct, 0, y);
+    float *out = drift_image_pixel(&f->direct, 0, y);
+    const int32_t ce = f->environment_direct.channels, co = f->direct.channels;
+    for (int32_t x = 0; x < w; ++x) {
+        float *o = out + (ptrdiff_t)x * co;
+        const float *e = env + (ptrdiff_t)x * ce;
+        o[0] = e[0];
+        o[1] = e[1];
+        o[2] = e[2];
+    }
     for (uint32_t l = 0; l < f->light_count; ++l) {
         const drift_frame_light_buffers *b = &f->light_buffers[l];
-        d = drift_vec3_fma(d, drift_image_get3(&b->unshadowed, x, y),
-                           drift_image_pixel(&b->shadow, x, y)[0]);
+        const float *u = drift_image_pixel(&b->unshadowed, 0, y);
+        const float *s = drift_image_pixel(&b->shadow, 0, y);
+        const int32_t cu = b->unshadowed.channels, cs = b->shadow.channels;
+        for (int32_t x = 0; x < w; ++x) {
+            float *o = out + (ptrdiff_t)x * co;
+            const float *ux = u + (ptrdiff_t)x * cu;
+            float sx = s[(ptrdiff_t)x * cs];
+            o[0] = o[0] + ux[0] * sx;
+            o[1] = o[1] + ux[1] * sx;
+            o[2] = o[2] + ux[2] * sx;
+        }
     }
-    drift_image_set3(&f->direct, x, y, d);
 }
 
 drift_result drift_realtime_ensure_shadow_map(drift_frame_state *f, uint32_t light, uint64_t *rays)
@@ -562,6 +581,6 @@ drift_result drift_realtime_pass_pcss(drift_frame_state *f, const drift_pass_arg
 
 drift_result drift_realtime_pass_sum_direct(drift_frame_state *f)
 {
-    drift_pass_pixels(f, DRIFT_PASS_COMPOSE, sum_direct_pixel, NULL); // part of composition
+    drift_pass_rows(f, DRIFT_PASS_COMPOSE, sum_direct_row, NULL); // part of composition
     return DRIFT_OK;
 }

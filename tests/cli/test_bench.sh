@@ -30,6 +30,18 @@ for k in ("primary", "shadow", "bounce"): assert d[k]["drift_rays_per_s"] > 0, k
         expect 0 "$drift" bench frame "$box" --width 16 --height 12 --frames 1 --json
         check frame 'assert d["width"] == 16 and len(d["configs"]) >= 1, d
 for c in d["configs"]: assert c["frame_ms"] > 0 and c["passes"]["primary"] >= 0, c'
+        # --floors: each pass against the bytes it must move, at the copy bandwidth of the run.
+        expect 0 "$drift" bench frame "$box" --floors --width 16 --height 12 --frames 1 --json
+        check frame-floors 'assert d["width"] == 16 and d["copy_gb_per_s"] > 0, d
+p = {x["name"]: x for x in d["passes"]}
+assert set(p) == {"compose", "post dof", "a-trous", "glare conv", "isg shadows",
+                  "isg reflections", "isg dof"}, d
+assert p["post dof"]["bytes"] == 16 * 12 * (12 + 4 + 12), p["post dof"]
+for x in d["passes"]:
+    assert x["ms"] >= 0 and x["floor_ms"] > 0 and x["bytes"] > 0, x
+    floor = x["bytes"] / (d["copy_gb_per_s"] * 1e6)  # bytes at the measured bandwidth
+    assert abs(x["floor_ms"] - floor) <= 0.01 * floor + 1e-6 and x["floor_ratio"] >= 0, x
+assert p["isg dof"]["samples"] == 0 and p["isg shadows"]["samples"] > 0, d  # a pinhole: no DOF'
         ;;
     isg)
         expect 0 "$drift" bench isg "$box" --width 16 --height 12 --qwidth 16 --qheight 12 \
