@@ -433,8 +433,8 @@ drift_result drift_temporal_apply(drift_temporal *t, const drift_gbuffer *g,
 
 bool drift_temporal_reseeds(const drift_hybrid_params *p)
 {
-    return p->indirect != DRIFT_INDIRECT_ISM && p->indirect != DRIFT_INDIRECT_IR &&
-           p->indirect != DRIFT_INDIRECT_MICRO && p->reflections != DRIFT_REFLECTIONS_MICRO &&
+    // ISM and IR reseed their VPLs without remaking the scene points (drift_ism_set_seed).
+    return p->indirect != DRIFT_INDIRECT_MICRO && p->reflections != DRIFT_REFLECTIONS_MICRO &&
            p->reflections != DRIFT_REFLECTIONS_ENVMAP;
 }
 
