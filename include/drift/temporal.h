@@ -20,7 +20,10 @@
 //      luminance exp(-|l_p - l_q| / (phi_luminance sqrt(var_p) + 1e-4)); the variance is
 //      filtered with squared weights. The history keeps the unfiltered l_acc, so a still
 //      camera converges to the mean of its frames (the reference when each frame is unbiased)
-//   5. remodulate: c' = e + a l_filtered
+//   5. remodulate: c' = e + a l_filtered, then resolve as TAA does: out = lerp(out_hist, c',
+//      1 / N) with out_hist the previous out through the same valid taps (N = 1: c'), so that
+//      what each frame's sub-pixel offset changes outside the lighting (the albedo and the
+//      emission at edges, textures, emitters) converges as well
 //
 // Settings (zeroed: the defaults; one place, so that they can become a knob-table row):
 //   max_history      = 0 -> 32 frames (the accumulation's floor is alpha = 1 / 32)
@@ -92,6 +95,12 @@ drift_result drift_temporal_apply(drift_temporal *t, const drift_gbuffer *gbuffe
 // draws a new set of VPLs from the cached scene points (drift_ism_set_seed), so that the
 // history gathers a different VPL set every frame (interleaving VPLs across frames).
 bool drift_temporal_reseeds(const drift_hybrid_params *params);
+// Frame k of a history (k = 0 after a reset) set up the one way the viewer and `drift render`
+// (--animation, --frames with --temporal on) do: the seed base_seed + k when
+// drift_temporal_reseeds(frame's params) (else the frame's seed is left alone), and the
+// jitter of frame k added to *camera's film shift. Errors: drift_hybrid_set_params'.
+drift_result drift_temporal_prepare(drift_hybrid *frame, uint32_t base_seed, uint32_t k,
+                                    drift_camera *camera);
 // Frame k's sub-pixel offset in pixels, in [-0.5, 0.5)^2: the Halton (2, 3) point k + 1, so
 // that the history's samples cover the pixel's box filter evenly (add it to the camera's
 // film_shift_x, film_shift_y).
