@@ -20,10 +20,7 @@
 //      luminance exp(-|l_p - l_q| / (phi_luminance sqrt(var_p) + 1e-4)); the variance is
 //      filtered with squared weights. The history keeps the unfiltered l_acc, so a still
 //      camera converges to the mean of its frames (the reference when each frame is unbiased)
-//   5. remodulate: c' = e + a l_filtered, then resolve as TAA does: out = lerp(out_hist, c',
-//      1 / N) with out_hist the previous out through the same valid taps (N = 1: c'), so that
-//      what each frame's sub-pixel offset changes outside the lighting (the albedo and the
-//      emission at edges, textures, emitters) converges as well
+//   5. remodulate: c' = e + a l_filtered
 //
 // Settings (zeroed: the defaults; one place, so that they can become a knob-table row):
 //   max_history      = 0 -> 32 frames (the accumulation's floor is alpha = 1 / 32)

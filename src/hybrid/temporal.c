@@ -28,11 +28,6 @@ struct drift_temporal {
     drift_image sample_lum;       // 1: this frame's demodulated luminance (spatial moments)
     drift_image filter[2];        // 4: lighting and variance, ping-pong
     drift_image out;              // 3
-    // The resolve: out averaged over the same history as the lighting, so that what the
-    // lighting's demodulation leaves per frame (the albedo and emission at each frame's
-    // sub-pixel offset: edges, textures, emitters) converges too (TAA's resolve).
-    drift_image out_prev; // 3: the last frame's out
-    drift_image out_hist; // 3: out_prev reprojected by this frame's valid taps
 };
 
 drift_temporal_settings drift_temporal_settings_resolve(const drift_temporal_settings *in)
@@ -65,8 +60,6 @@ void drift_temporal_destroy(drift_temporal *t)
     }
     drift_image_destroy(t->ctx, &t->sample_lum);
     drift_image_destroy(t->ctx, &t->out);
-    drift_image_destroy(t->ctx, &t->out_prev);
-    drift_image_destroy(t->ctx, &t->out_hist);
     drift_free(t->ctx, t);
 }
 
@@ -111,9 +104,8 @@ drift_result drift_temporal_create(drift_context *ctx, int32_t width, int32_t he
     if (r == DRIFT_OK) {
         r = drift_image_create(ctx, width, height, 1, &t->sample_lum);
     }
-    drift_image *rgb[] = { &t->out, &t->out_prev, &t->out_hist };
-    for (size_t i = 0; r == DRIFT_OK && i < sizeof rgb / sizeof *rgb; ++i) {
-        r = drift_image_create(ctx, width, height, 3, rgb[i]);
+    if (r == DRIFT_OK) {
+        r = drift_image_create(ctx, width, height, 3, &t->out);
     }
     if (r != DRIFT_OK) {
         drift_temporal_destroy(t);
@@ -210,7 +202,7 @@ static void accumulate_rows(size_t begin, size_t end, int thread_index, void *us
             float lum = drift_luminance(l);
             drift_image_pixel(&t->sample_lum, x, y)[0] = lum;
             // The history: the valid bilinear taps around p + motion.
-            drift_vec3 hist = drift_vec3_splat(0.0f), hist_out = drift_vec3_splat(0.0f);
+            drift_vec3 hist = drift_vec3_splat(0.0f);
             float hist_mom[2] = { 0.0f, 0.0f };
             float hist_len = 0.0f, weight = 0.0f;
             if (t->has_prev) {
@@ -226,7 +218,6 @@ static void accumulate_rows(size_t begin, size_t end, int thread_index, void *us
                         continue;
                     }
                     hist = drift_vec3_fma(hist, drift_image_get3(&t->light[pr], tx, ty), w);
-                    hist_out = drift_vec3_fma(hist_out, drift_image_get3(&t->out_prev, tx, ty), w);
                     const float *hm = drift_image_pixel(&t->moments[pr], tx, ty);
                     hist_mom[0] += w * hm[0];
                     hist_mom[1] += w * hm[1];
@@ -238,7 +229,6 @@ static void accumulate_rows(size_t begin, size_t end, int thread_index, void *us
             if (weight > 1e-3f) {
                 float inv = 1.0f / weight;
                 hist = drift_vec3_scale(hist, inv);
-                hist_out = drift_vec3_scale(hist_out, inv);
                 hist_mom[0] *= inv;
                 hist_mom[1] *= inv;
                 n_frames = fminf(hist_len * inv + 1.0f, (float)t->s.max_history);
@@ -253,7 +243,6 @@ static void accumulate_rows(size_t begin, size_t end, int thread_index, void *us
                 n_frames > 1.0f ? (1.0f - alpha_m) * hist_mom[1] + alpha_m * lum * lum : lum * lum;
             len[0] = n_frames;
             drift_image_set3(&t->light[c], x, y, acc);
-            drift_image_set3(&t->out_hist, x, y, hist_out);
         }
     }
 }
@@ -409,14 +398,9 @@ static void remodulate_rows(size_t begin, size_t end, int thread_index, void *us
             const float *l = drift_image_pixel(filtered, x, y);
             drift_vec3 a = demodulation(g, x, y);
             drift_vec3 e = drift_image_get3(&g->emission, x, y);
-            drift_vec3 c = drift_vec3_add(e, drift_vec3_make(a.x * l[0], a.y * l[1], a.z * l[2]));
-            // The resolve: the same 1 / N as the lighting's (N = 1: no history, c alone).
-            float n_frames = drift_image_pixel(&t->length[job->cur], x, y)[0];
-            if (n_frames > 1.0f) {
-                drift_vec3 h = drift_image_get3(&t->out_hist, x, y);
-                c = drift_vec3_add(h, drift_vec3_scale(drift_vec3_sub(c, h), 1.0f / n_frames));
-            }
-            drift_image_set3(&t->out, x, y, c);
+            drift_image_set3(
+                &t->out, x, y,
+                drift_vec3_add(e, drift_vec3_make(a.x * l[0], a.y * l[1], a.z * l[2])));
         }
     }
 }
@@ -442,8 +426,6 @@ drift_result drift_temporal_apply(drift_temporal *t, const drift_gbuffer *g,
         drift_parallel_for(t->ctx, rows, 4, filter_rows, &fj);
     }
     drift_parallel_for(t->ctx, rows, 4, remodulate_rows, &job);
-    memcpy(t->out_prev.pixels, t->out.pixels,
-           (size_t)t->width * (size_t)t->height * 3 * sizeof(float));
     (void)camera; // the motion vectors carry the camera's move
     t->has_prev = true;
     return DRIFT_OK;
