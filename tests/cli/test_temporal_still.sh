@@ -4,8 +4,8 @@
 # frames 0..15 of a camera path that does not move, with --temporal on, scored by FLIP against
 # the path tracer at 128 spp. The error is monotone in the frames within noise (each of frames
 # 2, 4, 8, 16 at most 2% above the one before, and frame 16 below 0.95 x frame 1; measured
-# 0.212, 0.198, 0.193, 0.189, 0.185), and `--frames N --temporal on` (the viewer's set-up, drift/temporal.h)
-# writes frame N - 1 of that sequence bit for bit. $1 is the drift binary.
+# 0.212, 0.198, 0.193, 0.189, 0.185), and `--frames N --temporal on` (the viewer's set-up,
+# drift/temporal.h) writes frame N - 1 of that sequence bit for bit. $1 is the drift binary.
 set -u
 drift="$1"
 source "$(dirname "$0")/common.sh"
