@@ -281,7 +281,8 @@ static const cli_option render_table[] = {
             "are a frame with warm caches (default 1; first_frame_ms in\n"
             "--stats has the first)"),
     CLI_CHOICE("--temporal", "off|on", O, temporal, "off|on",
-               "reuse across --animation frames: reprojection, disocclusion tests,\n"
+               "reuse across --animation frames (or --frames N of a still camera:\n"
+               "the last, accumulated, is written): reprojection, disocclusion tests,\n"
                "variance-guided accumulation and filtering (docs/temporal.md)"),
     CLI_INT("--temporal-history", "N", O, temporal_settings.max_history, 1, 4096,
             "frames the temporal accumulation averages at most (default 32)"),

@@ -204,6 +204,7 @@ int render_hybrid(const render_options *o, const cli_session *session)
     drift_scene *scene = session->scene;
     const char *scene_path = session->scene_path;
     drift_hybrid *frame = NULL;
+    drift_temporal *temporal = NULL; // --temporal on (--frames: a still camera's sequence)
     drift_result r = DRIFT_OK;
     int exit_code = 1;
     if (o->aperture >= 0.0) {
@@ -246,9 +247,23 @@ int render_hybrid(const render_options *o, const cli_session *session)
     }
     // Frames after the first reuse what the frame keeps (shadow maps, probes, the techniques'
     // state slots): the last frame's stats are the interactive cost.
+    // --temporal on: the frames are a still camera's sequence with temporal reuse (the
+    // viewer's), and the last frame's accumulated image is written.
     drift_hybrid_stats first = { 0 };
+    if (o->temporal) {
+        r = drift_temporal_create(ctx, params.width, params.height, &o->temporal_settings,
+                                  &temporal);
+    }
     for (long k = 0; k < o->frames && r == DRIFT_OK; ++k) {
-        r = drift_hybrid_render(frame, &scene->camera, render_catch_sigint());
+        drift_camera camera = scene->camera;
+        if (temporal) {
+            r = drift_temporal_prepare(frame, (uint32_t)o->seed, (uint32_t)k, &camera);
+        }
+        r = r == DRIFT_OK ? drift_hybrid_render(frame, &camera, render_catch_sigint()) : r;
+        if (r == DRIFT_OK && temporal) {
+            r = drift_temporal_apply(temporal, drift_hybrid_gbuffer(frame), &camera,
+                                     drift_hybrid_image(frame));
+        }
         if (k == 0) {
             first = drift_hybrid_get_stats(frame);
         }
@@ -269,7 +284,9 @@ int render_hybrid(const render_options *o, const cli_session *session)
     }
     // --out, its PNG, --aov and --stats: all written, or none.
     render_stage stage = { 0 };
-    if (!render_stage_hybrid_images(ctx, o, drift_hybrid_image(frame), frame, NULL, &stage)) {
+    const drift_image *image =
+        temporal ? drift_temporal_image(temporal) : drift_hybrid_image(frame);
+    if (!render_stage_hybrid_images(ctx, o, image, frame, NULL, &stage)) {
         goto done;
     }
     double t_done = drift_time_now();
@@ -315,6 +332,7 @@ int render_hybrid(const render_options *o, const cli_session *session)
            drift_hybrid_get_stats(frame).frame_ms);
     exit_code = 0;
 done:
+    drift_temporal_destroy(temporal);
     drift_hybrid_destroy(frame);
     return exit_code;
 }

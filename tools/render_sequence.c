@@ -48,8 +48,10 @@ bool render_sequence_validate(const render_options *o)
             fprintf(stderr, "drift render: %s needs --animation A:B\n", given);
             return false;
         }
-        if (o->temporal) {
-            fprintf(stderr, "drift render: --temporal on needs --animation A:B (a sequence)\n");
+        if (o->temporal && o->refine.enabled) {
+            // Without --animation, --temporal on reuses across --frames N of a still camera.
+            fprintf(stderr, "drift render: --temporal on is for --animation A:B or --frames N; "
+                            "--refine refines one frame\n");
             return false;
         }
         return true;
@@ -140,15 +142,13 @@ static int hybrid_frame(sequence_run *s, long k, const drift_camera *camera, con
     uint32_t index = (uint32_t)(k - o->frame_first);
     if (s->temporal) {
         // A new seed and sub-pixel offset a frame: the history averages independent samples
-        // over the pixel's box filter, as the path tracer does.
-        drift_hybrid_params p = drift_hybrid_get_params(s->frame);
-        p.seed = (uint32_t)o->seed + (uint32_t)k;
-        if (drift_temporal_reseeds(&p) && drift_hybrid_set_params(s->frame, &p) != DRIFT_OK) {
+        // over the pixel's box filter, as the path tracer does (the viewer's set-up).
+        cam.film_shift_x = 0.0f;
+        cam.film_shift_y = 0.0f;
+        uint32_t base = (uint32_t)o->seed + (uint32_t)o->frame_first;
+        if (drift_temporal_prepare(s->frame, base, index, &cam) != DRIFT_OK) {
             return 1;
         }
-        drift_vec2 jitter = drift_temporal_jitter(index);
-        cam.film_shift_x = jitter.x;
-        cam.film_shift_y = jitter.y;
     }
     drift_result r = drift_hybrid_render(s->frame, &cam, render_catch_sigint());
     if (r == DRIFT_ERR_CANCELLED) {

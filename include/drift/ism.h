@@ -198,6 +198,11 @@ drift_result drift_ism_render(drift_ism *ism, const drift_gbuffer *gbuffer,
 drift_result drift_ism_render_slice(drift_ism *ism, const drift_gbuffer *gbuffer,
                                     const drift_camera *camera, const drift_image *direct,
                                     uint32_t slice, uint32_t slices);
+// Draws the next render's VPL paths (and the near-field rays) from `seed` without remaking
+// the pre-computation: the scene points keep the seed the object was created with. A sequence
+// that reseeds every frame gets an independent set of VPLs a frame at the cost of a render
+// (temporal reuse averages them: docs/temporal.md). NULL-safe.
+void drift_ism_set_seed(drift_ism *ism, uint32_t seed);
 
 // RGB radiance: the diffuse indirect light I at each pixel (0 where the G-buffer missed).
 const drift_image *drift_ism_indirect(const drift_ism *ism);

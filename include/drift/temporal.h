@@ -86,10 +86,18 @@ drift_result drift_temporal_apply(drift_temporal *t, const drift_gbuffer *gbuffe
                                   const drift_camera *camera, const drift_image *color);
 // Whether a driver of temporal reuse should give each frame of `params` a new seed (so that
 // the history averages independent samples): true unless a chosen technique keeps state built
-// from the seed that a new seed rebuilds (indirect ism, ir and micro: the VPLs and their maps,
-// the point hierarchy; reflections micro and envmap: the hierarchy, the probes). Those keep
-// their seed, and the frames differ by their sub-pixel offsets (and the camera's move) alone.
+// from the seed that a new seed rebuilds (indirect micro: the point hierarchy; reflections
+// micro and envmap: the hierarchy, the probes). Those keep their seed, and the frames differ by
+// their sub-pixel offsets (and the camera's move) alone. Indirect ism and ir reseed: a new seed
+// draws a new set of VPLs from the cached scene points (drift_ism_set_seed), so that the
+// history gathers a different VPL set every frame (interleaving VPLs across frames).
 bool drift_temporal_reseeds(const drift_hybrid_params *params);
+// Frame k of a history (k = 0 after a reset) set up the one way the viewer and `drift render`
+// (--animation, --frames with --temporal on) do: the seed base_seed + k when
+// drift_temporal_reseeds(frame's params) (else the frame's seed is left alone), and the
+// jitter of frame k added to *camera's film shift. Errors: drift_hybrid_set_params'.
+drift_result drift_temporal_prepare(drift_hybrid *frame, uint32_t base_seed, uint32_t k,
+                                    drift_camera *camera);
 // Frame k's sub-pixel offset in pixels, in [-0.5, 0.5)^2: the Halton (2, 3) point k + 1, so
 // that the history's samples cover the pixel's box filter evenly (add it to the camera's
 // film_shift_x, film_shift_y).

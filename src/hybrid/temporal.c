@@ -433,9 +433,29 @@ drift_result drift_temporal_apply(drift_temporal *t, const drift_gbuffer *g,
 
 bool drift_temporal_reseeds(const drift_hybrid_params *p)
 {
-    return p->indirect != DRIFT_INDIRECT_ISM && p->indirect != DRIFT_INDIRECT_IR &&
-           p->indirect != DRIFT_INDIRECT_MICRO && p->reflections != DRIFT_REFLECTIONS_MICRO &&
+    // ISM and IR reseed their VPLs without remaking the scene points (drift_ism_set_seed).
+    return p->indirect != DRIFT_INDIRECT_MICRO && p->reflections != DRIFT_REFLECTIONS_MICRO &&
            p->reflections != DRIFT_REFLECTIONS_ENVMAP;
+}
+
+drift_result drift_temporal_prepare(drift_hybrid *frame, uint32_t base_seed, uint32_t k,
+                                    drift_camera *camera)
+{
+    if (!frame || !camera) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    drift_hybrid_params p = drift_hybrid_get_params(frame);
+    if (drift_temporal_reseeds(&p) && p.seed != base_seed + k) {
+        p.seed = base_seed + k;
+        drift_result r = drift_hybrid_set_params(frame, &p);
+        if (r != DRIFT_OK) {
+            return r;
+        }
+    }
+    drift_vec2 jitter = drift_temporal_jitter(k);
+    camera->film_shift_x += jitter.x;
+    camera->film_shift_y += jitter.y;
+    return DRIFT_OK;
 }
 
 // The radical inverse of k in `base`.

@@ -157,7 +157,7 @@ drift_result drift__ism_reserve(drift_ism *ism, uint32_t vpls)
     if (p->points_per_vpl > 0 && drift_scene_triangle_count(ism->scene) > 0) {
         drift_points_desc pd = { .count = p->points_per_vpl * capacity,
                                  .subset_count = capacity,
-                                 .seed = p->seed };
+                                 .seed = ism->points_seed };
         drift_result r = drift_points_create(ism->ctx, ism->scene, &pd, &points);
         if (r != DRIFT_OK) {
             drift_free(ism->ctx, atlas);
@@ -215,6 +215,7 @@ drift_result drift_ism_create(drift_context *ctx, const drift_scene *scene,
     ism->scene = scene;
     ism->accel = accel;
     ism->params = p;
+    ism->points_seed = p.seed;
     ism->diagonal = drift_scene_extent(scene);
     ism->max_vpls = drift__ism_max_vpls(&p);
     // The push is left to the lookups for the usual 1 or 2 levels (drift__ism_lookup);
@@ -610,6 +611,14 @@ drift_result drift_ism_render_slice(drift_ism *ism, const drift_gbuffer *gbuffer
                                     uint32_t slice, uint32_t slices)
 {
     return render(ism, gbuffer, camera, direct, slice, slices);
+}
+
+void drift_ism_set_seed(drift_ism *ism, uint32_t seed)
+{
+    if (ism && ism->params.seed != seed) {
+        ism->params.seed = seed;
+        ism->lights_ready = false; // the next render draws the new seed's VPLs
+    }
 }
 
 const drift_image *drift_ism_indirect(const drift_ism *ism)

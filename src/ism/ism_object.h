@@ -13,6 +13,7 @@ struct drift_ism {
     drift_ism_params params;
     float diagonal;
     drift_points *points;
+    uint32_t points_seed; // the seed the points are drawn with: the create's (drift_ism_set_seed)
     uint32_t max_vpls;
     uint32_t map_capacity; // VPLs the atlas and the points hold now (<= max_vpls)
     drift_vpl *vpls;

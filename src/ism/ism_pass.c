@@ -33,9 +33,11 @@ static drift_ism_params params_of(const drift_frame_state *f, drift_ism_visibili
                                .later_vpl_count = f->params.ism.later_paths };
 }
 
+// All but the seed: a new seed draws new VPLs from the same scene points
+// (drift_ism_set_seed), so that a sequence can reseed every frame without the set-up.
 static bool same_params(const drift_ism_params *a, const drift_ism_params *b)
 {
-    return a->seed == b->seed && a->visibility == b->visibility && a->vpl_count == b->vpl_count &&
+    return a->visibility == b->visibility && a->vpl_count == b->vpl_count &&
            a->max_depth == b->max_depth && a->map_size == b->map_size &&
            a->points_per_vpl == b->points_per_vpl && a->vpl_importance == b->vpl_importance &&
            a->no_near_field == b->no_near_field && a->gather_scale == b->gather_scale &&
@@ -60,6 +62,9 @@ static drift_result indirect(drift_frame_state *f, const drift_pass_args *args,
         }
         drift_pass_set_state(f, args, made, state_destroy);
         s = made;
+    } else if (s->params.seed != want.seed) {
+        drift_ism_set_seed(s->ism, want.seed);
+        s->params.seed = want.seed;
     }
     // The lights do not move between the anti-aliasing passes of a frame (their paths key on
     // the frame's seed, not the pass's): pass 0 draws them, and each pass gathers its own

@@ -441,17 +441,8 @@ void drift_view_set_camera(drift_view *view, const drift_camera *camera)
 // independent samples over the pixel (the path tracer's box filter).
 drift_result drift_view_temporal_begin(drift_view *view, drift_camera *camera)
 {
-    uint32_t k = view->temporal_frame++;
-    drift_hybrid_params p = drift_hybrid_get_params(view->hybrid);
-    drift_result r = DRIFT_OK;
-    if (drift_temporal_reseeds(&p)) {
-        p.seed = view->base_seed + k;
-        r = drift_hybrid_set_params(view->hybrid, &p);
-    }
-    drift_vec2 jitter = drift_temporal_jitter(k);
-    camera->film_shift_x += jitter.x;
-    camera->film_shift_y += jitter.y;
-    return r;
+    // The same set-up as drift render's sequences and --frames (drift/temporal.h).
+    return drift_temporal_prepare(view->hybrid, view->base_seed, view->temporal_frame++, camera);
 }
 
 drift_result drift_view_frame(drift_view *view, const atomic_bool *cancel)
