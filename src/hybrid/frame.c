@@ -241,6 +241,7 @@ void drift_hybrid_destroy(drift_hybrid *h)
         }
     }
     destroy_probes(f);
+    drift_env_prefilter_destroy(ctx, f->env_prefilter);
     drift_pass_free_states(f);
     drift_isg_destroy(f);
     drift_aaf_state_destroy(ctx, f->aaf);
