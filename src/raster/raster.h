@@ -190,6 +190,12 @@ drift_raster_radiance drift_raster_trace_radiance(const drift_raster_shading *sh
 // clamped to ks).
 drift_vec3 drift_raster_reflection_weight(const drift_bsdf *bsdf, drift_vec3 wo);
 
+// The diffuse lobe's directional albedo toward w, what an image-space or VPL technique that
+// shades albedo x irradiance / pi multiplies by: kd for Lambert; for Burley's diffuse and
+// GGX's plastic base the integral of the BSDF's own diffuse lobe (16 cosine points); 0 for
+// mirrors and glass.
+drift_vec3 drift_raster_diffuse_albedo(const drift_bsdf *bsdf, drift_vec3 w);
+
 // Glossiness of a material for the gloss plane and gathers: the half angle theta_max of the
 // cone that holds 90% of the Phong lobe, cos(theta_max) = 0.1^(1/(n+1)); for GGX the cone
 // holding 90% of its reflected directions at normal incidence, drift_ggx_theta_90(alpha)

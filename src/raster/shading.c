@@ -166,6 +166,31 @@ static drift_vec3 diffuse_albedo_toward(const drift_bsdf *bsdf, const drift_surf
     return drift_vec3_scale(diffuse, DRIFT_PI);
 }
 
+drift_vec3 drift_raster_diffuse_albedo(const drift_bsdf *bsdf, drift_vec3 w)
+{
+    if (bsdf->type == DRIFT_MATERIAL_MIRROR) {
+        return drift_vec3_splat(0.0f);
+    }
+    if (bsdf->type == DRIFT_MATERIAL_DEFAULT && bsdf->diffuse_model == DRIFT_DIFFUSE_LAMBERT) {
+        return bsdf->diffuse;
+    }
+    if (!(drift_vec3_dot(w, bsdf->frame.z) > 0.0f)) {
+        w = bsdf->frame.z;
+    }
+    // int f_diffuse(w, wi) cos dwi = E[pi f_diffuse] over cosine-distributed wi: 16 points.
+    drift_vec3 sum = drift_vec3_splat(0.0f);
+    const uint32_t n = 16;
+    for (uint32_t k = 0; k < n; ++k) {
+        drift_vec3 local =
+            drift_sample_cosine_hemisphere(drift_hammersley_shifted(k, n, drift_vec2_make(0, 0)));
+        drift_vec3 diffuse, glossy;
+        drift_bsdf_eval_lobes(bsdf, w, drift_frame_to_world(&bsdf->frame, local), &diffuse,
+                              &glossy);
+        sum = drift_vec3_add(sum, diffuse);
+    }
+    return drift_vec3_scale(sum, DRIFT_PI / (float)n);
+}
+
 // The diffuse lobe's share of U_l in closed form: kd / pi * sum over polygons (or the sphere)
 // of L_e * E. Each polygon emits from its front face only.
 static drift_vec3 polygon_diffuse(const drift_scene *scene, const drift_raster_light *light,
