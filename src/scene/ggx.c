@@ -489,6 +489,16 @@ void drift_bsdf_ggx_reflection_albedo(const drift_bsdf *bsdf, float mu, drift_ve
         if (g->w_plastic > 0.0f) {
             single = drift_vec3_fma(single, coat_albedo(g->f0_coat, e1, es), g->w_plastic);
         }
+        if (g->w_dielectric > 0.0f && smooth_dielectric(g)) {
+            // A smooth dielectric's reflection, a delta no light sample finds: its Fresnel
+            // (a thin sheet's with the inter-reflections, as its sampling has it).
+            float r = drift__fresnel_dielectric(
+                fminf(mu, 1.0f), g->thin ? fmaxf(g->eta_rel, 1.0f / g->eta_rel) : g->eta_rel);
+            if (g->thin && r < 1.0f) {
+                r += (1.0f - r) * (1.0f - r) * r / (1.0f - r * r);
+            }
+            single = drift_vec3_add(single, drift_vec3_splat(g->w_dielectric * r));
+        }
     }
     *out_single = single;
     *out_multiple = multiple;
