@@ -232,11 +232,10 @@ static drift_vec3 gather_pixel(const gather_job *job, int32_t x, int32_t y,
     axis = drift_frame_to_local(&frame, axis);
     axis.z = fmaxf(axis.z, 0.05f);
     axis = drift_vec3_normalize(axis);
-    // GGX: all but 10^-3 of its half vectors lie within tan theta_h = 31.6 alpha (its tails
-    // reach further than the Phong-equivalent lobe's cap).
-    float cap = bsdf.type == DRIFT_MATERIAL_GGX
-                    ? cosf(fminf(2.0f * atanf(31.6f * fmaxf(bsdf.ggx.alpha, 1e-3f)), 1.55f))
-                    : drift__micro_phong_cap(bsdf.exponent);
+    // GGX too: the cap of its Phong-equivalent lobe. GGX's own 10^-3 cap (tan theta_h =
+    // 31.6 alpha, its tails) is ~12x wider and gives the peak too few cells: FLIP 0.297
+    // against 0.232 on scenes/ggx-spheres (docs/lab/2026-12-07-issue-41-s2.md).
+    float cap = drift__micro_phong_cap(bsdf.exponent);
     drift__micro_warp_build_cap(&warp, m->params.warp_size, axis, cap, glossy_lobe, &slice);
     if (!(warp.rho > 0.0f)) {
         return drift_vec3_splat(0.0f);
