@@ -191,9 +191,9 @@ drift_raster_radiance drift_raster_trace_radiance(const drift_raster_shading *sh
 drift_vec3 drift_raster_reflection_weight(const drift_bsdf *bsdf, drift_vec3 wo);
 
 // The diffuse lobe's directional albedo toward w, what an image-space or VPL technique that
-// shades albedo x irradiance / pi multiplies by: kd for Lambert; for Burley's diffuse and
-// GGX's plastic base the integral of the BSDF's own diffuse lobe (16 cosine points); 0 for
-// mirrors and glass.
+// shades albedo x irradiance / pi multiplies by: kd for Lambert; GGX's layered plastic base
+// exactly, base (1 - Ec(mu)); Burley's diffuse (and GGX's Principled base) the integral of
+// its lobe over 16 cosine points; 0 for mirrors and glass.
 drift_vec3 drift_raster_diffuse_albedo(const drift_bsdf *bsdf, drift_vec3 w);
 
 // Glossiness of a material for the gloss plane and gathers: the half angle theta_max of the

@@ -174,18 +174,45 @@ drift_vec3 drift_raster_diffuse_albedo(const drift_bsdf *bsdf, drift_vec3 w)
     if (bsdf->type == DRIFT_MATERIAL_DEFAULT && bsdf->diffuse_model == DRIFT_DIFFUSE_LAMBERT) {
         return bsdf->diffuse;
     }
-    if (!(drift_vec3_dot(w, bsdf->frame.z) > 0.0f)) {
+    float mu = drift_vec3_dot(w, bsdf->frame.z);
+    if (!(mu > 0.0f)) {
         w = bsdf->frame.z;
+        mu = 1.0f;
     }
-    // int f_diffuse(w, wi) cos dwi = E[pi f_diffuse] over cosine-distributed wi: 16 points.
+    drift_bsdf b = *bsdf;
+    if (b.type == DRIFT_MATERIAL_GGX) {
+        const drift_bsdf_ggx *g = &bsdf->ggx;
+        if (!(g->w_plastic > 0.0f) || g->skip_diffuse) {
+            return drift_vec3_splat(0.0f);
+        }
+        drift_vec3 base = drift_vec3_scale(g->base, g->w_plastic);
+        if (g->burley_roughness < 0.0f) {
+            // The layered base reflects base (1 - Ec(mu)) exactly (its normalisation by
+            // 1 - Ec_avg makes the cosine-weighted integral over wi of 1 - Ec(mu_i) one).
+            b.ggx.w_conductor = 0.0f;
+            b.ggx.w_dielectric = 0.0f;
+            b.ggx.w_plastic = 1.0f;
+            drift_vec3 ec, unused;
+            drift_bsdf_ggx_reflection_albedo(&b, mu, &ec, &unused);
+            return drift_vec3_mul(base, drift_vec3_sub(drift_vec3_splat(1.0f), ec));
+        }
+        // Principled's Burley base: the same lobe as a Burley material's.
+        b.type = DRIFT_MATERIAL_DEFAULT;
+        b.diffuse = base;
+        b.specular = drift_vec3_splat(0.0f);
+        b.diffuse_model = DRIFT_DIFFUSE_BURLEY;
+        b.diffuse_roughness = g->burley_roughness;
+    }
+    // Burley: int f_diffuse(w, wi) cos dwi = E[pi f_diffuse] over cosine-distributed wi (16
+    // points: 8 were 2% low at normal incidence).
     drift_vec3 sum = drift_vec3_splat(0.0f);
     const uint32_t n = 16;
     for (uint32_t k = 0; k < n; ++k) {
-        drift_vec3 local =
-            drift_sample_cosine_hemisphere(drift_hammersley_shifted(k, n, drift_vec2_make(0, 0)));
+        // (y shifted half a stratum: y = 0 is the disc's rim, a grazing direction of f = 0)
+        drift_vec3 local = drift_sample_cosine_hemisphere(
+            drift_hammersley_shifted(k, n, drift_vec2_make(0.0f, 0.5f / (float)n)));
         drift_vec3 diffuse, glossy;
-        drift_bsdf_eval_lobes(bsdf, w, drift_frame_to_world(&bsdf->frame, local), &diffuse,
-                              &glossy);
+        drift_bsdf_eval_lobes(&b, w, drift_frame_to_world(&b.frame, local), &diffuse, &glossy);
         sum = drift_vec3_add(sum, diffuse);
     }
     return drift_vec3_scale(sum, DRIFT_PI / (float)n);
