@@ -416,6 +416,11 @@ typedef struct drift_bsdf_ggx {
     // their cosine-weighted averages (src/scene/ggx_tables.c).
     int alpha_row;
     float alpha_frac, e1_avg, es_avg;
+    // False from drift_bsdf_make. A technique that renders a part itself sets them on its copy:
+    // drift_bsdf_eval and _eval_lobes then leave out the conductor and the coat's reflection
+    // (skip_reflection: the hybrid frame's split-sum environment light) or the plastic's
+    // diffuse base (skip_diffuse). The pdf and sampling do not change.
+    bool skip_reflection, skip_diffuse;
 } drift_bsdf_ggx;
 
 // Resolved material at one point (textures applied). All directions in world space.
@@ -469,6 +474,16 @@ drift_vec3 drift_bsdf_mirror_direction(const drift_bsdf *bsdf, drift_vec3 wo);
 // (the path tracer, AAF's specular buffer and SIR's ray tracer). It may point below the surface.
 drift_vec3 drift_bsdf_sample_glossy_lobe(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec2 u);
 bool drift_bsdf_is_delta(const drift_bsdf *bsdf);
+// A GGX BSDF's directional albedo toward wo (mu = cos theta_o) of its reflection lobes, the
+// split sum's DFG term: the conductor's and the coat's single-scattering lobe F0 (E1 - Es) + Es
+// (around the mirror direction) and the conductor's multiple-scattering lobe (nearly
+// cosine-shaped), each times its weight; a smooth (delta) dielectric's Fresnel reflection too
+// (a rough one's is left to sampling). Zero for other materials.
+// A visible normal of GGX roughness alpha for wo (local frame, wo.z > 0; Heitz 2018): the
+// path tracer's sampling, for techniques that trace the lobe's rays themselves.
+drift_vec3 drift_ggx_sample_visible_normal(float alpha, drift_vec3 wo, drift_vec2 u);
+void drift_bsdf_ggx_reflection_albedo(const drift_bsdf *bsdf, float mu, drift_vec3 *out_single,
+                                      drift_vec3 *out_multiple);
 
 // --- LIGHT SAMPLING ---
 

@@ -11,8 +11,15 @@
 
 static bool specular_at(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec3 *albedo, float *omega)
 {
-    *albedo = bsdf->specular;
-    *omega = bsdf->type == DRIFT_MATERIAL_MIRROR ? 0.0f : drift_aaf_omega_specular(bsdf->exponent);
+    if (bsdf->type == DRIFT_MATERIAL_GGX) {
+        *albedo = drift_raster_reflection_weight(bsdf, wo); // the GGX reflection's albedo
+    } else {
+        *albedo = bsdf->specular;
+    }
+    // The bandwidth of the lobe's Blinn-Phong exponent: GGX's by its 90% cone (docs/aaf.md).
+    *omega = bsdf->type == DRIFT_MATERIAL_MIRROR
+                 ? 0.0f
+                 : drift_aaf_omega_specular(0.25f * drift_gloss_blinn_exponent(bsdf));
     bool lobe = bsdf->type == DRIFT_MATERIAL_MIRROR || bsdf->exponent > 0.0f;
     // Seen from below, the lobe reflects nothing (drift_bsdf_eval is 0 there).
     return lobe && !drift_vec3_is_zero(bsdf->specular) && drift_vec3_dot(wo, bsdf->frame.z) > 0.0f;
@@ -28,6 +35,17 @@ static void specular_sample(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec2 u,
     if (*emission) {
         *wi = drift_bsdf_mirror_direction(bsdf, wo); // e(q) under reflection edits
         *weight = 1.0f;
+        return;
+    }
+    if (bsdf->type == DRIFT_MATERIAL_GGX) {
+        // GGX's own reflection lobe by its visible normals; the albedo (specular_at) carries
+        // the energy, so each sample weighs 1 (F G2 / G1 over the albedo averages 1).
+        drift_vec3 wo_local = drift_frame_to_local(&bsdf->frame, wo);
+        drift_vec3 m = drift_ggx_sample_visible_normal(bsdf->ggx.alpha, wo_local, u);
+        drift_vec3 wi_local =
+            drift_vec3_sub(drift_vec3_scale(m, 2.0f * drift_vec3_dot(wo_local, m)), wo_local);
+        *wi = drift_frame_to_world(&bsdf->frame, wi_local);
+        *weight = wi_local.z > 0.0f ? 1.0f : 0.0f;
         return;
     }
     float n = bsdf->exponent;

@@ -112,6 +112,9 @@ typedef struct drift_frame_state {
 
     drift_frame_probe *probes;
     uint32_t probe_count;
+    // The environment prefiltered by GGX roughness (the split sum's lookup; built on first
+    // use by the unshadowed pass, kept while the scene stands).
+    drift_env_prefilter *env_prefilter;
 
     drift_ray_counter *counters; // one per thread
     int thread_count;

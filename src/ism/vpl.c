@@ -9,6 +9,7 @@
 // over paths is an unbiased estimate of the emitted power and the sum of the VPLs' flux is the
 // reflected flux, bounce by bounce.
 #include "ism/ism_internal.h"
+#include "raster/raster.h"
 #include "scene/light_path.h"
 
 #include <math.h>
@@ -261,7 +262,10 @@ static bool emit(const path_job *job, drift_sampler *s, drift_ray *out_ray, drif
 static void glossy_lobe(const drift_bsdf *bsdf, drift_vec3 toward_light, drift_vec3 flux,
                         drift_vpl *vpl)
 {
-    float n = fminf(bsdf->exponent, DRIFT_VPL_MAX_EXPONENT);
+    // GGX: the Phong lobe of its 90% cone and of its reflection's albedo toward the light.
+    float n = bsdf->type == DRIFT_MATERIAL_GGX ? 0.25f * drift_gloss_blinn_exponent(bsdf)
+                                               : bsdf->exponent;
+    n = fminf(n, DRIFT_VPL_MAX_EXPONENT);
     uint32_t k = 0;
     while (k < DRIFT_VPL_MAX_SQUARINGS && (float)(2u << k) <= n) {
         ++k;
@@ -269,7 +273,10 @@ static void glossy_lobe(const drift_bsdf *bsdf, drift_vec3 toward_light, drift_v
     float m = (float)(1u << k);
     vpl->squarings = k;
     vpl->lobe = drift_bsdf_mirror_direction(bsdf, toward_light);
-    vpl->glossy = drift_vec3_scale(drift_vec3_mul(flux, bsdf->specular), 0.5f * (m + 2.0f));
+    drift_vec3 ks = bsdf->type == DRIFT_MATERIAL_GGX
+                        ? drift_raster_reflection_weight(bsdf, toward_light)
+                        : bsdf->specular;
+    vpl->glossy = drift_vec3_scale(drift_vec3_mul(flux, ks), 0.5f * (m + 2.0f));
 }
 
 // Every vertex leaves a VPL of the light its diffuse lobe reflects, and of its glossy lobe's.
@@ -306,8 +313,10 @@ static void trace_paths(size_t begin, size_t end, int thread, void *user)
                 break;
             }
             bool mirror = bsdf.type == DRIFT_MATERIAL_MIRROR;
+            // The diffuse lobe's albedo toward the light: kd for Lambert, Burley's and GGX's
+            // base integrated (drift_raster_diffuse_albedo).
             drift_vec3 diffuse =
-                drift_vec3_mul(flux, mirror ? drift_vec3_splat(0.0f) : bsdf.diffuse);
+                drift_vec3_mul(flux, drift_raster_diffuse_albedo(&bsdf, drift_vec3_neg(ray.dir)));
             drift_vpl vpl = {
                 .position = surf.position, .normal = surf.ns, .flux = diffuse, .bounce = b + 1
             };

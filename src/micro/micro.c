@@ -1,6 +1,7 @@
 // drift micro (include/drift/micro.h): the object, the per-frame passes, the gather points
 // and the bilateral upsampling (thesis §6.2.4).
 #include "micro/micro_internal.h"
+#include "raster/raster.h"
 
 #include <math.h>
 #include <string.h>
@@ -231,8 +232,11 @@ static drift_vec3 gather_pixel(const gather_job *job, int32_t x, int32_t y,
     axis = drift_frame_to_local(&frame, axis);
     axis.z = fmaxf(axis.z, 0.05f);
     axis = drift_vec3_normalize(axis);
-    drift__micro_warp_build_cap(&warp, m->params.warp_size, axis,
-                                drift__micro_phong_cap(bsdf.exponent), glossy_lobe, &slice);
+    // GGX too: the cap of its Phong-equivalent lobe. GGX's own 10^-3 cap (tan theta_h =
+    // 31.6 alpha, its tails) is ~12x wider and gives the peak too few cells: FLIP 0.297
+    // against 0.232 on scenes/ggx-spheres (docs/lab/2026-12-07-issue-41-s2.md).
+    float cap = drift__micro_phong_cap(bsdf.exponent);
+    drift__micro_warp_build_cap(&warp, m->params.warp_size, axis, cap, glossy_lobe, &slice);
     if (!(warp.rho > 0.0f)) {
         return drift_vec3_splat(0.0f);
     }
@@ -286,7 +290,10 @@ static float gloss_exponent(const drift_micro *m, const drift_gbuffer *gb, int32
     if (surf->material == DRIFT_INVALID_INDEX) {
         return 0.0f;
     }
-    return drift_bsdf_make(m->scene, surf).exponent;
+    drift_bsdf bsdf = drift_bsdf_make(m->scene, surf);
+    // GGX: the Phong exponent of its 90% cone (docs/micro.md), not the peak-matched one.
+    return bsdf.type == DRIFT_MATERIAL_GGX ? 0.25f * drift_gloss_blinn_exponent(&bsdf)
+                                           : bsdf.exponent;
 }
 
 static void upsample_rows(size_t begin, size_t end, int thread, void *user)

@@ -112,7 +112,9 @@ static void write_pixel(const gbuffer_job *job, int32_t x, int32_t y, const drif
     float material_id = -1.0f;
     if (surface->material != DRIFT_INVALID_INDEX) {
         drift_bsdf bsdf = drift_bsdf_make(scene, surface); // textures applied
-        albedo = bsdf.diffuse;
+        // Burley and GGX: the diffuse lobe's directional albedo toward the camera, not the
+        // Phong-equivalent kd (what albedo x irradiance / pi shades with; docs/materials.md).
+        albedo = drift_raster_diffuse_albedo(&bsdf, drift_vec3_neg(ray->dir));
         specular = bsdf.specular;
         gloss = job->gloss ? job->gloss[surface->material]
                            : material_gloss(&scene->materials[surface->material]);

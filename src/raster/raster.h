@@ -125,6 +125,28 @@ drift_raster_environment_direct_subset(const drift_scene *scene, const drift_acc
                                        drift_vec3 wo, uint32_t set_size, uint32_t first,
                                        uint32_t stride, drift_vec2 shift, uint64_t *rays);
 
+// --- GLOSSY ENVIRONMENT LIGHT BY THE SPLIT SUM (env_prefilter.c) ---
+
+// The scene's environment prefiltered by GGX roughness (levels of perceptual roughness k / 6,
+// level 0 the environment itself); a constant or absent environment is looked up as it is.
+typedef struct drift_env_prefilter drift_env_prefilter;
+drift_result drift_env_prefilter_build(drift_context *ctx, const drift_scene *scene,
+                                       drift_env_prefilter **out);
+void drift_env_prefilter_destroy(drift_context *ctx, drift_env_prefilter *prefilter); // NULL-safe
+// The environment along dir averaged over the GGX lobe of roughness alpha (n = v = dir).
+drift_vec3 drift_env_prefilter_lookup(const drift_env_prefilter *prefilter, drift_vec3 dir,
+                                      float alpha);
+// A GGX surface's environment light through its conductor and coat reflection (what
+// skip_reflection leaves out of drift_bsdf_eval): the prefiltered environment along the lobe's
+// dominant direction times the lobe's albedo (drift_bsdf_ggx_reflection_albedo), times the
+// share of `visibility_rays` visible-normal reflections (a Hammersley set shifted by `shift`,
+// counted in *rays) that escape the scene. Zero for other materials.
+drift_vec3 drift_raster_environment_split_sum(const drift_env_prefilter *prefilter,
+                                              const drift_accel *accel,
+                                              const drift_surface *surface, const drift_bsdf *bsdf,
+                                              drift_vec3 wo, uint32_t visibility_rays,
+                                              drift_vec2 shift, uint64_t *rays);
+
 // A shadow ray from the surface toward the light's centre (or against a directional
 // light's direction). Returns whether the centre is visible; distances to the nearest
 // occluder (INFINITY when visible) and to the light's centre go to the out pointers.
@@ -163,14 +185,30 @@ drift_raster_radiance drift_raster_trace_radiance(const drift_raster_shading *sh
                                                   float *out_distance);
 
 // Directional albedo of a specular lobe toward wo: what the radiance seen in the mirror
-// direction is weighted by in R (ks for a mirror; the normalized Phong lobe's integral of
-// f cos when the lobe is narrow, clamped to ks).
+// direction is weighted by in R (ks for a mirror; the GGX reflection lobes' albedo, the split
+// sum's DFG term; the normalized Phong lobe's integral of f cos when the lobe is narrow,
+// clamped to ks).
 drift_vec3 drift_raster_reflection_weight(const drift_bsdf *bsdf, drift_vec3 wo);
 
+// The diffuse lobe's directional albedo toward w, what an image-space or VPL technique that
+// shades albedo x irradiance / pi multiplies by: kd for Lambert; GGX's layered plastic base
+// exactly, base (1 - Ec(mu)); Burley's diffuse (and GGX's Principled base) the integral of
+// its lobe over 16 cosine points; 0 for mirrors and glass.
+drift_vec3 drift_raster_diffuse_albedo(const drift_bsdf *bsdf, drift_vec3 w);
+
 // Glossiness of a material for the gloss plane and gathers: the half angle theta_max of the
-// cone that holds 90% of the Phong lobe, cos(theta_max) = 0.1^(1/(n+1)); 0 for mirrors,
-// pi/2 for materials with no specular lobe.
+// cone that holds 90% of the Phong lobe, cos(theta_max) = 0.1^(1/(n+1)); for GGX the cone
+// holding 90% of its reflected directions at normal incidence, drift_ggx_theta_90(alpha)
+// (textures not applied); 0 for mirrors, pi/2 for materials with no specular lobe.
 float drift_gloss_theta_max(const drift_material *material);
+// 2 atan(3 alpha), at most pi/2: the cone about the mirror direction holding 90% of a GGX
+// lobe of roughness alpha at normal incidence.
+float drift_ggx_theta_90(float alpha);
+// The Blinn-Phong exponent m of the lobe (AAF's bandwidth 3.6 + 0.084 m reads it): 4 n for
+// the Phong lobe (n ~ m / 4); for GGX the m whose 90% cone of half vectors is GGX's,
+// m = 2 ln 10 / ln(1 + 9 alpha^2) - 2 (about 0.51 / alpha^2: GGX's tails make it a quarter
+// of Walter's 2 / alpha^2 - 2, which matches the peak); INFINITY for mirrors.
+float drift_gloss_blinn_exponent(const drift_bsdf *bsdf);
 
 // --- SHADOW MAPS (shadow_map.c) ---
 

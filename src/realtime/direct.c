@@ -23,17 +23,31 @@ static drift_vec3 environment_light(const drift_frame_state *f, const drift_surf
     // glossy part only.
     if (f->environment_diffuse_elsewhere) {
         bsdf.diffuse = drift_vec3_splat(0.0f);
+        bsdf.ggx.skip_diffuse = true;
     }
+    // A GGX surface's conductor and coat reflection of the environment: the split sum over
+    // the prefiltered environment (raster/env_prefilter.c); the samples below take the rest.
+    bool split = f->env_prefilter && bsdf.type == DRIFT_MATERIAL_GGX;
+    bsdf.ggx.skip_reflection = split;
+    drift_vec3 l;
     if (!f->params.environment_interleave) {
-        return drift_raster_environment_direct(f->scene, f->accel, s, &bsdf, wo,
-                                               f->params.light_samples, sampler, rays);
+        l = drift_raster_environment_direct(f->scene, f->accel, s, &bsdf, wo,
+                                            f->params.light_samples, sampler, rays);
+    } else {
+        // One shifted set of 4 m points for the 2 x 2 block; this pixel takes every fourth.
+        uint32_t m = (f->params.light_samples + 3) / 4;
+        drift_sampler block = drift_pass_sampler(f, DRIFT_STREAM_UNSHADOWED, x & ~1, y & ~1);
+        l = drift_raster_environment_direct_subset(f->scene, f->accel, s, &bsdf, wo, 4 * m,
+                                                   (uint32_t)((x & 1) | ((y & 1) << 1)), 4,
+                                                   drift_sampler_next2(&block), rays);
     }
-    // One shifted set of 4 m points for the 2 x 2 block; this pixel takes every fourth.
-    uint32_t m = (f->params.light_samples + 3) / 4;
-    drift_sampler block = drift_pass_sampler(f, DRIFT_STREAM_UNSHADOWED, x & ~1, y & ~1);
-    return drift_raster_environment_direct_subset(f->scene, f->accel, s, &bsdf, wo, 4 * m,
-                                                  (uint32_t)((x & 1) | ((y & 1) << 1)), 4,
-                                                  drift_sampler_next2(&block), rays);
+    if (split) {
+        uint32_t n = f->params.light_samples > 0 ? f->params.light_samples : 1;
+        l = drift_vec3_add(
+            l, drift_raster_environment_split_sum(f->env_prefilter, f->accel, s, &bsdf, wo, n,
+                                                  drift_sampler_next2(sampler), rays));
+    }
+    return l;
 }
 
 // The unshadowed light of pixels x0 .. x0 + n - 1 of row y (n <= DRIFT_RASTER_ROW_MAX): each
@@ -533,6 +547,14 @@ static drift_result gather_interleaved(drift_frame_state *f)
 
 drift_result drift_realtime_pass_unshadowed(drift_frame_state *f)
 {
+    if (!f->env_prefilter && drift_scene_has_environment(f->scene)) {
+        double t = drift_time_now(); // made once, timed with the environment-map probes
+        drift_result r = drift_env_prefilter_build(f->ctx, f->scene, &f->env_prefilter);
+        drift_pass_time(f, DRIFT_PASS_ENVMAP, t);
+        if (r != DRIFT_OK) {
+            return r;
+        }
+    }
     drift_pass_rows(f, DRIFT_PASS_UNSHADOWED, unshadowed_row, NULL);
     if (!drift_scene_has_environment(f->scene)) {
         return DRIFT_OK;

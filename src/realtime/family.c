@@ -82,6 +82,8 @@ static void destroy(drift_frame_state *f)
 {
     destroy_shadow_maps(f);
     destroy_probes(f);
+    drift_env_prefilter_destroy(f->ctx, f->env_prefilter); // built by the unshadowed pass
+    f->env_prefilter = NULL;
 }
 
 // The rays of the inputs this frame prepared; the shadow maps' and probes' rays are 0 on a

@@ -43,6 +43,65 @@ static drift_vec3 combine(const drift_bsdf *bsdf, drift_vec3 wo, drift_raster_ra
     return drift_vec3_mul(drift_raster_reflection_weight(bsdf, wo), seen);
 }
 
+// Smooth glass (a GGX dielectric below alpha 0.001): the light it lets through, traced.
+// The refracted ray goes on through up to GLASS_INTERFACES smooth-dielectric interfaces (each
+// refracting, or reflecting under total internal reflection), weighted by the transmitted
+// share w_dielectric (1 - F) at each; what it meets is shaded as a sharp reflection's hit
+// (emission, direct light with hard shadows; the environment on a miss). Rough glass and
+// every other lobe are not traced here (docs/hybrid.md, "Glass").
+#define GLASS_INTERFACES 4
+
+static bool smooth_glass(const drift_bsdf *b)
+{
+    return b->type == DRIFT_MATERIAL_GGX && b->ggx.w_dielectric > 0.0f &&
+           (b->ggx.thin || b->ggx.alpha < 1e-3f);
+}
+
+static drift_vec3 glass_transmission(drift_frame_state *f, const drift_surface *s,
+                                     const drift_bsdf *bsdf, drift_vec3 wo, drift_sampler *sampler,
+                                     uint64_t *rays)
+{
+    drift_vec3 throughput = drift_vec3_splat(1.0f);
+    drift_surface at = *s;
+    drift_bsdf b = *bsdf;
+    drift_vec3 w = wo;
+    for (int k = 0; k < GLASS_INTERFACES; ++k) {
+        // u_lobe at the top of the dielectric's range: transmit (reflect only under TIR);
+        // the sample's pdf is then the probability of that event, w_dielectric (1 - F).
+        drift_bsdf_sample bs = drift_bsdf_sample_wi(&b, w, 1.0f - 1e-6f, drift_vec2_make(0, 0));
+        if (!(bs.pdf > 0.0f)) {
+            break;
+        }
+        throughput = drift_vec3_scale(drift_vec3_mul(throughput, bs.weight), bs.pdf);
+        drift_ray ray = { .origin = drift_offset_origin(at.position, at.ng, bs.wi),
+                          .dir = bs.wi,
+                          .tmin = 0.0f,
+                          .tmax = INFINITY };
+        drift_hit hit;
+        ++*rays;
+        bool more = false;
+        if (drift_accel_intersect(f->accel, &ray, &hit)) {
+            drift_surface next = drift_scene_surface(f->scene, &ray, &hit);
+            if (next.material != DRIFT_INVALID_INDEX) {
+                drift_bsdf nb = drift_bsdf_make(f->scene, &next);
+                if (smooth_glass(&nb) && k + 1 < GLASS_INTERFACES) {
+                    at = next;
+                    b = nb;
+                    w = drift_vec3_neg(ray.dir);
+                    more = true;
+                }
+            }
+        }
+        if (!more) {
+            float distance;
+            drift_raster_radiance l = drift_raster_trace_radiance(
+                &f->shading, ray, DRIFT_INVALID_INDEX, sampler, rays, &distance);
+            return drift_vec3_mul(throughput, drift_vec3_add(l.emitted, l.reflected));
+        }
+    }
+    return drift_vec3_splat(0.0f);
+}
+
 static void sharp_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
 {
     (void)user;
@@ -69,7 +128,17 @@ static void sharp_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *ra
     drift_image_set3(&f->reflection_emitted, x, y, l.emitted);
     drift_image_set3(&f->reflection_reflected, x, y, l.reflected);
     drift_image_pixel(&f->reflection_distance, x, y)[0] = distance;
-    drift_image_set3(&f->reflections, x, y, combine(&bsdf, wo, l));
+    drift_vec3 r = combine(&bsdf, wo, l);
+    if (smooth_glass(&bsdf)) {
+        // A delta reflection: no light sample finds the emitters it sees (the environment's
+        // share is D's split sum).
+        if (isfinite(distance)) {
+            r = drift_vec3_add(
+                r, drift_vec3_mul(drift_raster_reflection_weight(&bsdf, wo), l.emitted));
+        }
+        r = drift_vec3_add(r, glass_transmission(f, s, &bsdf, wo, &sampler, rays));
+    }
+    drift_image_set3(&f->reflections, x, y, r);
 }
 
 static const drift_envmap *probe_for(const drift_frame_state *f, uint32_t mesh)

@@ -268,11 +268,17 @@ drift_vec3 drift__ggx_eval(const drift_bsdf_ggx *g, drift_vec3 wo, drift_vec3 wi
 {
     drift_vec3 f = drift_vec3_splat(0.0f), diffuse = f;
     if (wo.z > 0.0f && wi.z > 0.0f) {
-        if (g->w_conductor > 0.0f) {
+        if (g->w_conductor > 0.0f && !g->skip_reflection) {
             f = drift_vec3_scale(conductor_eval(g, wo, wi), g->w_conductor);
         }
         if (g->w_plastic > 0.0f) {
-            f = drift_vec3_fma(f, plastic_eval(g, wo, wi, &diffuse), g->w_plastic);
+            drift_vec3 p = plastic_eval(g, wo, wi, &diffuse);
+            p = g->skip_reflection ? diffuse : p;
+            if (g->skip_diffuse) {
+                p = drift_vec3_sub(p, diffuse);
+                diffuse = drift_vec3_splat(0.0f);
+            }
+            f = drift_vec3_fma(f, p, g->w_plastic);
             diffuse = drift_vec3_scale(diffuse, g->w_plastic);
         }
     }
@@ -453,4 +459,52 @@ drift_bsdf_sample drift__ggx_sample(const drift_bsdf_ggx *g, drift_vec3 wo, floa
     s.wi = wi;
     s.weight = drift_vec3_scale(f, fabsf(wi.z) / s.pdf);
     return s;
+}
+
+void drift_bsdf_ggx_reflection_albedo(const drift_bsdf *bsdf, float mu, drift_vec3 *out_single,
+                                      drift_vec3 *out_multiple)
+{
+    const drift_bsdf_ggx *g = &bsdf->ggx;
+    drift_vec3 single = drift_vec3_splat(0.0f), multiple = single;
+    if (bsdf->type == DRIFT_MATERIAL_GGX && mu > 0.0f) {
+        float e1, es;
+        albedos(g, fminf(mu, 1.0f), &e1, &es);
+        if (g->w_conductor > 0.0f) {
+            // Exact for Schlick's Fresnel; for eta/k the Schlick curve through its F0.
+            drift_vec3 f0 = conductor_fresnel(g, 1.0f);
+            single = drift_vec3_scale(coat_albedo(f0, e1, es), g->w_conductor);
+            float e_avg = g->e1_avg;
+            if (e_avg < 0.9999f) {
+                // The multiple-scattering lobe's albedo: F_ms (1 - E(mu)) (its cosine-weighted
+                // integral of (1 - E(mu_i)) is 1 - E_avg).
+                drift_vec3 f_avg = drift_vec3_add(
+                    f0, drift_vec3_scale(drift_vec3_sub(drift_vec3_splat(1.0f), f0), 1.0f / 21.0f));
+                drift_vec3 f_ms;
+                f_ms.x = f_avg.x * f_avg.x * e_avg / (1.0f - f_avg.x * (1.0f - e_avg));
+                f_ms.y = f_avg.y * f_avg.y * e_avg / (1.0f - f_avg.y * (1.0f - e_avg));
+                f_ms.z = f_avg.z * f_avg.z * e_avg / (1.0f - f_avg.z * (1.0f - e_avg));
+                multiple = drift_vec3_scale(f_ms, g->w_conductor * (1.0f - e1));
+            }
+        }
+        if (g->w_plastic > 0.0f) {
+            single = drift_vec3_fma(single, coat_albedo(g->f0_coat, e1, es), g->w_plastic);
+        }
+        if (g->w_dielectric > 0.0f && smooth_dielectric(g)) {
+            // A smooth dielectric's reflection, a delta no light sample finds: its Fresnel
+            // (a thin sheet's with the inter-reflections, as its sampling has it).
+            float r = drift__fresnel_dielectric(
+                fminf(mu, 1.0f), g->thin ? fmaxf(g->eta_rel, 1.0f / g->eta_rel) : g->eta_rel);
+            if (g->thin && r < 1.0f) {
+                r += (1.0f - r) * (1.0f - r) * r / (1.0f - r * r);
+            }
+            single = drift_vec3_add(single, drift_vec3_splat(g->w_dielectric * r));
+        }
+    }
+    *out_single = single;
+    *out_multiple = multiple;
+}
+
+drift_vec3 drift_ggx_sample_visible_normal(float alpha, drift_vec3 wo, drift_vec2 u)
+{
+    return drift__ggx_sample_vndf(fmaxf(alpha, DRIFT_GGX_MIN_ALPHA), wo, u);
 }
