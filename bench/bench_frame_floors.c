@@ -72,7 +72,7 @@ static double copy_bandwidth(drift_context *ctx, int32_t w, int32_t h, int repea
 {
     size_t bytes = (size_t)w * (size_t)h * 16u;
     unsigned char *a = drift_alloc(ctx, bytes), *b = drift_alloc(ctx, bytes);
-    double best = INFINITY;
+    double best = HUGE_VAL;
     if (a && b) {
         memset(a, 1, bytes);
         memset(b, 2, bytes);
@@ -125,7 +125,7 @@ static double sample_floor_ns(drift_context *ctx, int repeats)
 
     float *plane = drift_alloc(ctx, sizeof(float) * 6 * (N + 64));
     float *sum = drift_alloc(ctx, sizeof(float) * 4 * N);
-    double best = INFINITY;
+    double best = HUGE_VAL;
     if (plane && sum) {
         for (size_t i = 0; i < 6 * (size_t)(N + 64); ++i) {
             plane[i] = (float)(i % 97) * 0.01f;
@@ -157,7 +157,7 @@ typedef drift_result (*pass_call)(drift_frame_state *f, void *user);
 static drift_result time_pass(drift_frame_state *f, pass_call call, void *user, int repeats,
                               double *ms)
 {
-    *ms = INFINITY;
+    *ms = HUGE_VAL;
     for (int k = 0; k < repeats; ++k) {
         double t = now();
         drift_result r = call(f, user);

@@ -14,7 +14,9 @@
 // Compiled for AVX2 (8 lanes, hardware gathers) too, picked at load time where the CPU has it
 // (GCC and clang function multi-versioning on x86-64 ELF). With -ffp-contract=off both
 // versions do the same IEEE operations: the same image to the bit. Not under ThreadSanitizer:
-// the clones' resolver runs at load time, before TSan's runtime is up, and crashed.
+// the clones' resolver runs at load time, before TSan's runtime is up, and crashed. Clang 14
+// gives a static function's resolver external linkage: two files must not clone functions of
+// the same name (the fuzz build's link fails).
 #if defined(__SANITIZE_THREAD__)
 #    define DRIFT__TSAN 1
 #elif defined(__has_feature)

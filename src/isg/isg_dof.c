@@ -87,9 +87,9 @@ typedef struct dof_job {
     {                                                                                        \
         return drift_isg_filter_inline(k, range, value, image, 0, channels, x, y, out);      \
     }
-DOF_FILTER(filter_search, range_search, NULL, 1)
-DOF_FILTER(filter_gather, range_gather, NULL, 3)
-DOF_FILTER(filter_gather_behind, range_gather, value_behind, 3)
+DOF_FILTER(dof_filter_search, range_search, NULL, 1)
+DOF_FILTER(dof_filter_gather, range_gather, NULL, 3)
+DOF_FILTER(dof_filter_gather_behind, range_gather, value_behind, 3)
 #undef DOF_FILTER
 
 static void dof_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
@@ -110,7 +110,7 @@ static void dof_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays
         range_search, &rc,    NULL
     };
     float radius;
-    filter_search(&search, &f->coc, x, y, &radius); // the centre always counts
+    dof_filter_search(&search, &f->coc, x, y, &radius); // the centre always counts
     drift_image_pixel(&s->dof_search, x, y)[0] = radius;
     float *out = drift_image_pixel(&f->final, x, y);
     if (!(radius >= 0.5f)) {
@@ -126,7 +126,7 @@ static void dof_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays
     }
     drift_isg_kernel gather = { &s->gather,   jitter, drift_vec2_make(radius, radius),
                                 range_gather, &rc,    value };
-    (value ? filter_gather_behind : filter_gather)(&gather, &f->focus, x, y, out);
+    (value ? dof_filter_gather_behind : dof_filter_gather)(&gather, &f->focus, x, y, out);
 }
 
 drift_result drift_isg_pass_dof(drift_frame_state *f, const drift_pass_args *args)

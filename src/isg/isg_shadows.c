@@ -101,8 +101,8 @@ static float range_surface(const void *user, int32_t x, int32_t y)
     {                                                                                        \
         return drift_isg_filter_inline(k, range, NULL, image, first, 1, x, y, out);          \
     }
-SHADOW_FILTER(filter_search, range_search)
-SHADOW_FILTER(filter_gather, range_gather)
+SHADOW_FILTER(shadow_filter_search, range_search)
+SHADOW_FILTER(shadow_filter_gather, range_gather)
 SHADOW_FILTER(filter_surface, range_surface)
 #undef SHADOW_FILTER
 
@@ -161,7 +161,7 @@ static void shadow_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *r
             rect ? &s->search_rect : &s->search, jitter, search_radius, range_search, &rc, NULL
         };
         float d;
-        if (!(filter_search(&search, &b->hard_shadow, 1, x, y, &d) > 0.0f)) {
+        if (!(shadow_filter_search(&search, &b->hard_shadow, 1, x, y, &d) > 0.0f)) {
             continue; // no occluder in reach (every sample rejected): the centre's bit
         }
         // Eq. 8 per axis of the light's shape, then eq. 9.
@@ -176,7 +176,7 @@ static void shadow_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *r
         drift_isg_kernel gather = {
             rect ? &s->gather_rect : &s->gather, jitter, gather_radius, range_gather, &rc, NULL
         };
-        filter_gather(&gather, &b->hard_shadow, 0, x, y, shadow);
+        shadow_filter_gather(&gather, &b->hard_shadow, 0, x, y, shadow);
     }
 }
 
