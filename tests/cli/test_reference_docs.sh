@@ -57,4 +57,10 @@ for want in '^| `.json` ' '^### light spot' '^| `fov_y` ' '^| `KHR_texture_trans
     '^| `map_Kd` ' '^| `bsdf plastic, roughplastic'; do
     grep -q "$want" "$tmp/ref/scene-formats.md" || fail "scene-formats.md has no line matching $want"
 done
+# Every JSON key the reader accepts is explained on docs/scene-format.md.
+for key in $(sed -n '/^## JSON scene file keys/,/^## glTF/s/^| `\([a-z_]*\)` .*/\1/p' \
+    "$tmp/ref/scene-formats.md" | sort -u); do
+    grep -q "\`$key\`\|\"$key\"" "$src/docs/scene-format.md" \
+        || fail "docs/scene-format.md does not explain the JSON key '$key'"
+done
 exit $((failures > 0))
