@@ -491,6 +491,10 @@ int cli_dispatch(const char *cmd, const char *heading, const char *footer,
         cli_print_knobs_markdown(stdout); // docs/reference/knobs.md
         return 0;
     }
+    if (argc == 2 && !cmd && strcmp(argv[1], "--formats-markdown") == 0) {
+        drift_scene_formats_markdown(stdout); // docs/reference/scene-formats.md
+        return 0;
+    }
     if (argc < 2 || strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0) {
         print_subcommands(argc < 2 ? stderr : stdout, cmd, heading, footer, table, count);
         return argc < 2 ? 2 : 0;

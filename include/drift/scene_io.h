@@ -34,6 +34,7 @@
 #include "drift/scene.h"
 
 #include <stddef.h>
+#include <stdio.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -60,6 +61,11 @@ const drift_scene_format *drift_scene_format_get(int index); // NULL out of rang
 // The format that reads `path`, by its extension (case-insensitive, looking through a
 // trailing .gz when the format reads gzip), or NULL when no loader reads it.
 const drift_scene_format *drift_scene_format_of(const char *path);
+
+// Writes the scene-format reference as Markdown (docs/reference/scene-formats.md): the
+// registry's formats and the tables the readers check against: the JSON files' keys, the glTF
+// extensions, the OBJ/MTL statements and the Mitsuba plugins drift reads.
+void drift_scene_formats_markdown(FILE *out);
 
 // A file a scene load reads: the scene file, then each mesh file and texture it names, once
 // a path, as the loader opens them (drift render refuses outputs that name one of them).

@@ -34,14 +34,19 @@ struct drift__gltf {
     char dir[DRIFT__PATH_MAX]; // the file's folder, for its buffers' files
 };
 
-// The extensions this file turns into drift's quantities; any other in extensionsUsed is
-// named in a warning.
-static const char *const handled_extensions[] = {
-    "KHR_lights_punctual",        "KHR_materials_emissive_strength",
-    "KHR_materials_transmission", "KHR_materials_ior",
-    "KHR_materials_specular",     "KHR_materials_volume", // material_gltf.c
-    "KHR_texture_transform"
+// The extensions this file and material_gltf.c turn into drift's quantities; any other in
+// extensionsUsed is named in a warning. docs/reference/scene-formats.md prints this table.
+const drift__format_row drift__gltf_extensions[] = {
+    { "KHR_lights_punctual", "point, spot and directional lights (cd, lux / 683 → W)" },
+    { "KHR_materials_emissive_strength", "multiplies emissiveFactor" },
+    { "KHR_materials_transmission", "GGX transmission (refracting fraction)" },
+    { "KHR_materials_ior", "GGX index of refraction" },
+    { "KHR_materials_specular", "tint and strength of the coat's F0" },
+    { "KHR_materials_volume", "thickness 0: thin-walled; else solid glass" },
+    { "KHR_texture_transform", "offset, rotation, scale and texCoord of a texture" },
 };
+const size_t drift__gltf_extension_count =
+    sizeof drift__gltf_extensions / sizeof *drift__gltf_extensions;
 
 static uint32_t read_u32(const uint8_t *p)
 {
@@ -178,8 +183,8 @@ drift_result drift__gltf_open(drift_context *ctx, const char *path, bool gz, con
             continue;
         }
         bool handled = false;
-        for (size_t i = 0; i < sizeof(handled_extensions) / sizeof(handled_extensions[0]); ++i) {
-            handled = handled || strcmp(name->valuestring, handled_extensions[i]) == 0;
+        for (size_t i = 0; i < drift__gltf_extension_count; ++i) {
+            handled = handled || strcmp(name->valuestring, drift__gltf_extensions[i].name) == 0;
         }
         bool is_required = false;
         const cJSON *req;

@@ -280,4 +280,36 @@ drift_result drift__assimp_import_file(drift_context *ctx, const char *path, uns
 // The framing camera of a bare mesh file (see scene_io.h).
 drift_camera drift__framing_camera(drift_bounds3 bounds);
 
+// --- What each reader handles (docs/reference/scene-formats.md, scene_formats_doc.c) ---
+
+// One key of an object of the JSON scene or camera-views file (scene_json_keys.c).
+typedef struct drift__json_key {
+    const char *object;  // "scene", "camera", "material", "light spot", "view", ...
+    const char *key;     // its name in the file
+    const char *type;    // what its value is ("vec3, required", ...)
+    const char *def;     // its default ("": required or fixed)
+    const char *meaning; // one line
+} drift__json_key;
+
+extern const drift__json_key drift__json_keys[];
+extern const size_t drift__json_key_count;
+// Whether `key` is a row of `object` (or "comment", allowed everywhere).
+bool drift__json_key_known(const char *object, const char *key);
+
+// A name a reader recognises and what drift makes of it.
+typedef struct drift__format_row {
+    const char *name;
+    const char *what;
+} drift__format_row;
+
+// glTF extensions read (scene_gltf.c, material_gltf.c); any other warns.
+extern const drift__format_row drift__gltf_extensions[];
+extern const size_t drift__gltf_extension_count;
+// OBJ and MTL statements drift reads beside assimp (scene_obj.c).
+extern const drift__format_row drift__obj_statements[];
+extern const size_t drift__obj_statement_count;
+// Mitsuba elements and plugin types read, as "element type" (scene_mitsuba.c).
+extern const drift__format_row drift__mitsuba_plugins[];
+extern const size_t drift__mitsuba_plugin_count;
+
 #endif

@@ -155,21 +155,17 @@ static drift_result check_duplicates(const json_reader *r, const cJSON *obj, con
     return res;
 }
 
-// Warns about keys not in `allowed` (NULL: any key is allowed; "comment" always is) and
-// fails on duplicate keys.
+// Warns about keys that are not rows of `object` in the key table (scene_json_keys.c; NULL:
+// any key is allowed) and fails on duplicate keys.
 static drift_result check_keys(const json_reader *r, const cJSON *obj, const char *path,
-                               const char *const *allowed, size_t allowed_count)
+                               const char *object)
 {
     drift_result res = check_duplicates(r, obj, path);
-    if (res != DRIFT_OK || !allowed) {
+    if (res != DRIFT_OK || !object) {
         return res;
     }
     for (const cJSON *c = obj->child; c; c = c->next) {
-        bool known = strcmp(c->string, "comment") == 0;
-        for (size_t i = 0; i < allowed_count && !known; ++i) {
-            known = strcmp(c->string, allowed[i]) == 0;
-        }
-        if (!known) {
+        if (!drift__json_key_known(object, c->string)) {
             char full[KEY_PATH_MAX];
             key_path(full, path, c->string);
             report(r, DRIFT_LOG_WARNING, c, DRIFT_ERR_PARSE, "unknown key '%s' (ignored)", full);
@@ -178,9 +174,7 @@ static drift_result check_keys(const json_reader *r, const cJSON *obj, const cha
     return DRIFT_OK;
 }
 
-#define CHECK_KEYS(r, obj, path, ...)                                    \
-    check_keys((r), (obj), (path), (const char *const[]){ __VA_ARGS__ }, \
-               sizeof((const char *const[]){ __VA_ARGS__ }) / sizeof(const char *))
+#define CHECK_KEYS(r, obj, path, object) check_keys((r), (obj), (path), (object))
 
 static drift_result missing(const json_reader *r, const cJSON *obj, const char *path,
                             const char *key)
@@ -402,9 +396,7 @@ static drift_result read_material(json_reader *r, const cJSON *item)
     if (res != DRIFT_OK) {
         return res;
     }
-    res = CHECK_KEYS(r, item, path, "type", "diffuse", "specular", "exponent", "emission",
-                     "diffuse_texture", "diffuse_roughness", "roughness", "metallic",
-                     "transmission", "ior", "metal", "edge_tint", "thin");
+    res = CHECK_KEYS(r, item, path, "material");
     if (res != DRIFT_OK) {
         return res;
     }
@@ -499,7 +491,7 @@ static drift_result read_materials(json_reader *r, const cJSON *root)
                     "materials lists %d materials (at most %d)", count, MAX_JSON_MATERIALS);
     }
     // Material names are keys, so duplicates are caught by check_keys' duplicate test.
-    res = check_keys(r, materials, "materials", NULL, 0);
+    res = check_keys(r, materials, "materials", NULL);
     if (res != DRIFT_OK) {
         return res;
     }
@@ -558,7 +550,7 @@ static drift_result read_transform(const json_reader *r, const cJSON *obj, const
     if (res != DRIFT_OK) {
         return res;
     }
-    res = CHECK_KEYS(r, item, path, "translate", "rotate", "scale", "matrix");
+    res = CHECK_KEYS(r, item, path, "transform");
     if (res != DRIFT_OK) {
         return res;
     }
@@ -620,7 +612,7 @@ static drift_result read_transform(const json_reader *r, const cJSON *obj, const
         char rpath[KEY_PATH_MAX];
         key_path(rpath, path, "rotate");
         if ((res = expect_object(r, rotate, rpath)) != DRIFT_OK ||
-            (res = CHECK_KEYS(r, rotate, rpath, "axis", "degrees")) != DRIFT_OK) {
+            (res = CHECK_KEYS(r, rotate, rpath, "transform.rotate")) != DRIFT_OK) {
             return res;
         }
         drift_vec3 axis = drift_vec3_make(0, 1, 0);
@@ -648,7 +640,7 @@ static drift_result read_mesh(json_reader *r, const cJSON *item, const char *pat
     if (res != DRIFT_OK) {
         return res;
     }
-    if ((res = CHECK_KEYS(r, item, path, "path", "transform", "material", "camera")) != DRIFT_OK) {
+    if ((res = CHECK_KEYS(r, item, path, "mesh")) != DRIFT_OK) {
         return res;
     }
     const char *rel = NULL, *material_name = NULL, *camera = NULL;
@@ -741,7 +733,7 @@ static drift_result read_light(json_reader *r, const cJSON *item, const char *pa
     drift_light l = { 0 };
     if (strcmp(type, "point") == 0) {
         l.type = DRIFT_LIGHT_POINT;
-        if ((res = CHECK_KEYS(r, item, path, "type", "position", "intensity")) != DRIFT_OK ||
+        if ((res = CHECK_KEYS(r, item, path, "light point")) != DRIFT_OK ||
             (res = read_vec3(r, item, path, "position", true, VEC3_ANY, &l.position)) != DRIFT_OK ||
             (res = read_vec3(r, item, path, "intensity", true, VEC3_COLOR, &l.color)) != DRIFT_OK) {
             return res;
@@ -749,8 +741,7 @@ static drift_result read_light(json_reader *r, const cJSON *item, const char *pa
     } else if (strcmp(type, "spot") == 0) {
         l.type = DRIFT_LIGHT_SPOT;
         float inner = 0.0f, outer = 0.0f;
-        if ((res = CHECK_KEYS(r, item, path, "type", "position", "direction", "intensity",
-                              "inner_angle", "outer_angle")) != DRIFT_OK ||
+        if ((res = CHECK_KEYS(r, item, path, "light spot")) != DRIFT_OK ||
             (res = read_vec3(r, item, path, "position", true, VEC3_ANY, &l.position)) != DRIFT_OK ||
             (res = read_vec3(r, item, path, "direction", true, VEC3_DIRECTION, &l.direction)) !=
                 DRIFT_OK ||
@@ -765,7 +756,7 @@ static drift_result read_light(json_reader *r, const cJSON *item, const char *pa
         l.spot_outer = outer * DRIFT_PI / 180.0f;
     } else if (strcmp(type, "directional") == 0) {
         l.type = DRIFT_LIGHT_DIRECTIONAL;
-        if ((res = CHECK_KEYS(r, item, path, "type", "direction", "irradiance")) != DRIFT_OK ||
+        if ((res = CHECK_KEYS(r, item, path, "light directional")) != DRIFT_OK ||
             (res = read_vec3(r, item, path, "direction", true, VEC3_DIRECTION, &l.direction)) !=
                 DRIFT_OK ||
             (res = read_vec3(r, item, path, "irradiance", true, VEC3_COLOR, &l.color)) !=
@@ -774,8 +765,7 @@ static drift_result read_light(json_reader *r, const cJSON *item, const char *pa
         }
     } else if (strcmp(type, "quad") == 0) {
         l.type = DRIFT_LIGHT_QUAD;
-        if ((res = CHECK_KEYS(r, item, path, "type", "corner", "edge_u", "edge_v", "radiance")) !=
-                DRIFT_OK ||
+        if ((res = CHECK_KEYS(r, item, path, "light quad")) != DRIFT_OK ||
             (res = read_vec3(r, item, path, "corner", true, VEC3_ANY, &l.position)) != DRIFT_OK ||
             (res = read_vec3(r, item, path, "edge_u", true, VEC3_ANY, &l.edge_u)) != DRIFT_OK ||
             (res = read_vec3(r, item, path, "edge_v", true, VEC3_ANY, &l.edge_v)) != DRIFT_OK ||
@@ -784,8 +774,7 @@ static drift_result read_light(json_reader *r, const cJSON *item, const char *pa
         }
     } else if (strcmp(type, "disk") == 0) {
         l.type = DRIFT_LIGHT_DISK;
-        if ((res = CHECK_KEYS(r, item, path, "type", "center", "normal", "radius", "radiance")) !=
-                DRIFT_OK ||
+        if ((res = CHECK_KEYS(r, item, path, "light disk")) != DRIFT_OK ||
             (res = read_vec3(r, item, path, "center", true, VEC3_ANY, &l.position)) != DRIFT_OK ||
             (res = read_vec3(r, item, path, "normal", true, VEC3_DIRECTION, &l.direction)) !=
                 DRIFT_OK ||
@@ -796,7 +785,7 @@ static drift_result read_light(json_reader *r, const cJSON *item, const char *pa
         }
     } else if (strcmp(type, "sphere") == 0) {
         l.type = DRIFT_LIGHT_SPHERE;
-        if ((res = CHECK_KEYS(r, item, path, "type", "center", "radius", "radiance")) != DRIFT_OK ||
+        if ((res = CHECK_KEYS(r, item, path, "light sphere")) != DRIFT_OK ||
             (res = read_vec3(r, item, path, "center", true, VEC3_ANY, &l.position)) != DRIFT_OK ||
             (res = read_float(r, item, path, "radius", true, -(double)FLT_MAX, (double)FLT_MAX,
                               &l.radius)) != DRIFT_OK ||
@@ -849,8 +838,7 @@ static drift_result read_environment(json_reader *r, const cJSON *root)
     }
     const char *path = "environment";
     drift_result res = expect_object(r, env, path);
-    if (res != DRIFT_OK ||
-        (res = CHECK_KEYS(r, env, path, "color", "map", "multiplier")) != DRIFT_OK) {
+    if (res != DRIFT_OK || (res = CHECK_KEYS(r, env, path, "environment")) != DRIFT_OK) {
         return res;
     }
     bool has_map = cJSON_HasObjectItem(env, "map");
@@ -882,9 +870,7 @@ static drift_result read_camera(json_reader *r, const cJSON *root, bool *out_fou
     }
     const char *path = "camera";
     drift_result res = expect_object(r, cam, path);
-    if (res != DRIFT_OK ||
-        (res = CHECK_KEYS(r, cam, path, "position", "target", "up", "fov_y", "aperture_radius",
-                          "focus_distance", "width", "height")) != DRIFT_OK) {
+    if (res != DRIFT_OK || (res = CHECK_KEYS(r, cam, path, "camera")) != DRIFT_OK) {
         return res;
     }
     drift_camera c = { .up = drift_vec3_make(0, 1, 0), .width = 512, .height = 512 };
@@ -955,8 +941,7 @@ static drift_result report_syntax_error(const json_reader *r, const char *text, 
 static drift_result read_scene(json_reader *r, const cJSON *root)
 {
     drift_result res = expect_object(r, root, "the scene file");
-    if (res != DRIFT_OK || (res = CHECK_KEYS(r, root, "", "version", "camera", "materials",
-                                             "meshes", "lights", "environment")) != DRIFT_OK) {
+    if (res != DRIFT_OK || (res = CHECK_KEYS(r, root, "", "scene")) != DRIFT_OK) {
         return res;
     }
     const cJSON *version = cJSON_GetObjectItemCaseSensitive(root, "version");
@@ -1085,8 +1070,7 @@ static drift_result read_view(const json_reader *r, const cJSON *item, const cha
                               drift_camera_view *out)
 {
     drift_result res = expect_object(r, item, path);
-    if (res != DRIFT_OK || (res = CHECK_KEYS(r, item, path, "name", "position", "target", "fov_y",
-                                             "aperture_radius")) != DRIFT_OK) {
+    if (res != DRIFT_OK || (res = CHECK_KEYS(r, item, path, "view")) != DRIFT_OK) {
         return res;
     }
     *out = (drift_camera_view){ 0 };
@@ -1137,7 +1121,7 @@ drift_result drift_camera_views_load_json_text(drift_context *ctx, const char *t
     }
     const cJSON *list = cJSON_GetObjectItemCaseSensitive(root, "views");
     if ((res = expect_object(&r, root, "the views file")) != DRIFT_OK ||
-        (res = CHECK_KEYS(&r, root, "", "views")) != DRIFT_OK) {
+        (res = CHECK_KEYS(&r, root, "", "views file")) != DRIFT_OK) {
         // reported
     } else if (!cJSON_IsArray(list)) {
         res = list ? FAIL(&r, list, DRIFT_ERR_PARSE, "views must be an array, not %s",

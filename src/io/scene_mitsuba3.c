@@ -2,6 +2,7 @@
 // to the 0.6 form scene_mitsuba.c maps onto drift, so that one reader serves both and a v3
 // scene renders as its 0.6 twin (tests/cli/test_mitsuba3.sh). The mapping table is in
 // docs/scene-format.md ("Mitsuba 3").
+#include "scene_io_internal.h"
 #include "scene_mitsuba_xml.h"
 
 #include <ctype.h>
@@ -9,6 +10,28 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+// The Mitsuba elements and plugin types scene_mitsuba.c and this file turn into drift's
+// (docs/reference/ scene-formats.md prints this table; docs/scene-format.md gives each parameter).
+const drift__format_row drift__mitsuba_plugins[] = {
+    { "sensor perspective, thinlens", "the camera: fov, fovAxis, toWorld; its film's size" },
+    { "shape obj, ply", "imported through assimp with toWorld; faceNormals" },
+    { "shape rectangle, cube", "[−1, 1]² in z = 0, [−1, 1]³, transformed" },
+    { "shape sphere", "with an area emitter: a sphere light; else 32 × 16 facets" },
+    { "bsdf diffuse", "diffuse of reflectance (rgb, spectrum or bitmap)" },
+    { "bsdf plastic, roughplastic", "GGX plastic: diffuseReflectance, alpha, intIOR / extIOR" },
+    { "bsdf conductor, roughconductor", "GGX conductor of the named metal, or a mirror" },
+    { "bsdf dielectric, thindielectric, roughdielectric", "GGX dielectric that refracts" },
+    { "bsdf twosided", "its inner bsdf" },
+    { "bsdf principled (Mitsuba 3)", "roughplastic of base_color, alpha = roughness², warns" },
+    { "emitter area", "the shape's material emits radiance" },
+    { "emitter point, spot, directional", "point, spot (cutoffAngle, beamWidth), directional" },
+    { "emitter constant, envmap; background", "constant or lat-long environment" },
+    { "integrator; sunsky, sun, sky, media", "skipped (integrator silently)" },
+    { "default (Mitsuba 3)", "$name substituted in any attribute" },
+};
+const size_t drift__mitsuba_plugin_count =
+    sizeof drift__mitsuba_plugins / sizeof *drift__mitsuba_plugins;
 
 // Mitsuba 3 (and 2) property names and their Mitsuba 0.6 spelling.
 static const char *const renamed[][2] = {

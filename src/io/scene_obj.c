@@ -34,6 +34,25 @@ struct drift__obj {
     size_t mtl_count;
 };
 
+// The OBJ and MTL statements drift reads itself, beside assimp's reading, and what it makes of
+// them (docs/reference/scene-formats.md prints this table; docs/scene-format.md explains).
+const drift__format_row drift__obj_statements[] = {
+    { "mtllib", "a missing library is a warning naming the OBJ's file and line" },
+    { "o, g, s", "a smoothing group on (s 1) without vn: area-weighted smooth normals" },
+    { "newmtl", "starts a material; a texture statement before it is an error" },
+    { "Kd", "diffuse colour (multiplies map_Kd)" },
+    { "map_Kd", "diffuse texture, options skipped; alone (no Kd): the colour" },
+    { "Ks", "Blender MTL: Principled specular mean(Ks), F0 = 0.08 · it" },
+    { "Ns", "Blender MTL: roughness 1 − √(Ns / 1000)" },
+    { "illum", "0, 1: no highlight without Ks; ≥ 3: drawn as 2, with a warning" },
+    { "Ke", "emission (radiance)" },
+    { "d < 1, map_d", "a warning: drawn opaque" },
+    { "map_Ks, map_Ns, map_Bump, bump, norm, disp, map_Ke, refl", "a warning each" },
+    { "Ni, Ka", "ignored" },
+};
+const size_t drift__obj_statement_count =
+    sizeof drift__obj_statements / sizeof *drift__obj_statements;
+
 // The next line of text[*at .. size) without its end-of-line and surrounding whitespace,
 // into out (cut at out_size - 1); false at the end.
 static bool next_line(const char *text, size_t size, size_t *at, char *out, size_t out_size)

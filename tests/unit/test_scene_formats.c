@@ -1,7 +1,9 @@
 // The scene loaders' registry (src/io/scene_formats.c, drift_scene_format_get): every format
 // it lists loads a file of the repository through drift_scene_load, a path goes to the row
 // of its extension (any case, through .gz only where the row reads gzip), a path no row
-// reads is refused as unsupported, and the commands' --help lists every row.
+// reads is refused as unsupported, and the commands' --help lists every row. The JSON reader
+// checks each object's keys against the key table of its own object (a sphere light's `radius`
+// warns on a point light), and the scene-format reference prints every table.
 #include "drift/scene_io.h"
 #include "drift_test.h"
 
@@ -119,11 +121,68 @@ static void test_help_lists_every_format(void **state)
     }
 }
 
+// Unknown-key warnings read the key table by object: a key of another object (a sphere light's
+// `radius` on a point light) warns; every key of the right object (all the camera's, a spot's
+// `inner_angle`) does not.
+static void test_json_keys_checked_by_object(void **state)
+{
+    (void)state;
+    static const char text[] =
+        "{ \"camera\": { \"position\": [0, 0, 5], \"target\": [0, 0, 0], \"up\": [0, 1, 0],\n"
+        "    \"fov_y\": 40, \"aperture_radius\": 0, \"focus_distance\": 0, \"width\": 8,\n"
+        "    \"height\": 8 },\n"
+        "  \"environment\": { \"color\": 0.1 },\n"
+        "  \"lights\": [\n"
+        "    { \"type\": \"sphere\", \"center\": [0, 2, 0], \"radius\": 0.5, \"radiance\": 1 },\n"
+        "    { \"type\": \"point\", \"position\": [0, 2, 0], \"intensity\": 5, \"radius\": 1 },\n"
+        "    { \"type\": \"spot\", \"position\": [0, 2, 0], \"direction\": [0, -1, 0],\n"
+        "      \"intensity\": 5, \"outer_angle\": 30, \"inner_angle\": 10 } ] }\n";
+    test_log_capture log = { 0 };
+    drift_context *ctx = test_context(1, &log);
+    drift_scene *scene = NULL;
+    assert_int_equal(drift_scene_load_json_text(ctx, text, strlen(text), NULL, "keys.json", &scene),
+                     DRIFT_OK);
+    assert_int_equal(log.errors, 0);
+    assert_int_equal(log.warnings, 1);
+    assert_non_null(strstr(log.last_message, "lights[1].radius"));
+    assert_int_equal(scene->light_count, 3);
+    drift_scene_destroy(scene);
+    drift_context_destroy(ctx);
+}
+
+// The reference (docs/reference/scene-formats.md) prints every row of every reader's table.
+static void test_reference_prints_every_table(void **state)
+{
+    (void)state;
+    char *text = NULL;
+    size_t size = 0;
+    FILE *out = open_memstream(&text, &size);
+    assert_non_null(out);
+    drift_scene_formats_markdown(out);
+    assert_int_equal(fclose(out), 0);
+    const char *want[] = { "| `.json` | yes",
+                           "| `.xml` | no",
+                           "### camera",
+                           "### light spot",
+                           "| `inner_angle` | degrees | 0 |",
+                           "| `KHR_texture_transform` ",
+                           "| `map_Kd` ",
+                           "| `bsdf plastic, roughplastic` " };
+    for (size_t i = 0; i < sizeof want / sizeof *want; ++i) {
+        if (!strstr(text, want[i])) {
+            fail_msg("the scene-format reference has no '%s'", want[i]);
+        }
+    }
+    free(text);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_every_format_loads),
         cmocka_unit_test(test_help_lists_every_format),
+        cmocka_unit_test(test_json_keys_checked_by_object),
+        cmocka_unit_test(test_reference_prints_every_table),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
