@@ -173,6 +173,11 @@ bool render_reference_checkpoint(render_reference_run *run);
 // Writes the outputs (all or none) and, when tiles are short of --spp, the checkpoint, and
 // says so; removes the checkpoint of a finished render. Returns the exit status.
 int render_reference_finish(render_reference_run *run, bool cancelled, double t_rendered);
+// The EXR (beauty, --aov layers; an "spp" layer of each pixel's sample count when the tiles
+// hold different counts) and the PNG beside it, to the paths given (tools/render_images.c).
+drift_result render_write_images(drift_context *ctx, struct drift_pt *pt, const render_options *o,
+                                 float fov_y, const char *exr_path, const char *png_path,
+                                 double *out_denoise_ms);
 // The lowest and highest sample count of the pt's tiles.
 void render_spp_range(const struct drift_pt *pt, uint32_t *lowest, uint32_t *highest);
 // One progress line (a bar on a terminal): done of total spp, `first` where this run began.
