@@ -43,11 +43,13 @@ static void test_exr_conventions_channels_and_metadata(void **state)
         snprintf(names + len, sizeof names - len, "%s%s", i ? "," : "", list->entries[i].name.str);
     }
     // OpenEXR lists channels sorted by name.
-    // The conventional layers, then the feature-guided denoiser's inputs (issue 48).
+    // The conventional layers, then the feature-guided denoiser's inputs (issue 48: the
+    // features, the variances and the direct light, tools/cmd_render.c).
     assert_string_equal(names, "B,G,N.X,N.Y,N.Z,R,Z,albedo.B,albedo.G,albedo.R,"
+                               "direct.B,direct.G,direct.R,direct_variance.Y,"
                                "feature_albedo.B,feature_albedo.G,feature_albedo.R,"
                                "feature_depth.Y,feature_normal.X,feature_normal.Y,"
-                               "feature_normal.Z,variance.Y");
+                               "feature_normal.Z,indirect_variance.Y,variance.Y");
 
     exr_attr_chromaticities_t chroma_value = { 0 }, *chroma = &chroma_value;
     assert_int_equal(exr_attr_get_chromaticities(f, 0, "chromaticities", chroma), EXR_ERR_SUCCESS);
