@@ -136,10 +136,12 @@ drift_result render_save_png(drift_context *ctx, const render_options *o, const 
 // --view and its options checked (the config read, the names found); false: message printed.
 bool render_check_view(const render_options *o);
 // Writes the refiner's planes (sir may be NULL), then every plane of the frame, as the
-// layers of one EXR.
+// layers of one EXR; the normals as layer `normal_layer` ("N" or Blender's "Normal", from
+// --aov-normal).
 struct drift_refine;
 drift_result render_write_aov(drift_context *ctx, const char *path,
-                              const struct drift_hybrid *frame, const struct drift_refine *sir);
+                              const struct drift_hybrid *frame, const struct drift_refine *sir,
+                              const char *normal_layer);
 struct render_stage;
 // Stages `image` as --out (EXR) and its PNG (--exposure, --tonemap), and with --aov the planes
 // (render_write_aov). On failure says so, removes what was staged and returns false; on

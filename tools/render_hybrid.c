@@ -132,7 +132,7 @@ static bool write_stats(const render_options *o, const cli_session *session,
 }
 
 drift_result render_write_aov(drift_context *ctx, const char *path, const drift_hybrid *frame,
-                              const drift_refine *sir)
+                              const drift_refine *sir, const char *normal_layer)
 {
     const char *name;
     const drift_image *image;
@@ -158,12 +158,13 @@ drift_result render_write_aov(drift_context *ctx, const char *path, const drift_
         drift_image_layer *l = &layers[refine_count + i];
         drift_hybrid_plane(frame, i, &l->name, &l->image);
         // The G-buffer's depth and normal under the names tev, Nuke and Blender's compositor
-        // take as theirs (Z, N.X/N.Y/N.Z), as the path tracer's --aov file has them.
+        // take as theirs (Z, N.X/N.Y/N.Z or with --aov-normal Normal Blender's Normal.X/Y/Z),
+        // as the path tracer's --aov file has them.
         if (strcmp(l->name, "depth") == 0) {
             l->name = NULL;
             channels[refine_count + i] = "Z";
         } else if (strcmp(l->name, "normal") == 0) {
-            l->name = "N";
+            l->name = normal_layer;
             channels[refine_count + i] = "X,Y,Z";
         }
     }
@@ -187,7 +188,7 @@ bool render_stage_hybrid_images(drift_context *ctx, const render_options *o,
         r = render_save_png(ctx, o, png_temp, image);
     }
     if (r == DRIFT_OK && aov_temp) {
-        r = render_write_aov(ctx, aov_temp, frame, sir);
+        r = render_write_aov(ctx, aov_temp, frame, sir, o->aov_normal ? "Normal" : "N");
     }
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift render: cannot write the images: %s; nothing written\n",

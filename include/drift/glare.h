@@ -213,6 +213,20 @@ drift_image drift_glare_psf_mono(const drift_glare *glare);
 drift_image drift_glare_psf(const drift_glare *glare);
 drift_glare_eye drift_glare_eye_state(const drift_glare *glare);
 
+// What the last drift_glare_apply(_to) did: the aperture's FFT (N x N; 0 before the first
+// update), the RGB PSF's size K, whether that call made the PSF anew (static mode: only the
+// first call and a change of image width; dynamic: every call), and the convolution's
+// zero-padded FFT size and the pixels it convolved (0 with the billboard method).
+typedef struct drift_glare_stats {
+    int32_t aperture_fft;
+    int32_t psf_size;
+    bool psf_updated;
+    int32_t fft_width, fft_height;
+    uint64_t convolved_pixels;
+} drift_glare_stats;
+
+drift_glare_stats drift_glare_get_stats(const drift_glare *glare);
+
 #ifdef __cplusplus
 }
 #endif

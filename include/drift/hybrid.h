@@ -334,7 +334,7 @@ typedef enum drift_hybrid_pass {
 
 const char *drift_hybrid_pass_name(drift_hybrid_pass pass);
 
-#define DRIFT_HYBRID_MAX_COUNTS 32 // the counts one frame can report
+#define DRIFT_HYBRID_MAX_COUNTS 48 // the counts one frame can report
 
 typedef struct drift_hybrid_stats {
     double ms[DRIFT_PASS_COUNT]; // wall milliseconds of the last frame, per pass

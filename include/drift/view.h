@@ -193,6 +193,14 @@ drift_pt *drift_view_reference(drift_view *view);
 const drift_reflection_edits *drift_view_reflection_edits(const drift_view *view);
 int32_t drift_view_selected_constraint(const drift_view *view);
 
+// The overlay's text as the next frame draws it: lines by '\n', table cells by '\t' (the help
+// text while help is on; else the techniques, the knob, the buffer, the frame's stages and,
+// beside them, its counts: drift_hybrid_stats_count). Copies at most capacity - 1 bytes and a
+// NUL into text (may be NULL); returns the whole text's length. The overlay keeps at most
+// DRIFT_VIEW_OVERLAY_TEXT_MAX - 1 bytes.
+#define DRIFT_VIEW_OVERLAY_TEXT_MAX 4096
+size_t drift_view_overlay_text(const drift_view *view, char *text, size_t capacity);
+
 // "shadows", ..., "help": the stable name of a key (NULL out of range), for docs and logs.
 const char *drift_view_key_name(drift_view_key key);
 

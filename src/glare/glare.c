@@ -26,6 +26,8 @@ struct drift_glare {
     double ratio;     // PSF pixels per image pixel
     int32_t width_px; // image width the ratio was made for (0: none yet)
     bool psf_valid, psf_changed;
+    bool last_updated;       // the last apply made the PSF anew
+    uint64_t last_convolved; // pixels the last apply convolved by FFT (0: billboards)
     drift__glare_scene scene;
     drift__glare_eye_state eye;
     drift__glare_conv conv;
@@ -433,6 +435,8 @@ drift_result drift_glare_apply_to(drift_glare *g, const drift_image *in, double 
     bool refresh =
         g->p.mode == DRIFT_GLARE_MODE_DYNAMIC || !g->psf_valid || k != g->k || ratio != g->ratio;
     drift_result r = DRIFT_OK;
+    g->last_updated = refresh;
+    g->last_convolved = 0;
     if (refresh && (r = update(g, field > 0.0 ? field : 1e-6, dt, in->width)) != DRIFT_OK) {
         return r;
     }
@@ -441,6 +445,9 @@ drift_result drift_glare_apply_to(drift_glare *g, const drift_image *in, double 
     }
     r = drift__glare_convolve(ctx, &g->conv, in, g->rgb, g->k, g->psf_changed, out);
     g->psf_changed = false;
+    if (r == DRIFT_OK) {
+        g->last_convolved = (uint64_t)in->width * (uint64_t)in->height;
+    }
     return r;
 }
 
@@ -457,6 +464,17 @@ drift_result drift_glare_apply(drift_glare *g, const drift_image *in, double dt,
         drift_image_destroy(g->ctx, out);
     }
     return r;
+}
+
+drift_glare_stats drift_glare_get_stats(const drift_glare *g)
+{
+    bool fft = g->last_convolved > 0;
+    return (drift_glare_stats){ .aperture_fft = g->psf_valid ? g->n : 0,
+                                .psf_size = g->psf_valid ? g->k : 0,
+                                .psf_updated = g->last_updated,
+                                .fft_width = fft ? g->conv.width : 0,
+                                .fft_height = fft ? g->conv.height : 0,
+                                .convolved_pixels = g->last_convolved };
 }
 
 drift_image drift_glare_aperture(const drift_glare *g)

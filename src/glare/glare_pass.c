@@ -53,3 +53,10 @@ drift_result drift_glare_pass_dynamic(drift_frame_state *f, const drift_pass_arg
 {
     return apply(f, args, DRIFT_GLARE_MODE_DYNAMIC);
 }
+
+const drift_glare *drift_glare_pass_object(const drift_frame_state *f)
+{
+    const drift_pass_args args = { .effect = DRIFT_EFFECT_GLARE, .technique = f->params.glare };
+    const glare_pass_state *s = drift_pass_state(f, &args);
+    return s ? s->glare : NULL;
+}

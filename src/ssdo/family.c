@@ -14,7 +14,24 @@ static drift_result after_row(drift_frame_state *f, const drift_family_row *row)
     return DRIFT_OK;
 }
 
+// What the occlusion row's screen-space render did: its samples a pixel, the points marched
+// along each, the bounce, the extra views and layers, and the pixels it shaded.
+static void report(drift_frame_state *f, drift_family_count_fn count)
+{
+    drift_ssdo_pass_counts c;
+    if (!drift_ssdo_pass_report(f, &c)) {
+        return;
+    }
+    count(f, "ssdo.samples", c.samples);
+    count(f, "ssdo.steps", c.steps);
+    count(f, "ssdo.bounce", c.bounce ? 1.0 : 0.0);
+    count(f, "ssdo.views", c.views);
+    count(f, "ssdo.layers", c.layers);
+    count(f, "ssdo.shaded_pixels", (double)c.pixels);
+}
+
 const drift_family drift_ssdo_family = {
     .name = "ssdo",
     .after_row = after_row,
+    .report = report,
 };

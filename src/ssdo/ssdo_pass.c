@@ -12,7 +12,9 @@ typedef struct ssdo_pass_state {
     drift_ssdo_output out;
     drift_image back_depth; // 1: the second depth layer (layers = 2)
     drift_ssdo_view views[DRIFT_SSDO_MAX_VIEWS];
-    int32_t view_count; // rendered this frame (cameras > 0)
+    int32_t view_count;     // rendered this frame (cameras > 0)
+    drift_ssdo_params used; // the last render's resolved parameters (the family's report)
+    uint64_t pixels;        // pixels the last render shaded (they see a surface)
 } ssdo_pass_state;
 
 static void state_destroy(drift_context *ctx, void *data)
@@ -117,6 +119,12 @@ static drift_result render(drift_frame_state *f, const drift_pass_args *args,
     r = drift_ssdo_render(f->ctx, s->env, &in, &params, &s->out);
     if (r == DRIFT_OK) {
         drift_pass_copy_rgb(&s->out.radiance, &f->terms[args->effect]);
+        s->used = params;
+        s->pixels = 0;
+        size_t n = (size_t)f->params.width * (size_t)f->params.height;
+        for (size_t i = 0; i < n; ++i) {
+            s->pixels += f->gbuffer.surfaces[i].material != DRIFT_INVALID_INDEX;
+        }
     }
     return r;
 }
@@ -161,6 +169,23 @@ drift_result drift_ssdo_pass_reference(drift_frame_state *f, const drift_pass_ar
     reference_job job = { &f->terms[args->effect], args->stream };
     drift_pass_pixels(f, DRIFT_PASS_REFERENCE, reference_pixel, &job);
     return DRIFT_OK;
+}
+
+bool drift_ssdo_pass_report(const drift_frame_state *f, drift_ssdo_pass_counts *out)
+{
+    const drift_pass_args args = { .effect = DRIFT_EFFECT_OCCLUSION,
+                                   .technique = f->params.occlusion };
+    const ssdo_pass_state *s = drift_pass_state(f, &args);
+    if (!s) {
+        return false;
+    }
+    *out = (drift_ssdo_pass_counts){ .samples = s->used.samples,
+                                     .steps = s->used.steps,
+                                     .bounce = s->used.bounce,
+                                     .views = s->view_count,
+                                     .layers = f->params.occlusion_settings.layers == 2 ? 2 : 1,
+                                     .pixels = s->pixels };
+    return true;
 }
 
 void drift_ssdo_planes(const drift_frame_state *f, drift_pass_plane_fn add, void *sink)

@@ -19,4 +19,17 @@ drift_result drift_ssdo_pass_contact_shadows(drift_frame_state *frame);
 // occlusion.visibility, .bent_normal, .direct and .bounce of the last render.
 void drift_ssdo_planes(const drift_frame_state *frame, drift_pass_plane_fn add, void *sink);
 
+// What the occlusion row's last screen-space render did (SSAO, GTAO, SSDO), for the family's
+// report hook: the resolved samples a pixel (GTAO: horizon samples) and points marched along
+// each, whether the bounce ran, the extra cameras and depth layers read, and the pixels shaded.
+// False when no such row has run (occlusion none or reference).
+typedef struct drift_ssdo_pass_counts {
+    int32_t samples, steps;
+    bool bounce;
+    int32_t views, layers;
+    uint64_t pixels;
+} drift_ssdo_pass_counts;
+
+bool drift_ssdo_pass_report(const drift_frame_state *frame, drift_ssdo_pass_counts *out);
+
 #endif // DRIFT_SSDO_PASS_H

@@ -9,7 +9,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#define OVERLAY_TEXT_MAX 2048
+#define OVERLAY_TEXT_MAX DRIFT_VIEW_OVERLAY_TEXT_MAX
 
 // stb_easy_font indexes a table by (char - 32): keep printable ASCII, tabs and newlines.
 static void sanitize(char *text)
@@ -141,59 +141,99 @@ static const char *technique_of(const drift_hybrid_params *p, drift_effect effec
     return name ? name : "?";
 }
 
-void drift_view_draw_overlay(drift_view *view)
+// The frame's stages, two a line in columns 0-3 (they add up to the frame: none is left out),
+// and beside them, one a line in columns 4-5, its counts: what each chosen technique's family
+// reports it did (drift_hybrid_stats_count), the same as --stats and the CLI's pass table.
+#define OVERLAY_MAX_STAGES (DRIFT_EFFECT_COUNT + 8)
+
+static void append_frame_table(char *text, size_t *len, const drift_hybrid_stats *stats)
 {
-    char text[OVERLAY_TEXT_MAX];
+    const char *stage_names[OVERLAY_MAX_STAGES];
+    double stage_ms[OVERLAY_MAX_STAGES];
+    uint32_t stages = 0;
+    const char *name;
+    double value;
+    for (uint32_t k = 0;
+         stages < OVERLAY_MAX_STAGES && drift_hybrid_stats_stage(stats, k, &name, &value); ++k) {
+        if (value > 0.0) { // a stage that did not run this frame is left out
+            stage_names[stages] = name;
+            stage_ms[stages++] = value;
+        }
+    }
+    uint32_t counts = 0;
+    while (drift_hybrid_stats_count(stats, counts, &name, &value)) {
+        ++counts;
+    }
+    uint32_t stage_lines = (stages + 1) / 2;
+    uint32_t lines = stage_lines > counts ? stage_lines : counts;
+    for (uint32_t line = 0; line < lines; ++line) {
+        for (uint32_t j = 0; j < 2; ++j) {
+            uint32_t i = 2 * line + j;
+            if (i < stages) {
+                append(text, len, "%s%s\t%.2f ms", j ? "\t" : "", stage_names[i], stage_ms[i]);
+            } else {
+                append(text, len, "%s\t", j ? "\t" : "");
+            }
+        }
+        if (line < counts && drift_hybrid_stats_count(stats, line, &name, &value)) {
+            append(text, len, "\t%s\t%.6g", name, value);
+        }
+        append(text, len, "\n");
+    }
+}
+
+size_t drift_view_overlay_text(const drift_view *view, char *text, size_t capacity)
+{
+    char buf[OVERLAY_TEXT_MAX];
     size_t len = 0;
-    text[0] = '\0';
+    buf[0] = '\0';
     if (view->help && view->help_text) {
-        append(text, &len, "%s", view->help_text);
+        append(buf, &len, "%s", view->help_text);
     } else {
         for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
-            append(text, &len, "%s\t%s\n", drift_effect_name((drift_effect)e),
+            append(buf, &len, "%s\t%s\n", drift_effect_name((drift_effect)e),
                    technique_of(&view->params, (drift_effect)e));
         }
         {
             const drift_knob *k = drift_knob_get(view->knob);
             char value[64];
             drift_knob_format(k, drift_knob_value(&view->params, view->knob), value, sizeof value);
-            append(text, &len, "knob %d/%d\t%s %s\n", view->knob + 1, drift_knob_count(), k->name,
+            append(buf, &len, "knob %d/%d\t%s %s\n", view->knob + 1, drift_knob_count(), k->name,
                    value);
         }
-        append(text, &len, "buffer\t%s\n", view->buffer_name);
-        append(text, &len, "exposure\t%+.1f stops\n", (double)view->exposure_stops);
+        append(buf, &len, "buffer\t%s\n", view->buffer_name);
+        append(buf, &len, "exposure\t%+.1f stops\n", (double)view->exposure_stops);
         if (drift_reflection_edits_constraint_count(view->edits) > 0 ||
             drift_reflection_edits_region_count(view->edits) > 0) {
-            append(text, &len, "edits\t%u constraints, %u regions\n",
+            append(buf, &len, "edits\t%u constraints, %u regions\n",
                    drift_reflection_edits_constraint_count(view->edits),
                    drift_reflection_edits_region_count(view->edits));
         }
         if (view->split) {
-            append(text, &len, "pt reference\t%u spp\n",
+            append(buf, &len, "pt reference\t%u spp\n",
                    view->reference ? drift_pt_sample_count(view->reference) : 0u);
         } else {
-            append(text, &len, "pt reference\toff\n");
+            append(buf, &len, "pt reference\toff\n");
         }
         drift_hybrid_stats stats = drift_hybrid_get_stats(view->hybrid);
-        append(text, &len, "frame\t%.2f ms\n", stats.frame_ms);
-        // The frame's stages (they add up to the frame: none is left out), two a line.
-        int column = 0;
-        const char *name;
-        double ms;
-        for (uint32_t k = 0; drift_hybrid_stats_stage(&stats, k, &name, &ms); ++k) {
-            if (!(ms > 0.0)) {
-                continue; // the stage did not run this frame
-            }
-            append(text, &len, "%s%s\t%.2f ms", column ? "\t" : "", name, ms);
-            column = !column;
-            if (!column) {
-                append(text, &len, "\n");
-            }
-        }
+        append(buf, &len, "frame\t%.2f ms\n", stats.frame_ms);
+        append_frame_table(buf, &len, &stats);
     }
-    while (len > 0 && text[len - 1] == '\n') {
-        text[--len] = '\0';
+    while (len > 0 && buf[len - 1] == '\n') {
+        buf[--len] = '\0';
     }
+    if (text && capacity > 0) {
+        size_t n = len < capacity - 1 ? len : capacity - 1;
+        memcpy(text, buf, n);
+        text[n] = '\0';
+    }
+    return len;
+}
+
+void drift_view_draw_overlay(drift_view *view)
+{
+    char text[OVERLAY_TEXT_MAX];
+    drift_view_overlay_text(view, text, sizeof text);
     int32_t scale = view->width >= 1280 ? 2 : 1;
     draw_text(view, text, 6 * scale, 6 * scale, scale);
 }

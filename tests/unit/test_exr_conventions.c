@@ -43,11 +43,13 @@ static void test_exr_conventions_channels_and_metadata(void **state)
         snprintf(names + len, sizeof names - len, "%s%s", i ? "," : "", list->entries[i].name.str);
     }
     // OpenEXR lists channels sorted by name.
-    // The conventional layers, then the feature-guided denoiser's inputs (issue 48).
+    // The conventional layers, then the feature-guided denoiser's inputs (issue 48: the
+    // features, the variances and the direct light, tools/cmd_render.c).
     assert_string_equal(names, "B,G,N.X,N.Y,N.Z,R,Z,albedo.B,albedo.G,albedo.R,"
+                               "direct.B,direct.G,direct.R,direct_variance.Y,"
                                "feature_albedo.B,feature_albedo.G,feature_albedo.R,"
                                "feature_depth.Y,feature_normal.X,feature_normal.Y,"
-                               "feature_normal.Z,variance.Y");
+                               "feature_normal.Z,indirect_variance.Y,variance.Y");
 
     exr_attr_chromaticities_t chroma_value = { 0 }, *chroma = &chroma_value;
     assert_int_equal(exr_attr_get_chromaticities(f, 0, "chromaticities", chroma), EXR_ERR_SUCCESS);
@@ -69,6 +71,55 @@ static void test_exr_conventions_channels_and_metadata(void **state)
     assert_int_equal(exr_attr_get_string(f, 0, "drift.scene", &length, &value), EXR_ERR_SUCCESS);
     assert_non_null(strstr(value, ".json"));
     exr_finish(&f);
+}
+
+// The channel names of `exr` as OpenEXR's reader lists them (sorted), comma-separated.
+static void exr_channel_names(const char *exr, char *names, size_t capacity)
+{
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    exr_context_t f = NULL;
+    assert_int_equal(exr_start_read(&f, exr, &init), EXR_ERR_SUCCESS);
+    const exr_attr_chlist_t *list = NULL;
+    assert_int_equal(exr_get_channels(f, 0, &list), EXR_ERR_SUCCESS);
+    names[0] = '\0';
+    for (int i = 0; i < list->num_channels; ++i) {
+        size_t len = strlen(names);
+        snprintf(names + len, capacity - len, "%s%s,", i ? "" : ",", list->entries[i].name.str);
+    }
+    exr_finish(&f);
+}
+
+// The hybrid mode's --aov FILE.exr: the G-buffer's normals as N.X/N.Y/N.Z, or with
+// --aov-normal Normal as Blender's Normal.X/Y/Z (and no N.*), depth as Z, either way.
+static void test_exr_conventions_hybrid_aov_normal(void **state)
+{
+    (void)state;
+    const char *bin = getenv("DRIFT_BIN");
+    assert_non_null(bin);
+    static const char *const layers[2] = { "N", "Normal" };
+    for (int blender = 0; blender < 2; ++blender) {
+        char out[1024], aov[1024], command[4096];
+        test_out_path(out, blender ? "hybrid_blender.exr" : "hybrid_n.exr");
+        test_out_path(aov, blender ? "hybrid_blender_aov.exr" : "hybrid_n_aov.exr");
+        snprintf(command, sizeof command,
+                 "'%s' render --mode hybrid --indirect none --width 12 --height 10 --threads 1 "
+                 "--quiet --aov '%s' %s --out '%s' > /dev/null",
+                 bin, aov, blender ? "--aov-normal Normal" : "", out);
+        assert_int_equal(system(command), 0);
+        char names[8192];
+        exr_channel_names(aov, names, sizeof names);
+        for (int l = 0; l < 2; ++l) {
+            for (const char *c = "XYZ"; *c; ++c) {
+                char channel[32];
+                snprintf(channel, sizeof channel, ",%s.%c,", layers[l], *c);
+                if ((strstr(names, channel) != NULL) != (l == blender)) {
+                    fail_msg("--aov-normal %s: channel %s %s in %s", layers[blender], channel,
+                             l == blender ? "missing" : "present", names);
+                }
+            }
+        }
+        assert_non_null(strstr(names, ",Z,"));
+    }
 }
 
 // The PNG's CRC-32 (ISO 3309), for checking the chunk drift writes by hand.
@@ -138,6 +189,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_exr_conventions_channels_and_metadata),
         cmocka_unit_test(test_exr_conventions_png_has_srgb_chunk),
+        cmocka_unit_test(test_exr_conventions_hybrid_aov_normal),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

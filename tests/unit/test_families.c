@@ -260,6 +260,53 @@ static void test_a_frame_reports_what_it_did(void **state)
     check_counts_named(frame, "ism");
     assert_true(count_of(frame, "micro.indirect.points") == 512.0);
     assert_true(count_of(frame, "micro.indirect.gathers") > 0.0);
+
+    // SSDO: its resolved samples and steps (4 x 4 by default), the pixels it shaded (those
+    // that see a surface), one layer, no extra views, the bounce when asked for; none of it
+    // with occlusion reference.
+    p = small_params();
+    p.indirect = DRIFT_INDIRECT_NONE;
+    p.occlusion = DRIFT_OCCLUSION_SSDO;
+    render(&r, frame, &p);
+    check_counts_named(frame, "micro");
+    assert_true(count_of(frame, "ssdo.samples") == 4.0);
+    assert_true(count_of(frame, "ssdo.steps") == 4.0);
+    assert_true(count_of(frame, "ssdo.bounce") == 0.0);
+    assert_true(count_of(frame, "ssdo.layers") == 1.0);
+    assert_true(count_of(frame, "ssdo.views") == 0.0);
+    double shaded = count_of(frame, "ssdo.shaded_pixels");
+    assert_true(shaded > 0.0 && shaded <= 16.0 * 16.0);
+    p.occlusion_settings.samples = 8;
+    p.occlusion_settings.layers = 2;
+    p.occlusion_settings.bounce = true;
+    render(&r, frame, &p);
+    assert_true(count_of(frame, "ssdo.bounce") == 1.0);
+    assert_true(count_of(frame, "ssdo.samples") == 8.0);
+    assert_true(count_of(frame, "ssdo.layers") == 2.0);
+    assert_true(count_of(frame, "ssdo.shaded_pixels") == shaded);
+    p.occlusion = DRIFT_OCCLUSION_REFERENCE;
+    render(&r, frame, &p);
+    check_counts_named(frame, "ssdo");
+
+    // Glare: the static eye makes its PSF on the first frame only, and convolves every pixel
+    // on a padded FFT at least the frame's size each frame.
+    p = small_params();
+    p.indirect = DRIFT_INDIRECT_NONE;
+    p.glare = DRIFT_GLARE_STATIC;
+    render(&r, frame, &p);
+    check_counts_named(frame, "ssdo");
+    assert_true(count_of(frame, "glare.psf_updates") == 1.0);
+    assert_true(count_of(frame, "glare.aperture_fft") > 0.0);
+    assert_true(count_of(frame, "glare.psf_size") > 0.0);
+    assert_true(count_of(frame, "glare.fft_width") >= 16.0);
+    assert_true(count_of(frame, "glare.fft_height") >= 16.0);
+    assert_true(count_of(frame, "glare.convolved_pixels") == 16.0 * 16.0);
+    render(&r, frame, &p);
+    assert_true(count_of(frame, "glare.psf_updates") == 0.0);
+    assert_true(count_of(frame, "glare.convolved_pixels") == 16.0 * 16.0);
+    p.glare = DRIFT_GLARE_NONE;
+    render(&r, frame, &p);
+    check_counts_named(frame, "glare");
     drift_hybrid_destroy(frame);
     test_rig_destroy(&r);
 }

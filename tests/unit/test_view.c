@@ -11,6 +11,7 @@
 #include "drift_test.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -176,6 +177,50 @@ static void test_view_framebuffer_shows_the_scene(void **state)
     assert_true(changed > 50);
     assert_true(p[0] < plain[0] || plain[0] == 0); // darkened under the box
     free(plain);
+    rig_destroy(&r);
+}
+
+// The overlay shows the frame's counts beside its pass table: every count the frame reports
+// (drift_hybrid_stats_count) with its value, every stage that ran, and the first count on
+// the line of the first stage.
+static void test_view_overlay_shows_the_frames_counts(void **state)
+{
+    (void)state;
+    drift_hybrid_params p = cheap_params();
+    p.shadows = DRIFT_SHADOWS_PCSS;
+    p.occlusion = DRIFT_OCCLUSION_SSDO;
+    rig r = rig_make(&(drift_view_desc){ .hybrid = p });
+    frame(&r);
+    char text[DRIFT_VIEW_OVERLAY_TEXT_MAX];
+    size_t len = drift_view_overlay_text(r.view, text, sizeof text);
+    assert_true(len > 0 && len < sizeof text);
+    drift_hybrid_stats stats = drift_hybrid_get_stats(drift_view_hybrid(r.view));
+    const char *name;
+    double value;
+    uint32_t counts = 0;
+    for (; drift_hybrid_stats_count(&stats, counts, &name, &value); ++counts) {
+        char cell[160];
+        snprintf(cell, sizeof cell, "%s\t%.6g", name, value);
+        if (!strstr(text, cell)) {
+            fail_msg("the overlay leaves out the count '%s' (%g):\n%s", name, value, text);
+        }
+    }
+    assert_true(counts >= 4); // shadow maps, SSDO's samples, ...
+    const char *first_stage = NULL;
+    for (uint32_t k = 0; drift_hybrid_stats_stage(&stats, k, &name, &value); ++k) {
+        char cell[80];
+        snprintf(cell, sizeof cell, "%s\t", name);
+        if (value > 0.0 && !strstr(text, cell)) {
+            fail_msg("the overlay leaves out the stage '%s':\n%s", name, text);
+        }
+        first_stage = first_stage || !(value > 0.0) ? first_stage : name;
+    }
+    assert_non_null(first_stage);
+    const char *line = strstr(text, first_stage);
+    const char *end = strchr(line, '\n');
+    assert_true(drift_hybrid_stats_count(&stats, 0, &name, &value));
+    const char *beside = strstr(line, name);
+    assert_true(beside && (!end || beside < end));
     rig_destroy(&r);
 }
 
@@ -431,6 +476,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_view_framebuffer_shows_the_scene),
+        cmocka_unit_test(test_view_overlay_shows_the_frames_counts),
         cmocka_unit_test(test_view_technique_keys_cycle),
         cmocka_unit_test(test_view_buffer_keys_visit_every_plane),
         cmocka_unit_test(test_view_reference_restarts_when_the_camera_moves),
