@@ -181,3 +181,31 @@ drift_image test_rig_render_pt(test_rig *r, uint32_t components, int32_t max_dep
     assert_int_equal(drift_pt_resolve(*pt, DRIFT_PT_AOV_BEAUTY, &img), DRIFT_OK);
     return img;
 }
+
+void test_add_effects_stage(drift_scene *scene, uint32_t slices, uint32_t stacks, int32_t size)
+{
+    uint32_t white =
+        test_add_material(scene, drift_material_make(drift_vec3_make(0.7f, 0.6f, 0.5f)));
+    uint32_t glossy =
+        test_add_material(scene, (drift_material){ .diffuse = { 0.3f, 0.1f, 0.1f },
+                                                   .specular = { 0.5f, 0.5f, 0.5f },
+                                                   .exponent = 40.0f,
+                                                   .diffuse_texture = DRIFT_INVALID_INDEX });
+    uint32_t mirror =
+        test_add_material(scene, (drift_material){ .type = DRIFT_MATERIAL_MIRROR,
+                                                   .specular = { 0.9f, 0.9f, 0.9f },
+                                                   .diffuse_texture = DRIFT_INVALID_INDEX });
+    test_add_floor(scene, 3.0f, -1.0f, white);
+    test_add_quad(scene, drift_vec3_make(-3, -1, 2), drift_vec3_make(6, 0, 0),
+                  drift_vec3_make(0, 4, 0), white);
+    test_add_sphere(scene, drift_vec3_make(-0.6f, -0.5f, 0.5f), 0.5f, slices, stacks, glossy);
+    test_add_sphere(scene, drift_vec3_make(0.7f, -0.6f, 0.2f), 0.4f, slices, stacks, mirror);
+    test_add_quad_light(scene, drift_vec3_make(-0.5f, 2.0f, -0.5f), drift_vec3_make(1, 0, 0),
+                        drift_vec3_make(0, 0, 1), 8.0f); // emits down
+    scene->camera =
+        drift_camera_look_at(drift_vec3_make(0, 0.5f, -3.0f), drift_vec3_make(0, -0.5f, 0.5f),
+                             drift_vec3_make(0, 1, 0), 1.0f, size, size);
+    scene->environment.color = drift_vec3_make(0.3f, 0.35f, 0.4f);
+    scene->camera.aperture_radius = 0.05f;
+    scene->camera.focus_distance = 3.0f;
+}

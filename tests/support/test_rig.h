@@ -41,6 +41,10 @@ void test_add_floor(drift_scene *scene, float half, float height, uint32_t mater
 // UV sphere with smooth normals and outward winding; returns its mesh index.
 uint32_t test_add_sphere(drift_scene *scene, drift_vec3 centre, float radius, uint32_t slices,
                          uint32_t stacks, uint32_t material);
+// Every effect at once on a size x size camera: a floor and a back wall, a glossy and a mirror
+// sphere (slices x stacks), one quad light emitting down, an environment (for occlusion) and a
+// lens (for depth of field).
+void test_add_effects_stage(drift_scene *scene, uint32_t slices, uint32_t stacks, int32_t size);
 
 // The path tracer's image of the rig's scene camera through the pixel centres, pinhole, with
 // only `components` (DRIFT_PT_COMPONENT_*) up to max_depth, at spp samples: the truth a

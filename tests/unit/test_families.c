@@ -13,34 +13,10 @@
 #include <stdio.h>
 #include <string.h>
 
-// A floor, a back wall, a glossy and a mirror sphere under one quad light, an environment
-// (for occlusion) and a lens (for depth of field).
+// The effects stage (test_rig.h), its spheres at 16x8.
 static void build_scene(test_rig *r, int32_t size)
 {
-    uint32_t white =
-        test_add_material(r->scene, drift_material_make(drift_vec3_make(0.7f, 0.6f, 0.5f)));
-    uint32_t glossy =
-        test_add_material(r->scene, (drift_material){ .diffuse = { 0.3f, 0.1f, 0.1f },
-                                                      .specular = { 0.5f, 0.5f, 0.5f },
-                                                      .exponent = 40.0f,
-                                                      .diffuse_texture = DRIFT_INVALID_INDEX });
-    uint32_t mirror =
-        test_add_material(r->scene, (drift_material){ .type = DRIFT_MATERIAL_MIRROR,
-                                                      .specular = { 0.9f, 0.9f, 0.9f },
-                                                      .diffuse_texture = DRIFT_INVALID_INDEX });
-    test_add_floor(r->scene, 3.0f, -1.0f, white);
-    test_add_quad(r->scene, drift_vec3_make(-3, -1, 2), drift_vec3_make(6, 0, 0),
-                  drift_vec3_make(0, 4, 0), white);
-    test_add_sphere(r->scene, drift_vec3_make(-0.6f, -0.5f, 0.5f), 0.5f, 16, 8, glossy);
-    test_add_sphere(r->scene, drift_vec3_make(0.7f, -0.6f, 0.2f), 0.4f, 16, 8, mirror);
-    test_add_quad_light(r->scene, drift_vec3_make(-0.5f, 2.0f, -0.5f), drift_vec3_make(1, 0, 0),
-                        drift_vec3_make(0, 0, 1), 8.0f);
-    r->scene->camera =
-        drift_camera_look_at(drift_vec3_make(0, 0.5f, -3.0f), drift_vec3_make(0, -0.5f, 0.5f),
-                             drift_vec3_make(0, 1, 0), 1.0f, size, size);
-    r->scene->environment.color = drift_vec3_make(0.3f, 0.35f, 0.4f);
-    r->scene->camera.aperture_radius = 0.05f;
-    r->scene->camera.focus_distance = 3.0f;
+    test_add_effects_stage(r->scene, 16, 8, size);
 }
 
 static bool same_pixels(const drift_image *a, const drift_image *b)
