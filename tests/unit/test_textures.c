@@ -117,14 +117,14 @@ static void test_wrap_filter_transform(void **state)
     drift_context_destroy(ctx);
 }
 
-// A checker of 1-texel squares: at full size a texel, at a footprint of many texels its mean.
-static void test_mip_levels(void **state)
+enum {
+    CHECKER_TEXELS = 64
+};
+
+// A white material textured by a CHECKER_TEXELS-square checker of 1-texel squares.
+static uint32_t add_checker_material(drift_context *ctx, drift_scene *scene)
 {
-    (void)state;
-    drift_context *ctx = test_context(1, NULL);
-    drift_scene *scene = NULL;
-    assert_int_equal(drift_scene_create(ctx, &scene), DRIFT_OK);
-    const int n = 64;
+    const int n = CHECKER_TEXELS;
     drift_image img;
     assert_int_equal(drift_image_create(ctx, n, n, 3, &img), DRIFT_OK);
     for (int y = 0; y < n; ++y) {
@@ -138,6 +138,18 @@ static void test_mip_levels(void **state)
     drift_material m = drift_material_make(drift_vec3_splat(1.0f));
     m.diffuse_texture = tex;
     assert_int_equal(drift_scene_add_material(scene, &m, &mat), DRIFT_OK);
+    return mat;
+}
+
+// A checker of 1-texel squares: at full size a texel, at a footprint of many texels its mean.
+static void test_mip_levels(void **state)
+{
+    (void)state;
+    drift_context *ctx = test_context(1, NULL);
+    drift_scene *scene = NULL;
+    assert_int_equal(drift_scene_create(ctx, &scene), DRIFT_OK);
+    uint32_t mat = add_checker_material(ctx, scene);
+    const int n = CHECKER_TEXELS;
     float quad[] = { 0, 0, 0, 1, 0, 0, 0, 1, 0 };
     uint32_t tri[] = { 0, 1, 2 };
     test_add_mesh(scene, quad, 3, tri, 1, mat);
@@ -517,20 +529,7 @@ static drift_image checker_render(drift_context *ctx, bool point_sampling, uint3
 {
     drift_scene *scene = NULL;
     assert_int_equal(drift_scene_create(ctx, &scene), DRIFT_OK);
-    const int n = 64;
-    drift_image img;
-    assert_int_equal(drift_image_create(ctx, n, n, 3, &img), DRIFT_OK);
-    for (int y = 0; y < n; ++y) {
-        for (int x = 0; x < n; ++x) {
-            float *p = drift_image_pixel(&img, x, y);
-            p[0] = p[1] = p[2] = (float)((x + y) & 1);
-        }
-    }
-    uint32_t tex, mat;
-    assert_int_equal(drift_scene_add_texture(scene, img, &tex), DRIFT_OK);
-    drift_material m = drift_material_make(drift_vec3_splat(1.0f));
-    m.diffuse_texture = tex;
-    assert_int_equal(drift_scene_add_material(scene, &m, &mat), DRIFT_OK);
+    uint32_t mat = add_checker_material(ctx, scene);
     const float x0 = -200, x1 = 200, z0 = 2, z1 = -400, k = 0.25f; // a texel is 1/16 unit
     const float pos[] = { x0, 0, z0, x1, 0, z0, x1, 0, z1, x0, 0, z1 };
     const float uv[] = { k * x0, k * z0, k * x1, k * z0, k * x1, k * z1, k * x0, k * z1 };
