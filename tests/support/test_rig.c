@@ -209,3 +209,22 @@ void test_add_effects_stage(drift_scene *scene, uint32_t slices, uint32_t stacks
     scene->camera.aperture_radius = 0.05f;
     scene->camera.focus_distance = 3.0f;
 }
+
+double test_direct_light_mc(const drift_scene *scene, uint32_t light, const drift_surface *s,
+                            const drift_bsdf *bsdf, drift_vec3 wo, int n, int channel)
+{
+    double sum = 0.0;
+    for (int k = 0; k < n; ++k) {
+        drift_sampler ks = drift_sampler_make(7, 0, (uint32_t)k);
+        drift_light_sample ls =
+            drift_light_sample_li(scene, light, s->position, drift_sampler_next2(&ks));
+        if (ls.pdf > 0.0f) {
+            drift_vec3 f = drift_bsdf_eval(bsdf, wo, ls.wi);
+            float fl = channel == 0   ? f.x * ls.radiance.x
+                       : channel == 1 ? f.y * ls.radiance.y
+                                      : f.z * ls.radiance.z;
+            sum += (double)(fl * fabsf(drift_vec3_dot(ls.wi, s->ns)) / ls.pdf);
+        }
+    }
+    return sum / n;
+}

@@ -41,6 +41,10 @@ void test_add_floor(drift_scene *scene, float half, float height, uint32_t mater
 // UV sphere with smooth normals and outward winding; returns its mesh index.
 uint32_t test_add_sphere(drift_scene *scene, drift_vec3 centre, float radius, uint32_t slices,
                          uint32_t stacks, uint32_t material);
+// Direct light at `s` from the scene's light `light` by n light samples (seed 7, sample k):
+// the Monte Carlo truth a closed form of one light is compared with; `channel` 0, 1 or 2.
+double test_direct_light_mc(const drift_scene *scene, uint32_t light, const drift_surface *s,
+                            const drift_bsdf *bsdf, drift_vec3 wo, int n, int channel);
 // Every effect at once on a size x size camera: a floor and a back wall, a glossy and a mirror
 // sphere (slices x stacks), one quad light emitting down, an environment (for occlusion) and a
 // lens (for depth of field).

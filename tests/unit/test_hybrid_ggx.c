@@ -40,18 +40,7 @@ static void check_against_monte_carlo(drift_material m, const char *what)
         drift_sampler sampler = drift_sampler_make(1, 0, 0);
         drift_vec3 closed =
             drift_raster_unshadowed(r.scene, &lights[0], &s, &bsdf, wo, 256, &sampler);
-        double mc = 0.0;
-        const int n = 100000;
-        for (int k = 0; k < n; ++k) {
-            drift_sampler ks = drift_sampler_make(7, 0, (uint32_t)k);
-            drift_light_sample ls =
-                drift_light_sample_li(r.scene, 0, s.position, drift_sampler_next2(&ks));
-            if (ls.pdf > 0.0f) {
-                drift_vec3 f = drift_bsdf_eval(&bsdf, wo, ls.wi);
-                mc += (double)(f.y * ls.radiance.y * fabsf(drift_vec3_dot(ls.wi, s.ns)) / ls.pdf);
-            }
-        }
-        mc /= n;
+        double mc = test_direct_light_mc(r.scene, 0, &s, &bsdf, wo, 100000, 1);
         print_message("%s, view %d: closed form %g, Monte Carlo %g (ratio %.3f)\n", what, c,
                       (double)closed.y, mc, (double)closed.y / mc);
         assert_true(mc > 0.0);

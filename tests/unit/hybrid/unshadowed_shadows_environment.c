@@ -35,18 +35,7 @@ static void check_unshadowed_matches_monte_carlo(const drift_light *light,
         drift_sampler sampler = drift_sampler_make(1, 0, 0);
         drift_vec3 closed =
             drift_raster_unshadowed(r.scene, &lights[0], &s, &bsdf, wo, 8, &sampler);
-        double mc = 0.0;
-        const int n = 200000;
-        for (int k = 0; k < n; ++k) {
-            drift_sampler ks = drift_sampler_make(7, 0, (uint32_t)k);
-            drift_light_sample ls =
-                drift_light_sample_li(r.scene, 0, s.position, drift_sampler_next2(&ks));
-            if (ls.pdf > 0.0f) {
-                drift_vec3 f = drift_bsdf_eval(&bsdf, wo, ls.wi);
-                mc += (double)(f.x * ls.radiance.x * fabsf(drift_vec3_dot(ls.wi, s.ns)) / ls.pdf);
-            }
-        }
-        mc /= n;
+        double mc = test_direct_light_mc(r.scene, 0, &s, &bsdf, wo, 200000, 0);
         print_message("case %zu: closed form %g, Monte Carlo %g\n", c, (double)closed.x, mc);
         assert_near(closed.x, mc, 0.01 * mc + 1e-6);
         if (c == dark) {
