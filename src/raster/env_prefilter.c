@@ -18,13 +18,13 @@
 #define BASE_WIDTH   256
 #define MIPS         7   // 256 x 128 down to 4 x 2
 #define LEVEL_SPP    256 // most lobe samples per prefiltered texel (level_spp)
-#define SUPERSAMPLES 4   // per axis, for the base copy
+#define SUPERSAMPLES 2   // per axis, for the base copy
 
 static const float level_r[LEVELS] = { 0.0f, 0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.65f, 0.8f, 1.0f };
 static const int32_t level_width[LEVELS] = { 0, 128, 64, 64, 32, 32, 32, 32, 32 };
 // Wide lobes take more samples: the coarse levels are few texels, and a bright source (the sun)
 // seen through 32 samples turned with each texel's frame leaves blotches.
-static const uint32_t level_spp[LEVELS] = { 0, 32, 64, 64, 128, 256, 256, 256, 256 };
+static const uint32_t level_spp[LEVELS] = { 0, 16, 32, 32, 64, 128, 128, 128, 128 };
 
 typedef struct latlong {
     int32_t w, h;
