@@ -318,11 +318,10 @@ static void scene_name(const char *path, char *out, size_t size)
 {
     const char *base = strrchr(path, '/');
     base = base ? base + 1 : path;
-    snprintf(out, size, "%s", base);
-    char *dot = strchr(out, '.');
-    if (dot) {
-        *dot = '\0';
-    }
+    size_t length = strcspn(base, "."); // a long name is cut to the column's width
+    length = length < size - 1 ? length : size - 1;
+    memcpy(out, base, length);
+    out[length] = '\0';
 }
 
 static bool is_pt_family(row_family f)
