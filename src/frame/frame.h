@@ -187,6 +187,10 @@ enum {
     DRIFT_ROW_REPLACES_FRAME = 1u << 3,      // the pass renders `final` whole (the lens reference)
     DRIFT_ROW_ENVIRONMENT_DIFFUSE = 1u << 4, // the term is the environment's diffuse light: D
                                              // keeps only the glossy part of it
+    // Not the conductor's: drift bench frontier renders the row against the other searched
+    // rows of its effect (drift_technique_frontier, docs/frontier.md). The path-traced truths
+    // and the baselines a searched row dominates (pcf under pcss, the blur rows) are not.
+    DRIFT_ROW_FRONTIER = 1u << 5,
 };
 
 // Runs fn for every row, or every pixel, rows in parallel. `rays` is the calling thread's ray
