@@ -262,12 +262,8 @@ static drift_result measure_render(drift_context *ctx, const drift_scene *scene,
     e->term = effect == DRIFT_EFFECT_SHADOWS    ? "direct"
               : effect == DRIFT_EFFECT_INDIRECT ? "indirect"
                                                 : "reflections";
-    e->aaf = effect == DRIFT_EFFECT_SHADOWS    ? DRIFT_SHADOWS_AAF
-             : effect == DRIFT_EFFECT_INDIRECT ? DRIFT_INDIRECT_AAF
-                                               : DRIFT_REFLECTIONS_AAF;
-    int reference = effect == DRIFT_EFFECT_SHADOWS    ? DRIFT_SHADOWS_REFERENCE
-                    : effect == DRIFT_EFFECT_INDIRECT ? DRIFT_INDIRECT_REFERENCE
-                                                      : DRIFT_REFLECTIONS_REFERENCE;
+    e->aaf = drift_technique_parse(effect, "aaf"); // the effect's rows in the table
+    int reference = drift_technique_parse(effect, "reference");
     *out = (curve){ .effect = effect, .count = o->spp_count, .plain_count = o->mc_spp_count };
     e->ref_owner = ordinal % sweep_ranks();
     int most = o->spp_count > o->mc_spp_count ? o->spp_count : o->mc_spp_count;

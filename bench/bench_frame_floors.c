@@ -356,12 +356,13 @@ static drift_result measure_isg(drift_frame_state *f, const bench_floor_options 
             for (uint32_t l = 0; l < f->light_count; ++l) {
                 bytes += image_bytes(&f->light_buffers[l].hard_shadow) +
                          image_bytes(&f->light_buffers[l].shadow);
-                samples += count_samples(f, &f->isg->light_search[l], search, gather, true);
+                samples +=
+                    count_samples(f, &drift_isg_of(f)->light_search[l], search, gather, true);
             }
         } else if (effect == DRIFT_EFFECT_REFLECTIONS) {
             bytes = image_bytes(&f->reflection_emitted) + image_bytes(&f->reflection_reflected) +
                     image_bytes(&f->reflection_distance) + image_bytes(&f->reflections);
-            samples = count_samples(f, &f->isg->reflection_search, search, gather, false);
+            samples = count_samples(f, &drift_isg_of(f)->reflection_search, search, gather, false);
         } else {
             bytes = image_bytes(&f->focus) + image_bytes(&f->coc) + image_bytes(&f->final) +
                     image_bytes(&f->gbuffer.depth);
@@ -371,8 +372,9 @@ static drift_result measure_isg(drift_frame_state *f, const bench_floor_options 
                 samples = (double)o->width * (double)o->height * search;
                 for (int32_t y = 0; y < f->params.height; ++y) {
                     for (int32_t x = 0; x < f->params.width; ++x) {
-                        samples +=
-                            drift_image_pixel(&f->isg->dof_search, x, y)[0] >= 0.5f ? gather : 0.0;
+                        samples += drift_image_pixel(&drift_isg_of(f)->dof_search, x, y)[0] >= 0.5f
+                                       ? gather
+                                       : 0.0;
                     }
                 }
             }

@@ -35,8 +35,9 @@ static drift_result hybrid_row(frontier_state *b, const char *name,
     return r;
 }
 
-// The hybrid search space, from the knob table (drift/knobs.h): shadows hard, pcss, isg, aaf x
-// indirect none, ambient, ism, ir, aaf (checked against the technique table); each knob
+// The hybrid search space, from the technique table's searched rows (DRIFT_ROW_FRONTIER:
+// shadows hard, pcss, isg, aaf x indirect none, ambient, aaf, ism, ir) and the knob table
+// (drift/knobs.h): each knob
 // swept below is set through drift_knob_set (its row's range refuses a value out of it) and
 // swept only where its row says it acts: the effect's technique is among the row's
 // techniques (ism-vpls on ism and ir; --spp only on a path-traced technique, AAF's rows at
@@ -97,8 +98,6 @@ static bool sweep_set(drift_hybrid_params *p, const int index[SWEEP_COUNT], swee
 
 drift_result frontier_hybrid_rows(frontier_state *b, double limit_ms)
 {
-    static const char *const shadows[] = { "hard", "pcss", "isg", "aaf" };
-    static const char *const indirect[] = { "none", "ambient", "ism", "ir", "aaf" };
     const frontier_options *o = b->o;
     int index[SWEEP_COUNT];
     for (int k = 0; k < SWEEP_COUNT; ++k) {
@@ -115,18 +114,16 @@ drift_result frontier_hybrid_rows(frontier_state *b, double limit_ms)
     const bool lens = b->scene->camera.aperture_radius > 0.0f;
     const size_t ef_count = o->env_filter > 0 && drift_scene_has_environment(b->scene) ? 2 : 1;
     drift_result r = DRIFT_OK;
-    for (size_t s = 0; s < sizeof shadows / sizeof *shadows && r == DRIFT_OK; ++s) {
-        for (size_t i = 0; i < sizeof indirect / sizeof *indirect && r == DRIFT_OK; ++i) {
+    // The searched rows of the technique table (DRIFT_ROW_FRONTIER), in its order.
+    for (int ts = 0; ts < drift_technique_count(DRIFT_EFFECT_SHADOWS) && r == DRIFT_OK; ++ts) {
+        for (int ti = 0; ti < drift_technique_count(DRIFT_EFFECT_INDIRECT) && r == DRIFT_OK; ++ti) {
+            if (!drift_technique_frontier(DRIFT_EFFECT_SHADOWS, ts) ||
+                !drift_technique_frontier(DRIFT_EFFECT_INDIRECT, ti)) {
+                continue;
+            }
             drift_hybrid_params base = drift_hybrid_params_default();
             base.width = base.height = (int32_t)o->size;
             base.max_depth = FRONTIER_DEPTH;
-            int ts = drift_technique_parse(DRIFT_EFFECT_SHADOWS, shadows[s]);
-            int ti = drift_technique_parse(DRIFT_EFFECT_INDIRECT, indirect[i]);
-            if (ts < 0 || ti < 0) {
-                fprintf(stderr, "drift bench frontier: no technique %s + %s\n", shadows[s],
-                        indirect[i]);
-                return DRIFT_ERR_INVALID_ARGUMENT;
-            }
             drift_hybrid_params_set_technique(&base, DRIFT_EFFECT_SHADOWS, ts);
             drift_hybrid_params_set_technique(&base, DRIFT_EFFECT_INDIRECT, ti);
             drift_hybrid_params_set_technique(
@@ -175,7 +172,9 @@ drift_result frontier_hybrid_rows(frontier_state *b, double limit_ms)
                              sweep_set(&p, index, SWEEP_GATHER_SCALE, half_gather ? 2.0 : 1.0);
                     }
                     char name[96];
-                    int len = snprintf(name, sizeof name, "%s + %s", shadows[s], indirect[i]);
+                    int len = snprintf(name, sizeof name, "%s + %s",
+                                       drift_technique_name(DRIFT_EFFECT_SHADOWS, ts),
+                                       drift_technique_name(DRIFT_EFFECT_INDIRECT, ti));
                     if (vpl) {
                         len += snprintf(name + len, sizeof name - (size_t)len, " %ld VPLs%s",
                                         o->vpls[v / 3],

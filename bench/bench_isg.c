@@ -5,14 +5,12 @@
 //       (the rest of the frame with ISG on: primary, U_l, the sharp buffers, composition)
 //   (b) quality at --qwidth x --qheight: FLIP and RMSE of the final image against the
 //       `reference` technique of the same effect at --ref-spp, with every other effect the
-//       same in both, for ISG and the baselines, with each technique's own milliseconds
-//       (the passes that technique adds) so the times can be matched:
-//         shadows      hard, pcss, blur (the hard bits over a fixed disk), isg
-//         reflections  sharp, envmap, blur (the sharp buffer over a fixed disk), isg
-//       and isg-9x9 (ISG at 9 x 9 samples, its cheapest) for every effect, isg-2layers (with
-//       the second depth layer) for depth of field
-//         dof          none, post, isg; the focused frame has reference (path-traced)
-//                      shadows so that only depth of field differs from the lens reference
+//       same in both, for every real-time row of the effect in the technique table (ISG,
+//       its blur baselines, the real-time rows), with each technique's own milliseconds (the
+//       stage and inputs that technique adds) so the times can be matched; then isg-9x9 (ISG
+//       at 9 x 9 samples, its cheapest) for every effect, isg-2layers (with the second depth
+//       layer) for depth of field. Depth of field's focused frame has reference (path-traced)
+//       shadows so that only depth of field differs from the lens reference.
 #include "bench.h"
 #include "cli.h"
 #include "distributed/sweep.h"
@@ -167,21 +165,18 @@ static bool timing_collect(int first, double cells[16][2], bool ok, double table
     return true;
 }
 
-// The milliseconds a technique of an effect adds to the frame.
+// The milliseconds a technique of an effect adds to the frame: its row's stage (its pass, and
+// D's sum after a shadow row) and the shared inputs only rows of that effect ask for (the
+// hard-shadow buffer and the shadow maps; the sharp mirror rays and the probes).
 static double technique_ms(drift_effect effect, const drift_hybrid_stats *s)
 {
-    switch (effect) {
-    case DRIFT_EFFECT_SHADOWS:
-        return s->ms[DRIFT_PASS_HARD_SHADOWS] + s->ms[DRIFT_PASS_SHADOW_MAPS] +
-               s->ms[DRIFT_PASS_SHADOW_FILTER] + s->ms[DRIFT_PASS_ISG];
-    case DRIFT_EFFECT_REFLECTIONS:
-        return s->ms[DRIFT_PASS_REFLECTIONS] + s->ms[DRIFT_PASS_ENVMAP] + s->ms[DRIFT_PASS_ISG];
-    case DRIFT_EFFECT_DOF:
-        return s->ms[DRIFT_PASS_DOF] + s->ms[DRIFT_PASS_ISG];
-    default: // ISG has no technique for the other effects
-        break;
+    double ms = s->effect_ms[effect];
+    if (effect == DRIFT_EFFECT_SHADOWS) {
+        ms += s->ms[DRIFT_PASS_HARD_SHADOWS] + s->ms[DRIFT_PASS_SHADOW_MAPS];
+    } else if (effect == DRIFT_EFFECT_REFLECTIONS) {
+        ms += s->ms[DRIFT_PASS_REFLECTIONS] + s->ms[DRIFT_PASS_ENVMAP];
     }
-    return 0.0;
+    return ms;
 }
 
 typedef struct quality_row {
@@ -189,7 +184,41 @@ typedef struct quality_row {
     double flip, rmse, ms;
 } quality_row;
 
-#define MAX_ROWS 5
+#define MAX_ROWS 12
+
+// A row of (b): a technique of the effect, or one of ISG's variants.
+typedef enum quality_variant {
+    QUALITY_PLAIN,  // the technique at the bench's settings
+    QUALITY_CHEAP,  // "isg-9x9": ISG at its cheapest sample counts, the time-matched variant
+    QUALITY_LAYERS, // "isg-2layers": ISG's depth of field with the second depth layer
+} quality_variant;
+
+typedef struct quality_entry {
+    const char *name;
+    int technique;
+    quality_variant variant;
+} quality_entry;
+
+// (b)'s rows for an effect, from the technique table: every real-time row of the effect (the
+// path-traced ones are the reference's kind: drift bench aaf measures those), then ISG's
+// variants. The same list on every rank.
+static int quality_entries(drift_effect effect, quality_entry out[MAX_ROWS])
+{
+    int n = 0;
+    for (int t = 0; t < drift_technique_count(effect) && n < MAX_ROWS; ++t) {
+        if (!drift_technique_path_traced(effect, t)) {
+            out[n++] = (quality_entry){ drift_technique_name(effect, t), t, QUALITY_PLAIN };
+        }
+    }
+    int isg = isg_technique(effect);
+    if (n < MAX_ROWS) {
+        out[n++] = (quality_entry){ "isg-9x9", isg, QUALITY_CHEAP };
+    }
+    if (effect == DRIFT_EFFECT_DOF && n < MAX_ROWS) {
+        out[n++] = (quality_entry){ "isg-2layers", isg, QUALITY_LAYERS };
+    }
+    return n;
+}
 
 // (b) for one effect: the reference, then every technique against it. Under mpirun the
 // reference is rendered by one rank (effect ordinal mod N) while the others render the
@@ -197,28 +226,20 @@ typedef struct quality_row {
 // rank, each compares its own frames, and rank 0 gathers the rows.
 typedef struct quality_run {
     int ref_owner, count;
+    quality_entry entries[MAX_ROWS];
     int owners[MAX_ROWS];
     drift_image reference, tests[MAX_ROWS];
     double ms[MAX_ROWS];
 } quality_run;
 
-static const char *const quality_names[DRIFT_EFFECT_COUNT][MAX_ROWS] = {
-    { "hard", "pcss", "blur", "isg", "isg-9x9" },
-    { "sharp", "envmap", "blur", "isg", "isg-9x9" },
-    { "none", "post", "isg", "isg-9x9", "isg-2layers" },
-    { NULL },
-};
-
 static drift_result quality_render(const bench_ctx *b, drift_effect effect, int ordinal,
                                    quality_run *q)
 {
     const isg_options *o = b->o;
-    const char *const *names = quality_names[effect];
     q->ref_owner = ordinal % sweep_ranks();
-    q->count = 0;
-    while (q->count < MAX_ROWS && names[q->count]) {
-        q->owners[q->count] = sweep_owner_besides(q->ref_owner, q->count);
-        q->count++;
+    q->count = quality_entries(effect, q->entries);
+    for (int t = 0; t < q->count; ++t) {
+        q->owners[t] = sweep_owner_besides(q->ref_owner, t);
     }
     drift_hybrid_params ref = effect_params(effect, drift_technique_parse(effect, "reference"));
     ref.width = (int32_t)o->qwidth;
@@ -233,13 +254,9 @@ static drift_result quality_render(const bench_ctx *b, drift_effect effect, int 
         if (q->owners[t] != sweep_rank()) {
             continue;
         }
-        // "isg-9x9" is ISG at its cheapest sample counts: the time-matched variant.
-        // "isg-2layers" adds the second depth layer.
-        bool cheap = strcmp(names[t], "isg-9x9") == 0;
-        bool layers = strcmp(names[t], "isg-2layers") == 0;
-        drift_hybrid_params p =
-            effect_params(effect, cheap || layers ? isg_technique(effect)
-                                                  : drift_technique_parse(effect, names[t]));
+        bool cheap = q->entries[t].variant == QUALITY_CHEAP;
+        bool layers = q->entries[t].variant == QUALITY_LAYERS;
+        drift_hybrid_params p = effect_params(effect, q->entries[t].technique);
         p.isg.layers = layers ? 2 : 1;
         p.width = ref.width;
         p.height = ref.height;
@@ -253,8 +270,8 @@ static drift_result quality_render(const bench_ctx *b, drift_effect effect, int 
     return r;
 }
 
-static bool quality_compare(const bench_ctx *b, drift_effect effect, quality_run *q, bool ok,
-                            quality_row *rows, int *out_count)
+static bool quality_compare(const bench_ctx *b, quality_run *q, bool ok, quality_row *rows,
+                            int *out_count)
 {
     int32_t dims[3] = { q->reference.width, q->reference.height, q->reference.channels };
     ok = sweep_share(dims, sizeof dims, q->ref_owner, ok);
@@ -281,7 +298,7 @@ static bool quality_compare(const bench_ctx *b, drift_effect effect, quality_run
         return false;
     }
     for (int t = 0; t < q->count; ++t) { // names here: a pointer from another rank means nothing
-        rows[t].technique = quality_names[effect][t];
+        rows[t].technique = q->entries[t].name;
     }
     *out_count = q->count;
     return true;
@@ -432,7 +449,7 @@ int drift_bench_isg(int argc, char **argv)
             ok = timing_collect(16 * e, cells[e], ok, tables[e], &base[e]) && ok;
         }
         if (!o.skip_quality) {
-            ok = quality_compare(&b, effects[e], &runs[e], ok, rows[e], &row_count[e]) && ok;
+            ok = quality_compare(&b, &runs[e], ok, rows[e], &row_count[e]) && ok;
         }
     }
     if (r == DRIFT_OK && !ok) {

@@ -69,6 +69,10 @@ const char *drift_technique_summary(drift_effect effect, int technique);
 // Whether the technique path-traces (reference, AAF, ...): its cost grows with --spp. The
 // others are the real-time rows a frame benchmark sweeps.
 bool drift_technique_path_traced(drift_effect effect, int technique);
+// Whether the equal-time frontier (drift bench frontier, docs/frontier.md) searches the
+// technique: the table's DRIFT_ROW_FRONTIER flag (shadows hard, pcss, isg, aaf; indirect
+// none, ambient, aaf, ism, ir).
+bool drift_technique_frontier(drift_effect effect, int technique);
 // The technique called `name`, or -1.
 int drift_technique_parse(drift_effect effect, const char *name);
 

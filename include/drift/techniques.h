@@ -11,7 +11,8 @@
 //   summary     one line for --help and the viewer's overlay
 //   pass        the function that fills the effect's term (drift_pass_none: the inputs are it)
 //   inputs      DRIFT_INPUT_* the frame prepares before the pass (buffers shared by rows)
-//   flags       DRIFT_ROW_*: how the conductor treats the row's output
+//   flags       DRIFT_ROW_*: how the conductor treats the row's output, and whether the
+//               equal-time frontier searches the row (DRIFT_ROW_FRONTIER)
 //   planes      the function that lists the row's own --aov planes (drift_planes_none: none)
 //   stream      the sampler stream the pass keys its random numbers on (0: none)
 //   components  DRIFT_PT_COMPONENT_* of the effect's path-traced truth (its `reference` row)
@@ -41,21 +42,22 @@
 
 #define DRIFT_SHADOW_TECHNIQUES(X, P)                                                              \
     X(P, HARD, "hard", "ray-traced visibility of each light's centre", drift_pass_none,            \
-      DRIFT_INPUT_UNSHADOWED | DRIFT_INPUT_HARD_SHADOWS, DRIFT_ROW_SUMS_DIRECT, drift_planes_none, \
-      0, DRIFT_PT_COMPONENT_DIRECT)                                                                \
+      DRIFT_INPUT_UNSHADOWED | DRIFT_INPUT_HARD_SHADOWS,                                           \
+      DRIFT_ROW_SUMS_DIRECT | DRIFT_ROW_FRONTIER, drift_planes_none, 0, DRIFT_PT_COMPONENT_DIRECT) \
     X(P, PCF, "pcf", "shadow map, percentage-closer filtering", drift_realtime_pass_pcf,           \
       DRIFT_INPUT_UNSHADOWED | DRIFT_INPUT_SHADOW_MAPS, DRIFT_ROW_SUMS_DIRECT, drift_planes_none,  \
       0, DRIFT_PT_COMPONENT_DIRECT)                                                                \
     X(P, PCSS, "pcss", "shadow map, percentage-closer soft shadows (Fernando 2005)",               \
       drift_realtime_pass_pcss, DRIFT_INPUT_UNSHADOWED | DRIFT_INPUT_SHADOW_MAPS,                  \
-      DRIFT_ROW_SUMS_DIRECT, drift_planes_none, DRIFT_STREAM_PCSS, DRIFT_PT_COMPONENT_DIRECT)      \
+      DRIFT_ROW_SUMS_DIRECT | DRIFT_ROW_FRONTIER, drift_planes_none, DRIFT_STREAM_PCSS,            \
+      DRIFT_PT_COMPONENT_DIRECT)                                                                   \
     X(P, REFERENCE, "reference", "direct light path-traced at --spp", drift_hybrid_pass_reference, \
       0, DRIFT_ROW_PATH_TRACED, drift_planes_none, 0, DRIFT_PT_COMPONENT_DIRECT)                   \
     X(P, ISG, "isg", "image space gathering over the hard-shadow buffer (docs/isg.md)",            \
       drift_isg_pass_shadows,                                                                      \
       DRIFT_INPUT_UNSHADOWED | DRIFT_INPUT_HARD_SHADOWS | DRIFT_INPUT_OCCLUDER_DISTANCES,          \
-      DRIFT_ROW_SUMS_DIRECT, drift_isg_shadow_planes, DRIFT_STREAM_ISG_SHADOWS,                    \
-      DRIFT_PT_COMPONENT_DIRECT)                                                                   \
+      DRIFT_ROW_SUMS_DIRECT | DRIFT_ROW_FRONTIER, drift_isg_shadow_planes,                         \
+      DRIFT_STREAM_ISG_SHADOWS, DRIFT_PT_COMPONENT_DIRECT)                                         \
     X(P, BLUR, "blur", "baseline: the hard-shadow bits blurred over a fixed disk",                 \
       drift_isg_pass_shadows,                                                                      \
       DRIFT_INPUT_UNSHADOWED | DRIFT_INPUT_HARD_SHADOWS | DRIFT_INPUT_OCCLUDER_DISTANCES,          \
@@ -63,7 +65,7 @@
       DRIFT_PT_COMPONENT_DIRECT)                                                                   \
     X(P, AAF, "aaf", "axis-aligned filtering of ray-traced area-light visibility (docs/aaf.md)",   \
       drift_aaf_pass_shadows, DRIFT_INPUT_UNSHADOWED,                                              \
-      DRIFT_ROW_SUMS_DIRECT | DRIFT_ROW_PATH_TRACED, drift_aaf_shadow_planes,                      \
+      DRIFT_ROW_SUMS_DIRECT | DRIFT_ROW_PATH_TRACED | DRIFT_ROW_FRONTIER, drift_aaf_shadow_planes, \
       DRIFT_STREAM_AAF_SHADOWS, DRIFT_PT_COMPONENT_DIRECT)
 
 #define DRIFT_REFLECTION_TECHNIQUES(X, P)                                                          \
@@ -103,21 +105,23 @@
       DRIFT_PT_COMPONENT_ALL)
 
 #define DRIFT_INDIRECT_TECHNIQUES(X, P)                                                           \
-    X(P, NONE, "none", "no indirect light", drift_pass_none, 0, DRIFT_ROW_NO_TERM,                \
-      drift_planes_none, 0, DRIFT_PT_COMPONENT_DIFFUSE)                                           \
+    X(P, NONE, "none", "no indirect light", drift_pass_none, 0,                                   \
+      DRIFT_ROW_NO_TERM | DRIFT_ROW_FRONTIER, drift_planes_none, 0, DRIFT_PT_COMPONENT_DIFFUSE)   \
     X(P, AMBIENT, "ambient", "diffuse albedo x a constant radiance", drift_realtime_pass_ambient, \
-      0, 0, drift_planes_none, 0, DRIFT_PT_COMPONENT_DIFFUSE)                                     \
+      0, DRIFT_ROW_FRONTIER, drift_planes_none, 0, DRIFT_PT_COMPONENT_DIFFUSE)                    \
     X(P, REFERENCE, "reference", "first-bounce diffuse light path-traced at --spp",               \
       drift_hybrid_pass_reference, 0, DRIFT_ROW_PATH_TRACED, drift_planes_none, 0,                \
       DRIFT_PT_COMPONENT_DIFFUSE)                                                                 \
     X(P, AAF, "aaf",                                                                              \
       "diffuse indirect path-traced, adaptively sampled and filtered (docs/aaf.md)",              \
-      drift_aaf_pass_indirect, 0, DRIFT_ROW_PATH_TRACED, drift_aaf_indirect_planes,               \
-      DRIFT_STREAM_AAF_INDIRECT, DRIFT_PT_COMPONENT_DIFFUSE)                                      \
+      drift_aaf_pass_indirect, 0, DRIFT_ROW_PATH_TRACED | DRIFT_ROW_FRONTIER,                     \
+      drift_aaf_indirect_planes, DRIFT_STREAM_AAF_INDIRECT, DRIFT_PT_COMPONENT_DIFFUSE)           \
     X(P, ISM, "ism", "virtual point lights, imperfect shadow maps (thesis ch. 5, docs/ism.md)",   \
-      drift_ism_pass_indirect, 0, 0, drift_ism_indirect_planes, 0, DRIFT_PT_COMPONENT_DIFFUSE)    \
+      drift_ism_pass_indirect, 0, DRIFT_ROW_FRONTIER, drift_ism_indirect_planes, 0,               \
+      DRIFT_PT_COMPONENT_DIFFUSE)                                                                 \
     X(P, IR, "ir", "baseline: the same VPLs with ray-traced visibility (instant radiosity)",      \
-      drift_ism_pass_ir, 0, 0, drift_ism_indirect_planes, 0, DRIFT_PT_COMPONENT_DIFFUSE)          \
+      drift_ism_pass_ir, 0, DRIFT_ROW_FRONTIER, drift_ism_indirect_planes, 0,                     \
+      DRIFT_PT_COMPONENT_DIFFUSE)                                                                 \
     X(P, MICRO, "micro", "final gather into point-hierarchy micro-buffers (thesis ch. 6)",        \
       drift_micro_pass_indirect, 0, 0, drift_micro_indirect_planes, 0, DRIFT_PT_COMPONENT_DIFFUSE)
 

@@ -4,7 +4,7 @@
 #ifndef DRIFT_AAF_H
 #define DRIFT_AAF_H
 
-#include "frame/frame.h"
+#include "frame/family.h"
 
 // Defaults (docs/aaf.md explains each).
 #define DRIFT_AAF_SPARSE_MIN          4 // sparse samples a pixel, at least (when spp allows)
@@ -137,6 +137,26 @@ typedef struct drift_aaf_state {
     drift_aaf_lobe_buffers indirect, specular;
 } drift_aaf_state;
 
+// AAF's state, in its slot of the frame (frame/family.h): made empty by the family's create
+// hook, its buffers the first time a pass of the frame uses AAF (lights is NULL until then;
+// most frames never do), freed by its destroy hook.
+static inline drift_aaf_state *drift_aaf_of(const drift_frame_state *frame)
+{
+    return (drift_aaf_state *)drift_family_state(frame, DRIFT_FAMILY_AAF);
+}
+
+// The state once an AAF pass has made its buffers, else NULL (what the planes and counts read).
+static inline const drift_aaf_state *drift_aaf_buffers(const drift_frame_state *frame)
+{
+    const drift_aaf_state *s = drift_aaf_of(frame);
+    return s && s->lights ? s : NULL;
+}
+
+// The family's create and destroy hooks (aaf_state.c): an empty state; the state and all it
+// holds (NULL-safe).
+drift_result drift_aaf_state_create(drift_frame_state *frame, void **out_state);
+void drift_aaf_state_destroy(drift_frame_state *frame, void *state);
+// Makes the buffers on first use.
 drift_result drift_aaf_state_ensure(drift_frame_state *frame);
 // Makes a lobe's buffers the first time the lobe runs (a frame that filters only shadows, or
 // only one lobe, does not hold the others').
@@ -145,7 +165,6 @@ drift_result drift_aaf_lobe_buffers_ensure(drift_context *ctx, drift_aaf_lobe_bu
 // Makes the state if needed and fills its footprint plane; *out_active (may be NULL) gets the
 // number of pixels that see a surface (the pixels the average spp is over).
 drift_result drift_aaf_prepare(drift_frame_state *frame, size_t *out_active);
-void drift_aaf_state_destroy(drift_context *ctx, drift_aaf_state *state); // NULL-safe
 
 // Fills every light's shadow buffer S_l (--shadows aaf). Needs the G-buffer.
 drift_result drift_aaf_pass_shadows(drift_frame_state *frame, const drift_pass_args *args);

@@ -156,7 +156,7 @@ static void add_samples(drift_frame_state *f, const indirect_job *job, int32_t x
     drift_vec3 wo = drift_pass_wo(f, x, y);
     // Reflection edits re-aim the glossy and mirror lobes (the diffuse one does not change).
     drift_reflection_edits_aim_bsdf(f->params.reflection_edits, s, wo, &bsdf);
-    indirect_sums *sums = (indirect_sums *)&f->aaf->aux[DRIFT_AAF_AUX * i];
+    indirect_sums *sums = (indirect_sums *)&drift_aaf_of(f)->aux[DRIFT_AAF_AUX * i];
     float *radiance = drift_image_pixel(&job->lobe->buffers->radiance, x, y);
     drift_vec3 sum =
         drift_vec3_scale(drift_vec3_make(radiance[0], radiance[1], radiance[2]), sums->count);
@@ -189,7 +189,7 @@ float drift_aaf_omega_specular(float phong_exponent)
 static void sparse_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
 {
     const indirect_job *job = user;
-    drift_aaf_state *st = f->aaf;
+    drift_aaf_state *st = drift_aaf_of(f);
     drift_aaf_lobe_buffers *b = job->lobe->buffers;
     size_t i = pixel_index(f, x, y);
     indirect_sums *sums = (indirect_sums *)&st->aux[DRIFT_AAF_AUX * i];
@@ -220,7 +220,7 @@ static void sparse_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *r
 static bool neighbour_distances(const drift_frame_state *f, int32_t x, int32_t y, float *z_min,
                                 float *z_max)
 {
-    const drift_aaf_state *st = f->aaf;
+    const drift_aaf_state *st = drift_aaf_of(f);
     const drift_gbuffer *g = &f->gbuffer;
     float depth = drift_image_pixel(&g->depth, x, y)[0];
     drift_vec3 normal = drift_image_get3(&g->normal, x, y);
@@ -259,7 +259,7 @@ static void rates_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *ra
 {
     (void)rays;
     const indirect_job *job = user;
-    drift_aaf_state *st = f->aaf;
+    drift_aaf_state *st = drift_aaf_of(f);
     size_t i = pixel_index(f, x, y);
     drift_vec3 albedo;
     float omega;
@@ -286,7 +286,7 @@ static void rates_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *ra
 static void adaptive_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
 {
     const indirect_job *job = user;
-    drift_aaf_state *st = f->aaf;
+    drift_aaf_state *st = drift_aaf_of(f);
     size_t i = pixel_index(f, x, y);
     // The sparse pass recorded whether the pixel has the lobe.
     bool has = ((const indirect_sums *)&st->aux[DRIFT_AAF_AUX * i])->has_lobe > 0.0f;
@@ -324,7 +324,7 @@ drift_result drift_aaf_lobe_pass(drift_frame_state *f, const drift_aaf_lobe *lob
     if (r != DRIFT_OK) {
         return r;
     }
-    drift_aaf_state *st = f->aaf;
+    drift_aaf_state *st = drift_aaf_of(f);
     drift_aaf_lobe_buffers *b = lobe->buffers;
     drift_hybrid_stats *stats = &f->stats;
     size_t pixels = (size_t)f->params.width * (size_t)f->params.height;
@@ -409,7 +409,7 @@ drift_result drift_aaf_pass_indirect(drift_frame_state *f, const drift_pass_args
         return r;
     }
     drift_aaf_lobe lobe = { .stream = DRIFT_STREAM_AAF_INDIRECT,
-                            .buffers = &f->aaf->indirect,
+                            .buffers = &drift_aaf_of(f)->indirect,
                             .out = &f->indirect,
                             .shrink_from_spp = DRIFT_AAF_INDIRECT_SHRINK_SPP,
                             .shrink_exponent = DRIFT_AAF_INDIRECT_SHRINK_EXP,

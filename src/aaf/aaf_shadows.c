@@ -126,7 +126,7 @@ static float sums_visibility(const shadow_sums *sums)
 static void sparse_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
 {
     const shadow_job *job = user;
-    drift_aaf_state *st = f->aaf;
+    drift_aaf_state *st = drift_aaf_of(f);
     size_t i = pixel_index(f, x, y);
     shadow_sums *sums = (shadow_sums *)&st->aux[DRIFT_AAF_AUX * i];
     *sums = (shadow_sums){ 0.0f, 0.0f, 0.0f, INFINITY, 0.0f, 0.0f };
@@ -151,7 +151,7 @@ static void sparse_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *r
 // its sparse estimate, unfiltered: exactly 1 or 0.
 static bool occluder_ratios(const drift_frame_state *f, int32_t x, int32_t y, float *s1, float *s2)
 {
-    const drift_aaf_state *st = f->aaf;
+    const drift_aaf_state *st = drift_aaf_of(f);
     const shadow_sums *own = (const shadow_sums *)&st->aux[DRIFT_AAF_AUX * pixel_index(f, x, y)];
     bool lit = own->visible > 0.0f, occluded = isfinite(own->s2);
     double sum1 = 0.0, sum2 = 0.0;
@@ -191,7 +191,7 @@ static void rates_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *ra
 {
     (void)rays;
     const shadow_job *job = user;
-    drift_aaf_state *st = f->aaf;
+    drift_aaf_state *st = drift_aaf_of(f);
     size_t i = pixel_index(f, x, y);
     float s1, s2;
     drift_image_pixel(&st->lights[job->light].beta, x, y)[0] = 0.0f;
@@ -221,7 +221,7 @@ static void rates_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *ra
 static void adaptive_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
 {
     const shadow_job *job = user;
-    drift_aaf_state *st = f->aaf;
+    drift_aaf_state *st = drift_aaf_of(f);
     drift_aaf_light *al = &st->lights[job->light];
     size_t i = pixel_index(f, x, y);
     shadow_sums *sums = (shadow_sums *)&st->aux[DRIFT_AAF_AUX * i];
@@ -242,7 +242,7 @@ static void adaptive_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t 
 static void hard_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
 {
     const shadow_job *job = user;
-    drift_aaf_light *al = &f->aaf->lights[job->light];
+    drift_aaf_light *al = &drift_aaf_of(f)->lights[job->light];
     const drift_surface *s = &f->gbuffer.surfaces[pixel_index(f, x, y)];
     float v = 0.0f;
     if (s->material != DRIFT_INVALID_INDEX) {
@@ -262,7 +262,7 @@ static void footprint_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t
     (void)rays;
     (void)user;
     float z = drift_image_pixel(&f->gbuffer.depth, x, y)[0];
-    drift_image_pixel(&f->aaf->footprint, x, y)[0] =
+    drift_image_pixel(&drift_aaf_of(f)->footprint, x, y)[0] =
         drift_aaf_pixel_footprint(&f->camera, f->params.height, z);
 }
 
@@ -301,7 +301,7 @@ drift_result drift_aaf_pass_shadows(drift_frame_state *f, const drift_pass_args 
     if (r != DRIFT_OK) {
         return r;
     }
-    drift_aaf_state *st = f->aaf;
+    drift_aaf_state *st = drift_aaf_of(f);
     drift_hybrid_stats *stats = &f->stats;
     size_t pixels = (size_t)f->params.width * (size_t)f->params.height;
     for (uint32_t l = 0; l < f->light_count; ++l) {

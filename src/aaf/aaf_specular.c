@@ -61,7 +61,7 @@ drift_result drift_aaf_pass_specular(drift_frame_state *f, const drift_pass_args
         return r;
     }
     drift_aaf_lobe lobe = { .stream = DRIFT_STREAM_AAF_SPECULAR,
-                            .buffers = &f->aaf->specular,
+                            .buffers = &drift_aaf_of(f)->specular,
                             .out = &f->reflections,
                             .shrink_from_spp = DRIFT_AAF_INDIRECT_SHRINK_SPP,
                             .shrink_exponent = DRIFT_AAF_INDIRECT_SHRINK_EXP,

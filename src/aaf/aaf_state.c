@@ -1,14 +1,20 @@
-// AAF's per-frame buffers: made the first time a frame uses AAF (most frames never do), kept
-// until the frame is destroyed; an indirect lobe's only when that lobe first runs.
+// AAF's per-frame buffers, in the family's state (drift_aaf_of): made the first time a frame
+// uses AAF (most frames never do), kept until the frame is destroyed; an indirect lobe's only
+// when that lobe first runs.
 #include "aaf/aaf.h"
 
 #include <stdio.h>
+#include <string.h>
 
-void drift_aaf_state_destroy(drift_context *ctx, drift_aaf_state *s)
+drift_result drift_aaf_state_create(drift_frame_state *f, void **out_state)
 {
-    if (!s) {
-        return;
-    }
+    *out_state = drift_alloc(f->ctx, sizeof(drift_aaf_state));
+    return *out_state ? DRIFT_OK : DRIFT_ERR_OUT_OF_MEMORY;
+}
+
+// Frees every buffer; the state is then as create made it.
+static void free_buffers(drift_context *ctx, drift_aaf_state *s)
+{
     for (uint32_t l = 0; s->lights && l < s->light_count; ++l) {
         drift_image_destroy(ctx, &s->lights[l].beta);
         drift_image_destroy(ctx, &s->lights[l].spp);
@@ -35,21 +41,27 @@ void drift_aaf_state_destroy(drift_context *ctx, drift_aaf_state *s)
     drift_free(ctx, s->counts);
     drift_free(ctx, s->aux);
     drift_free(ctx, s->filter_workspace);
-    drift_free(ctx, s);
+    memset(s, 0, sizeof *s);
+}
+
+void drift_aaf_state_destroy(drift_frame_state *f, void *state)
+{
+    drift_aaf_state *s = state;
+    if (s) {
+        free_buffers(f->ctx, s);
+        drift_free(f->ctx, s);
+    }
 }
 
 drift_result drift_aaf_state_ensure(drift_frame_state *f)
 {
-    if (f->aaf) {
+    drift_aaf_state *s = drift_aaf_of(f);
+    if (s->lights) {
         return DRIFT_OK;
     }
     drift_context *ctx = f->ctx;
     int32_t w = f->params.width, h = f->params.height;
     size_t pixels = (size_t)w * (size_t)h;
-    drift_aaf_state *s = drift_alloc(ctx, sizeof *s);
-    if (!s) {
-        return DRIFT_ERR_OUT_OF_MEMORY;
-    }
     s->width = w;
     s->height = h;
     s->light_count = f->light_count;
@@ -79,11 +91,9 @@ drift_result drift_aaf_state_ensure(drift_frame_state *f)
         }
     }
     if (r != DRIFT_OK) {
-        drift_aaf_state_destroy(ctx, s);
-        return r;
+        free_buffers(ctx, s); // the next pass tries again
     }
-    f->aaf = s;
-    return DRIFT_OK;
+    return r;
 }
 
 drift_result drift_aaf_lobe_buffers_ensure(drift_context *ctx, drift_aaf_lobe_buffers *b,
@@ -148,10 +158,11 @@ static void lobe_planes(const drift_aaf_lobe_buffers *b, const char *lobe, drift
 
 void drift_aaf_shadow_planes(const drift_frame_state *f, drift_pass_plane_fn add, void *sink)
 {
-    for (uint32_t l = 0; f->aaf && l < f->light_count; ++l) {
+    const drift_aaf_state *s = drift_aaf_buffers(f);
+    for (uint32_t l = 0; s && l < f->light_count; ++l) {
         const char *names[3] = { "beta", "spp", "unfiltered" };
-        const drift_image *images[3] = { &f->aaf->lights[l].beta, &f->aaf->lights[l].spp,
-                                         &f->aaf->lights[l].unfiltered };
+        const drift_image *images[3] = { &s->lights[l].beta, &s->lights[l].spp,
+                                         &s->lights[l].unfiltered };
         for (int k = 0; k < 3; ++k) {
             char name[DRIFT_FRAME_PLANE_NAME];
             snprintf(name, sizeof name, "light%u.aaf.%s", l, names[k]);
@@ -162,14 +173,16 @@ void drift_aaf_shadow_planes(const drift_frame_state *f, drift_pass_plane_fn add
 
 void drift_aaf_indirect_planes(const drift_frame_state *f, drift_pass_plane_fn add, void *sink)
 {
-    if (f->aaf) {
-        lobe_planes(&f->aaf->indirect, "indirect", add, sink);
+    const drift_aaf_state *s = drift_aaf_buffers(f);
+    if (s) {
+        lobe_planes(&s->indirect, "indirect", add, sink);
     }
 }
 
 void drift_aaf_specular_planes(const drift_frame_state *f, drift_pass_plane_fn add, void *sink)
 {
-    if (f->aaf) {
-        lobe_planes(&f->aaf->specular, "reflections", add, sink);
+    const drift_aaf_state *s = drift_aaf_buffers(f);
+    if (s) {
+        lobe_planes(&s->specular, "reflections", add, sink);
     }
 }

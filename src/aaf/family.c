@@ -1,8 +1,6 @@
 // Axis-aligned filtering's hooks (frame/family.h): its settings (their defaults follow the
-// frame's --spp) and its buffers (frame->aaf, made by its passes on first use, kept across
-// frames).
-#include "frame/family.h"
-
+// frame's --spp) and its state (drift_aaf_of: made empty with the frame, its buffers by its
+// passes on first use, kept across frames).
 #include "aaf/aaf.h"
 
 static void resolve(drift_hybrid_params *p, const drift_scene *scene)
@@ -14,12 +12,6 @@ static void resolve(drift_hybrid_params *p, const drift_scene *scene)
 static const char *problem(const drift_hybrid_params *p)
 {
     return drift_aaf_settings_problem(&p->aaf, p->spp);
-}
-
-static void destroy(drift_frame_state *f)
-{
-    drift_aaf_state_destroy(f->ctx, f->aaf);
-    f->aaf = NULL;
 }
 
 // The samples a pixel took, n(x), averaged over the pixels that took any (a glossy row
@@ -36,7 +28,7 @@ static void report_lobe(drift_frame_state *f, drift_family_count_fn count, const
 
 static void report(drift_frame_state *f, drift_family_count_fn count)
 {
-    const drift_aaf_state *st = f->aaf;
+    const drift_aaf_state *st = drift_aaf_buffers(f);
     if (!st) {
         return;
     }
@@ -66,8 +58,10 @@ static void report(drift_frame_state *f, drift_family_count_fn count)
 
 const drift_family drift_aaf_family = {
     .name = "aaf",
+    .slot = DRIFT_FAMILY_AAF,
+    .create = drift_aaf_state_create,
     .resolve = resolve,
     .problem = problem,
-    .destroy = destroy,
+    .destroy = drift_aaf_state_destroy,
     .report = report,
 };

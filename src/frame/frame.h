@@ -49,7 +49,6 @@ typedef struct drift_frame_light_buffers {
     drift_image unshadowed;  // 3: U_l
     drift_image hard_shadow; // 3: visible (0/1), occluder distance (INFINITY: none), light distance
     drift_image shadow;      // 1: S_l of the chosen technique
-    drift_shadow_map *shadow_map; // built on first use, kept while the scene stands
 } drift_frame_light_buffers;
 
 // A technique's state kept across frames (drift_pass_state).
@@ -59,11 +58,8 @@ typedef struct drift_pass_state_slot {
     int technique; // the technique of the slot's effect that owns data
 } drift_pass_state_slot;
 
-// An environment probe: one for the whole scene, or one per reflective mesh.
-typedef struct drift_frame_probe {
-    uint32_t mesh; // DRIFT_INVALID_INDEX for the scene probe
-    drift_envmap *map;
-} drift_frame_probe;
+// The most technique families a frame holds state for (frame/family.h lists them).
+#define DRIFT_FAMILY_SLOTS 8
 
 typedef struct drift_frame_state {
     drift_context *ctx;
@@ -110,22 +106,17 @@ typedef struct drift_frame_state {
     bool environment_diffuse_elsewhere;
     uint32_t inputs; // DRIFT_INPUT_* the chosen rows asked for (this pass's)
 
-    drift_frame_probe *probes;
-    uint32_t probe_count;
-    // The environment prefiltered by GGX roughness (the split sum's lookup; built on first
-    // use by the unshadowed pass, kept while the scene stands).
-    drift_env_prefilter *env_prefilter;
-
     drift_ray_counter *counters; // one per thread
     int thread_count;
     drift_hybrid_stats stats;
     // State a technique keeps across frames (caches, atlases), one slot an effect, owned by
     // the technique that made it: drift_pass_state / drift_pass_set_state.
     drift_pass_state_slot effect_state[DRIFT_EFFECT_COUNT];
-    // Technique state, made by each technique on first use and freed by the conductor through
-    // the technique's destroy function (opaque here: this layer knows no technique).
-    struct drift_isg_state *isg; // image space gathering's buffers (isg/isg.h)
-    struct drift_aaf_state *aaf; // AAF's buffers (aaf/aaf.h)
+    // Each technique family's own state, one slot a family (frame/family.h's slots): made by
+    // the family's create hook when the frame is made, freed by its destroy hook. Opaque
+    // here: this layer knows no family; a family reads its slot through its own accessor
+    // (drift_realtime_of, drift_isg_of, ...).
+    void *family_state[DRIFT_FAMILY_SLOTS];
 } drift_frame_state;
 
 #define DRIFT_TERM_SLOT_(field, effect)    \
@@ -196,6 +187,10 @@ enum {
     DRIFT_ROW_REPLACES_FRAME = 1u << 3,      // the pass renders `final` whole (the lens reference)
     DRIFT_ROW_ENVIRONMENT_DIFFUSE = 1u << 4, // the term is the environment's diffuse light: D
                                              // keeps only the glossy part of it
+    // Not the conductor's: drift bench frontier renders the row against the other searched
+    // rows of its effect (drift_technique_frontier, docs/frontier.md). The path-traced truths
+    // and the baselines a searched row dominates (pcf under pcss, the blur rows) are not.
+    DRIFT_ROW_FRONTIER = 1u << 5,
 };
 
 // Runs fn for every row, or every pixel, rows in parallel. `rays` is the calling thread's ray

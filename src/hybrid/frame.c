@@ -195,6 +195,13 @@ drift_result drift_hybrid_create(drift_context *ctx, const drift_scene *scene,
     if (r == DRIFT_OK) {
         r = create_images(f);
     }
+    // Each family makes its own state, into its slot.
+    for (int i = 0; r == DRIFT_OK && drift_family_at(i); ++i) {
+        const drift_family *family = drift_family_at(i);
+        if (family->create) {
+            r = family->create(f, &f->family_state[family->slot]);
+        }
+    }
     if (r != DRIFT_OK) {
         drift_hybrid_destroy(h);
         return r;
@@ -217,9 +224,11 @@ void drift_hybrid_destroy(drift_hybrid *h)
     drift_context *ctx = f->ctx;
     // Each family frees what it made (its caches, its buffers), then the frame its own.
     for (int i = 0; drift_family_at(i); ++i) {
-        if (drift_family_at(i)->destroy) {
-            drift_family_at(i)->destroy(f);
+        const drift_family *family = drift_family_at(i);
+        if (family->destroy) {
+            family->destroy(f, f->family_state[family->slot]);
         }
+        f->family_state[family->slot] = NULL;
     }
     drift_pass_free_states(f);
     if (f->light_buffers) {

@@ -75,6 +75,12 @@ bool drift_technique_path_traced(drift_effect effect, int technique)
     return row && (row->flags & DRIFT_ROW_PATH_TRACED);
 }
 
+bool drift_technique_frontier(drift_effect effect, int technique)
+{
+    const drift_technique_row *row = drift_technique_row_of(effect, technique);
+    return row && (row->flags & DRIFT_ROW_FRONTIER);
+}
+
 int drift_technique_parse(drift_effect effect, const char *name)
 {
     for (int i = 0; name && i < drift_technique_count(effect); ++i) {

@@ -1,7 +1,5 @@
-// Image space gathering's hooks (frame/family.h): its settings and its buffers (frame->isg,
-// made by its passes on first use, kept across frames).
-#include "frame/family.h"
-
+// Image space gathering's hooks (frame/family.h): its settings and its state (drift_isg_of:
+// made empty with the frame, its buffers by its passes on first use, kept across frames).
 #include "isg/isg.h"
 
 static void resolve(drift_hybrid_params *p, const drift_scene *scene)
@@ -20,7 +18,7 @@ static const char *problem(const drift_hybrid_params *p)
 // under half a pixel). The blur rows gather every surface pixel over a fixed disk.
 static void report(drift_frame_state *f, drift_family_count_fn count)
 {
-    const drift_isg_state *s = f->isg;
+    const drift_isg_state *s = drift_isg_buffers(f);
     if (!s) {
         return;
     }
@@ -51,6 +49,8 @@ static void report(drift_frame_state *f, drift_family_count_fn count)
 
 const drift_family drift_isg_family = {
     .name = "isg",
+    .slot = DRIFT_FAMILY_ISG,
+    .create = drift_isg_create,
     .resolve = resolve,
     .problem = problem,
     .destroy = drift_isg_destroy,

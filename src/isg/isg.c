@@ -85,42 +85,66 @@ const char *drift_isg_settings_problem(const drift_isg_settings *s)
 
 // --- STATE ---
 
-drift_result drift_isg_prepare(drift_frame_state *f)
+drift_result drift_isg_create(drift_frame_state *f, void **out_state)
+{
+    *out_state = drift_alloc(f->ctx, sizeof(drift_isg_state));
+    return *out_state ? DRIFT_OK : DRIFT_ERR_OUT_OF_MEMORY;
+}
+
+static void free_buffers(drift_context *ctx, drift_isg_state *s)
+{
+    for (uint32_t l = 0; s->light_search && l < s->light_count; ++l) {
+        drift_image_destroy(ctx, &s->light_search[l]);
+    }
+    drift_free(ctx, s->light_search);
+    s->light_search = NULL;
+    s->light_count = 0;
+    drift_image_destroy(ctx, &s->reflection_search);
+    drift_image_destroy(ctx, &s->dof_search);
+    drift_image_destroy(ctx, &s->layer_depth);
+    drift_image_destroy(ctx, &s->layer_colour);
+}
+
+static drift_result make_buffers(drift_frame_state *f, drift_isg_state *s)
 {
     drift_context *ctx = f->ctx;
     int32_t w = f->params.width, h = f->params.height;
-    if (!f->isg) {
-        drift_isg_state *s = drift_alloc(ctx, sizeof(drift_isg_state));
-        if (!s) {
-            return DRIFT_ERR_OUT_OF_MEMORY;
-        }
-        f->isg = s;
-        s->light_search = drift_alloc(ctx, sizeof(drift_image) * (f->light_count + 1u));
-        if (!s->light_search) {
-            return DRIFT_ERR_OUT_OF_MEMORY;
-        }
-        s->light_count = f->light_count;
-        drift_result r = DRIFT_OK;
-        for (uint32_t l = 0; r == DRIFT_OK && l < f->light_count; ++l) {
-            r = drift_image_create(ctx, w, h, 2, &s->light_search[l]);
-        }
-        if (r == DRIFT_OK) {
-            r = drift_image_create(ctx, w, h, 2, &s->reflection_search);
-        }
-        if (r == DRIFT_OK) {
-            r = drift_image_create(ctx, w, h, 1, &s->dof_search);
-        }
-        if (r == DRIFT_OK) {
-            r = drift_image_create(ctx, w, h, 1, &s->layer_depth);
-        }
-        if (r == DRIFT_OK) {
-            r = drift_image_create(ctx, w, h, 3, &s->layer_colour);
-        }
+    s->light_search = drift_alloc(ctx, sizeof(drift_image) * (f->light_count + 1u));
+    if (!s->light_search) {
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    s->light_count = f->light_count;
+    drift_result r = DRIFT_OK;
+    for (uint32_t l = 0; r == DRIFT_OK && l < f->light_count; ++l) {
+        r = drift_image_create(ctx, w, h, 2, &s->light_search[l]);
+    }
+    if (r == DRIFT_OK) {
+        r = drift_image_create(ctx, w, h, 2, &s->reflection_search);
+    }
+    if (r == DRIFT_OK) {
+        r = drift_image_create(ctx, w, h, 1, &s->dof_search);
+    }
+    if (r == DRIFT_OK) {
+        r = drift_image_create(ctx, w, h, 1, &s->layer_depth);
+    }
+    if (r == DRIFT_OK) {
+        r = drift_image_create(ctx, w, h, 3, &s->layer_colour);
+    }
+    if (r != DRIFT_OK) {
+        free_buffers(ctx, s); // the next pass tries again
+    }
+    return r;
+}
+
+drift_result drift_isg_prepare(drift_frame_state *f)
+{
+    drift_isg_state *s = drift_isg_of(f);
+    if (!s->light_search) {
+        drift_result r = make_buffers(f, s);
         if (r != DRIFT_OK) {
             return r;
         }
     }
-    drift_isg_state *s = f->isg;
     drift_isg_pattern_make((uint32_t)f->params.isg.search, DRIFT_ISG_DISK, &s->search);
     drift_isg_pattern_make((uint32_t)f->params.isg.gather, DRIFT_ISG_DISK, &s->gather);
     drift_isg_pattern_make((uint32_t)f->params.isg.search, DRIFT_ISG_RECT, &s->search_rect);
@@ -128,50 +152,42 @@ drift_result drift_isg_prepare(drift_frame_state *f)
     return DRIFT_OK;
 }
 
-void drift_isg_destroy(drift_frame_state *f)
+void drift_isg_destroy(drift_frame_state *f, void *state)
 {
-    drift_isg_state *s = f->isg;
-    if (!s) {
-        return;
+    drift_isg_state *s = state;
+    if (s) {
+        free_buffers(f->ctx, s);
+        drift_free(f->ctx, s);
     }
-    if (s->light_search) {
-        for (uint32_t l = 0; l < s->light_count; ++l) {
-            drift_image_destroy(f->ctx, &s->light_search[l]);
-        }
-    }
-    drift_free(f->ctx, s->light_search);
-    drift_image_destroy(f->ctx, &s->reflection_search);
-    drift_image_destroy(f->ctx, &s->dof_search);
-    drift_image_destroy(f->ctx, &s->layer_depth);
-    drift_image_destroy(f->ctx, &s->layer_colour);
-    drift_free(f->ctx, s);
-    f->isg = NULL;
 }
 
 void drift_isg_shadow_planes(const drift_frame_state *f, drift_pass_plane_fn add, void *sink)
 {
-    for (uint32_t l = 0; f->isg && l < f->light_count; ++l) {
+    const drift_isg_state *s = drift_isg_buffers(f);
+    for (uint32_t l = 0; s && l < f->light_count; ++l) {
         char name[DRIFT_FRAME_PLANE_NAME];
         snprintf(name, sizeof name, "light%u.isg", l);
-        add(sink, name, &f->isg->light_search[l]);
+        add(sink, name, &s->light_search[l]);
     }
 }
 
 void drift_isg_reflection_planes(const drift_frame_state *f, drift_pass_plane_fn add, void *sink)
 {
-    if (f->isg) {
-        add(sink, "isg.reflection", &f->isg->reflection_search);
+    const drift_isg_state *s = drift_isg_buffers(f);
+    if (s) {
+        add(sink, "isg.reflection", &s->reflection_search);
     }
 }
 
 void drift_isg_dof_planes(const drift_frame_state *f, drift_pass_plane_fn add, void *sink)
 {
-    if (!f->isg) {
+    const drift_isg_state *s = drift_isg_buffers(f);
+    if (!s) {
         return;
     }
-    add(sink, "isg.dof", &f->isg->dof_search);
+    add(sink, "isg.dof", &s->dof_search);
     if (f->params.isg.layers == 2) {
-        add(sink, "isg.layer2.depth", &f->isg->layer_depth);
-        add(sink, "isg.layer2.colour", &f->isg->layer_colour);
+        add(sink, "isg.layer2.depth", &s->layer_depth);
+        add(sink, "isg.layer2.colour", &s->layer_colour);
     }
 }

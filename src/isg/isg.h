@@ -11,7 +11,7 @@
 #define DRIFT_ISG_INTERNAL_H
 
 #include "core/vectorise.h"
-#include "frame/frame.h"
+#include "frame/family.h"
 
 #include <math.h>
 
@@ -177,14 +177,32 @@ typedef struct drift_isg_state {
     drift_isg_pattern search, gather, search_rect, gather_rect;
 } drift_isg_state;
 
+// ISG's state, in its slot of the frame (frame/family.h): made empty by the family's create
+// hook, its buffers on the first ISG pass (light_search is NULL until then; most frames never
+// run ISG), freed by its destroy hook.
+static inline drift_isg_state *drift_isg_of(const drift_frame_state *frame)
+{
+    return (drift_isg_state *)drift_family_state(frame, DRIFT_FAMILY_ISG);
+}
+
+// The state once an ISG pass has made its buffers, else NULL (what the planes and counts read).
+static inline const drift_isg_state *drift_isg_buffers(const drift_frame_state *frame)
+{
+    const drift_isg_state *s = drift_isg_of(frame);
+    return s && s->light_search ? s : NULL;
+}
+
 // Fills ISG's zero settings with their defaults (drift/hybrid.h) for this scene.
 void drift_isg_settings_resolve(drift_isg_settings *settings, const drift_scene *scene);
 // What is wrong with resolved ISG settings, or NULL.
 const char *drift_isg_settings_problem(const drift_isg_settings *settings);
 
-// Creates the state on first use and the patterns for the current parameters.
+// The family's create and destroy hooks (isg.c): an empty state; the state and all it holds
+// (NULL-safe).
+drift_result drift_isg_create(drift_frame_state *frame, void **out_state);
+void drift_isg_destroy(drift_frame_state *frame, void *state);
+// Makes the buffers on first use and the patterns for the current parameters.
 drift_result drift_isg_prepare(drift_frame_state *frame);
-void drift_isg_destroy(drift_frame_state *frame); // NULL-safe state
 
 // The --aov planes of the ISG rows (light search radii, the reflection and lens searches,
 // the second layer).

@@ -96,7 +96,7 @@ static void dof_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays
 {
     (void)rays;
     const dof_job *job = user;
-    drift_isg_state *s = f->isg;
+    drift_isg_state *s = drift_isg_of(f);
     range_ctx rc = { .coc = &f->coc,
                      .depth = &f->gbuffer.depth,
                      .x0 = x,
@@ -152,7 +152,7 @@ drift_result drift_isg_pass_dof(drift_frame_state *f, const drift_pass_args *arg
         drift_pass_copy_rgb(&f->focus, &f->final); // a pinhole, or nearly: the identity
         for (int32_t y = 0; y < f->params.height; ++y) {
             for (int32_t x = 0; x < f->params.width; ++x) {
-                drift_image_pixel(&f->isg->dof_search, x, y)[0] = 0.0f;
+                drift_image_pixel(&drift_isg_of(f)->dof_search, x, y)[0] = 0.0f;
             }
         }
     } else {

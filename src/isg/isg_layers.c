@@ -10,7 +10,7 @@
 static void layer_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
 {
     (void)user;
-    drift_isg_state *s = f->isg;
+    drift_isg_state *s = drift_isg_of(f);
     size_t index = (size_t)y * (size_t)f->params.width + (size_t)x;
     const drift_gbuffer *g = &f->gbuffer;
     float *depth = drift_image_pixel(&s->layer_depth, x, y);

@@ -82,7 +82,7 @@ static void reflection_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_
     const reflection_job *job = user;
     const drift_gbuffer *g = &f->gbuffer;
     const drift_hybrid_params *p = &f->params;
-    drift_isg_state *s = f->isg;
+    drift_isg_state *s = drift_isg_of(f);
     float *search_out = drift_image_pixel(&s->reflection_search, x, y);
     search_out[0] = INFINITY;
     search_out[1] = 0.0f;

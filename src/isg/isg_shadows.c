@@ -116,7 +116,7 @@ static void shadow_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *r
     (void)rays;
     const shadow_job *job = user;
     const drift_gbuffer *g = &f->gbuffer;
-    const drift_isg_state *s = f->isg;
+    const drift_isg_state *s = drift_isg_of(f);
     if (drift_image_pixel(&g->material_id, x, y)[0] < 0.0f) {
         for (uint32_t l = 0; l < f->light_count; ++l) {
             float *out = drift_image_pixel(&s->light_search[l], x, y);

@@ -27,7 +27,8 @@ static drift_vec3 environment_light(const drift_frame_state *f, const drift_surf
     }
     // A GGX surface's conductor and coat reflection of the environment: the split sum over
     // the prefiltered environment (raster/env_prefilter.c); the samples below take the rest.
-    bool split = f->env_prefilter && bsdf.type == DRIFT_MATERIAL_GGX;
+    const drift_env_prefilter *prefilter = drift_realtime_of(f)->env_prefilter;
+    bool split = prefilter && bsdf.type == DRIFT_MATERIAL_GGX;
     bsdf.ggx.skip_reflection = split;
     drift_vec3 l;
     if (!f->params.environment_interleave) {
@@ -43,9 +44,9 @@ static drift_vec3 environment_light(const drift_frame_state *f, const drift_surf
     }
     if (split) {
         uint32_t n = f->params.light_samples > 0 ? f->params.light_samples : 1;
-        l = drift_vec3_add(
-            l, drift_raster_environment_split_sum(f->env_prefilter, f->accel, s, &bsdf, wo, n,
-                                                  drift_sampler_next2(sampler), rays));
+        l = drift_vec3_add(l,
+                           drift_raster_environment_split_sum(prefilter, f->accel, s, &bsdf, wo, n,
+                                                              drift_sampler_next2(sampler), rays));
     }
     return l;
 }
@@ -336,7 +337,7 @@ static void shadow_filter_pixel(drift_frame_state *f, int32_t x, int32_t y, uint
     uint32_t hash =
         drift_hash_combine(f->params.seed ^ DRIFT_STREAM_PCSS, (uint32_t)pixel_index(f, x, y));
     for (uint32_t l = 0; l < f->light_count; ++l) {
-        const drift_shadow_map *map = f->light_buffers[l].shadow_map;
+        const drift_shadow_map *map = drift_realtime_shadow_map(f, l);
         float v = 0.0f;
         if (s->material != DRIFT_INVALID_INDEX) {
             v = pcss ? drift_shadow_map_pcss(map, s->position, s->ng, drift_hash_u32(hash + l))
@@ -381,13 +382,21 @@ static void sum_direct_row(drift_frame_state *f, int32_t y, uint64_t *rays, void
 
 drift_result drift_realtime_ensure_shadow_map(drift_frame_state *f, uint32_t light, uint64_t *rays)
 {
-    if (f->light_buffers[light].shadow_map) {
+    drift_realtime_state *s = drift_realtime_of(f);
+    if (s->shadow_maps[light]) {
         return DRIFT_OK; // cached: the scene has not changed
     }
     drift_shadow_map_params params = { .size = f->params.shadow_map.size,
                                        .bias_texels = f->params.shadow_map.bias };
     return drift_shadow_map_build(f->ctx, f->scene, f->accel, &f->lights[light], &params,
-                                  &f->light_buffers[light].shadow_map, rays);
+                                  &s->shadow_maps[light], rays);
+}
+
+void drift_realtime_drop_shadow_map(drift_frame_state *f, uint32_t light)
+{
+    drift_realtime_state *s = drift_realtime_of(f);
+    drift_shadow_map_destroy(f->ctx, s->shadow_maps[light]);
+    s->shadow_maps[light] = NULL;
 }
 
 drift_result drift_realtime_build_shadow_maps(drift_frame_state *f)
@@ -547,9 +556,10 @@ static drift_result gather_interleaved(drift_frame_state *f)
 
 drift_result drift_realtime_pass_unshadowed(drift_frame_state *f)
 {
-    if (!f->env_prefilter && drift_scene_has_environment(f->scene)) {
+    drift_realtime_state *state = drift_realtime_of(f);
+    if (!state->env_prefilter && drift_scene_has_environment(f->scene)) {
         double t = drift_time_now(); // made once, timed with the environment-map probes
-        drift_result r = drift_env_prefilter_build(f->ctx, f->scene, &f->env_prefilter);
+        drift_result r = drift_env_prefilter_build(f->ctx, f->scene, &state->env_prefilter);
         drift_pass_time(f, DRIFT_PASS_ENVMAP, t);
         if (r != DRIFT_OK) {
             return r;

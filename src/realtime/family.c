@@ -1,8 +1,7 @@
 // The real-time family's hooks (frame/family.h): its settings, the inputs other rows share
 // (U_l, hard shadows, shadow maps, sharp reflections, probes), summing D after a row that
-// writes S_l, and the caches that survive frames (the shadow maps and the probes).
-#include "frame/family.h"
-
+// writes S_l, and the caches that survive frames (the shadow maps, the probes and the
+// prefiltered environment: its state, drift_realtime_state).
 #include "realtime/realtime.h"
 
 static void resolve(drift_hybrid_params *p, const drift_scene *scene)
@@ -43,30 +42,48 @@ static drift_result after_row(drift_frame_state *f, const drift_family_row *row)
     return (row->flags & DRIFT_ROW_SUMS_DIRECT) ? drift_realtime_pass_sum_direct(f) : DRIFT_OK;
 }
 
-static void destroy_probes(drift_frame_state *f)
+// The caches start empty: each is made by the first pass that needs it.
+static drift_result create(drift_frame_state *f, void **out_state)
 {
-    for (uint32_t i = 0; i < f->probe_count; ++i) {
-        drift_envmap_destroy(f->ctx, f->probes[i].map);
+    drift_realtime_state *s = drift_alloc(f->ctx, sizeof *s);
+    if (!s) {
+        return DRIFT_ERR_OUT_OF_MEMORY;
     }
-    drift_free(f->ctx, f->probes);
-    f->probes = NULL;
-    f->probe_count = 0;
+    *out_state = s;
+    // + 1: a scene with no lights still gets an allocation.
+    s->shadow_maps = drift_alloc(f->ctx, sizeof(drift_shadow_map *) * (f->light_count + 1u));
+    if (!s->shadow_maps) {
+        return DRIFT_ERR_OUT_OF_MEMORY; // destroy frees s
+    }
+    s->light_count = f->light_count;
+    return DRIFT_OK;
 }
 
-static void destroy_shadow_maps(drift_frame_state *f)
+static void destroy_probes(drift_frame_state *f, drift_realtime_state *s)
 {
-    for (uint32_t l = 0; f->light_buffers && l < f->light_count; ++l) {
-        drift_shadow_map_destroy(f->ctx, f->light_buffers[l].shadow_map);
-        f->light_buffers[l].shadow_map = NULL;
+    for (uint32_t i = 0; i < s->probe_count; ++i) {
+        drift_envmap_destroy(f->ctx, s->probes[i].map);
+    }
+    drift_free(f->ctx, s->probes);
+    s->probes = NULL;
+    s->probe_count = 0;
+}
+
+static void destroy_shadow_maps(drift_frame_state *f, drift_realtime_state *s)
+{
+    for (uint32_t l = 0; s->shadow_maps && l < s->light_count; ++l) {
+        drift_shadow_map_destroy(f->ctx, s->shadow_maps[l]);
+        s->shadow_maps[l] = NULL;
     }
 }
 
 // Cached maps that depend on a changed setting are rebuilt on next use.
 static void update(drift_frame_state *f, const drift_hybrid_params *p)
 {
+    drift_realtime_state *s = drift_realtime_of(f);
     if (p->shadow_map.size != f->params.shadow_map.size ||
         p->shadow_map.bias != f->params.shadow_map.bias) {
-        destroy_shadow_maps(f);
+        destroy_shadow_maps(f, s);
     }
     if (p->envmap.size != f->params.envmap.size ||
         p->envmap.has_probe != f->params.envmap.has_probe ||
@@ -74,16 +91,21 @@ static void update(drift_frame_state *f, const drift_hybrid_params *p)
         p->light_samples != f->params.light_samples ||
         (p->envmap.has_probe &&
          !drift_vec3_is_zero(drift_vec3_sub(p->envmap.probe, f->params.envmap.probe)))) {
-        destroy_probes(f);
+        destroy_probes(f, s);
     }
 }
 
-static void destroy(drift_frame_state *f)
+static void destroy(drift_frame_state *f, void *state)
 {
-    destroy_shadow_maps(f);
-    destroy_probes(f);
-    drift_env_prefilter_destroy(f->ctx, f->env_prefilter); // built by the unshadowed pass
-    f->env_prefilter = NULL;
+    drift_realtime_state *s = state;
+    if (!s) {
+        return;
+    }
+    destroy_shadow_maps(f, s);
+    destroy_probes(f, s);
+    drift_env_prefilter_destroy(f->ctx, s->env_prefilter); // built by the unshadowed pass
+    drift_free(f->ctx, s->shadow_maps);
+    drift_free(f->ctx, s);
 }
 
 // The rays of the inputs this frame prepared; the shadow maps' and probes' rays are 0 on a
@@ -100,7 +122,7 @@ static void report(drift_frame_state *f, drift_family_count_fn count)
     if (f->inputs & DRIFT_INPUT_SHADOW_MAPS) {
         uint32_t maps = 0;
         for (uint32_t l = 0; l < f->light_count; ++l) {
-            maps += f->light_buffers[l].shadow_map != NULL;
+            maps += drift_realtime_shadow_map(f, l) != NULL;
         }
         count(f, "realtime.shadow_maps", maps);
         count(f, "realtime.shadow_map_rays", (double)s->rays[DRIFT_PASS_SHADOW_MAPS]);
@@ -109,13 +131,15 @@ static void report(drift_frame_state *f, drift_family_count_fn count)
         count(f, "realtime.reflection_rays", (double)s->rays[DRIFT_PASS_REFLECTIONS]);
     }
     if (f->inputs & DRIFT_INPUT_PROBES) {
-        count(f, "realtime.probes", f->probe_count);
+        count(f, "realtime.probes", drift_realtime_of(f)->probe_count);
         count(f, "realtime.probe_rays", (double)s->rays[DRIFT_PASS_ENVMAP]);
     }
 }
 
 const drift_family drift_realtime_family = {
     .name = "realtime",
+    .slot = DRIFT_FAMILY_REALTIME,
+    .create = create,
     .resolve = resolve,
     .problem = problem,
     .provides = DRIFT_INPUT_UNSHADOWED | DRIFT_INPUT_HARD_SHADOWS | DRIFT_INPUT_SHADOW_MAPS |

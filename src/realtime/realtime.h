@@ -6,7 +6,46 @@
 #ifndef DRIFT_REALTIME_H
 #define DRIFT_REALTIME_H
 
-#include "frame/frame.h"
+#include "frame/family.h"
+
+// --- THE FAMILY'S STATE (family.c) ---
+
+// An environment probe: one for the whole scene, or one per reflective mesh.
+typedef struct drift_realtime_probe {
+    uint32_t mesh; // DRIFT_INVALID_INDEX for the scene probe
+    drift_envmap *map;
+} drift_realtime_probe;
+
+// What the real-time family keeps across frames, in its slot of the frame (frame/family.h):
+// made by its create hook, dropped by its update hook when a knob they depend on changes,
+// freed by its destroy hook. Other families read the maps and probes through the accessors
+// below (contact shadows, SIR's metrics).
+typedef struct drift_realtime_state {
+    drift_shadow_map **shadow_maps; // per light: built on first use, kept while the scene and
+                                    // the map settings stand
+    uint32_t light_count;
+    drift_realtime_probe *probes; // captured on first use, kept while the settings stand
+    uint32_t probe_count;
+    // The environment prefiltered by GGX roughness (the split sum's lookup; built on first
+    // use by the unshadowed pass, kept while the scene stands).
+    drift_env_prefilter *env_prefilter;
+} drift_realtime_state;
+
+static inline drift_realtime_state *drift_realtime_of(const drift_frame_state *frame)
+{
+    return (drift_realtime_state *)drift_family_state(frame, DRIFT_FAMILY_REALTIME);
+}
+
+// Light `light`'s shadow map, or NULL where none is built.
+static inline const drift_shadow_map *drift_realtime_shadow_map(const drift_frame_state *frame,
+                                                                uint32_t light)
+{
+    const drift_realtime_state *s = drift_realtime_of(frame);
+    return s && light < s->light_count ? s->shadow_maps[light] : NULL;
+}
+
+// The probe that serves `mesh` (its own, or the scene's), or NULL where none is captured.
+const drift_envmap *drift_realtime_probe_of(const drift_frame_state *frame, uint32_t mesh);
 
 // --- SETTINGS (settings.c) ---
 
@@ -33,6 +72,8 @@ drift_result drift_realtime_build_shadow_maps(drift_frame_state *frame);
 // One light's shadow map, built if the cache has none; adds the rays it casts to *rays.
 drift_result drift_realtime_ensure_shadow_map(drift_frame_state *frame, uint32_t light,
                                               uint64_t *rays);
+// Frees light `light`'s shadow map (the next use builds it again).
+void drift_realtime_drop_shadow_map(drift_frame_state *frame, uint32_t light);
 // The sharp reflection buffer: one mirror ray a glossy or mirror pixel, R from it.
 drift_result drift_realtime_pass_sharp_reflections(drift_frame_state *frame);
 // The environment-map probes, captured on first use (kept while the settings stand).

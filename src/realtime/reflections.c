@@ -141,11 +141,12 @@ static void sharp_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *ra
     drift_image_set3(&f->reflections, x, y, r);
 }
 
-static const drift_envmap *probe_for(const drift_frame_state *f, uint32_t mesh)
+const drift_envmap *drift_realtime_probe_of(const drift_frame_state *f, uint32_t mesh)
 {
-    for (uint32_t i = 0; i < f->probe_count; ++i) {
-        if (f->probes[i].mesh == mesh || f->probes[i].mesh == DRIFT_INVALID_INDEX) {
-            return f->probes[i].map;
+    const drift_realtime_state *s = drift_realtime_of(f);
+    for (uint32_t i = 0; s && i < s->probe_count; ++i) {
+        if (s->probes[i].mesh == mesh || s->probes[i].mesh == DRIFT_INVALID_INDEX) {
+            return s->probes[i].map;
         }
     }
     return NULL;
@@ -173,7 +174,7 @@ static void envmap_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *r
     drift_bsdf bsdf;
     const drift_envmap *map = NULL;
     if (has_reflection(f, s, &bsdf)) {
-        map = probe_for(f, f->gbuffer.mesh_index[index]);
+        map = drift_realtime_probe_of(f, f->gbuffer.mesh_index[index]);
     }
     if (!map) {
         drift_image_set3(&f->reflections, x, y, drift_vec3_splat(0.0f));
@@ -204,7 +205,8 @@ static drift_vec3 mesh_centre(const drift_scene *scene, uint32_t mesh)
 // Captures the probes on first use; they hold while the scene and settings stand.
 static drift_result capture_probes(drift_frame_state *f)
 {
-    if (f->probes) {
+    drift_realtime_state *st = drift_realtime_of(f);
+    if (st->probes) {
         return DRIFT_OK;
     }
     const drift_scene *scene = f->scene;
@@ -218,8 +220,8 @@ static drift_result capture_probes(drift_frame_state *f)
             return DRIFT_OK;
         }
     }
-    f->probes = drift_alloc(f->ctx, sizeof(drift_frame_probe) * count);
-    if (!f->probes) {
+    st->probes = drift_alloc(f->ctx, sizeof(drift_realtime_probe) * count);
+    if (!st->probes) {
         return DRIFT_ERR_OUT_OF_MEMORY;
     }
     uint64_t *rays = &f->stats.rays[DRIFT_PASS_ENVMAP];
@@ -229,16 +231,16 @@ static drift_result capture_probes(drift_frame_state *f)
             f->params.envmap.has_probe
                 ? f->params.envmap.probe
                 : drift_vec3_scale(drift_vec3_add(scene->bounds.min, scene->bounds.max), 0.5f);
-        f->probes[0].mesh = DRIFT_INVALID_INDEX;
-        f->probe_count = 1;
+        st->probes[0].mesh = DRIFT_INVALID_INDEX;
+        st->probe_count = 1;
         return drift_envmap_capture(f->ctx, &f->shading, centre, DRIFT_INVALID_INDEX,
-                                    f->params.envmap.size, seed, &f->probes[0].map, rays);
+                                    f->params.envmap.size, seed, &st->probes[0].map, rays);
     }
     for (uint32_t m = 0; m < scene->mesh_count; ++m) {
         if (!mesh_is_reflective(scene, m)) {
             continue;
         }
-        drift_frame_probe *probe = &f->probes[f->probe_count++];
+        drift_realtime_probe *probe = &st->probes[st->probe_count++];
         probe->mesh = m;
         drift_result r = drift_envmap_capture(f->ctx, &f->shading, mesh_centre(scene, m), m,
                                               f->params.envmap.size, seed, &probe->map, rays);

@@ -66,10 +66,9 @@ static bool is_reflective(const drift_frame_state *f, const drift_surface *s)
 // frame would put the scene probe.
 static drift_vec3 probe_centre(const drift_frame_state *f, uint32_t mesh)
 {
-    for (uint32_t i = 0; i < f->probe_count; ++i) {
-        if (f->probes[i].mesh == mesh || f->probes[i].mesh == DRIFT_INVALID_INDEX) {
-            return drift_envmap_probe(f->probes[i].map);
-        }
+    const drift_envmap *map = drift_realtime_probe_of(f, mesh);
+    if (map) {
+        return drift_envmap_probe(map);
     }
     if (f->params.envmap.has_probe) {
         return f->params.envmap.probe;
@@ -121,16 +120,6 @@ static float display_change(drift_vec3 base, drift_vec3 delta)
     return fmaxf(
         fmaxf(fabsf(display(moved.x) - display(base.x)), fabsf(display(moved.y) - display(base.y))),
         fabsf(display(moved.z) - display(base.z)));
-}
-
-static const drift_envmap *probe_map(const drift_frame_state *f, uint32_t mesh)
-{
-    for (uint32_t i = 0; i < f->probe_count; ++i) {
-        if (f->probes[i].mesh == mesh || f->probes[i].mesh == DRIFT_INVALID_INDEX) {
-            return f->probes[i].map;
-        }
-    }
-    return NULL;
 }
 
 static drift_vec3 seen_in_map(const drift_envmap *map, drift_vec3 dir, float cone, bool mirror)
@@ -188,7 +177,7 @@ static float expected_reflection_error(drift_frame_state *f, size_t index, const
                                        drift_vec3 wo, uint32_t samples, drift_sampler *sampler,
                                        uint64_t *rays)
 {
-    const drift_envmap *map = probe_map(f, f->gbuffer.mesh_index[index]);
+    const drift_envmap *map = drift_realtime_probe_of(f, f->gbuffer.mesh_index[index]);
     if (!map || f->params.reflections != DRIFT_REFLECTIONS_ENVMAP) {
         return 1.0f;
     }
@@ -506,7 +495,7 @@ static void penumbra_check_pixel(drift_frame_state *f, int32_t x, int32_t y, uin
     if (drift_image_pixel(&job->out[DRIFT_METRIC_SHADOW], x, y)[0] > 0.0f &&
         s->material != DRIFT_INVALID_INDEX) {
         for (uint32_t l = 0; l < f->light_count; ++l) {
-            if (f->light_buffers[l].shadow_map && f->lights[l].radius > 0.0f) {
+            if (drift_realtime_shadow_map(f, l) && f->lights[l].radius > 0.0f) {
                 check.delta = drift_vec3_add(
                     check.delta, penumbra_mistake(f, l, x, y, s, job->params->lobe_samples,
                                                   &check.contradicted, rays));
@@ -537,7 +526,7 @@ static void penumbra_coarse_pixel(drift_frame_state *f, int32_t x, int32_t y, ui
     const drift_surface *s = &f->gbuffer.surfaces[index];
     for (uint32_t l = 0; l < f->light_count; ++l) {
         const drift_raster_light *light = &f->lights[l];
-        const drift_shadow_map *map = f->light_buffers[l].shadow_map;
+        const drift_shadow_map *map = drift_realtime_shadow_map(f, l);
         float e = -1.0f;
         const light_shape *shape = job->shapes ? &job->shapes[l] : NULL;
         bool behind =
@@ -581,7 +570,7 @@ static void shadow_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *r
     for (uint32_t l = 0; e == 0.0f && s->material != DRIFT_INVALID_INDEX && l < f->light_count;
          ++l) {
         const drift_raster_light *light = &f->lights[l];
-        const drift_shadow_map *map = f->light_buffers[l].shadow_map;
+        const drift_shadow_map *map = drift_realtime_shadow_map(f, l);
         if (!map || !(light->radius > 0.0f)) {
             continue;
         }
@@ -656,7 +645,7 @@ static void ensure_shadow_maps(drift_frame_state *f)
         uint64_t rays = 0;
         if (f->lights[l].radius > 0.0f &&
             drift_realtime_ensure_shadow_map(f, l, &rays) != DRIFT_OK) {
-            f->light_buffers[l].shadow_map = NULL; // logged; this light gets no estimate
+            drift_realtime_drop_shadow_map(f, l); // logged; this light gets no estimate
         }
     }
 }

@@ -6,6 +6,7 @@
 #include "ssdo/ssdo_pass.h"
 
 #include "drift/ssdo.h"
+#include "realtime/realtime.h"
 
 typedef struct ssdo_pass_state {
     drift_ssdo_env *env;
@@ -219,20 +220,24 @@ drift_result drift_ssdo_pass_contact_shadows(drift_frame_state *f)
     r = r ? r : drift_image_create(ctx, w, h, 1, &mask);
     r = r ? r : drift_image_create(ctx, w, h, 1, &back);
     r = r ? r : prepare_layers(f, &back, views, &view_count, &in);
+    drift_ssdo_contact_counts *counts = &drift_ssdo_family_of(f)->contact;
+    *counts = (drift_ssdo_contact_counts){ .samples = f->params.shadow_map.contact_samples };
     for (uint32_t l = 0; r == DRIFT_OK && l < f->light_count; ++l) {
         const drift_raster_light *light = &f->lights[l];
-        const drift_shadow_map *map = f->light_buffers[l].shadow_map;
+        const drift_shadow_map *map = drift_realtime_shadow_map(f, l);
         drift_image *shadow = &f->light_buffers[l].shadow;
         if (!map) {
             continue;
         }
+        ++counts->lights;
         for (int32_t y = 0; y < h; ++y) {
             for (int32_t x = 0; x < w; ++x) {
                 const drift_surface *s = &f->gbuffer.surfaces[(size_t)y * (size_t)w + (size_t)x];
                 bool lit =
                     s->material != DRIFT_INVALID_INDEX && drift_image_pixel(shadow, x, y)[0] > 0.0f;
-                drift_image_pixel(&lengths, x, y)[0] =
-                    lit ? drift_shadow_map_blind_length(map, s->position, s->ng) : 0.0f;
+                float length = lit ? drift_shadow_map_blind_length(map, s->position, s->ng) : 0.0f;
+                drift_image_pixel(&lengths, x, y)[0] = length;
+                counts->lit_pixels += length > 0.0f;
             }
         }
         bool directional = light->type == DRIFT_LIGHT_DIRECTIONAL;
@@ -241,7 +246,10 @@ drift_result drift_ssdo_pass_contact_shadows(drift_frame_state *f)
             f->params.shadow_map.contact_samples, &mask);
         for (int32_t y = 0; r == DRIFT_OK && y < h; ++y) {
             for (int32_t x = 0; x < w; ++x) {
-                drift_image_pixel(shadow, x, y)[0] *= drift_image_pixel(&mask, x, y)[0];
+                float visible = drift_image_pixel(&mask, x, y)[0];
+                drift_image_pixel(shadow, x, y)[0] *= visible;
+                counts->shadowed_pixels +=
+                    visible < 1.0f && drift_image_pixel(&lengths, x, y)[0] > 0.0f;
             }
         }
     }

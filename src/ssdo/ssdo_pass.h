@@ -3,7 +3,7 @@
 #ifndef DRIFT_SSDO_PASS_H
 #define DRIFT_SSDO_PASS_H
 
-#include "frame/frame.h"
+#include "frame/family.h"
 
 // Fill frame->terms[DRIFT_EFFECT_OCCLUSION] (O) by SSAO, GTAO or SSDO (with the one bounce
 // when params.occlusion.bounce and no indirect technique already has that light).
@@ -14,8 +14,30 @@ drift_result drift_ssdo_pass_ssdo(drift_frame_state *frame, const drift_pass_arg
 // visibility (what the screen-space techniques approximate; no bounce).
 drift_result drift_ssdo_pass_reference(drift_frame_state *frame, const drift_pass_args *args);
 // The contact-shadow fix for shadow-map bias in the frame's S_l (--contact-shadows on): runs
-// after the pcf or pcss row, before D is summed (src/hybrid/frame.c).
+// after the pcf or pcss row, before D is summed (the family's after_row hook).
 drift_result drift_ssdo_pass_contact_shadows(drift_frame_state *frame);
+
+// What the contact shadows did on the frame's last pass, for the family's report hook.
+typedef struct drift_ssdo_contact_counts {
+    uint32_t lights;          // the lights with a shadow map, each marched
+    uint64_t lit_pixels;      // pixels x lights the map let through: each marches toward its
+                              // light (unless its surface faces away from it)
+    uint64_t shadowed_pixels; // of those, the ones whose march met an occluder (S_l set to 0)
+    int32_t samples;          // points a march
+} drift_ssdo_contact_counts;
+
+// The ssdo family's own state, in its slot of the frame (frame/family.h): made by its create
+// hook, freed by its destroy hook. (The occlusion rows' buffers are in the occlusion effect's
+// slot: drift_pass_set_state.)
+typedef struct drift_ssdo_family_state {
+    drift_ssdo_contact_counts contact;
+} drift_ssdo_family_state;
+
+static inline drift_ssdo_family_state *drift_ssdo_family_of(const drift_frame_state *frame)
+{
+    return (drift_ssdo_family_state *)drift_family_state(frame, DRIFT_FAMILY_SSDO);
+}
+
 // occlusion.visibility, .bent_normal, .direct and .bounce of the last render.
 void drift_ssdo_planes(const drift_frame_state *frame, drift_pass_plane_fn add, void *sink);
 

@@ -78,6 +78,47 @@ for file in "$root"/src/*/family.c; do
   echo " $listed " | grep -q " $name " \
     || { echo "layers: ${file#$root/} is not listed in src/hybrid/families.c"; bad=1; }
 done
+# The families' state (frame/family.h's slots): the frame holds each family's state only as
+# an opaque slot, so its buffers (frame/frame.[ch], comments aside) name no family's type and
+# hold no technique's cache;
+# a family's slot is read through its own accessor, in its own folder (other families and
+# SIR call that accessor, an include checked above); a family with a create hook says which
+# slot its state goes to.
+for name in $listed; do
+  while IFS= read -r hit; do
+    echo "layers: $hit names family '$name''s internals in the frame's layer: keep them in its slot"
+    bad=1
+  done < <(cd "$root" && grep -n "\bdrift_${name}_[a-z_]*" src/frame/frame.[ch] \
+             | grep -v '^[^:]*:[0-9]*: *//' | cut -d: -f1,2 || true)
+done
+while IFS= read -r hit; do
+  echo "layers: $hit: the frame's state holds a technique's cache; it belongs in its family's slot"
+  bad=1
+done < <(cd "$root" && grep -nHE '^\s+drift_(shadow_map|envmap|env_prefilter)\b[^;(]*;' src/frame/frame.h \
+           | cut -d: -f1,2 || true)
+while IFS= read -r hit; do
+  echo "layers: $hit reads a family's slot directly: only frame/family.h's drift_family_state and the conductor do"
+  bad=1
+done < <(cd "$root" && grep -n 'family_state\[' src/*/*.[ch] \
+           | grep -v '^src/frame/\(frame\|family\)\.h:' | grep -v '^src/hybrid/frame\.c:' \
+           | cut -d: -f1,2 || true)
+while IFS= read -r hit; do
+  file=${hit%%:*}
+  slot=$(echo "$hit" | sed 's/.*DRIFT_FAMILY_\([A-Z_]*\).*/\1/' | tr 'A-Z' 'a-z')
+  case "$file" in
+    src/frame/family.h | "src/$slot/"*) ;;
+    *) echo "layers: $hit reads family '$slot''s slot outside src/$slot: use its accessor"; bad=1 ;;
+  esac
+done < <(cd "$root" && grep -nE 'DRIFT_FAMILY_(REALTIME|ISG|AAF|SSDO|ISM|MICRO|GLARE)\b' \
+           src/*/*.[ch] tools/*.c bench/*.c 2>/dev/null | cut -d: -f1,2,3- || true)
+for name in $listed; do
+  file="$root/src/$name/family.c"
+  [ -e "$file" ] || continue
+  if grep -q '^ *\.create = ' "$file" && ! grep -qE '^ *\.slot = DRIFT_FAMILY_[A-Z]+,' "$file"; then
+    echo "layers: src/$name/family.c has a create hook but no .slot for its state"
+    bad=1
+  fi
+done
 # The scene loaders: drift_scene_load reaches a format's loader only through the registry
 # (src/io/scene_formats.c); no other file calls a load function of the registry's rows.
 for fn in drift__scene_load_json_file drift__scene_load_mesh_file drift__scene_load_mitsuba; do

@@ -6,6 +6,7 @@
 // frees everything.
 #include "drift_test.h"
 #include "hybrid/families.h"
+#include "hybrid/frame_access.h"
 #include "hybrid/techniques.h"
 #include "test_rig.h"
 
@@ -210,6 +211,35 @@ static void test_a_frame_reports_what_it_did(void **state)
     assert_true(count_of(frame, "realtime.shadow_map_rays") > 0.0);
     assert_true(count_of(frame, "realtime.probe_rays") == 0.0);
 
+    // Contact shadows: the lights they marched (those with a map), the pixels the map let
+    // through, --contact-samples points each, and the pixels whose march met an occluder:
+    // exactly those whose S_l the fix turned to 0.
+    assert_true(isnan(count_of(frame, "ssdo.contact_shadows.lights")));
+    float before[16 * 16];
+    const drift_image *shadow = drift_hybrid_plane_named(frame, "light0.shadow");
+    assert_non_null(shadow);
+    for (int32_t i = 0; i < 16 * 16; ++i) {
+        before[i] = drift_image_pixel(shadow, i % 16, i / 16)[0];
+    }
+    p.shadow_map.contact_shadows = true;
+    p.shadow_map.contact_samples = 4;
+    render(&r, frame, &p);
+    check_counts_named(frame, "aaf");
+    shadow = drift_hybrid_plane_named(frame, "light0.shadow");
+    double turned = 0.0;
+    for (int32_t i = 0; i < 16 * 16; ++i) {
+        turned += before[i] > 0.0f && drift_image_pixel(shadow, i % 16, i / 16)[0] == 0.0f;
+    }
+    double lit = count_of(frame, "ssdo.contact_shadows.lit_pixels");
+    assert_true(count_of(frame, "ssdo.contact_shadows.lights") == 1.0);
+    assert_true(lit > 0.0 && lit <= 16.0 * 16.0);
+    assert_true(count_of(frame, "ssdo.contact_shadows.march_samples") == 4.0 * lit);
+    if (count_of(frame, "ssdo.contact_shadows.shadowed_pixels") != turned) {
+        fail_msg("contact shadows: %g pixels reported shadowed, %g turned to 0",
+                 count_of(frame, "ssdo.contact_shadows.shadowed_pixels"), turned);
+    }
+    p.shadow_map.contact_shadows = false;
+
     p = small_params();
     p.spp = 8;
     p.indirect = DRIFT_INDIRECT_AAF;
@@ -287,12 +317,50 @@ static void test_a_frame_reports_what_it_did(void **state)
     test_rig_destroy(&r);
 }
 
+// Each family that makes state (a create hook) puts it in a slot of its own, which the frame
+// holds from its creation to its end; the other families have none.
+static void test_each_family_owns_its_slot(void **state)
+{
+    (void)state;
+    bool taken[DRIFT_FAMILY_SLOT_COUNT] = { false };
+    int creators = 0;
+    for (int i = 0; drift_family_at(i); ++i) {
+        const drift_family *family = drift_family_at(i);
+        if (!family->create) {
+            assert_int_equal(family->slot, DRIFT_FAMILY_NONE);
+            continue;
+        }
+        if (family->slot == DRIFT_FAMILY_NONE || family->slot >= DRIFT_FAMILY_SLOT_COUNT ||
+            taken[family->slot]) {
+            fail_msg("family %s: its state has no slot of its own", family->name);
+        }
+        taken[family->slot] = true;
+        assert_non_null(family->destroy);
+        ++creators;
+    }
+    assert_true(creators >= 4); // realtime, isg, aaf, ssdo
+    test_rig r = test_rig_begin(1);
+    build_scene(&r, 8);
+    test_rig_commit(&r);
+    drift_hybrid_params p = small_params();
+    drift_hybrid *frame = NULL;
+    assert_int_equal(drift_hybrid_create(r.ctx, r.scene, r.accel, &p, &frame), DRIFT_OK);
+    const drift_frame_state *f = drift_hybrid_frame(frame);
+    for (int slot = 0; slot < DRIFT_FAMILY_SLOTS; ++slot) {
+        bool made = drift_family_state(f, (drift_family_slot)slot) != NULL;
+        assert_true(made == (slot < DRIFT_FAMILY_SLOT_COUNT && taken[slot]));
+    }
+    drift_hybrid_destroy(frame);
+    test_rig_destroy(&r);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_every_row_as_a_new_frame),
         cmocka_unit_test(test_caches_follow_their_knobs),
         cmocka_unit_test(test_a_frame_reports_what_it_did),
+        cmocka_unit_test(test_each_family_owns_its_slot),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -294,7 +294,7 @@ static void test_shadow_metric_conservative(void **state)
     const drift_gbuffer *g = drift_hybrid_gbuffer(r.frame);
     const drift_image *shadow = drift_refine_metric_image(r.sir, DRIFT_METRIC_SHADOW);
     uint32_t partial = 0, flagged = 0, estimated = 0, umbra = 0, lit_unflagged = 0;
-    const drift_shadow_map *map = drift_hybrid_frame(r.frame)->light_buffers[0].shadow_map;
+    const drift_shadow_map *map = drift_realtime_shadow_map(drift_hybrid_frame(r.frame), 0);
     assert_non_null(map);
     for (int32_t y = 0; y < h; ++y) {
         for (int32_t x = 0; x < w; ++x) {
@@ -495,7 +495,7 @@ static void test_hierarchical_search_matches_exhaustive(void **state)
         { .type = DRIFT_LIGHT_DIRECTIONAL, .direction = { 0.3f, -1.0f, 0.2f }, .radius = 0.05f },
     };
     uint32_t ones = 0, zeros = 0, extra[2] = { 0, 0 };
-    check_hierarchical_matches(drift_hybrid_frame(r.frame)->light_buffers[0].shadow_map, g, w, h,
+    check_hierarchical_matches(drift_realtime_shadow_map(drift_hybrid_frame(r.frame), 0), g, w, h,
                                &ones, &zeros, extra);
     for (int l = 0; l < 2; ++l) {
         drift_shadow_map *map = NULL;

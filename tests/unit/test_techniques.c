@@ -95,7 +95,7 @@ static void test_rows_are_consistent(void **state)
                                   DRIFT_STREAM_PROBE,      DRIFT_STREAM_ISG_LAYER,
                                   DRIFT_STREAM_SIR_AO,     DRIFT_STREAM_SIR_TRACE };
     const drift_technique_row *seen[64];
-    int seen_count = 0;
+    int seen_count = 0, searched[DRIFT_EFFECT_COUNT] = { 0 };
     for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
         uint32_t components = 0;
         for (int t = 0; t < drift_technique_count((drift_effect)e); ++t) {
@@ -115,6 +115,15 @@ static void test_rows_are_consistent(void **state)
             if (e != DRIFT_EFFECT_DOF) { // one truth an effect
                 assert_true(components == 0 || components == row->components);
                 components = row->components;
+            }
+            // The frontier searches shadows x indirect light (drift bench frontier), never
+            // against the truth it is scored by.
+            assert_int_equal(drift_technique_frontier((drift_effect)e, t),
+                             (row->flags & DRIFT_ROW_FRONTIER) != 0);
+            if (row->flags & DRIFT_ROW_FRONTIER) {
+                assert_true(e == DRIFT_EFFECT_SHADOWS || e == DRIFT_EFFECT_INDIRECT);
+                assert_string_not_equal(row->name, "reference");
+                ++searched[e];
             }
             if (row->flags & DRIFT_ROW_NO_TERM) { // adds nothing: runs nothing, needs nothing
                 assert_true(row->pass == drift_pass_none && row->inputs == 0);
@@ -138,6 +147,8 @@ static void test_rows_are_consistent(void **state)
         assert_null(drift_technique_summary((drift_effect)e, -1));
     }
     assert_null(drift_technique_row_of(DRIFT_EFFECT_COUNT, 0));
+    assert_true(searched[DRIFT_EFFECT_SHADOWS] >= 2 && searched[DRIFT_EFFECT_INDIRECT] >= 2);
+    assert_false(drift_technique_frontier(DRIFT_EFFECT_SHADOWS, -1));
 }
 
 static double mean_of(const drift_image *image)

@@ -241,5 +241,23 @@ void test_contact_shadows_fix_the_frames_shadow_map(void **state)
                   darkened);
     assert_true(contact >= 6);
     assert_true(darkened * 100 <= lit);
+    // The frame reports what the fix did (the ssdo family's counts): the pixels it turned to
+    // shadow, exactly those counted here, out of the pixels the map let through.
+    double through = 0.0, turned = 0.0, counted[2] = { NAN, NAN };
+    for (int32_t i = 0; i < N; ++i) {
+        through += biased[i] > 0.0f;
+        turned += biased[i] > 0.0f && fixed[i] == 0.0f;
+    }
+    drift_hybrid_stats stats = drift_hybrid_get_stats(r.frame);
+    const char *name;
+    double value;
+    for (uint32_t k = 0; drift_hybrid_stats_count(&stats, k, &name, &value); ++k) {
+        counted[0] = strcmp(name, "ssdo.contact_shadows.shadowed_pixels") == 0 ? value : counted[0];
+        counted[1] = strcmp(name, "ssdo.contact_shadows.lit_pixels") == 0 ? value : counted[1];
+    }
+    if (!(counted[0] == turned && turned >= contact && counted[1] > 0.0 && counted[1] <= through)) {
+        fail_msg("contact shadows report %g shadowed of %g marched; %g turned, %g let through",
+                 counted[0], counted[1], turned, through);
+    }
     test_rig_destroy(&r);
 }
