@@ -386,6 +386,12 @@ void drift_hybrid_destroy(drift_hybrid *frame); // NULL-safe
 // the environment map) are kept. The size may not change.
 drift_result drift_hybrid_set_params(drift_hybrid *frame, const drift_hybrid_params *params);
 drift_hybrid_params drift_hybrid_get_params(const drift_hybrid *frame);
+// The scene's geometry or lights moved (drift_scene_animation_pose, then a new `accel` built
+// over it): every technique's per-scene state (shadow maps, probes, VPLs, scene points,
+// caches) is dropped and remade on the next frame, which is right for any change and costs a
+// frame's set-up. The light count may not change. Motion vectors still follow the camera only:
+// a moving object's history is reprojected as if it stood still (docs/temporal.md).
+drift_result drift_hybrid_scene_changed(drift_hybrid *frame, const drift_accel *accel);
 
 // Renders one frame seen by `camera` (its width/height are ignored: the frame's size is
 // used). Motion vectors are relative to the camera of the previous call (zero the first

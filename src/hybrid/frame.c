@@ -274,6 +274,43 @@ drift_result drift_hybrid_set_params(drift_hybrid *h, const drift_hybrid_params 
     return DRIFT_OK;
 }
 
+drift_result drift_hybrid_scene_changed(drift_hybrid *h, const drift_accel *accel)
+{
+    drift_frame_state *f = &h->frame;
+    if (!accel || !f->scene->committed) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    // Every technique's state may hold the old geometry (shadow maps, probes, VPLs, points,
+    // caches): each family frees what it made and the techniques remake it on next use. The
+    // camera history (motion vectors) and the frame's buffers stay.
+    for (int i = 0; drift_family_at(i); ++i) {
+        if (drift_family_at(i)->destroy) {
+            drift_family_at(i)->destroy(f);
+        }
+    }
+    drift_pass_free_states(f);
+    drift_raster_light *lights = NULL;
+    uint32_t count = 0;
+    drift_result r = drift_raster_lights_build(f->ctx, f->scene, &lights, &count);
+    if (r != DRIFT_OK) {
+        return r;
+    }
+    if (count != f->light_count) {
+        drift_raster_lights_destroy(f->ctx, lights, count);
+        drift_log(f->ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, NULL, 0,
+                  "hybrid frame: the scene's lights changed in number (%u -> %u); make a new "
+                  "frame",
+                  f->light_count, count);
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    drift_raster_lights_destroy(f->ctx, f->lights, f->light_count);
+    f->lights = lights;
+    f->accel = accel;
+    f->shading.accel = accel;
+    f->shading.lights = lights;
+    return DRIFT_OK;
+}
+
 drift_hybrid_params drift_hybrid_get_params(const drift_hybrid *h)
 {
     return h->frame.params;

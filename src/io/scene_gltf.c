@@ -358,6 +358,64 @@ int drift__gltf_camera_index(const drift__gltf *g, const char *selector)
     return -1;
 }
 
+// nodes[index] when it is the node assimp named `ai_name` with `ai_children` children: the
+// same number of children and, where the file names the node, the same name.
+static int matched_node(const drift__gltf *g, const cJSON *index, const char *ai_name,
+                        unsigned ai_children)
+{
+    const cJSON *nodes = cJSON_GetObjectItemCaseSensitive(g->root, "nodes");
+    const cJSON *node = item_at(nodes, index);
+    if (!cJSON_IsObject(node)) {
+        return DRIFT__GLTF_NO_NODE;
+    }
+    const cJSON *children = cJSON_GetObjectItemCaseSensitive(node, "children");
+    const cJSON *name = cJSON_GetObjectItemCaseSensitive(node, "name");
+    unsigned count = cJSON_IsArray(children) ? (unsigned)cJSON_GetArraySize(children) : 0u;
+    bool named = cJSON_IsString(name) && name->valuestring[0] != '\0';
+    if (count != ai_children || (named && strcmp(name->valuestring, ai_name) != 0)) {
+        return DRIFT__GLTF_NO_NODE;
+    }
+    return (int)index->valuedouble;
+}
+
+// The root nodes of the file's scene (`scene`, else the first).
+static const cJSON *scene_roots(const drift__gltf *g)
+{
+    const cJSON *scenes = cJSON_GetObjectItemCaseSensitive(g->root, "scenes");
+    const cJSON *scene = cJSON_GetObjectItemCaseSensitive(g->root, "scene");
+    const cJSON *chosen = scene ? item_at(scenes, scene) : cJSON_GetArrayItem(scenes, 0);
+    return cJSON_GetObjectItemCaseSensitive(chosen, "nodes");
+}
+
+// assimp 5.2 makes a scene's only root node its root, and adds a root above several.
+int drift__gltf_root_node(const drift__gltf *g, const char *ai_name, unsigned ai_children)
+{
+    const cJSON *roots = g ? scene_roots(g) : NULL;
+    int count = cJSON_IsArray(roots) ? cJSON_GetArraySize(roots) : 0;
+    if (count == 1) {
+        return matched_node(g, cJSON_GetArrayItem(roots, 0), ai_name, ai_children);
+    }
+    return count > 1 && (unsigned)count == ai_children ? DRIFT__GLTF_SCENE_ROOT
+                                                       : DRIFT__GLTF_NO_NODE;
+}
+
+int drift__gltf_child_node(const drift__gltf *g, int parent, unsigned position, const char *ai_name,
+                           unsigned ai_children)
+{
+    if (!g || parent == DRIFT__GLTF_NO_NODE) {
+        return DRIFT__GLTF_NO_NODE;
+    }
+    const cJSON *list = NULL;
+    if (parent == DRIFT__GLTF_SCENE_ROOT) {
+        list = scene_roots(g);
+    } else {
+        const cJSON *nodes = cJSON_GetObjectItemCaseSensitive(g->root, "nodes");
+        list = cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(nodes, parent), "children");
+    }
+    const cJSON *index = cJSON_IsArray(list) ? cJSON_GetArrayItem(list, (int)position) : NULL;
+    return index ? matched_node(g, index, ai_name, ai_children) : DRIFT__GLTF_NO_NODE;
+}
+
 // Bytes [offset, offset + length) of buffer `index`: the .glb's BIN chunk, a data URI or a file
 // beside the glTF; *out_data allocated.
 static drift_result buffer_bytes(drift_context *ctx, const drift__gltf *g, const cJSON *index,
