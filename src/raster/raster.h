@@ -39,7 +39,10 @@ typedef struct drift_raster_light {
                             // and mesh: the (mean) normal light leaves along; else zero
     float radius;           // light size L: 0 for point, spot and directional lights; for
                             // area lights the radius of a bounding sphere about `centre`
-    bool one_sided;         // emits only into the hemisphere around `direction`
+    bool one_sided;         // has a mean normal `direction` and emits only into the hemisphere
+                            // around it, unless two_sided
+    bool two_sided;         // an emissive mesh that emits from both faces (glTF doubleSided, as
+                            // Cycles): points behind its plane are lit too
     uint32_t first_light;   // the scene lights it stands for: first_light ..
     uint32_t light_count;   //   first_light + light_count - 1 (1 unless a mesh)
     uint32_t mesh;          // the emissive mesh, or DRIFT_INVALID_INDEX
