@@ -13,8 +13,8 @@
 #          (an animated parent: the sphere swings round the origin);
 #   Point  the 600 W point light moves from (1.5, -2.0, 3.5) to (-1.0, -2.5, 3.0).
 # Exported as object_anim.glb (the exporter samples every frame, LINEAR, and writes frame 0's
-# pose as the nodes' rest transforms); Cycles renders frames 0, 12 and 24 into cycles_object_0000.exr, _0012, _0024 with
-# make_interchange.py's settings. tests/cli/test_gltf_animation.sh renders object_anim.glb with
+# pose as the nodes' rest transforms); Cycles renders frames 0, 12 and 24 into
+# cycles_object_0000.exr, _0012, _0024 with make_interchange.py's settings. tests/cli/test_gltf_animation.sh renders object_anim.glb with
 # `drift render --animation 0:2 --fps 2` (t = 0, 0.5, 1 s: Blender's frames 0, 12, 24) and
 # compares; Blender runs only to regenerate (the outputs are in the repository).
 import math
