@@ -190,6 +190,40 @@ bool drift__gltf_node_moves(const gltf_anim *a, int node)
     return false;
 }
 
+bool *drift__gltf_moving_nodes(const gltf_anim *a)
+{
+    // 0: not known yet, 1: moves, 2: still. Each walk up stops at a known node and marks the
+    // nodes it passed, so every node is walked once.
+    uint8_t *state = drift_alloc(a->ctx, (size_t)a->node_count + 1);
+    bool *moves = drift_alloc(a->ctx, (size_t)a->node_count + 1);
+    int *path = drift_alloc(a->ctx, sizeof(int) * (DRIFT__SCENE_MAX_NODE_DEPTH + 1));
+    if (!state || !moves || !path) {
+        drift_free(a->ctx, state);
+        drift_free(a->ctx, moves);
+        drift_free(a->ctx, path);
+        return NULL;
+    }
+    memset(state, 0, (size_t)a->node_count + 1);
+    for (int c = 0; c < a->channel_count; ++c) {
+        state[a->channels[c].node] = 1;
+    }
+    for (int i = 0; i < a->node_count; ++i) {
+        int n = 0, p = i;
+        while (p >= 0 && state[p] == 0 && n < DRIFT__SCENE_MAX_NODE_DEPTH) {
+            path[n++] = p;
+            p = a->nodes[p].parent;
+        }
+        uint8_t known = p >= 0 && n < DRIFT__SCENE_MAX_NODE_DEPTH ? state[p] : 2;
+        for (int k = 0; k < n; ++k) {
+            state[path[k]] = known;
+        }
+        moves[i] = state[i] == 1;
+    }
+    drift_free(a->ctx, state);
+    drift_free(a->ctx, path);
+    return moves;
+}
+
 bool drift__gltf_camera_moves(const gltf_anim *a)
 {
     for (int i = 0; i < a->node_count; ++i) {

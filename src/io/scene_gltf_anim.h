@@ -73,6 +73,9 @@ void drift__gltf_anim_close(gltf_anim *a);
 bool drift__gltf_node_world(const gltf_anim *a, int node, double t, bool at_rest, drift__mat4 *out);
 // Whether a channel moves nodes[node] or one of its parents.
 bool drift__gltf_node_moves(const gltf_anim *a, int node);
+// For each node, whether a channel moves it or one of its parents (node_count entries,
+// drift_free it), in time linear in the nodes and channels; NULL when out of memory.
+bool *drift__gltf_moving_nodes(const gltf_anim *a);
 // Whether a channel moves the node of the file's first camera (or its parents).
 bool drift__gltf_camera_moves(const gltf_anim *a);
 // Normalizes a quaternion; false when it is zero or not finite.

@@ -46,6 +46,7 @@ struct drift_scene_animation {
     moving_light *lights;
     uint32_t light_count;
     bool camera_moves;
+    bool *node_moves; // per node of the file: a channel moves it or a parent
 };
 
 static affine affine_of(const drift__mat4 *t)
@@ -187,7 +188,7 @@ static drift_result add_meshes(drift_scene_animation *s)
     for (uint32_t i = 0; i < scene->mesh_count; ++i) {
         const drift_mesh *m = &scene->meshes[i];
         int node = m->node == DRIFT_INVALID_INDEX ? -1 : (int)m->node;
-        if (node < 0 || node >= s->file.node_count || !drift__gltf_node_moves(&s->file, node)) {
+        if (node < 0 || node >= s->file.node_count || !s->node_moves[node]) {
             continue;
         }
         moving_mesh mm = { .mesh = i, .node = node };
@@ -216,8 +217,7 @@ static void add_lights(drift_scene_animation *s)
         // Emissive triangles follow their mesh (commit remakes them).
         bool punctual = l->type == DRIFT_LIGHT_POINT || l->type == DRIFT_LIGHT_SPOT ||
                         l->type == DRIFT_LIGHT_DIRECTIONAL;
-        if (!punctual || node < 0 || node >= s->file.node_count ||
-            !drift__gltf_node_moves(&s->file, node)) {
+        if (!punctual || node < 0 || node >= s->file.node_count || !s->node_moves[node]) {
             continue;
         }
         moving_light ml = { .light = i, .node = node, .at_rest = *l };
@@ -232,19 +232,24 @@ static void add_lights(drift_scene_animation *s)
 // file's parted (drift__gltf_child_node), so they render at rest.
 static void warn_unmatched(const drift_scene_animation *s)
 {
+    bool *placed = drift_alloc(s->ctx, (size_t)s->file.node_count + 1);
+    if (!placed) {
+        return;
+    }
+    memset(placed, 0, (size_t)s->file.node_count + 1);
+    for (uint32_t i = 0; i < s->scene->mesh_count; ++i) {
+        uint32_t n = s->scene->meshes[i].node;
+        if (n < (uint32_t)s->file.node_count) {
+            placed[n] = true;
+        }
+    }
     int unmatched = 0, first = -1;
     for (int n = 0; n < s->file.node_count; ++n) {
-        if (!s->file.nodes[n].has_mesh || !drift__gltf_node_moves(&s->file, n)) {
-            continue;
-        }
-        bool found = false;
-        for (uint32_t i = 0; !found && i < s->scene->mesh_count; ++i) {
-            found = s->scene->meshes[i].node == (uint32_t)n;
-        }
-        if (!found) {
+        if (s->file.nodes[n].has_mesh && s->node_moves[n] && !placed[n]) {
             first = unmatched++ == 0 ? n : first;
         }
     }
+    drift_free(s->ctx, placed);
     if (unmatched > 0) {
         drift_log(s->ctx, DRIFT_LOG_WARNING, DRIFT_ERR_UNSUPPORTED, s->file.path, 0,
                   "%d moving node(s) with a mesh (the first: nodes[%d]) were not matched to the "
@@ -265,6 +270,7 @@ void drift_scene_animation_destroy(drift_scene_animation *s)
     }
     drift_free(s->ctx, s->meshes);
     drift_free(s->ctx, s->lights);
+    drift_free(s->ctx, s->node_moves);
     drift__gltf_anim_close(&s->file);
     drift_free(s->ctx, s);
 }
@@ -286,6 +292,10 @@ drift_result drift_scene_animation_from_gltf(drift_context *ctx, const char *pat
     *s = (drift_scene_animation){ .ctx = ctx, .scene = scene };
     s->file = (gltf_anim){ .ctx = ctx, .level = DRIFT_LOG_ERROR, .path = path };
     drift_result r = drift__gltf_anim_open(&s->file);
+    if (r == DRIFT_OK) {
+        s->node_moves = drift__gltf_moving_nodes(&s->file);
+        r = s->node_moves ? DRIFT_OK : DRIFT_ERR_OUT_OF_MEMORY;
+    }
     if (r == DRIFT_OK) {
         r = add_meshes(s);
     }
