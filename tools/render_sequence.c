@@ -229,6 +229,16 @@ static int pose_scene(sequence_run *s, long k, double time, cJSON *entry)
             drift_accel_destroy(accel);
         }
     }
+    if (r == DRIFT_OK && s->frame) {
+        // The meshes' moves since the last frame, for the motion vectors (temporal reuse).
+        uint32_t n = session->scene->mesh_count;
+        float *motion = drift_alloc(session->ctx, sizeof(float) * 12 * ((size_t)n + 1));
+        r = motion ? drift_scene_animation_motion(s->anim, motion, n) : DRIFT_ERR_OUT_OF_MEMORY;
+        if (r == DRIFT_OK) {
+            r = drift_hybrid_set_mesh_motion(s->frame, motion, n);
+        }
+        drift_free(session->ctx, motion);
+    }
     cJSON_AddBoolToObject(entry, "scene_moved", moved);
     cli_json_number(entry, "scene_ms", 1e3 * (drift_time_now() - t0), 3);
     if (r != DRIFT_OK) {
@@ -307,9 +317,9 @@ int render_sequence(const render_options *o, cli_session *session)
         return 2;
     }
     if (s.anim && o->temporal) {
-        fprintf(stderr, "drift render: warning: --temporal reprojects by the camera's motion "
-                        "only: the history of moving objects is rejected or ghosts "
-                        "(docs/temporal.md)\n");
+        fprintf(stderr, "drift render: warning: --temporal follows moving objects by their "
+                        "motion vectors, but light that changes with them (their shadows, "
+                        "what they reflect) lags in the history (docs/temporal.md)\n");
     }
     if (!o->camera_path && s.anim && !drift_scene_animation_camera_moves(s.anim)) {
         s.still_camera = true; // objects move, the camera stands

@@ -122,6 +122,12 @@ void drift_scene_animation_destroy(drift_scene_animation *anim); // NULL-safe
 // transform gets its rest geometry back bit for bit. Errors: a degenerate or non-finite pose
 // (zero scale), logged with the time; the scene is then left at its rest pose.
 drift_result drift_scene_animation_pose(drift_scene_animation *anim, double time, bool *out_moved);
+// How each of the scene's meshes moved between the last two poses: out[12 m .. 12 m + 11]
+// is the row-major 3 x 4 affine map taking mesh m's points now to where they were (the
+// identity for a mesh that did not move), for drift_hybrid_set_mesh_motion's motion vectors.
+// mesh_count must be the scene's.
+drift_result drift_scene_animation_motion(const drift_scene_animation *anim, float *out,
+                                          uint32_t mesh_count);
 // Whether the file's first camera is animated (drift_camera_path_from_gltf plays it).
 bool drift_scene_animation_camera_moves(const drift_scene_animation *anim);
 // How many of the scene's meshes and lights the animation moves.

@@ -20,13 +20,14 @@ typedef struct affine {
 typedef struct moving_mesh {
     uint32_t mesh;
     int node;
-    affine rest_inverse; // W_rest^-1
-    drift__mat4 rest;    // W_rest as evaluated (a pose equal to it is the rest pose)
-    drift__mat4 posed;   // the world transform it stands at now
-    bool mirrored;       // its triangles are wound against the rest pose's (det M < 0)
-    float *positions;    // rest pose, 3 a vertex
-    float *normals;      // rest pose, or NULL
-    float *tangents;     // rest pose, 4 a vertex, or NULL
+    affine rest_inverse;  // W_rest^-1
+    drift__mat4 rest;     // W_rest as evaluated (a pose equal to it is the rest pose)
+    drift__mat4 posed;    // the world transform it stands at now
+    drift__mat4 previous; // and at the pose before (drift_scene_animation_motion)
+    bool mirrored;        // its triangles are wound against the rest pose's (det M < 0)
+    float *positions;     // rest pose, 3 a vertex
+    float *normals;       // rest pose, or NULL
+    float *tangents;      // rest pose, 4 a vertex, or NULL
 } moving_mesh;
 
 typedef struct moving_light {
@@ -195,7 +196,7 @@ static drift_result add_meshes(drift_scene_animation *s)
         if (!rest_of(s, node, &mm.rest, &mm.rest_inverse)) {
             continue;
         }
-        mm.posed = mm.rest;
+        mm.posed = mm.previous = mm.rest;
         size_t nv = m->vertex_count;
         mm.positions = copy_floats(s->ctx, m->positions, 3 * nv);
         mm.normals = copy_floats(s->ctx, m->normals, 3 * nv);
@@ -403,6 +404,9 @@ drift_result drift_scene_animation_pose(drift_scene_animation *s, double time, b
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
     bool moved = false, ok = true;
+    for (uint32_t i = 0; i < s->mesh_count; ++i) {
+        s->meshes[i].previous = s->meshes[i].posed;
+    }
     for (uint32_t i = 0; ok && i < s->mesh_count; ++i) {
         moving_mesh *mm = &s->meshes[i];
         drift__mat4 world;
@@ -441,6 +445,34 @@ drift_result drift_scene_animation_pose(drift_scene_animation *s, double time, b
         *out_moved = moved;
     }
     return r;
+}
+
+drift_result drift_scene_animation_motion(const drift_scene_animation *s, float *out,
+                                          uint32_t mesh_count)
+{
+    if (!s || !out || mesh_count != s->scene->mesh_count) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    for (uint32_t m = 0; m < mesh_count; ++m) {
+        float *a = out + 12 * (size_t)m;
+        memset(a, 0, 12 * sizeof(float));
+        a[0] = a[5] = a[10] = 1.0f;
+    }
+    for (uint32_t i = 0; i < s->mesh_count; ++i) {
+        const moving_mesh *mm = &s->meshes[i];
+        if (same_matrix(&mm->previous, &mm->posed)) {
+            continue;
+        }
+        affine now = affine_of(&mm->posed), now_inverse, was = affine_of(&mm->previous);
+        if (!affine_inverse(&now, &now_inverse)) {
+            continue; // a collapsed pose: no motion to tell
+        }
+        affine back = affine_mul(&was, &now_inverse);
+        for (int k = 0; k < 12; ++k) {
+            out[12 * (size_t)mm->mesh + (size_t)k] = (float)back.m[k];
+        }
+    }
+    return DRIFT_OK;
 }
 
 bool drift_scene_animation_camera_moves(const drift_scene_animation *s)

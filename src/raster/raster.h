@@ -12,10 +12,12 @@ drift_result drift_gbuffer_create(drift_context *ctx, int32_t width, int32_t hei
 void drift_gbuffer_destroy(drift_context *ctx, drift_gbuffer *gbuffer);
 
 // Fills every plane from one pinhole ray through each pixel centre of `camera` (coherent
-// packets, one tile at a time). prev_camera (NULL: none) sets the motion plane.
+// packets, one tile at a time). prev_camera (NULL: none) sets the motion plane, with
+// mesh_motion (NULL: no mesh moved; else 12 floats a scene mesh, the affine map from a point
+// now to where it was: drift_hybrid_set_mesh_motion) for the points of moving meshes.
 void drift_gbuffer_render(drift_context *ctx, const drift_scene *scene, const drift_accel *accel,
                           const drift_camera *camera, const drift_camera *prev_camera,
-                          drift_gbuffer *gbuffer, uint64_t *rays);
+                          const float *mesh_motion, drift_gbuffer *gbuffer, uint64_t *rays);
 
 // Whether pixels a and b (indices y * width + x) lie on one surface as an image-space filter
 // sees it: the same mesh, shading normals within ~25 degrees (a thin part of an object in

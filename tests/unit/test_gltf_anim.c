@@ -242,7 +242,8 @@ static void assert_same_image(const drift_image *a, const drift_image *b)
 // The wall's node rises (0, 0, 0) -> (0, 1, 0) over 1 s. Posed at 0.5 s the wall's vertices,
 // the path tracer's image and the hybrid frame (drift_hybrid_scene_changed over a new accel)
 // equal, bit for bit, those of mesh_moved.gltf, whose wall stands at (0, 0.5, 0) with no
-// animation (the translation is exact in binary, so the two roads give the same floats).
+// animation (the translation is exact in binary, so the two roads give the same floats); the
+// frame's motion vectors carry the wall's move (drift_hybrid_set_mesh_motion).
 // Posed at 0 s (its rest pose) it is the scene as loaded again, bit for bit.
 static void test_mesh_animation_poses_the_mesh(void **state)
 {
@@ -294,7 +295,35 @@ static void test_mesh_animation_poses_the_mesh(void **state)
     drift_accel *posed_accel = NULL, *twin_accel = NULL;
     assert_int_equal(drift_accel_create(ctx, scene, NULL, &posed_accel), DRIFT_OK);
     assert_int_equal(drift_hybrid_scene_changed(frame, posed_accel), DRIFT_OK);
+    float motion[2 * 12];
+    assert_int_equal(drift_scene_animation_motion(anim, motion, 2), DRIFT_OK);
+    assert_int_equal(drift_hybrid_set_mesh_motion(frame, motion, 2), DRIFT_OK);
     assert_int_equal(drift_hybrid_render(frame, &scene->camera, NULL), DRIFT_OK);
+    // Motion vectors (the camera stood still): the wall's points were 0.5 lower, the floor's
+    // did not move.
+    const drift_gbuffer *g = drift_hybrid_gbuffer(frame);
+    drift_camera_frame cf = drift_camera_frame_make(&scene->camera, 24, 24);
+    int wall_pixels = 0;
+    for (int32_t y = 0; y < 24; ++y) {
+        for (int32_t x = 0; x < 24; ++x) {
+            size_t i = (size_t)y * 24 + (size_t)x;
+            const float *mv = drift_image_pixel(&g->motion, x, y);
+            drift_vec3 om = g->object_motion[i];
+            if (g->mesh_index[i] == 0) {
+                assert_true(fabsf(mv[0]) < 1e-3f && fabsf(mv[1]) < 1e-3f && drift_vec3_is_zero(om));
+            } else if (g->mesh_index[i] == 1) {
+                ++wall_pixels;
+                assert_vec(om, 0.0, -0.5, 0.0, __LINE__);
+                drift_vec2 was;
+                assert_true(drift_camera_frame_project(
+                    &cf, drift_vec3_add(drift_image_get3(&g->position, x, y), om), &was));
+                test_assert_close(mv[0], was.x - ((float)x + 0.5f), 1e-3, __LINE__);
+                test_assert_close(mv[1], was.y - ((float)y + 0.5f), 1e-3, __LINE__);
+                assert_true(fabsf(mv[1]) > 0.5f); // half a metre is pixels here
+            }
+        }
+    }
+    assert_true(wall_pixels > 20);
     assert_int_equal(drift_accel_create(ctx, moved, NULL, &twin_accel), DRIFT_OK);
     drift_hybrid *twin_frame = NULL;
     assert_int_equal(drift_hybrid_create(ctx, moved, twin_accel, &hp, &twin_frame), DRIFT_OK);
