@@ -113,7 +113,7 @@ bool render_parse_animation(const char *cmd, const char *flag, const char *v, vo
 // --animation); prints the usage error and returns false if not.
 bool render_sequence_validate(const render_options *o);
 // Renders frames A..B (either mode) and writes each; returns the exit code.
-int render_sequence(const render_options *o, const cli_session *session);
+int render_sequence(const render_options *o, cli_session *session);
 
 // The --stats object's first fields (scene, mode, width, height); the caller adds the rest
 // and writes it with cli_json_write.

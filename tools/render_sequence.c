@@ -1,10 +1,14 @@
-// drift render --animation A:B: frames A..B of a camera path (--camera-path), each written to
+// drift render --animation A:B: frames A..B of a camera path (--camera-path, or a glTF scene's
+// camera animation) and of a glTF scene's node animation (its meshes and lights moved each
+// frame, the accel rebuilt and the hybrid frame's per-scene state remade), each written to
 // --out's pattern (DIR/frame_%04d.exr and its PNG), with per-frame stats, temporal reuse in
 // hybrid mode (--temporal on, drift/temporal.h) and an MP4 through ffmpeg (--video).
 #include "cli.h"
+#include "drift/accel.h"
 #include "drift/camera_path.h"
 #include "drift/glare.h"
 #include "drift/image_io.h"
+#include "drift/scene_io.h"
 #include "drift/temporal.h"
 #include "frame_pattern.h"
 #include "render.h"
@@ -119,8 +123,10 @@ static void encode_video(const render_options *o, double fps)
 
 typedef struct sequence_run {
     const render_options *o;
-    const cli_session *session;
+    cli_session *session;
     drift_camera_path path;
+    bool still_camera;           // a glTF whose nodes move but whose camera does not
+    drift_scene_animation *anim; // a glTF scene's moving meshes and lights, or NULL
     double fps;
     drift_hybrid *frame;
     drift_temporal *temporal;
@@ -202,6 +208,47 @@ static int hybrid_frame(sequence_run *s, long k, const drift_camera *camera, con
     return 0;
 }
 
+// Poses the glTF scene's moving meshes and lights at `time`; when they moved, a new accel over
+// them and the hybrid frame's per-scene state remade (drift_hybrid_scene_changed).
+static int pose_scene(sequence_run *s, long k, double time, cJSON *entry)
+{
+    cli_session *session = s->session;
+    double t0 = drift_time_now();
+    bool moved = false;
+    drift_result r = drift_scene_animation_pose(s->anim, time, &moved);
+    drift_accel *accel = NULL;
+    if (r == DRIFT_OK && moved) {
+        r = drift_accel_create(session->ctx, session->scene, &(drift_accel_desc){ 0 }, &accel);
+        if (r == DRIFT_OK && s->frame) {
+            r = drift_hybrid_scene_changed(s->frame, accel);
+        }
+        if (r == DRIFT_OK) {
+            drift_accel_destroy(session->accel);
+            session->accel = accel;
+        } else {
+            drift_accel_destroy(accel);
+        }
+    }
+    if (r == DRIFT_OK && s->frame) {
+        // The meshes' moves since the last frame, for the motion vectors (temporal reuse).
+        uint32_t n = session->scene->mesh_count;
+        float *motion = drift_alloc(session->ctx, sizeof(float) * 12 * ((size_t)n + 1));
+        r = motion ? drift_scene_animation_motion(s->anim, motion, n) : DRIFT_ERR_OUT_OF_MEMORY;
+        if (r == DRIFT_OK) {
+            r = drift_hybrid_set_mesh_motion(s->frame, motion, n);
+        }
+        drift_free(session->ctx, motion);
+    }
+    cJSON_AddBoolToObject(entry, "scene_moved", moved);
+    cli_json_number(entry, "scene_ms", 1e3 * (drift_time_now() - t0), 3);
+    if (r != DRIFT_OK) {
+        fprintf(stderr, "drift render: cannot pose the scene at frame %ld: %s\n", k,
+                drift_result_string(r));
+        return 1;
+    }
+    return 0;
+}
+
 static int run_frames(sequence_run *s)
 {
     const render_options *o = s->o;
@@ -220,14 +267,17 @@ static int run_frames(sequence_run *s)
         char out_path[4096];
         frame_pattern_format(o->out_path, &pattern, k, out_path, sizeof out_path);
         double time = (double)k / s->fps;
-        drift_camera cam = drift_camera_path_eval(&s->path, &base, time);
+        drift_camera cam = s->still_camera ? base : drift_camera_path_eval(&s->path, &base, time);
         cJSON *entry = cJSON_CreateObject();
         cJSON_AddItemToArray(s->frames, entry);
         cJSON_AddNumberToObject(entry, "frame", (double)k);
         cli_json_number(entry, "time", time, 6);
         cJSON_AddStringToObject(entry, "out", out_path);
         double t0 = drift_time_now();
-        int status = 0;
+        int status = s->anim ? pose_scene(s, k, time, entry) : 0;
+        if (status != 0) {
+            return status;
+        }
         if (o->hybrid_mode) {
             status = hybrid_frame(s, k, &cam, out_path, entry);
         } else {
@@ -255,29 +305,50 @@ static int run_frames(sequence_run *s)
     return 0;
 }
 
-int render_sequence(const render_options *o, const cli_session *session)
+int render_sequence(const render_options *o, cli_session *session)
 {
     drift_context *ctx = session->ctx;
     sequence_run s = { .o = o, .session = session };
     int exit_code = 1;
-    if (!o->camera_path) {
+    // A glTF scene's node animation moves its meshes and lights (src/io/scene_gltf_anim_nodes.c).
+    if (is_gltf(o->scene_path) &&
+        drift_scene_animation_from_gltf(ctx, o->scene_path, session->scene, &s.anim) != DRIFT_OK) {
+        fprintf(stderr, "drift render: cannot play the animation of %s\n", o->scene_path);
+        return 2;
+    }
+    if (s.anim && o->temporal) {
+        fprintf(stderr, "drift render: warning: --temporal follows moving objects by their "
+                        "motion vectors, but light that changes with them (their shadows, "
+                        "what they reflect) lags in the history (docs/temporal.md)\n");
+    }
+    if (!o->camera_path && s.anim && !drift_scene_animation_camera_moves(s.anim)) {
+        s.still_camera = true; // objects move, the camera stands
+        s.path.fps = o->fps > 0.0 ? o->fps : 24.0;
+    } else if (!o->camera_path) {
         // The scene's own glTF camera animation, sampled at each frame (src/io/scene_gltf_anim.c).
         s.fps = o->fps > 0.0 ? o->fps : 24.0;
         if (drift_camera_path_from_gltf(ctx, o->scene_path, NULL, s.fps, o->frame_first,
                                         o->frame_last, &s.path) != DRIFT_OK) {
             fprintf(stderr, "drift render: cannot play the camera animation of %s\n",
                     o->scene_path);
+            drift_scene_animation_destroy(s.anim);
             return 2;
         }
     } else if (drift_camera_path_load(ctx, o->camera_path, &s.path) != DRIFT_OK) {
         fprintf(stderr, "drift render: cannot read --camera-path %s\n", o->camera_path);
+        drift_scene_animation_destroy(s.anim);
         return 2;
     }
     s.fps = o->fps > 0.0 ? o->fps : s.path.fps;
     s.stats = render_stats_begin(o, session, o->hybrid_mode ? "hybrid" : "reference",
                                  (int)(o->width ? o->width : session->scene->camera.width),
                                  (int)(o->height ? o->height : session->scene->camera.height));
-    cJSON_AddStringToObject(s.stats, "camera_path", o->camera_path ? o->camera_path : "gltf");
+    cJSON_AddStringToObject(s.stats, "camera_path",
+                            o->camera_path   ? o->camera_path
+                            : s.still_camera ? "still"
+                                             : "gltf");
+    cJSON_AddNumberToObject(s.stats, "moving_meshes", drift_scene_animation_mesh_count(s.anim));
+    cJSON_AddNumberToObject(s.stats, "moving_lights", drift_scene_animation_light_count(s.anim));
     cli_json_number(s.stats, "fps", s.fps, 6);
     cJSON_AddNumberToObject(s.stats, "first_frame", (double)o->frame_first);
     cJSON_AddNumberToObject(s.stats, "last_frame", (double)o->frame_last);
@@ -347,5 +418,6 @@ done:
     drift_image_destroy(ctx, &s.glared);
     drift_hybrid_destroy(s.frame);
     drift_camera_path_free(ctx, &s.path);
+    drift_scene_animation_destroy(s.anim);
     return exit_code;
 }

@@ -313,8 +313,12 @@ typedef struct drift_gbuffer {
     drift_image material_id;      // 1: material index, -1 for a miss or a light's shape
     drift_image emission;         // 3: emitted radiance toward the camera (environment on a miss)
     drift_image motion;           // 2: pixels from here to this point in the previous frame
+                                  //    (the camera's move and its mesh's: set_mesh_motion)
     drift_surface *surfaces;      // width*height, what shading needs (material invalid = none)
     uint32_t *mesh_index;         // width*height, the mesh hit, DRIFT_INVALID_INDEX for none
+    // width*height: where this point was in the previous frame minus where it is (world
+    // space): zero unless its mesh moved (drift_hybrid_set_mesh_motion).
+    drift_vec3 *object_motion;
 } drift_gbuffer;
 
 // --- FRAME ---
@@ -390,6 +394,18 @@ void drift_hybrid_destroy(drift_hybrid *frame); // NULL-safe
 // the environment map) are kept. The size may not change.
 drift_result drift_hybrid_set_params(drift_hybrid *frame, const drift_hybrid_params *params);
 drift_hybrid_params drift_hybrid_get_params(const drift_hybrid *frame);
+// The scene's geometry or lights moved (drift_scene_animation_pose, then a new `accel` built
+// over it): every technique's per-scene state (shadow maps, probes, VPLs, scene points,
+// caches) is dropped and remade on the next frame, which is right for any change and costs a
+// frame's set-up. The light count may not change. The meshes' own motion for the motion
+// vectors is drift_hybrid_set_mesh_motion's.
+drift_result drift_hybrid_scene_changed(drift_hybrid *frame, const drift_accel *accel);
+// How each mesh moved since the previous frame, for the next drift_hybrid_render's motion
+// vectors: prev_from_now[12 m .. 12 m + 11] is the row-major 3 x 4 affine map taking mesh m's
+// points now to where they were (drift_scene_animation_motion); mesh_count must be the
+// scene's. NULL: no mesh moved. It holds for one frame (all its --aa passes).
+drift_result drift_hybrid_set_mesh_motion(drift_hybrid *frame, const float *prev_from_now,
+                                          uint32_t mesh_count);
 
 // Renders one frame seen by `camera` (its width/height are ignored: the frame's size is
 // used). Motion vectors are relative to the camera of the previous call (zero the first

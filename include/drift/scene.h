@@ -228,6 +228,9 @@ typedef struct drift_light {
     drift_spot_falloff spot_falloff;
     uint32_t mesh, triangle; // DRIFT_LIGHT_TRIANGLE only
     bool two_sided;          // DRIFT_LIGHT_TRIANGLE: emits from both faces (set by commit)
+    // The glTF node that placed it (its index in the file's `nodes`; node animation moves it:
+    // drift_scene_animation), else DRIFT_INVALID_INDEX. drift_scene_add_light sets it invalid.
+    uint32_t node;
 } drift_light;
 
 // True for lights with area (they are geometry: rays can hit them).
@@ -254,6 +257,9 @@ typedef struct drift_mesh {
     uint32_t triangle_count;
     uint32_t material;
     uint32_t first_light; // light index of triangle 0 when emissive (set by commit), else invalid
+    // The glTF node that placed it (its index in the file's `nodes`; node animation moves it:
+    // drift_scene_animation), else DRIFT_INVALID_INDEX. drift_scene_add_mesh sets it invalid.
+    uint32_t node;
 } drift_mesh;
 
 // Input for drift_scene_add_mesh; arrays are copied. normals and uvs are optional.

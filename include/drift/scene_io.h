@@ -93,6 +93,47 @@ drift_result drift_scene_load_json_text(drift_context *ctx, const char *text, si
                                         const char *base_dir, const char *name_for_messages,
                                         drift_scene **out_scene);
 
+// --- glTF NODE ANIMATION ---
+//
+// The meshes and punctual lights of a glTF scene that its animations move (docs/temporal.md,
+// "glTF animation"): node translation, rotation and scale channels, parents included, every
+// animation of the file at once. Posing the scene at time t writes each moved mesh's vertices,
+// normals and tangents (from the rest pose the file placed, kept here) and each moved light's
+// position and direction, and commits the scene again (bounds, emissive triangles' lights);
+// the caller rebuilds what copied the geometry (drift_accel, the hybrid frame's per-scene
+// state: drift_hybrid_scene_changed). Skins and morph-target weights are not played (the
+// loader warns). The camera's animation is drift_camera_path_from_gltf's.
+//
+//   drift_scene_animation *anim = NULL;
+//   drift_scene_animation_from_gltf(ctx, "anim.glb", scene, &anim);   // NULL: nothing moves
+//   bool moved; drift_scene_animation_pose(anim, frame / fps, &moved);
+//   if (moved) { rebuild the accel ... }
+typedef struct drift_scene_animation drift_scene_animation;
+
+// Reads the animations of the glTF file `path` that `scene` was loaded from (the scene's
+// meshes and lights record their nodes: drift_mesh.node). *out is NULL when no animation moves
+// one of the scene's meshes or lights. Errors: those of reading the animations (logged, with
+// the file), DRIFT_ERR_OUT_OF_MEMORY. The scene must outlive the animation.
+drift_result drift_scene_animation_from_gltf(drift_context *ctx, const char *path,
+                                             drift_scene *scene, drift_scene_animation **out);
+void drift_scene_animation_destroy(drift_scene_animation *anim); // NULL-safe
+// Poses the scene at `time` (seconds) and commits it; *out_moved (may be NULL) is whether any
+// vertex or light changed since the last pose (the load's pose first). A node at its rest
+// transform gets its rest geometry back bit for bit. Errors: a degenerate or non-finite pose
+// (zero scale), logged with the time; the scene is then left at its rest pose.
+drift_result drift_scene_animation_pose(drift_scene_animation *anim, double time, bool *out_moved);
+// How each of the scene's meshes moved between the last two poses: out[12 m .. 12 m + 11]
+// is the row-major 3 x 4 affine map taking mesh m's points now to where they were (the
+// identity for a mesh that did not move), for drift_hybrid_set_mesh_motion's motion vectors.
+// mesh_count must be the scene's.
+drift_result drift_scene_animation_motion(const drift_scene_animation *anim, float *out,
+                                          uint32_t mesh_count);
+// Whether the file's first camera is animated (drift_camera_path_from_gltf plays it).
+bool drift_scene_animation_camera_moves(const drift_scene_animation *anim);
+// How many of the scene's meshes and lights the animation moves.
+uint32_t drift_scene_animation_mesh_count(const drift_scene_animation *anim);
+uint32_t drift_scene_animation_light_count(const drift_scene_animation *anim);
+
 // --- CAMERA VIEWS ---
 //
 // A views file names cameras of one scene by what they change from its camera (the rows of

@@ -73,6 +73,11 @@ typedef struct drift_frame_state {
     uint32_t aa_pass; // this anti-aliasing pass's index (0 .. params.aa - 1)
     drift_camera camera, prev_camera;
     bool has_prev_camera;
+    // How each mesh moved since the previous frame (12 floats a mesh: a point now -> where it
+    // was), for this frame's motion vectors; NULL: none moved (drift_hybrid_set_mesh_motion).
+    float *mesh_motion;
+    uint32_t mesh_motion_capacity;
+    bool has_mesh_motion;
 
     drift_raster_light *lights;
     uint32_t light_count;

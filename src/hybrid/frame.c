@@ -254,6 +254,7 @@ void drift_hybrid_destroy(drift_hybrid *h)
     drift_raster_lights_destroy(ctx, f->lights, f->light_count);
     drift_free(ctx, f->light_buffers);
     drift_free(ctx, f->counters);
+    drift_free(ctx, f->mesh_motion);
     drift_image_destroy(ctx, &h->aa_sum);
     drift_free(ctx, h->planes);
     drift_free(ctx, h);
@@ -280,6 +281,68 @@ drift_result drift_hybrid_set_params(drift_hybrid *h, const drift_hybrid_params 
     }
     f->params = p;
     f->shading.light_samples = p.light_samples;
+    return DRIFT_OK;
+}
+
+drift_result drift_hybrid_scene_changed(drift_hybrid *h, const drift_accel *accel)
+{
+    drift_frame_state *f = &h->frame;
+    if (!accel || !f->scene->committed) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    // Every technique's state may hold the old geometry (shadow maps, probes, VPLs, points,
+    // caches): each family frees what it made and the techniques remake it on next use. The
+    // camera history (motion vectors) and the frame's buffers stay.
+    for (int i = 0; drift_family_at(i); ++i) {
+        if (drift_family_at(i)->destroy) {
+            drift_family_at(i)->destroy(f);
+        }
+    }
+    drift_pass_free_states(f);
+    drift_raster_light *lights = NULL;
+    uint32_t count = 0;
+    drift_result r = drift_raster_lights_build(f->ctx, f->scene, &lights, &count);
+    if (r != DRIFT_OK) {
+        return r;
+    }
+    if (count != f->light_count) {
+        drift_raster_lights_destroy(f->ctx, lights, count);
+        drift_log(f->ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, NULL, 0,
+                  "hybrid frame: the scene's lights changed in number (%u -> %u); make a new "
+                  "frame",
+                  f->light_count, count);
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    drift_raster_lights_destroy(f->ctx, f->lights, f->light_count);
+    f->lights = lights;
+    f->accel = accel;
+    f->shading.accel = accel;
+    f->shading.lights = lights;
+    return DRIFT_OK;
+}
+
+drift_result drift_hybrid_set_mesh_motion(drift_hybrid *h, const float *prev_from_now,
+                                          uint32_t mesh_count)
+{
+    drift_frame_state *f = &h->frame;
+    if (!prev_from_now) {
+        f->has_mesh_motion = false;
+        return DRIFT_OK;
+    }
+    if (mesh_count != f->scene->mesh_count) {
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
+    if (f->mesh_motion_capacity < mesh_count) {
+        float *grown = drift_alloc(f->ctx, sizeof(float) * 12 * (size_t)mesh_count);
+        if (!grown) {
+            return DRIFT_ERR_OUT_OF_MEMORY;
+        }
+        drift_free(f->ctx, f->mesh_motion);
+        f->mesh_motion = grown;
+        f->mesh_motion_capacity = mesh_count;
+    }
+    memcpy(f->mesh_motion, prev_from_now, sizeof(float) * 12 * (size_t)mesh_count);
+    f->has_mesh_motion = mesh_count > 0;
     return DRIFT_OK;
 }
 
@@ -547,7 +610,8 @@ static drift_result render_pass(drift_frame_state *f, const atomic_bool *cancel,
     prev.film_shift_x = f->camera.film_shift_x;
     prev.film_shift_y = f->camera.film_shift_y;
     drift_gbuffer_render(f->ctx, f->scene, f->accel, &f->camera, f->has_prev_camera ? &prev : NULL,
-                         &f->gbuffer, &f->stats.rays[DRIFT_PASS_PRIMARY]);
+                         f->has_mesh_motion ? f->mesh_motion : NULL, &f->gbuffer,
+                         &f->stats.rays[DRIFT_PASS_PRIMARY]);
     drift_pass_time(f, DRIFT_PASS_PRIMARY, t);
 
     const drift_technique_row *rows[DRIFT_EFFECT_COUNT];
@@ -641,6 +705,7 @@ drift_result drift_hybrid_render(drift_hybrid *h, const drift_camera *camera,
     f->camera.film_shift_y = camera->film_shift_y;
     f->prev_camera = f->camera;
     f->has_prev_camera = true;
+    f->has_mesh_motion = false; // one frame's
     double t_planes = drift_time_now();
     collect_planes(h, inputs);
     if (r == DRIFT_OK) {

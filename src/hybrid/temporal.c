@@ -207,7 +207,12 @@ static void accumulate_rows(size_t begin, size_t end, int thread_index, void *us
             float hist_len = 0.0f, weight = 0.0f;
             if (t->has_prev) {
                 const float *m = drift_image_pixel(&g->motion, x, y);
+                // Where the point was: the history's positions are the previous frame's.
                 drift_vec3 p = drift_image_get3(&g->position, x, y);
+                if (g->object_motion) {
+                    p = drift_vec3_add(p,
+                                       g->object_motion[(size_t)y * (size_t)g->width + (size_t)x]);
+                }
                 float qx = (float)x + m[0], qy = (float)y + m[1];
                 int32_t x0 = (int32_t)floorf(qx), y0 = (int32_t)floorf(qy);
                 float fx = qx - (float)x0, fy = qy - (float)y0;

@@ -251,7 +251,7 @@ static drift_result convert_materials(import_state *s)
 }
 
 static drift_result add_mesh(import_state *s, const struct aiMesh *mesh, const drift__mat4 *world,
-                             const char *node_name)
+                             const char *node_name, int gltf_node)
 {
     drift_context *ctx = s->ctx;
     if (!(mesh->mPrimitiveTypes & aiPrimitiveType_TRIANGLE) || mesh->mNumVertices == 0) {
@@ -371,12 +371,14 @@ static drift_result add_mesh(import_state *s, const struct aiMesh *mesh, const d
                              .vertex_count = (uint32_t)nv,
                              .triangle_count = tri_count,
                              .material = material };
-    r = drift_scene_add_mesh(s->scene, &desc, NULL);
+    uint32_t index = 0;
+    r = drift_scene_add_mesh(s->scene, &desc, &index);
     if (r != DRIFT_OK) {
         drift_log(ctx, DRIFT_LOG_ERROR, r, s->where, s->line, "mesh '%s' of '%s' is not valid",
                   name, s->params->path);
         goto done;
     }
+    s->scene->meshes[index].node = gltf_node >= 0 ? (uint32_t)gltf_node : DRIFT_INVALID_INDEX;
     s->info->mesh_count++;
 done:
     drift_free(ctx, positions);
@@ -388,7 +390,8 @@ done:
     return r;
 }
 
-static drift_result add_light(import_state *s, unsigned index, const drift__mat4 *world)
+static drift_result add_light(import_state *s, unsigned index, const drift__mat4 *world,
+                              int gltf_node)
 {
     const struct aiLight *l = s->ai->mLights[index];
     drift_light light = { 0 };
@@ -446,12 +449,14 @@ static drift_result add_light(import_state *s, unsigned index, const drift__mat4
                       s->params->path, name);
         }
     }
-    drift_result r = drift_scene_add_light(s->scene, &light, NULL);
+    uint32_t light_index = 0;
+    drift_result r = drift_scene_add_light(s->scene, &light, &light_index);
     if (r != DRIFT_OK) {
         drift_log(s->ctx, DRIFT_LOG_ERROR, r, s->where, s->line, "light '%s' of '%s' is not valid",
                   name, s->params->path);
         return r;
     }
+    s->scene->lights[light_index].node = gltf_node >= 0 ? (uint32_t)gltf_node : DRIFT_INVALID_INDEX;
     s->info->light_count++;
     return DRIFT_OK;
 }
@@ -488,8 +493,10 @@ static void set_camera(import_state *s, const struct aiCamera *cam, const drift_
     s->info->has_camera = true;
 }
 
+// gltf_node: the glTF node `node` was made from (drift__gltf_child_node), which the meshes and
+// lights it places record for node animation (drift_scene_animation).
 static drift_result walk_nodes(import_state *s, const struct aiNode *node,
-                               const drift__mat4 *parent, int depth)
+                               const drift__mat4 *parent, int depth, int gltf_node)
 {
     if (depth > DRIFT__SCENE_MAX_NODE_DEPTH) {
         drift_log(s->ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, s->where, s->line,
@@ -506,7 +513,7 @@ static drift_result walk_nodes(import_state *s, const struct aiNode *node,
         if (mi >= s->ai->mNumMeshes) {
             continue; // aiProcess_ValidateDataStructure rejects this; stay safe anyway
         }
-        drift_result r = add_mesh(s, s->ai->mMeshes[mi], &world, node_name);
+        drift_result r = add_mesh(s, s->ai->mMeshes[mi], &world, node_name, gltf_node);
         if (r != DRIFT_OK) {
             return r;
         }
@@ -520,14 +527,19 @@ static drift_result walk_nodes(import_state *s, const struct aiNode *node,
         const struct aiLight *l = s->ai->mLights[i];
         if (!s->light_placed[i] && strcmp(l->mName.data, node->mName.data) == 0) {
             s->light_placed[i] = true;
-            drift_result r = add_light(s, i, &world);
+            drift_result r = add_light(s, i, &world, gltf_node);
             if (r != DRIFT_OK) {
                 return r;
             }
         }
     }
     for (unsigned c = 0; c < node->mNumChildren; ++c) {
-        drift_result r = walk_nodes(s, node->mChildren[c], &world, depth + 1);
+        const struct aiNode *child = node->mChildren[c];
+        char child_name[DRIFT_NAME_MAX];
+        ai_name(&child->mName, child_name, sizeof(child_name));
+        int gltf_child =
+            drift__gltf_child_node(s->gltf, gltf_node, c, child_name, child->mNumChildren);
+        drift_result r = walk_nodes(s, child, &world, depth + 1, gltf_child);
         if (r != DRIFT_OK) {
             return r;
         }
@@ -554,12 +566,15 @@ static drift_result import_scene(import_state *s)
         r = convert_materials(s);
     }
     if (r == DRIFT_OK && ai->mRootNode) {
-        r = walk_nodes(s, ai->mRootNode, &root, 0);
+        char root_name[DRIFT_NAME_MAX];
+        ai_name(&ai->mRootNode->mName, root_name, sizeof(root_name));
+        int gltf_root = drift__gltf_root_node(s->gltf, root_name, ai->mRootNode->mNumChildren);
+        r = walk_nodes(s, ai->mRootNode, &root, 0, gltf_root);
     }
     // Lights no node names are in world space already.
     for (unsigned i = 0; r == DRIFT_OK && i < ai->mNumLights; ++i) {
         if (!s->light_placed[i]) {
-            r = add_light(s, i, &root);
+            r = add_light(s, i, &root, DRIFT__GLTF_NO_NODE);
         }
     }
     if (r == DRIFT_OK && s->info->mesh_count == 0) {

@@ -32,6 +32,13 @@ struct drift__gltf {
     uint8_t *bin;           // a .glb's BIN chunk (buffer 0 without a uri), or NULL
     size_t bin_size;
     char dir[DRIFT__PATH_MAX]; // the file's folder, for its buffers' files
+    // The node graph, indexed once (cJSON arrays are lists): nodes[i], the children of node i
+    // at children[child_start[i] .. child_start[i + 1]) (-1: not a node index), the scene's
+    // root nodes at roots[0 .. root_count).
+    const cJSON **nodes;
+    int node_count;
+    int *child_start, *children, *roots;
+    int root_count;
 };
 
 // The extensions this file and material_gltf.c turn into drift's quantities; any other in
@@ -86,6 +93,8 @@ static bool glb_bin(const char *data, size_t size, size_t json_length, const cha
     *out_size = length;
     return true;
 }
+
+static drift_result index_nodes(drift_context *ctx, drift__gltf *g);
 
 drift_result drift__gltf_open(drift_context *ctx, const char *path, bool gz, const char *where,
                               int line, drift__gltf **out)
@@ -199,7 +208,11 @@ drift_result drift__gltf_open(drift_context *ctx, const char *path, bool gz, con
                       name->valuestring, is_required ? " (the file marks it required)" : "");
         }
     }
-    drift__gltf_anim_check(ctx, root, path); // scene_gltf_anim.c: warns of what won't move
+    drift__gltf_anim_check(ctx, root, path); // scene_gltf_anim.c: warns of what won't play
+    if (index_nodes(ctx, g) != DRIFT_OK) {
+        drift__gltf_close(ctx, g);
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
     *out = g;
     return DRIFT_OK;
 }
@@ -209,6 +222,10 @@ void drift__gltf_close(drift_context *ctx, drift__gltf *g)
     if (g) {
         cJSON_Delete(g->root);
         drift_free(ctx, g->bin);
+        drift_free(ctx, g->nodes);
+        drift_free(ctx, g->child_start);
+        drift_free(ctx, g->children);
+        drift_free(ctx, g->roots);
         drift_free(ctx, g);
     }
 }
@@ -356,6 +373,116 @@ int drift__gltf_camera_index(const drift__gltf *g, const char *selector)
         }
     }
     return -1;
+}
+
+// `node` when it is the node assimp named `ai_name` with `ai_children` children: the same
+// number of children and, where the file names the node, the same name.
+static int matched_node(const drift__gltf *g, int node, const char *ai_name, unsigned ai_children)
+{
+    if (node < 0) {
+        return DRIFT__GLTF_NO_NODE;
+    }
+    const cJSON *name = cJSON_GetObjectItemCaseSensitive(g->nodes[node], "name");
+    unsigned count = (unsigned)(g->child_start[node + 1] - g->child_start[node]);
+    bool named = cJSON_IsString(name) && name->valuestring[0] != '\0';
+    if (count != ai_children || (named && strcmp(name->valuestring, ai_name) != 0)) {
+        return DRIFT__GLTF_NO_NODE;
+    }
+    return node;
+}
+
+// assimp 5.2 makes a scene's only root node its root, and adds a root above several.
+int drift__gltf_root_node(const drift__gltf *g, const char *ai_name, unsigned ai_children)
+{
+    if (!g || !g->nodes) {
+        return DRIFT__GLTF_NO_NODE;
+    }
+    if (g->root_count == 1) {
+        return matched_node(g, g->roots[0], ai_name, ai_children);
+    }
+    return g->root_count > 1 && (unsigned)g->root_count == ai_children ? DRIFT__GLTF_SCENE_ROOT
+                                                                       : DRIFT__GLTF_NO_NODE;
+}
+
+int drift__gltf_child_node(const drift__gltf *g, int parent, unsigned position, const char *ai_name,
+                           unsigned ai_children)
+{
+    if (!g || !g->nodes || parent == DRIFT__GLTF_NO_NODE) {
+        return DRIFT__GLTF_NO_NODE;
+    }
+    if (parent == DRIFT__GLTF_SCENE_ROOT) {
+        return position < (unsigned)g->root_count
+                   ? matched_node(g, g->roots[position], ai_name, ai_children)
+                   : DRIFT__GLTF_NO_NODE;
+    }
+    if (parent < 0 || parent >= g->node_count) {
+        return DRIFT__GLTF_NO_NODE;
+    }
+    unsigned count = (unsigned)(g->child_start[parent + 1] - g->child_start[parent]);
+    return position < count ? matched_node(g, g->children[g->child_start[parent] + (int)position],
+                                           ai_name, ai_children)
+                            : DRIFT__GLTF_NO_NODE;
+}
+
+// -1 unless v is the index of one of the file's nodes.
+static int node_index_of(const drift__gltf *g, const cJSON *v)
+{
+    double d = cJSON_IsNumber(v) ? v->valuedouble : -1.0;
+    return d >= 0.0 && d < (double)g->node_count && d == floor(d) ? (int)d : -1;
+}
+
+// Builds g's node index (the walk of drift__gltf_child_node is then linear in the nodes).
+static drift_result index_nodes(drift_context *ctx, drift__gltf *g)
+{
+    const cJSON *nodes = cJSON_GetObjectItemCaseSensitive(g->root, "nodes");
+    int n = cJSON_IsArray(nodes) ? cJSON_GetArraySize(nodes) : 0;
+    const cJSON *scenes = cJSON_GetObjectItemCaseSensitive(g->root, "scenes");
+    const cJSON *scene = cJSON_GetObjectItemCaseSensitive(g->root, "scene");
+    const cJSON *chosen = scene ? item_at(scenes, scene) : cJSON_GetArrayItem(scenes, 0);
+    const cJSON *roots = cJSON_GetObjectItemCaseSensitive(chosen, "nodes");
+    if (!cJSON_IsArray(nodes)) {
+        nodes = NULL; // no node: every count below is 0 (an object's members are no nodes)
+    }
+    if (!cJSON_IsArray(roots)) {
+        roots = NULL;
+    }
+    int total = 0, i = 0;
+    const cJSON *node, *c;
+    cJSON_ArrayForEach(node, nodes)
+    {
+        const cJSON *kids = cJSON_GetObjectItemCaseSensitive(node, "children");
+        total += cJSON_IsArray(kids) ? cJSON_GetArraySize(kids) : 0;
+    }
+    g->root_count = roots ? cJSON_GetArraySize(roots) : 0;
+    g->nodes = drift_alloc(ctx, ((size_t)n + 1) * sizeof *g->nodes);
+    g->child_start = drift_alloc(ctx, ((size_t)n + 1) * sizeof(int));
+    g->children = drift_alloc(ctx, ((size_t)total + 1) * sizeof(int));
+    g->roots = drift_alloc(ctx, ((size_t)g->root_count + 1) * sizeof(int));
+    if (!g->nodes || !g->child_start || !g->children || !g->roots) {
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    g->node_count = n;
+    int k = 0;
+    cJSON_ArrayForEach(node, nodes)
+    {
+        const cJSON *kids = cJSON_GetObjectItemCaseSensitive(node, "children");
+        if (!cJSON_IsArray(kids)) {
+            kids = NULL;
+        }
+        g->nodes[i] = node;
+        g->child_start[i++] = k;
+        cJSON_ArrayForEach(c, kids)
+        {
+            g->children[k++] = node_index_of(g, c);
+        }
+    }
+    g->child_start[n] = k;
+    k = 0;
+    cJSON_ArrayForEach(c, roots)
+    {
+        g->roots[k++] = node_index_of(g, c);
+    }
+    return DRIFT_OK;
 }
 
 // Bytes [offset, offset + length) of buffer `index`: the .glb's BIN chunk, a data URI or a file

@@ -7,9 +7,10 @@
 // as Blender's timeline plays the actions it exported; of two channels on one node and
 // property the later one wins.
 //
-// The scene loader (scene_gltf.c) calls drift__gltf_anim_check: a file whose animations move
-// nodes other than cameras gets one warning (drift renders meshes and lights at rest), a
-// malformed animation a warning naming it. Reading is in scene_gltf_anim_read.c.
+// The scene loader (scene_gltf.c) calls drift__gltf_anim_check: what drift does not play
+// (skins, morph-target weights) gets one warning each, a malformed animation a warning naming
+// it. Reading is in scene_gltf_anim_read.c; meshes and lights under moving nodes are posed by
+// scene_gltf_anim_nodes.c (drift_scene_animation).
 #include "scene_gltf_anim.h"
 
 #include "drift/camera_path.h"
@@ -132,8 +133,9 @@ static bool node_chain(const gltf_anim *a, int node, int *chain, int *length)
     return true;
 }
 
-// The world transform of chain[length - 1] at time t.
-static drift__mat4 chain_world(const gltf_anim *a, const int *chain, int length, double t)
+// The world transform of chain[length - 1] at time t (at rest: no channel applied).
+static drift__mat4 chain_world(const gltf_anim *a, const int *chain, int length, double t,
+                               bool at_rest)
 {
     drift__mat4 world = drift__mat4_identity();
     for (int i = 0; i < length; ++i) {
@@ -144,7 +146,7 @@ static drift__mat4 chain_world(const gltf_anim *a, const int *chain, int length,
             memcpy(trs[0], n->t, sizeof n->t);
             memcpy(trs[1], n->r, sizeof n->r);
             memcpy(trs[2], n->s, sizeof n->s);
-            for (int c = 0; c < a->channel_count; ++c) {
+            for (int c = 0; !at_rest && c < a->channel_count; ++c) {
                 if (a->channels[c].node == chain[i]) {
                     channel_eval(&a->channels[c], t, trs[a->channels[c].path]);
                 }
@@ -161,6 +163,72 @@ static bool node_animated(const gltf_anim *a, int node)
     for (int c = 0; c < a->channel_count; ++c) {
         if (a->channels[c].node == node) {
             return true;
+        }
+    }
+    return false;
+}
+
+bool drift__gltf_node_world(const gltf_anim *a, int node, double t, bool at_rest, drift__mat4 *out)
+{
+    int chain[DRIFT__SCENE_MAX_NODE_DEPTH], length = 0;
+    if (node < 0 || node >= a->node_count || !node_chain(a, node, chain, &length)) {
+        return false;
+    }
+    *out = chain_world(a, chain, length, t, at_rest);
+    return true;
+}
+
+bool drift__gltf_node_moves(const gltf_anim *a, int node)
+{
+    int depth = 0;
+    for (int i = node; i >= 0 && i < a->node_count && depth < DRIFT__SCENE_MAX_NODE_DEPTH;
+         i = a->nodes[i].parent, ++depth) {
+        if (node_animated(a, i)) {
+            return true;
+        }
+    }
+    return false;
+}
+
+bool *drift__gltf_moving_nodes(const gltf_anim *a)
+{
+    // 0: not known yet, 1: moves, 2: still. Each walk up stops at a known node and marks the
+    // nodes it passed, so every node is walked once.
+    uint8_t *state = drift_alloc(a->ctx, (size_t)a->node_count + 1);
+    bool *moves = drift_alloc(a->ctx, (size_t)a->node_count + 1);
+    int *path = drift_alloc(a->ctx, sizeof(int) * (DRIFT__SCENE_MAX_NODE_DEPTH + 1));
+    if (!state || !moves || !path) {
+        drift_free(a->ctx, state);
+        drift_free(a->ctx, moves);
+        drift_free(a->ctx, path);
+        return NULL;
+    }
+    memset(state, 0, (size_t)a->node_count + 1);
+    for (int c = 0; c < a->channel_count; ++c) {
+        state[a->channels[c].node] = 1;
+    }
+    for (int i = 0; i < a->node_count; ++i) {
+        int n = 0, p = i;
+        while (p >= 0 && state[p] == 0 && n < DRIFT__SCENE_MAX_NODE_DEPTH) {
+            path[n++] = p;
+            p = a->nodes[p].parent;
+        }
+        uint8_t known = p >= 0 && n < DRIFT__SCENE_MAX_NODE_DEPTH ? state[p] : 2;
+        for (int k = 0; k < n; ++k) {
+            state[path[k]] = known;
+        }
+        moves[i] = state[i] == 1;
+    }
+    drift_free(a->ctx, state);
+    drift_free(a->ctx, path);
+    return moves;
+}
+
+bool drift__gltf_camera_moves(const gltf_anim *a)
+{
+    for (int i = 0; i < a->node_count; ++i) {
+        if (a->nodes[i].camera == 0) {
+            return drift__gltf_node_moves(a, i);
         }
     }
     return false;
@@ -218,7 +286,7 @@ static drift_result camera_path(gltf_anim *a, const char *selector, double fps, 
     out->interpolation = DRIFT_CAMERA_PATH_LINEAR;
     for (uint32_t k = 0; k < keys; ++k) {
         double t = (double)(first + (long)k) / fps;
-        drift__mat4 world = chain_world(a, chain, length, t);
+        drift__mat4 world = chain_world(a, chain, length, t, false);
         drift_vec3 eye = drift__mat4_point(&world, drift_vec3_make(0.0f, 0.0f, 0.0f));
         drift_vec3 look = drift__mat4_vector(&world, drift_vec3_make(0.0f, 0.0f, -1.0f));
         drift_vec3 up = drift__mat4_vector(&world, drift_vec3_make(0.0f, 1.0f, 0.0f));
@@ -268,32 +336,22 @@ void drift__gltf_anim_check(drift_context *ctx, const cJSON *root, const char *p
         drift__gltf_anim_close(&a);
         return;
     }
-    // Nodes that move and hold no camera, nor a camera below them: drift renders them at rest.
-    bool *above_camera = drift_alloc(ctx, (size_t)a.node_count + 1);
-    int moving = 0, first = -1;
-    if (above_camera) {
-        memset(above_camera, 0, (size_t)a.node_count + 1);
-        for (int j = 0; j < a.node_count; ++j) {
-            int depth = 0;
-            for (int p = j; a.nodes[j].camera >= 0 && p >= 0 && !above_camera[p] &&
-                            depth < DRIFT__SCENE_MAX_NODE_DEPTH;
-                 p = a.nodes[p].parent, ++depth) {
-                above_camera[p] = true;
-            }
-        }
-        for (int i = 0; i < a.node_count; ++i) {
-            if (node_animated(&a, i) && !above_camera[i]) {
-                first = moving++ == 0 ? i : first;
-            }
-        }
-        drift_free(ctx, above_camera);
+    // Node transforms move cameras, meshes and lights (scene_gltf_anim_nodes.c); skins (their
+    // joints' channels) and morph-target weights are not played.
+    int skinned = 0;
+    for (int i = 0; i < a.node_count; ++i) {
+        skinned += a.nodes[i].skinned;
     }
-    if (moving > 0 || a.unsupported_channels > 0) {
+    if (a.channel_count > 0 && skinned > 0) {
         drift_log(ctx, DRIFT_LOG_WARNING, DRIFT_ERR_UNSUPPORTED, path, 0,
-                  "animation of %d node(s) that hold no camera (the first: nodes[%d]) and %d "
-                  "morph-weight channel(s) is not supported: they render at rest; "
-                  "--animation moves the camera only",
-                  moving, first, a.unsupported_channels);
+                  "%d skinned mesh node(s): skinning is not supported, they render in their "
+                  "bind pose (--animation moves whole nodes only)",
+                  skinned);
+    }
+    if (a.unsupported_channels > 0) {
+        drift_log(ctx, DRIFT_LOG_WARNING, DRIFT_ERR_UNSUPPORTED, path, 0,
+                  "%d morph-weight channel(s) are not supported: those meshes render at rest",
+                  a.unsupported_channels);
     }
     drift__gltf_anim_close(&a);
 }

@@ -1,6 +1,7 @@
 // Private to src/io/scene_gltf_anim*.c: a glTF file's nodes and animation channels, read by
-// scene_gltf_anim_read.c (buffers, accessors, nodes, channels; every range checked) and
-// evaluated by scene_gltf_anim.c (the camera's world transform at a time).
+// scene_gltf_anim_read.c (buffers, accessors, nodes, channels; every range checked),
+// evaluated by scene_gltf_anim.c (a node's world transform at a time, the camera path) and
+// played on a scene's meshes and lights by scene_gltf_anim_nodes.c.
 #ifndef DRIFT_SCENE_GLTF_ANIM_H
 #define DRIFT_SCENE_GLTF_ANIM_H
 
@@ -35,7 +36,8 @@ typedef struct anim_channel {
 typedef struct anim_node {
     int parent, camera; // -1: none
     bool has_matrix;
-    drift__mat4 matrix; // row-major (glTF's column-major `matrix`, transposed)
+    bool has_mesh, skinned; // a `mesh`; a `skin` (drift draws skinned meshes at rest)
+    drift__mat4 matrix;     // row-major (glTF's column-major `matrix`, transposed)
     float t[3], r[4], s[3];
 } anim_node;
 
@@ -65,6 +67,17 @@ typedef struct gltf_anim {
 // Errors are logged at a->level; drift__gltf_anim_close frees what it read, whatever the result.
 drift_result drift__gltf_anim_open(gltf_anim *a);
 void drift__gltf_anim_close(gltf_anim *a);
+// The world transform of nodes[node] at time t (its parents' included), or with at_rest the
+// nodes' own transforms, no channel applied (what the scene loader placed); false when its
+// parents form a cycle or are deeper than DRIFT__SCENE_MAX_NODE_DEPTH.
+bool drift__gltf_node_world(const gltf_anim *a, int node, double t, bool at_rest, drift__mat4 *out);
+// Whether a channel moves nodes[node] or one of its parents.
+bool drift__gltf_node_moves(const gltf_anim *a, int node);
+// For each node, whether a channel moves it or one of its parents (node_count entries,
+// drift_free it), in time linear in the nodes and channels; NULL when out of memory.
+bool *drift__gltf_moving_nodes(const gltf_anim *a);
+// Whether a channel moves the node of the file's first camera (or its parents).
+bool drift__gltf_camera_moves(const gltf_anim *a);
 // Normalizes a quaternion; false when it is zero or not finite.
 bool drift__quat_normalize(float q[4]);
 

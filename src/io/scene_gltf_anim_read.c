@@ -306,6 +306,8 @@ static drift_result parse_nodes(gltf_anim *a)
                         i);
         }
         d->camera = cJSON_GetObjectItemCaseSensitive(node, "camera") ? (int)camera : -1;
+        d->has_mesh = cJSON_GetObjectItemCaseSensitive(node, "mesh") != NULL;
+        d->skinned = cJSON_GetObjectItemCaseSensitive(node, "skin") != NULL;
         if (cJSON_GetObjectItemCaseSensitive(node, "matrix")) {
             d->has_matrix = true;
             for (int r = 0; r < 4; ++r) {

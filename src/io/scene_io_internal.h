@@ -207,6 +207,15 @@ bool drift__gltf_get_material(const drift__gltf *g, unsigned index, drift__gltf_
 void drift__gltf_camera_names(const drift__gltf *g, char *out, size_t out_size);
 // The index in `cameras` of the camera named `selector`, or numbered by it; -1 if none.
 int drift__gltf_camera_index(const drift__gltf *g, const char *selector);
+// Which of the file's `nodes` assimp made a node from, found by walking both graphs together:
+// the index, DRIFT__GLTF_SCENE_ROOT for the root assimp adds above a scene of several root
+// nodes, or DRIFT__GLTF_NO_NODE where the graphs part (names or child counts differ; g NULL).
+// _root for assimp's root node, _child for child `position` of a node already matched.
+#define DRIFT__GLTF_NO_NODE    (-1)
+#define DRIFT__GLTF_SCENE_ROOT (-2)
+int drift__gltf_root_node(const drift__gltf *g, const char *ai_name, unsigned ai_children);
+int drift__gltf_child_node(const drift__gltf *g, int parent, unsigned position, const char *ai_name,
+                           unsigned ai_children);
 
 // Loads a Mitsuba 0.5/0.6 scene file (.xml) with expat (scene_mitsuba.c); on_input as for
 // drift_scene_load_inputs.

@@ -31,7 +31,9 @@ drift_result drift_gbuffer_create(drift_context *ctx, int32_t width, int32_t hei
         size_t count = (size_t)width * (size_t)height;
         out->surfaces = drift_alloc(ctx, sizeof(drift_surface) * count);
         out->mesh_index = drift_alloc(ctx, sizeof(uint32_t) * count);
-        r = out->surfaces && out->mesh_index ? DRIFT_OK : DRIFT_ERR_OUT_OF_MEMORY;
+        out->object_motion = drift_alloc(ctx, sizeof(drift_vec3) * count);
+        r = out->surfaces && out->mesh_index && out->object_motion ? DRIFT_OK
+                                                                   : DRIFT_ERR_OUT_OF_MEMORY;
     }
     if (r != DRIFT_OK) {
         drift_gbuffer_destroy(ctx, out);
@@ -46,8 +48,10 @@ void drift_gbuffer_destroy(drift_context *ctx, drift_gbuffer *gbuffer)
 #undef DESTROY_PLANE
     drift_free(ctx, gbuffer->surfaces);
     drift_free(ctx, gbuffer->mesh_index);
+    drift_free(ctx, gbuffer->object_motion);
     gbuffer->surfaces = NULL;
     gbuffer->mesh_index = NULL;
+    gbuffer->object_motion = NULL;
 }
 
 typedef struct gbuffer_job {
@@ -56,6 +60,7 @@ typedef struct gbuffer_job {
     drift_camera_frame camera; // pinhole: the G-buffer samples no lens
     drift_camera_frame prev_camera;
     bool has_prev_camera;
+    const float *mesh_motion; // 12 floats a mesh (a point now -> where it was), or NULL
     drift_gbuffer *gbuffer;
     int32_t tiles_x;
     const drift_vec3 *gloss; // per material: the same for every pixel, so made once a frame
@@ -80,6 +85,7 @@ static void write_pixel(const gbuffer_job *job, int32_t x, int32_t y, const drif
     drift_surface *surface = &g->surfaces[index];
     g->mesh_index[index] = hit->mesh;
     drift_vec3 zero = drift_vec3_splat(0.0f);
+    g->object_motion[index] = zero;
     if (hit->mesh == DRIFT_INVALID_INDEX && hit->light == DRIFT_INVALID_INDEX) {
         *surface = (drift_surface){ .material = DRIFT_INVALID_INDEX,
                                     .light = DRIFT_INVALID_INDEX,
@@ -126,8 +132,16 @@ static void write_pixel(const gbuffer_job *job, int32_t x, int32_t y, const drif
     drift_image_pixel(&g->material_id, x, y)[0] = material_id;
     drift_vec2 prev;
     float *motion = drift_image_pixel(&g->motion, x, y);
-    if (job->has_prev_camera &&
-        drift_camera_frame_project(&job->prev_camera, surface->position, &prev)) {
+    drift_vec3 was = surface->position;
+    if (job->mesh_motion && hit->mesh != DRIFT_INVALID_INDEX) {
+        const float *a = job->mesh_motion + 12 * (size_t)hit->mesh;
+        drift_vec3 p = surface->position;
+        was = drift_vec3_make(a[0] * p.x + a[1] * p.y + a[2] * p.z + a[3],
+                              a[4] * p.x + a[5] * p.y + a[6] * p.z + a[7],
+                              a[8] * p.x + a[9] * p.y + a[10] * p.z + a[11]);
+        g->object_motion[index] = drift_vec3_sub(was, p);
+    }
+    if (job->has_prev_camera && drift_camera_frame_project(&job->prev_camera, was, &prev)) {
         motion[0] = prev.x - ((float)x + 0.5f);
         motion[1] = prev.y - ((float)y + 0.5f);
     } else {
@@ -173,7 +187,7 @@ static void render_tiles(size_t begin, size_t end, int thread_index, void *user)
 
 void drift_gbuffer_render(drift_context *ctx, const drift_scene *scene, const drift_accel *accel,
                           const drift_camera *camera, const drift_camera *prev_camera,
-                          drift_gbuffer *gbuffer, uint64_t *rays)
+                          const float *mesh_motion, drift_gbuffer *gbuffer, uint64_t *rays)
 {
     drift_camera pinhole = *camera;
     pinhole.aperture_radius = 0.0f;
@@ -182,6 +196,7 @@ void drift_gbuffer_render(drift_context *ctx, const drift_scene *scene, const dr
         .accel = accel,
         .camera = drift_camera_frame_make(&pinhole, gbuffer->width, gbuffer->height),
         .has_prev_camera = prev_camera != NULL,
+        .mesh_motion = mesh_motion,
         .gbuffer = gbuffer,
         .tiles_x = (gbuffer->width + TILE - 1) / TILE,
     };

@@ -155,6 +155,7 @@ static drift_result mesh_light(drift_context *ctx, const drift_scene *scene, uin
     // A closed emitter has no mean normal: treat it as emitting all around.
     float normal_length = drift_vec3_length(normal);
     out->one_sided = normal_length > 0.5f * (float)total;
+    out->two_sided = scene->lights[m->first_light].two_sided; // one material: all or none
     out->direction =
         out->one_sided ? drift_vec3_scale(normal, 1.0f / normal_length) : drift_vec3_splat(0.0f);
     for (uint32_t v = 0; v < m->vertex_count; ++v) {

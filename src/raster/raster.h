@@ -12,10 +12,12 @@ drift_result drift_gbuffer_create(drift_context *ctx, int32_t width, int32_t hei
 void drift_gbuffer_destroy(drift_context *ctx, drift_gbuffer *gbuffer);
 
 // Fills every plane from one pinhole ray through each pixel centre of `camera` (coherent
-// packets, one tile at a time). prev_camera (NULL: none) sets the motion plane.
+// packets, one tile at a time). prev_camera (NULL: none) sets the motion plane, with
+// mesh_motion (NULL: no mesh moved; else 12 floats a scene mesh, the affine map from a point
+// now to where it was: drift_hybrid_set_mesh_motion) for the points of moving meshes.
 void drift_gbuffer_render(drift_context *ctx, const drift_scene *scene, const drift_accel *accel,
                           const drift_camera *camera, const drift_camera *prev_camera,
-                          drift_gbuffer *gbuffer, uint64_t *rays);
+                          const float *mesh_motion, drift_gbuffer *gbuffer, uint64_t *rays);
 
 // Whether pixels a and b (indices y * width + x) lie on one surface as an image-space filter
 // sees it: the same mesh, shading normals within ~25 degrees (a thin part of an object in
@@ -39,7 +41,10 @@ typedef struct drift_raster_light {
                             // and mesh: the (mean) normal light leaves along; else zero
     float radius;           // light size L: 0 for point, spot and directional lights; for
                             // area lights the radius of a bounding sphere about `centre`
-    bool one_sided;         // emits only into the hemisphere around `direction`
+    bool one_sided;         // has a mean normal `direction` and emits only into the hemisphere
+                            // around it, unless two_sided
+    bool two_sided;         // an emissive mesh that emits from both faces (glTF doubleSided, as
+                            // Cycles): points behind its plane are lit too
     uint32_t first_light;   // the scene lights it stands for: first_light ..
     uint32_t light_count;   //   first_light + light_count - 1 (1 unless a mesh)
     uint32_t mesh;          // the emissive mesh, or DRIFT_INVALID_INDEX

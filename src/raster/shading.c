@@ -244,8 +244,9 @@ static drift_vec3 polygon_diffuse(const drift_scene *scene, const drift_raster_l
         }
         drift_vec3 polygon[4], normal;
         int count = light_polygon(scene, l, polygon, &normal);
-        if (drift_vec3_dot(drift_vec3_sub(surface->position, polygon[0]), normal) <= 0.0f) {
-            continue; // behind the emitting side
+        float side = drift_vec3_dot(drift_vec3_sub(surface->position, polygon[0]), normal);
+        if (!(side > 0.0f || (l->two_sided && side < 0.0f))) {
+            continue; // behind the emitting side (or in its plane)
         }
         float e = polygon_irradiance(surface->position, n, polygon, count);
         sum = drift_vec3_fma(sum, l->color, e);
@@ -264,11 +265,11 @@ static drift_vec3 polygon_diffuse(const drift_scene *scene, const drift_raster_l
 // scalar polygon_irradiance afterwards.
 
 // E of a unit-radiance polygon of M corners (v, its emitting normal en) at receivers i: e[i],
-// 0 behind its emitting side or below the horizon; straddles[i] = 1 where the horizon cuts it
-// (e[i] is then to be computed with the clip).
+// 0 behind its emitting side (unless two_sided: both sides emit) or below the horizon;
+// straddles[i] = 1 where the horizon cuts it (e[i] is then to be computed with the clip).
 static inline DRIFT_ALWAYS_INLINE void
-polygon_irradiance_rows(const float (*v)[3], const int m, drift_vec3 en, int32_t count,
-                        const float *restrict px, const float *restrict py,
+polygon_irradiance_rows(const float (*v)[3], const int m, drift_vec3 en, bool two_sided,
+                        int32_t count, const float *restrict px, const float *restrict py,
                         const float *restrict pz, const float *restrict nx,
                         const float *restrict ny, const float *restrict nz, float *restrict e,
                         int32_t *restrict straddles)
@@ -299,26 +300,26 @@ polygon_irradiance_rows(const float (*v)[3], const int m, drift_vec3 en, int32_t
             sum += length > 1e-12f ? t : 0.0f;
         }
         float side = (px[i] - v[0][0]) * en.x + (py[i] - v[0][1]) * en.y + (pz[i] - v[0][2]) * en.z;
-        bool lit = side > 0.0f;
+        bool lit = (side > 0.0f) | (two_sided & (side < 0.0f));
         e[i] = (lit & above) ? 0.5f * fabsf(sum) : 0.0f;
         straddles[i] = lit & !above & !below;
     }
 }
 
-DRIFT_AVX2_CLONES static void triangle_rows(const float (*v)[3], drift_vec3 en, int32_t count,
-                                            const float *px, const float *py, const float *pz,
-                                            const float *nx, const float *ny, const float *nz,
-                                            float *e, int32_t *straddles)
+DRIFT_AVX2_CLONES static void triangle_rows(const float (*v)[3], drift_vec3 en, bool two_sided,
+                                            int32_t count, const float *px, const float *py,
+                                            const float *pz, const float *nx, const float *ny,
+                                            const float *nz, float *e, int32_t *straddles)
 {
-    polygon_irradiance_rows(v, 3, en, count, px, py, pz, nx, ny, nz, e, straddles);
+    polygon_irradiance_rows(v, 3, en, two_sided, count, px, py, pz, nx, ny, nz, e, straddles);
 }
 
-DRIFT_AVX2_CLONES static void quad_rows(const float (*v)[3], drift_vec3 en, int32_t count,
-                                        const float *px, const float *py, const float *pz,
-                                        const float *nx, const float *ny, const float *nz, float *e,
-                                        int32_t *straddles)
+DRIFT_AVX2_CLONES static void quad_rows(const float (*v)[3], drift_vec3 en, bool two_sided,
+                                        int32_t count, const float *px, const float *py,
+                                        const float *pz, const float *nx, const float *ny,
+                                        const float *nz, float *e, int32_t *straddles)
 {
-    polygon_irradiance_rows(v, 4, en, count, px, py, pz, nx, ny, nz, e, straddles);
+    polygon_irradiance_rows(v, 4, en, two_sided, count, px, py, pz, nx, ny, nz, e, straddles);
 }
 
 bool drift_raster_has_polygon_rows(const drift_raster_light *light)
@@ -344,8 +345,9 @@ void drift_raster_polygon_rows(const drift_scene *scene, const drift_raster_ligh
         for (int k = 0; k < m; ++k) {
             v[k][0] = polygon[k].x, v[k][1] = polygon[k].y, v[k][2] = polygon[k].z;
         }
-        (m == 4 ? quad_rows : triangle_rows)((const float(*)[3])v, normal, count, rs->px, rs->py,
-                                             rs->pz, rs->nx, rs->ny, rs->nz, e, straddles);
+        (m == 4 ? quad_rows : triangle_rows)((const float(*)[3])v, normal, l->two_sided, count,
+                                             rs->px, rs->py, rs->pz, rs->nx, rs->ny, rs->nz, e,
+                                             straddles);
         for (int32_t i = 0; i < count; ++i) {
             if (straddles[i]) {
                 e[i] = polygon_irradiance(drift_vec3_make(rs->px[i], rs->py[i], rs->pz[i]),

@@ -291,14 +291,15 @@ static drift_result validate(drift_context *ctx, const drift_scene *scene, const
     return DRIFT_OK;
 }
 
-// Picks the faces to store (all but those behind a one-sided light).
+// Picks the faces to store (all but those behind a one-sided light; a two-sided one lights
+// both half-spaces).
 static void choose_faces(drift_shadow_map *map, const drift_raster_light *light,
                          int face_of_slot[CUBE_FACES])
 {
     map->slot_count = 0;
     for (int f = 0; f < CUBE_FACES; ++f) {
         map->face_slot[f] = -1;
-        if (!light->one_sided || face_faces(f, light->direction)) {
+        if (!light->one_sided || light->two_sided || face_faces(f, light->direction)) {
             face_of_slot[map->slot_count] = f;
             map->face_slot[f] = (int8_t)map->slot_count++;
         }

@@ -144,7 +144,8 @@ drift_result drift_scene_add_mesh(drift_scene *scene, const drift_mesh_desc *des
 
     drift_mesh mesh = { .vertex_count = desc->vertex_count,
                         .material = desc->material,
-                        .first_light = DRIFT_INVALID_INDEX };
+                        .first_light = DRIFT_INVALID_INDEX,
+                        .node = DRIFT_INVALID_INDEX };
     snprintf(mesh.name, sizeof(mesh.name), "%s", name);
     // One padding float: Embree reads 16 bytes for the last vertex (buffer_padding.md).
     mesh.positions = copy_array(ctx, desc->positions, (size_t)desc->vertex_count * 3, sizeof(float),
@@ -356,6 +357,7 @@ drift_result drift_scene_add_light(drift_scene *scene, const drift_light *light,
         return r;
     }
     scene->lights[index] = l;
+    scene->lights[index].node = DRIFT_INVALID_INDEX; // the glTF importer sets it after
     scene->committed = false;
     if (out_index) {
         *out_index = index;
@@ -651,7 +653,8 @@ drift_result drift_scene_commit(drift_scene *scene)
                                                   .color = triangle_emission(scene, mat, m, t),
                                                   .mesh = m,
                                                   .triangle = t,
-                                                  .two_sided = mat->emission_two_sided };
+                                                  .two_sided = mat->emission_two_sided,
+                                                  .node = mesh->node };
         }
     }
     drift_result r = drift__texture_pyramids_build(scene);

@@ -351,15 +351,16 @@ static void light_corners(const drift_scene *scene, const drift_raster_light *li
         out->corner[2] = drift_vec3_add(drift_vec3_add(l->position, l->edge_u), l->edge_v);
         out->corner[3] = drift_vec3_add(l->position, l->edge_v);
         out->count = 4;
-        out->planar = light->one_sided;
+        out->planar = light->one_sided && !light->two_sided;
         return;
     }
     if (l->type != DRIFT_LIGHT_TRIANGLE || 3u * light->light_count > MAX_CORNERS) {
         return;
     }
     // Triangle lights (one, or a small emissive mesh): every vertex; planar when each
-    // triangle faces the mean normal (then the back of the plane gets no light).
-    bool planar = light->one_sided;
+    // triangle faces the mean normal (then the back of the plane gets no light, unless the
+    // mesh emits from both faces).
+    bool planar = light->one_sided && !light->two_sided;
     for (uint32_t t = 0; t < light->light_count; ++t) {
         drift_vec3 *c = out->corner + 3u * t;
         drift_light_triangle_vertices(scene, &scene->lights[light->first_light + t], &c[0], &c[1],

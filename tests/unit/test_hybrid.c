@@ -560,8 +560,13 @@ int main(void)
         cmocka_unit_test(test_environment_filter_beats_two_rays),
         cmocka_unit_test(test_environment_scale_two_carries_the_light),
         cmocka_unit_test(test_constant_sky_is_exact_with_one_sample),
+        cmocka_unit_test(test_two_sided_mesh_light_closed_form),
+        cmocka_unit_test(test_two_sided_emitter_lights_hybrid_frame),
         cmocka_unit_test(test_technique_names_round_trip),
         cmocka_unit_test(test_rejects_bad_params),
     };
+    if (getenv("DRIFT_TEST_FILTER")) {
+        cmocka_set_test_filter(getenv("DRIFT_TEST_FILTER")); // e.g. "test_two_sided*"
+    }
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

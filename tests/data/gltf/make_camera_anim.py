@@ -9,7 +9,9 @@ Every file holds a floor quad, a tilted quad and a camera; its buffer is one bas
                        rotation STEP (identity, then 90 degrees about +y from 0.5 s)
   camera_step_cubic.glb  the same as a binary glTF (its buffer in the BIN chunk)
   mesh_anim.gltf       camera_linear plus a translation channel on the tilted quad's node
-                       (not supported: the loader warns once)
+                       (the wall rises (0, 0, 0) -> (0, 1, 0) over 1 s, LINEAR)
+  mesh_moved.gltf      camera_linear with the wall standing where mesh_anim.gltf's is at
+                       t = 0.5 s (translation (0, 0.5, 0)), no animation of it: the static twin
 The unit test computes the same cameras in closed form from the numbers below.
 """
 import base64
@@ -74,6 +76,8 @@ def scene(kind):
                  {"name": "wall", "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.2, 0.1, 1],
                                                            "metallicFactor": 0}}]
     nodes = [{"name": "floor", "mesh": 0}, {"name": "wall", "mesh": 1}]
+    if kind == "mesh_moved":
+        nodes[1]["translation"] = [0, 0.5, 0]
     samplers, channels = [], []
 
     def channel(node, path, times, values, type_, interp):
@@ -82,7 +86,7 @@ def scene(kind):
         samplers.append({"input": t, "output": v, "interpolation": interp})
         channels.append({"sampler": len(samplers) - 1, "target": {"node": node, "path": path}})
 
-    if kind in ("linear", "mesh"):
+    if kind in ("linear", "mesh", "mesh_moved"):
         nodes.append({"name": "rig", "children": [3]})
         nodes.append({"name": "Camera", "camera": 0, "translation": [0, 1, 5]})
         channel(2, "rotation", [0.0, 1.0], quat_y(0) + quat_y(90), "VEC4", "LINEAR")
@@ -131,7 +135,7 @@ def write_glb(gltf, path):
 
 write_glb(scene("step_cubic"), "camera_step_cubic.glb")
 for name, kind in (("camera_linear", "linear"), ("camera_step_cubic", "step_cubic"),
-                   ("mesh_anim", "mesh")):
+                   ("mesh_anim", "mesh"), ("mesh_moved", "mesh_moved")):
     with open(name + ".gltf", "w") as f:
         json.dump(scene(kind), f, indent=1)
         f.write("\n")

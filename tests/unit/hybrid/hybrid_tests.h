@@ -29,5 +29,7 @@ void test_environment_interleave_beats_equal_rays(void **state);
 void test_environment_filter_beats_two_rays(void **state);
 void test_environment_scale_two_carries_the_light(void **state);
 void test_constant_sky_is_exact_with_one_sample(void **state);
+void test_two_sided_mesh_light_closed_form(void **state);
+void test_two_sided_emitter_lights_hybrid_frame(void **state);
 
 #endif
