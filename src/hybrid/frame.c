@@ -290,15 +290,6 @@ drift_result drift_hybrid_scene_changed(drift_hybrid *h, const drift_accel *acce
     if (!accel || !f->scene->committed) {
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
-    // Every technique's state may hold the old geometry (shadow maps, probes, VPLs, points,
-    // caches): each family frees what it made and the techniques remake it on next use. The
-    // camera history (motion vectors) and the frame's buffers stay.
-    for (int i = 0; drift_family_at(i); ++i) {
-        if (drift_family_at(i)->destroy) {
-            drift_family_at(i)->destroy(f);
-        }
-    }
-    drift_pass_free_states(f);
     drift_raster_light *lights = NULL;
     uint32_t count = 0;
     drift_result r = drift_raster_lights_build(f->ctx, f->scene, &lights, &count);
@@ -313,12 +304,30 @@ drift_result drift_hybrid_scene_changed(drift_hybrid *h, const drift_accel *acce
                   f->light_count, count);
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
+    // Every technique's state may hold the old geometry (shadow maps, probes, VPLs, points,
+    // caches): each family frees its slot and makes it anew over the new lights, and the
+    // techniques remake their caches on next use. The camera history (motion vectors) and the
+    // frame's buffers stay.
+    for (int i = 0; drift_family_at(i); ++i) {
+        const drift_family *family = drift_family_at(i);
+        if (family->destroy) {
+            family->destroy(f, f->family_state[family->slot]);
+        }
+        f->family_state[family->slot] = NULL;
+    }
+    drift_pass_free_states(f);
     drift_raster_lights_destroy(f->ctx, f->lights, f->light_count);
     f->lights = lights;
     f->accel = accel;
     f->shading.accel = accel;
     f->shading.lights = lights;
-    return DRIFT_OK;
+    for (int i = 0; r == DRIFT_OK && drift_family_at(i); ++i) {
+        const drift_family *family = drift_family_at(i);
+        if (family->create) {
+            r = family->create(f, &f->family_state[family->slot]);
+        }
+    }
+    return r;
 }
 
 drift_result drift_hybrid_set_mesh_motion(drift_hybrid *h, const float *prev_from_now,
