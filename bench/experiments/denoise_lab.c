@@ -186,6 +186,11 @@ int main(int argc, char **argv)
         fp.sigma_luminance_indirect = getenv("SIGLI") ? (float)atof(getenv("SIGLI")) : 0.0f;
         fp.iterations = getenv("ITER") ? atoi(getenv("ITER")) : 0;
         fp.no_firefly_clamp = getenv("NOFF") != NULL;
+        // INDVG=1: the rest filtered VARIANCE_GUIDED (session 2's filter); RESSIG: the
+        // residual's sigma_l; METHOD: the params' method (0 1 2).
+        fp.indirect_variance_guided = getenv("INDVG") != NULL;
+        fp.sigma_luminance_residual = getenv("RESSIG") ? (float)atof(getenv("RESSIG")) : 0.0f;
+        fp.method = getenv("METHOD") ? (drift_denoise_method)atoi(getenv("METHOD")) : 0;
         drift_denoise_feature(ctx, &in, &fp, &out, NULL);
         double ms = 1e3 * (drift_time_now() - t0);
         double fo = flip(ctx, &ref, &out);
