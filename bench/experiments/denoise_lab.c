@@ -186,6 +186,9 @@ int main(int argc, char **argv)
         fp.sigma_luminance_indirect = getenv("SIGLI") ? (float)atof(getenv("SIGLI")) : 0.0f;
         fp.iterations = getenv("ITER") ? atoi(getenv("ITER")) : 0;
         fp.no_firefly_clamp = getenv("NOFF") != NULL;
+        fp.sigma_albedo = getenv("SIGA") ? (float)atof(getenv("SIGA")) : 0.0f;
+        fp.sigma_normal = getenv("SIGN") ? (float)atof(getenv("SIGN")) : 0.0f;
+        fp.sigma_depth = getenv("SIGZ") ? (float)atof(getenv("SIGZ")) : 0.0f;
         // INDVG=1: the rest filtered VARIANCE_GUIDED (session 2's filter); RESSIG: the
         // residual's sigma_l; METHOD: the params' method (0 1 2).
         fp.indirect_variance_guided = getenv("INDVG") != NULL;

@@ -131,9 +131,9 @@ typedef enum drift_denoise_method {
 
 typedef struct drift_denoise_feature_params {
     drift_denoise_method method;
-    int32_t iterations;             // 0 -> 5 (variance-guided passes); at most 10
+    int32_t iterations;             // 0 -> 4 (variance-guided passes); at most 10
     float sigma_luminance;          // 0 -> 4 (SVGF's sigma_l)
-    float sigma_luminance_direct;   // 0 -> 3: sigma_l of the direct part when it is apart
+    float sigma_luminance_direct;   // 0 -> 4: sigma_l of the direct part when it is apart
     float sigma_luminance_indirect; // 0 -> 8: sigma_l of the rest when the direct part is apart
                                     // and filtered VARIANCE_GUIDED (indirect_variance_guided)
     float sigma_luminance_residual; // 0 -> 32: sigma_l of REGRESSION_RESIDUAL's second step

@@ -10,13 +10,13 @@ drift_denoise_feature_params_resolve(const drift_denoise_feature_params *params)
 {
     drift_denoise_feature_params p = params ? *params : (drift_denoise_feature_params){ 0 };
     if (p.iterations == 0) {
-        p.iterations = 5;
+        p.iterations = 4;
     }
     if (p.sigma_luminance == 0.0f) {
         p.sigma_luminance = 4.0f;
     }
     if (p.sigma_luminance_direct == 0.0f) {
-        p.sigma_luminance_direct = 3.0f;
+        p.sigma_luminance_direct = 4.0f;
     }
     if (p.sigma_luminance_indirect == 0.0f) {
         p.sigma_luminance_indirect = 8.0f;
