@@ -193,6 +193,7 @@ int main(int argc, char **argv)
         // residual's sigma_l; METHOD: the params' method (0 1 2).
         fp.indirect_variance_guided = getenv("INDVG") != NULL;
         fp.sigma_luminance_residual = getenv("RESSIG") ? (float)atof(getenv("RESSIG")) : 0.0f;
+        fp.residual_block = getenv("RESBLOCK") ? atoi(getenv("RESBLOCK")) : 0;
         fp.method = getenv("METHOD") ? (drift_denoise_method)atoi(getenv("METHOD")) : 0;
         drift_denoise_feature(ctx, &in, &fp, &out, NULL);
         double ms = 1e3 * (drift_time_now() - t0);

@@ -109,10 +109,10 @@ drift_result drift_denoise_atrous(drift_context *ctx, const drift_image *color,
 //        in 32x32 blocks, overlapping by half and blended with tent weights, the
 //        irradiance is fitted per channel by least squares (ridge 1e-3) to the features
 //        1, normal, depth, depth^2, x, y, x^2, y^2 (scaled to [-1, 1] in the block)
-//      REGRESSION_RESIDUAL  REGRESSION's fit, plus the residual (irradiance - fit) filtered
-//        VARIANCE_GUIDED with sigma_luminance_residual: the fit carries the smooth light the
-//        luminance weight would break into blotches at few samples, the residual filter
-//        the detail a low-order fit cannot follow
+//      REGRESSION_RESIDUAL  REGRESSION's fit (in residual_block blocks), plus the residual
+//        (irradiance - fit) filtered VARIANCE_GUIDED with sigma_luminance_residual: the fit
+//        carries the smooth light the luminance weight would break into blotches at few
+//        samples, the residual filter the detail a low-order fit cannot follow
 //   6. remodulate: times the albedo divisor again; clamped to >= 0
 // With the direct part given (drift_denoise_inputs.direct), stages 1-6 run on the direct part
 // and on the rest apart, and the two are summed: the direct part by `method`
@@ -137,6 +137,8 @@ typedef struct drift_denoise_feature_params {
     float sigma_luminance_indirect; // 0 -> 8: sigma_l of the rest when the direct part is apart
                                     // and filtered VARIANCE_GUIDED (indirect_variance_guided)
     float sigma_luminance_residual; // 0 -> 32: sigma_l of REGRESSION_RESIDUAL's second step
+    int32_t residual_block;         // 0 -> 64 px below 16 spp, 32 from 16: REGRESSION_RESIDUAL's
+                                    // blocks (even, 8..128)
     bool indirect_variance_guided;  // true: the rest as the direct part, VARIANCE_GUIDED alone
     float sigma_normal;             // 0 -> 128
     float sigma_depth;              // 0 -> 0.1

@@ -197,7 +197,11 @@ static drift_result regression_residual(denoise_frame *f, float *out)
     if (!fit) {
         return DRIFT_ERR_OUT_OF_MEMORY;
     }
-    drift_result r = denoise_regression(f, fit);
+    int32_t block = f->params.residual_block;
+    if (block == 0) { // larger blocks average more noise; at 16 spp they lose detail
+        block = f->sample_count < 16 ? 64 : 32;
+    }
+    drift_result r = denoise_regression(f, block, fit);
     if (r == DRIFT_OK) {
         for (size_t i = 0; i < 3 * f->pixels; ++i) {
             f->irr[i] -= fit[i];
@@ -242,10 +246,12 @@ static drift_result denoise_one(drift_context *ctx, const drift_denoise_inputs *
         (unsigned)p.method >= DRIFT_DENOISE_METHOD_COUNT || p.iterations < 1 || p.iterations > 10 ||
         !(p.sigma_luminance > 0.0f) || !(p.sigma_luminance_direct > 0.0f) ||
         !(p.sigma_luminance_indirect > 0.0f) || !(p.sigma_luminance_residual > 0.0f) ||
-        !(p.sigma_normal > 0.0f) || !(p.sigma_depth > 0.0f) || !(p.sigma_albedo > 0.0f)) {
+        p.residual_block < 0 || p.residual_block > 128 || p.residual_block % 2 ||
+        (p.residual_block > 0 && p.residual_block < 8) || !(p.sigma_normal > 0.0f) ||
+        !(p.sigma_depth > 0.0f) || !(p.sigma_albedo > 0.0f)) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, NULL, 0,
                   "denoise: the colour must be RGB, every guide of its size and the params in "
-                  "range (iterations 1..10, sigmas > 0)");
+                  "range (iterations 1..10, sigmas > 0, residual_block 0 or even 8..128)");
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
     denoise_frame f = { .ctx = ctx,
@@ -290,7 +296,7 @@ static drift_result denoise_one(drift_context *ctx, const drift_denoise_inputs *
         box_moments(&f, 2, scratch, scratch + f.pixels, sums, sums + f.pixels);
         clamp_count = clamp_fireflies(&f, scratch, scratch + f.pixels);
     }
-    r = p.method == DRIFT_DENOISE_REGRESSION            ? denoise_regression(&f, scratch)
+    r = p.method == DRIFT_DENOISE_REGRESSION            ? denoise_regression(&f, 32, scratch)
         : p.method == DRIFT_DENOISE_REGRESSION_RESIDUAL ? regression_residual(&f, scratch)
                                                         : denoise_variance_guided(&f, scratch);
     if (r == DRIFT_OK) {

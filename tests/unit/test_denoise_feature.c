@@ -307,7 +307,9 @@ static void test_denoise_feature_rejects_bad_arguments(void **state)
     in = inputs_of(&v, 1);
     drift_denoise_feature_params bad = { .iterations = 11 };
     assert_int_equal(drift_denoise_feature(ctx, &in, &bad, &out, NULL), DRIFT_ERR_INVALID_ARGUMENT);
-    assert_int_equal(capture.errors, 2);
+    bad = (drift_denoise_feature_params){ .residual_block = 7 }; // odd: no half-block origin
+    assert_int_equal(drift_denoise_feature(ctx, &in, &bad, &out, NULL), DRIFT_ERR_INVALID_ARGUMENT);
+    assert_int_equal(capture.errors, 3);
     drift_image_destroy(ctx, &small);
     destroy_synthetic(ctx, &v);
     drift_context_destroy(ctx);
