@@ -136,7 +136,8 @@ typedef struct drift_denoise_feature_params {
     float sigma_luminance_direct;   // 0 -> 4: sigma_l of the direct part when it is apart
     float sigma_luminance_indirect; // 0 -> 8: sigma_l of the rest when the direct part is apart
                                     // and filtered VARIANCE_GUIDED (indirect_variance_guided)
-    float sigma_luminance_residual; // 0 -> 32: sigma_l of REGRESSION_RESIDUAL's second step
+    float sigma_luminance_residual; // 0 -> 64 below 16 spp, 32 from 16: sigma_l of
+                                    // REGRESSION_RESIDUAL's second step
     int32_t residual_block;         // 0 -> 64 px below 16 spp, 32 from 16: REGRESSION_RESIDUAL's
                                     // blocks (even, 8..128)
     bool indirect_variance_guided;  // true: the rest as the direct part, VARIANCE_GUIDED alone

@@ -21,9 +21,6 @@ drift_denoise_feature_params_resolve(const drift_denoise_feature_params *params)
     if (p.sigma_luminance_indirect == 0.0f) {
         p.sigma_luminance_indirect = 8.0f;
     }
-    if (p.sigma_luminance_residual == 0.0f) {
-        p.sigma_luminance_residual = 32.0f;
-    }
     if (p.sigma_normal == 0.0f) {
         p.sigma_normal = 128.0f;
     }
@@ -206,7 +203,8 @@ static drift_result regression_residual(denoise_frame *f, float *out)
         for (size_t i = 0; i < 3 * f->pixels; ++i) {
             f->irr[i] -= fit[i];
         }
-        f->params.sigma_luminance = f->params.sigma_luminance_residual;
+        float sigma = f->params.sigma_luminance_residual; // 0: by the spp, as the blocks
+        f->params.sigma_luminance = sigma > 0.0f ? sigma : f->sample_count < 16 ? 64.0f : 32.0f;
         r = denoise_variance_guided(f, out);
     }
     for (size_t i = 0; r == DRIFT_OK && i < 3 * f->pixels; ++i) {
@@ -245,7 +243,7 @@ static drift_result denoise_one(drift_context *ctx, const drift_denoise_inputs *
         !same_size(c, in->depth, 1) || !same_size(c, in->variance, 1) ||
         (unsigned)p.method >= DRIFT_DENOISE_METHOD_COUNT || p.iterations < 1 || p.iterations > 10 ||
         !(p.sigma_luminance > 0.0f) || !(p.sigma_luminance_direct > 0.0f) ||
-        !(p.sigma_luminance_indirect > 0.0f) || !(p.sigma_luminance_residual > 0.0f) ||
+        !(p.sigma_luminance_indirect > 0.0f) || !(p.sigma_luminance_residual >= 0.0f) ||
         p.residual_block < 0 || p.residual_block > 128 || p.residual_block % 2 ||
         (p.residual_block > 0 && p.residual_block < 8) || !(p.sigma_normal > 0.0f) ||
         !(p.sigma_depth > 0.0f) || !(p.sigma_albedo > 0.0f)) {
