@@ -81,28 +81,29 @@ static int dump(drift_context *ctx, char **a)
         (r = drift_accel_create(ctx, scene, &(drift_accel_desc){ 0 }, &accel)) != DRIFT_OK) {
         return fail(a[0], r);
     }
-    drift_pt_params pp = { .width = atoi(a[1]),
-                           .height = atoi(a[2]),
-                           .seed = (uint32_t)atoi(a[4]) };
-    if ((r = drift_pt_create(ctx, scene, accel, &pp, &pt)) != DRIFT_OK) {
-        return fail("pt", r);
-    }
-    // SPP is a comma list (1,4,16): the renders continue one another, OUT gets -SPP.bin.
-    uint32_t spp = 0;
+    // SPP is a comma list (1,4,16), OUT gets -SPP.bin. Each is its own render, as `drift render
+    // --spp N --seed SEED` makes it: the texture filter's ray cone follows the spp
+    // (drift_pt_params.texture_filter_spp), so a continued render would differ from the CLI's.
     for (char *s = a[3]; *s;) {
-        uint32_t next = (uint32_t)strtoul(s, &s, 10);
+        uint32_t spp = (uint32_t)strtoul(s, &s, 10);
         s += *s == ',';
-        if ((r = drift_pt_render_samples(pt, next - spp, NULL)) != DRIFT_OK) {
+        drift_pt_params pp = { .width = atoi(a[1]),
+                               .height = atoi(a[2]),
+                               .seed = (uint32_t)atoi(a[4]),
+                               .texture_filter_spp = spp };
+        if ((r = drift_pt_create(ctx, scene, accel, &pp, &pt)) != DRIFT_OK) {
+            return fail("pt", r);
+        }
+        if ((r = drift_pt_render_samples(pt, spp, NULL)) != DRIFT_OK) {
             return fail("render", r);
         }
-        spp = next;
         char path[4096];
         snprintf(path, sizeof path, "%s-%u.bin", a[5], spp);
         if (write_aovs(pt, spp, path)) {
             return 1;
         }
+        drift_pt_destroy(pt);
     }
-    drift_pt_destroy(pt);
     drift_accel_destroy(accel);
     drift_scene_destroy(scene);
     return 0;
@@ -184,6 +185,16 @@ int main(int argc, char **argv)
         fp.sigma_luminance_direct = getenv("SIGL") ? (float)atof(getenv("SIGL")) : 0.0f;
         fp.sigma_luminance_indirect = getenv("SIGLI") ? (float)atof(getenv("SIGLI")) : 0.0f;
         fp.iterations = getenv("ITER") ? atoi(getenv("ITER")) : 0;
+        fp.no_firefly_clamp = getenv("NOFF") != NULL;
+        fp.sigma_albedo = getenv("SIGA") ? (float)atof(getenv("SIGA")) : 0.0f;
+        fp.sigma_normal = getenv("SIGN") ? (float)atof(getenv("SIGN")) : 0.0f;
+        fp.sigma_depth = getenv("SIGZ") ? (float)atof(getenv("SIGZ")) : 0.0f;
+        // INDVG=1: the rest filtered VARIANCE_GUIDED (session 2's filter); RESSIG: the
+        // residual's sigma_l; METHOD: the params' method (0 1 2).
+        fp.indirect_variance_guided = getenv("INDVG") != NULL;
+        fp.sigma_luminance_residual = getenv("RESSIG") ? (float)atof(getenv("RESSIG")) : 0.0f;
+        fp.residual_block = getenv("RESBLOCK") ? atoi(getenv("RESBLOCK")) : 0;
+        fp.method = getenv("METHOD") ? (drift_denoise_method)atoi(getenv("METHOD")) : 0;
         drift_denoise_feature(ctx, &in, &fp, &out, NULL);
         double ms = 1e3 * (drift_time_now() - t0);
         double fo = flip(ctx, &ref, &out);

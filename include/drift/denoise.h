@@ -109,26 +109,38 @@ drift_result drift_denoise_atrous(drift_context *ctx, const drift_image *color,
 //        in 32x32 blocks, overlapping by half and blended with tent weights, the
 //        irradiance is fitted per channel by least squares (ridge 1e-3) to the features
 //        1, normal, depth, depth^2, x, y, x^2, y^2 (scaled to [-1, 1] in the block)
+//      REGRESSION_RESIDUAL  REGRESSION's fit (in residual_block blocks), plus the residual
+//        (irradiance - fit) filtered VARIANCE_GUIDED with sigma_luminance_residual: the fit
+//        carries the smooth light the luminance weight would break into blotches at few
+//        samples, the residual filter the detail a low-order fit cannot follow
 //   6. remodulate: times the albedo divisor again; clamped to >= 0
 // With the direct part given (drift_denoise_inputs.direct), stages 1-6 run on the direct part
-// (sigma_luminance_direct) and on the rest (sigma_luminance_indirect) apart, and the two are
-// summed. VARIANCE_GUIDED is the default: with the direct part apart never worse than the raw
-// image on the 17 corpus scenes at 1, 4 and 16 spp, where REGRESSION (without BMFR's temporal
-// part) is worse at 16 spp on most (docs/lab/2026-12-07-issue-48-s2.md). Every output pixel
-// is a gather (or a block fit) over the previous stage alone: bit-identical for any thread
-// count.
+// and on the rest apart, and the two are summed: the direct part by `method`
+// (sigma_luminance_direct), the rest by REGRESSION_RESIDUAL when `method` is VARIANCE_GUIDED
+// (else by `method`; with indirect_variance_guided by VARIANCE_GUIDED, sigma_luminance_indirect).
+// That default is never worse than the raw image on the 17 corpus scenes at 1, 4 and 16 spp;
+// REGRESSION alone (without BMFR's temporal part) is worse at 16 spp on most
+// (docs/lab/2026-12-07-issue-48-s3.md). Every output pixel is a gather (or a block fit) over
+// the previous stage alone: bit-identical for any thread count.
 typedef enum drift_denoise_method {
     DRIFT_DENOISE_VARIANCE_GUIDED = 0,
     DRIFT_DENOISE_REGRESSION,
+    DRIFT_DENOISE_REGRESSION_RESIDUAL,
     DRIFT_DENOISE_METHOD_COUNT
 } drift_denoise_method;
 
 typedef struct drift_denoise_feature_params {
     drift_denoise_method method;
-    int32_t iterations;             // 0 -> 5 (variance-guided passes); at most 10
+    int32_t iterations;             // 0 -> 4 (variance-guided passes); at most 10
     float sigma_luminance;          // 0 -> 4 (SVGF's sigma_l)
-    float sigma_luminance_direct;   // 0 -> 3: sigma_l of the direct part when it is apart
+    float sigma_luminance_direct;   // 0 -> 4: sigma_l of the direct part when it is apart
     float sigma_luminance_indirect; // 0 -> 8: sigma_l of the rest when the direct part is apart
+                                    // and filtered VARIANCE_GUIDED (indirect_variance_guided)
+    float sigma_luminance_residual; // 0 -> 64 below 16 spp, 32 from 16: sigma_l of
+                                    // REGRESSION_RESIDUAL's second step
+    int32_t residual_block;         // 0 -> 64 px below 16 spp, 32 from 16: REGRESSION_RESIDUAL's
+                                    // blocks (even, 8..128)
+    bool indirect_variance_guided;  // true: the rest as the direct part, VARIANCE_GUIDED alone
     float sigma_normal;             // 0 -> 128
     float sigma_depth;              // 0 -> 0.1
     float sigma_albedo;             // 0 -> 1

@@ -3,22 +3,20 @@
 // Regression for Real-Time Path-Tracing Reconstruction", ACM TOG 38(5)), first order in the
 // buffers and second order in depth and screen position, without its temporal part.
 //
-// The image is covered by 32x32 blocks whose origins are 16 pixels apart (so that every
-// pixel lies in four of them). In each block the irradiance of every channel is fitted by
-// least squares to the features
+// The image is covered by blocks (32x32 for REGRESSION; REGRESSION_RESIDUAL's size is a knob)
+// whose origins are half a block apart (so that every pixel lies in four of them). In each block
+// the irradiance of every channel is fitted by least squares to the features
 //   f = (1, n_x, n_y, n_z, z, z^2, x, y, x^2, y^2)
 // each but the constant scaled to [-1, 1] over the block (BMFR §3.2), solving the normal
 // equations (F^T F + lambda I) beta = F^T c by Cholesky with lambda = 1e-3 (max diagonal).
-// A pixel's output is its four blocks' fits blended by tent weights (1 - |d_x| / 16)
-// (1 - |d_y| / 16) from each block's centre, which sum to 1: no block seams.
+// A pixel's output is its four blocks' fits blended by tent weights (1 - |d_x| / s)
+// (1 - |d_y| / s) from each block's centre (s the half block), which sum to 1: no block seams.
 #include "feature_internal.h"
 
 #include <math.h>
 #include <string.h>
 
 #define BMFR_FEATURES 10
-#define BMFR_STRIDE   16
-#define BMFR_SIZE     (2 * BMFR_STRIDE)
 
 typedef struct bmfr_block {
     float lo[BMFR_FEATURES], inv_half[BMFR_FEATURES]; // scaled = (f - lo) * inv_half - 1
@@ -29,6 +27,7 @@ typedef struct bmfr_job {
     const denoise_frame *f;
     bmfr_block *blocks;
     int32_t blocks_x;
+    int32_t stride; // block origins apart, half the block's side
     float *out;
 } bmfr_job;
 
@@ -105,11 +104,11 @@ static void fit_blocks(size_t begin, size_t end, int thread_index, void *user)
     const denoise_frame *f = job->f;
     for (size_t bi = begin; bi < end; ++bi) {
         bmfr_block *b = &job->blocks[bi];
-        int32_t ox = (int32_t)(bi % (size_t)job->blocks_x) * BMFR_STRIDE - BMFR_STRIDE;
-        int32_t oy = (int32_t)(bi / (size_t)job->blocks_x) * BMFR_STRIDE - BMFR_STRIDE;
+        int32_t ox = (int32_t)(bi % (size_t)job->blocks_x) * job->stride - job->stride;
+        int32_t oy = (int32_t)(bi / (size_t)job->blocks_x) * job->stride - job->stride;
         int32_t x0 = ox < 0 ? 0 : ox, y0 = oy < 0 ? 0 : oy;
-        int32_t x1 = ox + BMFR_SIZE < f->width ? ox + BMFR_SIZE : f->width;
-        int32_t y1 = oy + BMFR_SIZE < f->height ? oy + BMFR_SIZE : f->height;
+        int32_t x1 = ox + (2 * job->stride) < f->width ? ox + (2 * job->stride) : f->width;
+        int32_t y1 = oy + (2 * job->stride) < f->height ? oy + (2 * job->stride) : f->height;
         float lo[BMFR_FEATURES], hi[BMFR_FEATURES], raw[BMFR_FEATURES];
         for (int k = 0; k < BMFR_FEATURES; ++k) {
             lo[k] = INFINITY;
@@ -164,11 +163,11 @@ static void blend_rows(size_t begin, size_t end, int thread_index, void *user)
         int32_t y = (int32_t)yy;
         for (int32_t x = 0; x < f->width; ++x) {
             float sum[3] = { 0.0f, 0.0f, 0.0f };
-            for (int32_t by = y / BMFR_STRIDE; by <= y / BMFR_STRIDE + 1; ++by) {
-                float wy = 1.0f - fabsf((float)y + 0.5f - (float)(by * BMFR_STRIDE)) / BMFR_STRIDE;
-                for (int32_t bx = x / BMFR_STRIDE; bx <= x / BMFR_STRIDE + 1; ++bx) {
+            for (int32_t by = y / job->stride; by <= y / job->stride + 1; ++by) {
+                float wy = 1.0f - fabsf((float)y + 0.5f - (float)(by * job->stride)) / job->stride;
+                for (int32_t bx = x / job->stride; bx <= x / job->stride + 1; ++bx) {
                     float wx =
-                        1.0f - fabsf((float)x + 0.5f - (float)(bx * BMFR_STRIDE)) / BMFR_STRIDE;
+                        1.0f - fabsf((float)x + 0.5f - (float)(bx * job->stride)) / job->stride;
                     const bmfr_block *b =
                         &job->blocks[(size_t)by * (size_t)job->blocks_x + (size_t)bx];
                     scaled_features(f, b, x, y, fs);
@@ -188,10 +187,11 @@ static void blend_rows(size_t begin, size_t end, int thread_index, void *user)
     }
 }
 
-drift_result denoise_regression(const denoise_frame *f, float *out)
+drift_result denoise_regression(const denoise_frame *f, int32_t block, float *out)
 {
-    int32_t blocks_x = f->width / BMFR_STRIDE + 2, blocks_y = f->height / BMFR_STRIDE + 2;
-    bmfr_job job = { .f = f, .blocks_x = blocks_x, .out = out };
+    int32_t stride = block / 2;
+    int32_t blocks_x = f->width / stride + 2, blocks_y = f->height / stride + 2;
+    bmfr_job job = { .f = f, .blocks_x = blocks_x, .stride = stride, .out = out };
     job.blocks = drift_alloc(f->ctx, (size_t)blocks_x * (size_t)blocks_y * sizeof(bmfr_block));
     if (!job.blocks) {
         return DRIFT_ERR_OUT_OF_MEMORY;

@@ -10,13 +10,13 @@ drift_denoise_feature_params_resolve(const drift_denoise_feature_params *params)
 {
     drift_denoise_feature_params p = params ? *params : (drift_denoise_feature_params){ 0 };
     if (p.iterations == 0) {
-        p.iterations = 5;
+        p.iterations = 4;
     }
     if (p.sigma_luminance == 0.0f) {
         p.sigma_luminance = 4.0f;
     }
     if (p.sigma_luminance_direct == 0.0f) {
-        p.sigma_luminance_direct = 3.0f;
+        p.sigma_luminance_direct = 4.0f;
     }
     if (p.sigma_luminance_indirect == 0.0f) {
         p.sigma_luminance_indirect = 8.0f;
@@ -184,6 +184,36 @@ static uint64_t clamp_fireflies(denoise_frame *f, const float *mean, const float
     return count;
 }
 
+// --- STAGE 5, REGRESSION_RESIDUAL ---
+
+// The block fit, plus the residual f->irr - fit filtered VARIANCE_GUIDED at
+// sigma_luminance_residual (f->irr is left holding the residual).
+static drift_result regression_residual(denoise_frame *f, float *out)
+{
+    float *fit = drift_alloc(f->ctx, f->pixels * 3 * sizeof(float));
+    if (!fit) {
+        return DRIFT_ERR_OUT_OF_MEMORY;
+    }
+    int32_t block = f->params.residual_block;
+    if (block == 0) { // larger blocks average more noise; at 16 spp they lose detail
+        block = f->sample_count < 16 ? 64 : 32;
+    }
+    drift_result r = denoise_regression(f, block, fit);
+    if (r == DRIFT_OK) {
+        for (size_t i = 0; i < 3 * f->pixels; ++i) {
+            f->irr[i] -= fit[i];
+        }
+        float sigma = f->params.sigma_luminance_residual; // 0: by the spp, as the blocks
+        f->params.sigma_luminance = sigma > 0.0f ? sigma : f->sample_count < 16 ? 64.0f : 32.0f;
+        r = denoise_variance_guided(f, out);
+    }
+    for (size_t i = 0; r == DRIFT_OK && i < 3 * f->pixels; ++i) {
+        out[i] += fit[i];
+    }
+    drift_free(f->ctx, fit);
+    return r;
+}
+
 // --- THE CALL ---
 
 static void frame_free(denoise_frame *f)
@@ -213,11 +243,13 @@ static drift_result denoise_one(drift_context *ctx, const drift_denoise_inputs *
         !same_size(c, in->depth, 1) || !same_size(c, in->variance, 1) ||
         (unsigned)p.method >= DRIFT_DENOISE_METHOD_COUNT || p.iterations < 1 || p.iterations > 10 ||
         !(p.sigma_luminance > 0.0f) || !(p.sigma_luminance_direct > 0.0f) ||
-        !(p.sigma_luminance_indirect > 0.0f) || !(p.sigma_normal > 0.0f) ||
+        !(p.sigma_luminance_indirect > 0.0f) || !(p.sigma_luminance_residual >= 0.0f) ||
+        p.residual_block < 0 || p.residual_block > 128 || p.residual_block % 2 ||
+        (p.residual_block > 0 && p.residual_block < 8) || !(p.sigma_normal > 0.0f) ||
         !(p.sigma_depth > 0.0f) || !(p.sigma_albedo > 0.0f)) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, NULL, 0,
                   "denoise: the colour must be RGB, every guide of its size and the params in "
-                  "range (iterations 1..10, sigmas > 0)");
+                  "range (iterations 1..10, sigmas > 0, residual_block 0 or even 8..128)");
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
     denoise_frame f = { .ctx = ctx,
@@ -262,8 +294,9 @@ static drift_result denoise_one(drift_context *ctx, const drift_denoise_inputs *
         box_moments(&f, 2, scratch, scratch + f.pixels, sums, sums + f.pixels);
         clamp_count = clamp_fireflies(&f, scratch, scratch + f.pixels);
     }
-    r = p.method == DRIFT_DENOISE_REGRESSION ? denoise_regression(&f, scratch)
-                                             : denoise_variance_guided(&f, scratch);
+    r = p.method == DRIFT_DENOISE_REGRESSION            ? denoise_regression(&f, 32, scratch)
+        : p.method == DRIFT_DENOISE_REGRESSION_RESIDUAL ? regression_residual(&f, scratch)
+                                                        : denoise_variance_guided(&f, scratch);
     if (r == DRIFT_OK) {
         r = drift_image_create(ctx, c->width, c->height, 3, out);
     }
@@ -296,7 +329,8 @@ done:
 }
 
 // With a direct part: the rest (colour - direct, at least 0) and the direct part filtered
-// apart, each with its own variance, and summed.
+// apart, each with its own variance, and summed; the rest by REGRESSION_RESIDUAL unless asked
+// otherwise (drift/denoise.h).
 drift_result drift_denoise_feature(drift_context *ctx, const drift_denoise_inputs *in,
                                    const drift_denoise_feature_params *params, drift_image *out,
                                    drift_denoise_report *report)
@@ -335,6 +369,9 @@ drift_result drift_denoise_feature(drift_context *ctx, const drift_denoise_input
         part.variance = in->indirect_variance;
         drift_denoise_feature_params pi = drift_denoise_feature_params_resolve(params);
         pi.sigma_luminance = pi.sigma_luminance_indirect;
+        if (pi.method == DRIFT_DENOISE_VARIANCE_GUIDED && !pi.indirect_variance_guided) {
+            pi.method = DRIFT_DENOISE_REGRESSION_RESIDUAL;
+        }
         r = denoise_one(ctx, &part, &pi, out, &rep_rest);
     }
     if (r == DRIFT_OK) {

@@ -26,6 +26,7 @@ static inline float denoise_lum(const float *c)
 
 // Stage 5, each writing 3 floats a pixel of filtered irradiance into out.
 drift_result denoise_variance_guided(const denoise_frame *f, float *out);
-drift_result denoise_regression(const denoise_frame *f, float *out);
+// The block fit with blocks `block` pixels wide (even).
+drift_result denoise_regression(const denoise_frame *f, int32_t block, float *out);
 
 #endif
