@@ -197,7 +197,7 @@ for r in d["rows"]:
     beaten = [q for q in d["rows"] if q is not r and q["ms"] <= r["ms"] + 1e-3 and q["flip"] <= r["flip"] + 1e-6]
     assert (not r["pareto"] or all(q["ms"] > r["ms"] - 1e-3 or q["flip"] >= r["flip"] - 1e-6 for q in beaten)) \
         and (r["pareto"] or beaten), r
-# Rows of equal ms (to the JSON's rounding) may both be on the front: the closer one last.
+# Rows of equal ms (as rounded in the JSON) may both be on the front: the closer one last.
 front = sorted((r for r in d["rows"] if r["pareto"]), key=lambda r: (r["ms"], -r["flip"]))
 assert front and all(a["flip"] >= b["flip"] for a, b in zip(front, front[1:])), front
 for f in d["front"]:
