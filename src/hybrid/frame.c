@@ -159,6 +159,31 @@ static drift_result create_images(drift_frame_state *f)
     return r;
 }
 
+// Each family makes its own state, into its slot.
+static drift_result families_create(drift_frame_state *f)
+{
+    drift_result r = DRIFT_OK;
+    for (int i = 0; r == DRIFT_OK && drift_family_at(i); ++i) {
+        const drift_family *family = drift_family_at(i);
+        if (family->create) {
+            r = family->create(f, &f->family_state[family->slot]);
+        }
+    }
+    return r;
+}
+
+// Each family frees what it made (its caches, its buffers); the slots are left empty.
+static void families_destroy(drift_frame_state *f)
+{
+    for (int i = 0; drift_family_at(i); ++i) {
+        const drift_family *family = drift_family_at(i);
+        if (family->destroy) {
+            family->destroy(f, f->family_state[family->slot]);
+        }
+        f->family_state[family->slot] = NULL;
+    }
+}
+
 drift_result drift_hybrid_create(drift_context *ctx, const drift_scene *scene,
                                  const drift_accel *accel, const drift_hybrid_params *params,
                                  drift_hybrid **out_frame)
@@ -195,12 +220,8 @@ drift_result drift_hybrid_create(drift_context *ctx, const drift_scene *scene,
     if (r == DRIFT_OK) {
         r = create_images(f);
     }
-    // Each family makes its own state, into its slot.
-    for (int i = 0; r == DRIFT_OK && drift_family_at(i); ++i) {
-        const drift_family *family = drift_family_at(i);
-        if (family->create) {
-            r = family->create(f, &f->family_state[family->slot]);
-        }
+    if (r == DRIFT_OK) {
+        r = families_create(f);
     }
     if (r != DRIFT_OK) {
         drift_hybrid_destroy(h);
@@ -222,14 +243,7 @@ void drift_hybrid_destroy(drift_hybrid *h)
     }
     drift_frame_state *f = &h->frame;
     drift_context *ctx = f->ctx;
-    // Each family frees what it made (its caches, its buffers), then the frame its own.
-    for (int i = 0; drift_family_at(i); ++i) {
-        const drift_family *family = drift_family_at(i);
-        if (family->destroy) {
-            family->destroy(f, f->family_state[family->slot]);
-        }
-        f->family_state[family->slot] = NULL;
-    }
+    families_destroy(f); // then the frame frees its own
     drift_pass_free_states(f);
     if (f->light_buffers) {
         for (uint32_t l = 0; l < f->light_count; ++l) {
@@ -308,26 +322,14 @@ drift_result drift_hybrid_scene_changed(drift_hybrid *h, const drift_accel *acce
     // caches): each family frees its slot and makes it anew over the new lights, and the
     // techniques remake their caches on next use. The camera history (motion vectors) and the
     // frame's buffers stay.
-    for (int i = 0; drift_family_at(i); ++i) {
-        const drift_family *family = drift_family_at(i);
-        if (family->destroy) {
-            family->destroy(f, f->family_state[family->slot]);
-        }
-        f->family_state[family->slot] = NULL;
-    }
+    families_destroy(f);
     drift_pass_free_states(f);
     drift_raster_lights_destroy(f->ctx, f->lights, f->light_count);
     f->lights = lights;
     f->accel = accel;
     f->shading.accel = accel;
     f->shading.lights = lights;
-    for (int i = 0; r == DRIFT_OK && drift_family_at(i); ++i) {
-        const drift_family *family = drift_family_at(i);
-        if (family->create) {
-            r = family->create(f, &f->family_state[family->slot]);
-        }
-    }
-    return r;
+    return families_create(f);
 }
 
 drift_result drift_hybrid_set_mesh_motion(drift_hybrid *h, const float *prev_from_now,
