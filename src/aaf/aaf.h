@@ -111,8 +111,9 @@ void drift_aaf_allocate(const float *want, size_t count, size_t active, uint32_t
 // --- THE DENOISER (aaf_denoise.c, --aaf-denoise) ---
 
 // Variance of the mean of a light-weighted visibility v estimated from n rays (Bernoulli,
-// v pulled half a ray toward 1/2 so that a pixel whose few rays agreed is not noise-free).
-float drift_aaf_visibility_variance(float v, float n);
+// v pulled half a ray toward 1/2 so that a pixel whose few rays agreed is not noise-free;
+// over n again for Sobol points, `random` false).
+float drift_aaf_visibility_variance(float v, float n, bool random);
 // Filters a pass's noisy estimate `in` (1 or 3 channels) with the feature-guided denoiser,
 // guided by the G-buffer's normal and depth, `variance` (1 channel) the variance of each
 // pixel's mean; writes out's channels (out the size of in, may be in).

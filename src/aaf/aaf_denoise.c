@@ -7,18 +7,21 @@
 #include "aaf/aaf.h"
 #include "drift/denoise.h"
 
-#include <math.h>
-
 // Variance of the mean of a pixel's light-weighted visibility v over n rays: a Bernoulli
 // variance, v taken as (n v + 1/2) / (n + 1) so that a pixel whose few rays all agreed (v 0
 // or 1 from 2 rays in a penumbra) is not taken as noise-free and left out of the filter.
-float drift_aaf_visibility_variance(float v, float n)
+// Sobol points integrate a pixel's visibility of a quad light with an error near 1/n, not
+// 1/sqrt(n) (aaf.h): their variance is the Bernoulli one over n again. (With the Bernoulli
+// variance alone the denoiser blurred the Cornell box's contact shadows: FLIP 0.0080 against
+// 0.0058 at 4 spp, the unfiltered samples 0.0049.)
+float drift_aaf_visibility_variance(float v, float n, bool random)
 {
     if (!(n > 0.0f)) {
         return 0.0f;
     }
     float p = (n * v + 0.5f) / (n + 1.0f);
-    return p * (1.0f - p) / n;
+    float var = p * (1.0f - p) / n;
+    return random ? var : var / n;
 }
 
 drift_result drift_aaf_denoise_estimate(drift_frame_state *f, const drift_image *in,

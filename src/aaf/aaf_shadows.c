@@ -311,7 +311,8 @@ static drift_result filter_light(drift_frame_state *f, uint32_t l, bool area)
         for (int32_t y = 0; y < shadow->height; ++y) {
             for (int32_t x = 0; x < shadow->width; ++x) {
                 drift_image_pixel(&st->scratch1, x, y)[0] = drift_aaf_visibility_variance(
-                    drift_image_pixel(in, x, y)[0], drift_image_pixel(&al->spp, x, y)[0]);
+                    drift_image_pixel(in, x, y)[0], drift_image_pixel(&al->spp, x, y)[0],
+                    f->params.aaf.random);
             }
         }
         r = drift_image_create(f->ctx, shadow->width, shadow->height, 1, &denoised);
