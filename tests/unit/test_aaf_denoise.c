@@ -1,8 +1,8 @@
 // --aaf-denoise (drift_aaf_settings.denoise): AAF's noisy estimates through the feature-guided
-// denoiser. On a small closed room under a quad light, the denoised AAF shadow and indirect
-// planes at 4 spp are closer to AAF's own converged estimate (1024 / 256 spp, every pixel,
-// unfiltered: the same estimator without noise) than the unfiltered samples, and the knob
-// round-trips through its table row.
+// denoiser. On a small closed room under a quad light, the denoised AAF shadow (random
+// sampler) and indirect planes at 4 spp are closer to AAF's own converged estimate (1024 / 256 spp,
+// every pixel, unfiltered: the same estimator without noise) than the unfiltered samples, and the
+// knob round-trips through its table row.
 #include "aaf/aaf.h"
 #include "drift/hybrid.h"
 #include "drift/knobs.h"
@@ -62,8 +62,9 @@ static drift_image plane_copy(test_rig *r, const drift_hybrid_params *params, co
 }
 
 // The pass's plane at 4 spp unfiltered and with the denoiser instead of AAF's filter, against
-// the converged estimate: the denoised error is below 0.8 of the unfiltered one.
-static void check_pass(test_rig *r, drift_hybrid_params p, const char *plane, uint32_t truth_spp)
+// the converged estimate: the denoised error is below `bound` times the unfiltered one.
+static void check_pass(test_rig *r, drift_hybrid_params p, const char *plane, uint32_t truth_spp,
+                       double bound)
 {
     drift_hybrid_params truth_params = p;
     truth_params.spp = truth_spp;
@@ -79,7 +80,7 @@ static void check_pass(test_rig *r, drift_hybrid_params p, const char *plane, ui
            e_denoised = test_rmse(r->ctx, &denoised, &truth);
     print_message("%s at 4 spp: rmse unfiltered %g, --aaf-denoise on %g\n", plane, e_raw,
                   e_denoised);
-    assert_true(e_denoised < 0.8 * e_raw);
+    assert_true(e_denoised < bound * e_raw);
     drift_image_destroy(r->ctx, &truth);
     drift_image_destroy(r->ctx, &raw);
     drift_image_destroy(r->ctx, &denoised);
@@ -89,19 +90,22 @@ static void test_denoised_passes_are_closer(void **state)
 {
     (void)state;
     test_rig r = room_rig();
+    // Shadows with independent random rays: Sobol points leave 4 spp's visibility so close to
+    // converged that no filter helps it (docs/aaf.md, --aaf-denoise).
     check_pass(&r,
                (drift_hybrid_params){ .shadows = DRIFT_SHADOWS_AAF,
                                       .indirect = DRIFT_INDIRECT_NONE,
                                       .reflections = DRIFT_REFLECTIONS_NONE,
+                                      .aaf.random = true,
                                       .seed = 3 },
-               "light0.shadow", 1024);
+               "light0.shadow", 1024, 0.9);
     check_pass(&r,
                (drift_hybrid_params){ .shadows = DRIFT_SHADOWS_HARD,
                                       .indirect = DRIFT_INDIRECT_AAF,
                                       .reflections = DRIFT_REFLECTIONS_NONE,
                                       .max_depth = 2,
                                       .seed = 5 },
-               "indirect", 256);
+               "indirect", 256, 0.5);
     test_rig_destroy(&r);
 }
 
