@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
-# --aaf-denoise per pass (docs/aaf.md, docs/lab/2026-12-07-issue-48-s3.md): for each AAF pass
+# --aaf-denoise per pass (docs/aaf.md, docs/lab/2026-12-07-issue-48-s3-aaf.md): for each AAF pass
 # (shadows, indirect, reflections) the hybrid frame with that pass AAF and the others held
 # fixed (shadows hard, indirect none, reflections none), against the same frame with the pass
 # path-traced (`reference`, 256 spp, seed 7777). --max-depth 2 (one bounce, AAF's and the
-# reference's). 160x120, 2 threads, AAF at 16 and 4 spp, four ways:
+# reference's). 160x120, 2 threads, AAF at 16 and 4 spp (SPPS="64 16 4": others), four ways:
 #   raw     --aaf-filter off: AAF's samples unfiltered
 #   aaf     AAF's own filter (the default)
 #   denoise --aaf-denoise on: the feature-guided denoiser instead of AAF's filter
@@ -31,7 +31,7 @@ for entry in $scenes; do
             ref="$out/$n-$p-ref.exr"
             [ -f "$ref" ] || nice "$drift" render "$s" --mode hybrid "${size[@]}" "${fixed[@]}" \
                 --"$p" reference --spp 256 --seed 7777 --out "$ref" >/dev/null 2>&1
-            for spp in 16 4; do
+            for spp in ${SPPS:-16 4}; do
                 for way in raw aaf denoise both; do
                     case $way in
                     raw) knobs=(--aaf-filter off) ;;
