@@ -144,11 +144,21 @@ typedef struct drift_isg_settings {
 //                plain Monte Carlo with AAF's sampler, the benchmark baseline)
 //   random     = false: AAF's samples are Owen-scrambled Sobol points; true: independent
 //                uniform random numbers (the paper's traditional Monte Carlo sampling)
+//   denoise    = OFF: AAF's own filter alone; ON: the path tracer's feature-guided denoiser
+//                (drift/denoise.h) instead of it; BOTH: the denoiser, then AAF's filter
+//                (measured in docs/aaf.md; OFF is the default)
+typedef enum drift_aaf_denoise {
+    DRIFT_AAF_DENOISE_OFF = 0,
+    DRIFT_AAF_DENOISE_ON,
+    DRIFT_AAF_DENOISE_BOTH,
+} drift_aaf_denoise;
+
 typedef struct drift_aaf_settings {
     uint32_t max_spp;
     bool uniform;
     bool unfiltered;
     bool random;
+    drift_aaf_denoise denoise;
 } drift_aaf_settings;
 
 // Instant radiosity (indirect ism and ir, docs/ism.md):

@@ -108,6 +108,18 @@ uint32_t drift_aaf_shadow_sparse_count(uint32_t spp);
 void drift_aaf_allocate(const float *want, size_t count, size_t active, uint32_t sparse,
                         uint32_t spp, uint32_t max_spp, uint32_t seed, uint32_t *counts);
 
+// --- THE DENOISER (aaf_denoise.c, --aaf-denoise) ---
+
+// Variance of the mean of a light-weighted visibility v estimated from n rays (Bernoulli,
+// v pulled half a ray toward 1/2 so that a pixel whose few rays agreed is not noise-free;
+// over n again for Sobol points, `random` false).
+float drift_aaf_visibility_variance(float v, float n, bool random);
+// Filters a pass's noisy estimate `in` (1 or 3 channels) with the feature-guided denoiser,
+// guided by the G-buffer's normal and depth, `variance` (1 channel) the variance of each
+// pixel's mean; writes out's channels (out the size of in, may be in).
+drift_result drift_aaf_denoise_estimate(drift_frame_state *frame, const drift_image *in,
+                                        const drift_image *variance, drift_image *out);
+
 // --- STATE AND PASSES ---
 
 #define DRIFT_AAF_AUX 6 // floats of running sums a pixel keeps between the passes

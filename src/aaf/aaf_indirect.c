@@ -131,8 +131,9 @@ static drift_vec3 trace_path(drift_frame_state *f, const indirect_job *job, cons
 }
 
 // Running sums a pixel keeps between the passes, in state->aux and the lobe's radiance.
+// lum_sq: the samples' squared luminance, summed (the denoiser's variance, --aaf-denoise).
 typedef struct indirect_sums {
-    float z_min, z_max, count, has_lobe;
+    float z_min, z_max, count, has_lobe, lum_sq;
 } indirect_sums;
 
 // Whether the pixel has the job's lobe, with its albedo and Omega_h^max.
@@ -163,7 +164,10 @@ static void add_samples(drift_frame_state *f, const indirect_job *job, int32_t x
     for (uint32_t k = first; k < end; ++k) {
         drift_aaf_sampler sampler = drift_aaf_sampler_make(job->key, (uint32_t)i, k, job->random);
         float distance;
-        sum = drift_vec3_add(sum, trace_path(f, job, s, &bsdf, wo, &sampler, &distance, rays));
+        drift_vec3 sample = trace_path(f, job, s, &bsdf, wo, &sampler, &distance, rays);
+        float lum = drift_luminance(sample);
+        sum = drift_vec3_add(sum, sample);
+        sums->lum_sq += lum * lum;
         if (isfinite(distance)) {
             sums->z_min = fminf(sums->z_min, distance);
             sums->z_max = fmaxf(sums->z_max, distance);
@@ -193,7 +197,7 @@ static void sparse_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *r
     drift_aaf_lobe_buffers *b = job->lobe->buffers;
     size_t i = pixel_index(f, x, y);
     indirect_sums *sums = (indirect_sums *)&st->aux[DRIFT_AAF_AUX * i];
-    *sums = (indirect_sums){ INFINITY, 0.0f, 0.0f, 0.0f };
+    *sums = (indirect_sums){ INFINITY, 0.0f, 0.0f, 0.0f, 0.0f };
     drift_image_set3(&b->radiance, x, y, drift_vec3_splat(0.0f));
     drift_image_pixel(&b->beta, x, y)[0] = 0.0f;
     st->want[i] = -1.0f; // outside the budget
@@ -299,6 +303,56 @@ static void adaptive_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t 
         has ? (float)(n > taken ? n : taken) : 0.0f;
 }
 
+// The variance of the pixel's mean luminance from its samples, into scratch1.
+static void variance_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
+{
+    (void)rays;
+    (void)user;
+    drift_aaf_state *st = drift_aaf_of(f);
+    const drift_aaf_lobe *lobe = ((const indirect_job *)user)->lobe;
+    const indirect_sums *sums =
+        (const indirect_sums *)&st->aux[DRIFT_AAF_AUX * pixel_index(f, x, y)];
+    float n = sums->count, mean = drift_luminance(drift_image_get3(&lobe->buffers->radiance, x, y));
+    float var = n > 1.0f ? fmaxf(sums->lum_sq / n - mean * mean, 0.0f) / (n - 1.0f) : 0.0f;
+    drift_image_pixel(&st->scratch1, x, y)[0] = var;
+}
+
+// b->filtered from b->radiance: AAF's filter, or (--aaf-denoise) the denoiser instead of it
+// or before it.
+static drift_result filter_lobe(drift_frame_state *f, indirect_job *job)
+{
+    drift_aaf_state *st = drift_aaf_of(f);
+    drift_aaf_lobe_buffers *b = job->lobe->buffers;
+    drift_aaf_denoise mode = f->params.aaf.denoise;
+    bool aaf_filter = !f->params.aaf.unfiltered && mode != DRIFT_AAF_DENOISE_ON;
+    const drift_image *in = &b->radiance;
+    drift_image denoised = { 0 }; // with both: the denoiser's output, AAF's filter's input
+    drift_result r = DRIFT_OK;
+    if (mode != DRIFT_AAF_DENOISE_OFF) {
+        drift_pass_for_each_pixel(f, variance_pixel, job);
+        if (aaf_filter) {
+            r = drift_image_create(f->ctx, f->params.width, f->params.height, 3, &denoised);
+        }
+        drift_image *to = aaf_filter ? &denoised : &b->filtered;
+        if (r == DRIFT_OK) {
+            r = drift_aaf_denoise_estimate(f, in, &st->scratch1, to);
+        }
+        in = to;
+    }
+    if (r == DRIFT_OK && aaf_filter) {
+        drift_aaf_filter_desc desc = { .beta = &b->beta,
+                                       .footprint = &st->footprint,
+                                       .gbuffer = &f->gbuffer,
+                                       .max_radius = DRIFT_AAF_MAX_RADIUS,
+                                       .workspace = st->filter_workspace };
+        r = drift_aaf_filter_separable(f->ctx, &desc, in, &st->scratch3, &b->filtered);
+    } else if (r == DRIFT_OK && in != &b->filtered) {
+        drift_pass_copy_rgb(in, &b->filtered);
+    }
+    drift_image_destroy(f->ctx, &denoised);
+    return r;
+}
+
 static void modulate_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
 {
     (void)rays;
@@ -363,18 +417,9 @@ drift_result drift_aaf_lobe_pass(drift_frame_state *f, const drift_aaf_lobe *lob
     stats->ms[DRIFT_PASS_AAF_SAMPLING] += 1000.0 * (drift_time_now() - t);
 
     t = drift_time_now();
-    if (f->params.aaf.unfiltered) {
-        drift_pass_copy_rgb(&b->radiance, &b->filtered);
-    } else {
-        drift_aaf_filter_desc desc = { .beta = &b->beta,
-                                       .footprint = &st->footprint,
-                                       .gbuffer = &f->gbuffer,
-                                       .max_radius = DRIFT_AAF_MAX_RADIUS,
-                                       .workspace = st->filter_workspace };
-        r = drift_aaf_filter_separable(f->ctx, &desc, &b->radiance, &st->scratch3, &b->filtered);
-        if (r != DRIFT_OK) {
-            return r;
-        }
+    r = filter_lobe(f, &job);
+    if (r != DRIFT_OK) {
+        return r;
     }
     drift_pass_for_each_pixel(f, modulate_pixel, &job);
     stats->ms[DRIFT_PASS_AAF_FILTER] += 1000.0 * (drift_time_now() - t);

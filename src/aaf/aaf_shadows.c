@@ -294,6 +294,56 @@ uint32_t drift_aaf_shadow_sparse_count(uint32_t spp)
     return k < spp ? k : spp;
 }
 
+// The light's shadow term from its unfiltered visibility: AAF's filter, or (--aaf-denoise)
+// the denoiser instead of it or before it. Delta lights' hard shadows are kept as they are.
+static drift_result filter_light(drift_frame_state *f, uint32_t l, bool area)
+{
+    drift_aaf_state *st = drift_aaf_of(f);
+    drift_aaf_light *al = &st->lights[l];
+    drift_image *shadow = &f->light_buffers[l].shadow;
+    drift_aaf_denoise mode = area ? f->params.aaf.denoise : DRIFT_AAF_DENOISE_OFF;
+    bool aaf_filter = area && !f->params.aaf.unfiltered && mode != DRIFT_AAF_DENOISE_ON;
+    const drift_image *in = &al->unfiltered;
+    drift_image denoised = { 0 };
+    drift_result r = DRIFT_OK;
+    if (mode != DRIFT_AAF_DENOISE_OFF) {
+        // The variance in scratch1, which the filter reuses once the denoiser is done.
+        for (int32_t y = 0; y < shadow->height; ++y) {
+            for (int32_t x = 0; x < shadow->width; ++x) {
+                drift_image_pixel(&st->scratch1, x, y)[0] = drift_aaf_visibility_variance(
+                    drift_image_pixel(in, x, y)[0], drift_image_pixel(&al->spp, x, y)[0],
+                    f->params.aaf.random);
+            }
+        }
+        r = drift_image_create(f->ctx, shadow->width, shadow->height, 1, &denoised);
+        if (r == DRIFT_OK) {
+            r = drift_aaf_denoise_estimate(f, in, &st->scratch1, &denoised);
+        }
+        in = &denoised;
+    }
+    if (r == DRIFT_OK && !aaf_filter) {
+        for (int32_t y = 0; y < shadow->height; ++y) {
+            for (int32_t x = 0; x < shadow->width; ++x) {
+                drift_image_pixel(shadow, x, y)[0] = drift_image_pixel(in, x, y)[0];
+            }
+        }
+    } else if (r == DRIFT_OK) {
+        drift_aaf_filter_desc desc = { .beta = &al->beta,
+                                       .footprint = &st->footprint,
+                                       .gbuffer = &f->gbuffer,
+                                       // World distance, not the paper's plane parallel to
+                                       // the light: that plane folds a wall's height away
+                                       // (docs/aaf.md, departures).
+                                       .has_axis = false,
+                                       .axis = f->lights[l].direction,
+                                       .max_radius = DRIFT_AAF_MAX_RADIUS,
+                                       .workspace = st->filter_workspace };
+        r = drift_aaf_filter_separable(f->ctx, &desc, in, &st->scratch1, shadow);
+    }
+    drift_image_destroy(f->ctx, &denoised);
+    return r;
+}
+
 drift_result drift_aaf_pass_shadows(drift_frame_state *f, const drift_pass_args *args)
 {
     (void)args;
@@ -341,30 +391,9 @@ drift_result drift_aaf_pass_shadows(drift_frame_state *f, const drift_pass_args 
         stats->ms[DRIFT_PASS_AAF_SAMPLING] += 1000.0 * (drift_time_now() - t);
 
         t = drift_time_now();
-        drift_aaf_light *al = &st->lights[l];
-        drift_image *shadow = &f->light_buffers[l].shadow;
-        if (!area || f->params.aaf.unfiltered) {
-            for (int32_t y = 0; y < shadow->height; ++y) {
-                for (int32_t x = 0; x < shadow->width; ++x) {
-                    drift_image_pixel(shadow, x, y)[0] =
-                        drift_image_pixel(&al->unfiltered, x, y)[0];
-                }
-            }
-        } else {
-            drift_aaf_filter_desc desc = { .beta = &al->beta,
-                                           .footprint = &st->footprint,
-                                           .gbuffer = &f->gbuffer,
-                                           // World distance, not the paper's plane parallel to
-                                           // the light: that plane folds a wall's height away
-                                           // (docs/aaf.md, departures).
-                                           .has_axis = false,
-                                           .axis = light->direction,
-                                           .max_radius = DRIFT_AAF_MAX_RADIUS,
-                                           .workspace = st->filter_workspace };
-            r = drift_aaf_filter_separable(f->ctx, &desc, &al->unfiltered, &st->scratch1, shadow);
-            if (r != DRIFT_OK) {
-                return r;
-            }
+        r = filter_light(f, l, area);
+        if (r != DRIFT_OK) {
+            return r;
         }
         stats->ms[DRIFT_PASS_AAF_FILTER] += 1000.0 * (drift_time_now() - t);
     }

@@ -134,9 +134,11 @@ void drift_aaf_settings_resolve(drift_aaf_settings *settings, uint32_t spp)
 
 const char *drift_aaf_settings_problem(const drift_aaf_settings *settings, uint32_t spp)
 {
-    return settings->max_spp < spp || settings->max_spp > 65536
-               ? "aaf max spp below spp or over 65536"
-               : NULL;
+    if (settings->max_spp < spp || settings->max_spp > 65536) {
+        return "aaf max spp below spp or over 65536";
+    }
+    return (unsigned)settings->denoise > DRIFT_AAF_DENOISE_BOTH ? "aaf denoise not off, on or both"
+                                                                : NULL;
 }
 
 // --- PLANES ---

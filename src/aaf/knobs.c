@@ -22,6 +22,10 @@ static const drift_knob rows[] = {
     DRIFT_KNOB_CHOICE_ROW("aaf-filter", aaf.unfiltered, "on|off", 0,
                           "off: AAF's unfiltered estimate (with uniform: plain Monte Carlo)", -1,
                           "aaf"),
+    DRIFT_KNOB_CHOICE_ROW("aaf-denoise", aaf.denoise, "off|on|both", 0,
+                          "on: the feature-guided denoiser (--denoise on) instead of AAF's\n"
+                          "filter; both: the denoiser, then AAF's filter",
+                          -1, "aaf"),
     DRIFT_KNOB_CHOICE_ROW("aaf-sampler", aaf.random, "sobol|random", 0,
                           "sobol: Owen-scrambled Sobol points; random: independent uniform\n"
                           "numbers (the paper's Monte Carlo)",
