@@ -83,6 +83,21 @@ void test_add_quad(drift_scene *scene, drift_vec3 corner, drift_vec3 u, drift_ve
     test_add_mesh(scene, p, 4, idx, 2, material);
 }
 
+void test_add_open_room(drift_scene *scene, float half, uint32_t white, uint32_t left)
+{
+    const float h = half, top = 3.05f;
+    test_add_quad(scene, drift_vec3_make(-h, 0, -h), drift_vec3_make(0, 0, 2 * h),
+                  drift_vec3_make(2 * h, 0, 0), white); // floor, up
+    test_add_quad(scene, drift_vec3_make(-h, top, -h), drift_vec3_make(2 * h, 0, 0),
+                  drift_vec3_make(0, 0, 2 * h), white); // ceiling
+    test_add_quad(scene, drift_vec3_make(-h, 0, -h), drift_vec3_make(0, top, 0),
+                  drift_vec3_make(0, 0, 2 * h), left); // left wall
+    test_add_quad(scene, drift_vec3_make(h, 0, -h), drift_vec3_make(0, 0, 2 * h),
+                  drift_vec3_make(0, top, 0), white);
+    test_add_quad(scene, drift_vec3_make(-h, 0, h), drift_vec3_make(0, top, 0),
+                  drift_vec3_make(2 * h, 0, 0), white);
+}
+
 void test_add_quad_light(drift_scene *scene, drift_vec3 corner, drift_vec3 u, drift_vec3 v,
                          float radiance)
 {

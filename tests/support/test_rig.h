@@ -36,6 +36,9 @@ void test_add_quad(drift_scene *scene, drift_vec3 corner, drift_vec3 u, drift_ve
 // cross(u, v).
 void test_add_quad_light(drift_scene *scene, drift_vec3 corner, drift_vec3 u, drift_vec3 v,
                          float radiance);
+// A room of half width `half` and height 3.05 open toward -z: floor, ceiling, the left (x =
+// -half) wall in `left`, the right and back (z = +half) walls in `white`, all facing in.
+void test_add_open_room(drift_scene *scene, float half, uint32_t white, uint32_t left);
 // Square of half size `half` in the plane y = height, facing +y.
 void test_add_floor(drift_scene *scene, float half, float height, uint32_t material);
 // UV sphere with smooth normals and outward winding; returns its mesh index.

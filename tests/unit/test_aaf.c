@@ -414,17 +414,7 @@ static void test_indirect_converges(void **state)
     uint32_t white, reddish;
     assert_int_equal(drift_scene_add_material(r.scene, &m, &white), DRIFT_OK);
     assert_int_equal(drift_scene_add_material(r.scene, &red, &reddish), DRIFT_OK);
-    const float h = 1.5f;
-    test_add_quad(r.scene, drift_vec3_make(-h, 0, -h), drift_vec3_make(0, 0, 2 * h),
-                  drift_vec3_make(2 * h, 0, 0), white); // floor, up
-    test_add_quad(r.scene, drift_vec3_make(-h, 3.05f, -h), drift_vec3_make(2 * h, 0, 0),
-                  drift_vec3_make(0, 0, 2 * h), white); // ceiling
-    test_add_quad(r.scene, drift_vec3_make(-h, 0, -h), drift_vec3_make(0, 3.05f, 0),
-                  drift_vec3_make(0, 0, 2 * h), reddish); // left wall
-    test_add_quad(r.scene, drift_vec3_make(h, 0, -h), drift_vec3_make(0, 0, 2 * h),
-                  drift_vec3_make(0, 3.05f, 0), white);
-    test_add_quad(r.scene, drift_vec3_make(-h, 0, h), drift_vec3_make(0, 3.05f, 0),
-                  drift_vec3_make(2 * h, 0, 0), white);
+    test_add_open_room(r.scene, 1.5f, white, reddish);
     add_square(r.scene, 0.3f, 0.8f, 0.2f, 0.4f, white);
     add_light(r.scene);
     r.scene->camera =

@@ -25,17 +25,7 @@ static test_rig room_rig(void)
         test_add_material(r.scene, drift_material_make(drift_vec3_make(0.7f, 0.6f, 0.5f)));
     uint32_t red =
         test_add_material(r.scene, drift_material_make(drift_vec3_make(0.7f, 0.1f, 0.1f)));
-    const float h = 1.5f;
-    test_add_quad(r.scene, drift_vec3_make(-h, 0, -h), drift_vec3_make(0, 0, 2 * h),
-                  drift_vec3_make(2 * h, 0, 0), white); // floor, up
-    test_add_quad(r.scene, drift_vec3_make(-h, 3.05f, -h), drift_vec3_make(2 * h, 0, 0),
-                  drift_vec3_make(0, 0, 2 * h), white); // ceiling
-    test_add_quad(r.scene, drift_vec3_make(-h, 0, -h), drift_vec3_make(0, 3.05f, 0),
-                  drift_vec3_make(0, 0, 2 * h), red); // left wall
-    test_add_quad(r.scene, drift_vec3_make(h, 0, -h), drift_vec3_make(0, 0, 2 * h),
-                  drift_vec3_make(0, 3.05f, 0), white);
-    test_add_quad(r.scene, drift_vec3_make(-h, 0, h), drift_vec3_make(0, 3.05f, 0),
-                  drift_vec3_make(2 * h, 0, 0), white);
+    test_add_open_room(r.scene, 1.5f, white, red);
     test_add_quad(r.scene, drift_vec3_make(-0.1f, 0.8f, -0.2f), drift_vec3_make(0.8f, 0, 0),
                   drift_vec3_make(0, 0, 0.8f), white); // the table, facing down and up
     test_add_quad(r.scene, drift_vec3_make(-0.1f, 0.8f, -0.2f), drift_vec3_make(0, 0, 0.8f),
