@@ -205,7 +205,8 @@ int render_hybrid(const render_options *o, const cli_session *session)
     drift_scene *scene = session->scene;
     const char *scene_path = session->scene_path;
     drift_hybrid *frame = NULL;
-    drift_temporal *temporal = NULL; // --temporal on (--frames: a still camera's sequence)
+    drift_temporal *temporal = NULL;  // --temporal on (--frames: a still camera's sequence)
+    drift_still_refine *still = NULL; // and its refinement toward the path tracer
     drift_result r = DRIFT_OK;
     int exit_code = 1;
     if (o->aperture >= 0.0) {
@@ -254,6 +255,13 @@ int render_hybrid(const render_options *o, const cli_session *session)
     if (o->temporal) {
         r = drift_temporal_create(ctx, params.width, params.height, &o->temporal_settings,
                                   &temporal);
+        if (r == DRIFT_OK && !o->temporal_settings.no_still_refine) {
+            r = drift_still_refine_create(
+                ctx, scene, session->accel, params.width, params.height,
+                &(drift_still_refine_settings){ .seed = (uint32_t)o->seed,
+                                                .max_depth = (int32_t)o->max_depth },
+                &still);
+        }
     }
     for (long k = 0; k < o->frames && r == DRIFT_OK; ++k) {
         drift_camera camera = scene->camera;
@@ -264,6 +272,10 @@ int render_hybrid(const render_options *o, const cli_session *session)
         if (r == DRIFT_OK && temporal) {
             r = drift_temporal_apply(temporal, drift_hybrid_gbuffer(frame), &camera,
                                      drift_hybrid_image(frame));
+        }
+        if (r == DRIFT_OK && still) {
+            r = drift_still_refine_apply(still, &scene->camera, drift_temporal_image(temporal),
+                                         render_catch_sigint());
         }
         if (k == 0) {
             first = drift_hybrid_get_stats(frame);
@@ -285,8 +297,9 @@ int render_hybrid(const render_options *o, const cli_session *session)
     }
     // --out, its PNG, --aov and --stats: all written, or none.
     render_stage stage = { 0 };
-    const drift_image *image =
-        temporal ? drift_temporal_image(temporal) : drift_hybrid_image(frame);
+    const drift_image *image = still      ? drift_still_refine_image(still)
+                               : temporal ? drift_temporal_image(temporal)
+                                          : drift_hybrid_image(frame);
     if (!render_stage_hybrid_images(ctx, o, image, frame, NULL, &stage)) {
         goto done;
     }
@@ -333,6 +346,7 @@ int render_hybrid(const render_options *o, const cli_session *session)
            drift_hybrid_get_stats(frame).frame_ms);
     exit_code = 0;
 done:
+    drift_still_refine_destroy(still);
     drift_temporal_destroy(temporal);
     drift_hybrid_destroy(frame);
     return exit_code;
