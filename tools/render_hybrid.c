@@ -25,9 +25,17 @@ static void render_stage_label(const drift_hybrid_params *p, const char *stage, 
     snprintf(out, size, "%s", stage);
 }
 
+// --temporal on's frames: their count, the wall time of them all (rendering, reuse and still
+// refinement) and the path-traced samples the refinement gathered.
+typedef struct temporal_stats {
+    long frames;
+    double ms;
+    uint32_t still_samples;
+} temporal_stats;
+
 static bool write_stats(const render_options *o, const cli_session *session,
                         const drift_hybrid *frame, const drift_hybrid_stats *first, double t_done,
-                        const char *path)
+                        const temporal_stats *temporal, const char *path)
 {
     double first_frame_ms = first->frame_ms;
     drift_hybrid_params p = drift_hybrid_get_params(frame);
@@ -67,6 +75,12 @@ static bool write_stats(const render_options *o, const cli_session *session,
     cli_json_count(root, "aa", p.aa ? p.aa : 1);
     cJSON_AddNumberToObject(root, "max_depth", p.max_depth);
     cJSON_AddNumberToObject(root, "threads", drift_context_thread_count(session->ctx));
+    if (temporal) {
+        cJSON *t = cJSON_AddObjectToObject(root, "temporal");
+        cli_json_count(t, "frames", (uint64_t)temporal->frames);
+        cli_json_number(t, "frames_ms", temporal->ms, 3);
+        cli_json_count(t, "still_samples", temporal->still_samples);
+    }
     uint64_t total_rays = 0;
     cJSON *passes = cJSON_AddObjectToObject(root, "passes");
     for (int k = 0; k < DRIFT_PASS_COUNT; ++k) {
@@ -263,6 +277,7 @@ int render_hybrid(const render_options *o, const cli_session *session)
                 &still);
         }
     }
+    double t_frames = drift_time_now();
     for (long k = 0; k < o->frames && r == DRIFT_OK; ++k) {
         drift_camera camera = scene->camera;
         if (temporal) {
@@ -281,6 +296,9 @@ int render_hybrid(const render_options *o, const cli_session *session)
             first = drift_hybrid_get_stats(frame);
         }
     }
+    temporal_stats timing = { .frames = o->frames,
+                              .ms = 1e3 * (drift_time_now() - t_frames),
+                              .still_samples = drift_still_refine_samples(still) };
     if (r == DRIFT_ERR_CANCELLED) {
         fprintf(stderr, "drift render: interrupted; a hybrid frame is all or nothing, nothing "
                         "written\n");
@@ -304,8 +322,8 @@ int render_hybrid(const render_options *o, const cli_session *session)
         goto done;
     }
     double t_done = drift_time_now();
-    if (o->stats_path &&
-        !write_stats(o, session, frame, &first, t_done, render_stage_add(&stage, o->stats_path))) {
+    if (o->stats_path && !write_stats(o, session, frame, &first, t_done, temporal ? &timing : NULL,
+                                      render_stage_add(&stage, o->stats_path))) {
         fprintf(stderr, "drift render: nothing written\n");
         render_stage_abort(&stage);
         goto done;
