@@ -410,6 +410,7 @@ int render_sequence(const render_options *o, cli_session *session)
         }
         // A moving scene changes under the path tracer's accumulation: no refinement there.
         if (o->temporal && !o->temporal_settings.no_still_refine && !s.anim &&
+            drift_still_refine_applies(&params) &&
             (r = drift_still_refine_create(
                  ctx, session->scene, session->accel, params.width, params.height,
                  &(drift_still_refine_settings){ .seed = (uint32_t)o->seed,

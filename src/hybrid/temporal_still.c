@@ -81,6 +81,12 @@ drift_result drift_still_refine_create(drift_context *ctx, const drift_scene *sc
     return DRIFT_OK;
 }
 
+bool drift_still_refine_applies(const drift_hybrid_params *params)
+{
+    return params && !params->reflection_edits &&
+           drift_hybrid_params_technique(params, DRIFT_EFFECT_GLARE) == 0;
+}
+
 void drift_still_refine_reset(drift_still_refine *s)
 {
     if (s) {

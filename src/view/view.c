@@ -482,10 +482,13 @@ drift_result drift_view_frame(drift_view *view, const atomic_bool *cancel)
         r = drift_temporal_apply(view->temporal, drift_hybrid_gbuffer(view->hybrid), &camera,
                                  drift_hybrid_image(view->hybrid));
     }
-    if (r == DRIFT_OK && view->still) {
+    bool refined = view->still && drift_still_refine_applies(&view->params);
+    if (r == DRIFT_OK && refined) {
         // The camera before its jitter: a still one refines toward the path tracer.
         r = drift_still_refine_apply(view->still, &view->camera,
                                      drift_temporal_image(view->temporal), cancel);
+    } else {
+        drift_still_refine_reset(view->still); // glare or edits on: the temporal image alone
     }
     if (r != DRIFT_OK) {
         return r;
@@ -537,7 +540,7 @@ drift_result drift_view_frame(drift_view *view, const atomic_bool *cancel)
     // The shown buffer: the composed frame, or a plane by name (it may have disappeared with
     // a technique change; then the frame again).
     const drift_image *shown = view->sir        ? drift_refine_image(view->sir)
-                               : view->still    ? drift_still_refine_image(view->still)
+                               : refined        ? drift_still_refine_image(view->still)
                                : view->temporal ? drift_temporal_image(view->temporal)
                                                 : drift_hybrid_image(view->hybrid);
     const char *plane_name = NULL; // NULL: the composed frame
