@@ -140,7 +140,8 @@ typedef struct drift_still_refine_settings {
 typedef struct drift_still_refine drift_still_refine;
 
 // Whether a frame of `params` can be refined: not under the frame's own glare pass or reflection
-// edits, which the path tracer does not render (the image would move to one without them).
+// edits (a constraint), which the path tracer does not render (the image would move to one
+// without them).
 bool drift_still_refine_applies(const drift_hybrid_params *params);
 // scene and accel are borrowed and must outlive the object. Errors: DRIFT_ERR_INVALID_ARGUMENT
 // (a size below 1, radius above 32), DRIFT_ERR_OUT_OF_MEMORY.

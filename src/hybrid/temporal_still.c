@@ -83,7 +83,9 @@ drift_result drift_still_refine_create(drift_context *ctx, const drift_scene *sc
 
 bool drift_still_refine_applies(const drift_hybrid_params *params)
 {
-    return params && !params->reflection_edits &&
+    return params &&
+           (!params->reflection_edits ||
+            drift_reflection_edits_constraint_count(params->reflection_edits) == 0) &&
            drift_hybrid_params_technique(params, DRIFT_EFFECT_GLARE) == 0;
 }
 
