@@ -288,6 +288,10 @@ static const cli_option render_table[] = {
             "frames the temporal accumulation averages at most (default 32)"),
     CLI_INT("--temporal-passes", "N", O, temporal_settings.filter_passes, 0, 8,
             "a-trous passes of the temporal filter (default 3; 0: none)"),
+    CLI_CHOICE("--still-refine", "on|off", O, still_refine, "off|on",
+               "--temporal on, a still camera: each frame adds a path-traced sample\n"
+               "a pixel, denoised and blended in where its error is the lower\n"
+               "(default on; docs/temporal.md)"),
     CLI_CUSTOM("--probe", "X,Y,Z|object", O, hybrid, parse_probe,
                "environment-map probe: a point, or one per reflective mesh\n"
                "(default: the scene's centre)"),
@@ -349,7 +353,8 @@ int render_parse_options(int argc, char **argv, render_options *o)
                            .debug_sample = -1,
                            .aperture = -1.0,
                            .focus_distance = -1.0,
-                           .temporal_settings = { .filter_passes = -1 } };
+                           .temporal_settings = { .filter_passes = -1 },
+                           .still_refine = true };
     const char *first[CLI_GROUP_COUNT] = { 0 };
     cli_knobs_unset(&o->hybrid);
     int status = cli_parse(&render_command, argc, argv, o, first);
@@ -359,6 +364,7 @@ int render_parse_options(int argc, char **argv, render_options *o)
     cli_knobs_finish(&o->hybrid, o->refine.enabled);
     // --temporal-passes 0 is no filter (0 in drift_temporal_settings is the default).
     o->temporal_settings.no_filter = o->temporal_settings.filter_passes == 0;
+    o->temporal_settings.no_still_refine = !o->still_refine;
     o->temporal_settings.filter_passes =
         o->temporal_settings.filter_passes > 0 ? o->temporal_settings.filter_passes : 0;
     o->hybrid_option = first[0];

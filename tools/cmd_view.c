@@ -41,6 +41,7 @@ typedef struct view_options {
     bool refine;            // --refine sir
     long refine_budget;     // --budget: SIR samples a frame (0: the default)
     bool temporal;          // --temporal on: reuse across frames (docs/temporal.md)
+    bool still_refine;      // --still-refine on|off: a still camera refines to the path tracer
     const char *edits_path; // --reflection-edits: loaded if it exists, saved by the save key
 } view_options;
 
@@ -136,6 +137,10 @@ static const cli_option view_table[] = {
     CLI_CHOICE("--temporal", "off|on", O, temporal, "off|on",
                "reuse across frames: a still camera converges, a moving one\n"
                "reprojects its history (docs/temporal.md; not with --refine)"),
+    CLI_CHOICE("--still-refine", "on|off", O, still_refine, "off|on",
+               "--temporal on, a still camera: each frame adds a path-traced\n"
+               "sample a pixel, denoised and blended in where its error is the\n"
+               "lower (default on; docs/temporal.md)"),
     CLI_NUMBER("--exposure", "STOPS", O, exposure, -64.0, 64.0, "display exposure (default 0)"),
     CLI_FLAG("--no-overlay", O, no_overlay, "start without the text overlay"),
     CLI_CUSTOM("--press", "KEY,KEY,...", O, press, parse_press,
@@ -253,7 +258,9 @@ static bool parse_press(const char *cmd, const char *flag, const char *v, void *
 // Returns 0 on success, 2 on a usage error (message printed), -1 after --help.
 static int parse_options(int argc, char **argv, view_options *o)
 {
-    *o = (view_options){ .spp = 4, .spp_per_frame = 1, .hybrid = drift_hybrid_params_default() };
+    *o = (view_options){
+        .spp = 4, .spp_per_frame = 1, .hybrid = drift_hybrid_params_default(), .still_refine = true
+    };
     cli_knobs_unset(&o->hybrid);
     int status = cli_parse(&view_command, argc, argv, o, NULL);
     if (status != CLI_PARSED) {
@@ -645,22 +652,23 @@ int drift_cmd_view(int argc, char **argv)
     const char *scene_path = session.scene_path;
     drift_hybrid_params params = o.hybrid;
     params.spp = (uint32_t)o.spp;
-    drift_result r =
-        drift_view_create(ctx, session.scene, session.accel,
-                          &(drift_view_desc){ .width = (int32_t)o.width,
-                                              .height = (int32_t)o.height,
-                                              .hybrid = params,
-                                              .spp_per_frame = (uint32_t)o.spp_per_frame,
-                                              .seed = (uint32_t)o.seed,
-                                              .exposure_stops = (float)o.exposure,
-                                              .split = o.split,
-                                              .hide_overlay = o.no_overlay,
-                                              .help_text = help_text(),
-                                              .refine = o.refine,
-                                              .refine_budget = (uint32_t)o.refine_budget,
-                                              .temporal = o.temporal,
-                                              .reflection_edits_path = o.edits_path },
-                          &view);
+    drift_result r = drift_view_create(
+        ctx, session.scene, session.accel,
+        &(drift_view_desc){ .width = (int32_t)o.width,
+                            .height = (int32_t)o.height,
+                            .hybrid = params,
+                            .spp_per_frame = (uint32_t)o.spp_per_frame,
+                            .seed = (uint32_t)o.seed,
+                            .exposure_stops = (float)o.exposure,
+                            .split = o.split,
+                            .hide_overlay = o.no_overlay,
+                            .help_text = help_text(),
+                            .refine = o.refine,
+                            .refine_budget = (uint32_t)o.refine_budget,
+                            .temporal = o.temporal,
+                            .temporal_settings = { .no_still_refine = !o.still_refine },
+                            .reflection_edits_path = o.edits_path },
+        &view);
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift view: %s\n", drift_result_string(r));
         goto done;

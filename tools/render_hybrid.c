@@ -6,6 +6,7 @@
 #include "drift/refine.h"
 #include "render.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -25,9 +26,19 @@ static void render_stage_label(const drift_hybrid_params *p, const char *stage, 
     snprintf(out, size, "%s", stage);
 }
 
+// --temporal on's frames: their count, the wall time of them all (rendering, reuse and still
+// refinement), of each (the first holds the techniques' set-up) and the path-traced samples
+// the refinement gathered.
+typedef struct temporal_stats {
+    long frames;
+    double ms;
+    uint32_t still_samples;
+    cJSON *frame_ms; // an array, handed to the stats object
+} temporal_stats;
+
 static bool write_stats(const render_options *o, const cli_session *session,
                         const drift_hybrid *frame, const drift_hybrid_stats *first, double t_done,
-                        const char *path)
+                        const temporal_stats *temporal, const char *path)
 {
     double first_frame_ms = first->frame_ms;
     drift_hybrid_params p = drift_hybrid_get_params(frame);
@@ -67,6 +78,13 @@ static bool write_stats(const render_options *o, const cli_session *session,
     cli_json_count(root, "aa", p.aa ? p.aa : 1);
     cJSON_AddNumberToObject(root, "max_depth", p.max_depth);
     cJSON_AddNumberToObject(root, "threads", drift_context_thread_count(session->ctx));
+    if (temporal) {
+        cJSON *t = cJSON_AddObjectToObject(root, "temporal");
+        cli_json_count(t, "frames", (uint64_t)temporal->frames);
+        cli_json_number(t, "frames_ms", temporal->ms, 3);
+        cli_json_count(t, "still_samples", temporal->still_samples);
+        cJSON_AddItemReferenceToObject(t, "frame_ms", temporal->frame_ms);
+    }
     uint64_t total_rays = 0;
     cJSON *passes = cJSON_AddObjectToObject(root, "passes");
     for (int k = 0; k < DRIFT_PASS_COUNT; ++k) {
@@ -205,7 +223,9 @@ int render_hybrid(const render_options *o, const cli_session *session)
     drift_scene *scene = session->scene;
     const char *scene_path = session->scene_path;
     drift_hybrid *frame = NULL;
-    drift_temporal *temporal = NULL; // --temporal on (--frames: a still camera's sequence)
+    drift_temporal *temporal = NULL;  // --temporal on (--frames: a still camera's sequence)
+    drift_still_refine *still = NULL; // and its refinement toward the path tracer
+    cJSON *frame_ms = NULL;           // --temporal on: each frame's wall time
     drift_result r = DRIFT_OK;
     int exit_code = 1;
     if (o->aperture >= 0.0) {
@@ -254,8 +274,19 @@ int render_hybrid(const render_options *o, const cli_session *session)
     if (o->temporal) {
         r = drift_temporal_create(ctx, params.width, params.height, &o->temporal_settings,
                                   &temporal);
+        if (r == DRIFT_OK && !o->temporal_settings.no_still_refine &&
+            drift_still_refine_applies(&params)) {
+            r = drift_still_refine_create(
+                ctx, scene, session->accel, params.width, params.height,
+                &(drift_still_refine_settings){ .seed = (uint32_t)o->seed,
+                                                .max_depth = (int32_t)o->max_depth },
+                &still);
+        }
     }
+    double t_frames = drift_time_now();
+    frame_ms = cJSON_CreateArray();
     for (long k = 0; k < o->frames && r == DRIFT_OK; ++k) {
+        double t_frame = drift_time_now();
         drift_camera camera = scene->camera;
         if (temporal) {
             r = drift_temporal_prepare(frame, (uint32_t)o->seed, (uint32_t)k, &camera);
@@ -265,10 +296,20 @@ int render_hybrid(const render_options *o, const cli_session *session)
             r = drift_temporal_apply(temporal, drift_hybrid_gbuffer(frame), &camera,
                                      drift_hybrid_image(frame));
         }
+        if (r == DRIFT_OK && still) {
+            r = drift_still_refine_apply(still, &scene->camera, drift_temporal_image(temporal),
+                                         render_catch_sigint());
+        }
         if (k == 0) {
             first = drift_hybrid_get_stats(frame);
         }
+        cJSON_AddItemToArray(frame_ms,
+                             cJSON_CreateNumber(round(1e6 * (drift_time_now() - t_frame)) / 1e3));
     }
+    temporal_stats timing = { .frames = o->frames,
+                              .ms = 1e3 * (drift_time_now() - t_frames),
+                              .still_samples = drift_still_refine_samples(still),
+                              .frame_ms = frame_ms };
     if (r == DRIFT_ERR_CANCELLED) {
         fprintf(stderr, "drift render: interrupted; a hybrid frame is all or nothing, nothing "
                         "written\n");
@@ -285,14 +326,15 @@ int render_hybrid(const render_options *o, const cli_session *session)
     }
     // --out, its PNG, --aov and --stats: all written, or none.
     render_stage stage = { 0 };
-    const drift_image *image =
-        temporal ? drift_temporal_image(temporal) : drift_hybrid_image(frame);
+    const drift_image *image = still      ? drift_still_refine_image(still)
+                               : temporal ? drift_temporal_image(temporal)
+                                          : drift_hybrid_image(frame);
     if (!render_stage_hybrid_images(ctx, o, image, frame, NULL, &stage)) {
         goto done;
     }
     double t_done = drift_time_now();
-    if (o->stats_path &&
-        !write_stats(o, session, frame, &first, t_done, render_stage_add(&stage, o->stats_path))) {
+    if (o->stats_path && !write_stats(o, session, frame, &first, t_done, temporal ? &timing : NULL,
+                                      render_stage_add(&stage, o->stats_path))) {
         fprintf(stderr, "drift render: nothing written\n");
         render_stage_abort(&stage);
         goto done;
@@ -333,6 +375,8 @@ int render_hybrid(const render_options *o, const cli_session *session)
            drift_hybrid_get_stats(frame).frame_ms);
     exit_code = 0;
 done:
+    cJSON_Delete(frame_ms);
+    drift_still_refine_destroy(still);
     drift_temporal_destroy(temporal);
     drift_hybrid_destroy(frame);
     return exit_code;

@@ -130,6 +130,7 @@ typedef struct sequence_run {
     double fps;
     drift_hybrid *frame;
     drift_temporal *temporal;
+    drift_still_refine *still; // a camera that stands refines toward the path tracer
     // --glare static|dynamic: applied here, after the temporal reuse, with the sequence's time
     // step 1 / fps (the hybrid frame's own glare pass steps by the wall clock)
     drift_glare *glare;
@@ -179,6 +180,16 @@ static int hybrid_frame(sequence_run *s, long k, const drift_camera *camera, con
             return 1;
         }
         image = drift_temporal_image(s->temporal);
+    }
+    if (s->still) {
+        // The camera before its jitter: frames where it stands refine (the viewer's).
+        r = drift_still_refine_apply(s->still, camera, image, render_catch_sigint());
+        if (r != DRIFT_OK) {
+            fprintf(stderr, "drift render: still refinement failed: %s\n", drift_result_string(r));
+            return r == DRIFT_ERR_CANCELLED ? render_interrupt_status() : 1;
+        }
+        image = drift_still_refine_image(s->still);
+        cJSON_AddNumberToObject(entry, "still_samples", drift_still_refine_samples(s->still));
     }
     if (s->glare) {
         double dt = k > o->frame_first ? 1.0 / s->fps : 0.0;
@@ -397,6 +408,17 @@ int render_sequence(const render_options *o, cli_session *session)
             exit_code = r == DRIFT_ERR_INVALID_ARGUMENT ? 2 : 1;
             goto done;
         }
+        // A moving scene changes under the path tracer's accumulation: no refinement there.
+        if (o->temporal && !o->temporal_settings.no_still_refine && !s.anim &&
+            drift_still_refine_applies(&params) &&
+            (r = drift_still_refine_create(
+                 ctx, session->scene, session->accel, params.width, params.height,
+                 &(drift_still_refine_settings){ .seed = (uint32_t)o->seed,
+                                                 .max_depth = (int32_t)o->max_depth },
+                 &s.still)) != DRIFT_OK) {
+            fprintf(stderr, "drift render: %s\n", drift_result_string(r));
+            goto done;
+        }
     }
     exit_code = run_frames(&s);
     if (exit_code == 0 && o->stats_path) {
@@ -413,6 +435,7 @@ int render_sequence(const render_options *o, cli_session *session)
     }
 done:
     cJSON_Delete(s.stats);
+    drift_still_refine_destroy(s.still);
     drift_temporal_destroy(s.temporal);
     drift_glare_destroy(s.glare);
     drift_image_destroy(ctx, &s.glared);

@@ -30,6 +30,8 @@
 //   filter_passes    = 0 -> 3; no_filter = true: none
 //   phi_luminance    = 0 -> 4
 //   depth_sigma      = 0 -> 1
+//   no_still_refine  = false: a still camera's frames refine toward the path tracer (the
+//                      drivers' drift_still_refine, below); true: the temporal image alone
 //
 // STEP BY STEP
 //   drift_temporal *t = NULL;
@@ -44,6 +46,7 @@
 #ifndef DRIFT_TEMPORAL_H
 #define DRIFT_TEMPORAL_H
 
+#include "drift/accel.h"
 #include "drift/core.h"
 #include "drift/hybrid.h"
 #include "drift/image.h"
@@ -62,6 +65,7 @@ typedef struct drift_temporal_settings {
     bool no_filter;
     float phi_luminance;
     float depth_sigma;
+    bool no_still_refine; // true: a still camera shows the temporal image alone (below)
 } drift_temporal_settings;
 
 // The settings with every 0 replaced by its default.
@@ -107,6 +111,56 @@ drift_vec2 drift_temporal_jitter(uint32_t frame);
 // the pixel sees no surface, 1 where its history was rejected).
 const drift_image *drift_temporal_image(const drift_temporal *t);
 const drift_image *drift_temporal_history(const drift_temporal *t);
+
+// --- STILL REFINEMENT (--still-refine on|off; docs/temporal.md "Still camera") ---
+//
+// The temporal history converges to the hybrid frame's mean, which keeps the techniques' bias
+// (ISM's one clamped bounce, shadow maps). Once the camera stands still, each frame also adds
+// `spp` samples of drift's path tracer (drift/pt.h; through the unjittered camera, its own
+// pixel jitter) to an accumulation, denoises it (drift_denoise_feature, `--denoise on`'s
+// filter) and shows, per pixel, the blend of the two that the estimated errors favour:
+//   Y_h the temporal image's luminance, Y_p and v_p the raw path-traced mean's and the
+//   variance of that mean (DRIFT_PT_AOV_VARIANCE); over a (2r+1)^2 box window B:
+//     hybrid error^2   e_h = max(B[(Y_h - Y_p)^2] - B[v_p], 0)   (its bias^2 plus its noise)
+//     path error^2     e_p = denoised_error x B[v_p]             (what the filter leaves)
+//     w = e_h / (e_h + e_p);  shown = (1 - w) hybrid + w denoised
+// so the image moves to the path tracer as its error falls below the hybrid's, and converges
+// to the reference. The first frame after a change of camera (or a reset: new techniques, a
+// moved scene) starts the accumulation over and shows the hybrid alone; below 2 samples (no
+// variance yet) the hybrid is shown. Bit-identical for any thread count (the path tracer's
+// and the denoiser's guarantee; the blend is a gather).
+typedef struct drift_still_refine_settings {
+    uint32_t spp;         // 0 -> 1 path-traced sample a pixel each still frame
+    uint32_t seed;        // the path tracer's seed
+    int32_t max_depth;    // 0 -> the path tracer's default (8)
+    float denoised_error; // 0 -> 0.25: the denoised mean's error^2 over the raw mean's variance
+    int32_t radius;       // 0 -> 4: the error windows' half-width in pixels
+} drift_still_refine_settings;
+
+typedef struct drift_still_refine drift_still_refine;
+
+// Whether a frame of `params` can be refined: not under the frame's own glare pass or reflection
+// edits (a constraint), which the path tracer does not render (the image would move to one
+// without them).
+bool drift_still_refine_applies(const drift_hybrid_params *params);
+// scene and accel are borrowed and must outlive the object. Errors: DRIFT_ERR_INVALID_ARGUMENT
+// (a size below 1, radius above 32), DRIFT_ERR_OUT_OF_MEMORY.
+drift_result drift_still_refine_create(drift_context *ctx, const drift_scene *scene,
+                                       const drift_accel *accel, int32_t width, int32_t height,
+                                       const drift_still_refine_settings *settings,
+                                       drift_still_refine **out);
+void drift_still_refine_destroy(drift_still_refine *s); // NULL-safe
+// Forgets the accumulation (new techniques, a moved scene): the next frame starts over.
+void drift_still_refine_reset(drift_still_refine *s);
+// One frame: `camera` is the frame's camera before drift_temporal_prepare's jitter (a camera
+// unlike the last call's restarts the accumulation), `hybrid` the temporal image
+// (drift_temporal_image). DRIFT_ERR_CANCELLED leaves the last image.
+drift_result drift_still_refine_apply(drift_still_refine *s, const drift_camera *camera,
+                                      const drift_image *hybrid, const atomic_bool *cancel);
+// The shown image (RGB), the path tracer's weight per pixel (1 channel) and its samples.
+const drift_image *drift_still_refine_image(const drift_still_refine *s);
+const drift_image *drift_still_refine_weight(const drift_still_refine *s);
+uint32_t drift_still_refine_samples(const drift_still_refine *s);
 
 #ifdef __cplusplus
 }

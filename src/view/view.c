@@ -254,6 +254,11 @@ drift_result drift_view_create(drift_context *ctx, const drift_scene *scene,
     view->base_seed = view->params.seed;
     if (d.temporal && !d.refine) {
         r = drift_temporal_create(ctx, width, height, &d.temporal_settings, &view->temporal);
+        if (r == DRIFT_OK && !d.temporal_settings.no_still_refine) {
+            r = drift_still_refine_create(ctx, scene, accel, width, height,
+                                          &(drift_still_refine_settings){ .seed = view->base_seed },
+                                          &view->still);
+        }
         if (r != DRIFT_OK) {
             goto fail;
         }
@@ -282,6 +287,7 @@ void drift_view_destroy(drift_view *view)
     }
     drift_context *ctx = view->ctx;
     drift_refine_destroy(view->sir);
+    drift_still_refine_destroy(view->still);
     drift_temporal_destroy(view->temporal);
     drift_hybrid_destroy(view->hybrid);
     drift_pt_destroy(view->reference);
@@ -453,6 +459,7 @@ drift_result drift_view_frame(drift_view *view, const atomic_bool *cancel)
     drift_result r = DRIFT_OK;
     if (view->params_changed) {
         drift_temporal_reset(view->temporal); // other techniques: the history is another image
+        drift_still_refine_reset(view->still);
         view->temporal_frame = 0;
         view->params.seed = view->base_seed;
         r = drift_hybrid_set_params(view->hybrid, &view->params);
@@ -474,6 +481,14 @@ drift_result drift_view_frame(drift_view *view, const atomic_bool *cancel)
     if (r == DRIFT_OK && view->temporal) {
         r = drift_temporal_apply(view->temporal, drift_hybrid_gbuffer(view->hybrid), &camera,
                                  drift_hybrid_image(view->hybrid));
+    }
+    bool refined = view->still && drift_still_refine_applies(&view->params);
+    if (r == DRIFT_OK && refined) {
+        // The camera before its jitter: a still one refines toward the path tracer.
+        r = drift_still_refine_apply(view->still, &view->camera,
+                                     drift_temporal_image(view->temporal), cancel);
+    } else {
+        drift_still_refine_reset(view->still); // glare or edits on: the temporal image alone
     }
     if (r != DRIFT_OK) {
         return r;
@@ -525,6 +540,7 @@ drift_result drift_view_frame(drift_view *view, const atomic_bool *cancel)
     // The shown buffer: the composed frame, or a plane by name (it may have disappeared with
     // a technique change; then the frame again).
     const drift_image *shown = view->sir        ? drift_refine_image(view->sir)
+                               : refined        ? drift_still_refine_image(view->still)
                                : view->temporal ? drift_temporal_image(view->temporal)
                                                 : drift_hybrid_image(view->hybrid);
     const char *plane_name = NULL; // NULL: the composed frame
