@@ -375,6 +375,17 @@ static void test_still_camera_converges(void **state)
     test_rig_destroy(&r);
 }
 
+// Mean absolute difference of a view's framebuffer from `ref`, in sRGB levels.
+static double view_error(const drift_view *view, const uint8_t *ref, int w)
+{
+    const uint8_t *px = drift_view_pixels(view);
+    double err = 0.0;
+    for (int i = 0; i < 3 * w * w; ++i) {
+        err += fabs((double)px[i] - (double)ref[i]) / (3.0 * w * w);
+    }
+    return err;
+}
+
 // The viewer with temporal reuse: a still camera's framebuffer after 16 frames is nearer the
 // converged frame's (8 x 64 spp over the pixel) than one frame's is, by more than half.
 static void test_view_converges(void **state)
@@ -407,10 +418,7 @@ static void test_view_converges(void **state)
     double err[2] = { 0.0, 0.0 };
     const uint8_t *ref = drift_view_pixels(views[2]);
     for (int v = 0; v < 2; ++v) {
-        const uint8_t *px = drift_view_pixels(views[v]);
-        for (int i = 0; i < 3 * w * w; ++i) {
-            err[v] += fabs((double)px[i] - (double)ref[i]) / (3.0 * w * w);
-        }
+        err[v] = view_error(views[v], ref, w);
     }
     if (getenv("DRIFT_TEST_VERBOSE")) {
         fprintf(stderr, "temporal view error %g, one frame %g (sRGB levels)\n", err[0], err[1]);
@@ -455,10 +463,7 @@ static void test_view_still_refines(void **state)
     for (int k = 1; k <= 16; ++k) {
         for (int v = 0; v < 2; ++v) {
             assert_int_equal(drift_view_frame(views[v], NULL), DRIFT_OK);
-            const uint8_t *px = drift_view_pixels(views[v]);
-            for (int i = 0; i < 3 * w * w; ++i) {
-                err[v][k] += fabs((double)px[i] - (double)ref[i]) / (3.0 * w * w);
-            }
+            err[v][k] = view_error(views[v], ref, w);
         }
         if (getenv("DRIFT_TEST_VERBOSE")) {
             fprintf(stderr, "frames %d: refined %g, history alone %g (sRGB levels)\n", k, err[0][k],
