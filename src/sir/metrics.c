@@ -7,336 +7,10 @@
 //   shadow          1 where drift_shadow_map_penumbra says a light's penumbra may fall, or
 //                   where an area light straddles the receiver's tangent plane; dilated (2 px
 //                   at 600 rows a 512-texel face, growing with the pixels a texel spans)
-#include "sir/sir.h"
+#include "sir/metrics_internal.h"
 
-#include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-// A polygonal light's corners (a quad's four, a triangle's three, a small emissive mesh's
-// vertices): the shadow metric bounds the light by them instead of its bounding sphere.
-#define MAX_CORNERS 64
-
-// A metric's value is its expected display-value error over this (the lambda fit's scale of
-// the real error), so it orders pixels as the error does.
-#define REAL_ERROR_SCALE 0.1f
-// A raster shadow this close to 0 or 1 claims an umbra or full light.
-#define CERTAIN_SHADOW 0.001f
-// Penumbra pixels whose raster shadows differ by more are not averaged together: across a
-// narrow contact shadow PCSS is too bright on one side and too dark on the other.
-#define SIMILAR_SHADOW 0.15f
-// The square over which the expected reflection error is averaged: 5 x 5 pixels.
-#define EXPECTED_RADIUS 2
-
-typedef struct light_shape {
-    uint32_t count; // 0: use the bounding sphere
-    bool planar;    // one-sided and every part faces `direction`: nothing lights its back
-    drift_vec3 corner[MAX_CORNERS];
-} light_shape;
-
-// What a penumbra pixel's shadow rays say of the raster's shadow there.
-typedef struct penumbra_check {
-    drift_vec3 delta;  // the raster's estimated shadow error, summed over the area lights
-    float raster;      // the raster's shadow S_l, averaged over those lights
-    bool contradicted; // its own rays saw what a raster claiming certainty denies
-} penumbra_check;
-
-typedef struct metric_job {
-    const drift_refine_metric_params *params;
-    drift_image *out;
-    float ao_radius;
-    uint64_t ao_rays;
-    light_shape *shapes;    // one a frame light, or NULL: bounding spheres
-    float *expected;        // a pixel's expected reflection error (-1: not reflective), or NULL
-    penumbra_check *checks; // a pixel: the raster's shadow checked by rays
-    float *coarse;          // the penumbra estimate at each 2 x 2 block's corner pixel, a light
-} metric_job;
-
-static bool is_reflective(const drift_frame_state *f, const drift_surface *s)
-{
-    if (s->material == DRIFT_INVALID_INDEX) {
-        return false;
-    }
-    const drift_material *m = &f->scene->materials[s->material];
-    return !drift_vec3_is_zero(m->specular) &&
-           (m->type == DRIFT_MATERIAL_MIRROR || m->exponent > 0.0f);
-}
-
-// The environment map's centre for a pixel of `mesh`: its probe when captured, else where the
-// frame would put the scene probe.
-static drift_vec3 probe_centre(const drift_frame_state *f, uint32_t mesh)
-{
-    const drift_envmap *map = drift_realtime_probe_of(f, mesh);
-    if (map) {
-        return drift_envmap_probe(map);
-    }
-    if (f->params.envmap.has_probe) {
-        return f->params.envmap.probe;
-    }
-    return drift_vec3_scale(drift_vec3_add(f->scene->bounds.min, f->scene->bounds.max), 0.5f);
-}
-
-// The farthest a point of the scene can be from c: the farthest corner of the bounds.
-static float max_distance(const drift_scene *scene, drift_vec3 c)
-{
-    float best = 0.0f;
-    for (int k = 0; k < 8; ++k) {
-        drift_vec3 corner = { (k & 1) ? scene->bounds.max.x : scene->bounds.min.x,
-                              (k & 2) ? scene->bounds.max.y : scene->bounds.min.y,
-                              (k & 4) ? scene->bounds.max.z : scene->bounds.min.z };
-        best = fmaxf(best, drift_vec3_length(drift_vec3_sub(corner, c)));
-    }
-    return best;
-}
-
-static float ambient_occlusion(const drift_frame_state *f, const drift_surface *s, float radius,
-                               uint32_t samples, drift_sampler *sampler, uint64_t *rays)
-{
-    drift_frame frame = drift_frame_from_normal(s->ns);
-    uint32_t hits = 0;
-    for (uint32_t k = 0; k < samples; ++k) {
-        drift_vec3 dir = drift_frame_to_world(
-            &frame, drift_sample_cosine_hemisphere(drift_sampler_next2(sampler)));
-        drift_ray ray = { .origin = drift_offset_origin(s->position, s->ng, dir),
-                          .dir = dir,
-                          .tmin = 0.0f,
-                          .tmax = radius };
-        ++*rays;
-        hits += drift_accel_occluded(f->accel, &ray) ? 1u : 0u;
-    }
-    return samples ? (float)hits / (float)samples : 0.0f;
-}
-
-static float display(float v)
-{
-    return powf(drift_clampf(v, 0.0f, 1.0f), 1.0f / 2.2f);
-}
-
-// How far the displayed pixel `base` moves when `delta` is added (largest channel, display
-// values: clamp to [0,1], gamma 1/2.2, as the real error is measured).
-static float display_change(drift_vec3 base, drift_vec3 delta)
-{
-    drift_vec3 moved = drift_vec3_add(base, delta);
-    return fmaxf(
-        fmaxf(fabsf(display(moved.x) - display(base.x)), fabsf(display(moved.y) - display(base.y))),
-        fabsf(display(moved.z) - display(base.z)));
-}
-
-static drift_vec3 seen_in_map(const drift_envmap *map, drift_vec3 dir, float cone, bool mirror)
-{
-    drift_raster_radiance l = drift_envmap_lookup(map, dir, cone);
-    return mirror ? drift_vec3_add(l.emitted, l.reflected) : l.reflected;
-}
-
-// The most lobe rays a pixel's expected reflection error keeps for shading.
-#define MAX_LOBE_RAYS 16
-// Shadow rays a light for each lobe ray's hit when shading what a hidden q shows.
-#define HIDDEN_LIGHT_SAMPLES 2
-
-// The expected reflection error where the map cannot see q: the lobe rays' hits shaded by the
-// pure ray tracer's direct light (one bounce), as it estimates R: each sample of the Phong lobe
-// weighs ks (n + 2) / (n + 1) cos theta_i (a mirror: ks), escaped and below-surface samples
-// count zero. Against the raster's R, in display values.
-static float hidden_reflection_error(drift_frame_state *f, size_t index, const drift_bsdf *bsdf,
-                                     const drift_ray *lobe, uint32_t lobe_count, uint32_t samples,
-                                     drift_vec3 raster, drift_sampler *sampler, uint64_t *rays)
-{
-    bool mirror = bsdf->type == DRIFT_MATERIAL_MIRROR;
-    drift_refine_tracer tracer = drift_refine_tracer_make(f, 0, 1);
-    tracer.light_samples = HIDDEN_LIGHT_SAMPLES;
-    drift_vec3 sum = drift_vec3_splat(0.0f);
-    for (uint32_t k = 0; k < lobe_count; ++k) {
-        float cos_i = drift_vec3_dot(lobe[k].dir, bsdf->frame.z);
-        if (!mirror && cos_i <= 0.0f) {
-            continue;
-        }
-        drift_vec3 w = mirror
-                           ? bsdf->specular
-                           : drift_vec3_scale(bsdf->specular, (bsdf->exponent + 2.0f) /
-                                                                  (bsdf->exponent + 1.0f) * cos_i);
-        sum = drift_vec3_fma(
-            sum, drift_vec3_mul(w, drift_refine_trace_ray(&tracer, lobe[k], mirror, sampler, rays)),
-            1.0f);
-    }
-    drift_vec3 traced = drift_vec3_scale(sum, 1.0f / (float)(samples ? samples : 1));
-    return display_change(drift_image_get3(&f->final, (int32_t)(index % (size_t)f->params.width),
-                                           (int32_t)(index / (size_t)f->params.width)),
-                          drift_vec3_sub(traced, raster));
-}
-
-// The raster's own expected reflection error at a reflective pixel, in display values: R
-// looks the map up along the mirror direction r as if the pixel sat at the probe c. The mirror
-// ray and rays drawn from the lobe find where the reflection really lands (q_k) and the share
-// of it that escapes the scene; the map seen from c toward each q_k, blurred over the lobe's
-// cone as R is (parallax-corrected, as local cube maps are), is what R would hold there. The change
-// of the pixel when R takes that value, weighted by the lobe's albedo as R is, is the expected
-// error. A q hidden from c is unknown to the map: there the lobe rays' hits are shaded as the
-// ray tracer would (hidden_reflection_error). Without a map (another reflection technique)
-// the error is unknown: 1.
-static float expected_reflection_error(drift_frame_state *f, size_t index, const drift_surface *s,
-                                       drift_vec3 wo, uint32_t samples, drift_sampler *sampler,
-                                       uint64_t *rays)
-{
-    const drift_envmap *map = drift_realtime_probe_of(f, f->gbuffer.mesh_index[index]);
-    if (!map || f->params.reflections != DRIFT_REFLECTIONS_ENVMAP) {
-        return 1.0f;
-    }
-    drift_bsdf bsdf = drift_bsdf_make(f->scene, s);
-    bool mirror = bsdf.type == DRIFT_MATERIAL_MIRROR;
-    float cone = mirror ? 0.0f : drift_gloss_theta_max(&f->scene->materials[s->material]);
-    drift_vec3 c = drift_envmap_probe(map);
-    drift_vec3 r = drift_vec3_reflect(wo, s->ns);
-    // Where R looks the map up for r, and the lobe's cone as the probe sees it there (the
-    // reflection pass's own lookup: box-projected under envmap.parallax = BOX).
-    bool box = f->params.envmap.parallax == DRIFT_ENVMAP_PARALLAX_BOX;
-    float cone_map = cone;
-    drift_vec3 r_map = drift_realtime_envmap_direction(f, map, s->position, r, &cone_map);
-    drift_vec3 escaped = drift_vec3_splat(0.0f);
-    uint32_t used = 0, hit_count = 0;
-    drift_vec3 hit_at[MAX_LOBE_RAYS + 1]; // the mirror ray's and the lobe rays' hit points
-    drift_ray lobe[MAX_LOBE_RAYS];
-    uint32_t lobe_count = 0;
-    // At most MAX_LOBE_RAYS lobe rays, so that every ray cast is kept and counted.
-    uint32_t lobe_rays = mirror ? 0u : (samples < MAX_LOBE_RAYS ? samples : MAX_LOBE_RAYS);
-    for (uint32_t k = 0; k <= lobe_rays; ++k) { // k = 0: the mirror ray
-        drift_vec3 dir =
-            k == 0 ? r : drift_bsdf_sample_glossy_lobe(&bsdf, wo, drift_sampler_next2(sampler));
-        if (drift_vec3_dot(dir, s->ng) <= 0.0f) {
-            continue; // below the surface: the ray tracer gives it no weight either
-        }
-        drift_ray ray = { .origin = drift_offset_origin(s->position, s->ng, dir),
-                          .dir = dir,
-                          .tmin = 0.0f,
-                          .tmax = INFINITY };
-        drift_hit hit;
-        ++*rays;
-        ++used;
-        if (drift_accel_intersect(f->accel, &ray, &hit)) {
-            hit_at[hit_count++] = drift_vec3_fma(ray.origin, dir, hit.t);
-            if (k > 0 || mirror) {
-                lobe[lobe_count++] = ray;
-            }
-        } else if (mirror && drift_scene_has_environment(f->scene)) {
-            escaped = drift_vec3_add(escaped, drift_environment_eval(f->scene, dir));
-        } // a glossy lobe's escaped rays see the environment in D, not R
-    }
-    if (used == 0) {
-        return 0.0f;
-    }
-    drift_vec3 expected = escaped;
-    drift_vec3 weight = drift_raster_reflection_weight(&bsdf, wo);
-    drift_vec3 raster = drift_vec3_mul(weight, seen_in_map(map, r_map, cone_map, mirror));
-    // Each hit q_k shows what the map sees toward it, blurred as R is over the lobe's cone at
-    // q_k as the probe sees it: the lobe rays that meet another surface than the mirror ray's
-    // (a statue's edge in a glossy floor) are part of the expectation, not of its blind spot.
-    for (uint32_t k = 0; k < hit_count; ++k) {
-        drift_vec3 to_q = drift_vec3_sub(hit_at[k], c);
-        float distance = drift_vec3_length(to_q);
-        if (!(distance > 0.0f)) {
-            return 1.0f;
-        }
-        drift_ray from_probe = { .origin = c,
-                                 .dir = drift_vec3_scale(to_q, 1.0f / distance),
-                                 .tmin = 0.0f,
-                                 .tmax = 0.99f * distance };
-        ++*rays;
-        if (drift_accel_occluded(f->accel, &from_probe)) {
-            // A q the map cannot see (a contact, the underside of an object in the floor):
-            // what the lobe's rays see there, shaded by the tracer's direct light (a few
-            // shadow rays), is the reflection the ray tracer will find.
-            return hidden_reflection_error(f, index, &bsdf, lobe, lobe_count,
-                                           mirror ? 1u : lobe_rays, raster, sampler, rays);
-        }
-        float from_p = drift_vec3_length(drift_vec3_sub(hit_at[k], s->position));
-        float cone_q = box ? drift_envmap_parallax_cone(cone, from_p / distance) : cone;
-        expected = drift_vec3_add(expected, seen_in_map(map, to_q, cone_q, mirror));
-    }
-    expected = drift_vec3_scale(expected, 1.0f / (float)used);
-    drift_vec3 delta = drift_vec3_sub(drift_vec3_mul(weight, expected), raster);
-    return display_change(drift_image_get3(&f->final, (int32_t)(index % (size_t)f->params.width),
-                                           (int32_t)(index / (size_t)f->params.width)),
-                          delta);
-}
-
-// First pass: the expected error of each reflective pixel (-1 elsewhere), into job->expected.
-static void expected_error_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays,
-                                 void *user)
-{
-    metric_job *job = user;
-    size_t index = (size_t)y * (size_t)f->params.width + (size_t)x;
-    const drift_surface *s = &f->gbuffer.surfaces[index];
-    float expected = -1.0f;
-    if (is_reflective(f, s)) {
-        drift_sampler sampler =
-            drift_pass_sampler(f, DRIFT_STREAM_SIR_LOBE ^ job->params->seed, x, y);
-        expected = expected_reflection_error(f, index, s, drift_pass_wo(f, x, y),
-                                             job->params->lobe_samples, &sampler, rays);
-    }
-    job->expected[index] = expected;
-}
-
-// A few lobe rays a pixel make a noisy estimate; its mean over the reflective pixels of a
-// (2 radius + 1)^2 square is steadier (the error it estimates varies smoothly, but for
-// contacts, which an unknown q marks 1 and the mean spreads).
-static void smooth_expected(const float *in, int32_t w, int32_t h, int32_t radius, float *out)
-{
-    for (int32_t y = 0; y < h; ++y) {
-        for (int32_t x = 0; x < w; ++x) {
-            size_t index = (size_t)y * (size_t)w + (size_t)x;
-            float sum = 0.0f;
-            int count = 0;
-            for (int32_t v = y - radius; in[index] >= 0.0f && v <= y + radius; ++v) {
-                for (int32_t u = x - radius; v >= 0 && v < h && u <= x + radius; ++u) {
-                    float e = u >= 0 && u < w ? in[(size_t)v * (size_t)w + (size_t)u] : -1.0f;
-                    sum += e >= 0.0f ? e : 0.0f;
-                    count += e >= 0.0f;
-                }
-            }
-            out[index] = count ? sum / (float)count : in[index];
-        }
-    }
-}
-
-static void reflection_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
-{
-    metric_job *job = user;
-    const drift_refine_metric_params *params = job->params;
-    size_t index = (size_t)y * (size_t)f->params.width + (size_t)x;
-    const drift_surface *s = &f->gbuffer.surfaces[index];
-    float e[5] = { 0 };
-    if (is_reflective(f, s)) {
-        drift_vec3 wo = drift_pass_wo(f, x, y); // -i
-        drift_vec3 r = drift_vec3_reflect(wo, s->ns);
-        drift_vec3 c = probe_centre(f, f->gbuffer.mesh_index[index]);
-        float far = max_distance(f->scene, c);
-        // The paper's metrics say where an environment map may be wrong; weigh them by how
-        // wrong this one is expected to be here, so a glossy surface whose raster reflection
-        // is already right is not flagged (0 below the tolerance).
-        float tolerance = params->reflection_tolerance;
-        float expected = job->expected ? job->expected[index] : 1.0f;
-        float weight =
-            expected >= tolerance ? drift_clampf(expected / REAL_ERROR_SCALE, 0.0f, 1.0f) : 0.0f;
-        weight = job->expected ? weight : 1.0f;
-        if (weight > 0.0f) {
-            e[0] = 1.0f;
-            e[1] = far > 0.0f ? drift_vec3_length(drift_vec3_sub(s->position, c)) / far : 0.0f;
-            // <-i, r> = 2 <-i, n>^2 - 1 runs from 1 head-on to -1 at grazing view: mapped
-            // onto [0,1] growing toward grazing view, where the map's parallax is largest
-            // (clamped as printed, it was 0 wherever the view is more than 45 degrees off).
-            e[2] = 0.5f * (1.0f - drift_vec3_dot(wo, r));
-            e[3] = drift_vec3_dot(wo, s->ns);
-            drift_sampler sampler = drift_pass_sampler(f, DRIFT_STREAM_SIR_AO ^ params->seed, x, y);
-            e[4] = ambient_occlusion(f, s, job->ao_radius, params->ao_samples, &sampler, rays);
-            for (int m = 0; m < 5; ++m) {
-                e[m] *= weight;
-            }
-        }
-    }
-    for (int m = 0; m < 5; ++m) {
-        drift_image_pixel(&job->out[DRIFT_METRIC_REFLECTION1 + m], x, y)[0] =
-            drift_clampf(e[m], 0.0f, 1.0f);
-    }
-}
 
 // The corners of a light, or count 0 when it has too many or none (spheres, disks).
 static void light_corners(const drift_scene *scene, const drift_raster_light *light,
@@ -630,7 +304,7 @@ static void shadow_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *r
     // seam, or a seam darkened by the map's own surfaces), its error is known.
     float leaked = 0.0f;
     if (e == 0.0f && !drift_vec3_is_zero(leak)) {
-        float change = display_change(drift_image_get3(&f->final, x, y), leak);
+        float change = drift__sir_display_change(drift_image_get3(&f->final, x, y), leak);
         leaked = change >= job->params->leak_tolerance
                      ? drift_clampf(change / REAL_ERROR_SCALE, 0.0f, 1.0f)
                      : 0.0f;
@@ -792,14 +466,15 @@ static void gate_penumbra(drift_frame_state *f, drift_image *shadow, const penum
                     ++count;
                 }
             }
-            float change = count ? display_change(drift_image_get3(&f->final, x, y),
+            float change =
+                count ? drift__sir_display_change(drift_image_get3(&f->final, x, y),
                                                   drift_vec3_scale(sum, 1.0f / (float)count))
-                                 : 0.0f;
+                      : 0.0f;
             // The average hides a sliver the raster got wrong for certain (a fold of a
             // scanned mesh letting light into an umbra): the pixel's own estimate speaks.
             if (checks[index].contradicted) {
-                change = fmaxf(
-                    change, display_change(drift_image_get3(&f->final, x, y), checks[index].delta));
+                change = fmaxf(change, drift__sir_display_change(drift_image_get3(&f->final, x, y),
+                                                                 checks[index].delta));
             }
             scratch[(size_t)y * (size_t)w + (size_t)x] =
                 drift_image_pixel(shadow, x, y)[0] > 0.0f && change >= tolerance
@@ -830,11 +505,11 @@ uint64_t drift_refine_compute_metrics(drift_frame_state *f,
     if (job.expected) {
         float *smooth = job.expected;
         job.expected = raw;
-        rays += drift_pass_for_each_pixel(f, expected_error_pixel, &job);
-        smooth_expected(raw, f->params.width, f->params.height, EXPECTED_RADIUS, smooth);
+        rays += drift_pass_for_each_pixel(f, drift__sir_expected_error_pixel, &job);
+        drift__sir_smooth_expected(raw, f->params.width, f->params.height, EXPECTED_RADIUS, smooth);
         job.expected = smooth;
     }
-    rays += drift_pass_for_each_pixel(f, reflection_pixel, &job);
+    rays += drift_pass_for_each_pixel(f, drift__sir_reflection_pixel, &job);
     drift_free(f->ctx, job.expected);
     drift_free(f->ctx, raw);
     ensure_shadow_maps(f);
