@@ -243,3 +243,13 @@ double test_direct_light_mc(const drift_scene *scene, uint32_t light, const drif
     }
     return sum / n;
 }
+
+drift_image test_image_copy(drift_context *ctx, const drift_image *image)
+{
+    drift_image copy;
+    assert_int_equal(drift_image_create(ctx, image->width, image->height, image->channels, &copy),
+                     DRIFT_OK);
+    memcpy(copy.pixels, image->pixels,
+           sizeof(float) * (size_t)image->channels * (size_t)image->width * (size_t)image->height);
+    return copy;
+}

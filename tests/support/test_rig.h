@@ -27,6 +27,9 @@ void test_rig_frame(test_rig *r, const drift_hybrid_params *params);
 void test_rig_destroy(test_rig *r);
 // The frame's plane named `wanted`; fails the test when there is none.
 const drift_image *test_rig_plane(const test_rig *r, const char *wanted);
+// A copy of `image` (a frame's planes are replaced by its next render); free with
+// drift_image_destroy.
+drift_image test_image_copy(drift_context *ctx, const drift_image *image);
 
 uint32_t test_add_material(drift_scene *scene, drift_material m);
 // The quad corner, corner + u, corner + u + v, corner + v (two triangles, wound as listed).

@@ -136,13 +136,7 @@ static region floor_region(drift_vec3 p)
 // The frame's direct-light plane, copied (the frame is replaced by the next render).
 static drift_image direct_plane(test_rig *r)
 {
-    const drift_image *plane = test_rig_plane(r, "direct");
-    drift_image copy;
-    assert_int_equal(
-        drift_image_create(r->ctx, plane->width, plane->height, plane->channels, &copy), DRIFT_OK);
-    memcpy(copy.pixels, plane->pixels,
-           sizeof(float) * (size_t)plane->channels * (size_t)plane->width * (size_t)plane->height);
-    return copy;
+    return test_image_copy(r->ctx, test_rig_plane(r, "direct"));
 }
 
 // On the Cornell box at 4 spp AAF's shadows have well under plain Monte Carlo's error and

@@ -42,13 +42,7 @@ static test_rig room_rig(void)
 static drift_image plane_copy(test_rig *r, const drift_hybrid_params *params, const char *name)
 {
     test_rig_frame(r, params);
-    const drift_image *plane = test_rig_plane(r, name);
-    drift_image copy;
-    assert_int_equal(
-        drift_image_create(r->ctx, plane->width, plane->height, plane->channels, &copy), DRIFT_OK);
-    memcpy(copy.pixels, plane->pixels,
-           sizeof(float) * (size_t)plane->channels * (size_t)plane->width * (size_t)plane->height);
-    return copy;
+    return test_image_copy(r->ctx, test_rig_plane(r, name));
 }
 
 // The pass's plane at 4 spp unfiltered and with the denoiser instead of AAF's filter, against

@@ -29,11 +29,7 @@ static test_rig sky_rig(int threads)
 static drift_image environment_plane(test_rig *r, const drift_hybrid_params *params)
 {
     test_rig_frame(r, params);
-    const drift_image *plane = test_rig_plane(r, "environment_direct");
-    drift_image copy;
-    assert_int_equal(drift_image_create(r->ctx, plane->width, plane->height, 3, &copy), DRIFT_OK);
-    memcpy(copy.pixels, plane->pixels, sizeof(float) * 3 * (size_t)plane->width * plane->height);
-    return copy;
+    return test_image_copy(r->ctx, test_rig_plane(r, "environment_direct"));
 }
 
 // With --env-denoise on the plane is not the traced one nor the a-trous one (the filter is

@@ -252,11 +252,7 @@ void test_aa_hard_shadows_draw_the_penumbra(void **state)
             // The mesh's triangle picks are noisy: its reference shadows take 4x the samples.
             p.spp = (kind == 2 ? 1024u : 256u) / passes[k];
             test_rig_frame(&r, &p);
-            drift_image truth;
-            const drift_image *img = drift_hybrid_image(r.frame);
-            assert_int_equal(drift_image_create(r.ctx, img->width, img->height, 3, &truth),
-                             DRIFT_OK);
-            memcpy(truth.pixels, img->pixels, (size_t)img->width * img->height * 3 * sizeof(float));
+            drift_image truth = test_image_copy(r.ctx, drift_hybrid_image(r.frame));
             p.shadows = DRIFT_SHADOWS_HARD;
             test_rig_frame(&r, &p);
             rmse[k] = test_rmse(r.ctx, drift_hybrid_image(r.frame), &truth);
@@ -388,11 +384,7 @@ void test_hard_shadows_any_hit_match_closest_hit(void **state)
 static drift_image environment_plane(test_rig *r, const drift_hybrid_params *params)
 {
     test_rig_frame(r, params);
-    const drift_image *plane = test_rig_plane(r, "environment_direct");
-    drift_image copy;
-    assert_int_equal(drift_image_create(r->ctx, plane->width, plane->height, 3, &copy), DRIFT_OK);
-    memcpy(copy.pixels, plane->pixels, sizeof(float) * 3 * (size_t)plane->width * plane->height);
-    return copy;
+    return test_image_copy(r->ctx, test_rig_plane(r, "environment_direct"));
 }
 
 // A white floor (albedo 0.7, half size `half`) under a constant sky of 0.5, with a low 2 x 2
