@@ -368,9 +368,8 @@ static drift_vec3 reflection_eval_pdf(const drift_bsdf_ggx *g, drift_vec3 wo, dr
     // D_wo(h) / (4 wo.h) = G1(wo) D / (4 wo.z).
     float pdf_r = wo_h > 0.0f ? d / ((1.0f + lo) * 4.0f * wo.z) : 0.0f;
     float pdf_c = wi.z * DRIFT_INV_PI;
-    float e1_o, es_o, e1_i, es_i;
+    float e1_o, es_o;
     albedos(g, wo.z, &e1_o, &es_o);
-    albedos(g, wi.z, &e1_i, &es_i);
     drift_vec3 f = drift_vec3_splat(0.0f);
     float pdf = 0.0f;
     if (g->w_conductor > 0.0f) {
@@ -395,6 +394,8 @@ static drift_vec3 reflection_eval_pdf(const drift_bsdf_ggx *g, drift_vec3 wo, dr
             float burley = (1.0f + fd90_minus_1 * fi5) * (1.0f + fd90_minus_1 * fo5);
             base = drift_vec3_scale(g->base, burley * DRIFT_INV_PI);
         } else {
+            float e1_i, es_i; // only the layered base reads the albedo toward wi
+            albedos(g, wi.z, &e1_i, &es_i);
             drift_vec3 ec_i = coat_albedo(g->f0_coat, e1_i, es_i);
             drift_vec3 ec_avg = coat_albedo(g->f0_coat, g->e1_avg, g->es_avg);
             base = drift_vec3_mul(drift_vec3_sub(one, ec_o), drift_vec3_sub(one, ec_i));
