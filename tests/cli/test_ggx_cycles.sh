@@ -17,7 +17,8 @@
 #    metallic-roughness map after rough bounces and FLIP is 0.121 (docs/materials.md). The
 #    bound is issue 41's 0.05 missed: 0.072 at 64 spp, 0.065 at 256, 0.063 at 1024 (the plastic
 #    squares, the checker's edges; docs/lab/2026-12-07-issue-41-s4.md); drift's own noise at
-#    64 spp about 0.03.
+#    64 spp about 0.03. Without the spheres: with them the textured scene is 0.086 at 64 spp,
+#    their sub-pixel highlights and caustics (the first scene has them).
 # DRIFT_GGX_SPP overrides the spp.
 # $1 is the drift binary.
 set -u
