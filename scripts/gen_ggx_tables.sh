@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Regenerates src/scene/ggx_tables.inc (the GGX albedo tables of docs/materials.md) from the
-# integrals in src/scene/microfacet.c. About a minute on one core.
+# integrals in src/scene/microfacet.c (and the multiple-scattering lobe's scale fitted to
+# them). About a minute on one core.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 tmp="$(mktemp -d)"

@@ -482,14 +482,17 @@ drift_vec3 drift_bsdf_sample_glossy_lobe(const drift_bsdf *bsdf, drift_vec3 wo, 
 bool drift_bsdf_is_delta(const drift_bsdf *bsdf);
 // A GGX BSDF's directional albedo toward wo (mu = cos theta_o) of its reflection lobes, the
 // split sum's DFG term: the conductor's and the coat's single-scattering lobe F0 (E1 - Es) + Es
-// (around the mirror direction) and the conductor's multiple-scattering lobe (nearly
-// cosine-shaped), each times its weight; a smooth (delta) dielectric's Fresnel reflection too
-// (a rough one's is left to sampling). Zero for other materials.
+// (around the mirror direction) and the conductor's multiple-scattering lobe (a broader GGX
+// lobe about the same direction), each times its weight; a smooth (delta) dielectric's
+// Fresnel reflection too (a rough one's is left to sampling). Zero for other materials.
 // A visible normal of GGX roughness alpha for wo (local frame, wo.z > 0; Heitz 2018): the
 // path tracer's sampling, for techniques that trace the lobe's rays themselves.
 drift_vec3 drift_ggx_sample_visible_normal(float alpha, drift_vec3 wo, drift_vec2 u);
 void drift_bsdf_ggx_reflection_albedo(const drift_bsdf *bsdf, float mu, drift_vec3 *out_single,
                                       drift_vec3 *out_multiple);
+// The GGX roughness of the conductor's multiple-scattering lobe for a material of roughness
+// alpha (a broader lobe about the same mirror direction; docs/materials.md).
+float drift_ggx_multiple_scattering_alpha(float alpha);
 
 // --- LIGHT SAMPLING ---
 

@@ -292,8 +292,13 @@ drift_vec3 drift_raster_environment_split_sum(const drift_env_prefilter *p,
     drift_vec3 dominant = drift_vec3_normalize(lerp3(n, r, lean));
     drift_vec3 l = drift_vec3_mul(single, drift_env_prefilter_lookup(p, dominant, alpha));
     if (!drift_vec3_is_zero(multiple)) {
-        // The multiple-scattering lobe is nearly cosine-shaped: the widest level around n.
-        l = drift_vec3_add(l, drift_vec3_mul(multiple, drift_env_prefilter_lookup(p, n, 1.0f)));
+        // The multiple-scattering lobe is a broader GGX lobe about the same mirror direction:
+        // its roughness's level (at most the widest) around its own dominant direction.
+        float alpha_ms = fminf(drift_ggx_multiple_scattering_alpha(alpha), 1.0f);
+        float s_ms = 1.0f - alpha_ms, lean_ms = s_ms * (sqrtf(s_ms) + alpha_ms);
+        drift_vec3 dominant_ms = drift_vec3_normalize(lerp3(n, r, lean_ms));
+        l = drift_vec3_add(
+            l, drift_vec3_mul(multiple, drift_env_prefilter_lookup(p, dominant_ms, alpha_ms)));
     }
     // Visibility: the share of visible-normal reflections of wo that escape the scene.
     uint32_t valid = 0, open = 0;

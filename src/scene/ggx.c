@@ -1,8 +1,10 @@
 // DRIFT_MATERIAL_GGX: a conductor, a dielectric-coated diffuse ("plastic") and a dielectric
 // that refracts, blended by weight (glTF's metallic-roughness and transmission), all on GGX
 // microfacets (Walter et al. 2007) with height-correlated Smith masking and visible-normal
-// sampling (microfacet.c). Energy lost by single scattering comes back as Kulla & Conty's
-// (2017) multiple-scattering lobe for the conductor; the plastic's diffuse base receives what
+// sampling (microfacet.c). Energy lost by single scattering comes back for the conductor in a
+// multiple-scattering lobe of Kulla & Conty's (2017) colour F_ms and albedo 1 - E(mu_o), shaped
+// as a broader GGX lobe about the specular direction (microfacet.h, docs/materials.md), where
+// Heitz et al.'s (2016) random walk puts it; the plastic's diffuse base receives what
 // its coat does not reflect, (1 - Ec(mu_o))(1 - Ec(mu_i)) / (pi (1 - Ec_avg)), so a white
 // plastic reflects exactly 1; the rough dielectric is divided by its single-scattering albedo
 // (Turquin 2019's normalisation for a lossless interface). docs/materials.md has the model.
@@ -115,41 +117,78 @@ static void albedos(const drift_bsdf_ggx *g, float mu, float *e1, float *es)
 
 // --- CONDUCTOR ---
 
+// Kulla & Conty's colour of the multiply scattered light, F_ms = F_avg^2 E_avg / (1 - F_avg (1 -
+// E_avg)) with F_avg = F0 + (1 - F0) / 21 (exact for Schlick).
+static drift_vec3 conductor_f_ms(const drift_bsdf_ggx *g)
+{
+    drift_vec3 f0 = conductor_fresnel(g, 1.0f);
+    drift_vec3 f_avg = drift_vec3_add(
+        f0, drift_vec3_scale(drift_vec3_sub(drift_vec3_splat(1.0f), f0), 1.0f / 21.0f));
+    float e_avg = g->e1_avg;
+    drift_vec3 f_ms;
+    f_ms.x = f_avg.x * f_avg.x * e_avg / (1.0f - f_avg.x * (1.0f - e_avg));
+    f_ms.y = f_avg.y * f_avg.y * e_avg / (1.0f - f_avg.y * (1.0f - e_avg));
+    f_ms.z = f_avg.z * f_avg.z * e_avg / (1.0f - f_avg.z * (1.0f - e_avg));
+    return f_ms;
+}
+
+// The multiple-scattering lobe with F = 1 at wo, wi (both above) and their half vector h:
+// s(mu_o) s(mu_i) D2(h) G2(wo, wi) / (4 mu_o mu_i) of the broad roughness; its sampling pdf
+// (the broad lobe's visible normals) in out_pdf.
+static float ms_lobe(const drift_bsdf_ggx *g, drift_vec3 wo, drift_vec3 wi, drift_vec3 h,
+                     float *out_pdf)
+{
+    float a2 = drift__ggx_ms_alpha(g->alpha);
+    float d = drift__ggx_d(a2, h);
+    float lo = drift__ggx_lambda(a2, wo), li = drift__ggx_lambda(a2, wi);
+    // D_wo(h) / (4 wo.h) = G1(wo) D / (4 wo.z).
+    *out_pdf = d / ((1.0f + lo) * 4.0f * wo.z);
+    float s = drift__ggx_ms_scale_at(wo.z, g->alpha_row, g->alpha_frac) *
+              drift__ggx_ms_scale_at(wi.z, g->alpha_row, g->alpha_frac);
+    return s * d / ((1.0f + lo + li) * 4.0f * wo.z * wi.z);
+}
+
+// Whether the conductor loses enough to single scattering to have the lobe at all.
+static bool has_ms(const drift_bsdf_ggx *g)
+{
+    return g->e1_avg < 0.9999f;
+}
+
 static drift_vec3 conductor_eval(const drift_bsdf_ggx *g, drift_vec3 wo, drift_vec3 wi)
 {
     drift_vec3 h;
     float ss = reflect_ss(ra(g), wo, wi, &h);
+    if (!(ss > 0.0f)) {
+        return drift_vec3_splat(0.0f);
+    }
     drift_vec3 f = drift_vec3_scale(conductor_fresnel(g, drift_vec3_dot(wo, h)), ss);
-    float e_avg = g->e1_avg;
-    if (e_avg < 0.9999f) {
-        drift_vec3 f0 = conductor_fresnel(g, 1.0f);
-        drift_vec3 f_avg = drift_vec3_add(
-            f0, drift_vec3_scale(drift_vec3_sub(drift_vec3_splat(1.0f), f0), 1.0f / 21.0f));
-        float e_o, e_i, unused;
-        albedos(g, wo.z, &e_o, &unused);
-        albedos(g, wi.z, &e_i, &unused);
-        float ms = (1.0f - e_o) * (1.0f - e_i) / (DRIFT_PI * (1.0f - e_avg));
-        drift_vec3 f_ms;
-        f_ms.x = f_avg.x * f_avg.x * e_avg / (1.0f - f_avg.x * (1.0f - e_avg));
-        f_ms.y = f_avg.y * f_avg.y * e_avg / (1.0f - f_avg.y * (1.0f - e_avg));
-        f_ms.z = f_avg.z * f_avg.z * e_avg / (1.0f - f_avg.z * (1.0f - e_avg));
-        f = drift_vec3_fma(f, f_ms, ms);
+    if (has_ms(g)) {
+        float unused;
+        f = drift_vec3_fma(f, conductor_f_ms(g), ms_lobe(g, wo, wi, h, &unused));
     }
     return f;
 }
 
-// Probability of sampling the single-scattering lobe (the rest goes to the cosine lobe).
+// Probability of sampling the single-scattering lobe, E1(mu_o): the rest, the albedo of the
+// multiple-scattering lobe with F = 1, goes to it.
 static float conductor_p_ss(const drift_bsdf_ggx *g, drift_vec3 wo)
 {
     float e1, es;
     albedos(g, wo.z, &e1, &es);
-    return drift_clampf(e1, 0.0f, 1.0f);
+    return has_ms(g) ? drift_clampf(e1, 0.0f, 1.0f) : 1.0f;
 }
 
 static float conductor_pdf(const drift_bsdf_ggx *g, drift_vec3 wo, drift_vec3 wi)
 {
     float p = conductor_p_ss(g, wo);
-    return p * reflect_pdf(ra(g), wo, wi) + (1.0f - p) * wi.z * DRIFT_INV_PI;
+    float pdf = p * reflect_pdf(ra(g), wo, wi);
+    if (p < 1.0f) {
+        drift_vec3 h = drift_vec3_normalize(drift_vec3_add(wo, wi));
+        float pdf_ms;
+        ms_lobe(g, wo, wi, h, &pdf_ms);
+        pdf += (1.0f - p) * pdf_ms;
+    }
+    return pdf;
 }
 
 // --- PLASTIC ---
@@ -329,28 +368,19 @@ static drift_vec3 reflection_eval_pdf(const drift_bsdf_ggx *g, drift_vec3 wo, dr
     // D_wo(h) / (4 wo.h) = G1(wo) D / (4 wo.z).
     float pdf_r = wo_h > 0.0f ? d / ((1.0f + lo) * 4.0f * wo.z) : 0.0f;
     float pdf_c = wi.z * DRIFT_INV_PI;
-    float e1_o, es_o, e1_i, es_i;
+    float e1_o, es_o;
     albedos(g, wo.z, &e1_o, &es_o);
-    albedos(g, wi.z, &e1_i, &es_i);
     drift_vec3 f = drift_vec3_splat(0.0f);
     float pdf = 0.0f;
     if (g->w_conductor > 0.0f) {
         drift_vec3 fc = drift_vec3_scale(conductor_fresnel(g, wo_h), ss);
-        float e_avg = g->e1_avg;
-        if (e_avg < 0.9999f) {
-            drift_vec3 f0 = conductor_fresnel(g, 1.0f);
-            drift_vec3 f_avg = drift_vec3_add(
-                f0, drift_vec3_scale(drift_vec3_sub(drift_vec3_splat(1.0f), f0), 1.0f / 21.0f));
-            float ms = (1.0f - e1_o) * (1.0f - e1_i) / (DRIFT_PI * (1.0f - e_avg));
-            drift_vec3 f_ms;
-            f_ms.x = f_avg.x * f_avg.x * e_avg / (1.0f - f_avg.x * (1.0f - e_avg));
-            f_ms.y = f_avg.y * f_avg.y * e_avg / (1.0f - f_avg.y * (1.0f - e_avg));
-            f_ms.z = f_avg.z * f_avg.z * e_avg / (1.0f - f_avg.z * (1.0f - e_avg));
-            fc = drift_vec3_fma(fc, f_ms, ms);
+        float p = 1.0f, pdf_ms = 0.0f;
+        if (has_ms(g)) {
+            fc = drift_vec3_fma(fc, conductor_f_ms(g), ms_lobe(g, wo, wi, h, &pdf_ms));
+            p = drift_clampf(e1_o, 0.0f, 1.0f);
         }
-        float p = drift_clampf(e1_o, 0.0f, 1.0f);
         f = drift_vec3_scale(fc, g->w_conductor);
-        pdf += g->w_conductor * (p * pdf_r + (1.0f - p) * pdf_c);
+        pdf += g->w_conductor * (p * pdf_r + (1.0f - p) * pdf_ms);
     }
     if (g->w_plastic > 0.0f) {
         drift_vec3 coat = drift_vec3_scale(schlick(g->f0_coat, wo_h), ss);
@@ -364,6 +394,8 @@ static drift_vec3 reflection_eval_pdf(const drift_bsdf_ggx *g, drift_vec3 wo, dr
             float burley = (1.0f + fd90_minus_1 * fi5) * (1.0f + fd90_minus_1 * fo5);
             base = drift_vec3_scale(g->base, burley * DRIFT_INV_PI);
         } else {
+            float e1_i, es_i; // only the layered base reads the albedo toward wi
+            albedos(g, wi.z, &e1_i, &es_i);
             drift_vec3 ec_i = coat_albedo(g->f0_coat, e1_i, es_i);
             drift_vec3 ec_avg = coat_albedo(g->f0_coat, g->e1_avg, g->es_avg);
             base = drift_vec3_mul(drift_vec3_sub(one, ec_o), drift_vec3_sub(one, ec_i));
@@ -420,8 +452,10 @@ drift_bsdf_sample drift__ggx_sample(const drift_bsdf_ggx *g, drift_vec3 wo, floa
         float w = conductor ? g->w_conductor : g->w_plastic;
         float v = (u_lobe - (conductor ? 0.0f : g->w_conductor)) / w;
         float p = conductor ? conductor_p_ss(g, wo) : plastic_p_coat(g, wo);
-        if (v < p) {
-            drift_vec3 m = drift__ggx_sample_vndf(ra(g), wo, u);
+        if (v < p || conductor) {
+            // The specular lobe, or the conductor's broader multiple-scattering lobe.
+            float a = v < p ? ra(g) : drift__ggx_ms_alpha(g->alpha);
+            drift_vec3 m = drift__ggx_sample_vndf(a, wo, u);
             wi = drift_vec3_sub(drift_vec3_scale(m, 2.0f * drift_vec3_dot(wo, m)), wo);
             if (wi.z <= 0.0f) {
                 return s;
@@ -473,17 +507,10 @@ void drift_bsdf_ggx_reflection_albedo(const drift_bsdf *bsdf, float mu, drift_ve
             // Exact for Schlick's Fresnel; for eta/k the Schlick curve through its F0.
             drift_vec3 f0 = conductor_fresnel(g, 1.0f);
             single = drift_vec3_scale(coat_albedo(f0, e1, es), g->w_conductor);
-            float e_avg = g->e1_avg;
-            if (e_avg < 0.9999f) {
-                // The multiple-scattering lobe's albedo: F_ms (1 - E(mu)) (its cosine-weighted
-                // integral of (1 - E(mu_i)) is 1 - E_avg).
-                drift_vec3 f_avg = drift_vec3_add(
-                    f0, drift_vec3_scale(drift_vec3_sub(drift_vec3_splat(1.0f), f0), 1.0f / 21.0f));
-                drift_vec3 f_ms;
-                f_ms.x = f_avg.x * f_avg.x * e_avg / (1.0f - f_avg.x * (1.0f - e_avg));
-                f_ms.y = f_avg.y * f_avg.y * e_avg / (1.0f - f_avg.y * (1.0f - e_avg));
-                f_ms.z = f_avg.z * f_avg.z * e_avg / (1.0f - f_avg.z * (1.0f - e_avg));
-                multiple = drift_vec3_scale(f_ms, g->w_conductor * (1.0f - e1));
+            if (has_ms(g)) {
+                // The multiple-scattering lobe's albedo: F_ms (1 - E(mu)) (its scale s is fitted
+                // to that, microfacet.h).
+                multiple = drift_vec3_scale(conductor_f_ms(g), g->w_conductor * (1.0f - e1));
             }
         }
         if (g->w_plastic > 0.0f) {
@@ -507,4 +534,9 @@ void drift_bsdf_ggx_reflection_albedo(const drift_bsdf *bsdf, float mu, drift_ve
 drift_vec3 drift_ggx_sample_visible_normal(float alpha, drift_vec3 wo, drift_vec2 u)
 {
     return drift__ggx_sample_vndf(fmaxf(alpha, DRIFT_GGX_MIN_ALPHA), wo, u);
+}
+
+float drift_ggx_multiple_scattering_alpha(float alpha)
+{
+    return drift__ggx_ms_alpha(alpha);
 }

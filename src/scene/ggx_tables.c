@@ -88,3 +88,18 @@ void drift__ggx_e1_es_at(float mu, int row, float frac, float *e1, float *es)
     *e1 = a + (b - a) * frac;
     *es = c + (d - c) * frac;
 }
+
+float drift__ggx_ms_scale(float mu, float alpha)
+{
+    return lookup2(&ggx_table_ms_scale[0][0], DRIFT_GGX_TABLE_ALPHA_N, DRIFT_GGX_TABLE_MU_N, mu,
+                   alpha, false);
+}
+
+float drift__ggx_ms_scale_at(float mu, int row, float frac)
+{
+    float fm;
+    int im = grid_pos(mu * (float)DRIFT_GGX_TABLE_MU_N - 0.5f, DRIFT_GGX_TABLE_MU_N, &fm);
+    const float *a0 = &ggx_table_ms_scale[row][im], *a1 = &ggx_table_ms_scale[row + 1][im];
+    float a = a0[0] + (a0[1] - a0[0]) * fm, b = a1[0] + (a1[1] - a1[0]) * fm;
+    return a + (b - a) * frac;
+}

@@ -212,3 +212,76 @@ float drift__ggx_integrate_dielectric(float mu, float alpha, float eta, int stra
     }
     return (float)(sum / (strata * strata));
 }
+
+// --- THE MULTIPLE-SCATTERING LOBE'S SCALE ---
+
+float drift__ggx_ms_alpha(float alpha)
+{
+    return DRIFT_GGX_MS_WIDTH * fmaxf(alpha, DRIFT_GGX_MIN_ALPHA);
+}
+
+float drift__ggx_fit_ms_scale(float ms_alpha, const float *e1, int strata, float *out_scale)
+{
+    enum {
+        MU = DRIFT_GGX_TABLE_MU_N
+    };
+
+    // b[i][j]: the albedo at mu_i of the broad lobe weighted by the hat function of grid point
+    // j in mu_i (the table's linear interpolation, constant beyond the end cells).
+    double b[MU][MU];
+    for (int i = 0; i < MU; ++i) {
+        drift_vec3 wo = dir_of_mu((i + 0.5f) / MU);
+        float lo = drift__ggx_lambda(ms_alpha, wo);
+        for (int j = 0; j < MU; ++j) {
+            b[i][j] = 0.0;
+        }
+        for (int u0 = 0; u0 < strata; ++u0) {
+            for (int u1 = 0; u1 < strata; ++u1) {
+                drift_vec2 u =
+                    drift_vec2_make((u0 + 0.5f) / (float)strata, (u1 + 0.5f) / (float)strata);
+                drift_vec3 m = drift__ggx_sample_vndf(ms_alpha, wo, u);
+                drift_vec3 wi =
+                    drift_vec3_sub(drift_vec3_scale(m, 2.0f * drift_vec3_dot(wo, m)), wo);
+                if (wi.z <= 0.0f) {
+                    continue;
+                }
+                double li = (double)drift__ggx_lambda(ms_alpha, wi);
+                double w = (1.0 + (double)lo) / (1.0 + (double)lo + li);
+                double x = fmin(fmax((double)wi.z * MU - 0.5, 0.0), MU - 1.0);
+                int j = x >= MU - 1 ? MU - 2 : (int)x;
+                b[i][j] += w * (j + 1 - x);
+                b[i][j + 1] += w * (x - j);
+            }
+        }
+        for (int j = 0; j < MU; ++j) {
+            b[i][j] /= (double)strata * strata;
+        }
+    }
+    // Symmetric Sinkhorn-Knopp (Knight 2008): s <- sqrt(s t / (B s)), the geometric mean of s
+    // and the one-sided update, converges to s_i (B s)_i = t_i for B near symmetric.
+    double s[MU], t[MU], bs[MU], residual = 0.0;
+    for (int i = 0; i < MU; ++i) {
+        t[i] = fmax(0.0, 1.0 - (double)e1[i]);
+        s[i] = 1.0;
+    }
+    for (int iter = 0; iter < 4000; ++iter) {
+        residual = 0.0;
+        for (int i = 0; i < MU; ++i) {
+            bs[i] = 0.0;
+            for (int j = 0; j < MU; ++j) {
+                bs[i] += b[i][j] * s[j];
+            }
+            residual = fmax(residual, fabs(s[i] * bs[i] - t[i]));
+        }
+        if (residual < 1e-7) {
+            break;
+        }
+        for (int i = 0; i < MU; ++i) {
+            s[i] = bs[i] > 0.0 ? sqrt(s[i] * t[i] / bs[i]) : 0.0;
+        }
+    }
+    for (int i = 0; i < MU; ++i) {
+        out_scale[i] = (float)s[i];
+    }
+    return (float)residual;
+}

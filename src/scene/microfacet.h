@@ -43,6 +43,9 @@ float drift__ggx_e_dielectric(float mu, float alpha, float eta);
 // The same lookups with the roughness's row of the table found once (a BSDF's alpha is fixed).
 void drift__ggx_alpha_slot(float alpha, int *row, float *frac);
 void drift__ggx_e1_es_at(float mu, int row, float frac, float *e1, float *es);
+// The multiple-scattering lobe's scale s(mu) at a row (see drift__ggx_fit_ms_scale).
+float drift__ggx_ms_scale_at(float mu, int row, float frac);
+float drift__ggx_ms_scale(float mu, float alpha);
 
 // The tables' grids: mu at (i + 0.5) / MU_N (dielectric: at drift__ggx_grid_mu_d(i), from
 // 0 to 1 inclusive, for the steep change near normal incidence inside); sqrt(alpha) at j / (ALPHA_N
@@ -64,6 +67,20 @@ float drift__ggx_grid_mu_d(int i);
 // The integrals the tables hold, on a strata x strata grid of visible normals.
 void drift__ggx_integrate_reflection(float mu, float alpha, int strata, float *e1, float *es);
 float drift__ggx_integrate_dielectric(float mu, float alpha, float eta, int strata);
+
+// The conductor's multiple-scattering lobe (docs/materials.md): with F = 1,
+//   f_ms(wo, wi) = s(mu_o) s(mu_i) D2(h) G2(wo, wi) / (4 mu_o mu_i),
+// single-scatter GGX of the broader roughness drift__ggx_ms_alpha(alpha), scaled by s so that
+// its albedo is 1 - E1(mu_o) at every mu_o: reciprocal and white-furnace exact. s is tabulated
+// on the E tables' grid (drift__ggx_ms_scale_at, linear in mu between cell centres).
+#define DRIFT_GGX_MS_WIDTH 2.5f
+float drift__ggx_ms_alpha(float alpha);
+// One alpha row of s for the broad lobe's roughness ms_alpha and that row of the E1 table (e1,
+// DRIFT_GGX_TABLE_MU_N values): with wo at each grid mu, the lobe's albedo is linear in s's
+// entries, B s (B by strata x strata visible normals of ms_alpha); s solves
+// s_i (B s)_i = 1 - e1[i] by a symmetric Sinkhorn-Knopp scaling. Returns the largest residual
+// |s_i (B s)_i - (1 - e1[i])|.
+float drift__ggx_fit_ms_scale(float ms_alpha, const float *e1, int strata, float *out_scale);
 
 // The GGX material's value, pdf and sampling in the local frame. out_diffuse (may be NULL)
 // gets the plastic's diffuse part of the value.

@@ -94,13 +94,14 @@ static void test_ggx_white_conductor_reflects_everything(void **state)
 {
     (void)state;
     int n = (int)(10000 * test_intensity());
-    const float roughness[] = { 0.0f, 0.2f, 0.4f, 0.6f, 0.8f, 1.0f }; // perceptual
-    const float theta[] = { 0.0f, 0.7f, 1.2f };
-    for (int r = 0; r < 6; ++r) {
+    // Perceptual; 0.3 and 0.47 fall between rows of the tables.
+    const float roughness[] = { 0.0f, 0.2f, 0.3f, 0.4f, 0.47f, 0.6f, 0.8f, 1.0f };
+    const float theta[] = { 0.0f, 0.7f, 1.2f, 1.45f };
+    for (int r = 0; r < 8; ++r) {
         float alpha = roughness[r] * roughness[r];
         drift_material m = ggx_material(drift_vec3_splat(1.0f), alpha, 1.0f, 0.0f);
         drift_bsdf b = make_bsdf(&m, true);
-        for (int t = 0; t < 3; ++t) {
+        for (int t = 0; t < 4; ++t) {
             double a = albedo(&b, dir_at(theta[t]), n);
             if (!(a >= 0.99 && a <= 1.01)) {
                 fail_msg("white conductor roughness %.1f theta %.1f reflects %.4f",
@@ -270,6 +271,8 @@ static void test_ggx_sampling_matches_pdf(void **state)
     (void)state;
     drift_material conductor = ggx_material(drift_vec3_make(0.9f, 0.7f, 0.4f), 0.1f, 1.0f, 0.0f);
     drift_material rough_conductor = ggx_material(drift_vec3_splat(0.9f), 0.7f, 1.0f, 0.0f);
+    // Its multiple-scattering lobe (alpha 2.5) takes up to half of the samples.
+    drift_material roughest_conductor = ggx_material(drift_vec3_splat(1.0f), 1.0f, 1.0f, 0.0f);
     drift_material plastic = ggx_material(drift_vec3_make(0.6f, 0.3f, 0.1f), 0.2f, 0.0f, 0.0f);
     drift_material glass = ggx_material(drift_vec3_splat(1.0f), 0.3f, 0.0f, 1.0f);
     drift_material blend = ggx_material(drift_vec3_make(0.5f, 0.5f, 0.5f), 0.4f, 0.3f, 0.5f);
@@ -281,6 +284,7 @@ static void test_ggx_sampling_matches_pdf(void **state)
         chi_square_check("plastic, Burley base", &principled, true, theta[t]);
         chi_square_check("conductor alpha 0.1", &conductor, true, theta[t]);
         chi_square_check("conductor alpha 0.7", &rough_conductor, true, theta[t]);
+        chi_square_check("conductor alpha 1", &roughest_conductor, true, theta[t]);
         chi_square_check("plastic alpha 0.2", &plastic, true, theta[t]);
         chi_square_check("rough glass outside", &glass, true, theta[t]);
         chi_square_check("rough glass inside", &glass, false, theta[t]);
@@ -457,6 +461,91 @@ static void test_ggx_albedo_tables_match_their_integrals(void **state)
             assert_near(drift__ggx_e_dielectric(mus[i], alphas[j], 1.0f / 1.45f), ed, 0.012);
         }
     }
+
+    // The multiple-scattering lobe's scale: rows refitted from the E1 table on a coarser grid
+    // of visible normals (at alpha 0.017 that grid resolves the sharp lobe to about 1e-3).
+    enum {
+        MU = DRIFT_GGX_TABLE_MU_N,
+        AL = DRIFT_GGX_TABLE_ALPHA_N
+    };
+
+    const int rows[] = { 4, 9, 17, 31 };
+    for (int k = 0; k < 4; ++k) {
+        float alpha = drift__ggx_grid_alpha(rows[k], AL), e1[MU], scale[MU];
+        for (int i = 0; i < MU; ++i) {
+            e1[i] = drift__ggx_e1((i + 0.5f) / MU, alpha);
+        }
+        float residual = drift__ggx_fit_ms_scale(drift__ggx_ms_alpha(alpha), e1, 128, scale);
+        assert_true(residual < 1e-5f);
+        for (int i = 0; i < MU; ++i) {
+            float table = drift__ggx_ms_scale((i + 0.5f) / MU, alpha);
+            if (fabsf(table - scale[i]) > 0.01f * scale[i] + 1e-3f) {
+                fail_msg("ms scale row %d mu %d: table %g, refitted %g", rows[k], i, (double)table,
+                         (double)scale[i]);
+            }
+        }
+    }
+}
+
+// The multiple-scattering lobe alone (the white conductor less its single scattering) returns
+// what single scattering loses, 1 - E1(mu_o), between the tables' rows and at grazing angles
+// too; for the sharp lobes (alpha <= 0.2) it is larger at the mirror direction than 80 degrees
+// off the plane of incidence, where Kulla & Conty's separable lobe was at its largest.
+static void test_ggx_multiple_scattering_lobe(void **state)
+{
+    (void)state;
+    const float alphas[] = { 0.09f, 0.2f, 0.45f, 0.8f }, thetas[] = { 0.3f, 1.0f, 1.4f };
+    for (int a = 0; a < 4; ++a) {
+        drift_material m = ggx_material(drift_vec3_splat(1.0f), alphas[a], 1.0f, 0.0f);
+        drift_bsdf b = make_bsdf(&m, true);
+        for (int t = 0; t < 3; ++t) {
+            drift_vec3 wo = dir_at(thetas[t]);
+            // Quadrature over the broad lobe's visible normals: weight f_ms cos / pdf.
+            float a2 = drift__ggx_ms_alpha(alphas[a]);
+            const int n = 256;
+            double sum = 0.0, peak = 0.0, off = 0.0;
+            for (int i = 0; i < n; ++i) {
+                for (int j = 0; j < n; ++j) {
+                    drift_vec2 u = drift_vec2_make((i + 0.5f) / n, (j + 0.5f) / n);
+                    drift_vec3 h = drift__ggx_sample_vndf(a2, wo, u);
+                    drift_vec3 wi =
+                        drift_vec3_sub(drift_vec3_scale(h, 2.0f * drift_vec3_dot(wo, h)), wo);
+                    if (wi.z <= 0.0f) {
+                        continue;
+                    }
+                    float ss =
+                        drift__ggx_d(alphas[a], h) / ((1.0f + drift__ggx_lambda(alphas[a], wo) +
+                                                       drift__ggx_lambda(alphas[a], wi)) *
+                                                      4.0f * wo.z * wi.z);
+                    float f_ms = drift_bsdf_eval(&b, wo, wi).x - ss;
+                    float pdf = drift__ggx_pdf_vndf(a2, wo, h) / (4.0f * drift_vec3_dot(wo, h));
+                    sum += (double)(f_ms * wi.z / pdf);
+                }
+            }
+            sum /= (double)n * n;
+            double lost = 1.0 - (double)drift__ggx_e1(wo.z, alphas[a]);
+            if (fabs(sum - lost) > 0.004 + 0.02 * lost) {
+                fail_msg("alpha %.2f theta %.1f: the lobe's albedo %.4f, 1 - E1 %.4f",
+                         (double)alphas[a], (double)thetas[t], sum, lost);
+            }
+            // f_ms at the mirror direction against 80 degrees off the plane of incidence.
+            drift_vec3 mirror = drift_vec3_make(-wo.x, -wo.y, wo.z);
+            drift_vec3 side = drift_vec3_make(0.0f, sinf(1.4f), cosf(1.4f));
+            drift_vec3 hm = drift_vec3_make(0.0f, 0.0f, 1.0f);
+            drift_vec3 hs = drift_vec3_normalize(drift_vec3_add(wo, side));
+            peak = drift_bsdf_eval(&b, wo, mirror).x -
+                   drift__ggx_d(alphas[a], hm) /
+                       ((1.0f + 2.0f * drift__ggx_lambda(alphas[a], wo)) * 4.0f * wo.z * wo.z);
+            off = drift_bsdf_eval(&b, wo, side).x -
+                  drift__ggx_d(alphas[a], hs) / ((1.0f + drift__ggx_lambda(alphas[a], wo) +
+                                                  drift__ggx_lambda(alphas[a], side)) *
+                                                 4.0f * wo.z * side.z);
+            if (alphas[a] <= 0.2f && !(peak > off)) {
+                fail_msg("alpha %.2f theta %.1f: f_ms %g at the mirror direction, %g off it",
+                         (double)alphas[a], (double)thetas[t], peak, off);
+            }
+        }
+    }
 }
 
 int main(void)
@@ -472,6 +561,7 @@ int main(void)
         cmocka_unit_test(test_ggx_snell_and_total_internal_reflection),
         cmocka_unit_test(test_ggx_conductor_fresnel),
         cmocka_unit_test(test_ggx_albedo_tables_match_their_integrals),
+        cmocka_unit_test(test_ggx_multiple_scattering_lobe),
         cmocka_unit_test(test_ggx_normal_map_bends_the_normal),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
