@@ -200,6 +200,7 @@ typedef struct drift__micro_pixels {
     int32_t k;
     drift_vec3 dir[DRIFT_MICRO_MAX_K * DRIFT_MICRO_MAX_K];
     float omega[DRIFT_MICRO_MAX_K * DRIFT_MICRO_MAX_K];
+    float omega_max; // the largest of omega: a node bigger than it is refined in any pixel
 } drift__micro_pixels;
 
 void drift__micro_pixels_make(drift__micro_pixels *pixels, const drift__micro_warp *warp,

@@ -107,6 +107,13 @@ drift_vec3 drift__micro_gather(const drift__micro_gather_desc *desc, drift_vec3 
             continue;
         }
         float omega_node = dist > r ? DRIFT_PI * r * r / (dist * dist) : INFINITY;
+        if (!leaf && omega_node > desc->cut_scale * pixels->omega_max) {
+            // Bigger than the biggest pixel: refined whichever pixel it falls in, so its
+            // pixel (the warp's inverse, most of a visit's cost) is not looked up.
+            stack[top++] = 2 * i + 2;
+            stack[top++] = 2 * i + 1;
+            continue;
+        }
         int32_t pix = -1;
         if (local.z > 0.0f && dist > r && cos_c >= cap_cos) {
             drift_vec2 xy =
@@ -153,11 +160,10 @@ drift_vec3 drift__micro_gather(const drift__micro_gather_desc *desc, drift_vec3 
         int32_t span = (int32_t)ceilf(sin_a / pixel_a) + 1;
         span = span > k / 2 ? k / 2 : span;
         int32_t px = pix % k, py = pix / k;
-        for (int32_t qy = py - span; qy <= py + span; ++qy) {
-            for (int32_t qx = px - span; qx <= px + span; ++qx) {
-                if (qx < 0 || qy < 0 || qx >= k || qy >= k) {
-                    continue;
-                }
+        int32_t y0 = py > span ? py - span : 0, y1 = py + span < k ? py + span : k - 1;
+        int32_t x0 = px > span ? px - span : 0, x1 = px + span < k ? px + span : k - 1;
+        for (int32_t qy = y0; qy <= y1; ++qy) {
+            for (int32_t qx = x0; qx <= x1; ++qx) {
                 int32_t q = qy * k + qx;
                 if (dist < depth[q] && drift_vec3_dot(pixels->dir[q], w) >= cos_a) {
                     depth[q] = dist;

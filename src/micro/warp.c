@@ -209,4 +209,8 @@ void drift__micro_pixels_make(drift__micro_pixels *pixels, const drift__micro_wa
             pixels->omega[j * k + i] = omega > 0.0f ? omega : (pdf > 0.0f ? inv * inv / pdf : 0.0f);
         }
     }
+    pixels->omega_max = 0.0f;
+    for (int32_t i = 0; i < k * k; ++i) {
+        pixels->omega_max = fmaxf(pixels->omega_max, pixels->omega[i]);
+    }
 }

@@ -312,7 +312,7 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
         }
         drift_surface surf = drift_scene_surface(scene, &ray, &hit);
         cone_width += cone_spread * hit.t;
-        if (cone_spread > 0.0f) {
+        if (cone_spread > 0.0f && scene->texture_count > 0) { // only textures read it
             drift_surface_set_footprint(scene, &surf, cone_width, ray.dir);
         }
         drift_vec3 wo = drift_vec3_neg(ray.dir);

@@ -30,6 +30,64 @@ static void test_sampling_sampler_is_deterministic_and_in_range(void **state)
     assert_true(u.x != v.x || u.y != v.y);
 }
 
+// The sampler as Burley 2020 lists it (nested uniform scrambles of the index and of each Sobol
+// dimension, dimension 1 by its direction numbers v_i = v_{i-1} ^ (v_{i-1} >> 1)), written
+// here without the sampler's shortcuts: the sampler must give these values to the bit.
+static uint32_t textbook_laine_karras(uint32_t x, uint32_t seed)
+{
+    x += seed;
+    x ^= x * 0x6c50b47cU;
+    x ^= x * 0xb82f1e52U;
+    x ^= x * 0xc7afe638U;
+    x ^= x * 0x8d22f6e6U;
+    return x;
+}
+
+static uint32_t textbook_scramble(uint32_t x, uint32_t seed)
+{
+    return drift_reverse_bits(textbook_laine_karras(drift_reverse_bits(x), seed));
+}
+
+static uint32_t textbook_sobol_dim1(uint32_t index)
+{
+    uint32_t result = 0, v = 0x80000000U;
+    for (; index; index >>= 1, v ^= v >> 1) {
+        if (index & 1U) {
+            result ^= v;
+        }
+    }
+    return result;
+}
+
+static void test_sampling_sampler_matches_the_textbook_sobol(void **state)
+{
+    (void)state;
+    uint32_t rng = 12345;
+    for (int trial = 0; trial < 20000; ++trial) {
+        rng = drift_hash_u32(rng + 1u);
+        uint32_t seed = rng & 0xffu, pixel = drift_hash_u32(rng) & 0xfffffu;
+        // Sample indices over the whole range: small ones and scrambled 32-bit ones.
+        uint32_t sample = trial % 2 ? (uint32_t)trial : drift_hash_u32(rng ^ 0x5bd1e995U);
+        drift_sampler smp = drift_sampler_make(seed, pixel, sample);
+        uint32_t key = drift_hash_combine(drift_hash_u32(seed), pixel);
+        for (uint32_t dim = 0; dim < 6; ++dim) {
+            uint32_t pair_key = drift_hash_combine(key, dim);
+            uint32_t index = textbook_scramble(sample, pair_key);
+            uint32_t x =
+                textbook_scramble(drift_reverse_bits(index), drift_hash_combine(pair_key, 1));
+            uint32_t y =
+                textbook_scramble(textbook_sobol_dim1(index), drift_hash_combine(pair_key, 2));
+            if (dim % 3 == 2) { // next1: the pair's first value
+                assert_true(drift_sampler_next1(&smp) == drift_u32_to_unit(x));
+                continue;
+            }
+            drift_vec2 u = drift_sampler_next2(&smp);
+            assert_true(u.x == drift_u32_to_unit(x));
+            assert_true(u.y == drift_u32_to_unit(y));
+        }
+    }
+}
+
 // A (0,2)-sequence puts exactly one of the first 2^k points in every elementary interval
 // of area 2^-k; Owen scrambling keeps that. Check all shapes for 2^k = 64.
 static void test_sampling_sampler_is_stratified(void **state)
@@ -472,6 +530,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sampling_sampler_is_deterministic_and_in_range),
         cmocka_unit_test(test_sampling_sampler_is_stratified),
+        cmocka_unit_test(test_sampling_sampler_matches_the_textbook_sobol),
         cmocka_unit_test(test_sampling_warps_match_their_pdfs),
         cmocka_unit_test(test_sampling_chi_square_detects_a_wrong_pdf),
         cmocka_unit_test(test_sampling_bsdf_chi_square),
