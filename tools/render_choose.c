@@ -157,6 +157,7 @@ typedef struct calibration {
     double scale[GROUP_COUNT], setup_ms[GROUP_COUNT], safety[GROUP_COUNT];
     const cJSON *setup_table; // the model's setup_ms: a hybrid candidate's techniques' set-up
     double setup_scale;       // its ms (at the load it records) to this load's
+    double finish_ms;         // what every frame pays after it (the writes), predicted
     double load, cores, frame_cores; // the load average, the cores, the cores a frame gets
     double available_ms;
 } calibration;
@@ -294,6 +295,7 @@ static bool score(const cJSON *model, const double f[SCENE_FEATURE_COUNT], const
                 cal->scale[g] +
             cal->setup_ms[g] +
             (g == GROUP_HYBRID ? cal->setup_scale * technique_setup_ms(cal->setup_table, c) : 0.0);
+        ms += cal->finish_ms;
         if (ms < fastest->ms) {
             *fastest = (choice){ c, ms, predict_flip(near, k, key) };
         }
@@ -417,7 +419,7 @@ static double cores_for(int threads, double cores, double load)
 // probed where the model's median of it is within 5 % of T, else that median, plus the
 // model's set-up of each technique it names (scripts/chooser/measure_setup.py, wall ms at the
 // load it records: rescaled to this load). The budget left is T less what was spent since the
-// scene was loaded (the accel, the features, the probes).
+// scene was loaded (the accel, the features, the probes); every candidate adds the writes.
 static void calibrate(const cJSON *model, const double f[SCENE_FEATURE_COUNT],
                       const render_options *o, const cli_session *session, calibration *cal,
                       render_probe *probe)
@@ -455,6 +457,11 @@ static void calibrate(const cJSON *model, const double f[SCENE_FEATURE_COUNT],
     cal->setup_ms[GROUP_HYBRID] =
         probe->hybrid_ms > 0.0 ? probe->hybrid_ms / cal->frame_cores : base;
     cal->setup_table = table;
+    // The writes (and what else the measured frames paid that the rows did not: the model's
+    // finish_ms, fitted by scripts/chooser/fit_calibration.py) at the frame's pixels.
+    double size = number(model, "size", 400.0);
+    cal->finish_ms =
+        number(model, "finish_ms", 0.0) * (double)o->width * (double)o->height / (size * size);
     cal->setup_scale =
         cores_for(threads, number(table, "cores", cal->cores), number(table, "load", cal->load)) /
         cal->frame_cores;
