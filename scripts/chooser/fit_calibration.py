@@ -11,7 +11,7 @@ left), the ms the frame and its writes took after it (--stats' total less the lo
 and its prediction. finish_ms: the median of (taken - predicted) on the path tracer's picks, at
 the model's size (each run's scaled by the model's pixels over its own): the writes and
 whatever else a one-shot frame pays that the bench's rows did not. calibrated_safety: the
-QUANTILE of taken / (predicted + finish) over all picks, so that most fit. Fit on the fit
+--quantile (0.8) of taken / (predicted + finish) over all picks, so that most fit. Fit on the fit
 scenes only: the judge scenes are what validate_budget.py reports on.
 """
 import argparse
@@ -31,6 +31,8 @@ def main():
     a = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     a.add_argument("runs", help="validate_budget.py --jsonl on the fit scenes")
     a.add_argument("--model", required=True)
+    a.add_argument("--quantile", type=float, default=QUANTILE,
+                   help="of taken / predicted, the safety (default %g)" % QUANTILE)
     o = a.parse_args()
     model = json.load(open(o.model))
     size = model.get("size", 400)
@@ -47,7 +49,7 @@ def main():
     pt = [(taken - pred) * scale for hybrid, pred, taken, scale in runs if not hybrid]
     finish = max(median(pt), 0.0) if pt else 0.0
     ratios = sorted(taken / (pred + finish / scale) for _, pred, taken, scale in runs)
-    safety = max(ratios[int(QUANTILE * (len(ratios) - 1))], 1.0) if ratios else 1.0
+    safety = max(ratios[int(o.quantile * (len(ratios) - 1))], 1.0) if ratios else 1.0
     model["finish_ms"] = round(finish, 1)
     model["calibrated_safety"] = {"pt": round(safety, 3), "hybrid": round(safety, 3)}
     with open(o.model, "w") as fh:
