@@ -273,6 +273,12 @@ static const cli_option render_table[] = {
                "lowest FLIP within T ms, from the scene's features (docs/corpus.md)"),
     CLI_STRING("--chooser", "FILE", O, chooser_path,
                "--budget-ms's model (default scenes/corpus/chooser.json)"),
+    CLI_CHOICE("--budget-probe", "on|off", O, no_budget_probe, "on|off",
+               "--budget-ms: first time cheap frames of the scene and scale the\n"
+               "model's costs by them and the load average; T counts all after the\n"
+               "scene's load: accel, probes, frame (on, the default; the probes'\n"
+               "timings vary, so the pick may differ run to run); off: the fitted\n"
+               "costs as they are, T the frame's alone, the same pick every run"),
     CLI_NOTE("each technique is listed below; reference = that effect\n"
              "alone path-traced at --spp; aaf: --spp rays a pixel on\n"
              "average (shadows: per area light)"),

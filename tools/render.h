@@ -63,6 +63,7 @@ typedef struct render_options {
     const char *edits_path;          // --reflection-edits FILE.json (docs/reflection-editing.md)
     double budget_ms;                // --budget-ms T: the chooser picks (tools/render_choose.c)
     const char *chooser_path;        // --chooser FILE: its model (default: the repository's)
+    bool no_budget_probe;            // --budget-probe off: the fitted costs as they are
     bool print_features;             // --features: the scene's features as JSON, then exit
     long upsample_width, upsample_height; // > 0: the chooser's path tracer at reduced
                                           // resolution, written upsampled to this size
@@ -87,6 +88,19 @@ int render_parse_options(int argc, char **argv, render_options *o);
 // --budget-ms: picks the techniques, or the path tracer, for the loaded scene (0 or an exit
 // status); --features prints the chooser's inputs. tools/render_choose.c.
 int render_choose(render_options *o, const cli_session *session);
+
+// --budget-ms's probes (tools/render_choose_probe.c): one-shot frames of the loaded scene at
+// w x h, their CPU ms (all threads, set-up included): the path tracer at 1 spp, the median of
+// three, and given `base_hybrid`, one hybrid frame of it.
+typedef struct render_probe {
+    double pixels;    // the probes' frame
+    double pt_ms;     // CPU ms; < 0: the probe failed
+    double hybrid_ms; // CPU ms of create and first frame; < 0: not run or failed
+    double spent_ms;  // the probes' own wall time, all of it
+} render_probe;
+
+void render_choose_probe(const cli_session *session, int32_t w, int32_t h,
+                         const drift_hybrid_params *base_hybrid, render_probe *out);
 int render_print_features(const cli_session *session);
 // `low` (3 channels or more) bilinearly up to w x h (a new image, 3 channels): the chooser's
 // path tracer at 1/2 or 1/4 resolution, as drift bench frontier's rows upsample it.

@@ -14,6 +14,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 int render_print_features(const cli_session *session)
 {
@@ -138,12 +139,48 @@ typedef struct choice {
     double ms, flip; // predicted at the frame's size; FLIP over the best row's
 } choice;
 
-// Scores every candidate of the model for a scene of features `f` at `budget_ms` ms for a
-// frame of `pixels`; *best_hybrid and *best_pt: the lowest predicted FLIP of each group that
-// fits (pick NULL: none), *fastest: the candidate of the lowest predicted ms. False when the
-// model is not one this build reads.
-static bool score(const cJSON *model, const double f[SCENE_FEATURE_COUNT], double budget_ms,
-                  double pixels, choice *best_hybrid, choice *best_pt, choice *fastest)
+enum {
+    GROUP_PT,
+    GROUP_HYBRID,
+    GROUP_COUNT
+};
+
+static int group_index(const char *group)
+{
+    return strcmp(group, "pt") == 0 ? GROUP_PT : GROUP_HYBRID;
+}
+
+// How the fitted costs become this run's: a candidate's predicted ms times its group's
+// `scale` (1 without probes; else measured over predicted of the probe of its group) plus its
+// group's `setup_ms` fits when that times `safety` is within `available_ms`.
+typedef struct calibration {
+    double scale[GROUP_COUNT], setup_ms[GROUP_COUNT], safety[GROUP_COUNT];
+    const cJSON *setup_table; // the model's setup_ms: a hybrid candidate's techniques' set-up
+    double setup_scale;       // its ms (at the load it records) to this load's
+    double finish_ms;         // what every frame pays after it (the writes), predicted
+    double load, cores, frame_cores; // the load average, the cores, the cores a frame gets
+    double available_ms;
+} calibration;
+
+// The set-up a one-shot frame of hybrid candidate `c` pays for its techniques beyond the base
+// row's, from the model's table (0 without one).
+static double technique_setup_ms(const cJSON *table, const cJSON *c)
+{
+    double ms = 0.0;
+    const char *effects[] = { "shadows", "indirect" };
+    for (int e = 0; table && e < 2; ++e) {
+        const char *name = string(c, effects[e]);
+        ms += name ? number(cJSON_GetObjectItemCaseSensitive(table, effects[e]), name, 0.0) : 0.0;
+    }
+    if (table && number(c, "environment_filter", 0.0) > 0.0) {
+        ms += number(cJSON_GetObjectItemCaseSensitive(table, "environment_filter"), "4", 0.0);
+    }
+    return ms;
+}
+
+// The model's cost features as indices of the scene's; false when the model is not one this
+// build reads.
+static bool cost_indices(const cJSON *model, int cost_index[SCENE_FEATURE_COUNT], int *cost_count)
 {
     const cJSON *names = cJSON_GetObjectItemCaseSensitive(model, "features");
     const cJSON *cost_names = cJSON_GetObjectItemCaseSensitive(model, "cost_features");
@@ -156,9 +193,9 @@ static bool score(const cJSON *model, const double f[SCENE_FEATURE_COUNT], doubl
             return false;
         }
     }
-    int cost_index[SCENE_FEATURE_COUNT], cost_count = 0;
+    *cost_count = 0;
     for (const cJSON *n = cost_names ? cost_names->child : NULL;
-         n && cost_count < SCENE_FEATURE_COUNT; n = n->next) {
+         n && *cost_count < SCENE_FEATURE_COUNT; n = n->next) {
         int k = 0;
         while (k < SCENE_FEATURE_COUNT &&
                (!cJSON_IsString(n) || strcmp(n->valuestring, scene_feature_name(k)) != 0)) {
@@ -167,7 +204,56 @@ static bool score(const cJSON *model, const double f[SCENE_FEATURE_COUNT], doubl
         if (k == SCENE_FEATURE_COUNT) {
             return false;
         }
-        cost_index[cost_count++] = k;
+        cost_index[(*cost_count)++] = k;
+    }
+    return true;
+}
+
+// The fitted prediction of candidate `c`'s ms for a frame of `pixels` (uncalibrated).
+static double predict_ms(const cJSON *model, const cJSON *c, const double f[SCENE_FEATURE_COUNT],
+                         double pixels)
+{
+    int cost_index[SCENE_FEATURE_COUNT], cost_count = 0;
+    double size = number(model, "size", 400.0);
+    if (!cost_indices(model, cost_index, &cost_count)) {
+        return (double)INFINITY;
+    }
+    return exp(predict_log_ms(model, c, f, cost_index, cost_count)) * pixels / (size * size);
+}
+
+// The candidate of `key`, or of the lowest prediction in `group` (key NULL).
+static const cJSON *find_candidate(const cJSON *model, const double f[SCENE_FEATURE_COUNT],
+                                   const char *key, const char *group)
+{
+    const cJSON *found = NULL;
+    double lowest = (double)INFINITY;
+    const cJSON *cands = cJSON_GetObjectItemCaseSensitive(model, "candidates");
+    for (const cJSON *c = cands ? cands->child : NULL; c; c = c->next) {
+        const char *k = string(c, "key"), *g = string(c, "group");
+        if (!k || !g) {
+            continue;
+        }
+        if (key ? strcmp(k, key) == 0 : strcmp(g, group) == 0) {
+            double ms = key ? 0.0 : predict_ms(model, c, f, 1.0);
+            if (ms < lowest) {
+                found = c;
+                lowest = ms;
+            }
+        }
+    }
+    return found;
+}
+
+// Scores every candidate of the model for a scene of features `f` for a frame of `pixels`
+// under `cal`; *best_hybrid and *best_pt: the lowest predicted FLIP of each group that fits
+// (pick NULL: none), *fastest: the candidate of the lowest predicted ms (each ms calibrated).
+// False when the model is not one this build reads.
+static bool score(const cJSON *model, const double f[SCENE_FEATURE_COUNT], const calibration *cal,
+                  double pixels, choice *best_hybrid, choice *best_pt, choice *fastest)
+{
+    int cost_index[SCENE_FEATURE_COUNT], cost_count = 0;
+    if (!cost_indices(model, cost_index, &cost_count)) {
+        return false;
     }
     // The k nearest fitted scenes in standardised features.
     const cJSON *scale = cJSON_GetObjectItemCaseSensitive(model, "scale");
@@ -196,7 +282,6 @@ static bool score(const cJSON *model, const double f[SCENE_FEATURE_COUNT], doubl
     int k = (int)number(model, "k", 2);
     k = k < 1 ? 1 : k > n ? n : k;
     double size = number(model, "size", 400.0);
-    const cJSON *safety = cJSON_GetObjectItemCaseSensitive(model, "safety");
     *best_hybrid = *best_pt = *fastest = (choice){ NULL, (double)INFINITY, (double)INFINITY };
     const cJSON *cands = cJSON_GetObjectItemCaseSensitive(model, "candidates");
     for (const cJSON *c = cands ? cands->child : NULL; c; c = c->next) {
@@ -204,15 +289,20 @@ static bool score(const cJSON *model, const double f[SCENE_FEATURE_COUNT], doubl
         if (!group || !key) {
             continue;
         }
+        int g = group_index(group);
         double ms =
-            exp(predict_log_ms(model, c, f, cost_index, cost_count)) * pixels / (size * size);
+            exp(predict_log_ms(model, c, f, cost_index, cost_count)) * pixels / (size * size) *
+                cal->scale[g] +
+            cal->setup_ms[g] +
+            (g == GROUP_HYBRID ? cal->setup_scale * technique_setup_ms(cal->setup_table, c) : 0.0);
+        ms += cal->finish_ms;
         if (ms < fastest->ms) {
             *fastest = (choice){ c, ms, predict_flip(near, k, key) };
         }
-        if (ms * number(safety, group, 1.0) > budget_ms) {
+        if (ms * cal->safety[g] > cal->available_ms) {
             continue;
         }
-        choice *best = strcmp(group, "pt") == 0 ? best_pt : best_hybrid;
+        choice *best = g == GROUP_PT ? best_pt : best_hybrid;
         double flip = predict_flip(near, k, key);
         if (flip < best->flip) {
             *best = (choice){ c, ms, flip };
@@ -297,6 +387,87 @@ drift_result render_upsample_bilinear(drift_context *ctx, const drift_image *low
     return r;
 }
 
+// The 1-minute load average (Linux's /proc/loadavg; 0 where there is none).
+static double load_average(void)
+{
+    double load = 0.0;
+    FILE *f = fopen("/proc/loadavg", "r");
+    if (f) {
+        if (fscanf(f, "%lf", &load) != 1) {
+            load = 0.0;
+        }
+        fclose(f);
+    }
+    return load;
+}
+
+// The cores a frame of `threads` threads gets on `cores` cores while `load` other threads
+// are runnable (the 1-minute load average): the scheduler shares the cores evenly.
+static double cores_for(int threads, double cores, double load)
+{
+    double t = threads > 0 ? threads : 1;
+    return fmin(fmin(t, cores), cores * t / (fmax(load, 0.0) + t));
+}
+
+// --budget-probe on (the default): what this scene costs on this machine now. The path
+// tracer at 1 spp on a small frame is timed in CPU ms; every candidate's fitted cost is scaled
+// by that over the fitted cost of the probe (the model's "pt|1 spp" at the probe's size: the
+// rows were measured under another load, on other scenes) and divided by the cores the frame
+// will get now (cores_for, from the load average: a probe of a few ms runs within a time
+// slice and cannot see the load). A hybrid candidate adds its set-up (a one-shot render pays
+// it; the bench's rows are warm frames): the base hybrid frame's (hard shadows, no indirect),
+// probed where the model's median of it is within 5 % of T, else that median, plus the
+// model's set-up of each technique it names (scripts/chooser/measure_setup.py, wall ms at the
+// load it records: rescaled to this load). The budget left is T less what was spent since the
+// scene was loaded (the accel, the features, the probes); every candidate adds the writes.
+static void calibrate(const cJSON *model, const double f[SCENE_FEATURE_COUNT],
+                      const render_options *o, const cli_session *session, calibration *cal,
+                      render_probe *probe)
+{
+    const cJSON *pt1 = find_candidate(model, f, "pt|1 spp", NULL);
+    double frame_ms =
+        pt1 ? predict_ms(model, pt1, f, (double)o->width * (double)o->height) : (double)INFINITY;
+    // Each of the three path-tracer probes ~1.5 % of T by the fitted cost, at most 1/4 of the
+    // frame's side, at least 16 pixels.
+    double side =
+        frame_ms > 0.0 && isfinite(frame_ms) ? sqrt(0.015 * o->budget_ms / frame_ms) : 0.25;
+    side = fmin(side, 0.25);
+    int32_t w = (int32_t)fmax(fmin(16.0, (double)o->width), (double)o->width * side);
+    int32_t h = (int32_t)fmax(fmin(16.0, (double)o->height), (double)o->height * side);
+    const cJSON *table = cJSON_GetObjectItemCaseSensitive(model, "setup_ms");
+    double base = number(table, "base", 0.0);
+    drift_hybrid_params hybrid = o->hybrid;
+    bool probe_hybrid = table && base <= 0.05 * o->budget_ms &&
+                        apply_technique(&hybrid, DRIFT_EFFECT_SHADOWS, "hard") &&
+                        apply_technique(&hybrid, DRIFT_EFFECT_INDIRECT, "none");
+    hybrid.environment_filter = 0;
+    render_choose_probe(session, w, h, probe_hybrid ? &hybrid : NULL, probe);
+    cal->load = load_average();
+    cal->cores = sysconf(_SC_NPROCESSORS_ONLN) > 0 ? (double)sysconf(_SC_NPROCESSORS_ONLN) : 1.0;
+    int threads = drift_context_thread_count(session->ctx);
+    cal->frame_cores = cores_for(threads, cal->cores, cal->load);
+    double predicted = pt1 ? predict_ms(model, pt1, f, probe->pixels) : 0.0;
+    const cJSON *safety = cJSON_GetObjectItemCaseSensitive(model, "calibrated_safety");
+    if (probe->pt_ms > 0.0 && predicted > 0.0 && isfinite(predicted)) {
+        cal->scale[GROUP_PT] = cal->scale[GROUP_HYBRID] =
+            probe->pt_ms / predicted / cal->frame_cores;
+        cal->safety[GROUP_PT] = number(safety, "pt", 1.0);
+        cal->safety[GROUP_HYBRID] = number(safety, "hybrid", 1.0);
+    }
+    cal->setup_ms[GROUP_HYBRID] =
+        probe->hybrid_ms > 0.0 ? probe->hybrid_ms / cal->frame_cores : base;
+    cal->setup_table = table;
+    // The writes (and what else the measured frames paid that the rows did not: the model's
+    // finish_ms, fitted by scripts/chooser/fit_calibration.py) at the frame's pixels.
+    double size = number(model, "size", 400.0);
+    cal->finish_ms =
+        number(model, "finish_ms", 0.0) * (double)o->width * (double)o->height / (size * size);
+    cal->setup_scale =
+        cores_for(threads, number(table, "cores", cal->cores), number(table, "load", cal->load)) /
+        cal->frame_cores;
+    cal->available_ms = o->budget_ms - 1e3 * (drift_time_now() - session->t_loaded);
+}
+
 int render_choose(render_options *o, const cli_session *session)
 {
     char fallback[4096];
@@ -317,9 +488,18 @@ int render_choose(render_options *o, const cli_session *session)
     if (o->height <= 0) {
         o->height = session->scene->camera.height;
     }
+    // --budget-probe off: the fitted costs times the model's safety factors, within T.
+    const cJSON *safety = cJSON_GetObjectItemCaseSensitive(model, "safety");
+    calibration cal = { .scale = { 1.0, 1.0 },
+                        .setup_scale = 1.0,
+                        .safety = { number(safety, "pt", 1.0), number(safety, "hybrid", 1.0) },
+                        .available_ms = o->budget_ms };
+    render_probe probe = { .pt_ms = -1.0 };
+    if (!o->no_budget_probe) {
+        calibrate(model, f, o, session, &cal, &probe);
+    }
     choice hybrid, pt, fastest;
-    bool ok =
-        score(model, f, o->budget_ms, (double)o->width * (double)o->height, &hybrid, &pt, &fastest);
+    bool ok = score(model, f, &cal, (double)o->width * (double)o->height, &hybrid, &pt, &fastest);
     double margin = number(model, "pt_margin", 1.0);
     // A hybrid frame only where it is predicted clearly closer than the best path tracer that
     // fits: the chooser must not trade the path tracer's image for a worse one.
@@ -337,15 +517,25 @@ int render_choose(render_options *o, const cli_session *session)
         return 1;
     }
     if (!o->quiet) {
+        char probed[256] = "";
+        if (!o->no_budget_probe) {
+            snprintf(probed, sizeof probed,
+                     "; probes %.1f ms: fitted costs x%.2f (load %.1f on %.0f cores: %.2f "
+                     "for the frame), hybrid set-up %.1f ms + its techniques'; %.0f ms of T "
+                     "left after the accel and probes",
+                     probe.spent_ms, cal.scale[GROUP_PT], cal.load, cal.cores, cal.frame_cores,
+                     cal.setup_ms[GROUP_HYBRID], cal.available_ms);
+        }
         fprintf(stderr,
                 "drift render: --budget-ms %g: %s%s (predicted %.0f ms, FLIP %.2fx the best "
-                "row's on the nearest fitted scenes)%s\n",
+                "row's on the nearest fitted scenes)%s%s\n",
                 o->budget_ms,
                 c == &fastest    ? "nothing is predicted to fit, the fastest: "
                 : o->hybrid_mode ? "hybrid "
                                  : "the path tracer is expected to win: ",
                 row ? row : "?", c->ms, c->flip,
-                c == &pt && hybrid.pick ? "; the best hybrid frame was predicted no closer" : "");
+                c == &pt && hybrid.pick ? "; the best hybrid frame was predicted no closer" : "",
+                probed);
     }
     cJSON_Delete(model);
     return 0;

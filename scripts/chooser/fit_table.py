@@ -409,8 +409,14 @@ def main():
         replace_block(o.frontier_md, head + "".join(tee.parts))
     if o.model:
         train = [s for s in scenes if o.train == "all" or is_fit(s)]
+        m = model_json(fit(train), train[0]["size"], os.path.basename(o.rows), o.pt_margin)
+        # What --budget-probe on reads that this fit does not make (scripts/chooser/
+        # measure_setup.py's set-up table, the safety under calibration) is kept.
+        if os.path.exists(o.model):
+            old = json.load(open(o.model))
+            m.update({k: old[k] for k in ("setup_ms", "calibrated_safety") if k in old})
         with open(o.model, "w") as fh:
-            json.dump(model_json(fit(train), train[0]["size"], os.path.basename(o.rows), o.pt_margin), fh, indent=1)
+            json.dump(m, fh, indent=1)
             fh.write("\n")
 
 

@@ -1,12 +1,16 @@
 #!/usr/bin/env bash
 # drift render --mode hybrid --budget-ms (issue 40): on the built-in Cornell box and two corpus
-# scenes at 32 x 32, the chooser (scenes/corpus/chooser.json) picks a row the renderer runs,
-# whose cost-model prediction is within the budget, and its image is within FLIP 0.3 of the
-# path tracer at 128 spp (cached beside the binary; a black or wrong frame is at 0.5 and
-# more). With a hand-made model where the path tracer's row is the best, it picks and renders
-# the path tracer (and says so), also when a hybrid row is predicted only slightly better
-# (within the model's pt_margin); where the hybrid row is clearly better, that. Bad
-# --budget-ms and a missing model exit with errors.
+# scenes at 32 x 32, the chooser (scenes/corpus/chooser.json, --budget-probe off: the fitted
+# costs, no timing) picks a row the renderer runs, whose cost-model prediction is within the
+# budget, and its image is within FLIP 0.3 of the path tracer at 128 spp (cached beside the
+# binary; a black or wrong frame is at 0.5 and more). With the probes on (the default) the
+# choice says what the probes measured and what is left of T, and a pick that is not "nothing
+# fits" is predicted within what is left. With a hand-made model where the path tracer's row
+# is the best, it picks and renders the path tracer (and says so), also when a hybrid row is
+# predicted only slightly better (within the model's pt_margin); where the hybrid row is
+# clearly better, that; where that row's technique has a set-up (the model's setup_ms) far
+# over the budget, the probes count it and the other row is picked. Bad --budget-ms and a
+# missing model exit with errors.
 # $1 is the drift binary.
 set -u
 drift="$1"
@@ -26,7 +30,7 @@ for scene in "" "$root/scenes/corpus/veach_mi.json" "$root/scenes/corpus/teapot_
     if [ ! -s "$ref" ]; then
         "$drift" render $scene "${size[@]}" --spp 128 --quiet --out "$ref" || fail "$name: reference"
     fi
-    expect 0 "$drift" render $scene --mode hybrid --budget-ms 100 "${size[@]}" \
+    expect 0 "$drift" render $scene --mode hybrid --budget-ms 100 --budget-probe off "${size[@]}" \
         --out "$tmp/$name.exr" --stats "$tmp/$name.json"
     line=$(grep -- "--budget-ms 100" "$tmp/err") || fail "$name: the choice is not said"
     python3 - "$line" <<'PY' || fail "$name: the pick is over its budget: $line"
@@ -39,6 +43,18 @@ PY
     python3 -c "import sys; sys.exit(0 if float('$flip') <= 0.3 else 1)" ||
         fail "$name: FLIP $flip over 0.3"
 done
+# The probes on: what they measured is said, and the pick fits what is left of T.
+expect 0 "$drift" render --mode hybrid --budget-ms 100 "${size[@]}" --out "$tmp/p.exr"
+line=$(grep -- "--budget-ms 100" "$tmp/err") || fail "probes: the choice is not said"
+python3 - "$line" <<'PY' || fail "probes: the pick is over what is left: $line"
+import re, sys
+line = sys.argv[1]
+left = re.search(r"(-?\d+) ms of T left after the accel and probes", line)
+pred = re.search(r"\(predicted (\d+) ms, FLIP", line)
+assert left and pred and "probes " in line, line
+assert float(left.group(1)) <= 100, line
+assert "nothing is predicted to fit" in line or float(pred.group(1)) <= float(left.group(1)), line
+PY
 # A model of one fitted scene and two candidates, both predicted at 10 ms (alpha = ln 10 at
 # the model's 32 x 32, no cost features): the lower predicted FLIP ratio wins, but a hybrid
 # row only below pt_margin (0.9) x the path tracer's.
@@ -64,7 +80,7 @@ PY
 for case in "1.5 1.0 pt" "0.95 1.0 pt" "0.5 1.0 hybrid"; do
     set -- $case
     model "$1" "$2" || fail "model $case"
-    expect 0 "$drift" render --mode hybrid --budget-ms 50 --chooser "$tmp/model.json" \
+    expect 0 "$drift" render --mode hybrid --budget-ms 50 --budget-probe off --chooser "$tmp/model.json" \
         "${size[@]}" --out "$tmp/m.exr" --stats "$tmp/m.json"
     if [ "$3" = pt ]; then
         grep -q "the path tracer is expected to win: pt 2 spp" "$tmp/err" ||
@@ -74,6 +90,38 @@ for case in "1.5 1.0 pt" "0.95 1.0 pt" "0.5 1.0 hybrid"; do
         grep -q "hybrid hard + none" "$tmp/err" || fail "hybrid $1, pt $2: not the hybrid row"
     fi
 done
+# Two hybrid rows and the path tracer's, all predicted at 10 ms; pcss + none the closest,
+# but its set-up in the model's table is 1e9 ms: with the probes (the default) it is counted
+# and hard + none is picked; --budget-probe off reads the warm frames alone and picks pcss.
+python3 - "$tmp/model.json" "$tmp/features.json" <<'PY' || fail "set-up model"
+import json, math, sys
+feats = json.load(open(sys.argv[2]))
+names = list(feats)
+row = lambda key, kind, extra: dict({"key": key, "group": kind, "alpha": math.log(10.0),
+                                     "kind": kind}, **extra)
+json.dump({"size": 32, "k": 1, "pt_margin": 0.9, "features": names, "cost_features": [],
+           "beta": {"pt": [], "hybrid": []}, "safety": {"pt": 1.0, "hybrid": 1.0},
+           "setup_ms": {"size": 32, "load": 0, "cores": 1, "base": 0.0,
+                        "shadows": {"pcss": 1e9}},
+           "scale": [1.0] * len(names),
+           "candidates": [
+               row("hybrid|hard + none", "hybrid",
+                   {"row": "hard + none", "shadows": "hard", "indirect": "none"}),
+               row("hybrid|pcss + none", "hybrid",
+                   {"row": "pcss + none", "shadows": "pcss", "indirect": "none"}),
+               row("pt|1 spp", "pt", {"row": "pt 1 spp", "spp": 1, "scale": 1, "denoise": "none"})],
+           "scenes": [{"name": "box", "features": [feats[n] for n in names],
+                       "flip": {"hybrid|hard + none": 0.6, "hybrid|pcss + none": 0.5,
+                                "pt|1 spp": 1.0}}]}, open(sys.argv[1], "w"))
+PY
+expect 0 "$drift" render --mode hybrid --budget-ms 100000 --chooser "$tmp/model.json" \
+    "${size[@]}" --out "$tmp/m.exr"
+grep -q "hybrid hard + none" "$tmp/err" || fail "probes: the set-up is not counted: $(cat "$tmp/err")"
+expect 0 "$drift" render --mode hybrid --budget-ms 100000 --budget-probe off \
+    --chooser "$tmp/model.json" "${size[@]}" --out "$tmp/m.exr"
+grep -q "hybrid pcss + none" "$tmp/err" || fail "probe off: not the closest row: $(cat "$tmp/err")"
+expect 2 "$drift" render --mode hybrid --budget-ms 100 --budget-probe maybe "${size[@]}" \
+    --out "$tmp/x.exr"
 expect 2 "$drift" render --mode hybrid --budget-ms -5 "${size[@]}" --out "$tmp/x.exr"
 expect 2 "$drift" render --budget-ms 100 "${size[@]}" --out "$tmp/x.exr"
 expect 1 "$drift" render --mode hybrid --budget-ms 100 --chooser "$tmp/none.json" "${size[@]}" \
