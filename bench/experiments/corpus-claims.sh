@@ -34,7 +34,7 @@ while [ $# -gt 0 ]; do
     --aaf-ref) aaf_ref="$2"; shift ;;
     --aaf-scenes) AAF_SCENES="$2"; shift ;;
     --sir-scenes) SIR_SCENES="$2"; shift ;;
-    -h | --help) sed -n '2,14p' "$0"; exit 0 ;;
+    -h | --help) sed -n '2,/^set /{/^#/p}' "$0"; exit 0 ;;
     *) bins+=("$1") ;;
     esac
     shift
