@@ -28,7 +28,8 @@ typedef struct aaf_options {
     int spp_count, mc_spp_count;
     int effect; // --effect: shadows, indirect, both, reflections
     bool shadows, indirect, reflections, json;
-    bool random; // --sampler random: AAF and plain MC both take independent random numbers
+    bool random;    // --sampler random: AAF and plain MC both take independent random numbers
+    bool ref_plain; // --ref plain: the reference is plain MC's own estimate at --ref-spp
 } aaf_options;
 
 // --spp and --mc-spp: an increasing list of 2..MAX_SPPS counts into that list and its count.
@@ -87,6 +88,10 @@ static const cli_option aaf_table[] = {
                "sobol (default) or random, for AAF and plain MC alike: random is\n"
                "the paper's traditional Monte Carlo (Fig. 3.6)"),
     CLI_INT("--ref-spp", "N", O, ref_spp, 1, 1 << 20, "reference samples a pixel (default 4096)"),
+    CLI_CHOICE("--ref", "R", O, ref_plain, "path|plain",
+               "path (default): the effect's term path-traced; plain: plain MC's own\n"
+               "estimate at --ref-spp (the same unshadowed light: only the sampler's\n"
+               "error is left where the hybrid's U_l differs from the path tracer)"),
     CLI_INT("--width", "W", O, width, 1, DRIFT_IMAGE_MAX_DIMENSION,
             "error images (default 160x120)"),
     CLI_INT("--height", "H", O, height, 1, DRIFT_IMAGE_MAX_DIMENSION, "error images"),
@@ -277,7 +282,8 @@ static drift_result measure_render(drift_context *ctx, const drift_scene *scene,
     drift_hybrid *frame = NULL;
     drift_hybrid_params p;
     if (e->ref_owner == me) {
-        p = effect_params(effect, reference, o, o->ref_spp);
+        p = effect_params(effect, o->ref_plain ? e->aaf : reference, o, o->ref_spp);
+        p.aaf.uniform = p.aaf.unfiltered = o->ref_plain;
         r = render(ctx, scene, accel, &p, &e->ref);
     }
     for (int k = 0; r == DRIFT_OK && k < most; ++k) {
@@ -517,6 +523,7 @@ static bool print_json(const aaf_options *o, const char *scene_path, int threads
     cJSON_AddNumberToObject(root, "width", (double)o->width);
     cJSON_AddNumberToObject(root, "height", (double)o->height);
     cJSON_AddNumberToObject(root, "ref_spp", (double)o->ref_spp);
+    cJSON_AddStringToObject(root, "reference", o->ref_plain ? "plain" : "path");
     cJSON_AddNumberToObject(root, "threads", threads);
     cJSON_AddNumberToObject(root, "light_samples", (double)o->light_samples);
     cJSON_AddStringToObject(root, "sampler", o->random ? "random" : "sobol");
@@ -560,8 +567,9 @@ static bool print_json(const aaf_options *o, const char *scene_path, int threads
 static void print_text(const aaf_options *o, const char *scene_path, int threads,
                        const curve *curves, int count)
 {
-    printf("%s, %ldx%ld, reference %ld spp, %d thread(s), %s sampler\n", scene_path, o->width,
-           o->height, o->ref_spp, threads, o->random ? "random" : "sobol");
+    printf("%s, %ldx%ld, reference %ld spp (%s), %d thread(s), %s sampler\n", scene_path, o->width,
+           o->height, o->ref_spp, o->ref_plain ? "plain MC" : "path-traced", threads,
+           o->random ? "random" : "sobol");
     for (int c = 0; c < count; ++c) {
         const curve *cv = &curves[c];
         printf("\n%s\n%8s %10s %12s %10s %9s\n", drift_effect_name(cv->effect), "spp", "aaf spp",

@@ -9,6 +9,7 @@
 // Defaults (docs/aaf.md explains each).
 #define DRIFT_AAF_SPARSE_MIN          4 // sparse samples a pixel, at least (when spp allows)
 #define DRIFT_AAF_DILATE              4 // pixels searched for occluders a pixel's sparse rays missed
+#define DRIFT_AAF_FLAT_EVIDENCE       16.0f // sparse rays (own + neighbours') that may call a pixel flat
 #define DRIFT_AAF_MAX_RADIUS          16 // filter half width in pixels (the paper's "large constant")
 #define DRIFT_AAF_FLOOR_SHARE         0.75 // an adaptive pixel's least share of their mean budget
 #define DRIFT_AAF_BETA_RATIO          2.0f // neighbours whose beta differs by more are rejected

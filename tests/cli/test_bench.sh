@@ -59,6 +59,12 @@ e = d["effects"][0]
 assert len(e["aaf"]) == 2 and len(e["plain_mc"]) == 2, e
 assert all(math.isfinite(p["rmse"]) and p["rmse"] >= 0 for p in e["aaf"] + e["plain_mc"]), e
 assert e["timing"]["frame_ms"] > 0, e'
+        # --ref plain: the reference is plain MC's own estimate, so plain MC at --ref-spp is it.
+        expect 0 "$drift" bench aaf "$box" --width 16 --height 12 --ref-spp 4 --ref plain \
+            --spp 1,2 --mc-spp 2,4 --timing-size 16x12 --timing-spp 1 --light-samples 2 --json
+        check aaf 'assert d["reference"] == "plain", d
+e = d["effects"][0]
+assert e["plain_mc"][1]["rmse"] == 0 and e["plain_mc"][0]["rmse"] > 0, e'
         ;;
     sir)
         expect 0 "$drift" bench sir "$box" --sizes 16x12 --spp 1 --budget 64 --json

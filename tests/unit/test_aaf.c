@@ -265,6 +265,47 @@ static void test_full_light_and_full_shadow_are_exact(void **state)
     }
 }
 
+// A pixel is kept at its sparse rays (flat, exactly 0 or 1) only on the word of enough rays:
+// a lit square two pixels across, floating over the shadow scene (its pixels have few
+// neighbours on their surface, so the 2 sparse rays a pixel at 4 spp are all there is), takes
+// at least --spp samples a pixel, as plain sampling would give it, and stays exactly lit. It
+// was flat on 2 rays: at 4 spp the Breakfast Room's small surfaces held a third of AAF's error
+// that way (docs/aaf.md).
+static void test_few_rays_do_not_make_a_pixel_flat(void **state)
+{
+    (void)state;
+    test_rig r = test_rig_begin(2);
+    build_shadow_scene(&r);
+    uint32_t white;
+    drift_material m = drift_material_make(drift_vec3_splat(0.6f));
+    assert_int_equal(drift_scene_add_material(r.scene, &m, &white), DRIFT_OK);
+    const float height = 2.0f, half = 0.01f; // 0.5 below the camera: about 2 x 2 pixels
+    add_square(r.scene, 0.2f, height, -1.1f, half, white);
+    test_rig_commit(&r);
+    const uint32_t spp = 4;
+    assert_true(drift_aaf_shadow_sparse_count(spp) < spp);
+    test_rig_frame(&r,
+                   &(drift_hybrid_params){ .shadows = DRIFT_SHADOWS_AAF, .spp = spp, .seed = 5 });
+    const drift_gbuffer *g = drift_hybrid_gbuffer(r.frame);
+    const drift_image *taken = test_rig_plane(&r, "light0.aaf.spp"),
+                      *shadow = test_rig_plane(&r, "light0.shadow");
+    int pixels = 0;
+    for (int y = 0; y < SH; ++y) {
+        for (int x = 0; x < SW; ++x) {
+            if (drift_image_pixel(&g->material_id, x, y)[0] < 0.0f ||
+                fabsf(drift_image_get3(&g->position, x, y).y - height) > 1e-3f) {
+                continue;
+            }
+            ++pixels;
+            assert_true(drift_image_pixel(taken, x, y)[0] >= (float)spp);
+            assert_true(drift_image_pixel(shadow, x, y)[0] == 1.0f);
+        }
+    }
+    print_message("%d pixels on the small square\n", pixels);
+    assert_true(pixels >= 1 && pixels <= 6);
+    test_rig_destroy(&r);
+}
+
 // The separable filter (eq. 3.7) against the exact 2-D filter (eq. 3.2) on a smooth, curved
 // penumbra with a slowly varying beta: the largest difference stays under 0.02 (visibility
 // units) and the mean under 0.002, while the filter itself moves values by far more.
@@ -594,6 +635,7 @@ int main(void)
         cmocka_unit_test(test_shadows_at_4_spp_on_the_cornell_box),
         cmocka_unit_test(test_beta_and_rate_follow_the_geometry),
         cmocka_unit_test(test_full_light_and_full_shadow_are_exact),
+        cmocka_unit_test(test_few_rays_do_not_make_a_pixel_flat),
         cmocka_unit_test(test_separable_filter_close_to_exact),
         cmocka_unit_test(test_budget_keeps_the_mean),
         cmocka_unit_test(test_indirect_converges),
