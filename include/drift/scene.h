@@ -441,12 +441,14 @@ typedef struct drift_bsdf_ggx {
     // diffuse base (skip_diffuse). The pdf and sampling do not change.
     bool skip_reflection, skip_diffuse;
     // The clear coat over all of the above (src/scene/clearcoat.c), textures applied: its
-    // weight (0: none, the material above bit for bit), alpha, form, and its alpha's row of the
-    // albedo tables with the coat's cosine-weighted average albedo (weight included).
+    // weight (0: none, the material above bit for bit), alpha, form, its alpha's row of the
+    // albedo tables, the coat's cosine-weighted average albedo (weight included), and the gain
+    // that gives the plastic's diffuse base back the light the coat reflects down into it.
     float clearcoat, clearcoat_alpha;
     bool clearcoat_principled;
     int clearcoat_row;
     float clearcoat_frac, clearcoat_avg;
+    drift_vec3 clearcoat_diffuse_gain;
 } drift_bsdf_ggx;
 
 // Resolved material at one point (textures applied). All directions in world space.

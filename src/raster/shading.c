@@ -185,12 +185,10 @@ drift_vec3 drift_raster_diffuse_albedo(const drift_bsdf *bsdf, drift_vec3 w)
         if (!(g->w_plastic > 0.0f) || g->skip_diffuse) {
             return drift_vec3_splat(0.0f);
         }
-        // A layered clear coat dims the base by 1 - c Ec(mu) toward w and, cosine-averaged
-        // over the other side, by 1 - c Ec_avg (src/scene/clearcoat.c).
+        // A layered clear coat leaves the diffuse base's albedo toward w exactly 1 - c Ec(mu)
+        // of the uncoated one (src/scene/clearcoat.c).
         float coat =
-            g->clearcoat_principled
-                ? 1.0f
-                : (1.0f - drift_bsdf_clearcoat_albedo(bsdf, mu, NULL)) * (1.0f - g->clearcoat_avg);
+            g->clearcoat_principled ? 1.0f : 1.0f - drift_bsdf_clearcoat_albedo(bsdf, mu, NULL);
         b.ggx.clearcoat = 0.0f;
         drift_vec3 base = drift_vec3_scale(g->base, g->w_plastic * coat);
         if (g->burley_roughness < 0.0f) {

@@ -3,15 +3,20 @@
 // Two forms (docs/materials.md "Clear coat", docs/decisions/0411-gltf-clearcoat.md):
 //
 //   layered (the glTF specification's, made reciprocal and energy-bounded):
-//     f = c f_coat(wo, wi) + (1 - c Ec(mu_o)) (1 - c Ec(mu_i)) f_base(wo, wi)
+//     f = c f_coat(wo, wi) + T(mu_o) T(mu_i) (f_base(wo, wi) + (gain - 1) f_diffuse(wo, wi))
 //   Principled (Blender 3.4's Cycles, Disney's clearcoat):
 //     f = 0.25 c f_coat(wo, wi) + f_base(wo, wi)
 //
-// with f_coat = F_Schlick(0.04, wo.h) D G2 / (4 mu_o mu_i) and Ec its directional albedo (the
-// albedo tables of ggx_tables.c). The layered base is dimmed by the light the coat reflects on
-// the way in and on the way out; the light the coat reflects back down into the base is not
-// returned, so a white base under a coat reflects c Ec(mu_o) + (1 - c Ec(mu_o)) times the
-// base's albedo through the coat, at most 1. The coat lies about the base's shading normal.
+// with f_coat = F_Schlick(0.04, wo.h) D G2 / (4 mu_o mu_i), Ec its directional albedo (the
+// albedo tables of ggx_tables.c) and T = 1 - c Ec the light that crosses the coat. The base is
+// dimmed on the way in and on the way out. Its diffuse part f_diffuse (the plastic's) gets back
+// the light the coat reflects down into it, as the plastic does under its own coat: `gain`
+// makes the diffuse albedo toward any mu_o exactly T(mu_o) times the uncoated one (for the
+// layered plastic gain = (1 - Ep_avg) / int (1 - Ep)(1 - c Ec) 2 mu dmu, Ep the plastic coat's
+// albedo; for Burley's 1 / (1 - c Ec_avg)). So a white plastic under a clear coat reflects
+// c Ec + T (Ep + 1 - Ep) = 1 but for what its own coat's reflection loses through the clear coat
+// (< 0.5% at normal incidence); a conductor base gets nothing back (a smooth mirror under a
+// smooth coat at 77 degrees reflects 0.79). The coat lies about the base's shading normal.
 #include "clearcoat.h"
 
 #include "microfacet.h"
@@ -75,6 +80,29 @@ void drift__clearcoat_make(const drift_scene *scene, const drift_material *m,
     drift__ggx_alpha_slot(a, &g->clearcoat_row, &g->clearcoat_frac);
     float e1_avg = drift__ggx_e1_avg(a), es_avg = drift__ggx_es_avg(a);
     g->clearcoat_avg = coat_scale(g) * (DRIFT_CLEARCOAT_F0 * (e1_avg - es_avg) + es_avg);
+    g->clearcoat_diffuse_gain = drift_vec3_splat(1.0f);
+    if (g->clearcoat_principled || !(g->w_plastic > 0.0f)) {
+        return;
+    }
+    if (g->burley_roughness >= 0.0f) {
+        // Lambert's: int (1 - c Ec(mu_i)) cos / pi = 1 - c Ec_avg.
+        g->clearcoat_diffuse_gain = drift_vec3_splat(1.0f / (1.0f - g->clearcoat_avg));
+        return;
+    }
+    // The layered plastic's diffuse is kd (1 - Ep(mu_o))(1 - Ep(mu_i)) / (pi (1 - Ep_avg)):
+    // the ratio of the cosine-weighted integrals of 1 - Ep and (1 - Ep)(1 - c Ec), by the same
+    // midpoint rule on the tables' mu grid.
+    drift_vec3 plain = drift_vec3_splat(0.0f), coated = plain, one = drift_vec3_splat(1.0f);
+    for (int i = 0; i < DRIFT_GGX_TABLE_MU_N; ++i) {
+        float mu = ((float)i + 0.5f) / (float)DRIFT_GGX_TABLE_MU_N, e1, es;
+        drift__ggx_e1_es_at(mu, g->alpha_row, g->alpha_frac, &e1, &es);
+        drift_vec3 ep = drift_vec3_add(drift_vec3_scale(g->f0_coat, e1 - es), drift_vec3_splat(es));
+        drift_vec3 below = drift_vec3_scale(drift_vec3_sub(one, ep), mu);
+        plain = drift_vec3_add(plain, below);
+        coated = drift_vec3_fma(coated, below, coat_transmittance(g, mu));
+    }
+    g->clearcoat_diffuse_gain =
+        drift_vec3_make(plain.x / coated.x, plain.y / coated.y, plain.z / coated.z);
 }
 
 // The coat lobe f_coat (scale included), wo and wi above the surface.
@@ -133,9 +161,11 @@ drift_vec3 drift__coated_eval(const drift_bsdf_ggx *g, drift_vec3 wo, drift_vec3
     }
     // Transmission through a coated dielectric is dimmed on both sides too (docs/materials.md).
     float t = coat_transmittance(g, wo.z) * coat_transmittance(g, fabsf(wi.z));
-    f = drift_vec3_scale(f, t);
+    drift_vec3 more =
+        drift_vec3_mul(diffuse, drift_vec3_sub(g->clearcoat_diffuse_gain, drift_vec3_splat(1.0f)));
+    f = drift_vec3_scale(drift_vec3_add(f, more), t);
     if (out_diffuse) {
-        *out_diffuse = drift_vec3_scale(diffuse, t);
+        *out_diffuse = drift_vec3_scale(drift_vec3_mul(diffuse, g->clearcoat_diffuse_gain), t);
     }
     if (wi.z > 0.0f && !g->skip_reflection) {
         f = drift_vec3_add(f, drift_vec3_splat(coat_eval(g, wo, wi)));

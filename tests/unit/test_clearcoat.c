@@ -123,6 +123,65 @@ static void test_clearcoat_white_base_reflects_at_most_one(void **state)
     }
 }
 
+// The diffuse albedo (drift_bsdf_eval_lobes' diffuse part, by quadrature).
+static double diffuse_quadrature(const drift_bsdf *b, drift_vec3 wo)
+{
+    const int nt = 128, np = 64;
+    double sum = 0.0;
+    for (int i = 0; i < nt; ++i) {
+        double ct = (i + 0.5) / nt, st = sqrt(1.0 - ct * ct);
+        for (int j = 0; j < np; ++j) {
+            double phi = (j + 0.5) * M_PI / np;
+            drift_vec3 wi =
+                drift_vec3_make((float)(st * cos(phi)), (float)(st * sin(phi)), (float)ct);
+            drift_vec3 d, gl;
+            drift_bsdf_eval_lobes(b, wo, wi, &d, &gl);
+            sum += 2.0 * (double)d.x * ct * (1.0 / nt) * (M_PI / np);
+        }
+    }
+    return sum;
+}
+
+// The layered form gives the plastic's diffuse base back the light the coat reflects down: its
+// albedo toward mu_o is exactly (1 - c Ec(mu_o)) times the uncoated one, for the layered
+// plastic and for Burley's base; so a white plastic under a clear coat reflects 1 but for what
+// its own coat's reflection loses through the clear coat.
+static void test_clearcoat_white_plastic_reflects_nearly_one(void **state)
+{
+    (void)state;
+    const float coats[][2] = { { 1.0f, 0.0025f }, { 1.0f, 0.09f }, { 0.5f, 0.5f } };
+    for (int burley = 0; burley < 2; ++burley) {
+        for (int c = 0; c < 3; ++c) {
+            drift_material m0 = coated(drift_vec3_splat(1.0f), 0.2f, 0.0f, 0.0f, 0.0f, false);
+            if (burley) {
+                m0.diffuse_model = DRIFT_DIFFUSE_BURLEY;
+                m0.diffuse_roughness = 0.45f;
+            }
+            drift_material m1 = m0;
+            m1.ggx.clearcoat = coats[c][0];
+            m1.ggx.clearcoat_alpha = coats[c][1];
+            drift_bsdf b0 = make_bsdf(&m0, true), b1 = make_bsdf(&m1, true);
+            for (float theta = 0.0f; theta < 1.4f; theta += 0.45f) {
+                double t = 1.0 - (double)drift__clearcoat_albedo(&b1.ggx, cosf(theta));
+                double d0 = diffuse_quadrature(&b0, dir_at(theta));
+                double d1 = diffuse_quadrature(&b1, dir_at(theta));
+                if (fabs(d1 - t * d0) > 0.003 * d0) {
+                    fail_msg("%s base, coat %d, theta %.2f: diffuse albedo %.4f, expected %.4f x "
+                             "%.4f",
+                             burley ? "Burley" : "layered", c, (double)theta, d1, t, d0);
+                }
+                if (!burley && theta < 1.0f && coats[c][1] >= 0.09f) {
+                    double q = albedo_quadrature(&b1, dir_at(theta));
+                    if (!(q >= 0.99 && q <= 1.003)) {
+                        fail_msg("white plastic under coat %d, theta %.2f: albedo %.4f", c,
+                                 (double)theta, q);
+                    }
+                }
+            }
+        }
+    }
+}
+
 // The Principled form adds the coat lobe to the undimmed base: the difference of the albedos
 // by quadrature is the coat's tabulated albedo 0.25 c Ec(mu_o) (and so a white conductor under
 // it reflects more than 1, as Cycles 3.4's).
@@ -332,6 +391,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_clearcoat_white_base_reflects_at_most_one),
+        cmocka_unit_test(test_clearcoat_white_plastic_reflects_nearly_one),
         cmocka_unit_test(test_clearcoat_principled_adds_the_coat_albedo),
         cmocka_unit_test(test_clearcoat_is_reciprocal),
         cmocka_unit_test(test_clearcoat_sampling_matches_pdf),
