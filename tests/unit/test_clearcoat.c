@@ -3,9 +3,10 @@
 // most 1 (the layered form) and the Principled form adds exactly the coat's tabulated albedo
 // 0.25 c Ec(mu_o) to its base's; reciprocity; the mixed sampling against its pdf (chi-square,
 // the pdf integrating to the success rate) and its weights against eval / pdf; a coat of 0 is
-// the uncoated material bit for bit.
+// the uncoated material bit for bit; JSON `ggx`'s clearcoat keys.
 #include "drift/math.h"
 #include "drift/scene.h"
+#include "drift/scene_io.h"
 #include "drift_test.h"
 #include "scene/clearcoat.h"
 #include "scene/microfacet.h"
@@ -388,6 +389,33 @@ static void test_clearcoat_zero_is_the_uncoated_material(void **state)
     }
 }
 
+// --- SCENE FILES ---
+
+// JSON `ggx` takes `clearcoat` and `clearcoat_roughness` (perceptual: alpha = r^2), the layered
+// form; a Phong material refuses them.
+static void test_clearcoat_json_keys(void **state)
+{
+    (void)state;
+    drift_context *ctx = test_context(1, NULL);
+    const char *text =
+        "{\"materials\": {\"paint\": {\"type\": \"ggx\", \"diffuse\": [0.7, 0.1, 0.1],"
+        " \"clearcoat\": 0.75, \"clearcoat_roughness\": 0.2}}}";
+    drift_scene *scene = NULL;
+    assert_int_equal(drift_scene_load_json_text(ctx, text, strlen(text), NULL, "c.json", &scene),
+                     DRIFT_OK);
+    const drift_material *m = &scene->materials[0];
+    assert_int_equal(m->type, DRIFT_MATERIAL_GGX);
+    assert_float_equal(m->ggx.clearcoat, 0.75f, 0.0f);
+    assert_float_equal(m->ggx.clearcoat_alpha, 0.04f, 1e-6f);
+    assert_false(m->ggx.clearcoat_principled);
+    drift_scene_destroy(scene);
+    const char *phong = "{\"materials\": {\"p\": {\"type\": \"diffuse\", \"clearcoat\": 1}}}";
+    scene = NULL;
+    assert_int_not_equal(
+        drift_scene_load_json_text(ctx, phong, strlen(phong), NULL, "p.json", &scene), DRIFT_OK);
+    drift_context_destroy(ctx);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -398,6 +426,7 @@ int main(void)
         cmocka_unit_test(test_clearcoat_sampling_matches_pdf),
         cmocka_unit_test(test_clearcoat_sample_agrees_with_eval_and_pdf),
         cmocka_unit_test(test_clearcoat_zero_is_the_uncoated_material),
+        cmocka_unit_test(test_clearcoat_json_keys),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
