@@ -140,6 +140,17 @@ typedef struct drift_ggx_params {
     uint32_t emissive_texture;
     uint32_t occlusion_texture;
     float occlusion_strength;
+    // KHR_materials_clearcoat (docs/materials.md "Clear coat"): a GGX dielectric coat of IOR 1.5
+    // over the whole material, of weight clearcoat (0: none) and roughness alpha
+    // clearcoat_alpha (perceptual roughness squared). The textures' R (clearcoat_texture) and G
+    // (clearcoat_roughness_texture, perceptual roughness) multiply them. clearcoat_principled:
+    // Blender 3.4's Principled form (0.25 clearcoat times the coat, the base not dimmed) in
+    // place of the glTF specification's layering.
+    float clearcoat;
+    float clearcoat_alpha;
+    uint32_t clearcoat_texture;
+    uint32_t clearcoat_roughness_texture;
+    bool clearcoat_principled;
 } drift_ggx_params;
 
 // How a material reads one of its textures (glTF's sampler, texCoord and KHR_texture_transform,
@@ -170,6 +181,8 @@ typedef enum drift_texture_slot {
     DRIFT_TEXTURE_NORMAL,
     DRIFT_TEXTURE_EMISSIVE,
     DRIFT_TEXTURE_OCCLUSION,
+    DRIFT_TEXTURE_CLEARCOAT,
+    DRIFT_TEXTURE_CLEARCOAT_ROUGHNESS,
     DRIFT_TEXTURE_SLOT_COUNT
 } drift_texture_slot;
 
@@ -427,6 +440,15 @@ typedef struct drift_bsdf_ggx {
     // (skip_reflection: the hybrid frame's split-sum environment light) or the plastic's
     // diffuse base (skip_diffuse). The pdf and sampling do not change.
     bool skip_reflection, skip_diffuse;
+    // The clear coat over all of the above (src/scene/clearcoat.c), textures applied: its
+    // weight (0: none, the material above bit for bit), alpha, form, its alpha's row of the
+    // albedo tables, the coat's cosine-weighted average albedo (weight included), and the gain
+    // that gives the plastic's diffuse base back the light the coat reflects down into it.
+    float clearcoat, clearcoat_alpha;
+    bool clearcoat_principled;
+    int clearcoat_row;
+    float clearcoat_frac, clearcoat_avg;
+    drift_vec3 clearcoat_diffuse_gain;
 } drift_bsdf_ggx;
 
 // Resolved material at one point (textures applied). All directions in world space.
@@ -493,6 +515,11 @@ void drift_bsdf_ggx_reflection_albedo(const drift_bsdf *bsdf, float mu, drift_ve
 // The GGX roughness of the conductor's multiple-scattering lobe for a material of roughness
 // alpha (a broader lobe about the same mirror direction; docs/materials.md).
 float drift_ggx_multiple_scattering_alpha(float alpha);
+// A GGX BSDF's clear coat toward wo (mu = cos theta_o): the coat lobe's directional albedo
+// (weight included; 0 without a coat), and its alpha in out_alpha. The lobe is about the same
+// shading normal as the rest; drift_bsdf_ggx_reflection_albedo's lobes are already dimmed by
+// what the coat takes (docs/materials.md "Clear coat").
+float drift_bsdf_clearcoat_albedo(const drift_bsdf *bsdf, float mu, float *out_alpha);
 
 // --- LIGHT SAMPLING ---
 

@@ -1,5 +1,5 @@
-// glTF's metallic-roughness material and its KHR_materials_transmission, _ior, _specular and
-// _volume extensions onto DRIFT_MATERIAL_GGX (docs/materials.md, "glTF").
+// glTF's metallic-roughness material and its KHR_materials_transmission, _ior, _specular,
+// _volume and _clearcoat extensions onto DRIFT_MATERIAL_GGX (docs/materials.md, "glTF").
 #include "drift/image_io.h"
 #include "scene_io_internal.h"
 
@@ -255,7 +255,9 @@ void drift__gltf_read_ggx(const cJSON *root, const cJSON *material, drift__gltf_
     *g = (drift_ggx_params){ .metallic_roughness_texture = DRIFT_INVALID_INDEX,
                              .normal_texture = DRIFT_INVALID_INDEX,
                              .emissive_texture = DRIFT_INVALID_INDEX,
-                             .occlusion_texture = DRIFT_INVALID_INDEX };
+                             .occlusion_texture = DRIFT_INVALID_INDEX,
+                             .clearcoat_texture = DRIFT_INVALID_INDEX,
+                             .clearcoat_roughness_texture = DRIFT_INVALID_INDEX };
     g->metallic = drift_clampf(number_at(pbr, "metallicFactor", 1.0f), 0.0f, 1.0f);
     float roughness = drift_clampf(number_at(pbr, "roughnessFactor", 1.0f), 0.0f, 1.0f);
     g->alpha = roughness * roughness;
@@ -279,7 +281,17 @@ void drift__gltf_read_ggx(const cJSON *root, const cJSON *material, drift__gltf_
     // it back as solid: drift follows Blender there (docs/materials.md).
     const cJSON *volume = cJSON_GetObjectItemCaseSensitive(ext, "KHR_materials_volume");
     g->thin = volume && !(number_at(volume, "thicknessFactor", 0.0f) > 0.0f);
-    out->has_clearcoat = cJSON_GetObjectItemCaseSensitive(ext, "KHR_materials_clearcoat") != NULL;
+    // KHR_materials_clearcoat: factor and perceptual roughness (defaults 0), each multiplied by
+    // its texture's R / G channel. The coat's own normal map is not read: the coat follows the
+    // base's shading normal (docs/materials.md "Clear coat").
+    const cJSON *clearcoat = cJSON_GetObjectItemCaseSensitive(ext, "KHR_materials_clearcoat");
+    g->clearcoat = drift_clampf(number_at(clearcoat, "clearcoatFactor", 0.0f), 0.0f, 1.0f);
+    float coat_roughness =
+        drift_clampf(number_at(clearcoat, "clearcoatRoughnessFactor", 0.0f), 0.0f, 1.0f);
+    g->clearcoat_alpha = coat_roughness * coat_roughness;
+    g->clearcoat_principled = DRIFT_GLTF_CLEARCOAT_PRINCIPLED;
+    out->has_clearcoat_normal =
+        cJSON_GetObjectItemCaseSensitive(clearcoat, "clearcoatNormalTexture") != NULL;
     const cJSON *normal = cJSON_GetObjectItemCaseSensitive(material, "normalTexture");
     const cJSON *occlusion = cJSON_GetObjectItemCaseSensitive(material, "occlusionTexture");
     const cJSON *refs[DRIFT_TEXTURE_SLOT_COUNT] = {
@@ -289,6 +301,9 @@ void drift__gltf_read_ggx(const cJSON *root, const cJSON *material, drift__gltf_
         [DRIFT_TEXTURE_NORMAL] = normal,
         [DRIFT_TEXTURE_EMISSIVE] = cJSON_GetObjectItemCaseSensitive(material, "emissiveTexture"),
         [DRIFT_TEXTURE_OCCLUSION] = occlusion,
+        [DRIFT_TEXTURE_CLEARCOAT] = cJSON_GetObjectItemCaseSensitive(clearcoat, "clearcoatTexture"),
+        [DRIFT_TEXTURE_CLEARCOAT_ROUGHNESS] =
+            cJSON_GetObjectItemCaseSensitive(clearcoat, "clearcoatRoughnessTexture"),
     };
     for (int k = 0; k < DRIFT_TEXTURE_SLOT_COUNT; ++k) {
         read_texture(root, refs[k], &out->textures[k]);
@@ -333,6 +348,10 @@ void drift__gltf_material_apply(drift_scene *scene, const drift__gltf *gltf,
         { DRIFT_TEXTURE_EMISSIVE, true, &m->ggx.emissive_texture,
           "emissive texture (its factor is used)" },
         { DRIFT_TEXTURE_OCCLUSION, false, &m->ggx.occlusion_texture, "occlusion texture" },
+        { DRIFT_TEXTURE_CLEARCOAT, false, &m->ggx.clearcoat_texture,
+          "clearcoat texture (its factor is used)" },
+        { DRIFT_TEXTURE_CLEARCOAT_ROUGHNESS, false, &m->ggx.clearcoat_roughness_texture,
+          "clearcoat roughness texture (its factor is used)" },
     };
 
     for (size_t k = 0; k < sizeof loads / sizeof loads[0]; ++k) {
@@ -361,7 +380,8 @@ void drift__gltf_material_apply(drift_scene *scene, const drift__gltf *gltf,
         const char *what;
     } ignored[] = {
         { gm->alpha_blended, "alpha mode (drawn opaque)" },
-        { gm->has_clearcoat, "clearcoat (KHR_materials_clearcoat; drift has one coat)" },
+        { gm->has_clearcoat_normal,
+          "clearcoat normal texture (the coat follows the base's shading normal)" },
     };
 
     for (size_t k = 0; k < sizeof(ignored) / sizeof(ignored[0]); ++k) {

@@ -50,6 +50,7 @@ const drift__format_row drift__gltf_extensions[] = {
     { "KHR_materials_ior", "GGX index of refraction" },
     { "KHR_materials_specular", "tint and strength of the coat's F0" },
     { "KHR_materials_volume", "thickness 0: thin-walled; else solid glass" },
+    { "KHR_materials_clearcoat", "GGX clear coat of IOR 1.5 (factor, roughness, their textures)" },
     { "KHR_texture_transform", "offset, rotation, scale and texCoord of a texture" },
 };
 const size_t drift__gltf_extension_count =

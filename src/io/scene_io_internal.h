@@ -140,6 +140,10 @@ typedef struct drift__gltf_texture {
     int tex_coord;             // the texCoord asked for (drift reads sets 0 and 1)
 } drift__gltf_texture;
 
+// The form of KHR_materials_clearcoat's coat (drift_ggx_params.clearcoat_principled) a glTF
+// file gets: docs/decisions/0411-gltf-clearcoat.md.
+#define DRIFT_GLTF_CLEARCOAT_PRINCIPLED true
+
 // A glTF metallic-roughness material as drift's diffuse + glossy (docs/scene-format.md).
 typedef struct drift__gltf_material {
     drift_vec3 diffuse, specular, emission; // emission includes KHR_materials_emissive_strength
@@ -151,7 +155,7 @@ typedef struct drift__gltf_material {
     // roughness and the KHR_materials_transmission / _ior / _specular / _clearcoat values.
     drift_vec3 base_color;
     drift_ggx_params ggx;
-    bool has_clearcoat; // drift has no second coat: folded in as noted in docs/materials.md
+    bool has_clearcoat_normal; // clearcoatNormalTexture: not read (docs/materials.md)
     // Its textures by drift_texture_slot (base colour, metallic-roughness, normal, emissive,
     // occlusion), with normalTexture.scale and occlusionTexture.strength.
     drift__gltf_texture textures[DRIFT_TEXTURE_SLOT_COUNT];

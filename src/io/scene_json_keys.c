@@ -41,6 +41,9 @@ const drift__json_key drift__json_keys[] = {
     { "material", "metal", "string", "none", "ggx: measured conductor Au, Ag, Cu or Al" },
     { "material", "edge_tint", "colour", "0 (Schlick)", "ggx: Gulbrandsen edge tint" },
     { "material", "thin", "boolean", "false", "ggx: thin-walled sheet" },
+    { "material", "clearcoat", "number in [0, 1]", "0", "ggx: clear coat weight (IOR 1.5)" },
+    { "material", "clearcoat_roughness", "number in [0, 1]", "0",
+      "ggx: the coat's perceptual roughness" },
     // "meshes": [mesh entry]
     { "mesh", "path", "path, required", "", "mesh file (.obj, .gltf, .glb, .ply, optionally .gz)" },
     { "mesh", "material", "string", "the file's", "material name replacing every one of the file" },

@@ -26,7 +26,7 @@ static drift_result read_ggx_material(json_reader *r, const cJSON *item, const c
     drift_material m = drift_material_make(drift_vec3_splat(0.8f));
     snprintf(m.name, sizeof(m.name), "%s", item->string);
     m.type = DRIFT_MATERIAL_GGX;
-    float roughness = 0.5f;
+    float roughness = 0.5f, clearcoat_roughness = 0.0f;
     const char *metal = NULL;
     drift_result res;
     if ((res = drift__json_read_vec3(r, item, path, "diffuse", false, VEC3_COLOR, &m.diffuse)) !=
@@ -45,10 +45,15 @@ static drift_result read_ggx_material(json_reader *r, const cJSON *item, const c
             DRIFT_OK ||
         (res = drift__json_read_vec3(r, item, path, "edge_tint", false, VEC3_COLOR,
                                      &m.ggx.edge_tint)) != DRIFT_OK ||
+        (res = drift__json_read_float(r, item, path, "clearcoat", false, 0.0, 1.0,
+                                      &m.ggx.clearcoat)) != DRIFT_OK ||
+        (res = drift__json_read_float(r, item, path, "clearcoat_roughness", false, 0.0, 1.0,
+                                      &clearcoat_roughness)) != DRIFT_OK ||
         (res = drift__json_read_string(r, item, path, "metal", false, &metal)) != DRIFT_OK) {
         return res;
     }
     m.ggx.alpha = roughness * roughness;
+    m.ggx.clearcoat_alpha = clearcoat_roughness * clearcoat_roughness;
     const cJSON *thin = cJSON_GetObjectItemCaseSensitive(item, "thin");
     if (thin && !cJSON_IsBool(thin)) {
         return FAIL(r, thin, DRIFT_ERR_PARSE, "%s.thin must be true or false", path);
@@ -99,8 +104,9 @@ static drift_result read_material(json_reader *r, const cJSON *item)
         return FAIL(r, type_item, DRIFT_ERR_INVALID_ARGUMENT,
                     "%s.type '%s' is not one of diffuse, glossy, mirror, ggx", path, type);
     }
-    static const char *const ggx_only[] = { "roughness", "metallic",  "transmission", "ior",
-                                            "metal",     "edge_tint", "thin" };
+    static const char *const ggx_only[] = { "roughness", "metallic",  "transmission",
+                                            "ior",       "metal",     "edge_tint",
+                                            "thin",      "clearcoat", "clearcoat_roughness" };
     for (size_t k = 0; k < sizeof(ggx_only) / sizeof(ggx_only[0]); ++k) {
         if (cJSON_HasObjectItem(item, ggx_only[k])) {
             return FAIL(r, cJSON_GetObjectItemCaseSensitive(item, ggx_only[k]),

@@ -267,24 +267,16 @@ drift_vec3 drift_env_prefilter_lookup(const drift_env_prefilter *p, drift_vec3 d
     return lerp3(a, bilinear(&p->level[k0 + 1], dir), frac);
 }
 
-drift_vec3 drift_raster_environment_split_sum(const drift_env_prefilter *p,
-                                              const drift_accel *accel,
-                                              const drift_surface *surface, const drift_bsdf *bsdf,
-                                              drift_vec3 wo, uint32_t visibility_rays,
-                                              drift_vec2 shift, uint64_t *rays)
+// One GGX reflection lobe of roughness alpha: the prefiltered environment along its dominant
+// direction times its albedo `single` (and the multiple-scattering lobe's, nearly
+// cosine-shaped, around n), times the share of visible-normal reflections that escape.
+static drift_vec3 lobe_split_sum(const drift_env_prefilter *p, const drift_accel *accel,
+                                 const drift_surface *surface, const drift_bsdf *bsdf,
+                                 drift_vec3 wo, float alpha, drift_vec3 single, drift_vec3 multiple,
+                                 uint32_t visibility_rays, drift_vec2 shift, uint64_t *rays)
 {
-    drift_vec3 zero = drift_vec3_splat(0.0f);
     drift_vec3 n = bsdf->frame.z;
-    float mu = drift_vec3_dot(wo, n);
-    if (bsdf->type != DRIFT_MATERIAL_GGX || !(mu > 0.0f)) {
-        return zero;
-    }
-    drift_vec3 single, multiple;
-    drift_bsdf_ggx_reflection_albedo(bsdf, mu, &single, &multiple);
-    if (drift_vec3_is_zero(single) && drift_vec3_is_zero(multiple)) {
-        return zero;
-    }
-    float alpha = fmaxf(bsdf->ggx.alpha, 1e-3f);
+    alpha = fmaxf(alpha, 1e-3f);
     // The lobe's dominant direction leans from r toward n as it widens (Lagarde & de
     // Rousiers 2014, "Moving Frostbite to PBR", for GGX with height-correlated Smith).
     drift_vec3 r = drift_bsdf_mirror_direction(bsdf, wo);
@@ -322,4 +314,32 @@ drift_vec3 drift_raster_environment_split_sum(const drift_env_prefilter *p,
     }
     float visibility = valid ? (float)open / (float)valid : 1.0f;
     return drift_vec3_scale(l, visibility);
+}
+
+drift_vec3 drift_raster_environment_split_sum(const drift_env_prefilter *p,
+                                              const drift_accel *accel,
+                                              const drift_surface *surface, const drift_bsdf *bsdf,
+                                              drift_vec3 wo, uint32_t visibility_rays,
+                                              drift_vec2 shift, uint64_t *rays)
+{
+    drift_vec3 zero = drift_vec3_splat(0.0f);
+    float mu = drift_vec3_dot(wo, bsdf->frame.z);
+    if (bsdf->type != DRIFT_MATERIAL_GGX || !(mu > 0.0f)) {
+        return zero;
+    }
+    drift_vec3 single, multiple, l = zero;
+    drift_bsdf_ggx_reflection_albedo(bsdf, mu, &single, &multiple);
+    if (!drift_vec3_is_zero(single) || !drift_vec3_is_zero(multiple)) {
+        l = lobe_split_sum(p, accel, surface, bsdf, wo, bsdf->ggx.alpha, single, multiple,
+                           visibility_rays, shift, rays);
+    }
+    // A clear coat (src/scene/clearcoat.c): its own lobe, of its own roughness.
+    float coat_alpha;
+    float coat = drift_bsdf_clearcoat_albedo(bsdf, mu, &coat_alpha);
+    if (coat > 0.0f) {
+        l = drift_vec3_add(l, lobe_split_sum(p, accel, surface, bsdf, wo, coat_alpha,
+                                             drift_vec3_splat(coat), zero, visibility_rays, shift,
+                                             rays));
+    }
+    return l;
 }

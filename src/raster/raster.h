@@ -145,7 +145,8 @@ drift_vec3 drift_env_prefilter_lookup(const drift_env_prefilter *prefilter, drif
 // skip_reflection leaves out of drift_bsdf_eval): the prefiltered environment along the lobe's
 // dominant direction times the lobe's albedo (drift_bsdf_ggx_reflection_albedo), times the
 // share of `visibility_rays` visible-normal reflections (a Hammersley set shifted by `shift`,
-// counted in *rays) that escape the scene. Zero for other materials.
+// counted in *rays) that escape the scene; a clear coat's lobe the same way with its own
+// roughness and visibility rays. Zero for other materials.
 drift_vec3 drift_raster_environment_split_sum(const drift_env_prefilter *prefilter,
                                               const drift_accel *accel,
                                               const drift_surface *surface, const drift_bsdf *bsdf,

@@ -185,7 +185,12 @@ drift_vec3 drift_raster_diffuse_albedo(const drift_bsdf *bsdf, drift_vec3 w)
         if (!(g->w_plastic > 0.0f) || g->skip_diffuse) {
             return drift_vec3_splat(0.0f);
         }
-        drift_vec3 base = drift_vec3_scale(g->base, g->w_plastic);
+        // A layered clear coat leaves the diffuse base's albedo toward w exactly 1 - c Ec(mu)
+        // of the uncoated one (src/scene/clearcoat.c).
+        float coat =
+            g->clearcoat_principled ? 1.0f : 1.0f - drift_bsdf_clearcoat_albedo(bsdf, mu, NULL);
+        b.ggx.clearcoat = 0.0f;
+        drift_vec3 base = drift_vec3_scale(g->base, g->w_plastic * coat);
         if (g->burley_roughness < 0.0f) {
             // The layered base reflects base (1 - Ec(mu)) exactly (its normalisation by
             // 1 - Ec_avg makes the cosine-weighted integral over wi of 1 - Ec(mu_i) one).
@@ -636,7 +641,8 @@ drift_vec3 drift_raster_reflection_weight(const drift_bsdf *bsdf, drift_vec3 wo)
     if (bsdf->type == DRIFT_MATERIAL_GGX) { // the GGX reflection lobes' albedo (the DFG term)
         drift_vec3 single, multiple;
         drift_bsdf_ggx_reflection_albedo(bsdf, cos_o, &single, &multiple);
-        return drift_vec3_add(single, multiple);
+        float coat = drift_bsdf_clearcoat_albedo(bsdf, cos_o, NULL); // 0 without a coat
+        return drift_vec3_add(drift_vec3_add(single, multiple), drift_vec3_splat(coat));
     }
     float n = bsdf->exponent;
     return drift_vec3_scale(bsdf->specular, fminf(1.0f, (n + 2.0f) / (n + 1.0f) * cos_o));

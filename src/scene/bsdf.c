@@ -3,6 +3,7 @@
 // mirror; or, for materials from Blender and glTF, Burley's diffuse ("Physically-Based Shading
 // at Disney", 2012, section 5.3) in place of the Lambertian one. Directions are world space;
 // the lobe frame's z is the shading normal.
+#include "clearcoat.h"
 #include "microfacet.h"
 #include "scene_internal.h"
 
@@ -37,6 +38,7 @@ void drift__ggx_phong_equivalent(const drift_material *m, drift_vec3 base, float
     *kd = drift_vec3_scale(drift_vec3_mul(base, drift_vec3_sub(drift_vec3_splat(1.0f), f0_coat)),
                            w_plastic);
     *exponent = phong_exponent_of_alpha(alpha);
+    drift__clearcoat_phong(m, kd, ks);
 }
 
 // The tangent frame's first two axes at a surface point of a mesh with uvs: the mesh's
@@ -179,6 +181,7 @@ static void make_ggx(const drift_scene *scene, const drift_material *m,
     } else {
         g->schlick = true;
     }
+    drift__clearcoat_make(scene, m, surface, g);
     drift__ggx_phong_equivalent(m, g->base, alpha, metallic, &b->diffuse, &b->specular,
                                 &b->exponent);
 }
@@ -257,8 +260,8 @@ void drift_bsdf_eval_lobes(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec3 wi,
     *out_diffuse = drift_vec3_splat(0.0f);
     *out_glossy = drift_vec3_splat(0.0f);
     if (bsdf->type == DRIFT_MATERIAL_GGX) {
-        drift_vec3 f = drift__ggx_eval(&bsdf->ggx, drift_frame_to_local(&bsdf->frame, wo),
-                                       drift_frame_to_local(&bsdf->frame, wi), out_diffuse);
+        drift_vec3 f = drift__coated_eval(&bsdf->ggx, drift_frame_to_local(&bsdf->frame, wo),
+                                          drift_frame_to_local(&bsdf->frame, wi), out_diffuse);
         *out_glossy = drift_vec3_sub(f, *out_diffuse);
         return;
     }
@@ -288,8 +291,8 @@ drift_vec3 drift_bsdf_eval(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec3 wi)
 float drift_bsdf_pdf(const drift_bsdf *bsdf, drift_vec3 wo, drift_vec3 wi)
 {
     if (bsdf->type == DRIFT_MATERIAL_GGX) {
-        return drift__ggx_pdf(&bsdf->ggx, drift_frame_to_local(&bsdf->frame, wo),
-                              drift_frame_to_local(&bsdf->frame, wi));
+        return drift__coated_pdf(&bsdf->ggx, drift_frame_to_local(&bsdf->frame, wo),
+                                 drift_frame_to_local(&bsdf->frame, wi));
     }
     float cos_o = drift_vec3_dot(wo, bsdf->frame.z), cos_i = drift_vec3_dot(wi, bsdf->frame.z);
     if (bsdf->type == DRIFT_MATERIAL_MIRROR || cos_o <= 0.0f || cos_i <= 0.0f) {
@@ -322,7 +325,7 @@ drift_bsdf_sample drift_bsdf_sample_wi(const drift_bsdf *bsdf, drift_vec3 wo, fl
         return s;
     }
     if (bsdf->type == DRIFT_MATERIAL_GGX) {
-        s = drift__ggx_sample(&bsdf->ggx, drift_frame_to_local(&bsdf->frame, wo), u_lobe, u);
+        s = drift__coated_sample(&bsdf->ggx, drift_frame_to_local(&bsdf->frame, wo), u_lobe, u);
         s.wi = drift_frame_to_world(&bsdf->frame, s.wi);
         return s;
     }

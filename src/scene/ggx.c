@@ -8,6 +8,7 @@
 // its coat does not reflect, (1 - Ec(mu_o))(1 - Ec(mu_i)) / (pi (1 - Ec_avg)), so a white
 // plastic reflects exactly 1; the rough dielectric is divided by its single-scattering albedo
 // (Turquin 2019's normalisation for a lossless interface). docs/materials.md has the model.
+#include "clearcoat.h"
 #include "microfacet.h"
 
 #include <math.h>
@@ -526,6 +527,7 @@ void drift_bsdf_ggx_reflection_albedo(const drift_bsdf *bsdf, float mu, drift_ve
             }
             single = drift_vec3_add(single, drift_vec3_splat(g->w_dielectric * r));
         }
+        drift__clearcoat_dim_albedo(g, fminf(mu, 1.0f), &single, &multiple);
     }
     *out_single = single;
     *out_multiple = multiple;

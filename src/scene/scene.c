@@ -228,7 +228,9 @@ drift_material drift_material_make(drift_vec3 diffuse)
                              .ggx = { .metallic_roughness_texture = DRIFT_INVALID_INDEX,
                                       .normal_texture = DRIFT_INVALID_INDEX,
                                       .emissive_texture = DRIFT_INVALID_INDEX,
-                                      .occlusion_texture = DRIFT_INVALID_INDEX } };
+                                      .occlusion_texture = DRIFT_INVALID_INDEX,
+                                      .clearcoat_texture = DRIFT_INVALID_INDEX,
+                                      .clearcoat_roughness_texture = DRIFT_INVALID_INDEX } };
 }
 
 static bool vec3_is_nonnegative_finite(drift_vec3 v)
@@ -545,17 +547,22 @@ drift_result drift_scene_commit(drift_scene *scene)
             return DRIFT_ERR_INVALID_ARGUMENT;
         }
         if (m->type == DRIFT_MATERIAL_GGX) {
-            const uint32_t t[] = { m->ggx.metallic_roughness_texture, m->ggx.normal_texture,
-                                   m->ggx.emissive_texture, m->ggx.occlusion_texture };
+            const uint32_t t[] = {
+                m->ggx.metallic_roughness_texture, m->ggx.normal_texture,
+                m->ggx.emissive_texture,           m->ggx.occlusion_texture,
+                m->ggx.clearcoat_texture,          m->ggx.clearcoat_roughness_texture
+            };
             bool out_of_range = false;
             for (size_t k = 0; k < sizeof t / sizeof t[0]; ++k) {
                 out_of_range |= t[k] != DRIFT_INVALID_INDEX && t[k] >= scene->texture_count;
             }
             if (out_of_range) {
-                drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, m->name, 0,
-                          "metallic-roughness, normal, emissive or occlusion texture out of range "
-                          "(scene has %u)",
-                          scene->texture_count);
+                drift_log(
+                    ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, m->name, 0,
+                    "metallic-roughness, normal, emissive, occlusion or clearcoat texture out "
+                    "of range "
+                    "(scene has %u)",
+                    scene->texture_count);
                 return DRIFT_ERR_INVALID_ARGUMENT;
             }
             // What the Phong-shading techniques read of it (docs/materials.md).

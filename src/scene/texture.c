@@ -99,6 +99,10 @@ static uint32_t slot_texture(const drift_material *m, drift_texture_slot slot)
         return m->ggx.emissive_texture;
     case DRIFT_TEXTURE_OCCLUSION:
         return m->ggx.occlusion_texture;
+    case DRIFT_TEXTURE_CLEARCOAT:
+        return m->ggx.clearcoat_texture;
+    case DRIFT_TEXTURE_CLEARCOAT_ROUGHNESS:
+        return m->ggx.clearcoat_roughness_texture;
     default:
         return DRIFT_INVALID_INDEX;
     }

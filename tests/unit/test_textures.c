@@ -271,7 +271,8 @@ typedef struct quad_buffer {
     uint16_t idx[6];
 } quad_buffer;
 
-static void write_textured_gltf(drift_context *ctx, const char *path)
+// `material_extra`: more of the material's JSON members (each followed by a comma).
+static void write_textured_gltf(drift_context *ctx, const char *path, const char *material_extra)
 {
     quad_buffer q = { .pos = { -1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0 },
                       .nrm = { 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1 },
@@ -293,7 +294,7 @@ static void write_textured_gltf(drift_context *ctx, const char *path)
     char *b0_64 = malloc(n0 * 2 + 8), *a64 = malloc(na * 2 + 8);
     base64(b0, n0, b0_64);
     base64(png_a, na, a64);
-    size_t cap = strlen(b0_64) + strlen(a64) + 8192;
+    size_t cap = strlen(b0_64) + strlen(a64) + strlen(material_extra) + 8192;
     char *json = malloc(cap);
     snprintf(json, cap,
              "{\"asset\": {\"version\": \"2.0\"}, \"extensionsUsed\": [\"KHR_texture_transform\"],"
@@ -301,7 +302,7 @@ static void write_textured_gltf(drift_context *ctx, const char *path)
              " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0, \"NORMAL\": 1,"
              "  \"TEXCOORD_0\": 2, \"TEXCOORD_1\": 3, \"TANGENT\": 4}, \"indices\": 5,"
              "  \"material\": 0}]}],"
-             " \"materials\": [{\"name\": \"lamp\", \"doubleSided\": true,"
+             " \"materials\": [{\"name\": \"lamp\", \"doubleSided\": true, %s"
              "  \"emissiveFactor\": [2, 2, 2],"
              "  \"emissiveTexture\": {\"index\": 0, \"extensions\": {\"KHR_texture_transform\":"
              "   {\"texCoord\": 1, \"offset\": [0.5, 0], \"scale\": [1, 1]}}},"
@@ -329,7 +330,7 @@ static void write_textured_gltf(drift_context *ctx, const char *path)
              "  {\"bufferView\": 3, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC2\"},"
              "  {\"bufferView\": 4, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC4\"},"
              "  {\"bufferView\": 5, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}]}",
-             a64, n0, b0_64, offsetof(quad_buffer, pos), offsetof(quad_buffer, nrm),
+             material_extra, a64, n0, b0_64, offsetof(quad_buffer, pos), offsetof(quad_buffer, nrm),
              offsetof(quad_buffer, uv0), offsetof(quad_buffer, uv1), offsetof(quad_buffer, tan),
              offsetof(quad_buffer, idx), sizeof q, nb);
     FILE *f = fopen(path, "wb");
@@ -349,7 +350,7 @@ static void test_gltf_textures(void **state)
     drift_context *ctx = test_context(1, &log);
     char path[1024];
     test_out_path(path, "textures_quad.gltf");
-    write_textured_gltf(ctx, path);
+    write_textured_gltf(ctx, path, "");
     drift_scene *scene = NULL;
     assert_int_equal(drift_scene_load(ctx, path, &scene), DRIFT_OK);
     assert_int_equal(log.warnings, 0);
@@ -404,6 +405,54 @@ static void test_gltf_textures(void **state)
         assert_true(drift_accel_intersect(accel, &ray, &hit));
         drift_surface s = drift_scene_surface(scene, &ray, &hit);
         assert_near(s.emission.x, 2.0, 1e-5);
+    }
+    drift_accel_destroy(accel);
+    drift_scene_destroy(scene);
+    drift_context_destroy(ctx);
+}
+
+// KHR_materials_clearcoat with its textures: the factor times clearcoatTexture's R, the
+// roughness times clearcoatRoughnessTexture's G (both the 0 | 1 occlusion image, read as
+// data), read per point by drift_bsdf_make; clearcoatNormalTexture warns that it is dropped.
+static void test_gltf_clearcoat(void **state)
+{
+    (void)state;
+    test_log_capture log = { 0 };
+    drift_context *ctx = test_context(1, &log);
+    char path[1024];
+    test_out_path(path, "textures_clearcoat.gltf");
+    write_textured_gltf(ctx, path,
+                        "\"extensions\": {\"KHR_materials_clearcoat\": {\"clearcoatFactor\": 0.8,"
+                        " \"clearcoatRoughnessFactor\": 0.5, \"clearcoatTexture\": {\"index\": 1},"
+                        " \"clearcoatRoughnessTexture\": {\"index\": 1},"
+                        " \"clearcoatNormalTexture\": {\"index\": 0}}},");
+    drift_scene *scene = NULL;
+    assert_int_equal(drift_scene_load(ctx, path, &scene), DRIFT_OK);
+    assert_int_equal(log.warnings, 1);
+    assert_non_null(strstr(log.last_message, "clearcoat normal texture"));
+    const drift_mesh *mesh = &scene->meshes[0];
+    const drift_material *m = &scene->materials[mesh->material];
+    assert_near(m->ggx.clearcoat, 0.8, 1e-6);
+    assert_near(m->ggx.clearcoat_alpha, 0.25, 1e-6);
+    assert_true(m->ggx.clearcoat_texture < scene->texture_count);
+    assert_true(m->ggx.clearcoat_roughness_texture < scene->texture_count);
+    assert_true(m->ggx.clearcoat_principled); // docs/decisions/0411-gltf-clearcoat.md
+    drift_accel *accel = NULL;
+    assert_int_equal(drift_accel_create(ctx, scene, &(drift_accel_desc){ 0 }, &accel), DRIFT_OK);
+    for (float x = -0.5f; x < 0.9f; x += 1.0f) { // the texel centres
+        drift_ray ray = { .origin = drift_vec3_make(x, 0.1f, 1.0f),
+                          .dir = drift_vec3_make(0, 0, -1),
+                          .tmax = INFINITY };
+        drift_hit hit;
+        assert_true(drift_accel_intersect(accel, &ray, &hit));
+        drift_surface s = drift_scene_surface(scene, &ray, &hit);
+        drift_bsdf b = drift_bsdf_make(scene, &s);
+        // Left: R = 0, no coat; right: R = G = 1, the factors.
+        assert_near(b.ggx.clearcoat, x < 0.0f ? 0.0 : 0.8, 1e-6);
+        if (x > 0.0f) {
+            assert_near(b.ggx.clearcoat_alpha, 0.25, 1e-6);
+            assert_true(drift_bsdf_clearcoat_albedo(&b, 1.0f, NULL) > 0.0f);
+        }
     }
     drift_accel_destroy(accel);
     drift_scene_destroy(scene);
@@ -609,9 +658,13 @@ static void test_pt_mip_mapping(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_wrap_filter_transform),      cmocka_unit_test(test_mip_levels),
-        cmocka_unit_test(test_computed_tangents),          cmocka_unit_test(test_gltf_textures),
-        cmocka_unit_test(test_two_sided_textured_emitter), cmocka_unit_test(test_pt_mip_mapping),
+        cmocka_unit_test(test_wrap_filter_transform),
+        cmocka_unit_test(test_mip_levels),
+        cmocka_unit_test(test_computed_tangents),
+        cmocka_unit_test(test_gltf_textures),
+        cmocka_unit_test(test_gltf_clearcoat),
+        cmocka_unit_test(test_two_sided_textured_emitter),
+        cmocka_unit_test(test_pt_mip_mapping),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
