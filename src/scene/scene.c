@@ -649,6 +649,11 @@ drift_result drift_scene_commit(drift_scene *scene)
             return DRIFT_ERR_INVALID_ARGUMENT;
         }
         mesh->first_light = scene->light_count;
+        // Closed and not see-through: the faces turned away from the camera's side light
+        // only the mesh's inside (or outside), which the camera's side never receives.
+        bool two_sided = mat->emission_two_sided &&
+                         !(mat->type == DRIFT_MATERIAL_GGX && mat->ggx.transmission > 0.0f) &&
+                         !drift__closed_emitter_front_only(scene, m);
         for (uint32_t t = 0; t < mesh->triangle_count; ++t) {
             uint32_t index;
             drift_result r = push_back(ctx, (void **)&scene->lights, &scene->light_count,
@@ -660,7 +665,7 @@ drift_result drift_scene_commit(drift_scene *scene)
                                                   .color = triangle_emission(scene, mat, m, t),
                                                   .mesh = m,
                                                   .triangle = t,
-                                                  .two_sided = mat->emission_two_sided,
+                                                  .two_sided = two_sided,
                                                   .node = mesh->node };
         }
     }

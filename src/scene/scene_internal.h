@@ -42,6 +42,11 @@ void drift__texture_pyramids_destroy(drift_scene *scene);
 drift_vec3 drift__texture_sample(const drift_scene *scene, uint32_t index,
                                  const drift_texture_map *map, drift_vec2 uv, float footprint);
 // The surface of triangle `triangle` of mesh `mesh` at barycentrics (u, v), seen from its front.
+// Whether emissive mesh `mesh` is closed and its front faces face the camera's side of it
+// (then its faces turned away emit nothing the camera's side can receive;
+// src/scene/closed_emitter.c).
+bool drift__closed_emitter_front_only(const drift_scene *scene, uint32_t mesh);
+
 drift_surface drift__triangle_surface(const drift_scene *scene, uint32_t mesh, uint32_t triangle,
                                       float u, float v);
 // The emission of material m at a surface point (its emissive texture applied).

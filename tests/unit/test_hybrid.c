@@ -562,6 +562,7 @@ int main(void)
         cmocka_unit_test(test_constant_sky_is_exact_with_one_sample),
         cmocka_unit_test(test_two_sided_mesh_light_closed_form),
         cmocka_unit_test(test_two_sided_emitter_lights_hybrid_frame),
+        cmocka_unit_test(test_closed_two_sided_emitter_is_one_sided),
         cmocka_unit_test(test_technique_names_round_trip),
         cmocka_unit_test(test_rejects_bad_params),
     };

@@ -31,5 +31,6 @@ void test_environment_scale_two_carries_the_light(void **state);
 void test_constant_sky_is_exact_with_one_sample(void **state);
 void test_two_sided_mesh_light_closed_form(void **state);
 void test_two_sided_emitter_lights_hybrid_frame(void **state);
+void test_closed_two_sided_emitter_is_one_sided(void **state);
 
 #endif

@@ -97,3 +97,68 @@ void test_two_sided_emitter_lights_hybrid_frame(void **state)
     drift_pt_destroy(pt); // owns `truth`
     test_rig_destroy(&r);
 }
+
+// A two-sided emissive cube (one mesh, 8 shared corners, fronts facing out) 0.5 m above the
+// floor: the floor sees the fronts of its bottom and sides; the backs of the top and far sides
+// face the floor too but their light stays inside the cube. Commit makes it one-sided, so the
+// hybrid frame's unshadowed closed form (which does not see a light's own surface) no longer
+// counts those backs: before, the frame was ~1.5x the path tracer. With the camera inside the
+// cube, the backs are what it sees lit: the cube stays two-sided.
+static void emissive_cube_stage(test_rig *r, drift_vec3 eye, drift_vec3 target)
+{
+    uint32_t white = test_add_material(r->scene, drift_material_make(drift_vec3_splat(0.7f)));
+    drift_material glow = drift_material_make(drift_vec3_splat(0.0f));
+    glow.emission = drift_vec3_splat(4.0f);
+    glow.emission_two_sided = true;
+    uint32_t lamp = test_add_material(r->scene, glow);
+    test_add_floor(r->scene, 3.0f, 0.0f, white);
+    float p[24];
+    for (int v = 0; v < 8; ++v) {
+        p[3 * v + 0] = (v & 1) ? 0.25f : -0.25f;
+        p[3 * v + 1] = (v & 2) ? 1.0f : 0.5f;
+        p[3 * v + 2] = (v & 4) ? 0.25f : -0.25f;
+    }
+    // Corner bit 0: +x, bit 1: +y, bit 2: +z; each face's two triangles wound to face out.
+    const uint32_t idx[36] = { 0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5, 0, 1, 5, 0, 5, 4,
+                               2, 6, 7, 2, 7, 3, 0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6 };
+    test_add_mesh(r->scene, p, 8, idx, 12, lamp);
+    r->scene->camera = drift_camera_look_at(eye, target, drift_vec3_make(0, 1, 0), 1.0f, 40, 30);
+    test_rig_commit(r);
+}
+
+void test_closed_two_sided_emitter_is_one_sided(void **state)
+{
+    (void)state;
+    test_rig r = test_rig_begin(2);
+    emissive_cube_stage(&r, drift_vec3_make(0.0f, 1.6f, -3.0f), drift_vec3_make(0.0f, 0.3f, 0.0f));
+    const drift_mesh *cube = &r.scene->meshes[1];
+    for (uint32_t t = 0; t < cube->triangle_count; ++t) {
+        assert_false(r.scene->lights[cube->first_light + t].two_sided);
+    }
+    drift_pt *pt = NULL;
+    drift_image truth = test_rig_render_pt(
+        &r, DRIFT_PT_COMPONENT_EMISSION | DRIFT_PT_COMPONENT_DIRECT, 1, 256, 5, &pt);
+    double truth_mean = drift_image_mean_luminance(&truth);
+    const drift_shadow_technique rows[] = { DRIFT_SHADOWS_HARD, DRIFT_SHADOWS_ISG };
+    for (size_t i = 0; i < sizeof rows / sizeof *rows; ++i) {
+        drift_hybrid_params p = { .seed = 3, .spp = 16 };
+        p.shadows = rows[i];
+        p.reflections = DRIFT_REFLECTIONS_NONE;
+        p.indirect = DRIFT_INDIRECT_NONE;
+        p.dof = DRIFT_DOF_NONE;
+        test_rig_frame(&r, &p);
+        double ratio = drift_image_mean_luminance(drift_hybrid_image(r.frame)) / truth_mean;
+        print_message("closed cube, shadows %-4s: mean luminance / path tracer %.4f\n",
+                      drift_technique_name(DRIFT_EFFECT_SHADOWS, (int)rows[i]), ratio);
+        assert_true(fabs(ratio - 1.0) < 0.05);
+    }
+    drift_pt_destroy(pt); // owns `truth`
+    test_rig_destroy(&r);
+
+    test_rig inside = test_rig_begin(1);
+    emissive_cube_stage(&inside, drift_vec3_make(0.0f, 0.75f, 0.0f),
+                        drift_vec3_make(0.0f, 0.75f, 1.0f));
+    const drift_mesh *box = &inside.scene->meshes[1];
+    assert_true(inside.scene->lights[box->first_light].two_sided);
+    test_rig_destroy(&inside);
+}
