@@ -233,3 +233,18 @@ bool test_chi_square_passes(const char *what, test_pdf_fn pdf, test_sample_fn sa
     }
     return true;
 }
+
+double test_bsdf_albedo_sampled(const struct drift_bsdf *bsdf, drift_vec3 wo, int n, uint32_t seed,
+                                uint32_t pixel)
+{
+    double sum = 0.0;
+    for (int i = 0; i < n; ++i) {
+        drift_sampler s = drift_sampler_make(seed, pixel, (uint32_t)i);
+        drift_vec2 u = drift_sampler_next2(&s);
+        drift_bsdf_sample bs = drift_bsdf_sample_wi(bsdf, wo, drift_sampler_next1(&s), u);
+        if (bs.pdf > 0.0f) {
+            sum += (double)bs.weight.x;
+        }
+    }
+    return sum / n;
+}

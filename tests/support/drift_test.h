@@ -49,6 +49,12 @@ struct drift_scene;
 uint32_t test_add_mesh(struct drift_scene *scene, const float *positions, uint32_t vertex_count,
                        const uint32_t *indices, uint32_t triangle_count, uint32_t material);
 
+// Directional albedo (red channel) of a BSDF toward wo by its own sampling: the mean of
+// f |cos| / pdf over samples 0 .. n - 1 of the sampler (seed, pixel).
+struct drift_bsdf;
+double test_bsdf_albedo_sampled(const struct drift_bsdf *bsdf, drift_vec3 wo, int n, uint32_t seed,
+                                uint32_t pixel);
+
 // DRIFT_TEST_INTENSITY (default 1) scales sample counts in statistical tests.
 double test_intensity(void);
 

@@ -58,16 +58,7 @@ static drift_vec3 dir_at(float theta)
 // Directional albedo (red channel) by the sampling estimator: the mean of f |cos| / pdf.
 static double albedo(const drift_bsdf *b, drift_vec3 wo, int n)
 {
-    double sum = 0.0;
-    for (int i = 0; i < n; ++i) {
-        drift_sampler s = drift_sampler_make(3, 7, (uint32_t)i);
-        drift_vec2 u = drift_sampler_next2(&s);
-        drift_bsdf_sample bs = drift_bsdf_sample_wi(b, wo, drift_sampler_next1(&s), u);
-        if (bs.pdf > 0.0f) {
-            sum += (double)bs.weight.x;
-        }
-    }
-    return sum / n;
+    return test_bsdf_albedo_sampled(b, wo, n, 3, 7);
 }
 
 // The same albedo by quadrature of f |cos| over the sphere (independent of the sampling).

@@ -63,6 +63,18 @@ void test_two_sided_mesh_light_closed_form(void **state)
     }
 }
 
+// The rig's hybrid frame with direct light only, shadows by `shadows`.
+static const drift_image *direct_light_frame(test_rig *r, drift_shadow_technique shadows)
+{
+    drift_hybrid_params p = { .seed = 3, .spp = 16 };
+    p.shadows = shadows;
+    p.reflections = DRIFT_REFLECTIONS_NONE;
+    p.indirect = DRIFT_INDIRECT_NONE;
+    p.dof = DRIFT_DOF_NONE;
+    test_rig_frame(r, &p);
+    return drift_hybrid_image(r->frame);
+}
+
 // The whole hybrid frame (direct light only, each shadow technique) against the path
 // tracer's emission + direct light of the same scene: the floor lit by the back of a
 // two-sided emitter, the occluder's shadow under it. Before the hybrid lights honoured
@@ -80,13 +92,7 @@ void test_two_sided_emitter_lights_hybrid_frame(void **state)
                                             DRIFT_SHADOWS_PCSS, DRIFT_SHADOWS_ISG,
                                             DRIFT_SHADOWS_AAF,  DRIFT_SHADOWS_REFERENCE };
     for (size_t i = 0; i < sizeof rows / sizeof *rows; ++i) {
-        drift_hybrid_params p = { .seed = 3, .spp = 16 };
-        p.shadows = rows[i];
-        p.reflections = DRIFT_REFLECTIONS_NONE;
-        p.indirect = DRIFT_INDIRECT_NONE;
-        p.dof = DRIFT_DOF_NONE;
-        test_rig_frame(&r, &p);
-        const drift_image *img = drift_hybrid_image(r.frame);
+        const drift_image *img = direct_light_frame(&r, rows[i]);
         double ratio = drift_image_mean_luminance(img) / truth_mean;
         double nrmse = test_nrmse(r.ctx, &truth, img);
         print_message("shadows %-9s mean luminance / path tracer %.4f, NRMSE %.4f\n",
@@ -141,13 +147,7 @@ void test_closed_two_sided_emitter_is_one_sided(void **state)
     double truth_mean = drift_image_mean_luminance(&truth);
     const drift_shadow_technique rows[] = { DRIFT_SHADOWS_HARD, DRIFT_SHADOWS_ISG };
     for (size_t i = 0; i < sizeof rows / sizeof *rows; ++i) {
-        drift_hybrid_params p = { .seed = 3, .spp = 16 };
-        p.shadows = rows[i];
-        p.reflections = DRIFT_REFLECTIONS_NONE;
-        p.indirect = DRIFT_INDIRECT_NONE;
-        p.dof = DRIFT_DOF_NONE;
-        test_rig_frame(&r, &p);
-        double ratio = drift_image_mean_luminance(drift_hybrid_image(r.frame)) / truth_mean;
+        double ratio = drift_image_mean_luminance(direct_light_frame(&r, rows[i])) / truth_mean;
         print_message("closed cube, shadows %-4s: mean luminance / path tracer %.4f\n",
                       drift_technique_name(DRIFT_EFFECT_SHADOWS, (int)rows[i]), ratio);
         assert_true(fabs(ratio - 1.0) < 0.05);
