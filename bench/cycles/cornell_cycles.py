@@ -49,8 +49,8 @@
 #     pbrt --max-depth D+1. diffuse/glossy/transmission bounces = same, volume 0.
 #   * Russian roulette off by default (min_light_bounces = max_bounces) = a plain path tracer of
 #     fixed depth; --russian-roulette restores Cycles' default (RR from the first bounce),
-#     --rr-min-bounces N starts it after N bounces (N=2 ~ drift's rr_depth 3; Cycles survives
-#     with sqrt(max throughput), drift/pbrt-v4 with max throughput).
+#     --rr-min-bounces N starts it after N bounces (N=2 ~ drift's rr_depth 3; both survive
+#     with sqrt(max throughput), pbrt-v4 with max throughput).
 #   * No clamping (direct/indirect 0), filter glossy 0, light threshold 0, no adaptive sampling,
 #     no denoising, box pixel filter of width 1 px, exposure 0, gamma 1, view transform Standard.
 #     Cycles still does next-event estimation + MIS (material "multiple importance" on).
