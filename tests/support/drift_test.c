@@ -248,3 +248,47 @@ double test_bsdf_albedo_sampled(const struct drift_bsdf *bsdf, drift_vec3 wo, in
     }
     return sum / n;
 }
+
+drift_bsdf test_bsdf_of_material(const drift_material *m, bool front_face)
+{
+    drift_context *ctx = test_context(1, NULL);
+    drift_scene *scene = NULL;
+    assert_int_equal(drift_scene_create(ctx, &scene), DRIFT_OK);
+    uint32_t index;
+    assert_int_equal(drift_scene_add_material(scene, m, &index), DRIFT_OK);
+    drift_surface surf = { .material = index,
+                           .ns = drift_vec3_make(0, 0, 1),
+                           .ng = drift_vec3_make(0, 0, 1),
+                           .front_face = front_face };
+    drift_bsdf b = drift_bsdf_make(scene, &surf);
+    drift_scene_destroy(scene);
+    drift_context_destroy(ctx);
+    return b;
+}
+
+typedef struct bsdf_pair {
+    const drift_bsdf *sampled, *pdf;
+    drift_vec3 wo;
+} bsdf_pair;
+
+static bool bsdf_pair_sample(void *user, drift_vec2 u, float u_lobe, drift_vec3 *out_wi)
+{
+    const bsdf_pair *p = user;
+    drift_bsdf_sample bs = drift_bsdf_sample_wi(p->sampled, p->wo, u_lobe, u);
+    *out_wi = bs.wi;
+    return bs.pdf > 0.0f;
+}
+
+static float bsdf_pair_pdf(void *user, drift_vec3 wi)
+{
+    const bsdf_pair *p = user;
+    return drift_bsdf_pdf(p->pdf, p->wo, wi);
+}
+
+bool test_bsdf_chi_square_passes(const char *what, const drift_bsdf *sampled, const drift_bsdf *pdf,
+                                 drift_vec3 wo, int sample_count, char *why, size_t why_size)
+{
+    bsdf_pair p = { .sampled = sampled, .pdf = pdf, .wo = wo };
+    return test_chi_square_passes(what, bsdf_pair_pdf, bsdf_pair_sample, &p, sample_count, 16, why,
+                                  why_size);
+}

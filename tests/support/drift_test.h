@@ -49,6 +49,17 @@ struct drift_scene;
 uint32_t test_add_mesh(struct drift_scene *scene, const float *positions, uint32_t vertex_count,
                        const uint32_t *indices, uint32_t triangle_count, uint32_t material);
 
+// The BSDF of material m at a surface at the origin with normal +z (front_face: wo above it),
+// from a scene of that one material.
+struct drift_material;
+struct drift_bsdf test_bsdf_of_material(const struct drift_material *m, bool front_face);
+
+// The chi-square test of `sampled`'s sampling toward wo against `pdf`'s density (the same
+// BSDF, or another one in a test that the check can fail).
+bool test_bsdf_chi_square_passes(const char *what, const struct drift_bsdf *sampled,
+                                 const struct drift_bsdf *pdf, drift_vec3 wo, int sample_count,
+                                 char *why, size_t why_size);
+
 // Directional albedo (red channel) of a BSDF toward wo by its own sampling: the mean of
 // f |cos| / pdf over samples 0 .. n - 1 of the sampler (seed, pixel).
 struct drift_bsdf;

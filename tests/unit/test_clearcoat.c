@@ -17,23 +17,6 @@
 
 #define M_PI 3.14159265358979323846
 
-static drift_bsdf make_bsdf(const drift_material *m, bool front_face)
-{
-    drift_context *ctx = test_context(1, NULL);
-    drift_scene *scene = NULL;
-    assert_int_equal(drift_scene_create(ctx, &scene), DRIFT_OK);
-    uint32_t index;
-    assert_int_equal(drift_scene_add_material(scene, m, &index), DRIFT_OK);
-    drift_surface surf = { .material = index,
-                           .ns = drift_vec3_make(0, 0, 1),
-                           .ng = drift_vec3_make(0, 0, 1),
-                           .front_face = front_face };
-    drift_bsdf b = drift_bsdf_make(scene, &surf);
-    drift_scene_destroy(scene);
-    drift_context_destroy(ctx);
-    return b;
-}
-
 // A GGX material of base colour `base`, roughness alpha and metallic under a coat of weight c
 // and roughness alpha_c, layered or Principled.
 static drift_material coated(drift_vec3 base, float alpha, float metallic, float c, float alpha_c,
@@ -91,7 +74,7 @@ static void test_clearcoat_white_base_reflects_at_most_one(void **state)
         for (int c = 0; c < 3; ++c) {
             drift_material m =
                 coated(white, bases[k][0], bases[k][1], coats[c][0], coats[c][1], false);
-            drift_bsdf b = make_bsdf(&m, true);
+            drift_bsdf b = test_bsdf_of_material(&m, true);
             for (float theta = 0.0f; theta < 1.5f; theta += 0.45f) {
                 double a = albedo(&b, dir_at(theta), n);
                 // The coat returns none of the light it reflects back down into the base: at
@@ -152,7 +135,7 @@ static void test_clearcoat_white_plastic_reflects_nearly_one(void **state)
             drift_material m1 = m0;
             m1.ggx.clearcoat = coats[c][0];
             m1.ggx.clearcoat_alpha = coats[c][1];
-            drift_bsdf b0 = make_bsdf(&m0, true), b1 = make_bsdf(&m1, true);
+            drift_bsdf b0 = test_bsdf_of_material(&m0, true), b1 = test_bsdf_of_material(&m1, true);
             for (float theta = 0.0f; theta < 1.4f; theta += 0.45f) {
                 double t = 1.0 - (double)drift__clearcoat_albedo(&b1.ggx, cosf(theta));
                 double d0 = diffuse_quadrature(&b0, dir_at(theta));
@@ -184,7 +167,7 @@ static void test_clearcoat_principled_adds_the_coat_albedo(void **state)
     for (int k = 0; k < 3; ++k) {
         drift_material base = coated(drift_vec3_splat(1.0f), 0.5f, 1.0f, 0.0f, 0.0f, true);
         drift_material top = coated(drift_vec3_splat(1.0f), 0.5f, 1.0f, 1.0f, alphas[k], true);
-        drift_bsdf b0 = make_bsdf(&base, true), b1 = make_bsdf(&top, true);
+        drift_bsdf b0 = test_bsdf_of_material(&base, true), b1 = test_bsdf_of_material(&top, true);
         for (float theta = 0.0f; theta < 1.4f; theta += 0.45f) {
             double coat =
                 albedo_quadrature(&b1, dir_at(theta)) - albedo_quadrature(&b0, dir_at(theta));
@@ -212,7 +195,7 @@ static void test_clearcoat_is_reciprocal(void **state)
     principled.diffuse_roughness = 0.5f;
     const drift_material *materials[] = { &red, &gold, &blend, &principled };
     for (int k = 0; k < 4; ++k) {
-        drift_bsdf b = make_bsdf(materials[k], true);
+        drift_bsdf b = test_bsdf_of_material(materials[k], true);
         for (uint32_t i = 0; i < 300; ++i) {
             drift_vec3 wo = drift_sample_cosine_hemisphere(
                 drift_vec2_make(test_hash_unit(4 * i), test_hash_unit(4 * i + 1)));
@@ -230,34 +213,13 @@ static void test_clearcoat_is_reciprocal(void **state)
 
 // --- SAMPLING ---
 
-typedef struct coat_case {
-    drift_bsdf sampled, pdf;
-    drift_vec3 wo;
-} coat_case;
-
-static bool sample_cb(void *user, drift_vec2 u, float u_lobe, drift_vec3 *out_wi)
-{
-    const coat_case *c = user;
-    drift_bsdf_sample bs = drift_bsdf_sample_wi(&c->sampled, c->wo, u_lobe, u);
-    *out_wi = bs.wi;
-    return bs.pdf > 0.0f;
-}
-
-static float pdf_cb(void *user, drift_vec3 wi)
-{
-    const coat_case *c = user;
-    return drift_bsdf_pdf(&c->pdf, c->wo, wi);
-}
-
 static bool chi_square(const char *what, const drift_material *sampled, const drift_material *pdf,
                        bool front, float theta, int sample_count, char *why, size_t why_size)
 {
-    coat_case c = { .sampled = make_bsdf(sampled, front),
-                    .pdf = make_bsdf(pdf, front),
-                    .wo = dir_at(theta) };
+    drift_bsdf s = test_bsdf_of_material(sampled, front), d = test_bsdf_of_material(pdf, front);
     char label[128];
     snprintf(label, sizeof(label), "%s theta_o=%.1f", what, (double)theta);
-    return test_chi_square_passes(label, pdf_cb, sample_cb, &c, sample_count, 16, why, why_size);
+    return test_bsdf_chi_square_passes(label, &s, &d, dir_at(theta), sample_count, why, why_size);
 }
 
 static void test_clearcoat_sampling_matches_pdf(void **state)
@@ -313,7 +275,7 @@ static void test_clearcoat_sample_agrees_with_eval_and_pdf(void **state)
     principled.ggx.clearcoat_principled = true;
     const drift_material *materials[] = { &red, &glass, &principled };
     for (int k = 0; k < 3; ++k) {
-        drift_bsdf b = make_bsdf(materials[k], true);
+        drift_bsdf b = test_bsdf_of_material(materials[k], true);
         drift_vec3 wo = dir_at(0.7f);
         for (uint32_t i = 0; i < 400; ++i) {
             drift_sampler s = drift_sampler_make(2, 9, i);
@@ -350,7 +312,8 @@ static void test_clearcoat_zero_is_the_uncoated_material(void **state)
         drift_material zero = plain[k];
         zero.ggx.clearcoat_alpha = 0.3f;
         zero.ggx.clearcoat_principled = k == 1;
-        drift_bsdf a = make_bsdf(&plain[k], true), b = make_bsdf(&zero, true);
+        drift_bsdf a = test_bsdf_of_material(&plain[k], true),
+                   b = test_bsdf_of_material(&zero, true);
         for (uint32_t i = 0; i < 300; ++i) {
             drift_vec3 wo = drift_sample_cosine_hemisphere(
                 drift_vec2_make(test_hash_unit(4 * i), test_hash_unit(4 * i + 1)));

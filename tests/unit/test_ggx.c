@@ -23,23 +23,6 @@ typedef struct ggx_case {
     drift_vec3 wo;
 } ggx_case;
 
-static drift_bsdf make_bsdf(const drift_material *m, bool front_face)
-{
-    drift_context *ctx = test_context(1, NULL);
-    drift_scene *scene = NULL;
-    assert_int_equal(drift_scene_create(ctx, &scene), DRIFT_OK);
-    uint32_t index;
-    assert_int_equal(drift_scene_add_material(scene, m, &index), DRIFT_OK);
-    drift_surface surf = { .material = index,
-                           .ns = drift_vec3_make(0, 0, 1),
-                           .ng = drift_vec3_make(0, 0, 1),
-                           .front_face = front_face };
-    drift_bsdf b = drift_bsdf_make(scene, &surf);
-    drift_scene_destroy(scene);
-    drift_context_destroy(ctx);
-    return b;
-}
-
 static drift_material ggx_material(drift_vec3 base, float alpha, float metallic, float transmission)
 {
     drift_material m = drift_material_make(base);
@@ -91,7 +74,7 @@ static void test_ggx_white_conductor_reflects_everything(void **state)
     for (int r = 0; r < 8; ++r) {
         float alpha = roughness[r] * roughness[r];
         drift_material m = ggx_material(drift_vec3_splat(1.0f), alpha, 1.0f, 0.0f);
-        drift_bsdf b = make_bsdf(&m, true);
+        drift_bsdf b = test_bsdf_of_material(&m, true);
         for (int t = 0; t < 4; ++t) {
             double a = albedo(&b, dir_at(theta[t]), n);
             if (!(a >= 0.99 && a <= 1.01)) {
@@ -118,7 +101,7 @@ static void test_ggx_white_plastic_reflects_everything(void **state)
     const float alphas[] = { 0.01f, 0.1f, 0.5f, 1.0f };
     for (int r = 0; r < 4; ++r) {
         drift_material m = ggx_material(drift_vec3_splat(1.0f), alphas[r], 0.0f, 0.0f);
-        drift_bsdf b = make_bsdf(&m, true);
+        drift_bsdf b = test_bsdf_of_material(&m, true);
         for (float theta = 0.0f; theta < 1.4f; theta += 0.6f) {
             double a = albedo(&b, dir_at(theta), n);
             if (!(a >= 0.99 && a <= 1.01)) {
@@ -137,7 +120,7 @@ static void test_ggx_rough_dielectric_reflects_plus_transmits_one(void **state)
     for (int r = 0; r < 4; ++r) {
         for (int side = 0; side < 2; ++side) {
             drift_material m = ggx_material(drift_vec3_splat(1.0f), alphas[r], 0.0f, 1.0f);
-            drift_bsdf b = make_bsdf(&m, side == 0);
+            drift_bsdf b = test_bsdf_of_material(&m, side == 0);
             for (float theta = 0.1f; theta < 1.4f; theta += 0.6f) {
                 double a = albedo(&b, dir_at(theta), n);
                 if (!(a >= 0.975 && a <= 1.025)) { // the eta interpolation: docs/materials.md
@@ -166,7 +149,7 @@ static void test_ggx_reflection_is_reciprocal(void **state)
     principled.diffuse_roughness = 0.6f;
     const drift_material *materials[] = { &metal, &gold, &tinted, &plastic, &blend, &principled };
     for (int k = 0; k < 6; ++k) {
-        drift_bsdf b = make_bsdf(materials[k], true);
+        drift_bsdf b = test_bsdf_of_material(materials[k], true);
         for (uint32_t i = 0; i < 200; ++i) {
             drift_vec3 wo = drift_sample_cosine_hemisphere(
                 drift_vec2_make(test_hash_unit(4 * i), test_hash_unit(4 * i + 1)));
@@ -196,7 +179,7 @@ static void test_ggx_sample_agrees_with_eval_and_pdf(void **state)
     drift_material glass = ggx_material(drift_vec3_splat(1.0f), 0.3f, 0.2f, 0.7f);
     const drift_material *materials[] = { &metal, &plastic, &principled, &blend, &glass };
     for (int k = 0; k < 5; ++k) {
-        drift_bsdf b = make_bsdf(materials[k], true);
+        drift_bsdf b = test_bsdf_of_material(materials[k], true);
         drift_vec3 wo = dir_at(0.7f);
         for (uint32_t i = 0; i < 300; ++i) {
             drift_sampler s = drift_sampler_make(9, 1, i);
@@ -219,37 +202,16 @@ static void test_ggx_sample_agrees_with_eval_and_pdf(void **state)
 
 // --- CHI-SQUARE (test_chi_square_passes, drift_test.h: the same test as test_sampling.c's) ---
 
-// Samples of `sampled` against the pdf of `pdf` (the same case, but in the test that the
-// check can fail).
-typedef struct ggx_pair {
-    const ggx_case *sampled, *pdf;
-} ggx_pair;
-
-static bool ggx_sample_cb(void *user, drift_vec2 u, float u_lobe, drift_vec3 *out_wi)
-{
-    const ggx_pair *p = user;
-    drift_bsdf_sample bs = drift_bsdf_sample_wi(&p->sampled->bsdf, p->sampled->wo, u_lobe, u);
-    *out_wi = bs.wi;
-    return bs.pdf > 0.0f;
-}
-
-static float ggx_pdf_cb(void *user, drift_vec3 wi)
-{
-    const ggx_pair *p = user;
-    return drift_bsdf_pdf(&p->pdf->bsdf, p->pdf->wo, wi);
-}
-
 static bool chi_square_passes(const char *what, const ggx_case *c, const ggx_case *pdf_case,
                               int sample_count, char *why, size_t why_size)
 {
-    ggx_pair p = { .sampled = c, .pdf = pdf_case };
-    return test_chi_square_passes(what, ggx_pdf_cb, ggx_sample_cb, &p, sample_count, 16, why,
-                                  why_size);
+    return test_bsdf_chi_square_passes(what, &c->bsdf, &pdf_case->bsdf, c->wo, sample_count, why,
+                                       why_size);
 }
 
 static void chi_square_check(const char *what, const drift_material *m, bool front, float theta)
 {
-    ggx_case c = { .bsdf = make_bsdf(m, front), .wo = dir_at(theta) };
+    ggx_case c = { .bsdf = test_bsdf_of_material(m, front), .wo = dir_at(theta) };
     char why[256] = "", label[128];
     snprintf(label, sizeof(label), "%s theta_o=%.1f", what, (double)theta);
     if (!chi_square_passes(label, &c, &c, (int)(40000 * test_intensity()), why, sizeof(why))) {
@@ -290,8 +252,8 @@ static void test_ggx_chi_square_detects_a_wrong_pdf(void **state)
     (void)state;
     drift_material m = ggx_material(drift_vec3_splat(0.9f), 0.2f, 1.0f, 0.0f);
     drift_material m2 = ggx_material(drift_vec3_splat(0.9f), 0.25f, 1.0f, 0.0f);
-    ggx_case right = { .bsdf = make_bsdf(&m, true), .wo = dir_at(0.5f) };
-    ggx_case wrong = { .bsdf = make_bsdf(&m2, true), .wo = dir_at(0.5f) };
+    ggx_case right = { .bsdf = test_bsdf_of_material(&m, true), .wo = dir_at(0.5f) };
+    ggx_case wrong = { .bsdf = test_bsdf_of_material(&m2, true), .wo = dir_at(0.5f) };
     char why[256];
     assert_true(chi_square_passes("right pdf", &right, &right, 50000, why, sizeof(why)));
     assert_false(chi_square_passes("wrong pdf", &right, &wrong, 50000, why, sizeof(why)));
@@ -305,7 +267,7 @@ static void test_ggx_snell_and_total_internal_reflection(void **state)
     drift_material glass = ggx_material(drift_vec3_splat(1.0f), 0.0f, 0.0f, 1.0f);
     glass.ggx.ior = 1.5f;
     // Outside, at 30 degrees: refracted at asin(sin 30 / 1.5) on the other side, in the plane.
-    drift_bsdf outside = make_bsdf(&glass, true);
+    drift_bsdf outside = test_bsdf_of_material(&glass, true);
     assert_true(drift_bsdf_is_delta(&outside));
     drift_vec3 wo = dir_at(0.5235988f);
     double expect_sin = 0.5 / 1.5;
@@ -336,7 +298,7 @@ static void test_ggx_snell_and_total_internal_reflection(void **state)
     // Normal incidence: ((n - 1) / (n + 1))^2 = 0.04.
     assert_near(drift__fresnel_dielectric(1.0f, 1.5f), 0.04, 1e-6);
     // Inside, past the critical angle asin(1 / 1.5) = 41.8 degrees: always reflected.
-    drift_bsdf inside = make_bsdf(&glass, false);
+    drift_bsdf inside = test_bsdf_of_material(&glass, false);
     drift_vec3 steep = dir_at(0.8f); // 45.8 degrees
     for (int i = 0; i < 100; ++i) {
         drift_bsdf_sample s =
@@ -352,7 +314,7 @@ static void test_ggx_snell_and_total_internal_reflection(void **state)
     assert_near(drift__fresnel_dielectric(cosf(0.75f), 1.0f / 1.5f), 1.0, 0.0);
     // A thin sheet transmits straight through.
     glass.ggx.thin = true;
-    drift_bsdf thin = make_bsdf(&glass, true);
+    drift_bsdf thin = test_bsdf_of_material(&glass, true);
     drift_bsdf_sample s = drift_bsdf_sample_wi(&thin, wo, 0.99f, drift_vec2_make(0.5f, 0.5f));
     assert_near(s.wi.x, -wo.x, 1e-6);
     assert_near(s.wi.z, -wo.z, 1e-6);
@@ -488,7 +450,7 @@ static void test_ggx_multiple_scattering_lobe(void **state)
     const float alphas[] = { 0.09f, 0.2f, 0.45f, 0.8f }, thetas[] = { 0.3f, 1.0f, 1.4f };
     for (int a = 0; a < 4; ++a) {
         drift_material m = ggx_material(drift_vec3_splat(1.0f), alphas[a], 1.0f, 0.0f);
-        drift_bsdf b = make_bsdf(&m, true);
+        drift_bsdf b = test_bsdf_of_material(&m, true);
         for (int t = 0; t < 3; ++t) {
             drift_vec3 wo = dir_at(thetas[t]);
             // Quadrature over the broad lobe's visible normals: weight f_ms cos / pdf.
