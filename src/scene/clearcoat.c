@@ -108,29 +108,19 @@ void drift__clearcoat_make(const drift_scene *scene, const drift_material *m,
 // The coat lobe f_coat (scale included), wo and wi above the surface.
 static float coat_eval(const drift_bsdf_ggx *g, drift_vec3 wo, drift_vec3 wi)
 {
-    drift_vec3 h = drift_vec3_add(wo, wi);
-    float len = drift_vec3_length(h);
-    if (!(len > 0.0f)) {
+    drift_vec3 h;
+    float ss = drift__ggx_reflect_ss(coat_alpha(g), wo, wi, &h);
+    if (!(ss > 0.0f)) {
         return 0.0f;
     }
-    h = drift_vec3_scale(h, 1.0f / len);
-    float a = coat_alpha(g);
     float m = 1.0f - drift_clampf(drift_vec3_dot(wo, h), 0.0f, 1.0f), m5 = (m * m) * (m * m) * m;
     float fresnel = DRIFT_CLEARCOAT_F0 + (1.0f - DRIFT_CLEARCOAT_F0) * m5;
-    float g2 = 1.0f / (1.0f + drift__ggx_lambda(a, wo) + drift__ggx_lambda(a, wi));
-    return coat_scale(g) * fresnel * drift__ggx_d(a, h) * g2 / (4.0f * wo.z * wi.z);
+    return coat_scale(g) * fresnel * ss;
 }
 
 static float coat_pdf(const drift_bsdf_ggx *g, drift_vec3 wo, drift_vec3 wi)
 {
-    drift_vec3 h = drift_vec3_add(wo, wi);
-    float len = drift_vec3_length(h);
-    if (!(len > 0.0f)) {
-        return 0.0f;
-    }
-    h = drift_vec3_scale(h, 1.0f / len);
-    float wo_h = drift_vec3_dot(wo, h);
-    return wo_h > 0.0f ? drift__ggx_pdf_vndf(coat_alpha(g), wo, h) / (4.0f * wo_h) : 0.0f;
+    return drift__ggx_reflect_pdf(coat_alpha(g), wo, wi);
 }
 
 // Probability of sampling the coat lobe toward wo: its albedo against the light the base

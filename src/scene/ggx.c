@@ -78,26 +78,6 @@ static float g2(float alpha, drift_vec3 wo, drift_vec3 wi)
     return 1.0f / (1.0f + drift__ggx_lambda(alpha, wo) + drift__ggx_lambda(alpha, wi));
 }
 
-// Single-scattering reflection D G2 / (4 mu_o mu_i), without the Fresnel term; h in out_h.
-static float reflect_ss(float alpha, drift_vec3 wo, drift_vec3 wi, drift_vec3 *out_h)
-{
-    drift_vec3 h = drift_vec3_add(wo, wi);
-    float len = drift_vec3_length(h);
-    if (!(len > 0.0f)) {
-        return 0.0f;
-    }
-    h = drift_vec3_scale(h, 1.0f / len);
-    *out_h = h;
-    return drift__ggx_d(alpha, h) * g2(alpha, wo, wi) / (4.0f * wo.z * wi.z);
-}
-
-static float reflect_pdf(float alpha, drift_vec3 wo, drift_vec3 wi)
-{
-    drift_vec3 h = drift_vec3_normalize(drift_vec3_add(wo, wi));
-    float wo_h = drift_vec3_dot(wo, h);
-    return wo_h > 0.0f ? drift__ggx_pdf_vndf(alpha, wo, h) / (4.0f * wo_h) : 0.0f;
-}
-
 // The coat's directional albedo per channel: F0 (E1 - Es) + Es.
 static drift_vec3 coat_albedo(drift_vec3 f0, float e1, float es)
 {
@@ -158,7 +138,7 @@ static bool has_ms(const drift_bsdf_ggx *g)
 static drift_vec3 conductor_eval(const drift_bsdf_ggx *g, drift_vec3 wo, drift_vec3 wi)
 {
     drift_vec3 h;
-    float ss = reflect_ss(ra(g), wo, wi, &h);
+    float ss = drift__ggx_reflect_ss(ra(g), wo, wi, &h);
     if (!(ss > 0.0f)) {
         return drift_vec3_splat(0.0f);
     }
@@ -182,7 +162,7 @@ static float conductor_p_ss(const drift_bsdf_ggx *g, drift_vec3 wo)
 static float conductor_pdf(const drift_bsdf_ggx *g, drift_vec3 wo, drift_vec3 wi)
 {
     float p = conductor_p_ss(g, wo);
-    float pdf = p * reflect_pdf(ra(g), wo, wi);
+    float pdf = p * drift__ggx_reflect_pdf(ra(g), wo, wi);
     if (p < 1.0f) {
         drift_vec3 h = drift_vec3_normalize(drift_vec3_add(wo, wi));
         float pdf_ms;
@@ -198,7 +178,7 @@ static drift_vec3 plastic_eval(const drift_bsdf_ggx *g, drift_vec3 wo, drift_vec
                                drift_vec3 *out_diffuse)
 {
     drift_vec3 h;
-    float ss = reflect_ss(ra(g), wo, wi, &h);
+    float ss = drift__ggx_reflect_ss(ra(g), wo, wi, &h);
     drift_vec3 coat = drift_vec3_scale(schlick(g->f0_coat, drift_vec3_dot(wo, h)), ss);
     if (g->burley_roughness >= 0.0f) {
         // Burley's factor (docs/materials.md): F_D90 = 1/2 + r (1 + wi.wo).
@@ -239,7 +219,7 @@ static float plastic_p_coat(const drift_bsdf_ggx *g, drift_vec3 wo)
 static float plastic_pdf(const drift_bsdf_ggx *g, drift_vec3 wo, drift_vec3 wi)
 {
     float p = plastic_p_coat(g, wo);
-    return p * reflect_pdf(ra(g), wo, wi) + (1.0f - p) * wi.z * DRIFT_INV_PI;
+    return p * drift__ggx_reflect_pdf(ra(g), wo, wi) + (1.0f - p) * wi.z * DRIFT_INV_PI;
 }
 
 // --- ROUGH DIELECTRIC (Walter et al. 2007, as pbrt-v4 writes it) ---

@@ -285,3 +285,28 @@ float drift__ggx_fit_ms_scale(float ms_alpha, const float *e1, int strata, float
     }
     return (float)residual;
 }
+
+float drift__ggx_reflect_ss(float alpha, drift_vec3 wo, drift_vec3 wi, drift_vec3 *out_h)
+{
+    drift_vec3 h = drift_vec3_add(wo, wi);
+    float len = drift_vec3_length(h);
+    if (!(len > 0.0f)) {
+        return 0.0f;
+    }
+    h = drift_vec3_scale(h, 1.0f / len);
+    *out_h = h;
+    float g2 = 1.0f / (1.0f + drift__ggx_lambda(alpha, wo) + drift__ggx_lambda(alpha, wi));
+    return drift__ggx_d(alpha, h) * g2 / (4.0f * wo.z * wi.z);
+}
+
+float drift__ggx_reflect_pdf(float alpha, drift_vec3 wo, drift_vec3 wi)
+{
+    drift_vec3 h = drift_vec3_add(wo, wi);
+    float len = drift_vec3_length(h);
+    if (!(len > 0.0f)) {
+        return 0.0f;
+    }
+    h = drift_vec3_scale(h, 1.0f / len);
+    float wo_h = drift_vec3_dot(wo, h);
+    return wo_h > 0.0f ? drift__ggx_pdf_vndf(alpha, wo, h) / (4.0f * wo_h) : 0.0f;
+}

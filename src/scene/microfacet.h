@@ -17,6 +17,10 @@ float drift__ggx_lambda(float alpha, drift_vec3 w);
 // Normals"), and its density D_wo(m) = G1(wo) max(0, wo.m) D(m) / wo.z.
 drift_vec3 drift__ggx_sample_vndf(float alpha, drift_vec3 wo, drift_vec2 u);
 float drift__ggx_pdf_vndf(float alpha, drift_vec3 wo, drift_vec3 m);
+// Single-scattering reflection D G2 / (4 mu_o mu_i) without the Fresnel term (h in out_h),
+// and the density of sampling wi through the visible normals; 0 when wo + wi = 0.
+float drift__ggx_reflect_ss(float alpha, drift_vec3 wo, drift_vec3 wi, drift_vec3 *out_h);
+float drift__ggx_reflect_pdf(float alpha, drift_vec3 wo, drift_vec3 wi);
 
 // Unpolarized Fresnel reflectance of a dielectric interface; cos_i may be negative (from the
 // other side); eta = IOR on the transmitted side over the IOR on the incident side for cos_i > 0.
