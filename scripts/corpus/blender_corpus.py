@@ -270,9 +270,14 @@ def night(out):
     for i, x in enumerate([-6, 0, 6]):
         add(bpy.ops.mesh.primitive_cube_add, "House%d" % i, material("House%d" % i, (0.6, 0.5, 0.4)),
             size=1, location=(x, 8, 2), scale=(2, 2, 2))
-    add(bpy.ops.mesh.primitive_cylinder_add, "Pole", material("Pole", (0.3, 0.3, 0.3), 0.4),
-        radius=0.08, depth=5, location=(1.5, 2, 2.5))
-    light("SPOT", "StreetLamp", (1.5, 2, 4.9), 20000.0, (1.0, 0.8, 0.5), target=(1.0, 1.5, 0),
+    pole = material("Pole", (0.3, 0.3, 0.3), 0.4)
+    add(bpy.ops.mesh.primitive_cylinder_add, "Pole", pole, radius=0.08, depth=5,
+        location=(1.5, 2, 2.5))
+    # The lamp hangs from an arm, 0.6 m off the pole: inside the pole (as until 2026-12-07) its
+    # light never left the cylinder, and the path tracer saw only the sky.
+    add(bpy.ops.mesh.primitive_cube_add, "Arm", pole, size=1, location=(1.5, 1.7, 4.95),
+        scale=(0.04, 0.34, 0.04))
+    light("SPOT", "StreetLamp", (1.5, 1.4, 4.8), 20000.0, (1.0, 0.8, 0.5), target=(1.0, 1.5, 0),
           size=math.radians(110))
     camera((-3, -9, 2.0), (1, 3, 1.2), 30)
     return {"environment": {"map": "HDRI/night.exr", "multiplier": 0.15}}
