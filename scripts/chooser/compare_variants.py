@@ -69,6 +69,10 @@ VARIANTS = [
      True),
     ("all gauss h2 + prior 1, kappa 0.5, pt1 norm, probe", {"k": 0, "kernel": "gauss",
      "bandwidth": 2.0, "prior": 1.0, "kappa": 0.5, "norm": "pt1"}, True),
+    ("k2 idw + prior 1, probe, hybrid q0.9", {"prior": 1.0, "hybrid_quantile": 0.9}, True),
+    ("k2 idw + prior 1, probe, hybrid q0.95", {"prior": 1.0, "hybrid_quantile": 0.95}, True),
+    ("k2 idw + prior 1, kappa 0.5, pt1 norm, probe, hybrid q0.9", {"prior": 1.0, "kappa": 0.5,
+     "norm": "pt1", "hybrid_quantile": 0.9}, True),
     ("k3 idw + prior 1, kappa 1, pt1 norm, probe", {"k": 3, "prior": 1.0, "kappa": 1.0,
      "norm": "pt1"}, True),
 ]
@@ -116,7 +120,7 @@ def main():
             cells = [c for c in ft.loso(scenes if train_all else fit_scenes + judge, is_fit, budgets,
                                         o.pt_margin, train_all, qp, probe) if not c["fit"]]
             print("| %s | %s | %s | %s | %s |" % (
-                name if not train_all else "", "%.3f" % sc if not train_all else "",
+                name if not train_all else "", "%.4f" % sc if not train_all else "",
                 "%.2f" % med if not train_all else "", "all" if train_all else "fit",
                 " | ".join(row(cells, budgets, "judge"))))
         sys.stdout.flush()

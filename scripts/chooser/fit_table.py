@@ -55,7 +55,8 @@ RIDGE = 0.1
 # ranks by mean + kappa x spread of the log ratio), robust feature scales, the cost safety's
 # quantile. These defaults are session 2's chooser.
 QUALITY = {"k": 2, "kernel": "idw", "bandwidth": 1.0, "prior": 0.0, "kappa": 0.0,
-           "robust": False, "safety_quantile": SAFETY_QUANTILE, "norm": "best"}
+           "robust": False, "safety_quantile": SAFETY_QUANTILE, "hybrid_quantile": None,
+           "norm": "best"}
 
 
 def key_text(key):
@@ -164,7 +165,7 @@ def smooth_pt(alpha, count):
     return out
 
 
-def fit_cost(train, quantile=SAFETY_QUANTILE):
+def fit_cost(train, quantile=SAFETY_QUANTILE, hybrid_quantile=None):
     """alpha per pickable row, beta per group: log ms = alpha + beta . x (block coordinate
     descent on the ridge least squares; it is convex, 50 rounds converge)."""
     obs = [(key, cost_x(s), math.log(ms), s["name"]) for s in train
@@ -206,8 +207,10 @@ def fit_cost(train, quantile=SAFETY_QUANTILE):
         res[group(key)].append(r)
         if name in pt1 and key != ("pt", "1 spp"):
             probe_res[group(key)].append(r - pt1[name])
-    q = lambda r: math.exp(sorted(r)[int(quantile * (len(r) - 1))]) if r else 1.0
-    return alpha, beta, {g: q(r) for g, r in res.items()}, {g: q(r) for g, r in probe_res.items()}
+    qs = {"pt": quantile, "hybrid": hybrid_quantile or quantile}
+    q = lambda r, g: math.exp(sorted(r)[int(qs[g] * (len(r) - 1))]) if r else 1.0
+    return (alpha, beta, {g: q(r, g) for g, r in res.items()},
+            {g: q(r, g) for g, r in probe_res.items()})
 
 
 def predict_ms(cost, key, x):
@@ -256,9 +259,9 @@ def fit(train, qp=None):
     """The model fitted on `train`: the cost model, the features' scales, each scene's FLIP
     ratios and each candidate's prior (mean and variance of its log ratio over the scenes)."""
     qp = dict(QUALITY, **(qp or {}))
-    memo = (tuple(s["name"] for s in train), qp["safety_quantile"])
+    memo = (tuple(s["name"] for s in train), qp["safety_quantile"], qp["hybrid_quantile"])
     if memo not in _COST:  # the same training scenes' cost model (the slow part) once
-        _COST[memo] = fit_cost(train, qp["safety_quantile"])
+        _COST[memo] = fit_cost(train, qp["safety_quantile"], qp["hybrid_quantile"])
     cost = _COST[memo]
     scenes = [(s["name"], s["features"], quality(s, qp["norm"])) for s in train]
     prior = {}
@@ -519,6 +522,8 @@ def main():
     q.add_argument("--robust", action="store_true", help="features scaled by their MAD")
     q.add_argument("--norm", choices=("best", "pt1"), default=QUALITY["norm"])
     q.add_argument("--safety-quantile", type=float, default=QUALITY["safety_quantile"])
+    q.add_argument("--hybrid-quantile", type=float,
+                   help="the hybrid rows' safety quantile (default: --safety-quantile's)")
     q.add_argument("--probe", action="store_true",
                    help="leave-one-out as --budget-probe on: each scene's predicted ms scaled "
                         "by its own pt 1 spp row over the prediction of it")
@@ -542,7 +547,7 @@ def main():
 
     qp = {"k": o.k, "kernel": o.kernel, "bandwidth": o.bandwidth, "prior": o.prior,
           "kappa": o.kappa, "robust": o.robust, "norm": o.norm,
-          "safety_quantile": o.safety_quantile}
+          "safety_quantile": o.safety_quantile, "hybrid_quantile": o.hybrid_quantile}
     tee = Tee()
     validate(scenes, is_fit, budgets, o.pt_margin, tee, o.train == "all", qp, o.probe)
     if o.frontier_md:
@@ -553,7 +558,8 @@ def main():
                 "%sregret = chosen FLIP / best FLIP in hindsight within the budget; "
                 "/pt = chosen FLIP / best path tracer's; %d px, the bench's size).\n\n" % (
                     os.path.basename(o.rows), args,
-                    "every other scene" if o.train == "all" else "the other fit scenes",
+                    "every other scene" if o.train == "all" else
+                    "the fit scenes (a fit scene's on the other fit scenes)",
                     "costs scaled by the scene's own pt 1 spp row, as --budget-probe on scales "
                     "them by its probe; " if o.probe else "", scenes[0]["size"]))
         replace_block(o.frontier_md, head + "".join(tee.parts))
