@@ -1,11 +1,12 @@
 // drift render --mode hybrid --budget-ms T (issue 40): the techniques chosen for the scene and
 // the budget. The model (scenes/corpus/chooser.json, refitted by scripts/chooser/fit_table.py
-// from drift bench frontier --corpus --json) holds, for each scene it was fitted on, its
-// features (tools/scene_features.h) and, for each budget, the row that gave the lowest FLIP
-// within it: a hybrid combination, or the path tracer (plain or through a-trous). The chooser
-// takes the nearest fitted scene in standardised feature space and its row at the largest
-// budget <= T (the smallest budget when T is below them all), and says what it chose. T is
-// scaled to the model's image size by the ratio of pixels.
+// from drift bench frontier --corpus --json, docs/corpus.md) holds every candidate row (a
+// hybrid combination or the path tracer: plain, through a-trous or the feature denoiser, at
+// reduced resolution) with its fitted cost, and for each scene it was fitted on its features
+// and each row's FLIP over its best. A candidate's predicted FLIP comes from the nearest fitted
+// scenes in standardised features, shrunk toward its mean over them all; the pick is the
+// lowest predicted FLIP whose calibrated cost fits T (a hybrid row only clearly below the path
+// tracer), and the renderer says what it chose. scripts/chooser/pick.py makes the same pick.
 #include "cli.h"
 #include "render.h"
 #include "scene_features.h"

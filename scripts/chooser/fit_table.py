@@ -15,8 +15,10 @@ The model (what tools/render_choose.c reads) has two parts, both fitted on the -
   environment), one beta for the path tracer's rows and one for the hybrid rows, ridge least
   squares; a frame of P pixels costs P / size^2 of that;
 - a quality model: each fitted scene's features and its rows' FLIP over the scene's best;
-  a candidate's predicted FLIP on a new scene is the inverse-distance weighted geometric mean
-  over the K nearest fitted scenes (standardised features).
+  a candidate's predicted log FLIP ratio on a new scene is the kernel-weighted mean over the
+  k nearest fitted scenes (standardised features), shrunk toward the candidate's prior (its
+  mean over every fitted scene) with weight --prior against the neighbours' 1; --kappa > 0
+  ranks by that plus kappa x the spread (QUALITY, predict()).
 The pick is the candidate with the lowest predicted FLIP whose predicted ms fit T; a hybrid
 row is taken only when it is predicted below PT_MARGIN x the best path-tracer candidate,
 else the path tracer (plain, a-trous, drift's feature denoiser, or at 1/2 or 1/4 resolution
@@ -527,9 +529,10 @@ def main():
     q.add_argument("--probe", action="store_true",
                    help="leave-one-out as --budget-probe on: each scene's predicted ms scaled "
                         "by its own pt 1 spp row over the prediction of it")
-    a.add_argument("--train", choices=("all", "fit"), default="all",
-                   help="what a left-out scene's model is fitted on: every other scene (all, the "
-                        "default) or the other fit scenes; --model is fitted likewise")
+    a.add_argument("--train", choices=("all", "fit"), default="fit",
+                   help="what a left-out scene's model is fitted on: the fit scenes (fit, the "
+                        "default: a judge scene's pick is the shipped model's) or every other "
+                        "scene (all); --model is fitted likewise")
     o = a.parse_args()
     budgets = [float(b) for b in o.budgets.split(",")]
     scenes = load(o.rows, o.drift)
