@@ -1,11 +1,12 @@
 // drift render --mode hybrid --budget-ms T (issue 40): the techniques chosen for the scene and
 // the budget. The model (scenes/corpus/chooser.json, refitted by scripts/chooser/fit_table.py
-// from drift bench frontier --corpus --json) holds, for each scene it was fitted on, its
-// features (tools/scene_features.h) and, for each budget, the row that gave the lowest FLIP
-// within it: a hybrid combination, or the path tracer (plain or through a-trous). The chooser
-// takes the nearest fitted scene in standardised feature space and its row at the largest
-// budget <= T (the smallest budget when T is below them all), and says what it chose. T is
-// scaled to the model's image size by the ratio of pixels.
+// from drift bench frontier --corpus --json, docs/corpus.md) holds every candidate row (a
+// hybrid combination or the path tracer: plain, through a-trous or the feature denoiser, at
+// reduced resolution) with its fitted cost, and for each scene it was fitted on its features
+// and each row's FLIP over its best. A candidate's predicted FLIP comes from the nearest fitted
+// scenes in standardised features, shrunk toward its mean over them all; the pick is the
+// lowest predicted FLIP whose calibrated cost fits T (a hybrid row only clearly below the path
+// tracer), and the renderer says what it chose. scripts/chooser/pick.py makes the same pick.
 #include "cli.h"
 #include "render.h"
 #include "scene_features.h"
@@ -109,7 +110,7 @@ static double flip_ratio(const cJSON *flips, const char *key)
 
 typedef struct neighbour {
     const cJSON *scene;
-    double d2;
+    double d2, w; // squared standardised distance; kernel weight (the k nearest sum to 1)
 } neighbour;
 
 static int compare_neighbour(const void *a, const void *b)
@@ -118,25 +119,68 @@ static int compare_neighbour(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-// The predicted FLIP ratio of `key`: the inverse-distance weighted geometric mean over the
-// k nearest fitted scenes (`near`, sorted) of their FLIP over their best row's.
-static double predict_flip(const neighbour *near, int k, const char *key)
+// The quality model's parameters (the model's "k" and "quality"; without them, session 2's
+// chooser: the 2 nearest, inverse-distance weights, no prior, ranked by the mean).
+typedef struct quality_params {
+    int k;      // nearest scenes (0: all)
+    bool gauss; // weights exp(-d^2 / 2 bandwidth^2), else 1 / (d + 0.1)
+    double bandwidth, prior, kappa;
+} quality_params;
+
+static quality_params read_quality(const cJSON *model)
+{
+    const cJSON *q = cJSON_GetObjectItemCaseSensitive(model, "quality");
+    const char *kernel = string(q, "kernel");
+    return (quality_params){ .k = (int)number(model, "k", 2),
+                             .gauss = kernel && strcmp(kernel, "gauss") == 0,
+                             .bandwidth = number(q, "bandwidth", 1.0),
+                             .prior = number(q, "prior", 0.0),
+                             .kappa = number(q, "kappa", 0.0) };
+}
+
+// The predicted FLIP ratio (over the best row's) of candidate `c`: the mean of the k nearest
+// fitted scenes' log ratios (`near`, sorted and weighted), shrunk toward the candidate's prior
+// (the mean over every fitted scene, weighing `prior` against the neighbourhood's 1). *rank:
+// what the pick ranks by, exp(that mean + kappa x the spread of the log ratios about it): a
+// row good on one neighbour and bad on another ranks below one good on both.
+// scripts/chooser/fit_table.py's predict() is the same.
+static double predict_flip(const neighbour *near, int k, const cJSON *c, const char *key,
+                           const quality_params *qp, double *rank)
 {
     double num = 0.0, den = 0.0;
     for (int i = 0; i < k; ++i) {
         double v = flip_ratio(cJSON_GetObjectItemCaseSensitive(near[i].scene, "flip"), key);
         if (v > 0.0) {
-            double w = 1.0 / (sqrt(near[i].d2) + 0.1);
-            num += w * log(v);
-            den += w;
+            num += near[i].w * log(v);
+            den += near[i].w;
         }
     }
-    return den > 0.0 ? exp(num / den) : (double)INFINITY;
+    const cJSON *prior = cJSON_GetObjectItemCaseSensitive(c, "prior");
+    const cJSON *pm = cJSON_GetArrayItem(prior, 0), *pv = cJSON_GetArrayItem(prior, 1);
+    double lambda = cJSON_IsNumber(pm) && cJSON_IsNumber(pv) ? qp->prior : 0.0;
+    *rank = (double)INFINITY;
+    if (!(den + lambda > 0.0)) {
+        return (double)INFINITY;
+    }
+    double mean = lambda > 0.0 ? (num + lambda * pm->valuedouble) / (den + lambda) : num / den;
+    double var = 0.0;
+    for (int i = 0; i < k; ++i) {
+        double v = flip_ratio(cJSON_GetObjectItemCaseSensitive(near[i].scene, "flip"), key);
+        if (v > 0.0) {
+            var += near[i].w * (log(v) - mean) * (log(v) - mean);
+        }
+    }
+    if (lambda > 0.0) {
+        var += lambda * (pv->valuedouble + (pm->valuedouble - mean) * (pm->valuedouble - mean));
+    }
+    var /= den + lambda;
+    *rank = exp(mean + qp->kappa * sqrt(var));
+    return exp(mean);
 }
 
 typedef struct choice {
     const cJSON *pick;
-    double ms, flip; // predicted at the frame's size; FLIP over the best row's
+    double ms, flip, rank; // predicted at the frame's size; FLIP over the best row's; rank
 } choice;
 
 enum {
@@ -272,17 +316,28 @@ static bool score(const cJSON *model, const double f[SCENE_FEATURE_COUNT], const
             double x = (cJSON_GetArrayItem(sf, k)->valuedouble - f[k]) / w;
             d += x * x;
         }
-        near[n++] = (neighbour){ s, d };
+        near[n++] = (neighbour){ s, d, 0.0 };
     }
     if (!near || n == 0) {
         free(near);
         return false;
     }
     qsort(near, (size_t)n, sizeof *near, compare_neighbour);
-    int k = (int)number(model, "k", 2);
-    k = k < 1 ? 1 : k > n ? n : k;
+    quality_params qp = read_quality(model);
+    int k = qp.k < 1 || qp.k > n ? n : qp.k;
+    double total = 0.0;
+    for (int i = 0; i < k; ++i) {
+        double d = sqrt(near[i].d2);
+        near[i].w =
+            qp.gauss ? exp(-0.5 * (d / qp.bandwidth) * (d / qp.bandwidth)) : 1.0 / (d + 0.1);
+        total += near[i].w;
+    }
+    for (int i = 0; i < k; ++i) {
+        near[i].w = total > 0.0 ? near[i].w / total : 1.0 / k;
+    }
     double size = number(model, "size", 400.0);
-    *best_hybrid = *best_pt = *fastest = (choice){ NULL, (double)INFINITY, (double)INFINITY };
+    *best_hybrid = *best_pt = *fastest =
+        (choice){ NULL, (double)INFINITY, (double)INFINITY, (double)INFINITY };
     const cJSON *cands = cJSON_GetObjectItemCaseSensitive(model, "candidates");
     for (const cJSON *c = cands ? cands->child : NULL; c; c = c->next) {
         const char *group = string(c, "group"), *key = string(c, "key");
@@ -296,16 +351,16 @@ static bool score(const cJSON *model, const double f[SCENE_FEATURE_COUNT], const
             cal->setup_ms[g] +
             (g == GROUP_HYBRID ? cal->setup_scale * technique_setup_ms(cal->setup_table, c) : 0.0);
         ms += cal->finish_ms;
+        double rank, flip = predict_flip(near, k, c, key, &qp, &rank);
         if (ms < fastest->ms) {
-            *fastest = (choice){ c, ms, predict_flip(near, k, key) };
+            *fastest = (choice){ c, ms, flip, rank };
         }
         if (ms * cal->safety[g] > cal->available_ms) {
             continue;
         }
         choice *best = g == GROUP_PT ? best_pt : best_hybrid;
-        double flip = predict_flip(near, k, key);
-        if (flip < best->flip) {
-            *best = (choice){ c, ms, flip };
+        if (rank < best->rank) {
+            *best = (choice){ c, ms, flip, rank };
         }
     }
     free(near);
@@ -504,7 +559,7 @@ int render_choose(render_options *o, const cli_session *session)
     // A hybrid frame only where it is predicted clearly closer than the best path tracer that
     // fits: the chooser must not trade the path tracer's image for a worse one.
     const choice *c = !ok                                                           ? NULL
-                      : hybrid.pick && (!pt.pick || hybrid.flip < margin * pt.flip) ? &hybrid
+                      : hybrid.pick && (!pt.pick || hybrid.rank < margin * pt.rank) ? &hybrid
                       : pt.pick                                                     ? &pt
                                                                                     : &fastest;
     const char *row = c ? string(c->pick, "row") : NULL;

@@ -15,8 +15,10 @@ The model (what tools/render_choose.c reads) has two parts, both fitted on the -
   environment), one beta for the path tracer's rows and one for the hybrid rows, ridge least
   squares; a frame of P pixels costs P / size^2 of that;
 - a quality model: each fitted scene's features and its rows' FLIP over the scene's best;
-  a candidate's predicted FLIP on a new scene is the inverse-distance weighted geometric mean
-  over the K nearest fitted scenes (standardised features).
+  a candidate's predicted log FLIP ratio on a new scene is the kernel-weighted mean over the
+  k nearest fitted scenes (standardised features), shrunk toward the candidate's prior (its
+  mean over every fitted scene) with weight --prior against the neighbours' 1; --kappa > 0
+  ranks by that plus kappa x the spread (QUALITY, predict()).
 The pick is the candidate with the lowest predicted FLIP whose predicted ms fit T; a hybrid
 row is taken only when it is predicted below PT_MARGIN x the best path-tracer candidate,
 else the path tracer (plain, a-trous, drift's feature denoiser, or at 1/2 or 1/4 resolution
@@ -48,8 +50,15 @@ PT_FAMILIES = {"pt", "pt+atrous", "pt+denoise", "pt-low", "pt-low+atrous"}
 # feature denoiser; at reduced resolution upsampled bilinearly (the joint-bilateral rows need
 # a full-resolution G-buffer the renderer does not build: in the hindsight best, not picked).
 PICKABLE = {"hybrid"} | PT_FAMILIES
-K = 2
 RIDGE = 0.1
+# The quality model's and the pick's parameters (model_json writes them, render_choose.c reads
+# them): the k nearest scenes (0: all), their kernel ("idw": 1 / (d + 0.1); "gauss":
+# exp(-d^2 / 2 bandwidth^2)), the prior's weight against the neighbourhood's, kappa (the pick
+# ranks by mean + kappa x spread of the log ratio), robust feature scales, the cost safety's
+# quantile. These defaults are session 2's chooser.
+QUALITY = {"k": 2, "kernel": "idw", "bandwidth": 1.0, "prior": 0.0, "kappa": 0.0,
+           "robust": False, "safety_quantile": SAFETY_QUANTILE, "hybrid_quantile": None,
+           "norm": "best"}
 
 
 def key_text(key):
@@ -158,17 +167,17 @@ def smooth_pt(alpha, count):
     return out
 
 
-def fit_cost(train):
+def fit_cost(train, quantile=SAFETY_QUANTILE, hybrid_quantile=None):
     """alpha per pickable row, beta per group: log ms = alpha + beta . x (block coordinate
     descent on the ridge least squares; it is convex, 50 rounds converge)."""
-    obs = [(key, cost_x(s), math.log(ms)) for s in train for key, (ms, f) in s["rows"].items()
-           if pickable(key) and 0.0 < ms < math.inf]
+    obs = [(key, cost_x(s), math.log(ms), s["name"]) for s in train
+           for key, (ms, f) in s["rows"].items() if pickable(key) and 0.0 < ms < math.inf]
     d = len(COST_FEATURES)
     beta = {"pt": [0.0] * d, "hybrid": [0.0] * d}
     alpha = {}
     for _ in range(50):
         sums = {}
-        for key, x, y in obs:
+        for key, x, y, _ in obs:
             r = y - sum(b * v for b, v in zip(beta[group(key)], x))
             t = sums.setdefault(key, [0.0, 0])
             t[0] += r
@@ -178,7 +187,7 @@ def fit_cost(train):
         for g in beta:
             ata = [[RIDGE * (i == j) for j in range(d)] for i in range(d)]
             atb = [0.0] * d
-            for key, x, y in obs:
+            for key, x, y, _ in obs:
                 if group(key) != g:
                     continue
                 r = y - alpha[key]
@@ -189,11 +198,21 @@ def fit_cost(train):
             beta[g] = solve(ata, atb)
     # The safety factor: a pick must fit the budget at its prediction x the SAFETY_QUANTILE of
     # measured over predicted on the training rows (each group), so that most picks fit.
+    # probe_safety: the same of the residuals less the scene's "pt 1 spp" residual, what is left
+    # once a probe of that row has scaled the scene's predictions (leave-one-out's --probe).
     res = {"pt": [], "hybrid": []}
-    for key, x, y in obs:
-        res[group(key)].append(y - alpha[key] - sum(b * v for b, v in zip(beta[group(key)], x)))
-    safety = {g: math.exp(sorted(r)[int(SAFETY_QUANTILE * (len(r) - 1))]) if r else 1.0 for g, r in res.items()}
-    return alpha, beta, safety
+    probe_res = {"pt": [], "hybrid": []}
+    resid = [(key, y - alpha[key] - sum(b * v for b, v in zip(beta[group(key)], x)), name)
+             for key, x, y, name in obs]
+    pt1 = {name: r for key, r, name in resid if key == ("pt", "1 spp")}
+    for key, r, name in resid:
+        res[group(key)].append(r)
+        if name in pt1 and key != ("pt", "1 spp"):
+            probe_res[group(key)].append(r - pt1[name])
+    qs = {"pt": quantile, "hybrid": hybrid_quantile or quantile}
+    q = lambda r, g: math.exp(sorted(r)[int(qs[g] * (len(r) - 1))]) if r else 1.0
+    return (alpha, beta, {g: q(r, g) for g, r in res.items()},
+            {g: q(r, g) for g, r in probe_res.items()})
 
 
 def predict_ms(cost, key, x):
@@ -203,61 +222,127 @@ def predict_ms(cost, key, x):
     return math.exp(alpha[key] + sum(b * v for b, v in zip(beta[group(key)], x)))
 
 
-def scales(train):
+def scales(train, robust=False):
+    """Each feature's spread over the training scenes (floor 0.1): the standard deviation, or
+    robust: 1.4826 x the median absolute deviation (one outlying scene does not stretch it)."""
     out = []
     for k in range(len(FEATURES)):
         v = [s["features"][k] for s in train]
-        m = sum(v) / len(v)
-        out.append(max(math.sqrt(sum((x - m) ** 2 for x in v) / len(v)), 0.1))
+        if robust:
+            m = median(v)
+            sd = 1.4826 * median([abs(x - m) for x in v])
+        else:
+            m = sum(v) / len(v)
+            sd = math.sqrt(sum((x - m) ** 2 for x in v) / len(v))
+        out.append(max(sd, 0.1))
     return out
 
 
-def quality(s):
-    """The scene's pickable rows' FLIP over its best row's."""
+def quality(s, norm="best"):
+    """The scene's pickable rows' FLIP over its best row's (norm "pt1": over its path tracer's
+    at 1 spp, a row every scene has, whereas the best row depends on how far the bench ran)."""
     best = min(f for _, f in s["rows"].values())
+    if norm == "pt1" and ("pt", "1 spp") in s["rows"]:
+        best = s["rows"][("pt", "1 spp")][1]
     return {k: f / best for k, (ms, f) in s["rows"].items() if pickable(k)}
 
 
-def fit(train):
-    return {"cost": fit_cost(train), "scale": scales(train),
-            "scenes": [(s["name"], s["features"], quality(s)) for s in train]}
+def ratio_of(q, key):
+    """A fitted scene's FLIP ratio of `key`, or of the same row without its environment filter
+    (a scene without an environment ran it without); None where the scene has neither."""
+    v = q.get(key)
+    return v if v is not None else q.get((key[0], re.sub(r" ef \d+", "", key[1])))
 
 
-def predict_flip(model, feats, key):
-    sc = model["scale"]
-    near = sorted(((sum(((a - b) / w) ** 2 for a, b, w in zip(f, feats, sc)), q)
-                   for _, f, q in model["scenes"]), key=lambda t: t[0])[:K]
+_COST = {}
+
+
+def fit(train, qp=None):
+    """The model fitted on `train`: the cost model, the features' scales, each scene's FLIP
+    ratios and each candidate's prior (mean and variance of its log ratio over the scenes)."""
+    qp = dict(QUALITY, **(qp or {}))
+    memo = (tuple(s["name"] for s in train), qp["safety_quantile"], qp["hybrid_quantile"])
+    if memo not in _COST:  # the same training scenes' cost model (the slow part) once
+        _COST[memo] = fit_cost(train, qp["safety_quantile"], qp["hybrid_quantile"])
+    cost = _COST[memo]
+    scenes = [(s["name"], s["features"], quality(s, qp["norm"])) for s in train]
+    prior = {}
+    for key in cost[0]:
+        logs = [math.log(v) for v in (ratio_of(q, key) for _, _, q in scenes) if v]
+        if logs:
+            m = sum(logs) / len(logs)
+            prior[key] = (m, sum((x - m) ** 2 for x in logs) / len(logs))
+    return {"cost": cost, "scale": scales(train, qp["robust"]), "scenes": scenes,
+            "prior": prior, "q": qp}
+
+
+def neighbours(model, feats):
+    """The K nearest fitted scenes (all with K 0) and their kernel weights, summing to 1."""
+    qp, sc = model["q"], model["scale"]
+    d = sorted(((math.sqrt(sum(((a - b) / w) ** 2 for a, b, w in zip(f, feats, sc))), q)
+                for _, f, q in model["scenes"]), key=lambda t: t[0])
+    d = d[:qp["k"]] if qp["k"] > 0 else d
+    if qp["kernel"] == "gauss":
+        w = [math.exp(-0.5 * (x / qp["bandwidth"]) ** 2) for x, _ in d]
+    else:
+        w = [1.0 / (x + 0.1) for x, _ in d]
+    t = sum(w) or 1.0
+    return [(wi / t, q) for wi, (_, q) in zip(w, d)]
+
+
+def predict(model, near, key):
+    """(predicted FLIP ratio, the ratio the pick ranks by) of `key`: the neighbours' weighted
+    mean log ratio shrunk toward the candidate's prior (weight `prior` against the
+    neighbourhood's 1), and that plus kappa x the spread (the weighted standard deviation of
+    the neighbours' and the prior's log ratios about it): a row good on one neighbour and bad
+    on another ranks below one good on both."""
+    qp = model["q"]
     num = den = 0.0
-    for d, q in near:
-        v = q.get(key)
-        if v is None:
-            v = q.get((key[0], re.sub(r" ef \d+", "", key[1])))
-        if v is None:
-            continue
-        w = 1.0 / (math.sqrt(d) + 0.1)
-        num += w * math.log(v)
-        den += w
-    return math.exp(num / den) if den else math.inf
+    pts = []
+    for w, q in near:
+        v = ratio_of(q, key)
+        if v:
+            num += w * math.log(v)
+            den += w
+            pts.append((w, math.log(v)))
+    pm = model["prior"].get(key)
+    lam = qp["prior"] if pm else 0.0
+    if den + lam <= 0.0:
+        return math.inf, math.inf
+    mean = (num + lam * pm[0]) / (den + lam) if lam else num / den
+    var = sum(w * (x - mean) ** 2 for w, x in pts)
+    if lam:
+        var += lam * (pm[1] + (pm[0] - mean) ** 2)
+    var /= den + lam
+    return math.exp(mean), math.exp(mean + qp["kappa"] * math.sqrt(var))
 
 
-def choose(model, feats, budget, pt_margin):
+def choose(model, feats, budget, pt_margin, cost_scale=None, oracle=None):
     """(key, predicted ms, predicted FLIP ratio, why) for a scene of `feats` at `budget` ms
-    (at the model's size)."""
+    (at the model's size); with a probe, every predicted ms times `cost_scale` (what it
+    measured) and the safety is the cost model's probe_safety.
+    oracle (a diagnosis, not a chooser): the scene's measured rows, their ms in place of the
+    predictions (and the safety 1)."""
     x = [feats[FEATURES.index(k)] for k in COST_FEATURES]
+    near = neighbours(model, feats)
     cands = []
     for key in model["cost"][0]:
-        ms = predict_ms(model["cost"], key, x)
-        fits = ms * model["cost"][2][group(key)] <= budget
-        cands.append((key, ms, predict_flip(model, feats, key) if fits else math.inf))
-    fit_ = [c for c in cands if c[2] < math.inf]
+        if oracle is not None:
+            ms = lookup(oracle, key)[0]
+            fits = ms <= budget
+        else:
+            ms = predict_ms(model["cost"], key, x) * (cost_scale or 1.0)
+            fits = ms * model["cost"][2 if cost_scale is None else 3][group(key)] <= budget
+        cands.append((key, ms, predict(model, near, key) if fits else (math.inf, math.inf)))
+    fit_ = [c for c in cands if c[2][1] < math.inf]
     if not fit_:
         key, ms, _ = min(cands, key=lambda c: c[1])
-        return key, ms, predict_flip(model, feats, key), "nothing predicted within the budget: the fastest"
-    pt = min((c for c in fit_ if group(c[0]) == "pt"), key=lambda c: c[2], default=None)
-    hy = min((c for c in fit_ if group(c[0]) == "hybrid"), key=lambda c: c[2], default=None)
-    if hy and (pt is None or hy[2] < pt_margin * pt[2]):
-        return hy[0], hy[1], hy[2], "hybrid"
-    return pt[0], pt[1], pt[2], "path tracer"
+        return key, ms, predict(model, near, key)[0], "nothing predicted within the budget: the fastest"
+    pt = min((c for c in fit_ if group(c[0]) == "pt"), key=lambda c: c[2][1], default=None)
+    hy = min((c for c in fit_ if group(c[0]) == "hybrid"), key=lambda c: c[2][1], default=None)
+    if hy and (pt is None or hy[2][1] < pt_margin * pt[2][1]):
+        return hy[0], hy[1], hy[2][0], "hybrid"
+    return pt[0], pt[1], pt[2][0], "path tracer"
 
 
 def to_pick(key, ms, flip):
@@ -283,22 +368,42 @@ def to_pick(key, ms, flip):
 
 
 def model_json(model, size, source, pt_margin):
-    alpha, beta, safety = model["cost"]
+    alpha, beta, safety = model["cost"][:3]
+    qp = model["q"]
     cands = []
     for key in sorted(alpha):
         c = to_pick(key, None, None)
         c.update({"key": key_text(key), "alpha": round(alpha[key], 5), "group": group(key)})
+        if key in model["prior"]:  # the mean and variance of its log FLIP ratio over the scenes
+            c["prior"] = [round(v, 5) for v in model["prior"][key]]
         cands.append(c)
     return {"comment": "The technique chooser of drift render --budget-ms (tools/render_choose.c), "
                        "fitted by scripts/chooser/fit_table.py from %s on the corpus's fit scenes: "
                        "a cost model (log ms at size^2 = alpha + beta[group] . cost features) and, "
-                       "for each fitted scene, its features and its rows' FLIP over its best." % source,
-            "size": size, "k": K, "pt_margin": pt_margin, "features": FEATURES,
+                       "for each fitted scene, its features and its rows' FLIP over its best "
+                       "(quality.norm: best, its best row's; pt1, its pt 1 spp's); each "
+                       "candidate's prior (mean, variance of its log ratio over the scenes)." % source,
+            "size": size, "k": qp["k"], "pt_margin": pt_margin, "features": FEATURES,
+            "quality": {k: qp[k] for k in ("kernel", "bandwidth", "prior", "kappa", "norm")},
             "cost_features": COST_FEATURES, "beta": {g: [round(v, 5) for v in b] for g, b in beta.items()},
             "safety": {g: round(v, 4) for g, v in safety.items()},
             "scale": model["scale"], "candidates": cands,
             "scenes": [{"name": n, "features": f, "flip": {key_text(k): round(v, 4) for k, v in sorted(q.items())}}
                        for n, f, q in model["scenes"]]}
+
+
+def from_json(m):
+    """The model as fit() returns it, from what model_json() wrote (for scripts/chooser/pick.py:
+    the script's pick from the file the renderer reads)."""
+    key = lambda text: tuple(text.split("|", 1))
+    cands = m["candidates"]
+    safety = m["safety"]
+    return {"cost": ({key(c["key"]): c["alpha"] for c in cands}, m["beta"], safety, safety),
+            "scale": m["scale"],
+            "scenes": [(s["name"], s["features"], {key(k): v for k, v in s["flip"].items()})
+                       for s in m["scenes"]],
+            "prior": {key(c["key"]): tuple(c["prior"]) for c in cands if "prior" in c},
+            "q": dict(QUALITY, k=m.get("k", 2), **m.get("quality", {}))}
 
 
 def median(v):
@@ -311,13 +416,25 @@ def gmean(v):
     return math.exp(sum(math.log(x) for x in v) / len(v)) if v else float("nan")
 
 
-def validate(scenes, is_fit, budgets, pt_margin, out, train_all):
+def probe_scale(model, s):
+    """What --budget-probe on measures, from the scene's own rows: its path tracer at 1 spp
+    over the model's prediction of it (every candidate's predicted ms is scaled by that)."""
+    ms, _ = lookup(s["rows"], ("pt", "1 spp"))
+    pred = predict_ms(model["cost"], ("pt", "1 spp"), cost_x(s))
+    return ms / pred if 0.0 < ms < math.inf and 0.0 < pred < math.inf else 1.0
+
+
+def loso(scenes, is_fit, budgets, pt_margin, train_all, qp=None, probe=False):
+    """The leave-one-scene-out cells: each scene's pick at each budget by a model fitted
+    without it (on every other scene, or on the other fit scenes)."""
     cells = []
     for s in scenes:
         train = [t for t in scenes if t is not s and (train_all or is_fit(t))]
-        model = fit(train)
+        model = fit(train, qp)
+        scale = probe_scale(model, s) if probe is True else None
+        oracle = s["rows"] if probe == "oracle" else None
         for b in budgets:
-            key, pms, _, why = choose(model, s["features"], b, pt_margin)
+            key, pms, _, why = choose(model, s["features"], b, pt_margin, scale, oracle)
             ms, f = lookup(s["rows"], key)
             top, topkey = best_within(s["rows"], b)
             pt, _ = best_within(s["rows"], b, PT_FAMILIES)
@@ -326,6 +443,25 @@ def validate(scenes, is_fit, budgets, pt_margin, out, train_all):
                           "best_pt": pt,
                           "regret": f / top if top and f < math.inf else math.inf,
                           "vs_pt": f / pt if pt and f < math.inf else math.inf})
+    return cells
+
+
+def summary(cells, b, role):
+    """One budget's figures over one role's cells (None without cells)."""
+    cs = [c for c in cells if c["budget"] == b and c["fit"] == (role == "fit")]
+    if not cs:
+        return None
+    return {"cells": len(cs), "median_regret": median([c["regret"] for c in cs]),
+            "worst_regret": max(c["regret"] for c in cs),
+            "median_vs_pt": median([c["vs_pt"] for c in cs]),
+            "within_1_1_pt": sum(c["vs_pt"] <= 1.1 for c in cs),
+            "within_budget": sum(c["ms"] <= b for c in cs),
+            "hybrid": sum(group(c["key"]) == "hybrid" for c in cs),
+            "median_flip": median([c["flip"] for c in cs])}
+
+
+def validate(scenes, is_fit, budgets, pt_margin, out, train_all, qp=None, probe=False):
+    cells = loso(scenes, is_fit, budgets, pt_margin, train_all, qp, probe)
     w = out.write
     w("| scene | role | " + " | ".join("%g ms" % b for b in budgets) + " |\n")
     w("|---|---|" + "---|" * len(budgets) + "\n")
@@ -345,14 +481,11 @@ def validate(scenes, is_fit, budgets, pt_margin, out, train_all):
     w("|---|---|---|---|---|---|---|---|---|---|\n")
     for role in ("judge", "fit"):
         for b in budgets:
-            cs = [c for c in cells if c["budget"] == b and c["fit"] == (role == "fit")]
-            if not cs:
-                continue
-            w("| %g | %s | %d | %.2f | %.2f | %.2f | %d | %d | %d | %.3f |\n" % (
-                b, role, len(cs), median([c["regret"] for c in cs]), max(c["regret"] for c in cs),
-                median([c["vs_pt"] for c in cs]), sum(c["vs_pt"] <= 1.1 for c in cs),
-                sum(c["ms"] <= b for c in cs), sum(group(c["key"]) == "hybrid" for c in cs),
-                median([c["flip"] for c in cs])))
+            m = summary(cells, b, role)
+            if m:
+                w("| %g | %s | %d | %.2f | %.2f | %.2f | %d | %d | %d | %.3f |\n" % (
+                    b, role, m["cells"], m["median_regret"], m["worst_regret"], m["median_vs_pt"],
+                    m["within_1_1_pt"], m["within_budget"], m["hybrid"], m["median_flip"]))
     return cells
 
 
@@ -380,9 +513,26 @@ def main():
     a.add_argument("--pt-margin", type=float, default=0.9,
                    help="a hybrid row is picked only when predicted below this x the best path "
                         "tracer's FLIP (default 0.9)")
-    a.add_argument("--train", choices=("all", "fit"), default="all",
-                   help="what a left-out scene's model is fitted on: every other scene (all, the "
-                        "default) or the other fit scenes; --model is fitted likewise")
+    q = a.add_argument_group("the quality model and the pick (defaults: session 2's chooser)")
+    q.add_argument("--k", type=int, default=QUALITY["k"], help="nearest scenes (0: all)")
+    q.add_argument("--kernel", choices=("idw", "gauss"), default=QUALITY["kernel"])
+    q.add_argument("--bandwidth", type=float, default=QUALITY["bandwidth"])
+    q.add_argument("--prior", type=float, default=QUALITY["prior"],
+                   help="the candidate's prior's weight against the neighbourhood's 1")
+    q.add_argument("--kappa", type=float, default=QUALITY["kappa"],
+                   help="rank by mean + kappa x spread of the predicted log FLIP ratio")
+    q.add_argument("--robust", action="store_true", help="features scaled by their MAD")
+    q.add_argument("--norm", choices=("best", "pt1"), default=QUALITY["norm"])
+    q.add_argument("--safety-quantile", type=float, default=QUALITY["safety_quantile"])
+    q.add_argument("--hybrid-quantile", type=float,
+                   help="the hybrid rows' safety quantile (default: --safety-quantile's)")
+    q.add_argument("--probe", action="store_true",
+                   help="leave-one-out as --budget-probe on: each scene's predicted ms scaled "
+                        "by its own pt 1 spp row over the prediction of it")
+    a.add_argument("--train", choices=("all", "fit"), default="fit",
+                   help="what a left-out scene's model is fitted on: the fit scenes (fit, the "
+                        "default: a judge scene's pick is the shipped model's) or every other "
+                        "scene (all); --model is fitted likewise")
     o = a.parse_args()
     budgets = [float(b) for b in o.budgets.split(",")]
     scenes = load(o.rows, o.drift)
@@ -398,23 +548,32 @@ def main():
             sys.stdout.write(t)
             self.parts.append(t)
 
+    qp = {"k": o.k, "kernel": o.kernel, "bandwidth": o.bandwidth, "prior": o.prior,
+          "kappa": o.kappa, "robust": o.robust, "norm": o.norm,
+          "safety_quantile": o.safety_quantile, "hybrid_quantile": o.hybrid_quantile}
     tee = Tee()
-    validate(scenes, is_fit, budgets, o.pt_margin, tee, o.train == "all")
+    validate(scenes, is_fit, budgets, o.pt_margin, tee, o.train == "all", qp, o.probe)
     if o.frontier_md:
-        head = ("Generated by `python3 scripts/chooser/fit_table.py %s --fit %s --pt-margin %g` "
-                "(leave-one-scene-out: each scene's pick by a model fitted on the fit scenes "
-                "without it; regret = chosen FLIP / best FLIP in hindsight within the budget; "
+        args = " ".join(sys.argv[2:])
+        args = re.sub(r"--(model|frontier-md|drift) \S+ ?", "", args).strip()
+        head = ("Generated by `python3 scripts/chooser/fit_table.py %s %s` "
+                "(leave-one-scene-out: each scene's pick by a model fitted without it, on %s; "
+                "%sregret = chosen FLIP / best FLIP in hindsight within the budget; "
                 "/pt = chosen FLIP / best path tracer's; %d px, the bench's size).\n\n" % (
-                    os.path.basename(o.rows), os.path.basename(o.fit), o.pt_margin, scenes[0]["size"]))
+                    os.path.basename(o.rows), args,
+                    "every other scene" if o.train == "all" else
+                    "the fit scenes (a fit scene's on the other fit scenes)",
+                    "costs scaled by the scene's own pt 1 spp row, as --budget-probe on scales "
+                    "them by its probe; " if o.probe else "", scenes[0]["size"]))
         replace_block(o.frontier_md, head + "".join(tee.parts))
     if o.model:
         train = [s for s in scenes if o.train == "all" or is_fit(s)]
-        m = model_json(fit(train), train[0]["size"], os.path.basename(o.rows), o.pt_margin)
+        m = model_json(fit(train, qp), train[0]["size"], os.path.basename(o.rows), o.pt_margin)
         # What --budget-probe on reads that this fit does not make (scripts/chooser/
         # measure_setup.py's set-up table, the safety under calibration) is kept.
         if os.path.exists(o.model):
             old = json.load(open(o.model))
-            m.update({k: old[k] for k in ("setup_ms", "calibrated_safety") if k in old})
+            m.update({k: old[k] for k in ("setup_ms", "calibrated_safety", "finish_ms") if k in old})
         with open(o.model, "w") as fh:
             json.dump(m, fh, indent=1)
             fh.write("\n")

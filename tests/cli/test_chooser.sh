@@ -9,7 +9,9 @@
 # is the best, it picks and renders the path tracer (and says so), also when a hybrid row is
 # predicted only slightly better (within the model's pt_margin); where the hybrid row is
 # clearly better, that; where that row's technique has a set-up (the model's setup_ms) far
-# over the budget, the probes count it and the other row is picked. Bad --budget-ms and a
+# over the budget, the probes count it and the other row is picked. The renderer's pick is
+# scripts/chooser/pick.py's (the fitting script's) from the same model on the three scenes,
+# and on a hand-made model where the prior and kappa change the pick. Bad --budget-ms and a
 # missing model exit with errors.
 # $1 is the drift binary.
 set -u
@@ -37,6 +39,16 @@ for scene in "" "$root/scenes/corpus/veach_mi.json" "$root/scenes/corpus/teapot_
 import re, sys
 m = re.search(r"\(predicted (\d+) ms, FLIP", sys.argv[1])
 assert m and float(m.group(1)) <= 100, sys.argv[1]
+PY
+    # The script that fits the model picks the same row from the same file for this scene.
+    "$drift" render $scene --features --quiet >"$tmp/$name-features.json" || fail "$name: --features"
+    want=$(python3 "$root/scripts/chooser/pick.py" "$root/scenes/corpus/chooser.json" \
+        "$tmp/$name-features.json" --budget-ms 100 --pixels 1024) || fail "$name: pick.py"
+    python3 - "$line" "$want" <<'PY' || fail "$name: the renderer's pick is not the script's ($want): $line"
+import re, sys
+m = re.search(r"--budget-ms 100: (?:hybrid |the path tracer is expected to win: |"
+              r"nothing is predicted to fit, the fastest: )(.*) \(predicted", sys.argv[1])
+assert m and m.group(1) == sys.argv[2], (m and m.group(1), sys.argv[2])
 PY
     flip=$("$drift" diff "$ref" "$tmp/$name.exr" | awk '$1 == "flip" { print $2 }')
     echo "$name: FLIP $flip against 128 spp ($line)"
@@ -120,6 +132,37 @@ grep -q "hybrid hard + none" "$tmp/err" || fail "probes: the set-up is not count
 expect 0 "$drift" render --mode hybrid --budget-ms 100000 --budget-probe off \
     --chooser "$tmp/model.json" "${size[@]}" --out "$tmp/m.exr"
 grep -q "hybrid pcss + none" "$tmp/err" || fail "probe off: not the closest row: $(cat "$tmp/err")"
+# The quality model's prior and kappa: two fitted scenes at the frame's features (equal
+# weights); pt 1 spp has FLIP ratio 1 on both, pt 2 spp 0.5 on one and 1.6 on the other
+# (geometric mean 0.894, log spread 0.58). Ranked by the mean, 2 spp; with kappa 0.5 its
+# rank is exp(-0.112 + 0.29) = 1.19 > 1: 1 spp; with the prior (log ratio 0.69 over the corpus)
+# weighing 10 against the neighbours' 1, its mean is 0.62 > 0: 1 spp. pick.py agrees on each.
+for case in "0 0 2" "0.5 0 1" "0 10 1"; do
+    set -- $case
+    python3 - "$1" "$2" "$tmp/model.json" "$tmp/features.json" <<'PY' || fail "prior model"
+import json, math, sys
+feats = json.load(open(sys.argv[4]))
+names = list(feats)
+pt = lambda spp, prior: {"key": "pt|%d spp" % spp, "group": "pt", "alpha": math.log(10.0),
+                         "kind": "pt", "row": "pt %d spp" % spp, "spp": spp, "scale": 1,
+                         "denoise": "none", "prior": [prior, 0.0]}
+scene = lambda name, r: {"name": name, "features": [feats[n] for n in names],
+                         "flip": {"pt|1 spp": 1.0, "pt|2 spp": r}}
+json.dump({"size": 32, "k": 2, "pt_margin": 0.9, "features": names, "cost_features": [],
+           "quality": {"kernel": "idw", "bandwidth": 1.0, "prior": float(sys.argv[2]),
+                       "kappa": float(sys.argv[1]), "norm": "best"},
+           "beta": {"pt": [], "hybrid": []}, "safety": {"pt": 1.0, "hybrid": 1.0},
+           "scale": [1.0] * len(names), "candidates": [pt(1, 0.0), pt(2, math.log(2.0))],
+           "scenes": [scene("a", 0.5), scene("b", 1.6)]}, open(sys.argv[3], "w"))
+PY
+    expect 0 "$drift" render --mode hybrid --budget-ms 50 --budget-probe off --chooser "$tmp/model.json" \
+        "${size[@]}" --out "$tmp/m.exr"
+    grep -q "the path tracer is expected to win: pt $3 spp (" "$tmp/err" ||
+        fail "kappa $1, prior $2: not pt $3 spp: $(cat "$tmp/err")"
+    want=$(python3 "$root/scripts/chooser/pick.py" "$tmp/model.json" "$tmp/features.json" \
+        --budget-ms 50 --pixels 1024)
+    [ "$want" = "pt $3 spp" ] || fail "kappa $1, prior $2: pick.py says $want, not pt $3 spp"
+done
 expect 2 "$drift" render --mode hybrid --budget-ms 100 --budget-probe maybe "${size[@]}" \
     --out "$tmp/x.exr"
 expect 2 "$drift" render --mode hybrid --budget-ms -5 "${size[@]}" --out "$tmp/x.exr"
