@@ -3,8 +3,9 @@
 //
 // Both renderers run as child processes and are timed whole (fork -> exit, wall and CPU); each
 // also reports its own render time: drift's --stats milliseconds.render (no load, accel or write),
-// Cycles' render_seconds from bench/cycles/cornell_cycles.py ("Sample 0/N" -> "Sample N/N": no
-// scene sync, BVH or EXR write) or, for a glTF, Blender's own " Time: " line (sync included).
+// Cycles' render_seconds from bench/cycles/cornell_cycles.py or obj_cycles.py (a JSON of OBJ
+// meshes; "Sample 0/N" -> "Sample N/N": no scene sync, BVH or EXR write) or, for a glTF,
+// Blender's own " Time: " line (sync included).
 // Both images are compared with a higher-spp drift reference (cached, keyed by the scene file,
 // size, depth and spp): ꟻLIP and relMSE. The equal-error ratio assumes relMSE ∝ 1/spp and time ∝
 // spp for each renderer, so the time to reach a relMSE e is t * relMSE / e and the ratio of the
@@ -63,7 +64,8 @@ static const cli_option cycles_table[] = {
 static const cli_command cycles_command = {
     .name = "bench cycles",
     .usage = "usage: drift bench cycles [SCENE] [options]\n\n"
-             "Renders SCENE (default the Cornell box; or a .gltf/.glb) with drift's path tracer\n"
+             "Renders SCENE (default the Cornell box; a drift .json of OBJ meshes such as the\n"
+             "Breakfast Room; or a .gltf/.glb) with drift's path tracer\n"
              "and with Blender's Cycles at the same size, spp, depth and threads, one after the\n"
              "other; prints both whole-process and render-only times, the ratio Cycles / drift,\n"
              "both images' FLIP and relMSE against a cached higher-spp drift reference and the\n"
@@ -234,7 +236,7 @@ typedef struct cycles_run {
     double drift_render_s, cycles_render_s, blender_render_s;
     drift_metric_report drift_q, cycles_q;
     double drift_lo_relmse, cycles_lo_relmse, drift_slope, cycles_slope, ref_noise;
-    bool gltf;
+    bool gltf, cornell; // neither: a drift scene JSON of OBJ meshes (obj_cycles.py)
     char scene[4096], dir[4096], ref[4352], drift_exr[4352], cycles_exr[4352], cycles_log[4352];
     char drift_lo_exr[4352], cycles_lo_exr[4352], cycles_lo_log[4352];
 } cycles_run;
@@ -336,8 +338,22 @@ static int render_cycles(const cycles_options *o, const cycles_run *r, long spp,
     snprintf(s_bounces, sizeof s_bounces, "%ld", o->max_depth - 1);
     snprintf(s_threads, sizeof s_threads, "%ld", o->threads);
     snprintf(script, sizeof script, "%s/bench/cycles/%s", DRIFT_SOURCE_DIR,
-             r->gltf ? "gltf_cycles.py" : "cornell_cycles.py");
+             r->gltf      ? "gltf_cycles.py"
+             : r->cornell ? "cornell_cycles.py"
+                          : "obj_cycles.py");
     char *blender = (char *)o->blender;
+    if (!r->gltf && !r->cornell) {
+        // Materials mapped from the MTL as drift reads it, roulette from the 4th vertex.
+        char *argv[] = { blender,    "-b",        "--factory-startup",
+                         "-noaudio", "--python",  script,
+                         "--",       "--scene",   (char *)r->scene,
+                         "--spp",    s_spp,       "--max-depth",
+                         s_depth,    "--threads", s_threads,
+                         "--width",  s_size,      "--height",
+                         s_size,     "--out",     out,
+                         NULL };
+        return run_child(argv, log, t);
+    }
     if (r->gltf) {
         char *argv[] = { blender,     "-b",       "--factory-startup",
                          "-noaudio",  "--python", script,
@@ -378,7 +394,7 @@ static int render_cycles(const cycles_options *o, const cycles_run *r, long spp,
                      "--out",
                      out,
                      "--rr-min-bounces",
-                     "2",
+                     "1", // Cycles' +1: roulette from the 4th vertex, as drift's rr_depth 3
                      "--one-sided-light",
                      "--light-diffuse",
                      NULL };
@@ -417,10 +433,11 @@ int drift_bench_cycles(int argc, char **argv)
         return 2;
     }
     r.gltf = ends_with(r.scene, ".gltf") || ends_with(r.scene, ".glb");
-    if (!r.gltf && !ends_with(r.scene, "/cornell_box.json")) {
+    r.cornell = ends_with(r.scene, "/cornell_box.json");
+    if (!r.gltf && !ends_with(r.scene, ".json")) {
         fprintf(stderr,
-                "drift bench cycles: %s: Blender reads the Cornell box (cornell_box.json beside "
-                "its cornell_box.obj) or a .gltf/.glb; export other scenes to glTF first\n",
+                "drift bench cycles: %s: Blender reads a drift scene .json of OBJ meshes (the "
+                "Cornell box, the Breakfast Room) or a .gltf/.glb\n",
                 r.scene);
         return 2;
     }
