@@ -146,8 +146,9 @@ static char *read_text(const char *path)
     return text;
 }
 
-// drift's --stats milliseconds.render in seconds; NAN when absent.
-static double drift_render_seconds(const char *stats_path)
+// drift's --stats milliseconds.render in seconds, and its cpu_milliseconds.render into
+// *cpu_s; NAN when absent.
+static double drift_render_seconds(const char *stats_path, double *cpu_s)
 {
     char *text = read_text(stats_path);
     cJSON *root = text ? cJSON_Parse(text) : NULL;
@@ -155,18 +156,26 @@ static double drift_render_seconds(const char *stats_path)
     cJSON *ms = cJSON_GetObjectItemCaseSensitive(root, "milliseconds");
     cJSON *render = cJSON_GetObjectItemCaseSensitive(ms, "render");
     double s = cJSON_IsNumber(render) ? 1e-3 * render->valuedouble : (double)NAN;
+    cJSON *cpu = cJSON_GetObjectItemCaseSensitive(
+        cJSON_GetObjectItemCaseSensitive(root, "cpu_milliseconds"), "render");
+    *cpu_s = cJSON_IsNumber(cpu) ? 1e-3 * cpu->valuedouble : (double)NAN;
     cJSON_Delete(root);
     return s;
 }
 
-// The last "CYCLES_TIME render_seconds=S" of the log (cornell_cycles.py) into *render_s and the
+// The last "CYCLES_TIME render_seconds=S" of the log (cornell_cycles.py) into *render_s, the
+// last "render_cpu_seconds=S" (the same window's CPU time, all threads) into *cpu_s and the
 // last Blender " Time: [HH:]MM:SS.ss" (render call, sync included) into *blender_s; NAN if absent.
-static void cycles_times(const char *log, double *render_s, double *blender_s)
+static void cycles_times(const char *log, double *render_s, double *cpu_s, double *blender_s)
 {
-    *render_s = *blender_s = (double)NAN;
+    *render_s = *cpu_s = *blender_s = (double)NAN;
     char *text = read_text(log);
     for (char *line = text ? strtok(text, "\n") : NULL; line; line = strtok(NULL, "\n")) {
         double h = 0, m = 0, s = 0;
+        const char *cpu = strstr(line, "render_cpu_seconds=");
+        if (cpu && strncmp(line, "CYCLES_TIME", 11) == 0) {
+            *cpu_s = strtod(cpu + 19, NULL);
+        }
         if (strncmp(line, "CYCLES_TIME render_seconds=", 27) == 0) {
             *render_s = strtod(line + 27, NULL);
         } else if (sscanf(line, " Time: %lf:%lf:%lf", &h, &m, &s) == 3) {
@@ -234,6 +243,10 @@ static bool compare(drift_context *ctx, const char *ref_path, const char *const 
 typedef struct cycles_run {
     child_time drift_process, cycles_process;
     double drift_render_s, cycles_render_s, blender_render_s;
+    double drift_render_cpu_s, cycles_render_cpu_s; // the same windows' CPU seconds
+    // Cycles / drift in CPU seconds: on a shared machine the wall-clock ratios follow who got
+    // the cores at the time, CPU time much less.
+    double ratio_process_cpu, ratio_render_cpu, equal_error_cpu;
     drift_metric_report drift_q, cycles_q;
     double drift_lo_relmse, cycles_lo_relmse, drift_slope, cycles_slope, ref_noise;
     bool gltf, cornell; // neither: a drift scene JSON of OBJ meshes (obj_cycles.py)
@@ -255,18 +268,20 @@ static void print_json(const cycles_options *o, const cycles_run *r, double rati
     const struct {
         const char *name;
         const child_time *p;
-        double render_s;
+        double render_s, render_cpu_s;
         const drift_metric_report *q;
         const char *image;
-    } rows[2] = { { "drift", &r->drift_process, r->drift_render_s, &r->drift_q, r->drift_exr },
-                  { "cycles", &r->cycles_process, r->cycles_render_s, &r->cycles_q,
-                    r->cycles_exr } };
+    } rows[2] = { { "drift", &r->drift_process, r->drift_render_s, r->drift_render_cpu_s,
+                    &r->drift_q, r->drift_exr },
+                  { "cycles", &r->cycles_process, r->cycles_render_s, r->cycles_render_cpu_s,
+                    &r->cycles_q, r->cycles_exr } };
 
     for (int i = 0; i < 2; ++i) {
         cJSON *row = cJSON_AddObjectToObject(root, rows[i].name);
         cli_json_number(row, "process_s", rows[i].p->wall_s, 4);
         cli_json_number(row, "process_cpu_s", rows[i].p->cpu_s, 4);
         cli_json_number(row, "render_s", rows[i].render_s, 4);
+        cli_json_number(row, "render_cpu_s", rows[i].render_cpu_s, 4);
         cli_json_number(row, "flip", rows[i].q->flip, 5);
         cli_json_number(row, "relmse", rows[i].q->relmse, 7);
         cJSON_AddStringToObject(row, "image", rows[i].image);
@@ -276,6 +291,9 @@ static void print_json(const cycles_options *o, const cycles_run *r, double rati
     cli_json_number(root, "ratio_process", ratio_process, 4);
     cli_json_number(root, "ratio_render", ratio_render, 4);
     cli_json_number(root, "equal_error_ratio", equal_error, 4);
+    cli_json_number(root, "ratio_process_cpu", r->ratio_process_cpu, 4);
+    cli_json_number(root, "ratio_render_cpu", r->ratio_render_cpu, 4);
+    cli_json_number(root, "equal_error_ratio_cpu", r->equal_error_cpu, 4);
     cli_json_count(root, "fit_spp",
                    (uint64_t)(o->fit_spp > 0 && o->fit_spp < o->spp ? o->fit_spp : 0));
     cli_json_number(root, "reference_relmse", r->ref_noise, 7);
@@ -300,6 +318,9 @@ static void print_text(const cycles_options *o, const cycles_run *r, double rati
     printf("  Cycles / drift: whole process %.3f, render %.3f, equal relMSE %.3f (>1: drift "
            "faster)\n",
            ratio_process, ratio_render, equal_error);
+    printf("  in CPU seconds: whole process %.3f, render %.3f (%.3f / %.3f s), equal relMSE %.3f\n",
+           r->ratio_process_cpu, r->ratio_render_cpu, r->cycles_render_cpu_s, r->drift_render_cpu_s,
+           r->equal_error_cpu);
     printf("  relMSE ∝ spp^-k, less the reference's own %.3g: k drift %.3f, Cycles %.3f (%s)\n",
            r->ref_noise, r->drift_slope, r->cycles_slope,
            o->fit_spp > 0 && o->fit_spp < o->spp ? "fitted from --fit-spp" : "assumed");
@@ -507,7 +528,7 @@ int drift_bench_cycles(int argc, char **argv)
         fprintf(stderr, "drift bench cycles: the Cycles render failed, see %s\n", r.cycles_log);
         return 1;
     }
-    cycles_times(r.cycles_log, &r.cycles_render_s, &r.blender_render_s);
+    cycles_times(r.cycles_log, &r.cycles_render_s, &r.cycles_render_cpu_s, &r.blender_render_s);
     if (!isfinite(r.cycles_render_s)) {
         r.cycles_render_s = r.blender_render_s; // gltf_cycles.py: Blender's own, sync included
     }
@@ -516,7 +537,7 @@ int drift_bench_cycles(int argc, char **argv)
         fprintf(stderr, "drift bench cycles: the drift render failed, see %s\n", drift_log);
         return 1;
     }
-    r.drift_render_s = drift_render_seconds(stats);
+    r.drift_render_s = drift_render_seconds(stats, &r.drift_render_cpu_s);
     if (!isfinite(r.cycles_render_s) || !isfinite(r.drift_render_s)) {
         fprintf(stderr, "drift bench cycles: no render time in %s or %s\n", r.cycles_log, stats);
         return 1;
@@ -563,10 +584,14 @@ int drift_bench_cycles(int argc, char **argv)
     double ratio_render = r.cycles_render_s / r.drift_render_s;
     // Each one's render time to reach the larger of the two relMSEs, t (relMSE / e)^(1/k).
     double e = fmax(err[0], err[1]);
-    double equal_error = err[0] > 0 && err[1] > 0 && r.drift_slope > 0 && r.cycles_slope > 0
-                             ? r.cycles_render_s * pow(err[1] / e, 1.0 / r.cycles_slope) /
-                                   (r.drift_render_s * pow(err[0] / e, 1.0 / r.drift_slope))
-                             : (double)NAN;
+    double noise =
+        err[0] > 0 && err[1] > 0 && r.drift_slope > 0 && r.cycles_slope > 0
+            ? pow(err[1] / e, 1.0 / r.cycles_slope) / pow(err[0] / e, 1.0 / r.drift_slope)
+            : (double)NAN;
+    double equal_error = ratio_render * noise;
+    r.ratio_process_cpu = r.cycles_process.cpu_s / r.drift_process.cpu_s;
+    r.ratio_render_cpu = r.cycles_render_cpu_s / r.drift_render_cpu_s; // NAN if either is absent
+    r.equal_error_cpu = r.ratio_render_cpu * noise;
     if (o.json) {
         print_json(&o, &r, ratio_process, ratio_render, equal_error);
     } else {

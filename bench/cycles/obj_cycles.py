@@ -18,8 +18,8 @@
 # - Sampling as cornell_cycles.py (configure()): box filter 1 px, no adaptive sampling,
 #   clamping, denoising or light threshold; max_bounces D + offset (-1: drift's --max-depth D);
 #   Russian roulette with min_light_bounces N (N = 1: from the 4th vertex, as drift's rr_depth 3).
-# Prints CYCLES_TIME render_seconds=... (Sample 0/N -> N/N, as cornell_cycles.py) and
-# CYCLES_MEAN r g b.
+# Prints CYCLES_TIME render_seconds=... render_cpu_seconds=... (Sample 0/N -> N/N, as
+# cornell_cycles.py; the CPU time of all threads over the same window) and CYCLES_MEAN r g b.
 import argparse
 import json
 import math
@@ -180,13 +180,13 @@ def main():
           (bpy.app.version_string, args.spp, depth, args.rr_min_bounces, args.threads), flush=True)
     t0 = time.perf_counter()
     cc.render_captured(timer)
-    if timer.t_first_sample is None or timer.t_last_sample is None:
-        render_s = time.perf_counter() - t0
-    else:
+    render_s, cpu_s = time.perf_counter() - t0, float("nan")
+    if timer.t_first_sample is not None and timer.t_last_sample is not None:
         render_s = timer.t_last_sample - timer.t_first_sample
-    print("CYCLES_TIME render_seconds=%.6f spp=%d width=%d height=%d threads=%d depth=%d" %
-          (render_s, args.spp, args.width, args.height, args.threads, args.max_depth),
-          flush=True)
+        cpu_s = timer.cpu_last_sample - timer.cpu_first_sample  # all threads, same window
+    print("CYCLES_TIME render_seconds=%.6f render_cpu_seconds=%.6f spp=%d width=%d height=%d "
+          "threads=%d depth=%d" % (render_s, cpu_s, args.spp, args.width, args.height,
+                                   args.threads, args.max_depth), flush=True)
     print("CYCLES_MEAN %.6f %.6f %.6f" % cc.image_mean(args.out)[1], flush=True)
 
 
