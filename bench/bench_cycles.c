@@ -376,13 +376,29 @@ static int render_cycles(const cycles_options *o, const cycles_run *r, long spp,
         return run_child(argv, log, t);
     }
     if (r->gltf) {
-        char *argv[] = { blender,     "-b",       "--factory-startup",
-                         "-noaudio",  "--python", script,
-                         "--",        "--gltf",   (char *)r->scene,
-                         "--spp",     s_spp,      "--width",
-                         s_size,      "--height", s_size,
-                         "--threads", s_threads,  "--max-bounces",
-                         s_bounces,   "--out",    out,
+        char *argv[] = { blender,
+                         "-b",
+                         "--factory-startup",
+                         "-noaudio",
+                         "--python",
+                         script,
+                         "--",
+                         "--gltf",
+                         (char *)r->scene,
+                         "--spp",
+                         s_spp,
+                         "--width",
+                         s_size,
+                         "--height",
+                         s_size,
+                         "--threads",
+                         s_threads,
+                         "--max-bounces",
+                         s_bounces,
+                         "--out",
+                         out,
+                         "--rr-min-bounces",
+                         "1", // drift's roulette, no light threshold
                          NULL };
         return run_child(argv, log, t);
     }
