@@ -3,8 +3,9 @@
 //
 // Both renderers run as child processes and are timed whole (fork -> exit, wall and CPU); each
 // also reports its own render time: drift's --stats milliseconds.render (no load, accel or write),
-// Cycles' render_seconds from bench/cycles/cornell_cycles.py ("Sample 0/N" -> "Sample N/N": no
-// scene sync, BVH or EXR write) or, for a glTF, Blender's own " Time: " line (sync included).
+// Cycles' render_seconds from bench/cycles/cornell_cycles.py or obj_cycles.py (a JSON of OBJ
+// meshes; "Sample 0/N" -> "Sample N/N": no scene sync, BVH or EXR write) or, for a glTF,
+// Blender's own " Time: " line (sync included).
 // Both images are compared with a higher-spp drift reference (cached, keyed by the scene file,
 // size, depth and spp): ꟻLIP and relMSE. The equal-error ratio assumes relMSE ∝ 1/spp and time ∝
 // spp for each renderer, so the time to reach a relMSE e is t * relMSE / e and the ratio of the
@@ -63,7 +64,8 @@ static const cli_option cycles_table[] = {
 static const cli_command cycles_command = {
     .name = "bench cycles",
     .usage = "usage: drift bench cycles [SCENE] [options]\n\n"
-             "Renders SCENE (default the Cornell box; or a .gltf/.glb) with drift's path tracer\n"
+             "Renders SCENE (default the Cornell box; a drift .json of OBJ meshes such as the\n"
+             "Breakfast Room; or a .gltf/.glb) with drift's path tracer\n"
              "and with Blender's Cycles at the same size, spp, depth and threads, one after the\n"
              "other; prints both whole-process and render-only times, the ratio Cycles / drift,\n"
              "both images' FLIP and relMSE against a cached higher-spp drift reference and the\n"
@@ -144,8 +146,9 @@ static char *read_text(const char *path)
     return text;
 }
 
-// drift's --stats milliseconds.render in seconds; NAN when absent.
-static double drift_render_seconds(const char *stats_path)
+// drift's --stats milliseconds.render in seconds, and its cpu_milliseconds.render into
+// *cpu_s; NAN when absent.
+static double drift_render_seconds(const char *stats_path, double *cpu_s)
 {
     char *text = read_text(stats_path);
     cJSON *root = text ? cJSON_Parse(text) : NULL;
@@ -153,18 +156,26 @@ static double drift_render_seconds(const char *stats_path)
     cJSON *ms = cJSON_GetObjectItemCaseSensitive(root, "milliseconds");
     cJSON *render = cJSON_GetObjectItemCaseSensitive(ms, "render");
     double s = cJSON_IsNumber(render) ? 1e-3 * render->valuedouble : (double)NAN;
+    cJSON *cpu = cJSON_GetObjectItemCaseSensitive(
+        cJSON_GetObjectItemCaseSensitive(root, "cpu_milliseconds"), "render");
+    *cpu_s = cJSON_IsNumber(cpu) ? 1e-3 * cpu->valuedouble : (double)NAN;
     cJSON_Delete(root);
     return s;
 }
 
-// The last "CYCLES_TIME render_seconds=S" of the log (cornell_cycles.py) into *render_s and the
+// The last "CYCLES_TIME render_seconds=S" of the log (cornell_cycles.py) into *render_s, the
+// last "render_cpu_seconds=S" (the same window's CPU time, all threads) into *cpu_s and the
 // last Blender " Time: [HH:]MM:SS.ss" (render call, sync included) into *blender_s; NAN if absent.
-static void cycles_times(const char *log, double *render_s, double *blender_s)
+static void cycles_times(const char *log, double *render_s, double *cpu_s, double *blender_s)
 {
-    *render_s = *blender_s = (double)NAN;
+    *render_s = *cpu_s = *blender_s = (double)NAN;
     char *text = read_text(log);
     for (char *line = text ? strtok(text, "\n") : NULL; line; line = strtok(NULL, "\n")) {
         double h = 0, m = 0, s = 0;
+        const char *cpu = strstr(line, "render_cpu_seconds=");
+        if (cpu && strncmp(line, "CYCLES_TIME", 11) == 0) {
+            *cpu_s = strtod(cpu + 19, NULL);
+        }
         if (strncmp(line, "CYCLES_TIME render_seconds=", 27) == 0) {
             *render_s = strtod(line + 27, NULL);
         } else if (sscanf(line, " Time: %lf:%lf:%lf", &h, &m, &s) == 3) {
@@ -232,9 +243,13 @@ static bool compare(drift_context *ctx, const char *ref_path, const char *const 
 typedef struct cycles_run {
     child_time drift_process, cycles_process;
     double drift_render_s, cycles_render_s, blender_render_s;
+    double drift_render_cpu_s, cycles_render_cpu_s; // the same windows' CPU seconds
+    // Cycles / drift in CPU seconds: on a shared machine the wall-clock ratios follow who got
+    // the cores at the time, CPU time much less.
+    double ratio_process_cpu, ratio_render_cpu, equal_error_cpu;
     drift_metric_report drift_q, cycles_q;
     double drift_lo_relmse, cycles_lo_relmse, drift_slope, cycles_slope, ref_noise;
-    bool gltf;
+    bool gltf, cornell; // neither: a drift scene JSON of OBJ meshes (obj_cycles.py)
     char scene[4096], dir[4096], ref[4352], drift_exr[4352], cycles_exr[4352], cycles_log[4352];
     char drift_lo_exr[4352], cycles_lo_exr[4352], cycles_lo_log[4352];
 } cycles_run;
@@ -253,18 +268,20 @@ static void print_json(const cycles_options *o, const cycles_run *r, double rati
     const struct {
         const char *name;
         const child_time *p;
-        double render_s;
+        double render_s, render_cpu_s;
         const drift_metric_report *q;
         const char *image;
-    } rows[2] = { { "drift", &r->drift_process, r->drift_render_s, &r->drift_q, r->drift_exr },
-                  { "cycles", &r->cycles_process, r->cycles_render_s, &r->cycles_q,
-                    r->cycles_exr } };
+    } rows[2] = { { "drift", &r->drift_process, r->drift_render_s, r->drift_render_cpu_s,
+                    &r->drift_q, r->drift_exr },
+                  { "cycles", &r->cycles_process, r->cycles_render_s, r->cycles_render_cpu_s,
+                    &r->cycles_q, r->cycles_exr } };
 
     for (int i = 0; i < 2; ++i) {
         cJSON *row = cJSON_AddObjectToObject(root, rows[i].name);
         cli_json_number(row, "process_s", rows[i].p->wall_s, 4);
         cli_json_number(row, "process_cpu_s", rows[i].p->cpu_s, 4);
         cli_json_number(row, "render_s", rows[i].render_s, 4);
+        cli_json_number(row, "render_cpu_s", rows[i].render_cpu_s, 4);
         cli_json_number(row, "flip", rows[i].q->flip, 5);
         cli_json_number(row, "relmse", rows[i].q->relmse, 7);
         cJSON_AddStringToObject(row, "image", rows[i].image);
@@ -274,6 +291,9 @@ static void print_json(const cycles_options *o, const cycles_run *r, double rati
     cli_json_number(root, "ratio_process", ratio_process, 4);
     cli_json_number(root, "ratio_render", ratio_render, 4);
     cli_json_number(root, "equal_error_ratio", equal_error, 4);
+    cli_json_number(root, "ratio_process_cpu", r->ratio_process_cpu, 4);
+    cli_json_number(root, "ratio_render_cpu", r->ratio_render_cpu, 4);
+    cli_json_number(root, "equal_error_ratio_cpu", r->equal_error_cpu, 4);
     cli_json_count(root, "fit_spp",
                    (uint64_t)(o->fit_spp > 0 && o->fit_spp < o->spp ? o->fit_spp : 0));
     cli_json_number(root, "reference_relmse", r->ref_noise, 7);
@@ -298,6 +318,9 @@ static void print_text(const cycles_options *o, const cycles_run *r, double rati
     printf("  Cycles / drift: whole process %.3f, render %.3f, equal relMSE %.3f (>1: drift "
            "faster)\n",
            ratio_process, ratio_render, equal_error);
+    printf("  in CPU seconds: whole process %.3f, render %.3f (%.3f / %.3f s), equal relMSE %.3f\n",
+           r->ratio_process_cpu, r->ratio_render_cpu, r->cycles_render_cpu_s, r->drift_render_cpu_s,
+           r->equal_error_cpu);
     printf("  relMSE ∝ spp^-k, less the reference's own %.3g: k drift %.3f, Cycles %.3f (%s)\n",
            r->ref_noise, r->drift_slope, r->cycles_slope,
            o->fit_spp > 0 && o->fit_spp < o->spp ? "fitted from --fit-spp" : "assumed");
@@ -336,16 +359,46 @@ static int render_cycles(const cycles_options *o, const cycles_run *r, long spp,
     snprintf(s_bounces, sizeof s_bounces, "%ld", o->max_depth - 1);
     snprintf(s_threads, sizeof s_threads, "%ld", o->threads);
     snprintf(script, sizeof script, "%s/bench/cycles/%s", DRIFT_SOURCE_DIR,
-             r->gltf ? "gltf_cycles.py" : "cornell_cycles.py");
+             r->gltf      ? "gltf_cycles.py"
+             : r->cornell ? "cornell_cycles.py"
+                          : "obj_cycles.py");
     char *blender = (char *)o->blender;
+    if (!r->gltf && !r->cornell) {
+        // Materials mapped from the MTL as drift reads it, roulette from the 4th vertex.
+        char *argv[] = { blender,    "-b",        "--factory-startup",
+                         "-noaudio", "--python",  script,
+                         "--",       "--scene",   (char *)r->scene,
+                         "--spp",    s_spp,       "--max-depth",
+                         s_depth,    "--threads", s_threads,
+                         "--width",  s_size,      "--height",
+                         s_size,     "--out",     out,
+                         NULL };
+        return run_child(argv, log, t);
+    }
     if (r->gltf) {
-        char *argv[] = { blender,     "-b",       "--factory-startup",
-                         "-noaudio",  "--python", script,
-                         "--",        "--gltf",   (char *)r->scene,
-                         "--spp",     s_spp,      "--width",
-                         s_size,      "--height", s_size,
-                         "--threads", s_threads,  "--max-bounces",
-                         s_bounces,   "--out",    out,
+        char *argv[] = { blender,
+                         "-b",
+                         "--factory-startup",
+                         "-noaudio",
+                         "--python",
+                         script,
+                         "--",
+                         "--gltf",
+                         (char *)r->scene,
+                         "--spp",
+                         s_spp,
+                         "--width",
+                         s_size,
+                         "--height",
+                         s_size,
+                         "--threads",
+                         s_threads,
+                         "--max-bounces",
+                         s_bounces,
+                         "--out",
+                         out,
+                         "--rr-min-bounces",
+                         "1", // drift's roulette, no light threshold
                          NULL };
         return run_child(argv, log, t);
     }
@@ -378,7 +431,7 @@ static int render_cycles(const cycles_options *o, const cycles_run *r, long spp,
                      "--out",
                      out,
                      "--rr-min-bounces",
-                     "2",
+                     "1", // Cycles' +1: roulette from the 4th vertex, as drift's rr_depth 3
                      "--one-sided-light",
                      "--light-diffuse",
                      NULL };
@@ -417,10 +470,11 @@ int drift_bench_cycles(int argc, char **argv)
         return 2;
     }
     r.gltf = ends_with(r.scene, ".gltf") || ends_with(r.scene, ".glb");
-    if (!r.gltf && !ends_with(r.scene, "/cornell_box.json")) {
+    r.cornell = ends_with(r.scene, "/cornell_box.json");
+    if (!r.gltf && !ends_with(r.scene, ".json")) {
         fprintf(stderr,
-                "drift bench cycles: %s: Blender reads the Cornell box (cornell_box.json beside "
-                "its cornell_box.obj) or a .gltf/.glb; export other scenes to glTF first\n",
+                "drift bench cycles: %s: Blender reads a drift scene .json of OBJ meshes (the "
+                "Cornell box, the Breakfast Room) or a .gltf/.glb\n",
                 r.scene);
         return 2;
     }
@@ -490,7 +544,7 @@ int drift_bench_cycles(int argc, char **argv)
         fprintf(stderr, "drift bench cycles: the Cycles render failed, see %s\n", r.cycles_log);
         return 1;
     }
-    cycles_times(r.cycles_log, &r.cycles_render_s, &r.blender_render_s);
+    cycles_times(r.cycles_log, &r.cycles_render_s, &r.cycles_render_cpu_s, &r.blender_render_s);
     if (!isfinite(r.cycles_render_s)) {
         r.cycles_render_s = r.blender_render_s; // gltf_cycles.py: Blender's own, sync included
     }
@@ -499,7 +553,7 @@ int drift_bench_cycles(int argc, char **argv)
         fprintf(stderr, "drift bench cycles: the drift render failed, see %s\n", drift_log);
         return 1;
     }
-    r.drift_render_s = drift_render_seconds(stats);
+    r.drift_render_s = drift_render_seconds(stats, &r.drift_render_cpu_s);
     if (!isfinite(r.cycles_render_s) || !isfinite(r.drift_render_s)) {
         fprintf(stderr, "drift bench cycles: no render time in %s or %s\n", r.cycles_log, stats);
         return 1;
@@ -546,10 +600,14 @@ int drift_bench_cycles(int argc, char **argv)
     double ratio_render = r.cycles_render_s / r.drift_render_s;
     // Each one's render time to reach the larger of the two relMSEs, t (relMSE / e)^(1/k).
     double e = fmax(err[0], err[1]);
-    double equal_error = err[0] > 0 && err[1] > 0 && r.drift_slope > 0 && r.cycles_slope > 0
-                             ? r.cycles_render_s * pow(err[1] / e, 1.0 / r.cycles_slope) /
-                                   (r.drift_render_s * pow(err[0] / e, 1.0 / r.drift_slope))
-                             : (double)NAN;
+    double noise =
+        err[0] > 0 && err[1] > 0 && r.drift_slope > 0 && r.cycles_slope > 0
+            ? pow(err[1] / e, 1.0 / r.cycles_slope) / pow(err[0] / e, 1.0 / r.drift_slope)
+            : (double)NAN;
+    double equal_error = ratio_render * noise;
+    r.ratio_process_cpu = r.cycles_process.cpu_s / r.drift_process.cpu_s;
+    r.ratio_render_cpu = r.cycles_render_cpu_s / r.drift_render_cpu_s; // NAN if either is absent
+    r.equal_error_cpu = r.ratio_render_cpu * noise;
     if (o.json) {
         print_json(&o, &r, ratio_process, ratio_render, equal_error);
     } else {

@@ -448,6 +448,7 @@ int render_reference(const render_options *o, const cli_session *session)
     bool tty = isatty(STDERR_FILENO) != 0;
     uint32_t total = (uint32_t)o->spp, done_spp = run.resumed_spp, pass = 1;
     run.t_render = drift_time_now();
+    run.cpu_render = render_cpu_now();
     double last_checkpoint = run.t_render, last_report = 0.0;
     if (!o->quiet) {
         fprintf(stderr, "drift render: %s, %dx%d, %u spp, depth %d, %d threads\n",

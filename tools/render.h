@@ -10,6 +10,16 @@
 #include <stdatomic.h>
 #include <stdbool.h>
 #include <stddef.h>
+#include <time.h>
+
+// The process's CPU seconds, all threads: the render's CPU time in --stats, which a shared
+// machine's load changes much less than its wall time (drift bench cycles).
+static inline double render_cpu_now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
 
 // --refine sir and its options (hybrid mode; tools/render_refine.c, docs/sir.md).
 typedef struct render_refine_options {
@@ -177,6 +187,8 @@ typedef struct render_reference_run {
     uint32_t resumed_spp; // the lowest tile count the checkpoint held (0: a fresh render)
     int ranks;            // processes that rendered (0: not distributed)
     double t_render;      // drift_time_now() when rendering began
+    double cpu_render;    // render_cpu_now() then (0: not taken; the stats leave it out)
+    double cpu_rendered;  // and when rendering ended
     double denoise_ms;    // --denoise's filter, within the write (the stats' "denoise")
     char key[1024];       // render_checkpoint_key
     char checkpoint_path[4096];

@@ -63,6 +63,10 @@ static cJSON *reference_stats(const render_reference_run *run, double t_rendered
         cli_json_number(ms, "denoise", run->denoise_ms, 3);
     }
     cli_json_number(ms, "total", 1e3 * (t_written - session->t_start), 3);
+    if (run->cpu_render > 0.0 && run->cpu_rendered >= run->cpu_render) {
+        cJSON *cpu = cJSON_AddObjectToObject(root, "cpu_milliseconds");
+        cli_json_number(cpu, "render", 1e3 * (run->cpu_rendered - run->cpu_render), 3);
+    }
     return root;
 }
 
@@ -185,6 +189,7 @@ bool render_reference_checkpoint(render_reference_run *run)
 int render_reference_finish(render_reference_run *run, bool cancelled, double t_rendered)
 {
     const render_options *o = run->o;
+    run->cpu_rendered = render_cpu_now();
     bool tty = isatty(STDERR_FILENO) != 0;
     uint32_t lowest, highest;
     render_spp_range(run->pt, &lowest, &highest);

@@ -30,6 +30,11 @@ def parse_args():
     p.add_argument("--multiscatter", action="store_true",
                    help="set each Principled BSDF to Multiscatter GGX (energy-conserving rough "
                         "metals, as drift's GGX material compensates; issue 41)")
+    p.add_argument("--rr-min-bounces", type=int, default=None, metavar="N",
+                   help="Cycles min_light_bounces N (Cycles adds one: N=1 starts the roulette at "
+                        "the 4th vertex, as drift's rr_depth 3) and light threshold 0, as "
+                        "cornell_cycles.py; default: Blender's defaults (roulette from the 3rd "
+                        "vertex, light threshold 0.01)")
     p.add_argument("--lambert", action="store_true",
                    help="replace each Principled BSDF by a Diffuse BSDF of its base colour "
                         "(emission kept): separates the material model from the light units")
@@ -105,6 +110,9 @@ def main():
     c.blur_glossy = 0.0
     c.pixel_filter_type = "BOX"
     c.filter_width = 1.0
+    if args.rr_min_bounces is not None:
+        c.min_light_bounces = c.min_transparent_bounces = max(0, args.rr_min_bounces)
+        c.light_sampling_threshold = 0.0
     bpy.ops.render.render(write_still=True)
     img = bpy.data.images.load(args.out)
     px = array.array("f", img.pixels[:])

@@ -24,7 +24,7 @@
 #                         counts scattering vertices like pbrt (1 = direct light only), Cycles'
 #                         max_bounces counts bounces after the first hit (0 = direct light only).
 #   CYCLES_ARGS           extra args for cornell_cycles.py. Default
-#                         "--rr-min-bounces 2 --one-sided-light --light-diffuse", i.e. as drift's
+#                         "--rr-min-bounces 1 --one-sided-light --light-diffuse", i.e. as drift's
 #                         reference: Russian roulette from the 4th vertex on (rr_depth 3), one-sided
 #                         emitter, and the light quad also reflects with its .mtl Kd 0.78.
 #                         CYCLES_ARGS=" " = plain Cycles: no roulette, two-sided pure emitter.
@@ -41,7 +41,7 @@ OUT_DIR=${OUT_DIR:-/tmp/drift-vs-cycles}
 WIDTH=${WIDTH:-512} HEIGHT=${HEIGHT:-512} THREADS=${THREADS:-1} REPEATS=${REPEATS:-1}
 SEED=${SEED:-0} BLENDER=${BLENDER:-blender}
 CYCLES_BOUNCES_OFFSET=${CYCLES_BOUNCES_OFFSET:--1}
-CYCLES_ARGS=${CYCLES_ARGS:---rr-min-bounces 2 --one-sided-light --light-diffuse}
+CYCLES_ARGS=${CYCLES_ARGS:---rr-min-bounces 1 --one-sided-light --light-diffuse}
 mkdir -p "$OUT_DIR"
 
 if ! "$BLENDER" --version >/dev/null 2>&1; then

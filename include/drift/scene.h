@@ -537,6 +537,10 @@ typedef struct drift_light_sample {
 // Picks a light in proportion to its power. Returns DRIFT_INVALID_INDEX when the scene has
 // no lights; out_pmf gets the probability of the pick.
 uint32_t drift_scene_pick_light(const drift_scene *scene, float u, float *out_pmf);
+// The same pick, and *u rescaled from the picked light's [cdf, cdf + pmf) to [0, 1): one
+// number both picks the light and, reused, places the sample on it, so that a stratified 2D
+// point is still stratified over each light and not a random subset of it (Cycles does this).
+uint32_t drift_scene_pick_light_reuse(const drift_scene *scene, float *u, float *out_pmf);
 // Probability with which pick_light returns `light`.
 float drift_scene_light_pmf(const drift_scene *scene, uint32_t light);
 // Samples a point (or direction) on light `light` as seen from the point `ref`; the index

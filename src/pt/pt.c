@@ -209,7 +209,8 @@ static drift_vec3 sample_direct(const drift_pt *pt, const drift_surface *surf,
     const drift_scene *scene = pt->scene;
     drift_vec2 u_light = drift_sampler_next2(sampler);
     float pmf;
-    uint32_t light = drift_scene_pick_light(scene, u_pick, &pmf);
+    (void)u_pick; // the pick reuses u_light.x (drift_scene_pick_light_reuse)
+    uint32_t light = drift_scene_pick_light_reuse(scene, &u_light.x, &pmf);
     if (light == DRIFT_INVALID_INDEX || !(pmf > 0.0f)) {
         return drift_vec3_splat(0.0f);
     }

@@ -264,6 +264,18 @@ uint32_t drift_scene_pick_light(const drift_scene *scene, float u, float *out_pm
     return i;
 }
 
+uint32_t drift_scene_pick_light_reuse(const drift_scene *scene, float *u, float *out_pmf)
+{
+    uint32_t i = drift_scene_pick_light(scene, *u, out_pmf);
+    if (i != DRIFT_INVALID_INDEX && *out_pmf > 0.0f) {
+        const drift_light_table *t = scene->light_table;
+        // Clamped below 1: a float's rounding at the top of the interval must not reach it.
+        *u = fminf((*u - t->cdf[i]) / *out_pmf, 0x1.fffffep-1f);
+        *u = fmaxf(*u, 0.0f);
+    }
+    return i;
+}
+
 float drift_scene_light_pmf(const drift_scene *scene, uint32_t light)
 {
     const drift_light_table *t = scene->light_table;

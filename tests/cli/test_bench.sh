@@ -237,8 +237,8 @@ assert d["frame_ms_unedited"] > 0 and d["frame_ms_edited"] > 0, d'
         # Without Blender: skipped with exit status 77 and a message saying so.
         expect 77 "$drift" bench cycles "$box" --blender /nonexistent/blender --size 8 --spp 1
         grep -q "skipped: Blender" "$tmp/err" || fail "bench cycles: missing Blender not said"
-        expect 2 "$drift" bench cycles "${box%/cornell-box/*}/breakfast-room/breakfast_room.json"
-        grep -q "glTF" "$tmp/err" || fail "bench cycles: a scene Blender cannot read not named"
+        expect 2 "$drift" bench cycles "${box%.json}.obj"
+        grep -q "OBJ meshes" "$tmp/err" || fail "bench cycles: a scene Blender cannot read not named"
         if blender --version >/dev/null 2>&1; then
             expect 0 "$drift" bench cycles "$box" --size 16 --spp 4 --ref-spp 64 --max-depth 3 \
                 --threads 1 --cache "$tmp/cycles-cache" --out-dir "$tmp/cycles" --json
@@ -251,6 +251,15 @@ for k in ("ratio_process", "ratio_render", "equal_error_ratio", "drift_error_slo
     assert math.isfinite(d[k]) and d[k] > 0, (k, d)
 assert 0 < d["reference_relmse"] < d["drift"]["relmse"], d
 assert abs(d["ratio_render"] - d["cycles"]["render_s"] / d["drift"]["render_s"]) < 0.05 * d["ratio_render"], d'
+            # Another scene JSON of OBJ meshes (the box under another name): obj_cycles.py.
+            mkdir -p "$tmp/obj-scene"
+            cp "$box" "$tmp/obj-scene/scene.json"
+            cp "${box%.json}.obj" "${box%.json}.mtl" "$tmp/obj-scene/"
+            expect 0 "$drift" bench cycles "$tmp/obj-scene/scene.json" --size 16 --spp 4 \
+                --ref-spp 64 --max-depth 3 --threads 1 --cache "$tmp/cycles-cache" \
+                --out-dir "$tmp/cycles-obj" --json
+            check cycles 'assert d["scene"].endswith("scene.json") and d["cycles"]["render_s"] > 0, d
+assert 0 <= d["cycles"]["flip"] <= 1 and math.isfinite(d["cycles"]["relmse"]), d'
         else
             echo "cli.bench: Blender is not installed: bench cycles checked for its skip only"
         fi

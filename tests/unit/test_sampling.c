@@ -458,6 +458,55 @@ static void test_sampling_light_pick_follows_power(void **state)
     drift_context_destroy(ctx);
 }
 
+// The pick that reuses its number: the light is the plain pick's, and the number comes back
+// rescaled over that light's interval of the CDF, so each light sees a uniform [0, 1) (and a
+// stratified set of numbers stays stratified over each light: Cycles' reuse).
+static void test_sampling_light_pick_reuse_rescales(void **state)
+{
+    (void)state;
+    drift_context *ctx = test_context(1, NULL);
+    drift_scene *scene = NULL;
+    assert_int_equal(drift_scene_create(ctx, &scene), DRIFT_OK);
+    drift_light a = { .type = DRIFT_LIGHT_POINT, .color = { 1, 1, 1 } };
+    drift_light b = { .type = DRIFT_LIGHT_POINT, .position = { 1, 0, 0 }, .color = { 3, 3, 3 } };
+    assert_int_equal(drift_scene_add_light(scene, &a, NULL), DRIFT_OK);
+    assert_int_equal(drift_scene_add_light(scene, &b, NULL), DRIFT_OK);
+    assert_int_equal(drift_scene_commit(scene), DRIFT_OK);
+    const float u_in[4] = { 0.1f, 0.4f, 0.25f, 0.99999994f };
+    const uint32_t light[4] = { 0, 1, 1, 1 };
+    const float u_out[4] = { 0.4f, 0.2f, 0.0f, 1.0f };
+    for (int i = 0; i < 4; ++i) {
+        float u = u_in[i], pmf = 0.0f, plain_pmf = 0.0f;
+        assert_int_equal(drift_scene_pick_light_reuse(scene, &u, &pmf), light[i]);
+        assert_int_equal(drift_scene_pick_light(scene, u_in[i], &plain_pmf), light[i]);
+        assert_float_equal(pmf, plain_pmf, 0.0f);
+        assert_float_equal(u, u_out[i], 1e-5f);
+        assert_true(u >= 0.0f && u < 1.0f);
+    }
+
+    // N evenly spaced numbers: each light gets its share, spaced evenly over [0, 1).
+    enum {
+        N = 64
+    };
+
+    float seen[2][N];
+    int count[2] = { 0, 0 };
+    for (int i = 0; i < N; ++i) {
+        float u = ((float)i + 0.5f) / (float)N, pmf;
+        uint32_t l = drift_scene_pick_light_reuse(scene, &u, &pmf);
+        seen[l][count[l]++] = u;
+    }
+    assert_int_equal(count[0], N / 4);
+    assert_int_equal(count[1], 3 * N / 4);
+    for (int l = 0; l < 2; ++l) {
+        for (int k = 0; k < count[l]; ++k) {
+            assert_float_equal(seen[l][k], ((float)k + 0.5f) / (float)count[l], 1e-5f);
+        }
+    }
+    drift_scene_destroy(scene);
+    drift_context_destroy(ctx);
+}
+
 // --- ENVIRONMENT ---
 
 static float environment_pdf_cb(void *user, drift_vec3 wi)
@@ -541,6 +590,7 @@ int main(void)
         cmocka_unit_test(test_sampling_quad_light_irradiance_closed_form),
         cmocka_unit_test(test_sampling_light_pdf_matches_sample),
         cmocka_unit_test(test_sampling_light_pick_follows_power),
+        cmocka_unit_test(test_sampling_light_pick_reuse_rescales),
         cmocka_unit_test(test_sampling_environment_pdf_integrates_to_one),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
