@@ -298,6 +298,16 @@ static const cli_option render_table[] = {
                "--temporal on, a still camera: each frame adds a path-traced sample\n"
                "a pixel, denoised and blended in where its error is the lower\n"
                "(default on; docs/temporal.md)"),
+    CLI_CHOICE("--moving-refine", "off|path|residual", O, temporal_settings.moving_refine,
+               "off|path|residual",
+               "--temporal on: every frame adds a path-traced sample a pixel,\n"
+               "accumulated through the history's reprojection, filtered and\n"
+               "blended in where its error is the lower; residual: the sample\n"
+               "minus the hybrid frame is accumulated and added (default off;\n"
+               "docs/temporal.md)"),
+    CLI_INT("--moving-refine-history", "N", O, temporal_settings.moving_refine_history, 1, 4096,
+            "frames the moving refinement's path-traced accumulation averages\n"
+            "at most (default 32)"),
     CLI_CUSTOM("--probe", "X,Y,Z|object", O, hybrid, parse_probe,
                "environment-map probe: a point, or one per reflective mesh\n"
                "(default: the scene's centre)"),
