@@ -44,11 +44,11 @@ void temporal_size(const drift_temporal *t, int32_t *width, int32_t *height);
 drift_vec3 temporal_demodulation(const drift_gbuffer *g, int32_t x, int32_t y);
 
 // The error-weighted blend of the still and moving refinements (docs/temporal.md):
-//   e_h = max(B[(Y_h - Y_p)^2] - B[v_p], 0),  e_p = B[v_d] or denoised_error B[v_p]
+//   e_h = max(B[(Y_h - Y_p)^2] - B[v_p], 0),  e_p = denoised_error B[v_d or v_p]
 //   w = e_h / (e_h + e_p),  out = (1 - w) hybrid + w denoised
 // Y_h the hybrid's luminance, Y_p the raw path-traced mean's (`raw`), v_p the variance of that
 // mean (1 channel), v_d the denoised image's variance where the filter estimates it
-// (`denoised_variance`, 1 channel; NULL: the fixed fraction), B a (2r+1)^2 box mean.
+// (`denoised_variance`, 1 channel; NULL: v_p's), B a (2r+1)^2 box mean.
 // scratch: 4 arrays of width x height floats (the fourth only with denoised_variance).
 void temporal_error_blend(const drift_image *hybrid, const drift_image *raw,
                           const drift_image *variance, const drift_image *denoised,

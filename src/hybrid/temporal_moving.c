@@ -187,7 +187,7 @@ drift_result drift_moving_refine_apply(drift_moving_refine *m, const drift_gbuff
     // The hybrid's error is judged against the filtered accumulation (its variance the
     // filter's estimate): the raw mean of a few one-sample frames is too noisy to show the
     // hybrid's bias under it (the weight stayed near 0.1-0.2 on both measured scenes).
-    temporal_error_blend(hybrid, &m->path, &m->fvar, &m->path, &m->fvar, 0.0f, m->s.radius,
+    temporal_error_blend(hybrid, &m->path, &m->fvar, &m->path, &m->fvar, 1.0f, m->s.radius,
                          m->scratch, &m->out, &m->weight);
     return DRIFT_OK;
 }

@@ -240,7 +240,7 @@ void temporal_error_blend(const drift_image *hybrid, const drift_image *raw,
         for (int32_t x = 0; x < w; ++x) {
             size_t i = (size_t)y * (size_t)w + (size_t)x;
             float hybrid_error = fmaxf(diff2[i] - var[i], 0.0f);
-            float path_error = denoised_variance ? dvar[i] : denoised_error * var[i];
+            float path_error = denoised_error * (denoised_variance ? dvar[i] : var[i]);
             float sum = hybrid_error + path_error;
             float wp = sum > 0.0f ? hybrid_error / sum : 1.0f; // both 0: they agree
             drift_vec3 a = drift_image_get3(hybrid, x, y);

@@ -437,9 +437,8 @@ static void test_view_converges(void **state)
 // white box) is biased against the path tracer (depth 8); after 16 still frames the refined
 // framebuffer is nearer the converged path tracer's than the temporal history alone, which
 // converges to the hybrid's mean.
-static void test_view_still_refines(void **state)
+static void view_still_refines(int moving_refine)
 {
-    (void)state;
     test_rig r = test_rig_begin(2);
     const int w = 24;
     add_lit_box(&r, w);
@@ -447,10 +446,11 @@ static void test_view_still_refines(void **state)
                              .height = w,
                              .hide_overlay = true,
                              .temporal = true,
+                             .temporal_settings = { .moving_refine = moving_refine },
                              .hybrid = { .indirect = DRIFT_INDIRECT_REFERENCE, .spp = 1 } };
     drift_view *views[3] = { NULL, NULL, NULL };
     assert_int_equal(drift_view_create(r.ctx, r.scene, r.accel, &desc, &views[0]), DRIFT_OK);
-    desc.temporal_settings.no_still_refine = true;
+    desc.temporal_settings = (drift_temporal_settings){ .no_still_refine = true };
     assert_int_equal(drift_view_create(r.ctx, r.scene, r.accel, &desc, &views[1]), DRIFT_OK);
     // The path tracer, converged over the pixel's box filter: the same frame to depth 8.
     desc.temporal = false;
@@ -467,8 +467,8 @@ static void test_view_still_refines(void **state)
             err[v][k] = view_error(views[v], ref, w);
         }
         if (getenv("DRIFT_TEST_VERBOSE")) {
-            fprintf(stderr, "frames %d: refined %g, history alone %g (sRGB levels)\n", k, err[0][k],
-                    err[1][k]);
+            fprintf(stderr, "moving %d frames %d: refined %g, history alone %g (sRGB levels)\n",
+                    moving_refine, k, err[0][k], err[1][k]);
         }
     }
     // Falling with the frames within noise (each of 2, 4, 8, 16 at most 10% above the one
@@ -486,6 +486,14 @@ static void test_view_still_refines(void **state)
         drift_view_destroy(views[v]);
     }
     test_rig_destroy(&r);
+}
+
+// The still refinement alone, and fed by the moving refinement (the viewer chains them).
+static void test_view_still_refines(void **state)
+{
+    (void)state;
+    view_still_refines(0);
+    view_still_refines(1);
 }
 
 // --- MOVING REFINEMENT ---
