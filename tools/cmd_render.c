@@ -389,6 +389,11 @@ int render_parse_options(int argc, char **argv, render_options *o)
         fprintf(stderr, "drift render: %s needs --mode hybrid\n", o->hybrid_option);
         return 2;
     }
+    if (o->temporal_settings.moving_refine && (!o->temporal || !o->animation)) {
+        // It refines a moving camera's frames: without a sequence it would do nothing.
+        fprintf(stderr, "drift render: --moving-refine needs --animation A:B and --temporal on\n");
+        return 2;
+    }
     if (o->hybrid_mode && o->denoise) {
         fprintf(stderr, "drift render: --denoise filters the path tracer's image; the "
                         "hybrid frame has its own techniques (drop --mode hybrid or --denoise)\n");
