@@ -308,6 +308,9 @@ static const cli_option render_table[] = {
     CLI_INT("--moving-refine-history", "N", O, temporal_settings.moving_refine_history, 1, 4096,
             "frames the moving refinement's path-traced accumulation averages\n"
             "at most (default 32)"),
+    CLI_INT("--moving-refine-scale", "1|2", O, temporal_settings.moving_refine_scale, 1, 2,
+            "2: the moving refinement traces its samples at half the width and\n"
+            "height (a quarter of the rays), upsampled by the G-buffer (default 1)"),
     CLI_CUSTOM("--probe", "X,Y,Z|object", O, hybrid, parse_probe,
                "environment-map probe: a point, or one per reflective mesh\n"
                "(default: the scene's centre)"),

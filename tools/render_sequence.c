@@ -433,7 +433,8 @@ int render_sequence(const render_options *o, cli_session *session)
                      .seed = (uint32_t)o->seed + 0x9e3779b9u,
                      .max_depth = (int32_t)o->max_depth,
                      .max_history = o->temporal_settings.moving_refine_history,
-                     .residual = o->temporal_settings.moving_refine == 2 },
+                     .residual = o->temporal_settings.moving_refine == 2,
+                     .scale = o->temporal_settings.moving_refine_scale },
                  &s.moving)) != DRIFT_OK) {
             fprintf(stderr, "drift render: %s\n", drift_result_string(r));
             goto done;

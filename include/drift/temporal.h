@@ -73,6 +73,7 @@ typedef struct drift_temporal_settings {
     // their residual against the hybrid frame (drift_moving_refine, below; the drivers')
     int32_t moving_refine;
     int32_t moving_refine_history; // 0 -> 32: the path-traced accumulation's frames at most
+    int32_t moving_refine_scale;   // 0, 1: a path-traced sample a pixel; 2: at half size
 } drift_temporal_settings;
 
 // The settings with every 0 replaced by its default.
@@ -198,12 +199,17 @@ typedef struct drift_moving_refine_settings {
     // show hybrid + residual where the blend favours it (a control variate: the hybrid's
     // structure stays, the filter smooths only its bias and the path tracer's noise)
     bool residual;
+    // 0, 1: a sample for every pixel; 2: the path tracer at half the width and height (a
+    // quarter of the rays), each pixel taking the sample of the nearest half-size pixel whose
+    // hit distance is closest to its G-buffer point's (a guided upsampling)
+    int32_t scale;
 } drift_moving_refine_settings;
 
 typedef struct drift_moving_refine drift_moving_refine;
 
 // scene, accel and temporal are borrowed. Errors: DRIFT_ERR_INVALID_ARGUMENT (settings out of
-// range: max_history 1..4096, filter_passes 0..8, radius 0..32), DRIFT_ERR_OUT_OF_MEMORY.
+// range: max_history 1..4096, filter_passes 0..8, radius 0..32, scale 0..2),
+// DRIFT_ERR_OUT_OF_MEMORY.
 drift_result drift_moving_refine_create(drift_context *ctx, const drift_scene *scene,
                                         const drift_accel *accel, drift_temporal *temporal,
                                         const drift_moving_refine_settings *settings,

@@ -6,6 +6,8 @@
 #include "drift/temporal.h"
 #include "temporal_internal.h"
 
+#include <math.h>
+
 struct drift_moving_refine {
     drift_context *ctx;
     const drift_scene *scene;
@@ -13,13 +15,14 @@ struct drift_moving_refine {
     drift_temporal *t;
     int32_t width, height;
     drift_moving_refine_settings s;
-    uint32_t frame;       // applies so far: frame k's seed is seed + k
-    temporal_layer layer; // the path-traced samples' accumulation
-    drift_image path;     // 3: the filtered accumulation, remodulated
-    drift_image out;      // 3: the shown image
-    drift_image weight;   // 1: the path tracer's weight
-    drift_image fvar;     // 1: the filtered accumulation's variance, image units
-    float *scratch[4];    // width x height: the blend's
+    uint32_t frame;        // applies so far: frame k's seed is seed + k
+    temporal_layer layer;  // the path-traced samples' accumulation
+    drift_image path;      // 3: the filtered accumulation, remodulated
+    drift_image out;       // 3: the shown image
+    drift_image weight;    // 1: the path tracer's weight
+    drift_image fvar;      // 1: the filtered accumulation's variance, image units
+    drift_image upsampled; // 3: scale 2: the half-size samples at full size
+    float *scratch[4];     // width x height: the blend's
 };
 
 static drift_moving_refine_settings resolve(const drift_moving_refine_settings *in)
@@ -41,6 +44,7 @@ void drift_moving_refine_destroy(drift_moving_refine *m)
     drift_image_destroy(m->ctx, &m->out);
     drift_image_destroy(m->ctx, &m->weight);
     drift_image_destroy(m->ctx, &m->fvar);
+    drift_image_destroy(m->ctx, &m->upsampled);
     for (int k = 0; k < 4; ++k) {
         drift_free(m->ctx, m->scratch[k]);
     }
@@ -58,7 +62,7 @@ drift_result drift_moving_refine_create(drift_context *ctx, const drift_scene *s
     *out = NULL;
     drift_moving_refine_settings s = resolve(settings);
     if (!ctx || !scene || !accel || !temporal || s.max_history < 1 || s.max_history > 4096 ||
-        s.filter_passes < 0 || s.filter_passes > 8 || s.radius > 32) {
+        s.filter_passes < 0 || s.filter_passes > 8 || s.radius > 32 || s.scale < 0 || s.scale > 2) {
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
     drift_moving_refine *m = drift_alloc(ctx, sizeof(*m));
@@ -80,6 +84,9 @@ drift_result drift_moving_refine_create(drift_context *ctx, const drift_scene *s
     }
     if (r == DRIFT_OK) {
         r = drift_image_create(ctx, w, h, 1, &m->fvar);
+    }
+    if (r == DRIFT_OK && s.scale == 2) {
+        r = drift_image_create(ctx, w, h, 3, &m->upsampled);
     }
     for (int k = 0; k < 4 && r == DRIFT_OK; ++k) {
         m->scratch[k] = drift_alloc(ctx, sizeof(float) * (size_t)w * (size_t)h);
@@ -132,6 +139,42 @@ static void add_residual(drift_moving_refine *m, const drift_gbuffer *g, const d
     }
 }
 
+// Each pixel takes the half-size sample, among the 3 x 3 around its own, whose hit distance
+// is relatively closest to its G-buffer point's (a miss: one that missed); ties keep the
+// nearest. `depth` is the half-size path tracer's distance along the ray (0: a miss).
+static void upsample(drift_moving_refine *m, const drift_gbuffer *g, const drift_camera *camera,
+                     const drift_image *half, const drift_image *depth)
+{
+    for (int32_t y = 0; y < m->height; ++y) {
+        for (int32_t x = 0; x < m->width; ++x) {
+            bool hit = drift_image_pixel(&g->depth, x, y)[0] > 0.0f;
+            float d = hit ? drift_vec3_length(drift_vec3_sub(drift_image_get3(&g->position, x, y),
+                                                             camera->position))
+                          : 0.0f;
+            int32_t cx = x / 2, cy = y / 2, bx = cx, by = cy;
+            float best = INFINITY;
+            for (int k = 0; k < 9; ++k) {
+                static const int8_t order[9][2] = { { 0, 0 },  { -1, 0 }, { 1, 0 },
+                                                    { 0, -1 }, { 0, 1 },  { -1, -1 },
+                                                    { 1, -1 }, { -1, 1 }, { 1, 1 } };
+                int32_t qx = cx + order[k][0], qy = cy + order[k][1];
+                if (qx < 0 || qy < 0 || qx >= half->width || qy >= half->height) {
+                    continue;
+                }
+                float dq = drift_image_pixel(depth, qx, qy)[0];
+                float e =
+                    hit ? (dq > 0.0f ? fabsf(dq - d) / d : INFINITY) : (dq > 0.0f ? 1.0f : 0.0f);
+                if (e < best) {
+                    best = e;
+                    bx = qx;
+                    by = qy;
+                }
+            }
+            drift_image_set3(&m->upsampled, x, y, drift_image_get3(half, bx, by));
+        }
+    }
+}
+
 drift_result drift_moving_refine_apply(drift_moving_refine *m, const drift_gbuffer *g,
                                        const drift_camera *camera, const drift_image *frame,
                                        const drift_image *hybrid, const atomic_bool *cancel)
@@ -143,8 +186,9 @@ drift_result drift_moving_refine_apply(drift_moving_refine *m, const drift_gbuff
     }
     // This frame's sample: a new path tracer through this camera (its own pixel jitter, so the
     // samples cover the pixel's box as the reference's do).
-    drift_pt_params p = { .width = m->width,
-                          .height = m->height,
+    bool half = m->s.scale == 2;
+    drift_pt_params p = { .width = half ? (m->width + 1) / 2 : m->width,
+                          .height = half ? (m->height + 1) / 2 : m->height,
                           .seed = m->s.seed + m->frame,
                           .max_depth = m->s.max_depth,
                           .texture_filter_spp = (uint32_t)m->s.max_history,
@@ -157,6 +201,12 @@ drift_result drift_moving_refine_apply(drift_moving_refine *m, const drift_gbuff
     drift_image beauty;
     if (r == DRIFT_OK) {
         r = drift_pt_resolve(pt, DRIFT_PT_AOV_BEAUTY, &beauty);
+    }
+    drift_image depth;
+    if (r == DRIFT_OK && half &&
+        (r = drift_pt_resolve(pt, DRIFT_PT_AOV_DEPTH, &depth)) == DRIFT_OK) {
+        upsample(m, g, camera, &beauty, &depth);
+        beauty = m->upsampled; // the layer reads it as the frame's samples
     }
     if (r != DRIFT_OK) {
         drift_pt_destroy(pt);

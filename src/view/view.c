@@ -257,10 +257,11 @@ drift_result drift_view_create(drift_context *ctx, const drift_scene *scene,
         if (r == DRIFT_OK && d.temporal_settings.moving_refine) {
             r = drift_moving_refine_create(
                 ctx, scene, accel, view->temporal,
-                &(drift_moving_refine_settings){
-                    .seed = view->base_seed + 0x9e3779b9u,
-                    .max_history = d.temporal_settings.moving_refine_history,
-                    .residual = d.temporal_settings.moving_refine == 2 },
+                &(drift_moving_refine_settings){ .seed = view->base_seed + 0x9e3779b9u,
+                                                 .max_history =
+                                                     d.temporal_settings.moving_refine_history,
+                                                 .residual = d.temporal_settings.moving_refine == 2,
+                                                 .scale = d.temporal_settings.moving_refine_scale },
                 &view->moving);
         }
         if (r == DRIFT_OK && !d.temporal_settings.no_still_refine) {

@@ -524,8 +524,8 @@ static drift_image moving_reference(test_rig *r, const drift_camera *cam, int w)
 }
 
 // Runs `frames` frames of the move through the temporal reuse and the moving refinement (mode
-// 1 path, 2 residual; 0 none) and returns a copy of the last shown image; errors[k] (may be
-// NULL) gets frame k's RMSE against the reference where refs[k] is set.
+// 1 path, 2 residual, 3 path at half size; 0 none) and returns a copy of the last shown image;
+// errors[k] (may be NULL) gets frame k's RMSE against the reference where refs[k] is set.
 static drift_image run_moving(test_rig *r, int w, int mode, int frames, const drift_image *refs,
                               double *errors)
 {
@@ -540,7 +540,8 @@ static drift_image run_moving(test_rig *r, int w, int mode, int frames, const dr
     if (mode) {
         assert_int_equal(drift_moving_refine_create(
                              r->ctx, r->scene, r->accel, t,
-                             &(drift_moving_refine_settings){ .seed = 5, .residual = mode == 2 },
+                             &(drift_moving_refine_settings){
+                                 .seed = 5, .residual = mode == 2, .scale = mode == 3 ? 2 : 1 },
                              &m),
                          DRIFT_OK);
     }
@@ -573,7 +574,7 @@ static drift_image run_moving(test_rig *r, int w, int mode, int frames, const dr
 // depth, the reference to depth 8): the refined image's error against each frame's
 // path-traced reference falls with the frames (4, 8, 16, 24: each at most 10% above the one
 // before, the last below 0.8 of the fourth frame's) and ends below 0.7 of the temporal
-// history's alone, for both the path and the residual forms.
+// history's alone, for the path and the residual forms and the half-size path samples.
 static void test_moving_refine_converges(void **state)
 {
     (void)state;
@@ -590,7 +591,7 @@ static void test_moving_refine_converges(void **state)
     double plain[25] = { 0 };
     drift_image last = run_moving(&r, w, 0, frames, refs, plain);
     drift_image_destroy(r.ctx, &last);
-    for (int mode = 1; mode <= 2; ++mode) {
+    for (int mode = 1; mode <= 3; ++mode) {
         double e[25] = { 0 };
         last = run_moving(&r, w, mode, frames, refs, e);
         drift_image_destroy(r.ctx, &last);
@@ -617,26 +618,31 @@ static void test_moving_refine_converges(void **state)
     test_rig_destroy(&r);
 }
 
-// The same move's refined frames are bit-identical for 1 and 2 threads.
+// The same move's refined frames are bit-identical for 1 and 2 threads (the residual form,
+// and the path form at half size).
 static void test_moving_refine_threads(void **state)
 {
     (void)state;
     const int w = 20;
     size_t bytes = sizeof(float) * 3 * (size_t)(w * w);
-    float *out[2];
+    float *out[2][2];
     for (int i = 0; i < 2; ++i) {
         test_rig r = test_rig_begin(i + 1);
         add_lit_box(&r, w);
-        drift_image last = run_moving(&r, w, 2, 6, NULL, NULL);
-        out[i] = malloc(bytes);
-        assert_non_null(out[i]);
-        memcpy(out[i], last.pixels, bytes);
-        drift_image_destroy(r.ctx, &last);
+        for (int mode = 2; mode <= 3; ++mode) {
+            drift_image last = run_moving(&r, w, mode, 6, NULL, NULL);
+            out[i][mode - 2] = malloc(bytes);
+            assert_non_null(out[i][mode - 2]);
+            memcpy(out[i][mode - 2], last.pixels, bytes);
+            drift_image_destroy(r.ctx, &last);
+        }
         test_rig_destroy(&r);
     }
-    assert_memory_equal(out[0], out[1], bytes);
-    free(out[0]);
-    free(out[1]);
+    for (int k = 0; k < 2; ++k) {
+        assert_memory_equal(out[0][k], out[1][k], bytes);
+        free(out[0][k]);
+        free(out[1][k]);
+    }
 }
 
 int main(void)
