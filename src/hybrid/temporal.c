@@ -470,22 +470,39 @@ static void filter_rows(size_t begin, size_t end, int thread_index, void *user)
     }
 }
 
-void temporal_remodulate(drift_temporal *t, const drift_gbuffer *g, const drift_image *light,
-                         const drift_image *misses, drift_image *out)
+typedef struct remodulate_job {
+    const drift_temporal *t;
+    const drift_gbuffer *g;
+    const drift_image *light, *misses;
+    drift_image *out;
+} remodulate_job;
+
+static void remodulate_rows(size_t begin, size_t end, int thread_index, void *user)
 {
-    for (int32_t y = 0; y < t->height; ++y) {
-        for (int32_t x = 0; x < t->width; ++x) {
+    (void)thread_index;
+    const remodulate_job *job = user;
+    const drift_gbuffer *g = job->g;
+    for (int32_t y = (int32_t)begin; y < (int32_t)end; ++y) {
+        for (int32_t x = 0; x < job->t->width; ++x) {
             if (!(drift_image_pixel(&g->depth, x, y)[0] > 0.0f)) {
-                drift_image_set3(out, x, y, drift_image_get3(misses, x, y));
+                drift_image_set3(job->out, x, y, drift_image_get3(job->misses, x, y));
                 continue;
             }
-            const float *l = drift_image_pixel(light, x, y);
+            const float *l = drift_image_pixel(job->light, x, y);
             drift_vec3 a = temporal_demodulation(g, x, y);
             drift_vec3 e = drift_image_get3(&g->emission, x, y);
             drift_image_set3(
-                out, x, y, drift_vec3_add(e, drift_vec3_make(a.x * l[0], a.y * l[1], a.z * l[2])));
+                job->out, x, y,
+                drift_vec3_add(e, drift_vec3_make(a.x * l[0], a.y * l[1], a.z * l[2])));
         }
     }
+}
+
+void temporal_remodulate(drift_temporal *t, const drift_gbuffer *g, const drift_image *light,
+                         const drift_image *misses, drift_image *out)
+{
+    remodulate_job job = { .t = t, .g = g, .light = light, .misses = misses, .out = out };
+    drift_parallel_for(t->ctx, (size_t)t->height, 4, remodulate_rows, &job);
 }
 
 const drift_image *temporal_layer_apply(drift_temporal *t, temporal_layer *L,
