@@ -298,6 +298,19 @@ static const cli_option render_table[] = {
                "--temporal on, a still camera: each frame adds a path-traced sample\n"
                "a pixel, denoised and blended in where its error is the lower\n"
                "(default on; docs/temporal.md)"),
+    CLI_CHOICE("--moving-refine", "off|path|residual", O, temporal_settings.moving_refine,
+               "off|path|residual",
+               "--temporal on: every frame adds a path-traced sample a pixel,\n"
+               "accumulated through the history's reprojection, filtered and\n"
+               "blended in where its error is the lower; residual: the sample\n"
+               "minus the hybrid frame is accumulated and added (default off;\n"
+               "docs/temporal.md)"),
+    CLI_INT("--moving-refine-history", "N", O, temporal_settings.moving_refine_history, 1, 4096,
+            "frames the moving refinement's path-traced accumulation averages\n"
+            "at most (default 32)"),
+    CLI_INT("--moving-refine-scale", "1|2", O, temporal_settings.moving_refine_scale, 1, 2,
+            "2: the moving refinement traces its samples at half the width and\n"
+            "height (a quarter of the rays), upsampled by the G-buffer (default 1)"),
     CLI_CUSTOM("--probe", "X,Y,Z|object", O, hybrid, parse_probe,
                "environment-map probe: a point, or one per reflective mesh\n"
                "(default: the scene's centre)"),
@@ -377,6 +390,11 @@ int render_parse_options(int argc, char **argv, render_options *o)
     o->refine.first_option = first[1];
     if (!o->hybrid_mode && o->hybrid_option) {
         fprintf(stderr, "drift render: %s needs --mode hybrid\n", o->hybrid_option);
+        return 2;
+    }
+    if (o->temporal_settings.moving_refine && (!o->temporal || !o->animation)) {
+        // It refines a moving camera's frames: without a sequence it would do nothing.
+        fprintf(stderr, "drift render: --moving-refine needs --animation A:B and --temporal on\n");
         return 2;
     }
     if (o->hybrid_mode && o->denoise) {

@@ -42,6 +42,7 @@ typedef struct view_options {
     long refine_budget;     // --budget: SIR samples a frame (0: the default)
     bool temporal;          // --temporal on: reuse across frames (docs/temporal.md)
     bool still_refine;      // --still-refine on|off: a still camera refines to the path tracer
+    long moving_refine;     // --moving-refine off|path|residual (temporal_settings)
     const char *edits_path; // --reflection-edits: loaded if it exists, saved by the save key
 } view_options;
 
@@ -141,6 +142,10 @@ static const cli_option view_table[] = {
                "--temporal on, a still camera: each frame adds a path-traced\n"
                "sample a pixel, denoised and blended in where its error is the\n"
                "lower (default on; docs/temporal.md)"),
+    CLI_CHOICE("--moving-refine", "off|path|residual", O, moving_refine, "off|path|residual",
+               "--temporal on: every frame adds a path-traced sample a pixel,\n"
+               "reprojected with the history, filtered and blended in where its\n"
+               "error is the lower (default off; docs/temporal.md)"),
     CLI_NUMBER("--exposure", "STOPS", O, exposure, -64.0, 64.0, "display exposure (default 0)"),
     CLI_FLAG("--no-overlay", O, no_overlay, "start without the text overlay"),
     CLI_CUSTOM("--press", "KEY,KEY,...", O, press, parse_press,
@@ -666,7 +671,8 @@ int drift_cmd_view(int argc, char **argv)
                             .refine = o.refine,
                             .refine_budget = (uint32_t)o.refine_budget,
                             .temporal = o.temporal,
-                            .temporal_settings = { .no_still_refine = !o.still_refine },
+                            .temporal_settings = { .no_still_refine = !o.still_refine,
+                                                   .moving_refine = (int32_t)o.moving_refine },
                             .reflection_edits_path = o.edits_path },
         &view);
     if (r != DRIFT_OK) {

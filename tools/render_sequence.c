@@ -130,7 +130,8 @@ typedef struct sequence_run {
     double fps;
     drift_hybrid *frame;
     drift_temporal *temporal;
-    drift_still_refine *still; // a camera that stands refines toward the path tracer
+    drift_moving_refine *moving; // every frame refines toward reprojected path-traced samples
+    drift_still_refine *still;   // a camera that stands refines toward the path tracer
     // --glare static|dynamic: applied here, after the temporal reuse, with the sequence's time
     // step 1 / fps (the hybrid frame's own glare pass steps by the wall clock)
     drift_glare *glare;
@@ -170,6 +171,7 @@ static int hybrid_frame(sequence_run *s, long k, const drift_camera *camera, con
         return 1;
     }
     const drift_image *image = drift_hybrid_image(s->frame);
+    const drift_image *raw = image;
     double temporal_ms = 0.0;
     if (s->temporal) {
         double t0 = drift_time_now();
@@ -180,6 +182,18 @@ static int hybrid_frame(sequence_run *s, long k, const drift_camera *camera, con
             return 1;
         }
         image = drift_temporal_image(s->temporal);
+    }
+    if (s->moving) {
+        // The camera before its jitter (the path tracer jitters its own samples).
+        double t0 = drift_time_now();
+        r = drift_moving_refine_apply(s->moving, drift_hybrid_gbuffer(s->frame), camera, raw, image,
+                                      render_catch_sigint());
+        cli_json_number(entry, "moving_refine_ms", 1e3 * (drift_time_now() - t0), 3);
+        if (r != DRIFT_OK) {
+            fprintf(stderr, "drift render: moving refinement failed: %s\n", drift_result_string(r));
+            return r == DRIFT_ERR_CANCELLED ? render_interrupt_status() : 1;
+        }
+        image = drift_moving_refine_image(s->moving);
     }
     if (s->still) {
         // The camera before its jitter: frames where it stands refine (the viewer's).
@@ -408,7 +422,23 @@ int render_sequence(const render_options *o, cli_session *session)
             exit_code = r == DRIFT_ERR_INVALID_ARGUMENT ? 2 : 1;
             goto done;
         }
-        // A moving scene changes under the path tracer's accumulation: no refinement there.
+        // A moving scene changes under the path tracer's accumulation: no refinement there
+        // (the moving refinement reprojects by the camera's and the meshes' motion vectors,
+        // but light that changes with the meshes would lag, as the history's does).
+        if (o->temporal && o->temporal_settings.moving_refine && !s.anim &&
+            drift_still_refine_applies(&params) &&
+            (r = drift_moving_refine_create(
+                 ctx, session->scene, session->accel, s.temporal,
+                 &(drift_moving_refine_settings){
+                     .seed = (uint32_t)o->seed + 0x9e3779b9u,
+                     .max_depth = (int32_t)o->max_depth,
+                     .max_history = o->temporal_settings.moving_refine_history,
+                     .residual = o->temporal_settings.moving_refine == 2,
+                     .scale = o->temporal_settings.moving_refine_scale },
+                 &s.moving)) != DRIFT_OK) {
+            fprintf(stderr, "drift render: %s\n", drift_result_string(r));
+            goto done;
+        }
         if (o->temporal && !o->temporal_settings.no_still_refine && !s.anim &&
             drift_still_refine_applies(&params) &&
             (r = drift_still_refine_create(
@@ -436,6 +466,7 @@ int render_sequence(const render_options *o, cli_session *session)
 done:
     cJSON_Delete(s.stats);
     drift_still_refine_destroy(s.still);
+    drift_moving_refine_destroy(s.moving);
     drift_temporal_destroy(s.temporal);
     drift_glare_destroy(s.glare);
     drift_image_destroy(ctx, &s.glared);

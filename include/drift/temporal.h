@@ -32,6 +32,9 @@
 //   depth_sigma      = 0 -> 1
 //   no_still_refine  = false: a still camera's frames refine toward the path tracer (the
 //                      drivers' drift_still_refine, below); true: the temporal image alone
+//   moving_refine    = false; true: the drivers' drift_moving_refine (below) refines every
+//                      frame, moving or not, toward reprojected path-traced samples
+//   moving_refine_history = 0 -> 32 frames (its accumulation's floor alpha = 1 / 32)
 //
 // STEP BY STEP
 //   drift_temporal *t = NULL;
@@ -66,6 +69,11 @@ typedef struct drift_temporal_settings {
     float phi_luminance;
     float depth_sigma;
     bool no_still_refine; // true: a still camera shows the temporal image alone (below)
+    // 0: off; 1: every frame refines toward reprojected path-traced samples; 2: the same with
+    // their residual against the hybrid frame (drift_moving_refine, below; the drivers')
+    int32_t moving_refine;
+    int32_t moving_refine_history; // 0 -> 32: the path-traced accumulation's frames at most
+    int32_t moving_refine_scale;   // 0, 1: a path-traced sample a pixel; 2: at half size
 } drift_temporal_settings;
 
 // The settings with every 0 replaced by its default.
@@ -161,6 +169,65 @@ drift_result drift_still_refine_apply(drift_still_refine *s, const drift_camera 
 const drift_image *drift_still_refine_image(const drift_still_refine *s);
 const drift_image *drift_still_refine_weight(const drift_still_refine *s);
 uint32_t drift_still_refine_samples(const drift_still_refine *s);
+
+// --- MOVING REFINEMENT (--moving-refine on|off; docs/temporal.md "Moving camera") ---
+//
+// The still refinement for a camera that moves, in the manner of SVGF: each frame adds one
+// path-traced sample a pixel (drift_pt through the frame's unjittered camera, a new seed a
+// frame), demodulated by the hybrid frame's G-buffer, to an accumulation that is reprojected
+// with the temporal history's own taps (drift_temporal_apply's motion vectors and depth,
+// normal and material tests: no second reprojection), N = min(N_prev + 1, max_history), with
+// its luminance moments; the accumulation is filtered by the temporal's variance-guided
+// a-trous filter (filter_passes), which also estimates the filtered value's variance v_d, and
+// blended with the temporal image per pixel by the still refinement's form with the filtered
+// image in the raw mean's place: e_h = max(B[(Y_h - Y_d)^2] - B[v_d], 0), e_p = B[v_d],
+// w = e_h / (e_h + e_p) over a (2r+1)^2 window (against the raw mean of a few one-sample
+// frames the hybrid's bias drowned in the noise: weights of 0.1-0.2). Where the history is
+// short (disocclusions, the first frames) the 7x7 spatial variance of this frame's samples
+// stands in, large at one sample, so the hybrid is shown there. With `residual` the layer
+// accumulates (sample - hybrid frame) and the candidate is hybrid + filtered residual.
+// Call drift_moving_refine_apply after each drift_temporal_apply of the same temporal (its
+// taps are that frame's); drift_temporal_reset goes with drift_moving_refine_reset.
+// Bit-identical for any thread count (the path tracer's guarantee; the rest are gathers).
+typedef struct drift_moving_refine_settings {
+    uint32_t seed;         // frame k's path tracer takes seed + k (k counts applies)
+    int32_t max_depth;     // 0 -> the path tracer's default (8)
+    int32_t max_history;   // 0 -> 32
+    int32_t filter_passes; // 0 -> 5 a-trous passes (one sample a frame is noisy)
+    int32_t radius;        // 0 -> 4: the error windows' half-width in pixels
+    // true: accumulate and filter the residual (path-traced sample - the hybrid frame) and
+    // show hybrid + residual where the blend favours it (a control variate: the hybrid's
+    // structure stays, the filter smooths only its bias and the path tracer's noise)
+    bool residual;
+    // 0, 1: a sample for every pixel; 2: the path tracer at half the width and height (a
+    // quarter of the rays), each pixel taking the sample of the nearest half-size pixel whose
+    // hit distance is closest to its G-buffer point's (a guided upsampling)
+    int32_t scale;
+} drift_moving_refine_settings;
+
+typedef struct drift_moving_refine drift_moving_refine;
+
+// scene, accel and temporal are borrowed. Errors: DRIFT_ERR_INVALID_ARGUMENT (settings out of
+// range: max_history 1..4096, filter_passes 0..8, radius 0..32, scale 0..2),
+// DRIFT_ERR_OUT_OF_MEMORY.
+drift_result drift_moving_refine_create(drift_context *ctx, const drift_scene *scene,
+                                        const drift_accel *accel, drift_temporal *temporal,
+                                        const drift_moving_refine_settings *settings,
+                                        drift_moving_refine **out);
+void drift_moving_refine_destroy(drift_moving_refine *m); // NULL-safe
+void drift_moving_refine_reset(drift_moving_refine *m);
+// One frame: `gbuffer` and `frame` the G-buffer and colour drift_temporal_apply was just
+// given, `camera` the frame's camera before drift_temporal_prepare's jitter, `hybrid` the
+// temporal image.
+// DRIFT_ERR_CANCELLED leaves the last image.
+drift_result drift_moving_refine_apply(drift_moving_refine *m, const drift_gbuffer *gbuffer,
+                                       const drift_camera *camera, const drift_image *frame,
+                                       const drift_image *hybrid, const atomic_bool *cancel);
+// The shown image (RGB), the path tracer's weight per pixel (1 channel), and the filtered
+// path-traced accumulation alone (RGB).
+const drift_image *drift_moving_refine_image(const drift_moving_refine *m);
+const drift_image *drift_moving_refine_weight(const drift_moving_refine *m);
+const drift_image *drift_moving_refine_path(const drift_moving_refine *m);
 
 #ifdef __cplusplus
 }

@@ -3,6 +3,7 @@
 #include "drift/temporal.h"
 
 #include "drift/math.h"
+#include "temporal_internal.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -18,16 +19,16 @@ struct drift_temporal {
     drift_temporal_settings s;
     int cur; // index of the current frame's planes
     bool has_prev;
-    drift_image light[PLANES];    // 3: accumulated demodulated lighting
-    drift_image moments[PLANES];  // 2: accumulated luminance moments
-    drift_image length[PLANES];   // 1: history length in frames
+    temporal_layer hybrid;        // the hybrid frame's lighting
     drift_image depth[PLANES];    // 1
     drift_image position[PLANES]; // 3: world position
     drift_image normal[PLANES];   // 3
     drift_image material[PLANES]; // 1
-    drift_image sample_lum;       // 1: this frame's demodulated luminance (spatial moments)
-    drift_image filter[2];        // 4: lighting and variance, ping-pong
-    drift_image out;              // 3
+    // The last apply's reprojection: each pixel's bilinear taps around p + motion in the
+    // previous frame (x0, y0 the top-left one) and their weights, 0 where a tap was rejected.
+    drift_image tap_origin; // 2: x0, y0
+    drift_image tap_weight; // 4
+    drift_image out;        // 3
 };
 
 drift_temporal_settings drift_temporal_settings_resolve(const drift_temporal_settings *in)
@@ -40,7 +41,38 @@ drift_temporal_settings drift_temporal_settings_resolve(const drift_temporal_set
     s.filter_passes = s.no_filter ? 0 : (s.filter_passes ? s.filter_passes : 3);
     s.phi_luminance = s.phi_luminance > 0.0f ? s.phi_luminance : 4.0f;
     s.depth_sigma = s.depth_sigma > 0.0f ? s.depth_sigma : 1.0f;
+    s.moving_refine_history = s.moving_refine_history ? s.moving_refine_history : 32;
     return s;
+}
+
+drift_result temporal_layer_init(drift_context *ctx, int32_t width, int32_t height,
+                                 int32_t max_history, temporal_layer *L)
+{
+    *L = (temporal_layer){ .max_history = max_history };
+    drift_result r = drift_image_create(ctx, width, height, 1, &L->sample_lum);
+    for (int k = 0; k < PLANES && r == DRIFT_OK; ++k) {
+        if ((r = drift_image_create(ctx, width, height, 3, &L->light[k])) != DRIFT_OK ||
+            (r = drift_image_create(ctx, width, height, 2, &L->moments[k])) != DRIFT_OK ||
+            (r = drift_image_create(ctx, width, height, 1, &L->length[k])) != DRIFT_OK ||
+            (r = drift_image_create(ctx, width, height, 4, &L->filter[k])) != DRIFT_OK) {
+            break;
+        }
+    }
+    if (r != DRIFT_OK) {
+        temporal_layer_free(ctx, L);
+    }
+    return r;
+}
+
+void temporal_layer_free(drift_context *ctx, temporal_layer *L)
+{
+    for (int k = 0; k < PLANES; ++k) {
+        drift_image_destroy(ctx, &L->light[k]);
+        drift_image_destroy(ctx, &L->moments[k]);
+        drift_image_destroy(ctx, &L->length[k]);
+        drift_image_destroy(ctx, &L->filter[k]);
+    }
+    drift_image_destroy(ctx, &L->sample_lum);
 }
 
 void drift_temporal_destroy(drift_temporal *t)
@@ -48,17 +80,15 @@ void drift_temporal_destroy(drift_temporal *t)
     if (!t) {
         return;
     }
+    temporal_layer_free(t->ctx, &t->hybrid);
     for (int k = 0; k < PLANES; ++k) {
-        drift_image_destroy(t->ctx, &t->light[k]);
-        drift_image_destroy(t->ctx, &t->moments[k]);
-        drift_image_destroy(t->ctx, &t->length[k]);
         drift_image_destroy(t->ctx, &t->depth[k]);
         drift_image_destroy(t->ctx, &t->position[k]);
         drift_image_destroy(t->ctx, &t->normal[k]);
         drift_image_destroy(t->ctx, &t->material[k]);
-        drift_image_destroy(t->ctx, &t->filter[k]);
     }
-    drift_image_destroy(t->ctx, &t->sample_lum);
+    drift_image_destroy(t->ctx, &t->tap_origin);
+    drift_image_destroy(t->ctx, &t->tap_weight);
     drift_image_destroy(t->ctx, &t->out);
     drift_free(t->ctx, t);
 }
@@ -74,7 +104,8 @@ drift_result drift_temporal_create(drift_context *ctx, int32_t width, int32_t he
     if (width < 1 || height < 1 || s.max_history < 1 || s.max_history > 4096 ||
         !(s.moments_alpha <= 1.0f) || !(s.depth_tolerance <= 1.0f) ||
         !(s.normal_tolerance <= 1.0f) || s.filter_passes < 0 || s.filter_passes > 8 ||
-        !isfinite(s.phi_luminance) || !isfinite(s.depth_sigma)) {
+        !isfinite(s.phi_luminance) || !isfinite(s.depth_sigma) || s.moving_refine_history < 1 ||
+        s.moving_refine_history > 4096) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, NULL, 0,
                   "temporal: size %dx%d or settings out of range (drift/temporal.h)", width,
                   height);
@@ -88,21 +119,20 @@ drift_result drift_temporal_create(drift_context *ctx, int32_t width, int32_t he
     t->width = width;
     t->height = height;
     t->s = s;
-    drift_result r = DRIFT_OK;
+    drift_result r = temporal_layer_init(ctx, width, height, s.max_history, &t->hybrid);
     for (int k = 0; k < PLANES && r == DRIFT_OK; ++k) {
-        if ((r = drift_image_create(ctx, width, height, 3, &t->light[k])) != DRIFT_OK ||
-            (r = drift_image_create(ctx, width, height, 2, &t->moments[k])) != DRIFT_OK ||
-            (r = drift_image_create(ctx, width, height, 1, &t->length[k])) != DRIFT_OK ||
-            (r = drift_image_create(ctx, width, height, 1, &t->depth[k])) != DRIFT_OK ||
+        if ((r = drift_image_create(ctx, width, height, 1, &t->depth[k])) != DRIFT_OK ||
             (r = drift_image_create(ctx, width, height, 3, &t->position[k])) != DRIFT_OK ||
             (r = drift_image_create(ctx, width, height, 3, &t->normal[k])) != DRIFT_OK ||
-            (r = drift_image_create(ctx, width, height, 1, &t->material[k])) != DRIFT_OK ||
-            (r = drift_image_create(ctx, width, height, 4, &t->filter[k])) != DRIFT_OK) {
+            (r = drift_image_create(ctx, width, height, 1, &t->material[k])) != DRIFT_OK) {
             break;
         }
     }
     if (r == DRIFT_OK) {
-        r = drift_image_create(ctx, width, height, 1, &t->sample_lum);
+        r = drift_image_create(ctx, width, height, 2, &t->tap_origin);
+    }
+    if (r == DRIFT_OK) {
+        r = drift_image_create(ctx, width, height, 4, &t->tap_weight);
     }
     if (r == DRIFT_OK) {
         r = drift_image_create(ctx, width, height, 3, &t->out);
@@ -119,7 +149,14 @@ void drift_temporal_reset(drift_temporal *t)
 {
     if (t) {
         t->has_prev = false;
+        t->hybrid.has_prev = false;
     }
+}
+
+void temporal_size(const drift_temporal *t, int32_t *width, int32_t *height)
+{
+    *width = t->width;
+    *height = t->height;
 }
 
 const drift_image *drift_temporal_image(const drift_temporal *t)
@@ -129,19 +166,21 @@ const drift_image *drift_temporal_image(const drift_temporal *t)
 
 const drift_image *drift_temporal_history(const drift_temporal *t)
 {
-    return t ? &t->length[t->cur] : NULL;
+    return t ? &t->hybrid.length[t->cur] : NULL;
 }
 
 // --- REPROJECTION AND ACCUMULATION ---
 
 typedef struct frame_job {
     drift_temporal *t;
+    temporal_layer *layer;
     const drift_gbuffer *g;
     const drift_image *color;
+    drift_image *raw_variance; // may be NULL
     int cur, prev;
 } frame_job;
 
-static drift_vec3 demodulation(const drift_gbuffer *g, int32_t x, int32_t y)
+drift_vec3 temporal_demodulation(const drift_gbuffer *g, int32_t x, int32_t y)
 {
     drift_vec3 a = drift_image_get3(&g->albedo, x, y);
     return drift_vec3_make(fmaxf(a.x, 0.01f), fmaxf(a.y, 0.01f), fmaxf(a.z, 0.01f));
@@ -159,7 +198,7 @@ static bool tap_valid(const frame_job *job, int32_t x, int32_t y, float material
         return false;
     }
     int pr = job->prev;
-    if (drift_image_pixel(&t->length[pr], x, y)[0] <= 0.0f ||
+    if (!(drift_image_pixel(&t->depth[pr], x, y)[0] > 0.0f) ||
         drift_image_pixel(&t->material[pr], x, y)[0] != material) {
         return false;
     }
@@ -170,13 +209,14 @@ static bool tap_valid(const frame_job *job, int32_t x, int32_t y, float material
     return fabsf(drift_vec3_dot(drift_vec3_sub(q, p), n)) <= t->s.depth_tolerance * z;
 }
 
-static void accumulate_rows(size_t begin, size_t end, int thread_index, void *user)
+// This frame's G-buffer into the current planes, and each pixel's reprojection taps.
+static void reproject_rows(size_t begin, size_t end, int thread_index, void *user)
 {
     (void)thread_index;
     const frame_job *job = user;
     drift_temporal *t = job->t;
     const drift_gbuffer *g = job->g;
-    int c = job->cur, pr = job->prev;
+    int c = job->cur;
     for (int32_t y = (int32_t)begin; y < (int32_t)end; ++y) {
         for (int32_t x = 0; x < t->width; ++x) {
             float z = drift_image_pixel(&g->depth, x, y)[0];
@@ -186,47 +226,83 @@ static void accumulate_rows(size_t begin, size_t end, int thread_index, void *us
             drift_image_pixel(&t->material[c], x, y)[0] = material;
             drift_image_set3(&t->normal[c], x, y, n);
             drift_image_set3(&t->position[c], x, y, drift_image_get3(&g->position, x, y));
-            float *len = drift_image_pixel(&t->length[c], x, y);
-            float *mom = drift_image_pixel(&t->moments[c], x, y);
+            float *origin = drift_image_pixel(&t->tap_origin, x, y);
+            float *tw = drift_image_pixel(&t->tap_weight, x, y);
+            tw[0] = tw[1] = tw[2] = tw[3] = 0.0f;
+            origin[0] = (float)x;
+            origin[1] = (float)y;
+            if (!(z > 0.0f) || !t->has_prev) { // a miss, or no previous frame: no history
+                continue;
+            }
+            // The valid bilinear taps around p + motion.
+            const float *m = drift_image_pixel(&g->motion, x, y);
+            // Where the point was: the history's positions are the previous frame's.
+            drift_vec3 p = drift_image_get3(&g->position, x, y);
+            if (g->object_motion) {
+                p = drift_vec3_add(p, g->object_motion[(size_t)y * (size_t)g->width + (size_t)x]);
+            }
+            float qx = (float)x + m[0], qy = (float)y + m[1];
+            int32_t x0 = (int32_t)floorf(qx), y0 = (int32_t)floorf(qy);
+            float fx = qx - (float)x0, fy = qy - (float)y0;
+            origin[0] = (float)x0;
+            origin[1] = (float)y0;
+            for (int k = 0; k < 4; ++k) {
+                int32_t tx = x0 + (k & 1), ty = y0 + (k >> 1);
+                float w = ((k & 1) ? fx : 1.0f - fx) * ((k >> 1) ? fy : 1.0f - fy);
+                if (w > 0.0f && tap_valid(job, tx, ty, material, n, p, z)) {
+                    tw[k] = w;
+                }
+            }
+        }
+    }
+}
+
+// Accumulates the job's colour into its layer through the taps: N = min(N_prev + 1, max),
+// alpha = 1 / N, the lighting and the luminance moments blended with the reprojected history.
+static void accumulate_rows(size_t begin, size_t end, int thread_index, void *user)
+{
+    (void)thread_index;
+    const frame_job *job = user;
+    drift_temporal *t = job->t;
+    temporal_layer *L = job->layer;
+    const drift_gbuffer *g = job->g;
+    int c = job->cur, pr = job->prev;
+    for (int32_t y = (int32_t)begin; y < (int32_t)end; ++y) {
+        for (int32_t x = 0; x < t->width; ++x) {
+            float z = drift_image_pixel(&g->depth, x, y)[0];
+            float *len = drift_image_pixel(&L->length[c], x, y);
+            float *mom = drift_image_pixel(&L->moments[c], x, y);
             if (!(z > 0.0f)) { // a miss: passes through, no history
                 len[0] = 0.0f;
                 mom[0] = mom[1] = 0.0f;
-                drift_image_set3(&t->light[c], x, y, drift_vec3_splat(0.0f));
-                drift_image_pixel(&t->sample_lum, x, y)[0] = 0.0f;
+                drift_image_set3(&L->light[c], x, y, drift_vec3_splat(0.0f));
+                drift_image_pixel(&L->sample_lum, x, y)[0] = 0.0f;
                 continue;
             }
-            drift_vec3 a = demodulation(g, x, y);
+            drift_vec3 a = temporal_demodulation(g, x, y);
             drift_vec3 col = drift_vec3_sub(drift_image_get3(job->color, x, y),
                                             drift_image_get3(&g->emission, x, y));
             drift_vec3 l = drift_vec3_make(col.x / a.x, col.y / a.y, col.z / a.z);
             float lum = drift_luminance(l);
-            drift_image_pixel(&t->sample_lum, x, y)[0] = lum;
-            // The history: the valid bilinear taps around p + motion.
+            drift_image_pixel(&L->sample_lum, x, y)[0] = lum;
             drift_vec3 hist = drift_vec3_splat(0.0f);
             float hist_mom[2] = { 0.0f, 0.0f };
             float hist_len = 0.0f, weight = 0.0f;
-            if (t->has_prev) {
-                const float *m = drift_image_pixel(&g->motion, x, y);
-                // Where the point was: the history's positions are the previous frame's.
-                drift_vec3 p = drift_image_get3(&g->position, x, y);
-                if (g->object_motion) {
-                    p = drift_vec3_add(p,
-                                       g->object_motion[(size_t)y * (size_t)g->width + (size_t)x]);
-                }
-                float qx = (float)x + m[0], qy = (float)y + m[1];
-                int32_t x0 = (int32_t)floorf(qx), y0 = (int32_t)floorf(qy);
-                float fx = qx - (float)x0, fy = qy - (float)y0;
+            if (L->has_prev) {
+                const float *origin = drift_image_pixel(&t->tap_origin, x, y);
+                const float *tw = drift_image_pixel(&t->tap_weight, x, y);
+                int32_t x0 = (int32_t)origin[0], y0 = (int32_t)origin[1];
                 for (int k = 0; k < 4; ++k) {
+                    float w = tw[k];
                     int32_t tx = x0 + (k & 1), ty = y0 + (k >> 1);
-                    float w = ((k & 1) ? fx : 1.0f - fx) * ((k >> 1) ? fy : 1.0f - fy);
-                    if (w <= 0.0f || !tap_valid(job, tx, ty, material, n, p, z)) {
+                    if (!(w > 0.0f) || !(drift_image_pixel(&L->length[pr], tx, ty)[0] > 0.0f)) {
                         continue;
                     }
-                    hist = drift_vec3_fma(hist, drift_image_get3(&t->light[pr], tx, ty), w);
-                    const float *hm = drift_image_pixel(&t->moments[pr], tx, ty);
+                    hist = drift_vec3_fma(hist, drift_image_get3(&L->light[pr], tx, ty), w);
+                    const float *hm = drift_image_pixel(&L->moments[pr], tx, ty);
                     hist_mom[0] += w * hm[0];
                     hist_mom[1] += w * hm[1];
-                    hist_len += w * drift_image_pixel(&t->length[pr], tx, ty)[0];
+                    hist_len += w * drift_image_pixel(&L->length[pr], tx, ty)[0];
                     weight += w;
                 }
             }
@@ -236,7 +312,7 @@ static void accumulate_rows(size_t begin, size_t end, int thread_index, void *us
                 hist = drift_vec3_scale(hist, inv);
                 hist_mom[0] *= inv;
                 hist_mom[1] *= inv;
-                n_frames = fminf(hist_len * inv + 1.0f, (float)t->s.max_history);
+                n_frames = fminf(hist_len * inv + 1.0f, (float)L->max_history);
             }
             float alpha = 1.0f / n_frames;
             float alpha_m = fmaxf(alpha, t->s.moments_alpha);
@@ -247,7 +323,7 @@ static void accumulate_rows(size_t begin, size_t end, int thread_index, void *us
             mom[1] =
                 n_frames > 1.0f ? (1.0f - alpha_m) * hist_mom[1] + alpha_m * lum * lum : lum * lum;
             len[0] = n_frames;
-            drift_image_set3(&t->light[c], x, y, acc);
+            drift_image_set3(&L->light[c], x, y, acc);
         }
     }
 }
@@ -260,20 +336,24 @@ static void variance_rows(size_t begin, size_t end, int thread_index, void *user
     (void)thread_index;
     const frame_job *job = user;
     drift_temporal *t = job->t;
+    temporal_layer *L = job->layer;
     int c = job->cur;
     for (int32_t y = (int32_t)begin; y < (int32_t)end; ++y) {
         for (int32_t x = 0; x < t->width; ++x) {
-            float *f = drift_image_pixel(&t->filter[0], x, y);
-            drift_vec3 l = drift_image_get3(&t->light[c], x, y);
+            float *f = drift_image_pixel(&L->filter[0], x, y);
+            drift_vec3 l = drift_image_get3(&L->light[c], x, y);
             f[0] = l.x;
             f[1] = l.y;
             f[2] = l.z;
-            float n_frames = drift_image_pixel(&t->length[c], x, y)[0];
+            float n_frames = drift_image_pixel(&L->length[c], x, y)[0];
             if (n_frames <= 0.0f) {
                 f[3] = 0.0f;
+                if (job->raw_variance) {
+                    drift_image_pixel(job->raw_variance, x, y)[0] = 0.0f;
+                }
                 continue;
             }
-            const float *mom = drift_image_pixel(&t->moments[c], x, y);
+            const float *mom = drift_image_pixel(&L->moments[c], x, y);
             float var = fmaxf(mom[1] - mom[0] * mom[0], 0.0f);
             if (n_frames < 4.0f) {
                 float z = drift_image_pixel(&t->depth[c], x, y)[0];
@@ -290,7 +370,7 @@ static void variance_rows(size_t begin, size_t end, int thread_index, void *user
                             drift_vec3_dot(drift_image_get3(&t->normal[c], qx, qy), n) < 0.8f) {
                             continue;
                         }
-                        float s = drift_image_pixel(&t->sample_lum, qx, qy)[0];
+                        float s = drift_image_pixel(&L->sample_lum, qx, qy)[0];
                         m1 += s;
                         m2 += s * s;
                         wsum += 1.0f;
@@ -300,6 +380,9 @@ static void variance_rows(size_t begin, size_t end, int thread_index, void *user
                 var = fmaxf(m2 / wsum - m1 * m1, 0.0f);
             }
             f[3] = var / n_frames; // the variance of the mean of N frames
+            if (job->raw_variance) {
+                drift_image_pixel(job->raw_variance, x, y)[0] = f[3];
+            }
         }
     }
 }
@@ -387,27 +470,70 @@ static void filter_rows(size_t begin, size_t end, int thread_index, void *user)
     }
 }
 
+typedef struct remodulate_job {
+    const drift_temporal *t;
+    const drift_gbuffer *g;
+    const drift_image *light, *misses;
+    drift_image *out;
+} remodulate_job;
+
 static void remodulate_rows(size_t begin, size_t end, int thread_index, void *user)
 {
     (void)thread_index;
-    const frame_job *job = user;
-    drift_temporal *t = job->t;
+    const remodulate_job *job = user;
     const drift_gbuffer *g = job->g;
-    const drift_image *filtered = &t->filter[t->s.filter_passes & 1];
     for (int32_t y = (int32_t)begin; y < (int32_t)end; ++y) {
-        for (int32_t x = 0; x < t->width; ++x) {
+        for (int32_t x = 0; x < job->t->width; ++x) {
             if (!(drift_image_pixel(&g->depth, x, y)[0] > 0.0f)) {
-                drift_image_set3(&t->out, x, y, drift_image_get3(job->color, x, y));
+                drift_image_set3(job->out, x, y, drift_image_get3(job->misses, x, y));
                 continue;
             }
-            const float *l = drift_image_pixel(filtered, x, y);
-            drift_vec3 a = demodulation(g, x, y);
+            const float *l = drift_image_pixel(job->light, x, y);
+            drift_vec3 a = temporal_demodulation(g, x, y);
             drift_vec3 e = drift_image_get3(&g->emission, x, y);
             drift_image_set3(
-                &t->out, x, y,
+                job->out, x, y,
                 drift_vec3_add(e, drift_vec3_make(a.x * l[0], a.y * l[1], a.z * l[2])));
         }
     }
+}
+
+void temporal_remodulate(drift_temporal *t, const drift_gbuffer *g, const drift_image *light,
+                         const drift_image *misses, drift_image *out)
+{
+    remodulate_job job = { .t = t, .g = g, .light = light, .misses = misses, .out = out };
+    drift_parallel_for(t->ctx, (size_t)t->height, 4, remodulate_rows, &job);
+}
+
+const drift_image *temporal_layer_apply(drift_temporal *t, temporal_layer *L,
+                                        const drift_gbuffer *g, const drift_image *color,
+                                        int32_t passes, drift_image *raw_variance)
+{
+    frame_job job = { .t = t,
+                      .layer = L,
+                      .g = g,
+                      .color = color,
+                      .raw_variance = raw_variance,
+                      .cur = t->cur,
+                      .prev = t->cur ^ 1 };
+    size_t rows = (size_t)t->height;
+    drift_parallel_for(t->ctx, rows, 4, accumulate_rows, &job);
+    drift_parallel_for(t->ctx, rows, 4, variance_rows, &job);
+    for (int32_t pass = 0; pass < passes; ++pass) {
+        filter_job fj = { .t = t,
+                          .in = &L->filter[pass & 1],
+                          .out = &L->filter[(pass & 1) ^ 1],
+                          .cur = t->cur,
+                          .step = 1 << pass };
+        drift_parallel_for(t->ctx, rows, 4, filter_rows, &fj);
+    }
+    L->has_prev = true;
+    return &L->filter[passes & 1];
+}
+
+const drift_image *temporal_layer_light(const drift_temporal *t, const temporal_layer *L)
+{
+    return &L->light[t->cur];
 }
 
 drift_result drift_temporal_apply(drift_temporal *t, const drift_gbuffer *g,
@@ -418,19 +544,11 @@ drift_result drift_temporal_apply(drift_temporal *t, const drift_gbuffer *g,
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
     t->cur ^= 1;
-    frame_job job = { .t = t, .g = g, .color = color, .cur = t->cur, .prev = t->cur ^ 1 };
-    size_t rows = (size_t)t->height;
-    drift_parallel_for(t->ctx, rows, 4, accumulate_rows, &job);
-    drift_parallel_for(t->ctx, rows, 4, variance_rows, &job);
-    for (int32_t pass = 0; pass < t->s.filter_passes; ++pass) {
-        filter_job fj = { .t = t,
-                          .in = &t->filter[pass & 1],
-                          .out = &t->filter[(pass & 1) ^ 1],
-                          .cur = t->cur,
-                          .step = 1 << pass };
-        drift_parallel_for(t->ctx, rows, 4, filter_rows, &fj);
-    }
-    drift_parallel_for(t->ctx, rows, 4, remodulate_rows, &job);
+    frame_job job = { .t = t, .g = g, .cur = t->cur, .prev = t->cur ^ 1 };
+    drift_parallel_for(t->ctx, (size_t)t->height, 4, reproject_rows, &job);
+    const drift_image *filtered =
+        temporal_layer_apply(t, &t->hybrid, g, color, t->s.filter_passes, NULL);
+    temporal_remodulate(t, g, filtered, color, &t->out);
     (void)camera; // the motion vectors carry the camera's move
     t->has_prev = true;
     return DRIFT_OK;

@@ -4,6 +4,7 @@
 #include "drift/math.h"
 #include "drift/pt.h"
 #include "drift/temporal.h"
+#include "temporal_internal.h"
 
 #include <math.h>
 #include <string.h>
@@ -20,7 +21,7 @@ struct drift_still_refine {
     drift_image out;      // 3: the shown image
     drift_image weight;   // 1: the path tracer's weight
     drift_image denoised; // 3: drift_denoise_feature's output (remade each frame)
-    float *scratch[3];    // width x height: squared difference, variance, a blur's rows
+    float *scratch[4];    // width x height: squared difference, variance, a blur's rows
 };
 
 static drift_still_refine_settings resolve(const drift_still_refine_settings *in)
@@ -41,7 +42,7 @@ void drift_still_refine_destroy(drift_still_refine *s)
     drift_image_destroy(s->ctx, &s->out);
     drift_image_destroy(s->ctx, &s->weight);
     drift_image_destroy(s->ctx, &s->denoised);
-    for (int k = 0; k < 3; ++k) {
+    for (int k = 0; k < 4; ++k) {
         drift_free(s->ctx, s->scratch[k]);
     }
     drift_free(s->ctx, s);
@@ -69,7 +70,7 @@ drift_result drift_still_refine_create(drift_context *ctx, const drift_scene *sc
     if (r == DRIFT_OK) {
         r = drift_image_create(ctx, width, height, 1, &s->weight);
     }
-    for (int k = 0; k < 3 && r == DRIFT_OK; ++k) {
+    for (int k = 0; k < 4 && r == DRIFT_OK; ++k) {
         s->scratch[k] = drift_alloc(ctx, sizeof(float) * (size_t)width * (size_t)height);
         r = s->scratch[k] ? DRIFT_OK : DRIFT_ERR_OUT_OF_MEMORY;
     }
@@ -204,34 +205,50 @@ drift_result drift_still_refine_apply(drift_still_refine *s, const drift_camera 
         (r = drift_pt_resolve(s->pt, DRIFT_PT_AOV_VARIANCE, &variance)) != DRIFT_OK) {
         return r;
     }
-    int32_t w = s->width, h = s->height;
-    float *diff2 = s->scratch[0], *var = s->scratch[1];
+    temporal_error_blend(hybrid, &beauty, &variance, &s->denoised, NULL, s->s.denoised_error,
+                         s->s.radius, s->scratch, &s->out, &s->weight);
+    return DRIFT_OK;
+}
+
+void temporal_error_blend(const drift_image *hybrid, const drift_image *raw,
+                          const drift_image *variance, const drift_image *denoised,
+                          const drift_image *denoised_variance, float denoised_error,
+                          int32_t radius, float *scratch[4], drift_image *out, drift_image *weight)
+{
+    int32_t w = hybrid->width, h = hybrid->height;
+    float *diff2 = scratch[0], *var = scratch[1], *dvar = scratch[3];
     for (int32_t y = 0; y < h; ++y) {
         for (int32_t x = 0; x < w; ++x) {
             size_t i = (size_t)y * (size_t)w + (size_t)x;
             float d = drift_luminance(drift_image_get3(hybrid, x, y)) -
-                      drift_luminance(drift_image_get3(&beauty, x, y));
-            float v = *drift_image_pixel(&variance, x, y);
+                      drift_luminance(drift_image_get3(raw, x, y));
+            float v = *drift_image_pixel(variance, x, y);
             diff2[i] = isfinite(d) ? d * d : 0.0f;
             var[i] = isfinite(v) && v > 0.0f ? v : 0.0f;
+            if (denoised_variance) {
+                float dv = *drift_image_pixel(denoised_variance, x, y);
+                dvar[i] = isfinite(dv) && dv > 0.0f ? dv : 0.0f;
+            }
         }
     }
-    box_blur(diff2, s->scratch[2], w, h, s->s.radius);
-    box_blur(var, s->scratch[2], w, h, s->s.radius);
+    box_blur(diff2, scratch[2], w, h, radius);
+    box_blur(var, scratch[2], w, h, radius);
+    if (denoised_variance) {
+        box_blur(dvar, scratch[2], w, h, radius);
+    }
     for (int32_t y = 0; y < h; ++y) {
         for (int32_t x = 0; x < w; ++x) {
             size_t i = (size_t)y * (size_t)w + (size_t)x;
             float hybrid_error = fmaxf(diff2[i] - var[i], 0.0f);
-            float path_error = s->s.denoised_error * var[i];
+            float path_error = denoised_error * (denoised_variance ? dvar[i] : var[i]);
             float sum = hybrid_error + path_error;
             float wp = sum > 0.0f ? hybrid_error / sum : 1.0f; // both 0: they agree
             drift_vec3 a = drift_image_get3(hybrid, x, y);
-            drift_vec3 b = drift_image_get3(&s->denoised, x, y);
-            drift_image_set3(&s->out, x, y, drift_vec3_fma(a, drift_vec3_sub(b, a), wp));
-            *drift_image_pixel(&s->weight, x, y) = wp;
+            drift_vec3 b = drift_image_get3(denoised, x, y);
+            drift_image_set3(out, x, y, drift_vec3_fma(a, drift_vec3_sub(b, a), wp));
+            *drift_image_pixel(weight, x, y) = wp;
         }
     }
-    return DRIFT_OK;
 }
 
 const drift_image *drift_still_refine_image(const drift_still_refine *s)

@@ -254,6 +254,16 @@ drift_result drift_view_create(drift_context *ctx, const drift_scene *scene,
     view->base_seed = view->params.seed;
     if (d.temporal && !d.refine) {
         r = drift_temporal_create(ctx, width, height, &d.temporal_settings, &view->temporal);
+        if (r == DRIFT_OK && d.temporal_settings.moving_refine) {
+            r = drift_moving_refine_create(
+                ctx, scene, accel, view->temporal,
+                &(drift_moving_refine_settings){ .seed = view->base_seed + 0x9e3779b9u,
+                                                 .max_history =
+                                                     d.temporal_settings.moving_refine_history,
+                                                 .residual = d.temporal_settings.moving_refine == 2,
+                                                 .scale = d.temporal_settings.moving_refine_scale },
+                &view->moving);
+        }
         if (r == DRIFT_OK && !d.temporal_settings.no_still_refine) {
             r = drift_still_refine_create(ctx, scene, accel, width, height,
                                           &(drift_still_refine_settings){ .seed = view->base_seed },
@@ -288,6 +298,7 @@ void drift_view_destroy(drift_view *view)
     drift_context *ctx = view->ctx;
     drift_refine_destroy(view->sir);
     drift_still_refine_destroy(view->still);
+    drift_moving_refine_destroy(view->moving);
     drift_temporal_destroy(view->temporal);
     drift_hybrid_destroy(view->hybrid);
     drift_pt_destroy(view->reference);
@@ -460,6 +471,7 @@ drift_result drift_view_frame(drift_view *view, const atomic_bool *cancel)
     if (view->params_changed) {
         drift_temporal_reset(view->temporal); // other techniques: the history is another image
         drift_still_refine_reset(view->still);
+        drift_moving_refine_reset(view->moving);
         view->temporal_frame = 0;
         view->params.seed = view->base_seed;
         r = drift_hybrid_set_params(view->hybrid, &view->params);
@@ -482,11 +494,21 @@ drift_result drift_view_frame(drift_view *view, const atomic_bool *cancel)
         r = drift_temporal_apply(view->temporal, drift_hybrid_gbuffer(view->hybrid), &camera,
                                  drift_hybrid_image(view->hybrid));
     }
+    // The moving refinement (every frame) feeds the still one (frames of a standing camera).
+    bool moving = view->moving && drift_still_refine_applies(&view->params);
+    if (r == DRIFT_OK && moving) {
+        r = drift_moving_refine_apply(view->moving, drift_hybrid_gbuffer(view->hybrid),
+                                      &view->camera, drift_hybrid_image(view->hybrid),
+                                      drift_temporal_image(view->temporal), cancel);
+    } else {
+        drift_moving_refine_reset(view->moving);
+    }
+    const drift_image *temporal_image =
+        moving ? drift_moving_refine_image(view->moving) : drift_temporal_image(view->temporal);
     bool refined = view->still && drift_still_refine_applies(&view->params);
     if (r == DRIFT_OK && refined) {
         // The camera before its jitter: a still one refines toward the path tracer.
-        r = drift_still_refine_apply(view->still, &view->camera,
-                                     drift_temporal_image(view->temporal), cancel);
+        r = drift_still_refine_apply(view->still, &view->camera, temporal_image, cancel);
     } else {
         drift_still_refine_reset(view->still); // glare or edits on: the temporal image alone
     }
@@ -541,7 +563,7 @@ drift_result drift_view_frame(drift_view *view, const atomic_bool *cancel)
     // a technique change; then the frame again).
     const drift_image *shown = view->sir        ? drift_refine_image(view->sir)
                                : refined        ? drift_still_refine_image(view->still)
-                               : view->temporal ? drift_temporal_image(view->temporal)
+                               : view->temporal ? temporal_image
                                                 : drift_hybrid_image(view->hybrid);
     const char *plane_name = NULL; // NULL: the composed frame
     uint32_t index = buffer_index(view, view->buffer_name);

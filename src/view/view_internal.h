@@ -45,10 +45,11 @@ struct drift_view {
     bool overlay, help;
     char *help_text;
 
-    drift_temporal *temporal;  // NULL unless desc.temporal
-    uint32_t temporal_frame;   // frames since the history began (seed and jitter index)
-    drift_still_refine *still; // a still camera's path-traced refinement, with temporal
-    uint32_t base_seed;        // the hybrid frame's seed from the desc
+    drift_temporal *temporal;    // NULL unless desc.temporal
+    uint32_t temporal_frame;     // frames since the history began (seed and jitter index)
+    drift_still_refine *still;   // a still camera's path-traced refinement, with temporal
+    drift_moving_refine *moving; // every frame's reprojected path-traced refinement, or NULL
+    uint32_t base_seed;          // the hybrid frame's seed from the desc
 
     drift_refine *sir;       // NULL unless the view refines (desc.refine)
     drift_camera sir_camera; // the camera of the last sort: a move (or new techniques,

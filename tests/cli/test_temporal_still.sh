@@ -58,4 +58,11 @@ assert f[-1] < 0.95 * f[0], f
 assert f[-1] < 0.8 * h, (f, h)
 PY
     fail "a still camera does not converge below the hybrid's ${hybrid_only}: ${flips[*]}"
+# The moving refinement is for sequences: without --animation (or --temporal on) a usage error;
+# with them three frames render (its quality is unit.temporal's test_moving_refine_*).
+expect 2 "$drift" render "$scene" "${size[@]}" "${hybrid[@]}" --moving-refine path \
+    --out "$tmp/mr.exr"
+mkdir -p "$tmp/mr"
+expect 0 "$drift" render "$scene" "${size[@]}" "${hybrid[@]}" --moving-refine residual \
+    --camera-path "$tmp/still.json" --animation 0:2 --out "$tmp/mr/f_%04d.exr"
 exit $((failures > 0))
