@@ -174,12 +174,28 @@ static float conductor_pdf(const drift_bsdf_ggx *g, drift_vec3 wo, drift_vec3 wi
 
 // --- PLASTIC ---
 
+// The coat's Fresnel: Schlick of F0 (glTF); for the Principled form (a Burley base) Cycles
+// 3.4's interpolate_fresnel_color, the exact dielectric Fresnel of the IOR rescaled to run from
+// F0 to 1 (up to 27% above Schlick at 60 degrees off the half vector for IOR 1.5).
+static drift_vec3 coat_fresnel(const drift_bsdf_ggx *g, float c)
+{
+    if (g->burley_roughness < 0.0f) {
+        return schlick(g->f0_coat, c);
+    }
+    float eta = fmaxf(g->eta_rel, 1.0f / g->eta_rel), f0n = (eta - 1.0f) / (eta + 1.0f);
+    f0n *= f0n;
+    float fh = f0n < 1.0f ? (drift__fresnel_dielectric(drift_clampf(c, 0.0f, 1.0f), eta) - f0n) /
+                                (1.0f - f0n)
+                          : 1.0f;
+    return drift_vec3_add(drift_vec3_scale(g->f0_coat, 1.0f - fh), drift_vec3_splat(fh));
+}
+
 static drift_vec3 plastic_eval(const drift_bsdf_ggx *g, drift_vec3 wo, drift_vec3 wi,
                                drift_vec3 *out_diffuse)
 {
     drift_vec3 h;
     float ss = drift__ggx_reflect_ss(ra(g), wo, wi, &h);
-    drift_vec3 coat = drift_vec3_scale(schlick(g->f0_coat, drift_vec3_dot(wo, h)), ss);
+    drift_vec3 coat = drift_vec3_scale(coat_fresnel(g, drift_vec3_dot(wo, h)), ss);
     if (g->burley_roughness >= 0.0f) {
         // Burley's factor (docs/materials.md): F_D90 = 1/2 + r (1 + wi.wo).
         float fd90_minus_1 = g->burley_roughness * (1.0f + drift_vec3_dot(wo, wi)) - 0.5f;
@@ -364,7 +380,7 @@ static drift_vec3 reflection_eval_pdf(const drift_bsdf_ggx *g, drift_vec3 wo, dr
         pdf += g->w_conductor * (p * pdf_r + (1.0f - p) * pdf_ms);
     }
     if (g->w_plastic > 0.0f) {
-        drift_vec3 coat = drift_vec3_scale(schlick(g->f0_coat, wo_h), ss);
+        drift_vec3 coat = drift_vec3_scale(coat_fresnel(g, wo_h), ss);
         drift_vec3 one = drift_vec3_splat(1.0f);
         drift_vec3 ec_o = coat_albedo(g->f0_coat, e1_o, es_o);
         drift_vec3 base;
