@@ -216,7 +216,8 @@ static inline bool drift_bounds3_is_empty(drift_bounds3 b)
 
 // fmaxf / fminf as glibc computes them (a NaN argument gives the other; equal arguments, +0 and
 // -0 included, give the second), but inline: without -ffinite-math-only GCC calls libm for
-// fmaxf, a call per use in the path tracer's per-vertex code. Same bits as the libm call.
+// fmaxf, a call per use in the path tracer's per-vertex code. Same bits as the libm call but
+// for the sign of a zero from +0 against -0, which C leaves open (GCC may swap the operands).
 static inline float drift_maxf(float a, float b)
 {
     return (a > b || b != b) ? a : b;
