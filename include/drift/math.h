@@ -214,6 +214,20 @@ static inline bool drift_bounds3_is_empty(drift_bounds3 b)
     return b.min.x > b.max.x || b.min.y > b.max.y || b.min.z > b.max.z;
 }
 
+// fmaxf / fminf as glibc computes them (a NaN argument gives the other; equal arguments, +0 and
+// -0 included, give the second), but inline: without -ffinite-math-only GCC calls libm for
+// fmaxf, a call per use in the path tracer's per-vertex code. Same bits as the libm call but
+// for the sign of a zero from +0 against -0, which C leaves open (GCC may swap the operands).
+static inline float drift_maxf(float a, float b)
+{
+    return (a > b || b != b) ? a : b;
+}
+
+static inline float drift_minf(float a, float b)
+{
+    return (a < b || b != b) ? a : b;
+}
+
 // --- HASHING AND RANDOM NUMBERS ---
 
 // Integer hash with good avalanche (Wellons' lowbias32); the basis of every random
@@ -265,9 +279,10 @@ static inline float drift_u32_to_unit(uint32_t x)
 // pure function of (seed, pixel, sample, dimension), which makes renders bit-identical for
 // any thread count and lets a single sample be replayed.
 typedef struct drift_sampler {
-    uint32_t key;       // hash of (seed, pixel)
-    uint32_t sample;    // sample index within the pixel
-    uint32_t dimension; // next dimension pair to hand out
+    uint32_t key;             // hash of (seed, pixel)
+    uint32_t sample;          // sample index within the pixel
+    uint32_t dimension;       // next dimension pair to hand out
+    uint32_t sample_reversed; // sample's bits reversed, once a sample, not once a pair
 } drift_sampler;
 
 drift_sampler drift_sampler_make(uint32_t seed, uint32_t pixel, uint32_t sample);

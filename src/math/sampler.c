@@ -40,17 +40,24 @@ drift_sampler drift_sampler_make(uint32_t seed, uint32_t pixel, uint32_t sample)
 {
     return (drift_sampler){ .key = drift_hash_combine(drift_hash_u32(seed), pixel),
                             .sample = sample,
-                            .dimension = 0 };
+                            .dimension = 0,
+                            .sample_reversed = drift_reverse_bits(sample) };
 }
 
 // The scrambled index of the sample in the current dimension pair (its bits reversed) and the
-// pair's key; advances the dimension.
-static uint32_t pair_index(drift_sampler *s, uint32_t *out_pair_key)
+// pair's key; advances the dimension. Forced inline: GCC left it a call (perf, Cornell box:
+// 3.7% of the render's samples in it beside next2's 8.2%).
+#if defined(__GNUC__)
+#    define PAIR_INDEX_INLINE static inline __attribute__((always_inline))
+#else
+#    define PAIR_INDEX_INLINE static inline
+#endif
+PAIR_INDEX_INLINE uint32_t pair_index(drift_sampler *s, uint32_t *out_pair_key)
 {
     uint32_t pair_key = drift_hash_combine(s->key, s->dimension++);
     *out_pair_key = pair_key;
     // Shuffle the sample order per dimension pair so pairs are decorrelated (Burley §4).
-    return drift_reverse_bits(owen_scramble_reversed(drift_reverse_bits(s->sample), pair_key));
+    return drift_reverse_bits(owen_scramble_reversed(s->sample_reversed, pair_key));
 }
 
 drift_vec2 drift_sampler_next2(drift_sampler *s)

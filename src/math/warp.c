@@ -23,14 +23,14 @@ drift_vec3 drift_sample_cosine_hemisphere(drift_vec2 u)
 {
     // Malley's method: project the uniform disk up to the hemisphere.
     drift_vec2 d = drift_sample_disk_concentric(u);
-    float z = sqrtf(fmaxf(0.0f, 1.0f - d.x * d.x - d.y * d.y));
+    float z = sqrtf(drift_maxf(0.0f, 1.0f - d.x * d.x - d.y * d.y));
     return (drift_vec3){ d.x, d.y, z };
 }
 
 drift_vec3 drift_sample_uniform_sphere(drift_vec2 u)
 {
     float z = 1.0f - 2.0f * u.x;
-    float r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+    float r = sqrtf(drift_maxf(0.0f, 1.0f - z * z));
     float phi = 2.0f * DRIFT_PI * u.y;
     return (drift_vec3){ r * cosf(phi), r * sinf(phi), z };
 }
@@ -38,7 +38,7 @@ drift_vec3 drift_sample_uniform_sphere(drift_vec2 u)
 drift_vec3 drift_sample_uniform_cone(drift_vec2 u, float cos_max)
 {
     float cos_theta = (1.0f - u.x) + u.x * cos_max;
-    float sin_theta = sqrtf(fmaxf(0.0f, 1.0f - cos_theta * cos_theta));
+    float sin_theta = sqrtf(drift_maxf(0.0f, 1.0f - cos_theta * cos_theta));
     float phi = 2.0f * DRIFT_PI * u.y;
     return (drift_vec3){ sin_theta * cosf(phi), sin_theta * sinf(phi), cos_theta };
 }

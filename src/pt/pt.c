@@ -281,7 +281,7 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
     // angle, a pixel's at the camera. Textures read the mip level of its footprint.
     float cone_width = 0.0f;
     uint32_t planned = p->texture_filter_spp > 1 ? p->texture_filter_spp : 1;
-    float spp_scale = fmaxf(0.125f, 1.0f / sqrtf((float)planned));
+    float spp_scale = drift_maxf(0.125f, 1.0f / sqrtf((float)planned));
     float cone_spread = p->texture_point_sampling
                             ? 0.0f
                             : spp_scale * 2.0f * pt->camera.tan_half / (float)pt->camera.height;
@@ -411,7 +411,7 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
         // measured 1.08-1.14x less relMSE x time (docs/lab/2026-12-07-issue-46-s4.md).
         float max_beta = drift_vec3_max_component(beta);
         if (!p->disable_rr && depth + 1 >= p->rr_depth && max_beta < 1.0f) {
-            float q = fmaxf(0.0f, 1.0f - sqrtf(max_beta));
+            float q = drift_maxf(0.0f, 1.0f - sqrtf(max_beta));
             if (u_rr < q) {
                 break;
             }

@@ -14,7 +14,7 @@
 // n ~ m / 4 (docs/materials.md).
 static float phong_exponent_of_alpha(float alpha)
 {
-    float a = fmaxf(alpha, DRIFT_GGX_MIN_ALPHA);
+    float a = drift_maxf(alpha, DRIFT_GGX_MIN_ALPHA);
     return drift_clampf(0.5f / (a * a) - 0.5f, 0.5f, 1e6f);
 }
 
@@ -120,7 +120,7 @@ static drift_vec3 normal_mapped(const drift_scene *scene, const drift_material *
     drift_vec3 c = drift_material_texture(scene, m, DRIFT_TEXTURE_NORMAL, surface);
     float scale = m->ggx.normal_scale > 0.0f ? m->ggx.normal_scale : 1.0f;
     drift_vec3 local = drift_vec3_make((2.0f * c.x - 1.0f) * scale, (2.0f * c.y - 1.0f) * scale,
-                                       fmaxf(2.0f * c.z - 1.0f, 0.0f));
+                                       drift_maxf(2.0f * c.z - 1.0f, 0.0f));
     drift_vec3 bent = drift_vec3_add(
         drift_vec3_add(drift_vec3_scale(tangent, local.x), drift_vec3_scale(bitangent, local.y)),
         drift_vec3_scale(n, local.z));
@@ -143,7 +143,7 @@ static void make_ggx(const drift_scene *scene, const drift_material *m,
     float burley_roughness = m->diffuse_roughness;
     if (p->metallic_roughness_texture != DRIFT_INVALID_INDEX && scene) {
         drift_vec3 t = drift_material_texture(scene, m, DRIFT_TEXTURE_METALLIC_ROUGHNESS, surface);
-        float r = sqrtf(fmaxf(alpha, 0.0f)) * t.y;
+        float r = sqrtf(drift_maxf(alpha, 0.0f)) * t.y;
         alpha = r * r;
         metallic *= t.z;
         burley_roughness = drift_clampf(burley_roughness * t.y, 0.0f, 1.0f);
@@ -172,7 +172,7 @@ static void make_ggx(const drift_scene *scene, const drift_material *m,
         drift_vec3_is_zero(p->specular_tint) ? drift_vec3_splat(1.0f) : p->specular_tint;
     g->f0_coat = drift_vec3_min(drift_vec3_scale(tint, f0 * f0), drift_vec3_splat(1.0f));
     g->thin = p->thin;
-    float table_alpha = fmaxf(alpha, DRIFT_GGX_MIN_ALPHA);
+    float table_alpha = drift_maxf(alpha, DRIFT_GGX_MIN_ALPHA);
     drift__ggx_alpha_slot(table_alpha, &g->alpha_row, &g->alpha_frac);
     g->e1_avg = drift__ggx_e1_avg(table_alpha);
     g->es_avg = drift__ggx_es_avg(table_alpha);
@@ -243,7 +243,7 @@ drift_vec3 drift_bsdf_mirror_direction(const drift_bsdf *bsdf, drift_vec3 wo)
 static float phong_cos_alpha(const drift_bsdf *b, drift_vec3 wo, drift_vec3 wi)
 {
     drift_vec3 r = lobe_axis(b, wo);
-    return fmaxf(0.0f, drift_vec3_dot(r, wi));
+    return drift_maxf(0.0f, drift_vec3_dot(r, wi));
 }
 
 // Burley's diffuse over Lambert's: (1 + (F_D90 − 1)(1 − cos θl)^5)(1 + (F_D90 − 1)(1 − cos θv)^5)
@@ -316,7 +316,7 @@ drift_vec3 drift_bsdf_sample_glossy_lobe(const drift_bsdf *bsdf, drift_vec3 wo, 
 {
     drift_frame f = drift_frame_from_normal(lobe_axis(bsdf, wo));
     float cos_a = powf(u.x, 1.0f / (bsdf->exponent + 1.0f));
-    float sin_a = sqrtf(fmaxf(0.0f, 1.0f - cos_a * cos_a));
+    float sin_a = sqrtf(drift_maxf(0.0f, 1.0f - cos_a * cos_a));
     float phi = 2.0f * DRIFT_PI * u.y;
     return drift_frame_to_world(&f, drift_vec3_make(sin_a * cosf(phi), sin_a * sinf(phi), cos_a));
 }

@@ -78,7 +78,7 @@ float drift_light_spot_falloff(const drift_light *l, float cos_theta)
     switch (l->spot_falloff) {
     case DRIFT_SPOT_GLTF: {
         // lightAngleScale = 1 / max(0.001, cos inner − cos outer), as the extension's code.
-        float t = drift_clampf((cos_theta - lo) / fmaxf(0.001f, hi - lo), 0.0f, 1.0f);
+        float t = drift_clampf((cos_theta - lo) / drift_maxf(0.001f, hi - lo), 0.0f, 1.0f);
         return t * t;
     }
     case DRIFT_SPOT_BLENDER: {
@@ -270,8 +270,8 @@ uint32_t drift_scene_pick_light_reuse(const drift_scene *scene, float *u, float 
     if (i != DRIFT_INVALID_INDEX && *out_pmf > 0.0f) {
         const drift_light_table *t = scene->light_table;
         // Clamped below 1: a float's rounding at the top of the interval must not reach it.
-        *u = fminf((*u - t->cdf[i]) / *out_pmf, 0x1.fffffep-1f);
-        *u = fmaxf(*u, 0.0f);
+        *u = drift_minf((*u - t->cdf[i]) / *out_pmf, 0x1.fffffep-1f);
+        *u = drift_maxf(*u, 0.0f);
     }
     return i;
 }
@@ -302,7 +302,7 @@ static float area_to_solid_angle(float pdf_area, float dist, drift_vec3 wi, drif
 static float sphere_cone_one_minus_cos(float r, float d)
 {
     float sin2 = (r * r) / (d * d);
-    return sin2 / (1.0f + sqrtf(fmaxf(0.0f, 1.0f - sin2)));
+    return sin2 / (1.0f + sqrtf(drift_maxf(0.0f, 1.0f - sin2)));
 }
 
 // A uniformly sampled point p on area light `light` (density 1 / area), seen from ref.
@@ -412,7 +412,7 @@ drift_light_sample drift_light_sample_li(const drift_scene *scene, uint32_t ligh
         // Distance to the near intersection of the sampled ray with the sphere.
         float b = drift_vec3_dot(wi, to_center);
         float disc = l->radius * l->radius - (dc * dc - b * b);
-        float t = b - sqrtf(fmaxf(0.0f, disc));
+        float t = b - sqrtf(drift_maxf(0.0f, disc));
         s.wi = wi;
         s.distance = t;
         s.point = drift_vec3_fma(ref, wi, t);
@@ -550,7 +550,7 @@ bool drift_light_emit_area(const drift_scene *scene, const drift_light *l, drift
             } else {
                 u2.x = 2.0f * u2.x - 1.0f;
             }
-            u2.x = fminf(u2.x, 0x1.fffffep-1f);
+            u2.x = drift_minf(u2.x, 0x1.fffffep-1f);
         }
         break;
     }

@@ -149,7 +149,7 @@ void drift_surface_set_footprint(const drift_scene *scene, drift_surface *surfac
     // The cone's width over the surface: width / |cos| (eq. 34's log2|n . d| term), kept
     // finite at grazing angles.
     float cos_theta = fabsf(drift_vec3_dot(surface->ng, drift_vec3_normalize(ray_dir)));
-    float w = width / fmaxf(cos_theta, 1e-3f);
+    float w = width / drift_maxf(cos_theta, 1e-3f);
     surface->uv_footprint = w * uv_density(mesh, tri, mesh->uvs, area);
     surface->uv1_footprint =
         mesh->uvs1 ? w * uv_density(mesh, tri, mesh->uvs1, area) : surface->uv_footprint;
@@ -158,8 +158,9 @@ void drift_surface_set_footprint(const drift_scene *scene, drift_surface *surfac
 drift_vec3 drift_offset_origin(drift_vec3 position, drift_vec3 ng, drift_vec3 dir)
 {
     // Offset scaled to the coordinates' magnitude: float spacing grows with |p|.
-    float magnitude = fmaxf(fabsf(position.x), fmaxf(fabsf(position.y), fabsf(position.z)));
-    float eps = 3e-5f * fmaxf(1.0f, magnitude);
+    float magnitude =
+        drift_maxf(fabsf(position.x), drift_maxf(fabsf(position.y), fabsf(position.z)));
+    float eps = 3e-5f * drift_maxf(1.0f, magnitude);
     drift_vec3 n = drift_vec3_dot(ng, dir) < 0.0f ? drift_vec3_neg(ng) : ng;
     return drift_vec3_fma(position, n, eps);
 }

@@ -14,6 +14,35 @@
 
 // --- SAMPLER ---
 
+// drift_maxf / drift_minf replace fmaxf / fminf in the path tracer's loop and must give the
+// same bits: a NaN argument gives the other, equal arguments (+0 and -0) the second, as
+// glibc's fmaxf (maxss) does, and the libm call itself for ordinary and infinite values (for
+// +0 against -0 only the value: C leaves the sign open and GCC may swap fmaxf's operands).
+static void test_sampling_maxf_minf_match_libm(void **state)
+{
+    (void)state;
+    volatile float nan = NAN, pz = 0.0f, nz = -0.0f;
+    assert_true(drift_maxf(nan, 1.0f) == 1.0f && drift_maxf(1.0f, nan) == 1.0f);
+    assert_true(drift_minf(nan, -1.0f) == -1.0f && drift_minf(-1.0f, nan) == -1.0f);
+    assert_true(isnan(drift_maxf(nan, nan)) && isnan(drift_minf(nan, nan)));
+    assert_true(signbit(drift_maxf(pz, nz)) && !signbit(drift_maxf(nz, pz)));
+    assert_true(signbit(drift_minf(pz, nz)) && !signbit(drift_minf(nz, pz)));
+    const float v[] = { -INFINITY, -3.5f, -1e-40f, -0.0f, 0.0f, 1e-40f, 0.25f, 7.0f, INFINITY };
+    size_t n = sizeof v / sizeof v[0];
+    for (size_t i = 0; i < n; ++i) {
+        for (size_t j = 0; j < n; ++j) {
+            volatile float a = v[i], b = v[j];
+            float mx = drift_maxf(a, b), mn = drift_minf(a, b), lx = fmaxf(a, b), ln = fminf(a, b);
+            if (a == 0.0f && b == 0.0f) {
+                assert_true(mx == 0.0f && lx == 0.0f && mn == 0.0f && ln == 0.0f);
+                continue;
+            }
+            assert_memory_equal(&mx, &lx, sizeof mx);
+            assert_memory_equal(&mn, &ln, sizeof mn);
+        }
+    }
+}
+
 static void test_sampling_sampler_is_deterministic_and_in_range(void **state)
 {
     (void)state;
@@ -589,6 +618,7 @@ int main(void)
         cmocka_unit_test(test_sampling_disk_light_irradiance_closed_form),
         cmocka_unit_test(test_sampling_quad_light_irradiance_closed_form),
         cmocka_unit_test(test_sampling_light_pdf_matches_sample),
+        cmocka_unit_test(test_sampling_maxf_minf_match_libm),
         cmocka_unit_test(test_sampling_light_pick_follows_power),
         cmocka_unit_test(test_sampling_light_pick_reuse_rescales),
         cmocka_unit_test(test_sampling_environment_pdf_integrates_to_one),
