@@ -204,12 +204,13 @@ static drift_vec3 split_select(const path_split *s, uint32_t components)
 // sampling (Veach 1997, §9.2), with visibility.
 static drift_vec3 sample_direct(const drift_pt *pt, const drift_surface *surf,
                                 const drift_bsdf *bsdf, drift_vec3 wo, drift_sampler *sampler,
-                                float u_pick, thread_stats *stats)
+                                thread_stats *stats)
 {
     const drift_scene *scene = pt->scene;
     drift_vec2 u_light = drift_sampler_next2(sampler);
     float pmf;
-    (void)u_pick; // the pick reuses u_light.x (drift_scene_pick_light_reuse)
+    // The pick reuses u_light.x, rescaled (drift_scene_pick_light_reuse): the light's point
+    // keeps its stratification.
     uint32_t light = drift_scene_pick_light_reuse(scene, &u_light.x, &pmf);
     if (light == DRIFT_INVALID_INDEX || !(pmf > 0.0f)) {
         return drift_vec3_splat(0.0f);
@@ -371,9 +372,11 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
             feature_open = false;
         }
         path_length += hit.t;
-        drift_vec2 u_choice = drift_sampler_next2(&sampler); // x: light pick, y: lobe pick
+        // y: the lobe pick. x is unused since the light pick reuses the light sample's number;
+        // the pair is still drawn so that every later dimension, and every image, stays as it was.
+        drift_vec2 u_choice = drift_sampler_next2(&sampler);
         if (!p->disable_nee && !drift_bsdf_is_delta(&bsdf)) {
-            drift_vec3 ld = sample_direct(pt, &surf, &bsdf, wo, &sampler, u_choice.x, stats);
+            drift_vec3 ld = sample_direct(pt, &surf, &bsdf, wo, &sampler, stats);
             drift_vec3 c = drift_vec3_mul(beta, ld);
             radiance = drift_vec3_add(radiance, c);
             split_add(&split, depth, false, c);

@@ -466,10 +466,9 @@ static void test_sampling_light_pdf_matches_sample(void **state)
     drift_context_destroy(ctx);
 }
 
-static void test_sampling_light_pick_follows_power(void **state)
+// Two point lights of power 1 and 3: the pick's pmf is 1/4 and 3/4.
+static drift_scene *two_point_lights(drift_context *ctx)
 {
-    (void)state;
-    drift_context *ctx = test_context(1, NULL);
     drift_scene *scene = NULL;
     assert_int_equal(drift_scene_create(ctx, &scene), DRIFT_OK);
     drift_light a = { .type = DRIFT_LIGHT_POINT, .color = { 1, 1, 1 } };
@@ -477,6 +476,14 @@ static void test_sampling_light_pick_follows_power(void **state)
     assert_int_equal(drift_scene_add_light(scene, &a, NULL), DRIFT_OK);
     assert_int_equal(drift_scene_add_light(scene, &b, NULL), DRIFT_OK);
     assert_int_equal(drift_scene_commit(scene), DRIFT_OK);
+    return scene;
+}
+
+static void test_sampling_light_pick_follows_power(void **state)
+{
+    (void)state;
+    drift_context *ctx = test_context(1, NULL);
+    drift_scene *scene = two_point_lights(ctx);
     assert_float_equal(drift_scene_light_pmf(scene, 0), 0.25f, 1e-5f);
     assert_float_equal(drift_scene_light_pmf(scene, 1), 0.75f, 1e-5f);
     float pmf;
@@ -494,13 +501,7 @@ static void test_sampling_light_pick_reuse_rescales(void **state)
 {
     (void)state;
     drift_context *ctx = test_context(1, NULL);
-    drift_scene *scene = NULL;
-    assert_int_equal(drift_scene_create(ctx, &scene), DRIFT_OK);
-    drift_light a = { .type = DRIFT_LIGHT_POINT, .color = { 1, 1, 1 } };
-    drift_light b = { .type = DRIFT_LIGHT_POINT, .position = { 1, 0, 0 }, .color = { 3, 3, 3 } };
-    assert_int_equal(drift_scene_add_light(scene, &a, NULL), DRIFT_OK);
-    assert_int_equal(drift_scene_add_light(scene, &b, NULL), DRIFT_OK);
-    assert_int_equal(drift_scene_commit(scene), DRIFT_OK);
+    drift_scene *scene = two_point_lights(ctx);
     const float u_in[4] = { 0.1f, 0.4f, 0.25f, 0.99999994f };
     const uint32_t light[4] = { 0, 1, 1, 1 };
     const float u_out[4] = { 0.4f, 0.2f, 0.0f, 1.0f };
