@@ -231,8 +231,14 @@ int render_reference_finish(render_reference_run *run, bool cancelled, double t_
     drift_pt_params params = drift_pt_get_params(run->pt);
     char spp[64];
     snprintf(spp, sizeof spp, lowest == highest ? "%u spp" : "%u..%u spp", lowest, highest);
-    printf("wrote %s and %s (%s, %dx%d) in %.2f s (render %.2f s)\n", o->out_path, png, spp,
-           params.width, params.height, drift_time_now() - run->session->t_start,
-           t_rendered - run->t_render);
+    char size[96]; // the chooser's reduced-resolution pick is written upsampled
+    if (o->upsample_width > 0 && o->upsample_height > 0) {
+        snprintf(size, sizeof size, "rendered %dx%d, written %ldx%ld", params.width, params.height,
+                 o->upsample_width, o->upsample_height);
+    } else {
+        snprintf(size, sizeof size, "%dx%d", params.width, params.height);
+    }
+    printf("wrote %s and %s (%s, %s) in %.2f s (render %.2f s)\n", o->out_path, png, spp, size,
+           drift_time_now() - run->session->t_start, t_rendered - run->t_render);
     return cancelled ? render_interrupt_status() : complete ? 0 : 1;
 }
