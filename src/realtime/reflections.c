@@ -51,12 +51,6 @@ static drift_vec3 combine(const drift_bsdf *bsdf, drift_vec3 wo, drift_raster_ra
 // every other lobe are not traced here (docs/hybrid.md, "Glass").
 #define GLASS_INTERFACES 4
 
-static bool smooth_glass(const drift_bsdf *b)
-{
-    return b->type == DRIFT_MATERIAL_GGX && b->ggx.w_dielectric > 0.0f &&
-           (b->ggx.thin || b->ggx.alpha < 1e-3f);
-}
-
 static drift_vec3 glass_transmission(drift_frame_state *f, const drift_surface *s,
                                      const drift_bsdf *bsdf, drift_vec3 wo, drift_sampler *sampler,
                                      uint64_t *rays)
@@ -84,7 +78,7 @@ static drift_vec3 glass_transmission(drift_frame_state *f, const drift_surface *
             drift_surface next = drift_scene_surface(f->scene, &ray, &hit);
             if (next.material != DRIFT_INVALID_INDEX) {
                 drift_bsdf nb = drift_bsdf_make(f->scene, &next);
-                if (smooth_glass(&nb) && k + 1 < GLASS_INTERFACES) {
+                if (drift_bsdf_is_smooth_glass(&nb) && k + 1 < GLASS_INTERFACES) {
                     at = next;
                     b = nb;
                     w = drift_vec3_neg(ray.dir);
@@ -129,7 +123,7 @@ static void sharp_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *ra
     drift_image_set3(&f->reflection_reflected, x, y, l.reflected);
     drift_image_pixel(&f->reflection_distance, x, y)[0] = distance;
     drift_vec3 r = combine(&bsdf, wo, l);
-    if (smooth_glass(&bsdf)) {
+    if (drift_bsdf_is_smooth_glass(&bsdf)) {
         // A delta reflection: no light sample finds the emitters it sees (the environment's
         // share is D's split sum).
         if (isfinite(distance)) {

@@ -68,6 +68,12 @@ static bool smooth_dielectric(const drift_bsdf_ggx *g)
     return g->thin || g->alpha < DRIFT_GGX_MIN_ALPHA;
 }
 
+bool drift_bsdf_is_smooth_glass(const drift_bsdf *bsdf)
+{
+    return bsdf->type == DRIFT_MATERIAL_GGX && bsdf->ggx.w_dielectric > 0.0f &&
+           smooth_dielectric(&bsdf->ggx);
+}
+
 bool drift__ggx_is_delta(const drift_bsdf_ggx *g)
 {
     return g->w_dielectric >= 1.0f && smooth_dielectric(g);
