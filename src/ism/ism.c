@@ -93,17 +93,6 @@ static bool params_valid(const drift_ism_params *p)
            (uint64_t)p->points_per_vpl * drift__ism_max_vpls(p) <= (1u << 28);
 }
 
-// What one round of paths can leave: vpl_count first-bounce VPLs and later_vpl_count per
-// later bounce. max_vpls also covers the extra path rounds, which most scenes never need;
-// sizing the atlas and the scene points for it up front cost seconds and hundreds of MB at
-// 1024 VPLs and depth 8 (14M points), so they start at one round and grow on demand.
-static uint32_t initial_map_capacity(const drift_ism_params *p, uint32_t max_vpls)
-{
-    uint32_t bounces = p->max_depth > 1 ? (uint32_t)(p->max_depth - 1) : 0;
-    uint64_t one_round = bounces ? p->vpl_count + (uint64_t)(bounces - 1) * p->later_vpl_count : 0;
-    return one_round < max_vpls ? (uint32_t)one_round : max_vpls;
-}
-
 // A fingerprint of every mesh's vertex positions: the points are re-derived only when it
 // changes (a moving or deforming mesh), so a static frame skips the 3.4M random vertex reads
 // that the Breakfast Room's 417 maps of 8192 points cost (~250 ms loaded, as much as the
@@ -245,8 +234,12 @@ drift_result drift_ism_create(drift_context *ctx, const drift_scene *scene,
         if (r == DRIFT_OK && p.visibility == DRIFT_ISM_VISIBILITY_ISM) {
             ism->scratch =
                 drift_alloc(ctx, (size_t)drift_context_thread_count(ctx) * 2 * map * sizeof(float));
-            r = ism->scratch ? drift__ism_reserve(ism, initial_map_capacity(&p, ism->max_vpls))
-                             : DRIFT_ERR_OUT_OF_MEMORY;
+            // The atlas and the scene points are sized by the first render for the VPLs it
+            // made, and grow by half when a later one makes more (drift__ism_reserve). Sizing
+            // them up front for max_vpls (eight rounds of paths) sampled 14M points at 1024
+            // VPLs and depth 8; even one round's bound (1024 + 6 x 256 at depth 8) zeroed and
+            // faulted in 170 MB for a first frame that made 891 VPLs (1.6 s of a 1.9 s frame).
+            r = ism->scratch ? DRIFT_OK : DRIFT_ERR_OUT_OF_MEMORY;
         }
     }
     if (r != DRIFT_OK) {

@@ -395,9 +395,9 @@ void test_vpl_importance_keeps_useful_vpls(void **state)
     test_rig_destroy(&r);
 }
 
-// The atlas and the scene points start at one round of paths, not at the bound over eight
-// rounds (which sampled 14M points at 1024 VPLs, depth 8), and growing them changes no pixel:
-// point i is the same Sobol sample whatever the count.
+// The atlas and the scene points hold the VPLs a render made (at most one round of paths), not
+// the bound over eight rounds (which sampled 14M points at 1024 VPLs, depth 8), and growing
+// them changes no pixel: point i is the same Sobol sample whatever the count.
 void test_maps_grow_without_changing_the_image(void **state)
 {
     (void)state;
