@@ -80,7 +80,7 @@ drift_light_sample drift_raster_light_sample(const drift_scene *scene,
 
 // Unshadowed direct light U_l: outgoing radiance toward wo at the surface from light
 // `light` through the non-delta lobes, without visibility. Delta lights are exact. Quad
-// lights and emissive meshes of up to 8 triangles get their diffuse lobe in closed form
+// lights and emissive meshes of up to 32 triangles get their diffuse lobe in closed form
 // (Lambert's polygon formula, clipped to the hemisphere). What remains (the glossy lobe;
 // both lobes for disk, sphere and larger mesh lights) takes `sample_count` points of a
 // Hammersley set shifted by one random offset drawn from `sampler` (Cranley-Patterson

@@ -26,7 +26,7 @@ static drift_vec3 light_sample_contribution(const drift_surface *surface, const 
 // --- POLYGON LIGHTS IN CLOSED FORM ---
 
 // Meshes with more triangles than this are sampled rather than summed triangle by triangle.
-#define MAX_CLOSED_FORM_TRIANGLES 8
+#define MAX_CLOSED_FORM_TRIANGLES 32
 
 // Clips the convex polygon `in` to the half space above the plane through p with normal n
 // (Sutherland-Hodgman); returns the vertex count of `out` (room for count + 1).
