@@ -217,7 +217,13 @@ float drift__ggx_integrate_dielectric(float mu, float alpha, float eta, int stra
 
 float drift__ggx_ms_alpha(float alpha)
 {
-    return DRIFT_GGX_MS_WIDTH * fmaxf(alpha, DRIFT_GGX_MIN_ALPHA);
+    // Cycles 3.4's random walk keeps a rough metal's multiply scattered light nearer the
+    // specular direction than a lobe 2.5 times as wide (issue 41 s6: at r 0.8 the old width
+    // was 0.89-1.20x Cycles at theta >= 70 degrees, back-scattering too bright).
+    float a = fmaxf(alpha, DRIFT_GGX_MIN_ALPHA), r = sqrtf(a);
+    float t =
+        drift_clampf((r - DRIFT_GGX_MS_WIDTH_KNEE) / (1.0f - DRIFT_GGX_MS_WIDTH_KNEE), 0.0f, 1.0f);
+    return (DRIFT_GGX_MS_WIDTH + t * (DRIFT_GGX_MS_WIDTH_ROUGH - DRIFT_GGX_MS_WIDTH)) * a;
 }
 
 float drift__ggx_fit_ms_scale(float ms_alpha, const float *e1, int strata, float *out_scale)

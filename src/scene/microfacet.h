@@ -77,7 +77,11 @@ float drift__ggx_integrate_dielectric(float mu, float alpha, float eta, int stra
 // single-scatter GGX of the broader roughness drift__ggx_ms_alpha(alpha), scaled by s so that
 // its albedo is 1 - E1(mu_o) at every mu_o: reciprocal and white-furnace exact. s is tabulated
 // on the E tables' grid (drift__ggx_ms_scale_at, linear in mu between cell centres).
-#define DRIFT_GGX_MS_WIDTH 2.5f
+// The broad roughness is k(r) alpha, r = sqrt(alpha): k = 2.5 up to r = 0.35, then falling
+// linearly to 1 at r = 1 (fitted to Cycles 3.4's random walk: docs/materials.md).
+#define DRIFT_GGX_MS_WIDTH       2.5f
+#define DRIFT_GGX_MS_WIDTH_KNEE  0.35f
+#define DRIFT_GGX_MS_WIDTH_ROUGH 1.0f
 float drift__ggx_ms_alpha(float alpha);
 // One alpha row of s for the broad lobe's roughness ms_alpha and that row of the E1 table (e1,
 // DRIFT_GGX_TABLE_MU_N values): with wo at each grid mu, the lobe's albedo is linear in s's

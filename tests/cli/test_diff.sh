@@ -160,6 +160,52 @@ for cut in flat_cut rle_cut; do
     grep -q "$cut.hdr.*truncated" "$tmp/err" || fail "truncated $cut.hdr is named"
 done
 
+# --mask (per-object metrics, issue 41): a test image brighter than REF on its left 12 columns
+# only; masks of the left 8 columns, of the right 8 and of nothing. The masked MSE and luminance
+# ratio are checked against python's own sums over the same pixels.
+PYTHONPATH="$(dirname "$0")" python3 - "$tmp" <<'PY'
+import sys
+from make_exr import exr
+d = sys.argv[1]
+ref = lambda x, y: (0.1 + 0.02 * x, 0.2 + 0.01 * y, 0.3)
+exr(d + "/mref.exr", 32, 24, ref)
+exr(d + "/mtest.exr", 32, 24, lambda x, y: tuple(c * (1.5 if x < 12 else 1.0) for c in ref(x, y)))
+exr(d + "/mleft.exr", 32, 24, lambda x, y: (1.0 if x < 8 else 0.0,) * 3)
+exr(d + "/mright.exr", 32, 24, lambda x, y: (0.7 if x >= 24 else 0.3,) * 3)
+exr(d + "/mnone.exr", 32, 24, lambda x, y: (0.2, 0.2, 0.2))
+exr(d + "/msmall.exr", 16, 24, lambda x, y: (1.0, 1.0, 1.0))
+PY
+expect 0 "$drift" diff "$tmp/mref.exr" "$tmp/mtest.exr" --json
+cp "$tmp/out" "$tmp/whole.json"
+expect 0 "$drift" diff "$tmp/mref.exr" "$tmp/mtest.exr" --json --mask "$tmp/mleft.exr"
+cp "$tmp/out" "$tmp/left.json"
+expect 0 "$drift" diff "$tmp/mref.exr" "$tmp/mtest.exr" --json --mask "$tmp/mright.exr"
+cp "$tmp/out" "$tmp/right.json"
+python3 - "$tmp" <<'PY' || fail "--mask: metrics over the masked pixels"
+import json, sys
+d = sys.argv[1]
+w, l, r = (json.load(open(d + "/%s.json" % n)) for n in ("whole", "left", "right"))
+assert sorted(l) == sorted(["mse", "rmse", "relmse", "psnr", "flip", "luminance", "nonfinite",
+                            "mask_pixels"]), l
+assert l["mask_pixels"] == 8 * 24 and r["mask_pixels"] == 8 * 24, (l, r)
+ref = lambda x, y: (0.1 + 0.02 * x, 0.2 + 0.01 * y, 0.3)
+px = [ref(x, y) for y in range(24) for x in range(8)]
+mse = sum((0.5 * c) ** 2 for p in px for c in p) / (3 * len(px))
+assert abs(l["mse"] - mse) < 1e-6 * mse, (l["mse"], mse)
+assert abs(l["luminance"] - 1.5) < 1e-5, l
+assert r["mse"] == 0 and r["luminance"] == 1 and r["psnr"] is None, r
+assert l["flip"] > w["flip"] > r["flip"] >= 0, (l["flip"], w["flip"], r["flip"])
+PY
+expect 1 "$drift" diff "$tmp/mref.exr" "$tmp/mtest.exr" --mask "$tmp/mleft.exr" --difftol 0.01
+grep -q "exceeds" "$tmp/err" || fail "--difftol applies to the masked FLIP"
+expect 1 "$drift" diff "$tmp/mref.exr" "$tmp/mtest.exr" --mask "$tmp/mnone.exr"
+grep -q "selects no pixel" "$tmp/err" || fail "an empty mask is explained"
+expect 1 "$drift" diff "$tmp/mref.exr" "$tmp/mtest.exr" --mask "$tmp/msmall.exr"
+grep -q "msmall.exr.*16x24" "$tmp/err" || fail "a mask of another size is named"
+expect 1 "$drift" diff "$tmp/mref.exr" "$tmp/mtest.exr" --mask "$tmp/missing_mask.exr"
+grep -q "missing_mask.exr" "$tmp/err" || fail "a missing mask is named"
+expect 2 "$drift" diff "$tmp/mref.exr" "$tmp/mtest.exr" --mask "$tmp/mleft.exr" --frames 0:1
+
 if [ "$failures" -ne 0 ]; then
     echo "$failures failure(s)" >&2
     exit 1

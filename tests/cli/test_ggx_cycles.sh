@@ -5,10 +5,12 @@
 #
 # 1. Four gold metal spheres of roughness 0.05, 0.25, 0.5, 0.8, a glass sphere, a floor, an
 #    emissive slab and a point light (ggx_scene.glb): drift at 64x48, 64 spp must agree within
-#    FLIP 0.055 and 3% in mean luminance, the glass and the metals' reflections included. At
-#    64 spp drift's own noise is about 0.01 of FLIP (0.037 at 256 spp, 0.047 at 64;
-#    docs/materials.md); without the energy compensation, or with the glass thin-walled, FLIP
-#    is 0.10-0.11.
+#    FLIP 0.05 and 3% in mean luminance, the glass and the metals' reflections included (drift
+#    0.042-0.044 at 64 spp, four seeds; docs/lab/2026-12-07-issue-41-s6.md); without the energy
+#    compensation, or with the glass thin-walled, FLIP is 0.10-0.11. Per object, the rough
+#    (0.8) sphere alone (its coverage mask mask_metal3.exr, `drift diff --mask`): FLIP 0.10 and
+#    2% (drift 0.078-0.088 and +0.4..+0.9% at 64 spp, four seeds; with the multiple-scattering
+#    lobe 2.5 alpha wide at every roughness 0.106-0.131 and +2.7..+4.4%, which this fails).
 # 2. The textured scene without the spheres (textured/, --textured --no-spheres: a
 #    metallic-roughness checker floor of gold roughness 0.3 and plastic roughness 0.8, a
 #    normal-mapped wall), as exported (mip-mapped sampler): FLIP 0.06 and 3% at 64 spp (drift
@@ -53,7 +55,16 @@ sys.exit(0 if d["flip"] <= bound and abs(ratio - 1.0) <= 0.03 else 1)
 PY
 }
 
-against_cycles spheres "$data/ggx_scene.glb" "$data/cycles_64x48.exr" 0.055
+against_cycles spheres "$data/ggx_scene.glb" "$data/cycles_64x48.exr" 0.05
+expect 0 "$drift" diff "$data/cycles_64x48.exr" "$tmp/spheres.exr" --mask "$data/mask_metal3.exr" \
+    --json
+python3 - "$tmp/out" <<'PY' || fail "drift and Cycles disagree on the rough sphere"
+import json, sys
+d = json.load(open(sys.argv[1]))
+print("cli.ggx_cycles, the rough sphere (%d pixels): FLIP %.4f (<= 0.1), luminance drift/Cycles "
+      "%.4f (within 2%%)" % (d["mask_pixels"], d["flip"], d["luminance"]))
+sys.exit(0 if d["flip"] <= 0.1 and abs(d["luminance"] - 1.0) <= 0.02 else 1)
+PY
 
 # The textured scene as Blender exported it (its sampler mip-mapped: drift filters by the ray
 # cone, Cycles 3.4 reads texels unfiltered; the cone keeps the camera's spread through bounces).
