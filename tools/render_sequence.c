@@ -140,14 +140,24 @@ typedef struct sequence_run {
     cJSON *frames; // its "frames" array
 } sequence_run;
 
+static int finish_frame(sequence_run *s, long k, const drift_camera *camera,
+                        const drift_image *image, const char *out_path, cJSON *entry,
+                        double temporal_ms);
+
 // One hybrid frame of the sequence: rendered, reused (--temporal) and written.
 static int hybrid_frame(sequence_run *s, long k, const drift_camera *camera, const char *out_path,
                         cJSON *entry)
 {
     const render_options *o = s->o;
-    drift_context *ctx = s->session->ctx;
     drift_camera cam = *camera;
     uint32_t index = (uint32_t)(k - o->frame_first);
+    // --still-refine progressive: a standing camera's frames go to the path tracer alone.
+    if (s->still && !drift_still_refine_needs_hybrid(s->still, camera)) {
+        cJSON_AddBoolToObject(entry, "hybrid", false);
+        const drift_image *start =
+            s->moving ? drift_moving_refine_image(s->moving) : drift_temporal_image(s->temporal);
+        return finish_frame(s, k, camera, start, out_path, entry, 0.0);
+    }
     if (s->temporal) {
         // A new seed and sub-pixel offset a frame: the history averages independent samples
         // over the pixel's box filter, as the path tracer does (the viewer's set-up).
@@ -195,6 +205,17 @@ static int hybrid_frame(sequence_run *s, long k, const drift_camera *camera, con
         }
         image = drift_moving_refine_image(s->moving);
     }
+    return finish_frame(s, k, camera, image, out_path, entry, temporal_ms);
+}
+
+// The rest of a frame: the still refinement, the glare, the files and the stats.
+static int finish_frame(sequence_run *s, long k, const drift_camera *camera,
+                        const drift_image *image, const char *out_path, cJSON *entry,
+                        double temporal_ms)
+{
+    const render_options *o = s->o;
+    drift_context *ctx = s->session->ctx;
+    drift_result r = DRIFT_OK;
     if (s->still) {
         // The camera before its jitter: frames where it stands refine (the viewer's).
         r = drift_still_refine_apply(s->still, camera, image, render_catch_sigint());
@@ -298,7 +319,7 @@ static int run_frames(sequence_run *s)
         cJSON_AddNumberToObject(entry, "frame", (double)k);
         cli_json_number(entry, "time", time, 6);
         cJSON_AddStringToObject(entry, "out", out_path);
-        double t0 = drift_time_now();
+        double t0 = drift_time_now(), cpu0 = render_cpu_now();
         int status = s->anim ? pose_scene(s, k, time, entry) : 0;
         if (status != 0) {
             return status;
@@ -316,6 +337,7 @@ static int run_frames(sequence_run *s)
         }
         double ms = 1e3 * (drift_time_now() - t0);
         cli_json_number(entry, "ms", ms, 3);
+        cli_json_number(entry, "cpu_ms", 1e3 * (render_cpu_now() - cpu0), 3); // all threads
         total_ms += ms;
         if (status != 0) {
             return status;
@@ -444,7 +466,10 @@ int render_sequence(const render_options *o, cli_session *session)
             (r = drift_still_refine_create(
                  ctx, session->scene, session->accel, params.width, params.height,
                  &(drift_still_refine_settings){ .seed = (uint32_t)o->seed,
-                                                 .max_depth = (int32_t)o->max_depth },
+                                                 .max_depth = (int32_t)o->max_depth,
+                                                 .spp = o->temporal_settings.still_spp,
+                                                 .progressive =
+                                                     o->temporal_settings.still_progressive },
                  &s.still)) != DRIFT_OK) {
             fprintf(stderr, "drift render: %s\n", drift_result_string(r));
             goto done;
