@@ -297,9 +297,9 @@ static const cli_option render_table[] = {
     CLI_CHOICE("--still-refine", "on|off|progressive", O, still_refine, "off|on|progressive",
                "--temporal on, a still camera: each frame adds a path-traced sample\n"
                "a pixel, denoised and blended in where its error is the lower;\n"
-               "progressive: once still, no more hybrid frames, every frame path-\n"
-               "traces --still-spp samples and the hybrid fades out by sample count\n"
-               "(default on; docs/temporal.md)"),
+               "progressive: once still, no more hybrid frames, every frame adds\n"
+               "--still-spp path-traced samples and the hybrid fades out by sample\n"
+               "count (default on; docs/temporal.md)"),
     CLI_INT("--still-spp", "N", O, temporal_settings.still_spp, 1, 1 << 16,
             "path-traced samples a pixel each still frame adds (default 1; 4 with\n"
             "--still-refine progressive)"),

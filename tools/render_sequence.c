@@ -136,8 +136,9 @@ typedef struct sequence_run {
     // step 1 / fps (the hybrid frame's own glare pass steps by the wall clock)
     drift_glare *glare;
     drift_image glared;
-    cJSON *stats;  // the --stats object
-    cJSON *frames; // its "frames" array
+    double frame_t0, frame_cpu0; // this frame's start (wall, CPU): its time before writing
+    cJSON *stats;                // the --stats object
+    cJSON *frames;               // its "frames" array
 } sequence_run;
 
 static int finish_frame(sequence_run *s, long k, const drift_camera *camera,
@@ -235,6 +236,9 @@ static int finish_frame(sequence_run *s, long k, const drift_camera *camera,
         }
         image = &s->glared;
     }
+    // The frame's time without writing its files (what the viewer would spend on it).
+    cli_json_number(entry, "render_ms", 1e3 * (drift_time_now() - s->frame_t0), 3);
+    cli_json_number(entry, "render_cpu_ms", 1e3 * (render_cpu_now() - s->frame_cpu0), 3);
     render_options fo = *o;
     fo.out_path = out_path;
     fo.aov_path = NULL;
@@ -320,6 +324,8 @@ static int run_frames(sequence_run *s)
         cli_json_number(entry, "time", time, 6);
         cJSON_AddStringToObject(entry, "out", out_path);
         double t0 = drift_time_now(), cpu0 = render_cpu_now();
+        s->frame_t0 = t0;
+        s->frame_cpu0 = cpu0;
         int status = s->anim ? pose_scene(s, k, time, entry) : 0;
         if (status != 0) {
             return status;
