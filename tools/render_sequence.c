@@ -247,6 +247,9 @@ static int finish_frame(sequence_run *s, long k, const drift_camera *camera,
         !render_stage_commit(&stage)) {
         return 1;
     }
+    if (cJSON_IsFalse(cJSON_GetObjectItemCaseSensitive(entry, "hybrid"))) {
+        return 0; // no hybrid frame: its stats would be the last one's
+    }
     drift_hybrid_stats st = drift_hybrid_get_stats(s->frame);
     cli_json_number(entry, "frame_ms", st.frame_ms, 3);
     cli_json_number(entry, "temporal_ms", temporal_ms, 3);
