@@ -41,7 +41,8 @@ typedef struct view_options {
     bool refine;            // --refine sir
     long refine_budget;     // --budget: SIR samples a frame (0: the default)
     bool temporal;          // --temporal on: reuse across frames (docs/temporal.md)
-    bool still_refine;      // --still-refine on|off: a still camera refines to the path tracer
+    long still_refine;      // --still-refine off|on|progressive: a still camera refines to PT
+    long still_spp;         // --still-spp: path-traced samples a still frame (0: the default)
     long moving_refine;     // --moving-refine off|path|residual (temporal_settings)
     const char *edits_path; // --reflection-edits: loaded if it exists, saved by the save key
 } view_options;
@@ -138,10 +139,15 @@ static const cli_option view_table[] = {
     CLI_CHOICE("--temporal", "off|on", O, temporal, "off|on",
                "reuse across frames: a still camera converges, a moving one\n"
                "reprojects its history (docs/temporal.md; not with --refine)"),
-    CLI_CHOICE("--still-refine", "on|off", O, still_refine, "off|on",
+    CLI_CHOICE("--still-refine", "on|off|progressive", O, still_refine, "off|on|progressive",
                "--temporal on, a still camera: each frame adds a path-traced\n"
                "sample a pixel, denoised and blended in where its error is the\n"
-               "lower (default on; docs/temporal.md)"),
+               "lower; progressive: once still, no more hybrid frames, every\n"
+               "frame path-traces --still-spp samples and the hybrid fades out\n"
+               "by sample count (default on; docs/temporal.md)"),
+    CLI_INT("--still-spp", "N", O, still_spp, 1, 1 << 16,
+            "path-traced samples a pixel each still frame adds (default 1; 4\n"
+            "with --still-refine progressive)"),
     CLI_CHOICE("--moving-refine", "off|path|residual", O, moving_refine, "off|path|residual",
                "--temporal on: every frame adds a path-traced sample a pixel,\n"
                "reprojected with the history, filtered and blended in where its\n"
@@ -264,7 +270,7 @@ static bool parse_press(const char *cmd, const char *flag, const char *v, void *
 static int parse_options(int argc, char **argv, view_options *o)
 {
     *o = (view_options){
-        .spp = 4, .spp_per_frame = 1, .hybrid = drift_hybrid_params_default(), .still_refine = true
+        .spp = 4, .spp_per_frame = 1, .hybrid = drift_hybrid_params_default(), .still_refine = 1
     };
     cli_knobs_unset(&o->hybrid);
     int status = cli_parse(&view_command, argc, argv, o, NULL);
@@ -671,7 +677,9 @@ int drift_cmd_view(int argc, char **argv)
                             .refine = o.refine,
                             .refine_budget = (uint32_t)o.refine_budget,
                             .temporal = o.temporal,
-                            .temporal_settings = { .no_still_refine = !o.still_refine,
+                            .temporal_settings = { .no_still_refine = o.still_refine == 0,
+                                                   .still_progressive = o.still_refine == 2,
+                                                   .still_spp = (uint32_t)o.still_spp,
                                                    .moving_refine = (int32_t)o.moving_refine },
                             .reflection_edits_path = o.edits_path },
         &view);

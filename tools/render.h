@@ -86,7 +86,7 @@ typedef struct render_options {
     const char *video_path;  // --video FILE.mp4 (ffmpeg, when installed)
     bool temporal;           // --temporal on: reuse across frames (hybrid, drift/temporal.h)
     drift_temporal_settings temporal_settings;
-    bool still_refine; // --still-refine on|off (temporal_settings.no_still_refine)
+    long still_refine; // --still-refine off|on|progressive (0, 1, 2: temporal_settings)
 } render_options;
 
 // drift render's options from argv: 0, 2 after a usage error (message printed), -1 after

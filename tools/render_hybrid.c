@@ -33,7 +33,8 @@ typedef struct temporal_stats {
     long frames;
     double ms;
     uint32_t still_samples;
-    cJSON *frame_ms; // an array, handed to the stats object
+    cJSON *frame_ms;     // an array, handed to the stats object
+    cJSON *frame_cpu_ms; // each frame's CPU time, all threads (a loaded machine's fairer clock)
 } temporal_stats;
 
 static bool write_stats(const render_options *o, const cli_session *session,
@@ -84,6 +85,7 @@ static bool write_stats(const render_options *o, const cli_session *session,
         cli_json_number(t, "frames_ms", temporal->ms, 3);
         cli_json_count(t, "still_samples", temporal->still_samples);
         cJSON_AddItemReferenceToObject(t, "frame_ms", temporal->frame_ms);
+        cJSON_AddItemReferenceToObject(t, "frame_cpu_ms", temporal->frame_cpu_ms);
     }
     uint64_t total_rays = 0;
     cJSON *passes = cJSON_AddObjectToObject(root, "passes");
@@ -226,6 +228,7 @@ int render_hybrid(const render_options *o, const cli_session *session)
     drift_temporal *temporal = NULL;  // --temporal on (--frames: a still camera's sequence)
     drift_still_refine *still = NULL; // and its refinement toward the path tracer
     cJSON *frame_ms = NULL;           // --temporal on: each frame's wall time
+    cJSON *frame_cpu_ms = NULL;       // and CPU time
     drift_result r = DRIFT_OK;
     int exit_code = 1;
     if (o->aperture >= 0.0) {
@@ -279,22 +282,29 @@ int render_hybrid(const render_options *o, const cli_session *session)
             r = drift_still_refine_create(
                 ctx, scene, session->accel, params.width, params.height,
                 &(drift_still_refine_settings){ .seed = (uint32_t)o->seed,
-                                                .max_depth = (int32_t)o->max_depth },
+                                                .max_depth = (int32_t)o->max_depth,
+                                                .spp = o->temporal_settings.still_spp,
+                                                .progressive =
+                                                    o->temporal_settings.still_progressive },
                 &still);
         }
     }
     double t_frames = drift_time_now();
     frame_ms = cJSON_CreateArray();
+    frame_cpu_ms = cJSON_CreateArray();
     for (long k = 0; k < o->frames && r == DRIFT_OK; ++k) {
-        double t_frame = drift_time_now();
+        double t_frame = drift_time_now(), cpu_frame = render_cpu_now();
         drift_camera camera = scene->camera;
-        if (temporal) {
-            r = drift_temporal_prepare(frame, (uint32_t)o->seed, (uint32_t)k, &camera);
-        }
-        r = r == DRIFT_OK ? drift_hybrid_render(frame, &camera, render_catch_sigint()) : r;
-        if (r == DRIFT_OK && temporal) {
-            r = drift_temporal_apply(temporal, drift_hybrid_gbuffer(frame), &camera,
-                                     drift_hybrid_image(frame));
+        // --still-refine progressive: once the camera stands, no more hybrid frames.
+        if (!still || drift_still_refine_needs_hybrid(still, &scene->camera)) {
+            if (temporal) {
+                r = drift_temporal_prepare(frame, (uint32_t)o->seed, (uint32_t)k, &camera);
+            }
+            r = r == DRIFT_OK ? drift_hybrid_render(frame, &camera, render_catch_sigint()) : r;
+            if (r == DRIFT_OK && temporal) {
+                r = drift_temporal_apply(temporal, drift_hybrid_gbuffer(frame), &camera,
+                                         drift_hybrid_image(frame));
+            }
         }
         if (r == DRIFT_OK && still) {
             r = drift_still_refine_apply(still, &scene->camera, drift_temporal_image(temporal),
@@ -305,11 +315,14 @@ int render_hybrid(const render_options *o, const cli_session *session)
         }
         cJSON_AddItemToArray(frame_ms,
                              cJSON_CreateNumber(round(1e6 * (drift_time_now() - t_frame)) / 1e3));
+        cJSON_AddItemToArray(frame_cpu_ms,
+                             cJSON_CreateNumber(round(1e6 * (render_cpu_now() - cpu_frame)) / 1e3));
     }
     temporal_stats timing = { .frames = o->frames,
                               .ms = 1e3 * (drift_time_now() - t_frames),
                               .still_samples = drift_still_refine_samples(still),
-                              .frame_ms = frame_ms };
+                              .frame_ms = frame_ms,
+                              .frame_cpu_ms = frame_cpu_ms };
     if (r == DRIFT_ERR_CANCELLED) {
         fprintf(stderr, "drift render: interrupted; a hybrid frame is all or nothing, nothing "
                         "written\n");
@@ -376,6 +389,7 @@ int render_hybrid(const render_options *o, const cli_session *session)
     exit_code = 0;
 done:
     cJSON_Delete(frame_ms);
+    cJSON_Delete(frame_cpu_ms);
     drift_still_refine_destroy(still);
     drift_temporal_destroy(temporal);
     drift_hybrid_destroy(frame);

@@ -136,18 +136,29 @@ typedef struct sequence_run {
     // step 1 / fps (the hybrid frame's own glare pass steps by the wall clock)
     drift_glare *glare;
     drift_image glared;
-    cJSON *stats;  // the --stats object
-    cJSON *frames; // its "frames" array
+    double frame_t0, frame_cpu0; // this frame's start (wall, CPU): its time before writing
+    cJSON *stats;                // the --stats object
+    cJSON *frames;               // its "frames" array
 } sequence_run;
+
+static int finish_frame(sequence_run *s, long k, const drift_camera *camera,
+                        const drift_image *image, const char *out_path, cJSON *entry,
+                        double temporal_ms);
 
 // One hybrid frame of the sequence: rendered, reused (--temporal) and written.
 static int hybrid_frame(sequence_run *s, long k, const drift_camera *camera, const char *out_path,
                         cJSON *entry)
 {
     const render_options *o = s->o;
-    drift_context *ctx = s->session->ctx;
     drift_camera cam = *camera;
     uint32_t index = (uint32_t)(k - o->frame_first);
+    // --still-refine progressive: a standing camera's frames go to the path tracer alone.
+    if (s->still && !drift_still_refine_needs_hybrid(s->still, camera)) {
+        cJSON_AddBoolToObject(entry, "hybrid", false);
+        const drift_image *start =
+            s->moving ? drift_moving_refine_image(s->moving) : drift_temporal_image(s->temporal);
+        return finish_frame(s, k, camera, start, out_path, entry, 0.0);
+    }
     if (s->temporal) {
         // A new seed and sub-pixel offset a frame: the history averages independent samples
         // over the pixel's box filter, as the path tracer does (the viewer's set-up).
@@ -195,6 +206,17 @@ static int hybrid_frame(sequence_run *s, long k, const drift_camera *camera, con
         }
         image = drift_moving_refine_image(s->moving);
     }
+    return finish_frame(s, k, camera, image, out_path, entry, temporal_ms);
+}
+
+// The rest of a frame: the still refinement, the glare, the files and the stats.
+static int finish_frame(sequence_run *s, long k, const drift_camera *camera,
+                        const drift_image *image, const char *out_path, cJSON *entry,
+                        double temporal_ms)
+{
+    const render_options *o = s->o;
+    drift_context *ctx = s->session->ctx;
+    drift_result r = DRIFT_OK;
     if (s->still) {
         // The camera before its jitter: frames where it stands refine (the viewer's).
         r = drift_still_refine_apply(s->still, camera, image, render_catch_sigint());
@@ -214,6 +236,9 @@ static int hybrid_frame(sequence_run *s, long k, const drift_camera *camera, con
         }
         image = &s->glared;
     }
+    // The frame's time without writing its files (what the viewer would spend on it).
+    cli_json_number(entry, "render_ms", 1e3 * (drift_time_now() - s->frame_t0), 3);
+    cli_json_number(entry, "render_cpu_ms", 1e3 * (render_cpu_now() - s->frame_cpu0), 3);
     render_options fo = *o;
     fo.out_path = out_path;
     fo.aov_path = NULL;
@@ -221,6 +246,9 @@ static int hybrid_frame(sequence_run *s, long k, const drift_camera *camera, con
     if (!render_stage_hybrid_images(ctx, &fo, image, s->frame, NULL, &stage) ||
         !render_stage_commit(&stage)) {
         return 1;
+    }
+    if (cJSON_IsFalse(cJSON_GetObjectItemCaseSensitive(entry, "hybrid"))) {
+        return 0; // no hybrid frame: its stats would be the last one's
     }
     drift_hybrid_stats st = drift_hybrid_get_stats(s->frame);
     cli_json_number(entry, "frame_ms", st.frame_ms, 3);
@@ -298,7 +326,9 @@ static int run_frames(sequence_run *s)
         cJSON_AddNumberToObject(entry, "frame", (double)k);
         cli_json_number(entry, "time", time, 6);
         cJSON_AddStringToObject(entry, "out", out_path);
-        double t0 = drift_time_now();
+        double t0 = drift_time_now(), cpu0 = render_cpu_now();
+        s->frame_t0 = t0;
+        s->frame_cpu0 = cpu0;
         int status = s->anim ? pose_scene(s, k, time, entry) : 0;
         if (status != 0) {
             return status;
@@ -316,6 +346,7 @@ static int run_frames(sequence_run *s)
         }
         double ms = 1e3 * (drift_time_now() - t0);
         cli_json_number(entry, "ms", ms, 3);
+        cli_json_number(entry, "cpu_ms", 1e3 * (render_cpu_now() - cpu0), 3); // all threads
         total_ms += ms;
         if (status != 0) {
             return status;
@@ -444,7 +475,10 @@ int render_sequence(const render_options *o, cli_session *session)
             (r = drift_still_refine_create(
                  ctx, session->scene, session->accel, params.width, params.height,
                  &(drift_still_refine_settings){ .seed = (uint32_t)o->seed,
-                                                 .max_depth = (int32_t)o->max_depth },
+                                                 .max_depth = (int32_t)o->max_depth,
+                                                 .spp = o->temporal_settings.still_spp,
+                                                 .progressive =
+                                                     o->temporal_settings.still_progressive },
                  &s.still)) != DRIFT_OK) {
             fprintf(stderr, "drift render: %s\n", drift_result_string(r));
             goto done;

@@ -69,6 +69,10 @@ typedef struct drift_temporal_settings {
     float phi_luminance;
     float depth_sigma;
     bool no_still_refine; // true: a still camera shows the temporal image alone (below)
+    // true: once the camera stands, the drivers stop rendering the hybrid frame and spend each
+    // frame on still_spp path-traced samples (drift_still_refine_settings.progressive)
+    bool still_progressive;
+    uint32_t still_spp; // 0 -> 1 (on) or 4 (progressive): path-traced samples a still frame
     // 0: off; 1: every frame refines toward reprojected path-traced samples; 2: the same with
     // their residual against the hybrid frame (drift_moving_refine, below; the drivers')
     int32_t moving_refine;
@@ -143,6 +147,15 @@ typedef struct drift_still_refine_settings {
     int32_t max_depth;    // 0 -> the path tracer's default (8)
     float denoised_error; // 0 -> 0.25: the denoised mean's error^2 over the raw mean's variance
     int32_t radius;       // 0 -> 4: the error windows' half-width in pixels
+    // true (--still-refine progressive): from the second still frame on the drivers render no
+    // hybrid frame (drift_still_refine_needs_hybrid is false): the frame's time goes to `spp`
+    // path-traced samples, the last temporal image is only the start, and the path tracer's
+    // weight is at least n / (n + fade_samples) after n samples (fading the hybrid out by
+    // sample count, so the image converges to the denoised path tracer). fade_samples 1, 4,
+    // 16 at 400^2 after 4 samples: Cornell box 0.035, 0.042, 0.053 FLIP, Breakfast Room
+    // 0.096, 0.099, 0.110 (docs/lab/2026-12-07-issue-47-s6.md): the path tracer's quick.
+    bool progressive;
+    uint32_t fade_samples; // 0 -> 1
 } drift_still_refine_settings;
 
 typedef struct drift_still_refine drift_still_refine;
@@ -165,6 +178,9 @@ void drift_still_refine_reset(drift_still_refine *s);
 // (drift_temporal_image). DRIFT_ERR_CANCELLED leaves the last image.
 drift_result drift_still_refine_apply(drift_still_refine *s, const drift_camera *camera,
                                       const drift_image *hybrid, const atomic_bool *cancel);
+// Whether this frame needs a new hybrid (temporal) image: false only for a progressive
+// refinement whose camera stands where the last apply's did (its accumulation goes on).
+bool drift_still_refine_needs_hybrid(const drift_still_refine *s, const drift_camera *camera);
 // The shown image (RGB), the path tracer's weight per pixel (1 channel) and its samples.
 const drift_image *drift_still_refine_image(const drift_still_refine *s);
 const drift_image *drift_still_refine_weight(const drift_still_refine *s);

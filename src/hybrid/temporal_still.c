@@ -27,7 +27,8 @@ struct drift_still_refine {
 static drift_still_refine_settings resolve(const drift_still_refine_settings *in)
 {
     drift_still_refine_settings s = in ? *in : (drift_still_refine_settings){ 0 };
-    s.spp = s.spp ? s.spp : 1u;
+    s.spp = s.spp ? s.spp : (s.progressive ? 4u : 1u);
+    s.fade_samples = s.fade_samples ? s.fade_samples : 1u;
     s.denoised_error = s.denoised_error > 0.0f ? s.denoised_error : 0.25f;
     s.radius = s.radius > 0 ? s.radius : 4;
     return s;
@@ -140,6 +141,27 @@ static void show_hybrid(drift_still_refine *s, const drift_image *hybrid)
     }
 }
 
+// Progressive: the path tracer's weight is at least n / (n + fade_samples), so the frozen
+// hybrid start fades out as the samples come (the error blend alone keeps it wherever its bias
+// hides under the path tracer's noise estimate).
+static void fade_by_samples(drift_still_refine *s, const drift_image *hybrid)
+{
+    float n = (float)drift_pt_sample_count(s->pt);
+    float floor_w = n / (n + (float)s->s.fade_samples);
+    for (int32_t y = 0; y < s->height; ++y) {
+        for (int32_t x = 0; x < s->width; ++x) {
+            float *w = drift_image_pixel(&s->weight, x, y);
+            if (*w >= floor_w) {
+                continue;
+            }
+            *w = floor_w;
+            drift_vec3 a = drift_image_get3(hybrid, x, y);
+            drift_vec3 b = drift_image_get3(&s->denoised, x, y);
+            drift_image_set3(&s->out, x, y, drift_vec3_fma(a, drift_vec3_sub(b, a), floor_w));
+        }
+    }
+}
+
 // The path-traced mean denoised by --denoise on's filter (the direct part apart).
 static drift_result denoise(drift_still_refine *s)
 {
@@ -207,7 +229,16 @@ drift_result drift_still_refine_apply(drift_still_refine *s, const drift_camera 
     }
     temporal_error_blend(hybrid, &beauty, &variance, &s->denoised, NULL, s->s.denoised_error,
                          s->s.radius, s->scratch, &s->out, &s->weight);
+    if (s->s.progressive) {
+        fade_by_samples(s, hybrid);
+    }
     return DRIFT_OK;
+}
+
+bool drift_still_refine_needs_hybrid(const drift_still_refine *s, const drift_camera *camera)
+{
+    return !s || !camera || !s->s.progressive || !s->has_camera ||
+           memcmp(&s->camera, camera, sizeof *camera) != 0;
 }
 
 void temporal_error_blend(const drift_image *hybrid, const drift_image *raw,

@@ -265,9 +265,13 @@ drift_result drift_view_create(drift_context *ctx, const drift_scene *scene,
                 &view->moving);
         }
         if (r == DRIFT_OK && !d.temporal_settings.no_still_refine) {
-            r = drift_still_refine_create(ctx, scene, accel, width, height,
-                                          &(drift_still_refine_settings){ .seed = view->base_seed },
-                                          &view->still);
+            r = drift_still_refine_create(
+                ctx, scene, accel, width, height,
+                &(drift_still_refine_settings){ .seed = view->base_seed,
+                                                .spp = d.temporal_settings.still_spp,
+                                                .progressive =
+                                                    d.temporal_settings.still_progressive },
+                &view->still);
         }
         if (r != DRIFT_OK) {
             goto fail;
@@ -483,29 +487,35 @@ drift_result drift_view_frame(drift_view *view, const atomic_bool *cancel)
         }
     }
     drift_camera camera = view->camera;
-    if (view->temporal) {
+    bool refined = view->still && drift_still_refine_applies(&view->params);
+    // --still-refine progressive: a standing camera's frames go to the path tracer alone.
+    bool hybrid_frame = !refined || drift_still_refine_needs_hybrid(view->still, &view->camera);
+    if (view->temporal && hybrid_frame) {
         r = drift_view_temporal_begin(view, &camera);
         if (r != DRIFT_OK) {
             return r;
         }
     }
-    r = drift_hybrid_render(view->hybrid, &camera, cancel);
-    if (r == DRIFT_OK && view->temporal) {
+    if (hybrid_frame) {
+        r = drift_hybrid_render(view->hybrid, &camera, cancel);
+    }
+    if (r == DRIFT_OK && view->temporal && hybrid_frame) {
         r = drift_temporal_apply(view->temporal, drift_hybrid_gbuffer(view->hybrid), &camera,
                                  drift_hybrid_image(view->hybrid));
     }
     // The moving refinement (every frame) feeds the still one (frames of a standing camera).
     bool moving = view->moving && drift_still_refine_applies(&view->params);
     if (r == DRIFT_OK && moving) {
-        r = drift_moving_refine_apply(view->moving, drift_hybrid_gbuffer(view->hybrid),
-                                      &view->camera, drift_hybrid_image(view->hybrid),
-                                      drift_temporal_image(view->temporal), cancel);
+        if (hybrid_frame) { // else its last image stays the progressive refinement's start
+            r = drift_moving_refine_apply(view->moving, drift_hybrid_gbuffer(view->hybrid),
+                                          &view->camera, drift_hybrid_image(view->hybrid),
+                                          drift_temporal_image(view->temporal), cancel);
+        }
     } else {
         drift_moving_refine_reset(view->moving);
     }
     const drift_image *temporal_image =
         moving ? drift_moving_refine_image(view->moving) : drift_temporal_image(view->temporal);
-    bool refined = view->still && drift_still_refine_applies(&view->params);
     if (r == DRIFT_OK && refined) {
         // The camera before its jitter: a still one refines toward the path tracer.
         r = drift_still_refine_apply(view->still, &view->camera, temporal_image, cancel);

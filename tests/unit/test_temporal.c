@@ -436,8 +436,9 @@ static void test_view_converges(void **state)
 // Still refinement in the viewer: the hybrid (indirect light path-traced to depth 2 in a closed
 // white box) is biased against the path tracer (depth 8); after 16 still frames the refined
 // framebuffer is nearer the converged path tracer's than the temporal history alone, which
-// converges to the hybrid's mean.
-static void view_still_refines(int moving_refine)
+// converges to the hybrid's mean. `progressive`: --still-refine progressive (no hybrid frames
+// once still, 4 path-traced samples a frame, the hybrid faded out by sample count).
+static void view_still_refines(int moving_refine, bool progressive)
 {
     test_rig r = test_rig_begin(2);
     const int w = 24;
@@ -446,7 +447,8 @@ static void view_still_refines(int moving_refine)
                              .height = w,
                              .hide_overlay = true,
                              .temporal = true,
-                             .temporal_settings = { .moving_refine = moving_refine },
+                             .temporal_settings = { .moving_refine = moving_refine,
+                                                    .still_progressive = progressive },
                              .hybrid = { .indirect = DRIFT_INDIRECT_REFERENCE, .spp = 1 } };
     drift_view *views[3] = { NULL, NULL, NULL };
     assert_int_equal(drift_view_create(r.ctx, r.scene, r.accel, &desc, &views[0]), DRIFT_OK);
@@ -467,8 +469,10 @@ static void view_still_refines(int moving_refine)
             err[v][k] = view_error(views[v], ref, w);
         }
         if (getenv("DRIFT_TEST_VERBOSE")) {
-            fprintf(stderr, "moving %d frames %d: refined %g, history alone %g (sRGB levels)\n",
-                    moving_refine, k, err[0][k], err[1][k]);
+            fprintf(stderr,
+                    "moving %d progressive %d frames %d: refined %g, history alone %g (sRGB "
+                    "levels)\n",
+                    moving_refine, (int)progressive, k, err[0][k], err[1][k]);
         }
     }
     // Falling with the frames within noise (each of 2, 4, 8, 16 at most 10% above the one
@@ -492,8 +496,10 @@ static void view_still_refines(int moving_refine)
 static void test_view_still_refines(void **state)
 {
     (void)state;
-    view_still_refines(0);
-    view_still_refines(1);
+    view_still_refines(0, false);
+    view_still_refines(1, false);
+    view_still_refines(0, true);
+    view_still_refines(1, true);
 }
 
 // --- MOVING REFINEMENT ---
