@@ -347,7 +347,8 @@ static DRIFT_AVX2_CLONES void atrous_bands(size_t begin, size_t end, int thread_
 }
 
 // Each pass's per-pixel terms: |luminance| of its colour and the depth weight's scale.
-static DRIFT_AVX2_CLONES void pixel_terms(size_t begin, size_t end, int thread_index, void *user)
+static DRIFT_AVX2_CLONES void atrous_pixel_terms(size_t begin, size_t end, int thread_index,
+                                                 void *user)
 {
     (void)thread_index;
     const atrous_job *j = user;
@@ -523,7 +524,7 @@ drift_result drift_denoise_atrous(drift_context *ctx, const drift_image *color,
         float scale = ldexpf(1.0f, -i); // sigma_color^2 halved each pass
         job.inv_color = p.disable_color ? 0.0f : 1.0f / (p.sigma_color * p.sigma_color * scale);
         job.inv_depth = 1.0f / (p.sigma_depth * (float)job.step);
-        drift_parallel_for(ctx, (size_t)h, 16, pixel_terms, &job);
+        drift_parallel_for(ctx, (size_t)h, 16, atrous_pixel_terms, &job);
         drift_parallel_for(ctx, (size_t)((h + band - 1) / band), 1, atrous_bands, &job);
         for (int k = 0; k < 3; ++k) {
             float *t = planes.color[k];
