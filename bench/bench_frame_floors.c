@@ -10,7 +10,9 @@
 // environment, then E + D + the terms and the circle of confusion), post depth of field, the
 // three ISG passes (soft shadows, glossy reflections, depth of field), the a-trous filter
 // (5 passes over the frame's colour with its G-buffer guides) and the glare convolution of the
-// frame with a 256 x 256 RGB PSF.
+// frame with a 256 x 256 RGB PSF. The a-trous filter also gets the bytes of its passes apart
+// (each reading the colour and the guides, writing the colour) and a compute floor: its taps
+// at the ISG sample's cost.
 #include "bench_frame_floors.h"
 
 #include "bench.h"
@@ -49,6 +51,7 @@ typedef struct floor_pass {
     const char *name;
     double ms;           // least of the repeats
     double bytes;        // bytes the pass must read and write
+    double level_bytes;  // a-trous: the bytes of its passes, each on its own (0: none)
     double compute_ms;   // its compute floor (0: none stated)
     const char *compute; // what the compute floor counts
     double samples;      // filter samples (ISG)
@@ -268,9 +271,29 @@ static drift_result measure_plain(drift_frame_state *f, const bench_floor_option
     }
 
     p = add_pass(run, "a-trous");
-    // The colour, albedo, normal and depth once; the filtered colour once (5 passes).
-    p->bytes = image_bytes(&f->focus) * 2.0 + image_bytes(&f->gbuffer.albedo) +
-               image_bytes(&f->gbuffer.normal) + image_bytes(&f->gbuffer.depth);
+    // The floor: the colour, albedo, normal and depth once; the filtered colour once, as a
+    // filter fusing its 5 passes in cache would move them. Beside it, the bytes of 5 passes
+    // each on its own: each reads the colour and the three guides and writes the colour.
+    double guides = image_bytes(&f->gbuffer.albedo) + image_bytes(&f->gbuffer.normal) +
+                    image_bytes(&f->gbuffer.depth);
+    p->bytes = image_bytes(&f->focus) * 2.0 + guides;
+    drift_denoise_params dp = drift_denoise_params_resolve(NULL);
+    p->level_bytes = (double)dp.iterations * (2.0 * 12.0 * px + guides);
+    // Compute floor: each tap in the image (24 a pixel and pass, fewer at the edges) at least
+    // an ideal bilateral sample (a 3-float distance, exp, three weighted channels).
+    double taps = 0.0;
+    for (int32_t i = 0; i < dp.iterations; ++i) {
+        double s = ldexp(1.0, i), w = (double)o->width, h = (double)o->height;
+        double row = 0.0, col = 0.0;
+        for (int d = -2; d <= 2; ++d) {
+            row += fmax(w - fabs((double)d) * s, 0.0);
+            col += fmax(h - fabs((double)d) * s, 0.0);
+        }
+        taps += row * col - w * h; // less the centre tap, which weighs nothing
+    }
+    p->samples = taps;
+    p->compute_ms = taps * run->sample_ns * 1e-6;
+    p->compute = "taps x the ideal vectorised bilateral sample";
     drift_image out = { 0 };
     if (r == DRIFT_OK) {
         r = time_pass(f, call_atrous, &out, o->repeats, &p->ms);
@@ -419,7 +442,13 @@ static void print_run(const char *scene_path, const bench_floor_options *o, int 
                 cli_json_number(item, "compute_floor_ratio", p->ms / p->compute_ms, 2);
                 cJSON_AddStringToObject(item, "compute_floor", p->compute);
             }
-            if (p->isg) {
+            if (p->level_bytes > 0.0) {
+                double level_ms = p->level_bytes / (run->copy_gbs * 1e6);
+                cli_json_number(item, "level_bytes", p->level_bytes, 0);
+                cli_json_number(item, "level_floor_ms", level_ms, 6);
+                cli_json_number(item, "level_floor_ratio", p->ms / level_ms, 2);
+            }
+            if (p->isg || p->samples > 0.0) {
                 cli_json_number(item, "samples", p->samples, 0);
             }
             if (p->samples > 0.0) {
@@ -442,6 +471,10 @@ static void print_run(const char *scene_path, const bench_floor_options *o, int 
                p->ms / floor_ms);
         if (p->compute_ms > 0.0) {
             printf(" %10.2f %7.1fx", p->compute_ms, p->ms / p->compute_ms);
+        }
+        if (p->level_bytes > 0.0) {
+            printf("  (passes apart: %.1f MB, %.1fx)", p->level_bytes * 1e-6,
+                   p->ms / (p->level_bytes / (run->copy_gbs * 1e6)));
         }
         printf("\n");
     }

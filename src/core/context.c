@@ -1,3 +1,4 @@
+#include "core/scratch.h"
 #include "drift/core.h"
 
 #include <pthread.h>
@@ -36,6 +37,9 @@ struct drift_context {
     pool_job *job;       // current job, guarded by mutex
     uint64_t job_serial; // bumps once per job so sleeping workers see a new one
     bool shutting_down;
+    pthread_mutex_t scratch_mutex; // guards scratch (core/scratch.h)
+    void *scratch;
+    size_t scratch_size;
 };
 
 #define DRIFT__RESULT_TEXT(name, text) text,
@@ -123,6 +127,7 @@ drift_result drift_context_create(const drift_context_desc *desc, drift_context 
     memset(ctx, 0, sizeof(*ctx));
     ctx->desc = d;
     pthread_mutex_init(&ctx->mutex, NULL);
+    pthread_mutex_init(&ctx->scratch_mutex, NULL);
     pthread_cond_init(&ctx->wake, NULL);
     pthread_cond_init(&ctx->done, NULL);
     // The calling thread is worker 0; the pool adds thread_count - 1 more.
@@ -152,6 +157,8 @@ void drift_context_destroy(drift_context *ctx)
         pthread_join(ctx->workers[i], NULL);
     }
     pthread_mutex_destroy(&ctx->mutex);
+    pthread_mutex_destroy(&ctx->scratch_mutex);
+    drift_free(ctx, ctx->scratch);
     pthread_cond_destroy(&ctx->wake);
     pthread_cond_destroy(&ctx->done);
     drift_allocator a = ctx->desc.allocator;
@@ -160,6 +167,39 @@ void drift_context_destroy(drift_context *ctx)
     } else {
         free(ctx);
     }
+}
+
+void *drift__scratch_take(drift_context *ctx, size_t size, size_t *have)
+{
+    pthread_mutex_lock(&ctx->scratch_mutex);
+    void *block = ctx->scratch;
+    *have = ctx->scratch_size;
+    ctx->scratch = NULL;
+    ctx->scratch_size = 0;
+    pthread_mutex_unlock(&ctx->scratch_mutex);
+    if (block && *have >= size) {
+        return block;
+    }
+    drift_free(ctx, block);
+    block = drift_alloc(ctx, size);
+    *have = block ? size : 0;
+    return block;
+}
+
+void drift__scratch_give(drift_context *ctx, void *block, size_t size)
+{
+    if (!block) {
+        return;
+    }
+    pthread_mutex_lock(&ctx->scratch_mutex);
+    if (!ctx->scratch || ctx->scratch_size < size) {
+        void *t = ctx->scratch;
+        ctx->scratch = block;
+        ctx->scratch_size = size;
+        block = t;
+    }
+    pthread_mutex_unlock(&ctx->scratch_mutex);
+    drift_free(ctx, block);
 }
 
 int drift_context_thread_count(const drift_context *ctx)

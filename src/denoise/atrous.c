@@ -1,4 +1,5 @@
 // The edge-avoiding a-trous filter (include/drift/denoise.h gives the weights and defaults).
+#include "core/scratch.h"
 #include "core/vectorise.h"
 #include "denoise/exp_neg.h"
 #include "drift/denoise.h"
@@ -40,9 +41,13 @@ typedef struct atrous_planes {
 
 typedef struct atrous_job {
     atrous_planes in; // in.color: this pass's input; the guides are shared
-    float *out[3];
+    float *out[3];    // the sums of colour, then (each row once done) the filtered colour
+    float *wsum;      // the sums of weights
+    float *lum;       // |luminance| of in.color, per pixel (the colour weight's mean)
+    float *inv_z;     // inv_depth / max(z, 1e-30), per pixel (the depth weight's scale)
     int32_t width, height;
     int32_t step;
+    int32_t band;    // rows a band: bands run in parallel, each recomputes the pairs above it
     int radius;      // 2: the 5 x 5 B3-spline kernel; 1: the 3 x 3 one
     float inv_color; // 1 / (sigma_color^2 2^-i); 0: no colour weight
     float sigma_normal;
@@ -57,19 +62,17 @@ static const float b1[3] = { 1.0f / 4.0f, 1.0f / 2.0f, 1.0f / 4.0f };
 
 #define ATROUS_RUN 128 // pixels of a row whose taps are weighed together
 
-// The weights of one tap (kernel weight wk, the neighbour `offset` pixels away) over pixels
-// [p, p + n) of the centre's planes, added into the run's sums.
-static inline DRIFT_ALWAYS_INLINE void atrous_tap(const atrous_job *j, bool color, size_t p,
-                                                  ptrdiff_t offset, int32_t n, float wk,
-                                                  float *restrict sum0, float *restrict sum1,
-                                                  float *restrict sum2, float *restrict wsum)
+// The normal weight max(n_p . n_q, 0)^sigma_normal of pixels [p, p + n) and their neighbours
+// `offset` away: symmetric in p and q (the same products summed in the same order).
+static inline DRIFT_ALWAYS_INLINE void
+normal_weights(const atrous_job *j, size_t p, ptrdiff_t offset, int32_t n, float *restrict nw)
 {
     const atrous_planes *g = &j->in;
     size_t q = (size_t)((ptrdiff_t)p + offset);
     const float *restrict nc0 = g->normal[0] + p, *restrict nq0 = g->normal[0] + q;
     const float *restrict nc1 = g->normal[1] + p, *restrict nq1 = g->normal[1] + q;
     const float *restrict nc2 = g->normal[2] + p, *restrict nq2 = g->normal[2] + q;
-    float nw[ATROUS_RUN], power[ATROUS_RUN];
+    float power[ATROUS_RUN];
     DRIFT_IVDEP
     for (int32_t i = 0; i < n; ++i) {
         float d = nc0[i] * nq0[i] + nc1[i] * nq1[i] + nc2[i] * nq2[i];
@@ -106,25 +109,37 @@ static inline DRIFT_ALWAYS_INLINE void atrous_tap(const atrous_job *j, bool colo
             }
         }
     }
+}
+
+// One tap (kernel weight wk, the neighbour `offset` pixels away) of pixels [p, p + n), added
+// into their sums: the taps of a pixel's own row, whose pairs are not shared (below).
+static inline DRIFT_ALWAYS_INLINE void atrous_tap(const atrous_job *j, bool color, size_t p,
+                                                  ptrdiff_t offset, int32_t n, float wk)
+{
+    const atrous_planes *g = &j->in;
+    size_t q = (size_t)((ptrdiff_t)p + offset);
+    float nw[ATROUS_RUN];
+    normal_weights(j, p, offset, n, nw);
     const float *restrict zc = g->depth + p, *restrict zq = g->depth + q;
+    const float *restrict sc = j->inv_z + p;
+    const float *restrict lc = j->lum + p, *restrict lq = j->lum + q;
     const float *restrict ac0 = g->albedo[0] + p, *restrict aq0 = g->albedo[0] + q;
     const float *restrict ac1 = g->albedo[1] + p, *restrict aq1 = g->albedo[1] + q;
     const float *restrict ac2 = g->albedo[2] + p, *restrict aq2 = g->albedo[2] + q;
     const float *restrict cc0 = g->color[0] + p, *restrict cq0 = g->color[0] + q;
     const float *restrict cc1 = g->color[1] + p, *restrict cq1 = g->color[1] + q;
     const float *restrict cc2 = g->color[2] + p, *restrict cq2 = g->color[2] + q;
-    const float inv_depth = j->inv_depth, inv_albedo = j->inv_albedo, inv_color = j->inv_color;
+    float *restrict sum0 = j->out[0] + p, *restrict sum1 = j->out[1] + p,
+                    *restrict sum2 = j->out[2] + p, *restrict wsum = j->wsum + p;
+    const float inv_albedo = j->inv_albedo, inv_color = j->inv_color;
     DRIFT_IVDEP
     for (int32_t i = 0; i < n; ++i) {
-        float z = zc[i] > 1e-30f ? zc[i] : 1e-30f; // a miss (z = 0): see keep
-        float e = fabsf(zc[i] - zq[i]) * (inv_depth / z);
+        float e = fabsf(zc[i] - zq[i]) * sc[i]; // a miss (z = 0): see keep
         float a0 = ac0[i] - aq0[i], a1 = ac1[i] - aq1[i], a2 = ac2[i] - aq2[i];
         e += (a0 * a0 + a1 * a1 + a2 * a2) * inv_albedo;
         if (color) { // a constant at each call: two loops, one without the colour weight
             float c0 = cc0[i] - cq0[i], c1 = cc1[i] - cq1[i], c2 = cc2[i] - cq2[i];
-            float mean = 0.5f * (fabsf(0.2126f * cc0[i] + 0.7152f * cc1[i] + 0.0722f * cc2[i]) +
-                                 fabsf(0.2126f * cq0[i] + 0.7152f * cq1[i] + 0.0722f * cq2[i])) +
-                         DENOISE_LUM_EPS;
+            float mean = 0.5f * (lc[i] + lq[i]) + DENOISE_LUM_EPS;
             e += (c0 * c0 + c1 * c1 + c2 * c2) * inv_color / (mean * mean);
         }
         // A pixel whose ray missed mixes only with other misses; past the cutoff a tap adds
@@ -140,60 +155,213 @@ static inline DRIFT_ALWAYS_INLINE void atrous_tap(const atrous_job *j, bool colo
     }
 }
 
-static DRIFT_AVX2_CLONES void atrous_rows(size_t begin, size_t end, int thread_index, void *user)
+// A pair of taps at once: pixels [p, p + n) and their neighbours q `offset` away, q in a row
+// below. The normal, albedo and colour terms are symmetric in p and q and computed once; the
+// depth term (|z_p - z_q| over the centre's z) and the cutoff are each side's own. Each
+// weight is the same float operations in the same order as atrous_tap's: the same bits. With
+// `mine`, p's sums take q's colour now; q's weights go to wq for its sums later, in order.
+static inline DRIFT_ALWAYS_INLINE void atrous_pair(const atrous_job *j, bool color, bool mine,
+                                                   size_t p, ptrdiff_t offset, int32_t n, float wk,
+                                                   float *restrict wq)
 {
-    (void)thread_index;
-    const atrous_job *j = user;
-    const int32_t w = j->width, h = j->height;
-    const int radius = j->radius;
+    const atrous_planes *g = &j->in;
+    size_t q = (size_t)((ptrdiff_t)p + offset);
+    float nw[ATROUS_RUN];
+    normal_weights(j, p, offset, n, nw);
+    const float *restrict zc = g->depth + p, *restrict zq = g->depth + q;
+    const float *restrict sc = j->inv_z + p, *restrict sq = j->inv_z + q;
+    const float *restrict lc = j->lum + p, *restrict lq = j->lum + q;
+    const float *restrict ac0 = g->albedo[0] + p, *restrict aq0 = g->albedo[0] + q;
+    const float *restrict ac1 = g->albedo[1] + p, *restrict aq1 = g->albedo[1] + q;
+    const float *restrict ac2 = g->albedo[2] + p, *restrict aq2 = g->albedo[2] + q;
+    const float *restrict cc0 = g->color[0] + p, *restrict cq0 = g->color[0] + q;
+    const float *restrict cc1 = g->color[1] + p, *restrict cq1 = g->color[1] + q;
+    const float *restrict cc2 = g->color[2] + p, *restrict cq2 = g->color[2] + q;
+    float *restrict sum0 = j->out[0] + p, *restrict sum1 = j->out[1] + p,
+                    *restrict sum2 = j->out[2] + p, *restrict wsum = j->wsum + p;
+    const float inv_albedo = j->inv_albedo, inv_color = j->inv_color;
+    DRIFT_IVDEP
+    for (int32_t i = 0; i < n; ++i) {
+        float dz = fabsf(zc[i] - zq[i]);
+        float a0 = ac0[i] - aq0[i], a1 = ac1[i] - aq1[i], a2 = ac2[i] - aq2[i];
+        float albedo = (a0 * a0 + a1 * a1 + a2 * a2) * inv_albedo;
+        float ep = dz * sc[i], eq = dz * sq[i];
+        ep += albedo;
+        eq += albedo;
+        if (color) {
+            float c0 = cc0[i] - cq0[i], c1 = cc1[i] - cq1[i], c2 = cc2[i] - cq2[i];
+            float mean = 0.5f * (lc[i] + lq[i]) + DENOISE_LUM_EPS;
+            float ec = (c0 * c0 + c1 * c1 + c2 * c2) * inv_color / (mean * mean);
+            ep += ec;
+            eq += ec;
+        }
+        float hit_c = zc[i] > 0.0f ? 1.0f : 0.0f, hit_q = zq[i] > 0.0f ? 1.0f : 0.0f;
+        float keep = hit_c == hit_q ? 1.0f : 0.0f;
+        float keep_q = eq <= DENOISE_EXP_CUTOFF ? keep : 0.0f;
+        wq[i] = keep_q * wk * nw[i] * exp_neg(eq < DENOISE_EXP_CUTOFF ? eq : DENOISE_EXP_CUTOFF);
+        if (mine) {
+            float keep_p = ep <= DENOISE_EXP_CUTOFF ? keep : 0.0f;
+            float w =
+                keep_p * wk * nw[i] * exp_neg(ep < DENOISE_EXP_CUTOFF ? ep : DENOISE_EXP_CUTOFF);
+            sum0[i] += w * cq0[i];
+            sum1[i] += w * cq1[i];
+            sum2[i] += w * cq2[i];
+            wsum[i] += w;
+        }
+    }
+}
+
+// q's side of the pairs: pixels [q, q + n) take the colour of their neighbours `offset` away
+// (p, a row above) with the weights wq.
+static inline DRIFT_ALWAYS_INLINE void add_taken(const atrous_job *j, size_t q, ptrdiff_t offset,
+                                                 int32_t n, const float *restrict wq)
+{
+    size_t p = (size_t)((ptrdiff_t)q + offset);
+    const float *restrict cp0 = j->in.color[0] + p, *restrict cp1 = j->in.color[1] + p,
+                          *restrict cp2 = j->in.color[2] + p;
+    float *restrict sum0 = j->out[0] + q, *restrict sum1 = j->out[1] + q,
+                    *restrict sum2 = j->out[2] + q, *restrict wsum = j->wsum + q;
+    DRIFT_IVDEP
+    for (int32_t i = 0; i < n; ++i) {
+        sum0[i] += wq[i] * cp0[i];
+        sum1[i] += wq[i] * cp1[i];
+        sum2[i] += wq[i] * cp2[i];
+        wsum[i] += wq[i];
+    }
+}
+
+// The pixels [lo, hi) of the run at x0 whose neighbour `shift` pixels along lies in the row.
+static bool tap_interval(int32_t w, int32_t x0, int32_t n, int32_t shift, int32_t *lo, int32_t *hi)
+{
+    *lo = -(x0 + shift) > 0 ? -(x0 + shift) : 0;
+    *hi = w - x0 - shift < n ? w - x0 - shift : n;
+    return *lo < *hi;
+}
+
+// The pairs of row y's run at x0 with row y + dy step below (dy > 0): with `mine`, the run's
+// sums take them (dx ascending, the taps' order); the row below's sums take theirs where that
+// row lies in [first_row, last_row), dx descending: each pixel there then takes its taps of
+// this row from left to right over the runs, the taps' order again.
+static inline DRIFT_ALWAYS_INLINE void pair_row(const atrous_job *j, bool color, bool mine,
+                                                int32_t y, int32_t x0, int32_t n, int dy,
+                                                int32_t first_row, int32_t last_row)
+{
+    const int32_t w = j->width, radius = j->radius;
+    const float *kernel = radius == 1 ? b1 : b3;
+    int32_t qy = y + dy * j->step;
+    bool theirs = qy >= first_row && qy < last_row;
+    if (qy >= j->height || (!mine && !theirs)) {
+        return;
+    }
+    size_t p = (size_t)y * (size_t)w + (size_t)x0;
+    float wq[5][ATROUS_RUN];
+    int32_t lo[5], hi[5];
+    for (int dx = -radius; dx <= radius; ++dx) {
+        int32_t shift = dx * j->step;
+        if (!tap_interval(w, x0, n, shift, &lo[dx + radius], &hi[dx + radius])) {
+            continue;
+        }
+        ptrdiff_t offset = (ptrdiff_t)dy * j->step * w + shift;
+        float wk = kernel[dx + radius] * kernel[dy + radius];
+        int32_t l = lo[dx + radius];
+        atrous_pair(j, color, mine, p + (size_t)l, offset, hi[dx + radius] - l, wk,
+                    wq[dx + radius] + l);
+    }
+    if (!theirs) {
+        return;
+    }
+    for (int dx = radius; dx >= -radius; --dx) {
+        int32_t l = lo[dx + radius], h = hi[dx + radius];
+        if (l < h) {
+            ptrdiff_t offset = (ptrdiff_t)dy * j->step * w + dx * j->step;
+            add_taken(j, (size_t)((ptrdiff_t)(p + (size_t)l) + offset), -offset, h - l,
+                      wq[dx + radius] + l);
+        }
+    }
+}
+
+// Rows [y0, y1) of a band: each pixel's sum starts at its centre tap and takes its taps in
+// the kernel's order, row above first: those of the rows above come from the pairs computed
+// there (the band's own rows, or, above the band, pairs computed again for this band's side
+// only), then the taps of its own row, then its side of the pairs with the rows below.
+static inline DRIFT_ALWAYS_INLINE void atrous_band(const atrous_job *j, bool color, int32_t y0,
+                                                   int32_t y1)
+{
+    const int32_t w = j->width, radius = j->radius;
     const float *kernel = radius == 1 ? b1 : b3;
     const float centre = kernel[radius] * kernel[radius];
-    float sum0[ATROUS_RUN], sum1[ATROUS_RUN], sum2[ATROUS_RUN], wsum[ATROUS_RUN];
-    for (int32_t y = (int32_t)begin; y < (int32_t)end; ++y) {
+    size_t begin = (size_t)y0 * (size_t)w, end = (size_t)y1 * (size_t)w;
+    for (size_t i = begin; i < end; ++i) {
+        j->out[0][i] = centre * j->in.color[0][i];
+        j->out[1][i] = centre * j->in.color[1][i];
+        j->out[2][i] = centre * j->in.color[2][i];
+        j->wsum[i] = centre;
+    }
+    int32_t above = y0 - radius * j->step > 0 ? y0 - radius * j->step : 0;
+    for (int32_t y = above; y < y0; ++y) {
+        for (int32_t x0 = 0; x0 < w; x0 += ATROUS_RUN) {
+            int32_t n = w - x0 < ATROUS_RUN ? w - x0 : ATROUS_RUN;
+            for (int dy = 1; dy <= radius; ++dy) {
+                pair_row(j, color, false, y, x0, n, dy, y0, y1);
+            }
+        }
+    }
+    for (int32_t y = y0; y < y1; ++y) {
         for (int32_t x0 = 0; x0 < w; x0 += ATROUS_RUN) {
             int32_t n = w - x0 < ATROUS_RUN ? w - x0 : ATROUS_RUN;
             size_t p = (size_t)y * (size_t)w + (size_t)x0;
-            for (int32_t i = 0; i < n; ++i) {
-                sum0[i] = centre * j->in.color[0][p + (size_t)i];
-                sum1[i] = centre * j->in.color[1][p + (size_t)i];
-                sum2[i] = centre * j->in.color[2][p + (size_t)i];
-                wsum[i] = centre;
-            }
-            for (int dy = -radius; dy <= radius; ++dy) {
-                int32_t qy = y + dy * j->step;
-                if (qy < 0 || qy >= h) {
-                    continue;
-                }
-                for (int dx = -radius; dx <= radius; ++dx) {
-                    if (dx == 0 && dy == 0) {
-                        continue;
-                    }
-                    // The pixels of the run whose neighbour lies inside the row: one interval.
-                    int32_t shift = dx * j->step;
-                    int32_t lo = -(x0 + shift) > 0 ? -(x0 + shift) : 0;
-                    int32_t hi = w - x0 - shift < n ? w - x0 - shift : n;
-                    if (lo >= hi) {
-                        continue;
-                    }
-                    ptrdiff_t offset = (ptrdiff_t)dy * j->step * w + shift;
-                    size_t first = p + (size_t)lo;
-                    float wk = kernel[dx + radius] * kernel[dy + radius];
-                    if (j->inv_color > 0.0f) {
-                        atrous_tap(j, true, first, offset, hi - lo, wk, sum0 + lo, sum1 + lo,
-                                   sum2 + lo, wsum + lo);
-                    } else {
-                        atrous_tap(j, false, first, offset, hi - lo, wk, sum0 + lo, sum1 + lo,
-                                   sum2 + lo, wsum + lo);
-                    }
+            for (int dx = -radius; dx <= radius; ++dx) {
+                int32_t lo, hi, shift = dx * j->step;
+                if (dx != 0 && tap_interval(w, x0, n, shift, &lo, &hi)) {
+                    atrous_tap(j, color, p + (size_t)lo, shift, hi - lo,
+                               kernel[dx + radius] * kernel[radius]);
                 }
             }
-            // wsum >= the centre tap's weight, (3/8)^2 or (1/2)^2, > 0.
-            for (int32_t i = 0; i < n; ++i) {
-                j->out[0][p + (size_t)i] = sum0[i] / wsum[i];
-                j->out[1][p + (size_t)i] = sum1[i] / wsum[i];
-                j->out[2][p + (size_t)i] = sum2[i] / wsum[i];
+            for (int dy = 1; dy <= radius; ++dy) {
+                pair_row(j, color, true, y, x0, n, dy, y0, y1);
             }
         }
+        // Row y has all its taps. wsum >= the centre tap's weight, (3/8)^2 or (1/2)^2, > 0.
+        size_t row = (size_t)y * (size_t)w;
+        for (size_t i = row; i < row + (size_t)w; ++i) {
+            j->out[0][i] /= j->wsum[i];
+            j->out[1][i] /= j->wsum[i];
+            j->out[2][i] /= j->wsum[i];
+        }
+    }
+}
+
+static DRIFT_AVX2_CLONES void atrous_bands(size_t begin, size_t end, int thread_index, void *user)
+{
+    (void)thread_index;
+    const atrous_job *j = user;
+    for (size_t b = begin; b < end; ++b) {
+        int32_t y0 = (int32_t)b * j->band;
+        int32_t y1 = y0 + j->band < j->height ? y0 + j->band : j->height;
+        if (j->inv_color > 0.0f) {
+            atrous_band(j, true, y0, y1);
+        } else {
+            atrous_band(j, false, y0, y1);
+        }
+    }
+}
+
+// Each pass's per-pixel terms: |luminance| of its colour and the depth weight's scale.
+static DRIFT_AVX2_CLONES void atrous_pixel_terms(size_t begin, size_t end, int thread_index,
+                                                 void *user)
+{
+    (void)thread_index;
+    const atrous_job *j = user;
+    size_t first = begin * (size_t)j->width, last = end * (size_t)j->width;
+    const float *restrict c0 = j->in.color[0], *restrict c1 = j->in.color[1],
+                          *restrict c2 = j->in.color[2], *restrict z = j->in.depth;
+    float *restrict lum = j->lum, *restrict inv_z = j->inv_z;
+    const float inv_depth = j->inv_depth;
+    DRIFT_IVDEP
+    for (size_t i = first; i < last; ++i) {
+        lum[i] = fabsf(0.2126f * c0[i] + 0.7152f * c1[i] + 0.0722f * c2[i]);
+        float zc = z[i] > 1e-30f ? z[i] : 1e-30f; // a miss (z = 0): see keep
+        inv_z[i] = inv_depth / zc;
     }
 }
 
@@ -296,11 +464,15 @@ drift_result drift_denoise_atrous(drift_context *ctx, const drift_image *color,
     }
     const int32_t w = color->width, h = color->height;
     size_t count = (size_t)w * (size_t)h;
-    // Planes: colour ping and pong (3 each), normal (3), albedo (3), depth.
-    float *block = drift_alloc(ctx, 13 * count * sizeof(float));
+    // Planes: colour ping and pong (3 each), normal (3), albedo (3), depth, the weights' sum,
+    // |luminance| and the depth scale; every one written before it is read. The context keeps
+    // them for the next call (core/scratch.h): at 1080p their first touch cost as much as the
+    // filter's arithmetic.
+    size_t have = 0;
+    float *block = drift__scratch_take(ctx, 16 * count * sizeof(float), &have);
     drift_result r = drift_image_create(ctx, w, h, 3, out);
     if (!block || r != DRIFT_OK) {
-        drift_free(ctx, block);
+        drift__scratch_give(ctx, block, have);
         drift_image_destroy(ctx, out);
         return r != DRIFT_OK ? r : DRIFT_ERR_OUT_OF_MEMORY;
     }
@@ -326,7 +498,18 @@ drift_result drift_denoise_atrous(drift_context *ctx, const drift_image *color,
     } else if (p.sigma_normal == floorf(p.sigma_normal) && p.sigma_normal <= 4096.0f) {
         normal_pow = (int)p.sigma_normal;
     }
+    // One band a thread (bit-identical for any split: each pixel's sum takes the same taps in
+    // the same order), or four where there are several, to balance them; a band is at least
+    // 32 rows, as its pairs above it are computed again.
+    int threads = drift_context_thread_count(ctx);
+    int32_t bands = threads > 1 ? 4 * threads : 1;
+    int32_t band = (h + bands - 1) / bands;
+    band = band < 32 ? 32 : band;
     atrous_job job = { .width = w,
+                       .wsum = block + 13 * count,
+                       .lum = block + 14 * count,
+                       .inv_z = block + 15 * count,
+                       .band = band,
                        .radius = p.small_kernel ? 1 : 2,
                        .height = h,
                        .sigma_normal = p.sigma_normal,
@@ -341,7 +524,8 @@ drift_result drift_denoise_atrous(drift_context *ctx, const drift_image *color,
         float scale = ldexpf(1.0f, -i); // sigma_color^2 halved each pass
         job.inv_color = p.disable_color ? 0.0f : 1.0f / (p.sigma_color * p.sigma_color * scale);
         job.inv_depth = 1.0f / (p.sigma_depth * (float)job.step);
-        drift_parallel_for(ctx, (size_t)h, 4, atrous_rows, &job);
+        drift_parallel_for(ctx, (size_t)h, 16, atrous_pixel_terms, &job);
+        drift_parallel_for(ctx, (size_t)((h + band - 1) / band), 1, atrous_bands, &job);
         for (int k = 0; k < 3; ++k) {
             float *t = planes.color[k];
             planes.color[k] = pong[k];
@@ -350,6 +534,6 @@ drift_result drift_denoise_atrous(drift_context *ctx, const drift_image *color,
     }
     io.out = out;
     drift_parallel_for(ctx, (size_t)h, 8, image_from_planes, &io);
-    drift_free(ctx, block);
+    drift__scratch_give(ctx, block, have);
     return DRIFT_OK;
 }

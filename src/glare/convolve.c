@@ -86,14 +86,18 @@ drift_result drift__glare_convolve(drift_context *ctx, drift__glare_conv *c, con
     }
     const float norm = 1.0f / (float)real_count; // kissfft's inverse is unnormalised
     for (int32_t ch = 0; ch < 3; ++ch) {
-        memset(c->real, 0, real_count * sizeof(float));
+        // The image's channel, zeros around it (only the padding is cleared: the image region
+        // is written over).
         for (int32_t y = 0; y < in->height; ++y) {
             const float *src = drift_image_pixel(in, 0, y);
             float *dst = c->real + (size_t)y * (size_t)pw;
             for (int32_t x = 0; x < in->width; ++x) {
                 dst[x] = src[(size_t)x * (size_t)in->channels + (size_t)ch];
             }
+            memset(dst + in->width, 0, (size_t)(pw - in->width) * sizeof(float));
         }
+        memset(c->real + (size_t)in->height * (size_t)pw, 0,
+               (size_t)(ph - in->height) * (size_t)pw * sizeof(float));
         drift__glare_rfft_forward(c->forward, c->real, c->spectrum);
         const drift__cpx *p = c->psf_spectrum[ch];
         for (size_t i = 0; i < spec_count; ++i) {

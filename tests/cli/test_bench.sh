@@ -41,7 +41,12 @@ for x in d["passes"]:
     assert x["ms"] >= 0 and x["floor_ms"] > 0 and x["bytes"] > 0, x
     floor = x["bytes"] / (d["copy_gb_per_s"] * 1e6)  # bytes at the measured bandwidth
     assert abs(x["floor_ms"] - floor) <= 0.01 * floor + 1e-6 and x["floor_ratio"] >= 0, x
-assert p["isg dof"]["samples"] == 0 and p["isg shadows"]["samples"] > 0, d  # a pinhole: no DOF'
+assert p["isg dof"]["samples"] == 0 and p["isg shadows"]["samples"] > 0, d  # a pinhole: no DOF
+a = p["a-trous"]  # 5 passes apart: colour in and out, albedo, normal (12 bytes), depth (4)
+assert a["level_bytes"] == 5 * 16 * 12 * (12 + 12 + 12 + 12 + 4), a
+taps = sum(sum(max(0, 16 - abs(t) * 2**i) for t in range(-2, 3)) *
+           sum(max(0, 12 - abs(t) * 2**i) for t in range(-2, 3)) - 16 * 12 for i in range(5))
+assert a["samples"] == taps and a["compute_floor_ms"] > 0, (a, taps)'
         ;;
     isg)
         expect 0 "$drift" bench isg "$box" --width 16 --height 12 --qwidth 16 --qheight 12 \

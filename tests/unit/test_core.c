@@ -1,3 +1,4 @@
+#include "core/scratch.h"
 #include "drift/math.h"
 #include "drift_test.h"
 
@@ -107,6 +108,39 @@ static void test_core_alloc_is_zeroed(void **state)
     drift_context_destroy(ctx);
 }
 
+// The scratch block: a take after a give returns the kept block when it is large enough
+// (its contents as left), a larger request gets a new zeroed one, two takes never share one,
+// and the context keeps the larger of two given back (ASan: nothing leaks or is freed twice).
+static void test_core_scratch_is_kept_and_never_shared(void **state)
+{
+    (void)state;
+    drift_context *ctx = test_context(1, NULL);
+    size_t have = 0, have2 = 0;
+    unsigned char *a = drift__scratch_take(ctx, 1000, &have);
+    assert_non_null(a);
+    assert_true(have >= 1000);
+    a[999] = 7;
+    drift__scratch_give(ctx, a, have);
+    unsigned char *b = drift__scratch_take(ctx, 500, &have);
+    assert_ptr_equal(b, a);
+    assert_int_equal(b[999], 7);
+    unsigned char *c = drift__scratch_take(ctx, 500, &have2); // the first is out: a new one
+    assert_non_null(c);
+    assert_ptr_not_equal(c, b);
+    assert_int_equal(c[499], 0);
+    drift__scratch_give(ctx, c, have2);
+    drift__scratch_give(ctx, b, have); // larger: kept, c freed
+    unsigned char *d = drift__scratch_take(ctx, 800, &have);
+    assert_ptr_equal(d, b);
+    unsigned char *e = drift__scratch_take(ctx, 4000, &have2);
+    assert_true(have2 >= 4000);
+    assert_int_equal(e[3999], 0);
+    drift__scratch_give(ctx, d, have);
+    drift__scratch_give(ctx, e, have2);
+    drift__scratch_give(ctx, NULL, 0);
+    drift_context_destroy(ctx); // frees the kept block
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -117,6 +151,7 @@ int main(void)
         cmocka_unit_test(test_core_size_mul_detects_overflow),
         cmocka_unit_test(test_core_log_reaches_logger),
         cmocka_unit_test(test_core_alloc_is_zeroed),
+        cmocka_unit_test(test_core_scratch_is_kept_and_never_shared),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,7 +1,7 @@
 // The edge-avoiding a-trous filter (include/drift/denoise.h): a constant image is a fixed
 // point, i.i.d. noise on a flat image loses most of its variance, a step edge in the guides is
 // kept, one pass is the header's formula evaluated directly (either kernel), and the output
-// does not depend on the thread count.
+// depends neither on the thread count nor on earlier calls (the planes the context keeps).
 #include "drift/denoise.h"
 #include "drift/image.h"
 #include "drift_test.h"
@@ -375,6 +375,43 @@ static void test_denoise_rejects_bad_arguments(void **state)
     drift_context_destroy(ctx);
 }
 
+// The context keeps the filter's planes between calls (core/scratch.h): a call after others
+// (a larger image, another kernel) leaves the same image as the first call on that context.
+static void test_denoise_kept_planes_change_nothing(void **state)
+{
+    (void)state;
+    drift_context *ctx = test_context(2, NULL);
+    drift_image color = make_noise(ctx, 21), other = make_noise(ctx, 22), first, again, big;
+    guides g = make_flat_guides(ctx);
+    for (int32_t y = 0; y < H; ++y) {
+        for (int32_t x = 0; x < W; ++x) {
+            drift_image_pixel(&g.depth, x, y)[0] = x < W / 2 ? 2.0f : 0.0f; // misses on the right
+        }
+    }
+    assert_int_equal(
+        drift_denoise_atrous(ctx, &color, &g.albedo, &g.normal, &g.depth, NULL, &first), DRIFT_OK);
+    drift_denoise_params small = { .small_kernel = true, .iterations = 3 };
+    assert_int_equal(drift_denoise_atrous(ctx, &other, NULL, NULL, NULL, &small, &again), DRIFT_OK);
+    drift_image_destroy(ctx, &again);
+    drift_image wide;
+    assert_int_equal(drift_image_create(ctx, 2 * W, H, 3, &wide), DRIFT_OK);
+    assert_int_equal(drift_denoise_atrous(ctx, &wide, NULL, NULL, NULL, NULL, &big), DRIFT_OK);
+    assert_int_equal(
+        drift_denoise_atrous(ctx, &color, &g.albedo, &g.normal, &g.depth, NULL, &again), DRIFT_OK);
+    for (int32_t y = 0; y < H; ++y) {
+        assert_memory_equal(drift_image_pixel(&first, 0, y), drift_image_pixel(&again, 0, y),
+                            W * 3 * sizeof(float));
+    }
+    drift_image_destroy(ctx, &big);
+    drift_image_destroy(ctx, &wide);
+    drift_image_destroy(ctx, &again);
+    drift_image_destroy(ctx, &first);
+    destroy_guides(ctx, &g);
+    drift_image_destroy(ctx, &other);
+    drift_image_destroy(ctx, &color);
+    drift_context_destroy(ctx);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -385,6 +422,7 @@ int main(void)
         cmocka_unit_test(test_denoise_one_pass_is_the_formula),
         cmocka_unit_test(test_denoise_small_kernel_smooths),
         cmocka_unit_test(test_denoise_rejects_bad_arguments),
+        cmocka_unit_test(test_denoise_kept_planes_change_nothing),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
