@@ -299,7 +299,7 @@ static const cli_option render_table[] = {
                "a pixel, denoised and blended in where its error is the lower;\n"
                "progressive: once still, no more hybrid frames, every frame adds\n"
                "--still-spp path-traced samples and the hybrid fades out by sample\n"
-               "count (default on; docs/temporal.md)"),
+               "count (default progressive; docs/temporal.md)"),
     CLI_INT("--still-spp", "N", O, temporal_settings.still_spp, 1, 1 << 16,
             "path-traced samples a pixel each still frame adds (default 1; 4 with\n"
             "--still-refine progressive)"),
@@ -378,7 +378,7 @@ int render_parse_options(int argc, char **argv, render_options *o)
                            .aperture = -1.0,
                            .focus_distance = -1.0,
                            .temporal_settings = { .filter_passes = -1 },
-                           .still_refine = 1 };
+                           .still_refine = 2 };
     const char *first[CLI_GROUP_COUNT] = { 0 };
     cli_knobs_unset(&o->hybrid);
     int status = cli_parse(&render_command, argc, argv, o, first);
@@ -389,7 +389,7 @@ int render_parse_options(int argc, char **argv, render_options *o)
     // --temporal-passes 0 is no filter (0 in drift_temporal_settings is the default).
     o->temporal_settings.no_filter = o->temporal_settings.filter_passes == 0;
     o->temporal_settings.no_still_refine = o->still_refine == 0;
-    o->temporal_settings.still_progressive = o->still_refine == 2;
+    o->temporal_settings.still_keeps_hybrid = o->still_refine == 1;
     o->temporal_settings.filter_passes =
         o->temporal_settings.filter_passes > 0 ? o->temporal_settings.filter_passes : 0;
     o->hybrid_option = first[0];

@@ -144,7 +144,7 @@ static const cli_option view_table[] = {
                "sample a pixel, denoised and blended in where its error is the\n"
                "lower; progressive: once still, no more hybrid frames, every\n"
                "frame path-traces --still-spp samples and the hybrid fades out\n"
-               "by sample count (default on; docs/temporal.md)"),
+               "by sample count (default progressive; docs/temporal.md)"),
     CLI_INT("--still-spp", "N", O, still_spp, 1, 1 << 16,
             "path-traced samples a pixel each still frame adds (default 1; 4\n"
             "with --still-refine progressive)"),
@@ -270,7 +270,7 @@ static bool parse_press(const char *cmd, const char *flag, const char *v, void *
 static int parse_options(int argc, char **argv, view_options *o)
 {
     *o = (view_options){
-        .spp = 4, .spp_per_frame = 1, .hybrid = drift_hybrid_params_default(), .still_refine = 1
+        .spp = 4, .spp_per_frame = 1, .hybrid = drift_hybrid_params_default(), .still_refine = 2
     };
     cli_knobs_unset(&o->hybrid);
     int status = cli_parse(&view_command, argc, argv, o, NULL);
@@ -678,7 +678,7 @@ int drift_cmd_view(int argc, char **argv)
                             .refine_budget = (uint32_t)o.refine_budget,
                             .temporal = o.temporal,
                             .temporal_settings = { .no_still_refine = o.still_refine == 0,
-                                                   .still_progressive = o.still_refine == 2,
+                                                   .still_keeps_hybrid = o.still_refine == 1,
                                                    .still_spp = (uint32_t)o.still_spp,
                                                    .moving_refine = (int32_t)o.moving_refine },
                             .reflection_edits_path = o.edits_path },

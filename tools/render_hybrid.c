@@ -284,8 +284,8 @@ int render_hybrid(const render_options *o, const cli_session *session)
                 &(drift_still_refine_settings){ .seed = (uint32_t)o->seed,
                                                 .max_depth = (int32_t)o->max_depth,
                                                 .spp = o->temporal_settings.still_spp,
-                                                .progressive =
-                                                    o->temporal_settings.still_progressive },
+                                                .keeps_hybrid =
+                                                    o->temporal_settings.still_keeps_hybrid },
                 &still);
         }
     }

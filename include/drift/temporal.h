@@ -69,10 +69,12 @@ typedef struct drift_temporal_settings {
     float phi_luminance;
     float depth_sigma;
     bool no_still_refine; // true: a still camera shows the temporal image alone (below)
-    // true: once the camera stands, the drivers stop rendering the hybrid frame and spend each
-    // frame on still_spp path-traced samples (drift_still_refine_settings.progressive)
-    bool still_progressive;
-    uint32_t still_spp; // 0 -> 1 (on) or 4 (progressive): path-traced samples a still frame
+    // false (the default, --still-refine progressive): once the camera stands, the drivers stop
+    // rendering the hybrid frame and spend each frame on still_spp path-traced samples; true
+    // (--still-refine on): they keep rendering it and blend the samples in
+    // (drift_still_refine_settings.keeps_hybrid)
+    bool still_keeps_hybrid;
+    uint32_t still_spp; // 0 -> 4 (progressive) or 1 (on): path-traced samples a still frame
     // 0: off; 1: every frame refines toward reprojected path-traced samples; 2: the same with
     // their residual against the hybrid frame (drift_moving_refine, below; the drivers')
     int32_t moving_refine;
@@ -142,19 +144,21 @@ const drift_image *drift_temporal_history(const drift_temporal *t);
 // variance yet) the hybrid is shown. Bit-identical for any thread count (the path tracer's
 // and the denoiser's guarantee; the blend is a gather).
 typedef struct drift_still_refine_settings {
-    uint32_t spp;         // 0 -> 1 path-traced sample a pixel each still frame
+    uint32_t spp;         // 0 -> 4 path-traced samples a pixel each still frame (1 keeping hybrid)
     uint32_t seed;        // the path tracer's seed
     int32_t max_depth;    // 0 -> the path tracer's default (8)
     float denoised_error; // 0 -> 0.25: the denoised mean's error^2 over the raw mean's variance
     int32_t radius;       // 0 -> 4: the error windows' half-width in pixels
-    // true (--still-refine progressive): from the second still frame on the drivers render no
-    // hybrid frame (drift_still_refine_needs_hybrid is false): the frame's time goes to `spp`
-    // path-traced samples, the last temporal image is only the start, and the path tracer's
-    // weight is at least n / (n + fade_samples) after n samples (fading the hybrid out by
+    // false (the default, --still-refine progressive): from the second still frame on the
+    // drivers render no hybrid frame (drift_still_refine_needs_hybrid is false): the frame's time
+    // goes to `spp` path-traced samples, the last temporal image is only the start, and the path
+    // tracer's weight is at least n / (n + fade_samples) after n samples (fading the hybrid out by
     // sample count, so the image converges to the denoised path tracer). fade_samples 1, 4,
     // 16 at 400^2 after 4 samples: Cornell box 0.035, 0.042, 0.053 FLIP, Breakfast Room
     // 0.096, 0.099, 0.110 (docs/lab/2026-12-07-issue-47-s6.md): the path tracer's quick.
-    bool progressive;
+    // true (--still-refine on): every still frame renders the hybrid frame and blends `spp`
+    // path-traced samples in where their error is the lower.
+    bool keeps_hybrid;
     uint32_t fade_samples; // 0 -> 1
 } drift_still_refine_settings;
 

@@ -27,7 +27,7 @@ struct drift_still_refine {
 static drift_still_refine_settings resolve(const drift_still_refine_settings *in)
 {
     drift_still_refine_settings s = in ? *in : (drift_still_refine_settings){ 0 };
-    s.spp = s.spp ? s.spp : (s.progressive ? 4u : 1u);
+    s.spp = s.spp ? s.spp : (s.keeps_hybrid ? 1u : 4u);
     s.fade_samples = s.fade_samples ? s.fade_samples : 1u;
     s.denoised_error = s.denoised_error > 0.0f ? s.denoised_error : 0.25f;
     s.radius = s.radius > 0 ? s.radius : 4;
@@ -229,7 +229,7 @@ drift_result drift_still_refine_apply(drift_still_refine *s, const drift_camera 
     }
     temporal_error_blend(hybrid, &beauty, &variance, &s->denoised, NULL, s->s.denoised_error,
                          s->s.radius, s->scratch, &s->out, &s->weight);
-    if (s->s.progressive) {
+    if (!s->s.keeps_hybrid) {
         fade_by_samples(s, hybrid);
     }
     return DRIFT_OK;
@@ -237,7 +237,7 @@ drift_result drift_still_refine_apply(drift_still_refine *s, const drift_camera 
 
 bool drift_still_refine_needs_hybrid(const drift_still_refine *s, const drift_camera *camera)
 {
-    return !s || !camera || !s->s.progressive || !s->has_camera ||
+    return !s || !camera || s->s.keeps_hybrid || !s->has_camera ||
            memcmp(&s->camera, camera, sizeof *camera) != 0;
 }
 

@@ -269,8 +269,8 @@ drift_result drift_view_create(drift_context *ctx, const drift_scene *scene,
                 ctx, scene, accel, width, height,
                 &(drift_still_refine_settings){ .seed = view->base_seed,
                                                 .spp = d.temporal_settings.still_spp,
-                                                .progressive =
-                                                    d.temporal_settings.still_progressive },
+                                                .keeps_hybrid =
+                                                    d.temporal_settings.still_keeps_hybrid },
                 &view->still);
         }
         if (r != DRIFT_OK) {

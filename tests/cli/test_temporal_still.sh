@@ -6,7 +6,7 @@
 # 2, 4, 8, 16 at most 2% above the one before, and frame 16 below 0.95 x frame 1), and
 # `--frames N --temporal on` (the viewer's set-up, drift/temporal.h) writes frame N - 1 of that
 # sequence bit for bit, for 1 and 2 threads.
-# Still refinement (--still-refine, on by default) adds a path-traced sample a frame: frame 16
+# Still refinement --still-refine on adds a path-traced sample a frame: frame 16
 # goes below 0.8 x what the hybrid alone (--still-refine off) has converged to after 16 frames,
 # the hybrid's bias (measured: refined 0.212, 0.198, 0.168, 0.137, 0.117; the hybrid alone
 # 0.212, 0.198, 0.193, 0.189, 0.185). $1 is the drift binary.
@@ -23,12 +23,12 @@ size=(--width 32 --height 32 --threads 2 --quiet)
 hybrid=(--mode hybrid --temporal on --indirect ism --ism-vpls 64 --reflections none --shadows hard)
 expect 0 "$drift" render "$scene" "${size[@]}" --spp 128 --out "$tmp/ref.exr"
 mkdir -p "$tmp/s"
-expect 0 "$drift" render "$scene" "${size[@]}" "${hybrid[@]}" \
+expect 0 "$drift" render "$scene" "${size[@]}" "${hybrid[@]}" --still-refine on \
     --camera-path "$tmp/still.json" --animation 0:15 --out "$tmp/s/f_%04d.exr"
-expect 0 "$drift" render "$scene" "${size[@]}" "${hybrid[@]}" --frames 16 \
+expect 0 "$drift" render "$scene" "${size[@]}" "${hybrid[@]}" --still-refine on --frames 16 \
     --out "$tmp/last.exr"
-expect 0 "$drift" render "$scene" "${size[@]}" "${hybrid[@]}" --frames 16 --threads 1 \
-    --out "$tmp/last1.exr"
+expect 0 "$drift" render "$scene" "${size[@]}" "${hybrid[@]}" --still-refine on --frames 16 \
+    --threads 1 --out "$tmp/last1.exr"
 expect 0 "$drift" render "$scene" "${size[@]}" "${hybrid[@]}" --frames 16 --still-refine off \
     --out "$tmp/hybrid_only.exr"
 "$drift" diff "$tmp/last.exr" "$tmp/last1.exr" >"$tmp/threads.txt" 2>&1 ||
@@ -62,12 +62,13 @@ PY
 # stats' "hybrid": false) and each frame path-traces 4 samples a pixel, the hybrid fading out by
 # sample count. Monotone within 2% over 1, 2, 4, 8, 16 frames, frame 16 below 0.8 x the
 # refinement that keeps rendering hybrid frames (--still-refine on, above), and bit-identical
-# for 1 and 2 threads (measured: 0.213, 0.162, 0.129, 0.102, 0.082).
+# for 1 and 2 threads (measured: 0.213, 0.162, 0.129, 0.102, 0.082). It is the default: the
+# 1-thread run names no --still-refine.
 mkdir -p "$tmp/p"
 expect 0 "$drift" render "$scene" "${size[@]}" "${hybrid[@]}" --still-refine progressive \
     --camera-path "$tmp/still.json" --animation 0:15 --out "$tmp/p/f_%04d.exr" \
     --stats "$tmp/p/stats.json"
-expect 0 "$drift" render "$scene" "${size[@]}" "${hybrid[@]}" --still-refine progressive \
+expect 0 "$drift" render "$scene" "${size[@]}" "${hybrid[@]}" \
     --frames 16 --threads 1 --out "$tmp/p/last1.exr"
 "$drift" diff "$tmp/p/f_0015.exr" "$tmp/p/last1.exr" >"$tmp/p/threads.txt" 2>&1 ||
     fail "progressive: 1 and 2 threads differ: $(cat "$tmp/p/threads.txt")"

@@ -448,7 +448,7 @@ static void view_still_refines(int moving_refine, bool progressive)
                              .hide_overlay = true,
                              .temporal = true,
                              .temporal_settings = { .moving_refine = moving_refine,
-                                                    .still_progressive = progressive },
+                                                    .still_keeps_hybrid = !progressive },
                              .hybrid = { .indirect = DRIFT_INDIRECT_REFERENCE, .spp = 1 } };
     drift_view *views[3] = { NULL, NULL, NULL };
     assert_int_equal(drift_view_create(r.ctx, r.scene, r.accel, &desc, &views[0]), DRIFT_OK);
