@@ -479,6 +479,8 @@ static void render_tiles(size_t begin, size_t end, int thread_index, void *user)
     thread_stats *stats = &pt->thread_stats[thread_index];
     int32_t width = pt->params.width;
     // A pixel's samples run in a row: the cache hashes their pair seeds once (once a call).
+    // A pixel with one sample to add skips it: filling a cache never read cost 3% more
+    // instructions than hashing (1-spp passes, docs/lab/2026-12-07-issue-46-s6-pt.md).
     drift_sampler_cache cache;
     drift_sampler_cache_init(&cache);
     for (size_t i = begin; i < end; ++i) {
@@ -497,7 +499,7 @@ static void render_tiles(size_t begin, size_t end, int thread_index, void *user)
                 }
                 for (uint32_t s = first; s < last; ++s) {
                     path_result r;
-                    trace_path(pt, x, y, s, &cache, &r, stats);
+                    trace_path(pt, x, y, s, last - first > 1 ? &cache : NULL, &r, stats);
                     if (!drift_vec3_is_finite(r.radiance)) {
                         stats->nan_samples++;
                         r.radiance = drift_vec3_splat(0.0f);
