@@ -254,8 +254,12 @@ static inline uint32_t drift_reverse_bits(uint32_t x)
     x = ((x >> 1) & 0x55555555U) | ((x & 0x55555555U) << 1);
     x = ((x >> 2) & 0x33333333U) | ((x & 0x33333333U) << 2);
     x = ((x >> 4) & 0x0f0f0f0fU) | ((x & 0x0f0f0f0fU) << 4);
+#if defined(__GNUC__)
+    return __builtin_bswap32(x); // the last two swaps in one instruction
+#else
     x = ((x >> 8) & 0x00ff00ffU) | ((x & 0x00ff00ffU) << 8);
     return (x >> 16) | (x << 16);
+#endif
 }
 
 // Point k of a Hammersley set of n points in [0,1)^2, shifted by `shift` modulo 1 (a
@@ -278,14 +282,33 @@ static inline float drift_u32_to_unit(uint32_t x)
 // 2020, "Practical Hash-based Owen Scrambling", §4 padding by shuffling). Every value is a
 // pure function of (seed, pixel, sample, dimension), which makes renders bit-identical for
 // any thread count and lets a single sample be replayed.
+// The per-pair scramble seeds depend on (seed, pixel, dimension) only, not on the sample: a
+// caller that draws many samples of one pixel in a row keeps them here and hashes each pair's
+// three seeds once a pixel instead of once a sample. Filled lazily, in dimension order; it
+// belongs to the pixel whose key it holds and starts over when a sampler of another key uses it
+// (two pixels of the same key derive the same seeds, so the values never depend on the cache).
+#define DRIFT_SAMPLER_CACHE_PAIRS 96
+
+typedef struct drift_sampler_cache {
+    uint32_t key;   // the pixel key the entries belong to
+    uint32_t count; // pairs filled, from dimension pair 0
+    uint32_t seeds[DRIFT_SAMPLER_CACHE_PAIRS][3];
+} drift_sampler_cache;
+
 typedef struct drift_sampler {
-    uint32_t key;             // hash of (seed, pixel)
-    uint32_t sample;          // sample index within the pixel
-    uint32_t dimension;       // next dimension pair to hand out
-    uint32_t sample_reversed; // sample's bits reversed, once a sample, not once a pair
+    uint32_t key;               // hash of (seed, pixel)
+    uint32_t sample;            // sample index within the pixel
+    uint32_t dimension;         // next dimension pair to hand out
+    uint32_t sample_reversed;   // sample's bits reversed, once a sample, not once a pair
+    drift_sampler_cache *cache; // NULL: the seeds are hashed at every draw
 } drift_sampler;
 
 drift_sampler drift_sampler_make(uint32_t seed, uint32_t pixel, uint32_t sample);
+// The same sampler, drawing its pair seeds through `cache` (drift_sampler_cache_init first):
+// the same numbers as drift_sampler_make's, bit for bit.
+drift_sampler drift_sampler_make_cached(uint32_t seed, uint32_t pixel, uint32_t sample,
+                                        drift_sampler_cache *cache);
+void drift_sampler_cache_init(drift_sampler_cache *cache);
 // Next two dimensions, each in [0, 1).
 drift_vec2 drift_sampler_next2(drift_sampler *s);
 // Next dimension alone (uses a pair and drops one half).

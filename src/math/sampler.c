@@ -1,5 +1,7 @@
 #include "drift/math.h"
 
+#include <stddef.h>
+
 // Burley 2020, §3: Laine-Karras style hash that only lets lower bits affect higher ones;
 // applied to bit-reversed values it is a nested uniform (Owen) scramble.
 static uint32_t laine_karras_permutation(uint32_t x, uint32_t seed)
@@ -41,32 +43,72 @@ drift_sampler drift_sampler_make(uint32_t seed, uint32_t pixel, uint32_t sample)
     return (drift_sampler){ .key = drift_hash_combine(drift_hash_u32(seed), pixel),
                             .sample = sample,
                             .dimension = 0,
-                            .sample_reversed = drift_reverse_bits(sample) };
+                            .sample_reversed = drift_reverse_bits(sample),
+                            .cache = NULL };
 }
 
-// The scrambled index of the sample in the current dimension pair (its bits reversed) and the
-// pair's key; advances the dimension. Forced inline: GCC left it a call (perf, Cornell box:
-// 3.7% of the render's samples in it beside next2's 8.2%).
-#if defined(__GNUC__)
-#    define PAIR_INDEX_INLINE static inline __attribute__((always_inline))
-#else
-#    define PAIR_INDEX_INLINE static inline
-#endif
-PAIR_INDEX_INLINE uint32_t pair_index(drift_sampler *s, uint32_t *out_pair_key)
+void drift_sampler_cache_init(drift_sampler_cache *cache)
 {
-    uint32_t pair_key = drift_hash_combine(s->key, s->dimension++);
-    *out_pair_key = pair_key;
-    // Shuffle the sample order per dimension pair so pairs are decorrelated (Burley §4).
-    return drift_reverse_bits(owen_scramble_reversed(s->sample_reversed, pair_key));
+    cache->key = 0;
+    cache->count = 0;
+}
+
+drift_sampler drift_sampler_make_cached(uint32_t seed, uint32_t pixel, uint32_t sample,
+                                        drift_sampler_cache *cache)
+{
+    drift_sampler s = drift_sampler_make(seed, pixel, sample);
+    if (cache->key != s.key) {
+        cache->key = s.key;
+        cache->count = 0;
+    }
+    s.cache = cache;
+    return s;
+}
+
+// The scramble seeds of the current dimension pair: the shuffle's, x's and y's; advances the
+// dimension. Forced inline: GCC left the older pair_index a call (perf, Cornell box: 3.7% of
+// the render's samples in it beside next2's 8.2%).
+#if defined(__GNUC__)
+#    define PAIR_INLINE static inline __attribute__((always_inline))
+#else
+#    define PAIR_INLINE static inline
+#endif
+PAIR_INLINE void pair_seeds(drift_sampler *s, uint32_t seeds[3])
+{
+    uint32_t d = s->dimension++;
+    drift_sampler_cache *c = s->cache;
+    if (c && d < c->count) {
+        seeds[0] = c->seeds[d][0];
+        seeds[1] = c->seeds[d][1];
+        seeds[2] = c->seeds[d][2];
+        return;
+    }
+    uint32_t pair_key = drift_hash_combine(s->key, d);
+    seeds[0] = pair_key;
+    seeds[1] = drift_hash_combine(pair_key, 1);
+    seeds[2] = drift_hash_combine(pair_key, 2);
+    // Pairs are drawn in order, so a miss is the next entry (or past the end).
+    if (c && d == c->count && d < DRIFT_SAMPLER_CACHE_PAIRS) {
+        c->seeds[d][0] = seeds[0];
+        c->seeds[d][1] = seeds[1];
+        c->seeds[d][2] = seeds[2];
+        c->count = d + 1;
+    }
+}
+
+// The sample's index shuffled per dimension pair (Burley §4), so pairs are decorrelated.
+PAIR_INLINE uint32_t shuffled_index(const drift_sampler *s, uint32_t shuffle_seed)
+{
+    return drift_reverse_bits(owen_scramble_reversed(s->sample_reversed, shuffle_seed));
 }
 
 drift_vec2 drift_sampler_next2(drift_sampler *s)
 {
-    uint32_t pair_key;
-    uint32_t index = pair_index(s, &pair_key);
-    uint32_t x = owen_scramble_reversed(index, drift_hash_combine(pair_key, 1));
-    uint32_t y =
-        owen_scramble_reversed(sobol_dim1_reversed(index), drift_hash_combine(pair_key, 2));
+    uint32_t seeds[3];
+    pair_seeds(s, seeds);
+    uint32_t index = shuffled_index(s, seeds[0]);
+    uint32_t x = owen_scramble_reversed(index, seeds[1]);
+    uint32_t y = owen_scramble_reversed(sobol_dim1_reversed(index), seeds[2]);
     return (drift_vec2){ drift_u32_to_unit(drift_reverse_bits(x)),
                          drift_u32_to_unit(drift_reverse_bits(y)) };
 }
@@ -75,9 +117,9 @@ drift_vec2 drift_sampler_next2(drift_sampler *s)
 // (and skips) a whole pair, as it always has, so every later dimension keeps its values.
 float drift_sampler_next1(drift_sampler *s)
 {
-    uint32_t pair_key;
-    uint32_t index = pair_index(s, &pair_key);
-    uint32_t x = owen_scramble_reversed(index, drift_hash_combine(pair_key, 1));
+    uint32_t seeds[3];
+    pair_seeds(s, seeds);
+    uint32_t x = owen_scramble_reversed(shuffled_index(s, seeds[0]), seeds[1]);
     return drift_u32_to_unit(drift_reverse_bits(x));
 }
 

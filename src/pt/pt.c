@@ -256,13 +256,15 @@ static float emission_weight(const drift_pt *pt, bool prev_specular, float bsdf_
     return drift_power_heuristic(bsdf_pdf, light_pdf);
 }
 
-static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample, path_result *out,
-                       thread_stats *stats)
+// cache: the pixel's sampler seeds (drift_sampler_cache), or NULL.
+static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample,
+                       drift_sampler_cache *cache, path_result *out, thread_stats *stats)
 {
     const drift_scene *scene = pt->scene;
     const drift_pt_params *p = &pt->params;
     uint32_t pixel = (uint32_t)y * (uint32_t)p->width + (uint32_t)x;
-    drift_sampler sampler = drift_sampler_make(p->seed, pixel, sample);
+    drift_sampler sampler = cache ? drift_sampler_make_cached(p->seed, pixel, sample, cache)
+                                  : drift_sampler_make(p->seed, pixel, sample);
     drift_vec2 film = drift_sampler_next2(&sampler);
     drift_vec2 lens = drift_sampler_next2(&sampler);
     if (p->pixel_centre) {
@@ -436,7 +438,7 @@ drift_vec3 drift_pt_trace_sample(const drift_pt *pt, int32_t x, int32_t y, uint3
 {
     thread_stats scratch = { 0 };
     path_result r;
-    trace_path(pt, x, y, sample, &r, &scratch);
+    trace_path(pt, x, y, sample, NULL, &r, &scratch);
     return r.radiance;
 }
 
@@ -476,6 +478,11 @@ static void render_tiles(size_t begin, size_t end, int thread_index, void *user)
     drift_pt *pt = job->pt;
     thread_stats *stats = &pt->thread_stats[thread_index];
     int32_t width = pt->params.width;
+    // A pixel's samples run in a row: the cache hashes their pair seeds once (once a call).
+    // A pixel with one sample to add skips it: filling a cache never read cost 3% more
+    // instructions than hashing (1-spp passes, docs/lab/2026-12-07-issue-46-s6-pt.md).
+    drift_sampler_cache cache;
+    drift_sampler_cache_init(&cache);
     for (size_t i = begin; i < end; ++i) {
         if (job->cancel && atomic_load(job->cancel)) {
             return;
@@ -492,7 +499,7 @@ static void render_tiles(size_t begin, size_t end, int thread_index, void *user)
                 }
                 for (uint32_t s = first; s < last; ++s) {
                     path_result r;
-                    trace_path(pt, x, y, s, &r, stats);
+                    trace_path(pt, x, y, s, last - first > 1 ? &cache : NULL, &r, stats);
                     if (!drift_vec3_is_finite(r.radiance)) {
                         stats->nan_samples++;
                         r.radiance = drift_vec3_splat(0.0f);

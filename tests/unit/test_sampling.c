@@ -59,6 +59,34 @@ static void test_sampling_sampler_is_deterministic_and_in_range(void **state)
     assert_true(u.x != v.x || u.y != v.y);
 }
 
+// The seed cache changes no number: samples of one pixel in a row, then others, pixels that
+// come back, draws past the cache's end and one-dimensional draws, against uncached samplers.
+static void test_sampling_sampler_cache_gives_the_same_numbers(void **state)
+{
+    (void)state;
+    drift_sampler_cache cache;
+    drift_sampler_cache_init(&cache);
+    const uint32_t pixels[] = { 5, 5, 6, 5, 900, 900, 6 };
+    for (size_t p = 0; p < sizeof pixels / sizeof pixels[0]; ++p) {
+        for (uint32_t s = 0; s < 24; ++s) {
+            drift_sampler a = drift_sampler_make_cached(11, pixels[p], s, &cache);
+            drift_sampler b = drift_sampler_make(11, pixels[p], s);
+            // Paths of varying length, some past the cache's last pair.
+            int pairs = (int)((s * 37u + (uint32_t)p * 11u) % (DRIFT_SAMPLER_CACHE_PAIRS + 20));
+            for (int d = 0; d < pairs; ++d) {
+                if (d % 5 == 3) {
+                    float u = drift_sampler_next1(&a), v = drift_sampler_next1(&b);
+                    assert_memory_equal(&u, &v, sizeof u);
+                } else {
+                    drift_vec2 u = drift_sampler_next2(&a), v = drift_sampler_next2(&b);
+                    assert_memory_equal(&u, &v, sizeof u);
+                }
+            }
+        }
+    }
+    assert_true(cache.count == DRIFT_SAMPLER_CACHE_PAIRS); // it did fill
+}
+
 // The sampler as Burley 2020 lists it (nested uniform scrambles of the index and of each Sobol
 // dimension, dimension 1 by its direction numbers v_i = v_{i-1} ^ (v_{i-1} >> 1)), written
 // here without the sampler's shortcuts: the sampler must give these values to the bit.
@@ -608,6 +636,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sampling_sampler_is_deterministic_and_in_range),
+        cmocka_unit_test(test_sampling_sampler_cache_gives_the_same_numbers),
         cmocka_unit_test(test_sampling_sampler_is_stratified),
         cmocka_unit_test(test_sampling_sampler_matches_the_textbook_sobol),
         cmocka_unit_test(test_sampling_warps_match_their_pdfs),
