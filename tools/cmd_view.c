@@ -138,7 +138,8 @@ static const cli_option view_table[] = {
             "SIR samples a frame (default 16384; docs/sir.md)"),
     CLI_CHOICE("--temporal", "off|on", O, temporal, "off|on",
                "reuse across frames: a still camera converges, a moving one\n"
-               "reprojects its history (docs/temporal.md; not with --refine)"),
+               "reprojects its history (default on; docs/temporal.md; not with\n"
+               "--refine, which turns it off)"),
     CLI_CHOICE("--still-refine", "on|off|progressive", O, still_refine, "off|on|progressive",
                "--temporal on, a still camera: each frame adds a path-traced\n"
                "sample a pixel, denoised and blended in where its error is the\n"
@@ -269,9 +270,11 @@ static bool parse_press(const char *cmd, const char *flag, const char *v, void *
 // Returns 0 on success, 2 on a usage error (message printed), -1 after --help.
 static int parse_options(int argc, char **argv, view_options *o)
 {
-    *o = (view_options){
-        .spp = 4, .spp_per_frame = 1, .hybrid = drift_hybrid_params_default(), .still_refine = 2
-    };
+    *o = (view_options){ .spp = 4,
+                         .spp_per_frame = 1,
+                         .hybrid = drift_hybrid_params_default(),
+                         .temporal = true,
+                         .still_refine = 2 };
     cli_knobs_unset(&o->hybrid);
     int status = cli_parse(&view_command, argc, argv, o, NULL);
     if (status != CLI_PARSED) {

@@ -55,6 +55,17 @@ expect 0 "$drift" diff "$tmp/plain.png" "$tmp/split.png" --json
 python3 -c "import json,sys; d=json.load(open('$tmp/out')); sys.exit(0 if d['mse'] > 0 else 1)" \
     || fail "split view with another buffer looks the same as the plain frame"
 
+# Temporal reuse is the viewer's default (a still camera converges; docs/temporal.md): three
+# plain frames are --temporal on's, bit for bit, and not --temporal off's.
+for t in on off; do
+    expect 0 xvfb-run -a "$drift" view --width 160 --height 120 --threads 2 --indirect none --frames 3 \
+        --no-overlay --temporal "$t" --screenshot "$tmp/temporal_$t.png"
+done
+expect 0 xvfb-run -a "$drift" view --width 160 --height 120 --threads 2 --indirect none --frames 3 \
+    --no-overlay --screenshot "$tmp/temporal_default.png"
+cmp -s "$tmp/temporal_default.png" "$tmp/temporal_on.png" || fail "the viewer's default is not --temporal on"
+cmp -s "$tmp/temporal_default.png" "$tmp/temporal_off.png" && fail "--temporal off changes nothing"
+
 # The knob panel: a knob of the knob table set from the viewer (knob-next/-prev select,
 # knob-up steps: the second knob, --aa, from 1 to 2) gives the frame the command line's
 # --aa 2 gives, and not the default frame.
