@@ -75,16 +75,17 @@
       drift_realtime_pass_envmap_reflections, DRIFT_INPUT_PROBES, 0, drift_planes_none, 0,         \
       DRIFT_PT_COMPONENT_SPECULAR)                                                                 \
     X(P, SHARP, "sharp", "one mirror ray per pixel", drift_pass_none,                              \
-      DRIFT_INPUT_SHARP_REFLECTIONS, 0, drift_planes_none, 0, DRIFT_PT_COMPONENT_SPECULAR)         \
-    X(P, REFERENCE, "reference", "first-bounce glossy and mirror light path-traced at --spp",      \
-      drift_hybrid_pass_reference, 0, DRIFT_ROW_PATH_TRACED, drift_planes_none, 0,                 \
+      DRIFT_INPUT_SHARP_REFLECTIONS, DRIFT_ROW_TRACES_GLASS, drift_planes_none, 0,                 \
       DRIFT_PT_COMPONENT_SPECULAR)                                                                 \
+    X(P, REFERENCE, "reference", "first-bounce glossy and mirror light path-traced at --spp",      \
+      drift_hybrid_pass_reference, 0, DRIFT_ROW_PATH_TRACED | DRIFT_ROW_TRACES_GLASS,              \
+      drift_planes_none, 0, DRIFT_PT_COMPONENT_SPECULAR)                                           \
     X(P, ISG, "isg", "image space gathering over the sharp buffer (docs/isg.md)",                  \
-      drift_isg_pass_reflections, DRIFT_INPUT_SHARP_REFLECTIONS, 0, drift_isg_reflection_planes,   \
-      DRIFT_STREAM_ISG_REFLECTIONS, DRIFT_PT_COMPONENT_SPECULAR)                                   \
+      drift_isg_pass_reflections, DRIFT_INPUT_SHARP_REFLECTIONS, DRIFT_ROW_TRACES_GLASS,           \
+      drift_isg_reflection_planes, DRIFT_STREAM_ISG_REFLECTIONS, DRIFT_PT_COMPONENT_SPECULAR)      \
     X(P, BLUR, "blur", "baseline: the sharp buffer blurred over a fixed disk",                     \
-      drift_isg_pass_reflections, DRIFT_INPUT_SHARP_REFLECTIONS, 0, drift_planes_none,             \
-      DRIFT_STREAM_ISG_REFLECTIONS, DRIFT_PT_COMPONENT_SPECULAR)                                   \
+      drift_isg_pass_reflections, DRIFT_INPUT_SHARP_REFLECTIONS, DRIFT_ROW_TRACES_GLASS,           \
+      drift_planes_none, DRIFT_STREAM_ISG_REFLECTIONS, DRIFT_PT_COMPONENT_SPECULAR)                \
     X(P, AAF, "aaf", "glossy light path-traced, adaptively sampled and filtered (docs/aaf.md)",    \
       drift_aaf_pass_specular, 0, DRIFT_ROW_PATH_TRACED, drift_aaf_specular_planes,                \
       DRIFT_STREAM_AAF_SPECULAR, DRIFT_PT_COMPONENT_SPECULAR)                                      \

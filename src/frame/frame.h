@@ -24,6 +24,8 @@ typedef enum drift_stream {
     DRIFT_STREAM_PROBE = 4,            // environment-map capture (realtime/reflections.c)
     DRIFT_STREAM_HARD_SHADOW_AIM = 5,  // --aa's shadow-ray aim points, keyed on base_seed
                                        // (one stratified set over the passes; direct.c)
+    DRIFT_STREAM_GLASS = 6,            // glass transmission after the rows that do not trace
+                                       // it (realtime/reflections.c)
     DRIFT_STREAM_ISG_SHADOWS = 11,     // isg/isg_shadows.c
     DRIFT_STREAM_ISG_REFLECTIONS = 12, // isg/isg_reflections.c
     DRIFT_STREAM_ISG_DOF = 13,         // isg/isg_dof.c
@@ -196,6 +198,10 @@ enum {
     // rows of its effect (drift_technique_frontier, docs/frontier.md). The path-traced truths
     // and the baselines a searched row dominates (pcf under pcss, the blur rows) are not.
     DRIFT_ROW_FRONTIER = 1u << 5,
+    // A reflection row whose R already holds the light smooth glass lets through (the rows
+    // over the sharp buffer, the path-traced one); after any other the realtime family adds
+    // it (drift_realtime_pass_glass_transmission), so that no row renders glass opaque.
+    DRIFT_ROW_TRACES_GLASS = 1u << 6,
 };
 
 // Runs fn for every row, or every pixel, rows in parallel. `rays` is the calling thread's ray

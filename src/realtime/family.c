@@ -39,6 +39,10 @@ static drift_result prepare(drift_frame_state *f, uint32_t inputs)
 
 static drift_result after_row(drift_frame_state *f, const drift_family_row *row)
 {
+    if (row->args->effect == DRIFT_EFFECT_REFLECTIONS &&
+        !(row->flags & (DRIFT_ROW_NO_TERM | DRIFT_ROW_TRACES_GLASS))) {
+        return drift_realtime_pass_glass_transmission(f);
+    }
     return (row->flags & DRIFT_ROW_SUMS_DIRECT) ? drift_realtime_pass_sum_direct(f) : DRIFT_OK;
 }
 

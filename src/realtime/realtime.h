@@ -76,6 +76,9 @@ drift_result drift_realtime_ensure_shadow_map(drift_frame_state *frame, uint32_t
 void drift_realtime_drop_shadow_map(drift_frame_state *frame, uint32_t light);
 // The sharp reflection buffer: one mirror ray a glossy or mirror pixel, R from it.
 drift_result drift_realtime_pass_sharp_reflections(drift_frame_state *frame);
+// Adds to R the light smooth glass lets through (traced as the sharp pass does) at the
+// glass pixels, after a reflection row that does not trace it (no DRIFT_ROW_TRACES_GLASS).
+drift_result drift_realtime_pass_glass_transmission(drift_frame_state *frame);
 // The environment-map probes, captured on first use (kept while the settings stand).
 drift_result drift_realtime_capture_probes(drift_frame_state *frame);
 // The direction R looks `map` up in for a reflected ray from p along dir: dir, or with

@@ -251,6 +251,31 @@ drift_result drift_realtime_pass_sharp_reflections(drift_frame_state *f)
     return DRIFT_OK;
 }
 
+static void glass_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
+{
+    (void)user;
+    const drift_surface *s = &f->gbuffer.surfaces[pixel_index(f, x, y)];
+    if (s->material == DRIFT_INVALID_INDEX) {
+        return;
+    }
+    drift_bsdf bsdf = drift_bsdf_make(f->scene, s);
+    if (!drift_bsdf_is_smooth_glass(&bsdf)) {
+        return;
+    }
+    drift_vec3 wo = drift_pass_wo(f, x, y);
+    // Its own stream: the row's R stays what it was, the transmission is added.
+    drift_sampler sampler = drift_pass_sampler(f, DRIFT_STREAM_GLASS, x, y);
+    drift_vec3 t = glass_transmission(f, s, &bsdf, wo, &sampler, rays);
+    drift_image_set3(&f->reflections, x, y,
+                     drift_vec3_add(drift_image_get3(&f->reflections, x, y), t));
+}
+
+drift_result drift_realtime_pass_glass_transmission(drift_frame_state *f)
+{
+    drift_pass_pixels(f, DRIFT_PASS_REFLECTIONS, glass_pixel, NULL);
+    return DRIFT_OK;
+}
+
 drift_result drift_realtime_capture_probes(drift_frame_state *f)
 {
     double t = drift_time_now();

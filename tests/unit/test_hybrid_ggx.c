@@ -76,10 +76,12 @@ static void test_closed_form_shades_the_ggx_plastic_base(void **state)
 // Smooth glass in the hybrid frame: an emitter seen through a thin glass sheet head-on arrives
 // times the sheet's transmittance, 1 - R_thin with R_thin = r + (1 - r)^2 r / (1 - r^2),
 // r = ((1.5 - 1) / (1.5 + 1))^2 (the path tracer's thin sheet). It rendered 0 before the glass
-// was traced (only a 4% reflection of what is behind the camera). The rows that gather over the
-// sharp buffer (isg, the default, and blur) must keep it: at 65 pixels ISG's cone for the
-// smooth lobe (2 atan(3e-3)) is 1.3 pixels wide, and its gather of the reflected light alone
-// rendered the sheet black.
+// was traced (only a 4% reflection of what is behind the camera). Every reflection row but
+// `none` and the path-traced `reference` shows it: the rows that gather over the sharp buffer
+// (isg, the default, and blur) keep it — at 65 pixels ISG's cone for the smooth lobe
+// (2 atan(3e-3)) is 1.3 pixels wide, and its gather of the reflected light alone rendered the
+// sheet black — and after envmap, aaf and micro, which look up or gather reflection only, the
+// realtime family traces it (DRIFT_ROW_TRACES_GLASS).
 static void test_reflections_see_through_thin_glass(void **state)
 {
     (void)state;
@@ -101,7 +103,8 @@ static void test_reflections_see_through_thin_glass(void **state)
                                            drift_vec3_make(0, 1, 0), 0.3f, size, size);
     test_rig_commit(&r);
     const drift_reflection_technique rows[] = { DRIFT_REFLECTIONS_SHARP, DRIFT_REFLECTIONS_ISG,
-                                                DRIFT_REFLECTIONS_BLUR };
+                                                DRIFT_REFLECTIONS_BLUR,  DRIFT_REFLECTIONS_ENVMAP,
+                                                DRIFT_REFLECTIONS_AAF,   DRIFT_REFLECTIONS_MICRO };
     float f = 0.04f, thin = f + (1.0f - f) * (1.0f - f) * f / (1.0f - f * f);
     float want = 2.0f * (1.0f - thin);
     for (size_t k = 0; k < sizeof rows / sizeof *rows; ++k) {

@@ -92,8 +92,9 @@ static void test_rows_are_consistent(void **state)
 {
     (void)state;
     const uint32_t reserved[] = { DRIFT_STREAM_UNSHADOWED, DRIFT_STREAM_REFLECTION,
-                                  DRIFT_STREAM_PROBE,      DRIFT_STREAM_ISG_LAYER,
-                                  DRIFT_STREAM_SIR_AO,     DRIFT_STREAM_SIR_TRACE };
+                                  DRIFT_STREAM_PROBE,      DRIFT_STREAM_GLASS,
+                                  DRIFT_STREAM_ISG_LAYER,  DRIFT_STREAM_SIR_AO,
+                                  DRIFT_STREAM_SIR_TRACE };
     const drift_technique_row *seen[64];
     int seen_count = 0, searched[DRIFT_EFFECT_COUNT] = { 0 };
     for (int e = 0; e < DRIFT_EFFECT_COUNT; ++e) {
