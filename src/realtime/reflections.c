@@ -43,57 +43,80 @@ static drift_vec3 combine(const drift_bsdf *bsdf, drift_vec3 wo, drift_raster_ra
     return drift_vec3_mul(drift_raster_reflection_weight(bsdf, wo), seen);
 }
 
+// The light along a ray leaving a smooth-glass interface: what it meets shaded as a sharp
+// reflection's hit, or, at another smooth-glass interface with interfaces left, that
+// interface's light (glass_interface).
+static drift_vec3 glass_interface(drift_frame_state *f, const drift_surface *s,
+                                  const drift_bsdf *bsdf, drift_vec3 wo, int left, bool inside,
+                                  drift_sampler *sampler, uint64_t *rays);
+
+static drift_vec3 glass_ray(drift_frame_state *f, const drift_surface *at, drift_vec3 wi, int left,
+                            drift_sampler *sampler, uint64_t *rays)
+{
+    drift_ray ray = { .origin = drift_offset_origin(at->position, at->ng, wi),
+                      .dir = wi,
+                      .tmin = 0.0f,
+                      .tmax = INFINITY };
+    drift_hit hit;
+    ++*rays;
+    if (left > 0 && drift_accel_intersect(f->accel, &ray, &hit)) {
+        drift_surface next = drift_scene_surface(f->scene, &ray, &hit);
+        if (next.material != DRIFT_INVALID_INDEX) {
+            drift_bsdf nb = drift_bsdf_make(f->scene, &next);
+            if (drift_bsdf_is_smooth_glass(&nb)) {
+                return glass_interface(f, &next, &nb, drift_vec3_neg(ray.dir), left, true, sampler,
+                                       rays);
+            }
+        }
+    }
+    float distance;
+    drift_raster_radiance l = drift_raster_trace_radiance(&f->shading, ray, DRIFT_INVALID_INDEX,
+                                                          sampler, rays, &distance);
+    return drift_vec3_add(l.emitted, l.reflected);
+}
+
+// Both branches of a smooth-glass interface, each weighted by its share (1 - F, or F): u_lobe
+// at the top of the dielectric's range transmits (reflects only under total internal
+// reflection), at its bottom reflects. The camera's own interface leaves its reflection to
+// the sharp buffer (inside = false). Inside the glass, exits near grazing reflect most of the
+// light (F -> 1 before total internal reflection): the transmitted branch alone lost it.
+static drift_vec3 glass_interface(drift_frame_state *f, const drift_surface *s,
+                                  const drift_bsdf *bsdf, drift_vec3 wo, int left, bool inside,
+                                  drift_sampler *sampler, uint64_t *rays)
+{
+    drift_vec3 sum = drift_vec3_splat(0.0f);
+    drift_bsdf_sample t = drift_bsdf_sample_wi(bsdf, wo, 1.0f - 1e-6f, drift_vec2_make(0, 0));
+    drift_bsdf_sample r = { 0 };
+    if (inside && t.pdf < bsdf->ggx.w_dielectric) {
+        r = drift_bsdf_sample_wi(bsdf, wo, 1.0f - bsdf->ggx.w_dielectric, drift_vec2_make(0, 0));
+        if (drift_vec3_dot(r.wi, t.wi) > 0.9999f) {
+            r.pdf = 0.0f; // total internal reflection: t already is the reflection
+        }
+    }
+    const drift_bsdf_sample *branch[2] = { &t, &r };
+    for (int i = 0; i < 2; ++i) {
+        if (branch[i]->pdf > 0.0f) {
+            drift_vec3 w = drift_vec3_scale(branch[i]->weight, branch[i]->pdf);
+            sum = drift_vec3_add(
+                sum, drift_vec3_mul(w, glass_ray(f, s, branch[i]->wi, left - 1, sampler, rays)));
+        }
+    }
+    return sum;
+}
+
 // Smooth glass (a GGX dielectric below alpha 0.001): the light it lets through, traced.
-// The refracted ray goes on through up to GLASS_INTERFACES smooth-dielectric interfaces (each
-// refracting, or reflecting under total internal reflection), weighted by the transmitted
-// share w_dielectric (1 - F) at each; what it meets is shaded as a sharp reflection's hit
-// (emission, direct light with hard shadows; the environment on a miss). Rough glass and
-// every other lobe are not traced here (docs/hybrid.md, "Glass").
+// The refracted ray goes on through up to GLASS_INTERFACES smooth-dielectric interfaces,
+// splitting at each inside one into its transmitted and reflected rays, weighted by their
+// shares; what they meet is shaded as a sharp reflection's hit (emission, direct light with
+// hard shadows; the environment on a miss). Rough glass and every other lobe are not traced
+// here (docs/hybrid.md, "Glass").
 #define GLASS_INTERFACES 4
 
 static drift_vec3 glass_transmission(drift_frame_state *f, const drift_surface *s,
                                      const drift_bsdf *bsdf, drift_vec3 wo, drift_sampler *sampler,
                                      uint64_t *rays)
 {
-    drift_vec3 throughput = drift_vec3_splat(1.0f);
-    drift_surface at = *s;
-    drift_bsdf b = *bsdf;
-    drift_vec3 w = wo;
-    for (int k = 0; k < GLASS_INTERFACES; ++k) {
-        // u_lobe at the top of the dielectric's range: transmit (reflect only under TIR);
-        // the sample's pdf is then the probability of that event, w_dielectric (1 - F).
-        drift_bsdf_sample bs = drift_bsdf_sample_wi(&b, w, 1.0f - 1e-6f, drift_vec2_make(0, 0));
-        if (!(bs.pdf > 0.0f)) {
-            break;
-        }
-        throughput = drift_vec3_scale(drift_vec3_mul(throughput, bs.weight), bs.pdf);
-        drift_ray ray = { .origin = drift_offset_origin(at.position, at.ng, bs.wi),
-                          .dir = bs.wi,
-                          .tmin = 0.0f,
-                          .tmax = INFINITY };
-        drift_hit hit;
-        ++*rays;
-        bool more = false;
-        if (drift_accel_intersect(f->accel, &ray, &hit)) {
-            drift_surface next = drift_scene_surface(f->scene, &ray, &hit);
-            if (next.material != DRIFT_INVALID_INDEX) {
-                drift_bsdf nb = drift_bsdf_make(f->scene, &next);
-                if (drift_bsdf_is_smooth_glass(&nb) && k + 1 < GLASS_INTERFACES) {
-                    at = next;
-                    b = nb;
-                    w = drift_vec3_neg(ray.dir);
-                    more = true;
-                }
-            }
-        }
-        if (!more) {
-            float distance;
-            drift_raster_radiance l = drift_raster_trace_radiance(
-                &f->shading, ray, DRIFT_INVALID_INDEX, sampler, rays, &distance);
-            return drift_vec3_mul(throughput, drift_vec3_add(l.emitted, l.reflected));
-        }
-    }
-    return drift_vec3_splat(0.0f);
+    return glass_interface(f, s, bsdf, wo, GLASS_INTERFACES, false, sampler, rays);
 }
 
 static void sharp_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
