@@ -190,12 +190,6 @@ void drift__micro_warp_build_diffuse(drift__micro_warp *warp, int32_t n);
 drift_vec3 drift__micro_warp_forward(const drift__micro_warp *warp, drift_vec2 xy, float *out_pdf);
 // Phi^-1: a unit local direction with z >= 0 -> its point of [0, 1]^2.
 drift_vec2 drift__micro_warp_inverse(const drift__micro_warp *warp, drift_vec3 omega);
-struct drift__micro_pixels;
-// The same, unless omega_node > cut pixels->cell_bound of omega's table cell (then false: a
-// node of that solid angle is bigger than its pixel whichever it is).
-bool drift__micro_warp_inverse_bounded(const drift__micro_warp *warp,
-                                       const struct drift__micro_pixels *pixels, drift_vec3 omega,
-                                       float omega_node, float cut, drift_vec2 *out);
 
 // --- MICRO-BUFFER (§6.2.2) ---
 
@@ -212,9 +206,6 @@ typedef struct drift__micro_pixels {
     // omega of any pixel the warp's inverse can put a direction of that bin in, so that a
     // node bigger than it is refined without the inverse (the same cut, bit for bit).
     float omega_bound[DRIFT_MICRO_BOUND_BINS];
-    // The same by the warp's table cell (column c, row r at c n + r): tighter, after the
-    // inverse's first half (u, t), before its CDF lookups.
-    float cell_bound[DRIFT_MICRO_MAX_WARP * DRIFT_MICRO_MAX_WARP];
 } drift__micro_pixels;
 
 void drift__micro_pixels_make(drift__micro_pixels *pixels, const drift__micro_warp *warp,

@@ -116,17 +116,12 @@ drift_vec3 drift__micro_gather(const drift__micro_gather_desc *desc, drift_vec3 
         }
         int32_t pix = -1;
         if (local.z > 0.0f && dist > r && cos_c >= cap_cos) {
-            // Bigger than any pixel of its direction's cosine bin, or of its warp cell: refined
-            // (or left to the rays) whichever its pixel is, so the inverse's CDF lookups (most
-            // of a visit's cost) are skipped. The same cut, bit for bit.
+            // Bigger than any pixel of its direction's cosine bin: refined (or left to the
+            // rays) whichever its pixel is, so the warp's inverse is skipped.
             float z = capped ? cos_c : local.z / dist;
             int32_t bin = (int32_t)fminf(z * z * (float)DRIFT_MICRO_BOUND_BINS,
                                          (float)(DRIFT_MICRO_BOUND_BINS - 1));
-            drift_vec2 xy;
-            if (omega_node > desc->cut_scale * pixels->omega_bound[bin] ||
-                !drift__micro_warp_inverse_bounded(desc->warp, pixels,
-                                                   drift_vec3_scale(local, 1.0f / dist), omega_node,
-                                                   desc->cut_scale, &xy)) {
+            if (omega_node > desc->cut_scale * pixels->omega_bound[bin]) {
                 if (!leaf) {
                     stack[top++] = 2 * i + 2;
                     stack[top++] = 2 * i + 1;
@@ -135,6 +130,8 @@ drift_vec3 drift__micro_gather(const drift__micro_gather_desc *desc, drift_vec3 
                 }
                 continue;
             }
+            drift_vec2 xy =
+                drift__micro_warp_inverse(desc->warp, drift_vec3_scale(local, 1.0f / dist));
             int32_t px = (int32_t)drift_clampf(floorf(xy.x * (float)k), 0.0f, (float)(k - 1));
             int32_t py = (int32_t)drift_clampf(floorf(xy.y * (float)k), 0.0f, (float)(k - 1));
             pix = py * k + px;

@@ -151,28 +151,6 @@ drift_vec2 drift__micro_warp_inverse(const drift__micro_warp *warp, drift_vec3 o
     return drift_vec2_make(x, y);
 }
 
-bool drift__micro_warp_inverse_bounded(const drift__micro_warp *warp,
-                                       const drift__micro_pixels *pixels, drift_vec3 omega,
-                                       float omega_node, float cut, drift_vec2 *out)
-{
-    // drift__micro_warp_inverse's steps, the cell's bound tested between them.
-    int32_t n = warp->n;
-    float sc = warp->scale;
-    drift_vec3 wc = drift_frame_to_local(&warp->cap, omega);
-    float u = drift_clampf(wc.x / sc, -1.0f, 1.0f);
-    float s = sqrtf(fmaxf(1.0f - u * u, 0.0f)) * sc;
-    float t = s > 1e-7f ? drift_clampf(wc.y / s, -1.0f, 1.0f) : 0.0f;
-    int32_t c = (int32_t)drift_clampf(floorf((u + 1.0f) * 0.5f * (float)n), 0.0f, (float)(n - 1));
-    int32_t r = (int32_t)drift_clampf(floorf((t + 1.0f) * 0.5f * (float)n), 0.0f, (float)(n - 1));
-    if (omega_node > cut * pixels->cell_bound[c * n + r]) {
-        return false;
-    }
-    float x = cdf_at(warp->marginal, n, u);
-    float y = cdf_at(warp->conditional + (size_t)c * (size_t)(n + 1), n, t);
-    *out = drift_vec2_make(x, y);
-    return true;
-}
-
 // Solid angle of the spherical triangle a, b, c (Van Oosterom and Strackee 1983).
 static float triangle_solid_angle(drift_vec3 a, drift_vec3 b, drift_vec3 c)
 {
@@ -230,7 +208,6 @@ static void make_omega_bound(drift__micro_pixels *pixels, const drift__micro_war
                     most = fmaxf(most, pixels->omega[y * k + x]);
                 }
             }
-            pixels->cell_bound[c * n + r] = most;
             float z2lo = 1.0f - s2 * (u2hi + t2hi - u2hi * t2hi) - pad;
             float z2hi = 1.0f - s2 * (u2lo + t2lo - u2lo * t2lo) + pad;
             int32_t b0 = (int32_t)drift_clampf(floorf(z2lo * (float)bins), 0.0f, (float)(bins - 1));
