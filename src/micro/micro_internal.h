@@ -193,7 +193,8 @@ drift_vec2 drift__micro_warp_inverse(const drift__micro_warp *warp, drift_vec3 o
 
 // --- MICRO-BUFFER (§6.2.2) ---
 
-#define DRIFT_MICRO_MAX_K 32
+#define DRIFT_MICRO_MAX_K      32
+#define DRIFT_MICRO_BOUND_BINS 128
 
 // A K x K micro-buffer's pixels through one warp: direction (local) and solid angle of each.
 typedef struct drift__micro_pixels {
@@ -201,6 +202,10 @@ typedef struct drift__micro_pixels {
     drift_vec3 dir[DRIFT_MICRO_MAX_K * DRIFT_MICRO_MAX_K];
     float omega[DRIFT_MICRO_MAX_K * DRIFT_MICRO_MAX_K];
     float omega_max; // the largest of omega: a node bigger than it is refined in any pixel
+    // By the cosine z of a direction to the warp's axis (bin floor(z^2 BINS)): at least the
+    // omega of any pixel the warp's inverse can put a direction of that bin in, so that a
+    // node bigger than it is refined without the inverse (the same cut, bit for bit).
+    float omega_bound[DRIFT_MICRO_BOUND_BINS];
 } drift__micro_pixels;
 
 void drift__micro_pixels_make(drift__micro_pixels *pixels, const drift__micro_warp *warp,

@@ -116,6 +116,20 @@ drift_vec3 drift__micro_gather(const drift__micro_gather_desc *desc, drift_vec3 
         }
         int32_t pix = -1;
         if (local.z > 0.0f && dist > r && cos_c >= cap_cos) {
+            // Bigger than any pixel of its direction's cosine bin: refined (or left to the
+            // rays) whichever its pixel is, so the warp's inverse is skipped.
+            float z = capped ? cos_c : local.z / dist;
+            int32_t bin = (int32_t)fminf(z * z * (float)DRIFT_MICRO_BOUND_BINS,
+                                         (float)(DRIFT_MICRO_BOUND_BINS - 1));
+            if (omega_node > desc->cut_scale * pixels->omega_bound[bin]) {
+                if (!leaf) {
+                    stack[top++] = 2 * i + 2;
+                    stack[top++] = 2 * i + 1;
+                } else {
+                    post++;
+                }
+                continue;
+            }
             drift_vec2 xy =
                 drift__micro_warp_inverse(desc->warp, drift_vec3_scale(local, 1.0f / dist));
             int32_t px = (int32_t)drift_clampf(floorf(xy.x * (float)k), 0.0f, (float)(k - 1));

@@ -159,6 +159,66 @@ static float triangle_solid_angle(drift_vec3 a, drift_vec3 b, drift_vec3 c)
     return 2.0f * atan2f(num, den);
 }
 
+// The pixels [*lo, *hi] a coordinate of CDF cell i can land in (drift__micro_warp_inverse),
+// padded by 10^-3 pixel for its rounding (~10^-5 pixel); the whole row where the CDF is empty.
+static void cell_pixels(const float *cdf, int32_t n, int32_t i, int32_t k, int32_t *lo, int32_t *hi)
+{
+    *lo = 0;
+    *hi = k - 1;
+    if (cdf[n] > 0.0f) {
+        int32_t a = (int32_t)floorf(cdf[i] / cdf[n] * (float)k - 1e-3f);
+        int32_t b = (int32_t)floorf(cdf[i + 1] / cdf[n] * (float)k + 1e-3f);
+        *lo = a > 0 ? a : 0;
+        *hi = b < k - 1 ? b : k - 1;
+    }
+}
+
+// The squares of the smallest and largest |a| over [a0, a1].
+static void square_range(float a0, float a1, float *lo, float *hi)
+{
+    *lo = a0 <= 0.0f && a1 >= 0.0f ? 0.0f : fminf(a0 * a0, a1 * a1);
+    *hi = fmaxf(a0 * a0, a1 * a1);
+}
+
+// drift__micro_pixels.omega_bound. A table cell (u, t) holds the directions of cap-frame
+// cosine z with z^2 = 1 - s^2 (u^2 + t^2 - u^2 t^2) (increasing in |u| and |t|): each bin
+// its cells' z^2 range meets (padded for rounding) takes the largest omega of the pixels
+// the cell's CDF ranges reach.
+static void make_omega_bound(drift__micro_pixels *pixels, const drift__micro_warp *warp, int32_t k)
+{
+    const int32_t bins = DRIFT_MICRO_BOUND_BINS, n = warp->n;
+    const float s2 = warp->scale * warp->scale, cell = 2.0f / (float)n, pad = 1e-4f;
+    for (int32_t b = 0; b < bins; ++b) {
+        pixels->omega_bound[b] = 0.0f;
+    }
+    for (int32_t c = 0; c < n; ++c) {
+        int32_t x0, x1;
+        cell_pixels(warp->marginal, n, c, k, &x0, &x1);
+        const float *cond = warp->conditional + (size_t)c * (size_t)(n + 1);
+        float u2lo, u2hi;
+        square_range(-1.0f + (float)c * cell, -1.0f + (float)(c + 1) * cell, &u2lo, &u2hi);
+        for (int32_t r = 0; r < n; ++r) {
+            int32_t y0, y1;
+            cell_pixels(cond, n, r, k, &y0, &y1);
+            float t2lo, t2hi;
+            square_range(-1.0f + (float)r * cell, -1.0f + (float)(r + 1) * cell, &t2lo, &t2hi);
+            float most = 0.0f;
+            for (int32_t y = y0; y <= y1; ++y) {
+                for (int32_t x = x0; x <= x1; ++x) {
+                    most = fmaxf(most, pixels->omega[y * k + x]);
+                }
+            }
+            float z2lo = 1.0f - s2 * (u2hi + t2hi - u2hi * t2hi) - pad;
+            float z2hi = 1.0f - s2 * (u2lo + t2lo - u2lo * t2lo) + pad;
+            int32_t b0 = (int32_t)drift_clampf(floorf(z2lo * (float)bins), 0.0f, (float)(bins - 1));
+            int32_t b1 = (int32_t)drift_clampf(floorf(z2hi * (float)bins), 0.0f, (float)(bins - 1));
+            for (int32_t b = b0; b <= b1; ++b) {
+                pixels->omega_bound[b] = fmaxf(pixels->omega_bound[b], most);
+            }
+        }
+    }
+}
+
 void drift__micro_pixels_make(drift__micro_pixels *pixels, const drift__micro_warp *warp, int32_t k)
 {
     pixels->k = k;
@@ -213,4 +273,5 @@ void drift__micro_pixels_make(drift__micro_pixels *pixels, const drift__micro_wa
     for (int32_t i = 0; i < k * k; ++i) {
         pixels->omega_max = fmaxf(pixels->omega_max, pixels->omega[i]);
     }
+    make_omega_bound(pixels, warp, k);
 }

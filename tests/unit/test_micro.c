@@ -533,11 +533,73 @@ static void test_glossy_against_path_tracer(void **state)
     test_rig_destroy(&r);
 }
 
+// The gathers skip the warp's inverse for a node bigger than omega_bound of its direction's
+// cosine bin: that bound must be at least the omega of the pixel the inverse gives, for every
+// direction (else the cut would change). Dense random directions, diffuse, Phong 5, a cap.
+static void test_pixel_bound_holds(void **state)
+{
+    (void)state;
+    drift__micro_warp *warp = malloc(sizeof *warp);
+    drift__micro_pixels *pixels = malloc(sizeof *pixels);
+    uint64_t seed = 12345u;
+    for (int lobe = 0; lobe < 3; ++lobe) {
+        phong_slice slice = { lobe == 2 ? 200.0f : 5.0f,
+                              lobe == 2 ? drift_vec3_normalize(drift_vec3_make(0.3f, -0.2f, 0.9f))
+                                        : drift_vec3_make(0.0f, 0.0f, 1.0f) };
+        if (lobe == 0) {
+            drift__micro_warp_build_diffuse(warp, 32);
+        } else if (lobe == 1) {
+            drift__micro_warp_build(warp, 32, phong_lobe, &slice);
+        } else {
+            drift__micro_warp_build_cap(warp, 32, slice.mirror, drift__micro_phong_cap(200.0f),
+                                        phong_lobe, &slice);
+        }
+        const int32_t k = 16;
+        drift__micro_pixels_make(pixels, warp, k);
+        bool capped = warp->scale < 1.0f;
+        float cap_cos = sqrtf(fmaxf(1.0f - warp->scale * warp->scale, 0.0f));
+        double ratio = 0.0;
+        int tested = 0;
+        for (int s = 0; s < 200000; ++s) {
+            float v[3];
+            for (int a = 0; a < 3; ++a) {
+                seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+                v[a] = (float)(seed >> 40) / (float)(1u << 24) * 2.0f - 1.0f;
+            }
+            drift_vec3 w = drift_vec3_make(v[0], v[1], fabsf(v[2]));
+            float len = drift_vec3_length(w);
+            if (!(len > 1e-3f) || len > 1.0f) {
+                continue;
+            }
+            w = drift_vec3_scale(w, 1.0f / len);
+            float z = capped ? drift_vec3_dot(w, warp->cap.z) : w.z;
+            if (!(w.z > 0.0f) || z < cap_cos) {
+                continue;
+            }
+            drift_vec2 xy = drift__micro_warp_inverse(warp, w);
+            int32_t px = (int32_t)drift_clampf(floorf(xy.x * (float)k), 0.0f, (float)(k - 1));
+            int32_t py = (int32_t)drift_clampf(floorf(xy.y * (float)k), 0.0f, (float)(k - 1));
+            int32_t bin = (int32_t)fminf(z * z * (float)DRIFT_MICRO_BOUND_BINS,
+                                         (float)(DRIFT_MICRO_BOUND_BINS - 1));
+            float omega = pixels->omega[py * k + px], bound = pixels->omega_bound[bin];
+            assert_true(bound >= omega);
+            ratio += (double)(bound / omega);
+            tested++;
+        }
+        printf("lobe %d: %d directions, bound / pixel omega %.3f on average\n", lobe, tested,
+               ratio / (double)tested);
+        assert_true(tested > 1000);
+    }
+    free(warp);
+    free(pixels);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_warp_round_trip_and_solid_angles),
         cmocka_unit_test(test_warp_is_distribution_correct),
+        cmocka_unit_test(test_pixel_bound_holds),
         cmocka_unit_test(test_white_furnace),
         cmocka_unit_test(test_hierarchy_invariants_after_refit),
         cmocka_unit_test(test_covered_leaves_left_out),
