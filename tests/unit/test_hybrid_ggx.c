@@ -73,6 +73,20 @@ static void test_closed_form_shades_the_ggx_plastic_base(void **state)
     check_against_monte_carlo(m, "GGX plastic, Burley base");
 }
 
+// A glass material (IOR 1.5; thin-walled or solid) and an emitter of radiance 2, in `scene`.
+static void add_glass_and_lamp(drift_scene *scene, bool thin, uint32_t *glass_out,
+                               uint32_t *lamp_out)
+{
+    drift_material glass = drift_material_make(drift_vec3_splat(1.0f));
+    glass.type = DRIFT_MATERIAL_GGX;
+    glass.ggx.transmission = 1.0f;
+    glass.ggx.thin = thin;
+    *glass_out = test_add_material(scene, glass);
+    drift_material lamp = drift_material_make(drift_vec3_splat(0.0f));
+    lamp.emission = drift_vec3_splat(2.0f);
+    *lamp_out = test_add_material(scene, lamp);
+}
+
 // Smooth glass in the hybrid frame: an emitter seen through a thin glass sheet head-on arrives
 // times the sheet's transmittance, 1 - R_thin with R_thin = r + (1 - r)^2 r / (1 - r^2),
 // r = ((1.5 - 1) / (1.5 + 1))^2 (the path tracer's thin sheet). It rendered 0 before the glass
@@ -86,14 +100,8 @@ static void test_reflections_see_through_thin_glass(void **state)
 {
     (void)state;
     test_rig r = test_rig_begin(1);
-    drift_material glass = drift_material_make(drift_vec3_splat(1.0f));
-    glass.type = DRIFT_MATERIAL_GGX;
-    glass.ggx.transmission = 1.0f;
-    glass.ggx.thin = true;
-    uint32_t g = test_add_material(r.scene, glass);
-    drift_material lamp = drift_material_make(drift_vec3_splat(0.0f));
-    lamp.emission = drift_vec3_splat(2.0f);
-    uint32_t e = test_add_material(r.scene, lamp);
+    uint32_t g, e;
+    add_glass_and_lamp(r.scene, true, &g, &e);
     test_add_quad(r.scene, drift_vec3_make(-1, -1, 0), drift_vec3_make(2, 0, 0),
                   drift_vec3_make(0, 2, 0), g);
     test_add_quad(r.scene, drift_vec3_make(-2, -2, -1), drift_vec3_make(4, 0, 0),
@@ -131,13 +139,8 @@ static void test_glass_keeps_its_internal_reflections(void **state)
 {
     (void)state;
     test_rig r = test_rig_begin(1);
-    drift_material glass = drift_material_make(drift_vec3_splat(1.0f));
-    glass.type = DRIFT_MATERIAL_GGX;
-    glass.ggx.transmission = 1.0f;
-    uint32_t g = test_add_material(r.scene, glass);
-    drift_material lamp = drift_material_make(drift_vec3_splat(0.0f));
-    lamp.emission = drift_vec3_splat(2.0f);
-    uint32_t e = test_add_material(r.scene, lamp);
+    uint32_t g, e;
+    add_glass_and_lamp(r.scene, false, &g, &e);
     // The slab's faces point out of it: +z on top, -z below; the emitter faces up.
     test_add_quad(r.scene, drift_vec3_make(-20, -20, 0), drift_vec3_make(40, 0, 0),
                   drift_vec3_make(0, 40, 0), g);

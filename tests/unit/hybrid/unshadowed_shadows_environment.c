@@ -175,40 +175,38 @@ void test_tessellated_sphere_light_in_closed_form(void **state)
         } else {
             assert_near(lights[0].sphere_radius, 0.4, 0.004);
         }
-        {
-            const unshadowed_case cases[] = {
-                { { 0, 0, 0 }, { 0, 1, 0 } },
-                { { 2, 0.5f, 0.3f }, { -0.6f, 0.8f, 0 } },
-                { { 0.45f, 1.0f, 0 }, { 0, 1, 0 } },
-                { { 0.6f, 1.0f, 0 }, { -0.3f, 1, 0 } },
-            };
-            for (size_t c = 0; c < sizeof cases / sizeof *cases; ++c) {
-                drift_surface s = { .position = cases[c].p,
-                                    .material = white,
-                                    .light = DRIFT_INVALID_INDEX };
-                s.ns = s.ng = drift_vec3_normalize(cases[c].n);
-                drift_bsdf bsdf = drift_bsdf_make(r.scene, &s);
-                drift_sampler sampler = drift_sampler_make(1, 0, 0);
-                drift_vec3 closed =
-                    drift_raster_unshadowed(r.scene, &lights[0], &s, &bsdf, s.ns, 1, &sampler);
-                double mc = 0.0;
-                const int n = 400000;
-                for (int k = 0; k < n; ++k) {
-                    drift_sampler ks = drift_sampler_make(7, 0, (uint32_t)k);
-                    float pick = drift_sampler_next1(&ks);
-                    drift_light_sample ls = drift_raster_light_sample(
-                        r.scene, &lights[0], s.position, pick, drift_sampler_next2(&ks));
-                    float cos_i = drift_vec3_dot(ls.wi, s.ns);
-                    if (ls.pdf > 0.0f && cos_i > 0.0f) {
-                        drift_vec3 f = drift_bsdf_eval(&bsdf, s.ns, ls.wi);
-                        mc += (double)(f.x * ls.radiance.x * cos_i / ls.pdf);
-                    }
+        const unshadowed_case cases[] = {
+            { { 0, 0, 0 }, { 0, 1, 0 } },
+            { { 2, 0.5f, 0.3f }, { -0.6f, 0.8f, 0 } },
+            { { 0.45f, 1.0f, 0 }, { 0, 1, 0 } },
+            { { 0.6f, 1.0f, 0 }, { -0.3f, 1, 0 } },
+        };
+        for (size_t c = 0; c < sizeof cases / sizeof *cases; ++c) {
+            drift_surface s = { .position = cases[c].p,
+                                .material = white,
+                                .light = DRIFT_INVALID_INDEX };
+            s.ns = s.ng = drift_vec3_normalize(cases[c].n);
+            drift_bsdf bsdf = drift_bsdf_make(r.scene, &s);
+            drift_sampler sampler = drift_sampler_make(1, 0, 0);
+            drift_vec3 closed =
+                drift_raster_unshadowed(r.scene, &lights[0], &s, &bsdf, s.ns, 1, &sampler);
+            double mc = 0.0;
+            const int n = 400000;
+            for (int k = 0; k < n; ++k) {
+                drift_sampler ks = drift_sampler_make(7, 0, (uint32_t)k);
+                float pick = drift_sampler_next1(&ks);
+                drift_light_sample ls = drift_raster_light_sample(r.scene, &lights[0], s.position,
+                                                                  pick, drift_sampler_next2(&ks));
+                float cos_i = drift_vec3_dot(ls.wi, s.ns);
+                if (ls.pdf > 0.0f && cos_i > 0.0f) {
+                    drift_vec3 f = drift_bsdf_eval(&bsdf, s.ns, ls.wi);
+                    mc += (double)(f.x * ls.radiance.x * cos_i / ls.pdf);
                 }
-                mc /= n;
-                print_message("case %zu: closed form %g, Monte Carlo over the mesh %g\n", c,
-                              (double)closed.x, mc);
-                assert_near(closed.x, mc, 0.015 * mc);
             }
+            mc /= n;
+            print_message("case %zu: closed form %g, Monte Carlo over the mesh %g\n", c,
+                          (double)closed.x, mc);
+            assert_near(closed.x, mc, 0.015 * mc);
         }
         drift_raster_lights_destroy(r.ctx, lights, light_count);
         test_rig_destroy(&r);
