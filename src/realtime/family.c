@@ -39,11 +39,15 @@ static drift_result prepare(drift_frame_state *f, uint32_t inputs)
 
 static drift_result after_row(drift_frame_state *f, const drift_family_row *row)
 {
+    drift_result r = DRIFT_OK;
     if (row->args->effect == DRIFT_EFFECT_REFLECTIONS &&
         !(row->flags & (DRIFT_ROW_NO_TERM | DRIFT_ROW_TRACES_GLASS))) {
-        return drift_realtime_pass_glass_transmission(f);
+        r = drift_realtime_pass_glass_transmission(f);
     }
-    return (row->flags & DRIFT_ROW_SUMS_DIRECT) ? drift_realtime_pass_sum_direct(f) : DRIFT_OK;
+    if (r == DRIFT_OK && (row->flags & DRIFT_ROW_SUMS_DIRECT)) {
+        r = drift_realtime_pass_sum_direct(f);
+    }
+    return r;
 }
 
 // The caches start empty: each is made by the first pass that needs it.
