@@ -497,6 +497,8 @@ drift_bsdf_sample drift_bsdf_sample_wi(const drift_bsdf *bsdf, drift_vec3 wo, fl
 // Smooth glass: a GGX dielectric whose lobes are deltas (thin-walled, or alpha below 1e-3).
 // The hybrid frame traces the light it lets through along with the sharp reflection ray.
 bool drift_bsdf_is_smooth_glass(const drift_bsdf *bsdf);
+// Glass of any roughness: a GGX material with a dielectric (transmitting) component.
+bool drift_bsdf_is_glass(const drift_bsdf *bsdf);
 // The direction the glossy and mirror lobes centre on: the mirror direction of wo about the
 // shading normal, or edited_mirror when set (the one ray a mirror reflects).
 drift_vec3 drift_bsdf_mirror_direction(const drift_bsdf *bsdf, drift_vec3 wo);

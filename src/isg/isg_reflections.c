@@ -93,8 +93,9 @@ static void reflection_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_
         return; // no reflection, or a mirror: the sharp buffer stands
     }
     drift_bsdf bsdf = drift_bsdf_make(f->scene, surface);
-    if (bsdf.type == DRIFT_MATERIAL_MIRROR || drift_bsdf_is_smooth_glass(&bsdf)) {
-        return; // delta lobes: the sharp buffer stands (glass's holds the light it lets through)
+    if (bsdf.type == DRIFT_MATERIAL_MIRROR || drift_bsdf_is_glass(&bsdf)) {
+        return; // delta lobes and glass: the sharp buffer stands (it holds the light glass
+                // lets through; a rough pane's reflection, a few percent, stays sharp)
     }
     drift_vec3 wo = drift_pass_wo(f, x, y);
     range_ctx rc = { .g = g,

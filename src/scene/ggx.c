@@ -74,6 +74,11 @@ bool drift_bsdf_is_smooth_glass(const drift_bsdf *bsdf)
            smooth_dielectric(&bsdf->ggx);
 }
 
+bool drift_bsdf_is_glass(const drift_bsdf *bsdf)
+{
+    return bsdf->type == DRIFT_MATERIAL_GGX && bsdf->ggx.w_dielectric > 0.0f;
+}
+
 bool drift__ggx_is_delta(const drift_bsdf_ggx *g)
 {
     return g->w_dielectric >= 1.0f && smooth_dielectric(g);
