@@ -104,9 +104,13 @@ bool cli_check_writable(const char *cmd, const cli_file *outputs, size_t output_
 // What a command opens: a context, and unless told otherwise the scene and its ray-tracing
 // structure. Zero is the default: all cores, the built-in Cornell box, scene and accel.
 typedef struct cli_session_desc {
-    const char *cmd;           // "render", "bench isg": in messages
-    const char *scene_path;    // NULL: default_scene
-    const char *camera;        // a glTF scene's camera by name or index (NULL: its first)
+    const char *cmd;        // "render", "bench isg": in messages
+    const char *scene_path; // NULL: default_scene
+    const char *camera;     // a glTF scene's camera by name or index (NULL: its first)
+    // --environment: an image file (lat-long) or R,G,B that replaces the scene's environment,
+    // times environment_strength (0 is taken as 1); NULL: the scene's own.
+    const char *environment;
+    double environment_strength;
     const char *default_scene; // NULL: cli_default_scene_path()
     int threads;               // worker threads; 0: one a core
     bool verbose;              // info-level log messages too
@@ -133,8 +137,10 @@ typedef struct cli_session {
     double t_start;         // drift_time_now() at open, after loading and after the accel:
     double t_loaded;        // for phase timings
     double t_built;
-    bool refused;        // an output names an input (cli_session_desc's outputs): exit status 2
-    const char *camera;  // cli_session_desc's camera, for every load
+    bool refused;            // an output names an input (cli_session_desc's outputs): exit status 2
+    const char *camera;      // cli_session_desc's camera, for every load
+    const char *environment; // cli_session_desc's environment and strength, for every load
+    double environment_strength;
     char **scene_inputs; // the files the scene load read (drift_scene_load_inputs)
     size_t scene_input_count;
     char path[4096];

@@ -1,6 +1,7 @@
 #include "cli.h"
 #include "drift/accel.h"
 #include "drift/file.h"
+#include "drift/image_io.h"
 #include "drift/knobs.h"
 #include "drift/scene_io.h"
 
@@ -360,6 +361,56 @@ static bool build_accel(cli_session *s, const char *cmd)
     return true;
 }
 
+// --environment: the scene's environment replaced by a lat-long image or a constant colour
+// (times the strength), and the scene committed again (its light table samples it). glTF files
+// carry no world, so this is how a Blender user's HDRI comes back.
+static bool apply_environment(cli_session *s, const char *cmd)
+{
+    if (!s->environment) {
+        return true;
+    }
+    double strength = s->environment_strength > 0.0 ? s->environment_strength : 1.0;
+    drift_environment env = { .texture = DRIFT_INVALID_INDEX };
+    char *end = NULL;
+    (void)strtod(s->environment, &end);
+    if (end != s->environment) { // starts with a number: a colour
+        if (!cli_parse_vec3(cmd, "--environment", s->environment, true, &env.color)) {
+            return false;
+        }
+        if (env.color.x < 0.0f || env.color.y < 0.0f || env.color.z < 0.0f) {
+            fprintf(stderr, "drift %s: --environment expects a colour >= 0, got '%s'\n", cmd,
+                    s->environment);
+            return false;
+        }
+        env.color = drift_vec3_scale(env.color, (float)strength);
+    } else {
+        note_scene_input(s->environment, s); // an output may not overwrite it
+        drift_image map;
+        if (drift_image_load(s->ctx, s->environment, &map) != DRIFT_OK) {
+            fprintf(stderr, "drift %s: cannot read --environment %s (see above)\n", cmd,
+                    s->environment);
+            return false;
+        }
+        if (drift_scene_add_texture(s->scene, map, &env.texture) != DRIFT_OK) {
+            drift_image_destroy(s->ctx, &map);
+            fprintf(stderr, "drift %s: --environment %s: out of memory\n", cmd, s->environment);
+            return false;
+        }
+        env.color = drift_vec3_splat((float)strength);
+    }
+    s->scene->environment = env;
+    if (s->scene->default_lights) { // the loader's stand-in sun goes with its environment
+        s->scene->light_count = 0;
+        s->scene->default_lights = false;
+    }
+    if (drift_scene_commit(s->scene) != DRIFT_OK) {
+        fprintf(stderr, "drift %s: the scene with --environment %s is not valid (see above)\n", cmd,
+                s->environment);
+        return false;
+    }
+    return true;
+}
+
 bool cli_session_load(cli_session *s, const char *cmd, const char *path, bool no_accel)
 {
     drift_accel_destroy(s->accel);
@@ -376,13 +427,19 @@ bool cli_session_load(cli_session *s, const char *cmd, const char *path, bool no
                 drift_result_string(r));
         return false;
     }
+    if (!apply_environment(s, cmd)) {
+        return false;
+    }
     s->t_loaded = drift_time_now();
     return no_accel ? (s->t_built = drift_time_now(), true) : build_accel(s, cmd);
 }
 
 bool cli_session_open(const cli_session_desc *desc, cli_session *s)
 {
-    *s = (cli_session){ .t_start = drift_time_now(), .camera = desc->camera };
+    *s = (cli_session){ .t_start = drift_time_now(),
+                        .camera = desc->camera,
+                        .environment = desc->environment,
+                        .environment_strength = desc->environment_strength };
     s->ctx = open_context(desc->cmd, desc->threads, desc->verbose);
     if (!s->ctx) {
         return false;

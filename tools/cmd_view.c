@@ -33,7 +33,9 @@ static void on_sigint(int sig)
 typedef struct view_options {
     const char *scene_path;
     const char *screenshot_path;
-    const char *press; // --press: view keys applied before the first frame
+    const char *press;           // --press: view keys applied before the first frame
+    const char *environment;     // --environment FILE|R,G,B
+    double environment_strength; // --environment-strength X
     long width, height, threads, spp_per_frame, spp, seed, frames;
     double exposure;
     drift_hybrid_params hybrid; // techniques and knobs (drift_hybrid_params_default else)
@@ -154,6 +156,11 @@ static const cli_option view_table[] = {
                "reprojected with the history, filtered and blended in where its\n"
                "error is the lower (default off; docs/temporal.md)"),
     CLI_NUMBER("--exposure", "STOPS", O, exposure, -64.0, 64.0, "display exposure (default 0)"),
+    CLI_STRING("--environment", "FILE|R,G,B", O, environment,
+               "replace the scene's environment by a lat-long image (.hdr, .exr)\n"
+               "or a constant colour (glTF files carry no world; docs/scene-format.md)"),
+    CLI_NUMBER("--environment-strength", "X", O, environment_strength, 0.0, 1e9,
+               "multiplies --environment (default 1)"),
     CLI_FLAG("--no-overlay", O, no_overlay, "start without the text overlay"),
     CLI_CUSTOM("--press", "KEY,KEY,...", O, press, parse_press,
                "apply view keys before the first frame, by their names\n"
@@ -657,6 +664,8 @@ int drift_cmd_view(int argc, char **argv)
     cli_session session;
     if (!cli_session_open(&(cli_session_desc){ .cmd = "view",
                                                .scene_path = o.scene_path,
+                                               .environment = o.environment,
+                                               .environment_strength = o.environment_strength,
                                                .threads = (int)o.threads,
                                                .verbose = o.verbose },
                           &session)) {

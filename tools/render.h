@@ -80,11 +80,13 @@ typedef struct render_options {
     // sequences (tools/render_sequence.c, docs/temporal.md)
     bool animation; // --animation A:B given: frames A..B, --out a %04d pattern
     long frame_first, frame_last;
-    double fps;              // --fps; 0: the camera path's (24 unless it says)
-    const char *camera_path; // --camera-path F.json
-    const char *camera;      // --camera NAME: a glTF scene's camera
-    const char *video_path;  // --video FILE.mp4 (ffmpeg, when installed)
-    bool temporal;           // --temporal on: reuse across frames (hybrid, drift/temporal.h)
+    double fps;                  // --fps; 0: the camera path's (24 unless it says)
+    const char *camera_path;     // --camera-path F.json
+    const char *camera;          // --camera NAME: a glTF scene's camera
+    const char *environment;     // --environment FILE|R,G,B: replaces the scene's environment
+    double environment_strength; // --environment-strength X (0: 1)
+    const char *video_path;      // --video FILE.mp4 (ffmpeg, when installed)
+    bool temporal;               // --temporal on: reuse across frames (hybrid, drift/temporal.h)
     drift_temporal_settings temporal_settings;
     long still_refine; // --still-refine off|on|progressive (0, 1, 2: temporal_settings)
 } render_options;

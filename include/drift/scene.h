@@ -320,6 +320,9 @@ typedef struct drift_scene {
     // one), set by commit: the scene's extent as a length scale (drift_scene_extent).
     drift_bounds3 reflector_bounds;
     drift_light_table *light_table; // set by commit
+    // Set by the loaders when the file had no light, emitter or environment and they added
+    // the default sun (lights[0]) and environment of docs/scene-format.md.
+    bool default_lights;
     // Private: the mip-map pyramid of each texture materials read (built by commit).
     struct drift_texture_pyramid *pyramids;
     bool committed;

@@ -328,6 +328,7 @@ static drift_result add_default_lights(drift_scene *scene, const char *path)
     }
     scene->environment.color = drift_vec3_splat(0.2f);
     scene->environment.texture = DRIFT_INVALID_INDEX;
+    scene->default_lights = true;
     drift_log(scene->ctx, DRIFT_LOG_INFO, DRIFT_OK, path, 0,
               "no lights or emitters in the file: added a directional light and an environment "
               "of 0.2");

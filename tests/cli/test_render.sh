@@ -157,6 +157,59 @@ mkdir "$tmp/empty"
 expect 1 "$drift" render --spp 1 --width 8 --height 8 --quiet --out "$tmp/typo-dir/f.exr"
 [ -e "$tmp/typo-dir" ] && fail "a missing --out folder was made"
 
+# --environment replaces the scene's environment (glTF files carry none): a camera that sees no
+# geometry shows it exactly, a colour or an image's texel times --environment-strength, over
+# the scene's own environment (5).
+cat >"$tmp/env-scene.json" <<'JSON'
+{ "version": 1,
+  "camera": { "position": [0, 0, 0], "target": [0, 0, -1], "up": [0, 1, 0], "fov_y": 30,
+              "width": 8, "height": 6 },
+  "materials": { "m": { "type": "diffuse", "diffuse": 0.5 } },
+  "meshes": [ { "path": "env-tri.obj", "material": "m" } ],
+  "environment": { "color": [5, 5, 5] } }
+JSON
+printf 'v 0 0 5\nv 1 0 5\nv 0 1 5\nf 1 2 3\n' >"$tmp/env-tri.obj"
+PYTHONPATH="$(dirname "$0")" python3 - "$tmp" <<'PY'
+import sys
+from make_exr import exr
+t = sys.argv[1]
+exr(t + "/env-map.exr", 16, 8, lambda x, y: (0.1, 0.2, 0.3))
+exr(t + "/env-want-map.exr", 8, 6, lambda x, y: (0.3, 0.6, 0.9))
+exr(t + "/env-want-rgb.exr", 8, 6, lambda x, y: (0.5, 1.0, 2.0))
+PY
+expect 0 "$drift" render "$tmp/env-scene.json" --spp 1 --quiet --checkpoint 0 \
+    --environment 0.25,0.5,1 --environment-strength 2 --out "$tmp/env-rgb.exr"
+expect 0 "$drift" diff "$tmp/env-want-rgb.exr" "$tmp/env-rgb.exr" --json
+python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); assert d["mse"] < 1e-12, d' "$tmp/out" \
+    || fail "--environment R,G,B: the background is not the colour times the strength"
+expect 0 "$drift" render "$tmp/env-scene.json" --spp 1 --quiet --checkpoint 0 \
+    --environment "$tmp/env-map.exr" --environment-strength 3 --out "$tmp/env-map-out.exr"
+expect 0 "$drift" diff "$tmp/env-want-map.exr" "$tmp/env-map-out.exr" --json
+python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); assert d["mse"] < 1e-10, d' "$tmp/out" \
+    || fail "--environment FILE: the background is not the map times the strength"
+expect 1 "$drift" render "$tmp/env-scene.json" --spp 1 --quiet --environment "$tmp/no-such.hdr" \
+    --out "$tmp/never.exr"
+grep -q "no-such.hdr" "$tmp/err" || fail "a missing --environment file is not named"
+expect 1 "$drift" render "$tmp/env-scene.json" --spp 1 --quiet --environment -1,0,0 \
+    --out "$tmp/never.exr"
+expect 2 "$drift" render "$tmp/env-scene.json" --spp 1 --quiet --environment "$tmp/env-map.exr" \
+    --out "$tmp/env-map.exr"
+[ -e "$tmp/never.exr" ] && fail "a failed --environment wrote an image"
+# A mesh file without lights gets a stand-in sun; --environment replaces it with its
+# environment: a grey quad in a furnace of 0.5 is then darker than the furnace (with the sun
+# still there it would be about twice as bright).
+printf 'v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3 4\n' >"$tmp/env-quad.obj"
+PYTHONPATH="$(dirname "$0")" python3 - "$tmp" <<'PY'
+import sys
+from make_exr import exr
+exr(sys.argv[1] + "/env-half.exr", 16, 16, lambda x, y: (0.5, 0.5, 0.5))
+PY
+expect 0 "$drift" render "$tmp/env-quad.obj" --spp 16 --width 16 --height 16 --quiet \
+    --checkpoint 0 --environment 0.5 --out "$tmp/env-quad.exr"
+expect 0 "$drift" diff "$tmp/env-half.exr" "$tmp/env-quad.exr" --mask "$tmp/env-half.exr" --json
+python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); assert d["luminance"] < 1.0, d' \
+    "$tmp/out" || fail "--environment kept the stand-in sun of a file without lights"
+
 if [ "$failures" -ne 0 ]; then
     echo "$failures render CLI check(s) failed"
     exit 1
