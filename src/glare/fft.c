@@ -1,5 +1,7 @@
-// kissfft (BSD-3, Debian libkissfft-dev) behind drift's allocator: the plans' memory comes from
-// the context (kissfft's lenmem protocol), so no FFT here is hand-written.
+// The FFTs of src/glare: the PSF's complex 2-D transform is kissfft's (BSD-3, Debian
+// libkissfft-dev) behind drift's allocator (the plans' memory comes from the context through
+// kissfft's lenmem protocol); the convolution's real 2-D transforms run on fft_lanes.c, 8 rows
+// or columns at a time in SIMD lanes (kissfft's scalar transforms were most of the pass's time).
 #include "core/vectorise.h"
 #include "glare_internal.h"
 

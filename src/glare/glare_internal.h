@@ -1,5 +1,6 @@
-// Internal pieces of src/glare shared by its files and by tests/unit/test_glare.c: the kissfft
-// wrappers, the eye state, the aperture rasteriser, the PSF steps and the FFT convolution.
+// Internal pieces of src/glare shared by its files and by tests/unit/test_glare.c: the FFTs
+// (kissfft's and the lane FFT), the eye state, the aperture rasteriser, the PSF steps and the FFT
+// convolution.
 #ifndef DRIFT_GLARE_INTERNAL_H
 #define DRIFT_GLARE_INTERNAL_H
 
@@ -9,7 +10,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-// --- FFT (kissfft) ---
+// --- FFT ---
 
 // A complex number laid out as kissfft's kiss_fft_cpx (float r, i).
 typedef struct drift__cpx {
