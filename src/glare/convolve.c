@@ -88,24 +88,8 @@ drift_result drift__glare_convolve(drift_context *ctx, drift__glare_conv *c, con
     }
     const float norm = 1.0f / (float)real_count; // the inverse is unnormalised
     for (int32_t ch = 0; ch < 3; ++ch) {
-        // The image's channel, zeros on its right (the rows below it are taken as zeros).
-        for (int32_t y = 0; y < in->height; ++y) {
-            const float *src = drift_image_pixel(in, 0, y);
-            float *dst = c->real + (size_t)y * (size_t)pw;
-            for (int32_t x = 0; x < in->width; ++x) {
-                dst[x] = src[(size_t)x * (size_t)in->channels + (size_t)ch];
-            }
-            memset(dst + in->width, 0, (size_t)(pw - in->width) * sizeof(float));
-        }
-        drift__glare_rfft_convolve(c->forward, c->inverse, c->real, in->height, c->psf_spectrum[ch],
-                                   norm, c->spectrum, c->real);
-        for (int32_t y = 0; y < in->height; ++y) {
-            const float *src = c->real + (size_t)y * (size_t)pw;
-            float *dst = drift_image_pixel(out, 0, y);
-            for (int32_t x = 0; x < in->width; ++x) {
-                dst[(size_t)x * (size_t)out->channels + (size_t)ch] = src[x];
-            }
-        }
+        drift__glare_rfft_convolve(c->forward, c->inverse, in, ch, c->psf_spectrum[ch], norm,
+                                   c->spectrum, out);
     }
     if (in->channels == 4 && out->pixels != in->pixels) {
         for (int32_t y = 0; y < in->height; ++y) {

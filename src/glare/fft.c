@@ -8,6 +8,7 @@
 #include <kiss_fft.h>
 #include <kiss_fftnd.h>
 #include <math.h>
+#include <stdint.h>
 #include <string.h>
 
 _Static_assert(sizeof(drift__cpx) == sizeof(kiss_fft_cpx), "drift__cpx mirrors kiss_fft_cpx");
@@ -121,10 +122,17 @@ void drift__glare_rfft_destroy(drift_context *ctx, drift__glare_rfft *fft)
     drift_free(ctx, fft);
 }
 
+// Real rows as read or written: row y's sample x at base[y * stride + x * step], the samples
+// from `valid` on zeros (read) or left out (written). A plane of W floats a row, or one channel
+// of an image.
+typedef struct real_rows {
+    float *base;
+    size_t stride, step, valid;
+} real_rows;
+
 typedef struct rfft_job {
     const drift__glare_rfft *fft;
-    const float *real_in;
-    float *real_out;
+    real_rows real_in, real_out;
     drift__cpx *spectrum;
     const drift__glare_rfft *then; // the convolution: the inverse plan run after the kernel
     const float *kernel;           // its spectrum, lane layout (NULL: a plain transform)
@@ -193,16 +201,22 @@ static DRIFT_AVX2_CLONES void glare_row_forward(size_t begin, size_t end, int th
 {
     const rfft_job *job = user;
     const drift__glare_rfft *fft = job->fft;
-    const size_t n2 = (size_t)(fft->width / 2), w = n2 + 1, rw = (size_t)fft->width;
+    const size_t n2 = (size_t)(fft->width / 2), w = n2 + 1;
+    const real_rows in = job->real_in;
     float *data = fft->buffers + (size_t)thread_index * fft->buffer;
     float *work = data + fft->buffer / 2;
     for (size_t y0 = begin; y0 < end; y0 += L) {
         size_t n = end - y0 < L ? end - y0 : L;
         for (size_t b = 0; b < L; ++b) {
-            const float *row = job->real_in + (y0 + (b < n ? b : 0)) * rw;
-            for (size_t m = 0; m < n2; ++m) {
-                data[2 * L * m + b] = b < n ? row[2 * m] : 0.0f;
-                data[2 * L * m + L + b] = b < n ? row[2 * m + 1] : 0.0f;
+            const float *row = in.base + (y0 + (b < n ? b : 0)) * in.stride;
+            size_t m = 0;
+            for (; b < n && 2 * m + 1 < in.valid; ++m) {
+                data[2 * L * m + b] = row[2 * m * in.step];
+                data[2 * L * m + L + b] = row[(2 * m + 1) * in.step];
+            }
+            for (; m < n2; ++m) {
+                data[2 * L * m + b] = b < n && 2 * m < in.valid ? row[2 * m * in.step] : 0.0f;
+                data[2 * L * m + L + b] = 0.0f;
             }
         }
         const float *z = drift__glare_lanes_run(fft->half, data, work);
@@ -227,7 +241,8 @@ static DRIFT_AVX2_CLONES void glare_row_inverse(size_t begin, size_t end, int th
 {
     const rfft_job *job = user;
     const drift__glare_rfft *fft = job->fft;
-    const size_t n2 = (size_t)(fft->width / 2), w = n2 + 1, rw = (size_t)fft->width;
+    const size_t n2 = (size_t)(fft->width / 2), w = n2 + 1;
+    const real_rows out = job->real_out;
     float *data = fft->buffers + (size_t)thread_index * fft->buffer;
     float *work = data + fft->buffer / 2;
     for (size_t y0 = begin; y0 < end; y0 += L) {
@@ -247,10 +262,14 @@ static DRIFT_AVX2_CLONES void glare_row_inverse(size_t begin, size_t end, int th
         }
         const float *z = drift__glare_lanes_run(fft->half, data, work);
         for (size_t b = 0; b < n; ++b) {
-            float *row = job->real_out + (y0 + b) * rw;
-            for (size_t m = 0; m < n2; ++m) {
-                row[2 * m] = z[2 * L * m + b];
-                row[2 * m + 1] = z[2 * L * m + L + b];
+            float *row = out.base + (y0 + b) * out.stride;
+            size_t m = 0;
+            for (; 2 * m + 1 < out.valid; ++m) {
+                row[2 * m * out.step] = z[2 * L * m + b];
+                row[(2 * m + 1) * out.step] = z[2 * L * m + L + b];
+            }
+            if (2 * m < out.valid) {
+                row[2 * m * out.step] = z[2 * L * m + b];
             }
         }
     }
@@ -277,7 +296,10 @@ void drift__glare_rfft_forward(const drift__glare_rfft *fft, const float *in, in
     const size_t w = (size_t)(fft->width / 2 + 1);
     rows = rows < fft->height ? rows : fft->height;
     memset(out + (size_t)rows * w, 0, (size_t)(fft->height - rows) * w * sizeof(*out));
-    rfft_job job = { .fft = fft, .real_in = in, .spectrum = out };
+    rfft_job job = { .fft = fft,
+                     .real_in = { (float *)(uintptr_t)in, (size_t)fft->width, 1,
+                                  (size_t)fft->width },
+                     .spectrum = out };
     drift_parallel_for(fft->ctx, (size_t)rows, 16, glare_row_forward, &job);
     drift_parallel_for(fft->ctx, column_block_count(fft), 2, column_blocks, &job);
 }
@@ -286,7 +308,9 @@ void drift__glare_rfft_inverse(const drift__glare_rfft *fft, drift__cpx *in, int
                                float *out)
 {
     rows = rows < fft->height ? rows : fft->height;
-    rfft_job job = { .fft = fft, .real_out = out, .spectrum = in };
+    rfft_job job = { .fft = fft,
+                     .real_out = { out, (size_t)fft->width, 1, (size_t)fft->width },
+                     .spectrum = in };
     drift_parallel_for(fft->ctx, column_block_count(fft), 2, column_blocks, &job);
     drift_parallel_for(fft->ctx, (size_t)rows, 16, glare_row_inverse, &job);
 }
@@ -306,24 +330,26 @@ void drift__glare_rfft_kernel_layout(const drift__glare_rfft *fft, const drift__
 }
 
 void drift__glare_rfft_convolve(const drift__glare_rfft *forward, const drift__glare_rfft *inverse,
-                                const float *in, int32_t rows, const float *kernel, float norm,
-                                drift__cpx *spectrum, float *out)
+                                const drift_image *in, int32_t channel, const float *kernel,
+                                float norm, drift__cpx *spectrum, const drift_image *out)
 {
     const size_t w = (size_t)(forward->width / 2 + 1);
-    rows = rows < forward->height ? rows : forward->height;
-    memset(spectrum + (size_t)rows * w, 0,
-           (size_t)(forward->height - rows) * w * sizeof(*spectrum));
+    size_t rows = (size_t)(in->height < forward->height ? in->height : forward->height);
+    memset(spectrum + rows * w, 0, ((size_t)forward->height - rows) * w * sizeof(*spectrum));
+    // The image's channel read and written in place of a plane: zeros to its right and below.
     rfft_job job = { .fft = forward,
-                     .real_in = in,
-                     .real_out = out,
+                     .real_in = { in->pixels + channel, (size_t)in->stride, (size_t)in->channels,
+                                  (size_t)in->width },
+                     .real_out = { out->pixels + channel, (size_t)out->stride,
+                                   (size_t)out->channels, (size_t)out->width },
                      .spectrum = spectrum,
                      .then = inverse,
                      .kernel = kernel,
                      .norm = norm };
-    drift_parallel_for(forward->ctx, (size_t)rows, 16, glare_row_forward, &job);
+    drift_parallel_for(forward->ctx, rows, 16, glare_row_forward, &job);
     drift_parallel_for(forward->ctx, column_block_count(forward), 2, column_blocks, &job);
     job.fft = inverse;
-    drift_parallel_for(forward->ctx, (size_t)rows, 16, glare_row_inverse, &job);
+    drift_parallel_for(forward->ctx, rows, 16, glare_row_inverse, &job);
 }
 
 int32_t drift__glare_fft_size(int32_t n)

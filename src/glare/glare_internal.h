@@ -57,15 +57,16 @@ void drift__glare_lanes_scatter(const float *src, size_t count, drift__cpx *dst,
 // data = data x kernel x norm, `count` elements.
 void drift__glare_lanes_multiply(float *data, const float *kernel, size_t count, float norm);
 // Convolution without the spectrum's round trip: the kernel's spectrum (forward's output) in
-// the lane layout (kernel_floats floats), then `in` (its first `rows` rows, the rest zeros)
-// transformed, multiplied by the kernel's spectrum and norm column block by column block, and
-// transformed back into the first `rows` rows of `out` (`spectrum`: scratch).
+// the lane layout (kernel_floats floats), then channel `channel` of `in` (zeros to its right
+// and below, in smaller than the plan) transformed, multiplied by the kernel's spectrum and
+// norm column block by column block, and transformed back into channel `channel` of `out`
+// (in's size; it may be in). `spectrum`: scratch.
 size_t drift__glare_rfft_kernel_floats(const drift__glare_rfft *fft);
 void drift__glare_rfft_kernel_layout(const drift__glare_rfft *fft, const drift__cpx *spectrum,
                                      float *kernel);
 void drift__glare_rfft_convolve(const drift__glare_rfft *forward, const drift__glare_rfft *inverse,
-                                const float *in, int32_t rows, const float *kernel, float norm,
-                                drift__cpx *spectrum, float *out);
+                                const drift_image *in, int32_t channel, const float *kernel,
+                                float norm, drift__cpx *spectrum, const drift_image *out);
 // The smallest even size >= n with no prime factor above 5.
 int32_t drift__glare_fft_size(int32_t n);
 
