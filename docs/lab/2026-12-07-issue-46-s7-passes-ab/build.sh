@@ -1,11 +1,11 @@
 #!/bin/bash
-# The lab's A/B programs (issue 46, session 7): main's glare convolution and post DOF compiled
+# The lab's A/B programs (issue 46, session 7): main's (554ca4b) glare convolution and post DOF compiled
 # beside this tree's (renamed), linked with this tree's build/release/libdrift.a.
 #   bash docs/lab/2026-12-07-issue-46-s7-passes-ab/build.sh /tmp/ab7
 #   /tmp/ab7/glare_time 3; /tmp/ab7/post_dof_time 5
 set -euo pipefail
 out=$1; here=$(cd "$(dirname "$0")" && pwd); R=$(cd "$here/../../.." && pwd)
-base=${BASE:-main}
+base=${BASE:-554ca4b} # main when this branch began
 mkdir -p "$out"; cd "$out"
 git -C "$R" show $base:src/glare/fft.c > old_fft.c
 git -C "$R" show $base:src/glare/convolve.c > old_convolve.c
