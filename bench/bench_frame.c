@@ -14,6 +14,7 @@
 
 typedef struct frame_options {
     const char *scene_path;
+    const char *passes; // --passes: the passes --floors times (NULL: all)
     long width, height, frames, threads;
     bool json, floors;
 } frame_options;
@@ -36,6 +37,9 @@ static const cli_option frame_table[] = {
     CLI_FLAG("--floors", O, floors,
              "each image pass (compose, post DOF, ISG, a-trous, glare convolution) as a multiple "
              "of its bandwidth floor, the copy bandwidth measured in the same run"),
+    CLI_STRING("--passes", "LIST", O, passes,
+               "with --floors, time only these passes (comma-separated names as printed, e.g. "
+               "'post dof,glare conv'; default all)"),
     BENCH_OPTION_THREADS(O),
     BENCH_OPTION_JSON(O),
 };
@@ -145,10 +149,12 @@ int drift_bench_frame(int argc, char **argv)
     drift_context *ctx = session.ctx;
     const char *scene_path = session.scene_path;
     if (o.floors) {
-        exit_code = bench_frame_floors(
-            ctx, session.scene, session.accel, scene_path,
-            &(bench_floor_options){
-                .width = o.width, .height = o.height, .repeats = o.frames, .json = o.json });
+        exit_code = bench_frame_floors(ctx, session.scene, session.accel, scene_path,
+                                       &(bench_floor_options){ .width = o.width,
+                                                               .height = o.height,
+                                                               .repeats = o.frames,
+                                                               .json = o.json,
+                                                               .passes = o.passes });
         goto done;
     }
     drift_result r = DRIFT_OK;

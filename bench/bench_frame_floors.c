@@ -54,13 +54,15 @@ typedef struct floor_pass {
     double level_bytes;  // a-trous: the bytes of its passes, each on its own (0: none)
     double compute_ms;   // its compute floor (0: none stated)
     const char *compute; // what the compute floor counts
-    double samples;      // filter samples (ISG)
+    double samples;      // filter samples (ISG), taps (a-trous, post DOF)
+    double flops;        // the float operations its compute floor counts (0: not by flops)
     bool isg;
 } floor_pass;
 
 typedef struct floor_run {
     double copy_gbs;  // bytes moved (read + written) per ns
     double sample_ns; // the ideal cross-bilateral sample, ns (ISG's compute floor)
+    double gflops;    // float multiplies and adds a ns, one thread, vectorised (glare, post DOF)
     floor_pass pass[FLOOR_PASS_MAX];
     int count;
 } floor_run;
@@ -154,6 +156,128 @@ static double sample_floor_ns(drift_context *ctx, int repeats)
     return isfinite(best) ? best * 1e9 / ((double)N * TAPS) : 0.0;
 }
 
+// The machine's FLOP rate on one thread: 16 independent chains of 8-lane multiplies and adds
+// (a multiply, then an add: -ffp-contract=off keeps them apart, as in the passes), enough
+// chains to fill both arithmetic ports through their latency. The glare FFT's and the post
+// DOF gather's compute floors are their float operations at this rate.
+typedef float flop_v __attribute__((vector_size(32)));
+
+static DRIFT_AVX2_CLONES void flop_chains(flop_v *x, long rounds)
+{
+    const flop_v m = { 0.999f, 0.999f, 0.999f, 0.999f, 0.999f, 0.999f, 0.999f, 0.999f };
+    const flop_v c = { 1e-3f, 1e-3f, 1e-3f, 1e-3f, 1e-3f, 1e-3f, 1e-3f, 1e-3f };
+    flop_v a0 = x[0], a1 = x[1], a2 = x[2], a3 = x[3], a4 = x[4], a5 = x[5], a6 = x[6], a7 = x[7];
+    flop_v a8 = x[8], a9 = x[9], a10 = x[10], a11 = x[11], a12 = x[12], a13 = x[13], a14 = x[14],
+           a15 = x[15];
+    for (long r = 0; r < rounds; ++r) {
+        a0 = a0 * m + c, a1 = a1 * m + c, a2 = a2 * m + c, a3 = a3 * m + c;
+        a4 = a4 * m + c, a5 = a5 * m + c, a6 = a6 * m + c, a7 = a7 * m + c;
+        a8 = a8 * m + c, a9 = a9 * m + c, a10 = a10 * m + c, a11 = a11 * m + c;
+        a12 = a12 * m + c, a13 = a13 * m + c, a14 = a14 * m + c, a15 = a15 * m + c;
+    }
+    x[0] = a0, x[1] = a1, x[2] = a2, x[3] = a3, x[4] = a4, x[5] = a5, x[6] = a6, x[7] = a7;
+    x[8] = a8, x[9] = a9, x[10] = a10, x[11] = a11, x[12] = a12, x[13] = a13, x[14] = a14;
+    x[15] = a15;
+}
+
+static double flop_rate(int repeats)
+{
+    enum {
+        ROUNDS = 1 << 20
+    };
+
+    flop_v x[16];
+    for (int i = 0; i < 16; ++i) {
+        for (int l = 0; l < 8; ++l) {
+            x[i][l] = (float)(i + l) * 0.01f;
+        }
+    }
+    double best = HUGE_VAL;
+    for (int k = 0; k < repeats + 1; ++k) {
+        double t = now();
+        flop_chains(x, ROUNDS);
+        t = now() - t;
+        best = k > 0 && t < best ? t : best;
+    }
+    volatile float keep = x[3][5];
+    (void)keep;
+    return isfinite(best) ? 16.0 * 8.0 * 2.0 * ROUNDS / best * 1e-9 : 0.0;
+}
+
+// Whether --passes names the pass (every pass without --passes).
+static bool wanted(const bench_floor_options *o, const char *name)
+{
+    if (!o->passes) {
+        return true;
+    }
+    size_t n = strlen(name);
+    for (const char *p = o->passes; *p;) {
+        const char *comma = strchr(p, ',');
+        size_t len = comma ? (size_t)(comma - p) : strlen(p);
+        if (len == n && strncmp(p, name, n) == 0) {
+            return true;
+        }
+        p += len + (comma ? 1 : 0);
+    }
+    return false;
+}
+
+// The post DOF gather's taps on this frame, by its own rules (src/raster/post_dof.c): none
+// where the circle's radius is under half a pixel or the 16 x 16 tile and all it reads hold one
+// colour (those pixels are copied); else the centre and a power of two of the 64-entry table,
+// one a quarter of the disk's area (at least 4, at most 63), of which all but the centre are
+// fetched.
+static double post_dof_taps(const drift_image *in, const drift_image *coc)
+{
+    enum {
+        TILE = 16,
+        TABLE = 64
+    };
+
+    double taps = 0.0;
+    for (int32_t ty = 0; ty * TILE < in->height; ++ty) {
+        for (int32_t tx = 0; tx * TILE < in->width; ++tx) {
+            int32_t x0 = tx * TILE, y0 = ty * TILE;
+            int32_t x1 = x0 + TILE < in->width ? x0 + TILE : in->width;
+            int32_t y1 = y0 + TILE < in->height ? y0 + TILE : in->height;
+            float reach = 0.0f;
+            for (int32_t y = y0; y < y1; ++y) {
+                for (int32_t x = x0; x < x1; ++x) {
+                    reach = fmaxf(reach, drift_image_pixel(coc, x, y)[0]);
+                }
+            }
+            int32_t pad = (int32_t)ceilf(fminf(reach, (float)(in->width + in->height))) + 1;
+            const float *first = drift_image_pixel(in, x0, y0);
+            bool uniform = true;
+            for (int32_t y = y0 - pad; uniform && y <= y1 - 1 + pad; ++y) {
+                int32_t cy = y < 0 ? 0 : (y >= in->height ? in->height - 1 : y);
+                for (int32_t x = x0 - pad; uniform && x <= x1 - 1 + pad; ++x) {
+                    int32_t cx = x < 0 ? 0 : (x >= in->width ? in->width - 1 : x);
+                    const float *q = drift_image_pixel(in, cx, cy);
+                    for (int32_t c = 0; c < in->channels; ++c) {
+                        uniform = uniform && q[c] == first[c];
+                    }
+                }
+            }
+            for (int32_t y = y0; !uniform && y < y1; ++y) {
+                for (int32_t x = x0; x < x1; ++x) {
+                    float radius = drift_image_pixel(coc, x, y)[0];
+                    if (!(radius >= 0.5f)) {
+                        continue;
+                    }
+                    float quarter_area = 0.25f * 3.14159265f * radius * radius;
+                    uint32_t n = 4;
+                    while ((float)n < quarter_area && n < TABLE - 1) {
+                        n *= 2;
+                    }
+                    taps += (double)((n + 1 < TABLE ? n + 1 : TABLE) - 1);
+                }
+            }
+        }
+    }
+    return taps;
+}
+
 typedef drift_result (*pass_call)(drift_frame_state *f, void *user);
 
 // The least milliseconds of `repeats` calls.
@@ -238,10 +362,50 @@ static floor_pass *add_pass(floor_run *run, const char *name)
     return p;
 }
 
+static drift_result measure_compose(drift_frame_state *f, const bench_floor_options *o,
+                                    floor_run *run);
+static drift_result measure_atrous(drift_frame_state *f, const bench_floor_options *o,
+                                   floor_run *run, double px);
+static drift_result measure_glare(drift_frame_state *f, const bench_floor_options *o,
+                                  floor_run *run);
+
 // Compose, post DOF, a-trous and the glare convolution on the frame of hard shadows, sharp
-// reflections and post DOF.
+// reflections and post DOF (those --passes names).
 static drift_result measure_plain(drift_frame_state *f, const bench_floor_options *o,
                                   floor_run *run)
+{
+    double px = (double)o->width * (double)o->height;
+    drift_result r = DRIFT_OK;
+    floor_pass *p = NULL;
+    if (wanted(o, "compose")) {
+        r = measure_compose(f, o, run);
+    }
+    if (r == DRIFT_OK && wanted(o, "post dof")) {
+        p = add_pass(run, "post dof");
+        p->bytes = image_bytes(&f->focus) + image_bytes(&f->coc) + image_bytes(&f->final);
+        // Compute floor: each tap's bilinear RGB fetch and weighted sum (3 channels x 3 lerps of
+        // 3 operations, 3 x a difference, a product and a sum, the weight's sum: 37), counted
+        // for every tap; a tap whose weight is zero skips its fetch (it still computes the
+        // weight, ~12 operations), so on frames with many such taps this floor is high.
+        p->samples = post_dof_taps(&f->focus, &f->coc);
+        p->flops = 37.0 * p->samples;
+        p->compute_ms = p->flops / (run->gflops * 1e6);
+        p->compute = "taps x 37 float operations (bilinear RGB fetch + weighted sum) at the "
+                     "measured FLOP rate";
+        r = time_pass(f, call_post_dof, NULL, o->repeats, &p->ms);
+    }
+    if (r == DRIFT_OK && wanted(o, "a-trous")) {
+        r = measure_atrous(f, o, run, px);
+    }
+    if (r == DRIFT_OK && wanted(o, "glare conv")) {
+        r = measure_glare(f, o, run);
+    }
+    return r;
+}
+
+// Compose: D = sum_l U_l S_l + environment, then E + D + the terms and the circle of confusion.
+static drift_result measure_compose(drift_frame_state *f, const bench_floor_options *o,
+                                    floor_run *run)
 {
     double px = (double)o->width * (double)o->height;
     floor_pass *p = add_pass(run, "compose");
@@ -262,15 +426,14 @@ static drift_result measure_plain(drift_frame_state *f, const bench_floor_option
         }
     }
     p->bytes = bytes;
-    drift_result r = time_pass(f, call_compose, NULL, o->repeats, &p->ms);
+    return time_pass(f, call_compose, NULL, o->repeats, &p->ms);
+}
 
-    p = add_pass(run, "post dof");
-    p->bytes = image_bytes(&f->focus) + image_bytes(&f->coc) + image_bytes(&f->final);
-    if (r == DRIFT_OK) {
-        r = time_pass(f, call_post_dof, NULL, o->repeats, &p->ms);
-    }
-
-    p = add_pass(run, "a-trous");
+static drift_result measure_atrous(drift_frame_state *f, const bench_floor_options *o,
+                                   floor_run *run, double px)
+{
+    drift_result r = DRIFT_OK;
+    floor_pass *p = add_pass(run, "a-trous");
     // The floor: the colour, albedo, normal and depth once; the filtered colour once, as a
     // filter fusing its 5 passes in cache would move them. Beside it, the bytes of 5 passes
     // each on its own: each reads the colour and the three guides and writes the colour.
@@ -299,8 +462,15 @@ static drift_result measure_plain(drift_frame_state *f, const bench_floor_option
         r = time_pass(f, call_atrous, &out, o->repeats, &p->ms);
     }
     drift_image_destroy(f->ctx, &out);
+    return r;
+}
 
-    p = add_pass(run, "glare conv");
+// The glare convolution of the frame with a 256 x 256 RGB PSF, its spectrum cached.
+static drift_result measure_glare(drift_frame_state *f, const bench_floor_options *o,
+                                  floor_run *run)
+{
+    drift_result r = DRIFT_OK;
+    floor_pass *p = add_pass(run, "glare conv");
     p->bytes = image_bytes(&f->focus) + image_bytes(&f->final);
 
     // A 256 x 256 PSF, its energy at the centre and a faint halo (the values do not change
@@ -326,11 +496,14 @@ static drift_result measure_plain(drift_frame_state *f, const bench_floor_option
     if (r == DRIFT_OK) {
         r = time_pass(f, call_glare, &g, o->repeats, &p->ms);
     }
-    // Compute floor: 3 channels x (forward + inverse) real FFTs of the padded plane, each at
-    // least one read and one write of it, twice (rows, then columns), at copy bandwidth.
-    double plane = (double)g.conv.width * (double)g.conv.height * 4.0;
-    p->compute_ms = 3.0 * 2.0 * 2.0 * 2.0 * plane / (run->copy_gbs * 1e6);
-    p->compute = "3 channels x 2 FFTs x (rows + columns) x read+write of the padded plane";
+    // Compute floor: 3 channels x (forward + inverse) real 2-D FFTs of the padded plane of P
+    // points, 2.5 P log2 P float operations each (half the 5 N log2 N of a complex FFT), and
+    // the product of the spectra (6 operations a bin), at the measured FLOP rate.
+    double points = (double)g.conv.width * (double)g.conv.height;
+    double bins = (double)(g.conv.width / 2 + 1) * (double)g.conv.height;
+    p->flops = 3.0 * (2.0 * 2.5 * points * log2(points) + 6.0 * bins);
+    p->compute_ms = p->flops / (run->gflops * 1e6);
+    p->compute = "3 channels x (2 real FFTs x 2.5 P log2 P + 6 a bin) at the measured FLOP rate";
     drift__glare_conv_release(f->ctx, &g.conv);
     drift_free(f->ctx, psf);
     return r;
@@ -368,6 +541,9 @@ static drift_result measure_isg(drift_frame_state *f, const bench_floor_options 
     double search = (double)f->params.isg.search, gather = (double)f->params.isg.gather;
     drift_result r = DRIFT_OK;
     for (int k = 0; k < 3 && r == DRIFT_OK; ++k) {
+        if (!wanted(o, isg[k].name)) {
+            continue;
+        }
         floor_pass *p = add_pass(run, isg[k].name);
         drift_effect effect = isg[k].effect;
         r = time_pass(f, call_isg, &effect, o->repeats, &p->ms);
@@ -426,6 +602,7 @@ static void print_run(const char *scene_path, const bench_floor_options *o, int 
         cJSON_AddStringToObject(root, "clock", cpu_clock ? "process cpu" : "wall");
         cli_json_number(root, "copy_gb_per_s", run->copy_gbs, 4);
         cli_json_number(root, "sample_floor_ns", run->sample_ns, 4);
+        cli_json_number(root, "gflop_per_s", run->gflops, 3);
         cJSON *array = cJSON_AddArrayToObject(root, "passes");
         for (int k = 0; k < run->count; ++k) {
             const floor_pass *p = &run->pass[k];
@@ -448,6 +625,9 @@ static void print_run(const char *scene_path, const bench_floor_options *o, int 
                 cli_json_number(item, "level_floor_ms", level_ms, 6);
                 cli_json_number(item, "level_floor_ratio", p->ms / level_ms, 2);
             }
+            if (p->flops > 0.0) {
+                cli_json_number(item, "flops", p->flops, 0);
+            }
             if (p->isg || p->samples > 0.0) {
                 cli_json_number(item, "samples", p->samples, 0);
             }
@@ -460,8 +640,9 @@ static void print_run(const char *scene_path, const bench_floor_options *o, int 
     }
     printf("%s, %ldx%ld, %d thread(s), least of %ld runs a pass, %s ms\n", scene_path, o->width,
            o->height, threads, o->repeats, cpu_clock ? "process CPU" : "wall");
-    printf("copy bandwidth %.2f GB/s (read + write); ideal bilateral sample %.3f ns\n",
-           run->copy_gbs, run->sample_ns);
+    printf("copy bandwidth %.2f GB/s (read + write); ideal bilateral sample %.3f ns; "
+           "%.1f GFLOP/s (one thread, 8 lanes)\n",
+           run->copy_gbs, run->sample_ns, run->gflops);
     printf("%-16s %10s %10s %10s %8s %10s %8s\n", "pass", "ms", "MB", "floor ms", "x floor",
            "compute ms", "x comp");
     for (int k = 0; k < run->count; ++k) {
@@ -487,7 +668,8 @@ int bench_frame_floors(drift_context *ctx, const drift_scene *scene, const drift
     cpu_clock = drift_context_thread_count(ctx) == 1;
     run.copy_gbs = copy_bandwidth(ctx, (int32_t)o->width, (int32_t)o->height, (int)o->repeats);
     run.sample_ns = sample_floor_ns(ctx, (int)o->repeats);
-    if (!(run.copy_gbs > 0.0)) {
+    run.gflops = flop_rate((int)o->repeats);
+    if (!(run.copy_gbs > 0.0) || !(run.gflops > 0.0)) {
         fprintf(stderr, "drift bench frame: out of memory measuring the copy bandwidth\n");
         return 1;
     }
@@ -502,7 +684,8 @@ int bench_frame_floors(drift_context *ctx, const drift_scene *scene, const drift
     }
     drift_hybrid_destroy(frame);
     frame = NULL;
-    if (r == DRIFT_OK) {
+    if (r == DRIFT_OK &&
+        (wanted(o, "isg shadows") || wanted(o, "isg reflections") || wanted(o, "isg dof"))) {
         drift_hybrid_params params = { 0 };
         drift_hybrid_params_set_technique(&params, DRIFT_EFFECT_SHADOWS,
                                           drift_technique_parse(DRIFT_EFFECT_SHADOWS, "isg"));

@@ -11,6 +11,7 @@
 typedef struct bench_floor_options {
     long width, height, repeats;
     bool json;
+    const char *passes; // comma-separated pass names to time (NULL: all)
 } bench_floor_options;
 
 // Renders the frames, times the passes and prints the table (or JSON). Returns the exit status.

@@ -34,8 +34,9 @@ static drift_result conv_prepare(drift_context *ctx, drift__glare_conv *c, int32
     if (r == DRIFT_OK) {
         c->real = drift_alloc(ctx, real);
         c->spectrum = drift_alloc(ctx, spec);
+        size_t kernel = drift__glare_rfft_kernel_floats(c->forward) * sizeof(float);
         for (int32_t i = 0; i < 3; ++i) {
-            c->psf_spectrum[i] = drift_alloc(ctx, spec);
+            c->psf_spectrum[i] = drift_alloc(ctx, kernel);
         }
         if (!c->real || !c->spectrum || !c->psf_spectrum[0] || !c->psf_spectrum[1] ||
             !c->psf_spectrum[2]) {
@@ -67,9 +68,9 @@ drift_result drift__glare_convolve(drift_context *ctx, drift__glare_conv *c, con
         psf_changed = true;
     }
     size_t real_count = (size_t)pw * (size_t)ph;
-    size_t spec_count = (size_t)(pw / 2 + 1) * (size_t)ph;
     if (psf_changed || c->psf_k != k) {
-        // The PSF with its centre (k/2, k/2) moved to the origin, wrapped.
+        // The PSF with its centre (k/2, k/2) moved to the origin, wrapped; its spectrum kept in
+        // the layout the convolution's column blocks read.
         for (int32_t ch = 0; ch < 3; ++ch) {
             memset(c->real, 0, real_count * sizeof(float));
             for (int32_t v = 0; v < k; ++v) {
@@ -80,39 +81,15 @@ drift_result drift__glare_convolve(drift_context *ctx, drift__glare_conv *c, con
                         psf[((size_t)v * (size_t)k + (size_t)u) * 3 + (size_t)ch];
                 }
             }
-            drift__glare_rfft_forward(c->forward, c->real, c->psf_spectrum[ch]);
+            drift__glare_rfft_forward(c->forward, c->real, ph, c->spectrum);
+            drift__glare_rfft_kernel_layout(c->forward, c->spectrum, c->psf_spectrum[ch]);
         }
         c->psf_k = k;
     }
-    const float norm = 1.0f / (float)real_count; // kissfft's inverse is unnormalised
+    const float norm = 1.0f / (float)real_count; // the inverse is unnormalised
     for (int32_t ch = 0; ch < 3; ++ch) {
-        // The image's channel, zeros around it (only the padding is cleared: the image region
-        // is written over).
-        for (int32_t y = 0; y < in->height; ++y) {
-            const float *src = drift_image_pixel(in, 0, y);
-            float *dst = c->real + (size_t)y * (size_t)pw;
-            for (int32_t x = 0; x < in->width; ++x) {
-                dst[x] = src[(size_t)x * (size_t)in->channels + (size_t)ch];
-            }
-            memset(dst + in->width, 0, (size_t)(pw - in->width) * sizeof(float));
-        }
-        memset(c->real + (size_t)in->height * (size_t)pw, 0,
-               (size_t)(ph - in->height) * (size_t)pw * sizeof(float));
-        drift__glare_rfft_forward(c->forward, c->real, c->spectrum);
-        const drift__cpx *p = c->psf_spectrum[ch];
-        for (size_t i = 0; i < spec_count; ++i) {
-            drift__cpx a = c->spectrum[i], b = p[i];
-            c->spectrum[i] = (drift__cpx){ (a.re * b.re - a.im * b.im) * norm,
-                                           (a.re * b.im + a.im * b.re) * norm };
-        }
-        drift__glare_rfft_inverse(c->inverse, c->spectrum, c->real);
-        for (int32_t y = 0; y < in->height; ++y) {
-            const float *src = c->real + (size_t)y * (size_t)pw;
-            float *dst = drift_image_pixel(out, 0, y);
-            for (int32_t x = 0; x < in->width; ++x) {
-                dst[(size_t)x * (size_t)out->channels + (size_t)ch] = src[x];
-            }
-        }
+        drift__glare_rfft_convolve(c->forward, c->inverse, in, ch, c->psf_spectrum[ch], norm,
+                                   c->spectrum, out);
     }
     if (in->channels == 4 && out->pixels != in->pixels) {
         for (int32_t y = 0; y < in->height; ++y) {

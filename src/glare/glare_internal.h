@@ -1,5 +1,6 @@
-// Internal pieces of src/glare shared by its files and by tests/unit/test_glare.c: the kissfft
-// wrappers, the eye state, the aperture rasteriser, the PSF steps and the FFT convolution.
+// Internal pieces of src/glare shared by its files and by tests/unit/test_glare.c: the FFTs
+// (kissfft's and the lane FFT), the eye state, the aperture rasteriser, the PSF steps and the FFT
+// convolution.
 #ifndef DRIFT_GLARE_INTERNAL_H
 #define DRIFT_GLARE_INTERNAL_H
 
@@ -9,7 +10,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-// --- FFT (kissfft) ---
+// --- FFT ---
 
 // A complex number laid out as kissfft's kiss_fft_cpx (float r, i).
 typedef struct drift__cpx {
@@ -27,14 +28,45 @@ void drift__glare_fft_destroy(drift_context *ctx, drift__glare_fft *fft);
 void drift__glare_fft_run(const drift__glare_fft *fft, const drift__cpx *in, drift__cpx *out);
 
 // A 2-D real FFT plan (width even): forward takes height x width floats to height x
-// (width / 2 + 1) complex numbers; inverse the other way (destroying its input). Unnormalised
-// as above. Not thread-safe on one plan.
+// (width / 2 + 1) complex numbers, reading only the first `rows` rows (the rest are taken as
+// zeros); inverse the other way (destroying its input), writing only the first `rows` rows.
+// Unnormalised as above. Not thread-safe on one plan.
 typedef struct drift__glare_rfft drift__glare_rfft;
 drift_result drift__glare_rfft_create(drift_context *ctx, int32_t width, int32_t height,
                                       bool inverse, drift__glare_rfft **out_fft);
 void drift__glare_rfft_destroy(drift_context *ctx, drift__glare_rfft *fft);
-void drift__glare_rfft_forward(const drift__glare_rfft *fft, const float *in, drift__cpx *out);
-void drift__glare_rfft_inverse(const drift__glare_rfft *fft, drift__cpx *in, float *out);
+void drift__glare_rfft_forward(const drift__glare_rfft *fft, const float *in, int32_t rows,
+                               drift__cpx *out);
+void drift__glare_rfft_inverse(const drift__glare_rfft *fft, drift__cpx *in, int32_t rows,
+                               float *out);
+// Complex FFTs of DRIFT__GLARE_LANES sequences of n points at once (n with no prime factor
+// above 5), one a SIMD lane (fft_lanes.c). Element e of the sequences is 2 * LANES floats:
+// the LANES real parts, then the LANES imaginary parts. run transforms `data` using `work`
+// (both n elements) and returns whichever holds the result. Unnormalised like kissfft; a plan
+// is read-only, so threads share it.
+#define DRIFT__GLARE_LANES 8
+typedef struct drift__glare_lanes drift__glare_lanes;
+drift_result drift__glare_lanes_create(drift_context *ctx, int32_t n, bool inverse,
+                                       drift__glare_lanes **out);
+void drift__glare_lanes_destroy(drift_context *ctx, drift__glare_lanes *plan);
+float *drift__glare_lanes_run(const drift__glare_lanes *plan, float *data, float *work);
+// LANES consecutive complex numbers of `count` rows `stride` apart to `count` elements, and
+// back.
+void drift__glare_lanes_gather(const drift__cpx *src, size_t stride, size_t count, float *dst);
+void drift__glare_lanes_scatter(const float *src, size_t count, drift__cpx *dst, size_t stride);
+// data = data x kernel x norm, `count` elements.
+void drift__glare_lanes_multiply(float *data, const float *kernel, size_t count, float norm);
+// Convolution without the spectrum's round trip: the kernel's spectrum (forward's output) in
+// the lane layout (kernel_floats floats), then channel `channel` of `in` (zeros to its right
+// and below, in smaller than the plan) transformed, multiplied by the kernel's spectrum and
+// norm column block by column block, and transformed back into channel `channel` of `out`
+// (in's size; it may be in). `spectrum`: scratch.
+size_t drift__glare_rfft_kernel_floats(const drift__glare_rfft *fft);
+void drift__glare_rfft_kernel_layout(const drift__glare_rfft *fft, const drift__cpx *spectrum,
+                                     float *kernel);
+void drift__glare_rfft_convolve(const drift__glare_rfft *forward, const drift__glare_rfft *inverse,
+                                const drift_image *in, int32_t channel, const float *kernel,
+                                float norm, drift__cpx *spectrum, const drift_image *out);
 // The smallest even size >= n with no prime factor above 5.
 int32_t drift__glare_fft_size(int32_t n);
 
@@ -183,10 +215,10 @@ void drift__glare_psf_rgb(const float *mono, int32_t n, int32_t wavelength_count
 typedef struct drift__glare_conv {
     int32_t width, height; // padded size
     drift__glare_rfft *forward, *inverse;
-    float *real;          // width * height
-    drift__cpx *spectrum; // height * (width/2 + 1)
-    drift__cpx *psf_spectrum[3];
-    int32_t psf_k; // k of the cached PSF spectra (0: none)
+    float *real;            // width * height
+    drift__cpx *spectrum;   // height * (width/2 + 1)
+    float *psf_spectrum[3]; // lane layout (drift__glare_rfft_kernel_layout)
+    int32_t psf_k;          // k of the cached PSF spectra (0: none)
 } drift__glare_conv;
 
 drift_result drift__glare_convolve(drift_context *ctx, drift__glare_conv *cache,

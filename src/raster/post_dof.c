@@ -9,10 +9,12 @@
 // artefact kept, because it is what a single-layer gather does: a blurred foreground object's
 // edge stays sharp against an in-focus background behind it, since those pixels (circles
 // under half a pixel) gather nothing. The reference technique and ISG's DOF have neither.
+#include "core/scratch.h"
 #include "core/vectorise.h"
 #include "raster/raster.h"
 
 #include <math.h>
+#include <string.h>
 
 #define DEFAULT_TAPS 64u
 #define TAP_SEED     0x6d0f5a3bu // one fixed pattern for every pixel and frame
@@ -55,7 +57,11 @@ typedef struct dof_job {
     const drift_vec2 *taps; // offsets on the unit disk; taps[0] is the centre
     uint32_t tap_count;
     uint8_t *uniform; // per UNIFORM_TILE tile: every pixel its gathers read is alike
+    int32_t *run;     // per pixel: the run of equal pixels from it rightwards (equal_runs)
     int32_t tiles_x;
+    // RGB, its indices in int32 and its coordinates under 2^21: the batched gather (with radii
+    // up to 2^20 pixels, so that its taps' coordinates stay whole in float arithmetic).
+    bool batched;
 } dof_job;
 
 #define UNIFORM_TILE 16
@@ -151,40 +157,98 @@ static inline void gather(const dof_job *job, int32_t x, int32_t y, float radius
     }
 }
 
-// gather for RGB with its sums in named locals: GCC kept gather's sum[] array on the stack, a
-// store and a load in each add's dependency chain (the same operations in the same order).
-static inline void gather_rgb(const dof_job *job, int32_t x, int32_t y, float radius, float *out)
+// The RGB gather of up to BATCH pixels of row y with the same tap count, one pixel a vector
+// lane: one loop a tap over the pixels, branch-free (docs/decisions/0028), the bilinear
+// corners and the circles read by gathers. Each pixel does gather()'s operations in its order,
+// a weightless tap left out by a select instead of a branch (it is fetched, at a clamped,
+// valid address, and not added): the same image to the bit.
+#define BATCH 64
+
+typedef struct dof_batch {
+    int32_t n;
+    uint32_t taps;
+    float x[BATCH], radius[BATCH];
+} dof_batch;
+
+// clamp_index((int32_t)v, n) for a whole v under 2^22 in magnitude, without a conversion: GCC
+// 12 does not vectorise an int index made by a conversion and a select (docs/decisions/0028),
+// so the clamp is in float and the bits of v + 1.5 * 2^23 give the integer.
+static inline int32_t clamp_lane(float v, float last)
 {
-    const float *centre = drift_image_pixel(job->in, x, y);
-    const float c0 = centre[0], c1 = centre[1], c2 = centre[2];
-    float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f, tap[3];
-    float total = 1.0f; // the centre: its own circle reaches it
-    uint32_t tap_count = taps_for_radius(radius, job->tap_count);
-    for (uint32_t k = 1; k < tap_count; ++k) {
-        float ox = job->taps[k].x * radius, oy = job->taps[k].y * radius;
-        float tx = (float)x + ox, ty = (float)y + oy;
-        float weight = tap_weight(job->coc, tx, ty, sqrtf(ox * ox + oy * oy));
-        if (!(weight > 0.0f)) {
-            continue;
-        }
-        fetch_bilinear(job->in, tx, ty, tap, 3);
-        s0 += weight * (tap[0] - c0);
-        s1 += weight * (tap[1] - c1);
-        s2 += weight * (tap[2] - c2);
-        total += weight;
-    }
-    float inv = 1.0f / total;
-    out[0] = c0 + s0 * inv;
-    out[1] = c1 + s1 * inv;
-    out[2] = c2 + s2 * inv;
+    v = v < 0.0f ? 0.0f : v;
+    v = v > last ? last : v;
+    float biased = v + 12582912.0f;
+    int32_t bits;
+    memcpy(&bits, &biased, sizeof bits);
+    return bits - 0x4B400000;
 }
 
-static void gather_pixel(const dof_job *job, int32_t x, int32_t y, float radius, float *out)
+static DRIFT_AVX2_CLONES void post_dof_gather_batch(const dof_job *job, int32_t y,
+                                                    const dof_batch *batch)
 {
-    if (job->in->channels == 3) {
-        gather_rgb(job, x, y, radius, out);
-    } else {
-        gather(job, x, y, radius, out, job->in->channels);
+    const drift_image *in = job->in, *coc = job->coc;
+    const float *restrict pix = in->pixels, *restrict reach_plane = coc->pixels;
+    const int32_t stride = (int32_t)in->stride;
+    const float w = (float)(in->width - 1), h = (float)(in->height - 1); // the last pixel
+    const int32_t coc_stride = (int32_t)coc->stride, coc_channels = coc->channels;
+    const int32_t n = batch->n;
+    const float yf = (float)y;
+    float c0[BATCH], c1[BATCH], c2[BATCH], s0[BATCH], s1[BATCH], s2[BATCH], total[BATCH];
+    float xs[BATCH], radii[BATCH];
+    for (int32_t i = 0; i < n; ++i) {
+        xs[i] = batch->x[i];
+        radii[i] = batch->radius[i];
+        const float *centre = drift_image_pixel(in, (int32_t)batch->x[i], y);
+        c0[i] = centre[0];
+        c1[i] = centre[1];
+        c2[i] = centre[2];
+        s0[i] = s1[i] = s2[i] = 0.0f;
+        total[i] = 1.0f; // the centre: its own circle reaches it
+    }
+    for (uint32_t k = 1; k < batch->taps; ++k) {
+        const float dx = job->taps[k].x, dy = job->taps[k].y;
+        DRIFT_IVDEP
+        for (int32_t i = 0; i < n; ++i) {
+            float radius = radii[i];
+            float ox = dx * radius, oy = dy * radius;
+            float tx = xs[i] + ox, ty = yf + oy;
+            // tap_weight
+            int32_t px = clamp_lane(floorf(tx + 0.5f), w);
+            int32_t py = clamp_lane(floorf(ty + 0.5f), h);
+            float reach = reach_plane[py * coc_stride + px * coc_channels];
+            float v = reach - sqrtf(ox * ox + oy * oy) + 1.0f;
+            v = v < 0.0f ? 0.0f : (v > 1.0f ? 1.0f : v);
+            float weight = reach >= 0.0f ? v : 0.0f;
+            // fetch_bilinear
+            float x0f = floorf(tx), y0f = floorf(ty);
+            float fx = tx - x0f, fy = ty - y0f;
+            int32_t xa = clamp_lane(x0f, w) * 3, xb = clamp_lane(x0f + 1.0f, w) * 3;
+            int32_t ya = clamp_lane(y0f, h) * stride, yb = clamp_lane(y0f + 1.0f, h) * stride;
+            float t0 = lerp(lerp(pix[ya + xa], pix[ya + xb], fx),
+                            lerp(pix[yb + xa], pix[yb + xb], fx), fy);
+            float t1 = lerp(lerp(pix[ya + xa + 1], pix[ya + xb + 1], fx),
+                            lerp(pix[yb + xa + 1], pix[yb + xb + 1], fx), fy);
+            float t2 = lerp(lerp(pix[ya + xa + 2], pix[ya + xb + 2], fx),
+                            lerp(pix[yb + xa + 2], pix[yb + xb + 2], fx), fy);
+            // A weightless tap adds exact zeros (a sum here is never -0: it starts at +0, and
+            // a sum of two floats is -0 only when both are), its difference zeroed first so
+            // that an infinite or NaN tap cannot leak in: what skipping it does.
+            bool on = weight > 0.0f;
+            float ws = on ? weight : 0.0f;
+            float d0 = on ? t0 - c0[i] : 0.0f, d1 = on ? t1 - c1[i] : 0.0f;
+            float d2 = on ? t2 - c2[i] : 0.0f;
+            s0[i] += ws * d0;
+            s1[i] += ws * d1;
+            s2[i] += ws * d2;
+            total[i] += ws;
+        }
+    }
+    for (int32_t i = 0; i < n; ++i) {
+        float inv = 1.0f / total[i];
+        float *out = drift_image_pixel(job->out, (int32_t)batch->x[i], y);
+        out[0] = c0[i] + s0[i] * inv;
+        out[1] = c1[i] + s1[i] * inv;
+        out[2] = c2[i] + s2[i] * inv;
     }
 }
 
@@ -206,20 +270,46 @@ static bool tile_is_uniform(const dof_job *job, int32_t tx, int32_t ty)
     }
     // A tap lands within the radius; its bilinear fetch reads one pixel further.
     int32_t pad = (int32_t)ceilf(fminf(reach, (float)(in->width + in->height))) + 1;
+    // Each row of the region: its first pixel equals the tile's first, and so do the ones
+    // after it (the run of equal pixels from there spans the region). Float == per channel, as
+    // a scan would compare: -0 equals +0, NaN nothing, so equal runs are all equal to their
+    // first pixel.
     const float *first = drift_image_pixel(in, x0, y0);
+    int32_t xa = clamp_index(x0 - pad, in->width), xb = clamp_index(x1 - 1 + pad, in->width);
     for (int32_t y = clamp_index(y0 - pad, in->height); y <= clamp_index(y1 - 1 + pad, in->height);
          ++y) {
-        for (int32_t x = clamp_index(x0 - pad, in->width);
-             x <= clamp_index(x1 - 1 + pad, in->width); ++x) {
-            const float *p = drift_image_pixel(in, x, y);
-            for (int32_t c = 0; c < in->channels; ++c) {
-                if (p[c] != first[c]) {
-                    return false;
-                }
+        const float *p = drift_image_pixel(in, xa, y);
+        for (int32_t c = 0; c < in->channels; ++c) {
+            if (p[c] != first[c]) {
+                return false;
             }
+        }
+        if (job->run[(size_t)y * (size_t)in->width + (size_t)xa] < xb - xa + 1) {
+            return false;
         }
     }
     return true;
+}
+
+// run[y][x]: how many pixels from (x, y) rightwards equal their left neighbour, itself
+// included (tile_is_uniform's rows).
+static void equal_runs(size_t begin, size_t end, int thread_index, void *user)
+{
+    (void)thread_index;
+    const dof_job *job = user;
+    const drift_image *in = job->in;
+    for (int32_t y = (int32_t)begin; y < (int32_t)end; ++y) {
+        int32_t *run = job->run + (size_t)y * (size_t)in->width;
+        run[in->width - 1] = 1;
+        for (int32_t x = in->width - 2; x >= 0; --x) {
+            const float *p = drift_image_pixel(in, x, y), *q = p + in->channels;
+            bool same = true;
+            for (int32_t c = 0; c < in->channels; ++c) {
+                same = same && p[c] == q[c];
+            }
+            run[x] = same ? run[x + 1] + 1 : 1;
+        }
+    }
 }
 
 static DRIFT_AVX2_CLONES void classify_tiles(size_t begin, size_t end, int thread_index, void *user)
@@ -233,15 +323,26 @@ static DRIFT_AVX2_CLONES void classify_tiles(size_t begin, size_t end, int threa
 }
 
 // Cloned for AVX2: floorf is one instruction there and sqrtf needs no errno (the file is built
-// with -fno-math-errno): 1.3x, the same image.
+// with -fno-math-errno): 1.3x, the same image. RGB pixels that gather wait in batches by tap
+// count (a power of two plus one, or the table: one batch for each), so a batch's lanes run
+// the same taps.
 static DRIFT_AVX2_CLONES void dof_rows(size_t begin, size_t end, int thread_index, void *user)
 {
     (void)thread_index;
     const dof_job *job = user;
     int32_t channels = job->in->channels;
+
+    enum {
+        BUCKETS = 32
+    };
+
+    dof_batch batches[BUCKETS];
     for (int32_t y = (int32_t)begin; y < (int32_t)end; ++y) {
         const uint8_t *uniform_row =
             job->uniform + (size_t)(y / UNIFORM_TILE) * (size_t)job->tiles_x;
+        for (int32_t b = 0; b < BUCKETS; ++b) {
+            batches[b].n = 0;
+        }
         for (int32_t x = 0; x < job->in->width; ++x) {
             float radius = drift_image_pixel(job->coc, x, y)[0];
             const float *src = drift_image_pixel(job->in, x, y);
@@ -254,7 +355,32 @@ static DRIFT_AVX2_CLONES void dof_rows(size_t begin, size_t end, int thread_inde
                 }
                 continue;
             }
-            gather_pixel(job, x, y, radius, dst);
+            if (!job->batched || !(radius <= 1048576.0f)) {
+                gather(job, x, y, radius, dst, channels); // the batches' bounds, below
+                continue;
+            }
+            uint32_t taps = taps_for_radius(radius, job->tap_count);
+            int32_t b = 0; // floor(log2(taps)): one count a bucket for the default table
+            while (b < BUCKETS - 1 && (2u << b) <= taps) {
+                ++b;
+            }
+            dof_batch *batch = &batches[b];
+            if (batch->n > 0 && batch->taps != taps) { // another table's counts can share it
+                post_dof_gather_batch(job, y, batch);
+                batch->n = 0;
+            }
+            batch->taps = taps;
+            batch->x[batch->n] = (float)x;
+            batch->radius[batch->n] = radius;
+            if (++batch->n == BATCH) {
+                post_dof_gather_batch(job, y, batch);
+                batch->n = 0;
+            }
+        }
+        for (int32_t b = 0; b < BUCKETS; ++b) {
+            if (batches[b].n > 0) {
+                post_dof_gather_batch(job, y, &batches[b]);
+            }
         }
     }
 }
@@ -302,7 +428,11 @@ drift_result drift_post_dof(drift_context *ctx, const drift_image *in, const dri
     int32_t tiles_y = (in->height + UNIFORM_TILE - 1) / UNIFORM_TILE;
     size_t tile_count = (size_t)tiles_x * (size_t)tiles_y;
     uint8_t *uniform = drift_alloc(ctx, tile_count);
-    if (!uniform) {
+    // The runs in the context's scratch block (kept between calls: no fresh pages each frame).
+    size_t run_bytes = (size_t)in->width * (size_t)in->height * sizeof(int32_t), have = 0;
+    int32_t *run = uniform ? drift__scratch_take(ctx, run_bytes, &have) : NULL;
+    if (!run) {
+        drift_free(ctx, uniform);
         drift_free(ctx, table);
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_OUT_OF_MEMORY, __FILE__, __LINE__,
                   "post dof: out of memory for %zu tiles", tile_count);
@@ -314,9 +444,16 @@ drift_result drift_post_dof(drift_context *ctx, const drift_image *in, const dri
                     .taps = table,
                     .tap_count = tap_count,
                     .uniform = uniform,
-                    .tiles_x = tiles_x };
+                    .run = run,
+                    .tiles_x = tiles_x,
+                    .batched = in->channels == 3 && in->width <= (1 << 20) &&
+                               in->height <= (1 << 20) &&
+                               (double)in->stride * (double)in->height < 2147483647.0 &&
+                               (double)coc->stride * (double)coc->height < 2147483647.0 };
+    drift_parallel_for(ctx, (size_t)in->height, 8, equal_runs, &job);
     drift_parallel_for(ctx, tile_count, 1, classify_tiles, &job);
     drift_parallel_for(ctx, (size_t)in->height, 1, dof_rows, &job);
+    drift__scratch_give(ctx, run, have);
     drift_free(ctx, uniform);
     drift_free(ctx, table);
     return DRIFT_OK;

@@ -46,7 +46,16 @@ a = p["a-trous"]  # 5 passes apart: colour in and out, albedo, normal (12 bytes)
 assert a["level_bytes"] == 5 * 16 * 12 * (12 + 12 + 12 + 12 + 4), a
 taps = sum(sum(max(0, 16 - abs(t) * 2**i) for t in range(-2, 3)) *
            sum(max(0, 12 - abs(t) * 2**i) for t in range(-2, 3)) - 16 * 12 for i in range(5))
-assert a["samples"] == taps and a["compute_floor_ms"] > 0, (a, taps)'
+assert a["samples"] == taps and a["compute_floor_ms"] > 0, (a, taps)
+assert d["gflop_per_s"] > 0, d
+g = p["glare conv"]  # 16 + 128 and 12 + 128 padded to 144 (2^4 3^2): 3 x (2 FFTs + product)
+P = 144 * 144
+assert abs(g["flops"] - 3 * (2 * 2.5 * P * math.log2(P) + 6 * 73 * 144)) < 1, g
+assert abs(g["compute_floor_ms"] - g["flops"] / (d["gflop_per_s"] * 1e6)) <= 1e-3, (g, d)'
+        # --passes: only the passes named.
+        expect 0 "$drift" bench frame "$box" --floors --width 16 --height 12 --frames 1 --json \
+            --passes "post dof,glare conv"
+        check frame-floors-passes 'assert [x["name"] for x in d["passes"]] == ["post dof", "glare conv"], d'
         ;;
     isg)
         expect 0 "$drift" bench isg "$box" --width 16 --height 12 --qwidth 16 --qheight 12 \
