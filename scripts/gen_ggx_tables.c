@@ -40,8 +40,8 @@ int main(void)
     }
     static float ms_scale[AL][MU];
     for (int j = 0; j < AL; ++j) {
-        float alpha2 = drift__ggx_ms_alpha(drift__ggx_grid_alpha(j, AL));
-        float residual = drift__ggx_fit_ms_scale(alpha2, e1[j], MS_STRATA, ms_scale[j]);
+        float residual =
+            drift__ggx_fit_ms_scale(drift__ggx_grid_alpha(j, AL), e1[j], MS_STRATA, ms_scale[j]);
         if (residual > 1e-5f) {
             fprintf(stderr, "ms scale row %d: residual %g\n", j, (double)residual);
             return 1;

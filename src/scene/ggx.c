@@ -125,7 +125,7 @@ static drift_vec3 conductor_f_ms(const drift_bsdf_ggx *g)
 }
 
 // The multiple-scattering lobe with F = 1 at wo, wi (both above) and their half vector h:
-// s(mu_o) s(mu_i) D2(h) G2(wo, wi) / (4 mu_o mu_i) of the broad roughness; its sampling pdf
+// s(mu_o) s(mu_i) K(mu_o, mu_i) D2(h) G2(wo, wi) / (4 mu_o mu_i) of the broad roughness; its pdf
 // (the broad lobe's visible normals) in out_pdf.
 static float ms_lobe(const drift_bsdf_ggx *g, drift_vec3 wo, drift_vec3 wi, drift_vec3 h,
                      float *out_pdf)
@@ -136,7 +136,8 @@ static float ms_lobe(const drift_bsdf_ggx *g, drift_vec3 wo, drift_vec3 wi, drif
     // D_wo(h) / (4 wo.h) = G1(wo) D / (4 wo.z).
     *out_pdf = d / ((1.0f + lo) * 4.0f * wo.z);
     float s = drift__ggx_ms_scale_at(wo.z, g->alpha_row, g->alpha_frac) *
-              drift__ggx_ms_scale_at(wi.z, g->alpha_row, g->alpha_frac);
+              drift__ggx_ms_scale_at(wi.z, g->alpha_row, g->alpha_frac) *
+              drift__ggx_ms_kernel(drift__ggx_ms_beta(g->alpha), wo.z, wi.z);
     return s * d / ((1.0f + lo + li) * 4.0f * wo.z * wi.z);
 }
 

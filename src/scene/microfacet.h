@@ -73,22 +73,30 @@ void drift__ggx_integrate_reflection(float mu, float alpha, int strata, float *e
 float drift__ggx_integrate_dielectric(float mu, float alpha, float eta, int strata);
 
 // The conductor's multiple-scattering lobe (docs/materials.md): with F = 1,
-//   f_ms(wo, wi) = s(mu_o) s(mu_i) D2(h) G2(wo, wi) / (4 mu_o mu_i),
-// single-scatter GGX of the broader roughness drift__ggx_ms_alpha(alpha), scaled by s so that
-// its albedo is 1 - E1(mu_o) at every mu_o: reciprocal and white-furnace exact. s is tabulated
-// on the E tables' grid (drift__ggx_ms_scale_at, linear in mu between cell centres).
-// The broad roughness is k(r) alpha, r = sqrt(alpha): k = 2.5 up to r = 0.35, then falling
-// linearly to 1 at r = 1 (fitted to Cycles 3.4's random walk: docs/materials.md).
+//   f_ms(wo, wi) = s(mu_o) s(mu_i) K(mu_o, mu_i) D2(h) G2(wo, wi) / (4 mu_o mu_i),
+// single-scatter GGX of the broader roughness drift__ggx_ms_alpha(alpha), times the kernel K,
+// scaled by s so that its albedo is 1 - E1(mu_o) at every mu_o: reciprocal and white-furnace
+// exact. s is tabulated on the E tables' grid (drift__ggx_ms_scale_at, linear in mu between
+// cell centres). The broad roughness is k(r) alpha, r = sqrt(alpha): k = 2.5 up to r = 0.35,
+// then falling linearly to 1 at r = 1; K = 1 + beta(r) ((1 - mu_o)(1 - mu_i))^2, beta 0 up to
+// r = 0.5, then rising by BETA_SLOPE per unit of r: it moves the walk's light toward grazing
+// pairs of directions, which no separable factor (s absorbs those) and no width can (both
+// fitted to Cycles 3.4's random walk: docs/materials.md).
 #define DRIFT_GGX_MS_WIDTH       2.5f
 #define DRIFT_GGX_MS_WIDTH_KNEE  0.35f
 #define DRIFT_GGX_MS_WIDTH_ROUGH 1.0f
+#define DRIFT_GGX_MS_BETA_KNEE   0.5f
+#define DRIFT_GGX_MS_BETA_SLOPE  6.667f
 float drift__ggx_ms_alpha(float alpha);
-// One alpha row of s for the broad lobe's roughness ms_alpha and that row of the E1 table (e1,
-// DRIFT_GGX_TABLE_MU_N values): with wo at each grid mu, the lobe's albedo is linear in s's
-// entries, B s (B by strata x strata visible normals of ms_alpha); s solves
-// s_i (B s)_i = 1 - e1[i] by a symmetric Sinkhorn-Knopp scaling. Returns the largest residual
-// |s_i (B s)_i - (1 - e1[i])|.
-float drift__ggx_fit_ms_scale(float ms_alpha, const float *e1, int strata, float *out_scale);
+float drift__ggx_ms_beta(float alpha);
+// K(mu_o, mu_i) for the lobe's beta.
+float drift__ggx_ms_kernel(float beta, float mu_o, float mu_i);
+// One alpha row of s for the BSDF's roughness alpha (the lobe of drift__ggx_ms_alpha(alpha) and
+// drift__ggx_ms_beta(alpha)) and that row of the E1 table (e1, DRIFT_GGX_TABLE_MU_N values):
+// with wo at each grid mu, the lobe's albedo is linear in s's entries, B s (B by strata x strata
+// visible normals of the broad lobe); s solves s_i (B s)_i = 1 - e1[i] by a symmetric
+// Sinkhorn-Knopp scaling. Returns the largest residual |s_i (B s)_i - (1 - e1[i])|.
+float drift__ggx_fit_ms_scale(float alpha, const float *e1, int strata, float *out_scale);
 
 // The GGX material's value, pdf and sampling in the local frame. out_diffuse (may be NULL)
 // gets the plastic's diffuse part of the value.
