@@ -88,7 +88,8 @@ typedef struct lobe_ctx {
     float alpha2, exponent;
     float lambda_o; // Smith's Lambda(wo), GGX
     int32_t x0, y0;
-    float centre_share; // the centre's weight factor: its one pixel against a sample's area
+    float centre_share;        // the centre's weight factor: its one pixel against a sample's area
+    const drift_image *points; // the reflected points (isg.h)
 } lobe_ctx;
 
 static float smith_lambda(float alpha2, float cos_t)
@@ -130,14 +131,41 @@ static float lobe_weight(const lobe_ctx *c, drift_vec3 wi)
 static float range_lobe_direction(const void *user, int32_t x, int32_t y)
 {
     const lobe_ctx *c = user;
-    const drift_gbuffer *g = &c->f->gbuffer;
     size_t i = (size_t)y * (size_t)c->f->params.width + (size_t)x;
-    if (g->mesh_index[i] != c->mesh || !has_lobe(g, x, y)) {
+    const float *h = drift_image_pixel(c->points, x, y);
+    if (!(h[3] >= 0.0f) || c->f->gbuffer.mesh_index[i] != c->mesh) {
         return 0.0f;
     }
-    float d = drift_image_pixel(&c->f->reflection_distance, x, y)[0];
-    float w = lobe_weight(c, sample_direction(c, i, d));
-    return x == c->x0 && y == c->y0 ? w * c->centre_share : w;
+    drift_vec3 w = drift_vec3_make(h[0], h[1], h[2]);
+    if (h[3] > 0.0f) {
+        w = drift_vec3_normalize(drift_vec3_sub(w, c->p0));
+    }
+    float weight = lobe_weight(c, w);
+    return x == c->x0 && y == c->y0 ? weight * c->centre_share : weight;
+}
+
+// Fills the reflected-point buffer (isg.h) the gather reads, once per frame: a sample then
+// costs one read and one normalisation.
+static void point_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
+{
+    (void)rays;
+    (void)user;
+    float *out = drift_image_pixel(&drift_isg_of(f)->reflection_points, x, y);
+    size_t i = (size_t)y * (size_t)f->params.width + (size_t)x;
+    if (!has_lobe(&f->gbuffer, x, y) || f->gbuffer.surfaces[i].material == DRIFT_INVALID_INDEX) {
+        out[0] = out[1] = out[2] = 0.0f;
+        out[3] = -1.0f;
+        return;
+    }
+    const drift_surface *s = &f->gbuffer.surfaces[i];
+    drift_vec3 wo = drift_vec3_normalize(drift_vec3_sub(f->camera.position, s->position));
+    drift_vec3 r = drift_vec3_reflect(wo, s->ns);
+    float d = drift_image_pixel(&f->reflection_distance, x, y)[0];
+    drift_vec3 h = isfinite(d) ? drift_vec3_add(s->position, drift_vec3_scale(r, d)) : r;
+    out[0] = h.x;
+    out[1] = h.y;
+    out[2] = h.z;
+    out[3] = isfinite(d) ? 1.0f : 0.0f;
 }
 
 // Radians w turns per pixel along (dx, dy) at (x, y), w taken at the searched distance E for
@@ -198,7 +226,8 @@ static float direction_gather(drift_frame_state *f, const drift_bsdf *bsdf, drif
                     .alpha2 = a * a,
                     .exponent = bsdf->exponent,
                     .x0 = x,
-                    .y0 = y };
+                    .y0 = y,
+                    .points = &s->reflection_points };
     lc.lambda_o = smith_lambda(lc.alpha2, drift_vec3_dot(wo, surface->ns));
     float rate_x = direction_rate(&lc, x, y, 1, 0, reflected_distance);
     float rate_y = direction_rate(&lc, x, y, 0, 1, reflected_distance);
@@ -318,6 +347,9 @@ drift_result drift_isg_pass_reflections(drift_frame_state *f, const drift_pass_a
     }
     reflection_job job = { .fov_x = drift_isg_fov_x(&f->camera, f->params.width, f->params.height),
                            .fov_y = f->camera.fov_y };
+    if (f->params.reflections == DRIFT_REFLECTIONS_ISG && !f->params.reflection_edits) {
+        drift_pass_for_each_pixel(f, point_pixel, NULL);
+    }
     drift_pass_for_each_pixel(f, reflection_pixel, &job);
     f->stats.ms[DRIFT_PASS_ISG] += 1000.0 * (drift_time_now() - t);
     return DRIFT_OK;
