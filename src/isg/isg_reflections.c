@@ -5,15 +5,16 @@
 //           r = exp(-(a l^2 + b n^2) / sigma), l the world distance (eq. 11; or to the
 //           centre's tangent plane with isg_range_plane), n = 1 - N_i . N_0
 //           (eq. 12) -> E, their average (misses rejected; none found: E = infinity)
-//   support tan alpha = E tan theta_max / (e + E) (eq. 13), e the eye distance; alpha / fov
-//           per axis (eq. 14's cos(theta_incident) is for half-vector lobes: not applied)
-//   gather  over the reflected radiance with range eq. 10 and a spatial weight shaped like
-//           the Phong lobe across the cone, 0.1^(rho^2) at fraction rho of the support (the
-//           search's weight is constant, as in the paper)
-// theta_max comes per pixel from the gloss plane (90% of the Phong lobe). The gathered
-// radiance is weighted by the centre's lobe albedo, as the sharp buffer is. Samples on
-// pixels without a specular lobe are rejected (their buffer holds no reflection). Mirrors
-// keep the sharp reflection. The `blur` baseline gathers over a fixed disk instead.
+//   gather  in direction space (beyond the paper, docs/isg.md): each sample weighted by the
+//           centre's lobe toward the point its mirror ray met, over a support of theta_max
+//           divided by the angle that direction turns per pixel here (eq. 13's alpha on a
+//           plane; on a curved reflector the normal's turn adds to it). Under reflection
+//           edits, the paper's gather: support eq. 13 (no eq. 14 cosine), range eq. 10 and a
+//           spatial weight 0.1^(rho^2) at fraction rho of the support.
+// theta_max comes per pixel from the gloss plane (90% of the lobe). The gathered radiance is
+// weighted by the centre's lobe albedo, as the sharp buffer is. Samples on pixels without a
+// specular lobe are rejected (their buffer holds no reflection). Mirrors keep the sharp
+// reflection. The `blur` baseline gathers over a fixed disk instead.
 #include "isg/isg.h"
 
 #include <math.h>
