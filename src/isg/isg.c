@@ -100,6 +100,7 @@ static void free_buffers(drift_context *ctx, drift_isg_state *s)
     s->light_search = NULL;
     s->light_count = 0;
     drift_image_destroy(ctx, &s->reflection_search);
+    drift_image_destroy(ctx, &s->reflection_points);
     drift_image_destroy(ctx, &s->dof_search);
     drift_image_destroy(ctx, &s->layer_depth);
     drift_image_destroy(ctx, &s->layer_colour);
@@ -120,6 +121,9 @@ static drift_result make_buffers(drift_frame_state *f, drift_isg_state *s)
     }
     if (r == DRIFT_OK) {
         r = drift_image_create(ctx, w, h, 2, &s->reflection_search);
+    }
+    if (r == DRIFT_OK) {
+        r = drift_image_create(ctx, w, h, 4, &s->reflection_points);
     }
     if (r == DRIFT_OK) {
         r = drift_image_create(ctx, w, h, 1, &s->dof_search);

@@ -171,9 +171,12 @@ typedef struct drift_isg_state {
     drift_image *light_search; // per light, 2: average occluder distance d, gather radius (px)
     uint32_t light_count;
     drift_image reflection_search; // 2: average reflected distance E, gather radius (px)
-    drift_image dof_search;        // 1: gather radius (px) found by the search
-    drift_image layer_depth;       // 1: view depth of the second layer (0: none; 1e30: a miss)
-    drift_image layer_colour;      // 3: its radiance (isg_layers.c)
+    // 4: what each glossy pixel's mirror ray met, the point p + d r (w = 1), or r for a miss
+    // (w = 0); w = -1 where there is no lobe (isg_reflections.c)
+    drift_image reflection_points;
+    drift_image dof_search;   // 1: gather radius (px) found by the search
+    drift_image layer_depth;  // 1: view depth of the second layer (0: none; 1e30: a miss)
+    drift_image layer_colour; // 3: its radiance (isg_layers.c)
     drift_isg_pattern search, gather, search_rect, gather_rect;
 } drift_isg_state;
 

@@ -284,7 +284,7 @@ static void test_gloss_support_eq13(void **state)
     assert_near(drift_isg_penumbra(0.5f, INFINITY, 3.0f), 0.0, 0.0);
 }
 
-// At a grazing view of a Phong-100 floor the gather's support is eq. 13's alpha on screen,
+// At a grazing view of a Phong-100 floor the gather's support is about eq. 13's alpha on screen,
 // not alpha cos(theta_incident) (eq. 14, for half-vector lobes): drift's Phong lobe is a cone
 // about the mirror direction, which a flat reflector shows undistorted. With the cosine the
 // floor of the open glossy room under-blurred about 5x (issue 17).
@@ -338,7 +338,11 @@ static void test_gloss_support_at_grazing_view(void **state)
         print_message("y %d: cos_i %.3f, radius %.3f px, eq. 13 %.3f px\n", y, (double)cos_incident,
                       (double)radius, alpha * scale);
         assert_true(cos_incident < 0.5f); // grazing
-        assert_near((double)radius, alpha * scale, 0.03 * alpha * scale);
+        // Within 15%: the gather's support is now the cone over the rate at which the
+        // reflected points turn per pixel, measured on the G-buffer (isg_reflections.c), which
+        // also sees the eye distance change from pixel to pixel at grazing view; eq. 13 takes
+        // e as constant. The cosine of eq. 14 would make it 0.17-0.45x.
+        assert_near((double)radius, alpha * scale, 0.15 * alpha * scale);
         ++checked;
     }
     assert_true(checked >= 3);
