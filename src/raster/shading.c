@@ -369,11 +369,31 @@ void drift_raster_polygon_rows(const drift_scene *scene, const drift_raster_ligh
 // --- GLOSSY LOBES: LIGHT AND BSDF SAMPLES BY MULTIPLE IMPORTANCE ---
 
 // Whether U's glossy lobe takes BSDF-sampled directions besides its light samples: a glossy
-// lobe, and a light whose shapes drift_raster_light_hit can meet.
-static bool glossy_mis_applies(const drift_raster_light *light, const drift_bsdf *bsdf)
+// lobe narrower than twice the light's angular radius seen from the surface (the lobe's 90%
+// cone, drift_ggx_theta_90; Phong's by its exponent), and a light whose shapes
+// drift_raster_light_hit can meet. A wider lobe is served by light samples alone (the floor's
+// rough plastic under a panel: it halves the pass's added cost), and either estimator is
+// unbiased, so the choice moves noise, not the mean.
+static bool glossy_mis_applies(const drift_raster_light *light, const drift_surface *surface,
+                               const drift_bsdf *bsdf)
 {
-    return !drift_vec3_is_zero(bsdf->specular) && drift_light_is_area(light->type) &&
-           light->light_count <= DRIFT_RASTER_HIT_TRIANGLES;
+    if (drift_vec3_is_zero(bsdf->specular) || !drift_light_is_area(light->type) ||
+        light->light_count > DRIFT_RASTER_HIT_TRIANGLES) {
+        return false;
+    }
+    float lobe;
+    if (bsdf->type == DRIFT_MATERIAL_GGX) {
+        float alpha = bsdf->ggx.alpha;
+        if (bsdf->ggx.clearcoat > 0.0f) {
+            alpha = fminf(alpha, bsdf->ggx.clearcoat_alpha);
+        }
+        lobe = drift_ggx_theta_90(alpha);
+    } else {
+        lobe = acosf(powf(0.1f, 1.0f / (fmaxf(bsdf->exponent, 0.0f) + 1.0f)));
+    }
+    float d = drift_vec3_length(drift_vec3_sub(light->centre, surface->position));
+    float sigma = d > light->radius ? asinf(light->radius / d) : 0.5f * DRIFT_PI;
+    return lobe < 2.0f * sigma;
 }
 
 // The sum over n BSDF-sampled directions (a shifted Hammersley set, the lobe picked by a
@@ -446,7 +466,7 @@ static drift_vec3 unshadowed(const drift_scene *scene, const drift_raster_light 
     // With a glossy lobe, as many BSDF-sampled directions again, each weighed against the light
     // samples by the power heuristic (as the path tracer): a near-mirror lobe's highlight of an
     // area light is a small solid angle that light samples almost never find.
-    bool mis = glossy_mis_applies(light, bsdf);
+    bool mis = glossy_mis_applies(light, surface, bsdf);
     for (uint32_t k = 0; k < n; ++k) {
         drift_vec2 u = drift_hammersley_shifted(k, n, shift);
         // Golden-ratio sequence for the triangle pick of mesh lights.
