@@ -371,9 +371,9 @@ void drift_raster_polygon_rows(const drift_scene *scene, const drift_raster_ligh
 // Whether U's glossy lobe takes BSDF-sampled directions besides its light samples: a glossy
 // lobe narrower than twice the light's angular radius seen from the surface (the lobe's 90%
 // cone, drift_ggx_theta_90; Phong's by its exponent), and a light whose shapes
-// drift_raster_light_hit can meet. A wider lobe is served by light samples alone (the floor's
-// rough plastic under a panel: it halves the pass's added cost), and either estimator is
-// unbiased, so the choice moves noise, not the mean.
+// drift_raster_light_hit can meet. A wider lobe is served by light samples alone (the GGX
+// scene's rough floor under its panel: the BSDF samples' cost saved there), and either
+// estimator is unbiased, so the choice moves noise, not the mean.
 static bool glossy_mis_applies(const drift_raster_light *light, const drift_surface *surface,
                                const drift_bsdf *bsdf)
 {
