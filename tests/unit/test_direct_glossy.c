@@ -146,7 +146,9 @@ static void test_smooth_conductor_mirrors_the_light(void **state)
 
 // Rough lobes (roughness 0.25, 0.5, 0.8: alpha 0.0625, 0.25, 0.64) of the conductor and the
 // plastic's coat against the Monte Carlo of the same BSDF by light samples alone (200000 of
-// them: converged for these lobes), within 3%: the two estimators' MIS weights sum to one.
+// them: converged for these lobes), within 3%: the two estimators' MIS weights sum to one. (The
+// 2 x 2 lights subtend ~28 degrees of radius here: alpha 0.0625's 90% cone of 21 degrees takes
+// BSDF samples, the two wider lobes light samples alone.)
 static void test_rough_lobes_match_monte_carlo(void **state)
 {
     (void)state;
