@@ -244,3 +244,131 @@ drift_light_sample drift_raster_light_sample(const drift_scene *scene,
     s.pdf *= pmf;
     return s;
 }
+
+// --- RAYS AGAINST THE LIGHT'S OWN SHAPES ---
+
+// Distance along the unit direction d from o to triangle (a, b, c) (Moller-Trumbore), and its
+// barycentrics of b and c; -1 on a miss. Both faces: which one emits is the surface's call.
+static float ray_triangle(drift_vec3 o, drift_vec3 d, drift_vec3 a, drift_vec3 b, drift_vec3 c,
+                          float *out_u, float *out_v)
+{
+    drift_vec3 e1 = drift_vec3_sub(b, a), e2 = drift_vec3_sub(c, a);
+    drift_vec3 p = drift_vec3_cross(d, e2);
+    float det = drift_vec3_dot(e1, p);
+    if (det == 0.0f) {
+        return -1.0f;
+    }
+    float inv = 1.0f / det;
+    drift_vec3 s = drift_vec3_sub(o, a);
+    float u = drift_vec3_dot(s, p) * inv;
+    if (u < 0.0f || u > 1.0f) {
+        return -1.0f;
+    }
+    drift_vec3 q = drift_vec3_cross(s, e1);
+    float v = drift_vec3_dot(d, q) * inv;
+    if (v < 0.0f || u + v > 1.0f) {
+        return -1.0f;
+    }
+    *out_u = u;
+    *out_v = v;
+    return drift_vec3_dot(e2, q) * inv;
+}
+
+// The nearest hit t > 0 of the ray (o, unit d) on scene light `index`'s shape, or INFINITY;
+// hit gets what drift_scene_surface needs.
+static float ray_scene_light(const drift_scene *scene, uint32_t index, drift_vec3 o, drift_vec3 d,
+                             drift_hit *hit)
+{
+    const drift_light *l = &scene->lights[index];
+    *hit = (drift_hit){ .mesh = DRIFT_INVALID_INDEX, .light = index };
+    float t = -1.0f;
+    switch (l->type) {
+    case DRIFT_LIGHT_QUAD: {
+        // The parallelogram p + s edge_u + r edge_v as two triangles.
+        drift_vec3 c = drift_vec3_add(l->position, drift_vec3_add(l->edge_u, l->edge_v));
+        drift_vec3 b = drift_vec3_add(l->position, l->edge_u);
+        drift_vec3 e = drift_vec3_add(l->position, l->edge_v);
+        t = ray_triangle(o, d, l->position, b, c, &hit->u, &hit->v);
+        if (!(t > 0.0f)) {
+            t = ray_triangle(o, d, l->position, c, e, &hit->u, &hit->v);
+        }
+        break;
+    }
+    case DRIFT_LIGHT_DISK: {
+        float cos_d = drift_vec3_dot(d, l->direction);
+        if (cos_d != 0.0f) {
+            t = drift_vec3_dot(drift_vec3_sub(l->position, o), l->direction) / cos_d;
+            drift_vec3 p = drift_vec3_sub(drift_vec3_fma(o, d, t), l->position);
+            t = drift_vec3_dot(p, p) <= l->radius * l->radius ? t : -1.0f;
+        }
+        break;
+    }
+    case DRIFT_LIGHT_SPHERE: {
+        drift_vec3 oc = drift_vec3_sub(l->position, o);
+        float b = drift_vec3_dot(oc, d), c = drift_vec3_dot(oc, oc) - l->radius * l->radius;
+        float disc = b * b - c;
+        if (disc >= 0.0f) {
+            float s = sqrtf(disc);
+            t = b - s > 0.0f ? b - s : b + s;
+        }
+        break;
+    }
+    case DRIFT_LIGHT_TRIANGLE: {
+        drift_vec3 a, b, c;
+        drift_light_triangle_vertices(scene, l, &a, &b, &c);
+        t = ray_triangle(o, d, a, b, c, &hit->u, &hit->v);
+        hit->mesh = l->mesh;
+        hit->prim = l->triangle;
+        break;
+    }
+    case DRIFT_LIGHT_POINT:
+    case DRIFT_LIGHT_SPOT:
+    case DRIFT_LIGHT_DIRECTIONAL:
+    case DRIFT_LIGHT_COUNT:
+        break;
+    }
+    hit->t = t;
+    return t > 0.0f ? t : INFINITY;
+}
+
+bool drift_raster_light_hit(const drift_scene *scene, const drift_raster_light *light,
+                            drift_vec3 origin, drift_vec3 dir, drift_vec3 *out_radiance,
+                            float *out_pdf)
+{
+    if (!drift_light_is_area(light->type) || light->light_count > DRIFT_RASTER_HIT_TRIANGLES) {
+        return false;
+    }
+    // Rays that pass the light's bounding sphere meet none of it.
+    drift_vec3 oc = drift_vec3_sub(light->centre, origin);
+    float b = drift_vec3_dot(oc, dir);
+    float reach = light->radius * 1.001f;
+    if (light->light_cdf && drift_vec3_dot(oc, oc) - b * b > reach * reach) {
+        return false;
+    }
+    float nearest = INFINITY;
+    uint32_t index = DRIFT_INVALID_INDEX;
+    drift_hit hit = { 0 };
+    for (uint32_t i = 0; i < light->light_count; ++i) {
+        drift_hit h;
+        float t = ray_scene_light(scene, light->first_light + i, origin, dir, &h);
+        if (t < nearest) {
+            nearest = t, index = i, hit = h;
+        }
+    }
+    if (index == DRIFT_INVALID_INDEX) {
+        return false;
+    }
+    drift_ray ray = { .origin = origin, .dir = dir, .tmin = 0.0f, .tmax = INFINITY };
+    drift_surface s = drift_scene_surface(scene, &ray, &hit);
+    if (drift_vec3_is_zero(s.emission)) {
+        return false; // its back face: the light's own shape hides the rest
+    }
+    float pmf = 1.0f;
+    if (light->light_cdf) {
+        pmf = light->light_cdf[index] - (index > 0 ? light->light_cdf[index - 1] : 0.0f);
+    }
+    *out_radiance = s.emission;
+    *out_pdf =
+        pmf * drift_light_pdf_li(scene, light->first_light + index, origin, dir, nearest, s.ng);
+    return true;
+}

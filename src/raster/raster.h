@@ -76,6 +76,19 @@ drift_light_sample drift_raster_light_sample(const drift_scene *scene,
                                              const drift_raster_light *light, drift_vec3 ref,
                                              float u_pick, drift_vec2 u);
 
+// Emissive meshes of more triangles than this are not hit-tested (their glossy light is the
+// light samples' alone).
+#define DRIFT_RASTER_HIT_TRIANGLES 64
+
+// Where the ray from `origin` along the unit `dir` meets the light's own shapes (nothing else
+// in the scene: no visibility): the radiance it sees there and the solid-angle pdf with which
+// drift_raster_light_sample would have chosen that direction (the first shape along the ray),
+// for weighing a BSDF-sampled direction against light samples. False on a miss, a back face,
+// a delta light or a mesh of more than DRIFT_RASTER_HIT_TRIANGLES triangles.
+bool drift_raster_light_hit(const drift_scene *scene, const drift_raster_light *light,
+                            drift_vec3 origin, drift_vec3 dir, drift_vec3 *out_radiance,
+                            float *out_pdf);
+
 // --- SHADING SHARED BY EVERY PASS (shading.c) ---
 
 // Unshadowed direct light U_l: outgoing radiance toward wo at the surface from light

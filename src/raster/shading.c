@@ -366,6 +366,68 @@ void drift_raster_polygon_rows(const drift_scene *scene, const drift_raster_ligh
     }
 }
 
+// --- GLOSSY LOBES: LIGHT AND BSDF SAMPLES BY MULTIPLE IMPORTANCE ---
+
+// Whether U's glossy lobe takes BSDF-sampled directions besides its light samples: a glossy
+// lobe narrower than twice the light's angular radius seen from the surface (the lobe's 90%
+// cone, drift_ggx_theta_90; Phong's by its exponent), and a light whose shapes
+// drift_raster_light_hit can meet. A wider lobe is served by light samples alone (the GGX
+// scene's rough floor under its panel: the BSDF samples' cost saved there), and either
+// estimator is unbiased, so the choice moves noise, not the mean.
+static bool glossy_mis_applies(const drift_raster_light *light, const drift_surface *surface,
+                               const drift_bsdf *bsdf)
+{
+    if (drift_vec3_is_zero(bsdf->specular) || !drift_light_is_area(light->type) ||
+        light->light_count > DRIFT_RASTER_HIT_TRIANGLES) {
+        return false;
+    }
+    float lobe;
+    if (bsdf->type == DRIFT_MATERIAL_GGX) {
+        float alpha = bsdf->ggx.alpha;
+        if (bsdf->ggx.clearcoat > 0.0f) {
+            alpha = fminf(alpha, bsdf->ggx.clearcoat_alpha);
+        }
+        lobe = drift_ggx_theta_90(alpha);
+    } else {
+        lobe = acosf(powf(0.1f, 1.0f / (fmaxf(bsdf->exponent, 0.0f) + 1.0f)));
+    }
+    float d = drift_vec3_length(drift_vec3_sub(light->centre, surface->position));
+    float sigma = d > light->radius ? asinf(light->radius / d) : 0.5f * DRIFT_PI;
+    return lobe < 2.0f * sigma;
+}
+
+// The sum over n BSDF-sampled directions (a shifted Hammersley set, the lobe picked by a
+// stratified number) of f L cos / p_bsdf times the power heuristic's weight against the light
+// samples, where the direction meets the light (its own shapes only: visibility is S_l's).
+// With glossy_only (the diffuse lobe in closed form) f is the glossy lobe alone; p_bsdf is the
+// whole BSDF's pdf either way, as the estimator's is.
+static drift_vec3 bsdf_sampled(const drift_scene *scene, const drift_raster_light *light,
+                               const drift_surface *surface, const drift_bsdf *bsdf, drift_vec3 wo,
+                               uint32_t n, bool glossy_only, drift_sampler *sampler)
+{
+    drift_vec3 sum = drift_vec3_splat(0.0f);
+    drift_vec2 shift = drift_sampler_next2(sampler);
+    float lobe_shift = drift_sampler_next1(sampler);
+    for (uint32_t k = 0; k < n; ++k) {
+        float u_lobe = ((float)k + lobe_shift) / (float)n;
+        drift_bsdf_sample bs = drift_bsdf_sample_wi(bsdf, wo, fminf(u_lobe, 1.0f - 1e-6f),
+                                                    drift_hammersley_shifted(k, n, shift));
+        drift_vec3 le;
+        float light_pdf;
+        if (!(bs.pdf > 0.0f) || bs.is_delta ||
+            !drift_raster_light_hit(scene, light, surface->position, bs.wi, &le, &light_pdf)) {
+            continue;
+        }
+        drift_vec3 diffuse, glossy;
+        drift_bsdf_eval_lobes(bsdf, wo, bs.wi, &diffuse, &glossy);
+        drift_vec3 f = glossy_only ? glossy : drift_vec3_add(diffuse, glossy);
+        float cos_i = fabsf(drift_vec3_dot(bs.wi, surface->ns));
+        float w = drift_power_heuristic(bs.pdf, light_pdf);
+        sum = drift_vec3_add(sum, drift_vec3_scale(drift_vec3_mul(f, le), cos_i * w / bs.pdf));
+    }
+    return sum;
+}
+
 static drift_vec3 unshadowed(const drift_scene *scene, const drift_raster_light *light,
                              const drift_surface *surface, const drift_bsdf *bsdf, drift_vec3 wo,
                              uint32_t sample_count, drift_sampler *sampler,
@@ -401,14 +463,25 @@ static drift_vec3 unshadowed(const drift_scene *scene, const drift_raster_light 
     uint32_t n = sample_count > 0 ? sample_count : 1;
     drift_vec2 shift = drift_sampler_next2(sampler);
     float pick_shift = drift_sampler_next1(sampler);
+    // With a glossy lobe, as many BSDF-sampled directions again, each weighed against the light
+    // samples by the power heuristic (as the path tracer): a near-mirror lobe's highlight of an
+    // area light is a small solid angle that light samples almost never find.
+    bool mis = glossy_mis_applies(light, surface, bsdf);
     for (uint32_t k = 0; k < n; ++k) {
         drift_vec2 u = drift_hammersley_shifted(k, n, shift);
         // Golden-ratio sequence for the triangle pick of mesh lights.
         float pick = (float)k * 0.618034f + pick_shift;
         drift_light_sample ls =
             drift_raster_light_sample(scene, light, surface->position, pick - floorf(pick), u);
-        sampled =
-            drift_vec3_add(sampled, light_sample_contribution(surface, bsdf, wo, &ls, closed_form));
+        drift_vec3 c = light_sample_contribution(surface, bsdf, wo, &ls, closed_form);
+        if (mis && !drift_vec3_is_zero(c)) {
+            c = drift_vec3_scale(c, drift_power_heuristic(ls.pdf, drift_bsdf_pdf(bsdf, wo, ls.wi)));
+        }
+        sampled = drift_vec3_add(sampled, c);
+    }
+    if (mis) {
+        sampled = drift_vec3_add(
+            sampled, bsdf_sampled(scene, light, surface, bsdf, wo, n, closed_form, sampler));
     }
     return drift_vec3_fma(sum, sampled, 1.0f / (float)n);
 }
