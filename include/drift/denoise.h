@@ -145,6 +145,9 @@ typedef struct drift_denoise_feature_params {
     float sigma_depth;              // 0 -> 0.1
     float sigma_albedo;             // 0 -> 1
     bool no_firefly_clamp;          // true: skip stage 3
+    bool signed_color;              // true: the colour may be negative (a residual, as
+                                    // drift_denoise_guided filters): stages 1 and 6 and the
+                                    // regression keep the sign; not with a direct part
 } drift_denoise_feature_params;
 
 drift_denoise_feature_params
@@ -176,6 +179,35 @@ typedef struct drift_denoise_report {
 drift_result drift_denoise_feature(drift_context *ctx, const drift_denoise_inputs *in,
                                    const drift_denoise_feature_params *params, drift_image *out,
                                    drift_denoise_report *report);
+
+// --- THE HYBRID-GUIDED DENOISER (src/denoise/guided.c, docs/denoiser.md) ---
+//
+// Combines a biased but noise-free image of the same frame, `guide` (the hybrid frame: sharp
+// shadows, reflections and contact, low-frequency bias), with the path tracer's noisy
+// unbiased samples (in, as drift_denoise_feature takes them):
+//   RESIDUAL    out = guide + F(colour - guide): the signed residual filtered by the feature
+//               denoiser (signed_color, no direct split; `method` of params, REGRESSION_RESIDUAL
+//               when it is VARIANCE_GUIDED), a control variate: where the guide is right the
+//               residual is zero-mean noise and filters to ~0, keeping the guide's structure;
+//               its low-frequency bias is what the filter keeps. Clamped to >= 0.
+//   REGRESSION  the guide's demodulated RGB as three more features of the block regression
+//               (drift_denoise_guided), REGRESSION_RESIDUAL (fit + filtered residual):
+//               the fit scales the guide's shadows and highlights per block
+// Either converges to the path tracer's mean as its samples grow (the filter's bias aside): the
+// guide's bias is in the residual the filter keeps. in->direct (and its variances) are ignored.
+typedef enum drift_denoise_guide_mode {
+    DRIFT_GUIDE_RESIDUAL = 0,
+    DRIFT_GUIDE_REGRESSION,
+    DRIFT_GUIDE_MODE_COUNT
+} drift_denoise_guide_mode;
+
+// out: a new 3-channel image (the caller destroys it); params may be NULL (the feature
+// denoiser's defaults). Errors as drift_denoise_feature's; a guide of another size or an
+// unknown mode: DRIFT_ERR_INVALID_ARGUMENT.
+drift_result drift_denoise_guided(drift_context *ctx, const drift_denoise_inputs *in,
+                                  const drift_image *guide, drift_denoise_guide_mode mode,
+                                  const drift_denoise_feature_params *params, drift_image *out,
+                                  drift_denoise_report *report);
 
 #ifdef __cplusplus
 }
