@@ -608,6 +608,7 @@ int drift_bench_frontier(int argc, char **argv)
     r = r ? r : frontier_sir_rows(b, 2.0 * max_budget);
     for (int g = 0; g < FRONTIER_GUIDES; ++g) {
         drift_image_destroy(b->ctx, &b->guide[g]);
+        drift_image_destroy(b->ctx, &b->guide_indirect[g]);
     }
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift bench frontier: %s\n", drift_result_string(r));

@@ -47,9 +47,10 @@ typedef enum row_family {
 
 extern const char *const family_names[FAMILY_COUNT];
 
-// The hybrid+pt rows' guides: the default hybrid frame, and the same with 256 VPLs gathered
-// at one pixel in 2 x 2 (cheaper; the residual corrects its indirect light's bias).
-#define FRONTIER_GUIDES 2
+// The hybrid+pt rows' guides: the default hybrid frame; the same with 256 VPLs gathered at one
+// pixel in 2 x 2 ("cheap"); the same with indirect none ("direct"): cheaper guides whose
+// indirect light's bias the residual corrects.
+#define FRONTIER_GUIDES 3
 
 typedef struct frontier_row {
     char name[96];
@@ -66,7 +67,8 @@ typedef struct frontier_state {
     frontier_row rows[MAX_ROWS];
     int row_count;
     drift_image guide[FRONTIER_GUIDES]; // hybrid frames (frontier_guide_frame); no pixels: none
-    double guide_ms[FRONTIER_GUIDES];   // their warm frames' median ms
+    drift_image guide_indirect[FRONTIER_GUIDES]; // their "indirect" planes (none: no pixels)
+    double guide_ms[FRONTIER_GUIDES];            // their warm frames' median ms
 } frontier_state;
 
 // Loads the cached reference or renders and caches it; *cached says which.

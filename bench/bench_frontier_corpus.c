@@ -392,6 +392,7 @@ static drift_result corpus_scene_rows(frontier_options *o, corpus_scene *cs, int
     r = r ? r : frontier_hybrid_rows(b, 2.0 * max_budget);
     for (int g = 0; g < FRONTIER_GUIDES; ++g) {
         drift_image_destroy(b->ctx, &b->guide[g]);
+        drift_image_destroy(b->ctx, &b->guide_indirect[g]);
     }
     if (r == DRIFT_OK) {
         fill_cells(b, cs);

@@ -8,7 +8,7 @@
 
 #include <stdio.h>
 
-static const char *const guide_names[FRONTIER_GUIDES] = { "", "cheap " };
+static const char *const guide_names[FRONTIER_GUIDES] = { "", "cheap ", "direct " };
 
 static drift_result guide_frame(frontier_state *b, int g)
 {
@@ -29,6 +29,10 @@ static drift_result guide_frame(frontier_state *b, int g)
             return DRIFT_ERR_INVALID_ARGUMENT;
         }
     }
+    if (g == 2) {
+        drift_hybrid_params_set_technique(&p, DRIFT_EFFECT_INDIRECT,
+                                          drift_technique_parse(DRIFT_EFFECT_INDIRECT, "none"));
+    }
     drift_hybrid *frame = NULL;
     drift_result r = drift_hybrid_create(b->ctx, b->scene, b->accel, &p, &frame);
     r = r ? r : drift_hybrid_render(frame, &b->scene->camera, NULL); // warm-up, as hybrid_row
@@ -43,6 +47,16 @@ static drift_result guide_frame(frontier_state *b, int g)
     for (int32_t y = 0; r == DRIFT_OK && y < img->height; ++y) {
         for (int32_t x = 0; x < img->width; ++x) {
             drift_image_set3(&b->guide[g], x, y, drift_image_get3(img, x, y));
+        }
+    }
+    const drift_image *indirect =
+        r == DRIFT_OK ? drift_hybrid_plane_named(frame, "indirect") : NULL;
+    r = r || !indirect
+            ? r
+            : drift_image_create(b->ctx, img->width, img->height, 3, &b->guide_indirect[g]);
+    for (int32_t y = 0; r == DRIFT_OK && indirect && y < img->height; ++y) {
+        for (int32_t x = 0; x < img->width; ++x) {
+            drift_image_set3(&b->guide_indirect[g], x, y, drift_image_get3(indirect, x, y));
         }
     }
     if (r == DRIFT_OK) {
@@ -67,17 +81,24 @@ drift_result frontier_guide_frame(frontier_state *b)
 drift_result frontier_guided_rows(frontier_state *b, long spp, double render_ms,
                                   const drift_denoise_inputs *in)
 {
-    // residual: the residual filtered variance-guided; residual-rr: by regression + residual
-    static const char *const variant_names[3] = { "residual", "residual-rr", "regression" };
+    // residual: the residual filtered variance-guided; residual-rr: by regression + residual;
+    // split: the direct part and the rest apart (REGRESSION measured worse than each at every
+    // spp on the fit scenes: not a row, docs/lab/2026-12-07-issue-40-s7-guided.md)
+    static const char *const variant_names[3] = { "residual", "residual-rr", "split" };
     drift_result r = DRIFT_OK;
     for (int g = 0; g < FRONTIER_GUIDES && r == DRIFT_OK; ++g) {
         for (int v = 0; v < 3 && r == DRIFT_OK; ++v) {
-            drift_denoise_guide_mode mode = v == 2 ? DRIFT_GUIDE_REGRESSION : DRIFT_GUIDE_RESIDUAL;
             drift_denoise_feature_params p = { .method = v == 1 ? DRIFT_DENOISE_REGRESSION_RESIDUAL
                                                                 : DRIFT_DENOISE_VARIANCE_GUIDED };
+            drift_denoise_inputs part = *in;
+            if (v < 2) {
+                part.direct = part.direct_variance = part.indirect_variance = NULL;
+            }
+            const drift_image *gi = b->guide_indirect[g].pixels ? &b->guide_indirect[g] : NULL;
             drift_image out = { 0 };
             double t0 = drift_time_now();
-            r = drift_denoise_guided(b->ctx, in, &b->guide[g], mode, &p, &out, NULL);
+            r = drift_denoise_guided(b->ctx, &part, &b->guide[g], gi, DRIFT_GUIDE_RESIDUAL, &p,
+                                     &out, NULL);
             double filter_ms = (drift_time_now() - t0) * 1e3;
             char name[64];
             snprintf(name, sizeof name, "%s%s %ld spp", guide_names[g], variant_names[v], spp);

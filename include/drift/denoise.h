@@ -185,16 +185,21 @@ drift_result drift_denoise_feature(drift_context *ctx, const drift_denoise_input
 // Combines a biased but noise-free image of the same frame, `guide` (the hybrid frame: sharp
 // shadows, reflections and contact, low-frequency bias), with the path tracer's noisy
 // unbiased samples (in, as drift_denoise_feature takes them):
-//   RESIDUAL    out = guide + F(colour - guide): the signed residual filtered by the feature
-//               denoiser (signed_color, no direct split; `method` of params, REGRESSION_RESIDUAL
-//               when it is VARIANCE_GUIDED), a control variate: where the guide is right the
-//               residual is zero-mean noise and filters to ~0, keeping the guide's structure;
-//               its low-frequency bias is what the filter keeps. Clamped to >= 0.
-//   REGRESSION  the guide's demodulated RGB as three more features of the block regression
-//               (drift_denoise_guided), REGRESSION_RESIDUAL (fit + filtered residual):
-//               the fit scales the guide's shadows and highlights per block
+//   RESIDUAL    out = guide + F(colour - guide), clamped to >= 0: the signed residual
+//               (signed_color) filtered by the feature denoiser with params' method, a control
+//               variate: where the guide is right the residual is zero-mean noise and filters
+//               to ~0, keeping the guide's structure; its bias is what the filter keeps. With
+//               the path tracer's direct part (in->direct and both variances) the residual is
+//               split as drift_denoise_feature splits the colour: direct - (guide -
+//               guide_indirect) at sigma_luminance_direct, and (colour - direct) -
+//               guide_indirect at sigma_luminance_indirect, both by `method`. guide_indirect: the
+//               guide's indirect part (the hybrid frame's "indirect" plane); NULL: none.
+//   REGRESSION  the guide's demodulated RGB (by the path tracer's albedo) as three more
+//               features of the block regression, REGRESSION_RESIDUAL (fit + filtered residual):
+//               the fit scales the guide's shadows and highlights per block. No direct part.
 // Either converges to the path tracer's mean as its samples grow (the filter's bias aside): the
-// guide's bias is in the residual the filter keeps. in->direct (and its variances) are ignored.
+// guide's bias is in the residual the filter keeps. On the corpus at 128² REGRESSION measured
+// worse than RESIDUAL at every spp (docs/denoiser.md).
 typedef enum drift_denoise_guide_mode {
     DRIFT_GUIDE_RESIDUAL = 0,
     DRIFT_GUIDE_REGRESSION,
@@ -202,10 +207,11 @@ typedef enum drift_denoise_guide_mode {
 } drift_denoise_guide_mode;
 
 // out: a new 3-channel image (the caller destroys it); params may be NULL (the feature
-// denoiser's defaults). Errors as drift_denoise_feature's; a guide of another size or an
-// unknown mode: DRIFT_ERR_INVALID_ARGUMENT.
+// denoiser's defaults). Errors as drift_denoise_feature's; a guide of another size, an unknown
+// mode, a direct part without both variances or with REGRESSION: DRIFT_ERR_INVALID_ARGUMENT.
 drift_result drift_denoise_guided(drift_context *ctx, const drift_denoise_inputs *in,
-                                  const drift_image *guide, drift_denoise_guide_mode mode,
+                                  const drift_image *guide, const drift_image *guide_indirect,
+                                  drift_denoise_guide_mode mode,
                                   const drift_denoise_feature_params *params, drift_image *out,
                                   drift_denoise_report *report);
 

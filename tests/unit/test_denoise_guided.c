@@ -4,7 +4,8 @@
 // is: its lighting 25 % too bright outside the shadow and 0.05 E too bright inside it, but
 // noise-free and with the shadow's edge in place. The path tracer's mean of n samples has
 // relative noise s / sqrt(n) (Gaussian) and its variance image the true variance of the mean.
-// Properties: (1) at 4 spp each mode is closer to the truth than the plain feature denoiser on
+// Each variant: RESIDUAL, REGRESSION, and RESIDUAL with the direct part apart.
+// Properties: (1) at 4 spp each variant is closer to the truth than the plain feature denoiser on
 // the same samples, and keeps the shadow's edge (within 0.8-1.3 of its step, where the plain
 // denoiser keeps ~0.4); (2) at 4096 spp the guide's bias is gone from
 // the output (within 2 %, where the guide is 25 % off); (3) a noise-free path tracer with a
@@ -40,18 +41,26 @@ static float irradiance(int32_t x, int32_t y)
     return in_shadow(x, y) ? 0.1f * g : g;
 }
 
+// direct: 0.7 of the colour (and of its variance 0.49, the rest's 0.09); the guide's indirect
+// part 0.3 of the guide: for the split residual.
 typedef struct frame {
     drift_image color, albedo, normal, depth, variance, truth, guide;
+    drift_image direct, direct_variance, indirect_variance, guide_indirect;
 } frame;
+
+#define PLANES 11
 
 static frame make_frame(drift_context *ctx, uint32_t n, float s, float bias_scale,
                         float bias_shadow, uint32_t seed)
 {
     frame v;
-    drift_image *all[7] = { &v.color,    &v.albedo, &v.normal, &v.depth,
-                            &v.variance, &v.truth,  &v.guide };
-    const int channels[7] = { 3, 3, 3, 1, 1, 3, 3 };
-    for (int i = 0; i < 7; ++i) {
+    drift_image *all[PLANES] = {
+        &v.color,         &v.albedo, &v.normal, &v.depth,           &v.variance,
+        &v.truth,         &v.guide,  &v.direct, &v.direct_variance, &v.indirect_variance,
+        &v.guide_indirect
+    };
+    const int channels[PLANES] = { 3, 3, 3, 1, 1, 3, 3, 3, 1, 1, 3 };
+    for (int i = 0; i < PLANES; ++i) {
         assert_int_equal(drift_image_create(ctx, W, H, channels[i], all[i]), DRIFT_OK);
     }
     for (int32_t y = 0; y < H; ++y) {
@@ -64,12 +73,16 @@ static frame make_frame(drift_context *ctx, uint32_t n, float s, float bias_scal
                 drift_image_pixel(&v.color, x, y)[c] = a * e * (1.0f + noise);
                 drift_image_pixel(&v.truth, x, y)[c] = a * e;
                 drift_image_pixel(&v.guide, x, y)[c] = a * guide;
+                drift_image_pixel(&v.direct, x, y)[c] = 0.7f * a * e * (1.0f + noise);
+                drift_image_pixel(&v.guide_indirect, x, y)[c] = 0.3f * a * guide;
                 drift_image_pixel(&v.albedo, x, y)[c] = a;
                 drift_image_pixel(&v.normal, x, y)[c] = c == 2 ? 1.0f : 0.0f;
             }
             *drift_image_pixel(&v.depth, x, y) = 3.0f;
             float sd = a * e * s;
             *drift_image_pixel(&v.variance, x, y) = sd * sd / (float)n;
+            *drift_image_pixel(&v.direct_variance, x, y) = 0.49f * sd * sd / (float)n;
+            *drift_image_pixel(&v.indirect_variance, x, y) = 0.09f * sd * sd / (float)n;
         }
     }
     return v;
@@ -77,9 +90,12 @@ static frame make_frame(drift_context *ctx, uint32_t n, float s, float bias_scal
 
 static void destroy_frame(drift_context *ctx, frame *v)
 {
-    drift_image *all[7] = { &v->color,    &v->albedo, &v->normal, &v->depth,
-                            &v->variance, &v->truth,  &v->guide };
-    for (int i = 0; i < 7; ++i) {
+    drift_image *all[PLANES] = {
+        &v->color,         &v->albedo, &v->normal, &v->depth,           &v->variance,
+        &v->truth,         &v->guide,  &v->direct, &v->direct_variance, &v->indirect_variance,
+        &v->guide_indirect
+    };
+    for (int i = 0; i < PLANES; ++i) {
         drift_image_destroy(ctx, all[i]);
     }
 }
@@ -92,6 +108,22 @@ static drift_denoise_inputs inputs_of(const frame *v, uint32_t n)
                                    .depth = &v->depth,
                                    .variance = &v->variance,
                                    .sample_count = n };
+}
+
+// Variant m: 0 RESIDUAL, 1 REGRESSION, 2 RESIDUAL with the direct part apart.
+#define VARIANTS 3
+
+static drift_result guided(drift_context *ctx, const frame *v, uint32_t n, int m, drift_image *out)
+{
+    drift_denoise_inputs in = inputs_of(v, n);
+    if (m == 2) {
+        in.direct = &v->direct;
+        in.direct_variance = &v->direct_variance;
+        in.indirect_variance = &v->indirect_variance;
+    }
+    return drift_denoise_guided(ctx, &in, &v->guide, m == 2 ? &v->guide_indirect : NULL,
+                                m == 1 ? DRIFT_GUIDE_REGRESSION : DRIFT_GUIDE_RESIDUAL, NULL, out,
+                                NULL);
 }
 
 static double mse(const drift_image *a, const drift_image *b)
@@ -150,22 +182,20 @@ static void test_denoise_guided_beats_the_plain_denoiser_at_few_samples(void **s
     drift_context *ctx = test_context(2, NULL);
     frame v = make_frame(ctx, 4, 1.5f, 1.25f, 0.05f, 3);
     drift_denoise_inputs in = inputs_of(&v, 4);
-    drift_image plain, guided[DRIFT_GUIDE_MODE_COUNT];
+    drift_image plain, out;
     assert_int_equal(drift_denoise_feature(ctx, &in, NULL, &plain, NULL), DRIFT_OK);
     double e_noisy = mse(&v.color, &v.truth), e_guide = mse(&v.guide, &v.truth),
            e_plain = mse(&plain, &v.truth);
     print_message("4 spp: mse noisy %.3g, guide %.3g, plain denoiser %.3g (shadow edge %.2f)\n",
                   e_noisy, e_guide, e_plain, shadow_edge(&v, &plain));
-    for (int m = 0; m < DRIFT_GUIDE_MODE_COUNT; ++m) {
-        assert_int_equal(drift_denoise_guided(ctx, &in, &v.guide, (drift_denoise_guide_mode)m, NULL,
-                                              &guided[m], NULL),
-                         DRIFT_OK);
-        double e = mse(&guided[m], &v.truth), edge = shadow_edge(&v, &guided[m]);
-        print_message("  mode %d: mse %.3g, shadow edge %.2f\n", m, e, edge);
+    for (int m = 0; m < VARIANTS; ++m) {
+        assert_int_equal(guided(ctx, &v, 4, m, &out), DRIFT_OK);
+        double e = mse(&out, &v.truth), edge = shadow_edge(&v, &out);
+        print_message("  variant %d: mse %.3g, shadow edge %.2f\n", m, e, edge);
         assert_true(e < 0.7 * e_plain);
         assert_true(e < e_guide);
         assert_true(edge > 0.8 && edge < 1.3); // the residual has its own step there
-        drift_image_destroy(ctx, &guided[m]);
+        drift_image_destroy(ctx, &out);
     }
     drift_image_destroy(ctx, &plain);
     destroy_frame(ctx, &v);
@@ -177,16 +207,13 @@ static void test_denoise_guided_bias_does_not_survive_many_samples(void **state)
     (void)state;
     drift_context *ctx = test_context(2, NULL);
     frame v = make_frame(ctx, 4096, 1.5f, 1.25f, 0.05f, 5);
-    drift_denoise_inputs in = inputs_of(&v, 4096);
     print_message("4096 spp: the guide's lit / shadow means over the truth %.3f / %.3f\n",
                   region_ratio(&v, &v.guide, false), region_ratio(&v, &v.guide, true));
-    for (int m = 0; m < DRIFT_GUIDE_MODE_COUNT; ++m) {
+    for (int m = 0; m < VARIANTS; ++m) {
         drift_image out;
-        assert_int_equal(
-            drift_denoise_guided(ctx, &in, &v.guide, (drift_denoise_guide_mode)m, NULL, &out, NULL),
-            DRIFT_OK);
+        assert_int_equal(guided(ctx, &v, 4096, m, &out), DRIFT_OK);
         double lit = region_ratio(&v, &out, false), shadow = region_ratio(&v, &out, true);
-        print_message("  mode %d: lit %.4f, shadow %.4f\n", m, lit, shadow);
+        print_message("  variant %d: lit %.4f, shadow %.4f\n", m, lit, shadow);
         assert_true(fabs(lit - 1.0) < 0.02);
         assert_true(fabs(shadow - 1.0) < 0.02);
         drift_image_destroy(ctx, &out);
@@ -202,11 +229,9 @@ static void test_denoise_guided_exact_guide_and_bad_arguments(void **state)
     drift_context *ctx = test_context(2, &capture);
     frame v = make_frame(ctx, 16, 0.0f, 1.0f, 0.0f, 7); // no noise, the guide is the truth
     drift_denoise_inputs in = inputs_of(&v, 16);
-    for (int m = 0; m < DRIFT_GUIDE_MODE_COUNT; ++m) {
+    for (int m = 0; m < VARIANTS; ++m) {
         drift_image out;
-        assert_int_equal(
-            drift_denoise_guided(ctx, &in, &v.guide, (drift_denoise_guide_mode)m, NULL, &out, NULL),
-            DRIFT_OK);
+        assert_int_equal(guided(ctx, &v, 16, m, &out), DRIFT_OK);
         double worst = 0.0;
         for (int32_t y = 0; y < H; ++y) {
             for (int32_t x = 0; x < W; ++x) {
@@ -215,25 +240,31 @@ static void test_denoise_guided_exact_guide_and_bad_arguments(void **state)
                 worst = fmax(worst, fabs(o / t - 1.0));
             }
         }
-        print_message("exact guide, mode %d: worst relative error %.2g\n", m, worst);
+        print_message("exact guide, variant %d: worst relative error %.2g\n", m, worst);
         assert_true(worst < 1e-3);
         drift_image_destroy(ctx, &out);
     }
     drift_image small, out;
     assert_int_equal(drift_image_create(ctx, W / 2, H, 3, &small), DRIFT_OK);
-    assert_int_equal(drift_denoise_guided(ctx, &in, &small, DRIFT_GUIDE_RESIDUAL, NULL, &out, NULL),
-                     DRIFT_ERR_INVALID_ARGUMENT);
+    assert_int_equal(
+        drift_denoise_guided(ctx, &in, &small, NULL, DRIFT_GUIDE_RESIDUAL, NULL, &out, NULL),
+        DRIFT_ERR_INVALID_ARGUMENT);
     assert_null(out.pixels);
     assert_int_equal(
-        drift_denoise_guided(ctx, &in, &v.guide, DRIFT_GUIDE_MODE_COUNT, NULL, &out, NULL),
+        drift_denoise_guided(ctx, &in, &v.guide, NULL, DRIFT_GUIDE_MODE_COUNT, NULL, &out, NULL),
         DRIFT_ERR_INVALID_ARGUMENT);
-    // A signed colour with a direct part: the split would clamp the residual's rest.
+    // REGRESSION with a direct part; a signed colour with a direct part in the plain
+    // denoiser (its split would clamp the rest).
+    in.direct = &v.direct;
+    in.direct_variance = &v.direct_variance;
+    in.indirect_variance = &v.indirect_variance;
+    assert_int_equal(
+        drift_denoise_guided(ctx, &in, &v.guide, NULL, DRIFT_GUIDE_REGRESSION, NULL, &out, NULL),
+        DRIFT_ERR_INVALID_ARGUMENT);
     drift_denoise_feature_params signed_params = { .signed_color = true };
-    in.direct = in.color;
-    in.direct_variance = in.indirect_variance = in.variance;
     assert_int_equal(drift_denoise_feature(ctx, &in, &signed_params, &out, NULL),
                      DRIFT_ERR_INVALID_ARGUMENT);
-    assert_int_equal(capture.errors, 3);
+    assert_int_equal(capture.errors, 4);
     drift_image_destroy(ctx, &small);
     destroy_frame(ctx, &v);
     drift_context_destroy(ctx);
