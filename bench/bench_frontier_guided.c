@@ -82,8 +82,8 @@ drift_result frontier_guided_rows(frontier_state *b, long spp, double render_ms,
                                   const drift_denoise_inputs *in)
 {
     // residual: the residual filtered variance-guided; residual-rr: by regression + residual;
-    // split: the direct part and the rest apart (REGRESSION measured worse than each at every
-    // spp on the fit scenes: not a row, docs/lab/2026-12-07-issue-40-s7-guided.md)
+    // split: the direct part and the rest apart (REGRESSION measured worse than residual at
+    // every spp on three fit scenes: not a row, docs/lab/2026-12-07-issue-40-s7-guided.md)
     static const char *const variant_names[3] = { "residual", "residual-rr", "split" };
     drift_result r = DRIFT_OK;
     for (int g = 0; g < FRONTIER_GUIDES && r == DRIFT_OK; ++g) {

@@ -198,8 +198,10 @@ drift_result drift_denoise_feature(drift_context *ctx, const drift_denoise_input
 //               features of the block regression, REGRESSION_RESIDUAL (fit + filtered residual):
 //               the fit scales the guide's shadows and highlights per block. No direct part.
 // Either converges to the path tracer's mean as its samples grow (the filter's bias aside): the
-// guide's bias is in the residual the filter keeps. On the corpus at 128² REGRESSION measured
-// worse than RESIDUAL at every spp (docs/denoiser.md).
+// guide's bias is in the residual the filter keeps. At 128² REGRESSION measured worse than
+// RESIDUAL at every spp on three fit scenes of the corpus; RESIDUAL is on par with
+// drift_denoise_feature at equal spp over the corpus, and at equal time pays the guide
+// (docs/denoiser.md).
 typedef enum drift_denoise_guide_mode {
     DRIFT_GUIDE_RESIDUAL = 0,
     DRIFT_GUIDE_REGRESSION,
