@@ -295,7 +295,7 @@ drift_result frontier_pt_rows(frontier_state *b, long spp, double *out_ms)
         r = r ? r : drift_denoise_feature(b->ctx, &in, NULL, &featured, NULL);
         feature_ms[k] = (drift_time_now() - t0) * 1e3;
         if (r == DRIFT_OK && b->guide[0].pixels && k == o->runs - 1) {
-            // The last run's image, its own render's ms (the filter's: the guided rows' median)
+            // The last run's image and its own render's ms (the guided filters timed once)
             r = frontier_guided_rows(b, spp, render_ms[k], &in);
         }
         drift_image_destroy(b->ctx, &plain);

@@ -81,12 +81,14 @@ drift_result frontier_add_row(frontier_state *b, row_family family, const char *
 // feature-guided one); *out_ms: the render's median.
 drift_result frontier_pt_rows(frontier_state *b, long spp, double *out_ms);
 drift_result frontier_hybrid_rows(frontier_state *b, double limit_ms);
-// The default hybrid frame (drift_hybrid_params_default at the bench's size, max depth 8,
-// glare none, depth of field none for a pinhole camera), its warm frame's median ms, into
-// b->guide: frontier_pt_rows then adds the hybrid+pt rows (bench_frontier_guided.c).
+// The guides (FRONTIER_GUIDES: drift_hybrid_params_default at the bench's size, max depth 8,
+// glare none, depth of field none for a pinhole camera, and its cheaper variants), their warm
+// frames' median ms, into b->guide: frontier_pt_rows then adds the hybrid+pt rows
+// (bench_frontier_guided.c).
 drift_result frontier_guide_frame(frontier_state *b);
 // The hybrid+pt rows of one path-traced image (its AOVs as drift_denoise_feature takes them):
-// each mode of drift_denoise_guided, ms = the guide's + render_ms + the filter's median.
+// each guide and filter, ms = the guide's + render_ms + the filter's (one timing: the last
+// of --runs renders).
 drift_result frontier_guided_rows(frontier_state *b, long spp, double render_ms,
                                   const drift_denoise_inputs *in);
 drift_result frontier_sir_rows(frontier_state *b, double limit_ms);
