@@ -28,8 +28,9 @@
 #include <string.h>
 #include <sys/stat.h>
 
-const char *const family_names[FAMILY_COUNT] = { "pt",     "pt+atrous",     "hybrid",    "sir",
-                                                 "pt-low", "pt-low+atrous", "pt+denoise" };
+const char *const family_names[FAMILY_COUNT] = { "pt",         "pt+atrous", "hybrid",
+                                                 "sir",        "pt-low",    "pt-low+atrous",
+                                                 "pt+denoise", "hybrid+pt" };
 
 static bool parse_budgets(const char *cmd, const char *flag, const char *value, void *field)
 {
@@ -293,6 +294,10 @@ drift_result frontier_pt_rows(frontier_state *b, long spp, double *out_ms)
         t0 = drift_time_now();
         r = r ? r : drift_denoise_feature(b->ctx, &in, NULL, &featured, NULL);
         feature_ms[k] = (drift_time_now() - t0) * 1e3;
+        if (r == DRIFT_OK && b->guide[0].pixels && k == o->runs - 1) {
+            // The last run's image and its own render's ms (the guided filters timed once)
+            r = frontier_guided_rows(b, spp, render_ms[k], &in);
+        }
         drift_image_destroy(b->ctx, &plain);
         r = r ? r : copy_rgb(b->ctx, &beauty, &plain);
         drift_pt_destroy(pt);
@@ -319,7 +324,8 @@ int frontier_best_within(const frontier_state *b, int family, double budget)
     int best = -1;
     for (int i = 0; i < b->row_count; ++i) {
         const frontier_row *row = &b->rows[i];
-        bool drift = row->family == FAMILY_HYBRID || row->family == FAMILY_SIR;
+        bool drift = row->family == FAMILY_HYBRID || row->family == FAMILY_SIR ||
+                     row->family == FAMILY_HYBRID_PT;
         if (row->ms <= budget &&
             (family == -1 || (int)row->family == family || (family == FAMILY_DRIFT && drift)) &&
             (best < 0 || row->flip < b->rows[best].flip)) {
@@ -474,7 +480,7 @@ static bool write_svg(const frontier_state *b, const char *path, const char *sce
     }
     fprintf(f, "\"/>\n");
     static const char *const colours[FAMILY_COUNT] = { "#c62f1f", "#e08a1e", "#1f63c6", "#2f9e44",
-                                                       "#9c4dc4", "#c44d8f", "#8a3ffc" };
+                                                       "#9c4dc4", "#c44d8f", "#8a3ffc", "#0a8a8a" };
     for (int i = 0; i < b->row_count; ++i) {
         const frontier_row *row = &b->rows[i];
         fprintf(f,
@@ -587,6 +593,7 @@ int drift_bench_frontier(int argc, char **argv)
         fprintf(stderr, "drift bench frontier: reference %s (%s, %.1f s)\n", ref_path,
                 cached ? "cached" : "rendered", ref_s);
     }
+    r = r ? r : frontier_guide_frame(b);
     // The path tracer at 1, 2, 4, ... spp until a render is over the largest budget.
     for (long spp = 1; r == DRIFT_OK; spp *= 2) {
         double ms = 0.0;
@@ -599,6 +606,10 @@ int drift_bench_frontier(int argc, char **argv)
     r = r ? r : frontier_low_res_rows(b, max_budget);
     r = r ? r : frontier_hybrid_rows(b, 2.0 * max_budget);
     r = r ? r : frontier_sir_rows(b, 2.0 * max_budget);
+    for (int g = 0; g < FRONTIER_GUIDES; ++g) {
+        drift_image_destroy(b->ctx, &b->guide[g]);
+        drift_image_destroy(b->ctx, &b->guide_indirect[g]);
+    }
     if (r != DRIFT_OK) {
         fprintf(stderr, "drift bench frontier: %s\n", drift_result_string(r));
         goto done;

@@ -6,6 +6,7 @@
 
 #include "bench.h"
 #include "drift/accel.h"
+#include "drift/denoise.h"
 #include "drift/scene.h"
 #include "render.h"
 
@@ -35,6 +36,8 @@ typedef enum row_family {
     FAMILY_PT_LOW,        // the path tracer at 1/2 or 1/4 resolution, upsampled
     FAMILY_PT_LOW_ATROUS, // the same through a-trous before the upsampling
     FAMILY_PT_DENOISE,    // the path tracer + drift's best denoiser (`--denoise on`)
+    FAMILY_HYBRID_PT,     // the default hybrid frame + the path tracer, combined by
+                          // drift_denoise_guided (both renders and the filter paid)
     FAMILY_COUNT
 } row_family;
 
@@ -43,6 +46,11 @@ typedef enum row_family {
 #define FAMILY_DRIFT (-2)
 
 extern const char *const family_names[FAMILY_COUNT];
+
+// The hybrid+pt rows' guides: the default hybrid frame; the same with 256 VPLs gathered at one
+// pixel in 2 x 2 ("cheap"); the same with indirect none ("direct"): cheaper guides whose
+// indirect light's bias the residual corrects.
+#define FRONTIER_GUIDES 3
 
 typedef struct frontier_row {
     char name[96];
@@ -58,6 +66,9 @@ typedef struct frontier_state {
     drift_image reference;
     frontier_row rows[MAX_ROWS];
     int row_count;
+    drift_image guide[FRONTIER_GUIDES]; // hybrid frames (frontier_guide_frame); no pixels: none
+    drift_image guide_indirect[FRONTIER_GUIDES]; // their "indirect" planes (none: no pixels)
+    double guide_ms[FRONTIER_GUIDES];            // their warm frames' median ms
 } frontier_state;
 
 // Loads the cached reference or renders and caches it; *cached says which.
@@ -70,6 +81,16 @@ drift_result frontier_add_row(frontier_state *b, row_family family, const char *
 // feature-guided one); *out_ms: the render's median.
 drift_result frontier_pt_rows(frontier_state *b, long spp, double *out_ms);
 drift_result frontier_hybrid_rows(frontier_state *b, double limit_ms);
+// The guides (FRONTIER_GUIDES: drift_hybrid_params_default at the bench's size, max depth 8,
+// glare none, depth of field none for a pinhole camera, and its cheaper variants), their warm
+// frames' median ms, into b->guide: frontier_pt_rows then adds the hybrid+pt rows
+// (bench_frontier_guided.c).
+drift_result frontier_guide_frame(frontier_state *b);
+// The hybrid+pt rows of one path-traced image (its AOVs as drift_denoise_feature takes them):
+// each guide and filter, ms = the guide's + render_ms + the filter's (one timing: the last
+// of --runs renders).
+drift_result frontier_guided_rows(frontier_state *b, long spp, double render_ms,
+                                  const drift_denoise_inputs *in);
 drift_result frontier_sir_rows(frontier_state *b, double limit_ms);
 // The row of `family` (-1: any; FAMILY_DRIFT: hybrid or sir) with the lowest FLIP within
 // `budget` ms, or -1.

@@ -379,6 +379,7 @@ static drift_result corpus_scene_rows(frontier_options *o, corpus_scene *cs, int
     fprintf(stderr, "drift bench frontier: [%d/%d] %s: reference %s (%s, %.1f s); rows...\n",
             index + 1, count, cs->name, ref_path, cached ? "cached" : "rendered",
             drift_time_now() - t0);
+    r = r ? r : frontier_guide_frame(b);
     for (long spp = 1; r == DRIFT_OK; spp *= 2) {
         double ms = 0.0;
         r = frontier_pt_rows(b, spp, &ms);
@@ -389,6 +390,10 @@ static drift_result corpus_scene_rows(frontier_options *o, corpus_scene *cs, int
     }
     r = r ? r : frontier_low_res_rows(b, max_budget);
     r = r ? r : frontier_hybrid_rows(b, 2.0 * max_budget);
+    for (int g = 0; g < FRONTIER_GUIDES; ++g) {
+        drift_image_destroy(b->ctx, &b->guide[g]);
+        drift_image_destroy(b->ctx, &b->guide_indirect[g]);
+    }
     if (r == DRIFT_OK) {
         fill_cells(b, cs);
         fprintf(stderr, "drift bench frontier: [%d/%d] %s: %d rows in %.1f s\n", index + 1, count,

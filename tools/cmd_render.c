@@ -198,10 +198,13 @@ static const cli_option render_table[] = {
             "image size (default: the scene camera's)"),
     CLI_STRING("--out", "FILE.exr", O, out_path,
                "output (default out/render.exr); FILE.png is written too"),
-    CLI_CHOICE("--denoise", "none|atrous|on|regression", O, denoise, "none|atrous|on|regression",
+    CLI_CHOICE("--denoise", "none|atrous|on|regression|guided", O, denoise,
+               "none|atrous|on|regression|guided",
                "reference: on = the feature-guided, variance-guided denoiser\n"
                "(docs/denoiser.md); atrous = the edge-avoiding a-trous filter;\n"
-               "regression = the blockwise feature regression it was measured against"),
+               "regression = the blockwise feature regression it was measured against;\n"
+               "--mode hybrid: guided = the hybrid frame plus the path tracer's\n"
+               "residual at --spp, filtered (drift_denoise_guided)"),
     CLI_TECHNIQUE("--glare", "T", O, hybrid,
                   "the last pass of either mode, at the camera's angular pitch\n"
                   "(docs/glare.md)"),
@@ -408,7 +411,12 @@ int render_parse_options(int argc, char **argv, render_options *o)
         fprintf(stderr, "drift render: --moving-refine needs --animation A:B and --temporal on\n");
         return 2;
     }
-    if (o->hybrid_mode && o->denoise) {
+    if (!o->hybrid_mode && o->denoise == 4) {
+        fprintf(stderr, "drift render: --denoise guided needs --mode hybrid (the hybrid frame "
+                        "guides the path tracer)\n");
+        return 2;
+    }
+    if (o->hybrid_mode && o->denoise && o->denoise != 4) {
         fprintf(stderr, "drift render: --denoise filters the path tracer's image; the "
                         "hybrid frame has its own techniques (drop --mode hybrid or --denoise)\n");
         return 2;

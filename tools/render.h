@@ -61,7 +61,8 @@ typedef struct render_options {
     const char *view, *display, *look, *ocio_config; // --view ...: the PNG through OpenColorIO
     bool aov;
     int aov_normal; // --aov-normal: 0 N (N.X/N.Y/N.Z), 1 Normal (Blender's Normal.X/Y/Z)
-    int denoise;    // --denoise: 0 none, 1 atrous, 2 on (drift_denoise_feature), 3 regression
+    int denoise;    // --denoise: 0 none, 1 atrous, 2 on (drift_denoise_feature), 3 regression,
+                    // 4 guided (--mode hybrid: drift_denoise_guided)
     bool quiet;
     bool verbose;
     long debug_x, debug_y, debug_sample; // -1: not replaying a sample
@@ -129,6 +130,12 @@ int render_mpi(int argc, char **argv);
 
 // Renders in hybrid mode with the session's scene; returns the process exit code.
 int render_hybrid(const render_options *o, const cli_session *session);
+// --denoise guided: the path tracer at --spp, combined with the hybrid frame `guide` (and its
+// indirect plane, NULL: none) by drift_denoise_guided into *out, a new image
+// (render_guided.c).
+drift_result render_guided_image(const render_options *o, const cli_session *session,
+                                 const drift_image *guide, const drift_image *guide_indirect,
+                                 drift_image *out);
 // The reference path tracer's image of the session's scene camera, written to --out.
 int render_reference(const render_options *o, const cli_session *session);
 

@@ -229,6 +229,7 @@ int render_hybrid(const render_options *o, const cli_session *session)
     drift_still_refine *still = NULL; // and its refinement toward the path tracer
     cJSON *frame_ms = NULL;           // --temporal on: each frame's wall time
     cJSON *frame_cpu_ms = NULL;       // and CPU time
+    drift_image guided = { 0 };       // --denoise guided's image
     drift_result r = DRIFT_OK;
     int exit_code = 1;
     if (o->aperture >= 0.0) {
@@ -342,6 +343,15 @@ int render_hybrid(const render_options *o, const cli_session *session)
     const drift_image *image = still      ? drift_still_refine_image(still)
                                : temporal ? drift_temporal_image(temporal)
                                           : drift_hybrid_image(frame);
+    if (o->denoise == 4) { // --denoise guided: the frame guides the path tracer's samples
+        r = render_guided_image(o, session, image, drift_hybrid_plane_named(frame, "indirect"),
+                                &guided);
+        if (r != DRIFT_OK) {
+            fprintf(stderr, "drift render: --denoise guided: %s\n", drift_result_string(r));
+            goto done;
+        }
+        image = &guided;
+    }
     if (!render_stage_hybrid_images(ctx, o, image, frame, NULL, &stage)) {
         goto done;
     }
@@ -388,6 +398,7 @@ int render_hybrid(const render_options *o, const cli_session *session)
            drift_hybrid_get_stats(frame).frame_ms);
     exit_code = 0;
 done:
+    drift_image_destroy(ctx, &guided);
     cJSON_Delete(frame_ms);
     cJSON_Delete(frame_cpu_ms);
     drift_still_refine_destroy(still);

@@ -145,6 +145,9 @@ typedef struct drift_denoise_feature_params {
     float sigma_depth;              // 0 -> 0.1
     float sigma_albedo;             // 0 -> 1
     bool no_firefly_clamp;          // true: skip stage 3
+    bool signed_color;              // true: the colour may be negative (a residual, as
+                                    // drift_denoise_guided filters): stages 1 and 6 and the
+                                    // regression keep the sign; not with a direct part
 } drift_denoise_feature_params;
 
 drift_denoise_feature_params
@@ -176,6 +179,43 @@ typedef struct drift_denoise_report {
 drift_result drift_denoise_feature(drift_context *ctx, const drift_denoise_inputs *in,
                                    const drift_denoise_feature_params *params, drift_image *out,
                                    drift_denoise_report *report);
+
+// --- THE HYBRID-GUIDED DENOISER (src/denoise/guided.c, docs/denoiser.md) ---
+//
+// Combines a biased but noise-free image of the same frame, `guide` (the hybrid frame: sharp
+// shadows, reflections and contact, low-frequency bias), with the path tracer's noisy
+// unbiased samples (in, as drift_denoise_feature takes them):
+//   RESIDUAL    out = guide + F(colour - guide), clamped to >= 0: the signed residual
+//               (signed_color) filtered by the feature denoiser with params' method, a control
+//               variate: where the guide is right the residual is zero-mean noise and filters
+//               to ~0, keeping the guide's structure; its bias is what the filter keeps. With
+//               the path tracer's direct part (in->direct and both variances) the residual is
+//               split as drift_denoise_feature splits the colour: direct - (guide -
+//               guide_indirect) at sigma_luminance_direct, and (colour - direct) -
+//               guide_indirect at sigma_luminance_indirect, both by `method`. guide_indirect: the
+//               guide's indirect part (the hybrid frame's "indirect" plane); NULL: none.
+//   REGRESSION  the guide's demodulated RGB (by the path tracer's albedo) as three more
+//               features of the block regression, REGRESSION_RESIDUAL (fit + filtered residual):
+//               the fit scales the guide's shadows and highlights per block. No direct part.
+// Either converges to the path tracer's mean as its samples grow (the filter's bias aside): the
+// guide's bias is in the residual the filter keeps. At 128² REGRESSION measured worse than
+// RESIDUAL at every spp on three fit scenes of the corpus; RESIDUAL is on par with
+// drift_denoise_feature at equal spp over the corpus, and at equal time pays the guide
+// (docs/denoiser.md).
+typedef enum drift_denoise_guide_mode {
+    DRIFT_GUIDE_RESIDUAL = 0,
+    DRIFT_GUIDE_REGRESSION,
+    DRIFT_GUIDE_MODE_COUNT
+} drift_denoise_guide_mode;
+
+// out: a new 3-channel image (the caller destroys it); params may be NULL (the feature
+// denoiser's defaults). Errors as drift_denoise_feature's; a guide of another size, an unknown
+// mode, a direct part without both variances or with REGRESSION: DRIFT_ERR_INVALID_ARGUMENT.
+drift_result drift_denoise_guided(drift_context *ctx, const drift_denoise_inputs *in,
+                                  const drift_image *guide, const drift_image *guide_indirect,
+                                  drift_denoise_guide_mode mode,
+                                  const drift_denoise_feature_params *params, drift_image *out,
+                                  drift_denoise_report *report);
 
 #ifdef __cplusplus
 }

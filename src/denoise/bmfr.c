@@ -7,6 +7,9 @@
 // whose origins are half a block apart (so that every pixel lies in four of them). In each block
 // the irradiance of every channel is fitted by least squares to the features
 //   f = (1, n_x, n_y, n_z, z, z^2, x, y, x^2, y^2)
+// and, with a guide image (drift_denoise_guided's regression), its three demodulated channels
+// g_r, g_g, g_b as well (13 features): where the guide has a shadow or a reflection the fit can
+// scale it rather than smooth it away;
 // each but the constant scaled to [-1, 1] over the block (BMFR §3.2), solving the normal
 // equations (F^T F + lambda I) beta = F^T c by Cholesky with lambda = 1e-3 (max diagonal).
 // A pixel's output is its four blocks' fits blended by tent weights (1 - |d_x| / s)
@@ -16,7 +19,7 @@
 #include <math.h>
 #include <string.h>
 
-#define BMFR_FEATURES 10
+#define BMFR_FEATURES 13 // the most: 10 without a guide
 
 typedef struct bmfr_block {
     float lo[BMFR_FEATURES], inv_half[BMFR_FEATURES]; // scaled = (f - lo) * inv_half - 1
@@ -45,23 +48,32 @@ static void raw_features(const denoise_frame *f, int32_t x, int32_t y, float *ou
     out[7] = v;
     out[8] = u * u;
     out[9] = v * v;
+    if (f->guide) {
+        out[10] = f->guide[3 * i];
+        out[11] = f->guide[3 * i + 1];
+        out[12] = f->guide[3 * i + 2];
+    }
+}
+
+static int feature_count(const denoise_frame *f)
+{
+    return f->guide ? BMFR_FEATURES : BMFR_FEATURES - 3;
 }
 
 static void scaled_features(const denoise_frame *f, const bmfr_block *b, int32_t x, int32_t y,
                             float *out)
 {
     raw_features(f, x, y, out);
-    for (int k = 1; k < BMFR_FEATURES; ++k) {
+    for (int k = 1; k < feature_count(f); ++k) {
         out[k] = (out[k] - b->lo[k]) * b->inv_half[k] - 1.0f;
     }
 }
 
 // Solves (A + lambda I) x = b for the three right-hand sides by Cholesky; A is symmetric
 // positive semi-definite (a Gram matrix), so with the ridge the factor exists.
-static void solve_ridge(double a[BMFR_FEATURES][BMFR_FEATURES], double b[BMFR_FEATURES][3],
+static void solve_ridge(int n, double a[BMFR_FEATURES][BMFR_FEATURES], double b[BMFR_FEATURES][3],
                         float beta[BMFR_FEATURES][3])
 {
-    const int n = BMFR_FEATURES;
     double largest = 0.0;
     for (int i = 0; i < n; ++i) {
         largest = fmax(largest, a[i][i]);
@@ -109,21 +121,23 @@ static void fit_blocks(size_t begin, size_t end, int thread_index, void *user)
         int32_t x0 = ox < 0 ? 0 : ox, y0 = oy < 0 ? 0 : oy;
         int32_t x1 = ox + (2 * job->stride) < f->width ? ox + (2 * job->stride) : f->width;
         int32_t y1 = oy + (2 * job->stride) < f->height ? oy + (2 * job->stride) : f->height;
+        const int n = feature_count(f);
         float lo[BMFR_FEATURES], hi[BMFR_FEATURES], raw[BMFR_FEATURES];
-        for (int k = 0; k < BMFR_FEATURES; ++k) {
+        memset(b, 0, sizeof *b);
+        for (int k = 0; k < n; ++k) {
             lo[k] = INFINITY;
             hi[k] = -INFINITY;
         }
         for (int32_t y = y0; y < y1; ++y) {
             for (int32_t x = x0; x < x1; ++x) {
                 raw_features(f, x, y, raw);
-                for (int k = 0; k < BMFR_FEATURES; ++k) {
+                for (int k = 0; k < n; ++k) {
                     lo[k] = fminf(lo[k], raw[k]);
                     hi[k] = fmaxf(hi[k], raw[k]);
                 }
             }
         }
-        for (int k = 0; k < BMFR_FEATURES; ++k) {
+        for (int k = 0; k < n; ++k) {
             float half = 0.5f * (hi[k] - lo[k]);
             b->lo[k] = x1 > x0 && y1 > y0 ? lo[k] : 0.0f;
             b->inv_half[k] = half > 1e-12f ? 1.0f / half : 0.0f; // constant: scaled to -1
@@ -134,7 +148,7 @@ static void fit_blocks(size_t begin, size_t end, int thread_index, void *user)
             for (int32_t x = x0; x < x1; ++x) {
                 scaled_features(f, b, x, y, fs);
                 const float *c = f->irr + 3 * ((size_t)y * (size_t)f->width + (size_t)x);
-                for (int i = 0; i < BMFR_FEATURES; ++i) {
+                for (int i = 0; i < n; ++i) {
                     for (int j = 0; j <= i; ++j) {
                         a[i][j] += (double)fs[i] * (double)fs[j];
                     }
@@ -144,12 +158,12 @@ static void fit_blocks(size_t begin, size_t end, int thread_index, void *user)
                 }
             }
         }
-        for (int i = 0; i < BMFR_FEATURES; ++i) {
-            for (int j = i + 1; j < BMFR_FEATURES; ++j) {
+        for (int i = 0; i < n; ++i) {
+            for (int j = i + 1; j < n; ++j) {
                 a[i][j] = a[j][i];
             }
         }
-        solve_ridge(a, rhs, b->beta);
+        solve_ridge(n, a, rhs, b->beta);
     }
 }
 
@@ -173,7 +187,7 @@ static void blend_rows(size_t begin, size_t end, int thread_index, void *user)
                     scaled_features(f, b, x, y, fs);
                     for (int k = 0; k < 3; ++k) {
                         float v = 0.0f;
-                        for (int i = 0; i < BMFR_FEATURES; ++i) {
+                        for (int i = 0; i < feature_count(f); ++i) {
                             v += fs[i] * b->beta[i][k];
                         }
                         sum[k] += wx * wy * v;
@@ -181,7 +195,8 @@ static void blend_rows(size_t begin, size_t end, int thread_index, void *user)
                 }
             }
             for (int k = 0; k < 3; ++k) {
-                job->out[3 * ((size_t)y * (size_t)f->width + (size_t)x) + k] = fmaxf(sum[k], 0.0f);
+                job->out[3 * ((size_t)y * (size_t)f->width + (size_t)x) + k] =
+                    f->params.signed_color ? sum[k] : fmaxf(sum[k], 0.0f);
             }
         }
     }

@@ -43,6 +43,7 @@ static bool same_size(const drift_image *a, const drift_image *b, int channels)
 
 typedef struct prepare_job {
     const drift_denoise_inputs *in;
+    const drift_image *guide;
     denoise_frame *f;
     uint64_t *nonfinite; // a row
 } prepare_job;
@@ -92,7 +93,12 @@ static void prepare_rows(size_t begin, size_t end, int thread_index, void *user)
             float div[3];
             for (int k = 0; k < 3; ++k) {
                 div[k] = drift_denoise_albedo_divisor(a[k]);
-                f->irr[3 * i + k] = fmaxf(finite_or_zero(c[k], &bad), 0.0f) / div[k];
+                float ck = finite_or_zero(c[k], &bad);
+                f->irr[3 * i + k] = (f->params.signed_color ? ck : fmaxf(ck, 0.0f)) / div[k];
+                if (f->guide) {
+                    float g = finite_or_zero(drift_image_pixel(job->guide, x, (int32_t)y)[k], &bad);
+                    f->guide[3 * i + k] = fmaxf(g, 0.0f) / div[k];
+                }
                 f->normal[3 * i + k] = n[k];
             }
             f->depth[i] = fmaxf(z, 0.0f);
@@ -223,11 +229,13 @@ static void frame_free(denoise_frame *f)
     drift_free(f->ctx, f->normal);
     drift_free(f->ctx, f->depth);
     drift_free(f->ctx, f->albedo_lum);
+    drift_free(f->ctx, f->guide);
 }
 
-static drift_result denoise_one(drift_context *ctx, const drift_denoise_inputs *in,
-                                const drift_denoise_feature_params *params, drift_image *out,
-                                drift_denoise_report *report)
+drift_result denoise_feature_guided(drift_context *ctx, const drift_denoise_inputs *in,
+                                    const drift_image *guide,
+                                    const drift_denoise_feature_params *params, drift_image *out,
+                                    drift_denoise_report *report)
 {
     if (out) {
         *out = (drift_image){ 0 };
@@ -240,7 +248,7 @@ static drift_result denoise_one(drift_context *ctx, const drift_denoise_inputs *
     const drift_image *c = in ? in->color : NULL;
     if (!out || !c || !c->pixels || c->channels < 3 || c->width <= 0 || c->height <= 0 ||
         !same_size(c, in->albedo, 3) || !same_size(c, in->normal, 3) ||
-        !same_size(c, in->depth, 1) || !same_size(c, in->variance, 1) ||
+        !same_size(c, in->depth, 1) || !same_size(c, in->variance, 1) || !same_size(c, guide, 3) ||
         (unsigned)p.method >= DRIFT_DENOISE_METHOD_COUNT || p.iterations < 1 || p.iterations > 10 ||
         !(p.sigma_luminance > 0.0f) || !(p.sigma_luminance_direct > 0.0f) ||
         !(p.sigma_luminance_indirect > 0.0f) || !(p.sigma_luminance_residual >= 0.0f) ||
@@ -263,15 +271,16 @@ static drift_result denoise_one(drift_context *ctx, const drift_denoise_inputs *
     f.normal = drift_alloc(ctx, f.pixels * 3 * sizeof(float));
     f.depth = drift_alloc(ctx, f.pixels * sizeof(float));
     f.albedo_lum = drift_alloc(ctx, f.pixels * sizeof(float));
+    f.guide = guide ? drift_alloc(ctx, f.pixels * 3 * sizeof(float)) : NULL;
     float *scratch = drift_alloc(ctx, f.pixels * 3 * sizeof(float));
     uint64_t *row_bad = drift_alloc(ctx, (size_t)f.height * sizeof(uint64_t));
     double *sums = drift_alloc(ctx, f.pixels * 2 * sizeof(double));
     drift_result r = DRIFT_ERR_OUT_OF_MEMORY;
     if (!f.irr || !f.var || !f.normal || !f.depth || !f.albedo_lum || !scratch || !row_bad ||
-        !sums) {
+        !sums || (guide && !f.guide)) {
         goto done;
     }
-    prepare_job pj = { in, &f, row_bad };
+    prepare_job pj = { in, guide, &f, row_bad };
     drift_parallel_for(ctx, (size_t)f.height, 4, prepare_rows, &pj);
     uint64_t nonfinite = 0, clamp_count = 0;
     for (int32_t y = 0; y < f.height; ++y) {
@@ -310,7 +319,8 @@ static drift_result denoise_one(drift_context *ctx, const drift_denoise_inputs *
                     float div = a && isfinite(a[k])
                                     ? drift_denoise_albedo_divisor(fmaxf(a[k], 0.0f))
                                     : 1.0f;
-                    dst[k] = fmaxf(scratch[3 * i + k], 0.0f) * div;
+                    float v = scratch[3 * i + k];
+                    dst[k] = (p.signed_color ? v : fmaxf(v, 0.0f)) * div;
                 }
             }
         }
@@ -336,12 +346,18 @@ drift_result drift_denoise_feature(drift_context *ctx, const drift_denoise_input
                                    drift_denoise_report *report)
 {
     if (!in || (!in->direct && !in->direct_variance && !in->indirect_variance)) {
-        return denoise_one(ctx, in, params, out, report);
+        return denoise_feature_guided(ctx, in, NULL, params, out, report);
     }
     if (out) {
         *out = (drift_image){ 0 };
     }
     const drift_image *c = in->color;
+    drift_denoise_feature_params resolved = drift_denoise_feature_params_resolve(params);
+    if (resolved.signed_color) {
+        drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, NULL, 0,
+                  "denoise: a signed colour takes no direct part");
+        return DRIFT_ERR_INVALID_ARGUMENT;
+    }
     if (!out || !c || !c->pixels || c->channels < 3 || !in->direct || !in->direct_variance ||
         !in->indirect_variance || !same_size(c, in->direct, 3) ||
         !same_size(c, in->direct_variance, 1) || !same_size(c, in->indirect_variance, 1)) {
@@ -372,14 +388,14 @@ drift_result drift_denoise_feature(drift_context *ctx, const drift_denoise_input
         if (pi.method == DRIFT_DENOISE_VARIANCE_GUIDED && !pi.indirect_variance_guided) {
             pi.method = DRIFT_DENOISE_REGRESSION_RESIDUAL;
         }
-        r = denoise_one(ctx, &part, &pi, out, &rep_rest);
+        r = denoise_feature_guided(ctx, &part, NULL, &pi, out, &rep_rest);
     }
     if (r == DRIFT_OK) {
         part.color = in->direct;
         part.variance = in->direct_variance;
         drift_denoise_feature_params pd = drift_denoise_feature_params_resolve(params);
         pd.sigma_luminance = pd.sigma_luminance_direct;
-        r = denoise_one(ctx, &part, &pd, &direct_out, &rep_direct);
+        r = denoise_feature_guided(ctx, &part, NULL, &pd, &direct_out, &rep_direct);
     }
     if (r == DRIFT_OK) {
         for (int32_t y = 0; y < c->height; ++y) {

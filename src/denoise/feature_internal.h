@@ -16,6 +16,8 @@ typedef struct denoise_frame {
     float *normal;     // 3 a pixel: (0, 0, 1) without a normal guide
     float *depth;      // 1 a pixel: 0 without a depth guide (or where the ray escaped)
     float *albedo_lum; // 1 a pixel: luminance of the albedo (0 without one)
+    float *guide;      // 3 a pixel: the guide image demodulated (denoise_feature_guided),
+                       // the regression's three extra features; NULL without one
 } denoise_frame;
 
 // Luminance of an RGB triple (Rec. 709, as drift_luminance).
@@ -23,6 +25,13 @@ static inline float denoise_lum(const float *c)
 {
     return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2];
 }
+
+// drift_denoise_feature without the direct split, with a guide image (RGB, in's size; NULL:
+// none) whose demodulated channels are three more regression features (bmfr.c).
+drift_result denoise_feature_guided(drift_context *ctx, const drift_denoise_inputs *in,
+                                    const drift_image *guide,
+                                    const drift_denoise_feature_params *params, drift_image *out,
+                                    drift_denoise_report *report);
 
 // Stage 5, each writing 3 floats a pixel of filtered irradiance into out.
 drift_result denoise_variance_guided(const denoise_frame *f, float *out);
