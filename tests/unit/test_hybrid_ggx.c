@@ -87,6 +87,18 @@ static void add_glass_and_lamp(drift_scene *scene, bool thin, uint32_t *glass_ou
     *lamp_out = test_add_material(scene, lamp);
 }
 
+// A glass slab 0.2 thick (its faces point out of it: +z on top, -z below) over a wide emitter
+// facing up at z = -1.
+static void add_slab_over_lamp(drift_scene *scene, uint32_t glass, uint32_t lamp)
+{
+    test_add_quad(scene, drift_vec3_make(-20, -20, 0), drift_vec3_make(40, 0, 0),
+                  drift_vec3_make(0, 40, 0), glass);
+    test_add_quad(scene, drift_vec3_make(-20, -20, -0.2f), drift_vec3_make(0, 40, 0),
+                  drift_vec3_make(40, 0, 0), glass);
+    test_add_quad(scene, drift_vec3_make(-50, -50, -1), drift_vec3_make(100, 0, 0),
+                  drift_vec3_make(0, 100, 0), lamp);
+}
+
 // Smooth glass in the hybrid frame: an emitter seen through a thin glass sheet head-on arrives
 // times the sheet's transmittance, 1 - R_thin with R_thin = r + (1 - r)^2 r / (1 - r^2),
 // r = ((1.5 - 1) / (1.5 + 1))^2 (the path tracer's thin sheet). It rendered 0 before the glass
@@ -141,13 +153,7 @@ static void test_glass_keeps_its_internal_reflections(void **state)
     test_rig r = test_rig_begin(1);
     uint32_t g, e;
     add_glass_and_lamp(r.scene, false, &g, &e);
-    // The slab's faces point out of it: +z on top, -z below; the emitter faces up.
-    test_add_quad(r.scene, drift_vec3_make(-20, -20, 0), drift_vec3_make(40, 0, 0),
-                  drift_vec3_make(0, 40, 0), g);
-    test_add_quad(r.scene, drift_vec3_make(-20, -20, -0.2f), drift_vec3_make(0, 40, 0),
-                  drift_vec3_make(40, 0, 0), g);
-    test_add_quad(r.scene, drift_vec3_make(-50, -50, -1), drift_vec3_make(100, 0, 0),
-                  drift_vec3_make(0, 100, 0), e);
+    add_slab_over_lamp(r.scene, g, e);
     const float theta = 80.0f * DRIFT_PI / 180.0f;
     const int32_t size = 17;
     r.scene->camera =
@@ -181,12 +187,7 @@ static void test_rough_glass_lets_light_through(void **state)
     uint32_t g, e;
     add_glass_and_lamp(r.scene, false, &g, &e);
     r.scene->materials[g].ggx.alpha = 0.2f;
-    test_add_quad(r.scene, drift_vec3_make(-20, -20, 0), drift_vec3_make(40, 0, 0),
-                  drift_vec3_make(0, 40, 0), g);
-    test_add_quad(r.scene, drift_vec3_make(-20, -20, -0.2f), drift_vec3_make(0, 40, 0),
-                  drift_vec3_make(40, 0, 0), g);
-    test_add_quad(r.scene, drift_vec3_make(-50, -50, -1), drift_vec3_make(100, 0, 0),
-                  drift_vec3_make(0, 100, 0), e);
+    add_slab_over_lamp(r.scene, g, e);
     const int32_t size = 17;
     r.scene->camera = drift_camera_look_at(drift_vec3_make(0, 0, 5), drift_vec3_make(0, 0, 0),
                                            drift_vec3_make(0, 1, 0), 0.05f, size, size);
