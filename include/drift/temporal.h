@@ -82,6 +82,7 @@ typedef struct drift_temporal_settings {
     int32_t moving_refine_scale;   // 0, 1: a path-traced sample a pixel; 2: at half size
     int32_t moving_refine_period;  // 0, 1: every pixel every frame; P in 2, 4, 8, 16: 1/P of the
                                    // pixels a frame, each every P frames (a 4x4 Bayer order)
+    int32_t moving_refine_passes;  // 0 -> 5: a-trous passes over its accumulation
 } drift_temporal_settings;
 
 // The settings with every 0 replaced by its default.

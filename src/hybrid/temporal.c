@@ -106,7 +106,8 @@ drift_result drift_temporal_create(drift_context *ctx, int32_t width, int32_t he
         !(s.normal_tolerance <= 1.0f) || s.filter_passes < 0 || s.filter_passes > 8 ||
         !isfinite(s.phi_luminance) || !isfinite(s.depth_sigma) || s.moving_refine_history < 1 ||
         s.moving_refine_history > 4096 || s.moving_refine_period < 0 ||
-        s.moving_refine_period > 16 || (s.moving_refine_period & (s.moving_refine_period - 1))) {
+        s.moving_refine_period > 16 || (s.moving_refine_period & (s.moving_refine_period - 1)) ||
+        s.moving_refine_passes < 0 || s.moving_refine_passes > 8) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, NULL, 0,
                   "temporal: size %dx%d or settings out of range (drift/temporal.h)", width,
                   height);
