@@ -400,9 +400,13 @@ static void variance_rows(size_t begin, size_t end, int thread_index, void *user
                         wsum += 1.0f;
                     }
                 }
-                if (wsum > 0.0f) { // none sampled near an unsampled pixel: the moments' variance
+                // With a sample mask the history may hold samples this frame's neighbours do
+                // not show (a pixel's last sample is up to P frames old): the larger of the two.
+                // None sampled near an unsampled pixel: the moments' variance.
+                if (wsum > 0.0f) {
                     m1 /= wsum;
-                    var = fmaxf(m2 / wsum - m1 * m1, 0.0f);
+                    float spatial = fmaxf(m2 / wsum - m1 * m1, 0.0f);
+                    var = job->sampled ? fmaxf(var, spatial) : spatial;
                 }
             }
             f[3] = var / n_frames; // the variance of the mean of N frames
