@@ -324,6 +324,13 @@ static const cli_option render_table[] = {
     CLI_INT("--moving-refine-scale", "1|2", O, temporal_settings.moving_refine_scale, 1, 2,
             "2: the moving refinement traces its samples at half the width and\n"
             "height (a quarter of the rays), upsampled by the G-buffer (default 1)"),
+    CLI_INT("--moving-refine-period", "1|2|4|8|16", O, temporal_settings.moving_refine_period, 1,
+            16,
+            "P: the moving refinement traces a sample for 1/P of the pixels a\n"
+            "frame, each pixel every P frames (a 4x4 Bayer order); the others\n"
+            "keep their reprojected history (default 1: every pixel)"),
+    CLI_INT("--moving-refine-passes", "N", O, temporal_settings.moving_refine_passes, 1, 8,
+            "a-trous passes over the moving refinement's accumulation (default 5)"),
     CLI_CUSTOM("--probe", "X,Y,Z|object", O, hybrid, parse_probe,
                "environment-map probe: a point, or one per reflective mesh\n"
                "(default: the scene's centre)"),

@@ -465,7 +465,9 @@ int render_sequence(const render_options *o, cli_session *session)
                      .max_depth = (int32_t)o->max_depth,
                      .max_history = o->temporal_settings.moving_refine_history,
                      .residual = o->temporal_settings.moving_refine == 2,
-                     .scale = o->temporal_settings.moving_refine_scale },
+                     .scale = o->temporal_settings.moving_refine_scale,
+                     .period = o->temporal_settings.moving_refine_period,
+                     .filter_passes = o->temporal_settings.moving_refine_passes },
                  &s.moving)) != DRIFT_OK) {
             fprintf(stderr, "drift render: %s\n", drift_result_string(r));
             goto done;

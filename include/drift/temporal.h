@@ -80,6 +80,9 @@ typedef struct drift_temporal_settings {
     int32_t moving_refine;
     int32_t moving_refine_history; // 0 -> 32: the path-traced accumulation's frames at most
     int32_t moving_refine_scale;   // 0, 1: a path-traced sample a pixel; 2: at half size
+    int32_t moving_refine_period;  // 0, 1: every pixel every frame; P in 2, 4, 8, 16: 1/P of the
+                                   // pixels a frame, each every P frames (a 4x4 Bayer order)
+    int32_t moving_refine_passes;  // 0 -> 5: a-trous passes over its accumulation
 } drift_temporal_settings;
 
 // The settings with every 0 replaced by its default.
@@ -223,12 +226,18 @@ typedef struct drift_moving_refine_settings {
     // quarter of the rays), each pixel taking the sample of the nearest half-size pixel whose
     // hit distance is closest to its G-buffer point's (a guided upsampling)
     int32_t scale;
+    // 0, 1: every pixel gets a sample every frame. P = 2, 4, 8 or 16: a pixel gets one every P
+    // frames, 1/P of them a frame, spread by the 4x4 Bayer matrix (P = 4: one pixel of each 2x2
+    // quad); the others keep their reprojected history (not a new sample: N does not grow) and
+    // the filter fills those that have none. The path tracer's cost a frame falls to 1/P.
+    int32_t period;
 } drift_moving_refine_settings;
 
 typedef struct drift_moving_refine drift_moving_refine;
 
 // scene, accel and temporal are borrowed. Errors: DRIFT_ERR_INVALID_ARGUMENT (settings out of
-// range: max_history 1..4096, filter_passes 0..8, radius 0..32, scale 0..2),
+// range: max_history 1..4096, filter_passes 0..8, radius 0..32, scale 0..2, period 0, 1, 2,
+// 4, 8 or 16; period above 1 with scale 2),
 // DRIFT_ERR_OUT_OF_MEMORY.
 drift_result drift_moving_refine_create(drift_context *ctx, const drift_scene *scene,
                                         const drift_accel *accel, drift_temporal *temporal,

@@ -105,7 +105,9 @@ drift_result drift_temporal_create(drift_context *ctx, int32_t width, int32_t he
         !(s.moments_alpha <= 1.0f) || !(s.depth_tolerance <= 1.0f) ||
         !(s.normal_tolerance <= 1.0f) || s.filter_passes < 0 || s.filter_passes > 8 ||
         !isfinite(s.phi_luminance) || !isfinite(s.depth_sigma) || s.moving_refine_history < 1 ||
-        s.moving_refine_history > 4096) {
+        s.moving_refine_history > 4096 || s.moving_refine_period < 0 ||
+        s.moving_refine_period > 16 || (s.moving_refine_period & (s.moving_refine_period - 1)) ||
+        s.moving_refine_passes < 0 || s.moving_refine_passes > 8) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, NULL, 0,
                   "temporal: size %dx%d or settings out of range (drift/temporal.h)", width,
                   height);
@@ -177,8 +179,14 @@ typedef struct frame_job {
     const drift_gbuffer *g;
     const drift_image *color;
     drift_image *raw_variance; // may be NULL
+    const uint8_t *sampled;    // the pixels `color` has a sample for (NULL: all)
     int cur, prev;
 } frame_job;
+
+static bool job_sampled(const frame_job *job, int32_t x, int32_t y)
+{
+    return !job->sampled || job->sampled[(size_t)y * (size_t)job->t->width + (size_t)x];
+}
 
 drift_vec3 temporal_demodulation(const drift_gbuffer *g, int32_t x, int32_t y)
 {
@@ -259,6 +267,7 @@ static void reproject_rows(size_t begin, size_t end, int thread_index, void *use
 
 // Accumulates the job's colour into its layer through the taps: N = min(N_prev + 1, max),
 // alpha = 1 / N, the lighting and the luminance moments blended with the reprojected history.
+// A pixel without a sample (job->sampled) keeps the reprojected history as it is (N, moments).
 static void accumulate_rows(size_t begin, size_t end, int thread_index, void *user)
 {
     (void)thread_index;
@@ -279,10 +288,14 @@ static void accumulate_rows(size_t begin, size_t end, int thread_index, void *us
                 drift_image_pixel(&L->sample_lum, x, y)[0] = 0.0f;
                 continue;
             }
-            drift_vec3 a = temporal_demodulation(g, x, y);
-            drift_vec3 col = drift_vec3_sub(drift_image_get3(job->color, x, y),
-                                            drift_image_get3(&g->emission, x, y));
-            drift_vec3 l = drift_vec3_make(col.x / a.x, col.y / a.y, col.z / a.z);
+            bool has_sample = job_sampled(job, x, y);
+            drift_vec3 l = drift_vec3_splat(0.0f);
+            if (has_sample) {
+                drift_vec3 a = temporal_demodulation(g, x, y);
+                drift_vec3 col = drift_vec3_sub(drift_image_get3(job->color, x, y),
+                                                drift_image_get3(&g->emission, x, y));
+                l = drift_vec3_make(col.x / a.x, col.y / a.y, col.z / a.z);
+            }
             float lum = drift_luminance(l);
             drift_image_pixel(&L->sample_lum, x, y)[0] = lum;
             drift_vec3 hist = drift_vec3_splat(0.0f);
@@ -312,7 +325,16 @@ static void accumulate_rows(size_t begin, size_t end, int thread_index, void *us
                 hist = drift_vec3_scale(hist, inv);
                 hist_mom[0] *= inv;
                 hist_mom[1] *= inv;
-                n_frames = fminf(hist_len * inv + 1.0f, (float)L->max_history);
+                n_frames =
+                    fminf(hist_len * inv + (has_sample ? 1.0f : 0.0f), (float)L->max_history);
+            }
+            if (!has_sample) { // the history as it is, or nothing known (N = 0)
+                bool known = weight > 1e-3f;
+                len[0] = known ? n_frames : 0.0f;
+                mom[0] = known ? hist_mom[0] : 0.0f;
+                mom[1] = known ? hist_mom[1] : 0.0f;
+                drift_image_set3(&L->light[c], x, y, known ? hist : drift_vec3_splat(0.0f));
+                continue;
             }
             float alpha = 1.0f / n_frames;
             float alpha_m = fmaxf(alpha, t->s.moments_alpha);
@@ -347,7 +369,8 @@ static void variance_rows(size_t begin, size_t end, int thread_index, void *user
             f[2] = l.z;
             float n_frames = drift_image_pixel(&L->length[c], x, y)[0];
             if (n_frames <= 0.0f) {
-                f[3] = 0.0f;
+                // A surface with neither sample nor history (only with job->sampled): unknown.
+                f[3] = drift_image_pixel(&t->depth[c], x, y)[0] > 0.0f ? -1.0f : 0.0f;
                 if (job->raw_variance) {
                     drift_image_pixel(job->raw_variance, x, y)[0] = 0.0f;
                 }
@@ -367,7 +390,8 @@ static void variance_rows(size_t begin, size_t end, int thread_index, void *user
                         }
                         float zq = drift_image_pixel(&t->depth[c], qx, qy)[0];
                         if (!(zq > 0.0f) || fabsf(zq - z) > 0.1f * z ||
-                            drift_vec3_dot(drift_image_get3(&t->normal[c], qx, qy), n) < 0.8f) {
+                            drift_vec3_dot(drift_image_get3(&t->normal[c], qx, qy), n) < 0.8f ||
+                            !job_sampled(job, qx, qy)) {
                             continue;
                         }
                         float s = drift_image_pixel(&L->sample_lum, qx, qy)[0];
@@ -376,8 +400,14 @@ static void variance_rows(size_t begin, size_t end, int thread_index, void *user
                         wsum += 1.0f;
                     }
                 }
-                m1 /= wsum;
-                var = fmaxf(m2 / wsum - m1 * m1, 0.0f);
+                // With a sample mask the history may hold samples this frame's neighbours do
+                // not show (a pixel's last sample is up to P frames old): the larger of the two.
+                // None sampled near an unsampled pixel: the moments' variance.
+                if (wsum > 0.0f) {
+                    m1 /= wsum;
+                    float spatial = fmaxf(m2 / wsum - m1 * m1, 0.0f);
+                    var = job->sampled ? fmaxf(var, spatial) : spatial;
+                }
             }
             f[3] = var / n_frames; // the variance of the mean of N frames
             if (job->raw_variance) {
@@ -414,13 +444,17 @@ static void filter_rows(size_t begin, size_t end, int thread_index, void *user)
                 memcpy(o, p, 4 * sizeof *o);
                 continue;
             }
-            // SVGF's 3x3 Gaussian of the variance steers the luminance weight.
+            // SVGF's 3x3 Gaussian of the variance steers the luminance weight. A pixel with
+            // variance < 0 is unknown (temporal_layer_apply's `sampled`): no tap takes it, and
+            // its own value is its known taps' mean without the luminance weight.
+            bool known = p[3] >= 0.0f;
             float var = 0.0f, gw = 0.0f;
             for (int32_t dy = -1; dy <= 1; ++dy) {
                 for (int32_t dx = -1; dx <= 1; ++dx) {
                     int32_t qx = x + dx, qy = y + dy;
                     if (qx < 0 || qy < 0 || qx >= t->width || qy >= t->height ||
-                        !(drift_image_pixel(&t->depth[c], qx, qy)[0] > 0.0f)) {
+                        !(drift_image_pixel(&t->depth[c], qx, qy)[0] > 0.0f) ||
+                        drift_image_pixel(job->in, qx, qy)[3] < 0.0f) {
                         continue;
                     }
                     float w = gauss[abs(dx)] * gauss[abs(dy)];
@@ -428,7 +462,7 @@ static void filter_rows(size_t begin, size_t end, int thread_index, void *user)
                     gw += w;
                 }
             }
-            var /= gw;
+            var = gw > 0.0f ? var / gw : 0.0f;
             float lum_p = drift_luminance(drift_vec3_make(p[0], p[1], p[2]));
             float phi_l = t->s.phi_luminance * sqrtf(var) + 1e-4f;
             float phi_z = t->s.depth_sigma * (float)job->step * z * 0.02f;
@@ -446,6 +480,9 @@ static void filter_rows(size_t begin, size_t end, int thread_index, void *user)
                         continue;
                     }
                     const float *q = drift_image_pixel(job->in, qx, qy);
+                    if (q[3] < 0.0f) {
+                        continue;
+                    }
                     float nd =
                         fmaxf(drift_vec3_dot(drift_image_get3(&t->normal[c], qx, qy), n), 0.0f);
                     float nd2 = nd * nd, nd4 = nd2 * nd2, nd8 = nd4 * nd4, nd16 = nd8 * nd8;
@@ -453,7 +490,8 @@ static void filter_rows(size_t begin, size_t end, int thread_index, void *user)
                     float w_n = nd64 * nd64; // ^128
                     float lum_q = drift_luminance(drift_vec3_make(q[0], q[1], q[2]));
                     float w = kernel[abs(i)] * kernel[abs(j)] * w_n *
-                              expf(-fabsf(z - zq) / phi_z - fabsf(lum_p - lum_q) / phi_l);
+                              expf(-fabsf(z - zq) / phi_z -
+                                   (known ? fabsf(lum_p - lum_q) / phi_l : 0.0f));
                     sum[0] += w * q[0];
                     sum[1] += w * q[1];
                     sum[2] += w * q[2];
@@ -461,7 +499,12 @@ static void filter_rows(size_t begin, size_t end, int thread_index, void *user)
                     wsum += w;
                 }
             }
-            // The centre tap always counts (weight 9/64), so wsum > 0.
+            // A known centre tap always counts (weight 9/64), so wsum > 0 but for an unknown
+            // pixel with no known tap, which stays unknown.
+            if (!(wsum > 0.0f)) {
+                memcpy(o, p, 4 * sizeof *o);
+                continue;
+            }
             o[0] = sum[0] / wsum;
             o[1] = sum[1] / wsum;
             o[2] = sum[2] / wsum;
@@ -507,13 +550,15 @@ void temporal_remodulate(drift_temporal *t, const drift_gbuffer *g, const drift_
 
 const drift_image *temporal_layer_apply(drift_temporal *t, temporal_layer *L,
                                         const drift_gbuffer *g, const drift_image *color,
-                                        int32_t passes, drift_image *raw_variance)
+                                        const uint8_t *sampled, int32_t passes,
+                                        drift_image *raw_variance)
 {
     frame_job job = { .t = t,
                       .layer = L,
                       .g = g,
                       .color = color,
                       .raw_variance = raw_variance,
+                      .sampled = sampled,
                       .cur = t->cur,
                       .prev = t->cur ^ 1 };
     size_t rows = (size_t)t->height;
@@ -547,7 +592,7 @@ drift_result drift_temporal_apply(drift_temporal *t, const drift_gbuffer *g,
     frame_job job = { .t = t, .g = g, .cur = t->cur, .prev = t->cur ^ 1 };
     drift_parallel_for(t->ctx, (size_t)t->height, 4, reproject_rows, &job);
     const drift_image *filtered =
-        temporal_layer_apply(t, &t->hybrid, g, color, t->s.filter_passes, NULL);
+        temporal_layer_apply(t, &t->hybrid, g, color, NULL, t->s.filter_passes, NULL);
     temporal_remodulate(t, g, filtered, color, &t->out);
     (void)camera; // the motion vectors carry the camera's move
     t->has_prev = true;

@@ -29,9 +29,14 @@ void temporal_layer_free(drift_context *ctx, temporal_layer *layer);
 // pixel's mean and runs `passes` passes of t's variance-guided filter. Returns the filtered
 // plane (4 channels: lighting, variance); *raw_variance (1 channel, may be NULL) gets the
 // unfiltered variance of the mean. Call once after each drift_temporal_apply.
+// `sampled` (width x height, row by row; NULL: every pixel) marks the pixels `color` holds a
+// sample for: the others keep their reprojected history without a new sample (N unchanged),
+// and one with no history either is unknown (variance -1 in the filter's plane) until the
+// filter fills it from known neighbours; one still unknown after the passes keeps -1.
 const drift_image *temporal_layer_apply(drift_temporal *t, temporal_layer *layer,
                                         const drift_gbuffer *g, const drift_image *color,
-                                        int32_t passes, drift_image *raw_variance);
+                                        const uint8_t *sampled, int32_t passes,
+                                        drift_image *raw_variance);
 // The layer's accumulated (unfiltered) lighting of the current frame.
 const drift_image *temporal_layer_light(const drift_temporal *t, const temporal_layer *layer);
 // c = e + a l per pixel over g (the first three channels of `light`); where g sees no surface,
@@ -49,8 +54,9 @@ drift_vec3 temporal_demodulation(const drift_gbuffer *g, int32_t x, int32_t y);
 // Y_h the hybrid's luminance, Y_p the raw path-traced mean's (`raw`), v_p the variance of that
 // mean (1 channel), v_d the denoised image's variance where the filter estimates it
 // (`denoised_variance`, 1 channel; NULL: v_p's), B a (2r+1)^2 box mean.
-// scratch: 4 arrays of width x height floats (the fourth only with denoised_variance).
-void temporal_error_blend(const drift_image *hybrid, const drift_image *raw,
+// scratch: 4 arrays of width x height floats (the fourth only with denoised_variance). Rows run
+// on ctx's threads; every pixel is a gather, so the result does not depend on their number.
+void temporal_error_blend(drift_context *ctx, const drift_image *hybrid, const drift_image *raw,
                           const drift_image *variance, const drift_image *denoised,
                           const drift_image *denoised_variance, float denoised_error,
                           int32_t radius, float *scratch[4], drift_image *out, drift_image *weight);

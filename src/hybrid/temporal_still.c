@@ -100,37 +100,6 @@ void drift_still_refine_reset(drift_still_refine *s)
     }
 }
 
-// A separable (2r+1)^2 box mean of `v` in place (clamped at the borders), through `tmp`.
-static void box_blur(float *v, float *tmp, int32_t w, int32_t h, int32_t r)
-{
-    for (int32_t y = 0; y < h; ++y) {
-        for (int32_t x = 0; x < w; ++x) {
-            float sum = 0.0f;
-            int32_t n = 0;
-            for (int32_t i = x - r; i <= x + r; ++i) {
-                if (i >= 0 && i < w) {
-                    sum += v[(size_t)y * (size_t)w + (size_t)i];
-                    n += 1;
-                }
-            }
-            tmp[(size_t)y * (size_t)w + (size_t)x] = sum / (float)n;
-        }
-    }
-    for (int32_t y = 0; y < h; ++y) {
-        for (int32_t x = 0; x < w; ++x) {
-            float sum = 0.0f;
-            int32_t n = 0;
-            for (int32_t j = y - r; j <= y + r; ++j) {
-                if (j >= 0 && j < h) {
-                    sum += tmp[(size_t)j * (size_t)w + (size_t)x];
-                    n += 1;
-                }
-            }
-            v[(size_t)y * (size_t)w + (size_t)x] = sum / (float)n;
-        }
-    }
-}
-
 static void show_hybrid(drift_still_refine *s, const drift_image *hybrid)
 {
     for (int32_t y = 0; y < s->height; ++y) {
@@ -227,8 +196,8 @@ drift_result drift_still_refine_apply(drift_still_refine *s, const drift_camera 
         (r = drift_pt_resolve(s->pt, DRIFT_PT_AOV_VARIANCE, &variance)) != DRIFT_OK) {
         return r;
     }
-    temporal_error_blend(hybrid, &beauty, &variance, &s->denoised, NULL, s->s.denoised_error,
-                         s->s.radius, s->scratch, &s->out, &s->weight);
+    temporal_error_blend(s->ctx, hybrid, &beauty, &variance, &s->denoised, NULL,
+                         s->s.denoised_error, s->s.radius, s->scratch, &s->out, &s->weight);
     if (!s->s.keeps_hybrid) {
         fade_by_samples(s, hybrid);
     }
@@ -241,45 +210,125 @@ bool drift_still_refine_needs_hybrid(const drift_still_refine *s, const drift_ca
            memcmp(&s->camera, camera, sizeof *camera) != 0;
 }
 
-void temporal_error_blend(const drift_image *hybrid, const drift_image *raw,
+// The blend's rows: its inputs' planes, a separable (2r+1)^2 box mean of each plane in place
+// (clamped at the borders; rows into tmp, then columns back), and the mix.
+typedef struct blend_job {
+    const drift_image *hybrid, *raw, *variance, *denoised, *denoised_variance;
+    float denoised_error;
+    int32_t w, h, radius;
+    float *diff2, *var, *tmp, *dvar;
+    float *plane; // the plane the box mean runs on
+    drift_image *out, *weight;
+} blend_job;
+
+static void blend_inputs_rows(size_t begin, size_t end, int thread_index, void *user)
+{
+    (void)thread_index;
+    const blend_job *j = user;
+    for (int32_t y = (int32_t)begin; y < (int32_t)end; ++y) {
+        for (int32_t x = 0; x < j->w; ++x) {
+            size_t i = (size_t)y * (size_t)j->w + (size_t)x;
+            float d = drift_luminance(drift_image_get3(j->hybrid, x, y)) -
+                      drift_luminance(drift_image_get3(j->raw, x, y));
+            float v = *drift_image_pixel(j->variance, x, y);
+            j->diff2[i] = isfinite(d) ? d * d : 0.0f;
+            j->var[i] = isfinite(v) && v > 0.0f ? v : 0.0f;
+            if (j->denoised_variance) {
+                float dv = *drift_image_pixel(j->denoised_variance, x, y);
+                j->dvar[i] = isfinite(dv) && dv > 0.0f ? dv : 0.0f;
+            }
+        }
+    }
+}
+
+static void box_rows(size_t begin, size_t end, int thread_index, void *user)
+{
+    (void)thread_index;
+    const blend_job *j = user;
+    int32_t w = j->w, r = j->radius;
+    for (int32_t y = (int32_t)begin; y < (int32_t)end; ++y) {
+        for (int32_t x = 0; x < w; ++x) {
+            float sum = 0.0f;
+            int32_t n = 0;
+            for (int32_t i = x - r; i <= x + r; ++i) {
+                if (i >= 0 && i < w) {
+                    sum += j->plane[(size_t)y * (size_t)w + (size_t)i];
+                    n += 1;
+                }
+            }
+            j->tmp[(size_t)y * (size_t)w + (size_t)x] = sum / (float)n;
+        }
+    }
+}
+
+static void box_columns(size_t begin, size_t end, int thread_index, void *user)
+{
+    (void)thread_index;
+    const blend_job *j = user;
+    int32_t w = j->w, h = j->h, r = j->radius;
+    for (int32_t y = (int32_t)begin; y < (int32_t)end; ++y) {
+        for (int32_t x = 0; x < w; ++x) {
+            float sum = 0.0f;
+            int32_t n = 0;
+            for (int32_t i = y - r; i <= y + r; ++i) {
+                if (i >= 0 && i < h) {
+                    sum += j->tmp[(size_t)i * (size_t)w + (size_t)x];
+                    n += 1;
+                }
+            }
+            j->plane[(size_t)y * (size_t)w + (size_t)x] = sum / (float)n;
+        }
+    }
+}
+
+static void mix_rows(size_t begin, size_t end, int thread_index, void *user)
+{
+    (void)thread_index;
+    const blend_job *j = user;
+    for (int32_t y = (int32_t)begin; y < (int32_t)end; ++y) {
+        for (int32_t x = 0; x < j->w; ++x) {
+            size_t i = (size_t)y * (size_t)j->w + (size_t)x;
+            float hybrid_error = fmaxf(j->diff2[i] - j->var[i], 0.0f);
+            float path_error = j->denoised_error * (j->denoised_variance ? j->dvar[i] : j->var[i]);
+            float sum = hybrid_error + path_error;
+            float wp = sum > 0.0f ? hybrid_error / sum : 1.0f; // both 0: they agree
+            drift_vec3 a = drift_image_get3(j->hybrid, x, y);
+            drift_vec3 b = drift_image_get3(j->denoised, x, y);
+            drift_image_set3(j->out, x, y, drift_vec3_fma(a, drift_vec3_sub(b, a), wp));
+            *drift_image_pixel(j->weight, x, y) = wp;
+        }
+    }
+}
+
+void temporal_error_blend(drift_context *ctx, const drift_image *hybrid, const drift_image *raw,
                           const drift_image *variance, const drift_image *denoised,
                           const drift_image *denoised_variance, float denoised_error,
                           int32_t radius, float *scratch[4], drift_image *out, drift_image *weight)
 {
-    int32_t w = hybrid->width, h = hybrid->height;
-    float *diff2 = scratch[0], *var = scratch[1], *dvar = scratch[3];
-    for (int32_t y = 0; y < h; ++y) {
-        for (int32_t x = 0; x < w; ++x) {
-            size_t i = (size_t)y * (size_t)w + (size_t)x;
-            float d = drift_luminance(drift_image_get3(hybrid, x, y)) -
-                      drift_luminance(drift_image_get3(raw, x, y));
-            float v = *drift_image_pixel(variance, x, y);
-            diff2[i] = isfinite(d) ? d * d : 0.0f;
-            var[i] = isfinite(v) && v > 0.0f ? v : 0.0f;
-            if (denoised_variance) {
-                float dv = *drift_image_pixel(denoised_variance, x, y);
-                dvar[i] = isfinite(dv) && dv > 0.0f ? dv : 0.0f;
-            }
-        }
+    blend_job j = { .hybrid = hybrid,
+                    .raw = raw,
+                    .variance = variance,
+                    .denoised = denoised,
+                    .denoised_variance = denoised_variance,
+                    .denoised_error = denoised_error,
+                    .w = hybrid->width,
+                    .h = hybrid->height,
+                    .radius = radius,
+                    .diff2 = scratch[0],
+                    .var = scratch[1],
+                    .tmp = scratch[2],
+                    .dvar = scratch[3],
+                    .out = out,
+                    .weight = weight };
+    size_t rows = (size_t)j.h;
+    drift_parallel_for(ctx, rows, 4, blend_inputs_rows, &j);
+    float *planes[3] = { j.diff2, j.var, j.dvar };
+    for (int k = 0; k < (denoised_variance ? 3 : 2); ++k) {
+        j.plane = planes[k];
+        drift_parallel_for(ctx, rows, 4, box_rows, &j);
+        drift_parallel_for(ctx, rows, 4, box_columns, &j);
     }
-    box_blur(diff2, scratch[2], w, h, radius);
-    box_blur(var, scratch[2], w, h, radius);
-    if (denoised_variance) {
-        box_blur(dvar, scratch[2], w, h, radius);
-    }
-    for (int32_t y = 0; y < h; ++y) {
-        for (int32_t x = 0; x < w; ++x) {
-            size_t i = (size_t)y * (size_t)w + (size_t)x;
-            float hybrid_error = fmaxf(diff2[i] - var[i], 0.0f);
-            float path_error = denoised_error * (denoised_variance ? dvar[i] : var[i]);
-            float sum = hybrid_error + path_error;
-            float wp = sum > 0.0f ? hybrid_error / sum : 1.0f; // both 0: they agree
-            drift_vec3 a = drift_image_get3(hybrid, x, y);
-            drift_vec3 b = drift_image_get3(denoised, x, y);
-            drift_image_set3(out, x, y, drift_vec3_fma(a, drift_vec3_sub(b, a), wp));
-            *drift_image_pixel(weight, x, y) = wp;
-        }
-    }
+    drift_parallel_for(ctx, rows, 4, mix_rows, &j);
 }
 
 const drift_image *drift_still_refine_image(const drift_still_refine *s)
