@@ -215,26 +215,26 @@ DRIFT_AVX2_CLONES float *drift__glare_lanes_run(const drift__glare_lanes *plan, 
 DRIFT_AVX2_CLONES void drift__glare_lanes_gather(const drift__cpx *src, size_t stride, size_t count,
                                                  float *dst)
 {
-    typedef int32_t lane_i __attribute__((vector_size(4 * DRIFT__GLARE_LANES)));
-    const lane_i even = { 0, 2, 4, 6, 8, 10, 12, 14 }, odd = { 1, 3, 5, 7, 9, 11, 13, 15 };
     for (size_t y = 0; y < count; ++y) {
         const float *p = (const float *)(const void *)(src + y * stride);
         lane_v a = *(const lane_u *)(const void *)p;
         lane_v b = *(const lane_u *)(const void *)(p + DRIFT__GLARE_LANES);
-        store(dst, y, (lane_cpx){ __builtin_shuffle(a, b, even), __builtin_shuffle(a, b, odd) });
+        // __builtin_shufflevector: GCC (12 on) and clang both have it, with constant indices.
+        store(dst, y,
+              (lane_cpx){ __builtin_shufflevector(a, b, 0, 2, 4, 6, 8, 10, 12, 14),
+                          __builtin_shufflevector(a, b, 1, 3, 5, 7, 9, 11, 13, 15) });
     }
 }
 
 DRIFT_AVX2_CLONES void drift__glare_lanes_scatter(const float *src, size_t count, drift__cpx *dst,
                                                   size_t stride)
 {
-    typedef int32_t lane_i __attribute__((vector_size(4 * DRIFT__GLARE_LANES)));
-    const lane_i low = { 0, 8, 1, 9, 2, 10, 3, 11 }, high = { 4, 12, 5, 13, 6, 14, 7, 15 };
     for (size_t y = 0; y < count; ++y) {
         lane_cpx v = load(src, y);
         float *p = (float *)(void *)(dst + y * stride);
-        *(lane_u *)(void *)p = __builtin_shuffle(v.re, v.im, low);
-        *(lane_u *)(void *)(p + DRIFT__GLARE_LANES) = __builtin_shuffle(v.re, v.im, high);
+        *(lane_u *)(void *)p = __builtin_shufflevector(v.re, v.im, 0, 8, 1, 9, 2, 10, 3, 11);
+        *(lane_u *)(void *)(p + DRIFT__GLARE_LANES) =
+            __builtin_shufflevector(v.re, v.im, 4, 12, 5, 13, 6, 14, 7, 15);
     }
 }
 
