@@ -202,6 +202,20 @@ drift_raster_radiance drift_raster_trace_radiance(const drift_raster_shading *sh
                                                   drift_ray ray, uint32_t skip_mesh,
                                                   drift_sampler *sampler, uint64_t *rays,
                                                   float *out_distance);
+// The same, also giving the surface it hit (material DRIFT_INVALID_INDEX on a miss or on a
+// surface with no material): for callers that shade the hit further (the sharp reflection
+// buffer's indirect light and second bounce, realtime/reflections.c).
+drift_raster_radiance drift_raster_trace_radiance_surface(const drift_raster_shading *shading,
+                                                          drift_ray ray, uint32_t skip_mesh,
+                                                          drift_sampler *sampler, uint64_t *rays,
+                                                          float *out_distance,
+                                                          drift_surface *out_surface);
+
+// What drift_raster_trace_radiance shades a hit's reflected light with: direct light from
+// every light with one hard shadow ray each, and the environment's direct light.
+drift_vec3 drift_raster_direct_hard(const drift_raster_shading *shading,
+                                    const drift_surface *surface, const drift_bsdf *bsdf,
+                                    drift_vec3 wo, drift_sampler *sampler, uint64_t *rays);
 
 // Directional albedo of a specular lobe toward wo: what the radiance seen in the mirror
 // direction is weighted by in R (ks for a mirror; the GGX reflection lobes' albedo, the split

@@ -605,9 +605,9 @@ bool drift_raster_hard_shadow(const drift_accel *accel, const drift_raster_light
 }
 
 // Direct light at a secondary hit from every light, each with its hard shadow.
-static drift_vec3 direct_with_hard_shadows(const drift_raster_shading *shading,
-                                           const drift_surface *surface, const drift_bsdf *bsdf,
-                                           drift_vec3 wo, drift_sampler *sampler, uint64_t *rays)
+drift_vec3 drift_raster_direct_hard(const drift_raster_shading *shading,
+                                    const drift_surface *surface, const drift_bsdf *bsdf,
+                                    drift_vec3 wo, drift_sampler *sampler, uint64_t *rays)
 {
     drift_vec3 sum = drift_vec3_splat(0.0f);
     for (uint32_t l = 0; l < shading->light_count; ++l) {
@@ -633,9 +633,21 @@ drift_raster_radiance drift_raster_trace_radiance(const drift_raster_shading *sh
                                                   drift_sampler *sampler, uint64_t *rays,
                                                   float *out_distance)
 {
+    drift_surface surface;
+    return drift_raster_trace_radiance_surface(shading, ray, skip_mesh, sampler, rays, out_distance,
+                                               &surface);
+}
+
+drift_raster_radiance drift_raster_trace_radiance_surface(const drift_raster_shading *shading,
+                                                          drift_ray ray, uint32_t skip_mesh,
+                                                          drift_sampler *sampler, uint64_t *rays,
+                                                          float *out_distance,
+                                                          drift_surface *out_surface)
+{
     const drift_scene *scene = shading->scene;
     drift_raster_radiance out = { drift_vec3_splat(0.0f), drift_vec3_splat(0.0f) };
     *out_distance = INFINITY;
+    out_surface->material = DRIFT_INVALID_INDEX;
     drift_hit hit;
     // Pass through the skipped mesh (a probe inside its own object); a few layers at most.
     for (int layer = 0;; ++layer) {
@@ -652,14 +664,14 @@ drift_raster_radiance drift_raster_trace_radiance(const drift_raster_shading *sh
         ray.tmin = hit.t * (1.0f + 1e-5f) + 1e-6f;
     }
     *out_distance = hit.t;
-    drift_surface surface = drift_scene_surface(scene, &ray, &hit);
-    out.emitted = surface.emission;
-    if (surface.material == DRIFT_INVALID_INDEX) {
+    *out_surface = drift_scene_surface(scene, &ray, &hit);
+    out.emitted = out_surface->emission;
+    if (out_surface->material == DRIFT_INVALID_INDEX) {
         return out;
     }
-    drift_bsdf bsdf = drift_bsdf_make(scene, &surface);
-    out.reflected =
-        direct_with_hard_shadows(shading, &surface, &bsdf, drift_vec3_neg(ray.dir), sampler, rays);
+    drift_bsdf bsdf = drift_bsdf_make(scene, out_surface);
+    out.reflected = drift_raster_direct_hard(shading, out_surface, &bsdf, drift_vec3_neg(ray.dir),
+                                             sampler, rays);
     return out;
 }
 

@@ -1,6 +1,7 @@
 // Reflections of the hybrid frame, R: light whose first bounce is the glossy or mirror lobe.
 // `sharp` traces one mirror ray per glossy or mirror pixel and shades its hit with direct
-// light and hard shadows; `envmap` looks the mirror direction up in a cube map captured at a
+// light and hard shadows, an ambient guess at its indirect light and one more mirror bounce
+// (trace_reflected); `envmap` looks the mirror direction up in a cube map captured at a
 // probe (blurred over the lobe's cone for glossy pixels). Both weight the radiance by the
 // lobe's directional albedo (drift_raster_reflection_weight). Under reflection edits both
 // look along the edited direction e(q) instead (drift/reflect_edit.h). Emission seen in the mirror
@@ -131,9 +132,158 @@ static drift_vec3 glass_transmission(drift_frame_state *f, const drift_surface *
     return glass_interface(f, s, &smooth, wo, GLASS_INTERFACES, false, sampler, rays);
 }
 
+// What a sharp ray's hit reflects besides its direct light (docs/hybrid.md, "Reflections"):
+// indirect light, the frame's ambient radiance (frame_ambient) times the hit's diffuse albedo,
+// a guess where no screen-space buffer reaches, and, at a glossy, mirror or glass hit, its own
+// mirror reflection traced the same way, SHARP_BOUNCES deep (metal seen in metal; glass's
+// transmission too). Without them a metal sphere seen in another was black in the buffer and
+// a floor lit only indirectly was missing its indirect light.
+#define SHARP_BOUNCES 1
+
+typedef struct sharp_job {
+    drift_vec3 ambient;
+    int bounces;
+} sharp_job;
+
+static drift_raster_radiance trace_reflected(drift_frame_state *f, const sharp_job *job,
+                                             drift_ray ray, int bounces, drift_sampler *sampler,
+                                             uint64_t *rays, float *distance)
+{
+    drift_surface hit;
+    drift_raster_radiance l = drift_raster_trace_radiance_surface(
+        &f->shading, ray, DRIFT_INVALID_INDEX, sampler, rays, distance, &hit);
+    if (hit.material == DRIFT_INVALID_INDEX) {
+        return l;
+    }
+    drift_bsdf bsdf = drift_bsdf_make(f->scene, &hit);
+    drift_vec3 wo = drift_vec3_neg(ray.dir);
+    l.reflected = drift_vec3_add(
+        l.reflected, drift_vec3_mul(drift_raster_diffuse_albedo(&bsdf, wo), job->ambient));
+    if (bounces <= 0 || !has_reflection(f, &hit, &bsdf)) {
+        return l;
+    }
+    drift_vec3 dir = drift_vec3_reflect(wo, hit.ns);
+    drift_ray next = { .origin = drift_offset_origin(hit.position, hit.ng, dir),
+                       .dir = dir,
+                       .tmin = 0.0f,
+                       .tmax = INFINITY };
+    float d;
+    drift_raster_radiance seen = trace_reflected(f, job, next, bounces - 1, sampler, rays, &d);
+    l.reflected = drift_vec3_add(l.reflected, combine(&bsdf, wo, seen));
+    if (drift_bsdf_is_glass(&bsdf)) {
+        l.reflected =
+            drift_vec3_add(l.reflected, glass_transmission(f, &hit, &bsdf, wo, sampler, rays));
+    }
+    return l;
+}
+
+// The light arriving at `at` after one bounce, from one cosine-distributed direction about its
+// shading normal turned toward wo: the direct light its hit reflects (a miss brings none: the
+// environment is direct light); the diffuse albedo of that hit toward `at` (0 on a miss) goes to
+// *out_albedo.
+static drift_vec3 one_bounce_sample(drift_frame_state *f, const drift_surface *at, drift_vec3 wo,
+                                    drift_sampler *sampler, uint64_t *rays, drift_vec3 *out_albedo)
+{
+    drift_vec3 n = drift_vec3_dot(at->ns, wo) < 0.0f ? drift_vec3_neg(at->ns) : at->ns;
+    drift_frame frame = drift_frame_from_normal(n);
+    drift_vec3 dir =
+        drift_frame_to_world(&frame, drift_sample_cosine_hemisphere(drift_sampler_next2(sampler)));
+    drift_ray ray = { .origin = drift_offset_origin(at->position, at->ng, dir),
+                      .dir = dir,
+                      .tmin = 0.0f,
+                      .tmax = INFINITY };
+    float distance;
+    drift_surface hit;
+    drift_raster_radiance l = drift_raster_trace_radiance_surface(
+        &f->shading, ray, DRIFT_INVALID_INDEX, sampler, rays, &distance, &hit);
+    *out_albedo = drift_vec3_splat(0.0f);
+    if (hit.material != DRIFT_INVALID_INDEX) {
+        drift_bsdf bsdf = drift_bsdf_make(f->scene, &hit);
+        *out_albedo = drift_raster_diffuse_albedo(&bsdf, drift_vec3_neg(dir));
+    }
+    return l.reflected;
+}
+
+// The frame's ambient radiance for the hits: the mean light arriving after one bounce at the
+// points the mirror rays meet, sampled where it is used: about AMBIENT_SAMPLES reflective
+// pixels, evenly spread in scan order, each trace their mirror ray and one_bounce_sample at
+// its hit. --ambient's radiance when given; none under --indirect none or --max-depth 2.
+// Two guesses that read the camera's view instead were measured and dropped (docs/lab, issue
+// 40 s7 reflhits): the `ambient` row's mean direct light leaving the visible surfaces (the
+// GGX scene's spheres too bright: it ignores how much of a hemisphere sees nothing), and the
+// mean one-bounce light at the visible surfaces (5x too dark for a ceiling seen in a mirror
+// that fills the view).
+#define AMBIENT_SAMPLES  1024
+#define AMBIENT_MAX_ECHO 0.9
+
+static drift_vec3 frame_ambient(drift_frame_state *f)
+{
+    if (f->params.indirect == DRIFT_INDIRECT_NONE || f->params.max_depth < 3) {
+        return drift_vec3_splat(0.0f);
+    }
+    if (f->params.has_ambient) {
+        return f->params.ambient;
+    }
+    const int32_t w = f->params.width, h = f->params.height;
+    size_t reflective = 0;
+    for (int32_t y = 0; y < h; ++y) {
+        for (int32_t x = 0; x < w; ++x) {
+            drift_bsdf bsdf;
+            reflective += has_reflection(f, &f->gbuffer.surfaces[pixel_index(f, x, y)], &bsdf);
+        }
+    }
+    size_t every = reflective / AMBIENT_SAMPLES + 1, seen = 0, count = 0;
+    double sum[3] = { 0.0, 0.0, 0.0 }, bounce[3] = { 0.0, 0.0, 0.0 };
+    uint64_t *rays = &f->stats.rays[DRIFT_PASS_REFLECTIONS];
+    for (int32_t y = 0; y < h; ++y) {
+        for (int32_t x = 0; x < w; ++x) {
+            const drift_surface *s = &f->gbuffer.surfaces[pixel_index(f, x, y)];
+            drift_bsdf bsdf;
+            if (!has_reflection(f, s, &bsdf) || seen++ % every != 0) {
+                continue;
+            }
+            drift_vec3 dir = reflection_direction(f, s, drift_pass_wo(f, x, y));
+            drift_ray ray = { .origin = drift_offset_origin(s->position, s->ng, dir),
+                              .dir = dir,
+                              .tmin = 0.0f,
+                              .tmax = INFINITY };
+            drift_hit hit;
+            ++*rays;
+            if (!drift_accel_intersect(f->accel, &ray, &hit)) {
+                continue;
+            }
+            drift_surface at = drift_scene_surface(f->scene, &ray, &hit);
+            if (at.material == DRIFT_INVALID_INDEX) {
+                continue;
+            }
+            drift_sampler sampler = drift_pass_sampler(f, DRIFT_STREAM_REFLECTION, x, y);
+            drift_vec3 albedo;
+            drift_vec3 d = one_bounce_sample(f, &at, drift_vec3_neg(dir), &sampler, rays, &albedo);
+            sum[0] += (double)d.x;
+            sum[1] += (double)d.y;
+            sum[2] += (double)d.z;
+            bounce[0] += (double)albedo.x;
+            bounce[1] += (double)albedo.y;
+            bounce[2] += (double)albedo.z;
+            ++count;
+        }
+    }
+    if (count == 0) {
+        return drift_vec3_splat(0.0f);
+    }
+    // Later bounces as a geometric series: each passes on the mean albedo the samples met
+    // (misses count 0), L1 / (1 - a) with a at most AMBIENT_MAX_ECHO.
+    float c[3];
+    for (int k = 0; k < 3; ++k) {
+        double a = fmin(bounce[k] / (double)count, AMBIENT_MAX_ECHO);
+        c[k] = (float)(sum[k] / (double)count / (1.0 - a));
+    }
+    return drift_vec3_make(c[0], c[1], c[2]);
+}
+
 static void sharp_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *rays, void *user)
 {
-    (void)user;
+    const sharp_job *job = user;
     const drift_surface *s = &f->gbuffer.surfaces[pixel_index(f, x, y)];
     drift_vec3 zero = drift_vec3_splat(0.0f);
     drift_bsdf bsdf;
@@ -152,8 +302,7 @@ static void sharp_pixel(drift_frame_state *f, int32_t x, int32_t y, uint64_t *ra
                       .tmax = INFINITY };
     drift_sampler sampler = drift_pass_sampler(f, DRIFT_STREAM_REFLECTION, x, y);
     float distance;
-    drift_raster_radiance l = drift_raster_trace_radiance(&f->shading, ray, DRIFT_INVALID_INDEX,
-                                                          &sampler, rays, &distance);
+    drift_raster_radiance l = trace_reflected(f, job, ray, job->bounces, &sampler, rays, &distance);
     drift_image_set3(&f->reflection_emitted, x, y, l.emitted);
     drift_image_set3(&f->reflection_reflected, x, y, l.reflected);
     drift_image_pixel(&f->reflection_distance, x, y)[0] = distance;
@@ -282,7 +431,12 @@ static drift_result capture_probes(drift_frame_state *f)
 
 drift_result drift_realtime_pass_sharp_reflections(drift_frame_state *f)
 {
-    drift_pass_pixels(f, DRIFT_PASS_REFLECTIONS, sharp_pixel, NULL);
+    // Both additions are paths of three segments or more: --max-depth 2 (the library's
+    // default, the `reference` row's one bounce) keeps the buffer what it was.
+    int depth_left = f->params.max_depth - 2;
+    sharp_job job = { .ambient = frame_ambient(f),
+                      .bounces = depth_left < SHARP_BOUNCES ? depth_left : SHARP_BOUNCES };
+    drift_pass_pixels(f, DRIFT_PASS_REFLECTIONS, sharp_pixel, &job);
     return DRIFT_OK;
 }
 
