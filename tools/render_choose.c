@@ -1,13 +1,15 @@
 // drift render --mode hybrid --budget-ms T (issue 40): the techniques chosen for the scene and
 // the budget. The model (scenes/corpus/chooser.json, refitted by scripts/chooser/fit_table.py
 // from drift bench frontier --corpus --json, docs/corpus.md) holds every candidate row (a
-// hybrid combination or the path tracer: plain, through a-trous or the feature denoiser, at
-// reduced resolution) with its fitted cost, and for each scene it was fitted on its features
+// hybrid combination; the path tracer: plain, through a-trous or the feature denoiser, at
+// reduced resolution; or, if fitted with --guided, a hybrid frame guiding the path tracer)
+// with its fitted cost, and for each scene it was fitted on its features
 // and each row's FLIP over its best. A candidate's predicted FLIP comes from the nearest fitted
 // scenes in standardised features, shrunk toward its mean over them all; the pick is the
 // lowest predicted FLIP whose calibrated cost fits T (a hybrid row only clearly below the path
 // tracer), and the renderer says what it chose. scripts/chooser/pick.py makes the same pick.
 #include "cli.h"
+#include "drift/knobs.h"
 #include "render.h"
 #include "scene_features.h"
 
@@ -84,6 +86,27 @@ static double predict_log_ms(const cJSON *model, const cJSON *c,
         y += (cJSON_IsNumber(b) ? b->valuedouble : 0.0) * f[cost_index[k]];
     }
     return y;
+}
+
+// The fitted ms at the model's size of candidate `c`: exp(its log ms), plus, for a hybrid+pt
+// candidate (the guide's hybrid frame and the path tracer's samples through the guided
+// filter), the ms of the path-tracer candidate its "plus" names (its n spp and a denoiser pass).
+static double candidate_ms(const cJSON *model, const cJSON *c, const double f[SCENE_FEATURE_COUNT],
+                           const int cost_index[SCENE_FEATURE_COUNT], int cost_count)
+{
+    double ms = exp(predict_log_ms(model, c, f, cost_index, cost_count));
+    const char *plus = string(c, "plus");
+    if (!plus) {
+        return ms;
+    }
+    const cJSON *cands = cJSON_GetObjectItemCaseSensitive(model, "candidates");
+    for (const cJSON *o = cands ? cands->child : NULL; o; o = o->next) {
+        const char *k = string(o, "key");
+        if (o != c && k && strcmp(k, plus) == 0 && !string(o, "plus")) {
+            return ms + exp(predict_log_ms(model, o, f, cost_index, cost_count));
+        }
+    }
+    return (double)INFINITY; // a model without the row it adds: never fits
 }
 
 // A fitted scene's FLIP ratio for `key` ("family|name"), or for the same row without its
@@ -262,7 +285,7 @@ static double predict_ms(const cJSON *model, const cJSON *c, const double f[SCEN
     if (!cost_indices(model, cost_index, &cost_count)) {
         return (double)INFINITY;
     }
-    return exp(predict_log_ms(model, c, f, cost_index, cost_count)) * pixels / (size * size);
+    return candidate_ms(model, c, f, cost_index, cost_count) * pixels / (size * size);
 }
 
 // The candidate of `key`, or of the lowest prediction in `group` (key NULL).
@@ -346,7 +369,7 @@ static bool score(const cJSON *model, const double f[SCENE_FEATURE_COUNT], const
         }
         int g = group_index(group);
         double ms =
-            exp(predict_log_ms(model, c, f, cost_index, cost_count)) * pixels / (size * size) *
+            candidate_ms(model, c, f, cost_index, cost_count) * pixels / (size * size) *
                 cal->scale[g] +
             cal->setup_ms[g] +
             (g == GROUP_HYBRID ? cal->setup_scale * technique_setup_ms(cal->setup_table, c) : 0.0);
@@ -378,10 +401,31 @@ static bool apply_technique(drift_hybrid_params *p, drift_effect effect, const c
 }
 
 // The pick into the options: a hybrid combination into o->hybrid (the effects it does not
-// name keep their defaults: ISG reflections, post depth of field), or the path tracer.
+// name keep their defaults: ISG reflections, post depth of field), the path tracer, or the
+// hybrid frame guiding the path tracer (hybrid+pt: --denoise guided --spp n).
 static bool apply_pick(render_options *o, const cJSON *pick)
 {
     const char *kind = string(pick, "kind");
+    if (kind && strcmp(kind, "hybrid+pt") == 0) {
+        // The bench's guide (bench/bench_frontier_guided.c): the default hybrid frame, with
+        // its indirect off ("direct") or 256 VPLs gathered at 1/2 ("cheap") as the pick says.
+        drift_hybrid_params d = drift_hybrid_params_default(), *p = &o->hybrid;
+        if (!apply_technique(p, DRIFT_EFFECT_SHADOWS, string(pick, "shadows")) ||
+            !apply_technique(p, DRIFT_EFFECT_INDIRECT, string(pick, "indirect"))) {
+            return false;
+        }
+        p->ism.vpls = (uint32_t)number(pick, "vpls", d.ism.vpls);
+        p->ism.gather_scale = (int32_t)number(pick, "gather_scale", d.ism.gather_scale);
+        p->ism.no_near_field = d.ism.no_near_field;
+        p->light_samples = d.light_samples;
+        p->environment_filter = d.environment_filter;
+        p->environment_scale = d.environment_scale;
+        p->aa = d.aa;
+        o->denoise = 4;
+        o->spp = (long)number(pick, "spp", 1);
+        o->max_depth = 8;
+        return o->spp >= 1;
+    }
     if (kind && strcmp(kind, "pt") == 0) {
         const char *denoise = string(pick, "denoise");
         o->hybrid_mode = false;

@@ -11,7 +11,9 @@
 # clearly better, that; where that row's technique has a set-up (the model's setup_ms) far
 # over the budget, the probes count it and the other row is picked. The renderer's pick is
 # scripts/chooser/pick.py's (the fitting script's) from the same model on the three scenes,
-# and on a hand-made model where the prior and kappa change the pick. Bad --budget-ms and a
+# and on a hand-made model where the prior and kappa change the pick. A hand-made hybrid+pt
+# candidate (a guide frame + the path tracer through --denoise guided) is costed as its parts'
+# sum and, picked, rendered as the guided frame with the guide's settings. Bad --budget-ms and a
 # missing model exit with errors.
 # $1 is the drift binary.
 set -u
@@ -162,6 +164,55 @@ PY
     want=$(python3 "$root/scripts/chooser/pick.py" "$tmp/model.json" "$tmp/features.json" \
         --budget-ms 50 --pixels 1024)
     [ "$want" = "pt $3 spp" ] || fail "kappa $1, prior $2: pick.py says $want, not pt $3 spp"
+done
+# A hybrid+pt candidate (fit_table.py --guided): the cheap guide plus pt+denoise at 2 spp, each
+# part predicted at 10 ms: its cost is the two summed (20 ms). At T = 50 it is the closest and
+# fits: the renderer runs --denoise guided --spp 2 on the cheap guide (ISG shadows, ISM with
+# 256 VPLs gathered at 1/2) and the image is within FLIP 0.3 of the 128-spp reference; at
+# T = 15 only the path tracer's row (10 ms) fits. pick.py agrees on both.
+python3 - "$tmp/model.json" "$tmp/features.json" <<'PY' || fail "hybrid+pt model"
+import json, math, sys
+feats = json.load(open(sys.argv[2]))
+names = list(feats)
+json.dump({"size": 32, "k": 1, "pt_margin": 0.9, "features": names, "cost_features": [],
+           "beta": {"pt": [], "hybrid": []}, "safety": {"pt": 1.0, "hybrid": 1.0},
+           "scale": [1.0] * len(names),
+           "candidates": [
+               {"key": "hybrid+pt|cheap split 2 spp", "group": "hybrid", "alpha": math.log(10.0),
+                "kind": "hybrid+pt", "row": "hybrid+pt cheap split 2 spp", "spp": 2,
+                "plus": "pt+denoise|2 spp", "shadows": "isg", "indirect": "ism", "vpls": 256,
+                "gather_scale": 2},
+               {"key": "pt+denoise|2 spp", "group": "pt", "alpha": math.log(10.0), "kind": "pt",
+                "row": "pt+denoise 2 spp", "spp": 2, "scale": 1, "denoise": "on"}],
+           "scenes": [{"name": "box", "features": [feats[n] for n in names],
+                       "flip": {"hybrid+pt|cheap split 2 spp": 0.5, "pt+denoise|2 spp": 1.0}}]},
+          open(sys.argv[1], "w"))
+PY
+for case in "50 hybrid+pt cheap split 2 spp" "15 pt+denoise 2 spp"; do
+    set -- $case
+    budget=$1
+    shift
+    expect 0 "$drift" render --mode hybrid --budget-ms "$budget" --budget-probe off \
+        --chooser "$tmp/model.json" "${size[@]}" --out "$tmp/g.exr" --stats "$tmp/g.json"
+    grep -q -- "--budget-ms $budget: .*$* (predicted $((budget > 15 ? 20 : 10)) ms" "$tmp/err" ||
+        fail "T $budget: not $*, or its cost is not the parts' sum: $(cat "$tmp/err")"
+    want=$(python3 "$root/scripts/chooser/pick.py" "$tmp/model.json" "$tmp/features.json" \
+        --budget-ms "$budget" --pixels 1024)
+    [ "$want" = "$*" ] || fail "T $budget: pick.py says $want, not $*"
+    [ "$budget" = 50 ] || continue
+    grep -q -- "--denoise guided: path tracer 2 spp" "$tmp/err" ||
+        fail "hybrid+pt: not rendered by --denoise guided at 2 spp: $(cat "$tmp/err")"
+    python3 - "$tmp/g.json" <<'PY' || fail "hybrid+pt: not the cheap guide: $(cat "$tmp/g.json")"
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["mode"] == "hybrid", d["mode"]
+assert d["techniques"]["shadows"] == "isg" and d["techniques"]["indirect"] == "ism", d["techniques"]
+assert d["knobs"]["ism-vpls"] == 256 and str(d["knobs"]["ism-gather-scale"]) == "2", d["knobs"]
+PY
+    flip=$("$drift" diff "$cache/chooser-builtin-32-128spp.exr" "$tmp/g.exr" | awk '$1 == "flip" { print $2 }')
+    echo "hybrid+pt: FLIP $flip against 128 spp"
+    python3 -c "import sys; sys.exit(0 if float('$flip') <= 0.3 else 1)" ||
+        fail "hybrid+pt: FLIP $flip over 0.3"
 done
 expect 2 "$drift" render --mode hybrid --budget-ms 100 --budget-probe maybe "${size[@]}" \
     --out "$tmp/x.exr"
