@@ -183,8 +183,8 @@ static inline DRIFT_ALWAYS_INLINE void stage(const drift__glare_lanes *p, int32_
     }
 }
 
-DRIFT_AVX2_CLONES float *drift__glare_lanes_run(const drift__glare_lanes *plan, float *data,
-                                                float *work)
+DRIFT_AVX2_CLONES static float *lanes_run_clones(const drift__glare_lanes *plan, float *data,
+                                                 float *work)
 {
     float *in = data, *out = work;
     for (int32_t s = 0, l = 1; s < plan->stages; l *= plan->radix[s++]) {
@@ -212,8 +212,8 @@ DRIFT_AVX2_CLONES float *drift__glare_lanes_run(const drift__glare_lanes *plan, 
 
 // The deinterleaving loads and interleaving stores of a block of L complex columns (one
 // 64-byte line of a spectrum row), `count` rows `stride` complex numbers apart.
-DRIFT_AVX2_CLONES void drift__glare_lanes_gather(const drift__cpx *src, size_t stride, size_t count,
-                                                 float *dst)
+DRIFT_AVX2_CLONES static void lanes_gather_clones(const drift__cpx *src, size_t stride,
+                                                  size_t count, float *dst)
 {
     for (size_t y = 0; y < count; ++y) {
         const float *p = (const float *)(const void *)(src + y * stride);
@@ -226,8 +226,8 @@ DRIFT_AVX2_CLONES void drift__glare_lanes_gather(const drift__cpx *src, size_t s
     }
 }
 
-DRIFT_AVX2_CLONES void drift__glare_lanes_scatter(const float *src, size_t count, drift__cpx *dst,
-                                                  size_t stride)
+DRIFT_AVX2_CLONES static void lanes_scatter_clones(const float *src, size_t count, drift__cpx *dst,
+                                                   size_t stride)
 {
     for (size_t y = 0; y < count; ++y) {
         lane_cpx v = load(src, y);
@@ -239,12 +239,36 @@ DRIFT_AVX2_CLONES void drift__glare_lanes_scatter(const float *src, size_t count
 }
 
 // data = data x kernel x norm, element by element (the spectrum times the PSF's).
-DRIFT_AVX2_CLONES void drift__glare_lanes_multiply(float *data, const float *kernel, size_t count,
-                                                   float norm)
+DRIFT_AVX2_CLONES static void lanes_multiply_clones(float *data, const float *kernel, size_t count,
+                                                    float norm)
 {
     for (size_t e = 0; e < count; ++e) {
         lane_cpx a = load(data, e), b = load(kernel, e);
         store(data, e,
               (lane_cpx){ (a.re * b.re - a.im * b.im) * norm, (a.re * b.im + a.im * b.re) * norm });
     }
+}
+
+// The entry points fft.c calls: plain functions over the clones above. Clang 14 emits a cloned
+// function's resolver only in a file that calls it, so an extern cloned definition that only
+// other files call has no symbol (the CI's clang link failed); the clones' names are this
+// file's alone (vectorise.h: clang gives a static clone's resolver external linkage).
+float *drift__glare_lanes_run(const drift__glare_lanes *plan, float *data, float *work)
+{
+    return lanes_run_clones(plan, data, work);
+}
+
+void drift__glare_lanes_gather(const drift__cpx *src, size_t stride, size_t count, float *dst)
+{
+    lanes_gather_clones(src, stride, count, dst);
+}
+
+void drift__glare_lanes_scatter(const float *src, size_t count, drift__cpx *dst, size_t stride)
+{
+    lanes_scatter_clones(src, count, dst, stride);
+}
+
+void drift__glare_lanes_multiply(float *data, const float *kernel, size_t count, float norm)
+{
+    lanes_multiply_clones(data, kernel, count, norm);
 }
