@@ -68,7 +68,8 @@ expect 1 "$drift" render --spp 1 --width 8 --height 8 --quiet --out "$tmp/missin
 "$drift" render --spp 100000 --width 64 --height 64 --threads 1 --checkpoint 0 \
     --out "$tmp/int.exr" --stats "$tmp/int.json" >"$tmp/out" 2>"$tmp/err" &
 pid=$!
-sleep 3
+# Once a pass is done (its progress line), not a fixed wait: at least 1 spp is in the image.
+for _ in $(seq 100); do grep -q "spp (" "$tmp/err" 2>/dev/null && break; sleep 0.1; done
 kill -INT "$pid"
 wait "$pid"
 status=$?

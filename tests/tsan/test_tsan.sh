@@ -3,7 +3,7 @@
 # the techniques that keep per-thread state (ISM, micro-rendering, AAF) at small settings and
 # the glare filter, each at --threads 1, 2, 16 and 256 on a 16x16 image. A data race (TSan's report)
 # or a run that fails ends the script with status 1. $1 is a drift binary built with
-# -DDRIFT_SANITIZE=thread (scripts/test.sh builds build/tsan). Under a minute on 2 cores.
+# -DDRIFT_SANITIZE=thread (scripts/test.sh builds build/tsan). About half a minute on 2 cores.
 set -u
 drift=${1:?usage: test_tsan.sh path/to/tsan/drift}
 tmp="$(mktemp -d)"
@@ -19,22 +19,34 @@ runs=(
     "render --mode hybrid --indirect micro --reflections micro --micro-points 2000 --micro-size 8"
     "render --mode hybrid --shadows aaf --spp 1 --indirect none"
 )
+# one NAME CMD...: runs a drift command under TSan into $tmp/NAME.*; a race or a failure leaves
+# $tmp/NAME.fail with its report.
+one() {
+    local name=$1
+    shift
+    if ! timeout -k 2 120 "$drift" "$@" >/dev/null 2>"$tmp/$name.err"; then
+        { echo "FAIL: drift $*"; head -40 "$tmp/$name.err"; } >"$tmp/$name.fail"
+    fi
+}
+# Two commands at a time (the machine's cores; TSan's runs are mostly one thread busy): the
+# glare run of a thread count reads that count's first render.
+jobs=${DRIFT_TSAN_JOBS:-2}
 for threads in 1 2 16 256; do
+    k=0
     for r in "${runs[@]}"; do
         # shellcheck disable=SC2086
-        if ! timeout -k 2 120 "$drift" $r "${small[@]}" --threads "$threads" \
-            --out "$tmp/t.exr" >/dev/null 2>"$tmp/err"; then
-            echo "FAIL: drift $r --threads $threads" >&2
-            head -40 "$tmp/err" >&2
-            failures=$((failures + 1))
-        fi
+        one "t$threads-$k" $r "${small[@]}" --threads "$threads" --out "$tmp/t$threads-$k.exr" &
+        k=$((k + 1))
+        while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do wait -n; done
     done
-    if ! timeout -k 2 120 "$drift" glare "$tmp/t.exr" --out "$tmp/g.exr" --psf-size 32 \
-        --threads "$threads" >/dev/null 2>"$tmp/err"; then
-        echo "FAIL: drift glare --threads $threads" >&2
-        head -40 "$tmp/err" >&2
-        failures=$((failures + 1))
-    fi
+    wait
+    one "g$threads" glare "$tmp/t$threads-0.exr" --out "$tmp/g$threads.exr" --psf-size 32 \
+        --threads "$threads"
+done
+for f in "$tmp"/*.fail; do
+    [ -e "$f" ] || continue
+    cat "$f" >&2
+    failures=$((failures + 1))
 done
 [ "$failures" -eq 0 ] || { echo "tsan: $failures failure(s)" >&2; exit 1; }
 echo "tsan: no race in ${#runs[@]} renders and glare at --threads 1, 2, 16, 256"
