@@ -224,50 +224,53 @@ static drift_vec3 frame_ambient(drift_frame_state *f)
     if (f->params.has_ambient) {
         return f->params.ambient;
     }
-    const int32_t w = f->params.width, h = f->params.height;
-    size_t reflective = 0;
-    for (int32_t y = 0; y < h; ++y) {
-        for (int32_t x = 0; x < w; ++x) {
-            drift_bsdf bsdf;
-            reflective += has_reflection(f, &f->gbuffer.surfaces[pixel_index(f, x, y)], &bsdf);
+    // One pass over the frame lists the reflective pixels (drift_bsdf_make each, once); the
+    // samples are every `every`-th of them in scan order.
+    const size_t pixels = (size_t)f->params.width * (size_t)f->params.height;
+    uint32_t *reflective = drift_alloc(f->ctx, pixels * sizeof *reflective);
+    if (!reflective) {
+        return drift_vec3_splat(0.0f); // no ambient guess: the buffer as without it
+    }
+    size_t total = 0;
+    for (size_t i = 0; i < pixels; ++i) {
+        drift_bsdf bsdf;
+        if (has_reflection(f, &f->gbuffer.surfaces[i], &bsdf)) {
+            reflective[total++] = (uint32_t)i;
         }
     }
-    size_t every = reflective / AMBIENT_SAMPLES + 1, seen = 0, count = 0;
+    size_t every = total / AMBIENT_SAMPLES + 1, count = 0;
     double sum[3] = { 0.0, 0.0, 0.0 }, bounce[3] = { 0.0, 0.0, 0.0 };
     uint64_t *rays = &f->stats.rays[DRIFT_PASS_REFLECTIONS];
-    for (int32_t y = 0; y < h; ++y) {
-        for (int32_t x = 0; x < w; ++x) {
-            const drift_surface *s = &f->gbuffer.surfaces[pixel_index(f, x, y)];
-            drift_bsdf bsdf;
-            if (!has_reflection(f, s, &bsdf) || seen++ % every != 0) {
-                continue;
-            }
-            drift_vec3 dir = reflection_direction(f, s, drift_pass_wo(f, x, y));
-            drift_ray ray = { .origin = drift_offset_origin(s->position, s->ng, dir),
-                              .dir = dir,
-                              .tmin = 0.0f,
-                              .tmax = INFINITY };
-            drift_hit hit;
-            ++*rays;
-            if (!drift_accel_intersect(f->accel, &ray, &hit)) {
-                continue;
-            }
-            drift_surface at = drift_scene_surface(f->scene, &ray, &hit);
-            if (at.material == DRIFT_INVALID_INDEX) {
-                continue;
-            }
-            drift_sampler sampler = drift_pass_sampler(f, DRIFT_STREAM_REFLECTION, x, y);
-            drift_vec3 albedo;
-            drift_vec3 d = one_bounce_sample(f, &at, drift_vec3_neg(dir), &sampler, rays, &albedo);
-            sum[0] += (double)d.x;
-            sum[1] += (double)d.y;
-            sum[2] += (double)d.z;
-            bounce[0] += (double)albedo.x;
-            bounce[1] += (double)albedo.y;
-            bounce[2] += (double)albedo.z;
-            ++count;
+    for (size_t j = 0; j < total; j += every) {
+        int32_t x = (int32_t)(reflective[j] % (uint32_t)f->params.width);
+        int32_t y = (int32_t)(reflective[j] / (uint32_t)f->params.width);
+        const drift_surface *s = &f->gbuffer.surfaces[reflective[j]];
+        drift_vec3 dir = reflection_direction(f, s, drift_pass_wo(f, x, y));
+        drift_ray ray = { .origin = drift_offset_origin(s->position, s->ng, dir),
+                          .dir = dir,
+                          .tmin = 0.0f,
+                          .tmax = INFINITY };
+        drift_hit hit;
+        ++*rays;
+        if (!drift_accel_intersect(f->accel, &ray, &hit)) {
+            continue;
         }
+        drift_surface at = drift_scene_surface(f->scene, &ray, &hit);
+        if (at.material == DRIFT_INVALID_INDEX) {
+            continue;
+        }
+        drift_sampler sampler = drift_pass_sampler(f, DRIFT_STREAM_REFLECTION, x, y);
+        drift_vec3 albedo;
+        drift_vec3 d = one_bounce_sample(f, &at, drift_vec3_neg(dir), &sampler, rays, &albedo);
+        sum[0] += (double)d.x;
+        sum[1] += (double)d.y;
+        sum[2] += (double)d.z;
+        bounce[0] += (double)albedo.x;
+        bounce[1] += (double)albedo.y;
+        bounce[2] += (double)albedo.z;
+        ++count;
     }
+    drift_free(f->ctx, reflective);
     if (count == 0) {
         return drift_vec3_splat(0.0f);
     }
