@@ -57,6 +57,22 @@ drift_result drift_image_load(drift_context *ctx, const char *path, drift_image 
 drift_result drift_image_load_memory(drift_context *ctx, const char *name, const void *data,
                                      size_t size, drift_image *out_image);
 
+// Where a coverage image's values come from when the file has no alpha channel.
+typedef enum drift_alpha_source {
+    DRIFT_ALPHA_CHANNEL = 0, // 1 (glTF: a base colour image without alpha is opaque)
+    DRIFT_ALPHA_OR_GREY,     // the mean of its colour channels as stored (an MTL's map_d)
+} drift_alpha_source;
+
+// The alpha channel of a PNG, JPEG or Radiance HDR (file or memory, as the two above), as
+// stored (8- and 16-bit values over 255 and 65535, not sRGB-decoded), into a 1-channel image;
+// where the file has none, what `source` says. OpenEXR is DRIFT_ERR_UNSUPPORTED. What a
+// material's coverage reads (drift_material.opacity_texture).
+drift_result drift_image_load_alpha(drift_context *ctx, const char *path, drift_alpha_source source,
+                                    drift_image *out_image);
+drift_result drift_image_load_alpha_memory(drift_context *ctx, const char *name, const void *data,
+                                           size_t size, drift_alpha_source source,
+                                           drift_image *out_image);
+
 // One layer of a multi-layer EXR. name NULL or "" is the default layer (plain channel names);
 // any other name prefixes the channels ("name.R"). Borrowed for the duration of the call.
 typedef struct drift_image_layer {

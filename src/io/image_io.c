@@ -359,9 +359,20 @@ static const char *format_name(image_format format)
     }
 }
 
+// What a load reads: the colour (sRGB-decoded, 3 channels), or a coverage (1 channel, values
+// as stored): the alpha channel, or where the file has none 1 (ALPHA_CHANNEL) or its grey
+// value (ALPHA_OR_GREY).
+typedef enum image_content {
+    CONTENT_COLOUR,
+    CONTENT_ALPHA_CHANNEL,
+    CONTENT_ALPHA_OR_GREY
+} image_content;
+
 static drift_result stb_load(drift_context *ctx, const char *path, image_format format,
-                             const uint8_t *data, size_t size, drift_image *out_image)
+                             const uint8_t *data, size_t size, image_content content_kind,
+                             drift_image *out_image)
 {
+    bool alpha = content_kind != CONTENT_COLOUR;
     if (size > (size_t)INT_MAX) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_UNSUPPORTED, path, 0, "file over 2 GiB");
         return DRIFT_ERR_UNSUPPORTED;
@@ -410,17 +421,20 @@ static drift_result stb_load(drift_context *ctx, const char *path, image_format 
         }
     }
     // Decode first, then allocate the float image, so corrupt files cost no float buffer.
-    size_t count = (size_t)width * (size_t)height * 3;
+    // For the alpha, stb decodes RGBA (grey+alpha and opaque files too) and the fourth
+    // channel is kept.
+    int decoded = alpha ? 4 : 3, kept = alpha ? 1 : 3;
+    size_t count = (size_t)width * (size_t)height * (size_t)kept;
     int w = 0, h = 0, n = 0;
     void *pixels = NULL;
     bool wide = false;
     if (is_hdr) {
-        pixels = stbi_loadf_from_memory(data, len, &w, &h, &n, 3);
+        pixels = stbi_loadf_from_memory(data, len, &w, &h, &n, decoded);
     } else if (format == FORMAT_PNG && stbi_is_16_bit_from_memory(data, len)) {
-        pixels = stbi_load_16_from_memory(data, len, &w, &h, &n, 3);
+        pixels = stbi_load_16_from_memory(data, len, &w, &h, &n, decoded);
         wide = true;
     } else {
-        pixels = stbi_load_from_memory(data, len, &w, &h, &n, 3);
+        pixels = stbi_load_from_memory(data, len, &w, &h, &n, decoded);
     }
     if (!pixels || w != width || h != height) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_PARSE, path, 0, "corrupt image: %s",
@@ -429,12 +443,24 @@ static drift_result stb_load(drift_context *ctx, const char *path, image_format 
         return DRIFT_ERR_PARSE;
     }
     drift_image img;
-    drift_result r = drift_image_create(ctx, width, height, 3, &img);
+    drift_result r = drift_image_create(ctx, width, height, kept, &img);
     if (r != DRIFT_OK) {
         stbi_image_free(pixels);
         return r;
     }
-    if (is_hdr) {
+    if (alpha) {
+        // n is the file's own channel count: 2 and 4 carry alpha.
+        bool grey = content_kind == CONTENT_ALPHA_OR_GREY && n != 2 && n != 4;
+        for (size_t i = 0; i < count; ++i) {
+            float v[4];
+            for (int c = 0; c < 4; ++c) {
+                v[c] = is_hdr ? ((const float *)pixels)[4 * i + (size_t)c]
+                       : wide ? (float)((const uint16_t *)pixels)[4 * i + (size_t)c] / 65535.0f
+                              : (float)((const uint8_t *)pixels)[4 * i + (size_t)c] / 255.0f;
+            }
+            img.pixels[i] = grey ? (v[0] + v[1] + v[2]) / 3.0f : v[3];
+        }
+    } else if (is_hdr) {
         memcpy(img.pixels, pixels, count * sizeof(float));
     } else if (wide) {
         const uint16_t *p16 = pixels;
@@ -458,8 +484,18 @@ static drift_result stb_load(drift_context *ctx, const char *path, image_format 
 
 // --- PUBLIC ---
 
-drift_result drift_image_load(drift_context *ctx, const char *path, drift_image *out_image)
+// An EXR's alpha is not read: glTF's and MTL's alpha textures are PNG or JPEG.
+static drift_result exr_alpha_refused(drift_context *ctx, const char *name)
 {
+    drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_UNSUPPORTED, name, 0,
+              "alpha is read from PNG, JPEG or Radiance HDR images, not OpenEXR");
+    return DRIFT_ERR_UNSUPPORTED;
+}
+
+static drift_result load_file(drift_context *ctx, const char *path, image_content content_kind,
+                              drift_image *out_image)
+{
+    bool alpha = content_kind != CONTENT_COLOUR;
     if (!out_image) {
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
@@ -473,6 +509,9 @@ drift_result drift_image_load(drift_context *ctx, const char *path, drift_image 
                   "unsupported image extension (use .exr, .png, .jpg, .jpeg or .hdr)");
         return DRIFT_ERR_UNSUPPORTED;
     }
+    if (format == FORMAT_EXR && alpha) {
+        return exr_alpha_refused(ctx, path);
+    }
     uint8_t *data = NULL;
     size_t size = 0;
     drift_result r = drift__image_read_file(ctx, path, &data, &size);
@@ -482,15 +521,16 @@ drift_result drift_image_load(drift_context *ctx, const char *path, drift_image 
     if (format == FORMAT_EXR) {
         r = drift__image_exr_load(ctx, path, data, size, out_image);
     } else {
-        r = stb_load(ctx, path, format, data, size, out_image);
+        r = stb_load(ctx, path, format, data, size, content_kind, out_image);
     }
     drift_free(ctx, data);
     return r;
 }
 
-drift_result drift_image_load_memory(drift_context *ctx, const char *name, const void *data,
-                                     size_t size, drift_image *out_image)
+static drift_result load_memory(drift_context *ctx, const char *name, const void *data, size_t size,
+                                image_content content_kind, drift_image *out_image)
 {
+    bool alpha = content_kind != CONTENT_COLOUR;
     if (!out_image) {
         return DRIFT_ERR_INVALID_ARGUMENT;
     }
@@ -500,7 +540,8 @@ drift_result drift_image_load_memory(drift_context *ctx, const char *name, const
     }
     static const uint8_t exr_magic[4] = { 0x76, 0x2f, 0x31, 0x01 };
     if (size >= 4 && memcmp(data, exr_magic, 4) == 0) {
-        return drift__image_exr_load(ctx, name, data, size, out_image);
+        return alpha ? exr_alpha_refused(ctx, name)
+                     : drift__image_exr_load(ctx, name, data, size, out_image);
     }
     image_format format = content_format(data, size);
     if (format == FORMAT_UNKNOWN) {
@@ -508,7 +549,36 @@ drift_result drift_image_load_memory(drift_context *ctx, const char *name, const
                   "image data is not PNG, JPEG, Radiance HDR or OpenEXR");
         return DRIFT_ERR_UNSUPPORTED;
     }
-    return stb_load(ctx, name, format, data, size, out_image);
+    return stb_load(ctx, name, format, data, size, content_kind, out_image);
+}
+
+drift_result drift_image_load(drift_context *ctx, const char *path, drift_image *out_image)
+{
+    return load_file(ctx, path, CONTENT_COLOUR, out_image);
+}
+
+drift_result drift_image_load_memory(drift_context *ctx, const char *name, const void *data,
+                                     size_t size, drift_image *out_image)
+{
+    return load_memory(ctx, name, data, size, CONTENT_COLOUR, out_image);
+}
+
+static image_content alpha_content(drift_alpha_source source)
+{
+    return source == DRIFT_ALPHA_OR_GREY ? CONTENT_ALPHA_OR_GREY : CONTENT_ALPHA_CHANNEL;
+}
+
+drift_result drift_image_load_alpha(drift_context *ctx, const char *path, drift_alpha_source source,
+                                    drift_image *out_image)
+{
+    return load_file(ctx, path, alpha_content(source), out_image);
+}
+
+drift_result drift_image_load_alpha_memory(drift_context *ctx, const char *name, const void *data,
+                                           size_t size, drift_alpha_source source,
+                                           drift_image *out_image)
+{
+    return load_memory(ctx, name, data, size, alpha_content(source), out_image);
 }
 
 typedef struct png_sink {
