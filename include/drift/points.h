@@ -68,12 +68,15 @@ typedef struct drift_points {
     drift_vec3 *normal;        // count, unit geometric normal (the winding's side)
     uint32_t count;
     uint32_t subset_count;
-    double area;        // total area of the sampled triangles at the last update
+    double area;        // total area of the sampled triangles at the last update, times coverage
+    double coverage;    // the share of that area a surface is there (drift_alpha_mode), 0..1
     bool skip_emissive; // from the desc
 } drift_points;
 
-// Samples the points of a committed scene. Errors: DRIFT_ERR_INVALID_ARGUMENT (uncommitted
-// scene, no triangles with area, subset_count > count), DRIFT_ERR_OUT_OF_MEMORY.
+// Samples the points of a committed scene. A point drawn where a MASK or BLEND material is not
+// there (drift_scene_covers) is drawn again, so the points lie on what rays hit. Errors:
+// DRIFT_ERR_INVALID_ARGUMENT (uncommitted scene, no triangles with area, subset_count > count),
+// DRIFT_ERR_OUT_OF_MEMORY.
 drift_result drift_points_create(drift_context *ctx, const drift_scene *scene,
                                  const drift_points_desc *desc, drift_points **out_points);
 void drift_points_destroy(drift_points *points); // NULL-safe

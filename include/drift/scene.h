@@ -190,6 +190,17 @@ typedef enum drift_texture_slot {
 // English names); false when the name is unknown.
 bool drift_ggx_named_metal(const char *name, drift_ggx_params *ggx);
 
+// How much of a surface is there (glTF's alphaMode): every ray hits an OPAQUE one; a MASK one
+// is hit where its opacity is at least alpha_cutoff (foliage and fence cards); a BLEND one is
+// hit with probability equal to its opacity (stochastic transparency: what Cycles renders of
+// Blender's alpha, converging to the blend).
+typedef enum drift_alpha_mode {
+    DRIFT_ALPHA_OPAQUE = 0,
+    DRIFT_ALPHA_MASK,
+    DRIFT_ALPHA_BLEND,
+    DRIFT_ALPHA_MODE_COUNT
+} drift_alpha_mode;
+
 typedef struct drift_material {
     char name[DRIFT_NAME_MAX];
     drift_material_type type;
@@ -203,6 +214,14 @@ typedef struct drift_material {
     drift_ggx_params ggx;    // DRIFT_MATERIAL_GGX only
     drift_texture_map maps[DRIFT_TEXTURE_SLOT_COUNT]; // how each texture is read (zero: default)
     bool emission_two_sided; // emits from both faces (glTF doubleSided, as Cycles)
+    // Coverage (drift_alpha_mode; zero: opaque, the fields below unread). opacity: glTF's
+    // baseColorFactor alpha, times opacity_texture (a 1-channel texture, the base colour
+    // image's alpha, read through maps[DRIFT_TEXTURE_BASE]) where set. Rays test it
+    // (src/accel), and so does every point set sampled on surfaces (src/points).
+    drift_alpha_mode alpha_mode;
+    float alpha_cutoff; // MASK: opacity >= cutoff is hit (glTF alphaCutoff, default 0.5)
+    float opacity;
+    uint32_t opacity_texture;
 } drift_material;
 
 // A material with no texture: the value to start from when filling one in.
@@ -408,6 +427,14 @@ drift_surface drift_scene_surface(const drift_scene *scene, const drift_ray *ray
 // density. Textures then read the mip level of that footprint.
 void drift_surface_set_footprint(const drift_scene *scene, drift_surface *surface, float width,
                                  drift_vec3 ray_dir);
+
+// Whether a ray meets mesh `mesh`'s triangle `prim` at barycentrics (u, v) (Embree's: the
+// weights of vertices 1 and 2): always for an opaque material; for MASK where its opacity is
+// at least alpha_cutoff; for BLEND when `xi` (uniform in [0, 1)) is below its opacity.
+bool drift_scene_covers(const drift_scene *scene, uint32_t mesh, uint32_t prim, float u, float v,
+                        float xi);
+// The material's opacity at (mesh, prim, u, v): opacity times its texture there, in [0, 1].
+float drift_scene_opacity(const drift_scene *scene, uint32_t mesh, uint32_t prim, float u, float v);
 
 // The value of texture slot `slot` of `material` at the surface (its map's uv set, transform,
 // wrap, filter and mip level), RGB linear; (1, 1, 1) when the material has no such texture.

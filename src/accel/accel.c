@@ -2,6 +2,8 @@
 // with Embree (no copies); area-light shapes get small buffers of their own.
 #include "drift/accel.h"
 
+#include "drift/math.h"
+
 #include <embree3/rtcore.h>
 #include <math.h>
 #include <stdatomic.h>
@@ -111,6 +113,44 @@ static drift_result check_device(drift_accel *accel, const char *what)
     return result_of(code);
 }
 
+// A random number of one ray meeting one triangle: the same for the same ray (so a pixel's
+// image does not depend on the thread count or on how often Embree asks), different for the
+// next sample's or bounce's ray, which starts or points elsewhere.
+// Embree's RTCRayN layout (rtcore_ray.h; its accessors are C++ only): org x, y, z, tnear, dir
+// x, y, z each N floats in a row. Its RTCHitN: Ng x, y, z, u, v, primID, geomID.
+static float ray_hit_uniform(const struct RTCRayN *ray, unsigned n, unsigned i, uint32_t prim)
+{
+    static const unsigned fields[6] = { 0, 1, 2, 4, 5, 6 }; // org xyz, dir xyz
+    const uint32_t *words = (const uint32_t *)(const void *)ray;
+    uint32_t h = drift_hash_u32(prim);
+    for (int k = 0; k < 6; ++k) {
+        uint32_t bits = words[fields[k] * n + i];
+        h = drift_hash_combine(h, bits);
+    }
+    return (float)(h >> 8) * 0x1p-24f;
+}
+
+// Embree's filter for meshes whose material is not opaque (drift_alpha_mode): a candidate hit
+// where the surface is not there is dropped and the ray goes on, for closest hits and shadow
+// rays alike.
+static void coverage_filter(const struct RTCFilterFunctionNArguments *args)
+{
+    const drift_accel *accel = args->geometryUserPtr;
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] != -1) {
+            continue;
+        }
+        const float *hit = (const float *)(const void *)args->hit;
+        const uint32_t *ids = (const uint32_t *)(const void *)args->hit;
+        uint32_t mesh = ids[6 * args->N + i], prim = ids[5 * args->N + i];
+        float u = hit[3 * args->N + i], v = hit[4 * args->N + i];
+        float xi = ray_hit_uniform(args->ray, args->N, i, prim);
+        if (!drift_scene_covers(accel->scene, mesh, prim, u, v, xi)) {
+            args->valid[i] = 0;
+        }
+    }
+}
+
 static drift_result add_mesh(drift_accel *accel, const drift_mesh *mesh, uint32_t id)
 {
     RTCGeometry geom = rtcNewGeometry(accel->device, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -123,6 +163,11 @@ static drift_result add_mesh(drift_accel *accel, const drift_mesh *mesh, uint32_
                                0, 3 * sizeof(float), mesh->vertex_count);
     rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, mesh->indices, 0,
                                3 * sizeof(uint32_t), mesh->triangle_count);
+    if (accel->scene->materials[mesh->material].alpha_mode != DRIFT_ALPHA_OPAQUE) {
+        rtcSetGeometryUserData(geom, accel);
+        rtcSetGeometryIntersectFilterFunction(geom, coverage_filter);
+        rtcSetGeometryOccludedFilterFunction(geom, coverage_filter);
+    }
     rtcCommitGeometry(geom);
     rtcAttachGeometryByID(accel->rtc_scene, geom, id);
     rtcReleaseGeometry(geom);

@@ -178,12 +178,34 @@ static void undo_srgb(drift_image *image)
     }
 }
 
+// The image inside the glTF (a .glb's buffer view, a data URI, a buffer file's view) that
+// texture t names: its colour, sRGB-decoded, or its alpha.
+static drift_result embedded_image(drift_context *ctx, const drift__gltf *g,
+                                   const drift__gltf_texture *t, bool alpha, const char *where,
+                                   int line, drift_image *out)
+{
+    uint8_t *bytes = NULL;
+    size_t size = 0;
+    drift_result r = drift__gltf_image_bytes(ctx, g, t->image, &bytes, &size);
+    char name[DRIFT__PATH_MAX];
+    snprintf(name, sizeof name, "%s (glTF image %d)", where ? where : "scene", t->image);
+    if (r == DRIFT_OK) {
+        r = alpha ? drift_image_load_alpha_memory(ctx, name, bytes, size, DRIFT_ALPHA_CHANNEL, out)
+                  : drift_image_load_memory(ctx, name, bytes, size, out);
+    }
+    drift_free(ctx, bytes);
+    if (r != DRIFT_OK) {
+        drift_image_destroy(ctx, out);
+        drift_log(ctx, DRIFT_LOG_WARNING, r, where, line, "cannot read or decode %s", name);
+    }
+    return r;
+}
+
 drift_result drift__gltf_load_texture(drift_scene *scene, const drift__gltf *g,
                                       const drift__gltf_texture *t, const char *dir,
                                       drift__texture_cache *cache, bool srgb, const char *where,
                                       int line, uint32_t *out_index)
 {
-    drift_context *ctx = scene->ctx;
     if (t->image < 0) {
         return DRIFT_ERR_PARSE;
     }
@@ -195,25 +217,38 @@ drift_result drift__gltf_load_texture(drift_scene *scene, const drift__gltf *g,
         return srgb && cache ? drift__texture_cache_get(scene, cache, full, where, line, out_index)
                              : drift__texture_load_data(scene, full, where, line, out_index);
     }
-    uint8_t *bytes = NULL;
-    size_t size = 0;
-    drift_result r = drift__gltf_image_bytes(ctx, g, t->image, &bytes, &size);
-    char name[DRIFT__PATH_MAX];
-    snprintf(name, sizeof name, "%s (glTF image %d)", where ? where : "scene", t->image);
     drift_image image = { 0 };
-    if (r == DRIFT_OK) {
-        r = drift_image_load_memory(ctx, name, bytes, size, &image);
-    }
-    drift_free(ctx, bytes);
+    drift_result r = embedded_image(scene->ctx, g, t, false, where, line, &image);
     if (r != DRIFT_OK) {
-        drift_image_destroy(ctx, &image);
-        drift_log(ctx, DRIFT_LOG_WARNING, r, where, line, "cannot read or decode %s", name);
         return r;
     }
     if (!srgb) {
         undo_srgb(&image);
     }
     return drift_scene_add_texture(scene, image, out_index);
+}
+
+drift_result drift__gltf_load_alpha(drift_scene *scene, const drift__gltf *g,
+                                    const drift__gltf_texture *t, const char *dir,
+                                    const char *where, int line, uint32_t *out_index)
+{
+    if (t->image < 0) {
+        return DRIFT_ERR_PARSE;
+    }
+    drift_image image = { 0 };
+    drift_result r;
+    if (t->uri[0]) {
+        char full[DRIFT__PATH_MAX];
+        if (!drift__path_join(dir, t->uri, full, sizeof full)) {
+            return DRIFT_ERR_IO;
+        }
+        size_t size = 0;
+        r = drift__check_file(scene->ctx, full, where, line, &size);
+        r = r ? r : drift_image_load_alpha(scene->ctx, full, DRIFT_ALPHA_CHANNEL, &image);
+    } else {
+        r = embedded_image(scene->ctx, g, t, true, where, line, &image);
+    }
+    return r ? r : drift_scene_add_texture(scene, image, out_index);
 }
 
 drift_result drift__texture_load_data(drift_scene *scene, const char *path, const char *where,
@@ -368,6 +403,21 @@ void drift__gltf_material_apply(drift_scene *scene, const drift__gltf *gltf,
                       "'%s': material '%s': %s not loaded; ignored", path, m->name, loads[k].what);
         }
     }
+    // Coverage: the base colour image's alpha times baseColorFactor's; where the alpha cannot
+    // be read the factor alone holds (a warning says so).
+    m->alpha_mode = gm->alpha_mode;
+    m->alpha_cutoff = gm->alpha_cutoff;
+    m->opacity = gm->opacity;
+    m->opacity_texture = DRIFT_INVALID_INDEX;
+    const drift__gltf_texture *base = &gm->textures[DRIFT_TEXTURE_BASE];
+    if (m->alpha_mode != DRIFT_ALPHA_OPAQUE && base->present &&
+        drift__gltf_load_alpha(scene, gltf, base, dir, where, line, &m->opacity_texture) !=
+            DRIFT_OK) {
+        m->opacity_texture = DRIFT_INVALID_INDEX;
+        drift_log(scene->ctx, DRIFT_LOG_WARNING, DRIFT_ERR_UNSUPPORTED, where, line,
+                  "'%s': material '%s': base colour alpha not loaded; its factor alone is used",
+                  path, m->name);
+    }
     m->ggx.normal_scale = gm->normal_scale;
     m->ggx.occlusion_strength = gm->occlusion_strength;
     if (m->ggx.emissive_texture != DRIFT_INVALID_INDEX && drift_vec3_is_zero(m->emission)) {
@@ -379,7 +429,6 @@ void drift__gltf_material_apply(drift_scene *scene, const drift__gltf *gltf,
         bool present;
         const char *what;
     } ignored[] = {
-        { gm->alpha_blended, "alpha mode (drawn opaque)" },
         { gm->has_clearcoat_normal,
           "clearcoat normal texture (the coat follows the base's shading normal)" },
     };

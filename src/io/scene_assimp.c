@@ -5,6 +5,7 @@
 // shaded flat (right for boxes like the Cornell box). UVs are kept as assimp gives them
 // (origin bottom-left, as docs/conventions.md wants).
 #include "drift/file.h"
+#include "drift/image_io.h"
 #include "scene_io_internal.h"
 
 #include <assimp/cimport.h>
@@ -183,6 +184,35 @@ static void material_texture(import_state *s, const struct aiMaterial *mat, drif
     }
 }
 
+// An MTL's opacity: d (or 1 - Tr) times map_d's alpha (its grey where it has none), drawn as
+// stochastic transparency, as Blender's OBJ importer makes it (Principled Alpha) and Cycles
+// renders it. A map_d that cannot be loaded is a warning naming its line; d alone then holds.
+static void obj_opacity(import_state *s, const drift__obj_material *om, drift_material *m)
+{
+    uint32_t texture = DRIFT_INVALID_INDEX;
+    if (om->map_d_line > 0) {
+        char full[DRIFT__PATH_MAX];
+        drift_image alpha = { 0 };
+        size_t size = 0;
+        drift_result r =
+            drift__path_join(s->dir, om->map_d, full, sizeof full) ? DRIFT_OK : DRIFT_ERR_IO;
+        r = r ? r : drift__check_file(s->ctx, full, om->mtl_path, om->map_d_line, &size);
+        r = r ? r : drift_image_load_alpha(s->ctx, full, DRIFT_ALPHA_OR_GREY, &alpha);
+        r = r ? r : drift_scene_add_texture(s->scene, alpha, &texture);
+        if (r != DRIFT_OK) {
+            texture = DRIFT_INVALID_INDEX;
+            drift_log(s->ctx, DRIFT_LOG_WARNING, r, om->mtl_path, om->map_d_line,
+                      "material '%s': map_d '%s' not loaded; its d alone is the opacity", m->name,
+                      om->map_d);
+        }
+    }
+    if (om->dissolve < 1.0f || texture != DRIFT_INVALID_INDEX) {
+        m->alpha_mode = DRIFT_ALPHA_BLEND;
+        m->opacity = om->dissolve;
+        m->opacity_texture = texture;
+    }
+}
+
 static drift_result convert_materials(import_state *s)
 {
     const struct aiScene *ai = s->ai;
@@ -233,6 +263,9 @@ static drift_result convert_materials(import_state *s)
         const drift__obj_material *om = drift__obj_get_material(s->obj, m.name);
         if (om && om->blender) { // Blender's MTL: Blender's importer's rule (scene_obj.c)
             drift__obj_blender_material(om, &m);
+        }
+        if (om) {
+            obj_opacity(s, om, &m);
         }
         uint32_t index;
         drift_result r = drift_scene_add_material(s->scene, &m, &index);

@@ -352,7 +352,12 @@ bool drift__gltf_get_material(const drift__gltf *g, unsigned index, drift__gltf_
                         fmaxf(emissive[2], 0.0f) * strength);
     out->double_sided = cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(m, "doubleSided"));
     const cJSON *alpha_mode = cJSON_GetObjectItemCaseSensitive(m, "alphaMode");
-    out->alpha_blended = cJSON_IsString(alpha_mode) && strcmp(alpha_mode->valuestring, "OPAQUE");
+    const char *mode = cJSON_IsString(alpha_mode) ? alpha_mode->valuestring : "OPAQUE";
+    out->alpha_mode = strcmp(mode, "MASK") == 0    ? DRIFT_ALPHA_MASK
+                      : strcmp(mode, "BLEND") == 0 ? DRIFT_ALPHA_BLEND
+                                                   : DRIFT_ALPHA_OPAQUE;
+    out->alpha_cutoff = drift_clampf(number_or(m, "alphaCutoff", 0.5f), 0.0f, 1.0f);
+    out->opacity = drift_clampf(base[3], 0.0f, 1.0f);
     drift__gltf_read_ggx(g->root, m, out);
     return true;
 }

@@ -92,6 +92,9 @@ typedef struct drift__obj_material {
     bool blender;                 // the library says Blender 2.8+ wrote it (its header)
     bool has_ks, has_ns;          // Ks, Ns given
     float ks, ns;                 // mean of Ks; Ns
+    float dissolve;               // d (1 - Tr), 1 when not given: the material's opacity
+    char map_d[DRIFT__PATH_MAX];  // map_d's file (its alpha, or its grey value), as map_kd
+    int map_d_line;               // its line in mtl_path (0: no map_d)
     const char *mtl_path;         // the library that defines it
 } drift__obj_material;
 
@@ -148,8 +151,9 @@ typedef struct drift__gltf_texture {
 typedef struct drift__gltf_material {
     drift_vec3 diffuse, specular, emission; // emission includes KHR_materials_emissive_strength
     float exponent;
-    float roughness; // the Burley diffuse's (the clamped roughnessFactor)
-    bool alpha_blended;
+    float roughness;             // the Burley diffuse's (the clamped roughnessFactor)
+    drift_alpha_mode alpha_mode; // alphaMode, with alphaCutoff and baseColorFactor's alpha
+    float alpha_cutoff, opacity;
     bool double_sided; // `doubleSided`: emits from both faces (Cycles does)
     // The same material for DRIFT_MATERIAL_GGX (material_gltf.c): base colour, metallic,
     // roughness and the KHR_materials_transmission / _ior / _specular / _clearcoat values.
@@ -175,6 +179,11 @@ drift_result drift__gltf_load_texture(drift_scene *scene, const drift__gltf *g,
                                       const drift__gltf_texture *t, const char *dir,
                                       drift__texture_cache *cache, bool srgb, const char *where,
                                       int line, uint32_t *out_index);
+// The alpha channel of texture `t`'s image (a file beside the glTF or one inside it) as a
+// 1-channel scene texture: a MASK or BLEND material's opacity (drift_material).
+drift_result drift__gltf_load_alpha(drift_scene *scene, const drift__gltf *g,
+                                    const drift__gltf_texture *t, const char *dir,
+                                    const char *where, int line, uint32_t *out_index);
 // The JSON root of an open glTF.
 const struct cJSON *drift__gltf_root(const drift__gltf *g);
 // Decodes a base64 `data:` URI (RFC 2397) into *out_data (allocated). DRIFT_ERR_PARSE when it

@@ -9,8 +9,9 @@
 // - per material: whether `Kd` is given (Blender's exporter leaves it out beside `map_Kd`:
 //   the texture alone is the colour, where assimp would multiply it by its default 0.6), the
 //   `map_Kd` file name with surrounding whitespace removed (trailing tabs/spaces made assimp
-//   look for a file that does not exist), `illum`, and warnings for what drift's material
-//   cannot hold (map_Ks, map_Ns, map_Bump/bump, norm, map_d, d < 1, illum ≥ 3).
+//   look for a file that does not exist), `illum`, the dissolve `d` (or `Tr`) and `map_d`
+//   (the material's opacity), and warnings for what drift's material cannot hold (map_Ks,
+//   map_Ns, map_Bump/bump, norm, illum ≥ 3).
 #include "scene_io_internal.h"
 
 #include <ctype.h>
@@ -46,7 +47,8 @@ const drift__format_row drift__obj_statements[] = {
     { "Ns", "Blender MTL: roughness 1 − √(Ns / 1000)" },
     { "illum", "0, 1: no highlight without Ks; ≥ 3: drawn as 2, with a warning" },
     { "Ke", "emission (radiance)" },
-    { "d < 1, map_d", "a warning: drawn opaque" },
+    { "d, Tr, map_d", "opacity d (1 − Tr) times map_d's alpha (its grey without one): "
+                      "stochastic transparency, as Cycles renders Blender's import" },
     { "map_Ks, map_Ns, map_Bump, bump, norm, disp, map_Ke, refl", "a warning each" },
     { "Ni, Ka", "ignored" },
 };
@@ -131,7 +133,7 @@ static drift__obj_material *add_material(drift_context *ctx, drift__obj *o, cons
     }
     o->materials = grown;
     drift__obj_material *m = &o->materials[o->material_count++];
-    *m = (drift__obj_material){ .illum = 2, .mtl_path = mtl_path };
+    *m = (drift__obj_material){ .illum = 2, .dissolve = 1.0f, .mtl_path = mtl_path };
     snprintf(m->name, sizeof m->name, "%s", name);
     return m;
 }
@@ -176,7 +178,6 @@ static drift_result read_mtl(drift_context *ctx, drift__obj *o, const char *path
         { "bump", "bump map" },
         { "map_bump", "bump map" },
         { "norm", "normal map" },
-        { "map_d", "opacity texture" },
         { "disp", "displacement map" },
         { "map_Ke", "emission texture" },
         { "refl", "reflection map" },
@@ -249,9 +250,19 @@ static drift_result read_mtl(drift_context *ctx, drift__obj *o, const char *path
                           "(a glossy highlight)",
                           m->name, m->illum);
             }
-        } else if (statement(line, "d", &arg) && strtod(arg, NULL) < 1.0) {
-            drift_log(ctx, DRIFT_LOG_WARNING, DRIFT_ERR_UNSUPPORTED, path, number,
-                      "material '%s': dissolve d %s ignored (drawn opaque)", m->name, arg);
+        } else if (statement(line, "d", &arg) || statement(line, "Tr", &arg)) {
+            bool tr = line[0] == 'T';
+            double v = strtod(arg, NULL), d = tr ? 1.0 - v : v;
+            if (!(d >= 0.0 && d <= 1.0)) {
+                drift_log(ctx, DRIFT_LOG_WARNING, DRIFT_ERR_INVALID_ARGUMENT, path, number,
+                          "material '%s': %s %s is not in [0, 1]; %s", m->name, tr ? "Tr" : "d",
+                          arg, d < 0.0 ? "transparent" : "opaque");
+                d = d < 0.0 ? 0.0 : 1.0;
+            }
+            m->dissolve = (float)d;
+        } else if (statement(line, "map_d", &arg)) {
+            snprintf(m->map_d, sizeof m->map_d, "%s", texture_file(arg));
+            m->map_d_line = number;
         } else {
             for (size_t k = 0; k < sizeof dropped / sizeof dropped[0]; ++k) {
                 if (statement(line, dropped[k].key, &arg)) {

@@ -3,6 +3,7 @@
 #include "drift/points.h"
 
 #include <math.h>
+#include <stdatomic.h>
 #include <string.h>
 
 drift_points_desc drift_points_desc_resolve(const drift_points_desc *desc)
@@ -50,6 +51,8 @@ typedef struct sample_job {
     uint32_t guides;
     uint32_t total;
     uint32_t key;
+    bool partial;             // some material is not opaque: points are tested for coverage
+    _Atomic uint64_t *misses; // first draws that fell where no surface is
 } sample_job;
 
 // The subset of point i: begin(s) = floor(count * s / subset_count) <= i < begin(s + 1).
@@ -78,6 +81,41 @@ static double unit_of(uint32_t h)
 #define R2_A2 0.5698402909980532
 
 // Points k0 .. k1 - 1 of subset s (points first .. first + n - 1).
+// The point at u in the area CDF and (x, y) in the unit square.
+static drift_scene_point draw_point(const sample_job *job, double u, double x, double y)
+{
+    // The guide table narrows the search to the triangles whose CDF interval meets u's
+    // 1 / guides cell (the cutpoint method): O(1) reads on average, not log2(total) cache
+    // misses.
+    uint32_t j = (uint32_t)(u * (double)job->guides);
+    j = j < job->guides ? j : job->guides - 1;
+    uint32_t lo = job->guide[j], hi = job->guide[j + 1] + 1;
+    hi = hi < job->total ? hi : job->total;
+    while (hi - lo > 1) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (job->cdf[mid] <= u) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    while (lo + 1 < job->total && !(job->cdf[lo + 1] > job->cdf[lo])) {
+        lo++;
+    }
+    drift_vec2 b = drift_sample_triangle(
+        drift_vec2_make(fminf((float)x, 0x1.fffffep-1f), fminf((float)y, 0x1.fffffep-1f)));
+    uint32_t mesh = job->mesh_of[lo];
+    return (
+        drift_scene_point){ .mesh = mesh, .triangle = lo - job->first[mesh], .b1 = b.x, .b2 = b.y };
+}
+
+static bool point_covered(const sample_job *job, const drift_scene_point *p, uint32_t h)
+{
+    return drift_scene_covers(job->scene, p->mesh, p->triangle, p->b1, p->b2,
+                              (float)unit_of(drift_hash_u32(h ^ 0x5bd1e995u)));
+}
+
+// Points k0 .. k1 - 1 of subset s (points first .. first + n - 1).
 static void sample_subset(const sample_job *job, uint32_t s, uint64_t first, uint64_t n,
                           uint64_t k0, uint64_t k1)
 {
@@ -85,36 +123,33 @@ static void sample_subset(const sample_job *job, uint32_t s, uint64_t first, uin
     double shift = unit_of(h);
     double x0 = unit_of(drift_hash_u32(h ^ 0x68bc21ebu));
     double y0 = unit_of(drift_hash_u32(h ^ 0x02e5be93u));
+    uint64_t misses = 0;
     for (uint64_t k = k0; k < k1; ++k) {
         double u = ((double)k + 0.5) / (double)n + shift;
         u -= floor(u);
-        // The guide table narrows the search to the triangles whose CDF interval meets
-        // u's 1 / guides cell (the cutpoint method): O(1) reads on average, not log2(total)
-        // cache misses.
-        uint32_t j = (uint32_t)(u * (double)job->guides);
-        j = j < job->guides ? j : job->guides - 1;
-        uint32_t lo = job->guide[j], hi = job->guide[j + 1] + 1;
-        hi = hi < job->total ? hi : job->total;
-        while (hi - lo > 1) {
-            uint32_t mid = lo + (hi - lo) / 2;
-            if (job->cdf[mid] <= u) {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        while (lo + 1 < job->total && !(job->cdf[lo + 1] > job->cdf[lo])) {
-            lo++;
-        }
         double x = x0 + (double)k * R2_A1, y = y0 + (double)k * R2_A2;
         x -= floor(x);
         y -= floor(y);
-        drift_vec2 b = drift_sample_triangle(
-            drift_vec2_make(fminf((float)x, 0x1.fffffep-1f), fminf((float)y, 0x1.fffffep-1f)));
-        uint32_t mesh = job->mesh_of[lo];
-        job->points->points[first + k] = (drift_scene_point){
-            .mesh = mesh, .triangle = lo - job->first[mesh], .b1 = b.x, .b2 = b.y
-        };
+        drift_scene_point p = draw_point(job, u, x, y);
+        uint32_t hk = drift_hash_combine(h, (uint32_t)k);
+        if (job->partial && !point_covered(job, &p, hk)) {
+            // Drawn again at random (the stratification is kept by the points that were
+            // there); after 16 misses the point stays where it fell.
+            ++misses;
+            for (uint32_t a = 1; a < 16; ++a) {
+                uint32_t ha = drift_hash_combine(hk, a);
+                p = draw_point(job, unit_of(drift_hash_u32(ha)),
+                               unit_of(drift_hash_u32(ha ^ 0x68bc21ebu)),
+                               unit_of(drift_hash_u32(ha ^ 0x02e5be93u)));
+                if (point_covered(job, &p, ha)) {
+                    break;
+                }
+            }
+        }
+        job->points->points[first + k] = p;
+    }
+    if (misses > 0) {
+        atomic_fetch_add(job->misses, misses);
     }
 }
 
@@ -171,6 +206,7 @@ drift_result drift_points_create(drift_context *ctx, const drift_scene *scene,
         pts->count = d.count;
         pts->subset_count = d.subset_count;
         pts->skip_emissive = d.skip_emissive;
+        pts->coverage = 1.0;
         pts->points = drift_alloc(ctx, (size_t)d.count * sizeof *pts->points);
         pts->position = drift_alloc(ctx, (size_t)d.count * sizeof *pts->position);
         pts->normal = drift_alloc(ctx, (size_t)d.count * sizeof *pts->normal);
@@ -216,14 +252,29 @@ drift_result drift_points_create(drift_context *ctx, const drift_scene *scene,
                 }
                 guide[j] = i;
             }
-            sample_job job = { pts,     scene, cdf,
-                               mesh_of, first, guide,
-                               guides,  total, drift_hash_combine(d.seed, DRIFT_POINTS_STREAM) };
+            _Atomic uint64_t misses = 0;
+            bool partial = false;
+            for (uint32_t m = 0; m < scene->material_count; ++m) {
+                partial |= scene->materials[m].alpha_mode != DRIFT_ALPHA_OPAQUE;
+            }
+            sample_job job = { .points = pts,
+                               .scene = scene,
+                               .cdf = cdf,
+                               .mesh_of = mesh_of,
+                               .first = first,
+                               .guide = guide,
+                               .guides = guides,
+                               .total = total,
+                               .key = drift_hash_combine(d.seed, DRIFT_POINTS_STREAM),
+                               .partial = partial,
+                               .misses = &misses };
             if (d.subset_count >= 64) {
                 drift_parallel_for(ctx, d.subset_count, 16, sample_subsets, &job);
             } else {
                 drift_parallel_for(ctx, d.count, 4096, sample_range, &job);
             }
+            // The share of the sampled area where a surface is: the first draws that hit it.
+            pts->coverage = 1.0 - (double)atomic_load(&misses) / (double)d.count;
             result = drift_points_update(pts, scene);
             drift_free(ctx, guide);
         }
@@ -305,7 +356,7 @@ drift_result drift_points_update_range(drift_points *points, const drift_scene *
             area += (double)triangle_area(&scene->meshes[m], t);
         }
     }
-    points->area = area;
+    points->area = area * points->coverage;
     update_job job = { points, scene, first };
     drift_parallel_for(points->ctx, count, 4096, update_range, &job);
     return DRIFT_OK;

@@ -230,7 +230,10 @@ drift_material drift_material_make(drift_vec3 diffuse)
                                       .emissive_texture = DRIFT_INVALID_INDEX,
                                       .occlusion_texture = DRIFT_INVALID_INDEX,
                                       .clearcoat_texture = DRIFT_INVALID_INDEX,
-                                      .clearcoat_roughness_texture = DRIFT_INVALID_INDEX } };
+                                      .clearcoat_roughness_texture = DRIFT_INVALID_INDEX },
+                             .alpha_cutoff = 0.5f,
+                             .opacity = 1.0f,
+                             .opacity_texture = DRIFT_INVALID_INDEX };
 }
 
 static bool vec3_is_nonnegative_finite(drift_vec3 v)
@@ -265,7 +268,9 @@ drift_result drift_scene_add_material(drift_scene *scene, const drift_material *
         (unsigned)m.type >= DRIFT_MATERIAL_COUNT ||
         (unsigned)m.diffuse_model > DRIFT_DIFFUSE_BURLEY ||
         !(m.diffuse_roughness >= 0.0f && m.diffuse_roughness <= 1.0f) ||
-        !ggx_params_valid(&m.ggx)) {
+        !ggx_params_valid(&m.ggx) || (unsigned)m.alpha_mode >= DRIFT_ALPHA_MODE_COUNT ||
+        (m.alpha_mode != DRIFT_ALPHA_OPAQUE &&
+         (!unit_range(m.opacity) || !unit_range(m.alpha_cutoff)))) {
         drift_log(scene->ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, m.name, 0,
                   "material has a negative, non-finite or out-of-range value");
         return DRIFT_ERR_INVALID_ARGUMENT;
@@ -537,6 +542,13 @@ drift_result drift_scene_commit(drift_scene *scene)
             m->diffuse_texture >= scene->texture_count) {
             drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, m->name, 0,
                       "texture %u out of range (scene has %u)", m->diffuse_texture,
+                      scene->texture_count);
+            return DRIFT_ERR_INVALID_ARGUMENT;
+        }
+        if (m->alpha_mode != DRIFT_ALPHA_OPAQUE && m->opacity_texture != DRIFT_INVALID_INDEX &&
+            m->opacity_texture >= scene->texture_count) {
+            drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, m->name, 0,
+                      "opacity texture %u out of range (scene has %u)", m->opacity_texture,
                       scene->texture_count);
             return DRIFT_ERR_INVALID_ARGUMENT;
         }

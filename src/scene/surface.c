@@ -164,3 +164,35 @@ drift_vec3 drift_offset_origin(drift_vec3 position, drift_vec3 ng, drift_vec3 di
     drift_vec3 n = drift_vec3_dot(ng, dir) < 0.0f ? drift_vec3_neg(ng) : ng;
     return drift_vec3_fma(position, n, eps);
 }
+
+float drift_scene_opacity(const drift_scene *scene, uint32_t mesh_index, uint32_t prim, float u,
+                          float v)
+{
+    const drift_mesh *mesh = &scene->meshes[mesh_index];
+    const drift_material *m = &scene->materials[mesh->material];
+    float opacity = m->opacity;
+    if (m->opacity_texture != DRIFT_INVALID_INDEX) {
+        // Level 0 at the hit's uv, as the base colour's texture reads it (its uv set,
+        // transform, wrap and filter): a cut-out's edge is where the artist painted it.
+        const drift_texture_map *map = &m->maps[DRIFT_TEXTURE_BASE];
+        const uint32_t *tri = &mesh->indices[3 * (size_t)prim];
+        const float *uvs = map->uv_set == 1 && mesh->uvs1 ? mesh->uvs1 : mesh->uvs;
+        drift_vec2 uv = uvs ? lerp_uv(uvs, tri, u, v) : drift_vec2_make(u, v);
+        opacity *= drift__texture_sample(scene, m->opacity_texture, map, uv, 0.0f).x;
+    }
+    return drift_clampf(opacity, 0.0f, 1.0f);
+}
+
+bool drift_scene_covers(const drift_scene *scene, uint32_t mesh, uint32_t prim, float u, float v,
+                        float xi)
+{
+    const drift_material *m = &scene->materials[scene->meshes[mesh].material];
+    switch (m->alpha_mode) {
+    case DRIFT_ALPHA_MASK:
+        return drift_scene_opacity(scene, mesh, prim, u, v) >= m->alpha_cutoff;
+    case DRIFT_ALPHA_BLEND:
+        return xi < drift_scene_opacity(scene, mesh, prim, u, v);
+    default:
+        return true;
+    }
+}
