@@ -284,6 +284,9 @@ typedef struct drift_mesh {
     // sign w with bitangent = w cross(n, t)): the file's (glTF TANGENT), or computed by commit
     // for normal-mapped meshes with normals and uvs (docs/materials.md); else NULL.
     float *tangents;
+    // 3 floats a vertex: linear RGB multiplying the material's base colour (glTF COLOR_0, as
+    // the spec and Blender's importer apply it), or NULL.
+    float *colors;
     uint32_t *indices; // 3 a triangle
     uint32_t vertex_count;
     uint32_t triangle_count;
@@ -306,6 +309,7 @@ typedef struct drift_mesh_desc {
     uint32_t material;
     const float *uvs1;     // optional second uv set
     const float *tangents; // optional, 4 floats a vertex (see drift_mesh)
+    const float *colors;   // optional, 3 floats a vertex (see drift_mesh)
 } drift_mesh_desc;
 
 // --- ENVIRONMENT ---

@@ -310,10 +310,14 @@ static drift_result add_mesh(import_state *s, const struct aiMesh *mesh, const d
     float *uvs = uv_source ? drift_alloc(ctx, nv * 2 * sizeof(float)) : NULL;
     float *uvs1 = uv1_source ? drift_alloc(ctx, nv * 2 * sizeof(float)) : NULL;
     float *tangents = keep_tangents ? drift_alloc(ctx, nv * 4 * sizeof(float)) : NULL;
+    // glTF COLOR_0 (linear, multiplying the base colour); other formats' vertex colours have no
+    // one meaning (a PLY scan's are sRGB bytes, often unused by its material) and are left out.
+    const struct aiColor4D *color_source = s->is_gltf ? mesh->mColors[0] : NULL;
+    float *colors = color_source ? drift_alloc(ctx, nv * 3 * sizeof(float)) : NULL;
     uint32_t *indices = drift_alloc(ctx, (size_t)tri_count * 3 * sizeof(uint32_t));
     drift_result r = DRIFT_OK;
     if (!positions || !indices || (keep_normals && !normals) || (uv_source && !uvs) ||
-        (uv1_source && !uvs1) || (keep_tangents && !tangents)) {
+        (uv1_source && !uvs1) || (keep_tangents && !tangents) || (color_source && !colors)) {
         r = DRIFT_ERR_OUT_OF_MEMORY;
         goto done;
     }
@@ -338,6 +342,12 @@ static drift_result add_mesh(import_state *s, const struct aiMesh *mesh, const d
         if (uvs) {
             uvs[2 * v] = uv_source[v].x;
             uvs[2 * v + 1] = uv_source[v].y;
+        }
+        if (colors) {
+            const struct aiColor4D *c = &color_source[v];
+            colors[3 * v] = isfinite(c->r) ? fmaxf(c->r, 0.0f) : 1.0f;
+            colors[3 * v + 1] = isfinite(c->g) ? fmaxf(c->g, 0.0f) : 1.0f;
+            colors[3 * v + 2] = isfinite(c->b) ? fmaxf(c->b, 0.0f) : 1.0f;
         }
         if (uvs1) {
             uvs1[2 * v] = uv1_source[v].x;
@@ -400,6 +410,7 @@ static drift_result add_mesh(import_state *s, const struct aiMesh *mesh, const d
                              .uvs = uvs,
                              .uvs1 = uvs1,
                              .tangents = tangents,
+                             .colors = colors,
                              .indices = indices,
                              .vertex_count = (uint32_t)nv,
                              .triangle_count = tri_count,
@@ -418,6 +429,7 @@ done:
     drift_free(ctx, normals);
     drift_free(ctx, uvs);
     drift_free(ctx, uvs1);
+    drift_free(ctx, colors);
     drift_free(ctx, tangents);
     drift_free(ctx, indices);
     return r;

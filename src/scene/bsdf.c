@@ -191,6 +191,17 @@ static void make_ggx(const drift_scene *scene, const drift_material *m,
                                 &b->exponent);
 }
 
+// The mesh's vertex colour at the surface's point (its barycentrics on its triangle).
+static drift_vec3 vertex_color(const drift_mesh *mesh, const drift_surface *surface)
+{
+    const uint32_t *tri = &mesh->indices[3 * (size_t)surface->triangle];
+    float u = surface->barycentric.x, v = surface->barycentric.y, w = 1.0f - u - v;
+    const float *a = &mesh->colors[3 * (size_t)tri[0]], *b = &mesh->colors[3 * (size_t)tri[1]],
+                *c = &mesh->colors[3 * (size_t)tri[2]];
+    return drift_vec3_make(w * a[0] + u * b[0] + v * c[0], w * a[1] + u * b[1] + v * c[1],
+                           w * a[2] + u * b[2] + v * c[2]);
+}
+
 drift_bsdf drift_bsdf_make(const drift_scene *scene, const drift_surface *surface)
 {
     const drift_material *m = &scene->materials[surface->material];
@@ -205,6 +216,12 @@ drift_bsdf drift_bsdf_make(const drift_scene *scene, const drift_surface *surfac
     if (m->diffuse_texture != DRIFT_INVALID_INDEX) {
         b.diffuse = drift_vec3_mul(b.diffuse,
                                    drift_material_texture(scene, m, DRIFT_TEXTURE_BASE, surface));
+    }
+    const drift_mesh *mesh =
+        surface->mesh < scene->mesh_count ? &scene->meshes[surface->mesh] : NULL;
+    if (mesh && mesh->colors && mesh->material == surface->material &&
+        surface->triangle < mesh->triangle_count) {
+        b.diffuse = drift_vec3_mul(b.diffuse, vertex_color(mesh, surface));
     }
     if (m->type == DRIFT_MATERIAL_GGX) {
         make_ggx(scene, m, surface, &b);

@@ -33,6 +33,7 @@ static void free_mesh(drift_context *ctx, drift_mesh *mesh)
     drift_free(ctx, mesh->normals);
     drift_free(ctx, mesh->uvs);
     drift_free(ctx, mesh->uvs1);
+    drift_free(ctx, mesh->colors);
     drift_free(ctx, mesh->tangents);
     drift_free(ctx, mesh->indices);
 }
@@ -165,9 +166,13 @@ drift_result drift_scene_add_mesh(drift_scene *scene, const drift_mesh_desc *des
         mesh.tangents =
             copy_array(ctx, desc->tangents, (size_t)desc->vertex_count * 4, sizeof(float), 0);
     }
+    if (desc->colors) {
+        mesh.colors =
+            copy_array(ctx, desc->colors, (size_t)desc->vertex_count * 3, sizeof(float), 0);
+    }
     if (!mesh.positions || !mesh.indices || (desc->normals && !mesh.normals) ||
         (desc->uvs && !mesh.uvs) || (desc->uvs1 && !mesh.uvs1) ||
-        (desc->tangents && !mesh.tangents)) {
+        (desc->tangents && !mesh.tangents) || (desc->colors && !mesh.colors)) {
         free_mesh(ctx, &mesh);
         return DRIFT_ERR_OUT_OF_MEMORY;
     }
