@@ -528,6 +528,14 @@ static void set_camera(import_state *s, const struct aiCamera *cam, const drift_
     if (!(fov_y > 0.0f && fov_y < DRIFT_PI)) {
         fov_y = 45.0f * DRIFT_PI / 180.0f;
     }
+    if (cam->mOrthographicWidth > 0.0f) {
+        // drift's cameras are perspective (thin lens); every technique projects that way.
+        drift_log(s->ctx, DRIFT_LOG_WARNING, DRIFT_ERR_UNSUPPORTED, s->where, s->line,
+                  "'%s': camera '%s' is orthographic (half width %g); drawn as a perspective "
+                  "camera of %.0f degrees from the same place",
+                  s->params->path, cam->mName.data, (double)cam->mOrthographicWidth,
+                  (double)(fov_y * 180.0f / DRIFT_PI));
+    }
     drift_vec3 eye = drift__mat4_point(world, local_eye);
     drift_vec3 look = drift_vec3_normalize(drift__mat4_vector(world, local_look));
     drift_vec3 up = drift_vec3_normalize(drift__mat4_vector(world, local_up));
