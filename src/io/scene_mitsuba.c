@@ -3,6 +3,7 @@
 // with expat into a small element tree and then mapped onto drift's scene (the mapping table
 // is in docs/scene-format.md). Unsupported elements are named in a warning with their line;
 // malformed XML, unknown shape types and bad values are errors naming the file and line.
+#include "drift/image_io.h"
 #include "scene_io_internal.h"
 #include "scene_mitsuba_xml.h"
 
@@ -389,6 +390,41 @@ static drift_result diffuse_texture(mitsuba_state *s, const xml_node *bsdf, cons
     return DRIFT_OK;
 }
 
+// A mask's `opacity`: <float value> in [0, 1], or <texture type="bitmap"> whose grey value
+// (its alpha where it has one) is the opacity; a bitmap that cannot be read is a warning and
+// leaves the surface opaque.
+static drift_result mask_opacity(mitsuba_state *s, const xml_node *b, drift_material *m)
+{
+    const xml_node *p = property(b, "opacity");
+    m->alpha_mode = DRIFT_ALPHA_BLEND;
+    m->opacity = 0.5f; // Mitsuba's default
+    if (p && strcmp(p->name, "texture") == 0) {
+        const xml_node *file = property(p, "filename");
+        const char *rel = file ? attr(file, "value") : NULL;
+        char full[DRIFT__PATH_MAX];
+        size_t size = 0;
+        drift_image image = { 0 };
+        drift_result r =
+            rel && drift__path_join(s->dir, rel, full, sizeof full) ? DRIFT_OK : DRIFT_ERR_IO;
+        r = r ? r : drift__check_file(s->ctx, full, s->path, p->line, &size);
+        r = r ? r : drift_image_load_alpha(s->ctx, full, DRIFT_ALPHA_OR_GREY, &image);
+        r = r ? r : drift_scene_add_texture(s->scene, image, &m->opacity_texture);
+        if (r != DRIFT_OK) {
+            drift_log(s->ctx, DRIFT_LOG_WARNING, r, s->path, p->line,
+                      "mask opacity '%s' not loaded; drawn opaque", rel ? rel : "(no filename)");
+            m->alpha_mode = DRIFT_ALPHA_OPAQUE;
+            m->opacity_texture = DRIFT_INVALID_INDEX;
+        }
+        m->opacity = 1.0f;
+        return DRIFT_OK;
+    }
+    drift_result r = read_float(s, b, "opacity", 0.5f, &m->opacity);
+    if (r == DRIFT_OK && !(m->opacity >= 0.0f && m->opacity <= 1.0f)) {
+        return fail(s, p, DRIFT_ERR_PARSE, "mask opacity is not in [0, 1]", NULL);
+    }
+    return r;
+}
+
 // A <bsdf> onto a drift material (docs/scene-format.md, Mitsuba mapping).
 static drift_result convert_bsdf(mitsuba_state *s, const xml_node *b, const char *name,
                                  drift_material *m)
@@ -396,6 +432,22 @@ static drift_result convert_bsdf(mitsuba_state *s, const xml_node *b, const char
     const char *type = attr(b, "type");
     if (!type) {
         return fail(s, b, DRIFT_ERR_PARSE, "<bsdf> without a type", NULL);
+    }
+    if (strcmp(type, "mask") == 0) {
+        // Mitsuba's mask blends the nested BSDF with a transparent one by `opacity` (a number,
+        // or a bitmap's grey): drift's stochastic coverage (DRIFT_ALPHA_BLEND).
+        const xml_node *inner = NULL;
+        for (const xml_node *c = b->first; c && !inner; c = c->next) {
+            inner = strcmp(c->name, "bsdf") == 0 ? c : NULL;
+        }
+        if (!inner) {
+            return fail(s, b, DRIFT_ERR_PARSE, "mask <bsdf> holds no <bsdf>", NULL);
+        }
+        drift_result r = convert_bsdf(s, inner, name, m);
+        if (r != DRIFT_OK) {
+            return r;
+        }
+        return mask_opacity(s, b, m);
     }
     if (strcmp(type, "twosided") == 0) {
         // drift shades both sides of a surface alike already.
@@ -511,8 +563,9 @@ static drift_result add_bsdf(mitsuba_state *s, const xml_node *b, uint32_t *out_
 }
 
 // Adds a triangle mesh from local positions under `world`.
+// uvs: 2 a vertex (origin at the bottom left, as Mitsuba's and OBJ's), or NULL.
 static drift_result add_triangles(mitsuba_state *s, const xml_node *n, const char *name,
-                                  const float *local, uint32_t vertex_count,
+                                  const float *local, const float *uvs, uint32_t vertex_count,
                                   const uint32_t *indices, uint32_t triangle_count,
                                   const drift__mat4 *world, uint32_t material)
 {
@@ -529,6 +582,7 @@ static drift_result add_triangles(mitsuba_state *s, const xml_node *n, const cha
     }
     drift_mesh_desc desc = { .name = name,
                              .positions = positions,
+                             .uvs = uvs,
                              .indices = indices,
                              .vertex_count = vertex_count,
                              .triangle_count = triangle_count,
@@ -624,8 +678,9 @@ static drift_result read_shape(mitsuba_state *s, const xml_node *n)
     }
     if (strcmp(type, "rectangle") == 0) {
         static const float quad[] = { -1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0 };
+        static const float quad_uv[] = { 0, 0, 1, 0, 1, 1, 0, 1 }; // Mitsuba's rectangle's
         static const uint32_t tris[] = { 0, 1, 2, 0, 2, 3 };
-        return add_triangles(s, n, name, quad, 4, tris, 2, &world, material);
+        return add_triangles(s, n, name, quad, quad_uv, 4, tris, 2, &world, material);
     }
     if (strcmp(type, "cube") == 0) {
         float v[24];
@@ -637,7 +692,7 @@ static drift_result read_shape(mitsuba_state *s, const xml_node *n)
         // Outward-facing (counter-clockwise seen from outside).
         static const uint32_t tris[] = { 0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6, 0, 1, 5, 0, 5, 4,
                                          2, 6, 7, 2, 7, 3, 0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5 };
-        return add_triangles(s, n, name, v, 8, tris, 12, &world, material);
+        return add_triangles(s, n, name, v, NULL, 8, tris, 12, &world, material);
     }
     if (strcmp(type, "sphere") == 0) {
         drift_vec3 center = drift_vec3_splat(0.0f);
@@ -699,7 +754,7 @@ static drift_result read_shape(mitsuba_state *s, const xml_node *n)
             }
         }
         drift__mat4 identity = drift__mat4_identity();
-        return add_triangles(s, n, name, v, (SEG + 1) * (RINGS + 1), tris, t / 3, &identity,
+        return add_triangles(s, n, name, v, NULL, (SEG + 1) * (RINGS + 1), tris, t / 3, &identity,
                              material);
     }
     return fail(s, n, DRIFT_ERR_UNSUPPORTED,

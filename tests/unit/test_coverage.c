@@ -159,6 +159,51 @@ static void test_obj_dissolve(void **state)
     drift_context_destroy(ctx);
 }
 
+// Mitsuba's mask BSDF: opacity a number (BLEND of that opacity over the nested BSDF) or a
+// bitmap (its grey or alpha: alpha.png's, read along the rectangle's u as Mitsuba lays it out).
+static void test_mitsuba_mask(void **state)
+{
+    (void)state;
+    test_log_capture log = { 0 };
+    drift_context *ctx = test_context(1, &log);
+    char xml[1024], png[1024];
+    test_out_path(xml, "coverage_mask.xml");
+    test_repo_path(png, "tests/data/coverage/alpha.png");
+    FILE *f = fopen(xml, "w");
+    assert_non_null(f);
+    fprintf(f,
+            "<scene version=\"0.6.0\">\n"
+            " <bsdf type=\"mask\" id=\"leaf\">\n"
+            "  <texture name=\"opacity\" type=\"bitmap\">"
+            "<string name=\"filename\" value=\"%s\"/></texture>\n"
+            "  <bsdf type=\"diffuse\"><rgb name=\"reflectance\" value=\"0.1, 0.6, 0.1\"/></bsdf>\n"
+            " </bsdf>\n"
+            " <bsdf type=\"mask\" id=\"veil\"><float name=\"opacity\" value=\"0.3\"/>"
+            "<bsdf type=\"diffuse\"/></bsdf>\n"
+            " <shape type=\"rectangle\"><ref id=\"leaf\"/></shape>\n"
+            " <shape type=\"rectangle\"><transform name=\"toWorld\"><translate z=\"-1\"/>"
+            "</transform><ref id=\"veil\"/></shape>\n"
+            "</scene>\n",
+            png);
+    fclose(f);
+    drift_scene *scene = NULL;
+    assert_int_equal(drift_scene_load(ctx, xml, &scene), DRIFT_OK);
+    const drift_material *leaf = &scene->materials[scene->meshes[0].material];
+    const drift_material *veil = &scene->materials[scene->meshes[1].material];
+    assert_int_equal(leaf->alpha_mode, DRIFT_ALPHA_BLEND);
+    assert_true(leaf->opacity_texture < scene->texture_count);
+    assert_near(leaf->diffuse.y, 0.6, 1e-6); // the nested BSDF's
+    assert_int_equal(veil->alpha_mode, DRIFT_ALPHA_BLEND);
+    assert_near(veil->opacity, 0.3, 1e-6);
+    // The bitmap along x (u), at texel centres on the bottom edge (triangle 0's barycentric u
+    // is the rectangle's u there): opacity 0 at the left texel, 0.5 and 1 further right.
+    assert_near(drift_scene_opacity(scene, 0, 0, 0.125f, 0.0f), 0.0, 1e-6);
+    assert_near(drift_scene_opacity(scene, 0, 0, 0.375f, 0.0f), 128.0 / 255.0, 1e-6);
+    assert_near(drift_scene_opacity(scene, 0, 0, 0.875f, 0.0f), 1.0, 1e-6);
+    drift_scene_destroy(scene);
+    drift_context_destroy(ctx);
+}
+
 // A quad in z = z0 facing +z, uv (0, 0) at its bottom-left corner, of `material`.
 static uint32_t add_card(drift_scene *scene, float half, float z0, uint32_t material)
 {
@@ -342,6 +387,7 @@ int main(void)
         cmocka_unit_test(test_alpha_channel_loads),
         cmocka_unit_test(test_gltf_alpha_modes),
         cmocka_unit_test(test_obj_dissolve),
+        cmocka_unit_test(test_mitsuba_mask),
         cmocka_unit_test(test_mask_rays),
         cmocka_unit_test(test_blend_stops_its_share),
         cmocka_unit_test(test_pt_sees_through_veil),
