@@ -12,6 +12,12 @@ not run on the scene: 4). (2) The judge scenes' figures, reported, not used to c
 judge scene's picks by a model fitted on the fit scenes (train fit) and on every other scene
 (train all). The variant of the lowest selection score is the one to ship; the judge columns
 say how it does on scenes it was not chosen on.
+
+--guided off|all|direct: which hybrid+pt rows every variant may pick (fit_table.py --guided).
+--baseline ROWS: one more row first, a model fitted on ROWS' fit scenes (the shipped model's
+rows; its quality parameters --baseline-prior, k 2, idw, probe, guided off, as shipped since
+session 5) judged on these rows' judge scenes: the shipped model against a refit on the same
+rows (its fit-scene columns are not leave-one-out, so it has no selection score).
 """
 import argparse
 import math
@@ -95,6 +101,9 @@ def main():
     a.add_argument("--pt-margin", type=float, default=0.9)
     a.add_argument("--drift", default="build/release/bin/drift")
     a.add_argument("--only", help="the variants whose names contain this")
+    a.add_argument("--guided", choices=("off", "all", "direct"), default="off")
+    a.add_argument("--baseline", help="rows the shipped model was fitted on")
+    a.add_argument("--baseline-prior", type=float, default=1.0)
     o = a.parse_args()
     budgets = [float(b) for b in o.budgets.split(",")]
     scenes = ft.load(o.rows, o.drift)
@@ -103,12 +112,21 @@ def main():
     is_fit = lambda s: os.path.realpath(s["path"]) in fit_set or s["name"] in names
     fit_scenes = [s for s in scenes if is_fit(s)]
     judge = [s for s in scenes if not is_fit(s)]
-    print("%s: %d fit scenes, %d judge scenes; cell = median/worst regret, cells <= 1.1x best "
-          "pt, cells within budget (of %d)\n" % (os.path.basename(o.rows), len(fit_scenes),
-                                                  len(judge), len(judge)))
+    print("%s: %d fit scenes, %d judge scenes, --guided %s; cell = median/worst regret, cells "
+          "<= 1.1x best pt, cells within budget (of %d)\n" % (
+              os.path.basename(o.rows), len(fit_scenes), len(judge), o.guided, len(judge)))
     head = " | ".join("%g ms" % b for b in budgets)
     print("| variant | selection score (fit LOSO) | fit: median eff. regret | train | " + head + " |")
     print("|---|---|---|---|" + "---|" * len(budgets))
+    if o.baseline:
+        ft.set_guided("off")
+        base = [s for s in ft.load(o.baseline, o.drift) if is_fit(s)]
+        model = ft.fit(base, {"prior": o.baseline_prior})
+        cells = [c for s in judge for c in ft.scene_cells(model, s, False, budgets, o.pt_margin, True)]
+        print("| baseline: fitted on %s (%d fit scenes), prior %g, probe | | | fit | %s |" % (
+            os.path.basename(o.baseline), len(base), o.baseline_prior,
+            " | ".join(row(cells, budgets, "judge"))))
+    ft.set_guided(o.guided)
     for name, qp, probe in VARIANTS:
         if o.only and o.only not in name:
             continue

@@ -83,6 +83,16 @@ def pickable(key):
     return key[0] in PICKABLE and "joint-bilateral" not in key[1]
 
 
+def set_guided(mode):
+    """Which hybrid+pt rows are candidates: "off" (none), "all" (the three guides' split rows)
+    or "direct" (the direct guide's); the fit and the pick read PICKABLE and GUIDED_ROW."""
+    global GUIDED_ROW
+    PICKABLE.discard(GUIDED)
+    if mode != "off":
+        PICKABLE.add(GUIDED)
+    GUIDED_ROW = re.compile(GUIDED_ROWS["all" if mode == "off" else mode])
+
+
 def guided_parts(key):
     """(guide, the path tracer's row it adds) of a hybrid+pt row: guide "" (the default hybrid
     frame), "cheap " or "direct "; (None, None) for any other row."""
@@ -494,24 +504,30 @@ def loso(scenes, is_fit, budgets, pt_margin, train_all, qp=None, probe=False):
     cells = []
     for s in scenes:
         train = [t for t in scenes if t is not s and (train_all or is_fit(t))]
-        model = fit(train, qp)
-        scale = probe_scale(model, s) if probe is True else None
-        oracle = s["rows"] if probe == "oracle" else None
-        for b in budgets:
-            key, pms, _, why = choose(model, s["features"], b, pt_margin, scale, oracle)
-            ms, f = lookup(s["rows"], key)
-            top, topkey = best_within(s["rows"], b)
-            pt, _ = best_within(s["rows"], b, PT_FAMILIES)
-            plain, _ = best_within(s["rows"], b, {"pt"})
-            den, _ = best_within(s["rows"], b, {"pt+denoise"})
-            cells.append({"scene": s["name"], "fit": is_fit(s), "budget": b, "key": key, "why": why,
-                          "pred_ms": pms, "ms": ms, "flip": f, "best": top, "best_key": topkey,
-                          "best_pt": pt,
-                          # within the budget (measured) and closer than the best plain path
-                          # tracer and the best pt+denoise within it (where none fits: beaten)
-                          "beats_pt": ms <= b and f < (plain or math.inf) and f < (den or math.inf),
-                          "regret": f / top if top and f < math.inf else math.inf,
-                          "vs_pt": f / pt if pt and f < math.inf else math.inf})
+        cells += scene_cells(fit(train, qp), s, is_fit(s), budgets, pt_margin, probe)
+    return cells
+
+
+def scene_cells(model, s, role_fit, budgets, pt_margin, probe=False):
+    """One scene's cells, each budget's pick by `model` scored on the scene's measured rows."""
+    cells = []
+    scale = probe_scale(model, s) if probe is True else None
+    oracle = s["rows"] if probe == "oracle" else None
+    for b in budgets:
+        key, pms, _, why = choose(model, s["features"], b, pt_margin, scale, oracle)
+        ms, f = lookup(s["rows"], key)
+        top, topkey = best_within(s["rows"], b)
+        pt, _ = best_within(s["rows"], b, PT_FAMILIES)
+        plain, _ = best_within(s["rows"], b, {"pt"})
+        den, _ = best_within(s["rows"], b, {"pt+denoise"})
+        cells.append({"scene": s["name"], "fit": role_fit, "budget": b, "key": key, "why": why,
+                      "pred_ms": pms, "ms": ms, "flip": f, "best": top, "best_key": topkey,
+                      "best_pt": pt,
+                      # within the budget (measured) and closer than the best plain path
+                      # tracer and the best pt+denoise within it (where none fits: beaten)
+                      "beats_pt": ms <= b and f < (plain or math.inf) and f < (den or math.inf),
+                      "regret": f / top if top and f < math.inf else math.inf,
+                      "vs_pt": f / pt if pt and f < math.inf else math.inf})
     return cells
 
 
@@ -610,10 +626,7 @@ def main():
                         "default: a judge scene's pick is the shipped model's) or every other "
                         "scene (all); --model is fitted likewise")
     o = a.parse_args()
-    global GUIDED_ROW
-    if o.guided != "off":
-        PICKABLE.add(GUIDED)
-        GUIDED_ROW = re.compile(GUIDED_ROWS[o.guided])
+    set_guided(o.guided)
     budgets = [float(b) for b in o.budgets.split(",")]
     scenes = load(o.rows, o.drift)
     fit_set = {os.path.realpath(l.strip()) for l in open(o.fit) if l.strip() and not l.startswith("#")}
