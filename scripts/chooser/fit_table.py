@@ -70,7 +70,7 @@ RIDGE = 0.1
 # quantile. These defaults are session 2's chooser.
 QUALITY = {"k": 2, "kernel": "idw", "bandwidth": 1.0, "prior": 0.0, "kappa": 0.0,
            "robust": False, "safety_quantile": SAFETY_QUANTILE, "hybrid_quantile": None,
-           "norm": "best"}
+           "norm": "best", "probe_safety": None}
 
 
 def key_text(key):
@@ -323,10 +323,15 @@ def fit(train, qp=None):
     """The model fitted on `train`: the cost model, the features' scales, each scene's FLIP
     ratios and each candidate's prior (mean and variance of its log ratio over the scenes)."""
     qp = dict(QUALITY, **(qp or {}))
-    memo = (tuple(s["name"] for s in train), qp["safety_quantile"], qp["hybrid_quantile"])
+    # Keyed by the scenes' objects (two rows files hold scenes of the same names) and the
+    # candidates (--guided).
+    memo = (tuple(id(s) for s in train), qp["safety_quantile"], qp["hybrid_quantile"],
+            GUIDED in PICKABLE, GUIDED_ROW.pattern)
     if memo not in _COST:  # the same training scenes' cost model (the slow part) once
         _COST[memo] = fit_cost(train, qp["safety_quantile"], qp["hybrid_quantile"])
     cost = _COST[memo]
+    if qp.get("probe_safety"):  # the renderer's: calibrated_safety, not the fitted residuals'
+        cost = cost[:3] + ({g: qp["probe_safety"] for g in cost[3]},) + cost[4:]
     scenes = [(s["name"], s["features"], quality(s, qp["norm"])) for s in train]
     prior = {}
     for key in cost[0]:
