@@ -122,15 +122,17 @@ def main():
           "<= 1.1x best pt, cells within budget (of %d)\n" % (
               os.path.basename(o.rows), len(fit_scenes), len(judge), o.guided, len(judge)))
     head = " | ".join("%g ms" % b for b in budgets)
-    print("| variant | selection score (fit LOSO) | fit: median eff. regret | judge score (reported, "
-          "not used to choose) | train | " + head + " |")
+    print("| variant | selection score (fit LOSO) | fit: median eff. regret | "
+          "judge score (reported, not used to choose) | train | " + head + " |")
     print("|---|---|---|---|---|" + "---|" * len(budgets))
     if o.baseline:
         ft.set_guided("off")
         base = [s for s in ft.load(o.baseline, o.drift) if is_fit(s)]
         model = ft.fit(base, {"prior": o.baseline_prior, "probe_safety": o.probe_safety})
-        cells = [c for s in judge for c in ft.scene_cells(model, s, False, budgets, o.pt_margin, True)]
-        print("| baseline: fitted on %s (%d fit scenes), prior %g, probe | | | %.4f | fit | %s |" % (
+        cells = [c for s in judge
+                 for c in ft.scene_cells(model, s, False, budgets, o.pt_margin, True)]
+        print("| baseline: fitted on %s (%d fit scenes), prior %g, probe | | | %.4f | fit "
+              "| %s |" % (
             os.path.basename(o.baseline), len(base), o.baseline_prior, score(cells),
             " | ".join(row(cells, budgets, "judge"))))
     ft.set_guided(o.guided)
