@@ -9,7 +9,6 @@ measured over predicted, fit and judge scenes apart.
 import argparse
 import math
 import os
-import re
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -23,9 +22,7 @@ def main():
     a.add_argument("--guided", choices=("off", "all", "direct"), default="all")
     a.add_argument("--drift", default="build/release/bin/drift")
     o = a.parse_args()
-    if o.guided != "off":
-        ft.PICKABLE.add(ft.GUIDED)
-        ft.GUIDED_ROW = re.compile(ft.GUIDED_ROWS[o.guided])
+    ft.set_guided(o.guided)
     scenes = ft.load(o.rows, o.drift)
     fit_names = {os.path.basename(l.strip()).rsplit(".", 1)[0] for l in open(o.fit)
                  if l.strip() and not l.startswith("#")}

@@ -10,8 +10,16 @@ log(effective regret), where a pick whose measured ms is over the budget has its
 multiplied by its overrun (ms / budget) and every regret is capped at 4 (a row the bench did
 not run on the scene: 4). (2) The judge scenes' figures, reported, not used to choose: each
 judge scene's picks by a model fitted on the fit scenes (train fit) and on every other scene
-(train all). The variant of the lowest selection score is the one to ship; the judge columns
+(train all), and their score as the selection score is made (mean log effective regret over
+the judge cells). The variant of the lowest selection score is the one to ship; the judge columns
 say how it does on scenes it was not chosen on.
+
+--guided off|all|direct: which hybrid+pt rows every variant may pick (fit_table.py --guided).
+--baseline ROWS: one more row first, a model fitted on ROWS' fit scenes (the shipped model's
+rows; its quality parameters --baseline-prior, k 2, idw, probe, guided off, as shipped since
+session 5) judged on these rows' judge scenes: the shipped model against a refit on the same
+rows (its fit-scene columns are not leave-one-out, so it has no selection score).
+--probe-safety S: the probe's safety S for both groups, as the renderer's calibrated_safety.
 """
 import argparse
 import math
@@ -95,6 +103,13 @@ def main():
     a.add_argument("--pt-margin", type=float, default=0.9)
     a.add_argument("--drift", default="build/release/bin/drift")
     a.add_argument("--only", help="the variants whose names contain this")
+    a.add_argument("--guided", choices=("off", "all", "direct"), default="off")
+    a.add_argument("--baseline", help="rows the shipped model was fitted on")
+    a.add_argument("--baseline-prior", type=float, default=1.0)
+    a.add_argument("--probe-safety", type=float,
+                   help="with the probe, every variant's (and the baseline's) safety this factor "
+                        "for both groups, as drift render applies the model's calibrated_safety, "
+                        "in place of the fitted residuals' quantile")
     o = a.parse_args()
     budgets = [float(b) for b in o.budgets.split(",")]
     scenes = ft.load(o.rows, o.drift)
@@ -103,15 +118,28 @@ def main():
     is_fit = lambda s: os.path.realpath(s["path"]) in fit_set or s["name"] in names
     fit_scenes = [s for s in scenes if is_fit(s)]
     judge = [s for s in scenes if not is_fit(s)]
-    print("%s: %d fit scenes, %d judge scenes; cell = median/worst regret, cells <= 1.1x best "
-          "pt, cells within budget (of %d)\n" % (os.path.basename(o.rows), len(fit_scenes),
-                                                  len(judge), len(judge)))
+    print("%s: %d fit scenes, %d judge scenes, --guided %s; cell = median/worst regret, cells "
+          "<= 1.1x best pt, cells within budget (of %d)\n" % (
+              os.path.basename(o.rows), len(fit_scenes), len(judge), o.guided, len(judge)))
     head = " | ".join("%g ms" % b for b in budgets)
-    print("| variant | selection score (fit LOSO) | fit: median eff. regret | train | " + head + " |")
-    print("|---|---|---|---|" + "---|" * len(budgets))
+    print("| variant | selection score (fit LOSO) | fit: median eff. regret | "
+          "judge score (reported, not used to choose) | train | " + head + " |")
+    print("|---|---|---|---|---|" + "---|" * len(budgets))
+    if o.baseline:
+        ft.set_guided("off")
+        base = [s for s in ft.load(o.baseline, o.drift) if is_fit(s)]
+        model = ft.fit(base, {"prior": o.baseline_prior, "probe_safety": o.probe_safety})
+        cells = [c for s in judge
+                 for c in ft.scene_cells(model, s, False, budgets, o.pt_margin, True)]
+        print("| baseline: fitted on %s (%d fit scenes), prior %g, probe | | | %.4f | fit "
+              "| %s |" % (
+            os.path.basename(o.baseline), len(base), o.baseline_prior, score(cells),
+            " | ".join(row(cells, budgets, "judge"))))
+    ft.set_guided(o.guided)
     for name, qp, probe in VARIANTS:
         if o.only and o.only not in name:
             continue
+        qp = dict(qp, probe_safety=o.probe_safety)
         sel = ft.loso(fit_scenes, is_fit, budgets, o.pt_margin, False, qp, probe)
         sc = score(sel)
         med = ft.median([effective(c) for c in sel])
@@ -119,9 +147,9 @@ def main():
             # The judge scenes' cells: a judge scene is never in its own model.
             cells = [c for c in ft.loso(scenes if train_all else fit_scenes + judge, is_fit, budgets,
                                         o.pt_margin, train_all, qp, probe) if not c["fit"]]
-            print("| %s | %s | %s | %s | %s |" % (
+            print("| %s | %s | %s | %.4f | %s | %s |" % (
                 name if not train_all else "", "%.4f" % sc if not train_all else "",
-                "%.2f" % med if not train_all else "", "all" if train_all else "fit",
+                "%.2f" % med if not train_all else "", score(cells), "all" if train_all else "fit",
                 " | ".join(row(cells, budgets, "judge"))))
         sys.stdout.flush()
 

@@ -70,7 +70,7 @@ RIDGE = 0.1
 # quantile. These defaults are session 2's chooser.
 QUALITY = {"k": 2, "kernel": "idw", "bandwidth": 1.0, "prior": 0.0, "kappa": 0.0,
            "robust": False, "safety_quantile": SAFETY_QUANTILE, "hybrid_quantile": None,
-           "norm": "best"}
+           "norm": "best", "probe_safety": None}
 
 
 def key_text(key):
@@ -81,6 +81,16 @@ def pickable(key):
     if key[0] == GUIDED:
         return GUIDED in PICKABLE and bool(GUIDED_ROW.match(key[1]))
     return key[0] in PICKABLE and "joint-bilateral" not in key[1]
+
+
+def set_guided(mode):
+    """Which hybrid+pt rows are candidates: "off" (none), "all" (the three guides' split rows)
+    or "direct" (the direct guide's); the fit and the pick read PICKABLE and GUIDED_ROW."""
+    global GUIDED_ROW
+    PICKABLE.discard(GUIDED)
+    if mode != "off":
+        PICKABLE.add(GUIDED)
+    GUIDED_ROW = re.compile(GUIDED_ROWS["all" if mode == "off" else mode])
 
 
 def guided_parts(key):
@@ -313,10 +323,15 @@ def fit(train, qp=None):
     """The model fitted on `train`: the cost model, the features' scales, each scene's FLIP
     ratios and each candidate's prior (mean and variance of its log ratio over the scenes)."""
     qp = dict(QUALITY, **(qp or {}))
-    memo = (tuple(s["name"] for s in train), qp["safety_quantile"], qp["hybrid_quantile"])
+    # Keyed by the scenes' objects (two rows files hold scenes of the same names) and the
+    # candidates (--guided).
+    memo = (tuple(id(s) for s in train), qp["safety_quantile"], qp["hybrid_quantile"],
+            GUIDED in PICKABLE, GUIDED_ROW.pattern)
     if memo not in _COST:  # the same training scenes' cost model (the slow part) once
         _COST[memo] = fit_cost(train, qp["safety_quantile"], qp["hybrid_quantile"])
     cost = _COST[memo]
+    if qp.get("probe_safety"):  # the renderer's: calibrated_safety, not the fitted residuals'
+        cost = cost[:3] + ({g: qp["probe_safety"] for g in cost[3]},) + cost[4:]
     scenes = [(s["name"], s["features"], quality(s, qp["norm"])) for s in train]
     prior = {}
     for key in cost[0]:
@@ -494,24 +509,30 @@ def loso(scenes, is_fit, budgets, pt_margin, train_all, qp=None, probe=False):
     cells = []
     for s in scenes:
         train = [t for t in scenes if t is not s and (train_all or is_fit(t))]
-        model = fit(train, qp)
-        scale = probe_scale(model, s) if probe is True else None
-        oracle = s["rows"] if probe == "oracle" else None
-        for b in budgets:
-            key, pms, _, why = choose(model, s["features"], b, pt_margin, scale, oracle)
-            ms, f = lookup(s["rows"], key)
-            top, topkey = best_within(s["rows"], b)
-            pt, _ = best_within(s["rows"], b, PT_FAMILIES)
-            plain, _ = best_within(s["rows"], b, {"pt"})
-            den, _ = best_within(s["rows"], b, {"pt+denoise"})
-            cells.append({"scene": s["name"], "fit": is_fit(s), "budget": b, "key": key, "why": why,
-                          "pred_ms": pms, "ms": ms, "flip": f, "best": top, "best_key": topkey,
-                          "best_pt": pt,
-                          # within the budget (measured) and closer than the best plain path
-                          # tracer and the best pt+denoise within it (where none fits: beaten)
-                          "beats_pt": ms <= b and f < (plain or math.inf) and f < (den or math.inf),
-                          "regret": f / top if top and f < math.inf else math.inf,
-                          "vs_pt": f / pt if pt and f < math.inf else math.inf})
+        cells += scene_cells(fit(train, qp), s, is_fit(s), budgets, pt_margin, probe)
+    return cells
+
+
+def scene_cells(model, s, role_fit, budgets, pt_margin, probe=False):
+    """One scene's cells, each budget's pick by `model` scored on the scene's measured rows."""
+    cells = []
+    scale = probe_scale(model, s) if probe is True else None
+    oracle = s["rows"] if probe == "oracle" else None
+    for b in budgets:
+        key, pms, _, why = choose(model, s["features"], b, pt_margin, scale, oracle)
+        ms, f = lookup(s["rows"], key)
+        top, topkey = best_within(s["rows"], b)
+        pt, _ = best_within(s["rows"], b, PT_FAMILIES)
+        plain, _ = best_within(s["rows"], b, {"pt"})
+        den, _ = best_within(s["rows"], b, {"pt+denoise"})
+        cells.append({"scene": s["name"], "fit": role_fit, "budget": b, "key": key, "why": why,
+                      "pred_ms": pms, "ms": ms, "flip": f, "best": top, "best_key": topkey,
+                      "best_pt": pt,
+                      # within the budget (measured) and closer than the best plain path
+                      # tracer and the best pt+denoise within it (where none fits: beaten)
+                      "beats_pt": ms <= b and f < (plain or math.inf) and f < (den or math.inf),
+                      "regret": f / top if top and f < math.inf else math.inf,
+                      "vs_pt": f / pt if pt and f < math.inf else math.inf})
     return cells
 
 
@@ -610,10 +631,7 @@ def main():
                         "default: a judge scene's pick is the shipped model's) or every other "
                         "scene (all); --model is fitted likewise")
     o = a.parse_args()
-    global GUIDED_ROW
-    if o.guided != "off":
-        PICKABLE.add(GUIDED)
-        GUIDED_ROW = re.compile(GUIDED_ROWS[o.guided])
+    set_guided(o.guided)
     budgets = [float(b) for b in o.budgets.split(",")]
     scenes = load(o.rows, o.drift)
     fit_set = {os.path.realpath(l.strip()) for l in open(o.fit) if l.strip() and not l.startswith("#")}
