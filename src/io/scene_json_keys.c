@@ -44,6 +44,12 @@ const drift__json_key drift__json_keys[] = {
     { "material", "clearcoat", "number in [0, 1]", "0", "ggx: clear coat weight (IOR 1.5)" },
     { "material", "clearcoat_roughness", "number in [0, 1]", "0",
       "ggx: the coat's perceptual roughness" },
+    { "material", "opacity", "number in [0, 1]", "1",
+      "any type: below 1, rays pass with probability 1 − opacity" },
+    { "material", "opacity_texture", "path", "none",
+      "any type: image whose alpha (else grey) multiplies opacity" },
+    { "material", "alpha_cutoff", "number in [0, 1]", "none",
+      "any type: a cut-out, there where opacity ≥ cutoff" },
     // "meshes": [mesh entry]
     { "mesh", "path", "path, required", "", "mesh file (.obj, .gltf, .glb, .ply, optionally .gz)" },
     { "mesh", "material", "string", "the file's", "material name replacing every one of the file" },

@@ -1,4 +1,5 @@
 // drift scene files (.json): the "materials" table (see scene_json.c).
+#include "drift/image_io.h"
 #include "scene_json_internal.h"
 
 #include <cjson/cJSON.h>
@@ -10,6 +11,49 @@
 #include <string.h>
 
 // --- MATERIALS ---
+
+// Coverage, for every type: "opacity" (default 1) times "opacity_texture" (an image's alpha,
+// or its grey value where it has none); "alpha_cutoff" makes it a MASK of that cutoff (glTF's),
+// else anything below 1 is a BLEND (stochastic transparency). None of them: opaque.
+static drift_result read_coverage(json_reader *r, const cJSON *item, const char *path,
+                                  drift_material *m)
+{
+    float opacity = 1.0f, cutoff = -1.0f;
+    const char *rel = NULL;
+    drift_result res;
+    if ((res = drift__json_read_float(r, item, path, "opacity", false, 0.0, 1.0, &opacity)) !=
+            DRIFT_OK ||
+        (res = drift__json_read_float(r, item, path, "alpha_cutoff", false, 0.0, 1.0, &cutoff)) !=
+            DRIFT_OK ||
+        (res = drift__json_read_string(r, item, path, "opacity_texture", false, &rel)) !=
+            DRIFT_OK) {
+        return res;
+    }
+    uint32_t texture = DRIFT_INVALID_INDEX;
+    if (rel) {
+        const cJSON *key = cJSON_GetObjectItemCaseSensitive(item, "opacity_texture");
+        char full[DRIFT__PATH_MAX];
+        size_t size = 0;
+        drift_image image = { 0 };
+        int line = drift__json_line_of(r, key);
+        if ((res = drift__json_resolve_path(r, key, rel, full)) != DRIFT_OK ||
+            (res = drift__check_file(r->scene->ctx, full, r->file, line, &size)) != DRIFT_OK ||
+            (res = drift_image_load_alpha(r->scene->ctx, full, DRIFT_ALPHA_OR_GREY, &image)) !=
+                DRIFT_OK ||
+            (res = drift_scene_add_texture(r->scene, image, &texture)) != DRIFT_OK) {
+            return FAIL(r, key, res, "%s.opacity_texture '%s' cannot be loaded", path, rel);
+        }
+    }
+    if (cutoff >= 0.0f) {
+        m->alpha_mode = DRIFT_ALPHA_MASK;
+        m->alpha_cutoff = cutoff;
+    } else if (opacity < 1.0f || texture != DRIFT_INVALID_INDEX) {
+        m->alpha_mode = DRIFT_ALPHA_BLEND;
+    }
+    m->opacity = opacity;
+    m->opacity_texture = texture;
+    return DRIFT_OK;
+}
 
 // type "ggx" (docs/materials.md): diffuse is the base colour; roughness is glTF's perceptual
 // roughness (alpha = roughness^2); metal names a measured conductor (and makes it metallic).
@@ -64,7 +108,8 @@ static drift_result read_ggx_material(json_reader *r, const cJSON *item, const c
                     "%s.metal '%s' is not one of Au, Ag, Cu, Al (gold, silver, copper, aluminium)",
                     path, metal);
     }
-    res = drift_scene_add_material(r->scene, &m, NULL);
+    res = read_coverage(r, item, path, &m);
+    res = res ? res : drift_scene_add_material(r->scene, &m, NULL);
     if (res != DRIFT_OK) {
         return FAIL(r, item, res, "%s is not valid", path);
     }
@@ -155,7 +200,8 @@ static drift_result read_material(json_reader *r, const cJSON *item)
     if (cJSON_HasObjectItem(item, "diffuse_roughness")) {
         m.diffuse_model = DRIFT_DIFFUSE_BURLEY;
     }
-    res = drift_scene_add_material(r->scene, &m, NULL);
+    res = read_coverage(r, item, path, &m);
+    res = res ? res : drift_scene_add_material(r->scene, &m, NULL);
     if (res != DRIFT_OK) {
         return FAIL(r, item, res, "%s is not valid", path);
     }

@@ -204,6 +204,46 @@ static void test_mitsuba_mask(void **state)
     drift_context_destroy(ctx);
 }
 
+// drift's own scene format: opacity alone is a BLEND, alpha_cutoff makes a MASK, an
+// opacity_texture is read as a coverage image; an opacity outside [0, 1] is refused.
+static void test_json_coverage(void **state)
+{
+    (void)state;
+    test_log_capture log = { 0 };
+    drift_context *ctx = test_context(1, &log);
+    char json[1024], png[1024], mesh[1024];
+    test_out_path(json, "coverage.json");
+    test_repo_path(png, "tests/data/coverage/alpha.png");
+    test_repo_path(mesh, "tests/data/coverage/cards.gltf");
+    for (int bad = 0; bad < 2; ++bad) {
+        FILE *f = fopen(json, "w");
+        assert_non_null(f);
+        fprintf(f,
+                "{\"materials\": {\"veil\": {\"opacity\": %s},\n"
+                "  \"card\": {\"type\": \"ggx\", \"opacity_texture\": \"%s\", "
+                "\"alpha_cutoff\": 0.4},\n"
+                "  \"wall\": {}},\n"
+                " \"meshes\": [{\"path\": \"%s\", \"material\": \"veil\"}]}\n",
+                bad ? "1.5" : "0.3", png, mesh);
+        fclose(f);
+        drift_scene *scene = NULL;
+        drift_result r = drift_scene_load(ctx, json, &scene);
+        if (bad) {
+            assert_int_not_equal(r, DRIFT_OK);
+            continue;
+        }
+        assert_int_equal(r, DRIFT_OK);
+        assert_int_equal(scene->materials[0].alpha_mode, DRIFT_ALPHA_BLEND);
+        assert_near(scene->materials[0].opacity, 0.3, 1e-6);
+        assert_int_equal(scene->materials[1].alpha_mode, DRIFT_ALPHA_MASK);
+        assert_near(scene->materials[1].alpha_cutoff, 0.4, 1e-6);
+        assert_true(scene->materials[1].opacity_texture < scene->texture_count);
+        assert_int_equal(scene->materials[2].alpha_mode, DRIFT_ALPHA_OPAQUE);
+        drift_scene_destroy(scene);
+    }
+    drift_context_destroy(ctx);
+}
+
 // A quad in z = z0 facing +z, uv (0, 0) at its bottom-left corner, of `material`.
 static uint32_t add_card(drift_scene *scene, float half, float z0, uint32_t material)
 {
@@ -388,6 +428,7 @@ int main(void)
         cmocka_unit_test(test_gltf_alpha_modes),
         cmocka_unit_test(test_obj_dissolve),
         cmocka_unit_test(test_mitsuba_mask),
+        cmocka_unit_test(test_json_coverage),
         cmocka_unit_test(test_mask_rays),
         cmocka_unit_test(test_blend_stops_its_share),
         cmocka_unit_test(test_pt_sees_through_veil),
