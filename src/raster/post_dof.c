@@ -9,6 +9,15 @@
 // artefact kept, because it is what a single-layer gather does: a blurred foreground object's
 // edge stays sharp against an in-focus background behind it, since those pixels (circles
 // under half a pixel) gather nothing. The reference technique and ISG's DOF have neither.
+//
+// Tile classification (issue 46; the tiles of production engines' DOF, Jimenez 2014): each
+// 16 x 16 tile is copied (every pixel in focus, or the tile and all its gathers read one
+// colour), gathered per pixel (the circles of its gathering pixels differ by more than 1.5x + 1
+// px: depth edges), or gathered at once: every pixel of the tile takes the same taps, the
+// table scaled by the tile's largest circle R, each tap weighed as above and also by whether
+// it lies on the pixel's own disk (1 within its radius, 0 a pixel beyond). Same offsets for
+// every pixel make a tap a vector load of a row of pixels from a padded planar copy of the
+// frame (one weight, one bilinear fraction for the whole tile), instead of 13 gathered loads.
 #include "core/scratch.h"
 #include "core/vectorise.h"
 #include "raster/raster.h"
@@ -56,15 +65,36 @@ typedef struct dof_job {
     drift_image *out;
     const drift_vec2 *taps; // offsets on the unit disk; taps[0] is the centre
     uint32_t tap_count;
-    uint8_t *uniform; // per UNIFORM_TILE tile: every pixel its gathers read is alike
-    int32_t *run;     // per pixel: the run of equal pixels from it rightwards (equal_runs)
     int32_t tiles_x;
+    float *tile_lo;      // per UNIFORM_TILE tile: its gathering pixels' smallest circle
+    float *tile_radius;  // per tile: its pixels' largest circle
+    uint8_t *tile_flat;  // per tile: its pixels all equal its first
+    uint8_t *tile_class; // per tile: TILE_COPY, TILE_GATHER or TILE_SHARED
+    uint8_t *row_shared; // per tile row of a TILE_GATHER tile (y * tiles_x + tx): shared
+    // The padded planar copy (the shared gathers): channels planes then the circles, each
+    // plane_height rows of plane_stride floats (tiles_x whole tiles and the pad each side),
+    // pixel (x, y) at (y + pad) * stride + x + pad, the nearest pixel repeated outside the
+    // frame (what the clamped fetches read).
+    float *planes;
+    int32_t pad, plane_stride, plane_height;
     // RGB, its indices in int32 and its coordinates under 2^21: the batched gather (with radii
     // up to 2^20 pixels, so that its taps' coordinates stay whole in float arithmetic).
     bool batched;
+    bool planes_allowed; // the shared path: channels <= 4, tables up to SHARED_MAX_TAPS
 } dof_job;
 
 #define UNIFORM_TILE 16
+
+// The tile classes, and the widest circle the shared path takes (its pad is the largest
+// such circle over the frame's shared tiles: one more pixel of pad a plane row and column).
+enum {
+    TILE_GATHER = 0, // per pixel (the batches)
+    TILE_COPY = 1,   // every pixel copied
+    TILE_SHARED = 2, // every pixel the same taps (shared_tile)
+};
+
+#define SHARED_MAX_RADIUS 32.0f
+#define SHARED_MAX_TAPS   256u // shared_tile's table on the stack
 
 // The centre, then the concentric-disk image of a scrambled Sobol (0,2)-sequence: its first
 // 2^k points are stratified over [0,1)^2, so the taps cover the disk evenly.
@@ -252,73 +282,292 @@ static DRIFT_AVX2_CLONES void post_dof_gather_batch(const dof_job *job, int32_t 
     }
 }
 
-// Whether every pixel the gathers of tile (tx, ty) can read holds the same value. Each
-// gather then returns its centre exactly (it sums differences from the centre), so the tile
-// is copied instead: the background of a frame, with the largest circle of confusion and a
-// single colour, costs a scan instead of a gather.
-static bool tile_is_uniform(const dof_job *job, int32_t tx, int32_t ty)
+// A tile whose gathering pixels' circles lie within [lo, 1.5 lo + 1] shares its taps: a pixel
+// of radius r then keeps about r^2 / R^2 >= 1/4 of the R disk's taps, near the count of its own
+// disk (one a four pixels either way, up to the table's size). Wider spreads are the depth
+// edges, gathered per pixel. NaN and negative circles (copied pixels) do not count.
+static bool circles_share(float lo, float hi)
 {
-    const drift_image *in = job->in;
-    int32_t x0 = tx * UNIFORM_TILE, y0 = ty * UNIFORM_TILE;
-    int32_t x1 = x0 + UNIFORM_TILE < in->width ? x0 + UNIFORM_TILE : in->width;
-    int32_t y1 = y0 + UNIFORM_TILE < in->height ? y0 + UNIFORM_TILE : in->height;
-    float reach = 0.0f;
-    for (int32_t y = y0; y < y1; ++y) {
-        for (int32_t x = x0; x < x1; ++x) {
-            reach = fmaxf(reach, drift_image_pixel(job->coc, x, y)[0]); // fmaxf drops NaN
-        }
-    }
-    // A tap lands within the radius; its bilinear fetch reads one pixel further.
-    int32_t pad = (int32_t)ceilf(fminf(reach, (float)(in->width + in->height))) + 1;
-    // Each row of the region: its first pixel equals the tile's first, and so do the ones
-    // after it (the run of equal pixels from there spans the region). Float == per channel, as
-    // a scan would compare: -0 equals +0, NaN nothing, so equal runs are all equal to their
-    // first pixel.
-    const float *first = drift_image_pixel(in, x0, y0);
-    int32_t xa = clamp_index(x0 - pad, in->width), xb = clamp_index(x1 - 1 + pad, in->width);
-    for (int32_t y = clamp_index(y0 - pad, in->height); y <= clamp_index(y1 - 1 + pad, in->height);
-         ++y) {
-        const float *p = drift_image_pixel(in, xa, y);
-        for (int32_t c = 0; c < in->channels; ++c) {
-            if (p[c] != first[c]) {
-                return false;
-            }
-        }
-        if (job->run[(size_t)y * (size_t)in->width + (size_t)xa] < xb - xa + 1) {
-            return false;
-        }
-    }
-    return true;
+    return hi <= 1.5f * lo + 1.0f && hi <= SHARED_MAX_RADIUS;
 }
 
-// run[y][x]: how many pixels from (x, y) rightwards equal their left neighbour, itself
-// included (tile_is_uniform's rows).
-static void equal_runs(size_t begin, size_t end, int thread_index, void *user)
+// Per tile: its gathering pixels' smallest circle, the largest circle of any pixel (how far
+// its gathers read; 0 when none is positive), and whether its pixels all equal its first one
+// (float == per channel: -0 equals +0, NaN nothing).
+static DRIFT_AVX2_CLONES void scan_tiles(size_t begin, size_t end, int thread_index, void *user)
 {
     (void)thread_index;
+
+    enum {
+        N = UNIFORM_TILE
+    };
+
     const dof_job *job = user;
     const drift_image *in = job->in;
-    for (int32_t y = (int32_t)begin; y < (int32_t)end; ++y) {
-        int32_t *run = job->run + (size_t)y * (size_t)in->width;
-        run[in->width - 1] = 1;
-        for (int32_t x = in->width - 2; x >= 0; --x) {
-            const float *p = drift_image_pixel(in, x, y), *q = p + in->channels;
-            bool same = true;
-            for (int32_t c = 0; c < in->channels; ++c) {
-                same = same && p[c] == q[c];
-            }
-            run[x] = same ? run[x + 1] + 1 : 1;
-        }
-    }
-}
-
-static DRIFT_AVX2_CLONES void classify_tiles(size_t begin, size_t end, int thread_index, void *user)
-{
-    (void)thread_index;
-    const dof_job *job = user;
+    const int32_t channels = in->channels, step = job->coc->channels;
+    // Per column (per float of a row): elementwise, so the loops vectorise (a conditional
+    // min reduction does not, without -ffast-math).
+    float first[N * 4], lo_lane[N], hi_lane[N];
+    int32_t differ[N * 4];
     for (size_t t = begin; t < end; ++t) {
-        job->uniform[t] = tile_is_uniform(job, (int32_t)(t % (size_t)job->tiles_x),
-                                          (int32_t)(t / (size_t)job->tiles_x));
+        int32_t x0 = (int32_t)(t % (size_t)job->tiles_x) * UNIFORM_TILE;
+        int32_t y0 = (int32_t)(t / (size_t)job->tiles_x) * UNIFORM_TILE;
+        int32_t n = in->width - x0 < N ? in->width - x0 : N;
+        int32_t y1 = y0 + N < in->height ? y0 + N : in->height;
+        const float *origin = drift_image_pixel(in, x0, y0);
+        for (int32_t k = 0; k < N * 4; ++k) {
+            first[k] = origin[k % channels];
+            differ[k] = 0;
+        }
+        for (int32_t i = 0; i < N; ++i) {
+            lo_lane[i] = HUGE_VALF;
+            hi_lane[i] = 0.0f;
+        }
+        for (int32_t y = y0; y < y1; ++y) {
+            const float *restrict row = drift_image_pixel(in, x0, y);
+            const float *restrict reach = drift_image_pixel(job->coc, x0, y);
+            if (n == N && step == 1) {
+                for (int32_t i = 0; i < N; ++i) {
+                    float r = reach[i], low = r >= 0.5f ? r : HUGE_VALF;
+                    lo_lane[i] = low < lo_lane[i] ? low : lo_lane[i];
+                    hi_lane[i] = r > hi_lane[i] ? r : hi_lane[i];
+                }
+            } else {
+                for (int32_t i = 0; i < n; ++i) {
+                    float r = reach[i * step], low = r >= 0.5f ? r : HUGE_VALF;
+                    lo_lane[i] = low < lo_lane[i] ? low : lo_lane[i];
+                    hi_lane[i] = r > hi_lane[i] ? r : hi_lane[i];
+                }
+            }
+            if (n == N && channels == 3) {
+                for (int32_t k = 0; k < N * 3; ++k) {
+                    differ[k] |= row[k] != first[k];
+                }
+            } else {
+                for (int32_t k = 0; k < n * channels; ++k) {
+                    differ[k] |= row[k] != first[k];
+                }
+            }
+        }
+        float lo = HUGE_VALF, hi = 0.0f;
+        int32_t any = 0;
+        for (int32_t i = 0; i < N; ++i) {
+            lo = lo_lane[i] < lo ? lo_lane[i] : lo;
+            hi = hi_lane[i] > hi ? hi_lane[i] : hi;
+        }
+        for (int32_t k = 0; k < N * 4; ++k) {
+            any |= differ[k];
+        }
+        job->tile_lo[t] = lo;
+        job->tile_radius[t] = hi;
+        job->tile_flat[t] = !any;
+    }
+}
+
+// A tile is copied when every pixel its gathers can read holds one value: each gather would
+// return its centre (it sums differences from the centre). Checked by whole tiles: every tile
+// the padded tile meets is flat and starts with the same value (a tap lands within the
+// largest radius; its bilinear fetch reads one pixel further). Also copied: tiles without a
+// gathering pixel. Then the shared tiles (circles_share), and the rest per pixel.
+static void classify_tiles(size_t begin, size_t end, int thread_index, void *user)
+{
+    (void)thread_index;
+    const dof_job *job = user;
+    const drift_image *in = job->in;
+    for (size_t t = begin; t < end; ++t) {
+        int32_t tx = (int32_t)(t % (size_t)job->tiles_x), ty = (int32_t)(t / (size_t)job->tiles_x);
+        float hi = job->tile_radius[t];
+        int32_t pad = (int32_t)ceilf(fminf(hi, (float)(in->width + in->height))) + 1;
+        int32_t x0 = tx * UNIFORM_TILE, y0 = ty * UNIFORM_TILE;
+        int32_t ua = clamp_index(x0 - pad, in->width) / UNIFORM_TILE;
+        int32_t ub = clamp_index(x0 + UNIFORM_TILE - 1 + pad, in->width) / UNIFORM_TILE;
+        int32_t va = clamp_index(y0 - pad, in->height) / UNIFORM_TILE;
+        int32_t vb = clamp_index(y0 + UNIFORM_TILE - 1 + pad, in->height) / UNIFORM_TILE;
+        const float *first = drift_image_pixel(in, x0, y0);
+        bool uniform = true;
+        for (int32_t v = va; uniform && v <= vb; ++v) {
+            for (int32_t u = ua; uniform && u <= ub; ++u) {
+                const float *q = drift_image_pixel(in, u * UNIFORM_TILE, v * UNIFORM_TILE);
+                uniform = job->tile_flat[(size_t)v * (size_t)job->tiles_x + (size_t)u];
+                for (int32_t c = 0; c < in->channels; ++c) {
+                    uniform = uniform && q[c] == first[c];
+                }
+            }
+        }
+        bool copy = uniform || !(hi >= 0.5f);
+        bool shared = job->planes_allowed && circles_share(job->tile_lo[t], hi);
+        job->tile_class[t] = copy ? TILE_COPY : (shared ? TILE_SHARED : TILE_GATHER);
+    }
+}
+
+// Row y of the frame into the planes' row `to` (its pad columns the row's first and last
+// pixel), `channels` constant once inlined, so the inner loop is a plain deinterleave.
+static inline void fill_plane_row(const dof_job *job, int32_t y, int32_t to, const int32_t channels)
+{
+    const drift_image *in = job->in;
+    const int32_t stride = job->plane_stride, pad = job->pad, width = in->width;
+    const int32_t step = job->coc->channels;
+    const size_t plane = (size_t)stride * (size_t)job->plane_height;
+    const float *restrict src = drift_image_pixel(in, 0, y);
+    const float *restrict reach = drift_image_pixel(job->coc, 0, y);
+    float *restrict row[5];
+    for (int32_t c = 0; c <= channels; ++c) {
+        row[c] = job->planes + (size_t)c * plane + (size_t)to * (size_t)stride + (size_t)pad;
+    }
+    for (int32_t x = 0; x < width; ++x) {
+        for (int32_t c = 0; c < channels; ++c) {
+            row[c][x] = src[x * channels + c];
+        }
+        row[channels][x] = reach[x * step];
+    }
+    for (int32_t c = 0; c <= channels; ++c) {
+        for (int32_t x = -pad; x < 0; ++x) {
+            row[c][x] = row[c][0];
+        }
+        for (int32_t x = width; x < stride - pad; ++x) {
+            row[c][x] = row[c][width - 1];
+        }
+    }
+}
+
+// The padded planar copy of plane rows [begin, end) (clamped reads of the frame).
+static DRIFT_AVX2_CLONES void fill_planes(size_t begin, size_t end, int thread_index, void *user)
+{
+    (void)thread_index;
+    const dof_job *job = user;
+    for (int32_t py = (int32_t)begin; py < (int32_t)end; ++py) {
+        int32_t y = clamp_index(py - job->pad, job->in->height);
+        switch (job->in->channels) {
+        case 1:
+            fill_plane_row(job, y, py, 1);
+            break;
+        case 2:
+            fill_plane_row(job, y, py, 2);
+            break;
+        case 3:
+            fill_plane_row(job, y, py, 3);
+            break;
+        default:
+            fill_plane_row(job, y, py, 4);
+            break;
+        }
+    }
+}
+
+// One tap of a shared tile: its offsets in the planes (nearest pixel, bilinear corner), the
+// bilinear fractions and its distance from the centre, the same for every pixel of the tile.
+typedef struct shared_tap {
+    ptrdiff_t near, corner;
+    float fx, fy, distance;
+} shared_tap;
+
+// The shared gather of tile row y (pixels x0 .. x0 + n - 1, n <= UNIFORM_TILE), `channels`
+// constant once inlined: gather()'s sums (differences from the centre, weighed; a weightless
+// tap adds exact zeros), each tap's weight times its place on the pixel's own disk.
+static inline void shared_row(const dof_job *job, int32_t x0, int32_t y, const shared_tap *taps,
+                              uint32_t tap_count, const int32_t channels)
+{
+    enum {
+        N = UNIFORM_TILE
+    };
+
+    const int32_t stride = job->plane_stride;
+    const size_t plane = (size_t)stride * (size_t)job->plane_height;
+    const size_t at = (size_t)(y + job->pad) * (size_t)stride + (size_t)(x0 + job->pad);
+    const float *restrict reach_at = job->planes + (size_t)channels * plane + at;
+    float radius[N], centre[4][N], sum[4][N], total[N];
+    // All N lanes, past the frame's right edge too (the planes hold whole tiles); only the
+    // frame's pixels are written.
+    for (int32_t i = 0; i < N; ++i) {
+        radius[i] = reach_at[i];
+        for (int32_t c = 0; c < channels; ++c) {
+            centre[c][i] = job->planes[(size_t)c * plane + at + (size_t)i];
+            sum[c][i] = 0.0f;
+        }
+        total[i] = 1.0f; // the centre: its own circle reaches it
+    }
+    for (uint32_t k = 0; k < tap_count; ++k) {
+        const shared_tap tap = taps[k];
+        const float *restrict reach = reach_at + tap.near;
+        const float *restrict corner[4];
+        for (int32_t c = 0; c < channels; ++c) {
+            corner[c] = job->planes + (size_t)c * plane + at + tap.corner;
+        }
+        DRIFT_IVDEP
+        for (int32_t i = 0; i < N; ++i) {
+            float v = reach[i] - tap.distance + 1.0f;
+            v = v < 0.0f ? 0.0f : (v > 1.0f ? 1.0f : v);
+            float own = radius[i] - tap.distance + 1.0f;
+            own = own < 0.0f ? 0.0f : (own > 1.0f ? 1.0f : own);
+            float weight = reach[i] >= 0.0f ? v * own : 0.0f;
+            bool on = weight > 0.0f;
+            float ws = on ? weight : 0.0f;
+            for (int32_t c = 0; c < channels; ++c) {
+                const float *p = corner[c] + i;
+                float t =
+                    lerp(lerp(p[0], p[1], tap.fx), lerp(p[stride], p[stride + 1], tap.fx), tap.fy);
+                float d = on ? t - centre[c][i] : 0.0f;
+                sum[c][i] += ws * d;
+            }
+            total[i] += ws;
+        }
+    }
+    float result[4][N];
+    for (int32_t i = 0; i < N; ++i) {
+        float inv = 1.0f / total[i];
+        for (int32_t c = 0; c < channels; ++c) {
+            result[c][i] = centre[c][i] + sum[c][i] * inv;
+        }
+    }
+    int32_t n = job->in->width - x0 < N ? job->in->width - x0 : N;
+    const float *src = drift_image_pixel(job->in, x0, y);
+    float *dst = drift_image_pixel(job->out, x0, y);
+    for (int32_t i = 0; i < n; ++i) {
+        // Below half a pixel (or NaN) the pixel is copied, as everywhere.
+        bool gathers = radius[i] >= 0.5f;
+        for (int32_t c = 0; c < channels; ++c) {
+            dst[i * channels + c] = gathers ? result[c][i] : src[i * channels + c];
+        }
+    }
+}
+
+// The taps of a shared gather of the largest circle `radius`: the table's first
+// taps_for_radius(radius) scaled by it, the centre left out; their count.
+static uint32_t shared_taps(const dof_job *job, float radius, shared_tap *taps)
+{
+    const uint32_t count = taps_for_radius(radius, job->tap_count);
+    const ptrdiff_t stride = job->plane_stride;
+    for (uint32_t k = 1; k < count; ++k) {
+        float ox = job->taps[k].x * radius, oy = job->taps[k].y * radius;
+        float fx0 = floorf(ox), fy0 = floorf(oy);
+        taps[k - 1] = (shared_tap){ .near = (ptrdiff_t)floorf(oy + 0.5f) * stride +
+                                            (ptrdiff_t)floorf(ox + 0.5f),
+                                    .corner = (ptrdiff_t)fy0 * stride + (ptrdiff_t)fx0,
+                                    .fx = ox - fx0,
+                                    .fy = oy - fy0,
+                                    .distance = sqrtf(ox * ox + oy * oy) };
+    }
+    return count - 1;
+}
+
+static inline void shared_rows(const dof_job *job, int32_t x0, int32_t y0, int32_t y1,
+                               const shared_tap *taps, uint32_t count)
+{
+    for (int32_t y = y0; y < y1; ++y) {
+        switch (job->in->channels) {
+        case 1:
+            shared_row(job, x0, y, taps, count, 1);
+            break;
+        case 2:
+            shared_row(job, x0, y, taps, count, 2);
+            break;
+        case 3:
+            shared_row(job, x0, y, taps, count, 3);
+            break;
+        default:
+            shared_row(job, x0, y, taps, count, 4);
+            break;
+        }
     }
 }
 
@@ -338,18 +587,32 @@ static DRIFT_AVX2_CLONES void dof_rows(size_t begin, size_t end, int thread_inde
 
     dof_batch batches[BUCKETS];
     for (int32_t y = (int32_t)begin; y < (int32_t)end; ++y) {
-        const uint8_t *uniform_row =
-            job->uniform + (size_t)(y / UNIFORM_TILE) * (size_t)job->tiles_x;
+        const uint8_t *class_row =
+            job->tile_class + (size_t)(y / UNIFORM_TILE) * (size_t)job->tiles_x;
+        const uint8_t *shared_row = job->row_shared + (size_t)y * (size_t)job->tiles_x;
         for (int32_t b = 0; b < BUCKETS; ++b) {
             batches[b].n = 0;
         }
         for (int32_t x = 0; x < job->in->width; ++x) {
+            int32_t tx = x / UNIFORM_TILE;
+            uint8_t tile = class_row[tx];
+            if (tile == TILE_SHARED || (tile == TILE_GATHER && shared_row[tx])) {
+                x = (tx + 1) * UNIFORM_TILE - 1; // dof_bands gathered it
+                continue;
+            }
+            if (tile == TILE_COPY) {
+                int32_t n = job->in->width - x < UNIFORM_TILE ? job->in->width - x : UNIFORM_TILE;
+                memcpy(drift_image_pixel(job->out, x, y), drift_image_pixel(job->in, x, y),
+                       sizeof(float) * (size_t)(n * channels));
+                x += n - 1;
+                continue;
+            }
             float radius = drift_image_pixel(job->coc, x, y)[0];
             const float *src = drift_image_pixel(job->in, x, y);
             float *dst = drift_image_pixel(job->out, x, y);
             // Below half a pixel the disk stays inside the pixel: copy, bit for bit (and
-            // NaN or negative radii count as in focus). A uniform tile copies too (above).
-            if (!(radius >= 0.5f) || uniform_row[x / UNIFORM_TILE]) {
+            // NaN or negative radii count as in focus).
+            if (!(radius >= 0.5f)) {
                 for (int32_t c = 0; c < channels; ++c) {
                     dst[c] = src[c];
                 }
@@ -385,6 +648,50 @@ static DRIFT_AVX2_CLONES void dof_rows(size_t begin, size_t end, int thread_inde
     }
 }
 
+// A band of tile rows (ty): its shared tiles, the rows of its per-pixel tiles whose circles
+// share (a tile across a depth edge has rows that do not cross it), then its rows' copies and
+// per-pixel gathers.
+static DRIFT_AVX2_CLONES void dof_bands(size_t begin, size_t end, int thread_index, void *user)
+{
+    const dof_job *job = user;
+    const drift_image *in = job->in;
+    shared_tap taps[SHARED_MAX_TAPS];
+    for (size_t ty = begin; ty < end; ++ty) {
+        int32_t y0 = (int32_t)ty * UNIFORM_TILE;
+        int32_t y1 = y0 + UNIFORM_TILE < in->height ? y0 + UNIFORM_TILE : in->height;
+        for (int32_t tx = 0; tx < job->tiles_x; ++tx) {
+            size_t t = ty * (size_t)job->tiles_x + (size_t)tx;
+            int32_t x0 = tx * UNIFORM_TILE;
+            if (job->tile_class[t] == TILE_SHARED) {
+                uint32_t count = shared_taps(job, job->tile_radius[t], taps);
+                shared_rows(job, x0, y0, y1, taps, count);
+                continue;
+            }
+            if (job->tile_class[t] != TILE_GATHER) {
+                continue;
+            }
+            int32_t n = in->width - x0 < UNIFORM_TILE ? in->width - x0 : UNIFORM_TILE;
+            for (int32_t y = y0; y < y1; ++y) {
+                const float *reach = drift_image_pixel(job->coc, x0, y);
+                float lo = HUGE_VALF, hi = 0.0f;
+                for (int32_t i = 0; i < n; ++i) {
+                    float r = reach[i * job->coc->channels];
+                    lo = r >= 0.5f && r < lo ? r : lo;
+                    hi = r > hi ? r : hi;
+                }
+                bool share = job->planes_allowed && hi >= 0.5f && circles_share(lo, hi) &&
+                             hi <= (float)(job->pad - 2);
+                job->row_shared[(size_t)y * (size_t)job->tiles_x + (size_t)tx] = share;
+                if (share) {
+                    uint32_t count = shared_taps(job, hi, taps);
+                    shared_rows(job, x0, y, y + 1, taps, count);
+                }
+            }
+        }
+        dof_rows((size_t)y0, (size_t)y1, thread_index, user);
+    }
+}
+
 static drift_result check_dof_args(drift_context *ctx, const drift_image *in,
                                    const drift_image *coc, uint32_t taps, const drift_image *out)
 {
@@ -412,6 +719,12 @@ static drift_result check_dof_args(drift_context *ctx, const drift_image *in,
 drift_result drift_post_dof(drift_context *ctx, const drift_image *in, const drift_image *coc,
                             uint32_t taps, drift_image *out)
 {
+    return drift_post_dof_tiles(ctx, in, coc, taps, true, out);
+}
+
+drift_result drift_post_dof_tiles(drift_context *ctx, const drift_image *in, const drift_image *coc,
+                                  uint32_t taps, bool shared, drift_image *out)
+{
     drift_result r = check_dof_args(ctx, in, coc, taps, out);
     if (r != DRIFT_OK) {
         return r;
@@ -427,34 +740,64 @@ drift_result drift_post_dof(drift_context *ctx, const drift_image *in, const dri
     int32_t tiles_x = (in->width + UNIFORM_TILE - 1) / UNIFORM_TILE;
     int32_t tiles_y = (in->height + UNIFORM_TILE - 1) / UNIFORM_TILE;
     size_t tile_count = (size_t)tiles_x * (size_t)tiles_y;
-    uint8_t *uniform = drift_alloc(ctx, tile_count);
-    // The runs in the context's scratch block (kept between calls: no fresh pages each frame).
-    size_t run_bytes = (size_t)in->width * (size_t)in->height * sizeof(int32_t), have = 0;
-    int32_t *run = uniform ? drift__scratch_take(ctx, run_bytes, &have) : NULL;
-    if (!run) {
-        drift_free(ctx, uniform);
+    size_t segments = (size_t)tiles_x * (size_t)in->height;
+    float *tile_floats = drift_alloc(ctx, tile_count * (2 * sizeof(float) + 2) + segments);
+    // The planes in the context's scratch block (kept between calls: no fresh pages each
+    // frame), sized for the widest pad.
+    bool planes_allowed = shared && in->channels <= 4 && tap_count <= SHARED_MAX_TAPS;
+    size_t max_pad = (size_t)SHARED_MAX_RADIUS + 2;
+    size_t plane_bytes = (size_t)(in->channels + 1) * sizeof(float) *
+                         ((size_t)tiles_x * UNIFORM_TILE + 2 * max_pad) *
+                         ((size_t)in->height + 2 * max_pad);
+    size_t have = 0;
+    float *planes =
+        planes_allowed && tile_floats ? drift__scratch_take(ctx, plane_bytes, &have) : NULL;
+    if (!tile_floats || (planes_allowed && !planes)) {
+        drift_free(ctx, tile_floats);
         drift_free(ctx, table);
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_OUT_OF_MEMORY, __FILE__, __LINE__,
                   "post dof: out of memory for %zu tiles", tile_count);
         return DRIFT_ERR_OUT_OF_MEMORY;
     }
+    uint8_t *tile_bytes = (uint8_t *)(tile_floats + 2 * tile_count);
     dof_job job = { .in = in,
                     .coc = coc,
                     .out = out,
                     .taps = table,
                     .tap_count = tap_count,
-                    .uniform = uniform,
-                    .run = run,
                     .tiles_x = tiles_x,
+                    .tile_lo = tile_floats,
+                    .tile_radius = tile_floats + tile_count,
+                    .tile_flat = tile_bytes,
+                    .tile_class = tile_bytes + tile_count,
+                    .row_shared = tile_bytes + 2 * tile_count,
+                    .planes = planes,
                     .batched = in->channels == 3 && in->width <= (1 << 20) &&
                                in->height <= (1 << 20) &&
                                (double)in->stride * (double)in->height < 2147483647.0 &&
-                               (double)coc->stride * (double)coc->height < 2147483647.0 };
-    drift_parallel_for(ctx, (size_t)in->height, 8, equal_runs, &job);
-    drift_parallel_for(ctx, tile_count, 1, classify_tiles, &job);
-    drift_parallel_for(ctx, (size_t)in->height, 1, dof_rows, &job);
-    drift__scratch_give(ctx, run, have);
-    drift_free(ctx, uniform);
+                               (double)coc->stride * (double)coc->height < 2147483647.0,
+                    .planes_allowed = planes_allowed };
+    drift_parallel_for(ctx, tile_count, 8, scan_tiles, &job);
+    drift_parallel_for(ctx, tile_count, 64, classify_tiles, &job);
+    // The pad: the widest circle a shared gather may take (a shared tile's, or a row of a tile
+    // gathered per pixel), a pixel for the bilinear corner, one to spare.
+    float widest = 0.0f;
+    for (size_t t = 0; planes_allowed && t < tile_count; ++t) {
+        float reach = job.tile_radius[t];
+        widest = job.tile_class[t] != TILE_COPY && reach > widest ? reach : widest;
+    }
+    widest = widest < SHARED_MAX_RADIUS ? widest : SHARED_MAX_RADIUS;
+    if (widest > 0.0f) {
+        job.pad = (int32_t)ceilf(widest) + 2;
+        job.plane_stride = tiles_x * UNIFORM_TILE + 2 * job.pad;
+        job.plane_height = in->height + 2 * job.pad;
+        drift_parallel_for(ctx, (size_t)job.plane_height, 8, fill_planes, &job);
+    } else {
+        job.planes_allowed = false;
+    }
+    drift_parallel_for(ctx, (size_t)tiles_y, 1, dof_bands, &job);
+    drift__scratch_give(ctx, planes, have);
+    drift_free(ctx, tile_floats);
     drift_free(ctx, table);
     return DRIFT_OK;
 }
