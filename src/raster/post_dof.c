@@ -18,7 +18,6 @@
 // it lies on the pixel's own disk (1 within its radius, 0 a pixel beyond). Same offsets for
 // every pixel make a tap a vector load of a row of pixels from a padded planar copy of the
 // frame (one weight, one bilinear fraction for the whole tile), instead of 13 gathered loads.
-#include "core/scratch.h"
 #include "core/vectorise.h"
 #include "raster/raster.h"
 
@@ -71,12 +70,8 @@ typedef struct dof_job {
     uint8_t *tile_flat;  // per tile: its pixels all equal its first
     uint8_t *tile_class; // per tile: TILE_COPY, TILE_GATHER or TILE_SHARED
     uint8_t *row_shared; // per tile row of a TILE_GATHER tile (y * tiles_x + tx): shared
-    // The padded planar copy (the shared gathers): channels planes then the circles, each
-    // plane_height rows of plane_stride floats (tiles_x whole tiles and the pad each side),
-    // pixel (x, y) at (y + pad) * stride + x + pad, the nearest pixel repeated outside the
-    // frame (what the clamped fetches read).
-    float *planes;
-    int32_t pad, plane_stride, plane_height;
+    float *local;        // each thread's tile_planes, local_floats apiece
+    size_t local_floats;
     // RGB, its indices in int32 and its coordinates under 2^21: the batched gather (with radii
     // up to 2^20 pixels, so that its taps' coordinates stay whole in float arithmetic).
     bool batched;
@@ -400,57 +395,79 @@ static void classify_tiles(size_t begin, size_t end, int thread_index, void *use
     }
 }
 
-// Row y of the frame into the planes' row `to` (its pad columns the row's first and last
-// pixel), `channels` constant once inlined, so the inner loop is a plain deinterleave.
-static inline void fill_plane_row(const dof_job *job, int32_t y, int32_t to, const int32_t channels)
+// A tile's padded planar copy: channels planes then the circles, each `size` rows of `stride`
+// floats (the tile and `pad` pixels each side), the nearest pixel repeated outside the frame
+// (what the clamped fetches read). Small enough to stay in the first-level cache and its
+// pages in the TLB (a frame-wide copy had each tap's rows on other pages: 1.6x slower).
+typedef struct tile_planes {
+    float *planes;
+    int32_t x0, y0, pad, stride;
+    size_t plane;
+} tile_planes;
+
+#define LOCAL_SIDE (UNIFORM_TILE + 2 * ((int32_t)SHARED_MAX_RADIUS + 2))
+
+static inline void fill_tile_planes(const dof_job *job, tile_planes *tp, const int32_t channels)
 {
     const drift_image *in = job->in;
-    const int32_t stride = job->plane_stride, pad = job->pad, width = in->width;
-    const int32_t step = job->coc->channels;
-    const size_t plane = (size_t)stride * (size_t)job->plane_height;
-    const float *restrict src = drift_image_pixel(in, 0, y);
-    const float *restrict reach = drift_image_pixel(job->coc, 0, y);
-    float *restrict row[5];
-    for (int32_t c = 0; c <= channels; ++c) {
-        row[c] = job->planes + (size_t)c * plane + (size_t)to * (size_t)stride + (size_t)pad;
+    const int32_t side = UNIFORM_TILE + 2 * tp->pad, step = job->coc->channels;
+    int32_t xs[LOCAL_SIDE];
+    for (int32_t lx = 0; lx < side; ++lx) {
+        xs[lx] = clamp_index(tp->x0 - tp->pad + lx, in->width);
     }
-    for (int32_t x = 0; x < width; ++x) {
-        for (int32_t c = 0; c < channels; ++c) {
-            row[c][x] = src[x * channels + c];
+    for (int32_t ly = 0; ly < side; ++ly) {
+        int32_t y = clamp_index(tp->y0 - tp->pad + ly, in->height);
+        const float *restrict src = drift_image_pixel(in, 0, y);
+        const float *restrict reach = drift_image_pixel(job->coc, 0, y);
+        float *restrict row = tp->planes + (size_t)ly * (size_t)tp->stride;
+        if (xs[0] == tp->x0 - tp->pad && xs[side - 1] == tp->x0 - tp->pad + side - 1 &&
+            step == 1) { // inside the frame: a plain deinterleave, vectorised
+            const float *restrict from = src + (size_t)xs[0] * (size_t)channels;
+            float *restrict to[5];
+            for (int32_t c = 0; c <= channels; ++c) {
+                to[c] = row + (size_t)c * tp->plane;
+            }
+            for (int32_t lx = 0; lx < side; ++lx) {
+                for (int32_t c = 0; c < channels; ++c) {
+                    to[c][lx] = from[lx * channels + c];
+                }
+            }
+            memcpy(to[channels], reach + xs[0], sizeof(float) * (size_t)side);
+            continue;
         }
-        row[channels][x] = reach[x * step];
-    }
-    for (int32_t c = 0; c <= channels; ++c) {
-        for (int32_t x = -pad; x < 0; ++x) {
-            row[c][x] = row[c][0];
-        }
-        for (int32_t x = width; x < stride - pad; ++x) {
-            row[c][x] = row[c][width - 1];
+        for (int32_t lx = 0; lx < side; ++lx) {
+            const float *p = src + (size_t)xs[lx] * (size_t)channels;
+            for (int32_t c = 0; c < channels; ++c) {
+                row[(size_t)c * tp->plane + (size_t)lx] = p[c];
+            }
+            row[(size_t)channels * tp->plane + (size_t)lx] = reach[(size_t)xs[lx] * (size_t)step];
         }
     }
 }
 
-// The padded planar copy of plane rows [begin, end) (clamped reads of the frame).
-static DRIFT_AVX2_CLONES void fill_planes(size_t begin, size_t end, int thread_index, void *user)
+// Sets up and fills tp for tile (tx, ty) with room for circles up to `radius`.
+static DRIFT_AVX2_CLONES void tile_planes_make(const dof_job *job, int32_t tx, int32_t ty,
+                                               float radius, float *buffer, tile_planes *tp)
 {
-    (void)thread_index;
-    const dof_job *job = user;
-    for (int32_t py = (int32_t)begin; py < (int32_t)end; ++py) {
-        int32_t y = clamp_index(py - job->pad, job->in->height);
-        switch (job->in->channels) {
-        case 1:
-            fill_plane_row(job, y, py, 1);
-            break;
-        case 2:
-            fill_plane_row(job, y, py, 2);
-            break;
-        case 3:
-            fill_plane_row(job, y, py, 3);
-            break;
-        default:
-            fill_plane_row(job, y, py, 4);
-            break;
-        }
+    tp->planes = buffer;
+    tp->x0 = tx * UNIFORM_TILE;
+    tp->y0 = ty * UNIFORM_TILE;
+    tp->pad = (int32_t)ceilf(radius) + 2; // a pixel for the bilinear corner, one to spare
+    tp->stride = UNIFORM_TILE + 2 * tp->pad;
+    tp->plane = (size_t)tp->stride * (size_t)tp->stride;
+    switch (job->in->channels) {
+    case 1:
+        fill_tile_planes(job, tp, 1);
+        break;
+    case 2:
+        fill_tile_planes(job, tp, 2);
+        break;
+    case 3:
+        fill_tile_planes(job, tp, 3);
+        break;
+    default:
+        fill_tile_planes(job, tp, 4);
+        break;
     }
 }
 
@@ -464,24 +481,24 @@ typedef struct shared_tap {
 // The shared gather of tile row y (pixels x0 .. x0 + n - 1, n <= UNIFORM_TILE), `channels`
 // constant once inlined: gather()'s sums (differences from the centre, weighed; a weightless
 // tap adds exact zeros), each tap's weight times its place on the pixel's own disk.
-static inline void shared_row(const dof_job *job, int32_t x0, int32_t y, const shared_tap *taps,
-                              uint32_t tap_count, const int32_t channels)
+static inline void shared_row(const dof_job *job, const tile_planes *tp, int32_t y,
+                              const shared_tap *taps, uint32_t tap_count, const int32_t channels)
 {
     enum {
         N = UNIFORM_TILE
     };
 
-    const int32_t stride = job->plane_stride;
-    const size_t plane = (size_t)stride * (size_t)job->plane_height;
-    const size_t at = (size_t)(y + job->pad) * (size_t)stride + (size_t)(x0 + job->pad);
-    const float *restrict reach_at = job->planes + (size_t)channels * plane + at;
+    const int32_t stride = tp->stride, x0 = tp->x0;
+    const size_t plane = tp->plane;
+    const size_t at = (size_t)(y - tp->y0 + tp->pad) * (size_t)stride + (size_t)tp->pad;
+    const float *restrict reach_at = tp->planes + (size_t)channels * plane + at;
     float radius[N], centre[4][N], sum[4][N], total[N];
     // All N lanes, past the frame's right edge too (the planes hold whole tiles); only the
     // frame's pixels are written.
     for (int32_t i = 0; i < N; ++i) {
         radius[i] = reach_at[i];
         for (int32_t c = 0; c < channels; ++c) {
-            centre[c][i] = job->planes[(size_t)c * plane + at + (size_t)i];
+            centre[c][i] = tp->planes[(size_t)c * plane + at + (size_t)i];
             sum[c][i] = 0.0f;
         }
         total[i] = 1.0f; // the centre: its own circle reaches it
@@ -491,7 +508,7 @@ static inline void shared_row(const dof_job *job, int32_t x0, int32_t y, const s
         const float *restrict reach = reach_at + tap.near;
         const float *restrict corner[4];
         for (int32_t c = 0; c < channels; ++c) {
-            corner[c] = job->planes + (size_t)c * plane + at + tap.corner;
+            corner[c] = tp->planes + (size_t)c * plane + at + tap.corner;
         }
         DRIFT_IVDEP
         for (int32_t i = 0; i < N; ++i) {
@@ -533,10 +550,9 @@ static inline void shared_row(const dof_job *job, int32_t x0, int32_t y, const s
 
 // The taps of a shared gather of the largest circle `radius`: the table's first
 // taps_for_radius(radius) scaled by it, the centre left out; their count.
-static uint32_t shared_taps(const dof_job *job, float radius, shared_tap *taps)
+static uint32_t shared_taps(const dof_job *job, float radius, ptrdiff_t stride, shared_tap *taps)
 {
     const uint32_t count = taps_for_radius(radius, job->tap_count);
-    const ptrdiff_t stride = job->plane_stride;
     for (uint32_t k = 1; k < count; ++k) {
         float ox = job->taps[k].x * radius, oy = job->taps[k].y * radius;
         float fx0 = floorf(ox), fy0 = floorf(oy);
@@ -550,22 +566,22 @@ static uint32_t shared_taps(const dof_job *job, float radius, shared_tap *taps)
     return count - 1;
 }
 
-static inline void shared_rows(const dof_job *job, int32_t x0, int32_t y0, int32_t y1,
+static inline void shared_rows(const dof_job *job, const tile_planes *tp, int32_t y0, int32_t y1,
                                const shared_tap *taps, uint32_t count)
 {
     for (int32_t y = y0; y < y1; ++y) {
         switch (job->in->channels) {
         case 1:
-            shared_row(job, x0, y, taps, count, 1);
+            shared_row(job, tp, y, taps, count, 1);
             break;
         case 2:
-            shared_row(job, x0, y, taps, count, 2);
+            shared_row(job, tp, y, taps, count, 2);
             break;
         case 3:
-            shared_row(job, x0, y, taps, count, 3);
+            shared_row(job, tp, y, taps, count, 3);
             break;
         default:
-            shared_row(job, x0, y, taps, count, 4);
+            shared_row(job, tp, y, taps, count, 4);
             break;
         }
     }
@@ -655,22 +671,27 @@ static DRIFT_AVX2_CLONES void dof_bands(size_t begin, size_t end, int thread_ind
 {
     const dof_job *job = user;
     const drift_image *in = job->in;
+    float *local = job->local + (size_t)thread_index * job->local_floats;
     shared_tap taps[SHARED_MAX_TAPS];
+    tile_planes tp;
     for (size_t ty = begin; ty < end; ++ty) {
         int32_t y0 = (int32_t)ty * UNIFORM_TILE;
         int32_t y1 = y0 + UNIFORM_TILE < in->height ? y0 + UNIFORM_TILE : in->height;
         for (int32_t tx = 0; tx < job->tiles_x; ++tx) {
             size_t t = ty * (size_t)job->tiles_x + (size_t)tx;
             int32_t x0 = tx * UNIFORM_TILE;
+            float widest = job->tile_radius[t];
             if (job->tile_class[t] == TILE_SHARED) {
-                uint32_t count = shared_taps(job, job->tile_radius[t], taps);
-                shared_rows(job, x0, y0, y1, taps, count);
+                tile_planes_make(job, tx, (int32_t)ty, widest, local, &tp);
+                uint32_t count = shared_taps(job, widest, tp.stride, taps);
+                shared_rows(job, &tp, y0, y1, taps, count);
                 continue;
             }
             if (job->tile_class[t] != TILE_GATHER) {
                 continue;
             }
             int32_t n = in->width - x0 < UNIFORM_TILE ? in->width - x0 : UNIFORM_TILE;
+            bool filled = false;
             for (int32_t y = y0; y < y1; ++y) {
                 const float *reach = drift_image_pixel(job->coc, x0, y);
                 float lo = HUGE_VALF, hi = 0.0f;
@@ -680,11 +701,15 @@ static DRIFT_AVX2_CLONES void dof_bands(size_t begin, size_t end, int thread_ind
                     hi = r > hi ? r : hi;
                 }
                 bool share = job->planes_allowed && hi >= 0.5f && circles_share(lo, hi) &&
-                             hi <= (float)(job->pad - 2);
+                             widest <= SHARED_MAX_RADIUS;
                 job->row_shared[(size_t)y * (size_t)job->tiles_x + (size_t)tx] = share;
                 if (share) {
-                    uint32_t count = shared_taps(job, hi, taps);
-                    shared_rows(job, x0, y, y + 1, taps, count);
+                    if (!filled) { // the tile's planes, padded for its widest circle
+                        tile_planes_make(job, tx, (int32_t)ty, widest, local, &tp);
+                        filled = true;
+                    }
+                    uint32_t count = shared_taps(job, hi, tp.stride, taps);
+                    shared_rows(job, &tp, y, y + 1, taps, count);
                 }
             }
         }
@@ -742,17 +767,14 @@ drift_result drift_post_dof_tiles(drift_context *ctx, const drift_image *in, con
     size_t tile_count = (size_t)tiles_x * (size_t)tiles_y;
     size_t segments = (size_t)tiles_x * (size_t)in->height;
     float *tile_floats = drift_alloc(ctx, tile_count * (2 * sizeof(float) + 2) + segments);
-    // The planes in the context's scratch block (kept between calls: no fresh pages each
-    // frame), sized for the widest pad.
+    // Each thread's tile planes, for the widest pad.
     bool planes_allowed = shared && in->channels <= 4 && tap_count <= SHARED_MAX_TAPS;
-    size_t max_pad = (size_t)SHARED_MAX_RADIUS + 2;
-    size_t plane_bytes = (size_t)(in->channels + 1) * sizeof(float) *
-                         ((size_t)tiles_x * UNIFORM_TILE + 2 * max_pad) *
-                         ((size_t)in->height + 2 * max_pad);
-    size_t have = 0;
-    float *planes =
-        planes_allowed && tile_floats ? drift__scratch_take(ctx, plane_bytes, &have) : NULL;
-    if (!tile_floats || (planes_allowed && !planes)) {
+    size_t local_floats = (size_t)(in->channels + 1) * LOCAL_SIDE * LOCAL_SIDE;
+    size_t threads = (size_t)drift_context_thread_count(ctx);
+    float *local = planes_allowed && tile_floats
+                       ? drift_alloc(ctx, sizeof(float) * local_floats * threads)
+                       : NULL;
+    if (!tile_floats || (planes_allowed && !local)) {
         drift_free(ctx, tile_floats);
         drift_free(ctx, table);
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_OUT_OF_MEMORY, __FILE__, __LINE__,
@@ -771,7 +793,8 @@ drift_result drift_post_dof_tiles(drift_context *ctx, const drift_image *in, con
                     .tile_flat = tile_bytes,
                     .tile_class = tile_bytes + tile_count,
                     .row_shared = tile_bytes + 2 * tile_count,
-                    .planes = planes,
+                    .local = local,
+                    .local_floats = local_floats,
                     .batched = in->channels == 3 && in->width <= (1 << 20) &&
                                in->height <= (1 << 20) &&
                                (double)in->stride * (double)in->height < 2147483647.0 &&
@@ -779,24 +802,8 @@ drift_result drift_post_dof_tiles(drift_context *ctx, const drift_image *in, con
                     .planes_allowed = planes_allowed };
     drift_parallel_for(ctx, tile_count, 8, scan_tiles, &job);
     drift_parallel_for(ctx, tile_count, 64, classify_tiles, &job);
-    // The pad: the widest circle a shared gather may take (a shared tile's, or a row of a tile
-    // gathered per pixel), a pixel for the bilinear corner, one to spare.
-    float widest = 0.0f;
-    for (size_t t = 0; planes_allowed && t < tile_count; ++t) {
-        float reach = job.tile_radius[t];
-        widest = job.tile_class[t] != TILE_COPY && reach > widest ? reach : widest;
-    }
-    widest = widest < SHARED_MAX_RADIUS ? widest : SHARED_MAX_RADIUS;
-    if (widest > 0.0f) {
-        job.pad = (int32_t)ceilf(widest) + 2;
-        job.plane_stride = tiles_x * UNIFORM_TILE + 2 * job.pad;
-        job.plane_height = in->height + 2 * job.pad;
-        drift_parallel_for(ctx, (size_t)job.plane_height, 8, fill_planes, &job);
-    } else {
-        job.planes_allowed = false;
-    }
     drift_parallel_for(ctx, (size_t)tiles_y, 1, dof_bands, &job);
-    drift__scratch_give(ctx, planes, have);
+    drift_free(ctx, local);
     drift_free(ctx, tile_floats);
     drift_free(ctx, table);
     return DRIFT_OK;
