@@ -13,13 +13,14 @@
 // Tile classification (issue 46; the tiles of production engines' DOF, Jimenez 2014): each
 // 16 x 16 tile is copied (every pixel in focus, or the tile and all its gathers read one
 // colour), gathered per pixel (the circles of its gathering pixels differ by more than 1.5x + 1
-// px: depth edges), or gathered at once: every pixel of the tile takes the same taps, the
-// table scaled by the tile's largest circle R, each tap weighed as above and also by whether
-// it lies on the pixel's own disk (1 within its radius, 0 a pixel beyond). Same offsets for
-// every pixel make a tap a vector load of a row of pixels from a padded planar copy of the
-// frame (one weight, one bilinear fraction for the whole tile), instead of 13 gathered loads.
-#include "core/vectorise.h"
-#include "raster/raster.h"
+// px: depth edges; their rows that do not cross the edge share taps), or gathered at once:
+// every pixel of the tile takes the same taps, the table scaled by the tile's largest circle
+// R, each tap weighed as above and also by whether it lies on the pixel's own disk (1 within
+// its radius, 0 a pixel beyond). Same offsets for every pixel make a tap a vector load of a
+// row of the tile from the tile's padded planar copy (one bilinear fraction for the whole
+// tile), instead of 13 gathered loads (post_dof_tiles.c). The per-pixel gather of every tile
+// stays selectable (drift_post_dof_tiles, the post-dof-tiles knob).
+#include "raster/post_dof_internal.h"
 
 #include <math.h>
 #include <string.h>
@@ -58,39 +59,6 @@ float drift_coc_radius_pixels(const drift_camera *camera, int32_t image_height, 
 
 // --- GATHER ---
 
-typedef struct dof_job {
-    const drift_image *in;
-    const drift_image *coc;
-    drift_image *out;
-    const drift_vec2 *taps; // offsets on the unit disk; taps[0] is the centre
-    uint32_t tap_count;
-    int32_t tiles_x;
-    float *tile_lo;      // per UNIFORM_TILE tile: its gathering pixels' smallest circle
-    float *tile_radius;  // per tile: its pixels' largest circle
-    uint8_t *tile_flat;  // per tile: its pixels all equal its first
-    uint8_t *tile_class; // per tile: TILE_COPY, TILE_GATHER or TILE_SHARED
-    uint8_t *row_shared; // per tile row of a TILE_GATHER tile (y * tiles_x + tx): shared
-    float *local;        // each thread's tile_planes, local_floats apiece
-    size_t local_floats;
-    // RGB, its indices in int32 and its coordinates under 2^21: the batched gather (with radii
-    // up to 2^20 pixels, so that its taps' coordinates stay whole in float arithmetic).
-    bool batched;
-    bool planes_allowed; // the shared path: channels <= 4, tables up to SHARED_MAX_TAPS
-} dof_job;
-
-#define UNIFORM_TILE 16
-
-// The tile classes, and the widest circle the shared path takes (its pad is the largest
-// such circle over the frame's shared tiles: one more pixel of pad a plane row and column).
-enum {
-    TILE_GATHER = 0, // per pixel (the batches)
-    TILE_COPY = 1,   // every pixel copied
-    TILE_SHARED = 2, // every pixel the same taps (shared_tile)
-};
-
-#define SHARED_MAX_RADIUS 32.0f
-#define SHARED_MAX_TAPS   256u // shared_tile's table on the stack
-
 // The centre, then the concentric-disk image of a scrambled Sobol (0,2)-sequence: its first
 // 2^k points are stratified over [0,1)^2, so the taps cover the disk evenly.
 static void make_taps(drift_vec2 *taps, uint32_t count)
@@ -100,16 +68,6 @@ static void make_taps(drift_vec2 *taps, uint32_t count)
         drift_sampler s = drift_sampler_make(TAP_SEED, 0, k - 1);
         taps[k] = drift_sample_disk_concentric(drift_sampler_next2(&s));
     }
-}
-
-static int32_t clamp_index(int32_t v, int32_t n)
-{
-    return v < 0 ? 0 : (v >= n ? n - 1 : v);
-}
-
-static float lerp(float a, float b, float t)
-{
-    return a + (b - a) * t; // exact when a == b, so a constant image stays constant
 }
 
 // Bilinear fetch at (x, y) in pixel-centre units (pixel p's centre at p), clamped to the image.
@@ -127,19 +85,6 @@ static inline void fetch_bilinear(const drift_image *image, float x, float y, fl
     for (int32_t c = 0; c < channels; ++c) {
         out[c] = lerp(lerp(p00[c], p10[c], fx), lerp(p01[c], p11[c], fx), fy);
     }
-}
-
-// Taps for a disk of `radius` pixels: the centre plus a power of two of the stratified set
-// (a prefix of 2^k points stays stratified), one per four pixels of the disk's area, at most
-// the table: each bilinear tap reads a 2x2 footprint, so together they read about every pixel.
-static uint32_t taps_for_radius(float radius, uint32_t table_size)
-{
-    float quarter_area = 0.25f * 3.14159265f * radius * radius;
-    uint32_t n = 4;
-    while ((float)n < quarter_area && n < table_size - 1) {
-        n *= 2;
-    }
-    return n + 1 < table_size ? n + 1 : table_size;
 }
 
 // How much a tap `distance` pixels from the centre is seen there: 1 where its own circle of
@@ -277,316 +222,6 @@ static DRIFT_AVX2_CLONES void post_dof_gather_batch(const dof_job *job, int32_t 
     }
 }
 
-// A tile whose gathering pixels' circles lie within [lo, 1.5 lo + 1] shares its taps: a pixel
-// of radius r then keeps about r^2 / R^2 >= 1/4 of the R disk's taps, near the count of its own
-// disk (one a four pixels either way, up to the table's size). Wider spreads are the depth
-// edges, gathered per pixel. NaN and negative circles (copied pixels) do not count.
-static bool circles_share(float lo, float hi)
-{
-    return hi <= 1.5f * lo + 1.0f && hi <= SHARED_MAX_RADIUS;
-}
-
-// Per tile: its gathering pixels' smallest circle, the largest circle of any pixel (how far
-// its gathers read; 0 when none is positive), and whether its pixels all equal its first one
-// (float == per channel: -0 equals +0, NaN nothing).
-static DRIFT_AVX2_CLONES void scan_tiles(size_t begin, size_t end, int thread_index, void *user)
-{
-    (void)thread_index;
-
-    enum {
-        N = UNIFORM_TILE
-    };
-
-    const dof_job *job = user;
-    const drift_image *in = job->in;
-    const int32_t channels = in->channels, step = job->coc->channels;
-    // Per column (per float of a row): elementwise, so the loops vectorise (a conditional
-    // min reduction does not, without -ffast-math).
-    float first[N * 4], lo_lane[N], hi_lane[N];
-    int32_t differ[N * 4];
-    for (size_t t = begin; t < end; ++t) {
-        int32_t x0 = (int32_t)(t % (size_t)job->tiles_x) * UNIFORM_TILE;
-        int32_t y0 = (int32_t)(t / (size_t)job->tiles_x) * UNIFORM_TILE;
-        int32_t n = in->width - x0 < N ? in->width - x0 : N;
-        int32_t y1 = y0 + N < in->height ? y0 + N : in->height;
-        const float *origin = drift_image_pixel(in, x0, y0);
-        for (int32_t k = 0; k < N * 4; ++k) {
-            first[k] = origin[k % channels];
-            differ[k] = 0;
-        }
-        for (int32_t i = 0; i < N; ++i) {
-            lo_lane[i] = HUGE_VALF;
-            hi_lane[i] = 0.0f;
-        }
-        for (int32_t y = y0; y < y1; ++y) {
-            const float *restrict row = drift_image_pixel(in, x0, y);
-            const float *restrict reach = drift_image_pixel(job->coc, x0, y);
-            if (n == N && step == 1) {
-                for (int32_t i = 0; i < N; ++i) {
-                    float r = reach[i], low = r >= 0.5f ? r : HUGE_VALF;
-                    lo_lane[i] = low < lo_lane[i] ? low : lo_lane[i];
-                    hi_lane[i] = r > hi_lane[i] ? r : hi_lane[i];
-                }
-            } else {
-                for (int32_t i = 0; i < n; ++i) {
-                    float r = reach[i * step], low = r >= 0.5f ? r : HUGE_VALF;
-                    lo_lane[i] = low < lo_lane[i] ? low : lo_lane[i];
-                    hi_lane[i] = r > hi_lane[i] ? r : hi_lane[i];
-                }
-            }
-            if (n == N && channels == 3) {
-                for (int32_t k = 0; k < N * 3; ++k) {
-                    differ[k] |= row[k] != first[k];
-                }
-            } else {
-                for (int32_t k = 0; k < n * channels; ++k) {
-                    differ[k] |= row[k] != first[k];
-                }
-            }
-        }
-        float lo = HUGE_VALF, hi = 0.0f;
-        int32_t any = 0;
-        for (int32_t i = 0; i < N; ++i) {
-            lo = lo_lane[i] < lo ? lo_lane[i] : lo;
-            hi = hi_lane[i] > hi ? hi_lane[i] : hi;
-        }
-        for (int32_t k = 0; k < N * 4; ++k) {
-            any |= differ[k];
-        }
-        job->tile_lo[t] = lo;
-        job->tile_radius[t] = hi;
-        job->tile_flat[t] = !any;
-    }
-}
-
-// A tile is copied when every pixel its gathers can read holds one value: each gather would
-// return its centre (it sums differences from the centre). Checked by whole tiles: every tile
-// the padded tile meets is flat and starts with the same value (a tap lands within the
-// largest radius; its bilinear fetch reads one pixel further). Also copied: tiles without a
-// gathering pixel. Then the shared tiles (circles_share), and the rest per pixel.
-static void classify_tiles(size_t begin, size_t end, int thread_index, void *user)
-{
-    (void)thread_index;
-    const dof_job *job = user;
-    const drift_image *in = job->in;
-    for (size_t t = begin; t < end; ++t) {
-        int32_t tx = (int32_t)(t % (size_t)job->tiles_x), ty = (int32_t)(t / (size_t)job->tiles_x);
-        float hi = job->tile_radius[t];
-        int32_t pad = (int32_t)ceilf(fminf(hi, (float)(in->width + in->height))) + 1;
-        int32_t x0 = tx * UNIFORM_TILE, y0 = ty * UNIFORM_TILE;
-        int32_t ua = clamp_index(x0 - pad, in->width) / UNIFORM_TILE;
-        int32_t ub = clamp_index(x0 + UNIFORM_TILE - 1 + pad, in->width) / UNIFORM_TILE;
-        int32_t va = clamp_index(y0 - pad, in->height) / UNIFORM_TILE;
-        int32_t vb = clamp_index(y0 + UNIFORM_TILE - 1 + pad, in->height) / UNIFORM_TILE;
-        const float *first = drift_image_pixel(in, x0, y0);
-        bool uniform = true;
-        for (int32_t v = va; uniform && v <= vb; ++v) {
-            for (int32_t u = ua; uniform && u <= ub; ++u) {
-                const float *q = drift_image_pixel(in, u * UNIFORM_TILE, v * UNIFORM_TILE);
-                uniform = job->tile_flat[(size_t)v * (size_t)job->tiles_x + (size_t)u];
-                for (int32_t c = 0; c < in->channels; ++c) {
-                    uniform = uniform && q[c] == first[c];
-                }
-            }
-        }
-        bool copy = uniform || !(hi >= 0.5f);
-        bool shared = job->planes_allowed && circles_share(job->tile_lo[t], hi);
-        job->tile_class[t] = copy ? TILE_COPY : (shared ? TILE_SHARED : TILE_GATHER);
-    }
-}
-
-// A tile's padded planar copy: channels planes then the circles, each `size` rows of `stride`
-// floats (the tile and `pad` pixels each side), the nearest pixel repeated outside the frame
-// (what the clamped fetches read). Small enough to stay in the first-level cache and its
-// pages in the TLB (a frame-wide copy had each tap's rows on other pages: 1.6x slower).
-typedef struct tile_planes {
-    float *planes;
-    int32_t x0, y0, pad, stride;
-    size_t plane;
-} tile_planes;
-
-#define LOCAL_SIDE (UNIFORM_TILE + 2 * ((int32_t)SHARED_MAX_RADIUS + 2))
-
-static inline void fill_tile_planes(const dof_job *job, tile_planes *tp, const int32_t channels)
-{
-    const drift_image *in = job->in;
-    const int32_t side = UNIFORM_TILE + 2 * tp->pad, step = job->coc->channels;
-    int32_t xs[LOCAL_SIDE];
-    for (int32_t lx = 0; lx < side; ++lx) {
-        xs[lx] = clamp_index(tp->x0 - tp->pad + lx, in->width);
-    }
-    for (int32_t ly = 0; ly < side; ++ly) {
-        int32_t y = clamp_index(tp->y0 - tp->pad + ly, in->height);
-        const float *restrict src = drift_image_pixel(in, 0, y);
-        const float *restrict reach = drift_image_pixel(job->coc, 0, y);
-        float *restrict row = tp->planes + (size_t)ly * (size_t)tp->stride;
-        if (xs[0] == tp->x0 - tp->pad && xs[side - 1] == tp->x0 - tp->pad + side - 1 &&
-            step == 1) { // inside the frame: a plain deinterleave, vectorised
-            const float *restrict from = src + (size_t)xs[0] * (size_t)channels;
-            float *restrict to[5];
-            for (int32_t c = 0; c <= channels; ++c) {
-                to[c] = row + (size_t)c * tp->plane;
-            }
-            for (int32_t lx = 0; lx < side; ++lx) {
-                for (int32_t c = 0; c < channels; ++c) {
-                    to[c][lx] = from[lx * channels + c];
-                }
-            }
-            memcpy(to[channels], reach + xs[0], sizeof(float) * (size_t)side);
-            continue;
-        }
-        for (int32_t lx = 0; lx < side; ++lx) {
-            const float *p = src + (size_t)xs[lx] * (size_t)channels;
-            for (int32_t c = 0; c < channels; ++c) {
-                row[(size_t)c * tp->plane + (size_t)lx] = p[c];
-            }
-            row[(size_t)channels * tp->plane + (size_t)lx] = reach[(size_t)xs[lx] * (size_t)step];
-        }
-    }
-}
-
-// Sets up and fills tp for tile (tx, ty) with room for circles up to `radius`.
-static DRIFT_AVX2_CLONES void tile_planes_make(const dof_job *job, int32_t tx, int32_t ty,
-                                               float radius, float *buffer, tile_planes *tp)
-{
-    tp->planes = buffer;
-    tp->x0 = tx * UNIFORM_TILE;
-    tp->y0 = ty * UNIFORM_TILE;
-    tp->pad = (int32_t)ceilf(radius) + 2; // a pixel for the bilinear corner, one to spare
-    tp->stride = UNIFORM_TILE + 2 * tp->pad;
-    tp->plane = (size_t)tp->stride * (size_t)tp->stride;
-    switch (job->in->channels) {
-    case 1:
-        fill_tile_planes(job, tp, 1);
-        break;
-    case 2:
-        fill_tile_planes(job, tp, 2);
-        break;
-    case 3:
-        fill_tile_planes(job, tp, 3);
-        break;
-    default:
-        fill_tile_planes(job, tp, 4);
-        break;
-    }
-}
-
-// One tap of a shared tile: its offsets in the planes (nearest pixel, bilinear corner), the
-// bilinear fractions and its distance from the centre, the same for every pixel of the tile.
-typedef struct shared_tap {
-    ptrdiff_t near, corner;
-    float fx, fy, distance;
-} shared_tap;
-
-// The shared gather of tile row y (pixels x0 .. x0 + n - 1, n <= UNIFORM_TILE), `channels`
-// constant once inlined: gather()'s sums (differences from the centre, weighed; a weightless
-// tap adds exact zeros), each tap's weight times its place on the pixel's own disk.
-static inline void shared_row(const dof_job *job, const tile_planes *tp, int32_t y,
-                              const shared_tap *taps, uint32_t tap_count, const int32_t channels)
-{
-    enum {
-        N = UNIFORM_TILE
-    };
-
-    const int32_t stride = tp->stride, x0 = tp->x0;
-    const size_t plane = tp->plane;
-    const size_t at = (size_t)(y - tp->y0 + tp->pad) * (size_t)stride + (size_t)tp->pad;
-    const float *restrict reach_at = tp->planes + (size_t)channels * plane + at;
-    float radius[N], centre[4][N], sum[4][N], total[N];
-    // All N lanes, past the frame's right edge too (the planes hold whole tiles); only the
-    // frame's pixels are written.
-    for (int32_t i = 0; i < N; ++i) {
-        radius[i] = reach_at[i];
-        for (int32_t c = 0; c < channels; ++c) {
-            centre[c][i] = tp->planes[(size_t)c * plane + at + (size_t)i];
-            sum[c][i] = 0.0f;
-        }
-        total[i] = 1.0f; // the centre: its own circle reaches it
-    }
-    for (uint32_t k = 0; k < tap_count; ++k) {
-        const shared_tap tap = taps[k];
-        const float *restrict reach = reach_at + tap.near;
-        const float *restrict corner[4];
-        for (int32_t c = 0; c < channels; ++c) {
-            corner[c] = tp->planes + (size_t)c * plane + at + tap.corner;
-        }
-        DRIFT_IVDEP
-        for (int32_t i = 0; i < N; ++i) {
-            float v = reach[i] - tap.distance + 1.0f;
-            v = v < 0.0f ? 0.0f : (v > 1.0f ? 1.0f : v);
-            float own = radius[i] - tap.distance + 1.0f;
-            own = own < 0.0f ? 0.0f : (own > 1.0f ? 1.0f : own);
-            float weight = reach[i] >= 0.0f ? v * own : 0.0f;
-            bool on = weight > 0.0f;
-            float ws = on ? weight : 0.0f;
-            for (int32_t c = 0; c < channels; ++c) {
-                const float *p = corner[c] + i;
-                float t =
-                    lerp(lerp(p[0], p[1], tap.fx), lerp(p[stride], p[stride + 1], tap.fx), tap.fy);
-                float d = on ? t - centre[c][i] : 0.0f;
-                sum[c][i] += ws * d;
-            }
-            total[i] += ws;
-        }
-    }
-    float result[4][N];
-    for (int32_t i = 0; i < N; ++i) {
-        float inv = 1.0f / total[i];
-        for (int32_t c = 0; c < channels; ++c) {
-            result[c][i] = centre[c][i] + sum[c][i] * inv;
-        }
-    }
-    int32_t n = job->in->width - x0 < N ? job->in->width - x0 : N;
-    const float *src = drift_image_pixel(job->in, x0, y);
-    float *dst = drift_image_pixel(job->out, x0, y);
-    for (int32_t i = 0; i < n; ++i) {
-        // Below half a pixel (or NaN) the pixel is copied, as everywhere.
-        bool gathers = radius[i] >= 0.5f;
-        for (int32_t c = 0; c < channels; ++c) {
-            dst[i * channels + c] = gathers ? result[c][i] : src[i * channels + c];
-        }
-    }
-}
-
-// The taps of a shared gather of the largest circle `radius`: the table's first
-// taps_for_radius(radius) scaled by it, the centre left out; their count.
-static uint32_t shared_taps(const dof_job *job, float radius, ptrdiff_t stride, shared_tap *taps)
-{
-    const uint32_t count = taps_for_radius(radius, job->tap_count);
-    for (uint32_t k = 1; k < count; ++k) {
-        float ox = job->taps[k].x * radius, oy = job->taps[k].y * radius;
-        float fx0 = floorf(ox), fy0 = floorf(oy);
-        taps[k - 1] = (shared_tap){ .near = (ptrdiff_t)floorf(oy + 0.5f) * stride +
-                                            (ptrdiff_t)floorf(ox + 0.5f),
-                                    .corner = (ptrdiff_t)fy0 * stride + (ptrdiff_t)fx0,
-                                    .fx = ox - fx0,
-                                    .fy = oy - fy0,
-                                    .distance = sqrtf(ox * ox + oy * oy) };
-    }
-    return count - 1;
-}
-
-static inline void shared_rows(const dof_job *job, const tile_planes *tp, int32_t y0, int32_t y1,
-                               const shared_tap *taps, uint32_t count)
-{
-    for (int32_t y = y0; y < y1; ++y) {
-        switch (job->in->channels) {
-        case 1:
-            shared_row(job, tp, y, taps, count, 1);
-            break;
-        case 2:
-            shared_row(job, tp, y, taps, count, 2);
-            break;
-        case 3:
-            shared_row(job, tp, y, taps, count, 3);
-            break;
-        default:
-            shared_row(job, tp, y, taps, count, 4);
-            break;
-        }
-    }
-}
-
 // Cloned for AVX2: floorf is one instruction there and sqrtf needs no errno (the file is built
 // with -fno-math-errno): 1.3x, the same image. RGB pixels that gather wait in batches by tap
 // count (a power of two plus one, or the table: one batch for each), so a batch's lanes run
@@ -664,56 +299,17 @@ static DRIFT_AVX2_CLONES void dof_rows(size_t begin, size_t end, int thread_inde
     }
 }
 
-// A band of tile rows (ty): its shared tiles, the rows of its per-pixel tiles whose circles
-// share (a tile across a depth edge has rows that do not cross it), then its rows' copies and
+// A band of tile rows: its shared gathers (post_dof_tiles.c), then its rows' copies and
 // per-pixel gathers.
 static DRIFT_AVX2_CLONES void dof_bands(size_t begin, size_t end, int thread_index, void *user)
 {
     const dof_job *job = user;
-    const drift_image *in = job->in;
     float *local = job->local + (size_t)thread_index * job->local_floats;
-    shared_tap taps[SHARED_MAX_TAPS];
-    tile_planes tp;
     for (size_t ty = begin; ty < end; ++ty) {
-        int32_t y0 = (int32_t)ty * UNIFORM_TILE;
-        int32_t y1 = y0 + UNIFORM_TILE < in->height ? y0 + UNIFORM_TILE : in->height;
-        for (int32_t tx = 0; tx < job->tiles_x; ++tx) {
-            size_t t = ty * (size_t)job->tiles_x + (size_t)tx;
-            int32_t x0 = tx * UNIFORM_TILE;
-            float widest = job->tile_radius[t];
-            if (job->tile_class[t] == TILE_SHARED) {
-                tile_planes_make(job, tx, (int32_t)ty, widest, local, &tp);
-                uint32_t count = shared_taps(job, widest, tp.stride, taps);
-                shared_rows(job, &tp, y0, y1, taps, count);
-                continue;
-            }
-            if (job->tile_class[t] != TILE_GATHER) {
-                continue;
-            }
-            int32_t n = in->width - x0 < UNIFORM_TILE ? in->width - x0 : UNIFORM_TILE;
-            bool filled = false;
-            for (int32_t y = y0; y < y1; ++y) {
-                const float *reach = drift_image_pixel(job->coc, x0, y);
-                float lo = HUGE_VALF, hi = 0.0f;
-                for (int32_t i = 0; i < n; ++i) {
-                    float r = reach[i * job->coc->channels];
-                    lo = r >= 0.5f && r < lo ? r : lo;
-                    hi = r > hi ? r : hi;
-                }
-                bool share = job->planes_allowed && hi >= 0.5f && circles_share(lo, hi) &&
-                             widest <= SHARED_MAX_RADIUS;
-                job->row_shared[(size_t)y * (size_t)job->tiles_x + (size_t)tx] = share;
-                if (share) {
-                    if (!filled) { // the tile's planes, padded for its widest circle
-                        tile_planes_make(job, tx, (int32_t)ty, widest, local, &tp);
-                        filled = true;
-                    }
-                    uint32_t count = shared_taps(job, hi, tp.stride, taps);
-                    shared_rows(job, &tp, y, y + 1, taps, count);
-                }
-            }
-        }
-        dof_rows((size_t)y0, (size_t)y1, thread_index, user);
+        drift__post_dof_shared_band(job, (int32_t)ty, local);
+        size_t y0 = ty * UNIFORM_TILE, y1 = y0 + UNIFORM_TILE;
+        dof_rows(y0, y1 < (size_t)job->in->height ? y1 : (size_t)job->in->height, thread_index,
+                 user);
     }
 }
 
@@ -800,8 +396,8 @@ drift_result drift_post_dof_tiles(drift_context *ctx, const drift_image *in, con
                                (double)in->stride * (double)in->height < 2147483647.0 &&
                                (double)coc->stride * (double)coc->height < 2147483647.0,
                     .planes_allowed = planes_allowed };
-    drift_parallel_for(ctx, tile_count, 8, scan_tiles, &job);
-    drift_parallel_for(ctx, tile_count, 64, classify_tiles, &job);
+    drift_parallel_for(ctx, tile_count, 8, drift__post_dof_scan_tiles, &job);
+    drift_parallel_for(ctx, tile_count, 64, drift__post_dof_classify_tiles, &job);
     drift_parallel_for(ctx, (size_t)tiles_y, 1, dof_bands, &job);
     drift_free(ctx, local);
     drift_free(ctx, tile_floats);
