@@ -120,9 +120,9 @@ typedef struct drift_envmap_settings {
 
 // Post-process depth of field (post; src/raster/post_dof.c):
 //   per_pixel = false: the 16 x 16 tiles whose gathering pixels' circles are alike gather with
-//               one set of taps for the tile (issue 46: the bench frame's pass 2.8x faster,
-//               FLIP against the path tracer unchanged to 1e-4); true: every pixel its own taps
-//               (the pass before)
+//               one set of taps for the whole tile (issue 46: about 2.8x faster on the bench
+//               frame, FLIP against the path tracer unchanged; docs/lab/2026-12-08-issue-46-s8-
+//               dof.md); true: every pixel its own taps (the pass before)
 typedef struct drift_post_dof_settings {
     bool per_pixel;
 } drift_post_dof_settings;
