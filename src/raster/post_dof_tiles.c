@@ -8,13 +8,16 @@
 #include <math.h>
 #include <string.h>
 
-// A tile whose gathering pixels' circles lie within [lo, 1.5 lo + 1] shares its taps: a pixel
-// of radius r then keeps about r^2 / R^2 >= 1/4 of the R disk's taps, near the count of its own
-// disk (one a four pixels either way, up to the table's size). Wider spreads are the depth
-// edges, gathered per pixel. NaN and negative circles (copied pixels) do not count.
+// A tile whose gathering pixels' circles lie within [lo, 1.2 lo + 0.5] shares its taps: a pixel
+// of radius r then keeps r^2 / R^2 >= 1/5 of the R disk's taps (about its own disk's count: one
+// a four pixels either way, up to the table's size), and its disk's soft edge (a pixel wide,
+// where the per-pixel disk stops at r) stays close to its own. Wider spreads are the depth
+// edges, gathered per pixel. NaN and negative circles (copied pixels) do not count. [lo, 1.5 lo
+// + 1] was as fast on the bench frame and raised the relMSE against the path tracer by a fifth
+// where a bright light's edge blurs (docs/lab/2026-12-08-issue-46-s8-dof.md).
 static bool circles_share(float lo, float hi)
 {
-    return hi <= 1.5f * lo + 1.0f && hi <= SHARED_MAX_RADIUS;
+    return hi <= 1.2f * lo + 0.5f && hi <= SHARED_MAX_RADIUS;
 }
 
 // Per tile: its gathering pixels' smallest circle, the largest circle of any pixel (how far

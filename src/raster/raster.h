@@ -359,7 +359,7 @@ static inline float drift_coc_lens_radius(const drift_coc_lens *lens, float z)
 drift_result drift_post_dof(drift_context *ctx, const drift_image *in, const drift_image *coc,
                             uint32_t taps, drift_image *out);
 // The same with the shared-tap tiles on or off. drift_post_dof's tiles whose gathering pixels'
-// circles lie within [r, 1.5 r + 1] (at most 32 px; images of up to 4 channels, tables of up to
+// circles lie within [r, 1.2 r + 0.5] (at most 32 px; images of up to 4 channels, tables of up to
 // 256 taps) gather at once: every pixel the same taps, the table scaled by the tile's largest
 // circle, each tap also weighed by whether it lies on the pixel's own disk (src/raster/
 // post_dof.c). Off: every gathering pixel on its own (the pass before issue 46's tiles).
