@@ -240,16 +240,19 @@ static DRIFT_AVX2_CLONES void dof_rows(size_t begin, size_t end, int thread_inde
     for (int32_t y = (int32_t)begin; y < (int32_t)end; ++y) {
         const uint8_t *class_row =
             job->tile_class + (size_t)(y / UNIFORM_TILE) * (size_t)job->tiles_x;
-        const uint8_t *shared_row = job->row_shared + (size_t)y * (size_t)job->tiles_x;
+        const uint16_t *row_lanes = job->row_lanes + (size_t)y * (size_t)job->tiles_x;
         for (int32_t b = 0; b < BUCKETS; ++b) {
             batches[b].n = 0;
         }
         for (int32_t x = 0; x < job->in->width; ++x) {
             int32_t tx = x / UNIFORM_TILE;
             uint8_t tile = class_row[tx];
-            if (tile == TILE_SHARED || (tile == TILE_GATHER && shared_row[tx])) {
+            if (tile == TILE_SHARED) {
                 x = (tx + 1) * UNIFORM_TILE - 1; // dof_bands gathered it
                 continue;
+            }
+            if (tile == TILE_GATHER && ((row_lanes[tx] >> (x - tx * UNIFORM_TILE)) & 1u)) {
+                continue; // gathered with shared taps (dof_bands)
             }
             if (tile == TILE_COPY) {
                 int32_t n = job->in->width - x < UNIFORM_TILE ? job->in->width - x : UNIFORM_TILE;
@@ -362,7 +365,8 @@ drift_result drift_post_dof_tiles(drift_context *ctx, const drift_image *in, con
     int32_t tiles_y = (in->height + UNIFORM_TILE - 1) / UNIFORM_TILE;
     size_t tile_count = (size_t)tiles_x * (size_t)tiles_y;
     size_t segments = (size_t)tiles_x * (size_t)in->height;
-    float *tile_floats = drift_alloc(ctx, tile_count * (2 * sizeof(float) + 2) + segments);
+    float *tile_floats =
+        drift_alloc(ctx, tile_count * (2 * sizeof(float) + 2) + segments * sizeof(uint16_t));
     // Each thread's tile planes, for the widest pad.
     bool planes_allowed = shared && in->channels <= 4 && tap_count <= SHARED_MAX_TAPS;
     size_t local_floats = (size_t)(in->channels + 1) * LOCAL_SIDE * LOCAL_SIDE;
@@ -388,7 +392,7 @@ drift_result drift_post_dof_tiles(drift_context *ctx, const drift_image *in, con
                     .tile_radius = tile_floats + tile_count,
                     .tile_flat = tile_bytes,
                     .tile_class = tile_bytes + tile_count,
-                    .row_shared = tile_bytes + 2 * tile_count,
+                    .row_lanes = (uint16_t *)(void *)(tile_bytes + 2 * tile_count),
                     .local = local,
                     .local_floats = local_floats,
                     .batched = in->channels == 3 && in->width <= (1 << 20) &&

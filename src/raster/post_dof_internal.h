@@ -20,7 +20,8 @@ typedef struct dof_job {
     float *tile_radius;  // per tile: its pixels' largest circle
     uint8_t *tile_flat;  // per tile: its pixels all equal its first
     uint8_t *tile_class; // per tile: TILE_COPY, TILE_GATHER or TILE_SHARED
-    uint8_t *row_shared; // per tile row of a TILE_GATHER tile (y * tiles_x + tx): shared
+    uint16_t *row_lanes; // per tile row of a TILE_GATHER tile (y * tiles_x + tx): the pixels
+                         // (bit i: x = 16 tx + i) gathered with shared taps
     float *local;        // each thread's tile_planes, local_floats apiece
     size_t local_floats;
     // RGB, its indices in int32 and its coordinates under 2^21: the batched gather (with radii
@@ -71,7 +72,8 @@ static inline uint32_t taps_for_radius(float radius, uint32_t table_size)
 void drift__post_dof_scan_tiles(size_t begin, size_t end, int thread_index, void *user);
 void drift__post_dof_classify_tiles(size_t begin, size_t end, int thread_index, void *user);
 // Tile row ty's shared gathers: its TILE_SHARED tiles, and the rows of its TILE_GATHER tiles
-// whose circles share (row_shared set for those), each tile's planes built in `local`.
+// whose circles share, in up to 3 groups a row (row_lanes set for those), each tile's planes
+// built in `local`.
 void drift__post_dof_shared_band(const dof_job *job, int32_t ty, float *local);
 
 #endif // DRIFT_RASTER_POST_DOF_INTERNAL_H

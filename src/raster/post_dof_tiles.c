@@ -215,7 +215,8 @@ typedef struct shared_tap {
 // constant once inlined: gather()'s sums (differences from the centre, weighed; a weightless
 // tap adds exact zeros), each tap's weight times its place on the pixel's own disk.
 static inline void shared_row(const dof_job *job, const tile_planes *tp, int32_t y,
-                              const shared_tap *taps, uint32_t tap_count, const int32_t channels)
+                              const shared_tap *taps, uint32_t tap_count, uint32_t lanes,
+                              const int32_t channels)
 {
     enum {
         N = UNIFORM_TILE
@@ -273,6 +274,9 @@ static inline void shared_row(const dof_job *job, const tile_planes *tp, int32_t
     const float *src = drift_image_pixel(job->in, x0, y);
     float *dst = drift_image_pixel(job->out, x0, y);
     for (int32_t i = 0; i < n; ++i) {
+        if (!((lanes >> i) & 1u)) {
+            continue; // another group's, or the per-pixel gather's
+        }
         // Below half a pixel (or NaN) the pixel is copied, as everywhere.
         bool gathers = radius[i] >= 0.5f;
         for (int32_t c = 0; c < channels; ++c) {
@@ -300,30 +304,39 @@ static uint32_t shared_taps(const dof_job *job, float radius, ptrdiff_t stride, 
 }
 
 static inline void shared_rows(const dof_job *job, const tile_planes *tp, int32_t y0, int32_t y1,
-                               const shared_tap *taps, uint32_t count)
+                               const shared_tap *taps, uint32_t count, uint32_t lanes)
 {
     for (int32_t y = y0; y < y1; ++y) {
         switch (job->in->channels) {
         case 1:
-            shared_row(job, tp, y, taps, count, 1);
+            shared_row(job, tp, y, taps, count, lanes, 1);
             break;
         case 2:
-            shared_row(job, tp, y, taps, count, 2);
+            shared_row(job, tp, y, taps, count, lanes, 2);
             break;
         case 3:
-            shared_row(job, tp, y, taps, count, 3);
+            shared_row(job, tp, y, taps, count, lanes, 3);
             break;
         default:
-            shared_row(job, tp, y, taps, count, 4);
+            shared_row(job, tp, y, taps, count, lanes, 4);
             break;
         }
     }
 }
 
-// Tile row ty's shared gathers (post_dof_internal.h): a tile across a depth edge is gathered
-// per pixel, but its rows that do not cross the edge share their taps.
+// Tile row ty's shared gathers (post_dof_internal.h). A tile across a depth edge is gathered
+// per pixel, but each of its rows is split into groups that share: the pixels whose circles
+// share with the row's largest remaining circle (circles_share), gathered with its taps (all 16
+// lanes run, the group's are written), then the same with the rest, up to 3 groups (two
+// depths and the pixels between); a group of under 3 pixels is left to the per-pixel gather
+// (16 lanes of shared taps cost about what 2 pixels' own gathers do).
 DRIFT_AVX2_CLONES void drift__post_dof_shared_band(const dof_job *job, int32_t ty, float *local)
 {
+    enum {
+        GROUPS = 3,
+        LEAST = 3
+    };
+
     const drift_image *in = job->in;
     shared_tap taps[SHARED_MAX_TAPS];
     tile_planes tp;
@@ -336,33 +349,52 @@ DRIFT_AVX2_CLONES void drift__post_dof_shared_band(const dof_job *job, int32_t t
         if (job->tile_class[t] == TILE_SHARED) {
             tile_planes_make(job, tx, ty, widest, local, &tp);
             uint32_t count = shared_taps(job, widest, tp.stride, taps);
-            shared_rows(job, &tp, y0, y1, taps, count);
+            shared_rows(job, &tp, y0, y1, taps, count, 0xFFFFu);
             continue;
         }
         if (job->tile_class[t] != TILE_GATHER) {
             continue;
         }
         int32_t n = in->width - x0 < UNIFORM_TILE ? in->width - x0 : UNIFORM_TILE;
-        bool filled = false;
+        bool filled = false, allowed = job->planes_allowed && widest <= SHARED_MAX_RADIUS;
+        float made = -1.0f; // the circle `taps` holds (for this tile's planes)
+        uint32_t count = 0;
         for (int32_t y = y0; y < y1; ++y) {
             const float *reach = drift_image_pixel(job->coc, x0, y);
-            float lo = HUGE_VALF, hi = 0.0f;
+            float r[UNIFORM_TILE];
+            uint32_t left = 0, done = 0; // the gathering pixels not yet gathered; those done
             for (int32_t i = 0; i < n; ++i) {
-                float r = reach[i * job->coc->channels];
-                lo = r >= 0.5f && r < lo ? r : lo;
-                hi = r > hi ? r : hi;
+                r[i] = reach[i * job->coc->channels];
+                left |= r[i] >= 0.5f ? 1u << i : 0u;
             }
-            bool share = job->planes_allowed && hi >= 0.5f && circles_share(lo, hi) &&
-                         widest <= SHARED_MAX_RADIUS;
-            job->row_shared[(size_t)y * (size_t)job->tiles_x + (size_t)tx] = share;
-            if (share) {
+            for (int group = 0; allowed && left && group < GROUPS; ++group) {
+                float hi = 0.0f;
+                for (int32_t i = 0; i < n; ++i) {
+                    hi = ((left >> i) & 1u) && r[i] > hi ? r[i] : hi;
+                }
+                uint32_t members = 0;
+                int32_t size = 0;
+                for (int32_t i = 0; i < n; ++i) {
+                    bool in_group = ((left >> i) & 1u) && circles_share(r[i], hi);
+                    members |= in_group ? 1u << i : 0u;
+                    size += in_group;
+                }
+                left &= ~members;
+                if (size < LEAST) {
+                    continue; // left to the per-pixel gather
+                }
                 if (!filled) { // the tile's planes, padded for its widest circle
                     tile_planes_make(job, tx, ty, widest, local, &tp);
                     filled = true;
                 }
-                uint32_t count = shared_taps(job, hi, tp.stride, taps);
-                shared_rows(job, &tp, y, y + 1, taps, count);
+                if (hi != made) { // rows beside one depth edge often repeat their circle
+                    count = shared_taps(job, hi, tp.stride, taps);
+                    made = hi;
+                }
+                shared_rows(job, &tp, y, y + 1, taps, count, members);
+                done |= members;
             }
+            job->row_lanes[(size_t)y * (size_t)job->tiles_x + (size_t)tx] = (uint16_t)done;
         }
     }
 }
