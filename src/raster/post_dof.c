@@ -12,14 +12,14 @@
 //
 // Tile classification (issue 46; the tiles of production engines' DOF, Jimenez 2014): each
 // 16 x 16 tile is copied (every pixel in focus, or the tile and all its gathers read one
-// colour), gathered per pixel (the circles of its gathering pixels differ by more than 1.2x +
-// 0.5 px: depth edges; their rows that do not cross the edge share taps), or gathered at once:
-// every pixel of the tile takes the same taps, the table scaled by the tile's largest circle
-// R, each tap weighed as above and also by whether it lies on the pixel's own disk (1 within
-// its radius, 0 a pixel beyond). Same offsets for every pixel make a tap a vector load of a
-// row of the tile from the tile's padded planar copy (one bilinear fraction for the whole
-// tile), instead of 13 gathered loads (post_dof_tiles.c). The per-pixel gather of every tile
-// stays selectable (drift_post_dof_tiles, the post-dof-tiles knob).
+// colour), split (the circles of its gathering pixels differ by more than 1.2x + 0.5 px: depth
+// edges; each row's pixels in up to 3 groups that share, the rest gathered per pixel), or
+// gathered at once: every pixel of the tile takes the same taps, the table scaled by the tile's
+// largest circle R, each tap weighed as above and also by whether it lies on the pixel's own disk
+// (1 within its radius, 0 a pixel beyond). Same offsets for every pixel make a tap a vector load of
+// a row of the tile from the tile's padded planar copy (one bilinear fraction for the whole tile),
+// instead of 13 gathered loads (post_dof_tiles.c). The per-pixel gather of every tile stays
+// selectable (drift_post_dof_tiles, the post-dof-tiles knob).
 #include "raster/post_dof_internal.h"
 
 #include <math.h>
