@@ -222,11 +222,13 @@ static bool wanted(const bench_floor_options *o, const char *name)
     return false;
 }
 
-// The post DOF gather's taps on this frame, by its own rules (src/raster/post_dof.c): none
-// where the circle's radius is under half a pixel or the 16 x 16 tile and all it reads hold one
-// colour (those pixels are copied); else the centre and a power of two of the 64-entry table,
-// one a quarter of the disk's area (at least 4, at most 63), of which all but the centre are
-// fetched.
+// The post DOF gather's taps on this frame, by the per-pixel gather's rules (src/raster/
+// post_dof.c): none where the circle's radius is under half a pixel or the 16 x 16 tile and all
+// it reads hold one colour (those pixels are copied); else the centre and a power of two of the
+// 64-entry table, one a quarter of the disk's area (at least 4, at most 63), of which all but
+// the centre are fetched. The default pass's shared tiles (post_dof_tiles.c) run at least as
+// many (each pixel the count of its tile's largest circle; flat tiles found by whole tiles), so
+// this stays a floor of its work.
 static double post_dof_taps(const drift_image *in, const drift_image *coc)
 {
     enum {

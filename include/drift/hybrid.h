@@ -118,6 +118,15 @@ typedef struct drift_envmap_settings {
     drift_envmap_parallax parallax;
 } drift_envmap_settings;
 
+// Post-process depth of field (post; src/raster/post_dof.c):
+//   per_pixel = false: the 16 x 16 tiles whose gathering pixels' circles are alike gather with
+//               one set of taps for the whole tile (issue 46: about 2.8x faster on the bench
+//               frame, FLIP against the path tracer unchanged; docs/lab/2026-12-08-issue-46-s8-
+//               dof.md); true: every pixel its own taps (the pass before)
+typedef struct drift_post_dof_settings {
+    bool per_pixel;
+} drift_post_dof_settings;
+
 // Image space gathering (docs/isg.md):
 //   search, gather = 0 -> 25, 49 samples (perfect squares 1..1024: 9, 25, 49, 81)
 //   sigma       = 0 -> (0.02 x scene extent)^2, sigma of eq. 6 and 10 in squared scene units
@@ -250,7 +259,8 @@ typedef struct drift_occlusion_settings {
 //                      `hard` shadow rays aim at a stratified point of an area light per pass
 //                      (the passes average N shadow samples: soft shadows; docs/hybrid.md).
 //   ambient          = used when has_ambient; otherwise the mean direct radiance of the frame
-//   shadow_map, envmap, isg, aaf, ism, micro, occlusion_settings: each family's settings (above)
+//   shadow_map, envmap, post_dof, isg, aaf, ism, micro, occlusion_settings: each family's
+//                      settings (above)
 //   reflection_edits = NULL: physical reflections. Otherwise the sharp and environment-map
 //                      reflections (and so ISG's glossy gather over the sharp buffer) and the
 //                      reference's first specular bounce follow e(q) (drift/reflect_edit.h).
@@ -284,6 +294,7 @@ typedef struct drift_hybrid_params {
     drift_vec3 ambient;
     drift_shadow_map_settings shadow_map;
     drift_envmap_settings envmap;
+    drift_post_dof_settings post_dof;
     drift_isg_settings isg;
     drift_aaf_settings aaf;
     drift_ism_settings ism;

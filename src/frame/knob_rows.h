@@ -66,6 +66,7 @@ typedef struct drift_knob_family {
 extern const drift_knob_family drift_frame_knobs;      // src/hybrid/knobs.c
 extern const drift_knob_family drift_shadow_map_knobs; // src/realtime/knobs.c
 extern const drift_knob_family drift_envmap_knobs;     // src/realtime/knobs.c
+extern const drift_knob_family drift_post_dof_knobs;   // src/realtime/knobs.c
 extern const drift_knob_family drift_isg_knobs;        // src/isg/knobs.c
 extern const drift_knob_family drift_aaf_knobs;        // src/aaf/knobs.c
 extern const drift_knob_family drift_occlusion_knobs;  // src/ssdo/knobs.c

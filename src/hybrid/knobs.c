@@ -42,8 +42,9 @@ DRIFT_KNOB_FAMILY(drift_frame_knobs, "the frame (docs/hybrid.md)", frame_rows);
 
 // The families in --help's order.
 static const drift_knob_family *const families[] = {
-    &drift_frame_knobs, &drift_shadow_map_knobs, &drift_envmap_knobs, &drift_isg_knobs,
-    &drift_aaf_knobs,   &drift_occlusion_knobs,  &drift_ism_knobs,    &drift_micro_knobs,
+    &drift_frame_knobs,     &drift_shadow_map_knobs, &drift_envmap_knobs,
+    &drift_post_dof_knobs,  &drift_isg_knobs,        &drift_aaf_knobs,
+    &drift_occlusion_knobs, &drift_ism_knobs,        &drift_micro_knobs,
 };
 
 enum {

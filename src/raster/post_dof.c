@@ -9,9 +9,18 @@
 // artefact kept, because it is what a single-layer gather does: a blurred foreground object's
 // edge stays sharp against an in-focus background behind it, since those pixels (circles
 // under half a pixel) gather nothing. The reference technique and ISG's DOF have neither.
-#include "core/scratch.h"
-#include "core/vectorise.h"
-#include "raster/raster.h"
+//
+// Tile classification (issue 46; the tiles of production engines' DOF, Jimenez 2014): each
+// 16 x 16 tile is copied (every pixel in focus, or the tile and all its gathers read one
+// colour), split (the circles of its gathering pixels differ by more than 1.2x + 0.5 px: depth
+// edges; each row's pixels in up to 3 groups that share, the rest gathered per pixel), or
+// gathered at once: every pixel of the tile takes the same taps, the table scaled by the tile's
+// largest circle R, each tap weighed as above and also by whether it lies on the pixel's own disk
+// (1 within its radius, 0 a pixel beyond). Same offsets for every pixel make a tap a vector load of
+// a row of the tile from the tile's padded planar copy (one bilinear fraction for the whole tile),
+// instead of 13 gathered loads (post_dof_tiles.c). The per-pixel gather of every tile stays
+// selectable (drift_post_dof_tiles, the post-dof-tiles knob).
+#include "raster/post_dof_internal.h"
 
 #include <math.h>
 #include <string.h>
@@ -50,22 +59,6 @@ float drift_coc_radius_pixels(const drift_camera *camera, int32_t image_height, 
 
 // --- GATHER ---
 
-typedef struct dof_job {
-    const drift_image *in;
-    const drift_image *coc;
-    drift_image *out;
-    const drift_vec2 *taps; // offsets on the unit disk; taps[0] is the centre
-    uint32_t tap_count;
-    uint8_t *uniform; // per UNIFORM_TILE tile: every pixel its gathers read is alike
-    int32_t *run;     // per pixel: the run of equal pixels from it rightwards (equal_runs)
-    int32_t tiles_x;
-    // RGB, its indices in int32 and its coordinates under 2^21: the batched gather (with radii
-    // up to 2^20 pixels, so that its taps' coordinates stay whole in float arithmetic).
-    bool batched;
-} dof_job;
-
-#define UNIFORM_TILE 16
-
 // The centre, then the concentric-disk image of a scrambled Sobol (0,2)-sequence: its first
 // 2^k points are stratified over [0,1)^2, so the taps cover the disk evenly.
 static void make_taps(drift_vec2 *taps, uint32_t count)
@@ -75,16 +68,6 @@ static void make_taps(drift_vec2 *taps, uint32_t count)
         drift_sampler s = drift_sampler_make(TAP_SEED, 0, k - 1);
         taps[k] = drift_sample_disk_concentric(drift_sampler_next2(&s));
     }
-}
-
-static int32_t clamp_index(int32_t v, int32_t n)
-{
-    return v < 0 ? 0 : (v >= n ? n - 1 : v);
-}
-
-static float lerp(float a, float b, float t)
-{
-    return a + (b - a) * t; // exact when a == b, so a constant image stays constant
 }
 
 // Bilinear fetch at (x, y) in pixel-centre units (pixel p's centre at p), clamped to the image.
@@ -102,19 +85,6 @@ static inline void fetch_bilinear(const drift_image *image, float x, float y, fl
     for (int32_t c = 0; c < channels; ++c) {
         out[c] = lerp(lerp(p00[c], p10[c], fx), lerp(p01[c], p11[c], fx), fy);
     }
-}
-
-// Taps for a disk of `radius` pixels: the centre plus a power of two of the stratified set
-// (a prefix of 2^k points stays stratified), one per four pixels of the disk's area, at most
-// the table: each bilinear tap reads a 2x2 footprint, so together they read about every pixel.
-static uint32_t taps_for_radius(float radius, uint32_t table_size)
-{
-    float quarter_area = 0.25f * 3.14159265f * radius * radius;
-    uint32_t n = 4;
-    while ((float)n < quarter_area && n < table_size - 1) {
-        n *= 2;
-    }
-    return n + 1 < table_size ? n + 1 : table_size;
 }
 
 // How much a tap `distance` pixels from the centre is seen there: 1 where its own circle of
@@ -252,76 +222,6 @@ static DRIFT_AVX2_CLONES void post_dof_gather_batch(const dof_job *job, int32_t 
     }
 }
 
-// Whether every pixel the gathers of tile (tx, ty) can read holds the same value. Each
-// gather then returns its centre exactly (it sums differences from the centre), so the tile
-// is copied instead: the background of a frame, with the largest circle of confusion and a
-// single colour, costs a scan instead of a gather.
-static bool tile_is_uniform(const dof_job *job, int32_t tx, int32_t ty)
-{
-    const drift_image *in = job->in;
-    int32_t x0 = tx * UNIFORM_TILE, y0 = ty * UNIFORM_TILE;
-    int32_t x1 = x0 + UNIFORM_TILE < in->width ? x0 + UNIFORM_TILE : in->width;
-    int32_t y1 = y0 + UNIFORM_TILE < in->height ? y0 + UNIFORM_TILE : in->height;
-    float reach = 0.0f;
-    for (int32_t y = y0; y < y1; ++y) {
-        for (int32_t x = x0; x < x1; ++x) {
-            reach = fmaxf(reach, drift_image_pixel(job->coc, x, y)[0]); // fmaxf drops NaN
-        }
-    }
-    // A tap lands within the radius; its bilinear fetch reads one pixel further.
-    int32_t pad = (int32_t)ceilf(fminf(reach, (float)(in->width + in->height))) + 1;
-    // Each row of the region: its first pixel equals the tile's first, and so do the ones
-    // after it (the run of equal pixels from there spans the region). Float == per channel, as
-    // a scan would compare: -0 equals +0, NaN nothing, so equal runs are all equal to their
-    // first pixel.
-    const float *first = drift_image_pixel(in, x0, y0);
-    int32_t xa = clamp_index(x0 - pad, in->width), xb = clamp_index(x1 - 1 + pad, in->width);
-    for (int32_t y = clamp_index(y0 - pad, in->height); y <= clamp_index(y1 - 1 + pad, in->height);
-         ++y) {
-        const float *p = drift_image_pixel(in, xa, y);
-        for (int32_t c = 0; c < in->channels; ++c) {
-            if (p[c] != first[c]) {
-                return false;
-            }
-        }
-        if (job->run[(size_t)y * (size_t)in->width + (size_t)xa] < xb - xa + 1) {
-            return false;
-        }
-    }
-    return true;
-}
-
-// run[y][x]: how many pixels from (x, y) rightwards equal their left neighbour, itself
-// included (tile_is_uniform's rows).
-static void equal_runs(size_t begin, size_t end, int thread_index, void *user)
-{
-    (void)thread_index;
-    const dof_job *job = user;
-    const drift_image *in = job->in;
-    for (int32_t y = (int32_t)begin; y < (int32_t)end; ++y) {
-        int32_t *run = job->run + (size_t)y * (size_t)in->width;
-        run[in->width - 1] = 1;
-        for (int32_t x = in->width - 2; x >= 0; --x) {
-            const float *p = drift_image_pixel(in, x, y), *q = p + in->channels;
-            bool same = true;
-            for (int32_t c = 0; c < in->channels; ++c) {
-                same = same && p[c] == q[c];
-            }
-            run[x] = same ? run[x + 1] + 1 : 1;
-        }
-    }
-}
-
-static DRIFT_AVX2_CLONES void classify_tiles(size_t begin, size_t end, int thread_index, void *user)
-{
-    (void)thread_index;
-    const dof_job *job = user;
-    for (size_t t = begin; t < end; ++t) {
-        job->uniform[t] = tile_is_uniform(job, (int32_t)(t % (size_t)job->tiles_x),
-                                          (int32_t)(t / (size_t)job->tiles_x));
-    }
-}
-
 // Cloned for AVX2: floorf is one instruction there and sqrtf needs no errno (the file is built
 // with -fno-math-errno): 1.3x, the same image. RGB pixels that gather wait in batches by tap
 // count (a power of two plus one, or the table: one batch for each), so a batch's lanes run
@@ -338,18 +238,35 @@ static DRIFT_AVX2_CLONES void dof_rows(size_t begin, size_t end, int thread_inde
 
     dof_batch batches[BUCKETS];
     for (int32_t y = (int32_t)begin; y < (int32_t)end; ++y) {
-        const uint8_t *uniform_row =
-            job->uniform + (size_t)(y / UNIFORM_TILE) * (size_t)job->tiles_x;
+        const uint8_t *class_row =
+            job->tile_class + (size_t)(y / UNIFORM_TILE) * (size_t)job->tiles_x;
+        const uint16_t *row_lanes = job->row_lanes + (size_t)y * (size_t)job->tiles_x;
         for (int32_t b = 0; b < BUCKETS; ++b) {
             batches[b].n = 0;
         }
         for (int32_t x = 0; x < job->in->width; ++x) {
+            int32_t tx = x / UNIFORM_TILE;
+            uint8_t tile = class_row[tx];
+            if (tile == TILE_SHARED) {
+                x = (tx + 1) * UNIFORM_TILE - 1; // dof_bands gathered it
+                continue;
+            }
+            if (tile == TILE_GATHER && ((row_lanes[tx] >> (x - tx * UNIFORM_TILE)) & 1u)) {
+                continue; // gathered with shared taps (dof_bands)
+            }
+            if (tile == TILE_COPY) {
+                int32_t n = job->in->width - x < UNIFORM_TILE ? job->in->width - x : UNIFORM_TILE;
+                memcpy(drift_image_pixel(job->out, x, y), drift_image_pixel(job->in, x, y),
+                       sizeof(float) * (size_t)(n * channels));
+                x += n - 1;
+                continue;
+            }
             float radius = drift_image_pixel(job->coc, x, y)[0];
             const float *src = drift_image_pixel(job->in, x, y);
             float *dst = drift_image_pixel(job->out, x, y);
             // Below half a pixel the disk stays inside the pixel: copy, bit for bit (and
-            // NaN or negative radii count as in focus). A uniform tile copies too (above).
-            if (!(radius >= 0.5f) || uniform_row[x / UNIFORM_TILE]) {
+            // NaN or negative radii count as in focus).
+            if (!(radius >= 0.5f)) {
                 for (int32_t c = 0; c < channels; ++c) {
                     dst[c] = src[c];
                 }
@@ -385,6 +302,20 @@ static DRIFT_AVX2_CLONES void dof_rows(size_t begin, size_t end, int thread_inde
     }
 }
 
+// A band of tile rows: its shared gathers (post_dof_tiles.c), then its rows' copies and
+// per-pixel gathers.
+static DRIFT_AVX2_CLONES void dof_bands(size_t begin, size_t end, int thread_index, void *user)
+{
+    const dof_job *job = user;
+    float *local = job->local + (size_t)thread_index * job->local_floats;
+    for (size_t ty = begin; ty < end; ++ty) {
+        drift__post_dof_shared_band(job, (int32_t)ty, local);
+        size_t y0 = ty * UNIFORM_TILE, y1 = y0 + UNIFORM_TILE;
+        dof_rows(y0, y1 < (size_t)job->in->height ? y1 : (size_t)job->in->height, thread_index,
+                 user);
+    }
+}
+
 static drift_result check_dof_args(drift_context *ctx, const drift_image *in,
                                    const drift_image *coc, uint32_t taps, const drift_image *out)
 {
@@ -412,6 +343,12 @@ static drift_result check_dof_args(drift_context *ctx, const drift_image *in,
 drift_result drift_post_dof(drift_context *ctx, const drift_image *in, const drift_image *coc,
                             uint32_t taps, drift_image *out)
 {
+    return drift_post_dof_tiles(ctx, in, coc, taps, true, out);
+}
+
+drift_result drift_post_dof_tiles(drift_context *ctx, const drift_image *in, const drift_image *coc,
+                                  uint32_t taps, bool shared, drift_image *out)
+{
     drift_result r = check_dof_args(ctx, in, coc, taps, out);
     if (r != DRIFT_OK) {
         return r;
@@ -427,34 +364,47 @@ drift_result drift_post_dof(drift_context *ctx, const drift_image *in, const dri
     int32_t tiles_x = (in->width + UNIFORM_TILE - 1) / UNIFORM_TILE;
     int32_t tiles_y = (in->height + UNIFORM_TILE - 1) / UNIFORM_TILE;
     size_t tile_count = (size_t)tiles_x * (size_t)tiles_y;
-    uint8_t *uniform = drift_alloc(ctx, tile_count);
-    // The runs in the context's scratch block (kept between calls: no fresh pages each frame).
-    size_t run_bytes = (size_t)in->width * (size_t)in->height * sizeof(int32_t), have = 0;
-    int32_t *run = uniform ? drift__scratch_take(ctx, run_bytes, &have) : NULL;
-    if (!run) {
-        drift_free(ctx, uniform);
+    size_t segments = (size_t)tiles_x * (size_t)in->height;
+    float *tile_floats =
+        drift_alloc(ctx, tile_count * (2 * sizeof(float) + 2) + segments * sizeof(uint16_t));
+    // Each thread's tile planes, for the widest pad.
+    bool planes_allowed = shared && in->channels <= 4 && tap_count <= SHARED_MAX_TAPS;
+    size_t local_floats = (size_t)(in->channels + 1) * LOCAL_SIDE * LOCAL_SIDE;
+    size_t threads = (size_t)drift_context_thread_count(ctx);
+    float *local = planes_allowed && tile_floats
+                       ? drift_alloc(ctx, sizeof(float) * local_floats * threads)
+                       : NULL;
+    if (!tile_floats || (planes_allowed && !local)) {
+        drift_free(ctx, tile_floats);
         drift_free(ctx, table);
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_OUT_OF_MEMORY, __FILE__, __LINE__,
                   "post dof: out of memory for %zu tiles", tile_count);
         return DRIFT_ERR_OUT_OF_MEMORY;
     }
+    uint8_t *tile_bytes = (uint8_t *)(tile_floats + 2 * tile_count);
     dof_job job = { .in = in,
                     .coc = coc,
                     .out = out,
                     .taps = table,
                     .tap_count = tap_count,
-                    .uniform = uniform,
-                    .run = run,
                     .tiles_x = tiles_x,
+                    .tile_lo = tile_floats,
+                    .tile_radius = tile_floats + tile_count,
+                    .tile_flat = tile_bytes,
+                    .tile_class = tile_bytes + tile_count,
+                    .row_lanes = (uint16_t *)(void *)(tile_bytes + 2 * tile_count),
+                    .local = local,
+                    .local_floats = local_floats,
                     .batched = in->channels == 3 && in->width <= (1 << 20) &&
                                in->height <= (1 << 20) &&
                                (double)in->stride * (double)in->height < 2147483647.0 &&
-                               (double)coc->stride * (double)coc->height < 2147483647.0 };
-    drift_parallel_for(ctx, (size_t)in->height, 8, equal_runs, &job);
-    drift_parallel_for(ctx, tile_count, 1, classify_tiles, &job);
-    drift_parallel_for(ctx, (size_t)in->height, 1, dof_rows, &job);
-    drift__scratch_give(ctx, run, have);
-    drift_free(ctx, uniform);
+                               (double)coc->stride * (double)coc->height < 2147483647.0,
+                    .planes_allowed = planes_allowed };
+    drift_parallel_for(ctx, tile_count, 8, drift__post_dof_scan_tiles, &job);
+    drift_parallel_for(ctx, tile_count, 64, drift__post_dof_classify_tiles, &job);
+    drift_parallel_for(ctx, (size_t)tiles_y, 1, dof_bands, &job);
+    drift_free(ctx, local);
+    drift_free(ctx, tile_floats);
     drift_free(ctx, table);
     return DRIFT_OK;
 }

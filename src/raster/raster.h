@@ -358,5 +358,12 @@ static inline float drift_coc_lens_radius(const drift_coc_lens *lens, float z)
 #define DRIFT_POST_DOF_MAX_TAPS 4096
 drift_result drift_post_dof(drift_context *ctx, const drift_image *in, const drift_image *coc,
                             uint32_t taps, drift_image *out);
+// The same with the shared-tap tiles on or off. drift_post_dof's tiles whose gathering pixels'
+// circles lie within [r, 1.2 r + 0.5] (at most 32 px; images of up to 4 channels, tables of up to
+// 256 taps) gather at once: every pixel the same taps, the table scaled by the tile's largest
+// circle, each tap also weighed by whether it lies on the pixel's own disk (src/raster/
+// post_dof.c). Off: every gathering pixel on its own (the pass before issue 46's tiles).
+drift_result drift_post_dof_tiles(drift_context *ctx, const drift_image *in, const drift_image *coc,
+                                  uint32_t taps, bool shared, drift_image *out);
 
 #endif // DRIFT_HYBRID_INTERNAL_H

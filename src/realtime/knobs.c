@@ -1,5 +1,6 @@
-// The knobs of the shadow maps (--shadows pcf|pcss, contact shadows) and of the environment
-// map (--reflections envmap): src/frame/knob_rows.h, include/drift/knobs.h.
+// The knobs of the shadow maps (--shadows pcf|pcss, contact shadows), of the environment
+// map (--reflections envmap) and of the post-process DOF (--dof post): src/frame/knob_rows.h,
+// include/drift/knobs.h.
 #include "frame/knob_rows.h"
 
 #define DRIFT_KNOB_FAMILY_NAME "shadow-map"
@@ -30,3 +31,14 @@ static const drift_knob envmap_rows[] = {
                           DRIFT_EFFECT_REFLECTIONS, "envmap"),
 };
 DRIFT_KNOB_FAMILY(drift_envmap_knobs, "environment map (--reflections envmap)", envmap_rows);
+#undef DRIFT_KNOB_FAMILY_NAME
+
+#define DRIFT_KNOB_FAMILY_NAME "post-dof"
+static const drift_knob post_dof_rows[] = {
+    DRIFT_KNOB_CHOICE_ROW("post-dof-tiles", post_dof.per_pixel, "shared|per-pixel", 0,
+                          "shared: 16 x 16 tiles whose circles of confusion are alike gather\n"
+                          "with one set of taps (issue 46); per-pixel: every pixel its own",
+                          DRIFT_EFFECT_DOF, "post"),
+};
+DRIFT_KNOB_FAMILY(drift_post_dof_knobs, "post-process depth of field (--dof post)", post_dof_rows);
+#undef DRIFT_KNOB_FAMILY_NAME

@@ -55,7 +55,8 @@ drift_result drift_realtime_pass_post_dof(drift_frame_state *f, const drift_pass
 {
     (void)args;
     double t = drift_time_now();
-    drift_result r = drift_post_dof(f->ctx, &f->focus, &f->coc, 0, &f->final);
+    drift_result r = drift_post_dof_tiles(f->ctx, &f->focus, &f->coc, 0,
+                                          !f->params.post_dof.per_pixel, &f->final);
     drift_pass_time(f, DRIFT_PASS_DOF, t);
     return r;
 }

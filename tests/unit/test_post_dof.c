@@ -372,6 +372,69 @@ static void test_post_dof_rgb_batches_equal_the_per_pixel_gather(void **state)
     free(first);
 }
 
+// Under one circle a tile's shared taps are the pixel's own: the table scaled by the same
+// radius, every tap on the pixel's disk. So on tiles of one circle each (0.7 to 20 pixels;
+// taps near a tile's border land on other circles, weighed by them in both paths) the shared
+// gather gives the per-pixel gather's image but for the bilinear fraction's rounding (the
+// shared path takes it from the offset, the per-pixel from the tap's position), on 1 and 3
+// threads, the same image to the bit on both.
+static void test_post_dof_shared_tiles_equal_the_per_pixel_gather(void **state)
+{
+    (void)state;
+    const int32_t w = 88, h = 72; // a partial tile at the right and bottom
+    const float radii[] = { 0.7f, 2.0f, 4.5f, 9.0f, 20.0f, 3.0f };
+    float *first = malloc(sizeof(float) * 3 * (size_t)(w * h));
+    assert_non_null(first);
+    for (int threads = 1; threads <= 3; threads += 2) {
+        drift_context *ctx = test_context(threads, NULL);
+        drift_image in, coc, shared, per_pixel;
+        assert_int_equal(drift_image_create(ctx, w, h, 3, &in), DRIFT_OK);
+        assert_int_equal(drift_image_create(ctx, w, h, 1, &coc), DRIFT_OK);
+        assert_int_equal(drift_image_create(ctx, w, h, 3, &shared), DRIFT_OK);
+        assert_int_equal(drift_image_create(ctx, w, h, 3, &per_pixel), DRIFT_OK);
+        uint32_t n = 0;
+        for (int32_t y = 0; y < h; ++y) {
+            for (int32_t x = 0; x < w; ++x) {
+                for (int c = 0; c < 3; ++c) {
+                    drift_image_pixel(&in, x, y)[c] = test_hash_unit(n++);
+                }
+                drift_image_pixel(&coc, x, y)[0] = radii[(x / 16 + 2 * (y / 16)) % 6];
+            }
+        }
+        assert_int_equal(drift_post_dof_tiles(ctx, &in, &coc, 0, true, &shared), DRIFT_OK);
+        assert_int_equal(drift_post_dof_tiles(ctx, &in, &coc, 0, false, &per_pixel), DRIFT_OK);
+        double worst = 0.0, moved = 0.0;
+        for (int32_t y = 0; y < h; ++y) {
+            for (int32_t x = 0; x < w; ++x) {
+                for (int c = 0; c < 3; ++c) {
+                    double a = drift_image_pixel(&shared, x, y)[c];
+                    double b = drift_image_pixel(&per_pixel, x, y)[c];
+                    worst = fmax(worst, fabs(a - b));
+                    moved = fmax(moved, fabs(b - (double)drift_image_pixel(&in, x, y)[c]));
+                }
+            }
+            float *row = first + (size_t)y * 3 * (size_t)w;
+            if (threads == 1) {
+                memcpy(row, drift_image_pixel(&shared, 0, y), 3 * sizeof(float) * (size_t)w);
+            } else {
+                assert_memory_equal(row, drift_image_pixel(&shared, 0, y),
+                                    3 * sizeof(float) * (size_t)w);
+            }
+        }
+        print_message("shared against per-pixel taps, one circle a tile: at most %.3g (the "
+                      "gather moved pixels by up to %.3g)\n",
+                      worst, moved);
+        assert_true(moved > 0.3);
+        assert_true(worst < 1e-5);
+        drift_image_destroy(ctx, &in);
+        drift_image_destroy(ctx, &coc);
+        drift_image_destroy(ctx, &shared);
+        drift_image_destroy(ctx, &per_pixel);
+        drift_context_destroy(ctx);
+    }
+    free(first);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -384,6 +447,7 @@ int main(void)
         cmocka_unit_test(test_post_dof_sharp_foreground_does_not_leak),
         cmocka_unit_test(test_post_dof_rejects_bad_arguments),
         cmocka_unit_test(test_post_dof_rgb_batches_equal_the_per_pixel_gather),
+        cmocka_unit_test(test_post_dof_shared_tiles_equal_the_per_pixel_gather),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
