@@ -79,6 +79,21 @@ bool drift_accel_occluded(const drift_accel *accel, const drift_ray *ray);
 // t = INFINITY. Same results as drift_accel_intersect ray by ray.
 void drift_accel_intersect_coherent(const drift_accel *accel, const drift_ray *rays,
                                     drift_hit *hits, uint32_t count);
+
+// How a ray treats the surfaces of BLEND materials (veils, drift_alpha_mode): by default it meets
+// one with probability equal to its opacity; a frame that composites its veils itself traces its
+// camera rays past them (SKIP) and then to each of them (MEET).
+typedef enum drift_accel_veils {
+    DRIFT_VEILS_STOCHASTIC = 0,
+    DRIFT_VEILS_SKIP,
+    DRIFT_VEILS_MEET
+} drift_accel_veils;
+
+// drift_accel_intersect and drift_accel_intersect_coherent with veils treated as `veils` says.
+bool drift_accel_intersect_veils(const drift_accel *accel, const drift_ray *ray,
+                                 drift_accel_veils veils, drift_hit *out_hit);
+void drift_accel_intersect_coherent_veils(const drift_accel *accel, const drift_ray *rays,
+                                          drift_hit *hits, uint32_t count, drift_accel_veils veils);
 // Occlusion for a batch; out_occluded[i] is 1 when ray i is blocked.
 void drift_accel_occluded_coherent(const drift_accel *accel, const drift_ray *rays,
                                    uint8_t *out_occluded, uint32_t count);

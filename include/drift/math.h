@@ -43,6 +43,10 @@ typedef struct drift_ray {
     float tmin;
     drift_vec3 dir; // need not be unit length for accel queries; t is in units of |dir|
     float tmax;
+    // Varies the ray's stochastic choices at veils (drift_alpha_mode BLEND) between rays that
+    // are otherwise the same (a pixel centre's camera ray, sample after sample); 0 will do for
+    // rays whose origin or direction is random already.
+    uint32_t seed;
 } drift_ray;
 
 typedef struct drift_bounds3 {

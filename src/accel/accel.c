@@ -113,22 +113,35 @@ static drift_result check_device(drift_accel *accel, const char *what)
     return result_of(code);
 }
 
-// A random number of one ray meeting one triangle: the same for the same ray (so a pixel's
-// image does not depend on the thread count or on how often Embree asks), different for the
-// next sample's or bounce's ray, which starts or points elsewhere.
+// A random number of one ray meeting one mesh's surface: the same for the same ray (so a
+// pixel's image does not depend on the thread count or on how often Embree asks), different
+// for the next sample's or bounce's ray, which starts or points elsewhere or carries another
+// seed (drift_ray.seed, in Embree's id). It keys on the mesh and the hit's distance, not the
+// triangle: a ray through a shared edge is offered both triangles, and two numbers gave it two
+// chances (a pixel-centre ray on a quad's diagonal met a veil of opacity 0.5 three times in
+// four). The distance's low 12 mantissa bits are dropped so both offers agree; the surfaces
+// of one mesh a ray meets further on (a closed veil's far side) get numbers of their own.
 // Embree's RTCRayN layout (rtcore_ray.h; its accessors are C++ only): org x, y, z, tnear, dir
-// x, y, z each N floats in a row. Its RTCHitN: Ng x, y, z, u, v, primID, geomID.
-static float ray_hit_uniform(const struct RTCRayN *ray, unsigned n, unsigned i, uint32_t prim)
+// x, y, z, time, tfar (the candidate hit's distance in a filter), mask, id, each N words in a
+// row.
+static float ray_hit_uniform(const struct RTCRayN *ray, unsigned n, unsigned i, uint32_t mesh)
 {
-    static const unsigned fields[6] = { 0, 1, 2, 4, 5, 6 }; // org xyz, dir xyz
+    static const unsigned fields[8] = { 0, 1, 2, 4, 5, 6, 10, 8 }; // org, dir, id, tfar
     const uint32_t *words = (const uint32_t *)(const void *)ray;
-    uint32_t h = drift_hash_u32(prim);
-    for (int k = 0; k < 6; ++k) {
+    uint32_t h = drift_hash_u32(mesh);
+    for (int k = 0; k < 8; ++k) {
         uint32_t bits = words[fields[k] * n + i];
-        h = drift_hash_combine(h, bits);
+        h = drift_hash_combine(h, fields[k] == 8 ? bits >> 12 : bits);
     }
     return (float)(h >> 8) * 0x1p-24f;
 }
+
+// Embree's context with how this query treats veils (drift_accel_veils): the filter below
+// reads it back from the context it is given.
+typedef struct veils_context {
+    struct RTCIntersectContext embree; // first: Embree passes a pointer to it
+    drift_accel_veils veils;
+} veils_context;
 
 // Embree's filter for meshes whose material is not opaque (drift_alpha_mode): a candidate hit
 // where the surface is not there is dropped and the ray goes on, for closest hits and shadow
@@ -136,6 +149,7 @@ static float ray_hit_uniform(const struct RTCRayN *ray, unsigned n, unsigned i, 
 static void coverage_filter(const struct RTCFilterFunctionNArguments *args)
 {
     const drift_accel *accel = args->geometryUserPtr;
+    drift_accel_veils veils = ((const veils_context *)(const void *)args->context)->veils;
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] != -1) {
             continue;
@@ -144,7 +158,12 @@ static void coverage_filter(const struct RTCFilterFunctionNArguments *args)
         const uint32_t *ids = (const uint32_t *)(const void *)args->hit;
         uint32_t mesh = ids[6 * args->N + i], prim = ids[5 * args->N + i];
         float u = hit[3 * args->N + i], v = hit[4 * args->N + i];
-        float xi = ray_hit_uniform(args->ray, args->N, i, prim);
+        float xi = ray_hit_uniform(args->ray, args->N, i, mesh);
+        bool veil = accel->scene->materials[accel->scene->meshes[mesh].material].alpha_mode ==
+                    DRIFT_ALPHA_BLEND;
+        if (veil && veils != DRIFT_VEILS_STOCHASTIC) {
+            xi = veils == DRIFT_VEILS_SKIP ? 2.0f : -1.0f; // never, or always, below opacity
+        }
         if (!drift_scene_covers(accel->scene, mesh, prim, u, v, xi)) {
             args->valid[i] = 0;
         }
@@ -396,7 +415,7 @@ static inline void ray_to_rtc(const drift_ray *ray, struct RTCRay *out)
     out->time = 0.0f;
     out->tfar = ray->tmax;
     out->mask = UINT32_MAX;
-    out->id = 0;
+    out->id = ray->seed;
     out->flags = 0;
 }
 
@@ -448,13 +467,29 @@ static inline void fill_miss(drift_hit *hit)
     hit->ng = (drift_vec3){ 0.0f, 0.0f, 0.0f };
 }
 
+static veils_context make_context(drift_accel_veils veils, bool coherent)
+{
+    veils_context c;
+    rtcInitIntersectContext(&c.embree);
+    if (coherent) {
+        c.embree.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    }
+    c.veils = veils;
+    return c;
+}
+
 bool drift_accel_intersect(const drift_accel *accel, const drift_ray *ray, drift_hit *out_hit)
 {
-    struct RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
+    return drift_accel_intersect_veils(accel, ray, DRIFT_VEILS_STOCHASTIC, out_hit);
+}
+
+bool drift_accel_intersect_veils(const drift_accel *accel, const drift_ray *ray,
+                                 drift_accel_veils veils, drift_hit *out_hit)
+{
+    veils_context context = make_context(veils, false);
     struct RTCRayHit rh;
     rayhit_init(ray, &rh);
-    rtcIntersect1(accel->rtc_scene, &context, &rh);
+    rtcIntersect1(accel->rtc_scene, &context.embree, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
         return false;
     }
@@ -464,11 +499,10 @@ bool drift_accel_intersect(const drift_accel *accel, const drift_ray *ray, drift
 
 bool drift_accel_occluded(const drift_accel *accel, const drift_ray *ray)
 {
-    struct RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
+    veils_context context = make_context(DRIFT_VEILS_STOCHASTIC, false);
     struct RTCRay r;
     ray_to_rtc(ray, &r);
-    rtcOccluded1(accel->rtc_scene, &context, &r);
+    rtcOccluded1(accel->rtc_scene, &context.embree, &r);
     // Embree marks an occluded ray by setting tfar to -inf; an empty segment (tmax < tmin,
     // e.g. a shadow ray that starts inside the sphere light it aims at) keeps its own tfar.
     return r.tfar == -INFINITY;
@@ -493,7 +527,7 @@ static inline void packet_load(const drift_ray *rays, uint32_t n, struct RTCRay1
         p->time[i] = 0.0f;
         p->tfar[i] = r->tmax;
         p->mask[i] = UINT32_MAX;
-        p->id[i] = 0;
+        p->id[i] = r->seed;
         p->flags[i] = 0;
     }
 }
@@ -501,9 +535,13 @@ static inline void packet_load(const drift_ray *rays, uint32_t n, struct RTCRay1
 void drift_accel_intersect_coherent(const drift_accel *accel, const drift_ray *rays,
                                     drift_hit *hits, uint32_t count)
 {
-    struct RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
-    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    drift_accel_intersect_coherent_veils(accel, rays, hits, count, DRIFT_VEILS_STOCHASTIC);
+}
+
+void drift_accel_intersect_coherent_veils(const drift_accel *accel, const drift_ray *rays,
+                                          drift_hit *hits, uint32_t count, drift_accel_veils veils)
+{
+    veils_context context = make_context(veils, true);
     struct RTCRayHit16 p;
     // Embree requires the valid mask, like the packet, aligned to the packet size.
     _Alignas(64) int valid[16];
@@ -514,7 +552,7 @@ void drift_accel_intersect_coherent(const drift_accel *accel, const drift_ray *r
             p.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
             p.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
         }
-        rtcIntersect16(valid, accel->rtc_scene, &context, &p);
+        rtcIntersect16(valid, accel->rtc_scene, &context.embree, &p);
         for (uint32_t i = 0; i < n; ++i) {
             drift_hit *hit = &hits[begin + i];
             if (p.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) {
@@ -533,16 +571,14 @@ void drift_accel_intersect_coherent(const drift_accel *accel, const drift_ray *r
 void drift_accel_occluded_coherent(const drift_accel *accel, const drift_ray *rays,
                                    uint8_t *out_occluded, uint32_t count)
 {
-    struct RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
-    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    veils_context context = make_context(DRIFT_VEILS_STOCHASTIC, true);
     struct RTCRay16 p;
     // Embree requires the valid mask, like the packet, aligned to the packet size.
     _Alignas(64) int valid[16];
     for (uint32_t begin = 0; begin < count; begin += 16) {
         uint32_t n = count - begin < 16 ? count - begin : 16;
         packet_load(rays + begin, n, &p, valid);
-        rtcOccluded16(valid, accel->rtc_scene, &context, &p);
+        rtcOccluded16(valid, accel->rtc_scene, &context.embree, &p);
         for (uint32_t i = 0; i < n; ++i) {
             // Embree marks an occluded ray by setting tfar to -inf (not a negative tmax).
             out_occluded[begin + i] = p.tfar[i] == -INFINITY;

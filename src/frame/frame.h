@@ -26,6 +26,7 @@ typedef enum drift_stream {
                                        // (one stratified set over the passes; direct.c)
     DRIFT_STREAM_GLASS = 6,            // glass transmission after the rows that do not trace
                                        // it (realtime/reflections.c)
+    DRIFT_STREAM_VEIL = 7,             // the veils' direct light (hybrid/veils.c)
     DRIFT_STREAM_ISG_SHADOWS = 11,     // isg/isg_shadows.c
     DRIFT_STREAM_ISG_REFLECTIONS = 12, // isg/isg_reflections.c
     DRIFT_STREAM_ISG_DOF = 13,         // isg/isg_dof.c

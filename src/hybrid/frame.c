@@ -654,6 +654,7 @@ static drift_result render_pass(drift_frame_state *f, const atomic_bool *cancel,
     if (r == DRIFT_OK && !replaced) {
         t = drift_time_now();
         r = drift_hybrid_pass_compose(f);
+        r = r ? r : drift_hybrid_pass_veils(f);
         f->stats.compose_ms += 1000.0 * (drift_time_now() - t);
     }
     for (int e = 0; r == DRIFT_OK && e < DRIFT_EFFECT_COUNT; ++e) {

@@ -49,6 +49,11 @@ const drift_technique_row *drift_technique_row_chosen(const drift_hybrid_params 
 drift_result drift_hybrid_pass_reference(drift_frame_state *frame, const drift_pass_args *args);
 // compose.c: focus = E + D + R + I (terms of NO_TERM rows left out), and the coc plane.
 drift_result drift_hybrid_pass_compose(drift_frame_state *frame);
+// veils.c: the scene's BLEND surfaces, which the G-buffer's rays pass, blended over focus by
+// their opacity (front to back, shaded by their emission, direct light and the indirect light
+// behind them). Nothing without such surfaces.
+drift_result drift_hybrid_pass_veils(drift_frame_state *frame);
+bool drift_hybrid_scene_has_veils(const drift_scene *scene);
 // compose.c: the depth-of-field rows the conductor owns: final = focus (pinhole), and the
 // whole frame path-traced through the lens with every enabled term.
 drift_result drift_hybrid_pass_pinhole(drift_frame_state *frame, const drift_pass_args *args);

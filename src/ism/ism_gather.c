@@ -203,7 +203,7 @@ static void gather_vpl_rays(const drift_ism *ism, const drift_vpl *v, receivers 
         drift_vec3 w = drift_vec3_scale(d, inv);
         drift_vec3 o = drift_offset_origin(xp, (drift_vec3){ rs->gx[i], rs->gy[i], rs->gz[i] }, w);
         float len = drift_vec3_length(drift_vec3_sub(v->position, o));
-        drift_ray ray = { o, 0.0f, w, len * 0.999f - 1e-4f * c->diagonal };
+        drift_ray ray = { o, 0.0f, w, len * 0.999f - 1e-4f * c->diagonal, 0 };
         (*rays)++;
         if (ray.tmax > 0.0f && drift_accel_occluded(ism->accel, &ray)) {
             continue;

@@ -308,7 +308,7 @@ void drift__ism_exact_map(float *depth, int32_t n, const drift_accel *accel, dri
             float d = INFINITY;
             if (p.x * p.x + p.y * p.y <= 1.0f) {
                 drift_vec3 dir = drift_frame_to_world(frame, drift_paraboloid_unproject(p));
-                drift_ray ray = { origin, 0.0f, dir, INFINITY };
+                drift_ray ray = { origin, 0.0f, dir, INFINITY, 0 };
                 drift_hit hit;
                 d = drift_accel_intersect(accel, &ray, &hit) ? hit.t : INFINITY;
             }

@@ -96,7 +96,7 @@ static void rsm_rows(size_t begin, size_t end, int thread, void *user)
                                    ((float)y + 0.5f) / (float)m->size);
             float len = drift_vec3_length(d);
             drift_vec3 w = drift_vec3_scale(d, 1.0f / len);
-            drift_ray ray = { job->light->position, 0.0f, w, INFINITY };
+            drift_ray ray = { job->light->position, 0.0f, w, INFINITY, 0 };
             drift_surface s;
             drift_vec3 kd;
             float flux = 0.0f;
@@ -244,7 +244,7 @@ static bool emit_point_rsm(const void *user, uint32_t li, drift_vec2 u1, drift_v
     if (!(pdf_dir > 0.0f)) {
         return false;
     }
-    *out_ray = (drift_ray){ l->position, 0.0f, w, INFINITY };
+    *out_ray = (drift_ray){ l->position, 0.0f, w, INFINITY, 0 };
     *out_flux = drift_vec3_scale(l->color, spot_falloff(l, w) / (pdf_dir * pmf * n));
     return true;
 }
@@ -344,7 +344,8 @@ static void trace_paths(size_t begin, size_t end, int thread, void *user)
             if (drift_vec3_is_zero(flux) || drift_vec3_dot(w, surf.ng) <= 0.0f) {
                 break;
             }
-            ray = (drift_ray){ drift_offset_origin(surf.position, surf.ng, w), 0.0f, w, INFINITY };
+            ray =
+                (drift_ray){ drift_offset_origin(surf.position, surf.ng, w), 0.0f, w, INFINITY, 0 };
         }
     }
 }

@@ -231,7 +231,8 @@ static void cover_range(size_t begin, size_t end, int thread, void *user)
         uint8_t bits = 0;
         for (int side = 0; side < 2; ++side) {
             drift_vec3 dir = side ? drift_vec3_neg(tree->axis[node]) : tree->axis[node];
-            drift_ray ray = { drift_offset_origin(tree->center[node], dir, dir), 0.0f, dir, reach };
+            drift_ray ray = { drift_offset_origin(tree->center[node], dir, dir), 0.0f, dir, reach,
+                              0 };
             if (drift_accel_occluded(job->accel, &ray)) {
                 bits |= (uint8_t)(1u << side);
             }

@@ -60,7 +60,7 @@ static void light_range(size_t begin, size_t end, int thread, void *user)
         const drift_scene_point *sp = &job->points->points[p];
         drift_vec3 x = job->points->position[p], nrm = job->points->normal[p];
         // The surface as a ray arriving from the front of the disc sees it.
-        drift_ray ray = { drift_vec3_add(x, nrm), 0.0f, drift_vec3_neg(nrm), 2.0f };
+        drift_ray ray = { drift_vec3_add(x, nrm), 0.0f, drift_vec3_neg(nrm), 2.0f, 0 };
         drift_hit hit = { .t = 1.0f,
                           .u = sp->b1,
                           .v = sp->b2,

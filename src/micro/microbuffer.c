@@ -201,7 +201,7 @@ drift_vec3 drift__micro_gather(const drift__micro_gather_desc *desc, drift_vec3 
         stats->cast++;
         for (int32_t pix = 0; pix < k2; ++pix) {
             drift_vec3 dir = drift_frame_to_world(frame, pixels->dir[pix]);
-            drift_ray ray = { drift_offset_origin(p, ng, dir), 0.0f, dir, INFINITY };
+            drift_ray ray = { drift_offset_origin(p, ng, dir), 0.0f, dir, INFINITY, 0 };
             drift_hit hit;
             stats->rays++;
             if (!drift_accel_intersect(desc->accel, &ray, &hit)) {

@@ -89,7 +89,7 @@ static void trace_range(size_t begin, size_t end, int thread, void *user)
                 break;
             }
             ray = (drift_ray){ drift_offset_origin(surf.position, surf.ng, bs.wi), 0.0f, bs.wi,
-                               INFINITY };
+                               INFINITY, 0 };
         }
     }
 }

@@ -271,6 +271,9 @@ static void trace_path(const drift_pt *pt, int32_t x, int32_t y, uint32_t sample
         film = drift_vec2_make(0.5f, 0.5f); // the dimensions are still drawn: same layout
     }
     drift_ray ray = drift_camera_frame_ray(&pt->camera, (float)x + film.x, (float)y + film.y, lens);
+    // A pixel centre's camera ray is the same sample after sample: its seed is not, so the
+    // veils it meets are met with their opacity's probability over the samples.
+    ray.seed = drift_hash_combine(drift_hash_u32(pixel ^ p->seed), sample);
     *out = (path_result){ 0 };
     drift_vec3 radiance = drift_vec3_splat(0.0f);
     drift_vec3 beta = drift_vec3_splat(1.0f);

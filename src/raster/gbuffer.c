@@ -169,7 +169,8 @@ static void render_tiles(size_t begin, size_t end, int thread_index, void *user)
                                                    drift_vec2_make(0.5f, 0.5f));
             }
         }
-        drift_accel_intersect_coherent(job->accel, rays, hits, n);
+        // Veils are passed: the frame blends them over what is behind (hybrid/veils.c).
+        drift_accel_intersect_coherent_veils(job->accel, rays, hits, n, DRIFT_VEILS_SKIP);
         // The surfaces first, then the planes: the vertex loads of a whole tile overlap.
         for (uint32_t i = 0; i < n; ++i) {
             if (hits[i].mesh != DRIFT_INVALID_INDEX || hits[i].light != DRIFT_INVALID_INDEX) {

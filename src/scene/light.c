@@ -496,7 +496,7 @@ bool drift_light_emit_distant(const drift_scene *scene, uint32_t light, drift_ve
     drift_vec3 o = drift_vec3_fma(centre, travel, -1.5f * radius);
     o = drift_vec3_fma(o, f.x, d.x * radius);
     o = drift_vec3_fma(o, f.y, d.y * radius);
-    *out_ray = (drift_ray){ o, 0.0f, travel, INFINITY };
+    *out_ray = (drift_ray){ o, 0.0f, travel, INFINITY, 0 };
     float area = DRIFT_PI * radius * radius;
     *out_flux = drift_vec3_scale(radiance, area / (pdf_dir * pmf * paths));
     return true;
@@ -559,7 +559,7 @@ bool drift_light_emit_area(const drift_scene *scene, const drift_light *l, drift
     }
     drift_frame fr = drift_frame_from_normal(normal);
     drift_vec3 w = drift_frame_to_world(&fr, drift_sample_cosine_hemisphere(u2));
-    *out_ray = (drift_ray){ drift_offset_origin(p, normal, w), 0.0f, w, INFINITY };
+    *out_ray = (drift_ray){ drift_offset_origin(p, normal, w), 0.0f, w, INFINITY, 0 };
     *out_flux = drift_vec3_scale(radiance, sides * DRIFT_PI * area / (pmf * paths));
     return true;
 }

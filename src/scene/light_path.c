@@ -23,7 +23,7 @@ static bool emit_point_uniform(const drift_scene *scene, uint32_t li, drift_vec2
     if (drift_vec3_is_zero(ls.radiance)) {
         return false;
     }
-    *out_ray = (drift_ray){ l->position, 0.0f, w, INFINITY };
+    *out_ray = (drift_ray){ l->position, 0.0f, w, INFINITY, 0 };
     *out_flux = drift_vec3_scale(ls.radiance, 1.0f / (pdf_dir * pmf * paths));
     return true;
 }

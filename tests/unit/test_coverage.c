@@ -347,6 +347,20 @@ static void test_blend_stops_its_share(void **state)
     double share = (double)stopped / n, sigma = sqrt(0.3 * 0.7 / n);
     print_message("BLEND opacity 0.3: %d of %d rays stopped (%.4f)\n", stopped, n, share);
     assert_near(share, 0.3, 4.0 * sigma);
+    // One ray, sample after sample (its seed), through the card's centre, on the edge its two
+    // triangles share: still 0.3, not 1 - 0.7^2 (a number a triangle gave two chances).
+    stopped = 0;
+    for (int i = 0; i < n; ++i) {
+        drift_ray ray = { .origin = drift_vec3_make(0, 0, 1),
+                          .dir = drift_vec3_make(0, 0, -1),
+                          .tmax = 10.0f,
+                          .seed = (uint32_t)i };
+        drift_hit hit;
+        stopped += drift_accel_intersect(r.accel, &ray, &hit);
+    }
+    share = (double)stopped / n;
+    print_message("BLEND opacity 0.3 on a shared edge: %.4f of one ray's samples stopped\n", share);
+    assert_near(share, 0.3, 4.0 * sigma);
     test_rig_destroy(&r);
 }
 
@@ -387,6 +401,68 @@ static void test_pt_sees_through_veil(void **state)
         drift_pt_destroy(pt);
         test_rig_destroy(&r);
     }
+}
+
+// The hybrid frame blends a veil over what is behind it: an emitter of radiance 2 through a
+// black veil of opacity a shows 2 (1 - a) in every pixel, with no dithering (each pixel was
+// 0 or 2 when the G-buffer's one camera ray met the veil by chance); a lit white veil over a
+// black background shows its direct light times a (the path tracer's, within 5%).
+static void test_hybrid_blends_veils(void **state)
+{
+    (void)state;
+    const float opacities[2] = { 0.35f, 0.8f };
+    for (int k = 0; k < 2; ++k) {
+        test_rig r = test_rig_begin(2);
+        drift_material veil = drift_material_make(drift_vec3_splat(0.0f));
+        veil.alpha_mode = DRIFT_ALPHA_BLEND;
+        veil.opacity = opacities[k];
+        add_card(r.scene, 3.0f, 0.0f, test_add_material(r.scene, veil));
+        drift_material lamp = drift_material_make(drift_vec3_splat(0.0f));
+        lamp.emission = drift_vec3_splat(2.0f);
+        add_card(r.scene, 6.0f, -1.0f, test_add_material(r.scene, lamp));
+        const int32_t size = 9;
+        r.scene->camera = drift_camera_look_at(drift_vec3_make(0, 0, 4), drift_vec3_make(0, 0, 0),
+                                               drift_vec3_make(0, 1, 0), 0.4f, size, size);
+        test_rig_commit(&r);
+        test_rig_frame(&r, &(drift_hybrid_params){ .width = size, .height = size });
+        const drift_image *img = drift_hybrid_image(r.frame);
+        double want = 2.0 * (1.0 - (double)opacities[k]);
+        for (int32_t y = 0; y < size; ++y) {
+            for (int32_t x = 0; x < size; ++x) {
+                assert_near(drift_image_pixel(img, x, y)[1], want, 0.01 * want);
+            }
+        }
+        test_rig_destroy(&r);
+    }
+    // A white veil of opacity 0.5 lit by a quad light off to the side, nothing behind it.
+    test_rig r = test_rig_begin(2);
+    drift_material veil = drift_material_make(drift_vec3_splat(0.8f));
+    veil.alpha_mode = DRIFT_ALPHA_BLEND;
+    veil.opacity = 0.5f;
+    add_card(r.scene, 1.0f, 0.0f, test_add_material(r.scene, veil));
+    test_add_quad_light(r.scene, drift_vec3_make(1.5f, -0.5f, 1.5f), drift_vec3_make(0, 1, 0),
+                        drift_vec3_make(1, 0, 0), 4.0f);
+    const int32_t size = 9;
+    r.scene->camera = drift_camera_look_at(drift_vec3_make(0, 0, 4), drift_vec3_make(0, 0, 0),
+                                           drift_vec3_make(0, 1, 0), 0.2f, size, size);
+    test_rig_commit(&r);
+    test_rig_frame(&r,
+                   &(drift_hybrid_params){ .width = size, .height = size, .light_samples = 256 });
+    drift_pt *pt = NULL;
+    drift_image truth = test_rig_render_pt(&r, 0, 4, 1024, 7, &pt);
+    double got = 0.0, want = 0.0;
+    const drift_image *img = drift_hybrid_image(r.frame);
+    for (int32_t y = 3; y <= 5; ++y) {
+        for (int32_t x = 3; x <= 5; ++x) {
+            got += (double)drift_image_pixel(img, x, y)[1];
+            want += (double)drift_image_pixel(&truth, x, y)[1];
+        }
+    }
+    print_message("lit veil: hybrid %.4f, path tracer %.4f\n", got / 9.0, want / 9.0);
+    assert_true(want > 0.05);
+    assert_near(got, want, 0.05 * want);
+    drift_pt_destroy(pt);
+    test_rig_destroy(&r);
 }
 
 // Points sampled on a scene of one half-masked card and one opaque card of the same size lie
@@ -432,6 +508,7 @@ int main(void)
         cmocka_unit_test(test_mask_rays),
         cmocka_unit_test(test_blend_stops_its_share),
         cmocka_unit_test(test_pt_sees_through_veil),
+        cmocka_unit_test(test_hybrid_blends_veils),
         cmocka_unit_test(test_points_lie_on_what_is_there),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -265,7 +265,7 @@ static double ism_agreement(test_rig *r, uint32_t points_count, int32_t n, int32
             }
             inside++;
             drift_vec3 dir = drift_frame_to_world(&frame, drift_paraboloid_unproject(p));
-            drift_ray ray = { origin, 0.0f, dir, INFINITY };
+            drift_ray ray = { origin, 0.0f, dir, INFINITY, 0 };
             drift_hit hit;
             float exact = drift_accel_intersect(r->accel, &ray, &hit) ? hit.t : INFINITY;
             float got = depth[y * n + x];
