@@ -302,6 +302,12 @@ static const cli_option render_table[] = {
             "frames the temporal accumulation averages at most (default 32)"),
     CLI_INT("--temporal-passes", "N", O, temporal_settings.filter_passes, 0, 8,
             "a-trous passes of the temporal filter (default 3; 0: none)"),
+    CLI_CHOICE("--temporal-resample", "bilinear|catmull-rom", O, temporal_settings.history_resample,
+               "bilinear|catmull-rom",
+               "how the history is read at a pixel's reprojected point: its 2 x 2\n"
+               "bilinear taps (default; a moving camera's long history blurs), or\n"
+               "its 4 x 4 Catmull-Rom taps clamped to the 2 x 2 range where all\n"
+               "16 show the pixel's surface (docs/temporal.md)"),
     CLI_CHOICE("--still-refine", "on|off|progressive", O, still_refine, "off|on|progressive",
                "--temporal on, a still camera: each frame adds a path-traced sample\n"
                "a pixel, denoised and blended in where its error is the lower;\n"

@@ -83,6 +83,11 @@ typedef struct drift_temporal_settings {
     int32_t moving_refine_period;  // 0, 1: every pixel every frame; P in 2, 4, 8, 16: 1/P of the
                                    // pixels a frame, each every P frames (a 4x4 Bayer order)
     int32_t moving_refine_passes;  // 0 -> 5: a-trous passes over its accumulation
+    // 0: the history is resampled at each pixel's reprojected point by its 2 x 2 bilinear taps
+    // (a moving camera's long history blurs: each frame filters it again); 1: by the 4 x 4
+    // Catmull-Rom taps where all 16 show the pixel's surface, clamped to the 2 x 2 taps' range
+    // (else bilinear), as TAA resamples (--temporal-resample)
+    int32_t history_resample;
 } drift_temporal_settings;
 
 // The settings with every 0 replaced by its default.

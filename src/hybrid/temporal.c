@@ -107,7 +107,8 @@ drift_result drift_temporal_create(drift_context *ctx, int32_t width, int32_t he
         !isfinite(s.phi_luminance) || !isfinite(s.depth_sigma) || s.moving_refine_history < 1 ||
         s.moving_refine_history > 4096 || s.moving_refine_period < 0 ||
         s.moving_refine_period > 16 || (s.moving_refine_period & (s.moving_refine_period - 1)) ||
-        s.moving_refine_passes < 0 || s.moving_refine_passes > 8) {
+        s.moving_refine_passes < 0 || s.moving_refine_passes > 8 || s.history_resample < 0 ||
+        s.history_resample > 1) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, NULL, 0,
                   "temporal: size %dx%d or settings out of range (drift/temporal.h)", width,
                   height);
@@ -265,6 +266,62 @@ static void reproject_rows(size_t begin, size_t end, int thread_index, void *use
     }
 }
 
+// The Catmull-Rom weights of the 4 taps at offsets -1, 0, 1, 2 for a point f in [0, 1) past
+// tap 0.
+static void catmull_rom_weights(float f, float w[4])
+{
+    w[0] = f * (-0.5f + f * (1.0f - 0.5f * f));
+    w[1] = 1.0f + f * f * (-2.5f + 1.5f * f);
+    w[2] = f * (0.5f + f * (2.0f - 1.5f * f));
+    w[3] = f * f * (-0.5f + 0.5f * f);
+}
+
+// --temporal-resample catmull-rom: the history's lighting at pixel (x, y)'s reprojected point
+// from the 4 x 4 taps around it, each of which must show the pixel's surface (tap_valid) and
+// hold history; clamped per channel to the 2 x 2 central taps' range so the negative lobes
+// cannot ring. False (keep the bilinear value) where a tap fails. Bilinear resampling low-pass
+// filters the history once a frame, so a moving camera's 32-frame history is blurred by up to
+// 32 such filters; this one keeps more of its detail.
+static bool resample_catmull_rom(const frame_job *job, const temporal_layer *L, int32_t x,
+                                 int32_t y, drift_vec3 *out)
+{
+    const drift_gbuffer *g = job->g;
+    int pr = job->prev;
+    const float *m = drift_image_pixel(&g->motion, x, y);
+    float qx = (float)x + m[0], qy = (float)y + m[1];
+    int32_t x0 = (int32_t)floorf(qx), y0 = (int32_t)floorf(qy);
+    float wx[4], wy[4];
+    catmull_rom_weights(qx - (float)x0, wx);
+    catmull_rom_weights(qy - (float)y0, wy);
+    float z = drift_image_pixel(&g->depth, x, y)[0];
+    float material = drift_image_pixel(&g->material_id, x, y)[0];
+    drift_vec3 n = drift_image_get3(&g->normal, x, y);
+    drift_vec3 p = drift_image_get3(&g->position, x, y);
+    if (g->object_motion) {
+        p = drift_vec3_add(p, g->object_motion[(size_t)y * (size_t)g->width + (size_t)x]);
+    }
+    drift_vec3 sum = drift_vec3_splat(0.0f);
+    drift_vec3 lo = drift_vec3_splat(INFINITY), hi = drift_vec3_splat(-INFINITY);
+    for (int j = 0; j < 4; ++j) {
+        for (int i = 0; i < 4; ++i) {
+            int32_t tx = x0 - 1 + i, ty = y0 - 1 + j;
+            if (!tap_valid(job, tx, ty, material, n, p, z) ||
+                !(drift_image_pixel(&L->length[pr], tx, ty)[0] > 0.0f)) {
+                return false;
+            }
+            drift_vec3 v = drift_image_get3(&L->light[pr], tx, ty);
+            sum = drift_vec3_fma(sum, v, wx[i] * wy[j]);
+            if ((i == 1 || i == 2) && (j == 1 || j == 2)) {
+                lo = drift_vec3_make(fminf(lo.x, v.x), fminf(lo.y, v.y), fminf(lo.z, v.z));
+                hi = drift_vec3_make(fmaxf(hi.x, v.x), fmaxf(hi.y, v.y), fmaxf(hi.z, v.z));
+            }
+        }
+    }
+    *out = drift_vec3_make(fminf(fmaxf(sum.x, lo.x), hi.x), fminf(fmaxf(sum.y, lo.y), hi.y),
+                           fminf(fmaxf(sum.z, lo.z), hi.z));
+    return true;
+}
+
 // Accumulates the job's colour into its layer through the taps: N = min(N_prev + 1, max),
 // alpha = 1 / N, the lighting and the luminance moments blended with the reprojected history.
 // A pixel without a sample (job->sampled) keeps the reprojected history as it is (N, moments).
@@ -323,6 +380,12 @@ static void accumulate_rows(size_t begin, size_t end, int thread_index, void *us
             if (weight > 1e-3f) {
                 float inv = 1.0f / weight;
                 hist = drift_vec3_scale(hist, inv);
+                drift_vec3 sharp;
+                // (It needs the 2 x 2 taps valid too: the weight is whole.)
+                if (t->s.history_resample == 1 && weight > 0.999f &&
+                    resample_catmull_rom(job, L, x, y, &sharp)) {
+                    hist = sharp;
+                }
                 hist_mom[0] *= inv;
                 hist_mom[1] *= inv;
                 n_frames =
