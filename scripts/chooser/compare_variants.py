@@ -16,9 +16,10 @@ say how it does on scenes it was not chosen on.
 
 --guided off|all|direct: which hybrid+pt rows every variant may pick (fit_table.py --guided).
 --baseline ROWS: one more row first, a model fitted on ROWS' fit scenes (the shipped model's
-rows; its quality parameters --baseline-prior, k 2, idw, probe, --baseline-guided (off), as
-shipped since session 5) judged on these rows' judge scenes: the shipped model against a refit on the same
-rows (its fit-scene columns are not leave-one-out, so it has no selection score).
+rows; its quality parameters --baseline-prior, k 2, idw, probe, --baseline-guided (off) and
+--baseline-norm, as shipped since session 5) judged on these rows' judge scenes: the shipped
+model against a refit on the same rows (its fit-scene columns are not leave-one-out, so it has
+no selection score).
 --probe-safety S: the probe's safety S for both groups, as the renderer's calibrated_safety.
 --guided-margin M: the hybrid+pt rows' margin against the path tracer (fit_table.py's).
 """

@@ -428,8 +428,8 @@ def choose(model, feats, budget, pt_margin, cost_scale=None, oracle=None):
     gm = model["q"].get("guided_margin") or pt_margin
     clear = []
     for fam, margin in (("hybrid", pt_margin), (GUIDED, gm)):
-        hy = min((c for c in fit_ if group(c[0]) == "hybrid" and (c[0][0] == GUIDED) == (fam == GUIDED)),
-                 key=lambda c: c[2][1], default=None)
+        hy = min((c for c in fit_ if group(c[0]) == "hybrid"
+                  and (c[0][0] == GUIDED) == (fam == GUIDED)), key=lambda c: c[2][1], default=None)
         if hy and (pt is None or hy[2][1] < margin * pt[2][1]):
             clear.append(hy)
     if clear:

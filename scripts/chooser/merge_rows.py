@@ -37,9 +37,9 @@ def main():
                             if (r["family"], r["name"]) in old_ms and r["ms"] > 0)
             scale = ratios[len(ratios) // 2] if ratios else 1.0
             d["rows"] += [dict(r, ms=r["ms"] * scale) for r in n["rows"] if r["family"] == GUIDED]
+            count = sum(r["family"] == GUIDED for r in n["rows"])
             print("merge_rows.py: %s: %d hybrid+pt rows, ms x %.3f" % (
-                d["scene"].rsplit("/", 1)[-1], sum(r["family"] == GUIDED for r in n["rows"]), scale),
-                file=sys.stderr)
+                d["scene"].rsplit("/", 1)[-1], count, scale), file=sys.stderr)
         print(json.dumps(d))
 
 
