@@ -312,11 +312,12 @@ static const cJSON *find_candidate(const cJSON *model, const double f[SCENE_FEAT
 }
 
 // Scores every candidate of the model for a scene of features `f` for a frame of `pixels`
-// under `cal`; *best_hybrid and *best_pt: the lowest predicted FLIP of each group that fits
-// (pick NULL: none), *fastest: the candidate of the lowest predicted ms (each ms calibrated).
-// False when the model is not one this build reads.
+// under `cal`; *best_hybrid, *best_guided (hybrid+pt) and *best_pt: the lowest predicted FLIP
+// of each family that fits (pick NULL: none), *fastest: the candidate of the lowest predicted
+// ms (each ms calibrated). False when the model is not one this build reads.
 static bool score(const cJSON *model, const double f[SCENE_FEATURE_COUNT], const calibration *cal,
-                  double pixels, choice *best_hybrid, choice *best_pt, choice *fastest)
+                  double pixels, choice *best_hybrid, choice *best_guided, choice *best_pt,
+                  choice *fastest)
 {
     int cost_index[SCENE_FEATURE_COUNT], cost_count = 0;
     if (!cost_indices(model, cost_index, &cost_count)) {
@@ -359,7 +360,7 @@ static bool score(const cJSON *model, const double f[SCENE_FEATURE_COUNT], const
         near[i].w = total > 0.0 ? near[i].w / total : 1.0 / k;
     }
     double size = number(model, "size", 400.0);
-    *best_hybrid = *best_pt = *fastest =
+    *best_hybrid = *best_guided = *best_pt = *fastest =
         (choice){ NULL, (double)INFINITY, (double)INFINITY, (double)INFINITY };
     const cJSON *cands = cJSON_GetObjectItemCaseSensitive(model, "candidates");
     for (const cJSON *c = cands ? cands->child : NULL; c; c = c->next) {
@@ -381,7 +382,10 @@ static bool score(const cJSON *model, const double f[SCENE_FEATURE_COUNT], const
         if (ms * cal->safety[g] > cal->available_ms) {
             continue;
         }
-        choice *best = g == GROUP_PT ? best_pt : best_hybrid;
+        const char *kind = string(c, "kind");
+        choice *best = g == GROUP_PT                            ? best_pt
+                       : kind && strcmp(kind, "hybrid+pt") == 0 ? best_guided
+                                                                : best_hybrid;
         if (rank < best->rank) {
             *best = (choice){ c, ms, flip, rank };
         }
@@ -597,15 +601,23 @@ int render_choose(render_options *o, const cli_session *session)
     if (!o->no_budget_probe) {
         calibrate(model, f, o, session, &cal, &probe);
     }
-    choice hybrid, pt, fastest;
-    bool ok = score(model, f, &cal, (double)o->width * (double)o->height, &hybrid, &pt, &fastest);
-    double margin = number(model, "pt_margin", 1.0);
+    choice hybrid, guided, pt, fastest;
+    bool ok = score(model, f, &cal, (double)o->width * (double)o->height, &hybrid, &guided, &pt,
+                    &fastest);
     // A hybrid frame only where it is predicted clearly closer than the best path tracer that
-    // fits: the chooser must not trade the path tracer's image for a worse one.
-    const choice *c = !ok                                                           ? NULL
-                      : hybrid.pick && (!pt.pick || hybrid.rank < margin * pt.rank) ? &hybrid
-                      : pt.pick                                                     ? &pt
-                                                                                    : &fastest;
+    // fits (pt_margin): the chooser must not trade the path tracer's image for a biased one. A
+    // hybrid+pt frame is the path tracer's samples plus a guide; its risk is its cost, not a
+    // bias, and it has its own margin (guided_margin, else pt_margin). Of the families that
+    // clear their margins, the closest.
+    double margin = number(model, "pt_margin", 1.0);
+    double guided_margin = number(model, "guided_margin", margin);
+    bool hybrid_clear = hybrid.pick && (!pt.pick || hybrid.rank < margin * pt.rank);
+    bool guided_clear = guided.pick && (!pt.pick || guided.rank < guided_margin * pt.rank);
+    const choice *c = !ok                                                             ? NULL
+                      : hybrid_clear && (!guided_clear || hybrid.rank <= guided.rank) ? &hybrid
+                      : guided_clear                                                  ? &guided
+                      : pt.pick                                                       ? &pt
+                                                                                      : &fastest;
     const char *row = c ? string(c->pick, "row") : NULL;
     if (!c || !apply_pick(o, c->pick)) {
         fprintf(stderr,
@@ -633,7 +645,9 @@ int render_choose(render_options *o, const cli_session *session)
                 : o->hybrid_mode ? "hybrid "
                                  : "the path tracer is expected to win: ",
                 row ? row : "?", c->ms, c->flip,
-                c == &pt && hybrid.pick ? "; the best hybrid frame was predicted no closer" : "",
+                c == &pt && (hybrid.pick || guided.pick)
+                    ? "; the best hybrid frame was predicted no closer"
+                    : "",
                 probed);
     }
     cJSON_Delete(model);

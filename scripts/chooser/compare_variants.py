@@ -16,10 +16,12 @@ say how it does on scenes it was not chosen on.
 
 --guided off|all|direct: which hybrid+pt rows every variant may pick (fit_table.py --guided).
 --baseline ROWS: one more row first, a model fitted on ROWS' fit scenes (the shipped model's
-rows; its quality parameters --baseline-prior, k 2, idw, probe, guided off, as shipped since
-session 5) judged on these rows' judge scenes: the shipped model against a refit on the same
-rows (its fit-scene columns are not leave-one-out, so it has no selection score).
+rows; its quality parameters --baseline-prior, k 2, idw, probe, --baseline-guided (off) and
+--baseline-norm, as shipped since session 5) judged on these rows' judge scenes: the shipped
+model against a refit on the same rows (its fit-scene columns are not leave-one-out, so it has
+no selection score).
 --probe-safety S: the probe's safety S for both groups, as the renderer's calibrated_safety.
+--guided-margin M: the hybrid+pt rows' margin against the path tracer (fit_table.py's).
 """
 import argparse
 import math
@@ -77,12 +79,18 @@ VARIANTS = [
      True),
     ("all gauss h2 + prior 1, kappa 0.5, pt1 norm, probe", {"k": 0, "kernel": "gauss",
      "bandwidth": 2.0, "prior": 1.0, "kappa": 0.5, "norm": "pt1"}, True),
+    ("k2 idw + prior 1, base norm, probe", {"prior": 1.0, "norm": "base"}, True),
     ("k2 idw + prior 1, probe, hybrid q0.9", {"prior": 1.0, "hybrid_quantile": 0.9}, True),
     ("k2 idw + prior 1, probe, hybrid q0.95", {"prior": 1.0, "hybrid_quantile": 0.95}, True),
     ("k2 idw + prior 1, kappa 0.5, pt1 norm, probe, hybrid q0.9", {"prior": 1.0, "kappa": 0.5,
      "norm": "pt1", "hybrid_quantile": 0.9}, True),
     ("k3 idw + prior 1, kappa 1, pt1 norm, probe", {"k": 3, "prior": 1.0, "kappa": 1.0,
      "norm": "pt1"}, True),
+    # A probe of the hybrid frame too (simulated from the scene's hard + none row; the renderer
+    # does not run it): hybrid rows scaled by it, the path tracer's and hybrid+pt's by pt 1 spp.
+    ("k2 idw + prior 1, hybrid probe", {"prior": 1.0}, "hybrid"),
+    ("k2 idw + prior 1, hybrid probe, hybrid q0.95", {"prior": 1.0, "hybrid_quantile": 0.95},
+     "hybrid"),
 ]
 
 
@@ -90,8 +98,8 @@ def row(cells, budgets, role):
     out = []
     for b in budgets:
         m = ft.summary(cells, b, role)
-        out.append("%.2f/%.2f %d %d" % (m["median_regret"], min(m["worst_regret"], 99),
-                                        m["within_1_1_pt"], m["within_budget"]))
+        out.append("%.2f/%.2f %d %d %d" % (m["median_regret"], min(m["worst_regret"], 99),
+                                           m["within_1_1_pt"], m["within_budget"], m["beats_pt"]))
     return out
 
 
@@ -104,8 +112,14 @@ def main():
     a.add_argument("--drift", default="build/release/bin/drift")
     a.add_argument("--only", help="the variants whose names contain this")
     a.add_argument("--guided", choices=("off", "all", "direct"), default="off")
+    a.add_argument("--guided-margin", type=float,
+                   help="every variant's margin for the hybrid+pt rows (default: --pt-margin's)")
     a.add_argument("--baseline", help="rows the shipped model was fitted on")
     a.add_argument("--baseline-prior", type=float, default=1.0)
+    a.add_argument("--baseline-guided", choices=("off", "all", "direct"), default="off",
+                   help="the baseline's hybrid+pt candidates (its rows must hold them: "
+                        "merge_rows.py); with --guided-margin, at that margin")
+    a.add_argument("--baseline-norm", choices=("best", "pt1", "base"), default="best")
     a.add_argument("--probe-safety", type=float,
                    help="with the probe, every variant's (and the baseline's) safety this factor "
                         "for both groups, as drift render applies the model's calibrated_safety, "
@@ -119,27 +133,30 @@ def main():
     fit_scenes = [s for s in scenes if is_fit(s)]
     judge = [s for s in scenes if not is_fit(s)]
     print("%s: %d fit scenes, %d judge scenes, --guided %s; cell = median/worst regret, cells "
-          "<= 1.1x best pt, cells within budget (of %d)\n" % (
+          "<= 1.1x best pt, cells within budget, cells within budget beating the best pt and "
+          "pt+denoise (of %d)\n" % (
               os.path.basename(o.rows), len(fit_scenes), len(judge), o.guided, len(judge)))
     head = " | ".join("%g ms" % b for b in budgets)
     print("| variant | selection score (fit LOSO) | fit: median eff. regret | "
           "judge score (reported, not used to choose) | train | " + head + " |")
     print("|---|---|---|---|---|" + "---|" * len(budgets))
     if o.baseline:
-        ft.set_guided("off")
+        ft.set_guided(o.baseline_guided)
         base = [s for s in ft.load(o.baseline, o.drift) if is_fit(s)]
-        model = ft.fit(base, {"prior": o.baseline_prior, "probe_safety": o.probe_safety})
+        model = ft.fit(base, {"prior": o.baseline_prior, "probe_safety": o.probe_safety,
+                              "norm": o.baseline_norm, "guided_margin": o.guided_margin})
         cells = [c for s in judge
                  for c in ft.scene_cells(model, s, False, budgets, o.pt_margin, True)]
-        print("| baseline: fitted on %s (%d fit scenes), prior %g, probe | | | %.4f | fit "
-              "| %s |" % (
-            os.path.basename(o.baseline), len(base), o.baseline_prior, score(cells),
+        print("| baseline: fitted on %s (%d fit scenes), prior %g, probe, guided %s, norm %s "
+              "| | | %.4f | fit | %s |" % (
+            os.path.basename(o.baseline), len(base), o.baseline_prior, o.baseline_guided,
+            o.baseline_norm, score(cells),
             " | ".join(row(cells, budgets, "judge"))))
     ft.set_guided(o.guided)
     for name, qp, probe in VARIANTS:
         if o.only and o.only not in name:
             continue
-        qp = dict(qp, probe_safety=o.probe_safety)
+        qp = dict(qp, probe_safety=o.probe_safety, guided_margin=o.guided_margin)
         sel = ft.loso(fit_scenes, is_fit, budgets, o.pt_margin, False, qp, probe)
         sc = score(sel)
         med = ft.median([effective(c) for c in sel])

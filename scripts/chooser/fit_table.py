@@ -59,6 +59,10 @@ PT_FAMILIES = {"pt", "pt+atrous", "pt+denoise", "pt-low", "pt-low+atrous"}
 # whose one-shot set-up is small). Off by default: over the s7 rows the judge scenes' figures
 # got worse with it (docs/lab/2026-12-07-issue-40-s7-chooser.md).
 GUIDED = "hybrid+pt"
+# The row a hybrid probe would time on the scene at hand (leave-one-out's probe "hybrid": the
+# hybrid frame's rows scaled by this row's measured over predicted ms; a simulation, the
+# renderer does not run it).
+HYBRID_PROBE = ("hybrid", "hard + none")
 GUIDED_ROWS = {"all": r"^(cheap |direct )?split (\d+) spp$", "direct": r"^(direct )split (\d+) spp$"}
 GUIDED_ROW = re.compile(GUIDED_ROWS["all"])
 PICKABLE = {"hybrid"} | PT_FAMILIES
@@ -70,7 +74,7 @@ RIDGE = 0.1
 # quantile. These defaults are session 2's chooser.
 QUALITY = {"k": 2, "kernel": "idw", "bandwidth": 1.0, "prior": 0.0, "kappa": 0.0,
            "robust": False, "safety_quantile": SAFETY_QUANTILE, "hybrid_quantile": None,
-           "norm": "best", "probe_safety": None}
+           "norm": "best", "probe_safety": None, "guided_margin": None}
 
 
 def key_text(key):
@@ -237,15 +241,19 @@ def fit_cost(train, quantile=SAFETY_QUANTILE, hybrid_quantile=None):
     resid = [(key, y - alpha[key] - sum(b * v for b, v in zip(beta[group(key)], x)), name)
              for key, x, y, name in obs]
     pt1 = {name: r for key, r, name in resid if key == ("pt", "1 spp")}
+    hy1 = {name: r for key, r, name in resid if key == HYBRID_PROBE}
+    hprobe_res = []
     for key, r, name in resid:
         res[group(key)].append(r)
         if name in pt1 and key != ("pt", "1 spp"):
             probe_res[group(key)].append(r - pt1[name])
+        if group(key) == "hybrid" and name in hy1 and key != HYBRID_PROBE:
+            hprobe_res.append(r - hy1[name])
     qs = {"pt": quantile, "hybrid": hybrid_quantile or quantile}
     q = lambda r, g: math.exp(sorted(r)[int(qs[g] * (len(r) - 1))]) if r else 1.0
     alpha, plus = fit_guided(alpha, beta, [o for o in every if o[0][0] == GUIDED])
     return (alpha, beta, {g: q(r, g) for g, r in res.items()},
-            {g: q(r, g) for g, r in probe_res.items()}, plus)
+            {g: q(r, g) for g, r in probe_res.items()}, plus, q(hprobe_res, "hybrid"))
 
 
 def fit_guided(alpha, beta, obs):
@@ -302,8 +310,10 @@ def scales(train, robust=False):
 
 def quality(s, norm="best"):
     """The scene's pickable rows' FLIP over its best row's (norm "pt1": over its path tracer's
-    at 1 spp, a row every scene has, whereas the best row depends on how far the bench ran)."""
-    best = min(f for _, f in s["rows"].values())
+    at 1 spp, a row every scene has, whereas the best row depends on how far the bench ran;
+    "base": over its best row but hybrid+pt's, so that adding those rows to older rows,
+    scripts/chooser/merge_rows.py, leaves the older rows' ratios as they were)."""
+    best = min(f for k, (_, f) in s["rows"].items() if norm != "base" or k[0] != GUIDED)
     if norm == "pt1" and ("pt", "1 spp") in s["rows"]:
         best = s["rows"][("pt", "1 spp")][1]
     return {k: f / best for k, (ms, f) in s["rows"].items() if pickable(k)}
@@ -397,6 +407,11 @@ def choose(model, feats, budget, pt_margin, cost_scale=None, oracle=None):
         if oracle is not None:
             ms = lookup(oracle, key)[0]
             fits = ms <= budget
+        elif isinstance(cost_scale, dict):  # the hybrid probe too: the hybrid frame's own
+            fam = GUIDED if key[0] == GUIDED else group(key)
+            ms = predict_ms(model["cost"], key, x) * cost_scale[fam]
+            safety = (model["cost"][5] if fam == "hybrid" else model["cost"][3][group(key)])
+            fits = ms * safety <= budget
         else:
             ms = predict_ms(model["cost"], key, x) * (cost_scale or 1.0)
             fits = ms * model["cost"][2 if cost_scale is None else 3][group(key)] <= budget
@@ -406,8 +421,19 @@ def choose(model, feats, budget, pt_margin, cost_scale=None, oracle=None):
         key, ms, _ = min(cands, key=lambda c: c[1])
         return key, ms, predict(model, near, key)[0], "nothing predicted within the budget: the fastest"
     pt = min((c for c in fit_ if group(c[0]) == "pt"), key=lambda c: c[2][1], default=None)
-    hy = min((c for c in fit_ if group(c[0]) == "hybrid"), key=lambda c: c[2][1], default=None)
-    if hy and (pt is None or hy[2][1] < pt_margin * pt[2][1]):
+    # Each hybrid family against the path tracer at its own margin: a hybrid frame must be
+    # clearly closer (its risk is a bias the quality model may not see); a hybrid+pt frame is
+    # the path tracer's samples plus a guide, its risk is its cost (guided_margin, default
+    # pt_margin). The closest of the families that clear their margins.
+    gm = model["q"].get("guided_margin") or pt_margin
+    clear = []
+    for fam, margin in (("hybrid", pt_margin), (GUIDED, gm)):
+        hy = min((c for c in fit_ if group(c[0]) == "hybrid"
+                  and (c[0][0] == GUIDED) == (fam == GUIDED)), key=lambda c: c[2][1], default=None)
+        if hy and (pt is None or hy[2][1] < margin * pt[2][1]):
+            clear.append(hy)
+    if clear:
+        hy = min(clear, key=lambda c: c[2][1])
         return hy[0], hy[1], hy[2][0], "hybrid"
     return pt[0], pt[1], pt[2][0], "path tracer"
 
@@ -463,6 +489,7 @@ def model_json(model, size, source, pt_margin):
                        "candidate's prior (mean, variance of its log ratio over the scenes)." % source,
             "size": size, "k": qp["k"], "pt_margin": pt_margin, "features": FEATURES,
             "quality": {k: qp[k] for k in ("kernel", "bandwidth", "prior", "kappa", "norm")},
+            **({"guided_margin": qp["guided_margin"]} if qp.get("guided_margin") else {}),
             "cost_features": COST_FEATURES, "beta": {g: [round(v, 5) for v in b] for g, b in beta.items()},
             "safety": {g: round(v, 4) for g, v in safety.items()},
             "scale": model["scale"], "candidates": cands,
@@ -482,7 +509,8 @@ def from_json(m):
             "scenes": [(s["name"], s["features"], {key(k): v for k, v in s["flip"].items()})
                        for s in m["scenes"]],
             "prior": {key(c["key"]): tuple(c["prior"]) for c in cands if "prior" in c},
-            "q": dict(QUALITY, k=m.get("k", 2), **m.get("quality", {}))}
+            "q": dict(QUALITY, k=m.get("k", 2), guided_margin=m.get("guided_margin"),
+                      **m.get("quality", {}))}
 
 
 def median(v):
@@ -516,7 +544,12 @@ def loso(scenes, is_fit, budgets, pt_margin, train_all, qp=None, probe=False):
 def scene_cells(model, s, role_fit, budgets, pt_margin, probe=False):
     """One scene's cells, each budget's pick by `model` scored on the scene's measured rows."""
     cells = []
-    scale = probe_scale(model, s) if probe is True else None
+    scale = probe_scale(model, s) if probe in (True, "hybrid") else None
+    if probe == "hybrid":
+        ms, _ = lookup(s["rows"], HYBRID_PROBE)
+        pred = predict_ms(model["cost"], HYBRID_PROBE, cost_x(s))
+        hy = ms / pred if 0.0 < ms < math.inf and 0.0 < pred < math.inf else scale
+        scale = {"pt": scale, GUIDED: scale, "hybrid": hy}
     oracle = s["rows"] if probe == "oracle" else None
     for b in budgets:
         key, pms, _, why = choose(model, s["features"], b, pt_margin, scale, oracle)
@@ -610,6 +643,8 @@ def main():
     a.add_argument("--pt-margin", type=float, default=0.9,
                    help="a hybrid row is picked only when predicted below this x the best path "
                         "tracer's FLIP (default 0.9)")
+    a.add_argument("--guided-margin", type=float,
+                   help="the same for a hybrid+pt row (default: --pt-margin's)")
     q = a.add_argument_group("the quality model and the pick (defaults: session 2's chooser)")
     q.add_argument("--k", type=int, default=QUALITY["k"], help="nearest scenes (0: all)")
     q.add_argument("--kernel", choices=("idw", "gauss"), default=QUALITY["kernel"])
@@ -619,7 +654,7 @@ def main():
     q.add_argument("--kappa", type=float, default=QUALITY["kappa"],
                    help="rank by mean + kappa x spread of the predicted log FLIP ratio")
     q.add_argument("--robust", action="store_true", help="features scaled by their MAD")
-    q.add_argument("--norm", choices=("best", "pt1"), default=QUALITY["norm"])
+    q.add_argument("--norm", choices=("best", "pt1", "base"), default=QUALITY["norm"])
     q.add_argument("--safety-quantile", type=float, default=QUALITY["safety_quantile"])
     q.add_argument("--hybrid-quantile", type=float,
                    help="the hybrid rows' safety quantile (default: --safety-quantile's)")
@@ -648,7 +683,8 @@ def main():
 
     qp = {"k": o.k, "kernel": o.kernel, "bandwidth": o.bandwidth, "prior": o.prior,
           "kappa": o.kappa, "robust": o.robust, "norm": o.norm,
-          "safety_quantile": o.safety_quantile, "hybrid_quantile": o.hybrid_quantile}
+          "safety_quantile": o.safety_quantile, "hybrid_quantile": o.hybrid_quantile,
+          "guided_margin": o.guided_margin}
     tee = Tee()
     validate(scenes, is_fit, budgets, o.pt_margin, tee, o.train == "all", qp, o.probe)
     if o.frontier_md:
