@@ -28,8 +28,9 @@ typedef struct aaf_options {
     int spp_count, mc_spp_count;
     int effect; // --effect: shadows, indirect, both, reflections
     bool shadows, indirect, reflections, json;
-    bool random;    // --sampler random: AAF and plain MC both take independent random numbers
-    bool ref_plain; // --ref plain: the reference is plain MC's own estimate at --ref-spp
+    bool random;         // --sampler random: AAF and plain MC both take independent random numbers
+    bool ref_plain;      // --ref plain: the reference is plain MC's own estimate at --ref-spp
+    bool aaf_unfiltered; // --aaf-filter off: AAF's rows without the filter (its samples alone)
 } aaf_options;
 
 // --spp and --mc-spp: an increasing list of 2..MAX_SPPS counts into that list and its count.
@@ -92,6 +93,9 @@ static const cli_option aaf_table[] = {
                "path (default): the effect's term path-traced; plain: plain MC's own\n"
                "estimate at --ref-spp (the same unshadowed light: only the sampler's\n"
                "error is left where the hybrid's U_l differs from the path tracer)"),
+    CLI_CHOICE("--aaf-filter", "F", O, aaf_unfiltered, "on|off",
+               "on (default); off: AAF's rows keep their adaptive samples but skip\n"
+               "the filter (how much of the ratio is where the samples go)"),
     CLI_INT("--width", "W", O, width, 1, DRIFT_IMAGE_MAX_DIMENSION,
             "error images (default 160x120)"),
     CLI_INT("--height", "H", O, height, 1, DRIFT_IMAGE_MAX_DIMENSION, "error images"),
@@ -294,6 +298,7 @@ static drift_result measure_render(drift_context *ctx, const drift_scene *scene,
             long spp = method == 0 ? o->spps[k] : o->mc_spps[k];
             p = effect_params(effect, e->aaf, o, spp);
             p.aaf.uniform = p.aaf.unfiltered = method == 1;
+            p.aaf.unfiltered = p.aaf.unfiltered || o->aaf_unfiltered;
             r = render(ctx, scene, accel, &p, &frame);
             if (r == DRIFT_OK) {
                 r = copy_plane(ctx, drift_hybrid_plane_named(frame, e->term), &e->tests[method][k]);
@@ -524,6 +529,7 @@ static bool print_json(const aaf_options *o, const char *scene_path, int threads
     cJSON_AddNumberToObject(root, "height", (double)o->height);
     cJSON_AddNumberToObject(root, "ref_spp", (double)o->ref_spp);
     cJSON_AddStringToObject(root, "reference", o->ref_plain ? "plain" : "path");
+    cJSON_AddBoolToObject(root, "aaf_filter", !o->aaf_unfiltered);
     cJSON_AddNumberToObject(root, "threads", threads);
     cJSON_AddNumberToObject(root, "light_samples", (double)o->light_samples);
     cJSON_AddStringToObject(root, "sampler", o->random ? "random" : "sobol");
@@ -567,9 +573,9 @@ static bool print_json(const aaf_options *o, const char *scene_path, int threads
 static void print_text(const aaf_options *o, const char *scene_path, int threads,
                        const curve *curves, int count)
 {
-    printf("%s, %ldx%ld, reference %ld spp (%s), %d thread(s), %s sampler\n", scene_path, o->width,
-           o->height, o->ref_spp, o->ref_plain ? "plain MC" : "path-traced", threads,
-           o->random ? "random" : "sobol");
+    printf("%s, %ldx%ld, reference %ld spp (%s), %d thread(s), %s sampler%s\n", scene_path,
+           o->width, o->height, o->ref_spp, o->ref_plain ? "plain MC" : "path-traced", threads,
+           o->random ? "random" : "sobol", o->aaf_unfiltered ? ", AAF's filter off" : "");
     for (int c = 0; c < count; ++c) {
         const curve *cv = &curves[c];
         printf("\n%s\n%8s %10s %12s %10s %9s\n", drift_effect_name(cv->effect), "spp", "aaf spp",

@@ -79,6 +79,18 @@ assert e["timing"]["frame_ms"] > 0, e'
         check aaf 'assert d["reference"] == "plain", d
 e = d["effects"][0]
 assert e["plain_mc"][1]["rmse"] == 0 and e["plain_mc"][0]["rmse"] > 0, e'
+        # --aaf-filter off: AAF's rows are its samples alone (the filter acts on the box's
+        # penumbrae, so their error changes); plain MC's rows are the same.
+        cp "$tmp/out" "$tmp/aaf-on.json"
+        expect 0 "$drift" bench aaf "$box" --width 16 --height 12 --ref-spp 4 --ref plain \
+            --spp 1,2 --mc-spp 2,4 --timing-size 16x12 --timing-spp 1 --light-samples 2 --json \
+            --aaf-filter off
+        check aaf 'import os
+on = json.load(open(os.path.join(os.path.dirname(sys.argv[1]), "aaf-on.json")))
+assert d["aaf_filter"] is False and on["aaf_filter"] is True, d
+e, f = d["effects"][0], on["effects"][0]
+assert [p["rmse"] for p in e["plain_mc"]] == [p["rmse"] for p in f["plain_mc"]], (e, f)
+assert [p["rmse"] for p in e["aaf"]] != [p["rmse"] for p in f["aaf"]], (e, f)'
         ;;
     sir)
         expect 0 "$drift" bench sir "$box" --sizes 16x12 --spp 1 --budget 64 --json
