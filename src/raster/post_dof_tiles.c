@@ -23,8 +23,10 @@ static bool circles_share(float lo, float hi)
 // Per tile: its gathering pixels' smallest circle, the largest circle of any pixel (how far
 // its gathers read; 0 when none is positive), and whether its pixels all equal its first one
 // (float == per channel: -0 equals +0, NaN nothing).
-DRIFT_AVX2_CLONES void drift__post_dof_scan_tiles(size_t begin, size_t end, int thread_index,
-                                                  void *user)
+// (The entry points below are plain functions over file-local clones: clang 14 emits a
+// target_clones function's resolver only in the files that call it, so an extern clone
+// called from post_dof.c did not link; decision 0460.)
+static DRIFT_AVX2_CLONES void scan_tiles(size_t begin, size_t end, int thread_index, void *user)
 {
     (void)thread_index;
 
@@ -330,7 +332,7 @@ static inline void shared_rows(const dof_job *job, const tile_planes *tp, int32_
 // lanes run, the group's are written), then the same with the rest, up to 3 groups (two
 // depths and the pixels between); a group of under 3 pixels is left to the per-pixel gather
 // (16 lanes of shared taps cost about what 2 pixels' own gathers do).
-DRIFT_AVX2_CLONES void drift__post_dof_shared_band(const dof_job *job, int32_t ty, float *local)
+static DRIFT_AVX2_CLONES void shared_band(const dof_job *job, int32_t ty, float *local)
 {
     enum {
         GROUPS = 3,
@@ -397,4 +399,14 @@ DRIFT_AVX2_CLONES void drift__post_dof_shared_band(const dof_job *job, int32_t t
             job->row_lanes[(size_t)y * (size_t)job->tiles_x + (size_t)tx] = (uint16_t)done;
         }
     }
+}
+
+void drift__post_dof_scan_tiles(size_t begin, size_t end, int thread_index, void *user)
+{
+    scan_tiles(begin, end, thread_index, user);
+}
+
+void drift__post_dof_shared_band(const dof_job *job, int32_t ty, float *local)
+{
+    shared_band(job, ty, local);
 }
