@@ -300,6 +300,10 @@ static const cli_option render_table[] = {
                "variance-guided accumulation and filtering (docs/temporal.md)"),
     CLI_INT("--temporal-history", "N", O, temporal_settings.max_history, 1, 4096,
             "frames the temporal accumulation averages at most (default 32)"),
+    CLI_INT("--temporal-moving-history", "N", O, temporal_settings.moving_history, 1, 4096,
+            "frames a pixel that moved averages at most (default 8; a still\n"
+            "pixel keeps --temporal-history): a moving history is resampled\n"
+            "every frame and a long one blurs (docs/temporal.md)"),
     CLI_INT("--temporal-passes", "N", O, temporal_settings.filter_passes, 0, 8,
             "a-trous passes of the temporal filter (default 3; 0: none)"),
     CLI_CHOICE("--temporal-resample", "bilinear|catmull-rom", O, temporal_settings.history_resample,

@@ -24,6 +24,7 @@
 //
 // Settings (zeroed: the defaults; one place, so that they can become a knob-table row):
 //   max_history      = 0 -> 32 frames (the accumulation's floor is alpha = 1 / 32)
+//   moving_history   = 0 -> 8 frames at most where the pixel moved since the last frame
 //   moments_alpha    = 0 -> 0.2
 //   depth_tolerance  = 0 -> 0.05 (relative)
 //   normal_tolerance = 0 -> 0.9 (cosine)
@@ -88,6 +89,10 @@ typedef struct drift_temporal_settings {
     // Catmull-Rom taps where all 16 show the pixel's surface, clamped to the 2 x 2 taps' range
     // (else bilinear), as TAA resamples (--temporal-resample)
     int32_t history_resample;
+    // 0 -> 8: the frames a pixel that moved (its motion vector over MOVING_PIXELS) averages
+    // at most, when below max_history. Each frame resamples a moving history bilinearly, so a
+    // long one blurs; a still pixel keeps max_history and converges (--temporal-moving-history)
+    int32_t moving_history;
 } drift_temporal_settings;
 
 // The settings with every 0 replaced by its default.

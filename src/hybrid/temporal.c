@@ -42,6 +42,7 @@ drift_temporal_settings drift_temporal_settings_resolve(const drift_temporal_set
     s.phi_luminance = s.phi_luminance > 0.0f ? s.phi_luminance : 4.0f;
     s.depth_sigma = s.depth_sigma > 0.0f ? s.depth_sigma : 1.0f;
     s.moving_refine_history = s.moving_refine_history ? s.moving_refine_history : 32;
+    s.moving_history = s.moving_history ? s.moving_history : 8;
     return s;
 }
 
@@ -108,7 +109,7 @@ drift_result drift_temporal_create(drift_context *ctx, int32_t width, int32_t he
         s.moving_refine_history > 4096 || s.moving_refine_period < 0 ||
         s.moving_refine_period > 16 || (s.moving_refine_period & (s.moving_refine_period - 1)) ||
         s.moving_refine_passes < 0 || s.moving_refine_passes > 8 || s.history_resample < 0 ||
-        s.history_resample > 1) {
+        s.history_resample > 1 || s.moving_history < 1 || s.moving_history > 4096) {
         drift_log(ctx, DRIFT_LOG_ERROR, DRIFT_ERR_INVALID_ARGUMENT, NULL, 0,
                   "temporal: size %dx%d or settings out of range (drift/temporal.h)", width,
                   height);
@@ -276,6 +277,32 @@ static void catmull_rom_weights(float f, float w[4])
     w[3] = f * f * (-0.5f + 0.5f * f);
 }
 
+// A pixel whose motion vector is longer than this has moved: its history is resampled off
+// the pixel grid this frame.
+#define MOVING_PIXELS 0.05f
+
+// The frames pixel (x, y)'s accumulation averages at most: the layer's max_history, or, in the
+// hybrid frame's layer, the shorter moving_history where the pixel moved since the last frame
+// (the camera's or its mesh's move; the path-traced refinement's layers keep theirs: their
+// samples are noisy, not biased). Measured (docs/lab/2026-12-08-issue-47-s8-tframe.md): under a
+// moving camera an 8-frame history beat 32 on both scenes (each frame's bilinear resampling blurs a
+// long one), while a still camera needs the long one to converge.
+static int32_t history_cap(const drift_temporal *t, const temporal_layer *L, const drift_gbuffer *g,
+                           int32_t x, int32_t y)
+{
+    if (L != &t->hybrid) {
+        return L->max_history;
+    }
+    const float *m = drift_image_pixel(&g->motion, x, y);
+    bool moved = m[0] * m[0] + m[1] * m[1] > MOVING_PIXELS * MOVING_PIXELS;
+    if (!moved && g->object_motion) {
+        drift_vec3 d = g->object_motion[(size_t)y * (size_t)g->width + (size_t)x];
+        moved = drift_vec3_dot(d, d) > 0.0f;
+    }
+    int32_t cap = t->s.moving_history < L->max_history ? t->s.moving_history : L->max_history;
+    return moved ? cap : L->max_history;
+}
+
 // --temporal-resample catmull-rom: the history's lighting at pixel (x, y)'s reprojected point
 // from the 4 x 4 taps around it, each of which must show the pixel's surface (tap_valid) and
 // hold history; clamped per channel to the 2 x 2 central taps' range so the negative lobes
@@ -388,8 +415,8 @@ static void accumulate_rows(size_t begin, size_t end, int thread_index, void *us
                 }
                 hist_mom[0] *= inv;
                 hist_mom[1] *= inv;
-                n_frames =
-                    fminf(hist_len * inv + (has_sample ? 1.0f : 0.0f), (float)L->max_history);
+                n_frames = fminf(hist_len * inv + (has_sample ? 1.0f : 0.0f),
+                                 (float)history_cap(t, L, g, x, y));
             }
             if (!has_sample) { // the history as it is, or nothing known (N = 0)
                 bool known = weight > 1e-3f;

@@ -230,7 +230,8 @@ static void test_reprojection_subpixel(void **state)
 // history should be the last frame itself; what differs is the resampling's blur, applied
 // once a frame. The bilinear taps' error grows with the frames; Catmull-Rom's must stay at
 // most half of it.
-static double pan_history_error(int resample)
+static double pan_history_error_lengths(int resample, int32_t moving_history, int frames, float pan,
+                                        float *out_length)
 {
     test_rig r = test_rig_begin(2);
     uint32_t white = test_add_material(r.scene, drift_material_make(drift_vec3_splat(0.6f)));
@@ -239,7 +240,7 @@ static double pan_history_error(int resample)
                           .position = drift_vec3_make(0.1f, 0.05f, 0.0f),
                           .color = drift_vec3_splat(0.05f) };
     assert_int_equal(drift_scene_add_light(r.scene, &light, NULL), DRIFT_OK);
-    const int w = 48, h = 32, frames = 16;
+    const int w = 48, h = 32;
     const float height = 1.0f, fov = 0.8f;
     r.scene->camera = drift_camera_look_at(drift_vec3_make(0, height, 0), drift_vec3_make(0, 0, 0),
                                            drift_vec3_make(0, 0, 1), fov, w, h);
@@ -247,14 +248,16 @@ static double pan_history_error(int resample)
     test_rig_frame(&r, &(drift_hybrid_params){ .width = w, .height = h });
     drift_temporal *t = NULL;
     assert_int_equal(
-        drift_temporal_create(
-            r.ctx, w, h,
-            &(drift_temporal_settings){ .no_filter = true, .history_resample = resample }, &t),
+        drift_temporal_create(r.ctx, w, h,
+                              &(drift_temporal_settings){ .no_filter = true,
+                                                          .history_resample = resample,
+                                                          .moving_history = moving_history },
+                              &t),
         DRIFT_OK);
     drift_camera cam = r.scene->camera;
     float footprint = 2.0f * height * tanf(0.5f * fov) / (float)h;
     drift_camera_frame fa = drift_camera_frame_make(&cam, w, h);
-    drift_vec3 step = drift_vec3_scale(fa.u, 0.5f * footprint);
+    drift_vec3 step = drift_vec3_scale(fa.u, pan * footprint);
     double error = 0.0;
     for (int k = 0; k < frames; ++k) {
         assert_int_equal(drift_hybrid_render(r.frame, &cam, NULL), DRIFT_OK);
@@ -275,6 +278,7 @@ static double pan_history_error(int resample)
                 }
             }
             error = sqrt(sum / n);
+            *out_length = drift_image_pixel(drift_temporal_history(t), w / 2, h / 2)[0];
         }
         cam.position = drift_vec3_add(cam.position, step);
         cam.target = drift_vec3_add(cam.target, step);
@@ -282,6 +286,31 @@ static double pan_history_error(int resample)
     drift_temporal_destroy(t);
     test_rig_destroy(&r);
     return error;
+}
+
+// The history under a half-pixel pan a frame, 16 frames, both at the old cap of 32 frames.
+static double pan_history_error(int resample)
+{
+    float length;
+    return pan_history_error_lengths(resample, 32, 16, 0.5f, &length);
+}
+
+// A moving pixel's history stops at moving_history frames (8 by default), a still one's runs
+// on to max_history; and the shorter history blurs less under the pan (the reason for it).
+static void test_moving_history_caps(void **state)
+{
+    (void)state;
+    float moving8 = 0.0f, moving32 = 0.0f, still = 0.0f;
+    double e8 = pan_history_error_lengths(0, 0, 20, 0.5f, &moving8);
+    double e32 = pan_history_error_lengths(0, 32, 20, 0.5f, &moving32);
+    pan_history_error_lengths(0, 0, 20, 0.0f, &still);
+    print_message("history length after 20 frames: panning %g (moving_history 8), %g (32); "
+                  "still %g; pan error %.5f / %.5f\n",
+                  (double)moving8, (double)moving32, (double)still, e8, e32);
+    assert_near(moving8, 8.0, 1e-3);
+    assert_near(moving32, 20.0, 1e-3);
+    assert_near(still, 20.0, 1e-3);
+    assert_true(e8 < e32);
 }
 
 static void test_history_resample_sharp(void **state)
@@ -801,6 +830,7 @@ int main(void)
         cmocka_unit_test(test_reprojection_whole_pixels),
         cmocka_unit_test(test_reprojection_subpixel),
         cmocka_unit_test(test_history_resample_sharp),
+        cmocka_unit_test(test_moving_history_caps),
         cmocka_unit_test(test_disocclusion),
         cmocka_unit_test(test_still_camera_converges),
         cmocka_unit_test(test_view_converges),
