@@ -284,7 +284,8 @@ static const cli_option render_table[] = {
     CLI_CHOICE("--budget-probe", "on|off", O, no_budget_probe, "on|off",
                "--budget-ms: first time cheap frames of the scene and scale the\n"
                "model's costs by them and the load average; T counts all after the\n"
-               "scene's load: accel, probes, frame (on, the default; the probes'\n"
+               "scene's load: accel, probes, frame; a path-tracer pick then takes\n"
+               "samples, denoised, while T lasts (on, the default; the probes'\n"
                "timings vary, so the pick may differ run to run); off: the fitted\n"
                "costs as they are, T the frame's alone, the same pick every run"),
     CLI_NOTE("each technique is listed below; reference = that effect\n"
@@ -501,18 +502,42 @@ int render_reference(const render_options *o, const cli_session *session)
     // `pass` samples nearer the total (tiles of a resumed render start where they were).
     bool tty = isatty(STDERR_FILENO) != 0;
     uint32_t total = (uint32_t)o->spp, done_spp = run.resumed_spp, pass = 1;
+    // A budget to fill (--budget-ms, a path-tracer pick): past --spp, passes go on while the
+    // next one and --denoise's filter (timed once on the image at --spp) end by the deadline.
+    const bool fill = o->budget_deadline > 0.0;
+    if (fill) {
+        total = 1u << 16; // the deadline ends it
+    }
+    double sampling_s = 0.0, reserve_s = -1.0;
+    run.target_spp = total;
     run.t_render = drift_time_now();
     run.cpu_render = render_cpu_now();
     double last_checkpoint = run.t_render, last_report = 0.0;
+    char spp_text[64];
+    snprintf(spp_text, sizeof spp_text, fill ? "samples while --budget-ms lasts" : "%u spp", total);
     if (!o->quiet) {
-        fprintf(stderr, "drift render: %s, %dx%d, %u spp, depth %d, %d threads\n",
-                session->scene_path, params.width, params.height, total, params.max_depth,
+        fprintf(stderr, "drift render: %s, %dx%d, %s, depth %d, %d threads\n", session->scene_path,
+                params.width, params.height, spp_text, params.max_depth,
                 drift_context_thread_count(ctx));
     }
     while (done_spp < total) {
+        if (fill && done_spp >= 1u) {
+            if (reserve_s < 0.0) { // 1.25x its time now: the filter's cost varies run to run
+                reserve_s = 1.25e-3 * render_denoise_ms(ctx, pt, o);
+            }
+            double per_spp = sampling_s / (double)(done_spp - run.resumed_spp);
+            double left = o->budget_deadline - reserve_s - drift_time_now();
+            double fits = per_spp > 0.0 ? floor(left / per_spp) : 0.0;
+            if (fits < 1.0) {
+                total = done_spp; // the budget is spent: this is the render, not a stop
+                break;
+            }
+            pass = fits < (double)pass ? (uint32_t)fits : pass;
+        }
         double t0 = drift_time_now();
         drift_result r = drift_pt_render_tiles(pt, NULL, 0, pass, total, &interrupted);
         double dt = drift_time_now() - t0;
+        sampling_s += dt;
         if (r == DRIFT_ERR_CANCELLED) {
             break;
         }
@@ -535,6 +560,7 @@ int render_reference(const render_options *o, const cli_session *session)
             last_checkpoint = now;
         }
     }
+    run.target_spp = total;
     exit_code = render_reference_finish(&run, atomic_load(&interrupted), drift_time_now());
 
 done:

@@ -76,6 +76,11 @@ typedef struct render_options {
     const char *chooser_path;        // --chooser FILE: its model (default: the repository's)
     bool no_budget_probe;            // --budget-probe off: the fitted costs as they are
     bool print_features;             // --features: the scene's features as JSON, then exit
+    // --budget-ms with the probes on and a path-tracer pick: drift_time_now() by which the
+    // render (its samples and its --denoise) should be done; it takes 1 spp and adds samples
+    // until then (0: none, --spp as given; --spp stays the pick's, the footprint textures are
+    // filtered for)
+    double budget_deadline;
     long upsample_width, upsample_height; // > 0: the chooser's path tracer at reduced
                                           // resolution, written upsampled to this size
     // sequences (tools/render_sequence.c, docs/temporal.md)
@@ -199,6 +204,7 @@ typedef struct render_reference_run {
     double cpu_render;    // render_cpu_now() then (0: not taken; the stats leave it out)
     double cpu_rendered;  // and when rendering ended
     double denoise_ms;    // --denoise's filter, within the write (the stats' "denoise")
+    uint32_t target_spp;  // the samples it set out to take: --spp, or more to fill a budget
     char key[1024];       // render_checkpoint_key
     char checkpoint_path[4096];
 } render_reference_run;
@@ -208,6 +214,9 @@ typedef struct render_reference_run {
 int render_reference_begin(render_reference_run *run);
 // Writes FILE.ckpt and the images so far (all or none); false after a message.
 bool render_reference_checkpoint(render_reference_run *run);
+// The milliseconds --denoise takes on the pt's image as it is now (0 without --denoise): what
+// a budget must keep for it after the samples.
+double render_denoise_ms(drift_context *ctx, struct drift_pt *pt, const render_options *o);
 // Writes the outputs (all or none) and, when tiles are short of --spp, the checkpoint, and
 // says so; removes the checkpoint of a finished render. Returns the exit status.
 int render_reference_finish(render_reference_run *run, bool cancelled, double t_rendered);

@@ -561,10 +561,12 @@ static void calibrate(const cJSON *model, const double f[SCENE_FEATURE_COUNT],
         probe->hybrid_ms > 0.0 ? probe->hybrid_ms / cal->frame_cores : base;
     cal->setup_table = table;
     // The writes (and what else the measured frames paid that the rows did not: the model's
-    // finish_ms, fitted by scripts/chooser/fit_calibration.py) at the frame's pixels.
+    // finish_ms, fitted by scripts/chooser/fit_calibration.py) at the frame's pixels, scaled
+    // by the probes as the frames are: encoding is CPU work too, and unscaled it left nothing
+    // of T = 100 ms on a machine 3x the fit's (114 ms of writes predicted at 320x180, 24 paid).
     double size = number(model, "size", 400.0);
-    cal->finish_ms =
-        number(model, "finish_ms", 0.0) * (double)o->width * (double)o->height / (size * size);
+    cal->finish_ms = number(model, "finish_ms", 0.0) * (double)o->width * (double)o->height /
+                     (size * size) * cal->scale[GROUP_PT];
     cal->setup_scale =
         cores_for(threads, number(table, "cores", cal->cores), number(table, "load", cal->load)) /
         cal->frame_cores;
@@ -618,6 +620,21 @@ int render_choose(render_options *o, const cli_session *session)
                       : guided_clear                                                  ? &guided
                       : pt.pick                                                       ? &pt
                                                                                       : &fastest;
+    // With the probes on, a path-tracer pick fills T (below): its samples follow the time, so
+    // the family (resolution, denoiser) is chosen as if its rows cost their fitted ms alone,
+    // not times the safety factor that keeps a fixed spp within T; it starts at 1 spp.
+    const bool fills = ok && !o->no_budget_probe && (c == &pt || c == &fastest);
+    calibration bare = cal;
+    choice h2, g2, pt_bare, fastest_bare;
+    if (fills) {
+        bare.safety[GROUP_PT] = 1.0;
+        if (score(model, f, &bare, (double)o->width * (double)o->height, &h2, &g2, &pt_bare,
+                  &fastest_bare) &&
+            pt_bare.pick) {
+            pt = pt_bare;
+            c = &pt;
+        }
+    }
     const char *row = c ? string(c->pick, "row") : NULL;
     if (!c || !apply_pick(o, c->pick)) {
         fprintf(stderr,
@@ -626,6 +643,18 @@ int render_choose(render_options *o, const cli_session *session)
                 path);
         cJSON_Delete(model);
         return 1;
+    }
+    // The render adds samples while they and the denoiser's filter end by the deadline, T less
+    // the writes (tools/cmd_render.c). A fixed spp carried the safety factors and left most of
+    // T unused on a quiet machine (a 320x180 scene at T = 250 ms: 1 spp rendered, 8 fitting).
+    if (fills && !o->hybrid_mode) { // 5% of T kept: the last pass's time varies
+        o->budget_deadline = drift_time_now() + 1e-3 * (0.95 * cal.available_ms - cal.finish_ms);
+        // Filling T, a plain path-tracer pick is denoised: the samples it gets are the time's
+        // either way, and the filter costs about one sample (judge scenes at 128²: the three
+        // cells where the bare costs picked `pt` over `pt+denoise` came out 0.01-0.04 worse).
+        if (o->denoise == 0) {
+            o->denoise = 2;
+        }
     }
     if (!o->quiet) {
         char probed[256] = "";
@@ -639,7 +668,7 @@ int render_choose(render_options *o, const cli_session *session)
         }
         fprintf(stderr,
                 "drift render: --budget-ms %g: %s%s (predicted %.0f ms, FLIP %.2fx the best "
-                "row's on the nearest fitted scenes)%s%s\n",
+                "row's on the nearest fitted scenes)%s%s%s\n",
                 o->budget_ms,
                 c == &fastest    ? "nothing is predicted to fit, the fastest: "
                 : o->hybrid_mode ? "hybrid "
@@ -648,7 +677,7 @@ int render_choose(render_options *o, const cli_session *session)
                 c == &pt && (hybrid.pick || guided.pick)
                     ? "; the best hybrid frame was predicted no closer"
                     : "",
-                probed);
+                probed, fills ? "; samples from 1 spp while T lasts" : "");
     }
     cJSON_Delete(model);
     return 0;

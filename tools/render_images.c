@@ -75,6 +75,53 @@ void render_spp_range(const drift_pt *pt, uint32_t *lowest, uint32_t *highest)
     }
 }
 
+// --denoise's filter of the pt's beauty into *out (created here): the feature-guided
+// denoiser (on, regression) over the pt's feature planes, or a-trous over its G-buffer planes.
+static drift_result denoise_beauty(drift_context *ctx, drift_pt *pt, const render_options *o,
+                                   const drift_image *beauty, drift_image *out)
+{
+    drift_image a, n, z, variance, direct, direct_var, indirect_var;
+    drift_result r;
+    if (o->denoise >= 2) {
+        if ((r = drift_pt_resolve(pt, DRIFT_PT_AOV_VARIANCE, &variance)) != DRIFT_OK ||
+            (r = drift_pt_resolve(pt, DRIFT_PT_AOV_FEATURE_ALBEDO, &a)) != DRIFT_OK ||
+            (r = drift_pt_resolve(pt, DRIFT_PT_AOV_FEATURE_NORMAL, &n)) != DRIFT_OK ||
+            (r = drift_pt_resolve(pt, DRIFT_PT_AOV_FEATURE_DEPTH, &z)) != DRIFT_OK ||
+            (r = drift_pt_resolve(pt, DRIFT_PT_AOV_DIRECT, &direct)) != DRIFT_OK ||
+            (r = drift_pt_resolve(pt, DRIFT_PT_AOV_DIRECT_VARIANCE, &direct_var)) != DRIFT_OK ||
+            (r = drift_pt_resolve(pt, DRIFT_PT_AOV_INDIRECT_VARIANCE, &indirect_var)) != DRIFT_OK) {
+            return r;
+        }
+        uint32_t lowest, highest;
+        render_spp_range(pt, &lowest, &highest);
+        drift_denoise_inputs in = { beauty, &a,      &n,          &z,           &variance,
+                                    lowest, &direct, &direct_var, &indirect_var };
+        drift_denoise_feature_params fp = { .method = o->denoise == 3
+                                                          ? DRIFT_DENOISE_REGRESSION
+                                                          : DRIFT_DENOISE_VARIANCE_GUIDED };
+        return drift_denoise_feature(ctx, &in, &fp, out, NULL);
+    }
+    if ((r = drift_pt_resolve(pt, DRIFT_PT_AOV_ALBEDO, &a)) != DRIFT_OK ||
+        (r = drift_pt_resolve(pt, DRIFT_PT_AOV_NORMAL, &n)) != DRIFT_OK ||
+        (r = drift_pt_resolve(pt, DRIFT_PT_AOV_DEPTH, &z)) != DRIFT_OK) {
+        return r;
+    }
+    return drift_denoise_atrous(ctx, beauty, &a, &n, &z, NULL, out);
+}
+
+double render_denoise_ms(drift_context *ctx, drift_pt *pt, const render_options *o)
+{
+    drift_image beauty, denoised = { 0 };
+    if (!o->denoise || drift_pt_resolve(pt, DRIFT_PT_AOV_BEAUTY, &beauty) != DRIFT_OK) {
+        return 0.0;
+    }
+    double t0 = drift_time_now();
+    drift_result r = denoise_beauty(ctx, pt, o, &beauty, &denoised);
+    double ms = 1e3 * (drift_time_now() - t0);
+    drift_image_destroy(ctx, &denoised);
+    return r == DRIFT_OK ? ms : 0.0;
+}
+
 // The EXR (beauty, --aov layers; an "spp" layer of each pixel's sample count when the tiles
 // hold different counts) and the PNG beside it, to the paths given (staged by the caller).
 drift_result render_write_images(drift_context *ctx, drift_pt *pt, const render_options *o,
@@ -89,8 +136,7 @@ drift_result render_write_images(drift_context *ctx, drift_pt *pt, const render_
     drift_image denoised = { 0 }, glared = { 0 }, spp = { 0 };
     drift_image variance = { 0 }, f_albedo = { 0 }, f_normal = { 0 }, f_depth = { 0 };
     drift_image direct = { 0 }, direct_var = { 0 }, indirect_var = { 0 };
-    bool feature = o->denoise >= 2; // --denoise on|regression: drift_denoise_feature
-    if (feature || o->aov) {        // the images stay the pt's until its next render call
+    if (o->aov) { // the images stay the pt's until its next render call
         if ((r = drift_pt_resolve(pt, DRIFT_PT_AOV_VARIANCE, &variance)) != DRIFT_OK ||
             (r = drift_pt_resolve(pt, DRIFT_PT_AOV_FEATURE_ALBEDO, &f_albedo)) != DRIFT_OK ||
             (r = drift_pt_resolve(pt, DRIFT_PT_AOV_FEATURE_NORMAL, &f_normal)) != DRIFT_OK ||
@@ -103,20 +149,7 @@ drift_result render_write_images(drift_context *ctx, drift_pt *pt, const render_
     }
     if (o->denoise) { // before glare (the last pass)
         double t_denoise = drift_time_now();
-        if (feature) {
-            uint32_t lowest, highest;
-            render_spp_range(pt, &lowest, &highest);
-            drift_denoise_inputs in = { &beauty, &f_albedo, &f_normal,   &f_depth,     &variance,
-                                        lowest,  &direct,   &direct_var, &indirect_var };
-            drift_denoise_feature_params fp = { .method = o->denoise == 3
-                                                              ? DRIFT_DENOISE_REGRESSION
-                                                              : DRIFT_DENOISE_VARIANCE_GUIDED };
-            r = drift_denoise_feature(ctx, &in, &fp, &denoised, NULL);
-        } else if ((r = drift_pt_resolve(pt, DRIFT_PT_AOV_ALBEDO, &albedo)) == DRIFT_OK &&
-                   (r = drift_pt_resolve(pt, DRIFT_PT_AOV_NORMAL, &normal)) == DRIFT_OK &&
-                   (r = drift_pt_resolve(pt, DRIFT_PT_AOV_DEPTH, &depth)) == DRIFT_OK) {
-            r = drift_denoise_atrous(ctx, &beauty, &albedo, &normal, &depth, NULL, &denoised);
-        }
+        r = denoise_beauty(ctx, pt, o, &beauty, &denoised);
         if (r != DRIFT_OK) {
             return r;
         }

@@ -193,7 +193,9 @@ int render_reference_finish(render_reference_run *run, bool cancelled, double t_
     bool tty = isatty(STDERR_FILENO) != 0;
     uint32_t lowest, highest;
     render_spp_range(run->pt, &lowest, &highest);
-    bool complete = lowest >= (uint32_t)o->spp;
+    // The samples it set out to take: --spp, or, filling a budget, those the budget held.
+    uint32_t target = run->target_spp ? run->target_spp : (uint32_t)o->spp;
+    bool complete = lowest >= target;
     if (!complete) {
         bool saved = render_checkpoint_write(run->checkpoint_path, run->key, run->pt);
         fprintf(stderr, "%sdrift render: %s at %u spp%s; writing what was rendered%s%s%s\n",

@@ -258,6 +258,21 @@ PY
 done
 expect 2 "$drift" render --mode hybrid --budget-ms 100 --budget-probe maybe "${size[@]}" \
     --out "$tmp/x.exr"
+# With the probes on (the default), a path-tracer pick fills T: it starts at 1 spp and adds
+# samples while they and the denoiser end by T, so a budget 20x longer takes many times the
+# samples (before: the pick's fixed spp, the same at both budgets, 32 spp here).
+fill_spp() { # T -> prints the spp the render took
+    expect 0 "$drift" render --mode hybrid --budget-ms "$1" "${size[@]}" --out "$tmp/fill.exr" \
+        --stats "$tmp/fill.json"
+    grep -q "the path tracer is expected to win: .*samples from 1 spp while T lasts" "$tmp/err" ||
+        fail "T $1: not a path tracer filling T: $(cat "$tmp/err")"
+    python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["spp"])' "$tmp/fill.json"
+}
+short=$(fill_spp 50)
+long=$(fill_spp 1000)
+echo "filling T: $short spp at 50 ms, $long spp at 1000 ms"
+python3 -c "import sys; sys.exit(0 if $short >= 1 and $long > 4 * $short else 1)" ||
+    fail "T 1000 took $long spp against $short at T 50"
 expect 2 "$drift" render --mode hybrid --budget-ms -5 "${size[@]}" --out "$tmp/x.exr"
 expect 2 "$drift" render --budget-ms 100 "${size[@]}" --out "$tmp/x.exr"
 expect 1 "$drift" render --mode hybrid --budget-ms 100 --chooser "$tmp/none.json" "${size[@]}" \
