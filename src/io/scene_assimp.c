@@ -5,8 +5,7 @@
 // shaded flat (right for boxes like the Cornell box). UVs are kept as assimp gives them
 // (origin bottom-left, as docs/conventions.md wants).
 #include "drift/file.h"
-#include "drift/image_io.h"
-#include "scene_io_internal.h"
+#include "scene_assimp_internal.h"
 
 #include <assimp/cimport.h>
 #include <assimp/material.h>
@@ -78,209 +77,6 @@ static void mat3_cofactor(const drift__mat4 *t, float c[9])
     c[6] = m[1] * m[6] - m[2] * m[5];
     c[7] = m[2] * m[4] - m[0] * m[6];
     c[8] = m[0] * m[5] - m[1] * m[4];
-}
-
-typedef struct import_state {
-    drift_scene *scene;
-    drift_context *ctx;
-    const struct aiScene *ai;
-    const drift__import_params *params;
-    const char *where;
-    int line;
-    char dir[DRIFT__PATH_MAX]; // folder of the mesh file, for texture paths
-    bool is_gltf;              // .gltf or .glb: glTF camera conventions
-    const char *base_name;     // file name without folder, for unnamed meshes and materials
-    uint32_t *material_map;    // assimp material -> drift material
-    bool *light_placed;        // assimp light already added through its node
-    uint32_t *embedded;        // assimp embedded texture -> drift texture (or invalid)
-    drift__gltf *gltf;         // the glTF JSON (glTF files only)
-    drift__obj *obj;           // the OBJ and MTL text (OBJ files only)
-    unsigned camera;           // assimp camera to use (glTF: chosen by params->camera)
-    drift__import_info *info;
-} import_state;
-
-static void ai_name(const struct aiString *s, char *out, size_t out_size)
-{
-    size_t n = s->length < out_size - 1 ? s->length : out_size - 1;
-    memcpy(out, s->data, n);
-    out[n] = '\0';
-}
-
-static drift_vec3 ai_color3(const struct aiMaterial *mat, const char *key, unsigned type,
-                            unsigned index, bool *found)
-{
-    struct aiColor4D c;
-    if (aiGetMaterialColor(mat, key, type, index, &c) == AI_SUCCESS) {
-        *found = true;
-        return drift_vec3_make(c.r, c.g, c.b);
-    }
-    *found = false;
-    return drift_vec3_splat(0.0f);
-}
-
-// Loads the diffuse texture of `mat`, if any. A texture that cannot be loaded is a
-// warning: the material keeps its colour, as viewers do.
-static void material_texture(import_state *s, const struct aiMaterial *mat, drift_material *m)
-{
-    struct aiString tex;
-
-    enum aiTextureType types[2] = { aiTextureType_DIFFUSE, aiTextureType_BASE_COLOR };
-
-    for (int t = 0; t < 2; ++t) {
-        if (aiGetMaterialTexture(mat, types[t], 0, &tex, NULL, NULL, NULL, NULL, NULL, NULL) !=
-            AI_SUCCESS) {
-            continue;
-        }
-        char rel[DRIFT__PATH_MAX];
-        ai_name(&tex, rel, sizeof(rel));
-        uint32_t index;
-        if (rel[0] != '\0' && drift__is_embedded_texture(s->ai, rel)) { // .glb, data URI
-            if (drift__embedded_texture(s->scene, s->ai, rel, s->embedded, s->where, s->line,
-                                        &index) != DRIFT_OK) {
-                drift_log(s->ctx, DRIFT_LOG_WARNING, DRIFT_ERR_IO, s->where, s->line,
-                          "material '%s': embedded texture %s not loaded; using its colour",
-                          m->name, rel);
-                return;
-            }
-            m->diffuse_texture = index;
-            m->diffuse = drift_vec3_is_zero(m->diffuse) ? drift_vec3_splat(1.0f) : m->diffuse;
-            return;
-        }
-        if (rel[0] == '\0') {
-            return;
-        }
-        // Files written on Windows use backslashes.
-        for (char *c = rel; *c; ++c) {
-            if (*c == '\\') {
-                *c = '/';
-            }
-        }
-        // An MTL's map_Kd as its text says (whitespace and options removed), named by the
-        // library's file and line when it cannot be loaded.
-        const drift__obj_material *om = drift__obj_get_material(s->obj, m->name);
-        bool from_mtl = om && om->map_kd[0];
-        if (from_mtl) {
-            snprintf(rel, sizeof rel, "%s", om->map_kd);
-        }
-        const char *where = from_mtl ? om->mtl_path : s->where;
-        int line = from_mtl ? om->map_kd_line : s->line;
-        char full[DRIFT__PATH_MAX];
-        if (!drift__path_join(s->dir, rel, full, sizeof(full)) ||
-            drift__texture_cache_get(s->scene, s->params->textures, full, where, line, &index) !=
-                DRIFT_OK) {
-            drift_log(s->ctx, DRIFT_LOG_WARNING, DRIFT_ERR_IO, where, line,
-                      "material '%s': texture '%s' not loaded; using its colour", m->name, rel);
-            return;
-        }
-        if (from_mtl && !om->has_kd) {
-            m->diffuse = drift_vec3_splat(1.0f); // Blender writes map_Kd without Kd: the texture
-        }
-        m->diffuse_texture = index;
-        // A texture multiplies the diffuse colour; a black Kd would hide it.
-        if (drift_vec3_is_zero(m->diffuse)) {
-            m->diffuse = drift_vec3_splat(1.0f);
-        }
-        return;
-    }
-}
-
-// An MTL's opacity: d (or 1 - Tr) times map_d's alpha (its grey where it has none), drawn as
-// stochastic transparency, as Blender's OBJ importer makes it (Principled Alpha) and Cycles
-// renders it. A map_d that cannot be loaded is a warning naming its line; d alone then holds.
-static void obj_opacity(import_state *s, const drift__obj_material *om, drift_material *m)
-{
-    uint32_t texture = DRIFT_INVALID_INDEX;
-    if (om->map_d_line > 0) {
-        char full[DRIFT__PATH_MAX];
-        drift_image alpha = { 0 };
-        size_t size = 0;
-        drift_result r =
-            drift__path_join(s->dir, om->map_d, full, sizeof full) ? DRIFT_OK : DRIFT_ERR_IO;
-        r = r ? r : drift__check_file(s->ctx, full, om->mtl_path, om->map_d_line, &size);
-        r = r ? r : drift_image_load_alpha(s->ctx, full, DRIFT_ALPHA_OR_GREY, &alpha);
-        r = r ? r : drift_scene_add_texture(s->scene, alpha, &texture);
-        if (r != DRIFT_OK) {
-            texture = DRIFT_INVALID_INDEX;
-            drift_log(s->ctx, DRIFT_LOG_WARNING, r, om->mtl_path, om->map_d_line,
-                      "material '%s': map_d '%s' not loaded; its d alone is the opacity", m->name,
-                      om->map_d);
-        }
-    }
-    if (om->dissolve < 1.0f || texture != DRIFT_INVALID_INDEX) {
-        m->alpha_mode = DRIFT_ALPHA_BLEND;
-        m->opacity = om->dissolve;
-        m->opacity_texture = texture;
-    }
-}
-
-static drift_result convert_materials(import_state *s)
-{
-    const struct aiScene *ai = s->ai;
-    for (unsigned i = 0; i < ai->mNumMaterials; ++i) {
-        const struct aiMaterial *mat = ai->mMaterials[i];
-        drift_material m = drift_material_make(drift_vec3_splat(0.5f));
-        struct aiString name;
-        if (aiGetMaterialString(mat, AI_MATKEY_NAME, &name) == AI_SUCCESS) {
-            ai_name(&name, m.name, sizeof(m.name));
-        }
-        if (!m.name[0]) {
-            snprintf(m.name, sizeof(m.name), "%s#material%u", s->base_name, i);
-        }
-        bool found;
-        drift_vec3 kd = ai_color3(mat, AI_MATKEY_COLOR_DIFFUSE, &found);
-        if (!found) {
-            kd = ai_color3(mat, AI_MATKEY_BASE_COLOR, &found);
-        }
-        if (found) {
-            m.diffuse = kd;
-        }
-        m.specular = ai_color3(mat, AI_MATKEY_COLOR_SPECULAR, &found);
-        float shininess = 0.0f;
-        if (aiGetMaterialFloatArray(mat, AI_MATKEY_SHININESS, &shininess, NULL) == AI_SUCCESS) {
-            // MTL Ns is the Phong exponent; drift's glossy lobe is normalized Phong.
-            m.exponent = shininess;
-        }
-        if (!drift_vec3_is_zero(m.specular) && !(m.exponent > 0.0f)) {
-            // Common (PLY default materials, MTL without Ns), so not worth a warning.
-            drift_log(s->ctx, DRIFT_LOG_INFO, DRIFT_ERR_INVALID_ARGUMENT, s->where, s->line,
-                      "material '%s' has a specular colour but no exponent; specular dropped",
-                      m.name);
-            m.specular = drift_vec3_splat(0.0f);
-            m.exponent = 0.0f;
-        }
-        m.emission = ai_color3(mat, AI_MATKEY_COLOR_EMISSIVE, &found);
-        float strength = 1.0f;
-        if (aiGetMaterialFloatArray(mat, AI_MATKEY_EMISSIVE_INTENSITY, &strength, NULL) ==
-            AI_SUCCESS) {
-            m.emission = drift_vec3_scale(m.emission, strength);
-        }
-        drift__gltf_material gm;
-        if (drift__gltf_get_material(s->gltf, i, &gm)) {
-            drift__gltf_material_apply(s->scene, s->gltf, &gm, s->dir, s->params->textures,
-                                       s->params->path, s->where, s->line, &m);
-        }
-        material_texture(s, mat, &m);
-        const drift__obj_material *om = drift__obj_get_material(s->obj, m.name);
-        if (om && om->blender) { // Blender's MTL: Blender's importer's rule (scene_obj.c)
-            drift__obj_blender_material(om, &m);
-        }
-        if (om) {
-            obj_opacity(s, om, &m);
-        }
-        uint32_t index;
-        drift_result r = drift_scene_add_material(s->scene, &m, &index);
-        if (r != DRIFT_OK) {
-            drift_log(s->ctx, DRIFT_LOG_ERROR, r, s->where, s->line,
-                      "material '%s' of '%s' is not valid", m.name, s->params->path);
-            return r;
-        }
-        s->material_map[i] = index;
-        if (!drift_vec3_is_zero(m.emission) &&
-            s->params->material_override == DRIFT_INVALID_INDEX) {
-            s->info->emissive_material_count++;
-        }
-    }
-    return DRIFT_OK;
 }
 
 static drift_result add_mesh(import_state *s, const struct aiMesh *mesh, const drift__mat4 *world,
@@ -400,7 +196,7 @@ static drift_result add_mesh(import_state *s, const struct aiMesh *mesh, const d
         material = s->material_map[mesh->mMaterialIndex];
     }
     char name[DRIFT_NAME_MAX];
-    ai_name(&mesh->mName, name, sizeof(name));
+    drift__ai_name(&mesh->mName, name, sizeof(name));
     if (!name[0]) {
         snprintf(name, sizeof(name), "%s", node_name[0] ? node_name : s->base_name);
     }
@@ -446,7 +242,7 @@ static drift_result add_light(import_state *s, unsigned index, const drift__mat4
         world, drift_vec3_make(l->mDirection.x, l->mDirection.y, l->mDirection.z)));
     light.color = drift_vec3_make(l->mColorDiffuse.r, l->mColorDiffuse.g, l->mColorDiffuse.b);
     char name[DRIFT_NAME_MAX];
-    ai_name(&l->mName, name, sizeof(name));
+    drift__ai_name(&l->mName, name, sizeof(name));
     switch (l->mType) {
     case aiLightSource_POINT:
         light.type = DRIFT_LIGHT_POINT;
@@ -560,7 +356,7 @@ static drift_result walk_nodes(import_state *s, const struct aiNode *node,
     drift__mat4 local = mat4_from_ai(&node->mTransformation);
     drift__mat4 world = drift__mat4_mul(parent, &local);
     char node_name[DRIFT_NAME_MAX];
-    ai_name(&node->mName, node_name, sizeof(node_name));
+    drift__ai_name(&node->mName, node_name, sizeof(node_name));
     for (unsigned i = 0; i < node->mNumMeshes; ++i) {
         unsigned mi = node->mMeshes[i];
         if (mi >= s->ai->mNumMeshes) {
@@ -589,7 +385,7 @@ static drift_result walk_nodes(import_state *s, const struct aiNode *node,
     for (unsigned c = 0; c < node->mNumChildren; ++c) {
         const struct aiNode *child = node->mChildren[c];
         char child_name[DRIFT_NAME_MAX];
-        ai_name(&child->mName, child_name, sizeof(child_name));
+        drift__ai_name(&child->mName, child_name, sizeof(child_name));
         int gltf_child =
             drift__gltf_child_node(s->gltf, gltf_node, c, child_name, child->mNumChildren);
         drift_result r = walk_nodes(s, child, &world, depth + 1, gltf_child);
@@ -616,11 +412,11 @@ static drift_result import_scene(import_state *s)
         s->embedded[i] = DRIFT_INVALID_INDEX;
     }
     if (r == DRIFT_OK) {
-        r = convert_materials(s);
+        r = drift__assimp_convert_materials(s);
     }
     if (r == DRIFT_OK && ai->mRootNode) {
         char root_name[DRIFT_NAME_MAX];
-        ai_name(&ai->mRootNode->mName, root_name, sizeof(root_name));
+        drift__ai_name(&ai->mRootNode->mName, root_name, sizeof(root_name));
         int gltf_root = drift__gltf_root_node(s->gltf, root_name, ai->mRootNode->mNumChildren);
         r = walk_nodes(s, ai->mRootNode, &root, 0, gltf_root);
     }
