@@ -522,8 +522,9 @@ int render_reference(const render_options *o, const cli_session *session)
     }
     while (done_spp < total) {
         if (fill && done_spp >= 1u) {
-            if (reserve_s < 0.0) { // 1.25x its time now: the filter's cost varies run to run
-                reserve_s = 1.25e-3 * render_denoise_ms(ctx, pt, o);
+            if (reserve_s < 0.0) { // 1.25x its time: the filter's cost varies run to run
+                reserve_s = 1.25e-3 * (o->budget_denoise_ms > 0.0 ? o->budget_denoise_ms
+                                                                  : render_denoise_ms(ctx, pt, o));
             }
             double per_spp = sampling_s / (double)(done_spp - run.resumed_spp);
             double left = o->budget_deadline - reserve_s - drift_time_now();

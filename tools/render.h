@@ -81,6 +81,7 @@ typedef struct render_options {
     // until then (0: none, --spp as given; --spp stays the pick's, the footprint textures are
     // filtered for)
     double budget_deadline;
+    double budget_denoise_ms; // the chooser's estimate of --denoise's filter at this size
     long upsample_width, upsample_height; // > 0: the chooser's path tracer at reduced
                                           // resolution, written upsampled to this size
     // sequences (tools/render_sequence.c, docs/temporal.md)
@@ -114,11 +115,19 @@ typedef struct render_probe {
     double pixels;    // the probes' frame
     double pt_ms;     // CPU ms; < 0: the probe failed
     double hybrid_ms; // CPU ms of create and first frame; < 0: not run or failed
-    double spent_ms;  // the probes' own wall time, all of it
+    // Wall ms of writing an image as EXR and PNG: fixed plus per pixel (< 0: not measured)
+    double write_fixed_ms, write_per_pixel_ms;
+    double spent_ms; // the probes' own wall time, all of it
 } render_probe;
 
 void render_choose_probe(const cli_session *session, int32_t w, int32_t h,
                          const drift_hybrid_params *base_hybrid, render_probe *out);
+// Times writing 64² and 128² images as EXR and PNG (both removed): out->write_fixed_ms and
+// write_per_pixel_ms, what a budget that fills T leaves for the frame's writes.
+void render_choose_probe_writes(const cli_session *session, render_probe *out);
+// Wall ms of --denoise's filter (o->denoise) on a 1-spp path-traced 96² frame of the scene,
+// per pixel: what a budget that fills T keeps for the frame's filter (< 0: failed).
+double render_choose_probe_denoise(const cli_session *session, const render_options *o);
 int render_print_features(const cli_session *session);
 // `low` (3 channels or more) bilinearly up to w x h (a new image, 3 channels): the chooser's
 // path tracer at 1/2 or 1/4 resolution, as drift bench frontier's rows upsample it.

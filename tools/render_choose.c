@@ -599,7 +599,7 @@ int render_choose(render_options *o, const cli_session *session)
                         .setup_scale = 1.0,
                         .safety = { number(safety, "pt", 1.0), number(safety, "hybrid", 1.0) },
                         .available_ms = o->budget_ms };
-    render_probe probe = { .pt_ms = -1.0 };
+    render_probe probe = { .pt_ms = -1.0, .write_per_pixel_ms = -1.0 };
     if (!o->no_budget_probe) {
         calibrate(model, f, o, session, &cal, &probe);
     }
@@ -623,11 +623,28 @@ int render_choose(render_options *o, const cli_session *session)
     // With the probes on, a path-tracer pick fills T (below): its samples follow the time, so
     // the family (resolution, denoiser) is chosen as if its rows cost their fitted ms alone,
     // not times the safety factor that keeps a fixed spp within T; it starts at 1 spp.
-    const bool fills = ok && !o->no_budget_probe && (c == &pt || c == &fastest);
+    bool fills = ok && !o->no_budget_probe && (c == &pt || c == &fastest);
+    // The writes as the probes time them at this frame's size, where the model's finish_ms
+    // (fitted at 128² under load, scaled by pixels) would take a tenth of T or more: at 400² it
+    // took 317 ms of T where 60 were paid. (Not below: the probe's few ms would cost a small
+    // T more than the estimate's error.)
+    if (fills && cal.finish_ms > 0.1 * cal.available_ms) {
+        render_choose_probe_writes(session, &probe);
+        cal.available_ms = o->budget_ms - 1e3 * (drift_time_now() - session->t_loaded);
+    }
     calibration bare = cal;
     choice h2, g2, pt_bare, fastest_bare;
+    double writes_ms =
+        probe.write_per_pixel_ms >= 0.0
+            ? probe.write_fixed_ms + probe.write_per_pixel_ms * (double)o->width * (double)o->height
+            : cal.finish_ms;
+    // Filling needs room: at least half of T left for the frame once the probes and the writes
+    // are paid. Below that (400² at T = 100 ms: the writes alone ~65 ms) the pick stays as it
+    // is, a few cheap samples within T, as filled it overran T by 40%.
+    fills = fills && cal.available_ms - writes_ms > 0.5 * o->budget_ms;
     if (fills) {
         bare.safety[GROUP_PT] = 1.0;
+        bare.finish_ms = writes_ms;
         if (score(model, f, &bare, (double)o->width * (double)o->height, &h2, &g2, &pt_bare,
                   &fastest_bare) &&
             pt_bare.pick) {
@@ -648,13 +665,19 @@ int render_choose(render_options *o, const cli_session *session)
     // the writes (tools/cmd_render.c). A fixed spp carried the safety factors and left most of
     // T unused on a quiet machine (a 320x180 scene at T = 250 ms: 1 spp rendered, 8 fitting).
     if (fills && !o->hybrid_mode) { // 5% of T kept: the last pass's time varies
-        o->budget_deadline = drift_time_now() + 1e-3 * (0.95 * cal.available_ms - cal.finish_ms);
+        // From the end of the scene's load, as T counts: the probes since are inside it.
+        o->budget_deadline = session->t_loaded + 1e-3 * (0.95 * o->budget_ms - writes_ms);
         // Filling T, a plain path-tracer pick is denoised: the samples it gets are the time's
         // either way, and the filter costs about one sample (judge scenes at 128²: the three
         // cells where the bare costs picked `pt` over `pt+denoise` came out 0.01-0.04 worse).
         if (o->denoise == 0) {
             o->denoise = 2;
         }
+        // The filter's time at this size, from a small frame's: timing it on the render's own
+        // image cost a second filter (at 400², the fill overran 100 ms budgets by 44%).
+        double per_pixel = render_choose_probe_denoise(session, o);
+        o->budget_denoise_ms =
+            per_pixel > 0.0 ? per_pixel * (double)o->width * (double)o->height : 0.0;
     }
     if (!o->quiet) {
         char probed[256] = "";
