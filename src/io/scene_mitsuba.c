@@ -3,9 +3,7 @@
 // with expat into a small element tree and then mapped onto drift's scene (the mapping table
 // is in docs/scene-format.md). Unsupported elements are named in a warning with their line;
 // malformed XML, unknown shape types and bad values are errors naming the file and line.
-#include "drift/image_io.h"
-#include "scene_io_internal.h"
-#include "scene_mitsuba_xml.h"
+#include "scene_mitsuba_internal.h"
 
 #include <expat.h>
 #include <math.h>
@@ -108,7 +106,7 @@ static void XMLCALL on_end(void *user, const XML_Char *name)
     x->current = x->current->parent;
 }
 
-static const char *attr(const xml_node *n, const char *key)
+const char *drift__mts_attr(const xml_node *n, const char *key)
 {
     for (char **a = n->attrs; a && a[0] && a[1]; a += 2) {
         if (strcmp(a[0], key) == 0) {
@@ -120,42 +118,25 @@ static const char *attr(const xml_node *n, const char *key)
 
 // --- SCENE BUILDING ---
 
-typedef struct named_bsdf {
-    const char *id;
-    uint32_t material;
-} named_bsdf;
-
-typedef struct mitsuba_state {
-    drift_context *ctx;
-    drift_scene *scene;
-    const char *path;
-    char dir[DRIFT__PATH_MAX];
-    drift__texture_cache *textures;
-    named_bsdf *bsdfs;
-    uint32_t bsdf_count, bsdf_capacity;
-    uint32_t shape_count;
-    bool has_camera, has_light;
-} mitsuba_state;
-
-static drift_result fail(mitsuba_state *s, const xml_node *n, drift_result code, const char *what,
-                         const char *detail)
+drift_result drift__mts_fail(mitsuba_state *s, const xml_node *n, drift_result code,
+                             const char *what, const char *detail)
 {
     drift_log(s->ctx, DRIFT_LOG_ERROR, code, s->path, n ? n->line : 0, "%s%s%s", what,
               detail ? ": " : "", detail ? detail : "");
     return code;
 }
 
-static void warn(mitsuba_state *s, const xml_node *n, const char *what)
+void drift__mts_warn(mitsuba_state *s, const xml_node *n, const char *what)
 {
-    const char *type = attr(n, "type");
-    const char *name = attr(n, "name");
+    const char *type = drift__mts_attr(n, "type");
+    const char *name = drift__mts_attr(n, "name");
     drift_log(s->ctx, DRIFT_LOG_WARNING, DRIFT_ERR_UNSUPPORTED, s->path, n->line,
               "<%s%s%s%s%s> %s; ignored", n->name, type ? " type=" : "", type ? type : "",
               name ? " name=" : "", name ? name : "", what);
 }
 
 // Up to n numbers separated by commas and/or spaces; returns how many were read.
-static int parse_numbers(const char *text, float *out, int n)
+int drift__mts_parse_numbers(const char *text, float *out, int n)
 {
     int count = 0;
     const char *p = text;
@@ -178,10 +159,10 @@ static int parse_numbers(const char *text, float *out, int n)
 }
 
 // The child property `name` of element n (a <float>, <rgb>, <spectrum>, <point>, ...).
-static const xml_node *property(const xml_node *n, const char *name)
+const xml_node *drift__mts_property(const xml_node *n, const char *name)
 {
     for (const xml_node *c = n->first; c; c = c->next) {
-        const char *cn = attr(c, "name");
+        const char *cn = drift__mts_attr(c, "name");
         if (cn && strcmp(cn, name) == 0) {
             return c;
         }
@@ -189,28 +170,28 @@ static const xml_node *property(const xml_node *n, const char *name)
     return NULL;
 }
 
-static drift_result read_float(mitsuba_state *s, const xml_node *n, const char *name,
-                               float fallback, float *out)
+drift_result drift__mts_read_float(mitsuba_state *s, const xml_node *n, const char *name,
+                                   float fallback, float *out)
 {
-    const xml_node *p = property(n, name);
+    const xml_node *p = drift__mts_property(n, name);
     *out = fallback;
     if (!p) {
         return DRIFT_OK;
     }
-    const char *v = attr(p, "value");
+    const char *v = drift__mts_attr(p, "value");
     float f;
-    if (!v || parse_numbers(v, &f, 1) != 1) {
-        return fail(s, p, DRIFT_ERR_PARSE, "expected a number in value=", name);
+    if (!v || drift__mts_parse_numbers(v, &f, 1) != 1) {
+        return drift__mts_fail(s, p, DRIFT_ERR_PARSE, "expected a number in value=", name);
     }
     *out = f;
     return DRIFT_OK;
 }
 
 // <rgb value="r, g, b"/> or <spectrum value="v"/> (one grey value) or <float value/>.
-static drift_result read_color(mitsuba_state *s, const xml_node *n, const char *name,
-                               drift_vec3 fallback, drift_vec3 *out, bool *found)
+drift_result drift__mts_read_color(mitsuba_state *s, const xml_node *n, const char *name,
+                                   drift_vec3 fallback, drift_vec3 *out, bool *found)
 {
-    const xml_node *p = property(n, name);
+    const xml_node *p = drift__mts_property(n, name);
     *out = fallback;
     if (found) {
         *found = p != NULL;
@@ -218,16 +199,17 @@ static drift_result read_color(mitsuba_state *s, const xml_node *n, const char *
     if (!p || strcmp(p->name, "texture") == 0) {
         return DRIFT_OK;
     }
-    const char *v = attr(p, "value");
+    const char *v = drift__mts_attr(p, "value");
     float c[3];
-    int k = v ? parse_numbers(v, c, 3) : -1;
+    int k = v ? drift__mts_parse_numbers(v, c, 3) : -1;
     if (k == 1) {
         c[1] = c[2] = c[0];
     } else if (k != 3) {
-        return fail(s, p, DRIFT_ERR_PARSE, "expected one or three numbers in value=", name);
+        return drift__mts_fail(s, p, DRIFT_ERR_PARSE,
+                               "expected one or three numbers in value=", name);
     }
     if (c[0] < 0.0f || c[1] < 0.0f || c[2] < 0.0f) {
-        return fail(s, p, DRIFT_ERR_INVALID_ARGUMENT, "negative colour", name);
+        return drift__mts_fail(s, p, DRIFT_ERR_INVALID_ARGUMENT, "negative colour", name);
     }
     *out = drift_vec3_make(c[0], c[1], c[2]);
     return DRIFT_OK;
@@ -236,10 +218,10 @@ static drift_result read_color(mitsuba_state *s, const xml_node *n, const char *
 static drift_result read_vec3_attrs(mitsuba_state *s, const xml_node *n, const char *key,
                                     drift_vec3 *out)
 {
-    const char *v = attr(n, key);
+    const char *v = drift__mts_attr(n, key);
     float c[3];
-    if (!v || parse_numbers(v, c, 3) != 3) {
-        return fail(s, n, DRIFT_ERR_PARSE, "expected three numbers in attribute", key);
+    if (!v || drift__mts_parse_numbers(v, c, 3) != 3) {
+        return drift__mts_fail(s, n, DRIFT_ERR_PARSE, "expected three numbers in attribute", key);
     }
     *out = drift_vec3_make(c[0], c[1], c[2]);
     return DRIFT_OK;
@@ -250,23 +232,24 @@ static drift_result read_vec3_attrs(mitsuba_state *s, const xml_node *n, const c
 static drift_result read_transform(mitsuba_state *s, const xml_node *n, drift__mat4 *out)
 {
     *out = drift__mat4_identity();
-    const xml_node *t = property(n, "toWorld");
+    const xml_node *t = drift__mts_property(n, "toWorld");
     if (!t || strcmp(t->name, "transform") != 0) {
         return DRIFT_OK;
     }
     for (const xml_node *op = t->first; op; op = op->next) {
         drift__mat4 m = drift__mat4_identity();
         if (strcmp(op->name, "matrix") == 0) {
-            const char *v = attr(op, "value");
-            if (!v || parse_numbers(v, m.m, 16) != 16) {
-                return fail(s, op, DRIFT_ERR_PARSE, "<matrix> needs 16 numbers", NULL);
+            const char *v = drift__mts_attr(op, "value");
+            if (!v || drift__mts_parse_numbers(v, m.m, 16) != 16) {
+                return drift__mts_fail(s, op, DRIFT_ERR_PARSE, "<matrix> needs 16 numbers", NULL);
             }
         } else if (strcmp(op->name, "lookat") == 0) {
-            drift_vec3 origin, target, up = drift_vec3_make(0.0f, 1.0f, 0.0f);
+            drift_vec3 origin = { 0 }, target = { 0 }, up = drift_vec3_make(0.0f, 1.0f, 0.0f);
             drift_result r;
             if ((r = read_vec3_attrs(s, op, "origin", &origin)) != DRIFT_OK ||
                 (r = read_vec3_attrs(s, op, "target", &target)) != DRIFT_OK ||
-                (attr(op, "up") && (r = read_vec3_attrs(s, op, "up", &up)) != DRIFT_OK)) {
+                (drift__mts_attr(op, "up") &&
+                 (r = read_vec3_attrs(s, op, "up", &up)) != DRIFT_OK)) {
                 return r;
             }
             drift_vec3 dir = drift_vec3_normalize(drift_vec3_sub(target, origin));
@@ -279,15 +262,15 @@ static drift_result read_transform(mitsuba_state *s, const xml_node *n, drift__m
             float v[3] = { scale ? 1.0f : 0.0f, scale ? 1.0f : 0.0f, scale ? 1.0f : 0.0f };
             const char *keys[3] = { "x", "y", "z" };
             for (int k = 0; k < 3; ++k) {
-                const char *a = attr(op, keys[k]);
-                if (a && parse_numbers(a, &v[k], 1) != 1) {
-                    return fail(s, op, DRIFT_ERR_PARSE, "expected a number in", keys[k]);
+                const char *a = drift__mts_attr(op, keys[k]);
+                if (a && drift__mts_parse_numbers(a, &v[k], 1) != 1) {
+                    return drift__mts_fail(s, op, DRIFT_ERR_PARSE, "expected a number in", keys[k]);
                 }
             }
-            const char *uniform = attr(op, "value");
+            const char *uniform = drift__mts_attr(op, "value");
             if (scale && uniform) {
-                if (parse_numbers(uniform, &v[0], 1) != 1) {
-                    return fail(s, op, DRIFT_ERR_PARSE, "expected a number in", "value");
+                if (drift__mts_parse_numbers(uniform, &v[0], 1) != 1) {
+                    return drift__mts_fail(s, op, DRIFT_ERR_PARSE, "expected a number in", "value");
                 }
                 v[1] = v[2] = v[0];
             }
@@ -304,14 +287,15 @@ static drift_result read_transform(mitsuba_state *s, const xml_node *n, drift__m
             float a[4] = { 0, 0, 0, 0 };
             const char *keys[4] = { "x", "y", "z", "angle" };
             for (int k = 0; k < 4; ++k) {
-                const char *v = attr(op, keys[k]);
-                if (v && parse_numbers(v, &a[k], 1) != 1) {
-                    return fail(s, op, DRIFT_ERR_PARSE, "expected a number in", keys[k]);
+                const char *v = drift__mts_attr(op, keys[k]);
+                if (v && drift__mts_parse_numbers(v, &a[k], 1) != 1) {
+                    return drift__mts_fail(s, op, DRIFT_ERR_PARSE, "expected a number in", keys[k]);
                 }
             }
             drift_vec3 axis = drift_vec3_make(a[0], a[1], a[2]);
             if (drift_vec3_is_zero(axis)) {
-                return fail(s, op, DRIFT_ERR_INVALID_ARGUMENT, "<rotate> needs an axis", NULL);
+                return drift__mts_fail(s, op, DRIFT_ERR_INVALID_ARGUMENT, "<rotate> needs an axis",
+                                       NULL);
             }
             axis = drift_vec3_normalize(axis);
             float th = a[3] * DRIFT_PI / 180.0f, c = cosf(th), sn = sinf(th), t1 = 1.0f - c;
@@ -321,7 +305,7 @@ static drift_result read_transform(mitsuba_state *s, const xml_node *n, drift__m
                                  t1 * x * z - sn * y, t1 * y * z + sn * x, t1 * z * z + c, 0, 0, 0,
                                  0, 1 } };
         } else {
-            warn(s, op, "is not a supported transform");
+            drift__mts_warn(s, op, "is not a supported transform");
             continue;
         }
         *out = drift__mat4_mul(&m, out);
@@ -330,239 +314,6 @@ static drift_result read_transform(mitsuba_state *s, const xml_node *n, drift__m
 }
 
 // Mitsuba's interior and exterior IORs (numbers or its names) as intIOR / extIOR.
-static float ior_value(mitsuba_state *s, const xml_node *b, const char *name, float fallback)
-{
-    static const struct {
-        const char *name;
-        float ior;
-    } named[] = { { "vacuum", 1.0f },         { "air", 1.000277f },  { "water", 1.333f },
-                  { "bk7", 1.5046f },         { "glass", 1.5046f },  { "acrylic glass", 1.49f },
-                  { "polypropylene", 1.49f }, { "diamond", 2.419f }, { "fused quartz", 1.458f },
-                  { "sapphire", 1.77f },      { "ethanol", 1.361f }, { "pyrex", 1.47f } };
-
-    const xml_node *p = property(b, name);
-    const char *v = p ? attr(p, "value") : NULL;
-    float f;
-    if (!v) {
-        return fallback;
-    }
-    if (parse_numbers(v, &f, 1) == 1 && f >= 1.0f && f <= 10.0f) {
-        return f;
-    }
-    for (size_t i = 0; i < sizeof(named) / sizeof(named[0]); ++i) {
-        if (strcmp(v, named[i].name) == 0) {
-            return named[i].ior;
-        }
-    }
-    warn(s, p, "is an IOR drift does not know (the default used)");
-    return fallback;
-}
-
-static float mitsuba_ior(mitsuba_state *s, const xml_node *b, float int_fallback)
-{
-    float ior = ior_value(s, b, "intIOR", int_fallback) / ior_value(s, b, "extIOR", 1.000277f);
-    return drift_clampf(ior, 1.0f, 10.0f);
-}
-
-static drift_result diffuse_texture(mitsuba_state *s, const xml_node *bsdf, const char *name,
-                                    drift_material *m)
-{
-    const xml_node *t = property(bsdf, name);
-    if (!t || strcmp(t->name, "texture") != 0) {
-        return DRIFT_OK;
-    }
-    const xml_node *file = property(t, "filename");
-    const char *rel = file ? attr(file, "value") : NULL;
-    char full[DRIFT__PATH_MAX];
-    uint32_t index;
-    // Scenes often ship without their textures: a missing file is a warning, not an error.
-    struct stat st;
-    if (!rel || !drift__path_join(s->dir, rel, full, sizeof(full)) || stat(full, &st) != 0 ||
-        drift__texture_cache_get(s->scene, s->textures, full, s->path, t->line, &index) !=
-            DRIFT_OK) {
-        drift_log(s->ctx, DRIFT_LOG_WARNING, DRIFT_ERR_IO, s->path, t->line,
-                  "texture '%s' not loaded; using grey 0.5", rel ? rel : "(no filename)");
-        m->diffuse = drift_vec3_splat(0.5f);
-        return DRIFT_OK;
-    }
-    m->diffuse_texture = index;
-    m->diffuse = drift_vec3_splat(1.0f);
-    return DRIFT_OK;
-}
-
-// A mask's `opacity`: <float value> in [0, 1], or <texture type="bitmap"> whose grey value
-// (its alpha where it has one) is the opacity; a bitmap that cannot be read is a warning and
-// leaves the surface opaque.
-static drift_result mask_opacity(mitsuba_state *s, const xml_node *b, drift_material *m)
-{
-    const xml_node *p = property(b, "opacity");
-    m->alpha_mode = DRIFT_ALPHA_BLEND;
-    m->opacity = 0.5f; // Mitsuba's default
-    if (p && strcmp(p->name, "texture") == 0) {
-        const xml_node *file = property(p, "filename");
-        const char *rel = file ? attr(file, "value") : NULL;
-        char full[DRIFT__PATH_MAX];
-        size_t size = 0;
-        drift_image image = { 0 };
-        drift_result r =
-            rel && drift__path_join(s->dir, rel, full, sizeof full) ? DRIFT_OK : DRIFT_ERR_IO;
-        r = r ? r : drift__check_file(s->ctx, full, s->path, p->line, &size);
-        r = r ? r : drift_image_load_alpha(s->ctx, full, DRIFT_ALPHA_OR_GREY, &image);
-        r = r ? r : drift_scene_add_texture(s->scene, image, &m->opacity_texture);
-        if (r != DRIFT_OK) {
-            drift_log(s->ctx, DRIFT_LOG_WARNING, r, s->path, p->line,
-                      "mask opacity '%s' not loaded; drawn opaque", rel ? rel : "(no filename)");
-            m->alpha_mode = DRIFT_ALPHA_OPAQUE;
-            m->opacity_texture = DRIFT_INVALID_INDEX;
-        }
-        m->opacity = 1.0f;
-        return DRIFT_OK;
-    }
-    drift_result r = read_float(s, b, "opacity", 0.5f, &m->opacity);
-    if (r == DRIFT_OK && !(m->opacity >= 0.0f && m->opacity <= 1.0f)) {
-        return fail(s, p, DRIFT_ERR_PARSE, "mask opacity is not in [0, 1]", NULL);
-    }
-    return r;
-}
-
-// A <bsdf> onto a drift material (docs/scene-format.md, Mitsuba mapping).
-static drift_result convert_bsdf(mitsuba_state *s, const xml_node *b, const char *name,
-                                 drift_material *m)
-{
-    const char *type = attr(b, "type");
-    if (!type) {
-        return fail(s, b, DRIFT_ERR_PARSE, "<bsdf> without a type", NULL);
-    }
-    if (strcmp(type, "mask") == 0) {
-        // Mitsuba's mask blends the nested BSDF with a transparent one by `opacity` (a number,
-        // or a bitmap's grey): drift's stochastic coverage (DRIFT_ALPHA_BLEND).
-        const xml_node *inner = NULL;
-        for (const xml_node *c = b->first; c && !inner; c = c->next) {
-            inner = strcmp(c->name, "bsdf") == 0 ? c : NULL;
-        }
-        if (!inner) {
-            return fail(s, b, DRIFT_ERR_PARSE, "mask <bsdf> holds no <bsdf>", NULL);
-        }
-        drift_result r = convert_bsdf(s, inner, name, m);
-        if (r != DRIFT_OK) {
-            return r;
-        }
-        return mask_opacity(s, b, m);
-    }
-    if (strcmp(type, "twosided") == 0) {
-        // drift shades both sides of a surface alike already.
-        for (const xml_node *c = b->first; c; c = c->next) {
-            if (strcmp(c->name, "bsdf") == 0) {
-                return convert_bsdf(s, c, name, m);
-            }
-        }
-        return fail(s, b, DRIFT_ERR_PARSE, "twosided <bsdf> holds no <bsdf>", NULL);
-    }
-    *m = drift_material_make(drift_vec3_splat(0.5f));
-    snprintf(m->name, sizeof(m->name), "%s", name);
-    drift_result r = DRIFT_OK;
-    float alpha = 0.0f;
-    if (strcmp(type, "diffuse") == 0) {
-        r = read_color(s, b, "reflectance", drift_vec3_splat(0.5f), &m->diffuse, NULL);
-        if (r == DRIFT_OK) {
-            r = diffuse_texture(s, b, "reflectance", m);
-        }
-    } else if (strcmp(type, "plastic") == 0 || strcmp(type, "roughplastic") == 0) {
-        // A diffuse base under a dielectric coat of the file's alpha, on GGX (docs/materials.md).
-        bool found = false;
-        r = read_color(s, b, "diffuseReflectance", drift_vec3_splat(0.5f), &m->diffuse, &found);
-        if (r == DRIFT_OK && !found) {
-            r = read_color(s, b, "reflectance", drift_vec3_splat(0.5f), &m->diffuse, NULL);
-        }
-        if (r == DRIFT_OK) {
-            r = read_float(s, b, "alpha", type[0] == 'r' ? 0.1f : 0.0f, &alpha);
-        }
-        m->type = DRIFT_MATERIAL_GGX;
-        m->ggx.alpha = drift_clampf(alpha, 0.0f, 1.0f);
-        m->ggx.ior = mitsuba_ior(s, b, 1.49f);
-        if (r == DRIFT_OK) {
-            r = diffuse_texture(
-                s, b, property(b, "diffuseReflectance") ? "diffuseReflectance" : "reflectance", m);
-            m->diffuse =
-                m->diffuse_texture != DRIFT_INVALID_INDEX ? drift_vec3_splat(1.0f) : m->diffuse;
-        }
-    } else if (strcmp(type, "conductor") == 0 || strcmp(type, "roughconductor") == 0) {
-        // A named metal (material=) by its measured complex IOR; otherwise the reflectance
-        // specularReflectance (default 0.9) as F0. Smooth conductors without a metal stay mirrors.
-        drift_vec3 ks;
-        r = read_color(s, b, "specularReflectance", drift_vec3_splat(0.9f), &ks, NULL);
-        if (r == DRIFT_OK) {
-            r = read_float(s, b, "alpha", type[0] == 'r' ? 0.1f : 0.0f, &alpha);
-        }
-        const xml_node *metal = property(b, "material");
-        const char *metal_name = metal ? attr(metal, "value") : NULL;
-        bool named = metal_name && drift_ggx_named_metal(metal_name, &m->ggx);
-        if (metal_name && !named && strcmp(metal_name, "none") != 0) {
-            warn(s, b,
-                 "names a metal drift has no table for (Au, Ag, Cu, Al); specularReflectance used");
-        }
-        if (type[0] == 'c' && !named) {
-            m->diffuse = drift_vec3_splat(0.0f);
-            m->specular = ks;
-            m->type = DRIFT_MATERIAL_MIRROR;
-        } else {
-            m->type = DRIFT_MATERIAL_GGX;
-            m->diffuse = ks; // F0 without a named metal
-            m->ggx.metallic = 1.0f;
-            m->ggx.alpha = drift_clampf(alpha, 0.0f, 1.0f);
-        }
-    } else if (strcmp(type, "dielectric") == 0 || strcmp(type, "thindielectric") == 0 ||
-               strcmp(type, "roughdielectric") == 0) {
-        r = read_float(s, b, "alpha", type[0] == 'r' ? 0.1f : 0.0f, &alpha);
-        m->type = DRIFT_MATERIAL_GGX;
-        m->diffuse = drift_vec3_splat(1.0f);
-        m->ggx.transmission = 1.0f;
-        m->ggx.alpha = drift_clampf(alpha, 0.0f, 1.0f);
-        m->ggx.ior = mitsuba_ior(s, b, 1.5046f);
-        m->ggx.thin = type[0] == 't';
-    } else {
-        warn(s, b, "is not a supported bsdf (grey diffuse 0.5 used)");
-    }
-    return r;
-}
-
-static drift_result add_bsdf(mitsuba_state *s, const xml_node *b, uint32_t *out_material)
-{
-    const char *id = attr(b, "id");
-    char name[DRIFT_NAME_MAX];
-    if (id) {
-        snprintf(name, sizeof(name), "%s", id);
-    } else {
-        snprintf(name, sizeof(name), "mitsuba#bsdf-line%d", b->line);
-    }
-    drift_material m;
-    drift_result r = convert_bsdf(s, b, name, &m);
-    if (r == DRIFT_OK) {
-        r = drift_scene_add_material(s->scene, &m, out_material);
-        if (r != DRIFT_OK) {
-            return fail(s, b, r, "material not valid", name);
-        }
-    }
-    if (r == DRIFT_OK && id) {
-        if (s->bsdf_count == s->bsdf_capacity) {
-            uint32_t cap = s->bsdf_capacity ? 2 * s->bsdf_capacity : 16;
-            named_bsdf *grown = drift_alloc(s->ctx, cap * sizeof(*grown));
-            if (!grown) {
-                return DRIFT_ERR_OUT_OF_MEMORY;
-            }
-            if (s->bsdfs) {
-                memcpy(grown, s->bsdfs, s->bsdf_count * sizeof(*grown));
-            }
-            drift_free(s->ctx, s->bsdfs);
-            s->bsdfs = grown;
-            s->bsdf_capacity = cap;
-        }
-        s->bsdfs[s->bsdf_count++] = (named_bsdf){ id, *out_material };
-    }
-    return r;
-}
-
-// Adds a triangle mesh from local positions under `world`.
 // uvs: 2 a vertex (origin at the bottom left, as Mitsuba's and OBJ's), or NULL.
 static drift_result add_triangles(mitsuba_state *s, const xml_node *n, const char *name,
                                   const float *local, const float *uvs, uint32_t vertex_count,
@@ -589,14 +340,14 @@ static drift_result add_triangles(mitsuba_state *s, const xml_node *n, const cha
                              .material = material };
     drift_result r = drift_scene_add_mesh(s->scene, &desc, NULL);
     drift_free(s->ctx, positions);
-    return r == DRIFT_OK ? DRIFT_OK : fail(s, n, r, "shape is not valid", name);
+    return r == DRIFT_OK ? DRIFT_OK : drift__mts_fail(s, n, r, "shape is not valid", name);
 }
 
 static drift_result read_shape(mitsuba_state *s, const xml_node *n)
 {
-    const char *type = attr(n, "type");
+    const char *type = drift__mts_attr(n, "type");
     if (!type) {
-        return fail(s, n, DRIFT_ERR_PARSE, "<shape> without a type", NULL);
+        return drift__mts_fail(s, n, DRIFT_ERR_PARSE, "<shape> without a type", NULL);
     }
     drift__mat4 world;
     drift_result r = read_transform(s, n, &world);
@@ -608,7 +359,7 @@ static drift_result read_shape(mitsuba_state *s, const xml_node *n)
     const xml_node *emitter = NULL;
     for (const xml_node *c = n->first; c && r == DRIFT_OK; c = c->next) {
         if (strcmp(c->name, "ref") == 0) {
-            const char *id = attr(c, "id");
+            const char *id = drift__mts_attr(c, "id");
             bool found = false;
             for (uint32_t i = 0; id && i < s->bsdf_count && !found; ++i) {
                 if (strcmp(s->bsdfs[i].id, id) == 0) {
@@ -617,11 +368,11 @@ static drift_result read_shape(mitsuba_state *s, const xml_node *n)
                 }
             }
             if (!found) {
-                return fail(s, c, DRIFT_ERR_PARSE, "<ref> to an unknown bsdf id",
-                            id ? id : "(none)");
+                return drift__mts_fail(s, c, DRIFT_ERR_PARSE, "<ref> to an unknown bsdf id",
+                                       id ? id : "(none)");
             }
         } else if (strcmp(c->name, "bsdf") == 0) {
-            r = add_bsdf(s, c, &material);
+            r = drift__mts_add_bsdf(s, c, &material);
         } else if (strcmp(c->name, "emitter") == 0) {
             emitter = c;
         }
@@ -631,12 +382,12 @@ static drift_result read_shape(mitsuba_state *s, const xml_node *n)
     }
     drift_vec3 radiance = drift_vec3_splat(0.0f);
     if (emitter) {
-        const char *et = attr(emitter, "type");
+        const char *et = drift__mts_attr(emitter, "type");
         if (!et || strcmp(et, "area") != 0) {
-            warn(s, emitter, "inside a shape must be an area emitter");
+            drift__mts_warn(s, emitter, "inside a shape must be an area emitter");
             emitter = NULL;
-        } else if ((r = read_color(s, emitter, "radiance", drift_vec3_splat(1.0f), &radiance,
-                                   NULL)) != DRIFT_OK) {
+        } else if ((r = drift__mts_read_color(s, emitter, "radiance", drift_vec3_splat(1.0f),
+                                              &radiance, NULL)) != DRIFT_OK) {
             return r;
         }
     }
@@ -648,7 +399,7 @@ static drift_result read_shape(mitsuba_state *s, const xml_node *n)
         snprintf(m.name, sizeof(m.name), "mitsuba#shape-line%d", n->line);
         m.emission = radiance;
         if ((r = drift_scene_add_material(s->scene, &m, &material)) != DRIFT_OK) {
-            return fail(s, n, r, "material not valid", m.name);
+            return drift__mts_fail(s, n, r, "material not valid", m.name);
         }
     }
     s->has_light = s->has_light || emitter;
@@ -656,15 +407,15 @@ static drift_result read_shape(mitsuba_state *s, const xml_node *n)
     snprintf(name, sizeof(name), "%s-line%d", type, n->line);
     s->shape_count++;
     if (strcmp(type, "obj") == 0 || strcmp(type, "ply") == 0) {
-        const xml_node *file = property(n, "filename");
-        const char *rel = file ? attr(file, "value") : NULL;
+        const xml_node *file = drift__mts_property(n, "filename");
+        const char *rel = file ? drift__mts_attr(file, "value") : NULL;
         char full[DRIFT__PATH_MAX];
         if (!rel || !drift__path_join(s->dir, rel, full, sizeof(full))) {
-            return fail(s, n, DRIFT_ERR_PARSE, "<shape> needs a filename", type);
+            return drift__mts_fail(s, n, DRIFT_ERR_PARSE, "<shape> needs a filename", type);
         }
         // faceNormals: Mitsuba shades the mesh flat, ignoring the file's normals.
-        const xml_node *face = property(n, "faceNormals");
-        const char *face_value = face ? attr(face, "value") : NULL;
+        const xml_node *face = drift__mts_property(n, "faceNormals");
+        const char *face_value = face ? drift__mts_attr(face, "value") : NULL;
         drift__import_params params = { .path = full,
                                         .where = s->path,
                                         .line = n->line,
@@ -696,20 +447,20 @@ static drift_result read_shape(mitsuba_state *s, const xml_node *n)
     }
     if (strcmp(type, "sphere") == 0) {
         drift_vec3 center = drift_vec3_splat(0.0f);
-        const xml_node *c = property(n, "center");
+        const xml_node *c = drift__mts_property(n, "center");
         if (c) {
             float xyz[3] = { 0, 0, 0 };
             const char *keys[3] = { "x", "y", "z" };
             for (int k = 0; k < 3; ++k) {
-                const char *a = attr(c, keys[k]);
-                if (a && parse_numbers(a, &xyz[k], 1) != 1) {
-                    return fail(s, c, DRIFT_ERR_PARSE, "expected a number in", keys[k]);
+                const char *a = drift__mts_attr(c, keys[k]);
+                if (a && drift__mts_parse_numbers(a, &xyz[k], 1) != 1) {
+                    return drift__mts_fail(s, c, DRIFT_ERR_PARSE, "expected a number in", keys[k]);
                 }
             }
             center = drift_vec3_make(xyz[0], xyz[1], xyz[2]);
         }
         float radius;
-        if ((r = read_float(s, n, "radius", 1.0f, &radius)) != DRIFT_OK) {
+        if ((r = drift__mts_read_float(s, n, "radius", 1.0f, &radius)) != DRIFT_OK) {
             return r;
         }
         center = drift__mat4_point(&world, center);
@@ -720,7 +471,8 @@ static drift_result read_shape(mitsuba_state *s, const xml_node *n)
                 .type = DRIFT_LIGHT_SPHERE, .color = radiance, .position = center, .radius = radius
             };
             r = drift_scene_add_light(s->scene, &light, NULL);
-            return r == DRIFT_OK ? DRIFT_OK : fail(s, n, r, "sphere emitter not valid", NULL);
+            return r == DRIFT_OK ? DRIFT_OK
+                                 : drift__mts_fail(s, n, r, "sphere emitter not valid", NULL);
         }
 
         // A plain sphere: 32 × 16 facets.
@@ -757,35 +509,39 @@ static drift_result read_shape(mitsuba_state *s, const xml_node *n)
         return add_triangles(s, n, name, v, NULL, (SEG + 1) * (RINGS + 1), tris, t / 3, &identity,
                              material);
     }
-    return fail(s, n, DRIFT_ERR_UNSUPPORTED,
-                "unknown shape type (drift reads obj, ply, rectangle, cube, sphere)", type);
+    return drift__mts_fail(s, n, DRIFT_ERR_UNSUPPORTED,
+                           "unknown shape type (drift reads obj, ply, rectangle, cube, sphere)",
+                           type);
 }
 
 static drift_result read_emitter(mitsuba_state *s, const xml_node *n)
 {
-    const char *type = attr(n, "type");
+    const char *type = drift__mts_attr(n, "type");
     drift__mat4 world;
     drift_result r = read_transform(s, n, &world);
     if (r != DRIFT_OK || !type) {
-        return r != DRIFT_OK ? r : fail(s, n, DRIFT_ERR_PARSE, "<emitter> without a type", NULL);
+        return r != DRIFT_OK
+                   ? r
+                   : drift__mts_fail(s, n, DRIFT_ERR_PARSE, "<emitter> without a type", NULL);
     }
     drift_light light = { 0 };
     if (strcmp(type, "constant") == 0) {
         s->has_light = true;
-        return read_color(s, n, "radiance", drift_vec3_splat(1.0f), &s->scene->environment.color,
-                          NULL);
+        return drift__mts_read_color(s, n, "radiance", drift_vec3_splat(1.0f),
+                                     &s->scene->environment.color, NULL);
     }
     if (strcmp(type, "envmap") == 0) {
-        const xml_node *file = property(n, "filename");
-        const char *rel = file ? attr(file, "value") : NULL;
+        const xml_node *file = drift__mts_property(n, "filename");
+        const char *rel = file ? drift__mts_attr(file, "value") : NULL;
         char full[DRIFT__PATH_MAX];
         float scale;
         uint32_t index;
-        if ((r = read_float(s, n, "scale", 1.0f, &scale)) != DRIFT_OK) {
+        if ((r = drift__mts_read_float(s, n, "scale", 1.0f, &scale)) != DRIFT_OK) {
             return r;
         }
         if (!rel || !drift__path_join(s->dir, rel, full, sizeof(full))) {
-            return fail(s, n, DRIFT_ERR_PARSE, "<emitter type=envmap> needs a filename", NULL);
+            return drift__mts_fail(s, n, DRIFT_ERR_PARSE, "<emitter type=envmap> needs a filename",
+                                   NULL);
         }
         if ((r = drift__texture_cache_get(s->scene, s->textures, full, s->path, n->line, &index)) !=
             DRIFT_OK) {
@@ -793,36 +549,36 @@ static drift_result read_emitter(mitsuba_state *s, const xml_node *n)
         }
         s->scene->environment = (drift_environment){ drift_vec3_splat(scale), index };
         s->has_light = true;
-        warn(s, n, "orientation (toWorld) is not applied to the map");
+        drift__mts_warn(s, n, "orientation (toWorld) is not applied to the map");
         return DRIFT_OK;
     }
     if (strcmp(type, "point") == 0) {
         light.type = DRIFT_LIGHT_POINT;
         drift_vec3 pos = drift_vec3_splat(0.0f);
-        const xml_node *p = property(n, "position");
+        const xml_node *p = drift__mts_property(n, "position");
         if (p) {
             float xyz[3] = { 0, 0, 0 };
             const char *keys[3] = { "x", "y", "z" };
             for (int k = 0; k < 3; ++k) {
-                const char *a = attr(p, keys[k]);
-                if (a && parse_numbers(a, &xyz[k], 1) != 1) {
-                    return fail(s, p, DRIFT_ERR_PARSE, "expected a number in", keys[k]);
+                const char *a = drift__mts_attr(p, keys[k]);
+                if (a && drift__mts_parse_numbers(a, &xyz[k], 1) != 1) {
+                    return drift__mts_fail(s, p, DRIFT_ERR_PARSE, "expected a number in", keys[k]);
                 }
             }
             pos = drift_vec3_make(xyz[0], xyz[1], xyz[2]);
         }
         light.position = drift__mat4_point(&world, pos);
-        r = read_color(s, n, "intensity", drift_vec3_splat(1.0f), &light.color, NULL);
+        r = drift__mts_read_color(s, n, "intensity", drift_vec3_splat(1.0f), &light.color, NULL);
     } else if (strcmp(type, "spot") == 0) {
         float cutoff, beam;
         light.type = DRIFT_LIGHT_SPOT;
         light.position = drift__mat4_point(&world, drift_vec3_splat(0.0f));
         light.direction =
             drift_vec3_normalize(drift__mat4_vector(&world, drift_vec3_make(0.0f, 0.0f, 1.0f)));
-        if ((r = read_color(s, n, "intensity", drift_vec3_splat(1.0f), &light.color, NULL)) ==
-                DRIFT_OK &&
-            (r = read_float(s, n, "cutoffAngle", 20.0f, &cutoff)) == DRIFT_OK &&
-            (r = read_float(s, n, "beamWidth", cutoff * 0.75f, &beam)) == DRIFT_OK) {
+        if ((r = drift__mts_read_color(s, n, "intensity", drift_vec3_splat(1.0f), &light.color,
+                                       NULL)) == DRIFT_OK &&
+            (r = drift__mts_read_float(s, n, "cutoffAngle", 20.0f, &cutoff)) == DRIFT_OK &&
+            (r = drift__mts_read_float(s, n, "beamWidth", cutoff * 0.75f, &beam)) == DRIFT_OK) {
             light.spot_outer = drift_clampf(cutoff, 0.0f, 180.0f) * DRIFT_PI / 180.0f;
             light.spot_inner = drift_clampf(beam * DRIFT_PI / 180.0f, 0.0f, light.spot_outer);
         }
@@ -830,27 +586,27 @@ static drift_result read_emitter(mitsuba_state *s, const xml_node *n)
         light.type = DRIFT_LIGHT_DIRECTIONAL;
         light.direction =
             drift_vec3_normalize(drift__mat4_vector(&world, drift_vec3_make(0.0f, 0.0f, 1.0f)));
-        const xml_node *d = property(n, "direction");
+        const xml_node *d = drift__mts_property(n, "direction");
         if (d) {
             float xyz[3] = { 0, 0, 1 };
             const char *keys[3] = { "x", "y", "z" };
             for (int k = 0; k < 3; ++k) {
-                const char *a = attr(d, keys[k]);
-                if (a && parse_numbers(a, &xyz[k], 1) != 1) {
-                    return fail(s, d, DRIFT_ERR_PARSE, "expected a number in", keys[k]);
+                const char *a = drift__mts_attr(d, keys[k]);
+                if (a && drift__mts_parse_numbers(a, &xyz[k], 1) != 1) {
+                    return drift__mts_fail(s, d, DRIFT_ERR_PARSE, "expected a number in", keys[k]);
                 }
             }
             light.direction = drift_vec3_normalize(drift_vec3_make(xyz[0], xyz[1], xyz[2]));
         }
-        r = read_color(s, n, "irradiance", drift_vec3_splat(1.0f), &light.color, NULL);
+        r = drift__mts_read_color(s, n, "irradiance", drift_vec3_splat(1.0f), &light.color, NULL);
     } else {
-        warn(s, n, "is not a supported emitter (sunsky, sky, sun: use an envmap)");
+        drift__mts_warn(s, n, "is not a supported emitter (sunsky, sky, sun: use an envmap)");
         return DRIFT_OK;
     }
     if (r == DRIFT_OK) {
         r = drift_scene_add_light(s->scene, &light, NULL);
         if (r != DRIFT_OK) {
-            return fail(s, n, r, "emitter not valid", type);
+            return drift__mts_fail(s, n, r, "emitter not valid", type);
         }
         s->has_light = true;
     }
@@ -859,31 +615,32 @@ static drift_result read_emitter(mitsuba_state *s, const xml_node *n)
 
 static drift_result read_sensor(mitsuba_state *s, const xml_node *n)
 {
-    const char *type = attr(n, "type");
+    const char *type = drift__mts_attr(n, "type");
     if (!type || (strcmp(type, "perspective") != 0 && strcmp(type, "thinlens") != 0)) {
-        warn(s, n, "is not a supported sensor (perspective, thinlens)");
+        drift__mts_warn(s, n, "is not a supported sensor (perspective, thinlens)");
         return DRIFT_OK;
     }
     drift__mat4 world;
     drift_result r = read_transform(s, n, &world);
     float fov, width = 768.0f, height = 576.0f;
-    if (r != DRIFT_OK || (r = read_float(s, n, "fov", 45.0f, &fov)) != DRIFT_OK) {
+    if (r != DRIFT_OK || (r = drift__mts_read_float(s, n, "fov", 45.0f, &fov)) != DRIFT_OK) {
         return r;
     }
     for (const xml_node *c = n->first; c; c = c->next) {
         if (strcmp(c->name, "film") == 0 &&
-            ((r = read_float(s, c, "width", width, &width)) != DRIFT_OK ||
-             (r = read_float(s, c, "height", height, &height)) != DRIFT_OK)) {
+            ((r = drift__mts_read_float(s, c, "width", width, &width)) != DRIFT_OK ||
+             (r = drift__mts_read_float(s, c, "height", height, &height)) != DRIFT_OK)) {
             return r;
         }
     }
     if (!(width >= 1.0f && width <= 32768.0f && height >= 1.0f && height <= 32768.0f &&
           fov > 0.0f && fov < 180.0f)) {
-        return fail(s, n, DRIFT_ERR_INVALID_ARGUMENT, "sensor fov or film size out of range", NULL);
+        return drift__mts_fail(s, n, DRIFT_ERR_INVALID_ARGUMENT,
+                               "sensor fov or film size out of range", NULL);
     }
     // fovAxis: x (the default), y, smaller or larger; drift keeps the vertical angle.
-    const xml_node *axis_node = property(n, "fovAxis");
-    const char *axis = axis_node ? attr(axis_node, "value") : "x";
+    const xml_node *axis_node = drift__mts_property(n, "fovAxis");
+    const char *axis = axis_node ? drift__mts_attr(axis_node, "value") : "x";
     axis = axis ? axis : "x";
     bool horizontal = strcmp(axis, "x") == 0 || (strcmp(axis, "smaller") == 0 && width <= height) ||
                       (strcmp(axis, "larger") == 0 && width >= height);
@@ -901,13 +658,14 @@ static drift_result read_sensor(mitsuba_state *s, const xml_node *n)
 static drift_result build_scene(mitsuba_state *s, const xml_node *root)
 {
     if (strcmp(root->name, "scene") != 0) {
-        return fail(s, root, DRIFT_ERR_PARSE, "the root element must be <scene>", root->name);
+        return drift__mts_fail(s, root, DRIFT_ERR_PARSE, "the root element must be <scene>",
+                               root->name);
     }
     drift_result r = DRIFT_OK;
     for (const xml_node *c = root->first; c && r == DRIFT_OK; c = c->next) {
         if (strcmp(c->name, "bsdf") == 0) {
             uint32_t m;
-            r = add_bsdf(s, c, &m);
+            r = drift__mts_add_bsdf(s, c, &m);
         } else if (strcmp(c->name, "shape") == 0) {
             r = read_shape(s, c);
         } else if (strcmp(c->name, "emitter") == 0) {
@@ -916,17 +674,17 @@ static drift_result build_scene(mitsuba_state *s, const xml_node *root)
             r = read_sensor(s, c);
         } else if (strcmp(c->name, "background") == 0) {
             // Mitsuba 0.4's constant background.
-            r = read_color(s, c, "radiance", drift_vec3_splat(0.0f), &s->scene->environment.color,
-                           NULL);
+            r = drift__mts_read_color(s, c, "radiance", drift_vec3_splat(0.0f),
+                                      &s->scene->environment.color, NULL);
             s->has_light = true;
         } else if (strcmp(c->name, "integrator") == 0 || strcmp(c->name, "default") == 0) {
             // drift's own integrator and options; not a warning.
         } else {
-            warn(s, c, "is not supported");
+            drift__mts_warn(s, c, "is not supported");
         }
     }
     if (r == DRIFT_OK && s->shape_count == 0) {
-        r = fail(s, root, DRIFT_ERR_PARSE, "the scene has no shapes", NULL);
+        r = drift__mts_fail(s, root, DRIFT_ERR_PARSE, "the scene has no shapes", NULL);
     }
     return r;
 }
