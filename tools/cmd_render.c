@@ -502,8 +502,9 @@ int render_reference(const render_options *o, const cli_session *session)
     // `pass` samples nearer the total (tiles of a resumed render start where they were).
     bool tty = isatty(STDERR_FILENO) != 0;
     uint32_t total = (uint32_t)o->spp, done_spp = run.resumed_spp, pass = 1;
-    // A budget to fill (--budget-ms, a path-tracer pick): past --spp, passes go on while the
-    // next one and --denoise's filter (timed once on the image at --spp) end by the deadline.
+    // A budget to fill (--budget-ms, a path-tracer pick): from 1 spp, passes go on while the
+    // next one and --denoise's filter (the chooser's estimate from a small frame; else timed
+    // once on this image) end by the deadline.
     const bool fill = o->budget_deadline > 0.0;
     if (fill) {
         total = 1u << 16; // the deadline ends it
